@@ -1,0 +1,102 @@
+//! Gauss–Legendre quadrature of any order.
+
+/// An `n`-point Gauss–Legendre rule on `[-1, 1]`: exact for polynomials of degree `2n - 1`.
+#[derive(Debug, Clone)]
+pub struct GaussLegendre {
+    /// Abscissae in `(-1, 1)`, increasing.
+    pub points: Vec<f64>,
+    /// Positive weights summing to 2.
+    pub weights: Vec<f64>,
+}
+
+impl GaussLegendre {
+    /// The rule with `n >= 1` points. Nodes are the roots of the Legendre polynomial
+    /// `P_n`, found by Newton's method from Chebyshev-like starting values; weights are
+    /// `w_i = 2 / ((1 - x_i^2) P_n'(x_i)^2)`.
+    pub fn new(n: usize) -> Self {
+        assert!(n >= 1, "a Gauss rule needs at least one point");
+        let mut points = vec![0.0; n];
+        let mut weights = vec![0.0; n];
+        let m = n.div_ceil(2);
+        for i in 0..m {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let (p, d) = legendre(n, x);
+                dp = d;
+                let dx = p / d;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            let (_, d) = legendre(n, x);
+            dp = if d != 0.0 { d } else { dp };
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            points[i] = -x;
+            points[n - 1 - i] = x;
+            weights[i] = w;
+            weights[n - 1 - i] = w;
+        }
+        if n % 2 == 1 {
+            points[n / 2] = 0.0;
+        }
+        Self { points, weights }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether the rule is empty (never, by construction).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Points and weights mapped affinely to `[a, b]`.
+    pub fn on(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let h = 0.5 * (b - a);
+        let c = 0.5 * (a + b);
+        self.points.iter().zip(&self.weights).map(move |(&x, &w)| (c + h * x, h * w))
+    }
+}
+
+/// `(P_n(x), P_n'(x))` by the three-term recurrence.
+fn legendre(n: usize, x: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, x);
+    if n == 0 {
+        return (1.0, 0.0);
+    }
+    for k in 2..=n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
+        p0 = p1;
+        p1 = p2;
+    }
+    let d = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+    (p1, d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_for_degree_2n_minus_1() {
+        for n in 1..=20 {
+            let g = GaussLegendre::new(n);
+            assert!((g.weights.iter().sum::<f64>() - 2.0).abs() < 1e-13);
+            for k in 0..(2 * n) {
+                let exact = (1.0f64.powi(k as i32 + 1) - 0.5f64.powi(k as i32 + 1)) / (k as f64 + 1.0);
+                let q: f64 = g.on(0.5, 1.0).map(|(x, w)| w * x.powi(k as i32)).sum();
+                assert!((q - exact).abs() < 1e-13 * exact.abs().max(1.0), "n={n} k={k}");
+            }
+            // not exact at degree 2n
+            let k = 2 * n;
+            let exact = 2.0 / (k as f64 + 1.0);
+            let q: f64 = g.on(-1.0, 1.0).map(|(x, w)| w * x.powi(k as i32)).sum();
+            assert!((q - exact).abs() > 1e-15);
+        }
+    }
+}

@@ -1,0 +1,206 @@
+//! Compressed sparse row matrices: prolongation operators, assembled operators and
+//! their fixed sparsity patterns. Factorizations go through faer.
+
+/// A real CSR matrix with sorted, unique column indices per row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Csr {
+    /// Number of rows.
+    pub nrows: usize,
+    /// Number of columns.
+    pub ncols: usize,
+    /// Row `i` occupies `row_ptr[i]..row_ptr[i+1]` of `col_idx` and `values`.
+    pub row_ptr: Vec<usize>,
+    /// Column index of each stored entry.
+    pub col_idx: Vec<usize>,
+    /// Value of each stored entry.
+    pub values: Vec<f64>,
+}
+
+impl Csr {
+    /// Build from `(row, col, value)` triplets; duplicates are summed.
+    pub fn from_triplets(nrows: usize, ncols: usize, triplets: &[(usize, usize, f64)]) -> Self {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nrows];
+        for &(i, j, v) in triplets {
+            debug_assert!(i < nrows && j < ncols);
+            rows[i].push((j, v));
+        }
+        Self::from_rows(ncols, rows)
+    }
+
+    /// Build from per-row lists of `(col, value)`; duplicates are summed.
+    pub fn from_rows(ncols: usize, rows: Vec<Vec<(usize, f64)>>) -> Self {
+        let nrows = rows.len();
+        let mut row_ptr = Vec::with_capacity(nrows + 1);
+        let mut col_idx = Vec::new();
+        let mut values = Vec::new();
+        row_ptr.push(0);
+        for mut r in rows {
+            r.sort_by_key(|e| e.0);
+            let start = col_idx.len();
+            for (j, v) in r {
+                if col_idx.len() > start && *col_idx.last().unwrap() == j {
+                    *values.last_mut().unwrap() += v;
+                } else {
+                    col_idx.push(j);
+                    values.push(v);
+                }
+            }
+            row_ptr.push(col_idx.len());
+        }
+        Self { nrows, ncols, row_ptr, col_idx, values }
+    }
+
+    /// The identity of size `n`.
+    pub fn identity(n: usize) -> Self {
+        Self { nrows: n, ncols: n, row_ptr: (0..=n).collect(), col_idx: (0..n).collect(), values: vec![1.0; n] }
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.col_idx.len()
+    }
+
+    /// Stored entries of row `i` as `(col, value)`.
+    pub fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        self.col_idx[r.clone()].iter().copied().zip(self.values[r].iter().copied())
+    }
+
+    /// Entry `(i, j)` (zero when not stored).
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        match self.col_idx[r.clone()].binary_search(&j) {
+            Ok(k) => self.values[r.start + k],
+            Err(_) => 0.0,
+        }
+    }
+
+    /// Position of entry `(i, j)` in `values`, if it is in the pattern.
+    pub fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        self.col_idx[r.clone()].binary_search(&j).ok().map(|k| r.start + k)
+    }
+
+    /// `y = A x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        debug_assert_eq!(x.len(), self.ncols);
+        for i in 0..self.nrows {
+            y[i] = self.row(i).map(|(j, v)| v * x[j]).sum();
+        }
+    }
+
+    /// `A x` as a new vector.
+    pub fn apply(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.nrows];
+        self.mul_vec(x, &mut y);
+        y
+    }
+
+    /// Apply to 2-D points (each coordinate separately).
+    pub fn apply_points(&self, x: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        (0..self.nrows)
+            .map(|i| {
+                let mut p = [0.0; 2];
+                for (j, v) in self.row(i) {
+                    p[0] += v * x[j][0];
+                    p[1] += v * x[j][1];
+                }
+                p
+            })
+            .collect()
+    }
+
+    /// The transpose.
+    pub fn transpose(&self) -> Self {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.ncols];
+        for i in 0..self.nrows {
+            for (j, v) in self.row(i) {
+                rows[j].push((i, v));
+            }
+        }
+        Self::from_rows(self.nrows, rows)
+    }
+
+    /// Kronecker product `self ⊗ other`: entry `(i1*m + i2, j1*n + j2) = a[i1,j1] b[i2,j2]`.
+    /// For tensor-product bases with `xi` fastest, the 2-D prolongation is `P_eta ⊗ P_xi`.
+    pub fn kron(&self, other: &Self) -> Self {
+        let nrows = self.nrows * other.nrows;
+        let ncols = self.ncols * other.ncols;
+        let mut row_ptr = Vec::with_capacity(nrows + 1);
+        let mut col_idx = Vec::with_capacity(self.nnz() * other.nnz());
+        let mut values = Vec::with_capacity(self.nnz() * other.nnz());
+        row_ptr.push(0);
+        for i1 in 0..self.nrows {
+            for i2 in 0..other.nrows {
+                for (j1, a) in self.row(i1) {
+                    for (j2, b) in other.row(i2) {
+                        col_idx.push(j1 * other.ncols + j2);
+                        values.push(a * b);
+                    }
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        Self { nrows, ncols, row_ptr, col_idx, values }
+    }
+
+    /// Product `self * other`.
+    pub fn matmul(&self, other: &Self) -> Self {
+        assert_eq!(self.ncols, other.nrows);
+        let rows = (0..self.nrows)
+            .map(|i| {
+                let mut r = Vec::new();
+                for (k, a) in self.row(i) {
+                    for (j, b) in other.row(k) {
+                        r.push((j, a * b));
+                    }
+                }
+                r
+            })
+            .collect();
+        Self::from_rows(other.ncols, rows)
+    }
+
+    /// Keep the rows `rows` and columns `cols` (given as old index -> new index maps,
+    /// `usize::MAX` for dropped ones).
+    pub fn submatrix(&self, row_map: &[usize], col_map: &[usize], ncols: usize) -> Self {
+        let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
+        let mut order: Vec<(usize, usize)> = row_map.iter().enumerate().filter(|(_, &n)| n != usize::MAX).map(|(o, &n)| (n, o)).collect();
+        order.sort();
+        for (_, old) in order {
+            rows.push(self.row(old).filter(|(j, _)| col_map[*j] != usize::MAX).map(|(j, v)| (col_map[j], v)).collect());
+        }
+        Self::from_rows(ncols, rows)
+    }
+
+    /// A dense copy (row-major), for tests and small problems.
+    pub fn to_dense(&self) -> Vec<Vec<f64>> {
+        let mut d = vec![vec![0.0; self.ncols]; self.nrows];
+        for i in 0..self.nrows {
+            for (j, v) in self.row(i) {
+                d[i][j] = v;
+            }
+        }
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kron_and_transpose() {
+        let a = Csr::from_triplets(2, 2, &[(0, 0, 1.0), (0, 1, 2.0), (1, 1, 3.0)]);
+        let b = Csr::from_triplets(2, 1, &[(0, 0, 4.0), (1, 0, 5.0)]);
+        let k = a.kron(&b);
+        assert_eq!(k.nrows, 4);
+        assert_eq!(k.ncols, 2);
+        assert_eq!(k.get(1, 1), 10.0);
+        assert_eq!(k.get(3, 1), 15.0);
+        assert_eq!(k.get(2, 0), 0.0);
+        assert_eq!(k.transpose().transpose(), k);
+        let m = a.matmul(&Csr::identity(2));
+        assert_eq!(m, a);
+    }
+}

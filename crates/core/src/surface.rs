@@ -1,0 +1,216 @@
+//! Tensor-product B-spline / NURBS maps of the unit square: a geometry is a basis
+//! (two knot vectors) plus control points, `x(xi, eta) = sum_ij c_ij N_i(xi) M_j(eta)`.
+
+use crate::basis::BasisDerivs;
+use crate::curve::{check_points, check_weights, Curve, Point};
+use crate::error::{Error, Result};
+use crate::knots::KnotVector;
+
+/// The four sides of the parameter square, in the order south, east, north, west.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// `eta = 0`, increasing `xi`.
+    South = 0,
+    /// `xi = 1`, increasing `eta`.
+    East = 1,
+    /// `eta = 1`, increasing `xi`.
+    North = 2,
+    /// `xi = 0`, increasing `eta`.
+    West = 3,
+}
+
+impl Side {
+    /// All sides in the order south, east, north, west.
+    pub const ALL: [Side; 4] = [Side::South, Side::East, Side::North, Side::West];
+
+    /// Lower-case name as in the JSON format.
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::South => "south",
+            Side::East => "east",
+            Side::North => "north",
+            Side::West => "west",
+        }
+    }
+
+    /// Parameter direction along the side: 0 (`xi`) for south/north, 1 (`eta`) for east/west.
+    pub fn direction(self) -> usize {
+        match self {
+            Side::South | Side::North => 0,
+            Side::East | Side::West => 1,
+        }
+    }
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A tensor-product map; control point `(i, j)` is stored at `j * n_xi + i`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    /// Knot vectors in `xi` and `eta`.
+    pub knots: [KnotVector; 2],
+    /// Control points, `xi` index fastest.
+    pub control_points: Vec<Point>,
+    /// Positive weights (NURBS) or `None`.
+    pub weights: Option<Vec<f64>>,
+}
+
+/// Value, gradient and Hessian of a map at a parameter point.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SurfaceDerivs {
+    /// `x`.
+    pub x: Point,
+    /// `x_xi`.
+    pub xu: Point,
+    /// `x_eta`.
+    pub xv: Point,
+    /// `x_xi_xi`.
+    pub xuu: Point,
+    /// `x_xi_eta`.
+    pub xuv: Point,
+    /// `x_eta_eta`.
+    pub xvv: Point,
+}
+
+impl SurfaceDerivs {
+    /// `det J = x_xi y_eta - x_eta y_xi` (paper eq. 43).
+    pub fn det_j(&self) -> f64 {
+        self.xu[0] * self.xv[1] - self.xv[0] * self.xu[1]
+    }
+}
+
+impl Surface {
+    /// Validate lengths, finiteness and weights.
+    pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
+        let n = knots[0].num_basis() * knots[1].num_basis();
+        if control_points.len() != n {
+            return Err(Error::Length {
+                context: String::new(),
+                what: "control_points".into(),
+                found: control_points.len(),
+                expected: n,
+            });
+        }
+        check_points(&control_points, "control point")?;
+        if let Some(w) = &weights {
+            check_weights(w, n)?;
+        }
+        let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
+        Ok(Self { knots, control_points, weights })
+    }
+
+    /// Number of basis functions per direction.
+    pub fn shape(&self) -> [usize; 2] {
+        [self.knots[0].num_basis(), self.knots[1].num_basis()]
+    }
+
+    /// Degrees per direction.
+    pub fn degrees(&self) -> [usize; 2] {
+        [self.knots[0].degree(), self.knots[1].degree()]
+    }
+
+    /// Control point `(i, j)`.
+    pub fn cp(&self, i: usize, j: usize) -> Point {
+        self.control_points[j * self.shape()[0] + i]
+    }
+
+    /// `x(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> Point {
+        let bu = BasisDerivs::at(&self.knots[0], u, 0);
+        let bv = BasisDerivs::at(&self.knots[1], v, 0);
+        self.derivs_with(&bu, &bv, 0).x
+    }
+
+    /// Value and derivatives up to order `nd <= 2`.
+    pub fn derivs(&self, u: f64, v: f64, nd: usize) -> SurfaceDerivs {
+        let bu = BasisDerivs::at(&self.knots[0], u, nd);
+        let bv = BasisDerivs::at(&self.knots[1], v, nd);
+        self.derivs_with(&bu, &bv, nd)
+    }
+
+    /// Value and derivatives from precomputed univariate basis values.
+    pub fn derivs_with(&self, bu: &BasisDerivs, bv: &BasisDerivs, nd: usize) -> SurfaceDerivs {
+        let nx = self.shape()[0];
+        let (fu, fv) = (bu.first(), bv.first());
+        // h[a][b] = d^a/du^a d^b/dv^b of (w x, w y, w)
+        let mut h = [[[0.0f64; 3]; 3]; 3];
+        for jb in 0..=bv.degree {
+            let j = fv + jb;
+            for ia in 0..=bu.degree {
+                let i = fu + ia;
+                let k = j * nx + i;
+                let w = self.weights.as_ref().map_or(1.0, |w| w[k]);
+                let c = self.control_points[k];
+                for a in 0..=nd {
+                    for b in 0..=(nd - a) {
+                        let n = bu.d[a][ia] * bv.d[b][jb] * w;
+                        h[a][b][0] += n * c[0];
+                        h[a][b][1] += n * c[1];
+                        h[a][b][2] += n;
+                    }
+                }
+            }
+        }
+        let pt = |a: usize, b: usize| [h[a][b][0], h[a][b][1]];
+        if self.weights.is_none() {
+            return SurfaceDerivs { x: pt(0, 0), xu: pt(1, 0), xv: pt(0, 1), xuu: pt(2, 0), xuv: pt(1, 1), xvv: pt(0, 2) };
+        }
+        let w = h[0][0][2];
+        let (wu, wv, wuu, wuv, wvv) = (h[1][0][2], h[0][1][2], h[2][0][2], h[1][1][2], h[0][2][2]);
+        let mut d = SurfaceDerivs::default();
+        for c in 0..2 {
+            let x = h[0][0][c] / w;
+            let xu = (h[1][0][c] - wu * x) / w;
+            let xv = (h[0][1][c] - wv * x) / w;
+            d.x[c] = x;
+            d.xu[c] = xu;
+            d.xv[c] = xv;
+            d.xuu[c] = (h[2][0][c] - 2.0 * wu * xu - wuu * x) / w;
+            d.xuv[c] = (h[1][1][c] - wu * xv - wv * xu - wuv * x) / w;
+            d.xvv[c] = (h[0][2][c] - 2.0 * wv * xv - wvv * x) / w;
+        }
+        d
+    }
+
+    /// Linear indices of the control points on a side, in the side's orientation.
+    pub fn side_indices(shape: [usize; 2], side: Side) -> Vec<usize> {
+        let [nx, ny] = shape;
+        match side {
+            Side::South => (0..nx).collect(),
+            Side::North => (0..nx).map(|i| (ny - 1) * nx + i).collect(),
+            Side::West => (0..ny).map(|j| j * nx).collect(),
+            Side::East => (0..ny).map(|j| j * nx + nx - 1).collect(),
+        }
+    }
+
+    /// The boundary curve on `side` (exact for open knot vectors).
+    pub fn boundary(&self, side: Side) -> Curve {
+        let idx = Self::side_indices(self.shape(), side);
+        let kv = self.knots[side.direction()].clone();
+        Curve {
+            knots: kv,
+            control_points: idx.iter().map(|&k| self.control_points[k]).collect(),
+            weights: self.weights.as_ref().map(|w| idx.iter().map(|&k| w[k]).collect()),
+        }
+    }
+
+    /// Transpose the parameter directions (`xi <-> eta`); flips orientation.
+    pub fn transposed(&self) -> Self {
+        let [nx, ny] = self.shape();
+        let mut cp = Vec::with_capacity(nx * ny);
+        let mut w = self.weights.as_ref().map(|_| Vec::with_capacity(nx * ny));
+        for i in 0..nx {
+            for j in 0..ny {
+                cp.push(self.control_points[j * nx + i]);
+                if let (Some(w), Some(src)) = (w.as_mut(), self.weights.as_ref()) {
+                    w.push(src[j * nx + i]);
+                }
+            }
+        }
+        Self { knots: [self.knots[1].clone(), self.knots[0].clone()], control_points: cp, weights: w }
+    }
+}
