@@ -10,12 +10,18 @@
 //! [`surface::Surface`] the geometries, [`refine`] and [`bezier`] the exact changes of
 //! basis.
 
+pub mod assembly;
 pub mod basis;
 pub mod bezier;
 pub mod boundary;
 pub mod curve;
+pub mod dofs;
+pub mod egg;
 pub mod error;
+pub mod fit;
 pub mod knots;
+pub mod linsolve;
+pub mod newton;
 pub mod quadrature;
 pub mod refine;
 pub mod sparse;

@@ -1,0 +1,587 @@
+//! Assembly of the Galerkin systems on a tensor-product basis: the EGG residual of
+//! paper eq. (8) with its exact Jacobian, the scaled variant `L / (g11 + g22)`, the mass
+//! matrix of eq. (30), the parametric Laplacian and linear elasticity (§6.3).
+//!
+//! Symbolic work is done once per basis ([`Discretization::new`]): univariate basis
+//! tables at the Gauss points, the free/fixed [`DofMap`], and the fixed sparsity pattern
+//! of the free-free system with a gather map from a dense *stencil* storage. Numeric work
+//! per Newton step writes element contributions straight into the stencil storage
+//! (entry `(k, k + di + n_xi dj)` at a computed offset, no search, no allocation per
+//! quadrature point) and gathers them into the CSR values. Element rows are processed in
+//! `q + 1` colours so that rows of one colour touch disjoint basis rows and run in
+//! parallel without atomics.
+
+use rayon::prelude::*;
+
+use crate::basis::BasisDerivs;
+use crate::dofs::{DofMap, FIXED};
+use crate::error::MAX_DEGREE;
+use crate::knots::KnotVector;
+use crate::quadrature::GaussLegendre;
+use crate::sparse::Csr;
+
+const W: usize = MAX_DEGREE + 1;
+
+/// Univariate basis values at one quadrature point: weight (times element length),
+/// abscissa, and `n[k][j]` = `k`-th derivative of the `j`-th non-zero function.
+#[derive(Debug, Clone, Copy)]
+pub struct QpTab {
+    /// Quadrature weight scaled to the element.
+    pub w: f64,
+    /// Abscissa.
+    pub u: f64,
+    /// Values and derivatives.
+    pub n: [[f64; W]; 3],
+}
+
+/// Basis tables of one direction: per element its first non-zero function and its
+/// quadrature points.
+#[derive(Debug, Clone)]
+pub struct DirTable {
+    /// Degree.
+    pub p: usize,
+    /// Points per element.
+    pub nq: usize,
+    /// First non-zero basis function per element.
+    pub first: Vec<usize>,
+    /// Element bounds.
+    pub bounds: Vec<(f64, f64)>,
+    /// `qp[e * nq + k]`.
+    pub qp: Vec<QpTab>,
+}
+
+impl DirTable {
+    /// Tabulate `kv` at `nq` Gauss points per element.
+    pub fn new(kv: &KnotVector, nq: usize) -> Self {
+        let g = GaussLegendre::new(nq);
+        let mut first = Vec::new();
+        let mut bounds = Vec::new();
+        let mut qp = Vec::new();
+        let mut b = BasisDerivs::default();
+        for (span, a, bb) in kv.elements() {
+            first.push(span - kv.degree());
+            bounds.push((a, bb));
+            for (u, w) in g.on(a, bb) {
+                b.eval_in_span(kv, span, u, 2);
+                qp.push(QpTab { w, u, n: b.d });
+            }
+        }
+        Self { p: kv.degree(), nq, first, bounds, qp }
+    }
+
+    /// Number of elements.
+    pub fn num_elements(&self) -> usize {
+        self.first.len()
+    }
+
+    /// Table of point `k` of element `e`.
+    pub fn at(&self, e: usize, k: usize) -> &QpTab {
+        &self.qp[e * self.nq + k]
+    }
+}
+
+/// Fixed sparsity pattern of a free-free system with `ncomp` components per basis
+/// function (unknown `z * m + f`), and the gather map from stencil storage.
+#[derive(Debug, Clone)]
+pub struct SystemPattern {
+    /// Components (1 scalar, 2 vector).
+    pub ncomp: usize,
+    /// Pattern (values are overwritten by [`SystemPattern::gather`]).
+    pub csr: Csr,
+    /// For each CSR entry, its position in the stencil storage.
+    pub src: Vec<usize>,
+}
+
+impl SystemPattern {
+    fn new(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
+        let [nx, ny] = dofs.shape();
+        let m = dofs.num_free();
+        let sw = (2 * p + 1) * (2 * q + 1);
+        let row_len = ncomp * ncomp * sw;
+        let mut row_ptr = vec![0];
+        let mut col_idx = Vec::new();
+        let mut src = Vec::new();
+        for z in 0..ncomp {
+            for &k in dofs.free() {
+                let (i, j) = (k % nx, k / nx);
+                for d in 0..ncomp {
+                    for dj in 0..=2 * q {
+                        let jj = j as isize + dj as isize - q as isize;
+                        if jj < 0 || jj >= ny as isize {
+                            continue;
+                        }
+                        for di in 0..=2 * p {
+                            let ii = i as isize + di as isize - p as isize;
+                            if ii < 0 || ii >= nx as isize {
+                                continue;
+                            }
+                            let kk = jj as usize * nx + ii as usize;
+                            let fc = dofs.free_index(kk);
+                            if fc == FIXED {
+                                continue;
+                            }
+                            col_idx.push(d * m + fc);
+                            src.push(k * row_len + (z * ncomp + d) * sw + dj * (2 * p + 1) + di);
+                        }
+                    }
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        let nnz = col_idx.len();
+        let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
+        Self { ncomp, csr, src }
+    }
+
+    /// Copy the stencil storage into the CSR values.
+    pub fn gather(&mut self, stencil: &[f64]) {
+        for (v, &s) in self.csr.values.iter_mut().zip(&self.src) {
+            *v = stencil[s];
+        }
+    }
+
+    /// A fresh matrix with the values gathered from `stencil`.
+    pub fn matrix(&self, stencil: &[f64]) -> Csr {
+        let mut m = self.csr.clone();
+        for (v, &s) in m.values.iter_mut().zip(&self.src) {
+            *v = stencil[s];
+        }
+        m
+    }
+}
+
+/// Everything computed once per basis: tables, DOF map, patterns.
+#[derive(Debug, Clone)]
+pub struct Discretization {
+    /// Knot vectors in `xi`, `eta`.
+    pub knots: [KnotVector; 2],
+    /// Basis tables per direction.
+    pub tables: [DirTable; 2],
+    /// Free versus fixed DOFs.
+    pub dofs: DofMap,
+    /// Pattern of the 2-component systems (EGG Jacobian, elasticity, block mass).
+    pub vector: SystemPattern,
+    /// Pattern of scalar systems (mass, Laplacian).
+    pub scalar: SystemPattern,
+}
+
+/// Which operator [`Discretization::egg`] discretizes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Operator {
+    /// `L(x, y, .)` of eq. (4), as in eq. (8).
+    #[default]
+    Plain,
+    /// `L(x, y, .) / (g11 + g22)`, the scaling G+Smo uses.
+    Scaled,
+}
+
+/// Geometry of the map at one quadrature point.
+#[derive(Debug, Clone, Copy, Default)]
+struct Geo {
+    xu: [f64; 2],
+    xv: [f64; 2],
+    xuu: [f64; 2],
+    xuv: [f64; 2],
+    xvv: [f64; 2],
+}
+
+/// Scratch of one element: tensor basis values and element vector/matrix.
+struct Scratch {
+    nloc: usize,
+    /// `b[k][a]` for k in (w, w_u, w_v, w_uu, w_uv, w_vv).
+    b: Vec<[f64; 6]>,
+    /// Per trial function: the four `dL_z/dc^d_b` values.
+    t: Vec<[f64; 4]>,
+    re: Vec<f64>,
+    ke: Vec<f64>,
+}
+
+impl Scratch {
+    fn new(p: usize, q: usize, ncomp: usize) -> Self {
+        let nloc = (p + 1) * (q + 1);
+        Self {
+            nloc,
+            b: vec![[0.0; 6]; nloc],
+            t: vec![[0.0; 4]; nloc],
+            re: vec![0.0; ncomp * nloc],
+            ke: vec![0.0; ncomp * ncomp * nloc * nloc],
+        }
+    }
+}
+
+/// Split `data` into the disjoint mutable chunks `[lo, hi)` (sorted, non-overlapping).
+fn split_ranges<'a>(mut data: &'a mut [f64], ranges: &[(usize, usize)]) -> Vec<&'a mut [f64]> {
+    let mut out = Vec::with_capacity(ranges.len());
+    let mut offset = 0;
+    for &(lo, hi) in ranges {
+        let rest = std::mem::take(&mut data);
+        let (_, tail) = rest.split_at_mut(lo - offset);
+        let (chunk, tail) = tail.split_at_mut(hi - lo);
+        out.push(chunk);
+        data = tail;
+        offset = hi;
+    }
+    out
+}
+
+impl Discretization {
+    /// Tables and patterns for the tensor basis `knots`, with `nq` Gauss points per
+    /// element and direction, and the given DOF map.
+    pub fn with_dofs(knots: [KnotVector; 2], nq: usize, dofs: DofMap) -> Self {
+        let tables = [DirTable::new(&knots[0], nq), DirTable::new(&knots[1], nq)];
+        let (p, q) = (knots[0].degree(), knots[1].degree());
+        let vector = SystemPattern::new(&dofs, p, q, 2);
+        let scalar = SystemPattern::new(&dofs, p, q, 1);
+        Self { knots, tables, dofs, vector, scalar }
+    }
+
+    /// Interior DOFs free, `max(p, q) + 2` Gauss points (exact for mass and Laplacian,
+    /// and for the EGG integrand up to a high-order remainder).
+    pub fn new(knots: [KnotVector; 2]) -> Self {
+        let nq = knots[0].degree().max(knots[1].degree()) + 2;
+        let dofs = DofMap::interior([knots[0].num_basis(), knots[1].num_basis()]);
+        Self::with_dofs(knots, nq, dofs)
+    }
+
+    /// Basis shape.
+    pub fn shape(&self) -> [usize; 2] {
+        self.dofs.shape()
+    }
+
+    /// Degrees `(p, q)`.
+    pub fn degrees(&self) -> (usize, usize) {
+        (self.tables[0].p, self.tables[1].p)
+    }
+
+    /// Number of elements.
+    pub fn num_elements(&self) -> usize {
+        self.tables[0].num_elements() * self.tables[1].num_elements()
+    }
+
+    fn stencil_width(&self) -> usize {
+        let (p, q) = self.degrees();
+        (2 * p + 1) * (2 * q + 1)
+    }
+
+    /// Length of the stencil storage of an `ncomp`-component system.
+    pub fn stencil_len(&self, ncomp: usize) -> usize {
+        self.dofs.num_total() * ncomp * ncomp * self.stencil_width()
+    }
+
+    /// Run `kernel(ex, ey, scratch)` on every element and scatter the element vectors
+    /// (`re`, `ncomp` per function) and matrices (`ke`) into full-size `res` (length
+    /// `n * ncomp`, may be empty) and stencil storage `stencil` (may be empty). Element
+    /// rows run in parallel, in `q + 1` colours.
+    fn assemble<K>(&self, ncomp: usize, res: &mut [f64], stencil: &mut [f64], kernel: K)
+    where
+        K: Fn(usize, usize, &mut Scratch) + Sync,
+    {
+        let (p, q) = self.degrees();
+        let nx = self.shape()[0];
+        let sw = self.stencil_width();
+        let row_len = ncomp * ncomp * sw;
+        let (tx, ty) = (&self.tables[0], &self.tables[1]);
+        let want_res = !res.is_empty();
+        let want_mat = !stencil.is_empty();
+        res.fill(0.0);
+        stencil.fill(0.0);
+        for color in 0..=q {
+            let rows: Vec<usize> = (color..ty.num_elements()).step_by(q + 1).collect();
+            let r_ranges: Vec<(usize, usize)> =
+                rows.iter().map(|&ey| (ty.first[ey] * nx * ncomp, (ty.first[ey] + q + 1) * nx * ncomp)).collect();
+            let m_ranges: Vec<(usize, usize)> =
+                rows.iter().map(|&ey| (ty.first[ey] * nx * row_len, (ty.first[ey] + q + 1) * nx * row_len)).collect();
+            let r_chunks: Vec<Option<&mut [f64]>> = if want_res {
+                split_ranges(res, &r_ranges).into_iter().map(Some).collect()
+            } else {
+                rows.iter().map(|_| None).collect()
+            };
+            let m_chunks: Vec<Option<&mut [f64]>> = if want_mat {
+                split_ranges(stencil, &m_ranges).into_iter().map(Some).collect()
+            } else {
+                rows.iter().map(|_| None).collect()
+            };
+            rows.into_par_iter().zip(r_chunks).zip(m_chunks).for_each_init(
+                || Scratch::new(p, q, ncomp),
+                |s, ((ey, mut rc), mut mc)| {
+                    for ex in 0..tx.num_elements() {
+                        let fx = tx.first[ex];
+                        kernel(ex, ey, s);
+                        let nloc = s.nloc;
+                        for ja in 0..=q {
+                            for ia in 0..=p {
+                                let a = ja * (p + 1) + ia;
+                                let row = ja * nx + fx + ia; // row inside the chunk
+                                if let Some(rc) = rc.as_deref_mut() {
+                                    for z in 0..ncomp {
+                                        rc[row * ncomp + z] += s.re[z * nloc + a];
+                                    }
+                                }
+                                if let Some(mc) = mc.as_deref_mut() {
+                                    let base = row * row_len;
+                                    for zd in 0..ncomp * ncomp {
+                                        let blk = &s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
+                                        let out = &mut mc[base + zd * sw..base + (zd + 1) * sw];
+                                        for jb in 0..=q {
+                                            let off = (jb + q - ja) * (2 * p + 1) + p - ia;
+                                            let src = &blk[jb * (p + 1)..(jb + 1) * (p + 1)];
+                                            for (o, v) in out[off..off + p + 1].iter_mut().zip(src) {
+                                                *o += v;
+                                            }
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                },
+            );
+        }
+    }
+
+    /// Fill `s.b` with the tensor-product basis values at point `(ku, kv)` of element
+    /// `(ex, ey)` and return the quadrature weight.
+    fn tensor_basis(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
+        let (p, q) = self.degrees();
+        let tu = self.tables[0].at(ex, ku);
+        let tv = self.tables[1].at(ey, kv);
+        for jb in 0..=q {
+            for ib in 0..=p {
+                let (u0, u1, u2) = (tu.n[0][ib], tu.n[1][ib], tu.n[2][ib]);
+                let (v0, v1, v2) = (tv.n[0][jb], tv.n[1][jb], tv.n[2][jb]);
+                s.b[jb * (p + 1) + ib] = [u0 * v0, u1 * v0, u0 * v1, u2 * v0, u1 * v1, u0 * v2];
+            }
+        }
+        tu.w * tv.w
+    }
+
+    fn geometry(&self, ex: usize, ey: usize, cps: &[[f64; 2]], s: &Scratch) -> Geo {
+        let (p, q) = self.degrees();
+        let nx = self.shape()[0];
+        let (fx, fy) = (self.tables[0].first[ex], self.tables[1].first[ey]);
+        let mut g = Geo::default();
+        for jb in 0..=q {
+            for ib in 0..=p {
+                let c = cps[(fy + jb) * nx + fx + ib];
+                let b = &s.b[jb * (p + 1) + ib];
+                for d in 0..2 {
+                    g.xu[d] += b[1] * c[d];
+                    g.xv[d] += b[2] * c[d];
+                    g.xuu[d] += b[3] * c[d];
+                    g.xuv[d] += b[4] * c[d];
+                    g.xvv[d] += b[5] * c[d];
+                }
+            }
+        }
+        g
+    }
+
+    /// EGG residual (eq. 8) and, when `stencil` is non-empty, its exact Jacobian.
+    ///
+    /// With `g11 = x_xi.x_xi`, `g12 = x_xi.x_eta`, `g22 = x_eta.x_eta` and
+    /// `L(z) = g22 z_xixi - 2 g12 z_xieta + g11 z_etaeta` (eq. 4), the residual is
+    /// `F^z_a = int w_a L(z)`. Its derivative with respect to component `d` of control
+    /// point `b` is `int w_a [dg22 z_xixi - 2 dg12 z_xieta + dg11 z_etaeta + delta_zd L(w_b)]`
+    /// with `dg11 = 2 x^d_xi w_b,xi`, `dg12 = x^d_xi w_b,eta + x^d_eta w_b,xi`,
+    /// `dg22 = 2 x^d_eta w_b,eta`. For [`Operator::Scaled`] the integrand is divided by
+    /// `s = g11 + g22` and the quotient rule adds `-L(z) ds / s^2`,
+    /// `ds = 2 (x^d_xi w_b,xi + x^d_eta w_b,eta)`.
+    ///
+    /// `res` has length `2 n` (full, component-interleaved); `stencil` has length
+    /// [`Discretization::stencil_len`]`(2)` or is empty.
+    pub fn egg(&self, cps: &[[f64; 2]], op: Operator, res: &mut [f64], stencil: &mut [f64]) {
+        let nq = [self.tables[0].nq, self.tables[1].nq];
+        let want_mat = !stencil.is_empty();
+        self.assemble(2, res, stencil, |ex, ey, s| {
+            let nloc = s.nloc;
+            s.re.fill(0.0);
+            if want_mat {
+                s.ke.fill(0.0);
+            }
+            for kv in 0..nq[1] {
+                for ku in 0..nq[0] {
+                    let wq = self.tensor_basis(ex, ey, ku, kv, s);
+                    let g = self.geometry(ex, ey, cps, s);
+                    let g11 = g.xu[0] * g.xu[0] + g.xu[1] * g.xu[1];
+                    let g12 = g.xu[0] * g.xv[0] + g.xu[1] * g.xv[1];
+                    let g22 = g.xv[0] * g.xv[0] + g.xv[1] * g.xv[1];
+                    let l = [
+                        g22 * g.xuu[0] - 2.0 * g12 * g.xuv[0] + g11 * g.xvv[0],
+                        g22 * g.xuu[1] - 2.0 * g12 * g.xuv[1] + g11 * g.xvv[1],
+                    ];
+                    let (scale, sden) = match op {
+                        Operator::Plain => (1.0, 0.0),
+                        Operator::Scaled => {
+                            let sd = g11 + g22;
+                            (1.0 / sd, sd)
+                        }
+                    };
+                    for a in 0..nloc {
+                        let wa = wq * s.b[a][0] * scale;
+                        s.re[a] += wa * l[0];
+                        s.re[nloc + a] += wa * l[1];
+                    }
+                    if !want_mat {
+                        continue;
+                    }
+                    for b in 0..nloc {
+                        let wb = &s.b[b];
+                        let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
+                        let mut t = [0.0; 4];
+                        for d in 0..2 {
+                            let dg11 = 2.0 * g.xu[d] * wb[1];
+                            let dg12 = g.xu[d] * wb[2] + g.xv[d] * wb[1];
+                            let dg22 = 2.0 * g.xv[d] * wb[2];
+                            let ds = 2.0 * (g.xu[d] * wb[1] + g.xv[d] * wb[2]);
+                            for z in 0..2 {
+                                let mut v = dg22 * g.xuu[z] - 2.0 * dg12 * g.xuv[z] + dg11 * g.xvv[z];
+                                if z == d {
+                                    v += lw;
+                                }
+                                if op == Operator::Scaled {
+                                    v -= l[z] * ds / sden;
+                                }
+                                t[z * 2 + d] = v;
+                            }
+                        }
+                        s.t[b] = t;
+                    }
+                    for zd in 0..4 {
+                        for a in 0..nloc {
+                            let wa = wq * s.b[a][0] * scale;
+                            let row = &mut s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
+                            for (r, t) in row.iter_mut().zip(&s.t) {
+                                *r += wa * t[zd];
+                            }
+                        }
+                    }
+                }
+            }
+        });
+    }
+
+    /// Scalar mass matrix `int w_a w_b` (eq. 30) into `stencil` (length `stencil_len(1)`).
+    pub fn mass(&self, stencil: &mut [f64]) {
+        self.scalar_form(stencil, |b, c| b[0] * c[0]);
+    }
+
+    /// Parametric Laplacian `int grad w_a . grad w_b` (a preconditioner of eq. 8).
+    pub fn laplace(&self, stencil: &mut [f64]) {
+        self.scalar_form(stencil, |b, c| b[1] * c[1] + b[2] * c[2]);
+    }
+
+    fn scalar_form(&self, stencil: &mut [f64], form: impl Fn(&[f64; 6], &[f64; 6]) -> f64 + Sync) {
+        let nq = [self.tables[0].nq, self.tables[1].nq];
+        self.assemble(1, &mut [], stencil, |ex, ey, s| {
+            let nloc = s.nloc;
+            s.ke.fill(0.0);
+            for kv in 0..nq[1] {
+                for ku in 0..nq[0] {
+                    let wq = self.tensor_basis(ex, ey, ku, kv, s);
+                    for a in 0..nloc {
+                        for b in 0..nloc {
+                            s.ke[a * nloc + b] += wq * form(&s.b[a], &s.b[b]);
+                        }
+                    }
+                }
+            }
+        });
+    }
+
+    /// Linear elasticity on the physical domain of the map `cps` (Lamé `lambda`, `mu`):
+    /// `a(u, v) = int_Omega lambda div u div v + 2 mu eps(u):eps(v) dx`, pulled back with
+    /// `grad_x w = J^{-T} grad_xi w` and `dx = |det J| dxi`. Where `det J` vanishes the
+    /// parametric gradients are used instead, so the operator stays definite.
+    pub fn elasticity(&self, cps: &[[f64; 2]], lambda: f64, mu: f64, stencil: &mut [f64]) {
+        let nq = [self.tables[0].nq, self.tables[1].nq];
+        self.assemble(2, &mut [], stencil, |ex, ey, s| {
+            let nloc = s.nloc;
+            s.ke.fill(0.0);
+            for kv in 0..nq[1] {
+                for ku in 0..nq[0] {
+                    let wq = self.tensor_basis(ex, ey, ku, kv, s);
+                    let g = self.geometry(ex, ey, cps, s);
+                    let det = g.xu[0] * g.xv[1] - g.xv[0] * g.xu[1];
+                    let scale = g.xu[0].hypot(g.xu[1]) * g.xv[0].hypot(g.xv[1]);
+                    // physical gradient of w_b stored in s.t[b][0..2]
+                    if det.abs() > 1e-12 * scale && scale > 0.0 {
+                        for b in 0..nloc {
+                            let (bu, bv) = (s.b[b][1], s.b[b][2]);
+                            s.t[b] = [(g.xv[1] * bu - g.xu[1] * bv) / det, (-g.xv[0] * bu + g.xu[0] * bv) / det, 0.0, 0.0];
+                        }
+                    } else {
+                        for b in 0..nloc {
+                            s.t[b] = [s.b[b][1], s.b[b][2], 0.0, 0.0];
+                        }
+                    }
+                    let dx = wq * if det.abs() > 1e-12 * scale { det.abs() } else { 1.0 };
+                    for z in 0..2 {
+                        for d in 0..2 {
+                            for a in 0..nloc {
+                                let ga = s.t[a];
+                                let row = &mut s.ke[((z * 2 + d) * nloc + a) * nloc..((z * 2 + d) * nloc + a + 1) * nloc];
+                                for (r, gb) in row.iter_mut().zip(&s.t) {
+                                    let mut v = lambda * ga[z] * gb[d] + mu * ga[d] * gb[z];
+                                    if z == d {
+                                        v += mu * (ga[0] * gb[0] + ga[1] * gb[1]);
+                                    }
+                                    *r += dx * v;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        });
+    }
+
+    /// Restrict a full component-interleaved vector (length `ncomp n`) to the free
+    /// unknowns `(z * m + f)`.
+    pub fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
+        let m = self.dofs.num_free();
+        let mut out = vec![0.0; ncomp * m];
+        for (f, &k) in self.dofs.free().iter().enumerate() {
+            for z in 0..ncomp {
+                out[z * m + f] = full[k * ncomp + z];
+            }
+        }
+        out
+    }
+
+    /// `K_free,fixed * u_fixed` for a 2-component stencil operator: the right-hand side
+    /// contribution of Dirichlet data `u` (full, per basis function) in a linear problem.
+    pub fn apply_to_fixed(&self, stencil: &[f64], u: &[[f64; 2]]) -> Vec<f64> {
+        let (p, q) = self.degrees();
+        let [nx, ny] = self.shape();
+        let sw = self.stencil_width();
+        let row_len = 4 * sw;
+        let m = self.dofs.num_free();
+        let mut out = vec![0.0; 2 * m];
+        for (f, &k) in self.dofs.free().iter().enumerate() {
+            let (i, j) = (k % nx, k / nx);
+            for dj in 0..=2 * q {
+                let jj = j as isize + dj as isize - q as isize;
+                if jj < 0 || jj >= ny as isize {
+                    continue;
+                }
+                for di in 0..=2 * p {
+                    let ii = i as isize + di as isize - p as isize;
+                    if ii < 0 || ii >= nx as isize {
+                        continue;
+                    }
+                    let kk = jj as usize * nx + ii as usize;
+                    if self.dofs.free_index(kk) != FIXED {
+                        continue;
+                    }
+                    let s = dj * (2 * p + 1) + di;
+                    for z in 0..2 {
+                        for d in 0..2 {
+                            out[z * m + f] += stencil[k * row_len + (z * 2 + d) * sw + s] * u[kk][d];
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}

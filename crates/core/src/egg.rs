@@ -1,0 +1,222 @@
+//! The discrete EGG problem on one basis: unknown interior control points, Dirichlet
+//! boundary control points, residual `F(c)` of eq. (12) and its Jacobian (eq. 23).
+
+use crate::assembly::{Discretization, Operator};
+use crate::curve::Point;
+use crate::sparse::Csr;
+
+/// A nonlinear system `F(c) = 0` with a Jacobian and a mass matrix (for pseudo time).
+pub trait NonlinearProblem {
+    /// Number of unknowns.
+    fn size(&self) -> usize;
+    /// `F(c)` into `f`.
+    fn residual(&mut self, c: &[f64], f: &mut [f64]);
+    /// `F(c)` into `f` and the Jacobian `dF/dc` (in a fixed pattern).
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64]) -> &Csr;
+    /// The block mass matrix `diag(M, M)` of eq. (30), in the Jacobian's pattern.
+    fn mass(&mut self) -> &Csr;
+}
+
+/// Quadrature back end of the EGG assembly (CPU here; the GPU crate implements it too).
+pub trait EggAssembler: Send + Sync {
+    /// Residual (full, interleaved, length `2 n`) and, if `stencil` is non-empty, the
+    /// Jacobian in stencil storage; see [`Discretization::egg`].
+    fn egg(&self, disc: &Discretization, cps: &[Point], op: Operator, res: &mut [f64], stencil: &mut [f64]);
+    /// Human-readable name of the back end ("cpu", "gpu: <adapter>").
+    fn name(&self) -> String;
+}
+
+/// The multi-threaded CPU assembler.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CpuAssembler;
+
+impl EggAssembler for CpuAssembler {
+    fn egg(&self, disc: &Discretization, cps: &[Point], op: Operator, res: &mut [f64], stencil: &mut [f64]) {
+        disc.egg(cps, op, res, stencil);
+    }
+    fn name(&self) -> String {
+        "cpu".into()
+    }
+}
+
+/// EGG on one level: the discretization, the control points (fixed ones hold the
+/// Dirichlet data) and storage requested once up front.
+pub struct EggProblem<'a> {
+    /// Tables, DOF map and patterns of the basis.
+    pub disc: &'a Discretization,
+    /// All control points; the free ones are overwritten from `c` on every call.
+    pub cps: Vec<Point>,
+    /// Which operator.
+    pub op: Operator,
+    assembler: &'a dyn EggAssembler,
+    res_full: Vec<f64>,
+    stencil: Vec<f64>,
+    jac: Csr,
+    mass: Option<Csr>,
+}
+
+impl std::fmt::Debug for EggProblem<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EggProblem").field("unknowns", &self.size()).field("op", &self.op).finish()
+    }
+}
+
+impl<'a> EggProblem<'a> {
+    /// Set up with all control points `cps` (free ones are the initial guess).
+    pub fn new(disc: &'a Discretization, cps: Vec<Point>, op: Operator, assembler: &'a dyn EggAssembler) -> Self {
+        let n = disc.dofs.num_total();
+        Self {
+            disc,
+            cps,
+            op,
+            assembler,
+            res_full: vec![0.0; 2 * n],
+            stencil: Vec::new(),
+            jac: disc.vector.csr.clone(),
+            mass: None,
+        }
+    }
+
+    /// The current unknown vector.
+    pub fn unknowns(&self) -> Vec<f64> {
+        self.disc.dofs.gather(&self.cps)
+    }
+
+    fn load(&mut self, c: &[f64]) {
+        self.disc.dofs.scatter(c, &mut self.cps);
+    }
+}
+
+impl NonlinearProblem for EggProblem<'_> {
+    fn size(&self) -> usize {
+        2 * self.disc.dofs.num_free()
+    }
+
+    fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+        self.load(c);
+        self.assembler.egg(self.disc, &self.cps, self.op, &mut self.res_full, &mut []);
+        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+    }
+
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64]) -> &Csr {
+        self.load(c);
+        if self.stencil.is_empty() {
+            self.stencil = vec![0.0; self.disc.stencil_len(2)];
+        }
+        self.assembler.egg(self.disc, &self.cps, self.op, &mut self.res_full, &mut self.stencil);
+        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+        for (v, &s) in self.jac.values.iter_mut().zip(&self.disc.vector.src) {
+            *v = self.stencil[s];
+        }
+        &self.jac
+    }
+
+    fn mass(&mut self) -> &Csr {
+        if self.mass.is_none() {
+            let mut st = vec![0.0; self.disc.stencil_len(1)];
+            self.disc.mass(&mut st);
+            let m = self.disc.scalar.matrix(&st);
+            // block diag(M, M) in the vector pattern
+            let ms = self.disc.dofs.num_free();
+            let mut out = self.disc.vector.csr.clone();
+            for r in 0..out.nrows {
+                let (z, f) = (r / ms, r % ms);
+                for k in out.row_ptr[r]..out.row_ptr[r + 1] {
+                    let cidx = out.col_idx[k];
+                    let (d, g) = (cidx / ms, cidx % ms);
+                    out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
+                }
+            }
+            self.mass = Some(out);
+        }
+        self.mass.as_ref().expect("set above")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::knots::KnotVector;
+    use crate::newton::{NonlinearOptions, NonlinearSolver, Status};
+    use crate::testutil::Lcg;
+
+    /// A curved map: the bilinear-plus-bump image of Greville points, perturbed.
+    fn setup(p: usize, ne: [usize; 2], seed: u64, noise: f64) -> (Discretization, Vec<Point>) {
+        let kx = KnotVector::open_uniform(p, ne[0]);
+        let ky = KnotVector::open_uniform(p, ne[1]).with_inserted(&[0.3]);
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let mut rng = Lcg::new(seed);
+        let mut cps = Vec::new();
+        for &v in &gy {
+            for &u in &gx {
+                let r = 1.0 + v;
+                let t = 1.2 * u;
+                cps.push([r * t.cos() + noise * (rng.uniform() - 0.5), r * t.sin() + noise * (rng.uniform() - 0.5)]);
+            }
+        }
+        (Discretization::new([kx, ky]), cps)
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        for op in [Operator::Plain, Operator::Scaled] {
+            let (disc, cps) = setup(3, [4, 3], 11, 0.05);
+            let asm = CpuAssembler;
+            let mut prob = EggProblem::new(&disc, cps, op, &asm);
+            let c = prob.unknowns();
+            let n = c.len();
+            let mut f = vec![0.0; n];
+            let jac = prob.jacobian(&c, &mut f).clone();
+            let dense = jac.to_dense();
+            let h = 1e-6;
+            let mut max_err: f64 = 0.0;
+            let mut max_val: f64 = 0.0;
+            for j in 0..n {
+                let mut cp = c.clone();
+                let mut cm = c.clone();
+                cp[j] += h;
+                cm[j] -= h;
+                let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+                prob.residual(&cp, &mut fp);
+                prob.residual(&cm, &mut fm);
+                for i in 0..n {
+                    let fd = (fp[i] - fm[i]) / (2.0 * h);
+                    max_err = max_err.max((fd - dense[i][j]).abs());
+                    max_val = max_val.max(fd.abs());
+                }
+            }
+            assert!(max_err < 1e-7 * max_val, "{op:?}: FD mismatch {max_err} (scale {max_val})");
+        }
+    }
+
+    #[test]
+    fn affine_map_is_a_fixed_point() {
+        let kx = KnotVector::open_uniform(3, 5);
+        let ky = KnotVector::open_uniform(2, 4);
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let cps: Vec<Point> = gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
+        let disc = Discretization::new([kx, ky]);
+        let asm = CpuAssembler;
+        let mut prob = EggProblem::new(&disc, cps, Operator::Plain, &asm);
+        let c = prob.unknowns();
+        let mut f = vec![0.0; c.len()];
+        prob.residual(&c, &mut f);
+        assert!(f.iter().all(|v| v.abs() < 1e-13), "{:?}", f.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+    }
+
+    #[test]
+    fn newton_converges_quadratically_from_a_perturbed_map() {
+        let (disc, cps) = setup(3, [6, 6], 5, 0.02);
+        let asm = CpuAssembler;
+        let prob = EggProblem::new(&disc, cps, Operator::Plain, &asm);
+        let c0 = prob.unknowns();
+        let opts = NonlinearOptions { scale: (disc.dofs.num_free() as f64).sqrt() / 27.0, ..Default::default() };
+        let mut s = NonlinearSolver::new(prob, c0, opts);
+        let its: Vec<_> = s.by_ref().collect::<crate::Result<Vec<_>>>().unwrap();
+        assert_eq!(s.status(), &Status::Converged, "{its:?}");
+        assert!(its.len() <= 7, "{its:?}");
+        // quadratic: the last reductions are much faster than linear
+        let r: Vec<f64> = its.iter().map(|i| i.residual).collect();
+        assert!(r[r.len() - 1] < 1e-6 * r[0]);
+    }
+}

@@ -1,0 +1,370 @@
+//! Nonlinear solvers for `F(c) = 0` as objects that yield their iterates: the damped
+//! (truncated) Newton method of paper §6.1 with a backtracking line search on `||F||`,
+//! and pseudo time-stepping (§6.2, eq. 30-33) with the SER time-step rule, used
+//! automatically when Newton stalls.
+
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use crate::egg::NonlinearProblem;
+use crate::error::Result;
+use crate::linsolve::{LinearMethod, LinearSolver};
+
+/// Nonlinear iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Damped Newton with line search (§6.1), falling back to pseudo time on a stall.
+    #[default]
+    Newton,
+    /// Pseudo time-stepping (§6.2) from the start.
+    PseudoTime,
+}
+
+/// Stopping rules and limits.
+#[derive(Debug, Clone, Copy)]
+pub struct NonlinearOptions {
+    /// Iteration to start with.
+    pub method: Method,
+    /// Converged when the scaled residual `||F|| * scale` is below this.
+    pub tol: f64,
+    /// ... or when `||F||` fell below `rtol` times the initial residual.
+    pub rtol: f64,
+    /// ... or when a full step is shorter than this (absolute, in length units) while the
+    /// scaled residual is below `sqrt(tol)`.
+    pub step_tol: f64,
+    /// Multiplier turning `||F||` into the scaled residual.
+    pub scale: f64,
+    /// Newton iteration cap.
+    pub max_newton: usize,
+    /// Pseudo-time iteration cap.
+    pub max_pseudo: usize,
+    /// Switch to pseudo time when Newton stalls.
+    pub fallback: bool,
+    /// Linear solver.
+    pub linear: LinearMethod,
+}
+
+impl Default for NonlinearOptions {
+    fn default() -> Self {
+        Self {
+            method: Method::Newton,
+            tol: 1e-9,
+            rtol: 1e-13,
+            step_tol: 1e-13,
+            scale: 1.0,
+            max_newton: 30,
+            max_pseudo: 400,
+            fallback: true,
+            linear: LinearMethod::Lu,
+        }
+    }
+}
+
+/// One iterate of the stream.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Iterate {
+    /// Iteration number (0 is the initial guess).
+    pub iteration: usize,
+    /// Method that produced it.
+    pub method: Method,
+    /// `||F||_2`.
+    pub residual: f64,
+    /// Scaled residual `||F|| * scale` (dimensionless).
+    pub scaled_residual: f64,
+    /// Max-norm of the step taken.
+    pub step: f64,
+    /// Line-search damping `delta` (1 for a full step), eq. (25).
+    pub damping: f64,
+    /// Pseudo time step, eq. (33).
+    pub dt: Option<f64>,
+}
+
+/// Where the iteration stands.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    /// More iterates to come.
+    Running,
+    /// Stopping rule met.
+    Converged,
+    /// Gave up, with the reason.
+    Failed(String),
+}
+
+/// Timings collected by the solver.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Timings {
+    /// Residual and Jacobian assembly.
+    pub assembly: Duration,
+    /// Factorizations and solves.
+    pub linear: Duration,
+}
+
+/// An iterative solve in progress; `Iterator` over its [`Iterate`]s.
+pub struct NonlinearSolver<P: NonlinearProblem> {
+    problem: P,
+    opts: NonlinearOptions,
+    c: Vec<f64>,
+    f: Vec<f64>,
+    norm: f64,
+    r0: f64,
+    iteration: usize,
+    newton_its: usize,
+    pseudo_its: usize,
+    method: Method,
+    dt: f64,
+    lin: LinearSolver,
+    status: Status,
+    started: bool,
+    /// Timings so far.
+    pub timings: Timings,
+}
+
+impl<P: NonlinearProblem> std::fmt::Debug for NonlinearSolver<P> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NonlinearSolver").field("iteration", &self.iteration).field("status", &self.status).finish()
+    }
+}
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl<P: NonlinearProblem> NonlinearSolver<P> {
+    /// Start from `c0`.
+    pub fn new(mut problem: P, c0: Vec<f64>, opts: NonlinearOptions) -> Self {
+        let mut f = vec![0.0; problem.size()];
+        let t = Instant::now();
+        problem.residual(&c0, &mut f);
+        let assembly = t.elapsed();
+        let norm = norm2(&f);
+        Self {
+            problem,
+            opts,
+            c: c0,
+            f,
+            norm,
+            r0: norm,
+            iteration: 0,
+            newton_its: 0,
+            pseudo_its: 0,
+            method: opts.method,
+            dt: 0.0,
+            lin: LinearSolver::new(opts.linear),
+            status: Status::Running,
+            started: false,
+            timings: Timings { assembly, linear: Duration::ZERO },
+        }
+    }
+
+    /// Current status.
+    pub fn status(&self) -> &Status {
+        &self.status
+    }
+
+    /// Current unknowns.
+    pub fn solution(&self) -> &[f64] {
+        &self.c
+    }
+
+    /// Current `||F||`.
+    pub fn residual(&self) -> f64 {
+        self.norm
+    }
+
+    /// The problem (e.g. to read the control points back).
+    pub fn problem(&self) -> &P {
+        &self.problem
+    }
+
+    /// Consume, returning the problem and the unknowns.
+    pub fn into_parts(self) -> (P, Vec<f64>) {
+        (self.problem, self.c)
+    }
+
+    fn scaled(&self) -> f64 {
+        self.norm * self.opts.scale
+    }
+
+    fn converged(&self, step: f64) -> bool {
+        let s = self.scaled();
+        s <= self.opts.tol || self.norm <= self.opts.rtol * self.r0 || (step <= self.opts.step_tol && s <= self.opts.tol.sqrt())
+    }
+
+    fn iterate(&self, step: f64, damping: f64) -> Iterate {
+        Iterate {
+            iteration: self.iteration,
+            method: self.method,
+            residual: self.norm,
+            scaled_residual: self.scaled(),
+            step,
+            damping,
+            dt: (self.method == Method::PseudoTime).then_some(self.dt),
+        }
+    }
+
+    /// Advance by one iteration; `Ok(None)` once converged or failed.
+    pub fn step(&mut self) -> Result<Option<Iterate>> {
+        if !self.started {
+            self.started = true;
+            if !self.norm.is_finite() {
+                self.status = Status::Failed("non-finite initial residual".into());
+            } else if self.converged(f64::INFINITY) {
+                self.status = Status::Converged;
+            }
+            return Ok(Some(self.iterate(0.0, 1.0)));
+        }
+        if self.status != Status::Running {
+            return Ok(None);
+        }
+        let it = match self.method {
+            Method::Newton => self.newton_step()?,
+            Method::PseudoTime => self.pseudo_step()?,
+        };
+        Ok(Some(it))
+    }
+
+    fn linear_step(&mut self, shift: Option<f64>) -> Result<Vec<f64>> {
+        let t = Instant::now();
+        let mut f = std::mem::take(&mut self.f);
+        let jac = self.problem.jacobian(&self.c, &mut f).clone();
+        self.f = f;
+        self.timings.assembly += t.elapsed();
+        let a = match shift {
+            None => jac,
+            Some(dt) => {
+                let m = self.problem.mass();
+                let mut a = jac;
+                for (v, mv) in a.values.iter_mut().zip(&m.values) {
+                    *v += mv / dt;
+                }
+                a
+            }
+        };
+        let t = Instant::now();
+        self.lin.factor(&a)?;
+        let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
+        let dx = self.lin.solve(&rhs);
+        self.timings.linear += t.elapsed();
+        dx
+    }
+
+    fn eval(&mut self, c: &[f64], f: &mut [f64]) -> f64 {
+        let t = Instant::now();
+        self.problem.residual(c, f);
+        self.timings.assembly += t.elapsed();
+        norm2(f)
+    }
+
+    fn newton_step(&mut self) -> Result<Iterate> {
+        self.iteration += 1;
+        self.newton_its += 1;
+        let dx = match self.linear_step(None) {
+            Ok(dx) => dx,
+            Err(e) => return Ok(self.stall(format!("Newton linear solve failed: {e}"))),
+        };
+        // Backtracking on phi = ||F||^2 / 2 with Armijo constant 1e-4; the slope along
+        // the Newton direction is -||F||^2.
+        let phi0 = 0.5 * self.norm * self.norm;
+        let mut delta = 1.0;
+        let mut trial = vec![0.0; self.c.len()];
+        let mut ft = vec![0.0; self.c.len()];
+        loop {
+            for ((t, c), d) in trial.iter_mut().zip(&self.c).zip(&dx) {
+                *t = c + delta * d;
+            }
+            let nt = self.eval(&trial, &mut ft);
+            let phi = 0.5 * nt * nt;
+            if nt.is_finite() && phi <= phi0 * (1.0 - 2e-4 * delta) {
+                let step = dx.iter().fold(0.0f64, |m, d| m.max((delta * d).abs()));
+                std::mem::swap(&mut self.c, &mut trial);
+                std::mem::swap(&mut self.f, &mut ft);
+                self.norm = nt;
+                if self.converged(step) {
+                    self.status = Status::Converged;
+                } else if self.newton_its >= self.opts.max_newton {
+                    return Ok(self.stall_with(format!("Newton reached {} iterations", self.opts.max_newton), step, delta));
+                }
+                return Ok(self.iterate(step, delta));
+            }
+            // minimiser of the quadratic through phi0, slope -2 phi0 and phi(delta)
+            let q = if nt.is_finite() { 2.0 * phi0 * delta * delta / (2.0 * (phi - phi0 + 2.0 * phi0 * delta)) } else { 0.1 * delta };
+            delta = q.clamp(0.1 * delta, 0.5 * delta);
+            if delta < 1e-4 {
+                return Ok(self.stall("line search failed (no descent along the Newton direction)".into()));
+            }
+        }
+    }
+
+    fn stall(&mut self, why: String) -> Iterate {
+        self.stall_with(why, 0.0, 0.0)
+    }
+
+    fn stall_with(&mut self, why: String, step: f64, damping: f64) -> Iterate {
+        let it = self.iterate(step, damping);
+        if self.opts.fallback && self.method == Method::Newton {
+            self.method = Method::PseudoTime;
+            self.dt = 0.0;
+        } else {
+            self.status = Status::Failed(why);
+        }
+        it
+    }
+
+    fn pseudo_step(&mut self) -> Result<Iterate> {
+        self.iteration += 1;
+        self.pseudo_its += 1;
+        if self.dt == 0.0 {
+            // initial pseudo time step: make M / dt comparable to the Jacobian
+            let mut f = std::mem::take(&mut self.f);
+            let jmax = self.problem.jacobian(&self.c, &mut f).values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            self.f = f;
+            let mmax = self.problem.mass().values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            self.dt = if jmax > 0.0 { mmax / jmax } else { 1.0 };
+        }
+        let mut attempts = 0;
+        loop {
+            let dx = self.linear_step(Some(self.dt));
+            let mut trial = self.c.clone();
+            let mut ft = vec![0.0; self.c.len()];
+            let nt = match &dx {
+                Ok(dx) => {
+                    for (t, d) in trial.iter_mut().zip(dx) {
+                        *t += d;
+                    }
+                    self.eval(&trial, &mut ft)
+                }
+                Err(_) => f64::NAN,
+            };
+            if nt.is_finite() && nt <= 10.0 * self.norm {
+                let step = dx.as_ref().map_or(0.0, |dx| dx.iter().fold(0.0f64, |m, d| m.max(d.abs())));
+                // SER rule, eq. (33), with the growth limited to a factor 10 per step
+                let ratio = (self.norm / nt).clamp(0.1, 10.0);
+                self.dt = (self.dt * ratio).min(1e30);
+                self.c = trial;
+                self.f = ft;
+                self.norm = nt;
+                if self.converged(step) {
+                    self.status = Status::Converged;
+                } else if self.pseudo_its >= self.opts.max_pseudo {
+                    self.status = Status::Failed(format!("pseudo time-stepping reached {} iterations", self.opts.max_pseudo));
+                }
+                return Ok(self.iterate(step, 1.0));
+            }
+            self.dt *= 0.25;
+            attempts += 1;
+            if attempts > 30 {
+                self.status = Status::Failed("pseudo time-stepping could not reduce the residual".into());
+                return Ok(self.iterate(0.0, 0.0));
+            }
+        }
+    }
+}
+
+impl<P: NonlinearProblem> Iterator for NonlinearSolver<P> {
+    type Item = Result<Iterate>;
+    fn next(&mut self) -> Option<Self::Item> {
+        self.step().transpose()
+    }
+}
