@@ -1,6 +1,8 @@
 //! The discrete EGG problem on one basis: unknown interior control points, Dirichlet
 //! boundary control points, residual `F(c)` of eq. (12) and its Jacobian (eq. 23).
 
+use std::sync::Arc;
+
 use crate::assembly::{Discretization, Operator};
 use crate::curve::Point;
 use crate::sparse::Csr;
@@ -41,32 +43,31 @@ impl EggAssembler for CpuAssembler {
 
 /// EGG on one level: the discretization, the control points (fixed ones hold the
 /// Dirichlet data) and storage requested once up front.
-pub struct EggProblem<'a> {
+pub struct EggProblem {
     /// Tables, DOF map and patterns of the basis.
-    pub disc: &'a Discretization,
+    pub disc: Arc<Discretization>,
     /// All control points; the free ones are overwritten from `c` on every call.
     pub cps: Vec<Point>,
     /// Which operator.
     pub op: Operator,
-    assembler: &'a dyn EggAssembler,
+    assembler: Arc<dyn EggAssembler>,
     res_full: Vec<f64>,
     stencil: Vec<f64>,
     jac: Csr,
     mass: Option<Csr>,
 }
 
-impl std::fmt::Debug for EggProblem<'_> {
+impl std::fmt::Debug for EggProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("EggProblem").field("unknowns", &self.size()).field("op", &self.op).finish()
     }
 }
 
-impl<'a> EggProblem<'a> {
+impl EggProblem {
     /// Set up with all control points `cps` (free ones are the initial guess).
-    pub fn new(disc: &'a Discretization, cps: Vec<Point>, op: Operator, assembler: &'a dyn EggAssembler) -> Self {
+    pub fn new(disc: Arc<Discretization>, cps: Vec<Point>, op: Operator, assembler: Arc<dyn EggAssembler>) -> Self {
         let n = disc.dofs.num_total();
         Self {
-            disc,
             cps,
             op,
             assembler,
@@ -74,6 +75,7 @@ impl<'a> EggProblem<'a> {
             stencil: Vec::new(),
             jac: disc.vector.csr.clone(),
             mass: None,
+            disc,
         }
     }
 
@@ -87,14 +89,14 @@ impl<'a> EggProblem<'a> {
     }
 }
 
-impl NonlinearProblem for EggProblem<'_> {
+impl NonlinearProblem for EggProblem {
     fn size(&self) -> usize {
         2 * self.disc.dofs.num_free()
     }
 
     fn residual(&mut self, c: &[f64], f: &mut [f64]) {
         self.load(c);
-        self.assembler.egg(self.disc, &self.cps, self.op, &mut self.res_full, &mut []);
+        self.assembler.egg(&self.disc, &self.cps, self.op, &mut self.res_full, &mut []);
         f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
     }
 
@@ -103,7 +105,7 @@ impl NonlinearProblem for EggProblem<'_> {
         if self.stencil.is_empty() {
             self.stencil = vec![0.0; self.disc.stencil_len(2)];
         }
-        self.assembler.egg(self.disc, &self.cps, self.op, &mut self.res_full, &mut self.stencil);
+        self.assembler.egg(&self.disc, &self.cps, self.op, &mut self.res_full, &mut self.stencil);
         f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
         for (v, &s) in self.jac.values.iter_mut().zip(&self.disc.vector.src) {
             *v = self.stencil[s];
@@ -161,8 +163,7 @@ mod tests {
     fn jacobian_matches_finite_differences() {
         for op in [Operator::Plain, Operator::Scaled] {
             let (disc, cps) = setup(3, [4, 3], 11, 0.05);
-            let asm = CpuAssembler;
-            let mut prob = EggProblem::new(&disc, cps, op, &asm);
+            let mut prob = EggProblem::new(Arc::new(disc), cps, op, Arc::new(CpuAssembler));
             let c = prob.unknowns();
             let n = c.len();
             let mut f = vec![0.0; n];
@@ -196,8 +197,7 @@ mod tests {
         let (gx, gy) = (kx.greville(), ky.greville());
         let cps: Vec<Point> = gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
         let disc = Discretization::new([kx, ky]);
-        let asm = CpuAssembler;
-        let mut prob = EggProblem::new(&disc, cps, Operator::Plain, &asm);
+        let mut prob = EggProblem::new(Arc::new(disc), cps, Operator::Plain, Arc::new(CpuAssembler));
         let c = prob.unknowns();
         let mut f = vec![0.0; c.len()];
         prob.residual(&c, &mut f);
@@ -207,10 +207,9 @@ mod tests {
     #[test]
     fn newton_converges_quadratically_from_a_perturbed_map() {
         let (disc, cps) = setup(3, [6, 6], 5, 0.02);
-        let asm = CpuAssembler;
-        let prob = EggProblem::new(&disc, cps, Operator::Plain, &asm);
-        let c0 = prob.unknowns();
         let opts = NonlinearOptions { scale: (disc.dofs.num_free() as f64).sqrt() / 27.0, ..Default::default() };
+        let prob = EggProblem::new(Arc::new(disc), cps, Operator::Plain, Arc::new(CpuAssembler));
+        let c0 = prob.unknowns();
         let mut s = NonlinearSolver::new(prob, c0, opts);
         let its: Vec<_> = s.by_ref().collect::<crate::Result<Vec<_>>>().unwrap();
         assert_eq!(s.status(), &Status::Converged, "{its:?}");

@@ -30,3 +30,19 @@ pub struct Hierarchy {
     pub tol_abs: f64,
     pub diameter: f64,
 }
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    pub degree: usize,
+    pub tol: f64,
+    pub initial_elements: usize,
+    pub max_levels: usize,
+    pub max_elements: usize,
+}
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self { degree: 3, tol: 1e-4, initial_elements: 1, max_levels: 14, max_elements: 4096 }
+    }
+}
+pub fn build_hierarchy(_b: &crate::boundary::Boundary, _o: &FitOptions) -> crate::error::Result<Hierarchy> {
+    Err(crate::error::Error::Invalid("fit not merged".into()))
+}

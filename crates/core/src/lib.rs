@@ -19,11 +19,15 @@ pub mod dofs;
 pub mod egg;
 pub mod error;
 pub mod fit;
+pub mod initial;
 pub mod knots;
 pub mod linsolve;
 pub mod newton;
+pub mod picture;
 pub mod quadrature;
+pub mod quality;
 pub mod refine;
+pub mod solver;
 pub mod sparse;
 pub mod surface;
 #[doc(hidden)]

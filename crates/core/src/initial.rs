@@ -1,0 +1,118 @@
+//! Initial guesses (paper §6.3): transfinite (Coons) interpolation of the boundary
+//! control points on the coarsest level, and prolongation plus a linear-elasticity
+//! correction of the boundary discrepancy on finer levels.
+
+use crate::assembly::Discretization;
+use crate::curve::{Curve, Point};
+use crate::error::{Error, Result};
+use crate::linsolve::{LinearMethod, LinearSolver};
+use crate::surface::{Side, Surface};
+
+/// Write the four side curves' control points into the boundary positions of a
+/// control net of shape `shape`. The curves must live on the net's knot vectors.
+pub fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) -> Result<()> {
+    for s in Side::ALL {
+        let idx = Surface::side_indices(shape, s);
+        let c = &sides[s as usize];
+        if c.control_points.len() != idx.len() {
+            return Err(Error::Invalid(format!(
+                "{s} side has {} control points, the basis needs {}",
+                c.control_points.len(),
+                idx.len()
+            )));
+        }
+        for (k, p) in idx.into_iter().zip(&c.control_points) {
+            cps[k] = *p;
+        }
+    }
+    Ok(())
+}
+
+/// Discrete Coons patch at the Greville abscissae `(u_i, v_j)`:
+/// `c_ij = (1-u) W_j + u E_j + (1-v) S_i + v N_i - [(1-u)(1-v) SW + u(1-v) SE + (1-u)v NW + uv NE]`.
+/// Reproduces every bilinear map exactly.
+pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Result<Vec<Point>> {
+    let shape = [knots[0].num_basis(), knots[1].num_basis()];
+    let [nx, ny] = shape;
+    let (gu, gv) = (knots[0].greville(), knots[1].greville());
+    let (a0, a1) = knots[0].domain();
+    let (b0, b1) = knots[1].domain();
+    let s = &sides[Side::South as usize].control_points;
+    let n = &sides[Side::North as usize].control_points;
+    let w = &sides[Side::West as usize].control_points;
+    let e = &sides[Side::East as usize].control_points;
+    let mut cps = vec![[0.0; 2]; nx * ny];
+    set_boundary(shape, sides, &mut cps)?;
+    let (sw, se, nw, ne) = (s[0], s[nx - 1], n[0], n[nx - 1]);
+    for j in 1..ny - 1 {
+        let v = (gv[j] - b0) / (b1 - b0);
+        for i in 1..nx - 1 {
+            let u = (gu[i] - a0) / (a1 - a0);
+            let mut c = [0.0; 2];
+            for d in 0..2 {
+                c[d] = (1.0 - u) * w[j][d] + u * e[j][d] + (1.0 - v) * s[i][d] + v * n[i][d]
+                    - ((1.0 - u) * (1.0 - v) * sw[d] + u * (1.0 - v) * se[d] + (1.0 - u) * v * nw[d] + u * v * ne[d]);
+            }
+            cps[j * nx + i] = c;
+        }
+    }
+    Ok(cps)
+}
+
+/// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).
+pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
+
+/// Prolong `coarse` onto the basis of `disc` and correct the boundary discrepancy with
+/// linear elasticity (§6.3): with `x_p = P c` and the target boundary `b`, solve
+/// `K_ff u_f = -K_fb (b - x_p)_b` on the physical domain of `x_p`, and return
+/// `x_p + u` with the boundary set to `b`.
+pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &[Curve; 4]) -> Result<Vec<Point>> {
+    let fine = coarse.refined(&disc.knots)?;
+    let shape = disc.shape();
+    let mut target = fine.control_points.clone();
+    set_boundary(shape, sides, &mut target)?;
+    let diff: Vec<Point> = target.iter().zip(&fine.control_points).map(|(t, f)| [t[0] - f[0], t[1] - f[1]]).collect();
+    if disc.dofs.num_free() == 0 || diff.iter().all(|d| d[0] == 0.0 && d[1] == 0.0) {
+        return Ok(target);
+    }
+    let mut st = vec![0.0; disc.stencil_len(2)];
+    disc.elasticity(&fine.control_points, LAME.0, LAME.1, &mut st);
+    let k = disc.vector.matrix(&st);
+    let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
+    let mut lin = LinearSolver::new(LinearMethod::Lu);
+    lin.factor(&k)?;
+    let u = lin.solve(&rhs)?;
+    let m = disc.dofs.num_free();
+    for (f, &kk) in disc.dofs.free().iter().enumerate() {
+        target[kk] = [fine.control_points[kk][0] + u[f], fine.control_points[kk][1] + u[m + f]];
+    }
+    Ok(target)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::knots::KnotVector;
+
+    #[test]
+    fn coons_reproduces_bilinear_maps() {
+        let k = [KnotVector::open_uniform(3, 4), KnotVector::open_uniform(2, 3)];
+        let f = |u: f64, v: f64| [1.0 + 2.0 * u + 0.3 * v + 0.5 * u * v, -1.0 + 0.2 * u + 1.7 * v - 0.4 * u * v];
+        let (gu, gv) = (k[0].greville(), k[1].greville());
+        let mk = |dir: usize, fixed: f64| {
+            let g = if dir == 0 { &gu } else { &gv };
+            let pts = g.iter().map(|&t| if dir == 0 { f(t, fixed) } else { f(fixed, t) }).collect();
+            Curve::polynomial(k[dir].clone(), pts)
+        };
+        let sides = [mk(0, 0.0), mk(1, 1.0), mk(0, 1.0), mk(1, 0.0)];
+        let cps = coons(&k, &sides).unwrap();
+        let nx = gu.len();
+        for (j, &v) in gv.iter().enumerate() {
+            for (i, &u) in gu.iter().enumerate() {
+                let e = f(u, v);
+                let c = cps[j * nx + i];
+                assert!((c[0] - e[0]).abs() < 1e-14 && (c[1] - e[1]).abs() < 1e-14);
+            }
+        }
+    }
+}

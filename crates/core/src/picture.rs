@@ -1,0 +1,194 @@
+//! A picture of a map without any GPU or window: the image of a fine parameter grid
+//! filled with a `det J` heat map (Gouraud-shaded triangles), the iso-lines of `xi` and
+//! `eta`, and the boundary. Non-positive `det J` is painted magenta, a colour that no
+//! positive value uses. Output is an RGBA buffer; the CLI encodes it as PNG.
+
+use crate::basis::BasisDerivs;
+use crate::curve::Point;
+use crate::surface::Surface;
+
+/// An RGBA8 image, row-major from the top-left.
+#[derive(Debug, Clone)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `4 * width * height` bytes.
+    pub rgba: Vec<u8>,
+}
+
+/// What to draw.
+#[derive(Debug, Clone)]
+pub struct PictureOptions {
+    /// Longer side of the image in pixels.
+    pub size: usize,
+    /// Iso-lines per direction (0: none).
+    pub grid_lines: usize,
+    /// Heat-map resolution (cells per direction).
+    pub resolution: usize,
+    /// Extra line segments to draw (e.g. matched pairs), physical coordinates.
+    pub segments: Vec<(Point, Point)>,
+}
+
+impl Default for PictureOptions {
+    fn default() -> Self {
+        Self { size: 900, grid_lines: 24, resolution: 240, segments: Vec::new() }
+    }
+}
+
+/// Colour of non-positive `det J`.
+pub const FOLD_COLOUR: [u8; 3] = [255, 0, 255];
+
+/// Viridis-like map of `t in [0, 1]` (never magenta).
+pub fn colormap(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 5] =
+        [[68.0, 1.0, 84.0], [59.0, 82.0, 139.0], [33.0, 145.0, 140.0], [94.0, 201.0, 98.0], [253.0, 231.0, 37.0]];
+    let t = t.clamp(0.0, 1.0) * 4.0;
+    let k = (t.floor() as usize).min(3);
+    let f = t - k as f64;
+    let mut c = [0u8; 3];
+    for i in 0..3 {
+        c[i] = (STOPS[k][i] * (1.0 - f) + STOPS[k + 1][i] * f).round() as u8;
+    }
+    c
+}
+
+struct Canvas {
+    w: usize,
+    h: usize,
+    rgba: Vec<u8>,
+    x0: f64,
+    y0: f64,
+    s: f64,
+}
+
+impl Canvas {
+    fn to_px(&self, p: Point) -> (f64, f64) {
+        ((p[0] - self.x0) * self.s, self.h as f64 - (p[1] - self.y0) * self.s)
+    }
+    fn put(&mut self, x: isize, y: isize, c: [u8; 3], alpha: f64) {
+        if x < 0 || y < 0 || x >= self.w as isize || y >= self.h as isize {
+            return;
+        }
+        let k = 4 * (y as usize * self.w + x as usize);
+        for i in 0..3 {
+            self.rgba[k + i] = (self.rgba[k + i] as f64 * (1.0 - alpha) + c[i] as f64 * alpha).round() as u8;
+        }
+        self.rgba[k + 3] = 255;
+    }
+    fn triangle(&mut self, p: [(f64, f64); 3], v: [f64; 3], shade: &dyn Fn(f64) -> [u8; 3]) {
+        let minx = p.iter().map(|q| q.0).fold(f64::INFINITY, f64::min).floor().max(0.0) as isize;
+        let maxx = p.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max).ceil().min(self.w as f64 - 1.0) as isize;
+        let miny = p.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).floor().max(0.0) as isize;
+        let maxy = p.iter().map(|q| q.1).fold(f64::NEG_INFINITY, f64::max).ceil().min(self.h as f64 - 1.0) as isize;
+        let area = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1);
+        if area.abs() < 1e-12 {
+            return;
+        }
+        for y in miny..=maxy {
+            for x in minx..=maxx {
+                let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                let w0 = ((p[1].0 - px) * (p[2].1 - py) - (p[2].0 - px) * (p[1].1 - py)) / area;
+                let w1 = ((p[2].0 - px) * (p[0].1 - py) - (p[0].0 - px) * (p[2].1 - py)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 >= -1e-9 && w1 >= -1e-9 && w2 >= -1e-9 {
+                    let val = w0 * v[0] + w1 * v[1] + w2 * v[2];
+                    self.put(x, y, shade(val), 1.0);
+                }
+            }
+        }
+    }
+    /// Xiaolin Wu style anti-aliased line of the given width (1 or 2 px).
+    fn line(&mut self, a: (f64, f64), b: (f64, f64), c: [u8; 3], alpha: f64) {
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let n = dx.abs().max(dy.abs()).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            let (x, y) = (a.0 + t * dx, a.1 + t * dy);
+            let (xi, yi) = (x.floor(), y.floor());
+            let (fx, fy) = (x - xi, y - yi);
+            self.put(xi as isize, yi as isize, c, alpha * (1.0 - fx) * (1.0 - fy));
+            self.put(xi as isize + 1, yi as isize, c, alpha * fx * (1.0 - fy));
+            self.put(xi as isize, yi as isize + 1, c, alpha * (1.0 - fx) * fy);
+            self.put(xi as isize + 1, yi as isize + 1, c, alpha * fx * fy);
+        }
+    }
+}
+
+/// Render `map`; the colour scale runs from 0 to the largest sampled `det J`.
+pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
+    let n = opts.resolution.max(8);
+    let mut pts = Vec::with_capacity((n + 1) * (n + 1));
+    let mut det = Vec::with_capacity((n + 1) * (n + 1));
+    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+    for j in 0..=n {
+        bv.eval(&map.knots[1], j as f64 / n as f64, 1);
+        for i in 0..=n {
+            bu.eval(&map.knots[0], i as f64 / n as f64, 1);
+            let d = map.derivs_with(&bu, &bv, 1);
+            pts.push(d.x);
+            det.push(d.det_j());
+        }
+    }
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for p in &pts {
+        xmin = xmin.min(p[0]);
+        xmax = xmax.max(p[0]);
+        ymin = ymin.min(p[1]);
+        ymax = ymax.max(p[1]);
+    }
+    let (wd, ht) = ((xmax - xmin).max(1e-300), (ymax - ymin).max(1e-300));
+    let margin = 0.04;
+    let inner = opts.size as f64 * (1.0 - 2.0 * margin);
+    let s = inner / wd.max(ht);
+    let (w, h) = (((wd * s) / (1.0 - 2.0 * margin)).ceil() as usize, ((ht * s) / (1.0 - 2.0 * margin)).ceil() as usize);
+    let (w, h) = (w.max(16), h.max(16));
+    let pad = (w as f64 - wd * s) / 2.0;
+    let padv = (h as f64 - ht * s) / 2.0;
+    let mut cv = Canvas { w, h, rgba: vec![255; 4 * w * h], x0: xmin - pad / s, y0: ymin - padv / s, s };
+    let dmax = det.iter().cloned().fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
+    let shade = move |v: f64| if v <= 0.0 { FOLD_COLOUR } else { colormap(v / dmax) };
+    let idx = |i: usize, j: usize| j * (n + 1) + i;
+    // positive cells first, then cells with a non-positive corner on top
+    for pass in 0..2 {
+        for j in 0..n {
+            for i in 0..n {
+                let ks = [idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)];
+                let folded = ks.iter().any(|&k| det[k] <= 0.0);
+                if folded != (pass == 1) {
+                    continue;
+                }
+                let p: Vec<(f64, f64)> = ks.iter().map(|&k| cv.to_px(pts[k])).collect();
+                let v: Vec<f64> = ks.iter().map(|&k| det[k]).collect();
+                cv.triangle([p[0], p[1], p[2]], [v[0], v[1], v[2]], &shade);
+                cv.triangle([p[0], p[2], p[3]], [v[0], v[2], v[3]], &shade);
+            }
+        }
+    }
+    // iso-lines
+    let gl = opts.grid_lines;
+    if gl > 0 {
+        for l in 1..gl {
+            let t = l as f64 / gl as f64;
+            let k = ((t * n as f64).round() as usize).min(n);
+            for m in 0..n {
+                let (a, b) = (cv.to_px(pts[idx(k, m)]), cv.to_px(pts[idx(k, m + 1)]));
+                cv.line(a, b, [30, 30, 30], 0.7);
+                let (a, b) = (cv.to_px(pts[idx(m, k)]), cv.to_px(pts[idx(m + 1, k)]));
+                cv.line(a, b, [30, 30, 30], 0.7);
+            }
+        }
+    }
+    for m in 0..n {
+        for (a, b) in [(idx(m, 0), idx(m + 1, 0)), (idx(m, n), idx(m + 1, n)), (idx(0, m), idx(0, m + 1)), (idx(n, m), idx(n, m + 1))] {
+            let (pa, pb) = (cv.to_px(pts[a]), cv.to_px(pts[b]));
+            cv.line(pa, pb, [0, 0, 0], 1.0);
+        }
+    }
+    for &(a, b) in &opts.segments {
+        let (pa, pb) = (cv.to_px(a), cv.to_px(b));
+        cv.line(pa, pb, [220, 30, 30], 1.0);
+    }
+    Image { width: w, height: h, rgba: cv.rgba }
+}

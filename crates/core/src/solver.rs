@@ -1,0 +1,566 @@
+//! The coarse-to-fine EGG solver (paper §6.3) as an object that yields its iterates:
+//! level starts, nonlinear iterates and level summaries come out of one stream that the
+//! CLI progress, the viewer's live plot and the tests all read.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use crate::assembly::{Discretization, Operator};
+use crate::boundary::Boundary;
+use crate::curve::Curve;
+use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
+use crate::error::{Error, Result};
+use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
+use crate::initial::{coons, elasticity_prolongation};
+use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
+use crate::quality::{functionals, sample_det_j};
+use crate::surface::{Side, Surface};
+
+/// Options of a complete solve.
+#[derive(Debug, Clone)]
+pub struct SolveOptions {
+    /// Contour fitting (degree, tolerance).
+    pub fit: FitOptions,
+    /// Nonlinear iteration on every level.
+    pub nonlinear: NonlinearOptions,
+    /// Operator of eq. (8), plain or scaled.
+    pub operator: Operator,
+    /// The finest level has at least this many elements per direction.
+    pub min_elements: usize,
+    /// Extra uniform halvings of the finest level.
+    pub refine: usize,
+    /// Solve at most this many levels (the finest is always solved).
+    pub max_levels: Option<usize>,
+    /// Basis growth factor between solved levels (the paper advises 4).
+    pub growth: f64,
+    /// `det J` is sampled on an `(n+1)^2` grid for the report.
+    pub sample: usize,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        Self {
+            fit: FitOptions::default(),
+            nonlinear: NonlinearOptions::default(),
+            operator: Operator::Plain,
+            min_elements: 8,
+            refine: 0,
+            max_levels: None,
+            growth: 4.0,
+            sample: 200,
+        }
+    }
+}
+
+/// How a level's initial guess was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialGuess {
+    /// Transfinite interpolation (coarsest level).
+    Coons,
+    /// Prolongation of the previous level plus linear elasticity.
+    Elasticity,
+}
+
+/// Summary of one solved level.
+#[derive(Debug, Clone, Serialize)]
+pub struct LevelReport {
+    /// Index among the solved levels.
+    pub level: usize,
+    /// Basis functions per direction.
+    pub shape: [usize; 2],
+    /// Elements per direction.
+    pub elements: [usize; 2],
+    /// Number of scalar unknowns (`2 m`).
+    pub unknowns: usize,
+    /// Initial guess used.
+    pub initial_guess: InitialGuess,
+    /// Smallest sampled `det J` of the initial guess.
+    pub initial_det_j_min: f64,
+    /// Nonlinear iterations (excluding the initial residual evaluation).
+    pub iterations: usize,
+    /// Newton iterations among them.
+    pub newton_iterations: usize,
+    /// Pseudo-time iterations among them.
+    pub pseudo_time_iterations: usize,
+    /// Whether the stopping rule was met.
+    pub converged: bool,
+    /// Failure reason, if any.
+    pub failure: Option<String>,
+    /// `||F||` per iterate, initial guess first.
+    pub residuals: Vec<f64>,
+    /// Scaled residuals per iterate.
+    pub scaled_residuals: Vec<f64>,
+    /// Seconds spent assembling.
+    pub assembly_seconds: f64,
+    /// Seconds spent in linear solves.
+    pub linear_seconds: f64,
+    /// Seconds for the whole level (set-up, initial guess, iterations).
+    pub seconds: f64,
+}
+
+/// One item of the solver's stream.
+#[derive(Debug, Clone)]
+pub enum Event {
+    /// A level begins.
+    LevelStarted {
+        /// Index among the solved levels.
+        level: usize,
+        /// Number of levels that will be solved.
+        levels: usize,
+        /// Basis shape.
+        shape: [usize; 2],
+        /// Scalar unknowns.
+        unknowns: usize,
+        /// Initial guess.
+        initial_guess: InitialGuess,
+    },
+    /// A nonlinear iterate.
+    Iterate {
+        /// Level index.
+        level: usize,
+        /// The iterate.
+        iterate: Iterate,
+    },
+    /// A level is done.
+    LevelFinished(LevelReport),
+}
+
+/// Angle of the domain at a corner and whether it forces `det J <= 0` there.
+#[derive(Debug, Clone, Serialize)]
+pub struct CornerReport {
+    /// "south-west", ...
+    pub corner: &'static str,
+    /// Interior angle in degrees (from the fitted sides' tangents).
+    pub angle_degrees: f64,
+    /// `det J` at the corner equals the cross product of the two side tangents; it is
+    /// `<= 0` whenever the angle is `>= 180` degrees or a tangent vanishes.
+    pub forces_nonpositive_det_j: bool,
+}
+
+/// Corners in the order south-west, south-east, north-east, north-west with their
+/// angles, from the side curves of a level.
+pub fn corner_report(sides: &[Curve; 4]) -> Vec<CornerReport> {
+    let d = |s: Side, t: f64| sides[s as usize].derivs(t, 1).d1;
+    // (name, x_xi, x_eta) at the corner; det J = x_xi x x_eta.
+    let corners = [
+        ("south-west", d(Side::South, 0.0), d(Side::West, 0.0)),
+        ("south-east", d(Side::South, 1.0), d(Side::East, 0.0)),
+        ("north-east", d(Side::North, 1.0), d(Side::East, 1.0)),
+        ("north-west", d(Side::North, 0.0), d(Side::West, 1.0)),
+    ];
+    corners
+        .into_iter()
+        .enumerate()
+        .map(|(k, (name, a, b))| {
+            let cross = a[0] * b[1] - a[1] * b[0];
+            let dot = a[0] * b[0] + a[1] * b[1];
+            // interior angle between the two outgoing edges
+            let (e1, e2) = match k {
+                0 => (a, b),
+                1 => ([-a[0], -a[1]], b),
+                2 => ([-b[0], -b[1]], [-a[0], -a[1]]),
+                _ => (a, [-b[0], -b[1]]),
+            };
+            let mut ang = (e1[0] * e2[1] - e1[1] * e2[0]).atan2(e1[0] * e2[0] + e1[1] * e2[1]).to_degrees();
+            if ang < 0.0 {
+                ang += 360.0;
+            }
+            let speed = a[0].hypot(a[1]) * b[0].hypot(b[1]);
+            let _ = dot;
+            CornerReport {
+                corner: name,
+                angle_degrees: ang,
+                forces_nonpositive_det_j: cross <= 1e-10 * speed || speed == 0.0,
+            }
+        })
+        .collect()
+}
+
+/// Choose the levels to solve: from the coarsest, each next one at least `growth` times
+/// larger, always ending with the finest.
+pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) -> Vec<usize> {
+    let last = sizes.len() - 1;
+    let mut out = vec![0];
+    for (k, &s) in sizes.iter().enumerate().skip(1) {
+        if k == last || s as f64 >= growth * sizes[*out.last().expect("non-empty")] as f64 {
+            if k == last && *out.last().expect("non-empty") == last {
+                continue;
+            }
+            out.push(k);
+        }
+    }
+    if let Some(m) = max_levels {
+        let m = m.max(1);
+        while out.len() > m {
+            out.remove(out.len() - 2);
+        }
+    }
+    out
+}
+
+/// Extend a hierarchy so that its finest level has at least `min_elements` elements per
+/// direction, plus `refine` uniform halvings (exact refinement of the fitted sides).
+pub fn extend_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize) -> Result<Vec<Level>> {
+    let mut extra = refine;
+    loop {
+        let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
+        let ne = [last.knots[0].num_elements(), last.knots[1].num_elements()];
+        let too_coarse = ne[0] < min_elements || ne[1] < min_elements;
+        if !too_coarse && extra == 0 {
+            return Ok(levels);
+        }
+        if !too_coarse {
+            extra -= 1;
+        }
+        let knots = [
+            if ne[0] < min_elements || !too_coarse { last.knots[0].halved() } else { last.knots[0].clone() },
+            if ne[1] < min_elements || !too_coarse { last.knots[1].halved() } else { last.knots[1].clone() },
+        ];
+        let mut sides = last.sides.clone();
+        for s in Side::ALL {
+            sides[s as usize] = sides[s as usize].refined(&knots[s.direction()])?;
+        }
+        levels.push(Level { knots, sides });
+    }
+}
+
+struct Active {
+    level: usize,
+    solver: NonlinearSolver<EggProblem>,
+    report: LevelReport,
+    started: Instant,
+}
+
+/// The coarse-to-fine solver; an `Iterator` over [`Event`]s. Drop it to cancel.
+pub struct EggSolver {
+    plan: Vec<Level>,
+    opts: SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    diameter: f64,
+    next_level: usize,
+    active: Option<Active>,
+    previous: Option<Surface>,
+    reports: Vec<LevelReport>,
+    started: Instant,
+    failed: bool,
+}
+
+impl std::fmt::Debug for EggSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EggSolver").field("levels", &self.plan.len()).field("next_level", &self.next_level).finish()
+    }
+}
+
+impl EggSolver {
+    /// A solver over the levels of `hierarchy` (extended and selected by `opts`).
+    pub fn new(hierarchy: &Hierarchy, opts: SolveOptions, assembler: Arc<dyn EggAssembler>) -> Result<Self> {
+        let levels = extend_levels(hierarchy.levels.clone(), opts.min_elements, opts.refine)?;
+        let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
+        let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
+        let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
+        Ok(Self {
+            plan,
+            opts,
+            assembler,
+            diameter: hierarchy.diameter,
+            next_level: 0,
+            active: None,
+            previous: None,
+            reports: Vec::new(),
+            started: Instant::now(),
+            failed: false,
+        })
+    }
+
+    /// The levels that will be solved.
+    pub fn plan(&self) -> &[Level] {
+        &self.plan
+    }
+
+    fn start_level(&mut self, k: usize) -> Result<Event> {
+        let t0 = Instant::now();
+        let level = &self.plan[k];
+        let disc = Arc::new(Discretization::new(level.knots.clone()));
+        let (cps, guess) = match &self.previous {
+            None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
+            Some(prev) => (elasticity_prolongation(prev, &disc, &level.sides)?, InitialGuess::Elasticity),
+        };
+        let shape = disc.shape();
+        let init = Surface { knots: level.knots.clone(), control_points: cps.clone(), weights: None };
+        let initial_det_j_min = sample_det_j(&init, 4 * shape[0].max(shape[1])).min_interior;
+        let m = disc.dofs.num_free();
+        let mut nl = self.opts.nonlinear;
+        // ||F|| ~ diam^3 / sqrt(m) when L is O(diam^3): scale to a dimensionless size.
+        nl.scale = (m.max(1) as f64).sqrt() / self.diameter.powi(3);
+        nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
+        let problem = EggProblem::new(disc, cps, self.opts.operator, self.assembler.clone());
+        let c0 = problem.unknowns();
+        let solver = NonlinearSolver::new(problem, c0, nl);
+        let report = LevelReport {
+            level: k,
+            shape,
+            elements: [level.knots[0].num_elements(), level.knots[1].num_elements()],
+            unknowns: 2 * m,
+            initial_guess: guess,
+            initial_det_j_min,
+            iterations: 0,
+            newton_iterations: 0,
+            pseudo_time_iterations: 0,
+            converged: false,
+            failure: None,
+            residuals: Vec::new(),
+            scaled_residuals: Vec::new(),
+            assembly_seconds: 0.0,
+            linear_seconds: 0.0,
+            seconds: 0.0,
+        };
+        self.active = Some(Active { level: k, solver, report, started: t0 });
+        Ok(Event::LevelStarted { level: k, levels: self.plan.len(), shape, unknowns: 2 * m, initial_guess: guess })
+    }
+
+    fn finish_level(&mut self) -> Event {
+        let mut a = self.active.take().expect("active level");
+        let status = a.solver.status().clone();
+        a.report.converged = status == Status::Converged;
+        if let Status::Failed(why) = status {
+            a.report.failure = Some(why);
+        }
+        let timings = a.solver.timings;
+        a.report.assembly_seconds = timings.assembly.as_secs_f64();
+        a.report.linear_seconds = timings.linear.as_secs_f64();
+        a.report.seconds = a.started.elapsed().as_secs_f64();
+        let (problem, c) = a.solver.into_parts();
+        let mut cps = problem.cps.clone();
+        problem.disc.dofs.scatter(&c, &mut cps);
+        self.previous = Some(Surface { knots: problem.disc.knots.clone(), control_points: cps, weights: None });
+        self.reports.push(a.report.clone());
+        Event::LevelFinished(a.report)
+    }
+
+    /// Finish: the map of the finest level and the full report. Runs the remaining
+    /// iterations first if the stream was not drained.
+    pub fn finish(mut self, name: &str, hierarchy: &Hierarchy) -> Result<Solution> {
+        for e in self.by_ref() {
+            e?;
+        }
+        let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let finest = self.plan.last().expect("non-empty plan");
+        Ok(Solution::new(name, map, hierarchy, &finest.sides, self.reports, &self.opts, self.assembler.name(), self.started.elapsed()))
+    }
+}
+
+impl Iterator for EggSolver {
+    type Item = Result<Event>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        if let Some(a) = self.active.as_mut() {
+            match a.solver.step() {
+                Ok(Some(it)) => {
+                    a.report.residuals.push(it.residual);
+                    a.report.scaled_residuals.push(it.scaled_residual);
+                    if it.iteration > 0 {
+                        a.report.iterations = it.iteration;
+                        match it.method {
+                            Method::Newton => a.report.newton_iterations += 1,
+                            Method::PseudoTime => a.report.pseudo_time_iterations += 1,
+                        }
+                    }
+                    return Some(Ok(Event::Iterate { level: a.level, iterate: it }));
+                }
+                Ok(None) => return Some(Ok(self.finish_level())),
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
+                }
+            }
+        }
+        if self.next_level < self.plan.len() {
+            let k = self.next_level;
+            self.next_level += 1;
+            let r = self.start_level(k);
+            if r.is_err() {
+                self.failed = true;
+            }
+            return Some(r);
+        }
+        None
+    }
+}
+
+/// Overall outcome of a solve, as seen on a dense sample of `det J`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// Converged and `det J > 0` on the whole sample.
+    PositiveOnSample,
+    /// Converged, `det J > 0` inside, but a corner angle of the boundary forces
+    /// `det J <= 0` there: the best map the boundary allows.
+    DegenerateCorner,
+    /// `det J <= 0` somewhere away from forced corners: the map folds.
+    Folded,
+    /// The finest level did not converge.
+    NotConverged,
+}
+
+/// Contour-fit summary per side.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    /// Side name.
+    pub side: &'static str,
+    /// Number of fit levels.
+    pub levels: usize,
+    /// Elements on the finest fit.
+    pub elements: usize,
+    /// Max deviation of the finest fit.
+    pub max_error: f64,
+    /// Whether the tolerance was met.
+    pub converged: bool,
+}
+
+/// The report stored in the map file and printed by the CLI.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Crate version.
+    pub version: &'static str,
+    /// Assembly back end.
+    pub backend: String,
+    /// Degree of the map.
+    pub degree: [usize; 2],
+    /// Operator.
+    pub operator: &'static str,
+    /// Absolute fit tolerance and the diameter it is relative to.
+    pub fit_tolerance: f64,
+    /// Bounding-box diameter of the boundary.
+    pub diameter: f64,
+    /// Per-side fit summary.
+    pub fit: Vec<FitReport>,
+    /// Per-level summaries.
+    pub levels: Vec<LevelReport>,
+    /// `det J` minimum on the sample grid (corners included).
+    pub det_j_min: f64,
+    /// `det J` minimum away from the four corners.
+    pub det_j_min_interior: f64,
+    /// `det J` maximum on the sample grid.
+    pub det_j_max: f64,
+    /// Parameter point of the minimum.
+    pub det_j_argmin: [f64; 2],
+    /// Sample grid size.
+    pub det_j_sample: usize,
+    /// Winslow functional (eq. 15-16); `null` when `det J <= 0` at a quadrature point.
+    pub winslow: Option<f64>,
+    /// Area of the mapped domain.
+    pub area: f64,
+    /// Corner angles.
+    pub corners: Vec<CornerReport>,
+    /// The outcome.
+    pub verdict: Verdict,
+    /// Plain-language summary of the verdict.
+    pub message: String,
+    /// Total seconds.
+    pub seconds: f64,
+}
+
+/// A solved map and its report.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Name of the geometry.
+    pub name: String,
+    /// The map of the finest level.
+    pub map: Surface,
+    /// The report.
+    pub report: Report,
+}
+
+impl Solution {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        name: &str,
+        map: Surface,
+        h: &Hierarchy,
+        sides: &[Curve; 4],
+        levels: Vec<LevelReport>,
+        opts: &SolveOptions,
+        backend: String,
+        elapsed: Duration,
+    ) -> Self {
+        let sample = sample_det_j(&map, opts.sample);
+        let fun = functionals(&map);
+        let corners = corner_report(sides);
+        let forced: Vec<&str> = corners.iter().filter(|c| c.forces_nonpositive_det_j).map(|c| c.corner).collect();
+        let converged = levels.last().is_some_and(|l| l.converged);
+        let scale = sample.max.abs().max(f64::MIN_POSITIVE);
+        let (verdict, message) = if !converged {
+            (
+                Verdict::NotConverged,
+                format!(
+                    "the nonlinear solver did not converge on the finest level ({}); the map is the last iterate",
+                    levels.last().and_then(|l| l.failure.clone()).unwrap_or_default()
+                ),
+            )
+        } else if sample.min_interior <= 0.0 {
+            let [u, v] = sample.argmin;
+            (Verdict::Folded, format!("det J <= 0 at (xi, eta) = ({u:.4}, {v:.4}): the map folds at this resolution"))
+        } else if !forced.is_empty() || sample.min <= 1e-12 * scale {
+            let names = if forced.is_empty() { "a corner".to_string() } else { forced.join(", ") };
+            (
+                Verdict::DegenerateCorner,
+                format!(
+                    "the boundary forces det J <= 0 at the {names} corner (angle >= 180 degrees or zero speed); \
+                     det J > 0 everywhere else: this is the best map this boundary admits"
+                ),
+            )
+        } else {
+            (Verdict::PositiveOnSample, format!("det J > 0 on the {}x{} sample grid", sample.n + 1, sample.n + 1))
+        };
+        let fit = Side::ALL
+            .iter()
+            .map(|&s| {
+                let f = &h.fits[s as usize];
+                FitReport {
+                    side: s.name(),
+                    levels: f.levels.len(),
+                    elements: f.levels.last().map_or(0, |c| c.knots.num_elements()),
+                    max_error: f.max_error.last().copied().unwrap_or(0.0),
+                    converged: f.converged,
+                }
+            })
+            .collect();
+        let report = Report {
+            version: env!("CARGO_PKG_VERSION"),
+            backend,
+            degree: map.degrees(),
+            operator: match opts.operator {
+                Operator::Plain => "plain",
+                Operator::Scaled => "scaled",
+            },
+            fit_tolerance: h.tol_abs,
+            diameter: h.diameter,
+            fit,
+            levels,
+            det_j_min: sample.min,
+            det_j_min_interior: sample.min_interior,
+            det_j_max: sample.max,
+            det_j_argmin: sample.argmin,
+            det_j_sample: sample.n,
+            winslow: fun.winslow.is_finite().then_some(fun.winslow),
+            area: fun.area,
+            corners,
+            verdict,
+            message,
+            seconds: elapsed.as_secs_f64(),
+        };
+        Self { name: name.to_string(), map, report }
+    }
+}
+
+/// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream.
+pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
+    let h = build_hierarchy(boundary, &opts.fit)?;
+    EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(&boundary.name, &h)
+}
