@@ -1,1 +1,381 @@
-fn main(){}
+//! `winslow`: the headless command-line front end. Everything the library does, from a
+//! shell: inspect a boundary, solve for a map, draw it, and benchmark the solver.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use winslow::assembly::Operator;
+use winslow::egg::CpuAssembler;
+use winslow::fit::{build_hierarchy, FitOptions};
+use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
+use winslow::linsolve::LinearMethod;
+use winslow::newton::Method;
+use winslow::picture::{render, PictureOptions};
+use winslow::solver::{EggSolver, Event, SolveOptions, Solution, Verdict};
+use winslow::{Boundary, Side};
+
+mod output;
+
+#[derive(Parser, Debug)]
+#[command(name = "winslow", version, about = "Bijective spline maps of the unit square from a planar boundary (elliptic grid generation in IGA)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print sides, degrees, knots, corner angles, orientation and fit tolerance per side.
+    Inspect(InspectArgs),
+    /// Solve the EGG equations for a boundary and write the map (with a report).
+    Solve(SolveArgs),
+    /// Draw an existing map file as a PNG (grid lines coloured by det J).
+    Render(RenderArgs),
+    /// Run the solver on a list of geometries and sizes and print a table.
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug, Clone)]
+struct FitArgs {
+    /// Spline degree of the map (p >= 2).
+    #[arg(long, default_value_t = 3)]
+    degree: usize,
+    /// Contour fit tolerance, relative to the bounding-box diameter.
+    #[arg(long, default_value_t = 1e-4)]
+    fit_tol: f64,
+    /// Turn a clockwise boundary counter-clockwise (swaps xi and eta) instead of failing.
+    #[arg(long)]
+    reorient: bool,
+}
+
+#[derive(Args, Debug)]
+struct InspectArgs {
+    /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
+    file: PathBuf,
+    #[command(flatten)]
+    fit: FitArgs,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum MethodArg {
+    Newton,
+    PseudoTime,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum OperatorArg {
+    Plain,
+    Scaled,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum LinearArg {
+    Lu,
+    Gmres,
+}
+
+#[derive(Args, Debug, Clone)]
+struct SolverArgs {
+    #[command(flatten)]
+    fit: FitArgs,
+    /// Nonlinear tolerance on the scaled residual ||F|| sqrt(m) / diam^3.
+    #[arg(long, default_value_t = 1e-9)]
+    tol: f64,
+    /// Solve at most this many levels of the hierarchy (the finest is always solved).
+    #[arg(long)]
+    levels: Option<usize>,
+    /// Minimum number of elements per direction on the finest level.
+    #[arg(long, default_value_t = 8)]
+    min_elements: usize,
+    /// Extra uniform halvings of the finest level.
+    #[arg(long, default_value_t = 0)]
+    refine: usize,
+    /// Nonlinear method (Newton falls back to pseudo time-stepping when it stalls).
+    #[arg(long, value_enum, default_value = "newton")]
+    method: MethodArg,
+    /// Operator: L of eq. (4) or L / (g11 + g22) as in G+Smo.
+    #[arg(long, value_enum, default_value = "plain")]
+    operator: OperatorArg,
+    /// Linear solver: sparse LU or GMRES with ILU(0).
+    #[arg(long, value_enum, default_value = "lu")]
+    linear: LinearArg,
+}
+
+impl SolverArgs {
+    fn options(&self) -> Result<SolveOptions> {
+        if self.fit.degree < 2 {
+            bail!("--degree must be at least 2 (the EGG equations need C1 maps), got {}", self.fit.degree);
+        }
+        if !(self.fit.fit_tol > 0.0 && self.fit.fit_tol < 1.0) {
+            bail!("--fit-tol must be in (0, 1), got {}", self.fit.fit_tol);
+        }
+        if !(self.tol > 0.0) {
+            bail!("--tol must be positive, got {}", self.tol);
+        }
+        let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
+        o.nonlinear.tol = self.tol;
+        o.nonlinear.method = match self.method {
+            MethodArg::Newton => Method::Newton,
+            MethodArg::PseudoTime => Method::PseudoTime,
+        };
+        o.nonlinear.linear = match self.linear {
+            LinearArg::Lu => LinearMethod::Lu,
+            LinearArg::Gmres => LinearMethod::Gmres,
+        };
+        o.operator = match self.operator {
+            OperatorArg::Plain => Operator::Plain,
+            OperatorArg::Scaled => Operator::Scaled,
+        };
+        o.max_levels = self.levels;
+        o.min_elements = self.min_elements.max(1);
+        o.refine = self.refine;
+        Ok(o)
+    }
+}
+
+fn fit_options(f: &FitArgs) -> FitOptions {
+    FitOptions { degree: f.degree, tol: f.fit_tol, ..Default::default() }
+}
+
+#[derive(Args, Debug)]
+struct SolveArgs {
+    /// Boundary file.
+    boundary: PathBuf,
+    /// Output map file (JSON, with a "report").
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    solver: SolverArgs,
+    /// Write a picture of the map (grid lines coloured by det J).
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Write a VTK structured grid with det J.
+    #[arg(long)]
+    vtk: Option<PathBuf>,
+    /// Print the report as JSON on stdout (progress goes to stderr).
+    #[arg(long)]
+    json: bool,
+    /// No progress output.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Map file.
+    map: PathBuf,
+    /// Output PNG.
+    #[arg(long)]
+    png: PathBuf,
+    /// Iso-lines per direction.
+    #[arg(long, default_value_t = 24)]
+    lines: usize,
+    /// Longer image side in pixels.
+    #[arg(long, default_value_t = 900)]
+    size: usize,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Boundary files (default: every JSON geometry in tests/data and tests/data/gismo).
+    files: Vec<PathBuf>,
+    /// Extra uniform halvings of the finest level to run, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0")]
+    refine: Vec<usize>,
+    #[command(flatten)]
+    solver: SolverArgs,
+    /// Print the rows as JSON lines instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let code = match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            1
+        }
+    };
+    std::process::exit(code);
+}
+
+fn run(cli: Cli) -> Result<i32> {
+    match cli.command {
+        Command::Inspect(a) => inspect(a),
+        Command::Solve(a) => solve(a),
+        Command::Render(a) => {
+            let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+            let Document::Map { map, .. } = doc else { bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display()) };
+            let opts = PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, ..Default::default() };
+            output::write_png(&a.png, &render(&map, &opts))?;
+            println!("wrote {}", a.png.display());
+            Ok(0)
+        }
+        Command::Bench(a) => bench(a),
+    }
+}
+
+fn load_boundary(path: &Path, fit: &FitArgs) -> Result<Boundary> {
+    let doc = read_document(path).with_context(|| format!("reading {}", path.display()))?;
+    let (b, _) = checked_boundary(doc.into_boundary(), &ReadOptions { reorient: fit.reorient })
+        .with_context(|| format!("validating {}", path.display()))?;
+    Ok(b)
+}
+
+fn inspect(a: InspectArgs) -> Result<i32> {
+    let doc = read_document(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
+    let kind = match &doc {
+        Document::Boundary(_) => "boundary",
+        Document::Map { .. } => "map (its four boundary curves are inspected)",
+    };
+    let boundary = doc.into_boundary();
+    let mut problems = Vec::new();
+    let checked = checked_boundary(boundary.clone(), &ReadOptions { reorient: a.fit.reorient });
+    let (boundary, report) = match checked {
+        Ok((b, r)) => (b, Some(r)),
+        Err(e) => {
+            problems.push(e.to_string());
+            (boundary, None)
+        }
+    };
+    let fit = if problems.is_empty() { Some(build_hierarchy(&boundary, &fit_options(&a.fit))) } else { None };
+    let fit = match fit {
+        Some(Ok(h)) => Some(h),
+        Some(Err(e)) => {
+            problems.push(format!("contour fit failed: {e}"));
+            None
+        }
+        None => None,
+    };
+    let text = output::inspect_text(&a.file, kind, &boundary, report.as_ref(), fit.as_ref(), &problems);
+    if a.json {
+        let v = output::inspect_json(&boundary, report.as_ref(), fit.as_ref(), &problems);
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        print!("{text}");
+    }
+    Ok(if problems.is_empty() { 0 } else { 2 })
+}
+
+/// Run the solver stream, printing progress.
+fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<Solution> {
+    let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
+    if !quiet {
+        let tol = h.tol_abs;
+        eprintln!(
+            "{}: fitted {} hierarchy levels (tolerance {tol:.3e}, diameter {:.4})",
+            boundary.name,
+            h.levels.len(),
+            h.diameter
+        );
+        for s in Side::ALL {
+            let f = &h.fits[s as usize];
+            if !f.converged {
+                eprintln!("  warning: {s} side fit did not reach the tolerance (max error {:.3e})", f.max_error.last().copied().unwrap_or(0.0));
+            }
+        }
+    }
+    let mut solver = EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?;
+    let stderr = std::io::stderr();
+    for event in solver.by_ref() {
+        let event = event?;
+        if quiet {
+            continue;
+        }
+        let mut e = stderr.lock();
+        match event {
+            Event::LevelStarted { level, levels, shape, unknowns, initial_guess } => {
+                writeln!(e, "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}", level + 1, shape[0], shape[1])?;
+            }
+            Event::Iterate { iterate: it, .. } => {
+                writeln!(
+                    e,
+                    "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}",
+                    it.iteration,
+                    format!("{:?}", it.method),
+                    it.residual,
+                    it.scaled_residual,
+                    it.step,
+                    it.damping,
+                    it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default()
+                )?;
+            }
+            Event::LevelFinished(r) => {
+                writeln!(
+                    e,
+                    "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
+                    r.iterations,
+                    if r.converged { "converged".to_string() } else { format!("NOT converged ({})", r.failure.unwrap_or_default()) },
+                    r.initial_det_j_min,
+                    r.seconds
+                )?;
+            }
+        }
+    }
+    Ok(solver.finish(&boundary.name, &h)?)
+}
+
+fn solve(a: SolveArgs) -> Result<i32> {
+    let opts = a.solver.options()?;
+    let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
+    let sol = run_solver(&boundary, &opts, a.quiet || a.json)?;
+    let report = serde_json::to_value(&sol.report)?;
+    write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
+        .with_context(|| format!("writing {}", a.output.display()))?;
+    if let Some(p) = &a.png {
+        output::write_png(p, &render(&sol.map, &PictureOptions::default()))?;
+    }
+    if let Some(p) = &a.vtk {
+        output::write_vtk(p, &sol.map, 128)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
+    }
+    Ok(match sol.report.verdict {
+        Verdict::PositiveOnSample | Verdict::DegenerateCorner => 0,
+        Verdict::Folded => 3,
+        Verdict::NotConverged => 4,
+    })
+}
+
+fn bench(a: BenchArgs) -> Result<i32> {
+    let opts = a.solver.options()?;
+    let files = if a.files.is_empty() { output::default_bench_files()? } else { a.files.clone() };
+    let mut rows = Vec::new();
+    for f in &files {
+        let boundary = match load_boundary(f, &a.solver.fit) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("skipping {}: {e:#}", f.display());
+                continue;
+            }
+        };
+        for &r in &a.refine {
+            let o = SolveOptions { refine: r, ..opts.clone() };
+            output::reset_peak_memory();
+            let t = Instant::now();
+            let sol = run_solver(&boundary, &o, true)?;
+            let total = t.elapsed().as_secs_f64();
+            let row = output::BenchRow::new(&sol, r, total);
+            if a.json {
+                println!("{}", serde_json::to_string(&row)?);
+            }
+            rows.push(row);
+        }
+    }
+    if !a.json {
+        print!("{}", output::bench_table(&rows));
+    }
+    Ok(0)
+}

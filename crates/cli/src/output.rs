@@ -1,0 +1,289 @@
+//! Text, table, PNG and VTK output of the CLI.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use winslow::fit::Hierarchy;
+use winslow::picture::Image;
+use winslow::quality::sample_det_j;
+use winslow::solver::{Solution, Verdict};
+use winslow::validate::ValidationReport;
+use winslow::{Boundary, Side, SideCurve, Surface};
+
+/// Encode an RGBA image as PNG.
+pub fn write_png(path: &Path, img: &Image) -> Result<()> {
+    ensure_parent(path)?;
+    let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), img.width as u32, img.height as u32);
+    enc.set_color(png::ColorType::Rgba);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header()?;
+    w.write_image_data(&img.rgba)?;
+    Ok(())
+}
+
+fn ensure_parent(path: &Path) -> Result<()> {
+    if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+    }
+    Ok(())
+}
+
+/// Legacy-VTK structured grid of the map sampled on `(n+1)^2` points with `det J`.
+pub fn write_vtk(path: &Path, map: &Surface, n: usize) -> Result<()> {
+    ensure_parent(path)?;
+    let s = sample_det_j(map, n);
+    let mut out = String::new();
+    writeln!(out, "# vtk DataFile Version 3.0\nwinslow map\nASCII\nDATASET STRUCTURED_GRID")?;
+    writeln!(out, "DIMENSIONS {} {} 1\nPOINTS {} double", n + 1, n + 1, (n + 1) * (n + 1))?;
+    for j in 0..=n {
+        for i in 0..=n {
+            let p = map.eval(i as f64 / n as f64, j as f64 / n as f64);
+            writeln!(out, "{:?} {:?} 0", p[0], p[1])?;
+        }
+    }
+    writeln!(out, "POINT_DATA {}\nSCALARS det_J double 1\nLOOKUP_TABLE default", (n + 1) * (n + 1))?;
+    for v in &s.values {
+        writeln!(out, "{v:?}")?;
+    }
+    std::fs::write(path, out).with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// The short human summary after a solve.
+pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
+    let r = &sol.report;
+    let mut s = String::new();
+    let last = r.levels.last();
+    let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
+    let _ = writeln!(s, "  {}", r.message);
+    if let Some(l) = last {
+        let _ = writeln!(
+            s,
+            "  map: degree {:?}, {}x{} control points, {} levels, {} iterations on the finest level",
+            r.degree,
+            l.shape[0],
+            l.shape[1],
+            r.levels.len(),
+            l.iterations
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  det J: min {:.4e} (interior {:.4e}), max {:.4e}; Winslow {}; time {:.3} s",
+        r.det_j_min,
+        r.det_j_min_interior,
+        r.det_j_max,
+        r.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
+        r.seconds
+    );
+    for c in r.corners.iter().filter(|c| c.forces_nonpositive_det_j) {
+        let _ = writeln!(s, "  corner {}: angle {:.1} deg forces det J <= 0 there", c.corner, c.angle_degrees);
+    }
+    let _ = writeln!(s, "  wrote {}", out.display());
+    if let Some(p) = png {
+        let _ = writeln!(s, "  wrote {}", p.display());
+    }
+    s
+}
+
+fn verdict_word(v: Verdict) -> &'static str {
+    match v {
+        Verdict::PositiveOnSample => "bijective (det J > 0 on the sample)",
+        Verdict::DegenerateCorner => "best possible map: degenerate corner forced by the boundary",
+        Verdict::Folded => "FOLDED",
+        Verdict::NotConverged => "NOT CONVERGED",
+    }
+}
+
+fn side_lines(s: &mut String, side: Side, c: &SideCurve) {
+    let _ = writeln!(s, "  {side:<5}: {}", c.describe());
+    if let SideCurve::Spline(c) = c {
+        let k = c.knots.knots();
+        let shown: Vec<String> = if k.len() <= 16 {
+            k.iter().map(|v| format!("{v}")).collect()
+        } else {
+            k[..6].iter().map(|v| format!("{v}")).chain(std::iter::once(format!("... ({} knots) ...", k.len()))).chain(k[k.len() - 6..].iter().map(|v| format!("{v}"))).collect()
+        };
+        let _ = writeln!(s, "         knots [{}]", shown.join(", "));
+    }
+}
+
+/// `winslow inspect` as text.
+pub fn inspect_text(
+    file: &Path,
+    kind: &str,
+    b: &Boundary,
+    report: Option<&ValidationReport>,
+    fit: Option<&Hierarchy>,
+    problems: &[String],
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "{} ({kind}): \"{}\"", file.display(), b.name);
+    for side in Side::ALL {
+        side_lines(&mut s, side, b.side(side));
+    }
+    if let Some(r) = report {
+        let _ = writeln!(s, "  bounding box [{:.6}, {:.6}] x [{:.6}, {:.6}], diameter {:.6}", r.bbox_min[0], r.bbox_max[0], r.bbox_min[1], r.bbox_max[1], r.diameter);
+        let _ = writeln!(s, "  orientation {:?} (signed area {:.6e})", r.orientation, r.signed_area);
+        let names = ["south-west", "south-east", "north-east", "north-west"];
+        for k in 0..4 {
+            let warn = if r.corner_angles[k] >= 180.0 { "  <- >= 180 deg: det J cannot be positive here" } else { "" };
+            let _ = writeln!(s, "  corner {:<10} ({:.6}, {:.6}) angle {:7.2} deg, gap {:.1e}{warn}", names[k], r.corners[k][0], r.corners[k][1], r.corner_angles[k], r.corner_gaps[k]);
+        }
+    }
+    if let Some(h) = fit {
+        let _ = writeln!(s, "  contour fit: tolerance {:.3e} (relative {:.1e} of the diameter), {} hierarchy levels", h.tol_abs, h.tol_abs / h.diameter, h.levels.len());
+        for side in Side::ALL {
+            let f = &h.fits[side as usize];
+            let last = f.levels.last();
+            let _ = writeln!(
+                s,
+                "    {side:<5}: {} levels, finest {} elements (p={}), max error {:.3e}{}",
+                f.levels.len(),
+                last.map_or(0, |c| c.knots.num_elements()),
+                last.map_or(0, |c| c.degree()),
+                f.max_error.last().copied().unwrap_or(0.0),
+                if f.converged { "" } else { "  (tolerance NOT met)" }
+            );
+        }
+        let sizes: Vec<String> = h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
+        let _ = writeln!(s, "    basis per level: {}", sizes.join(" -> "));
+    }
+    if problems.is_empty() {
+        let _ = writeln!(s, "  no problems found");
+    } else {
+        for p in problems {
+            let _ = writeln!(s, "  PROBLEM: {p}");
+        }
+    }
+    s
+}
+
+/// `winslow inspect --json`.
+pub fn inspect_json(b: &Boundary, report: Option<&ValidationReport>, fit: Option<&Hierarchy>, problems: &[String]) -> serde_json::Value {
+    let sides: Vec<serde_json::Value> = Side::ALL.iter().map(|&s| serde_json::json!({ "side": s.name(), "kind": b.side(s).describe() })).collect();
+    let fits: Option<Vec<serde_json::Value>> = fit.map(|h| {
+        Side::ALL
+            .iter()
+            .map(|&s| {
+                let f = &h.fits[s as usize];
+                serde_json::json!({
+                    "side": s.name(),
+                    "levels": f.levels.len(),
+                    "elements": f.levels.last().map_or(0, |c| c.knots.num_elements()),
+                    "max_error": f.max_error.last(),
+                    "converged": f.converged,
+                })
+            })
+            .collect()
+    });
+    serde_json::json!({
+        "name": b.name,
+        "sides": sides,
+        "diameter": report.map(|r| r.diameter),
+        "orientation": report.map(|r| format!("{:?}", r.orientation)),
+        "signed_area": report.map(|r| r.signed_area),
+        "corner_angles": report.map(|r| r.corner_angles),
+        "fit_tolerance": fit.map(|h| h.tol_abs),
+        "fit": fits,
+        "problems": problems,
+    })
+}
+
+/// One row of `winslow bench`.
+#[derive(Debug, Serialize)]
+pub struct BenchRow {
+    /// Geometry.
+    pub geometry: String,
+    /// Extra refinements.
+    pub refine: usize,
+    /// Unknowns on the finest level.
+    pub dofs: usize,
+    /// Solved levels.
+    pub levels: usize,
+    /// Newton iterations on the finest level.
+    pub newton: usize,
+    /// Pseudo-time iterations on the finest level.
+    pub pseudo: usize,
+    /// Assembly seconds (all levels).
+    pub assembly_s: f64,
+    /// Linear-solve seconds (all levels).
+    pub solve_s: f64,
+    /// Total seconds including fitting and reporting.
+    pub total_s: f64,
+    /// Peak resident memory in MiB.
+    pub peak_mib: f64,
+    /// Verdict.
+    pub verdict: Verdict,
+}
+
+impl BenchRow {
+    /// Row from a solution.
+    pub fn new(sol: &Solution, refine: usize, total_s: f64) -> Self {
+        let r = &sol.report;
+        let last = r.levels.last();
+        Self {
+            geometry: sol.name.clone(),
+            refine,
+            dofs: last.map_or(0, |l| l.unknowns),
+            levels: r.levels.len(),
+            newton: last.map_or(0, |l| l.newton_iterations),
+            pseudo: last.map_or(0, |l| l.pseudo_time_iterations),
+            assembly_s: r.levels.iter().map(|l| l.assembly_seconds).sum(),
+            solve_s: r.levels.iter().map(|l| l.linear_seconds).sum(),
+            total_s,
+            peak_mib: peak_memory_mib(),
+            verdict: r.verdict,
+        }
+    }
+}
+
+/// The table printed by `winslow bench`.
+pub fn bench_table(rows: &[BenchRow]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    for r in rows {
+        let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:?} |",
+            r.geometry, r.refine, r.dofs, r.levels, its, r.assembly_s, r.solve_s, r.total_s, r.peak_mib, r.verdict
+        );
+    }
+    s
+}
+
+/// Every JSON geometry under `tests/data` and `tests/data/gismo`.
+pub fn default_bench_files() -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for dir in ["tests/data", "tests/data/gismo"] {
+        let Ok(rd) = std::fs::read_dir(dir) else { continue };
+        let mut v: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect();
+        v.sort();
+        out.extend(v);
+    }
+    if out.is_empty() {
+        anyhow::bail!("no geometry files given and none found under tests/data");
+    }
+    Ok(out)
+}
+
+/// Reset the kernel's peak-RSS counter (Linux; ignored elsewhere).
+pub fn reset_peak_memory() {
+    if let Ok(mut f) = std::fs::OpenOptions::new().write(true).open("/proc/self/clear_refs") {
+        let _ = f.write_all(b"5");
+    }
+}
+
+/// Peak resident set size in MiB since the last reset (Linux `VmHWM`; 0 elsewhere).
+pub fn peak_memory_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse::<f64>().ok()))
+        .map_or(0.0, |kb| kb / 1024.0)
+}
