@@ -1,48 +1,1125 @@
-//! TEMPORARY: types agreed with the fitting branch; replaced when it merges.
-#![allow(missing_docs)]
-use crate::curve::Curve;
+//! Contour approximation (paper §5): each side of the boundary is approximated by a
+//! polynomial B-spline curve of degree `p` on a dyadic knot vector over `[0, 1]`, with
+//! the corner control points fixed, and the knot vector is refined adaptively until the
+//! fit is within a tolerance. The refits form a nested sequence of spline spaces per side;
+//! unifying the knot vectors of opposite sides gives the hierarchy of tensor-product bases
+//! `Σ^0 ⊂ Σ^1 ⊂ ...` of §5.4, on which the later solves (and their initial guesses, §6.3)
+//! are built.
+//!
+//! # The fit
+//!
+//! Given a knot vector `Ξ` with basis `{N_i}_{i=0}^{n-1}` and the two corners `c_0`,
+//! `c_{n-1}` (constrained, paper §5.1), the free control points `c_1, ..., c_{n-2}`
+//! minimize
+//!
+//! * for a spline or analytic side `f̄: [0,1] -> R^2` (§5.1, §5.2) the `L2` distance
+//!   `∫_0^1 ||f(ξ) - f̄(ξ)||^2 dξ`, with `f = Σ c_i N_i`; the normal equations
+//!   `Σ_j (∫ N_i N_j) c_j = ∫ N_i f̄` are assembled by Gauss quadrature over the common
+//!   refinement of the fit's elements and the input's elements (its breakpoints), so that
+//!   the integrand is smooth on every piece, with `p + q + 2` points per piece for an input
+//!   of degree `q` (two more when it is rational, `p + 6` for analytic sides);
+//! * for a point cloud `p_1, ..., p_K` (§5.3) the discrete distance (eq. 18)
+//!   `E(f) = Σ_j ||f(ξ_j) - p_j||^2` at the cord-length abscissae `ξ_j` of eq. 36-37,
+//!   plus a tiny smoothing term `λ Σ_e h_e^3 ∫_e ||f''||^2 dξ` (see [`REGULARIZATION`]):
+//!   an element without points (or a side of two points) would otherwise leave the
+//!   normal equations singular. The term vanishes on straight lines traversed with
+//!   constant speed, so a two-point side becomes exactly that segment. There is no
+//!   minimum number of points per element: elements may become smaller than the point
+//!   spacing, which is what lets a fit follow a sharp corner of the cloud; an element
+//!   without points has no measured error and is never bisected.
+//!
+//! The normal matrix is banded (half-bandwidth `p`) and symmetric positive definite once
+//! the corner unknowns are eliminated; it is factorized by a banded Cholesky
+//! decomposition, `O(n p^2)`.
+//!
+//! # Adaptive refinement
+//!
+//! Starting from `initial_elements` uniform elements, each fit is followed by the element
+//! error indicators: for curves the element-wise average residual of eq. 17,
+//! `η_e = (1/|e|) ∫_e ||f - f̄||^2 dξ`, together with the maximal deviation sampled on
+//! the element; for point clouds the local contribution of eq. 18 (the points of the
+//! element) and their maximal deviation. Every element whose RMS deviation `sqrt(η_e)` or
+//! whose maximal deviation exceeds `tol_abs` is bisected (a knot at its midpoint, so all
+//! knots stay dyadic, `k / (n_0 2^l)`) and the side is refit; each fit is one level. The
+//! loop ends when no element is marked (`converged`) or when `max_levels` fits or
+//! `max_elements` elements are reached. Marking also on the maximal deviation makes
+//! `converged` imply that the reported `max_error` of the finest level is within
+//! `tol_abs`.
+
+use crate::basis::BasisDerivs;
+use crate::boundary::{Analytic, Boundary, SideCurve};
+use crate::curve::{Curve, Point};
+use crate::error::{Error, Result, MAX_DEGREE};
 use crate::knots::KnotVector;
+use crate::quadrature::GaussLegendre;
 use crate::surface::Side;
 
+/// Relative weight `ε` of the smoothing term of point-cloud fits: `λ = ε · tr(B^T B) /
+/// tr(R)` on the free unknowns, with `B` the collocation matrix and `R` the matrix of
+/// `Σ_e h_e^3 ∫_e N_i'' N_j''` (`λ = 1` when no point constrains a free unknown). The
+/// factor `h_e^3` makes the term scale-free (like squared second differences of the
+/// control points), so it stays negligible against the data on fine elements too.
+pub const REGULARIZATION: f64 = 1e-10;
+
+/// Samples per input piece and fit element used to estimate the maximal deviation of a
+/// curve fit (the piece's end points included).
+pub const SAMPLES_PER_PIECE: usize = 8;
+
+/// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
+/// relative to the diameter (readers enforce the stricter `1e-9` of `formats.md`).
+pub const CORNER_GAP_TOL: f64 = 1e-6;
+
+/// Options of the adaptive contour fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitOptions {
+    /// Degree `p >= 2` of the fitted curves (and of the tensor basis). Default 3.
+    pub degree: usize,
+    /// Tolerance relative to the diameter of the boundary's bounding box. Default `1e-4`.
+    pub tol: f64,
+    /// Number of uniform elements of the coarsest fit. Default 1.
+    pub initial_elements: usize,
+    /// Largest number of fits (levels) per side. Default 14.
+    pub max_levels: usize,
+    /// Largest number of elements per side (safety cap). Default 4096.
+    pub max_elements: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            degree: 3,
+            tol: 1e-4,
+            initial_elements: 1,
+            max_levels: 14,
+            max_elements: 4096,
+        }
+    }
+}
+
+impl FitOptions {
+    /// Check the ranges of all fields.
+    pub fn validate(&self) -> Result<()> {
+        if self.degree < 2 || self.degree > MAX_DEGREE {
+            return Err(Error::Degree {
+                context: "fit options".into(),
+                degree: self.degree,
+                reason: format!("the contour fit needs 2 <= p <= {MAX_DEGREE}"),
+            });
+        }
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(Error::Invalid(format!(
+                "fit tolerance must be positive and finite, got {}",
+                self.tol
+            )));
+        }
+        if self.initial_elements == 0 || self.max_levels == 0 {
+            return Err(Error::Invalid(format!(
+                "fit needs initial_elements >= 1 and max_levels >= 1, got {} and {}",
+                self.initial_elements, self.max_levels
+            )));
+        }
+        if self.max_elements < self.initial_elements {
+            return Err(Error::Invalid(format!(
+                "max_elements ({}) is below initial_elements ({})",
+                self.max_elements, self.initial_elements
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The error of a fit on one element of its knot vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementError {
+    /// Span index of the element in the fit's knot vector.
+    pub span: usize,
+    /// Left end.
+    pub a: f64,
+    /// Right end.
+    pub b: f64,
+    /// Curves: `(1/|e|) ∫_e ||f - f̄||^2` (eq. 17, a mean squared deviation); point
+    /// clouds: `Σ_{ξ_j ∈ e} ||f(ξ_j) - p_j||^2` (the element's part of eq. 18).
+    pub indicator: f64,
+    /// Largest deviation on the element (sampled for curves, at the points for clouds).
+    pub max: f64,
+}
+
+/// One constrained least-squares fit on a given knot vector.
+#[derive(Debug, Clone)]
+pub struct Projection {
+    /// The fitted polynomial curve; its end points are the corners.
+    pub curve: Curve,
+    /// Largest deviation (sampled for curves, exact at the points for clouds).
+    pub max_error: f64,
+    /// Curves: `sqrt(∫_0^1 ||f - f̄||^2)`; clouds: `sqrt(E(f) / K)` (eq. 18).
+    pub rms_error: f64,
+    /// Per-element errors, in the order of [`KnotVector::elements`].
+    pub elements: Vec<ElementError>,
+}
+
+/// The adaptive fit of one side: the nested sequence of fits (levels).
+#[derive(Debug, Clone)]
+pub struct SideFit {
+    /// Which side.
+    pub side: Side,
+    /// The fits, coarse to fine: `levels[k + 1].knots` contains `levels[k].knots`; all are
+    /// polynomial curves of degree `p` on `[0, 1]` interpolating the two corners.
+    pub levels: Vec<Curve>,
+    /// Largest deviation of each level (absolute).
+    pub max_error: Vec<f64>,
+    /// RMS deviation of each level (absolute).
+    pub rms_error: Vec<f64>,
+    /// The cord-length abscissae (eq. 36-37) when the side is a point cloud.
+    pub params: Option<Vec<f64>>,
+    /// Whether the finest level is within the tolerance on every element.
+    pub converged: bool,
+}
+
+impl SideFit {
+    /// The finest (last) fit.
+    pub fn finest(&self) -> &Curve {
+        self.levels
+            .last()
+            .expect("a side fit has at least one level")
+    }
+
+    /// Largest deviation of the finest fit.
+    pub fn final_max_error(&self) -> f64 {
+        *self
+            .max_error
+            .last()
+            .expect("a side fit has at least one level")
+    }
+}
+
+/// One level of the hierarchy: a tensor-product basis and the four side fits on it.
 #[derive(Debug, Clone)]
 pub struct Level {
+    /// Knot vectors in `xi` (union of the south and north fits) and `eta` (union of the
+    /// east and west fits).
     pub knots: [KnotVector; 2],
+    /// South, east, north, west: each side's fit, prolonged exactly onto
+    /// `knots[side.direction()]` (so opposite sides share one knot vector).
     pub sides: [Curve; 4],
 }
+
 impl Level {
+    /// Number of tensor-product basis functions `n_xi * n_eta`.
     pub fn num_basis(&self) -> usize {
         self.knots[0].num_basis() * self.knots[1].num_basis()
     }
-}
-#[derive(Debug, Clone)]
-pub struct SideFit {
-    pub side: Side,
-    pub levels: Vec<Curve>,
-    pub max_error: Vec<f64>,
-    pub rms_error: Vec<f64>,
-    pub params: Option<Vec<f64>>,
-    pub converged: bool,
-}
-#[derive(Debug, Clone)]
-pub struct Hierarchy {
-    pub levels: Vec<Level>,
-    pub fits: [SideFit; 4],
-    pub tol_abs: f64,
-    pub diameter: f64,
-}
-#[derive(Debug, Clone)]
-pub struct FitOptions {
-    pub degree: usize,
-    pub tol: f64,
-    pub initial_elements: usize,
-    pub max_levels: usize,
-    pub max_elements: usize,
-}
-impl Default for FitOptions {
-    fn default() -> Self {
-        Self { degree: 3, tol: 1e-4, initial_elements: 1, max_levels: 14, max_elements: 4096 }
+
+    /// The side `s` on this level's basis.
+    pub fn side(&self, s: Side) -> &Curve {
+        &self.sides[s as usize]
     }
 }
-pub fn build_hierarchy(_b: &crate::boundary::Boundary, _o: &FitOptions) -> crate::error::Result<Hierarchy> {
-    Err(crate::error::Error::Invalid("fit not merged".into()))
+
+/// The nested hierarchy of tensor-product bases with the boundary fits (paper §5.4).
+#[derive(Debug, Clone)]
+pub struct Hierarchy {
+    /// Coarse to fine; knot vectors are nested from one level to the next.
+    pub levels: Vec<Level>,
+    /// The adaptive fits of south, east, north, west.
+    pub fits: [SideFit; 4],
+    /// Absolute tolerance `tol * diameter`.
+    pub tol_abs: f64,
+    /// Diameter of the boundary's bounding box.
+    pub diameter: f64,
+}
+
+impl Hierarchy {
+    /// The finest level.
+    pub fn finest(&self) -> &Level {
+        self.levels
+            .last()
+            .expect("a hierarchy has at least one level")
+    }
+
+    /// Whether all four sides met the tolerance.
+    pub fn converged(&self) -> bool {
+        self.fits.iter().all(|f| f.converged)
+    }
+
+    /// The largest final deviation over the four sides.
+    pub fn max_error(&self) -> f64 {
+        self.fits
+            .iter()
+            .map(SideFit::final_max_error)
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Cord-length abscissae of a point cloud (paper eq. 36-37): `ξ_1 = 0`,
+/// `ξ_i = l_i / l_K` with `l_i = l_{i-1} + ||p_i - p_{i-1}||`, and `ξ_K = 1` exactly.
+/// `None` when the cloud has fewer than two points or zero total length.
+pub fn cord_length_params(points: &[Point]) -> Option<Vec<f64>> {
+    if points.len() < 2 {
+        return None;
+    }
+    let mut l = Vec::with_capacity(points.len());
+    l.push(0.0);
+    for w in points.windows(2) {
+        let d = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+        l.push(l.last().unwrap() + d);
+    }
+    let total = *l.last().unwrap();
+    if !(total.is_finite() && total > 0.0) {
+        return None;
+    }
+    for v in &mut l {
+        *v /= total;
+    }
+    *l.last_mut().unwrap() = 1.0;
+    Some(l)
+}
+
+/// Lower-left and upper-right corner of a bounding box of the boundary: point clouds
+/// exactly, spline sides sampled at 16 points per input element, analytic sides at 1025
+/// points.
+pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut add = |p: Point| {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    };
+    for side in &boundary.sides {
+        match side {
+            SideCurve::Points(pts) => pts.iter().for_each(|&p| add(p)),
+            SideCurve::Spline(c) => {
+                for (_, a, b) in c.knots.elements() {
+                    for k in 0..=16 {
+                        add(c.eval(a + (b - a) * k as f64 / 16.0));
+                    }
+                }
+            }
+            SideCurve::Analytic(f) => (0..=1024).for_each(|k| add(f.eval(k as f64 / 1024.0))),
+        }
+    }
+    (lo, hi)
+}
+
+/// Diameter of [`bounding_box`].
+pub fn diameter(boundary: &Boundary) -> f64 {
+    let (lo, hi) = bounding_box(boundary);
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+/// The function (or data) being approximated on one side.
+enum Target<'a> {
+    /// A spline side, evaluated at `a + t (b - a)`; `breaks` are its element boundaries
+    /// mapped to `[0, 1]`.
+    Spline {
+        curve: &'a Curve,
+        a: f64,
+        len: f64,
+        breaks: Vec<f64>,
+        nq: usize,
+    },
+    Analytic {
+        f: &'a Analytic,
+        nq: usize,
+    },
+    Points {
+        params: Vec<f64>,
+        points: &'a [Point],
+    },
+}
+
+impl<'a> Target<'a> {
+    fn new(curve: &'a SideCurve, p: usize, side: &str) -> Result<Self> {
+        Ok(match curve {
+            SideCurve::Spline(c) => {
+                let (a, b) = c.domain();
+                let len = b - a;
+                let breaks = c
+                    .knots
+                    .breaks()
+                    .into_iter()
+                    .map(|u| ((u - a) / len).clamp(0.0, 1.0))
+                    .collect();
+                let nq = p + c.degree() + 2 + if c.is_rational() { 2 } else { 0 };
+                Target::Spline {
+                    curve: c,
+                    a,
+                    len,
+                    breaks,
+                    nq,
+                }
+            }
+            SideCurve::Analytic(f) => Target::Analytic { f, nq: p + 6 },
+            SideCurve::Points(pts) => {
+                if pts.len() < 2 {
+                    return Err(Error::TooFewPoints {
+                        side: side.to_string(),
+                        found: pts.len(),
+                        needed: 2,
+                    });
+                }
+                let params = cord_length_params(pts).ok_or_else(|| Error::DegenerateSide {
+                    side: side.to_string(),
+                    length: 0.0,
+                    tol: 0.0,
+                })?;
+                Target::Points {
+                    params,
+                    points: pts,
+                }
+            }
+        })
+    }
+
+    /// `f̄(t)` for curve targets.
+    fn eval(&self, t: f64) -> Point {
+        match self {
+            Target::Spline { curve, a, len, .. } => curve.eval(a + t.clamp(0.0, 1.0) * len),
+            Target::Analytic { f, .. } => f.eval(t),
+            Target::Points { .. } => unreachable!("point clouds are not evaluated"),
+        }
+    }
+
+    fn quad_points(&self) -> usize {
+        match self {
+            Target::Spline { nq, .. } | Target::Analytic { nq, .. } => *nq,
+            Target::Points { .. } => 0,
+        }
+    }
+
+    /// The pieces of `[a, b]` between consecutive input breakpoints.
+    fn pieces(&self, a: f64, b: f64, out: &mut Vec<(f64, f64)>) {
+        out.clear();
+        let tol = 1e-13;
+        let mut left = a;
+        if let Target::Spline { breaks, .. } = self {
+            let start = breaks.partition_point(|&u| u <= a + tol);
+            for &u in &breaks[start..] {
+                if u >= b - tol {
+                    break;
+                }
+                out.push((left, u));
+                left = u;
+            }
+        }
+        out.push((left, b));
+    }
+}
+
+/// Symmetric banded matrix, `band[i][d] = A[i][i + d]` for `d <= bw`.
+struct Banded {
+    bw: usize,
+    band: Vec<Vec<f64>>,
+}
+
+impl Banded {
+    fn new(n: usize, bw: usize) -> Self {
+        Self {
+            bw,
+            band: vec![vec![0.0; bw + 1]; n],
+        }
+    }
+
+    /// Add `w` to `A[i][j]` (and implicitly `A[j][i]`), `i <= j <= i + bw`.
+    fn add(&mut self, i: usize, j: usize, w: f64) {
+        self.band[i][j - i] += w;
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = if i <= j { (i, j) } else { (j, i) };
+        if j - i > self.bw {
+            0.0
+        } else {
+            self.band[i][j - i]
+        }
+    }
+
+    /// Solve `A[lo..hi, lo..hi] x = rhs` (`rhs.len() == hi - lo`) by banded Cholesky.
+    fn solve_block(&self, lo: usize, hi: usize, rhs: &mut [Point]) -> Result<()> {
+        let n = hi - lo;
+        let bw = self.bw;
+        // l[i][d] = L(i, i - d)
+        let mut l = vec![vec![0.0; bw + 1]; n];
+        for i in 0..n {
+            for d in (0..=bw.min(i)).rev() {
+                let j = i - d;
+                let mut s = self.band[lo + j][d];
+                for k in i.saturating_sub(bw)..j {
+                    s -= l[i][i - k] * l[j][j - k];
+                }
+                if d == 0 {
+                    if !(s > 0.0 && s.is_finite()) {
+                        return Err(Error::LinearSolver(format!(
+                            "contour fit: normal matrix not positive definite at unknown {} of {n} (pivot {s:e})",
+                            i + 1
+                        )));
+                    }
+                    l[i][0] = s.sqrt();
+                } else {
+                    l[i][d] = s / l[j][0];
+                }
+            }
+        }
+        for i in 0..n {
+            let mut s = rhs[i];
+            for k in i.saturating_sub(bw)..i {
+                for c in 0..2 {
+                    s[c] -= l[i][i - k] * rhs[k][c];
+                }
+            }
+            rhs[i] = [s[0] / l[i][0], s[1] / l[i][0]];
+        }
+        for i in (0..n).rev() {
+            let mut s = rhs[i];
+            for k in i + 1..n.min(i + bw + 1) {
+                for c in 0..2 {
+                    s[c] -= l[k][k - i] * rhs[k][c];
+                }
+            }
+            rhs[i] = [s[0] / l[i][0], s[1] / l[i][0]];
+        }
+        Ok(())
+    }
+}
+
+fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+fn dist2(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Assemble and solve the constrained least-squares problem on `kv`.
+fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Result<Curve> {
+    let p = kv.degree();
+    let n = kv.num_basis();
+    let mut mat = Banded::new(n, p);
+    let mut rhs = vec![[0.0; 2]; n];
+    let mut basis = BasisDerivs::default();
+    match target {
+        Target::Points { params, points } => {
+            for (&t, &pt) in params.iter().zip(points.iter()) {
+                basis.eval(kv, t, 0);
+                let f = basis.first();
+                for j in 0..=p {
+                    let nj = basis.d[0][j];
+                    rhs[f + j][0] += nj * pt[0];
+                    rhs[f + j][1] += nj * pt[1];
+                    for k in j..=p {
+                        mat.add(f + j, f + k, nj * basis.d[0][k]);
+                    }
+                }
+            }
+            // Smoothing term Σ_e h_e^3 ∫_e ||f''||^2 (exact with p Gauss points).
+            let mut reg = Banded::new(n, p);
+            let g = GaussLegendre::new(p);
+            for (s, a, b) in kv.elements() {
+                let h3 = (b - a).powi(3);
+                for (t, w) in g.on(a, b) {
+                    basis.eval_in_span(kv, s, t, 2);
+                    let f = basis.first();
+                    for j in 0..=p {
+                        for k in j..=p {
+                            reg.add(f + j, f + k, w * h3 * basis.d[2][j] * basis.d[2][k]);
+                        }
+                    }
+                }
+            }
+            let data_tr: f64 = (1..n - 1).map(|i| mat.band[i][0]).sum();
+            let reg_tr: f64 = (1..n - 1).map(|i| reg.band[i][0]).sum();
+            let lambda = if data_tr > 0.0 && reg_tr > 0.0 {
+                REGULARIZATION * data_tr / reg_tr
+            } else {
+                1.0
+            };
+            for (row, rrow) in mat.band.iter_mut().zip(&reg.band) {
+                for (x, r) in row.iter_mut().zip(rrow) {
+                    *x += lambda * r;
+                }
+            }
+        }
+        _ => {
+            let g = GaussLegendre::new(target.quad_points());
+            let mut pieces = Vec::new();
+            for (s, a, b) in kv.elements() {
+                target.pieces(a, b, &mut pieces);
+                for &(pa, pb) in &pieces {
+                    for (t, w) in g.on(pa, pb) {
+                        basis.eval_in_span(kv, s, t, 0);
+                        let y = target.eval(t);
+                        let f = basis.first();
+                        for j in 0..=p {
+                            let nj = w * basis.d[0][j];
+                            rhs[f + j][0] += nj * y[0];
+                            rhs[f + j][1] += nj * y[1];
+                            for k in j..=p {
+                                mat.add(f + j, f + k, nj * basis.d[0][k]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Eliminate the corner unknowns c_0 and c_{n-1}.
+    let (c0, c1) = corners;
+    let mut free: Vec<Point> = (1..n - 1)
+        .map(|i| {
+            let (a, b) = (mat.get(i, 0), mat.get(i, n - 1));
+            [
+                rhs[i][0] - a * c0[0] - b * c1[0],
+                rhs[i][1] - a * c0[1] - b * c1[1],
+            ]
+        })
+        .collect();
+    mat.solve_block(1, n - 1, &mut free)?;
+    let mut cps = Vec::with_capacity(n);
+    cps.push(c0);
+    cps.extend(free);
+    cps.push(c1);
+    if let Some(i) = cps
+        .iter()
+        .position(|c| !(c[0].is_finite() && c[1].is_finite()))
+    {
+        return Err(Error::NonFinite {
+            context: "contour fit".into(),
+            what: format!("control point {i} (the input curve gives non-finite values?)"),
+        });
+    }
+    Ok(Curve::polynomial(kv.clone(), cps))
+}
+
+/// Per-element and global errors of the fit `fit` of `target`.
+fn fit_errors(target: &Target, fit: &Curve) -> Projection {
+    let kv = &fit.knots;
+    let elements = kv.elements();
+    let mut errs: Vec<ElementError> = elements
+        .iter()
+        .map(|&(span, a, b)| ElementError {
+            span,
+            a,
+            b,
+            indicator: 0.0,
+            max: 0.0,
+        })
+        .collect();
+    let mut basis = BasisDerivs::default();
+    let (max_error, rms_error) = match target {
+        Target::Points { params, points } => {
+            let mut sum = 0.0;
+            let mut max = 0.0f64;
+            for (&t, &pt) in params.iter().zip(points.iter()) {
+                basis.eval(kv, t, 0);
+                let d2 = dist2(fit.derivs_with(&basis, 0).x, pt);
+                let d = d2.sqrt();
+                sum += d2;
+                max = max.max(d);
+                // element of the span; a point on a break also counts for the left element
+                let e = elements
+                    .partition_point(|el| el.0 < basis.span)
+                    .min(elements.len() - 1);
+                errs[e].indicator += d2;
+                errs[e].max = errs[e].max.max(d);
+                if e > 0 && t <= elements[e].1 {
+                    errs[e - 1].max = errs[e - 1].max.max(d);
+                }
+            }
+            (max, (sum / params.len() as f64).sqrt())
+        }
+        _ => {
+            let g = GaussLegendre::new(target.quad_points());
+            let mut pieces = Vec::new();
+            let mut total = 0.0;
+            let mut max = 0.0f64;
+            for (e, &(s, a, b)) in elements.iter().enumerate() {
+                target.pieces(a, b, &mut pieces);
+                let mut int = 0.0;
+                let mut emax = 0.0f64;
+                for &(pa, pb) in &pieces {
+                    for (t, w) in g.on(pa, pb) {
+                        basis.eval_in_span(kv, s, t, 0);
+                        int += w * dist2(fit.derivs_with(&basis, 0).x, target.eval(t));
+                    }
+                    for k in 0..=SAMPLES_PER_PIECE {
+                        let t = pa + (pb - pa) * k as f64 / SAMPLES_PER_PIECE as f64;
+                        basis.eval_in_span(kv, s, t, 0);
+                        emax = emax.max(dist(fit.derivs_with(&basis, 0).x, target.eval(t)));
+                    }
+                }
+                errs[e].indicator = int / (b - a);
+                errs[e].max = emax;
+                total += int;
+                max = max.max(emax);
+            }
+            (max, total.sqrt())
+        }
+    };
+    Projection {
+        curve: fit.clone(),
+        max_error,
+        rms_error,
+        elements: errs,
+    }
+}
+
+/// Constrained least-squares fit of one side on the fixed knot vector `knots` (an open
+/// vector on `[0, 1]` of degree `>= 2`), with the first and last control points set to
+/// `corners`; see the module documentation for the functionals. Point clouds are
+/// parameterized by cord length (eq. 36-37).
+pub fn project_side(
+    curve: &SideCurve,
+    knots: &KnotVector,
+    corners: (Point, Point),
+) -> Result<Projection> {
+    if knots.degree() < 2 || !knots.is_open() || knots.domain() != (0.0, 1.0) || knots.is_periodic()
+    {
+        return Err(Error::Invalid(format!(
+            "contour fit needs an open knot vector of degree >= 2 on [0, 1], got degree {} on {:?}",
+            knots.degree(),
+            knots.domain()
+        )));
+    }
+    let target = Target::new(curve, knots.degree(), "side")?;
+    let fit = solve_fit(&target, knots, corners)?;
+    Ok(fit_errors(&target, &fit))
+}
+
+/// Adaptive constrained least-squares fit of one side (paper §5.1-5.3): fit on
+/// `initial_elements` uniform elements, bisect every element whose RMS deviation
+/// `sqrt(η_e)` (eq. 17, or the points' part of eq. 18) or maximal deviation exceeds
+/// `tol_abs`, refit, and repeat until no element is marked or `max_levels` /
+/// `max_elements` is reached (then `converged` is false and the finest fit is the best
+/// one). When more elements are marked than `max_elements` allows, the worst ones are
+/// bisected first.
+pub fn fit_side(
+    side: Side,
+    curve: &SideCurve,
+    corners: (Point, Point),
+    opts: &FitOptions,
+    tol_abs: f64,
+) -> Result<SideFit> {
+    opts.validate()?;
+    if !(tol_abs.is_finite() && tol_abs > 0.0) {
+        return Err(Error::Invalid(format!(
+            "absolute fit tolerance must be positive and finite, got {tol_abs}"
+        )));
+    }
+    let target = Target::new(curve, opts.degree, side.name())?;
+    let mut kv = KnotVector::open_uniform(opts.degree, opts.initial_elements);
+    let mut out = SideFit {
+        side,
+        levels: Vec::new(),
+        max_error: Vec::new(),
+        rms_error: Vec::new(),
+        params: match &target {
+            Target::Points { params, .. } => Some(params.clone()),
+            _ => None,
+        },
+        converged: false,
+    };
+    let points = matches!(target, Target::Points { .. });
+    loop {
+        let fit = solve_fit(&target, &kv, corners).map_err(|e| e.within(side.name()))?;
+        let proj = fit_errors(&target, &fit);
+        out.levels.push(proj.curve);
+        out.max_error.push(proj.max_error);
+        out.rms_error.push(proj.rms_error);
+        // Marked elements with their error measure.
+        let mut marked: Vec<(usize, f64)> = proj
+            .elements
+            .iter()
+            .filter_map(|e| {
+                let measure = if points {
+                    e.max
+                } else {
+                    e.max.max(e.indicator.sqrt())
+                };
+                (measure > tol_abs).then_some((e.span, measure))
+            })
+            .collect();
+        if marked.is_empty() {
+            out.converged = true;
+            break;
+        }
+        let num_elements = proj.elements.len();
+        if out.levels.len() >= opts.max_levels || num_elements >= opts.max_elements {
+            break;
+        }
+        let room = opts.max_elements - num_elements;
+        if marked.len() > room {
+            marked.sort_by(|a, b| b.1.total_cmp(&a.1));
+            marked.truncate(room);
+            marked.sort_by_key(|m| m.0);
+        }
+        let spans: Vec<usize> = marked.iter().map(|m| m.0).collect();
+        kv = kv.with_inserted(&kv.midpoints_of(&spans));
+    }
+    Ok(out)
+}
+
+/// The four corners south-west, south-east, north-east, north-west, each the average of
+/// the two adjacent sides' end points; errors when two ends are further apart than
+/// [`CORNER_GAP_TOL`]` * diameter`.
+pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
+    let ends = boundary.sides.each_ref().map(SideCurve::endpoints);
+    let [s, e, n, w] = ends;
+    // (side a, its end, side b, its end)
+    let pairs = [
+        ("south", s.0, "west", w.0),
+        ("south", s.1, "east", e.0),
+        ("east", e.1, "north", n.1),
+        ("north", n.0, "west", w.1),
+    ];
+    let tol = CORNER_GAP_TOL * diameter;
+    let mut out = [[0.0; 2]; 4];
+    for (k, &(na, a, nb, b)) in pairs.iter().enumerate() {
+        let gap = dist(a, b);
+        if gap.is_nan() || gap > tol {
+            return Err(Error::CornerGap {
+                side_a: na.into(),
+                side_b: nb.into(),
+                gap,
+                tol,
+                x: 0.5 * (a[0] + b[0]),
+                y: 0.5 * (a[1] + b[1]),
+            });
+        }
+        out[k] = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+    }
+    Ok(out)
+}
+
+/// The (start, end) corners of a side in its orientation.
+pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
+    let [sw, se, ne, nw] = *corners;
+    match side {
+        Side::South => (sw, se),
+        Side::East => (se, ne),
+        Side::North => (nw, ne),
+        Side::West => (sw, nw),
+    }
+}
+
+/// Fit the four sides adaptively (see [`fit_side`]) with `tol_abs = tol * diameter` and
+/// the corners of [`corners`], then build the nested hierarchy of tensor-product bases
+/// (paper §5.4) with [`hierarchy_from_fits`].
+pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
+    opts.validate()?;
+    let diameter = diameter(boundary);
+    if !(diameter.is_finite() && diameter > 0.0) {
+        return Err(Error::Invalid(format!(
+            "boundary '{}' has diameter {diameter}",
+            boundary.name
+        )));
+    }
+    let tol_abs = opts.tol * diameter;
+    let corners = corners(boundary, diameter)?;
+    let mut fits = Vec::with_capacity(4);
+    for side in Side::ALL {
+        fits.push(fit_side(
+            side,
+            boundary.side(side),
+            side_corners(&corners, side),
+            opts,
+            tol_abs,
+        )?);
+    }
+    let fits: [SideFit; 4] = fits.try_into().expect("four sides");
+    hierarchy_from_fits(fits, tol_abs, diameter)
+}
+
+/// The hierarchy of tensor-product bases from the four side fits (south, east, north,
+/// west, in that order; paper §5.4): with `m` the largest number of levels over the sides
+/// (shorter sequences padded with their last fit), level `k` has `xi` knots = union of the
+/// south and north level-`k` knot vectors and `eta` knots = union of east and west, and
+/// each side's level-`k` fit prolonged exactly onto them, so opposite sides share one knot
+/// vector. Consecutive levels with identical knot vectors are merged (the later, more
+/// accurate fits are kept). All fits must be open, of one degree, on `[0, 1]`, with nested
+/// levels.
+pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> Result<Hierarchy> {
+    for (k, f) in fits.iter().enumerate() {
+        if f.side != Side::ALL[k] || f.levels.is_empty() {
+            return Err(Error::Invalid(format!(
+                "hierarchy needs non-empty fits of south, east, north, west in that order; position {k} holds {} with {} levels",
+                f.side,
+                f.levels.len()
+            )));
+        }
+    }
+    let m = fits.iter().map(|f| f.levels.len()).max().unwrap_or(1);
+    let pick = |s: Side, k: usize| {
+        let l = &fits[s as usize].levels;
+        &l[k.min(l.len() - 1)]
+    };
+    let mut levels: Vec<Level> = Vec::with_capacity(m);
+    for k in 0..m {
+        let xi = pick(Side::South, k)
+            .knots
+            .union(&pick(Side::North, k).knots)?;
+        let eta = pick(Side::East, k)
+            .knots
+            .union(&pick(Side::West, k).knots)?;
+        let knots = [xi, eta];
+        let sides = [
+            pick(Side::South, k).refined(&knots[0])?,
+            pick(Side::East, k).refined(&knots[1])?,
+            pick(Side::North, k).refined(&knots[0])?,
+            pick(Side::West, k).refined(&knots[1])?,
+        ];
+        let level = Level { knots, sides };
+        match levels.last_mut() {
+            Some(prev) if prev.knots == level.knots => *prev = level,
+            Some(prev)
+                if !(level.knots[0].contains(&prev.knots[0])
+                    && level.knots[1].contains(&prev.knots[1])) =>
+            {
+                return Err(Error::Invalid(format!(
+                    "side fits are not nested: level {k} does not refine level {}",
+                    k - 1
+                )));
+            }
+            _ => levels.push(level),
+        }
+    }
+    Ok(Hierarchy {
+        levels,
+        fits,
+        tol_abs,
+        diameter,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn uniform_fit_errors(f: &SideCurve, p: usize, sizes: &[usize]) -> Vec<f64> {
+        sizes
+            .iter()
+            .map(|&ne| {
+                let kv = KnotVector::open_uniform(p, ne);
+                let (a, b) = f.endpoints();
+                project_side(f, &kv, (a, b)).unwrap().max_error
+            })
+            .collect()
+    }
+
+    #[test]
+    fn polynomials_are_reproduced() {
+        // a cubic B-spline on one element and a quadratic curve with an inner knot at 0.3
+        let kv = KnotVector::new(3, vec![0., 0., 0., 0., 1., 1., 1., 1.]).unwrap();
+        let c = Curve::new(kv, vec![[0., 0.], [0.3, 0.4], [0.7, -0.2], [1., 0.1]], None).unwrap();
+        let side = SideCurve::Spline(c.clone());
+        for p in 3..=5 {
+            let fit = fit_side(
+                Side::South,
+                &side,
+                c.endpoints(),
+                &FitOptions {
+                    degree: p,
+                    ..Default::default()
+                },
+                1e-6,
+            )
+            .unwrap();
+            assert_eq!(fit.levels.len(), 1);
+            assert!(fit.converged);
+            assert!(fit.max_error[0] < 1e-13, "p={p}: {}", fit.max_error[0]);
+        }
+        let an = SideCurve::Analytic(Analytic::new(|t| [t, 2.0 * t * t - t]));
+        let fit = fit_side(
+            Side::West,
+            &an,
+            ([0., 0.], [1., 1.]),
+            &FitOptions {
+                degree: 2,
+                ..Default::default()
+            },
+            1e-8,
+        )
+        .unwrap();
+        assert_eq!(fit.levels.len(), 1);
+        assert!(fit.max_error[0] < 1e-13);
+    }
+
+    #[test]
+    fn convergence_order_is_p_plus_one() {
+        let f = SideCurve::Analytic(Analytic::new(|t| [t, (2.0 * PI * t).sin()]));
+        for p in 2..=4 {
+            let sizes = [8, 16, 32, 64];
+            let e = uniform_fit_errors(&f, p, &sizes);
+            let orders: Vec<f64> = e.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+            let last = *orders.last().unwrap();
+            assert!(
+                (last - (p + 1) as f64).abs() < 0.5,
+                "p={p} errors {e:?} orders {orders:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn banded_cholesky_matches_dense() {
+        let n = 9;
+        let bw = 2;
+        let mut m = Banded::new(n, bw);
+        for i in 0..n {
+            m.add(i, i, 4.0 + i as f64);
+            if i + 1 < n {
+                m.add(i, i + 1, -1.0);
+            }
+            if i + 2 < n {
+                m.add(i, i + 2, 0.5);
+            }
+        }
+        let b: Vec<Point> = (0..n).map(|i| [i as f64, 1.0 - i as f64 * 0.1]).collect();
+        let mut x = b[2..7].to_vec();
+        m.solve_block(2, 7, &mut x).unwrap();
+        for i in 2..7 {
+            for c in 0..2 {
+                let r: f64 = (2..7).map(|j| m.get(i, j) * x[j - 2][c]).sum();
+                assert!((r - b[i][c]).abs() < 1e-13);
+            }
+        }
+    }
+
+    #[test]
+    fn two_point_cloud_is_a_uniform_segment() {
+        let side = SideCurve::Points(vec![[0., 0.], [2., 1.]]);
+        let fit = fit_side(
+            Side::East,
+            &side,
+            ([0., 0.], [2., 1.]),
+            &FitOptions::default(),
+            1e-6,
+        )
+        .unwrap();
+        assert!(fit.converged);
+        let c = fit.finest();
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            let x = c.eval(t);
+            assert!(
+                (x[0] - 2.0 * t).abs() < 1e-12 && (x[1] - t).abs() < 1e-12,
+                "{t} {x:?}"
+            );
+        }
+        assert_eq!(fit.params.as_deref(), Some(&[0.0, 1.0][..]));
+    }
+
+    #[test]
+    fn bad_options_and_inputs_are_errors() {
+        let side = SideCurve::Points(vec![[0., 0.]]);
+        let o = FitOptions::default();
+        assert!(matches!(
+            fit_side(Side::South, &side, ([0., 0.], [0., 0.]), &o, 1e-3),
+            Err(Error::TooFewPoints { .. })
+        ));
+        let side = SideCurve::Points(vec![[0., 0.], [0., 0.]]);
+        assert!(matches!(
+            fit_side(Side::South, &side, ([0., 0.], [0., 0.]), &o, 1e-3),
+            Err(Error::DegenerateSide { .. })
+        ));
+        let side = SideCurve::Points(vec![[0., 0.], [1., 0.]]);
+        for bad in [
+            FitOptions { degree: 1, ..o },
+            FitOptions { tol: 0.0, ..o },
+            FitOptions { tol: f64::NAN, ..o },
+            FitOptions {
+                initial_elements: 0,
+                ..o
+            },
+            FitOptions { max_levels: 0, ..o },
+        ] {
+            assert!(fit_side(Side::South, &side, ([0., 0.], [1., 0.]), &bad, 1e-3).is_err());
+        }
+        let nan = SideCurve::Analytic(Analytic::new(|t| [t, if t > 0.5 { f64::NAN } else { 0.0 }]));
+        assert!(fit_side(Side::South, &nan, ([0., 0.], [1., 0.]), &o, 1e-3).is_err());
+    }
+
+    #[test]
+    fn adaptive_refinement_is_local_and_nested() {
+        // a curve with a sharp feature near t = 0.8 (a narrow Gaussian bump)
+        let f = SideCurve::Analytic(Analytic::new(|t| {
+            [t, 0.2 * (-((t - 0.8) / 0.03).powi(2)).exp()]
+        }));
+        let fit = fit_side(Side::South, &f, f.endpoints(), &FitOptions::default(), 1e-5).unwrap();
+        assert!(fit.converged);
+        assert!(fit.final_max_error() <= 1e-5);
+        for w in fit.levels.windows(2) {
+            assert!(w[1].knots.contains(&w[0].knots));
+        }
+        let el = fit.finest().knots.elements();
+        let h_min = el.iter().map(|e| e.2 - e.1).fold(1.0, f64::min);
+        let h_max = el.iter().map(|e| e.2 - e.1).fold(0.0, f64::max);
+        assert!(
+            h_max >= 8.0 * h_min,
+            "refinement should be local: h in [{h_min}, {h_max}]"
+        );
+        // dyadic knots
+        for &u in fit.finest().knots.knots() {
+            let s = u * 65536.0;
+            assert_eq!(s, s.round());
+        }
+    }
+
+    #[test]
+    fn element_cap_stops_refinement() {
+        let f = SideCurve::Analytic(Analytic::new(|t| [t, (40.0 * t).sin()]));
+        let o = FitOptions {
+            max_elements: 6,
+            ..Default::default()
+        };
+        let fit = fit_side(Side::South, &f, f.endpoints(), &o, 1e-9).unwrap();
+        assert!(!fit.converged);
+        assert!(fit.finest().knots.num_elements() <= 6);
+    }
+
+    fn synthetic_fit(side: Side, breaks: &[&[f64]]) -> SideFit {
+        let levels: Vec<Curve> = breaks
+            .iter()
+            .map(|b| {
+                let kv = KnotVector::open_from_breaks(3, b, 1);
+                let n = kv.num_basis();
+                let g = kv.greville();
+                let cps = (0..n).map(|i| [g[i], (3.0 * g[i]).sin()]).collect();
+                Curve::polynomial(kv, cps)
+            })
+            .collect();
+        let k = levels.len();
+        SideFit {
+            side,
+            levels,
+            max_error: vec![0.0; k],
+            rms_error: vec![0.0; k],
+            params: None,
+            converged: true,
+        }
+    }
+
+    #[test]
+    fn hierarchy_pads_unifies_and_merges_levels() {
+        // south refines at 0.5 then 0.75; north has 0.75 from level 1 on; so the xi
+        // unions of levels 1 and 2 coincide and are merged (keeping the later fits).
+        let s = synthetic_fit(
+            Side::South,
+            &[&[0.0, 1.0], &[0.0, 0.5, 1.0], &[0.0, 0.5, 0.75, 1.0]],
+        );
+        let n = synthetic_fit(Side::North, &[&[0.0, 1.0], &[0.0, 0.5, 0.75, 1.0]]);
+        let e = synthetic_fit(Side::East, &[&[0.0, 1.0]]);
+        let w = synthetic_fit(Side::West, &[&[0.0, 1.0], &[0.0, 0.25, 1.0]]);
+        let h = hierarchy_from_fits([s.clone(), e, n, w], 1e-3, 1.0).unwrap();
+        assert_eq!(h.levels.len(), 2);
+        assert_eq!(h.levels[0].num_basis(), 16);
+        assert_eq!(h.levels[1].knots[0].breaks(), vec![0.0, 0.5, 0.75, 1.0]);
+        assert_eq!(h.levels[1].knots[1].breaks(), vec![0.0, 0.25, 1.0]);
+        assert_eq!(h.levels[1].num_basis(), 6 * 5);
+        // the merged level carries south's level-2 fit, unchanged by the prolongation
+        assert_eq!(h.levels[1].side(Side::South), &s.levels[2]);
+        // wrong order is an error
+        let [a, b, c, d] = h.fits.clone();
+        assert!(hierarchy_from_fits([b, a, c, d], 1e-3, 1.0).is_err());
+    }
 }

@@ -8,7 +8,8 @@
 //! A geometry is a basis plus coefficients: [`knots::KnotVector`] and
 //! [`basis::BasisDerivs`] hold the univariate B-spline bases, [`curve::Curve`] and
 //! [`surface::Surface`] the geometries, [`refine`] and [`bezier`] the exact changes of
-//! basis.
+//! basis. [`fit`] approximates the boundary contours adaptively and builds the nested
+//! hierarchy of tensor-product bases (paper §5).
 
 pub mod assembly;
 pub mod basis;
@@ -36,5 +37,8 @@ pub mod testutil;
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use curve::{Curve, Point};
 pub use error::{Error, Result};
+pub use fit::{
+    build_hierarchy, fit_side, hierarchy_from_fits, FitOptions, Hierarchy, Level, SideFit,
+};
 pub use knots::KnotVector;
 pub use surface::{Side, Surface};

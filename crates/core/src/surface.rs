@@ -85,7 +85,11 @@ impl SurfaceDerivs {
 
 impl Surface {
     /// Validate lengths, finiteness and weights.
-    pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
+    pub fn new(
+        knots: [KnotVector; 2],
+        control_points: Vec<Point>,
+        weights: Option<Vec<f64>>,
+    ) -> Result<Self> {
         let n = knots[0].num_basis() * knots[1].num_basis();
         if control_points.len() != n {
             return Err(Error::Length {
@@ -100,7 +104,11 @@ impl Surface {
             check_weights(w, n)?;
         }
         let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
-        Ok(Self { knots, control_points, weights })
+        Ok(Self {
+            knots,
+            control_points,
+            weights,
+        })
     }
 
     /// Number of basis functions per direction.
@@ -157,7 +165,14 @@ impl Surface {
         }
         let pt = |a: usize, b: usize| [h[a][b][0], h[a][b][1]];
         if self.weights.is_none() {
-            return SurfaceDerivs { x: pt(0, 0), xu: pt(1, 0), xv: pt(0, 1), xuu: pt(2, 0), xuv: pt(1, 1), xvv: pt(0, 2) };
+            return SurfaceDerivs {
+                x: pt(0, 0),
+                xu: pt(1, 0),
+                xv: pt(0, 1),
+                xuu: pt(2, 0),
+                xuv: pt(1, 1),
+                xvv: pt(0, 2),
+            };
         }
         let w = h[0][0][2];
         let (wu, wv, wuu, wuv, wvv) = (h[1][0][2], h[0][1][2], h[2][0][2], h[1][1][2], h[0][2][2]);
@@ -194,7 +209,10 @@ impl Surface {
         Curve {
             knots: kv,
             control_points: idx.iter().map(|&k| self.control_points[k]).collect(),
-            weights: self.weights.as_ref().map(|w| idx.iter().map(|&k| w[k]).collect()),
+            weights: self
+                .weights
+                .as_ref()
+                .map(|w| idx.iter().map(|&k| w[k]).collect()),
         }
     }
 
@@ -211,6 +229,10 @@ impl Surface {
                 }
             }
         }
-        Self { knots: [self.knots[1].clone(), self.knots[0].clone()], control_points: cp, weights: w }
+        Self {
+            knots: [self.knots[1].clone(), self.knots[0].clone()],
+            control_points: cp,
+            weights: w,
+        }
     }
 }
