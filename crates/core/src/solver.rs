@@ -564,3 +564,35 @@ pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit)?;
     EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(&boundary.name, &h)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::{Analytic, SideCurve};
+
+    fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
+        let arc = move |r: f64| SideCurve::Analytic(Analytic::new(move |t| [r * (angle * t).cos(), r * (angle * t).sin()]));
+        let ray = move |a: f64| SideCurve::Analytic(Analytic::new(move |t| [(r0 + (r1 - r0) * t) * a.cos(), (r0 + (r1 - r0) * t) * a.sin()]));
+        // south: inner radius? use south = ray at angle 0, north = ray at `angle`,
+        // west = inner arc, east = outer arc (counter-clockwise).
+        Boundary { name: "annulus".into(), sides: [ray(0.0), arc(r1), ray(angle), arc(r0)] }
+    }
+
+    #[test]
+    fn quarter_annulus_solves_and_is_positive() {
+        let b = annulus(1.0, 2.0, std::f64::consts::FRAC_PI_2);
+        let sol = solve(&b, &SolveOptions::default()).unwrap();
+        let r = &sol.report;
+        assert_eq!(r.verdict, Verdict::PositiveOnSample, "{}", r.message);
+        let last = r.levels.last().unwrap();
+        assert!(last.converged && last.newton_iterations <= 5, "{last:?}");
+        assert!((r.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit_tolerance * r.diameter, "area {}", r.area);
+    }
+
+    #[test]
+    fn level_selection_quadruples() {
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None), vec![0, 2, 4, 5]);
+        assert_eq!(select_levels(&[16], 4.0, None), vec![0]);
+        assert_eq!(select_levels(&[16, 64, 256, 1024], 4.0, Some(2)), vec![0, 3]);
+    }
+}

@@ -1,0 +1,117 @@
+//! The EGG solver on the shared geometries: convergence, bijectivity on a dense sample,
+//! plain statements about boundaries that forbid a positive det J, and convergence under
+//! refinement.
+
+use std::path::Path;
+
+use winslow::io::{read_boundary, ReadOptions};
+use winslow::quality::sample_det_j;
+use winslow::solver::{solve, Solution, SolveOptions, Verdict};
+
+fn run(file: &str, opts: &SolveOptions) -> Solution {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
+    let b = read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"));
+    solve(&b, opts).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+fn assert_bijective(file: &str) {
+    let sol = run(file, &SolveOptions::default());
+    let r = &sol.report;
+    assert_eq!(r.verdict, Verdict::PositiveOnSample, "{file}: {}", r.message);
+    let last = r.levels.last().unwrap();
+    assert!(last.converged, "{file}: {last:?}");
+    // target: <= 5 Newton iterations on the finest level (the paper reports 3-5)
+    assert!(last.newton_iterations <= 5 && last.pseudo_time_iterations == 0, "{file}: {} its", last.newton_iterations);
+    // dense interior sample, independent of the report's grid
+    let s = sample_det_j(&sol.map, 600);
+    assert!(s.min_interior > 0.0, "{file}: det J min {} at {:?}", s.min_interior, s.argmin);
+}
+
+#[test]
+fn quarter_annulus() {
+    assert_bijective("quarter_annulus.json");
+}
+#[test]
+fn wavy_lid() {
+    assert_bijective("wavy_lid.json");
+}
+#[test]
+fn horseshoe() {
+    assert_bijective("horseshoe.json");
+}
+#[test]
+fn notched_square() {
+    assert_bijective("notched_square.json");
+}
+#[test]
+fn cooks_membrane() {
+    assert_bijective("gismo/cooks_membrane.json");
+}
+#[test]
+fn flapping_beam() {
+    assert_bijective("gismo/flapping_beam.json");
+}
+#[test]
+fn rotor_sector() {
+    assert_bijective("gismo/rotor_sector.json");
+}
+#[test]
+fn puzzle3() {
+    assert_bijective("gismo/puzzle3.json");
+}
+#[test]
+fn puzzle4() {
+    assert_bijective("gismo/puzzle4.json");
+}
+#[test]
+fn jigsaw01() {
+    assert_bijective("gismo/jigsaw01.json");
+}
+#[test]
+fn duck() {
+    assert_bijective("gismo/duck.json");
+}
+#[test]
+fn male_rotor() {
+    assert_bijective("gismo/male_rotor.json");
+}
+
+/// Boundaries whose corners force det J <= 0: the solver says so, names the corner and
+/// still returns its best map, positive everywhere else.
+#[test]
+fn degenerate_corners_are_named() {
+    for file in ["gismo/disk.json", "gismo/plate_with_hole.json", "gismo/lake.json", "gismo/butterfly.json"] {
+        let sol = run(file, &SolveOptions::default());
+        let r = &sol.report;
+        assert_eq!(r.verdict, Verdict::DegenerateCorner, "{file}: {}", r.message);
+        assert!(r.corners.iter().any(|c| c.forces_nonpositive_det_j), "{file}");
+        let named = r.corners.iter().filter(|c| c.forces_nonpositive_det_j).all(|c| r.message.contains(c.corner));
+        assert!(named, "{file}: {}", r.message);
+    }
+}
+
+/// The quarter annulus converges under refinement: successive maps get closer at the
+/// rate of the discretization (differences shrink by a factor of at least 4 per halving).
+#[test]
+fn quarter_annulus_converges_under_refinement() {
+    let maps: Vec<_> = (0..3)
+        .map(|r| {
+            let opts = SolveOptions { refine: r, fit: winslow::FitOptions { tol: 1e-9, ..Default::default() }, ..Default::default() };
+            run("quarter_annulus.json", &opts).map
+        })
+        .collect();
+    let diff = |a: &winslow::Surface, b: &winslow::Surface| {
+        let mut m: f64 = 0.0;
+        for j in 0..=40 {
+            for i in 0..=40 {
+                let (u, v) = (i as f64 / 40.0, j as f64 / 40.0);
+                let (p, q) = (a.eval(u, v), b.eval(u, v));
+                m = m.max((p[0] - q[0]).hypot(p[1] - q[1]));
+            }
+        }
+        m
+    };
+    let d1 = diff(&maps[0], &maps[1]);
+    let d2 = diff(&maps[1], &maps[2]);
+    assert!(d2 < d1 / 4.0, "no convergence: {d1:.3e} then {d2:.3e}");
+}
