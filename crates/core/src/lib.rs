@@ -8,13 +8,15 @@
 //! A geometry is a basis plus coefficients: [`knots::KnotVector`] and
 //! [`basis::BasisDerivs`] hold the univariate B-spline bases, [`curve::Curve`] and
 //! [`surface::Surface`] the geometries, [`refine`] and [`bezier`] the exact changes of
-//! basis.
+//! basis. [`io`] reads and writes the exchange formats (JSON, G+Smo XML) and
+//! [`mod@validate`] checks boundaries.
 
 pub mod basis;
 pub mod bezier;
 pub mod boundary;
 pub mod curve;
 pub mod error;
+pub mod io;
 pub mod knots;
 pub mod quadrature;
 pub mod refine;
@@ -22,9 +24,12 @@ pub mod sparse;
 pub mod surface;
 #[doc(hidden)]
 pub mod testutil;
+pub mod validate;
 
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use curve::{Curve, Point};
 pub use error::{Error, Result};
+pub use io::{read_boundary, read_document, Document, ReadOptions};
 pub use knots::KnotVector;
 pub use surface::{Side, Surface};
+pub use validate::{validate, ValidationReport};
