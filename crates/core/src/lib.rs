@@ -9,7 +9,14 @@
 //! [`basis::BasisDerivs`] hold the univariate B-spline bases, [`curve::Curve`] and
 //! [`surface::Surface`] the geometries, [`refine`] and [`bezier`] the exact changes of
 //! basis. [`fit`] approximates the boundary contours adaptively and builds the nested
-//! hierarchy of tensor-product bases (paper §5).
+//! hierarchy of tensor-product bases (paper §5). [`io`] reads and writes the exchange formats (JSON, G+Smo XML) and
+//! [`mod@validate`] checks boundaries.
+//!
+//! The solver (paper §4-§6): [`assembly`] discretizes eq. (8) on a tensor basis with the
+//! free/fixed split of [`dofs`]; [`egg`] poses `F(c) = 0`; [`newton`] iterates (damped
+//! Newton, pseudo time); [`initial`] makes initial guesses; [`solver`] walks the
+//! hierarchy coarse to fine and yields its iterates; [`quality`] and [`picture`] measure
+//! and draw the result.
 
 pub mod assembly;
 pub mod basis;
@@ -21,6 +28,7 @@ pub mod egg;
 pub mod error;
 pub mod fit;
 pub mod initial;
+pub mod io;
 pub mod knots;
 pub mod linsolve;
 pub mod newton;
@@ -33,6 +41,7 @@ pub mod sparse;
 pub mod surface;
 #[doc(hidden)]
 pub mod testutil;
+pub mod validate;
 
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use curve::{Curve, Point};
@@ -40,5 +49,7 @@ pub use error::{Error, Result};
 pub use fit::{
     build_hierarchy, fit_side, hierarchy_from_fits, FitOptions, Hierarchy, Level, SideFit,
 };
+pub use io::{read_boundary, read_document, Document, ReadOptions};
 pub use knots::KnotVector;
 pub use surface::{Side, Surface};
+pub use validate::{validate, ValidationReport};
