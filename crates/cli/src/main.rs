@@ -97,6 +97,9 @@ struct SolverArgs {
     /// Extra uniform halvings of the finest level.
     #[arg(long, default_value_t = 0)]
     refine: usize,
+    /// Basis growth factor between solved levels (1 solves every level of the hierarchy).
+    #[arg(long, default_value_t = SolveOptions::default().growth)]
+    growth: f64,
     /// Nonlinear method (Newton falls back to pseudo time-stepping when it stalls).
     #[arg(long, value_enum, default_value = "newton")]
     method: MethodArg,
@@ -136,6 +139,7 @@ impl SolverArgs {
         o.max_levels = self.levels;
         o.min_elements = self.min_elements.max(1);
         o.refine = self.refine;
+        o.growth = self.growth.max(1.0);
         Ok(o)
     }
 }

@@ -62,21 +62,26 @@ pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Resul
 /// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).
 pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 
-/// Prolong `coarse` onto the basis of `disc` and correct the boundary discrepancy with
-/// linear elasticity (§6.3): with `x_p = P c` and the target boundary `b`, solve
-/// `K_ff u_f = -K_fb (b - x_p)_b` on the physical domain of `x_p`, and return
-/// `x_p + u` with the boundary set to `b`.
-pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &[Curve; 4]) -> Result<Vec<Point>> {
-    let fine = coarse.refined(&disc.knots)?;
-    let shape = disc.shape();
-    let mut target = fine.control_points.clone();
-    set_boundary(shape, sides, &mut target)?;
-    let diff: Vec<Point> = target.iter().zip(&fine.control_points).map(|(t, f)| [t[0] - f[0], t[1] - f[1]]).collect();
-    if disc.dofs.num_free() == 0 || diff.iter().all(|d| d[0] == 0.0 && d[1] == 0.0) {
-        return Ok(target);
+/// Linear-elasticity correction (§6.3): move the fixed (boundary) control points of
+/// `base` to those of `target` and spread the displacement into the interior by solving
+/// `K_ff u_f = -K_fb (target - base)_b` on the physical domain of `base`. Returns
+/// `base + u` with the fixed control points of `target`.
+pub fn elasticity_correction(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
+    let mut out = base.to_vec();
+    let mut diff = vec![[0.0; 2]; base.len()];
+    let mut moved = false;
+    for k in 0..base.len() {
+        if disc.dofs.free_index(k) == crate::dofs::FIXED {
+            out[k] = target[k];
+            diff[k] = [target[k][0] - base[k][0], target[k][1] - base[k][1]];
+            moved |= diff[k] != [0.0, 0.0];
+        }
+    }
+    if disc.dofs.num_free() == 0 || !moved {
+        return Ok(out);
     }
     let mut st = vec![0.0; disc.stencil_len(2)];
-    disc.elasticity(&fine.control_points, LAME.0, LAME.1, &mut st);
+    disc.elasticity(base, LAME.0, LAME.1, &mut st);
     let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
     let mut lin = LinearSolver::new(LinearMethod::Lu);
@@ -84,9 +89,19 @@ pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &
     let u = lin.solve(&rhs)?;
     let m = disc.dofs.num_free();
     for (f, &kk) in disc.dofs.free().iter().enumerate() {
-        target[kk] = [fine.control_points[kk][0] + u[f], fine.control_points[kk][1] + u[m + f]];
+        out[kk] = [base[kk][0] + u[f], base[kk][1] + u[m + f]];
     }
-    Ok(target)
+    Ok(out)
+}
+
+/// Prolong `coarse` onto the basis of `disc` and correct the boundary discrepancy with
+/// linear elasticity (§6.3): with `x_p = P c` and the fitted boundary `b`, the result is
+/// [`elasticity_correction`]`(x_p, b)`.
+pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &[Curve; 4]) -> Result<Vec<Point>> {
+    let fine = coarse.refined(&disc.knots)?;
+    let mut target = fine.control_points.clone();
+    set_boundary(disc.shape(), sides, &mut target)?;
+    elasticity_correction(disc, &fine.control_points, &target)
 }
 
 #[cfg(test)]

@@ -1,7 +1,9 @@
 //! Nonlinear solvers for `F(c) = 0` as objects that yield their iterates: the damped
 //! (truncated) Newton method of paper §6.1 with a backtracking line search on `||F||`,
 //! and pseudo time-stepping (§6.2, eq. 30-33) with the SER time-step rule, used
-//! automatically when Newton stalls.
+//! automatically when Newton stalls. Because `dF/dc` of eq. (8) is negative definite
+//! (L behaves like the Laplacian), the pseudo-time flow is taken as `M dc/dt = F`, the
+//! dissipative sign; eq. (28) states it for `G = -L`.
 
 use std::time::{Duration, Instant};
 
@@ -234,10 +236,14 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         let a = match shift {
             None => jac,
             Some(dt) => {
+                // F_i = int w_i L(x) and L is elliptic (like the Laplacian), so dF/dc is
+                // negative definite near a solution; the dissipative pseudo-transient
+                // form of eq. (30)-(32) is therefore M dc/dt = +F, i.e.
+                // [M / dt - dF/dc] dc = F, written as [-(M / dt) + dF/dc] dc = -F.
                 let m = self.problem.mass();
                 let mut a = jac;
                 for (v, mv) in a.values.iter_mut().zip(&m.values) {
-                    *v += mv / dt;
+                    *v -= mv / dt;
                 }
                 a
             }

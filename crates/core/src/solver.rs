@@ -13,7 +13,8 @@ use crate::curve::Curve;
 use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
 use crate::error::{Error, Result};
 use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
-use crate::initial::{coons, elasticity_prolongation};
+use crate::initial::{coons, elasticity_correction, set_boundary};
+use crate::knots::KnotVector;
 use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
 use crate::quality::{functionals, sample_det_j};
 use crate::surface::{Side, Surface};
@@ -35,6 +36,9 @@ pub struct SolveOptions {
     pub max_levels: Option<usize>,
     /// Basis growth factor between solved levels (the paper advises 4).
     pub growth: f64,
+    /// Largest mean physical aspect ratio of the elements; the coarser direction of a
+    /// level is halved until it is met (see [`prepare_levels`]).
+    pub aspect: f64,
     /// `det J` is sampled on an `(n+1)^2` grid for the report.
     pub sample: usize,
 }
@@ -49,6 +53,7 @@ impl Default for SolveOptions {
             refine: 0,
             max_levels: None,
             growth: 4.0,
+            aspect: 2.0,
             sample: 200,
         }
     }
@@ -79,6 +84,11 @@ pub struct LevelReport {
     pub initial_guess: InitialGuess,
     /// Smallest sampled `det J` of the initial guess.
     pub initial_det_j_min: f64,
+    /// Damped boundary steps solved before the full boundary (paper §9); 0 when the
+    /// elasticity guess was already positive.
+    pub continuation_steps: usize,
+    /// Nonlinear iterations spent in those steps.
+    pub continuation_iterations: usize,
     /// Nonlinear iterations (excluding the initial residual evaluation).
     pub iterations: usize,
     /// Newton iterations among them.
@@ -201,31 +211,105 @@ pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) ->
     out
 }
 
-/// Extend a hierarchy so that its finest level has at least `min_elements` elements per
-/// direction, plus `refine` uniform halvings (exact refinement of the fitted sides).
-pub fn extend_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize) -> Result<Vec<Level>> {
-    let mut extra = refine;
-    loop {
-        let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
-        let ne = [last.knots[0].num_elements(), last.knots[1].num_elements()];
-        let too_coarse = ne[0] < min_elements || ne[1] < min_elements;
-        if !too_coarse && extra == 0 {
-            return Ok(levels);
+fn polyline_length(c: &Curve) -> f64 {
+    let n = 16 * c.knots.num_elements().max(4);
+    c.sample(n).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
+}
+
+/// Prepare the hierarchy for solving (paper §5.4 builds each level from the side fits
+/// alone, so a straight side keeps a single element however fine its opposite is):
+/// 1. *balance* every level, halving a direction until its elements are on average no
+///    more than `aspect` times longer (physically) than those of the other direction,
+///    and until it has `min_elements` elements; each level then takes the union with
+///    the coarser one so the hierarchy stays nested;
+/// 2. append `refine` uniformly halved copies of the finest level.
+///
+/// Sides are refined exactly (knot insertion), so the fitted contours are unchanged.
+pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize, aspect: f64) -> Result<Vec<Level>> {
+    let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
+    // mean physical length of the xi sides (south, north) and of the eta sides (west, east)
+    let len_xi = 0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
+    let len_eta = 0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
+    let mut previous: Option<[KnotVector; 2]> = None;
+    for level in levels.iter_mut() {
+        let mut knots = level.knots.clone();
+        // balance the mean physical element sizes of the two directions ...
+        loop {
+            let h = [len_xi / knots[0].num_elements() as f64, len_eta / knots[1].num_elements() as f64];
+            let d = if h[1] > aspect * h[0] {
+                1
+            } else if h[0] > aspect * h[1] {
+                0
+            } else {
+                break;
+            };
+            knots[d] = knots[d].halved();
         }
-        if !too_coarse {
-            extra -= 1;
+        // ... then give each direction its minimum number of elements
+        for kv in knots.iter_mut() {
+            while kv.num_elements() < min_elements {
+                *kv = kv.halved();
+            }
         }
-        let knots = [
-            if ne[0] < min_elements || !too_coarse { last.knots[0].halved() } else { last.knots[0].clone() },
-            if ne[1] < min_elements || !too_coarse { last.knots[1].halved() } else { last.knots[1].clone() },
-        ];
+        let size = knots[0].num_basis() * knots[1].num_basis();
+        if size > MAX_BASIS {
+            return Err(Error::TooLarge {
+                context: "solver hierarchy".into(),
+                what: "tensor basis size".into(),
+                found: size,
+                limit: MAX_BASIS,
+            });
+        }
+        // contain the coarser level: keeps the hierarchy nested
+        if let Some(prev) = &previous {
+            for d in 0..2 {
+                knots[d] = knots[d].union(&prev[d])?;
+            }
+        }
+        if knots != level.knots {
+            for s in Side::ALL {
+                level.sides[s as usize] = level.sides[s as usize].refined(&knots[s.direction()])?;
+            }
+            level.knots = knots.clone();
+        }
+        previous = Some(knots);
+    }
+    for _ in 0..refine {
+        let last = levels.last().expect("non-empty");
+        let knots = [last.knots[0].halved(), last.knots[1].halved()];
         let mut sides = last.sides.clone();
         for s in Side::ALL {
             sides[s as usize] = sides[s as usize].refined(&knots[s.direction()])?;
         }
         levels.push(Level { knots, sides });
     }
+    // drop levels made identical by balancing
+    levels.dedup_by(|b, a| a.knots == b.knots);
+    Ok(levels)
 }
+
+/// Bookkeeping of the boundary continuation of one level.
+#[derive(Debug, Default)]
+struct Continuation {
+    steps: usize,
+    iterations: usize,
+}
+
+/// Smallest `det J` on a sample of `4 max(n_xi, n_eta)` points per direction, away
+/// from the corners.
+fn det_j_min(disc: &Discretization, cps: &[crate::curve::Point]) -> f64 {
+    let shape = disc.shape();
+    let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: None };
+    sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
+}
+
+/// Largest tensor basis the solver accepts (about 8 million unknowns).
+pub const MAX_BASIS: usize = 1 << 22;
+
+/// Smallest fraction of the boundary displacement tried in one continuation step.
+const MIN_CONTINUATION_STEP: f64 = 1.0 / 64.0;
+/// Most damped boundary solves per level.
+const MAX_CONTINUATION_STEPS: usize = 24;
 
 struct Active {
     level: usize,
@@ -257,7 +341,7 @@ impl std::fmt::Debug for EggSolver {
 impl EggSolver {
     /// A solver over the levels of `hierarchy` (extended and selected by `opts`).
     pub fn new(hierarchy: &Hierarchy, opts: SolveOptions, assembler: Arc<dyn EggAssembler>) -> Result<Self> {
-        let levels = extend_levels(hierarchy.levels.clone(), opts.min_elements, opts.refine)?;
+        let levels = prepare_levels(hierarchy.levels.clone(), opts.min_elements, opts.refine, opts.aspect)?;
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
         let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
@@ -280,21 +364,96 @@ impl EggSolver {
         &self.plan
     }
 
+    /// Factor making `||F||` dimensionless: `F_i = int w_i L` with `int w_i ~ 1/m` and
+    /// `L ~ diam^3` (plain) or `L / (g11 + g22) ~ diam` (scaled), so `||F|| sqrt(m)`
+    /// divided by that size is the relative size of the operator's residual.
+    fn residual_scale(&self, m: usize) -> f64 {
+        let size = match self.opts.operator {
+            Operator::Plain => self.diameter.powi(3),
+            Operator::Scaled => self.diameter,
+        };
+        (m.max(1) as f64).sqrt() / size
+    }
+
+    /// Initial guess of a finer level (§6.3, §9): the elasticity correction of the
+    /// prolonged map `base` towards the fitted boundary `target`. When that guess is not
+    /// positive on a sample, the boundary displacement is damped by `alpha < 1`, the EGG
+    /// equations are solved with the damped boundary from the (positive) elasticity
+    /// guess, and the remaining displacement is applied from that solution, until the
+    /// target contour is reached.
+    fn continuation(
+        &self,
+        disc: &Arc<Discretization>,
+        base: Vec<crate::curve::Point>,
+        target: &[crate::curve::Point],
+        cont: &mut Continuation,
+    ) -> Result<Vec<crate::curve::Point>> {
+        let origin = base.clone();
+        let mut base = base;
+        let (mut done, mut step) = (0.0f64, 1.0f64);
+        let mut nl = self.opts.nonlinear;
+        nl.scale = self.residual_scale(disc.dofs.num_free());
+        nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
+        loop {
+            let a = (done + step).min(1.0);
+            let bnd: Vec<crate::curve::Point> =
+                origin.iter().zip(target).map(|(o, t)| [o[0] + a * (t[0] - o[0]), o[1] + a * (t[1] - o[1])]).collect();
+            let guess = elasticity_correction(disc, &base, &bnd)?;
+            let positive = det_j_min(disc, &guess) > 0.0;
+            let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
+            if a >= 1.0 && (positive || exhausted) {
+                return Ok(guess);
+            }
+            if !positive && !exhausted {
+                step *= 0.5;
+                continue;
+            }
+            // solve with the damped boundary
+            let problem = EggProblem::new(disc.clone(), guess.clone(), self.opts.operator, self.assembler.clone());
+            let c0 = problem.unknowns();
+            let mut solver = NonlinearSolver::new(problem, c0, nl);
+            let mut iterations = 0;
+            for it in solver.by_ref() {
+                iterations = it?.iteration;
+            }
+            cont.steps += 1;
+            let converged = *solver.status() == Status::Converged;
+            let (problem, c) = solver.into_parts();
+            let mut sol = problem.cps.clone();
+            problem.disc.dofs.scatter(&c, &mut sol);
+            cont.iterations += iterations;
+            if converged && det_j_min(disc, &sol) > 0.0 {
+                base = sol;
+                done = a;
+                step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
+            } else if exhausted {
+                return Ok(guess);
+            } else {
+                step *= 0.5;
+            }
+        }
+    }
+
     fn start_level(&mut self, k: usize) -> Result<Event> {
         let t0 = Instant::now();
         let level = &self.plan[k];
         let disc = Arc::new(Discretization::new(level.knots.clone()));
+        let mut cont = Continuation::default();
         let (cps, guess) = match &self.previous {
             None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
-            Some(prev) => (elasticity_prolongation(prev, &disc, &level.sides)?, InitialGuess::Elasticity),
+            Some(prev) => {
+                let fine = prev.refined(&level.knots)?.control_points;
+                let mut target = fine.clone();
+                set_boundary(disc.shape(), &level.sides, &mut target)?;
+                let cps = self.continuation(&disc, fine, &target, &mut cont)?;
+                (cps, InitialGuess::Elasticity)
+            }
         };
         let shape = disc.shape();
-        let init = Surface { knots: level.knots.clone(), control_points: cps.clone(), weights: None };
-        let initial_det_j_min = sample_det_j(&init, 4 * shape[0].max(shape[1])).min_interior;
+        let initial_det_j_min = det_j_min(&disc, &cps);
         let m = disc.dofs.num_free();
         let mut nl = self.opts.nonlinear;
-        // ||F|| ~ diam^3 / sqrt(m) when L is O(diam^3): scale to a dimensionless size.
-        nl.scale = (m.max(1) as f64).sqrt() / self.diameter.powi(3);
+        nl.scale = self.residual_scale(m);
         nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
         let problem = EggProblem::new(disc, cps, self.opts.operator, self.assembler.clone());
         let c0 = problem.unknowns();
@@ -306,6 +465,8 @@ impl EggSolver {
             unknowns: 2 * m,
             initial_guess: guess,
             initial_det_j_min,
+            continuation_steps: cont.steps,
+            continuation_iterations: cont.iterations,
             iterations: 0,
             newton_iterations: 0,
             pseudo_time_iterations: 0,
