@@ -79,6 +79,7 @@ enum OperatorArg {
 enum LinearArg {
     Lu,
     Gmres,
+    Auto,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -103,12 +104,19 @@ struct SolverArgs {
     /// Nonlinear method (Newton falls back to pseudo time-stepping when it stalls).
     #[arg(long, value_enum, default_value = "newton")]
     method: MethodArg,
-    /// Operator: L of eq. (4) or L / (g11 + g22) as in G+Smo.
-    #[arg(long, value_enum, default_value = "plain")]
+    /// Operator: L of eq. (4), or L / (g11 + g22) as in G+Smo (converges better on the
+    /// shared geometries, see BENCHMARKS.md).
+    #[arg(long, value_enum, default_value = "scaled")]
     operator: OperatorArg,
-    /// Linear solver: sparse LU or GMRES with ILU(0).
-    #[arg(long, value_enum, default_value = "lu")]
+    /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 20000 unknowns).
+    #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
+    /// When the finest map folds, halve the basis and solve again, at most this often.
+    #[arg(long, default_value_t = SolveOptions::default().repair)]
+    repair: usize,
+    /// Do not refine a folded map (same as --repair 0).
+    #[arg(long)]
+    no_repair: bool,
 }
 
 impl SolverArgs {
@@ -131,7 +139,9 @@ impl SolverArgs {
         o.nonlinear.linear = match self.linear {
             LinearArg::Lu => LinearMethod::Lu,
             LinearArg::Gmres => LinearMethod::Gmres,
+            LinearArg::Auto => LinearMethod::Auto,
         };
+        o.repair = if self.no_repair { 0 } else { self.repair };
         o.operator = match self.operator {
             OperatorArg::Plain => Operator::Plain,
             OperatorArg::Scaled => Operator::Scaled,
@@ -190,9 +200,10 @@ struct RenderArgs {
 struct BenchArgs {
     /// Boundary files (default: every JSON geometry in tests/data and tests/data/gismo).
     files: Vec<PathBuf>,
-    /// Extra uniform halvings of the finest level to run, comma-separated.
+    /// Extra uniform halvings of the finest level to run, comma-separated (one table row
+    /// per geometry and value).
     #[arg(long, value_delimiter = ',', default_value = "0")]
-    refine: Vec<usize>,
+    refinements: Vec<usize>,
     #[command(flatten)]
     solver: SolverArgs,
     /// Print the rows as JSON lines instead of a table.
@@ -325,7 +336,7 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
             }
         }
     }
-    Ok(solver.finish(&boundary.name, &h)?)
+    Ok(solver.finish(boundary, &h)?)
 }
 
 fn solve(a: SolveArgs) -> Result<i32> {
@@ -333,6 +344,7 @@ fn solve(a: SolveArgs) -> Result<i32> {
     let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
     let sol = run_solver(&boundary, &opts, a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
+    output::ensure_parent(&a.output)?;
     write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
         .with_context(|| format!("writing {}", a.output.display()))?;
     if let Some(p) = &a.png {
@@ -365,7 +377,7 @@ fn bench(a: BenchArgs) -> Result<i32> {
                 continue;
             }
         };
-        for &r in &a.refine {
+        for &r in &a.refinements {
             let o = SolveOptions { refine: r, ..opts.clone() };
             output::reset_peak_memory();
             let t = Instant::now();
@@ -382,4 +394,15 @@ fn bench(a: BenchArgs) -> Result<i32> {
         print!("{}", output::bench_table(&rows));
     }
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
 }

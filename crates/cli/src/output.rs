@@ -25,7 +25,7 @@ pub fn write_png(path: &Path, img: &Image) -> Result<()> {
     Ok(())
 }
 
-fn ensure_parent(path: &Path) -> Result<()> {
+pub fn ensure_parent(path: &Path) -> Result<()> {
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
     }
@@ -99,16 +99,24 @@ fn verdict_word(v: Verdict) -> &'static str {
     }
 }
 
+fn knot_list(k: &[f64]) -> String {
+    let shown: Vec<String> = if k.len() <= 16 {
+        k.iter().map(|v| format!("{v}")).collect()
+    } else {
+        k[..6]
+            .iter()
+            .map(|v| format!("{v}"))
+            .chain(std::iter::once(format!("... ({} knots) ...", k.len())))
+            .chain(k[k.len() - 6..].iter().map(|v| format!("{v}")))
+            .collect()
+    };
+    format!("[{}]", shown.join(", "))
+}
+
 fn side_lines(s: &mut String, side: Side, c: &SideCurve) {
     let _ = writeln!(s, "  {side:<5}: {}", c.describe());
     if let SideCurve::Spline(c) = c {
-        let k = c.knots.knots();
-        let shown: Vec<String> = if k.len() <= 16 {
-            k.iter().map(|v| format!("{v}")).collect()
-        } else {
-            k[..6].iter().map(|v| format!("{v}")).chain(std::iter::once(format!("... ({} knots) ...", k.len()))).chain(k[k.len() - 6..].iter().map(|v| format!("{v}"))).collect()
-        };
-        let _ = writeln!(s, "         knots [{}]", shown.join(", "));
+        let _ = writeln!(s, "         knots {}", knot_list(c.knots.knots()));
     }
 }
 
@@ -149,6 +157,9 @@ pub fn inspect_text(
                 f.max_error.last().copied().unwrap_or(0.0),
                 if f.converged { "" } else { "  (tolerance NOT met)" }
             );
+            if let Some(c) = last {
+                let _ = writeln!(s, "           fitted knots {}", knot_list(c.knots.knots()));
+            }
         }
         let sizes: Vec<String> = h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
         let _ = writeln!(s, "    basis per level: {}", sizes.join(" -> "));

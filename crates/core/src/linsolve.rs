@@ -17,7 +17,13 @@ pub enum LinearMethod {
     Lu,
     /// Restarted GMRES(50) with ILU(0), relative tolerance 1e-10.
     Gmres,
+    /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
+    /// does not converge.
+    Auto,
 }
+
+/// Largest system that [`LinearMethod::Auto`] factorizes directly.
+pub const AUTO_LU_LIMIT: usize = 20_000;
 
 /// A factorization-capable solver bound to one sparsity pattern.
 #[derive(Debug)]
@@ -29,17 +35,22 @@ pub struct LinearSolver {
     matrix: Option<Csr>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
+    fallback: bool,
 }
 
 impl LinearSolver {
     /// A solver using `method`.
     pub fn new(method: LinearMethod) -> Self {
-        Self { method, symbolic: None, lu: None, ilu: None, matrix: None, krylov_iterations: 0 }
+        let fallback = method == LinearMethod::Auto;
+        Self { method, symbolic: None, lu: None, ilu: None, matrix: None, krylov_iterations: 0, fallback }
     }
 
     /// Factorize (LU) or precondition (GMRES) the matrix `a`. The CSR storage of `a` is
     /// the CSC storage of `a^T`; faer factors `a^T` and we solve with its transpose.
     pub fn factor(&mut self, a: &Csr) -> Result<()> {
+        if self.method == LinearMethod::Auto {
+            self.method = if a.nrows <= AUTO_LU_LIMIT { LinearMethod::Lu } else { LinearMethod::Gmres };
+        }
         match self.method {
             LinearMethod::Lu => {
                 let sym = SymbolicSparseColMatRef::new_checked(a.ncols, a.nrows, &a.row_ptr, None, &a.col_idx);
@@ -58,6 +69,7 @@ impl LinearSolver {
                 self.ilu = Some(Ilu0::new(a)?);
                 self.matrix = Some(a.clone());
             }
+            LinearMethod::Auto => unreachable!("resolved above"),
         }
         Ok(())
     }
@@ -74,10 +86,23 @@ impl LinearSolver {
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let ilu = self.ilu.as_ref().expect("set with matrix");
-                let (x, it) = gmres(a, b, ilu, 50, 1e-10, 2000)?;
-                self.krylov_iterations += it;
-                x
+                match gmres(a, b, ilu, 50, 1e-10, 2000) {
+                    Ok((x, it)) => {
+                        self.krylov_iterations += it;
+                        x
+                    }
+                    Err(e) if self.fallback => {
+                        // GMRES did not converge: factorize this matrix directly instead
+                        let a = self.matrix.take().expect("set above");
+                        self.method = LinearMethod::Lu;
+                        self.fallback = false;
+                        self.factor(&a).map_err(|f| Error::LinearSolver(format!("{e}; LU fallback: {f}")))?;
+                        return self.solve(b);
+                    }
+                    Err(e) => return Err(e),
+                }
             }
+            LinearMethod::Auto => unreachable!("resolved in factor"),
         };
         if x.iter().any(|v| !v.is_finite()) {
             return Err(Error::LinearSolver("singular system (non-finite solution)".into()));

@@ -59,7 +59,7 @@ impl Default for NonlinearOptions {
             max_newton: 30,
             max_pseudo: 400,
             fallback: true,
-            linear: LinearMethod::Lu,
+            linear: LinearMethod::Auto,
         }
     }
 }

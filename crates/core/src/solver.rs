@@ -41,6 +41,8 @@ pub struct SolveOptions {
     pub aspect: f64,
     /// `det J` is sampled on an `(n+1)^2` grid for the report.
     pub sample: usize,
+    /// When the finest map folds, halve it and solve again, at most this many times.
+    pub repair: usize,
 }
 
 impl Default for SolveOptions {
@@ -48,13 +50,14 @@ impl Default for SolveOptions {
         Self {
             fit: FitOptions::default(),
             nonlinear: NonlinearOptions::default(),
-            operator: Operator::Plain,
+            operator: Operator::Scaled,
             min_elements: 8,
             refine: 0,
             max_levels: None,
             growth: 4.0,
             aspect: 2.0,
             sample: 200,
+            repair: 2,
         }
     }
 }
@@ -150,6 +153,63 @@ pub struct CornerReport {
     pub forces_nonpositive_det_j: bool,
 }
 
+/// Corner angles at or above this (degrees) force `det J <= 0` up to the fit tolerance.
+pub const FORCED_ANGLE: f64 = 179.0;
+
+/// A kink inside a spline side: a break of continuity `C^0` where the tangent turns.
+#[derive(Debug, Clone, Serialize)]
+pub struct KinkReport {
+    /// Side name.
+    pub side: &'static str,
+    /// Parameter on the side, in `[0, 1]`.
+    pub parameter: f64,
+    /// Physical point.
+    pub point: [f64; 2],
+    /// Turning angle of the tangent in degrees (180 for a cusp or zero speed).
+    pub turning_degrees: f64,
+}
+
+/// Kinks of the input's spline sides: at every interior knot the one-sided tangent
+/// directions are compared (just off the knot, so that a zero speed at the knot, as
+/// with coincident control points, still shows its turn); a turn of more than one
+/// degree is a kink. Any `C^1` map of the exact boundary has zero speed, so
+/// `det J = 0`, at such a point; the fitted boundary rounds it within the tolerance.
+pub fn boundary_kinks(boundary: &Boundary) -> Vec<KinkReport> {
+    use crate::basis::BasisDerivs;
+    let mut out = Vec::new();
+    for s in Side::ALL {
+        let crate::boundary::SideCurve::Spline(c) = boundary.side(s) else { continue };
+        let bm = c.knots.breaks_with_multiplicity();
+        let spans: Vec<(usize, f64, f64)> = c.knots.elements();
+        for &(u, _) in &bm[1..bm.len().saturating_sub(1)] {
+            let left = spans.iter().find(|e| e.2 == u);
+            let right = spans.iter().find(|e| e.1 == u);
+            let (Some(l), Some(r)) = (left, right) else { continue };
+            // one-sided tangent directions just off the break (robust to zero speed at it)
+            let mut b = BasisDerivs::default();
+            let dl = {
+                b.eval_in_span(&c.knots, l.0, u - 1e-9 * (l.2 - l.1), 1);
+                c.derivs_with(&b, 1).d1
+            };
+            let dr = {
+                b.eval_in_span(&c.knots, r.0, u + 1e-9 * (r.2 - r.1), 1);
+                c.derivs_with(&b, 1).d1
+            };
+            let (sl, sr) = (dl[0].hypot(dl[1]), dr[0].hypot(dr[1]));
+            let turning = if sl == 0.0 || sr == 0.0 {
+                180.0
+            } else {
+                (dl[0] * dr[1] - dl[1] * dr[0]).atan2(dl[0] * dr[0] + dl[1] * dr[1]).to_degrees().abs()
+            };
+            if turning > 1.0 {
+                let (a, bb) = c.domain();
+                out.push(KinkReport { side: s.name(), parameter: (u - a) / (bb - a), point: c.eval(u), turning_degrees: turning });
+            }
+        }
+    }
+    out
+}
+
 /// Corners in the order south-west, south-east, north-east, north-west with their
 /// angles, from the side curves of a level.
 pub fn corner_report(sides: &[Curve; 4]) -> Vec<CornerReport> {
@@ -166,24 +226,22 @@ pub fn corner_report(sides: &[Curve; 4]) -> Vec<CornerReport> {
         .enumerate()
         .map(|(k, (name, a, b))| {
             let cross = a[0] * b[1] - a[1] * b[0];
-            let dot = a[0] * b[0] + a[1] * b[1];
-            // interior angle between the two outgoing edges
-            let (e1, e2) = match k {
-                0 => (a, b),
-                1 => ([-a[0], -a[1]], b),
-                2 => ([-b[0], -b[1]], [-a[0], -a[1]]),
-                _ => (a, [-b[0], -b[1]]),
+            // incoming and outgoing tangents of the counter-clockwise traversal
+            // (south, east, reversed north, reversed west)
+            let (din, dout) = match k {
+                0 => ([-b[0], -b[1]], a),
+                1 => (a, b),
+                2 => (b, [-a[0], -a[1]]),
+                _ => ([-a[0], -a[1]], [-b[0], -b[1]]),
             };
-            let mut ang = (e1[0] * e2[1] - e1[1] * e2[0]).atan2(e1[0] * e2[0] + e1[1] * e2[1]).to_degrees();
-            if ang < 0.0 {
-                ang += 360.0;
-            }
+            let turn = (din[0] * dout[1] - din[1] * dout[0]).atan2(din[0] * dout[0] + din[1] * dout[1]).to_degrees();
+            let ang = 180.0 - turn;
             let speed = a[0].hypot(a[1]) * b[0].hypot(b[1]);
-            let _ = dot;
             CornerReport {
                 corner: name,
                 angle_degrees: ang,
-                forces_nonpositive_det_j: cross <= 1e-10 * speed || speed == 0.0,
+                // 180 degrees within the fit tolerance also counts: det J -> 0 there
+                forces_nonpositive_det_j: speed == 0.0 || cross <= 1e-10 * speed || ang >= FORCED_ANGLE,
             }
         })
         .collect()
@@ -330,6 +388,7 @@ pub struct EggSolver {
     reports: Vec<LevelReport>,
     started: Instant,
     failed: bool,
+    repairs: usize,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -356,6 +415,7 @@ impl EggSolver {
             reports: Vec::new(),
             started: Instant::now(),
             failed: false,
+            repairs: 0,
         })
     }
 
@@ -388,6 +448,11 @@ impl EggSolver {
         target: &[crate::curve::Point],
         cont: &mut Continuation,
     ) -> Result<Vec<crate::curve::Point>> {
+        let tol = 1e-12 * self.diameter;
+        if base.iter().zip(target).all(|(b, t)| (b[0] - t[0]).abs() <= tol && (b[1] - t[1]).abs() <= tol) {
+            // same boundary (e.g. a refinement of the previous level): nothing to move
+            return Ok(base);
+        }
         let origin = base.clone();
         let mut base = base;
         let (mut done, mut step) = (0.0f64, 1.0f64);
@@ -503,13 +568,30 @@ impl EggSolver {
 
     /// Finish: the map of the finest level and the full report. Runs the remaining
     /// iterations first if the stream was not drained.
-    pub fn finish(mut self, name: &str, hierarchy: &Hierarchy) -> Result<Solution> {
+    pub fn finish(mut self, boundary: &Boundary, hierarchy: &Hierarchy) -> Result<Solution> {
         for e in self.by_ref() {
             e?;
         }
         let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
         let finest = self.plan.last().expect("non-empty plan");
-        Ok(Solution::new(name, map, hierarchy, &finest.sides, self.reports, &self.opts, self.assembler.name(), self.started.elapsed()))
+        let ctx = ReportContext {
+            hierarchy,
+            sides: &finest.sides,
+            kinks: boundary_kinks(boundary),
+            opts: &self.opts,
+            backend: self.assembler.name(),
+            repairs: self.repairs,
+            elapsed: self.started.elapsed(),
+        };
+        Ok(Solution::new(&boundary.name, map, self.reports, ctx))
+    }
+
+    /// Whether the last solved map folds away from the corners its boundary forces.
+    fn folds(&self) -> bool {
+        let (Some(map), Some(level)) = (&self.previous, self.plan.last()) else { return false };
+        let forced = corner_report(&level.sides);
+        let s = sample_det_j(map, self.opts.sample);
+        min_away_from_corners(map, &s, &forced) <= 0.0
     }
 }
 
@@ -535,6 +617,23 @@ impl Iterator for EggSolver {
                     return Some(Ok(Event::Iterate { level: a.level, iterate: it }));
                 }
                 Ok(None) => return Some(Ok(self.finish_level())),
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
+                }
+            }
+        }
+        if self.next_level == self.plan.len() && self.repairs < self.opts.repair && !self.plan.is_empty() && self.folds() {
+            // defect correction by refinement: halve the finest level and solve again
+            let last = self.plan.last().expect("non-empty");
+            let knots = [last.knots[0].halved(), last.knots[1].halved()];
+            let sides = Side::ALL.map(|s| last.sides[s as usize].refined(&knots[s.direction()]));
+            match sides.into_iter().collect::<Result<Vec<_>>>() {
+                Ok(v) => {
+                    let sides: [Curve; 4] = v.try_into().expect("four sides");
+                    self.plan.push(Level { knots, sides });
+                    self.repairs += 1;
+                }
                 Err(e) => {
                     self.failed = true;
                     return Some(Err(e));
@@ -603,10 +702,15 @@ pub struct Report {
     pub fit: Vec<FitReport>,
     /// Per-level summaries.
     pub levels: Vec<LevelReport>,
+    /// Refinements added because the finest map folded.
+    pub repairs: usize,
     /// `det J` minimum on the sample grid (corners included).
     pub det_j_min: f64,
     /// `det J` minimum away from the four corners.
     pub det_j_min_interior: f64,
+    /// `det J` minimum away from the corners the boundary forces (two spans around
+    /// each); the verdict is `folded` when this is not positive.
+    pub det_j_min_away_from_forced_corners: f64,
     /// `det J` maximum on the sample grid.
     pub det_j_max: f64,
     /// Parameter point of the minimum.
@@ -619,6 +723,8 @@ pub struct Report {
     pub area: f64,
     /// Corner angles.
     pub corners: Vec<CornerReport>,
+    /// Kinks inside the input's spline sides.
+    pub kinks: Vec<KinkReport>,
     /// The outcome.
     pub verdict: Verdict,
     /// Plain-language summary of the verdict.
@@ -638,24 +744,53 @@ pub struct Solution {
     pub report: Report,
 }
 
+/// Smallest sampled `det J` outside the neighbourhoods of the corners that the
+/// boundary forces to `det J <= 0`: the first two knot spans in each direction there.
+pub fn min_away_from_corners(map: &Surface, s: &crate::quality::DetJSample, corners: &[CornerReport]) -> f64 {
+    let span = |d: usize, at_end: bool| {
+        let b = map.knots[d].breaks();
+        let k = b.len();
+        let w = if at_end { b[k - 1] - b[k.saturating_sub(3)] } else { b[2.min(k - 1)] - b[0] };
+        w.max(0.0)
+    };
+    let centres = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let n = s.n;
+    let mut min = f64::INFINITY;
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+            let near = corners.iter().zip(centres).any(|(c, (cu, cv))| {
+                c.forces_nonpositive_det_j && (u - cu).abs() <= span(0, cu > 0.5) && (v - cv).abs() <= span(1, cv > 0.5)
+            });
+            if !near {
+                min = min.min(s.values[j * (n + 1) + i]);
+            }
+        }
+    }
+    min
+}
+
+/// What the report is made from besides the map.
+struct ReportContext<'a> {
+    hierarchy: &'a Hierarchy,
+    sides: &'a [Curve; 4],
+    kinks: Vec<KinkReport>,
+    opts: &'a SolveOptions,
+    backend: String,
+    repairs: usize,
+    elapsed: Duration,
+}
+
 impl Solution {
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        name: &str,
-        map: Surface,
-        h: &Hierarchy,
-        sides: &[Curve; 4],
-        levels: Vec<LevelReport>,
-        opts: &SolveOptions,
-        backend: String,
-        elapsed: Duration,
-    ) -> Self {
+    fn new(name: &str, map: Surface, levels: Vec<LevelReport>, ctx: ReportContext<'_>) -> Self {
+        let (h, opts) = (ctx.hierarchy, ctx.opts);
         let sample = sample_det_j(&map, opts.sample);
         let fun = functionals(&map);
-        let corners = corner_report(sides);
+        let corners = corner_report(ctx.sides);
         let forced: Vec<&str> = corners.iter().filter(|c| c.forces_nonpositive_det_j).map(|c| c.corner).collect();
         let converged = levels.last().is_some_and(|l| l.converged);
-        let scale = sample.max.abs().max(f64::MIN_POSITIVE);
+        let away = min_away_from_corners(&map, &sample, &corners);
+        let kinks = ctx.kinks;
         let (verdict, message) = if !converged {
             (
                 Verdict::NotConverged,
@@ -664,21 +799,33 @@ impl Solution {
                     levels.last().and_then(|l| l.failure.clone()).unwrap_or_default()
                 ),
             )
-        } else if sample.min_interior <= 0.0 {
+        } else if away <= 0.0 {
             let [u, v] = sample.argmin;
             (Verdict::Folded, format!("det J <= 0 at (xi, eta) = ({u:.4}, {v:.4}): the map folds at this resolution"))
-        } else if !forced.is_empty() || sample.min <= 1e-12 * scale {
-            let names = if forced.is_empty() { "a corner".to_string() } else { forced.join(", ") };
+        } else if !forced.is_empty() {
+            let why: Vec<String> = corners
+                .iter()
+                .filter(|c| c.forces_nonpositive_det_j)
+                .map(|c| format!("the {} corner (angle {:.1} degrees)", c.corner, c.angle_degrees))
+                .collect();
             (
                 Verdict::DegenerateCorner,
                 format!(
-                    "the boundary forces det J <= 0 at the {names} corner (angle >= 180 degrees or zero speed); \
-                     det J > 0 everywhere else: this is the best map this boundary admits"
+                    "the boundary itself forces det J <= 0 at {}; det J > 0 everywhere else: this is the best map this boundary admits",
+                    why.join(" and ")
                 ),
             )
         } else {
             (Verdict::PositiveOnSample, format!("det J > 0 on the {}x{} sample grid", sample.n + 1, sample.n + 1))
         };
+        let mut message = message;
+        for k in &kinks {
+            message.push_str(&format!(
+                "; note: the input's {} side has a kink at ({:.6}, {:.6}) (tangent turns {:.1} degrees), where any C1 map of the \
+                 exact boundary has det J = 0; this map follows the fitted boundary, which rounds the kink within the fit tolerance",
+                k.side, k.point[0], k.point[1], k.turning_degrees
+            ));
+        }
         let fit = Side::ALL
             .iter()
             .map(|&s| {
@@ -694,7 +841,7 @@ impl Solution {
             .collect();
         let report = Report {
             version: env!("CARGO_PKG_VERSION"),
-            backend,
+            backend: ctx.backend,
             degree: map.degrees(),
             operator: match opts.operator {
                 Operator::Plain => "plain",
@@ -704,17 +851,20 @@ impl Solution {
             diameter: h.diameter,
             fit,
             levels,
+            repairs: ctx.repairs,
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
+            det_j_min_away_from_forced_corners: away,
             det_j_max: sample.max,
             det_j_argmin: sample.argmin,
             det_j_sample: sample.n,
             winslow: fun.winslow.is_finite().then_some(fun.winslow),
             area: fun.area,
             corners,
+            kinks,
             verdict,
             message,
-            seconds: elapsed.as_secs_f64(),
+            seconds: ctx.elapsed.as_secs_f64(),
         };
         Self { name: name.to_string(), map, report }
     }
@@ -723,7 +873,7 @@ impl Solution {
 /// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream.
 pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit)?;
-    EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(&boundary.name, &h)
+    EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(boundary, &h)
 }
 
 #[cfg(test)]
