@@ -6,10 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use winslow::fit::{cord_length_params, project_side};
-use winslow::{
-    build_hierarchy, Analytic, Boundary, Curve, FitOptions, Hierarchy, KnotVector, Point, Side,
-    SideCurve,
-};
+use winslow::{build_hierarchy, Analytic, Boundary, Curve, FitOptions, Hierarchy, KnotVector, Point, Side, SideCurve};
 
 fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
@@ -26,23 +23,10 @@ fn side_from_json(v: &Value) -> SideCurve {
         return SideCurve::Points(pts.as_array().unwrap().iter().map(point).collect());
     }
     let degree = v["degree"].as_u64().unwrap() as usize;
-    let knots = v["knots"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|k| k.as_f64().unwrap())
-        .collect();
+    let knots = v["knots"].as_array().unwrap().iter().map(|k| k.as_f64().unwrap()).collect();
     let kv = KnotVector::new(degree, knots).unwrap().normalized();
-    let cps = v["control_points"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(point)
-        .collect();
-    let weights = v
-        .get("weights")
-        .and_then(|w| w.as_array())
-        .map(|w| w.iter().map(|x| x.as_f64().unwrap()).collect());
+    let cps = v["control_points"].as_array().unwrap().iter().map(point).collect();
+    let weights = v.get("weights").and_then(|w| w.as_array()).map(|w| w.iter().map(|x| x.as_f64().unwrap()).collect());
     SideCurve::Spline(Curve::new(kv, cps, weights).unwrap())
 }
 
@@ -52,10 +36,7 @@ fn load(rel: &str) -> Boundary {
     let doc: Value = serde_json::from_str(&text).unwrap();
     let b = &doc["boundary"];
     let sides = ["south", "east", "north", "west"].map(|s| side_from_json(&b[s]));
-    Boundary {
-        name: doc["name"].as_str().unwrap_or(rel).to_string(),
-        sides,
-    }
+    Boundary { name: doc["name"].as_str().unwrap_or(rel).to_string(), sides }
 }
 
 const GEOMETRIES: [&str; 19] = [
@@ -88,24 +69,12 @@ fn check_hierarchy(name: &str, b: &Boundary, h: &Hierarchy) {
     let tol_corner = 1e-9 * h.diameter;
     for fit in &h.fits {
         let s = fit.side;
-        assert!(
-            fit.converged,
-            "{name} {s}: not converged, errors {:?}",
-            fit.max_error
-        );
-        assert!(
-            fit.final_max_error() <= h.tol_abs,
-            "{name} {s}: {} > {}",
-            fit.final_max_error(),
-            h.tol_abs
-        );
+        assert!(fit.converged, "{name} {s}: not converged, errors {:?}", fit.max_error);
+        assert!(fit.final_max_error() <= h.tol_abs, "{name} {s}: {} > {}", fit.final_max_error(), h.tol_abs);
         assert_eq!(fit.levels.len(), fit.max_error.len());
         assert_eq!(fit.levels.len(), fit.rms_error.len());
         for w in fit.levels.windows(2) {
-            assert!(
-                w[1].knots.contains(&w[0].knots),
-                "{name} {s}: side levels not nested"
-            );
+            assert!(w[1].knots.contains(&w[0].knots), "{name} {s}: side levels not nested");
         }
         let (a, e) = b.side(s).endpoints();
         for c in &fit.levels {
@@ -114,17 +83,13 @@ fn check_hierarchy(name: &str, b: &Boundary, h: &Hierarchy) {
             assert_eq!(c.domain(), (0.0, 1.0));
             // exact corner interpolation: the end control points are the corners
             assert!(
-                dist(c.control_points[0], a) <= tol_corner
-                    && dist(*c.control_points.last().unwrap(), e) <= tol_corner
+                dist(c.control_points[0], a) <= tol_corner && dist(*c.control_points.last().unwrap(), e) <= tol_corner
             );
         }
     }
     // all four corners are shared exactly by adjacent sides on every level
     for (k, lvl) in h.levels.iter().enumerate() {
-        let [s, e, n, w] = lvl
-            .sides
-            .each_ref()
-            .map(|c| (c.control_points[0], *c.control_points.last().unwrap()));
+        let [s, e, n, w] = lvl.sides.each_ref().map(|c| (c.control_points[0], *c.control_points.last().unwrap()));
         assert_eq!(s.0, w.0, "{name} level {k}: SW corner");
         assert_eq!(s.1, e.0, "{name} level {k}: SE corner");
         assert_eq!(n.1, e.1, "{name} level {k}: NE corner");
@@ -150,11 +115,7 @@ fn check_hierarchy(name: &str, b: &Boundary, h: &Hierarchy) {
         let (c, f) = (fit.finest(), fin.side(fit.side));
         for i in 0..=50 {
             let t = i as f64 / 50.0;
-            assert!(
-                dist(c.eval(t), f.eval(t)) < 1e-12 * h.diameter,
-                "{name}: prolongation changed {}",
-                fit.side
-            );
+            assert!(dist(c.eval(t), f.eval(t)) < 1e-12 * h.diameter, "{name}: prolongation changed {}", fit.side);
         }
     }
 }
@@ -162,34 +123,21 @@ fn check_hierarchy(name: &str, b: &Boundary, h: &Hierarchy) {
 #[test]
 fn shared_geometries_fit_within_tolerance() {
     let opts = FitOptions::default();
-    let mut table =
-        String::from("geometry            levels  basis sizes (n_xi x n_eta) per level\n");
+    let mut table = String::from("geometry            levels  basis sizes (n_xi x n_eta) per level\n");
     for rel in GEOMETRIES {
         let b = load(rel);
         let h = build_hierarchy(&b, &opts).unwrap_or_else(|e| panic!("{rel}: {e}"));
         check_hierarchy(rel, &b, &h);
-        let sizes: Vec<String> = h
-            .levels
-            .iter()
-            .map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis()))
-            .collect();
-        table.push_str(&format!(
-            "{:<20}{:>6}  {}\n",
-            b.name,
-            h.levels.len(),
-            sizes.join(" ")
-        ));
+        let sizes: Vec<String> =
+            h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
+        table.push_str(&format!("{:<20}{:>6}  {}\n", b.name, h.levels.len(), sizes.join(" ")));
     }
     println!("{table}");
 }
 
 #[test]
 fn point_clouds_use_cord_length_and_meet_tolerance() {
-    for rel in [
-        "narrow_tube.json",
-        "notched_square.json",
-        "spiral_channel.json",
-    ] {
+    for rel in ["narrow_tube.json", "notched_square.json", "spiral_channel.json"] {
         let b = load(rel);
         let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
         for fit in &h.fits {
@@ -197,10 +145,7 @@ fn point_clouds_use_cord_length_and_meet_tolerance() {
                 assert!(fit.params.is_none());
                 continue;
             };
-            let params = fit
-                .params
-                .as_ref()
-                .expect("point clouds report their abscissae");
+            let params = fit.params.as_ref().expect("point clouds report their abscissae");
             // eq. 36-37, computed independently
             let total: f64 = pts.windows(2).map(|w| dist(w[0], w[1])).sum();
             let mut l = 0.0;
@@ -208,29 +153,16 @@ fn point_clouds_use_cord_length_and_meet_tolerance() {
                 if j > 0 {
                     l += dist(pts[j - 1], pts[j]);
                 }
-                assert!(
-                    (xi - l / total).abs() < 1e-14,
-                    "{rel} {}: abscissa {j}",
-                    fit.side
-                );
+                assert!((xi - l / total).abs() < 1e-14, "{rel} {}: abscissa {j}", fit.side);
             }
             assert_eq!(params.first(), Some(&0.0));
             assert_eq!(params.last(), Some(&1.0));
             assert_eq!(cord_length_params(pts).as_ref(), Some(params));
             // the reported error is the deviation at those abscissae
             let c = fit.finest();
-            let max = params
-                .iter()
-                .zip(pts)
-                .map(|(&t, &p)| dist(c.eval(t), p))
-                .fold(0.0, f64::max);
+            let max = params.iter().zip(pts).map(|(&t, &p)| dist(c.eval(t), p)).fold(0.0, f64::max);
             assert!((max - fit.final_max_error()).abs() <= 1e-15 * h.diameter);
-            assert!(
-                max <= h.tol_abs,
-                "{rel} {}: {max} > {}",
-                fit.side,
-                h.tol_abs
-            );
+            assert!(max <= h.tol_abs, "{rel} {}: {max} > {}", fit.side, h.tol_abs);
         }
     }
 }
@@ -238,16 +170,8 @@ fn point_clouds_use_cord_length_and_meet_tolerance() {
 #[test]
 fn convergence_orders_under_uniform_halving() {
     let curves = [
-        (
-            "sine",
-            SideCurve::Analytic(Analytic::new(|t| [t, (2.0 * PI * t).sin()])),
-        ),
-        (
-            "arc",
-            SideCurve::Analytic(Analytic::new(|t| {
-                [(0.5 * PI * t).cos(), (0.5 * PI * t).sin()]
-            })),
-        ),
+        ("sine", SideCurve::Analytic(Analytic::new(|t| [t, (2.0 * PI * t).sin()]))),
+        ("arc", SideCurve::Analytic(Analytic::new(|t| [(0.5 * PI * t).cos(), (0.5 * PI * t).sin()]))),
     ];
     for (name, f) in &curves {
         for p in 2..=4 {
@@ -261,10 +185,7 @@ fn convergence_orders_under_uniform_halving() {
             let es: Vec<String> = errors.iter().map(|e| format!("{e:.3e}")).collect();
             println!("{name} p={p}: max errors {es:?}, observed orders {orders:.2?}");
             let last = orders[orders.len() - 1];
-            assert!(
-                (last - (p + 1) as f64).abs() < 0.5,
-                "{name} p={p}: orders {orders:?}"
-            );
+            assert!((last - (p + 1) as f64).abs() < 0.5, "{name} p={p}: orders {orders:?}");
         }
     }
 }
@@ -274,18 +195,8 @@ fn low_degree_sides_are_reproduced_on_the_coarsest_level() {
     // A cubic NURBS-free spline side with two inner knots: a degree-3 fit needs refinement,
     // but a straight segment and a single cubic segment are exact at level 0.
     let seg = KnotVector::new(3, vec![0., 0., 0., 0., 1., 1., 1., 1.]).unwrap();
-    let south = Curve::new(
-        seg.clone(),
-        vec![[0., 0.], [0.4, -0.1], [0.7, 0.1], [1., 0.]],
-        None,
-    )
-    .unwrap();
-    let east = Curve::new(
-        KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(),
-        vec![[1., 0.], [1., 1.]],
-        None,
-    )
-    .unwrap();
+    let south = Curve::new(seg.clone(), vec![[0., 0.], [0.4, -0.1], [0.7, 0.1], [1., 0.]], None).unwrap();
+    let east = Curve::new(KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(), vec![[1., 0.], [1., 1.]], None).unwrap();
     let north = Curve::new(
         KnotVector::new(2, vec![0., 0., 0., 1., 1., 1.]).unwrap(),
         vec![[0., 1.], [0.5, 1.3], [1., 1.]],
@@ -295,43 +206,26 @@ fn low_degree_sides_are_reproduced_on_the_coarsest_level() {
     let west = SideCurve::Analytic(Analytic::new(|t| [0.1 * t * (1.0 - t), t]));
     let b = Boundary {
         name: "polynomial".into(),
-        sides: [
-            SideCurve::Spline(south),
-            SideCurve::Spline(east),
-            SideCurve::Spline(north),
-            west,
-        ],
+        sides: [SideCurve::Spline(south), SideCurve::Spline(east), SideCurve::Spline(north), west],
     };
     let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
     assert_eq!(h.levels.len(), 1);
     assert_eq!(h.finest().num_basis(), 16);
     for fit in &h.fits {
         assert_eq!(fit.levels.len(), 1);
-        assert!(
-            fit.max_error[0] < 1e-13,
-            "{}: {}",
-            fit.side,
-            fit.max_error[0]
-        );
+        assert!(fit.max_error[0] < 1e-13, "{}: {}", fit.side, fit.max_error[0]);
     }
 }
 
 #[test]
 fn other_degrees_and_initial_meshes_converge() {
     for (p, ie) in [(2, 1), (4, 3), (5, 2)] {
-        let opts = FitOptions {
-            degree: p,
-            initial_elements: ie,
-            ..Default::default()
-        };
+        let opts = FitOptions { degree: p, initial_elements: ie, ..Default::default() };
         for rel in GEOMETRIES {
             let h = build_hierarchy(&load(rel), &opts).unwrap();
             assert!(h.converged(), "{rel} p={p} ie={ie}");
             assert!(h.max_error() <= h.tol_abs, "{rel} p={p} ie={ie}");
-            assert!(h
-                .levels
-                .iter()
-                .all(|l| l.knots[0].degree() == p && l.knots[1].degree() == p));
+            assert!(h.levels.iter().all(|l| l.knots[0].degree() == p && l.knots[1].degree() == p));
             assert!(h.levels[0].knots.iter().all(|k| k.num_elements() == ie));
         }
     }
@@ -342,11 +236,7 @@ fn point_cloud_fits_stay_near_the_polyline_between_points() {
     // Between the points nothing is measured; the fit should still follow the polyline.
     // Smooth clouds stay within the tolerance; at the sharp V of the notched square the
     // smooth fit overshoots the polyline slightly (a few tolerances).
-    for (rel, factor) in [
-        ("narrow_tube.json", 1.0),
-        ("spiral_channel.json", 1.0),
-        ("notched_square.json", 4.0),
-    ] {
+    for (rel, factor) in [("narrow_tube.json", 1.0), ("spiral_channel.json", 1.0), ("notched_square.json", 4.0)] {
         let b = load(rel);
         let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
         for fit in &h.fits {
@@ -362,17 +252,10 @@ fn point_cloud_fits_stay_near_the_polyline_between_points() {
                 let j = params.partition_point(|&u| u <= t).clamp(1, pts.len() - 1) - 1;
                 let lo = j.saturating_sub(4);
                 let hi = (j + 5).min(pts.len() - 1);
-                let d = (lo..hi)
-                    .map(|k| seg_dist(x, pts[k], pts[k + 1]))
-                    .fold(f64::INFINITY, f64::min);
+                let d = (lo..hi).map(|k| seg_dist(x, pts[k], pts[k + 1])).fold(f64::INFINITY, f64::min);
                 worst = worst.max(d);
             }
-            assert!(
-                worst <= factor * h.tol_abs,
-                "{rel} {}: {worst:e} vs tol {:e}",
-                fit.side,
-                h.tol_abs
-            );
+            assert!(worst <= factor * h.tol_abs, "{rel} {}: {worst:e} vs tol {:e}", fit.side, h.tol_abs);
         }
     }
 }
@@ -380,10 +263,6 @@ fn point_cloud_fits_stay_near_the_polyline_between_points() {
 fn seg_dist(x: Point, a: Point, b: Point) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let t = if l2 > 0.0 { (((x[0] - a[0]) * d[0] + (x[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0) } else { 0.0 };
     dist(x, [a[0] + t * d[0], a[1] + t * d[1]])
 }

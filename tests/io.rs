@@ -6,20 +6,15 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 use winslow::error::MAX_CONTROL_POINTS;
 use winslow::io::{
-    boundary_to_contour_json, boundary_to_json, checked_boundary, map_to_json, parse_document,
-    parse_gismo_xml, parse_json, write_json, MAX_FILE_BYTES,
+    boundary_to_contour_json, boundary_to_json, checked_boundary, map_to_json, parse_document, parse_gismo_xml,
+    parse_json, write_json, MAX_FILE_BYTES,
 };
 use winslow::testutil::Lcg;
 use winslow::validate::{inspect, Orientation};
-use winslow::{
-    read_boundary, read_document, validate, Boundary, Document, Error, Point, ReadOptions, Side,
-    SideCurve,
-};
+use winslow::{read_boundary, read_document, validate, Boundary, Document, Error, Point, ReadOptions, Side, SideCurve};
 
 fn data(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(rel)
 }
 
 fn files_in(dir: &str, ext: &str) -> Vec<PathBuf> {
@@ -51,18 +46,11 @@ fn every_shared_geometry_loads_and_validates() {
     assert!(data("gismo/NOTICE.md").exists());
     for f in files {
         let t = std::time::Instant::now();
-        let b = read_boundary(&f, &ReadOptions::default())
-            .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let b = read_boundary(&f, &ReadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         let r = validate(&b).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         assert_eq!(r.orientation, Orientation::CounterClockwise);
         assert!(r.signed_area > 0.0);
-        assert!(
-            r.corner_angles
-                .iter()
-                .all(|a| a.is_finite() && *a > 0.0 && *a < 360.0),
-            "{}: {r:?}",
-            f.display()
-        );
+        assert!(r.corner_angles.iter().all(|a| a.is_finite() && *a > 0.0 && *a < 360.0), "{}: {r:?}", f.display());
         assert!(!b.name.is_empty());
         eprintln!(
             "{:<28} area {:>12.5e} diam {:>10.4} corners [{:.1}, {:.1}, {:.1}, {:.1}] deg, {} polyline points, {:.0} ms",
@@ -81,11 +69,8 @@ fn every_shared_geometry_loads_and_validates() {
 
 #[test]
 fn corner_angles_of_known_geometries() {
-    let angles = |rel: &str| {
-        validate(&read_boundary(&data(rel), &ReadOptions::default()).unwrap())
-            .unwrap()
-            .corner_angles
-    };
+    let angles =
+        |rel: &str| validate(&read_boundary(&data(rel), &ReadOptions::default()).unwrap()).unwrap().corner_angles;
     // The disk: four quarter arcs meet at 180 degrees.
     for a in angles("gismo/disk.json") {
         assert!((a - 180.0).abs() < 1e-6, "{a}");
@@ -98,10 +83,7 @@ fn corner_angles_of_known_geometries() {
     let c = angles("gismo/cooks_membrane.json");
     let sum: f64 = c.iter().sum();
     assert!((sum - 360.0).abs() < 1e-9, "{c:?}");
-    assert!(
-        (c[0] - (90.0 - 44f64.atan2(48.0).to_degrees())).abs() < 1e-9,
-        "{c:?}"
-    );
+    assert!((c[0] - (90.0 - 44f64.atan2(48.0).to_degrees())).abs() < 1e-9, "{c:?}");
 }
 
 fn sides_agree(a: &Boundary, b: &Boundary, what: &str) {
@@ -111,11 +93,7 @@ fn sides_agree(a: &Boundary, b: &Boundary, what: &str) {
             panic!("{what}: {s} is not a spline on both sides");
         };
         assert_eq!(ca.degree(), cb.degree(), "{what}: {s}");
-        assert_eq!(
-            ca.control_points.len(),
-            cb.control_points.len(),
-            "{what}: {s}"
-        );
+        assert_eq!(ca.control_points.len(), cb.control_points.len(), "{what}: {s}");
         assert_eq!(ca.is_rational(), cb.is_rational(), "{what}: {s}");
         for (x, y) in ca.knots.knots().iter().zip(cb.knots.knots()) {
             assert!((x - y).abs() <= 1e-12, "{what}: {s} knots {x} vs {y}");
@@ -165,44 +143,20 @@ fn gismo_orientation_field_matches_the_assignment() {
 
 #[test]
 fn map_round_trip_is_bit_exact() {
-    for stem in [
-        "rotor_sector",
-        "plate_with_hole",
-        "disk",
-        "flapping_beam",
-        "lake",
-        "cooks_membrane",
-    ] {
-        let Document::Map { name, map } =
-            read_document(&data(&format!("gismo/xml/{stem}.xml"))).unwrap()
-        else {
+    for stem in ["rotor_sector", "plate_with_hole", "disk", "flapping_beam", "lake", "cooks_membrane"] {
+        let Document::Map { name, map } = read_document(&data(&format!("gismo/xml/{stem}.xml"))).unwrap() else {
             panic!("{stem} is not a map");
         };
         assert_eq!(name, stem);
         let extra = json!({"report": {"iterations": 7, "residuals": [1e-3, 2.5e-9]}});
         let v = map_to_json(&name, &map, Some(extra.clone()));
         let text = serde_json::to_string_pretty(&v).unwrap();
-        let Document::Map {
-            name: name2,
-            map: map2,
-        } = parse_json(&text).unwrap()
-        else {
-            panic!()
-        };
+        let Document::Map { name: name2, map: map2 } = parse_json(&text).unwrap() else { panic!() };
         assert_eq!(name2, name);
         assert_eq!(map2, map);
         let bits = |s: &winslow::Surface| -> Vec<u64> {
-            let mut b: Vec<u64> = s
-                .control_points
-                .iter()
-                .flatten()
-                .map(|x| x.to_bits())
-                .collect();
-            b.extend(
-                s.knots
-                    .iter()
-                    .flat_map(|k| k.knots().iter().map(|x| x.to_bits())),
-            );
+            let mut b: Vec<u64> = s.control_points.iter().flatten().map(|x| x.to_bits()).collect();
+            b.extend(s.knots.iter().flat_map(|k| k.knots().iter().map(|x| x.to_bits())));
             b.extend(s.weights.iter().flatten().map(|x| x.to_bits()));
             b
         };
@@ -215,19 +169,10 @@ fn map_round_trip_is_bit_exact() {
         let b = read_boundary(&path, &ReadOptions::default()).unwrap();
         std::fs::remove_file(&path).unwrap();
         for s in Side::ALL {
-            let SideCurve::Spline(c) = b.side(s) else {
-                panic!()
-            };
+            let SideCurve::Spline(c) = b.side(s) else { panic!() };
             let m = map.boundary(s);
-            assert_eq!(
-                (&c.knots, &c.control_points),
-                (&m.knots, &m.control_points),
-                "{stem} {s}"
-            );
-            let unit = |w: &Option<Vec<f64>>| {
-                w.clone()
-                    .unwrap_or_else(|| vec![1.0; m.control_points.len()])
-            };
+            assert_eq!((&c.knots, &c.control_points), (&m.knots, &m.control_points), "{stem} {s}");
+            let unit = |w: &Option<Vec<f64>>| w.clone().unwrap_or_else(|| vec![1.0; m.control_points.len()]);
             assert_eq!(unit(&c.weights), unit(&m.weights), "{stem} {s}");
         }
     }
@@ -247,15 +192,11 @@ fn random_map_round_trip_is_bit_exact() {
     for _ in 0..20 {
         let (a, b) = (kv(&mut rng, 2), kv(&mut rng, 3));
         let n = a.num_basis() * b.num_basis();
-        let cps: Vec<Point> = (0..n)
-            .map(|_| [rng.uniform() * 1e3 - 5e2, (rng.uniform() - 0.5) * 1e-7])
-            .collect();
+        let cps: Vec<Point> = (0..n).map(|_| [rng.uniform() * 1e3 - 5e2, (rng.uniform() - 0.5) * 1e-7]).collect();
         let w: Vec<f64> = (0..n).map(|_| 0.1 + rng.uniform()).collect();
         let s = winslow::Surface::new([a, b], cps, Some(w)).unwrap();
         let text = serde_json::to_string(&map_to_json("r", &s, None)).unwrap();
-        let Document::Map { map, .. } = parse_json(&text).unwrap() else {
-            panic!()
-        };
+        let Document::Map { map, .. } = parse_json(&text).unwrap() else { panic!() };
         assert_eq!(map, s);
     }
 }
@@ -277,44 +218,30 @@ fn star(n: usize) -> Vec<Point> {
 fn contour_document_round_trip() {
     let pts = star(64);
     let corners = [5usize, 20, 37, 50];
-    let doc =
-        json!({"name": "star", "note": "ignored", "contour": {"points": pts, "corners": corners}});
-    let Document::Boundary(b) = parse_json(&doc.to_string()).unwrap() else {
-        panic!()
-    };
+    let doc = json!({"name": "star", "note": "ignored", "contour": {"points": pts, "corners": corners}});
+    let Document::Boundary(b) = parse_json(&doc.to_string()).unwrap() else { panic!() };
     assert_eq!(b.name, "star");
     let r = validate(&b).unwrap();
     assert!(r.signed_area > 3.0);
-    let SideCurve::Points(south) = b.side(Side::South) else {
-        panic!()
-    };
+    let SideCurve::Points(south) = b.side(Side::South) else { panic!() };
     assert_eq!(south.len(), 16);
     assert_eq!(south[0], pts[5]);
     assert_eq!(south[15], pts[20]);
-    let SideCurve::Points(north) = b.side(Side::North) else {
-        panic!()
-    };
+    let SideCurve::Points(north) = b.side(Side::North) else { panic!() };
     assert_eq!(north[0], pts[50]);
     assert_eq!(*north.last().unwrap(), pts[37]);
-    let SideCurve::Points(west) = b.side(Side::West) else {
-        panic!()
-    };
+    let SideCurve::Points(west) = b.side(Side::West) else { panic!() };
     assert_eq!(west.len(), 64 - 50 + 5 + 1);
     assert_eq!(west[0], pts[5]);
     assert_eq!(*west.last().unwrap(), pts[50]);
 
     // boundary -> contour document -> boundary gives the same sides
     let back = boundary_to_contour_json(&b);
-    let Document::Boundary(b2) = parse_json(&back.to_string()).unwrap() else {
-        panic!()
-    };
+    let Document::Boundary(b2) = parse_json(&back.to_string()).unwrap() else { panic!() };
     // boundary -> boundary document -> boundary too
-    let Document::Boundary(b3) = parse_json(&boundary_to_json(&b).to_string()).unwrap() else {
-        panic!()
-    };
+    let Document::Boundary(b3) = parse_json(&boundary_to_json(&b).to_string()).unwrap() else { panic!() };
     for s in Side::ALL {
-        let (SideCurve::Points(p), SideCurve::Points(q), SideCurve::Points(r)) =
-            (b.side(s), b2.side(s), b3.side(s))
+        let (SideCurve::Points(p), SideCurve::Points(q), SideCurve::Points(r)) = (b.side(s), b2.side(s), b3.side(s))
         else {
             panic!()
         };
@@ -323,17 +250,11 @@ fn contour_document_round_trip() {
     }
     // Same polygon without the repeated point, through a file.
     let path = scratch("star-contour.json");
-    write_json(
-        &path,
-        &json!({"name": "star", "contour": {"points": &pts[..64], "corners": corners}}),
-    )
-    .unwrap();
+    write_json(&path, &json!({"name": "star", "contour": {"points": &pts[..64], "corners": corners}})).unwrap();
     let b4 = read_boundary(&path, &ReadOptions::default()).unwrap();
     std::fs::remove_file(&path).unwrap();
     for s in Side::ALL {
-        let (SideCurve::Points(p), SideCurve::Points(q)) = (b.side(s), b4.side(s)) else {
-            panic!()
-        };
+        let (SideCurve::Points(p), SideCurve::Points(q)) = (b.side(s), b4.side(s)) else { panic!() };
         assert_eq!(p, q, "{s}");
     }
 }
@@ -355,13 +276,8 @@ fn clockwise_contour_is_rejected_or_reoriented() {
     assert_eq!(r.orientation, Orientation::CounterClockwise);
     assert!(r.signed_area > 0.0);
     // the transposed boundary: new south = old west
-    let Document::Boundary(orig) = parse_json(&doc.to_string()).unwrap() else {
-        panic!()
-    };
-    let (SideCurve::Points(s), SideCurve::Points(w)) = (b.side(Side::South), orig.side(Side::West))
-    else {
-        panic!()
-    };
+    let Document::Boundary(orig) = parse_json(&doc.to_string()).unwrap() else { panic!() };
+    let (SideCurve::Points(s), SideCurve::Points(w)) = (b.side(Side::South), orig.side(Side::West)) else { panic!() };
     assert_eq!(s, w);
 }
 
@@ -424,10 +340,7 @@ fn zero_length_side() {
         "west": line([0., 0.], [0., 1.]),
     }});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::DegenerateSide { ref side, .. } if side == "south"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::DegenerateSide { ref side, .. } if side == "south"), "{e}");
     assert!(e.to_string().contains("south"));
 }
 
@@ -436,15 +349,9 @@ fn too_few_points() {
     let mut d = square_doc();
     d["boundary"]["north"] = json!({"points": [[0., 1.]]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::TooFewPoints { ref side, found: 1, .. } if side == "north"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::TooFewPoints { ref side, found: 1, .. } if side == "north"), "{e}");
     d["boundary"]["north"] = json!({"points": []});
-    assert!(matches!(
-        load(&d),
-        Err(Error::TooFewPoints { found: 0, .. })
-    ));
+    assert!(matches!(load(&d), Err(Error::TooFewPoints { found: 0, .. })));
 }
 
 #[test]
@@ -452,52 +359,28 @@ fn non_finite_numbers() {
     // JSON cannot carry NaN; an overflowing literal is a parse error (or infinity).
     let text = square_doc().to_string().replacen("0.5", "1e999", 1);
     assert!(text.contains("1e999"));
-    let e = parse_json(&text)
-        .and_then(|d| checked_boundary(d.into_boundary(), &ReadOptions::default()).map(|_| ()));
-    assert!(
-        matches!(e, Err(Error::Json { .. } | Error::NonFinite { .. })),
-        "{e:?}"
-    );
-    let text =
-        square_doc()
-            .to_string()
-            .replacen("[0.0,0.0],[1.0,0.0]", "[0.0,0.0],[-1e400,0.0]", 1);
-    assert!(matches!(
-        parse_json(&text),
-        Err(Error::Json { .. } | Error::NonFinite { .. })
-    ));
-    assert!(matches!(
-        parse_json(r#"{"boundary": NaN}"#),
-        Err(Error::Json { .. })
-    ));
+    let e = parse_json(&text).and_then(|d| checked_boundary(d.into_boundary(), &ReadOptions::default()).map(|_| ()));
+    assert!(matches!(e, Err(Error::Json { .. } | Error::NonFinite { .. })), "{e:?}");
+    let text = square_doc().to_string().replacen("[0.0,0.0],[1.0,0.0]", "[0.0,0.0],[-1e400,0.0]", 1);
+    assert!(matches!(parse_json(&text), Err(Error::Json { .. } | Error::NonFinite { .. })));
+    assert!(matches!(parse_json(r#"{"boundary": NaN}"#), Err(Error::Json { .. })));
     // From the library a NaN can be built directly.
-    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else {
-        panic!()
-    };
+    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else { panic!() };
     b.sides[3] = SideCurve::Points(vec![[0., 0.], [f64::NAN, 0.5], [0., 1.]]);
     let e = validate(&b).unwrap_err();
     assert!(matches!(e, Error::NonFinite { .. }), "{e}");
     assert!(e.to_string().contains("boundary.west"), "{e}");
     // ... or an infinite control point
-    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else {
-        panic!()
-    };
+    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else { panic!() };
     if let SideCurve::Spline(c) = &mut b.sides[0] {
         c.control_points[1][0] = f64::INFINITY;
     }
     let e = validate(&b).unwrap_err();
-    assert!(
-        matches!(e, Error::NonFinite { .. }) && e.to_string().contains("boundary.south"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::NonFinite { .. }) && e.to_string().contains("boundary.south"), "{e}");
     // huge but finite coordinates overflow the bounding box
     let mut d = square_doc();
-    d["boundary"]["north"] =
-        json!({"points": [[0., 1.], [1e308, -1e308], [-1e308, 1e308], [1., 1.]]});
-    assert!(matches!(
-        load(&d),
-        Err(Error::NonFinite { .. } | Error::SelfIntersection { .. })
-    ));
+    d["boundary"]["north"] = json!({"points": [[0., 1.], [1e308, -1e308], [-1e308, 1e308], [1., 1.]]});
+    assert!(matches!(load(&d), Err(Error::NonFinite { .. } | Error::SelfIntersection { .. })));
 }
 
 #[test]
@@ -513,8 +396,7 @@ fn self_intersection_names_the_sides() {
     let msg = e.to_string();
     assert!(msg.contains("south") && msg.contains("north"), "{msg}");
     // a side crossing itself
-    d["boundary"]["north"] =
-        json!({"points": [[0., 1.], [0.6, 1.2], [0.6, 0.8], [0.4, 1.0], [1., 1.]]});
+    d["boundary"]["north"] = json!({"points": [[0., 1.], [0.6, 1.2], [0.6, 0.8], [0.4, 1.0], [1., 1.]]});
     let e = load(&d).unwrap_err();
     assert!(
         matches!(e, Error::SelfIntersection { ref side_a, ref side_b, .. } if side_a == "north" && side_b == "north"),
@@ -559,45 +441,31 @@ fn narrow_gap_is_not_a_crossing() {
 #[test]
 fn wrong_lengths_decreasing_knots_weights_degree() {
     let mut d = square_doc();
-    d["boundary"]["west"] =
-        json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 0.5], [0, 1]]});
+    d["boundary"]["west"] = json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 0.5], [0, 1]]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Length { .. }) && e.to_string().contains("boundary.west"),
-        "{e}"
-    );
-
-    d["boundary"]["west"] = json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1]});
-    let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Length { .. }) && e.to_string().contains("boundary.west"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Length { .. }) && e.to_string().contains("boundary.west"), "{e}");
 
     d["boundary"]["west"] =
-        json!({"degree": 1, "knots": [0, 0.6, 0.4, 1], "control_points": [[0, 0], [0, 1]]});
+        json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Knots { .. }) && e.to_string().contains("boundary.west.knots"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Length { .. }) && e.to_string().contains("boundary.west"), "{e}");
 
-    d["boundary"]["west"] = json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1, -2]});
+    d["boundary"]["west"] = json!({"degree": 1, "knots": [0, 0.6, 0.4, 1], "control_points": [[0, 0], [0, 1]]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Weight { index: 1, .. }) && e.to_string().contains("boundary.west"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Knots { .. }) && e.to_string().contains("boundary.west.knots"), "{e}");
 
-    d["boundary"]["west"] = json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1, 0]});
+    d["boundary"]["west"] =
+        json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1, -2]});
+    let e = load(&d).unwrap_err();
+    assert!(matches!(e, Error::Weight { index: 1, .. }) && e.to_string().contains("boundary.west"), "{e}");
+
+    d["boundary"]["west"] =
+        json!({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [0, 1]], "weights": [1, 0]});
     assert!(matches!(load(&d), Err(Error::Weight { .. })));
 
     d["boundary"]["west"] = json!({"degree": 0, "knots": [0, 1], "control_points": [[0, 0]]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Degree { degree: 0, .. }) && e.to_string().contains("boundary.west"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Degree { degree: 0, .. }) && e.to_string().contains("boundary.west"), "{e}");
 
     d["boundary"]["west"] = json!({"degree": -1, "knots": [0, 1], "control_points": [[0, 0]]});
     assert!(matches!(load(&d), Err(Error::Json { .. })));
@@ -607,10 +475,7 @@ fn wrong_lengths_decreasing_knots_weights_degree() {
 
     d["boundary"]["west"] = json!({"points": [[0, 0, 3], [0, 1]]});
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Json { .. }) && e.to_string().contains("boundary.west"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Json { .. }) && e.to_string().contains("boundary.west"), "{e}");
 
     d["boundary"]["west"] = json!(42);
     assert!(matches!(load(&d), Err(Error::Json { .. })));
@@ -618,17 +483,11 @@ fn wrong_lengths_decreasing_knots_weights_degree() {
     let mut d = square_doc();
     d["boundary"].as_object_mut().unwrap().remove("east");
     let e = load(&d).unwrap_err();
-    assert!(
-        matches!(e, Error::Json { .. }) && e.to_string().contains("east"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::Json { .. }) && e.to_string().contains("east"), "{e}");
 
     let e = load(&json!({"name": "nothing"})).unwrap_err();
     assert!(matches!(e, Error::Json { .. }));
-    assert!(matches!(
-        load(&json!({"name": 3, "boundary": {}})),
-        Err(Error::Json { .. })
-    ));
+    assert!(matches!(load(&json!({"name": 3, "boundary": {}})), Err(Error::Json { .. })));
     assert!(matches!(load(&json!([1, 2])), Err(Error::Json { .. })));
 }
 
@@ -642,31 +501,13 @@ fn bad_map_documents() {
         d["map"][path] = v;
         parse_json(&d.to_string()).unwrap_err()
     };
-    assert!(matches!(
-        with("control_points", json!([[0, 0], [1, 0], [0, 1]])),
-        Error::Length { .. }
-    ));
-    assert!(matches!(
-        with("weights", json!([1, 1, 1, 0])),
-        Error::Weight { index: 3, .. }
-    ));
-    assert!(matches!(
-        with("weights", json!([1, 1, 1])),
-        Error::Length { .. }
-    ));
-    assert!(matches!(
-        with("degree", json!([0, 1])),
-        Error::Degree { .. }
-    ));
+    assert!(matches!(with("control_points", json!([[0, 0], [1, 0], [0, 1]])), Error::Length { .. }));
+    assert!(matches!(with("weights", json!([1, 1, 1, 0])), Error::Weight { index: 3, .. }));
+    assert!(matches!(with("weights", json!([1, 1, 1])), Error::Length { .. }));
+    assert!(matches!(with("degree", json!([0, 1])), Error::Degree { .. }));
     assert!(matches!(with("degree", json!([1])), Error::Json { .. }));
-    assert!(matches!(
-        with("knots", json!([[0, 0, 1, 1], [1, 1, 0, 0]])),
-        Error::Knots { .. }
-    ));
-    assert!(matches!(
-        with("knots", json!([[0, 0, 1, 1]])),
-        Error::Json { .. }
-    ));
+    assert!(matches!(with("knots", json!([[0, 0, 1, 1], [1, 1, 0, 0]])), Error::Knots { .. }));
+    assert!(matches!(with("knots", json!([[0, 0, 1, 1]])), Error::Json { .. }));
     let e = with("knots", json!([[0, 0, 1, 1], [0, 0, 0, 0]]));
     assert!(e.to_string().contains("map.knots[1]"), "{e}");
 }
@@ -674,16 +515,11 @@ fn bad_map_documents() {
 #[test]
 fn absurd_sizes() {
     // more points than MAX_CONTROL_POINTS
-    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else {
-        panic!()
-    };
+    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else { panic!() };
     let n = MAX_CONTROL_POINTS + 1;
     b.sides[2] = SideCurve::Points((0..n).map(|k| [k as f64 / (n - 1) as f64, 1.0]).collect());
     let e = validate(&b).unwrap_err();
-    assert!(
-        matches!(e, Error::TooLarge { .. }) && e.to_string().contains("boundary.north"),
-        "{e}"
-    );
+    assert!(matches!(e, Error::TooLarge { .. }) && e.to_string().contains("boundary.north"), "{e}");
     // a contour with too many points
     let pts: Vec<Point> = (0..n).map(|k| [k as f64, 0.0]).collect();
     let e = winslow::io::split_contour(&pts, [0, 1, 2, 3]).unwrap_err();
@@ -701,12 +537,7 @@ fn absurd_sizes() {
 #[test]
 fn truncated_and_mutated_inputs_never_panic() {
     let mut texts: Vec<String> = vec![square_doc().to_string()];
-    for rel in [
-        "gismo/xml/plate_with_hole.xml",
-        "gismo/xml/duck.xml",
-        "gismo/puzzle4.json",
-        "gismo/xml/disk.xml",
-    ] {
+    for rel in ["gismo/xml/plate_with_hole.xml", "gismo/xml/duck.xml", "gismo/puzzle4.json", "gismo/xml/disk.xml"] {
         texts.push(std::fs::read_to_string(data(rel)).unwrap());
     }
     let mut rng = Lcg::new(42);
@@ -715,10 +546,7 @@ fn truncated_and_mutated_inputs_never_panic() {
         let bytes = t.as_bytes();
         // every truncation point (on char boundaries)
         for cut in (0..bytes.len()).filter(|&c| t.is_char_boundary(c)) {
-            if parse_document(&t[..cut])
-                .and_then(|d| inspect(&d.into_boundary()))
-                .is_err()
-            {
+            if parse_document(&t[..cut]).and_then(|d| inspect(&d.into_boundary())).is_err() {
                 errors += 1;
             }
         }
@@ -751,21 +579,12 @@ fn unnamed_documents_take_the_file_stem() {
 
 #[test]
 fn analytic_sides_are_written_as_point_clouds() {
-    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else {
-        panic!()
-    };
-    b.sides[2] = SideCurve::Analytic(winslow::Analytic::new(|t| {
-        [t, 1.0 + 0.1 * (std::f64::consts::PI * t).sin()]
-    }));
+    let Document::Boundary(mut b) = parse_json(&square_doc().to_string()).unwrap() else { panic!() };
+    b.sides[2] = SideCurve::Analytic(winslow::Analytic::new(|t| [t, 1.0 + 0.1 * (std::f64::consts::PI * t).sin()]));
     validate(&b).unwrap();
     let v = boundary_to_json(&b);
-    assert_eq!(
-        v["boundary"]["north"]["points"].as_array().unwrap().len(),
-        1025
-    );
+    assert_eq!(v["boundary"]["north"]["points"].as_array().unwrap().len(), 1025);
     let b2 = load(&v).unwrap();
-    let SideCurve::Points(p) = b2.side(Side::North) else {
-        panic!()
-    };
+    let SideCurve::Points(p) = b2.side(Side::North) else { panic!() };
     assert_eq!(p[512], [0.5, 1.1]);
 }

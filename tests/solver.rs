@@ -86,7 +86,11 @@ fn degenerate_corners_are_named() {
         assert_eq!(r.verdict, Verdict::DegenerateCorner, "{file}: {}", r.message);
         let forced: Vec<_> = r.corners.iter().filter(|c| c.forces_nonpositive_det_j).collect();
         assert!(!forced.is_empty(), "{file}");
-        assert!(forced.iter().all(|c| c.angle_degrees >= 179.0 && r.message.contains(c.corner)), "{file}: {}", r.message);
+        assert!(
+            forced.iter().all(|c| c.angle_degrees >= 179.0 && r.message.contains(c.corner)),
+            "{file}: {}",
+            r.message
+        );
         assert!(r.det_j_min_away_from_forced_corners > 0.0, "{file}");
     }
 }
@@ -101,7 +105,9 @@ fn kinks_in_spline_sides_are_named() {
     assert_eq!(r.kinks.len(), 1, "{:?}", r.kinks);
     let k = &r.kinks[0];
     assert_eq!(k.side, "north");
-    assert!((k.turning_degrees - 90.0).abs() < 1.0 && (k.point[0] + 4.0).abs() < 1e-12 && (k.point[1] - 4.0).abs() < 1e-12);
+    assert!(
+        (k.turning_degrees - 90.0).abs() < 1.0 && (k.point[0] + 4.0).abs() < 1e-12 && (k.point[1] - 4.0).abs() < 1e-12
+    );
     assert!(r.message.contains("kink") && r.message.contains("north"), "{}", r.message);
     assert_eq!(r.verdict, Verdict::PositiveOnSample);
 }
@@ -128,7 +134,11 @@ fn hard_geometries_run_and_report() {
 fn quarter_annulus_converges_under_refinement() {
     let maps: Vec<_> = (0..3)
         .map(|r| {
-            let opts = SolveOptions { refine: r, fit: winslow::FitOptions { tol: 1e-9, ..Default::default() }, ..Default::default() };
+            let opts = SolveOptions {
+                refine: r,
+                fit: winslow::FitOptions { tol: 1e-9, ..Default::default() },
+                ..Default::default()
+            };
             run("quarter_annulus.json", &opts).map
         })
         .collect();

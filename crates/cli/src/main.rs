@@ -15,13 +15,17 @@ use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Docu
 use winslow::linsolve::LinearMethod;
 use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
-use winslow::solver::{EggSolver, Event, SolveOptions, Solution, Verdict};
+use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
 use winslow::{Boundary, Side};
 
 mod output;
 
 #[derive(Parser, Debug)]
-#[command(name = "winslow", version, about = "Bijective spline maps of the unit square from a planar boundary (elliptic grid generation in IGA)")]
+#[command(
+    name = "winslow",
+    version,
+    about = "Bijective spline maps of the unit square from a planar boundary (elliptic grid generation in IGA)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -127,7 +131,7 @@ impl SolverArgs {
         if !(self.fit.fit_tol > 0.0 && self.fit.fit_tol < 1.0) {
             bail!("--fit-tol must be in (0, 1), got {}", self.fit.fit_tol);
         }
-        if !(self.tol > 0.0) {
+        if self.tol.is_nan() || self.tol <= 0.0 {
             bail!("--tol must be positive, got {}", self.tol);
         }
         let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
@@ -229,7 +233,9 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Solve(a) => solve(a),
         Command::Render(a) => {
             let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-            let Document::Map { map, .. } = doc else { bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display()) };
+            let Document::Map { map, .. } = doc else {
+                bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+            };
             let opts = PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, ..Default::default() };
             output::write_png(&a.png, &render(&map, &opts))?;
             println!("wrote {}", a.png.display());
@@ -295,7 +301,10 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
         for s in Side::ALL {
             let f = &h.fits[s as usize];
             if !f.converged {
-                eprintln!("  warning: {s} side fit did not reach the tolerance (max error {:.3e})", f.max_error.last().copied().unwrap_or(0.0));
+                eprintln!(
+                    "  warning: {s} side fit did not reach the tolerance (max error {:.3e})",
+                    f.max_error.last().copied().unwrap_or(0.0)
+                );
             }
         }
     }
@@ -309,7 +318,13 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
         let mut e = stderr.lock();
         match event {
             Event::LevelStarted { level, levels, shape, unknowns, initial_guess } => {
-                writeln!(e, "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}", level + 1, shape[0], shape[1])?;
+                writeln!(
+                    e,
+                    "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}",
+                    level + 1,
+                    shape[0],
+                    shape[1]
+                )?;
             }
             Event::Iterate { iterate: it, .. } => {
                 writeln!(
@@ -329,7 +344,11 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
                     e,
                     "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
                     r.iterations,
-                    if r.converged { "converged".to_string() } else { format!("NOT converged ({})", r.failure.unwrap_or_default()) },
+                    if r.converged {
+                        "converged".to_string()
+                    } else {
+                        format!("NOT converged ({})", r.failure.unwrap_or_default())
+                    },
                     r.initial_det_j_min,
                     r.seconds
                 )?;

@@ -135,16 +135,30 @@ pub fn inspect_text(
         side_lines(&mut s, side, b.side(side));
     }
     if let Some(r) = report {
-        let _ = writeln!(s, "  bounding box [{:.6}, {:.6}] x [{:.6}, {:.6}], diameter {:.6}", r.bbox_min[0], r.bbox_max[0], r.bbox_min[1], r.bbox_max[1], r.diameter);
+        let _ = writeln!(
+            s,
+            "  bounding box [{:.6}, {:.6}] x [{:.6}, {:.6}], diameter {:.6}",
+            r.bbox_min[0], r.bbox_max[0], r.bbox_min[1], r.bbox_max[1], r.diameter
+        );
         let _ = writeln!(s, "  orientation {:?} (signed area {:.6e})", r.orientation, r.signed_area);
         let names = ["south-west", "south-east", "north-east", "north-west"];
         for k in 0..4 {
             let warn = if r.corner_angles[k] >= 180.0 { "  <- >= 180 deg: det J cannot be positive here" } else { "" };
-            let _ = writeln!(s, "  corner {:<10} ({:.6}, {:.6}) angle {:7.2} deg, gap {:.1e}{warn}", names[k], r.corners[k][0], r.corners[k][1], r.corner_angles[k], r.corner_gaps[k]);
+            let _ = writeln!(
+                s,
+                "  corner {:<10} ({:.6}, {:.6}) angle {:7.2} deg, gap {:.1e}{warn}",
+                names[k], r.corners[k][0], r.corners[k][1], r.corner_angles[k], r.corner_gaps[k]
+            );
         }
     }
     if let Some(h) = fit {
-        let _ = writeln!(s, "  contour fit: tolerance {:.3e} (relative {:.1e} of the diameter), {} hierarchy levels", h.tol_abs, h.tol_abs / h.diameter, h.levels.len());
+        let _ = writeln!(
+            s,
+            "  contour fit: tolerance {:.3e} (relative {:.1e} of the diameter), {} hierarchy levels",
+            h.tol_abs,
+            h.tol_abs / h.diameter,
+            h.levels.len()
+        );
         for side in Side::ALL {
             let f = &h.fits[side as usize];
             let last = f.levels.last();
@@ -161,7 +175,8 @@ pub fn inspect_text(
                 let _ = writeln!(s, "           fitted knots {}", knot_list(c.knots.knots()));
             }
         }
-        let sizes: Vec<String> = h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
+        let sizes: Vec<String> =
+            h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
         let _ = writeln!(s, "    basis per level: {}", sizes.join(" -> "));
     }
     if problems.is_empty() {
@@ -175,8 +190,14 @@ pub fn inspect_text(
 }
 
 /// `winslow inspect --json`.
-pub fn inspect_json(b: &Boundary, report: Option<&ValidationReport>, fit: Option<&Hierarchy>, problems: &[String]) -> serde_json::Value {
-    let sides: Vec<serde_json::Value> = Side::ALL.iter().map(|&s| serde_json::json!({ "side": s.name(), "kind": b.side(s).describe() })).collect();
+pub fn inspect_json(
+    b: &Boundary,
+    report: Option<&ValidationReport>,
+    fit: Option<&Hierarchy>,
+    problems: &[String],
+) -> serde_json::Value {
+    let sides: Vec<serde_json::Value> =
+        Side::ALL.iter().map(|&s| serde_json::json!({ "side": s.name(), "kind": b.side(s).describe() })).collect();
     let fits: Option<Vec<serde_json::Value>> = fit.map(|h| {
         Side::ALL
             .iter()
@@ -256,7 +277,10 @@ impl BenchRow {
 /// The table printed by `winslow bench`.
 pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict |");
+    let _ = writeln!(
+        s,
+        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict |"
+    );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
@@ -274,7 +298,10 @@ pub fn default_bench_files() -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for dir in ["tests/data", "tests/data/gismo"] {
         let Ok(rd) = std::fs::read_dir(dir) else { continue };
-        let mut v: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect();
+        let mut v: Vec<PathBuf> = rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .collect();
         v.sort();
         out.extend(v);
     }
@@ -295,6 +322,11 @@ pub fn reset_peak_memory() {
 pub fn peak_memory_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse::<f64>().ok()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse::<f64>().ok())
+        })
         .map_or(0.0, |kb| kb / 1024.0)
 }

@@ -14,7 +14,11 @@ fn data() -> PathBuf {
 }
 
 fn files(dir: &Path, ext: &str) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == ext)).collect();
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
     v.sort();
     v
 }
@@ -29,7 +33,17 @@ fn inspect_every_shared_geometry() {
         let out = bin().arg("inspect").arg(&f).output().unwrap();
         let text = String::from_utf8_lossy(&out.stdout);
         assert!(out.status.success(), "{}: {text}{}", f.display(), String::from_utf8_lossy(&out.stderr));
-        for needle in ["south", "east", "north", "west", "knots", "corner", "orientation CounterClockwise", "contour fit: tolerance", "no problems found"] {
+        for needle in [
+            "south",
+            "east",
+            "north",
+            "west",
+            "knots",
+            "corner",
+            "orientation CounterClockwise",
+            "contour fit: tolerance",
+            "no problems found",
+        ] {
             assert!(text.contains(needle), "{}: missing {needle:?} in\n{text}", f.display());
         }
     }
@@ -77,8 +91,16 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     std::fs::create_dir_all(&dir).unwrap();
     let cases = [
         ("truncated.json", r#"{"name": "x", "boundary": {"south": {"degree": 1, "knots": [0, 0, 1"#, "malformed JSON"),
-        ("gap.json", r#"{"name":"g","boundary":{"south":{"points":[[0,0],[1,0]]},"east":{"points":[[1,0],[1,1]]},"north":{"points":[[0,1],[1,1]]},"west":{"points":[[0,0.5],[0,1]]}}}"#, "corner gap"),
-        ("cw.json", r#"{"name":"c","boundary":{"south":{"points":[[0,0],[0,1]]},"east":{"points":[[0,1],[1,1]]},"north":{"points":[[1,0],[1,1]]},"west":{"points":[[0,0],[1,0]]}}}"#, "clockwise"),
+        (
+            "gap.json",
+            r#"{"name":"g","boundary":{"south":{"points":[[0,0],[1,0]]},"east":{"points":[[1,0],[1,1]]},"north":{"points":[[0,1],[1,1]]},"west":{"points":[[0,0.5],[0,1]]}}}"#,
+            "corner gap",
+        ),
+        (
+            "cw.json",
+            r#"{"name":"c","boundary":{"south":{"points":[[0,0],[0,1]]},"east":{"points":[[0,1],[1,1]]},"north":{"points":[[1,0],[1,1]]},"west":{"points":[[0,0],[1,0]]}}}"#,
+            "clockwise",
+        ),
     ];
     for (name, text, needle) in cases {
         let f = dir.join(name);
@@ -90,15 +112,28 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
     // reorienting fixes the clockwise one
-    let out = bin().arg("solve").arg(dir.join("cw.json")).arg("--reorient").arg("-o").arg(dir.join("out.json")).arg("-q").output().unwrap();
+    let out = bin()
+        .arg("solve")
+        .arg(dir.join("cw.json"))
+        .arg("--reorient")
+        .arg("-o")
+        .arg(dir.join("out.json"))
+        .arg("-q")
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn bench_prints_a_table() {
-    let out = bin().arg("bench").arg(data().join("quarter_annulus.json")).args(["--refinements", "0,1"]).output().unwrap();
+    let out =
+        bin().arg("bench").arg(data().join("quarter_annulus.json")).args(["--refinements", "0,1"]).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}");
-    assert!(text.contains("| geometry | refine | DOFs |") && text.lines().filter(|l| l.starts_with("| quarter_annulus")).count() == 2, "{text}");
+    assert!(
+        text.contains("| geometry | refine | DOFs |")
+            && text.lines().filter(|l| l.starts_with("| quarter_annulus")).count() == 2,
+        "{text}"
+    );
 }

@@ -29,7 +29,9 @@ fn bench(c: &mut Criterion) {
         g.throughput(Throughput::Elements(qp as u64));
         let mut res = vec![0.0; 2 * disc.dofs.num_total()];
         let mut st = vec![0.0; disc.stencil_len(2)];
-        g.bench_with_input(BenchmarkId::new("residual", ne), &ne, |b, _| b.iter(|| disc.egg(&cps, Operator::Plain, &mut res, &mut [])));
+        g.bench_with_input(BenchmarkId::new("residual", ne), &ne, |b, _| {
+            b.iter(|| disc.egg(&cps, Operator::Plain, &mut res, &mut []))
+        });
         g.bench_with_input(BenchmarkId::new("residual+jacobian", ne), &ne, |b, _| {
             b.iter(|| disc.egg(&cps, Operator::Plain, &mut res, &mut st))
         });

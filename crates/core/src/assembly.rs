@@ -507,7 +507,8 @@ impl Discretization {
                     if det.abs() > 1e-12 * scale && scale > 0.0 {
                         for b in 0..nloc {
                             let (bu, bv) = (s.b[b][1], s.b[b][2]);
-                            s.t[b] = [(g.xv[1] * bu - g.xu[1] * bv) / det, (-g.xv[0] * bu + g.xu[0] * bv) / det, 0.0, 0.0];
+                            s.t[b] =
+                                [(g.xv[1] * bu - g.xu[1] * bv) / det, (-g.xv[0] * bu + g.xu[0] * bv) / det, 0.0, 0.0];
                         }
                     } else {
                         for b in 0..nloc {
@@ -519,7 +520,8 @@ impl Discretization {
                         for d in 0..2 {
                             for a in 0..nloc {
                                 let ga = s.t[a];
-                                let row = &mut s.ke[((z * 2 + d) * nloc + a) * nloc..((z * 2 + d) * nloc + a + 1) * nloc];
+                                let row =
+                                    &mut s.ke[((z * 2 + d) * nloc + a) * nloc..((z * 2 + d) * nloc + a + 1) * nloc];
                                 for (r, gb) in row.iter_mut().zip(&s.t) {
                                     let mut v = lambda * ga[z] * gb[d] + mu * ga[d] * gb[z];
                                     if z == d {

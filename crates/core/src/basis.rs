@@ -22,11 +22,7 @@ pub struct BasisDerivs {
 
 impl Default for BasisDerivs {
     fn default() -> Self {
-        Self {
-            span: 0,
-            degree: 0,
-            d: [[0.0; W]; MAX_DERIV + 1],
-        }
+        Self { span: 0, degree: 0, d: [[0.0; W]; MAX_DERIV + 1] }
     }
 }
 
@@ -93,11 +89,7 @@ impl BasisDerivs {
                     dk = a[s2][0] * ndu[rk as usize][pk];
                 }
                 let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2 = if (r as isize - 1) <= pk as isize {
-                    k - 1
-                } else {
-                    p - r
-                };
+                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
                 for j in j1..=j2 {
                     let idx = (rk + j as isize) as usize;
                     a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
@@ -180,10 +172,7 @@ mod tests {
                     assert!(bd.ders(0).iter().all(|&x| x >= -1e-15));
                     let d1: f64 = bd.ders(1).iter().sum();
                     let d2: f64 = bd.ders(2).iter().sum();
-                    assert!(
-                        d1.abs() < 1e-10 && d2.abs() < 1e-8,
-                        "derivs of unity {d1} {d2}"
-                    );
+                    assert!(d1.abs() < 1e-10 && d2.abs() < 1e-8, "derivs of unity {d1} {d2}");
                     // central differences inside the same span
                     let h = 1e-6 * (b - a);
                     let s0 = kv.knots()[bd.span];
@@ -199,17 +188,9 @@ mod tests {
                         let fd1 = (hi.d[0][j] - lo.d[0][j]) / (2.0 * h);
                         let fd2 = (hi.d[1][j] - lo.d[1][j]) / (2.0 * h);
                         let scale = 1.0 + bd.d[1][j].abs();
-                        assert!(
-                            (fd1 - bd.d[1][j]).abs() < 1e-6 * scale,
-                            "p={p} d1 {fd1} vs {}",
-                            bd.d[1][j]
-                        );
+                        assert!((fd1 - bd.d[1][j]).abs() < 1e-6 * scale, "p={p} d1 {fd1} vs {}", bd.d[1][j]);
                         let scale2 = 1.0 + bd.d[2][j].abs();
-                        assert!(
-                            (fd2 - bd.d[2][j]).abs() < 1e-5 * scale2,
-                            "p={p} d2 {fd2} vs {}",
-                            bd.d[2][j]
-                        );
+                        assert!((fd2 - bd.d[2][j]).abs() < 1e-5 * scale2, "p={p} d2 {fd2} vs {}", bd.d[2][j]);
                     }
                 }
             }

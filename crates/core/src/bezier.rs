@@ -39,14 +39,9 @@ impl BezierExtraction {
         let p = kv.degree();
         let bm = kv.breaks_with_multiplicity();
         if bm[1..bm.len() - 1].iter().any(|&(_, m)| m > p) {
-            return Err(Error::Invalid(
-                "Bézier extraction needs interior multiplicities <= p".into(),
-            ));
+            return Err(Error::Invalid("Bézier extraction needs interior multiplicities <= p".into()));
         }
-        let inner: Vec<f64> = bm[1..bm.len() - 1]
-            .iter()
-            .flat_map(|&(u, m)| std::iter::repeat_n(u, p - m))
-            .collect();
+        let inner: Vec<f64> = bm[1..bm.len() - 1].iter().flat_map(|&(u, m)| std::iter::repeat_n(u, p - m)).collect();
         let bez = kv.with_inserted(&inner);
         let pm = prolongation(kv, &bez)?;
         let elements = kv.elements();
@@ -62,11 +57,7 @@ impl BezierExtraction {
             }
             ops.push(op);
         }
-        Ok(Self {
-            degree: p,
-            elements,
-            ops,
-        })
+        Ok(Self { degree: p, elements, ops })
     }
 }
 
@@ -77,11 +68,7 @@ mod tests {
 
     #[test]
     fn extraction_reproduces_bsplines() {
-        let kv = KnotVector::new(
-            3,
-            vec![0., 0., 0., 0., 0.2, 0.5, 0.5, 0.7, 0.7, 0.7, 1., 1., 1., 1.],
-        )
-        .unwrap();
+        let kv = KnotVector::new(3, vec![0., 0., 0., 0., 0.2, 0.5, 0.5, 0.7, 0.7, 0.7, 1., 1., 1., 1.]).unwrap();
         let ex = BezierExtraction::new(&kv).unwrap();
         let p = 3;
         let mut b = [0.0; 4];

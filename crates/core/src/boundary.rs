@@ -97,9 +97,6 @@ impl Boundary {
     /// east, new west = old south. Reverses the orientation of the contour.
     pub fn transposed(&self) -> Boundary {
         let [s, e, n, w] = self.sides.clone();
-        Boundary {
-            name: self.name.clone(),
-            sides: [w, n, e, s],
-        }
+        Boundary { name: self.name.clone(), sides: [w, n, e, s] }
     }
 }

@@ -44,26 +44,14 @@ pub(crate) fn check_points(pts: &[Point], what: &str) -> Result<()> {
 
 pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
     if w.len() != expected {
-        return Err(Error::Length {
-            context: String::new(),
-            what: "weights".into(),
-            found: w.len(),
-            expected,
-        });
+        return Err(Error::Length { context: String::new(), what: "weights".into(), found: w.len(), expected });
     }
     for (i, &x) in w.iter().enumerate() {
         if !x.is_finite() {
-            return Err(Error::NonFinite {
-                context: String::new(),
-                what: format!("weight {i} is {x}"),
-            });
+            return Err(Error::NonFinite { context: String::new(), what: format!("weight {i} is {x}") });
         }
         if x <= 0.0 {
-            return Err(Error::Weight {
-                context: String::new(),
-                index: i,
-                value: x,
-            });
+            return Err(Error::Weight { context: String::new(), index: i, value: x });
         }
     }
     Ok(())
@@ -71,11 +59,7 @@ pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
 
 impl Curve {
     /// Validate lengths, finiteness and weights.
-    pub fn new(
-        knots: KnotVector,
-        control_points: Vec<Point>,
-        weights: Option<Vec<f64>>,
-    ) -> Result<Self> {
+    pub fn new(knots: KnotVector, control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots.num_basis();
         if control_points.len() != n {
             return Err(Error::Length {
@@ -90,21 +74,13 @@ impl Curve {
             check_weights(w, n)?;
         }
         let weights = weights.filter(|w| w.iter().any(|&x| x != w[0]) || w[0] != 1.0);
-        Ok(Self {
-            knots,
-            control_points,
-            weights,
-        })
+        Ok(Self { knots, control_points, weights })
     }
 
     /// A polynomial curve (no validation beyond lengths; for internal use).
     pub fn polynomial(knots: KnotVector, control_points: Vec<Point>) -> Self {
         debug_assert_eq!(knots.num_basis(), control_points.len());
-        Self {
-            knots,
-            control_points,
-            weights: None,
-        }
+        Self { knots, control_points, weights: None }
     }
 
     /// Degree.
@@ -124,40 +100,27 @@ impl Curve {
 
     /// The same curve with its parameter domain mapped affinely onto `[0, 1]`.
     pub fn normalized(&self) -> Self {
-        Self {
-            knots: self.knots.normalized(),
-            ..self.clone()
-        }
+        Self { knots: self.knots.normalized(), ..self.clone() }
     }
 
     /// The same point set traversed backwards: `C_rev(u) = C(a + b - u)`.
     pub fn reversed(&self) -> Self {
         let (a, b) = self.domain();
-        let mut k: Vec<f64> = self
-            .knots
-            .knots()
-            .iter()
-            .rev()
-            .map(|&t| a + b - t)
-            .collect();
+        let mut k: Vec<f64> = self.knots.knots().iter().rev().map(|&t| a + b - t).collect();
         for t in &mut k {
             if (*t - a).abs() < 1e-15 * (b - a) {
                 *t = a;
             }
         }
-        let knots = KnotVector::with_periodic(self.degree(), k, self.knots.is_periodic())
-            .expect("reversal keeps validity");
+        let knots =
+            KnotVector::with_periodic(self.degree(), k, self.knots.is_periodic()).expect("reversal keeps validity");
         let mut cp = self.control_points.clone();
         cp.reverse();
         let weights = self.weights.clone().map(|mut w| {
             w.reverse();
             w
         });
-        Self {
-            knots,
-            control_points: cp,
-            weights,
-        }
+        Self { knots, control_points: cp, weights }
     }
 
     /// `C(u)`.
@@ -187,18 +150,11 @@ impl Curve {
             }
         }
         if self.weights.is_none() {
-            return CurveDerivs {
-                x: [a[0][0], a[0][1]],
-                d1: [a[1][0], a[1][1]],
-                d2: [a[2][0], a[2][1]],
-            };
+            return CurveDerivs { x: [a[0][0], a[0][1]], d1: [a[1][0], a[1][1]], d2: [a[2][0], a[2][1]] };
         }
         let w = a[0][2];
         let x = [a[0][0] / w, a[0][1] / w];
-        let d1 = [
-            (a[1][0] - a[1][2] * x[0]) / w,
-            (a[1][1] - a[1][2] * x[1]) / w,
-        ];
+        let d1 = [(a[1][0] - a[1][2] * x[0]) / w, (a[1][1] - a[1][2] * x[1]) / w];
         let d2 = [
             (a[2][0] - 2.0 * a[1][2] * d1[0] - a[2][2] * x[0]) / w,
             (a[2][1] - 2.0 * a[1][2] * d1[1] - a[2][2] * x[1]) / w,
@@ -215,9 +171,7 @@ impl Curve {
     /// `m + 1` points at uniformly spaced parameters.
     pub fn sample(&self, m: usize) -> Vec<Point> {
         let (a, b) = self.domain();
-        (0..=m)
-            .map(|k| self.eval(a + (b - a) * k as f64 / m as f64))
-            .collect()
+        (0..=m).map(|k| self.eval(a + (b - a) * k as f64 / m as f64)).collect()
     }
 }
 
@@ -229,12 +183,7 @@ mod tests {
     fn nurbs_quarter_circle_is_exact() {
         let kv = KnotVector::new(2, vec![0., 0., 0., 1., 1., 1.]).unwrap();
         let s = std::f64::consts::FRAC_1_SQRT_2;
-        let c = Curve::new(
-            kv,
-            vec![[1., 0.], [1., 1.], [0., 1.]],
-            Some(vec![1., s, 1.]),
-        )
-        .unwrap();
+        let c = Curve::new(kv, vec![[1., 0.], [1., 1.], [0., 1.]], Some(vec![1., s, 1.])).unwrap();
         for k in 0..=20 {
             let u = k as f64 / 20.0;
             let d = c.derivs(u, 2);
@@ -258,17 +207,11 @@ mod tests {
     #[test]
     fn rejects_bad_weights_and_lengths() {
         let kv = KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap();
-        assert!(matches!(
-            Curve::new(kv.clone(), vec![[0., 0.]], None),
-            Err(Error::Length { .. })
-        ));
+        assert!(matches!(Curve::new(kv.clone(), vec![[0., 0.]], None), Err(Error::Length { .. })));
         assert!(matches!(
             Curve::new(kv.clone(), vec![[0., 0.], [1., 0.]], Some(vec![1., 0.])),
             Err(Error::Weight { .. })
         ));
-        assert!(matches!(
-            Curve::new(kv, vec![[0., f64::INFINITY], [1., 0.]], None),
-            Err(Error::NonFinite { .. })
-        ));
+        assert!(matches!(Curve::new(kv, vec![[0., f64::INFINITY], [1., 0.]], None), Err(Error::NonFinite { .. })));
     }
 }

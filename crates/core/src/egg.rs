@@ -195,7 +195,8 @@ mod tests {
         let kx = KnotVector::open_uniform(3, 5);
         let ky = KnotVector::open_uniform(2, 4);
         let (gx, gy) = (kx.greville(), ky.greville());
-        let cps: Vec<Point> = gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
+        let cps: Vec<Point> =
+            gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
         let disc = Discretization::new([kx, ky]);
         let mut prob = EggProblem::new(Arc::new(disc), cps, Operator::Plain, Arc::new(CpuAssembler));
         let c = prob.unknowns();

@@ -13,29 +13,16 @@ pub enum Error {
     Knots { context: String, reason: String },
     /// Control points, weights or knots have inconsistent lengths.
     #[error("wrong length{}: {what} has {found}, expected {expected}", at(.context))]
-    Length {
-        context: String,
-        what: String,
-        found: usize,
-        expected: usize,
-    },
+    Length { context: String, what: String, found: usize, expected: usize },
     /// A number is NaN or infinite.
     #[error("non-finite number{}: {what}", at(.context))]
     NonFinite { context: String, what: String },
     /// A NURBS weight is zero, negative or non-finite.
     #[error("non-positive weight{}: weight {index} is {value}", at(.context))]
-    Weight {
-        context: String,
-        index: usize,
-        value: f64,
-    },
+    Weight { context: String, index: usize, value: f64 },
     /// A degree below 1 (or above the supported maximum).
     #[error("invalid degree{}: {degree} ({reason})", at(.context))]
-    Degree {
-        context: String,
-        degree: usize,
-        reason: String,
-    },
+    Degree { context: String, degree: usize, reason: String },
     /// A JSON document could not be parsed or has the wrong shape.
     #[error("malformed JSON{}: {message}", at(.context))]
     Json { context: String, message: String },
@@ -51,43 +38,22 @@ pub enum Error {
     },
     /// Adjacent sides do not meet at their common corner.
     #[error("corner gap between {side_a} and {side_b}: the ends are {gap:.3e} apart (tolerance {tol:.3e}) at ({x:.6}, {y:.6})")]
-    CornerGap {
-        side_a: String,
-        side_b: String,
-        gap: f64,
-        tol: f64,
-        x: f64,
-        y: f64,
-    },
+    CornerGap { side_a: String, side_b: String, gap: f64, tol: f64, x: f64, y: f64 },
     /// A side has (numerically) zero length.
     #[error("degenerate side {side}: its length is {length:.3e}, below {tol:.3e}")]
     DegenerateSide { side: String, length: f64, tol: f64 },
     /// A point cloud has too few points.
     #[error("too few points on {side}: {found}, need at least {needed}")]
-    TooFewPoints {
-        side: String,
-        found: usize,
-        needed: usize,
-    },
+    TooFewPoints { side: String, found: usize, needed: usize },
     /// The boundary crosses itself.
     #[error("self-intersecting contour: {side_a} near ({x:.6}, {y:.6}) crosses {side_b}")]
-    SelfIntersection {
-        side_a: String,
-        side_b: String,
-        x: f64,
-        y: f64,
-    },
+    SelfIntersection { side_a: String, side_b: String, x: f64, y: f64 },
     /// The boundary is traversed clockwise (signed area negative).
     #[error("clockwise contour (signed area {area:.6e}): south, east, reversed north, reversed west must run counter-clockwise; pass the reorient option to flip it")]
     Clockwise { area: f64 },
     /// An input exceeds the sizes the library accepts.
     #[error("absurd size{}: {what} is {found}, the limit is {limit}", at(.context))]
-    TooLarge {
-        context: String,
-        what: String,
-        found: usize,
-        limit: usize,
-    },
+    TooLarge { context: String, what: String, found: usize, limit: usize },
     /// A contour document's corner indices are unusable.
     #[error("invalid corners: {reason}")]
     Corners { reason: String },
@@ -114,11 +80,7 @@ impl Error {
     /// Prefix the location `ctx` (e.g. `"boundary.south"`) to the error's context.
     pub fn within(mut self, ctx: &str) -> Self {
         let push = |c: &mut String| {
-            *c = if c.is_empty() {
-                ctx.to_string()
-            } else {
-                format!("{ctx}.{c}")
-            };
+            *c = if c.is_empty() { ctx.to_string() } else { format!("{ctx}.{c}") };
         };
         match &mut self {
             Error::Knots { context, .. }

@@ -86,13 +86,7 @@ pub struct FitOptions {
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self {
-            degree: 3,
-            tol: 1e-4,
-            initial_elements: 1,
-            max_levels: 14,
-            max_elements: 4096,
-        }
+        Self { degree: 3, tol: 1e-4, initial_elements: 1, max_levels: 14, max_elements: 4096 }
     }
 }
 
@@ -107,10 +101,7 @@ impl FitOptions {
             });
         }
         if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(Error::Invalid(format!(
-                "fit tolerance must be positive and finite, got {}",
-                self.tol
-            )));
+            return Err(Error::Invalid(format!("fit tolerance must be positive and finite, got {}", self.tol)));
         }
         if self.initial_elements == 0 || self.max_levels == 0 {
             return Err(Error::Invalid(format!(
@@ -178,17 +169,12 @@ pub struct SideFit {
 impl SideFit {
     /// The finest (last) fit.
     pub fn finest(&self) -> &Curve {
-        self.levels
-            .last()
-            .expect("a side fit has at least one level")
+        self.levels.last().expect("a side fit has at least one level")
     }
 
     /// Largest deviation of the finest fit.
     pub fn final_max_error(&self) -> f64 {
-        *self
-            .max_error
-            .last()
-            .expect("a side fit has at least one level")
+        *self.max_error.last().expect("a side fit has at least one level")
     }
 }
 
@@ -231,9 +217,7 @@ pub struct Hierarchy {
 impl Hierarchy {
     /// The finest level.
     pub fn finest(&self) -> &Level {
-        self.levels
-            .last()
-            .expect("a hierarchy has at least one level")
+        self.levels.last().expect("a hierarchy has at least one level")
     }
 
     /// Whether all four sides met the tolerance.
@@ -243,10 +227,7 @@ impl Hierarchy {
 
     /// The largest final deviation over the four sides.
     pub fn max_error(&self) -> f64 {
-        self.fits
-            .iter()
-            .map(SideFit::final_max_error)
-            .fold(0.0, f64::max)
+        self.fits.iter().map(SideFit::final_max_error).fold(0.0, f64::max)
     }
 }
 
@@ -335,39 +316,21 @@ impl<'a> Target<'a> {
             SideCurve::Spline(c) => {
                 let (a, b) = c.domain();
                 let len = b - a;
-                let breaks = c
-                    .knots
-                    .breaks()
-                    .into_iter()
-                    .map(|u| ((u - a) / len).clamp(0.0, 1.0))
-                    .collect();
+                let breaks = c.knots.breaks().into_iter().map(|u| ((u - a) / len).clamp(0.0, 1.0)).collect();
                 let nq = p + c.degree() + 2 + if c.is_rational() { 2 } else { 0 };
-                Target::Spline {
-                    curve: c,
-                    a,
-                    len,
-                    breaks,
-                    nq,
-                }
+                Target::Spline { curve: c, a, len, breaks, nq }
             }
             SideCurve::Analytic(f) => Target::Analytic { f, nq: p + 6 },
             SideCurve::Points(pts) => {
                 if pts.len() < 2 {
-                    return Err(Error::TooFewPoints {
-                        side: side.to_string(),
-                        found: pts.len(),
-                        needed: 2,
-                    });
+                    return Err(Error::TooFewPoints { side: side.to_string(), found: pts.len(), needed: 2 });
                 }
                 let params = cord_length_params(pts).ok_or_else(|| Error::DegenerateSide {
                     side: side.to_string(),
                     length: 0.0,
                     tol: 0.0,
                 })?;
-                Target::Points {
-                    params,
-                    points: pts,
-                }
+                Target::Points { params, points: pts }
             }
         })
     }
@@ -415,10 +378,7 @@ struct Banded {
 
 impl Banded {
     fn new(n: usize, bw: usize) -> Self {
-        Self {
-            bw,
-            band: vec![vec![0.0; bw + 1]; n],
-        }
+        Self { bw, band: vec![vec![0.0; bw + 1]; n] }
     }
 
     /// Add `w` to `A[i][j]` (and implicitly `A[j][i]`), `i <= j <= i + bw`.
@@ -529,11 +489,7 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
             }
             let data_tr: f64 = (1..n - 1).map(|i| mat.band[i][0]).sum();
             let reg_tr: f64 = (1..n - 1).map(|i| reg.band[i][0]).sum();
-            let lambda = if data_tr > 0.0 && reg_tr > 0.0 {
-                REGULARIZATION * data_tr / reg_tr
-            } else {
-                1.0
-            };
+            let lambda = if data_tr > 0.0 && reg_tr > 0.0 { REGULARIZATION * data_tr / reg_tr } else { 1.0 };
             for (row, rrow) in mat.band.iter_mut().zip(&reg.band) {
                 for (x, r) in row.iter_mut().zip(rrow) {
                     *x += lambda * r;
@@ -568,10 +524,7 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
     let mut free: Vec<Point> = (1..n - 1)
         .map(|i| {
             let (a, b) = (mat.get(i, 0), mat.get(i, n - 1));
-            [
-                rhs[i][0] - a * c0[0] - b * c1[0],
-                rhs[i][1] - a * c0[1] - b * c1[1],
-            ]
+            [rhs[i][0] - a * c0[0] - b * c1[0], rhs[i][1] - a * c0[1] - b * c1[1]]
         })
         .collect();
     mat.solve_block(1, n - 1, &mut free)?;
@@ -579,10 +532,7 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
     cps.push(c0);
     cps.extend(free);
     cps.push(c1);
-    if let Some(i) = cps
-        .iter()
-        .position(|c| !(c[0].is_finite() && c[1].is_finite()))
-    {
+    if let Some(i) = cps.iter().position(|c| !(c[0].is_finite() && c[1].is_finite())) {
         return Err(Error::NonFinite {
             context: "contour fit".into(),
             what: format!("control point {i} (the input curve gives non-finite values?)"),
@@ -595,16 +545,8 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
 fn fit_errors(target: &Target, fit: &Curve) -> Projection {
     let kv = &fit.knots;
     let elements = kv.elements();
-    let mut errs: Vec<ElementError> = elements
-        .iter()
-        .map(|&(span, a, b)| ElementError {
-            span,
-            a,
-            b,
-            indicator: 0.0,
-            max: 0.0,
-        })
-        .collect();
+    let mut errs: Vec<ElementError> =
+        elements.iter().map(|&(span, a, b)| ElementError { span, a, b, indicator: 0.0, max: 0.0 }).collect();
     let mut basis = BasisDerivs::default();
     let (max_error, rms_error) = match target {
         Target::Points { params, points } => {
@@ -617,9 +559,7 @@ fn fit_errors(target: &Target, fit: &Curve) -> Projection {
                 sum += d2;
                 max = max.max(d);
                 // element of the span; a point on a break also counts for the left element
-                let e = elements
-                    .partition_point(|el| el.0 < basis.span)
-                    .min(elements.len() - 1);
+                let e = elements.partition_point(|el| el.0 < basis.span).min(elements.len() - 1);
                 errs[e].indicator += d2;
                 errs[e].max = errs[e].max.max(d);
                 if e > 0 && t <= elements[e].1 {
@@ -656,25 +596,15 @@ fn fit_errors(target: &Target, fit: &Curve) -> Projection {
             (max, total.sqrt())
         }
     };
-    Projection {
-        curve: fit.clone(),
-        max_error,
-        rms_error,
-        elements: errs,
-    }
+    Projection { curve: fit.clone(), max_error, rms_error, elements: errs }
 }
 
 /// Constrained least-squares fit of one side on the fixed knot vector `knots` (an open
 /// vector on `[0, 1]` of degree `>= 2`), with the first and last control points set to
 /// `corners`; see the module documentation for the functionals. Point clouds are
 /// parameterized by cord length (eq. 36-37).
-pub fn project_side(
-    curve: &SideCurve,
-    knots: &KnotVector,
-    corners: (Point, Point),
-) -> Result<Projection> {
-    if knots.degree() < 2 || !knots.is_open() || knots.domain() != (0.0, 1.0) || knots.is_periodic()
-    {
+pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Point)) -> Result<Projection> {
+    if knots.degree() < 2 || !knots.is_open() || knots.domain() != (0.0, 1.0) || knots.is_periodic() {
         return Err(Error::Invalid(format!(
             "contour fit needs an open knot vector of degree >= 2 on [0, 1], got degree {} on {:?}",
             knots.degree(),
@@ -702,9 +632,7 @@ pub fn fit_side(
 ) -> Result<SideFit> {
     opts.validate()?;
     if !(tol_abs.is_finite() && tol_abs > 0.0) {
-        return Err(Error::Invalid(format!(
-            "absolute fit tolerance must be positive and finite, got {tol_abs}"
-        )));
+        return Err(Error::Invalid(format!("absolute fit tolerance must be positive and finite, got {tol_abs}")));
     }
     let target = Target::new(curve, opts.degree, side.name())?;
     let mut kv = KnotVector::open_uniform(opts.degree, opts.initial_elements);
@@ -731,11 +659,7 @@ pub fn fit_side(
             .elements
             .iter()
             .filter_map(|e| {
-                let measure = if points {
-                    e.max
-                } else {
-                    e.max.max(e.indicator.sqrt())
-                };
+                let measure = if points { e.max } else { e.max.max(e.indicator.sqrt()) };
                 (measure > tol_abs).then_some((e.span, measure))
             })
             .collect();
@@ -809,22 +733,13 @@ pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarc
     opts.validate()?;
     let diameter = diameter(boundary);
     if !(diameter.is_finite() && diameter > 0.0) {
-        return Err(Error::Invalid(format!(
-            "boundary '{}' has diameter {diameter}",
-            boundary.name
-        )));
+        return Err(Error::Invalid(format!("boundary '{}' has diameter {diameter}", boundary.name)));
     }
     let tol_abs = opts.tol * diameter;
     let corners = corners(boundary, diameter)?;
     let mut fits = Vec::with_capacity(4);
     for side in Side::ALL {
-        fits.push(fit_side(
-            side,
-            boundary.side(side),
-            side_corners(&corners, side),
-            opts,
-            tol_abs,
-        )?);
+        fits.push(fit_side(side, boundary.side(side), side_corners(&corners, side), opts, tol_abs)?);
     }
     let fits: [SideFit; 4] = fits.try_into().expect("four sides");
     hierarchy_from_fits(fits, tol_abs, diameter)
@@ -855,12 +770,8 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
     };
     let mut levels: Vec<Level> = Vec::with_capacity(m);
     for k in 0..m {
-        let xi = pick(Side::South, k)
-            .knots
-            .union(&pick(Side::North, k).knots)?;
-        let eta = pick(Side::East, k)
-            .knots
-            .union(&pick(Side::West, k).knots)?;
+        let xi = pick(Side::South, k).knots.union(&pick(Side::North, k).knots)?;
+        let eta = pick(Side::East, k).knots.union(&pick(Side::West, k).knots)?;
         let knots = [xi, eta];
         let sides = [
             pick(Side::South, k).refined(&knots[0])?,
@@ -871,10 +782,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
         let level = Level { knots, sides };
         match levels.last_mut() {
             Some(prev) if prev.knots == level.knots => *prev = level,
-            Some(prev)
-                if !(level.knots[0].contains(&prev.knots[0])
-                    && level.knots[1].contains(&prev.knots[1])) =>
-            {
+            Some(prev) if !(level.knots[0].contains(&prev.knots[0]) && level.knots[1].contains(&prev.knots[1])) => {
                 return Err(Error::Invalid(format!(
                     "side fits are not nested: level {k} does not refine level {}",
                     k - 1
@@ -883,12 +791,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
             _ => levels.push(level),
         }
     }
-    Ok(Hierarchy {
-        levels,
-        fits,
-        tol_abs,
-        diameter,
-    })
+    Ok(Hierarchy { levels, fits, tol_abs, diameter })
 }
 
 #[cfg(test)]
@@ -914,33 +817,17 @@ mod tests {
         let c = Curve::new(kv, vec![[0., 0.], [0.3, 0.4], [0.7, -0.2], [1., 0.1]], None).unwrap();
         let side = SideCurve::Spline(c.clone());
         for p in 3..=5 {
-            let fit = fit_side(
-                Side::South,
-                &side,
-                c.endpoints(),
-                &FitOptions {
-                    degree: p,
-                    ..Default::default()
-                },
-                1e-6,
-            )
-            .unwrap();
+            let fit =
+                fit_side(Side::South, &side, c.endpoints(), &FitOptions { degree: p, ..Default::default() }, 1e-6)
+                    .unwrap();
             assert_eq!(fit.levels.len(), 1);
             assert!(fit.converged);
             assert!(fit.max_error[0] < 1e-13, "p={p}: {}", fit.max_error[0]);
         }
         let an = SideCurve::Analytic(Analytic::new(|t| [t, 2.0 * t * t - t]));
-        let fit = fit_side(
-            Side::West,
-            &an,
-            ([0., 0.], [1., 1.]),
-            &FitOptions {
-                degree: 2,
-                ..Default::default()
-            },
-            1e-8,
-        )
-        .unwrap();
+        let fit =
+            fit_side(Side::West, &an, ([0., 0.], [1., 1.]), &FitOptions { degree: 2, ..Default::default() }, 1e-8)
+                .unwrap();
         assert_eq!(fit.levels.len(), 1);
         assert!(fit.max_error[0] < 1e-13);
     }
@@ -953,10 +840,7 @@ mod tests {
             let e = uniform_fit_errors(&f, p, &sizes);
             let orders: Vec<f64> = e.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
             let last = *orders.last().unwrap();
-            assert!(
-                (last - (p + 1) as f64).abs() < 0.5,
-                "p={p} errors {e:?} orders {orders:?}"
-            );
+            assert!((last - (p + 1) as f64).abs() < 0.5, "p={p} errors {e:?} orders {orders:?}");
         }
     }
 
@@ -988,23 +872,13 @@ mod tests {
     #[test]
     fn two_point_cloud_is_a_uniform_segment() {
         let side = SideCurve::Points(vec![[0., 0.], [2., 1.]]);
-        let fit = fit_side(
-            Side::East,
-            &side,
-            ([0., 0.], [2., 1.]),
-            &FitOptions::default(),
-            1e-6,
-        )
-        .unwrap();
+        let fit = fit_side(Side::East, &side, ([0., 0.], [2., 1.]), &FitOptions::default(), 1e-6).unwrap();
         assert!(fit.converged);
         let c = fit.finest();
         for k in 0..=10 {
             let t = k as f64 / 10.0;
             let x = c.eval(t);
-            assert!(
-                (x[0] - 2.0 * t).abs() < 1e-12 && (x[1] - t).abs() < 1e-12,
-                "{t} {x:?}"
-            );
+            assert!((x[0] - 2.0 * t).abs() < 1e-12 && (x[1] - t).abs() < 1e-12, "{t} {x:?}");
         }
         assert_eq!(fit.params.as_deref(), Some(&[0.0, 1.0][..]));
     }
@@ -1027,10 +901,7 @@ mod tests {
             FitOptions { degree: 1, ..o },
             FitOptions { tol: 0.0, ..o },
             FitOptions { tol: f64::NAN, ..o },
-            FitOptions {
-                initial_elements: 0,
-                ..o
-            },
+            FitOptions { initial_elements: 0, ..o },
             FitOptions { max_levels: 0, ..o },
         ] {
             assert!(fit_side(Side::South, &side, ([0., 0.], [1., 0.]), &bad, 1e-3).is_err());
@@ -1042,9 +913,7 @@ mod tests {
     #[test]
     fn adaptive_refinement_is_local_and_nested() {
         // a curve with a sharp feature near t = 0.8 (a narrow Gaussian bump)
-        let f = SideCurve::Analytic(Analytic::new(|t| {
-            [t, 0.2 * (-((t - 0.8) / 0.03).powi(2)).exp()]
-        }));
+        let f = SideCurve::Analytic(Analytic::new(|t| [t, 0.2 * (-((t - 0.8) / 0.03).powi(2)).exp()]));
         let fit = fit_side(Side::South, &f, f.endpoints(), &FitOptions::default(), 1e-5).unwrap();
         assert!(fit.converged);
         assert!(fit.final_max_error() <= 1e-5);
@@ -1054,10 +923,7 @@ mod tests {
         let el = fit.finest().knots.elements();
         let h_min = el.iter().map(|e| e.2 - e.1).fold(1.0, f64::min);
         let h_max = el.iter().map(|e| e.2 - e.1).fold(0.0, f64::max);
-        assert!(
-            h_max >= 8.0 * h_min,
-            "refinement should be local: h in [{h_min}, {h_max}]"
-        );
+        assert!(h_max >= 8.0 * h_min, "refinement should be local: h in [{h_min}, {h_max}]");
         // dyadic knots
         for &u in fit.finest().knots.knots() {
             let s = u * 65536.0;
@@ -1068,10 +934,7 @@ mod tests {
     #[test]
     fn element_cap_stops_refinement() {
         let f = SideCurve::Analytic(Analytic::new(|t| [t, (40.0 * t).sin()]));
-        let o = FitOptions {
-            max_elements: 6,
-            ..Default::default()
-        };
+        let o = FitOptions { max_elements: 6, ..Default::default() };
         let fit = fit_side(Side::South, &f, f.endpoints(), &o, 1e-9).unwrap();
         assert!(!fit.converged);
         assert!(fit.finest().knots.num_elements() <= 6);
@@ -1089,24 +952,14 @@ mod tests {
             })
             .collect();
         let k = levels.len();
-        SideFit {
-            side,
-            levels,
-            max_error: vec![0.0; k],
-            rms_error: vec![0.0; k],
-            params: None,
-            converged: true,
-        }
+        SideFit { side, levels, max_error: vec![0.0; k], rms_error: vec![0.0; k], params: None, converged: true }
     }
 
     #[test]
     fn hierarchy_pads_unifies_and_merges_levels() {
         // south refines at 0.5 then 0.75; north has 0.75 from level 1 on; so the xi
         // unions of levels 1 and 2 coincide and are merged (keeping the later fits).
-        let s = synthetic_fit(
-            Side::South,
-            &[&[0.0, 1.0], &[0.0, 0.5, 1.0], &[0.0, 0.5, 0.75, 1.0]],
-        );
+        let s = synthetic_fit(Side::South, &[&[0.0, 1.0], &[0.0, 0.5, 1.0], &[0.0, 0.5, 0.75, 1.0]]);
         let n = synthetic_fit(Side::North, &[&[0.0, 1.0], &[0.0, 0.5, 0.75, 1.0]]);
         let e = synthetic_fit(Side::East, &[&[0.0, 1.0]]);
         let w = synthetic_fit(Side::West, &[&[0.0, 1.0], &[0.0, 0.25, 1.0]]);

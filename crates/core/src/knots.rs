@@ -27,10 +27,7 @@ impl KnotVector {
 
     /// Validate and wrap a knot vector, marking it periodic or not.
     pub fn with_periodic(degree: usize, knots: Vec<f64>, periodic: bool) -> Result<Self> {
-        let bad = |reason: String| Error::Knots {
-            context: String::new(),
-            reason,
-        };
+        let bad = |reason: String| Error::Knots { context: String::new(), reason };
         if degree == 0 || degree > MAX_DEGREE {
             return Err(Error::Degree {
                 context: String::new(),
@@ -47,44 +44,23 @@ impl KnotVector {
             });
         }
         if knots.len() < 2 * degree + 2 {
-            return Err(bad(format!(
-                "{} knots for degree {degree}: need at least {}",
-                knots.len(),
-                2 * degree + 2
-            )));
+            return Err(bad(format!("{} knots for degree {degree}: need at least {}", knots.len(), 2 * degree + 2)));
         }
         if let Some(i) = knots.iter().position(|k| !k.is_finite()) {
-            return Err(Error::NonFinite {
-                context: String::new(),
-                what: format!("knot {i} is {}", knots[i]),
-            });
+            return Err(Error::NonFinite { context: String::new(), what: format!("knot {i} is {}", knots[i]) });
         }
         if let Some(i) = (1..knots.len()).find(|&i| knots[i] < knots[i - 1]) {
-            return Err(bad(format!(
-                "knots decrease at index {i}: {} after {}",
-                knots[i],
-                knots[i - 1]
-            )));
+            return Err(bad(format!("knots decrease at index {i}: {} after {}", knots[i], knots[i - 1])));
         }
         let n = knots.len() - degree - 1;
         if knots[n] - knots[degree] <= 0.0 {
-            return Err(bad(format!(
-                "empty parameter domain [{}, {}]",
-                knots[degree], knots[n]
-            )));
+            return Err(bad(format!("empty parameter domain [{}, {}]", knots[degree], knots[n])));
         }
         // No interior knot may exceed multiplicity p + 1 (basis would be discontinuous and singular).
-        let kv = Self {
-            degree,
-            knots,
-            periodic,
-        };
+        let kv = Self { degree, knots, periodic };
         for (u, m) in kv.breaks_with_multiplicity() {
             if m > degree + 1 {
-                return Err(bad(format!(
-                    "knot {u} has multiplicity {m} > degree + 1 = {}",
-                    degree + 1
-                )));
+                return Err(bad(format!("knot {u} has multiplicity {m} > degree + 1 = {}", degree + 1)));
             }
         }
         Ok(kv)
@@ -106,11 +82,7 @@ impl KnotVector {
             knots.extend(std::iter::repeat_n(b, interior_mult));
         }
         knots.extend(std::iter::repeat_n(*breaks.last().unwrap(), degree + 1));
-        Self {
-            degree,
-            knots,
-            periodic: false,
-        }
+        Self { degree, knots, periodic: false }
     }
 
     /// Periodic uniform knot vector on `[0, 1]` with `elements` elements: the knots
@@ -118,14 +90,8 @@ impl KnotVector {
     /// functions, of which the last `p` wrap onto the first `p`.
     pub fn periodic_uniform(degree: usize, elements: usize) -> Self {
         let h = 1.0 / elements as f64;
-        let knots = (0..(elements + 2 * degree + 1))
-            .map(|i| (i as f64 - degree as f64) * h)
-            .collect();
-        Self {
-            degree,
-            knots,
-            periodic: true,
-        }
+        let knots = (0..(elements + 2 * degree + 1)).map(|i| (i as f64 - degree as f64) * h).collect();
+        Self { degree, knots, periodic: true }
     }
 
     /// Polynomial degree `p`.
@@ -229,10 +195,7 @@ impl KnotVector {
 
     /// Distinct knots inside the domain: the element boundaries.
     pub fn breaks(&self) -> Vec<f64> {
-        self.breaks_with_multiplicity()
-            .into_iter()
-            .map(|(u, _)| u)
-            .collect()
+        self.breaks_with_multiplicity().into_iter().map(|(u, _)| u).collect()
     }
 
     /// Number of non-empty elements in the domain.
@@ -243,18 +206,13 @@ impl KnotVector {
     /// The elements as `(span, a, b)`: span index `s` with `[t_s, t_{s+1}] = [a, b]`, `a < b`.
     pub fn elements(&self) -> Vec<(usize, f64, f64)> {
         let (p, n) = (self.degree, self.num_basis());
-        (p..n)
-            .filter(|&s| self.knots[s + 1] > self.knots[s])
-            .map(|s| (s, self.knots[s], self.knots[s + 1]))
-            .collect()
+        (p..n).filter(|&s| self.knots[s + 1] > self.knots[s]).map(|s| (s, self.knots[s], self.knots[s + 1])).collect()
     }
 
     /// Greville abscissae `(t_{i+1} + ... + t_{i+p}) / p`, one per basis function.
     pub fn greville(&self) -> Vec<f64> {
         let p = self.degree;
-        (0..self.num_basis())
-            .map(|i| self.knots[i + 1..=i + p].iter().sum::<f64>() / p as f64)
-            .collect()
+        (0..self.num_basis()).map(|i| self.knots[i + 1..=i + p].iter().sum::<f64>() / p as f64).collect()
     }
 
     /// A copy with the knots `new` inserted (kept sorted).
@@ -262,19 +220,12 @@ impl KnotVector {
         let mut knots = self.knots.clone();
         knots.extend_from_slice(new);
         knots.sort_by(f64::total_cmp);
-        Self {
-            degree: self.degree,
-            knots,
-            periodic: self.periodic,
-        }
+        Self { degree: self.degree, knots, periodic: self.periodic }
     }
 
     /// The knots to insert to bisect the given elements (by span index).
     pub fn midpoints_of(&self, spans: &[usize]) -> Vec<f64> {
-        spans
-            .iter()
-            .map(|&s| 0.5 * (self.knots[s] + self.knots[s + 1]))
-            .collect()
+        spans.iter().map(|&s| 0.5 * (self.knots[s] + self.knots[s + 1])).collect()
     }
 
     /// Dyadic refinement: every non-empty element halved.
@@ -299,11 +250,7 @@ impl KnotVector {
                 }
             })
             .collect();
-        Self {
-            degree: self.degree,
-            knots,
-            periodic: self.periodic,
-        }
+        Self { degree: self.degree, knots, periodic: self.periodic }
     }
 
     /// Union of two open vectors of the same degree and domain: every break with the
@@ -343,11 +290,7 @@ impl KnotVector {
             let m = if k == 0 || k == last { p + 1 } else { m };
             knots.extend(std::iter::repeat_n(u, m));
         }
-        Ok(Self {
-            degree: p,
-            knots,
-            periodic: false,
-        })
+        Ok(Self { degree: p, knots, periodic: false })
     }
 
     /// Whether every knot of `coarse` (with multiplicity) occurs in `self`: the coarse
@@ -405,22 +348,14 @@ impl KnotVector {
                 }
                 knots.push(t);
             }
-            return Self {
-                degree: p + 1,
-                knots,
-                periodic: self.periodic,
-            };
+            return Self { degree: p + 1, knots, periodic: self.periodic };
         }
         let last = bm.len() - 1;
         for (k, (u, m)) in bm.into_iter().enumerate() {
             let m = if k == 0 || k == last { p + 2 } else { m + 1 };
             knots.extend(std::iter::repeat_n(u, m));
         }
-        Self {
-            degree: p + 1,
-            knots,
-            periodic: false,
-        }
+        Self { degree: p + 1, knots, periodic: false }
     }
 }
 
@@ -466,26 +401,11 @@ mod tests {
 
     #[test]
     fn rejects_bad_vectors() {
-        assert!(matches!(
-            KnotVector::new(0, vec![0., 1.]),
-            Err(Error::Degree { .. })
-        ));
-        assert!(matches!(
-            KnotVector::new(1, vec![0., 0., 1.]),
-            Err(Error::Knots { .. })
-        ));
-        assert!(matches!(
-            KnotVector::new(1, vec![0., 0.5, 0.2, 1.]),
-            Err(Error::Knots { .. })
-        ));
-        assert!(matches!(
-            KnotVector::new(1, vec![0., 0., f64::NAN, 1., 1.]),
-            Err(Error::NonFinite { .. })
-        ));
-        assert!(matches!(
-            KnotVector::new(1, vec![0., 0., 0., 0.]),
-            Err(Error::Knots { .. })
-        ));
+        assert!(matches!(KnotVector::new(0, vec![0., 1.]), Err(Error::Degree { .. })));
+        assert!(matches!(KnotVector::new(1, vec![0., 0., 1.]), Err(Error::Knots { .. })));
+        assert!(matches!(KnotVector::new(1, vec![0., 0.5, 0.2, 1.]), Err(Error::Knots { .. })));
+        assert!(matches!(KnotVector::new(1, vec![0., 0., f64::NAN, 1., 1.]), Err(Error::NonFinite { .. })));
+        assert!(matches!(KnotVector::new(1, vec![0., 0., 0., 0.]), Err(Error::Knots { .. })));
     }
 
     #[test]

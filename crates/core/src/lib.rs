@@ -46,9 +46,7 @@ pub mod validate;
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use curve::{Curve, Point};
 pub use error::{Error, Result};
-pub use fit::{
-    build_hierarchy, fit_side, hierarchy_from_fits, FitOptions, Hierarchy, Level, SideFit,
-};
+pub use fit::{build_hierarchy, fit_side, hierarchy_from_fits, FitOptions, Hierarchy, Level, SideFit};
 pub use io::{read_boundary, read_document, Document, ReadOptions};
 pub use knots::KnotVector;
 pub use surface::{Side, Surface};

@@ -125,7 +125,8 @@ impl Ilu0 {
         let n = a.nrows;
         let mut diag = vec![usize::MAX; n];
         for i in 0..n {
-            diag[i] = lu.position(i, i).ok_or_else(|| Error::LinearSolver(format!("ILU(0): no diagonal in row {i}")))?;
+            diag[i] =
+                lu.position(i, i).ok_or_else(|| Error::LinearSolver(format!("ILU(0): no diagonal in row {i}")))?;
         }
         let mut pos = vec![usize::MAX; n];
         for i in 0..n {

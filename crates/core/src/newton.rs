@@ -191,7 +191,9 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
 
     fn converged(&self, step: f64) -> bool {
         let s = self.scaled();
-        s <= self.opts.tol || self.norm <= self.opts.rtol * self.r0 || (step <= self.opts.step_tol && s <= self.opts.tol.sqrt())
+        s <= self.opts.tol
+            || self.norm <= self.opts.rtol * self.r0
+            || (step <= self.opts.step_tol && s <= self.opts.tol.sqrt())
     }
 
     fn iterate(&self, step: f64, damping: f64) -> Iterate {
@@ -290,12 +292,20 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
                 if self.converged(step) {
                     self.status = Status::Converged;
                 } else if self.newton_its >= self.opts.max_newton {
-                    return Ok(self.stall_with(format!("Newton reached {} iterations", self.opts.max_newton), step, delta));
+                    return Ok(self.stall_with(
+                        format!("Newton reached {} iterations", self.opts.max_newton),
+                        step,
+                        delta,
+                    ));
                 }
                 return Ok(self.iterate(step, delta));
             }
             // minimiser of the quadratic through phi0, slope -2 phi0 and phi(delta)
-            let q = if nt.is_finite() { 2.0 * phi0 * delta * delta / (2.0 * (phi - phi0 + 2.0 * phi0 * delta)) } else { 0.1 * delta };
+            let q = if nt.is_finite() {
+                2.0 * phi0 * delta * delta / (2.0 * (phi - phi0 + 2.0 * phi0 * delta))
+            } else {
+                0.1 * delta
+            };
             delta = q.clamp(0.1 * delta, 0.5 * delta);
             if delta < 1e-4 {
                 return Ok(self.stall("line search failed (no descent along the Newton direction)".into()));
@@ -354,7 +364,8 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
                 if self.converged(step) {
                     self.status = Status::Converged;
                 } else if self.pseudo_its >= self.opts.max_pseudo {
-                    self.status = Status::Failed(format!("pseudo time-stepping reached {} iterations", self.opts.max_pseudo));
+                    self.status =
+                        Status::Failed(format!("pseudo time-stepping reached {} iterations", self.opts.max_pseudo));
                 }
                 return Ok(self.iterate(step, 1.0));
             }

@@ -181,7 +181,12 @@ pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
         }
     }
     for m in 0..n {
-        for (a, b) in [(idx(m, 0), idx(m + 1, 0)), (idx(m, n), idx(m + 1, n)), (idx(0, m), idx(0, m + 1)), (idx(n, m), idx(n, m + 1))] {
+        for (a, b) in [
+            (idx(m, 0), idx(m + 1, 0)),
+            (idx(m, n), idx(m + 1, n)),
+            (idx(0, m), idx(0, m + 1)),
+            (idx(n, m), idx(n, m + 1)),
+        ] {
             let (pa, pb) = (cv.to_px(pts[a]), cv.to_px(pts[b]));
             cv.line(pa, pb, [0, 0, 0], 1.0);
         }

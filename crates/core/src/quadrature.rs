@@ -58,10 +58,7 @@ impl GaussLegendre {
     pub fn on(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
         let h = 0.5 * (b - a);
         let c = 0.5 * (a + b);
-        self.points
-            .iter()
-            .zip(&self.weights)
-            .map(move |(&x, &w)| (c + h * x, h * w))
+        self.points.iter().zip(&self.weights).map(move |(&x, &w)| (c + h * x, h * w))
     }
 }
 
@@ -91,13 +88,9 @@ mod tests {
             let g = GaussLegendre::new(n);
             assert!((g.weights.iter().sum::<f64>() - 2.0).abs() < 1e-13);
             for k in 0..(2 * n) {
-                let exact =
-                    (1.0f64.powi(k as i32 + 1) - 0.5f64.powi(k as i32 + 1)) / (k as f64 + 1.0);
+                let exact = (1.0f64.powi(k as i32 + 1) - 0.5f64.powi(k as i32 + 1)) / (k as f64 + 1.0);
                 let q: f64 = g.on(0.5, 1.0).map(|(x, w)| w * x.powi(k as i32)).sum();
-                assert!(
-                    (q - exact).abs() < 1e-13 * exact.abs().max(1.0),
-                    "n={n} k={k}"
-                );
+                assert!((q - exact).abs() < 1e-13 * exact.abs().max(1.0), "n={n} k={k}");
             }
             // not exact at degree 2n
             let k = 2 * n;

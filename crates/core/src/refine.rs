@@ -35,9 +35,7 @@ fn combine(a: &SparseRow, wa: f64, b: &SparseRow, wb: f64) -> SparseRow {
 /// every knot of `coarse`; the knots are inserted one by one with Boehm's algorithm.
 pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
     if coarse.is_periodic() {
-        return Err(Error::Invalid(
-            "refinement of periodic knot vectors is not supported".into(),
-        ));
+        return Err(Error::Invalid("refinement of periodic knot vectors is not supported".into()));
     }
     let new = fine.difference(coarse).ok_or_else(|| {
         Error::Invalid(format!(
@@ -54,9 +52,7 @@ pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
     let mut rows: Vec<SparseRow> = (0..coarse.num_basis()).map(|i| vec![(i, 1.0)]).collect();
     for &u in &new {
         if u <= a || u >= b {
-            return Err(Error::Invalid(format!(
-                "cannot insert knot {u} outside the open domain ({a}, {b})"
-            )));
+            return Err(Error::Invalid(format!("cannot insert knot {u} outside the open domain ({a}, {b})")));
         }
         // k: last index with t[k] <= u
         let k = t.partition_point(|&x| x <= u) - 1;
@@ -87,9 +83,7 @@ pub(crate) fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[i][j]);
     let bm = faer::Mat::<f64>::from_fn(n, m, |i, j| b[i][j]);
     let x = am.partial_piv_lu().solve(&bm);
-    (0..n)
-        .map(|i| (0..m).map(|j| x[(i, j)]).collect())
-        .collect()
+    (0..n).map(|i| (0..m).map(|j| x[(i, j)]).collect()).collect()
 }
 
 /// The operator `E` (`n_elevated x n`) that writes a degree-`p` spline in the basis of
@@ -98,9 +92,7 @@ pub(crate) fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// exact because the spaces are nested.
 pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if kv.is_periodic() {
-        return Err(Error::Invalid(
-            "degree elevation of periodic knot vectors is not supported".into(),
-        ));
+        return Err(Error::Invalid("degree elevation of periodic knot vectors is not supported".into()));
     }
     let fine = kv.elevated();
     let g = fine.greville();
@@ -119,40 +111,19 @@ pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
         }
     }
     let x = dense_solve(&a, &bmat);
-    let rows = x
-        .into_iter()
-        .map(|r| {
-            r.into_iter()
-                .enumerate()
-                .filter(|(_, v)| v.abs() > 1e-15)
-                .collect()
-        })
-        .collect();
+    let rows = x.into_iter().map(|r| r.into_iter().enumerate().filter(|(_, v)| v.abs() > 1e-15).collect()).collect();
     Ok((fine, Csr::from_rows(n_c, rows)))
 }
 
 /// Apply a linear operator to the homogeneous coordinates `(w x, w y, w)` of a
 /// (possibly rational) set of control points.
-fn apply_homogeneous(
-    op: &Csr,
-    cps: &[Point],
-    weights: Option<&[f64]>,
-) -> (Vec<Point>, Option<Vec<f64>>) {
+fn apply_homogeneous(op: &Csr, cps: &[Point], weights: Option<&[f64]>) -> (Vec<Point>, Option<Vec<f64>>) {
     match weights {
         None => (op.apply_points(cps), None),
         Some(w) => {
-            let wc: Vec<Point> = cps
-                .iter()
-                .zip(w)
-                .map(|(c, &w)| [c[0] * w, c[1] * w])
-                .collect();
+            let wc: Vec<Point> = cps.iter().zip(w).map(|(c, &w)| [c[0] * w, c[1] * w]).collect();
             let wn = op.apply(w);
-            let cn = op
-                .apply_points(&wc)
-                .into_iter()
-                .zip(&wn)
-                .map(|(c, &w)| [c[0] / w, c[1] / w])
-                .collect();
+            let cn = op.apply_points(&wc).into_iter().zip(&wn).map(|(c, &w)| [c[0] / w, c[1] / w]).collect();
             (cn, Some(wn))
         }
     }
@@ -163,22 +134,14 @@ impl Curve {
     pub fn refined(&self, fine: &KnotVector) -> Result<Curve> {
         let p = prolongation(&self.knots, fine)?;
         let (cp, w) = apply_homogeneous(&p, &self.control_points, self.weights.as_deref());
-        Ok(Curve {
-            knots: fine.clone(),
-            control_points: cp,
-            weights: w,
-        })
+        Ok(Curve { knots: fine.clone(), control_points: cp, weights: w })
     }
 
     /// The same curve with its degree raised by one.
     pub fn elevated(&self) -> Result<Curve> {
         let (kv, e) = elevation(&self.knots)?;
         let (cp, w) = apply_homogeneous(&e, &self.control_points, self.weights.as_deref());
-        Ok(Curve {
-            knots: kv,
-            control_points: cp,
-            weights: w,
-        })
+        Ok(Curve { knots: kv, control_points: cp, weights: w })
     }
 }
 
@@ -194,11 +157,7 @@ impl Surface {
     pub fn refined(&self, fine: &[KnotVector; 2]) -> Result<Surface> {
         let p = self.prolongation_to(fine)?;
         let (cp, w) = apply_homogeneous(&p, &self.control_points, self.weights.as_deref());
-        Ok(Surface {
-            knots: fine.clone(),
-            control_points: cp,
-            weights: w,
-        })
+        Ok(Surface { knots: fine.clone(), control_points: cp, weights: w })
     }
 
     /// The same map with both degrees raised by one.
@@ -207,11 +166,7 @@ impl Surface {
         let (ky, ey) = elevation(&self.knots[1])?;
         let op = ey.kron(&ex);
         let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
-        Ok(Surface {
-            knots: [kx, ky],
-            control_points: cp,
-            weights: w,
-        })
+        Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
     }
 }
 
@@ -250,10 +205,7 @@ mod tests {
                 for k in 0..=97 {
                     let u = k as f64 / 97.0;
                     let (a, b) = (c.eval(u), e.eval(u));
-                    assert!(
-                        (a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13,
-                        "p={p} {a:?} {b:?}"
-                    );
+                    assert!((a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13, "p={p} {a:?} {b:?}");
                 }
             }
         }

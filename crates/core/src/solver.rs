@@ -203,7 +203,12 @@ pub fn boundary_kinks(boundary: &Boundary) -> Vec<KinkReport> {
             };
             if turning > 1.0 {
                 let (a, bb) = c.domain();
-                out.push(KinkReport { side: s.name(), parameter: (u - a) / (bb - a), point: c.eval(u), turning_degrees: turning });
+                out.push(KinkReport {
+                    side: s.name(),
+                    parameter: (u - a) / (bb - a),
+                    point: c.eval(u),
+                    turning_degrees: turning,
+                });
             }
         }
     }
@@ -286,8 +291,10 @@ fn polyline_length(c: &Curve) -> f64 {
 pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize, aspect: f64) -> Result<Vec<Level>> {
     let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
     // mean physical length of the xi sides (south, north) and of the eta sides (west, east)
-    let len_xi = 0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
-    let len_eta = 0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
+    let len_xi =
+        0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
+    let len_eta =
+        0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
     let mut previous: Option<[KnotVector; 2]> = None;
     for level in levels.iter_mut() {
         let mut knots = level.knots.clone();
@@ -623,7 +630,11 @@ impl Iterator for EggSolver {
                 }
             }
         }
-        if self.next_level == self.plan.len() && self.repairs < self.opts.repair && !self.plan.is_empty() && self.folds() {
+        if self.next_level == self.plan.len()
+            && self.repairs < self.opts.repair
+            && !self.plan.is_empty()
+            && self.folds()
+        {
             // defect correction by refinement: halve the finest level and solve again
             let last = self.plan.last().expect("non-empty");
             let knots = [last.knots[0].halved(), last.knots[1].halved()];
@@ -882,8 +893,13 @@ mod tests {
     use crate::boundary::{Analytic, SideCurve};
 
     fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
-        let arc = move |r: f64| SideCurve::Analytic(Analytic::new(move |t| [r * (angle * t).cos(), r * (angle * t).sin()]));
-        let ray = move |a: f64| SideCurve::Analytic(Analytic::new(move |t| [(r0 + (r1 - r0) * t) * a.cos(), (r0 + (r1 - r0) * t) * a.sin()]));
+        let arc =
+            move |r: f64| SideCurve::Analytic(Analytic::new(move |t| [r * (angle * t).cos(), r * (angle * t).sin()]));
+        let ray = move |a: f64| {
+            SideCurve::Analytic(Analytic::new(move |t| {
+                [(r0 + (r1 - r0) * t) * a.cos(), (r0 + (r1 - r0) * t) * a.sin()]
+            }))
+        };
         // south: inner radius? use south = ray at angle 0, north = ray at `angle`,
         // west = inner arc, east = outer arc (counter-clockwise).
         Boundary { name: "annulus".into(), sides: [ray(0.0), arc(r1), ray(angle), arc(r0)] }

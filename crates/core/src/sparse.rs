@@ -47,24 +47,12 @@ impl Csr {
             }
             row_ptr.push(col_idx.len());
         }
-        Self {
-            nrows,
-            ncols,
-            row_ptr,
-            col_idx,
-            values,
-        }
+        Self { nrows, ncols, row_ptr, col_idx, values }
     }
 
     /// The identity of size `n`.
     pub fn identity(n: usize) -> Self {
-        Self {
-            nrows: n,
-            ncols: n,
-            row_ptr: (0..=n).collect(),
-            col_idx: (0..n).collect(),
-            values: vec![1.0; n],
-        }
+        Self { nrows: n, ncols: n, row_ptr: (0..=n).collect(), col_idx: (0..n).collect(), values: vec![1.0; n] }
     }
 
     /// Number of stored entries.
@@ -75,10 +63,7 @@ impl Csr {
     /// Stored entries of row `i` as `(col, value)`.
     pub fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let r = self.row_ptr[i]..self.row_ptr[i + 1];
-        self.col_idx[r.clone()]
-            .iter()
-            .copied()
-            .zip(self.values[r].iter().copied())
+        self.col_idx[r.clone()].iter().copied().zip(self.values[r].iter().copied())
     }
 
     /// Entry `(i, j)` (zero when not stored).
@@ -93,10 +78,7 @@ impl Csr {
     /// Position of entry `(i, j)` in `values`, if it is in the pattern.
     pub fn position(&self, i: usize, j: usize) -> Option<usize> {
         let r = self.row_ptr[i]..self.row_ptr[i + 1];
-        self.col_idx[r.clone()]
-            .binary_search(&j)
-            .ok()
-            .map(|k| r.start + k)
+        self.col_idx[r.clone()].binary_search(&j).ok().map(|k| r.start + k)
     }
 
     /// `y = A x`.
@@ -159,13 +141,7 @@ impl Csr {
                 row_ptr.push(col_idx.len());
             }
         }
-        Self {
-            nrows,
-            ncols,
-            row_ptr,
-            col_idx,
-            values,
-        }
+        Self { nrows, ncols, row_ptr, col_idx, values }
     }
 
     /// Product `self * other`.
@@ -189,20 +165,11 @@ impl Csr {
     /// `usize::MAX` for dropped ones).
     pub fn submatrix(&self, row_map: &[usize], col_map: &[usize], ncols: usize) -> Self {
         let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
-        let mut order: Vec<(usize, usize)> = row_map
-            .iter()
-            .enumerate()
-            .filter(|(_, &n)| n != usize::MAX)
-            .map(|(o, &n)| (n, o))
-            .collect();
+        let mut order: Vec<(usize, usize)> =
+            row_map.iter().enumerate().filter(|(_, &n)| n != usize::MAX).map(|(o, &n)| (n, o)).collect();
         order.sort();
         for (_, old) in order {
-            rows.push(
-                self.row(old)
-                    .filter(|(j, _)| col_map[*j] != usize::MAX)
-                    .map(|(j, v)| (col_map[j], v))
-                    .collect(),
-            );
+            rows.push(self.row(old).filter(|(j, _)| col_map[*j] != usize::MAX).map(|(j, v)| (col_map[j], v)).collect());
         }
         Self::from_rows(ncols, rows)
     }

@@ -85,11 +85,7 @@ impl SurfaceDerivs {
 
 impl Surface {
     /// Validate lengths, finiteness and weights.
-    pub fn new(
-        knots: [KnotVector; 2],
-        control_points: Vec<Point>,
-        weights: Option<Vec<f64>>,
-    ) -> Result<Self> {
+    pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots[0].num_basis() * knots[1].num_basis();
         if control_points.len() != n {
             return Err(Error::Length {
@@ -104,11 +100,7 @@ impl Surface {
             check_weights(w, n)?;
         }
         let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
-        Ok(Self {
-            knots,
-            control_points,
-            weights,
-        })
+        Ok(Self { knots, control_points, weights })
     }
 
     /// Number of basis functions per direction.
@@ -209,10 +201,7 @@ impl Surface {
         Curve {
             knots: kv,
             control_points: idx.iter().map(|&k| self.control_points[k]).collect(),
-            weights: self
-                .weights
-                .as_ref()
-                .map(|w| idx.iter().map(|&k| w[k]).collect()),
+            weights: self.weights.as_ref().map(|w| idx.iter().map(|&k| w[k]).collect()),
         }
     }
 
@@ -229,10 +218,6 @@ impl Surface {
                 }
             }
         }
-        Self {
-            knots: [self.knots[1].clone(), self.knots[0].clone()],
-            control_points: cp,
-            weights: w,
-        }
+        Self { knots: [self.knots[1].clone(), self.knots[0].clone()], control_points: cp, weights: w }
     }
 }

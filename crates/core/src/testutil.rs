@@ -7,17 +7,11 @@ pub struct Lcg(u64);
 impl Lcg {
     /// A generator from a seed.
     pub fn new(seed: u64) -> Self {
-        Self(
-            seed.wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407),
-        )
+        Self(seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407))
     }
     /// Next raw value.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         self.0 ^ (self.0 >> 29)
     }
     /// Uniform in `[0, 1)`.

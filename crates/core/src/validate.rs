@@ -186,11 +186,7 @@ pub fn sample_side(side: &SideCurve, flat_tol: f64) -> Vec<Point> {
             out.push(prev.1);
             for &(_, a, b) in &elements {
                 for k in 1..=per {
-                    let t = if k == per {
-                        b
-                    } else {
-                        a + (b - a) * k as f64 / per as f64
-                    };
+                    let t = if k == per { b } else { a + (b - a) * k as f64 / per as f64 };
                     let p = f(t);
                     refine(&f, prev.0, prev.1, t, p, flat_tol, 0, &mut out);
                     prev = (t, p);
@@ -227,26 +223,17 @@ fn end_tangent(side: &SideCurve, poly: &[Point], at_end: bool) -> Point {
     }
     if let SideCurve::Analytic(f) = side {
         let h = 1e-7;
-        let d = if at_end {
-            sub(f.eval(1.0), f.eval(1.0 - h))
-        } else {
-            sub(f.eval(h), f.eval(0.0))
-        };
+        let d = if at_end { sub(f.eval(1.0), f.eval(1.0 - h)) } else { sub(f.eval(h), f.eval(0.0)) };
         if finite(d) && d[0].hypot(d[1]) > 0.0 {
             return d;
         }
     }
     if at_end {
         let q = poly[poly.len() - 1];
-        poly.iter()
-            .rev()
-            .find(|&&p| p != q)
-            .map_or([0.0, 0.0], |&p| sub(q, p))
+        poly.iter().rev().find(|&&p| p != q).map_or([0.0, 0.0], |&p| sub(q, p))
     } else {
         let q = poly[0];
-        poly.iter()
-            .find(|&&p| p != q)
-            .map_or([0.0, 0.0], |&p| sub(p, q))
+        poly.iter().find(|&&p| p != q).map_or([0.0, 0.0], |&p| sub(p, q))
     }
 }
 
@@ -273,19 +260,12 @@ pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
         check_side(side).map_err(|e| within_side(e, s))?;
         if let SideCurve::Points(p) = side {
             if p.len() < 2 {
-                return Err(Error::TooFewPoints {
-                    side: s.name().into(),
-                    found: p.len(),
-                    needed: 2,
-                });
+                return Err(Error::TooFewPoints { side: s.name().into(), found: p.len(), needed: 2 });
             }
         }
     }
     // Coarse sampling to size the problem, then adaptive sampling relative to it.
-    let coarse: Vec<Vec<Point>> = Side::ALL
-        .iter()
-        .map(|&s| sample_side(boundary.side(s), f64::INFINITY))
-        .collect();
+    let coarse: Vec<Vec<Point>> = Side::ALL.iter().map(|&s| sample_side(boundary.side(s), f64::INFINITY)).collect();
     for (k, poly) in coarse.iter().enumerate() {
         if let Some(i) = poly.iter().position(|&p| !finite(p)) {
             let p = poly[i];
@@ -327,11 +307,7 @@ pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
     for (k, poly) in polys.iter().enumerate() {
         side_lengths[k] = poly.windows(2).map(|w| dist(w[0], w[1])).sum();
         if side_lengths[k].is_nan() || side_lengths[k] <= tol {
-            return Err(Error::DegenerateSide {
-                side: Side::ALL[k].name().into(),
-                length: side_lengths[k],
-                tol,
-            });
+            return Err(Error::DegenerateSide { side: Side::ALL[k].name().into(), length: side_lengths[k], tol });
         }
     }
 
@@ -373,21 +349,13 @@ pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
     // shared (each side after the first contributes its points after the corner).
     let (pts, owner) = closed_polyline(&polys);
     let signed_area = shoelace(&pts);
-    let orientation = if signed_area > 0.0 {
-        Orientation::CounterClockwise
-    } else {
-        Orientation::Clockwise
-    };
+    let orientation = if signed_area > 0.0 { Orientation::CounterClockwise } else { Orientation::Clockwise };
     check_self_intersection(&pts, &owner, &corners, CORNER_NEIGHBOURHOOD * diameter)?;
 
     // Corner angles from the one-sided tangents in the traversal direction.
     let t = |s: Side, end: bool| end_tangent(boundary.side(s), &polys[s as usize], end);
     let neg = |p: Point| [-p[0], -p[1]];
-    let sign = if orientation == Orientation::CounterClockwise {
-        1.0
-    } else {
-        -1.0
-    };
+    let sign = if orientation == Orientation::CounterClockwise { 1.0 } else { -1.0 };
     let corner_angles = [
         interior_angle(neg(t(Side::West, false)), t(Side::South, false), sign),
         interior_angle(t(Side::South, true), t(Side::East, false), sign),
@@ -414,9 +382,7 @@ pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
 pub fn validate(boundary: &Boundary) -> Result<ValidationReport> {
     let report = inspect(boundary)?;
     if report.orientation == Orientation::Clockwise {
-        return Err(Error::Clockwise {
-            area: report.signed_area,
-        });
+        return Err(Error::Clockwise { area: report.signed_area });
     }
     Ok(report)
 }
@@ -449,17 +415,9 @@ fn closed_polyline(polys: &[Vec<Point>]) -> (Vec<Point>, Vec<Side>) {
     push(south[0], Side::West);
     south.iter().skip(1).for_each(|&p| push(p, Side::South));
     east.iter().skip(1).for_each(|&p| push(p, Side::East));
-    north
-        .iter()
-        .rev()
-        .skip(1)
-        .for_each(|&p| push(p, Side::North));
+    north.iter().rev().skip(1).for_each(|&p| push(p, Side::North));
     // The west side ends (reversed) at the south-west corner, which is vertex 0.
-    west.iter()
-        .rev()
-        .skip(1)
-        .take(west.len().saturating_sub(2))
-        .for_each(|&p| push(p, Side::West));
+    west.iter().rev().skip(1).take(west.len().saturating_sub(2)).for_each(|&p| push(p, Side::West));
     while verts.len() > 1 && verts.last().map(|v| v.0) == verts.first().map(|v| v.0) {
         verts.pop();
     }
@@ -489,18 +447,13 @@ fn segment_hit(a: Point, b: Point, c: Point, d: Point) -> Option<Point> {
     let d2 = cross(sub(b, a), sub(d, a));
     let d3 = cross(sub(d, c), sub(a, c));
     let d4 = cross(sub(d, c), sub(b, c));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
         let t = d3 / (d3 - d4);
         return Some([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
     }
     let on = |p: Point, q: Point, r: Point| {
         // r on segment pq, given collinearity
-        r[0] >= p[0].min(q[0])
-            && r[0] <= p[0].max(q[0])
-            && r[1] >= p[1].min(q[1])
-            && r[1] <= p[1].max(q[1])
+        r[0] >= p[0].min(q[0]) && r[0] <= p[0].max(q[0]) && r[1] >= p[1].min(q[1]) && r[1] <= p[1].max(q[1])
     };
     if d1 == 0.0 && on(a, b, c) {
         return Some(c);
@@ -525,12 +478,7 @@ fn segment_hit(a: Point, b: Point, c: Point, d: Point) -> Option<Point> {
 /// from a uniform grid of about as many cells as segments, each segment registered in
 /// the cells its line passes through, so the cost is about linear for contours whose
 /// segments are short compared with the domain.
-fn check_self_intersection(
-    pts: &[Point],
-    owner: &[Side],
-    corners: &[Point; 4],
-    radius: f64,
-) -> Result<()> {
+fn check_self_intersection(pts: &[Point], owner: &[Side], corners: &[Point; 4], radius: f64) -> Result<()> {
     let near_corner = |p: Point| corners.iter().any(|&c| dist(p, c) <= radius);
     let n = pts.len();
     if n < 3 {
@@ -558,10 +506,7 @@ fn check_self_intersection(
     }
     // Uniform grid over the bounding box.
     let (lo, hi) = bbox(pts.iter());
-    let (w, h) = (
-        (hi[0] - lo[0]).max(f64::MIN_POSITIVE),
-        (hi[1] - lo[1]).max(f64::MIN_POSITIVE),
-    );
+    let (w, h) = ((hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE));
     let cells = n.clamp(1, 1 << 22) as f64;
     let gx = ((cells * w / h).sqrt().ceil()).clamp(1.0, cells) as usize;
     let gy = ((cells / gx as f64).ceil()).clamp(1.0, cells) as usize;
@@ -575,10 +520,7 @@ fn check_self_intersection(
         let (c0, c1) = (col(p[0] - 1e-9 * cw), col(q[0] + 1e-9 * cw));
         for cx in c0..=c1 {
             // y-range of the segment inside this column (conservatively widened)
-            let (xa, xb) = (
-                (lo[0] + cx as f64 * cw).max(p[0]),
-                (lo[0] + (cx + 1) as f64 * cw).min(q[0]),
-            );
+            let (xa, xb) = ((lo[0] + cx as f64 * cw).max(p[0]), (lo[0] + (cx + 1) as f64 * cw).min(q[0]));
             let y_at = |x: f64| {
                 if q[0] > p[0] {
                     p[1] + (x - p[0]) * (q[1] - p[1]) / (q[0] - p[0])
@@ -586,11 +528,7 @@ fn check_self_intersection(
                     p[1]
                 }
             };
-            let (ya, yb) = if q[0] > p[0] {
-                (y_at(xa), y_at(xb))
-            } else {
-                (p[1], q[1])
-            };
+            let (ya, yb) = if q[0] > p[0] { (y_at(xa), y_at(xb)) } else { (p[1], q[1]) };
             let (y0, y1) = (ya.min(yb) - 1e-9 * ch, ya.max(yb) + 1e-9 * ch);
             for cy in row(y0)..=row(y1) {
                 entries.push((cy * gx + cx, i as u32));
@@ -632,14 +570,7 @@ mod tests {
     use crate::knots::KnotVector;
 
     fn line(a: Point, b: Point) -> SideCurve {
-        SideCurve::Spline(
-            Curve::new(
-                KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(),
-                vec![a, b],
-                None,
-            )
-            .unwrap(),
-        )
+        SideCurve::Spline(Curve::new(KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(), vec![a, b], None).unwrap())
     }
 
     fn square() -> Boundary {
@@ -694,11 +625,7 @@ mod tests {
             ],
         };
         let r = validate(&b).unwrap();
-        assert!(
-            (r.corner_angles[2] - 180.0).abs() < 1e-4,
-            "{:?}",
-            r.corner_angles
-        );
+        assert!((r.corner_angles[2] - 180.0).abs() < 1e-4, "{:?}", r.corner_angles);
         assert!((r.corner_angles[0] - 90.0).abs() < 1e-9);
     }
 

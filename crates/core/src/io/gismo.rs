@@ -35,10 +35,7 @@ const MAX_DEPTH: usize = 256;
 pub const ASSIGN_TOL: f64 = 1e-6;
 
 fn xml_err(context: &str, message: impl Into<String>) -> Error {
-    Error::Xml {
-        context: context.to_string(),
-        message: message.into(),
-    }
+    Error::Xml { context: context.to_string(), message: message.into() }
 }
 
 fn is(node: &Node, name: &str) -> bool {
@@ -72,9 +69,7 @@ fn numbers(node: Node, ctx: &str) -> Result<Vec<f64>> {
                     limit: 3 * MAX_CONTROL_POINTS + 64,
                 });
             }
-            let x: f64 = tok
-                .parse()
-                .map_err(|_| xml_err(ctx, format!("not a number: {tok:?}")))?;
+            let x: f64 = tok.parse().map_err(|_| xml_err(ctx, format!("not a number: {tok:?}")))?;
             if !x.is_finite() {
                 return Err(Error::NonFinite {
                     context: ctx.to_string(),
@@ -94,25 +89,13 @@ fn basis_type<'a>(node: &Node<'a, '_>) -> &'a str {
 /// `<Basis type="BSplineBasis"><KnotVector degree="p">...</KnotVector></Basis>`.
 fn bspline_basis(node: Node, ctx: &str) -> Result<KnotVector> {
     if basis_type(&node) != "BSplineBasis" {
-        return Err(xml_err(
-            ctx,
-            format!(
-                "expected a BSplineBasis, found type {:?}",
-                basis_type(&node)
-            ),
-        ));
+        return Err(xml_err(ctx, format!("expected a BSplineBasis, found type {:?}", basis_type(&node))));
     }
     let kv = only_child(node, "KnotVector", ctx)?;
     let ctx = format!("{ctx}.KnotVector");
-    let deg = kv
-        .attribute("degree")
-        .ok_or_else(|| xml_err(&ctx, "missing attribute degree"))?;
-    let degree: usize = deg.trim().parse().map_err(|_| {
-        xml_err(
-            &ctx,
-            format!("degree {deg:?} is not a non-negative integer"),
-        )
-    })?;
+    let deg = kv.attribute("degree").ok_or_else(|| xml_err(&ctx, "missing attribute degree"))?;
+    let degree: usize =
+        deg.trim().parse().map_err(|_| xml_err(&ctx, format!("degree {deg:?} is not a non-negative integer")))?;
     let knots = numbers(kv, &ctx)?;
     KnotVector::new(degree, knots).map_err(|e| e.within(&ctx))
 }
@@ -123,18 +106,12 @@ fn coefs(geom: Node, n: usize, ctx: &str) -> Result<Vec<Point>> {
     let ctx = format!("{ctx}.coefs");
     let vals = numbers(node, &ctx)?;
     let dim = match node.attribute("geoDim") {
-        Some(d) => d
-            .trim()
-            .parse::<usize>()
-            .map_err(|_| xml_err(&ctx, format!("geoDim {d:?} is not an integer")))?,
+        Some(d) => d.trim().parse::<usize>().map_err(|_| xml_err(&ctx, format!("geoDim {d:?} is not an integer")))?,
         None if n > 0 && vals.len() % n == 0 => vals.len() / n,
         None => return Err(xml_err(&ctx, "missing attribute geoDim")),
     };
     if dim != 2 && dim != 3 {
-        return Err(xml_err(
-            &ctx,
-            format!("geoDim {dim} is not supported (planar geometries only: 2 or 3)"),
-        ));
+        return Err(xml_err(&ctx, format!("geoDim {dim} is not supported (planar geometries only: 2 or 3)")));
     }
     if vals.len() != n * dim {
         return Err(Error::Length {
@@ -152,12 +129,7 @@ fn weights(basis: Node, n: usize, ctx: &str) -> Result<Vec<f64>> {
     let ctx = format!("{ctx}.weights");
     let w = numbers(node, &ctx)?;
     if w.len() != n {
-        return Err(Error::Length {
-            context: ctx,
-            what: "weights".into(),
-            found: w.len(),
-            expected: n,
-        });
+        return Err(Error::Length { context: ctx, what: "weights".into(), found: w.len(), expected: n });
     }
     Ok(w)
 }
@@ -168,10 +140,7 @@ fn curve(geom: Node, rational: bool, ctx: &str) -> Result<Curve> {
     let bctx = format!("{ctx}.Basis");
     let (kv, w) = if rational {
         if basis_type(&basis) != "NurbsBasis" {
-            return Err(xml_err(
-                &bctx,
-                format!("expected a NurbsBasis, found type {:?}", basis_type(&basis)),
-            ));
+            return Err(xml_err(&bctx, format!("expected a NurbsBasis, found type {:?}", basis_type(&basis))));
         }
         let kv = bspline_basis(only_child(basis, "Basis", &bctx)?, &format!("{bctx}.Basis"))?;
         let w = weights(basis, kv.num_basis(), &bctx)?;
@@ -187,33 +156,18 @@ fn curve(geom: Node, rational: bool, ctx: &str) -> Result<Curve> {
 /// A `TensorBSplineBasis2`: the two univariate bases ordered by their `index` attribute.
 fn tensor_basis(node: Node, ctx: &str) -> Result<[KnotVector; 2]> {
     if basis_type(&node) != "TensorBSplineBasis2" {
-        return Err(xml_err(
-            ctx,
-            format!(
-                "expected a TensorBSplineBasis2, found type {:?}",
-                basis_type(&node)
-            ),
-        ));
+        return Err(xml_err(ctx, format!("expected a TensorBSplineBasis2, found type {:?}", basis_type(&node))));
     }
     let parts: Vec<Node> = children(node, "Basis").collect();
     if parts.len() != 2 {
-        return Err(xml_err(
-            ctx,
-            format!("expected two univariate bases, found {}", parts.len()),
-        ));
+        return Err(xml_err(ctx, format!("expected two univariate bases, found {}", parts.len())));
     }
-    let index = |n: &Node| {
-        n.attribute("index")
-            .and_then(|i| i.trim().parse::<usize>().ok())
-    };
+    let index = |n: &Node| n.attribute("index").and_then(|i| i.trim().parse::<usize>().ok());
     let (a, b) = match (index(&parts[0]), index(&parts[1])) {
         (Some(1), Some(0)) => (parts[1], parts[0]),
         _ => (parts[0], parts[1]),
     };
-    Ok([
-        bspline_basis(a, &format!("{ctx}.Basis[0]"))?,
-        bspline_basis(b, &format!("{ctx}.Basis[1]"))?,
-    ])
+    Ok([bspline_basis(a, &format!("{ctx}.Basis[0]"))?, bspline_basis(b, &format!("{ctx}.Basis[1]"))?])
 }
 
 /// A `TensorBSpline2` or `TensorNurbs2` geometry, knot domains mapped to `[0, 1]`.
@@ -222,13 +176,7 @@ fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
     let bctx = format!("{ctx}.Basis");
     let (kv, w) = if rational {
         if basis_type(&basis) != "TensorNurbsBasis2" {
-            return Err(xml_err(
-                &bctx,
-                format!(
-                    "expected a TensorNurbsBasis2, found type {:?}",
-                    basis_type(&basis)
-                ),
-            ));
+            return Err(xml_err(&bctx, format!("expected a TensorNurbsBasis2, found type {:?}", basis_type(&basis))));
         }
         let kv = tensor_basis(only_child(basis, "Basis", &bctx)?, &format!("{bctx}.Basis"))?;
         let n = kv[0].num_basis().saturating_mul(kv[1].num_basis());
@@ -248,10 +196,7 @@ fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
     }
     let cps = coefs(geom, n, ctx)?;
     let s = Surface::new(kv, cps, w).map_err(|e| e.within(ctx))?;
-    let knots = [
-        normalized_knots(&s.knots[0])?,
-        normalized_knots(&s.knots[1])?,
-    ];
+    let knots = [normalized_knots(&s.knots[0])?, normalized_knots(&s.knots[1])?];
     Ok(Surface { knots, ..s })
 }
 
@@ -261,17 +206,10 @@ fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
 /// orientation). The name is left empty.
 pub fn parse_gismo_xml(text: &str) -> Result<Document> {
     if nesting_exceeds(text, MAX_DEPTH) {
-        return Err(xml_err(
-            "",
-            format!("elements are nested more than {MAX_DEPTH} levels deep"),
-        ));
+        return Err(xml_err("", format!("elements are nested more than {MAX_DEPTH} levels deep")));
     }
-    let opts = roxmltree::ParsingOptions {
-        allow_dtd: false,
-        nodes_limit: MAX_NODES,
-    };
-    let doc = roxmltree::Document::parse_with_options(text, opts)
-        .map_err(|e| xml_err("", e.to_string()))?;
+    let opts = roxmltree::ParsingOptions { allow_dtd: false, nodes_limit: MAX_NODES };
+    let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| xml_err("", e.to_string()))?;
     let root = doc.root_element();
     let mut curves = Vec::new();
     let mut patches = Vec::new();
@@ -285,12 +223,7 @@ pub fn parse_gismo_xml(text: &str) -> Result<Document> {
             "Nurbs" => curves.push(curve(g, true, &ctx)?),
             "TensorBSpline2" => patches.push(patch(g, false, &ctx)?),
             "TensorNurbs2" => patches.push(patch(g, true, &ctx)?),
-            other => {
-                return Err(xml_err(
-                    &ctx,
-                    format!("unsupported geometry type {other:?}"),
-                ))
-            }
+            other => return Err(xml_err(&ctx, format!("unsupported geometry type {other:?}"))),
         }
     }
     match (curves.len(), patches.len()) {
@@ -337,9 +270,7 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
         .iter()
         .map(|c| {
             let poly = sample_side(&SideCurve::Spline(c.clone()), f64::INFINITY);
-            poly.windows(2)
-                .map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0])
-                .sum()
+            poly.windows(2).map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0]).sum()
         })
         .collect();
     let d = |a: Point, b: Point| (a[0] - b[0]).hypot(a[1] - b[1]);
@@ -354,41 +285,19 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
             }
         };
         let (s, ea, n, w) = (e(0), e(1), e(2), e(3));
-        d(s.0, w.0)
-            .max(d(s.1, ea.0))
-            .max(d(n.0, w.1))
-            .max(d(n.1, ea.1))
+        d(s.0, w.0).max(d(s.1, ea.0)).max(d(n.0, w.1)).max(d(n.1, ea.1))
     };
     let area_of = |sides: Assignment| {
         let sign = [1.0, 1.0, -1.0, -1.0];
-        (0..4)
-            .map(|k| {
-                sign[k]
-                    * if sides[k].1 {
-                        -sweep[sides[k].0]
-                    } else {
-                        sweep[sides[k].0]
-                    }
-            })
-            .sum::<f64>()
-            * 0.5
+        (0..4).map(|k| sign[k] * if sides[k].1 { -sweep[sides[k].0] } else { sweep[sides[k].0] }).sum::<f64>() * 0.5
     };
     let build = |sides: Assignment, transpose: bool| -> Result<Boundary> {
         let mut out = Vec::with_capacity(4);
         for (i, r) in sides {
-            out.push(SideCurve::Spline(if r {
-                reversed_curve(&curves[i])?
-            } else {
-                curves[i].clone()
-            }));
+            out.push(SideCurve::Spline(if r { reversed_curve(&curves[i])? } else { curves[i].clone() }));
         }
-        let sides: [SideCurve; 4] = out
-            .try_into()
-            .map_err(|_| xml_err("", "four sides expected"))?;
-        let b = Boundary {
-            name: String::new(),
-            sides,
-        };
+        let sides: [SideCurve; 4] = out.try_into().map_err(|_| xml_err("", "four sides expected"))?;
+        let b = Boundary { name: String::new(), sides };
         Ok(if transpose { b.transposed() } else { b })
     };
 
@@ -417,10 +326,7 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
         Some((_, cw, _, sides)) => build(sides, cw),
         None => {
             let smallest = permutations4()
-                .flat_map(|perm| {
-                    (0u32..16)
-                        .map(move |mask| std::array::from_fn(|k| (perm[k], mask >> k & 1 == 1)))
-                })
+                .flat_map(|perm| (0u32..16).map(move |mask| std::array::from_fn(|k| (perm[k], mask >> k & 1 == 1))))
                 .map(gap_of)
                 .fold(f64::INFINITY, f64::min);
             Err(xml_err(
@@ -438,12 +344,8 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
 /// self-closing tags do not count).
 fn nesting_exceeds(text: &str, limit: usize) -> bool {
     let b = text.as_bytes();
-    let find = |from: usize, pat: &[u8]| {
-        b[from.min(b.len())..]
-            .windows(pat.len())
-            .position(|w| w == pat)
-            .map(|k| from + k)
-    };
+    let find =
+        |from: usize, pat: &[u8]| b[from.min(b.len())..].windows(pat.len()).position(|w| w == pat).map(|k| from + k);
     let (mut i, mut depth) = (0, 0usize);
     while i < b.len() {
         if b[i] != b'<' {
@@ -526,16 +428,12 @@ mod tests {
 
     #[test]
     fn four_curves_in_box_order() {
-        let Document::Boundary(b) = parse_gismo_xml(SQUARE_CURVES).unwrap() else {
-            panic!()
-        };
+        let Document::Boundary(b) = parse_gismo_xml(SQUARE_CURVES).unwrap() else { panic!() };
         assert_eq!(b.side(Side::South).endpoints(), ([0., 0.], [1., 0.]));
         assert_eq!(b.side(Side::East).endpoints(), ([1., 0.], [1., 1.]));
         assert_eq!(b.side(Side::North).endpoints(), ([0., 1.], [1., 1.]));
         assert_eq!(b.side(Side::West).endpoints(), ([0., 0.], [0., 1.]));
-        let SideCurve::Spline(n) = b.side(Side::North) else {
-            panic!()
-        };
+        let SideCurve::Spline(n) = b.side(Side::North) else { panic!() };
         assert_eq!(n.domain(), (0.0, 1.0));
     }
 
@@ -543,17 +441,9 @@ mod tests {
     fn shuffled_and_reversed_curves_are_assigned() {
         // north reversed and listed first, then south, west reversed, east
         let xml = SQUARE_CURVES
-            .replace(
-                "<coefs geoDim=\"2\">0 1 1 1</coefs>",
-                "<coefs geoDim=\"2\">1 1 0 1</coefs>",
-            )
-            .replace(
-                "<coefs geoDim=\"2\">0 0 0 1</coefs>",
-                "<coefs geoDim=\"2\">0 1 0 0</coefs>",
-            );
-        let Document::Boundary(b) = parse_gismo_xml(&xml).unwrap() else {
-            panic!()
-        };
+            .replace("<coefs geoDim=\"2\">0 1 1 1</coefs>", "<coefs geoDim=\"2\">1 1 0 1</coefs>")
+            .replace("<coefs geoDim=\"2\">0 0 0 1</coefs>", "<coefs geoDim=\"2\">0 1 0 0</coefs>");
+        let Document::Boundary(b) = parse_gismo_xml(&xml).unwrap() else { panic!() };
         let r = crate::validate::validate(&b).unwrap();
         assert!((r.signed_area - 1.0).abs() < 1e-12);
     }
@@ -562,20 +452,11 @@ mod tests {
     fn clockwise_box_order_is_transposed() {
         // swap the roles: curve 0/1 horizontal, 2/3 vertical -> box order runs clockwise
         let c = |a: Point, b: Point| {
-            Curve::new(
-                KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(),
-                vec![a, b],
-                None,
-            )
-            .unwrap()
+            Curve::new(KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(), vec![a, b], None).unwrap()
         };
-        let b = assign_sides([
-            c([0., 0.], [1., 0.]),
-            c([0., 1.], [1., 1.]),
-            c([0., 0.], [0., 1.]),
-            c([1., 0.], [1., 1.]),
-        ])
-        .unwrap();
+        let b =
+            assign_sides([c([0., 0.], [1., 0.]), c([0., 1.], [1., 1.]), c([0., 0.], [0., 1.]), c([1., 0.], [1., 1.])])
+                .unwrap();
         assert!(crate::validate::validate(&b).is_ok());
         assert_eq!(b.side(Side::South).endpoints(), ([0., 0.], [1., 0.]));
     }
@@ -593,19 +474,12 @@ mod tests {
           <Basis type="BSplineBasis" index="1"><KnotVector degree="1">0 0 1 1</KnotVector></Basis>
           <Basis type="BSplineBasis" index="0"><KnotVector degree="1">0 0 0.5 1 1</KnotVector></Basis></Basis>
           <coefs geoDim="2">0 0  1 0  2 0  0 1  1 1  2 1</coefs></Geometry></xml>"#;
-        let Document::Map { map, .. } = parse_gismo_xml(xml).unwrap() else {
-            panic!()
-        };
+        let Document::Map { map, .. } = parse_gismo_xml(xml).unwrap() else { panic!() };
         assert_eq!(map.shape(), [3, 2]);
         assert_eq!(map.cp(2, 0), [2., 0.]);
         // clockwise patch: transposed
-        let cw = xml.replace(
-            "0 0  1 0  2 0  0 1  1 1  2 1",
-            "0 0  1 0  2 0  0 -1  1 -1  2 -1",
-        );
-        let Document::Map { map, .. } = parse_gismo_xml(&cw).unwrap() else {
-            panic!()
-        };
+        let cw = xml.replace("0 0  1 0  2 0  0 1  1 1  2 1", "0 0  1 0  2 0  0 -1  1 -1  2 -1");
+        let Document::Map { map, .. } = parse_gismo_xml(&cw).unwrap() else { panic!() };
         assert_eq!(map.shape(), [2, 3]);
         assert!(map.derivs(0.5, 0.5, 1).det_j() > 0.0);
     }
@@ -625,10 +499,7 @@ mod tests {
         let bad_num = SQUARE_CURVES.replace("0 0 0 1</coefs>", "0 0 x 1</coefs>");
         assert!(matches!(parse_gismo_xml(&bad_num), Err(Error::Xml { .. })));
         let inf = SQUARE_CURVES.replace("0 0 0 1</coefs>", "0 0 inf 1</coefs>");
-        assert!(matches!(
-            parse_gismo_xml(&inf),
-            Err(Error::NonFinite { .. })
-        ));
+        assert!(matches!(parse_gismo_xml(&inf), Err(Error::NonFinite { .. })));
         let short = SQUARE_CURVES.replace("0 0 0 1</coefs>", "0 0 0</coefs>");
         assert!(matches!(parse_gismo_xml(&short), Err(Error::Length { .. })));
         let deg0 = SQUARE_CURVES.replacen("degree=\"1\"", "degree=\"0\"", 1);
@@ -636,10 +507,7 @@ mod tests {
         let w0 = SQUARE_CURVES.replace("<weights>1 1</weights>", "<weights>1 0</weights>");
         assert!(matches!(parse_gismo_xml(&w0), Err(Error::Weight { .. })));
         let decreasing = SQUARE_CURVES.replacen("0 0 1 1", "0 1 0 1", 1);
-        assert!(matches!(
-            parse_gismo_xml(&decreasing),
-            Err(Error::Knots { .. })
-        ));
+        assert!(matches!(parse_gismo_xml(&decreasing), Err(Error::Knots { .. })));
     }
 
     #[test]
@@ -650,10 +518,7 @@ mod tests {
         // unclosed tags count too
         assert!(parse_gismo_xml(&"<a x='/>'>".repeat(depth)).is_err());
         // siblings, self-closing tags and comments do not
-        let flat = format!(
-            "<xml>{}<!-- <a><a><a> --></xml>",
-            "<a/><b></b><c t=\"/\"/>".repeat(depth)
-        );
+        let flat = format!("<xml>{}<!-- <a><a><a> --></xml>", "<a/><b></b><c t=\"/\"/>".repeat(depth));
         assert!(!nesting_exceeds(&flat, 3));
         assert!(nesting_exceeds("<a><b><c><d>", 3));
     }

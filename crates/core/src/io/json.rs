@@ -63,9 +63,7 @@ impl SideJson {
     /// Decide by the presence of a `points` field.
     pub fn from_value(v: Value) -> std::result::Result<Self, serde_json::Error> {
         match &v {
-            Value::Object(o) if o.contains_key("points") => {
-                serde_json::from_value(v).map(SideJson::Points)
-            }
+            Value::Object(o) if o.contains_key("points") => serde_json::from_value(v).map(SideJson::Points),
             Value::Object(_) => serde_json::from_value(v).map(SideJson::Curve),
             other => Err(serde::de::Error::custom(format!(
                 "a side must be a Curve object or {{\"points\": [...]}}, found {}",
@@ -152,12 +150,7 @@ pub struct MapDoc {
 }
 
 fn too_large(what: &str, found: usize) -> Error {
-    Error::TooLarge {
-        context: String::new(),
-        what: what.into(),
-        found,
-        limit: MAX_CONTROL_POINTS,
-    }
+    Error::TooLarge { context: String::new(), what: what.into(), found, limit: MAX_CONTROL_POINTS }
 }
 
 impl CurveJson {
@@ -175,13 +168,9 @@ impl CurveJson {
     /// Validate (lengths, knots, degree, finiteness, weights) and map the domain to `[0, 1]`.
     pub fn to_curve(self) -> Result<Curve> {
         if self.control_points.len() > MAX_CONTROL_POINTS {
-            return Err(too_large(
-                "number of control points",
-                self.control_points.len(),
-            ));
+            return Err(too_large("number of control points", self.control_points.len()));
         }
-        let kv = KnotVector::with_periodic(self.degree, self.knots, self.periodic)
-            .map_err(|e| e.within("knots"))?;
+        let kv = KnotVector::with_periodic(self.degree, self.knots, self.periodic).map_err(|e| e.within("knots"))?;
         let c = Curve::new(kv, self.control_points, self.weights)?;
         normalized_curve(&c)
     }
@@ -196,9 +185,7 @@ impl SideJson {
             SideCurve::Points(p) => SideJson::Points(PointsJson { points: p.clone() }),
             SideCurve::Analytic(f) => {
                 let m = ANALYTIC_WRITE_POINTS - 1;
-                SideJson::Points(PointsJson {
-                    points: (0..=m).map(|k| f.eval(k as f64 / m as f64)).collect(),
-                })
+                SideJson::Points(PointsJson { points: (0..=m).map(|k| f.eval(k as f64 / m as f64)).collect() })
             }
         }
     }
@@ -222,39 +209,18 @@ impl BoundaryDoc {
     /// The JSON form of a boundary.
     pub fn from_boundary(b: &Boundary) -> Self {
         let [south, east, north, west] = b.sides.each_ref().map(SideJson::from_side);
-        BoundaryDoc {
-            name: b.name.clone(),
-            boundary: SidesJson {
-                south,
-                east,
-                north,
-                west,
-            },
-        }
+        BoundaryDoc { name: b.name.clone(), boundary: SidesJson { south, east, north, west } }
     }
 
     /// Convert to a boundary (sides converted by [`SideJson::to_side`]; errors name the side).
     pub fn to_boundary(self) -> Result<Boundary> {
-        let SidesJson {
-            south,
-            east,
-            north,
-            west,
-        } = self.boundary;
+        let SidesJson { south, east, north, west } = self.boundary;
         let mut sides = Vec::with_capacity(4);
         for (s, j) in Side::ALL.into_iter().zip([south, east, north, west]) {
-            sides.push(
-                j.to_side()
-                    .map_err(|e| e.within(&format!("boundary.{s}")))?,
-            );
+            sides.push(j.to_side().map_err(|e| e.within(&format!("boundary.{s}")))?);
         }
-        let sides: [SideCurve; 4] = sides
-            .try_into()
-            .map_err(|_| Error::Invalid("four sides expected".into()))?;
-        Ok(Boundary {
-            name: self.name,
-            sides,
-        })
+        let sides: [SideCurve; 4] = sides.try_into().map_err(|_| Error::Invalid("four sides expected".into()))?;
+        Ok(Boundary { name: self.name, sides })
     }
 }
 
@@ -262,10 +228,7 @@ impl ContourDoc {
     /// Split the polygon into the four sides ([`split_contour`]).
     pub fn to_boundary(self) -> Result<Boundary> {
         let sides = split_contour(&self.contour.points, self.contour.corners)?;
-        Ok(Boundary {
-            name: self.name,
-            sides: sides.map(SideCurve::Points),
-        })
+        Ok(Boundary { name: self.name, sides: sides.map(SideCurve::Points) })
     }
 }
 
@@ -284,16 +247,11 @@ impl MapJson {
     /// Validate and map both knot domains to `[0, 1]`.
     pub fn to_surface(self) -> Result<Surface> {
         if self.control_points.len() > MAX_CONTROL_POINTS {
-            return Err(too_large(
-                "number of control points",
-                self.control_points.len(),
-            ));
+            return Err(too_large("number of control points", self.control_points.len()));
         }
         let [k0, k1] = self.knots;
-        let kv0 = KnotVector::with_periodic(self.degree[0], k0, self.periodic[0])
-            .map_err(|e| e.within("knots[0]"))?;
-        let kv1 = KnotVector::with_periodic(self.degree[1], k1, self.periodic[1])
-            .map_err(|e| e.within("knots[1]"))?;
+        let kv0 = KnotVector::with_periodic(self.degree[0], k0, self.periodic[0]).map_err(|e| e.within("knots[0]"))?;
+        let kv1 = KnotVector::with_periodic(self.degree[1], k1, self.periodic[1]).map_err(|e| e.within("knots[1]"))?;
         let s = Surface::new([kv0, kv1], self.control_points, self.weights)?;
         let knots = [
             normalized_knots(&s.knots[0]).map_err(|e| e.within("knots[0]"))?,
@@ -315,10 +273,7 @@ fn kind_of(v: &Value) -> &'static str {
 }
 
 fn json_err(context: &str) -> impl Fn(serde_json::Error) -> Error + '_ {
-    move |e| Error::Json {
-        context: context.to_string(),
-        message: e.to_string(),
-    }
+    move |e| Error::Json { context: context.to_string(), message: e.to_string() }
 }
 
 /// Parse a boundary, contour or map document (see `formats.md`). The kind is decided by
@@ -351,37 +306,26 @@ pub fn parse_json(text: &str) -> Result<Document> {
         let Value::Object(mut sides) = b else {
             return Err(Error::Json {
                 context: "boundary".into(),
-                message: format!(
-                    "must be an object with south, east, north and west, found {}",
-                    kind_of(&b)
-                ),
+                message: format!("must be an object with south, east, north and west, found {}", kind_of(&b)),
             });
         };
         let mut out = Vec::with_capacity(4);
         for s in Side::ALL {
             let ctx = format!("boundary.{s}");
-            let v = sides.remove(s.name()).ok_or_else(|| Error::Json {
-                context: "boundary".into(),
-                message: format!("missing side \"{s}\""),
-            })?;
+            let v = sides
+                .remove(s.name())
+                .ok_or_else(|| Error::Json { context: "boundary".into(), message: format!("missing side \"{s}\"") })?;
             let side = SideJson::from_value(v).map_err(json_err(&ctx))?;
             out.push(side.to_side().map_err(|e| e.within(&ctx))?);
         }
-        let sides: [SideCurve; 4] = out
-            .try_into()
-            .map_err(|_| Error::Invalid("four sides expected".into()))?;
+        let sides: [SideCurve; 4] = out.try_into().map_err(|_| Error::Invalid("four sides expected".into()))?;
         return Ok(Document::Boundary(Boundary { name, sides }));
     }
     if let Some(c) = obj.remove("contour") {
         let contour: ContourJson = serde_json::from_value(c).map_err(json_err("contour"))?;
-        return ContourDoc { name, contour }
-            .to_boundary()
-            .map(Document::Boundary);
+        return ContourDoc { name, contour }.to_boundary().map(Document::Boundary);
     }
-    Err(Error::Json {
-        context: String::new(),
-        message: "expected a \"boundary\", \"contour\" or \"map\" field".into(),
-    })
+    Err(Error::Json { context: String::new(), message: "expected a \"boundary\", \"contour\" or \"map\" field".into() })
 }
 
 /// Split a closed polygon at its corners `[i_sw, i_se, i_ne, i_nw]` into the sides of
@@ -397,9 +341,7 @@ pub fn split_contour(points: &[Point], corners: [usize; 4]) -> Result<[Vec<Point
     }
     let len = points.len();
     if let Some(&i) = corners.iter().find(|&&i| i >= len) {
-        return Err(bad(format!(
-            "corner index {i} is out of range for {len} points"
-        )));
+        return Err(bad(format!("corner index {i} is out of range for {len} points")));
     }
     let mut n = len;
     if n >= 2 {
@@ -417,9 +359,7 @@ pub fn split_contour(points: &[Point], corners: [usize; 4]) -> Result<[Vec<Point
         }
     }
     if n < 4 {
-        return Err(bad(format!(
-            "a contour needs at least 4 distinct points, found {n}"
-        )));
+        return Err(bad(format!("a contour needs at least 4 distinct points, found {n}")));
     }
     let c = corners.map(|i| if i == n { 0 } else { i });
     let off = |i: usize| (c[i] + n - c[0]) % n;
@@ -516,10 +456,7 @@ pub fn map_to_json(name: &str, map: &Surface, extra: Option<Value>) -> Value {
 
 /// Write a JSON value to a file (pretty-printed, numbers round-trip exactly).
 pub fn write_json(path: &Path, value: &Value) -> Result<()> {
-    let io = |source: std::io::Error| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io = |source: std::io::Error| Error::Io { path: path.to_path_buf(), source };
     let text = serde_json::to_string_pretty(value).map_err(|e| io(std::io::Error::other(e)))?;
     std::fs::write(path, text + "\n").map_err(io)
 }
@@ -532,39 +469,22 @@ mod tests {
         let kv = KnotVector::open_uniform(2, 3);
         let n = kv.num_basis();
         let g = kv.greville();
-        let cps = (0..n * n)
-            .map(|k| [g[k % n] + 0.1 * (k as f64).sin(), g[k / n] * 1.0 / 3.0])
-            .collect();
+        let cps = (0..n * n).map(|k| [g[k % n] + 0.1 * (k as f64).sin(), g[k / n] * 1.0 / 3.0]).collect();
         Surface::new([kv.clone(), kv], cps, None).unwrap()
     }
 
     #[test]
     fn map_round_trip_is_bit_exact() {
         let mut s = unit_map();
-        s.weights = Some(
-            (0..s.control_points.len())
-                .map(|k| 1.0 + 0.1 / (k as f64 + 3.0))
-                .collect(),
-        );
-        let v = map_to_json(
-            "m",
-            &s,
-            Some(json!({"report": {"iterations": 3}, "name": "ignored"})),
-        );
+        s.weights = Some((0..s.control_points.len()).map(|k| 1.0 + 0.1 / (k as f64 + 3.0)).collect());
+        let v = map_to_json("m", &s, Some(json!({"report": {"iterations": 3}, "name": "ignored"})));
         assert_eq!(v["report"]["iterations"], 3);
         assert_eq!(v["name"], "m");
         let text = serde_json::to_string(&v).unwrap();
-        let Document::Map { name, map } = parse_json(&text).unwrap() else {
-            panic!("not a map")
-        };
+        let Document::Map { name, map } = parse_json(&text).unwrap() else { panic!("not a map") };
         assert_eq!(name, "m");
         assert_eq!(map, s);
-        let again = serde_json::to_string(&map_to_json(
-            "m",
-            &map,
-            Some(json!({"report": {"iterations": 3}})),
-        ))
-        .unwrap();
+        let again = serde_json::to_string(&map_to_json("m", &map, Some(json!({"report": {"iterations": 3}})))).unwrap();
         assert_eq!(again, text);
     }
 
@@ -572,9 +492,7 @@ mod tests {
     fn map_domain_is_normalized() {
         let text = r#"{"name":"x","map":{"degree":[1,1],"knots":[[2,2,4,4],[-1,-1,0,1,1]],
             "control_points":[[0,0],[1,0],[0,1],[1,1],[0,2],[1,2]],"weights":null}}"#;
-        let Document::Map { map, .. } = parse_json(text).unwrap() else {
-            panic!()
-        };
+        let Document::Map { map, .. } = parse_json(text).unwrap() else { panic!() };
         assert_eq!(map.knots[0].knots(), &[0., 0., 1., 1.]);
         assert_eq!(map.knots[1].knots(), &[0., 0., 0.5, 1., 1.]);
         assert!(!map.knots[0].is_periodic());
@@ -582,7 +500,8 @@ mod tests {
 
     #[test]
     fn map_errors_name_the_place() {
-        let text = r#"{"map":{"degree":[1,1],"knots":[[0,0,1,1],[0,1,0.5,1]],"control_points":[[0,0],[1,0],[0,1],[1,1]]}}"#;
+        let text =
+            r#"{"map":{"degree":[1,1],"knots":[[0,0,1,1],[0,1,0.5,1]],"control_points":[[0,0],[1,0],[0,1],[1,1]]}}"#;
         let e = parse_json(text).unwrap_err();
         assert!(matches!(e, Error::Knots { .. }), "{e}");
         assert!(e.to_string().contains("map.knots[1]"), "{e}");
@@ -593,17 +512,8 @@ mod tests {
     #[test]
     fn contour_split_orientation() {
         // square with 8 points, corners at the vertices; the last point repeats the first
-        let pts: Vec<Point> = vec![
-            [0., 0.],
-            [0.5, 0.],
-            [1., 0.],
-            [1., 0.5],
-            [1., 1.],
-            [0.5, 1.],
-            [0., 1.],
-            [0., 0.5],
-            [0., 0.],
-        ];
+        let pts: Vec<Point> =
+            vec![[0., 0.], [0.5, 0.], [1., 0.], [1., 0.5], [1., 1.], [0.5, 1.], [0., 1.], [0., 0.5], [0., 0.]];
         let [s, e, n, w] = split_contour(&pts, [0, 2, 4, 6]).unwrap();
         assert_eq!(s, vec![[0., 0.], [0.5, 0.], [1., 0.]]);
         assert_eq!(e, vec![[1., 0.], [1., 0.5], [1., 1.]]);
@@ -621,22 +531,10 @@ mod tests {
     #[test]
     fn contour_corner_errors() {
         let pts: Vec<Point> = vec![[0., 0.], [1., 0.], [1., 1.], [0., 1.]];
-        assert!(matches!(
-            split_contour(&pts, [0, 1, 2, 4]),
-            Err(Error::Corners { .. })
-        ));
-        assert!(matches!(
-            split_contour(&pts, [0, 2, 1, 3]),
-            Err(Error::Corners { .. })
-        ));
-        assert!(matches!(
-            split_contour(&pts, [0, 0, 2, 3]),
-            Err(Error::Corners { .. })
-        ));
-        assert!(matches!(
-            split_contour(&pts[..3], [0, 1, 2, 2]),
-            Err(Error::Corners { .. })
-        ));
+        assert!(matches!(split_contour(&pts, [0, 1, 2, 4]), Err(Error::Corners { .. })));
+        assert!(matches!(split_contour(&pts, [0, 2, 1, 3]), Err(Error::Corners { .. })));
+        assert!(matches!(split_contour(&pts, [0, 0, 2, 3]), Err(Error::Corners { .. })));
+        assert!(matches!(split_contour(&pts[..3], [0, 1, 2, 2]), Err(Error::Corners { .. })));
         assert!(split_contour(&pts, [1, 2, 3, 0]).is_ok());
     }
 
@@ -644,22 +542,10 @@ mod tests {
     fn side_json_dispatch() {
         let p: SideJson = serde_json::from_str(r#"{"points": [[0, 0], [1, 2]]}"#).unwrap();
         assert!(matches!(p, SideJson::Points(_)));
-        let c: SideJson = serde_json::from_str(
-            r#"{"degree": 1, "knots": [0,0,1,1], "control_points": [[0,0],[1,1]]}"#,
-        )
-        .unwrap();
-        assert!(matches!(
-            c,
-            SideJson::Curve(CurveJson {
-                weights: None,
-                periodic: false,
-                ..
-            })
-        ));
+        let c: SideJson =
+            serde_json::from_str(r#"{"degree": 1, "knots": [0,0,1,1], "control_points": [[0,0],[1,1]]}"#).unwrap();
+        assert!(matches!(c, SideJson::Curve(CurveJson { weights: None, periodic: false, .. })));
         assert!(serde_json::from_str::<SideJson>("[1, 2]").is_err());
-        assert_eq!(
-            serde_json::to_value(&p).unwrap(),
-            json!({"points": [[0.0, 0.0], [1.0, 2.0]]})
-        );
+        assert_eq!(serde_json::to_value(&p).unwrap(), json!({"points": [[0.0, 0.0], [1.0, 2.0]]}));
     }
 }

@@ -21,9 +21,8 @@ use crate::validate::{inspect, validate, Orientation, ValidationReport};
 
 pub use gismo::parse_gismo_xml;
 pub use json::{
-    boundary_to_contour_json, boundary_to_json, curve_to_json, map_to_json, parse_json,
-    split_contour, write_json, BoundaryDoc, ContourDoc, ContourJson, CurveJson, MapDoc, MapJson,
-    PointsJson, SideJson, SidesJson,
+    boundary_to_contour_json, boundary_to_json, curve_to_json, map_to_json, parse_json, split_contour, write_json,
+    BoundaryDoc, ContourDoc, ContourJson, CurveJson, MapDoc, MapJson, PointsJson, SideJson, SidesJson,
 };
 
 /// Largest file [`read_document`] accepts: 256 MiB.
@@ -72,18 +71,12 @@ impl Document {
             Document::Map { name, map } => {
                 let side = |s: Side| {
                     let mut c = map.boundary(s);
-                    if c.weights
-                        .as_ref()
-                        .is_some_and(|w| w.iter().all(|&x| x == 1.0))
-                    {
+                    if c.weights.as_ref().is_some_and(|w| w.iter().all(|&x| x == 1.0)) {
                         c.weights = None;
                     }
                     SideCurve::Spline(c)
                 };
-                Boundary {
-                    name,
-                    sides: Side::ALL.map(side),
-                }
+                Boundary { name, sides: Side::ALL.map(side) }
             }
         }
     }
@@ -99,10 +92,7 @@ pub struct ReadOptions {
 
 /// Read a whole file as UTF-8 text, refusing files above [`MAX_FILE_BYTES`].
 pub fn read_text(path: &Path) -> Result<String> {
-    let io = |source: std::io::Error| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io = |source: std::io::Error| Error::Io { path: path.to_path_buf(), source };
     let file = std::fs::File::open(path).map_err(io)?;
     let too_large = |found: u64| Error::TooLarge {
         context: path.display().to_string(),
@@ -116,14 +106,11 @@ pub fn read_text(path: &Path) -> Result<String> {
         }
     }
     let mut bytes = Vec::new();
-    file.take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
+    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(io)?;
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(too_large(bytes.len() as u64));
     }
-    String::from_utf8(bytes)
-        .map_err(|e| Error::Invalid(format!("{} is not UTF-8 text: {e}", path.display())))
+    String::from_utf8(bytes).map_err(|e| Error::Invalid(format!("{} is not UTF-8 text: {e}", path.display())))
 }
 
 /// Parse a document from text: JSON when it starts with `{`, G+Smo XML when it starts
@@ -145,10 +132,7 @@ pub fn parse_document(text: &str) -> Result<Document> {
 pub fn read_document(path: &Path) -> Result<Document> {
     let text = read_text(path)?;
     let mut doc = parse_document(&text)?;
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     doc.set_name_if_empty(&stem);
     Ok(doc)
 }
@@ -156,18 +140,13 @@ pub fn read_document(path: &Path) -> Result<Document> {
 /// Validate a boundary read from somewhere and orient it: a clockwise contour is an
 /// [`Error::Clockwise`] unless `opts.reorient`, which transposes it. Returns the
 /// (possibly transposed) boundary and its validation report.
-pub fn checked_boundary(
-    boundary: Boundary,
-    opts: &ReadOptions,
-) -> Result<(Boundary, ValidationReport)> {
+pub fn checked_boundary(boundary: Boundary, opts: &ReadOptions) -> Result<(Boundary, ValidationReport)> {
     let report = inspect(&boundary)?;
     if report.orientation == Orientation::CounterClockwise {
         return Ok((boundary, report));
     }
     if !opts.reorient {
-        return Err(Error::Clockwise {
-            area: report.signed_area,
-        });
+        return Err(Error::Clockwise { area: report.signed_area });
     }
     let t = boundary.transposed();
     let report = validate(&t)?;
@@ -191,10 +170,7 @@ pub(crate) fn normalized_knots(kv: &KnotVector) -> Result<KnotVector> {
 
 /// A curve with its domain mapped to `[0, 1]`, re-validated.
 pub(crate) fn normalized_curve(c: &Curve) -> Result<Curve> {
-    Ok(Curve {
-        knots: normalized_knots(&c.knots)?,
-        ..c.clone()
-    })
+    Ok(Curve { knots: normalized_knots(&c.knots)?, ..c.clone() })
 }
 
 /// `Curve::reversed` without the possibility of a panic on unusual knots.
@@ -217,15 +193,8 @@ pub(crate) fn reversed_curve(c: &Curve) -> Result<Curve> {
     let kv = KnotVector::with_periodic(c.degree(), knots, c.knots.is_periodic())?;
     let mut control_points = c.control_points.clone();
     control_points.reverse();
-    let weights = c
-        .weights
-        .as_ref()
-        .map(|w| w.iter().rev().copied().collect());
-    Ok(Curve {
-        knots: kv,
-        control_points,
-        weights,
-    })
+    let weights = c.weights.as_ref().map(|w| w.iter().rev().copied().collect());
+    Ok(Curve { knots: kv, control_points, weights })
 }
 
 /// Signed area enclosed by south, east, reversed north, reversed west of a map's boundary
@@ -236,11 +205,7 @@ pub(crate) fn surface_boundary_area(s: &Surface) -> f64 {
     for (k, side) in sides.iter().enumerate() {
         let poly = crate::validate::sample_side(side, f64::INFINITY);
         let sign = if k < 2 { 1.0 } else { -1.0 };
-        area += sign
-            * poly
-                .windows(2)
-                .map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0])
-                .sum::<f64>();
+        area += sign * poly.windows(2).map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0]).sum::<f64>();
     }
     0.5 * area
 }
@@ -253,10 +218,7 @@ mod tests {
     fn detects_kind_by_content() {
         assert!(matches!(parse_document(""), Err(Error::Invalid(_))));
         assert!(matches!(parse_document("hello"), Err(Error::Invalid(_))));
-        assert!(matches!(
-            parse_document("\u{feff} {"),
-            Err(Error::Json { .. })
-        ));
+        assert!(matches!(parse_document("\u{feff} {"), Err(Error::Json { .. })));
         assert!(matches!(parse_document("  <xml"), Err(Error::Xml { .. })));
     }
 
@@ -276,12 +238,7 @@ mod tests {
     #[test]
     fn reversal_matches_curve_reversed() {
         let kv = KnotVector::new(2, vec![0., 0., 0., 0.3, 1., 1., 1.]).unwrap();
-        let c = Curve::new(
-            kv,
-            vec![[0., 0.], [1., 2.], [2., 0.], [3., 1.]],
-            Some(vec![1., 2., 1., 1.]),
-        )
-        .unwrap();
+        let c = Curve::new(kv, vec![[0., 0.], [1., 2.], [2., 0.], [3., 1.]], Some(vec![1., 2., 1., 1.])).unwrap();
         assert_eq!(reversed_curve(&c).unwrap(), c.reversed());
     }
 }
