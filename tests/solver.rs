@@ -20,6 +20,10 @@ fn assert_bijective(file: &str) {
     assert_eq!(r.verdict, Verdict::PositiveOnSample, "{file}: {}", r.message);
     let last = r.levels.last().unwrap();
     assert!(last.converged, "{file}: {last:?}");
+    // the map's boundary is the input boundary up to the fit tolerance (point clouds are
+    // measured against their polyline, whose corners a smooth fit may cut a little)
+    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(dev <= 4.0 * r.fit_tolerance, "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}", r.fit_tolerance);
     // target: <= 5 Newton iterations on the finest level (the paper reports 3-5)
     assert!(last.newton_iterations <= 5 && last.pseudo_time_iterations == 0, "{file}: {} its", last.newton_iterations);
     // dense interior sample, independent of the report's grid

@@ -98,3 +98,43 @@ pub fn functionals(map: &Surface) -> Functionals {
     }
     Functionals { area, winslow, harmonic, min_det_j_qp: min_det }
 }
+
+/// Largest distance from the map's boundary to the input boundary, per side (south,
+/// east, north, west): each side of the map is sampled at `n + 1` points and the
+/// distance to the input side's polyline (chords within `1e-6` of the diameter) taken.
+pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n: usize) -> [f64; 4] {
+    use crate::surface::Side;
+    let diam = {
+        let pts: Vec<[f64; 2]> =
+            Side::ALL.iter().flat_map(|&s| crate::validate::sample_side(boundary.side(s), f64::INFINITY)).collect();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &pts {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+    };
+    Side::ALL.map(|s| {
+        let poly = crate::validate::sample_side(boundary.side(s), 1e-6 * diam);
+        let curve = map.boundary(s);
+        let mut worst: f64 = 0.0;
+        for k in 0..=n {
+            let p = curve.eval(k as f64 / n as f64);
+            let mut best = f64::INFINITY;
+            for w in poly.windows(2) {
+                best = best.min(point_segment_distance(p, w[0], w[1]));
+            }
+            worst = worst.max(best);
+        }
+        worst
+    })
+}
+
+fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}

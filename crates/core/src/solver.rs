@@ -348,9 +348,16 @@ pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize
         }
         levels.push(Level { knots, sides });
     }
-    // drop levels made identical by balancing
-    levels.dedup_by(|b, a| a.knots == b.knots);
-    Ok(levels)
+    // levels made identical by balancing: keep the last of each run, whose sides are
+    // the most accurate fits on that basis
+    let mut out: Vec<Level> = Vec::with_capacity(levels.len());
+    for l in levels {
+        match out.last_mut() {
+            Some(prev) if prev.knots == l.knots => *prev = l,
+            _ => out.push(l),
+        }
+    }
+    Ok(out)
 }
 
 /// Bookkeeping of the boundary continuation of one level.
@@ -585,6 +592,7 @@ impl EggSolver {
             hierarchy,
             sides: &finest.sides,
             kinks: boundary_kinks(boundary),
+            boundary_deviation: crate::quality::boundary_deviation(&map, boundary, 400),
             opts: &self.opts,
             backend: self.assembler.name(),
             repairs: self.repairs,
@@ -736,6 +744,9 @@ pub struct Report {
     pub corners: Vec<CornerReport>,
     /// Kinks inside the input's spline sides.
     pub kinks: Vec<KinkReport>,
+    /// Largest distance of the map's boundary from the input boundary, per side
+    /// (south, east, north, west).
+    pub boundary_deviation: [f64; 4],
     /// The outcome.
     pub verdict: Verdict,
     /// Plain-language summary of the verdict.
@@ -786,6 +797,7 @@ struct ReportContext<'a> {
     hierarchy: &'a Hierarchy,
     sides: &'a [Curve; 4],
     kinks: Vec<KinkReport>,
+    boundary_deviation: [f64; 4],
     opts: &'a SolveOptions,
     backend: String,
     repairs: usize,
@@ -873,6 +885,7 @@ impl Solution {
             area: fun.area,
             corners,
             kinks,
+            boundary_deviation: ctx.boundary_deviation,
             verdict,
             message,
             seconds: ctx.elapsed.as_secs_f64(),
