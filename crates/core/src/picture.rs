@@ -116,7 +116,8 @@ impl Canvas {
     }
 }
 
-/// Render `map`; the colour scale runs from 0 to the largest sampled `det J`.
+/// Render `map`; the colour scale is logarithmic from the smallest positive to the
+/// largest sampled `det J` (at most four decades).
 pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
     let n = opts.resolution.max(8);
     let mut pts = Vec::with_capacity((n + 1) * (n + 1));
@@ -147,8 +148,11 @@ pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
     let pad = (w as f64 - wd * s) / 2.0;
     let padv = (h as f64 - ht * s) / 2.0;
     let mut cv = Canvas { w, h, rgba: vec![255; 4 * w * h], x0: xmin - pad / s, y0: ymin - padv / s, s };
+    // logarithmic colour scale over the positive values (at most 4 decades)
     let dmax = det.iter().cloned().fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
-    let shade = move |v: f64| if v <= 0.0 { FOLD_COLOUR } else { colormap(v / dmax) };
+    let dmin = det.iter().cloned().filter(|&v| v > 0.0).fold(dmax, f64::min).max(dmax * 1e-4);
+    let span = (dmax / dmin).ln().max(1e-12);
+    let shade = move |v: f64| if v <= 0.0 { FOLD_COLOUR } else { colormap((v / dmin).ln() / span) };
     let idx = |i: usize, j: usize| j * (n + 1) + i;
     // positive cells first, then cells with a non-positive corner on top
     for pass in 0..2 {
