@@ -33,7 +33,14 @@ fn run() -> winslow::Result<(Verdict, f64)> {
     }
     let solution = solver.finish(&boundary, &hierarchy)?;
     let r = &solution.report;
-    println!("{}: {:?}, det J min {:.4}, area {:.6} (exact {:.6})", solution.name, r.verdict, r.det_j_min, r.area, 0.75 * PI * 3.0);
+    println!(
+        "{}: {:?}, det J min {:.4}, area {:.6} (exact {:.6})",
+        solution.name,
+        r.verdict,
+        r.det_j_min,
+        r.area,
+        0.75 * PI * 3.0
+    );
     for f in &r.fit {
         println!("  fit {}: {} elements, max error {:.2e}, converged {}", f.side, f.elements, f.max_error, f.converged);
     }

@@ -112,7 +112,7 @@ struct SolverArgs {
     /// shared geometries, see BENCHMARKS.md).
     #[arg(long, value_enum, default_value = "scaled")]
     operator: OperatorArg,
-    /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 20000 unknowns).
+    /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 5000 unknowns).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
     /// When the finest map folds, halve the basis and solve again, at most this often.

@@ -62,36 +62,47 @@ pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Resul
 /// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).
 pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 
-/// Linear-elasticity correction (§6.3): move the fixed (boundary) control points of
-/// `base` to those of `target` and spread the displacement into the interior by solving
-/// `K_ff u_f = -K_fb (target - base)_b` on the physical domain of `base`. Returns
-/// `base + u` with the fixed control points of `target`.
-pub fn elasticity_correction(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
-    let mut out = base.to_vec();
+/// Linear-elasticity displacement (§6.3): the interior displacement `u_f` with
+/// `K_ff u_f = -K_fb (target - base)_b` on the physical domain of `base`, returned for
+/// every control point (the fixed ones carry `target - base`). It is linear in the
+/// boundary displacement, so `base + alpha u` moves the boundary by `alpha`.
+pub fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
     let mut diff = vec![[0.0; 2]; base.len()];
     let mut moved = false;
     for k in 0..base.len() {
         if disc.dofs.free_index(k) == crate::dofs::FIXED {
-            out[k] = target[k];
             diff[k] = [target[k][0] - base[k][0], target[k][1] - base[k][1]];
             moved |= diff[k] != [0.0, 0.0];
         }
     }
     if disc.dofs.num_free() == 0 || !moved {
-        return Ok(out);
+        return Ok(diff);
     }
     let mut st = vec![0.0; disc.stencil_len(2)];
     disc.elasticity(base, LAME.0, LAME.1, &mut st);
     let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
-    let mut lin = LinearSolver::new(LinearMethod::Lu);
+    let mut lin = LinearSolver::new(LinearMethod::Auto);
     lin.factor(&k)?;
     let u = lin.solve(&rhs)?;
     let m = disc.dofs.num_free();
     for (f, &kk) in disc.dofs.free().iter().enumerate() {
-        out[kk] = [base[kk][0] + u[f], base[kk][1] + u[m + f]];
+        diff[kk] = [u[f], u[m + f]];
     }
-    Ok(out)
+    Ok(diff)
+}
+
+/// `base + alpha u` for a displacement `u` from [`elasticity_displacement`].
+pub fn displaced(base: &[Point], u: &[Point], alpha: f64) -> Vec<Point> {
+    base.iter().zip(u).map(|(b, d)| [b[0] + alpha * d[0], b[1] + alpha * d[1]]).collect()
+}
+
+/// Linear-elasticity correction (§6.3): move the fixed (boundary) control points of
+/// `base` to those of `target` and spread the displacement into the interior
+/// ([`elasticity_displacement`]). Returns `base + u`.
+pub fn elasticity_correction(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
+    let u = elasticity_displacement(disc, base, target)?;
+    Ok(displaced(base, &u, 1.0))
 }
 
 /// Prolong `coarse` onto the basis of `disc` and correct the boundary discrepancy with

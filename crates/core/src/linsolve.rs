@@ -23,7 +23,7 @@ pub enum LinearMethod {
 }
 
 /// Largest system that [`LinearMethod::Auto`] factorizes directly.
-pub const AUTO_LU_LIMIT: usize = 20_000;
+pub const AUTO_LU_LIMIT: usize = 5_000;
 
 /// A factorization-capable solver bound to one sparsity pattern.
 #[derive(Debug)]

@@ -13,7 +13,7 @@ use crate::curve::Curve;
 use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
 use crate::error::{Error, Result};
 use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
-use crate::initial::{coons, elasticity_correction, set_boundary};
+use crate::initial::{coons, displaced, elasticity_displacement, set_boundary};
 use crate::knots::KnotVector;
 use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
 use crate::quality::{functionals, sample_det_j};
@@ -467,17 +467,18 @@ impl EggSolver {
             // same boundary (e.g. a refinement of the previous level): nothing to move
             return Ok(base);
         }
-        let origin = base.clone();
         let mut base = base;
         let (mut done, mut step) = (0.0f64, 1.0f64);
         let mut nl = self.opts.nonlinear;
         nl.scale = self.residual_scale(disc.dofs.num_free());
         nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
+        // displacement from `base` to the full target; linear in the boundary motion, so
+        // a fraction `f` of the remaining motion is `f * u`
+        let mut u = elasticity_displacement(disc, &base, target)?;
         loop {
             let a = (done + step).min(1.0);
-            let bnd: Vec<crate::curve::Point> =
-                origin.iter().zip(target).map(|(o, t)| [o[0] + a * (t[0] - o[0]), o[1] + a * (t[1] - o[1])]).collect();
-            let guess = elasticity_correction(disc, &base, &bnd)?;
+            let f = (a - done) / (1.0 - done);
+            let guess = displaced(&base, &u, f);
             let positive = det_j_min(disc, &guess) > 0.0;
             let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
             if a >= 1.0 && (positive || exhausted) {
@@ -505,6 +506,7 @@ impl EggSolver {
                 base = sol;
                 done = a;
                 step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
+                u = elasticity_displacement(disc, &base, target)?;
             } else if exhausted {
                 return Ok(guess);
             } else {
