@@ -80,6 +80,18 @@ impl DirTable {
     }
 }
 
+/// The basis functions whose supports overlap that of function `k` (tensor index
+/// `(i, j)`): `(s, kk)` with the stencil slot `s = dj (2p + 1) + di` of
+/// `kk = (j + dj - q) n_xi + (i + di - p)`, for all offsets inside the basis.
+fn stencil_neighbours(shape: [usize; 2], p: usize, q: usize, k: usize) -> impl Iterator<Item = (usize, usize)> {
+    let [nx, ny] = shape;
+    let (i, j) = (k % nx, k / nx);
+    (0..=2 * q).flat_map(move |dj| (0..=2 * p).map(move |di| (di, dj))).filter_map(move |(di, dj)| {
+        let (ii, jj) = ((i + di).checked_sub(p)?, (j + dj).checked_sub(q)?);
+        (ii < nx && jj < ny).then_some((dj * (2 * p + 1) + di, jj * nx + ii))
+    })
+}
+
 /// Fixed sparsity pattern of a free-free system with `ncomp` components per basis
 /// function (unknown `z * m + f`), and the gather map from stencil storage.
 #[derive(Debug, Clone)]
@@ -94,7 +106,6 @@ pub struct SystemPattern {
 
 impl SystemPattern {
     fn new(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
-        let [nx, ny] = dofs.shape();
         let m = dofs.num_free();
         let sw = (2 * p + 1) * (2 * q + 1);
         let row_len = ncomp * ncomp * sw;
@@ -103,25 +114,12 @@ impl SystemPattern {
         let mut src = Vec::new();
         for z in 0..ncomp {
             for &k in dofs.free() {
-                let (i, j) = (k % nx, k / nx);
                 for d in 0..ncomp {
-                    for dj in 0..=2 * q {
-                        let jj = j as isize + dj as isize - q as isize;
-                        if jj < 0 || jj >= ny as isize {
-                            continue;
-                        }
-                        for di in 0..=2 * p {
-                            let ii = i as isize + di as isize - p as isize;
-                            if ii < 0 || ii >= nx as isize {
-                                continue;
-                            }
-                            let kk = jj as usize * nx + ii as usize;
-                            let fc = dofs.free_index(kk);
-                            if fc == FIXED {
-                                continue;
-                            }
+                    for (s, kk) in stencil_neighbours(dofs.shape(), p, q, k) {
+                        let fc = dofs.free_index(kk);
+                        if fc != FIXED {
                             col_idx.push(d * m + fc);
-                            src.push(k * row_len + (z * ncomp + d) * sw + dj * (2 * p + 1) + di);
+                            src.push(k * row_len + (z * ncomp + d) * sw + s);
                         }
                     }
                 }
@@ -554,32 +552,18 @@ impl Discretization {
     /// contribution of Dirichlet data `u` (full, per basis function) in a linear problem.
     pub fn apply_to_fixed(&self, stencil: &[f64], u: &[[f64; 2]]) -> Vec<f64> {
         let (p, q) = self.degrees();
-        let [nx, ny] = self.shape();
         let sw = self.stencil_width();
         let row_len = 4 * sw;
         let m = self.dofs.num_free();
         let mut out = vec![0.0; 2 * m];
         for (f, &k) in self.dofs.free().iter().enumerate() {
-            let (i, j) = (k % nx, k / nx);
-            for dj in 0..=2 * q {
-                let jj = j as isize + dj as isize - q as isize;
-                if jj < 0 || jj >= ny as isize {
+            for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
+                if self.dofs.free_index(kk) != FIXED {
                     continue;
                 }
-                for di in 0..=2 * p {
-                    let ii = i as isize + di as isize - p as isize;
-                    if ii < 0 || ii >= nx as isize {
-                        continue;
-                    }
-                    let kk = jj as usize * nx + ii as usize;
-                    if self.dofs.free_index(kk) != FIXED {
-                        continue;
-                    }
-                    let s = dj * (2 * p + 1) + di;
-                    for z in 0..2 {
-                        for d in 0..2 {
-                            out[z * m + f] += stencil[k * row_len + (z * 2 + d) * sw + s] * u[kk][d];
-                        }
+                for z in 0..2 {
+                    for d in 0..2 {
+                        out[z * m + f] += stencil[k * row_len + (z * 2 + d) * sw + s] * u[kk][d];
                     }
                 }
             }
