@@ -1,6 +1,6 @@
 //! Assembly of the Galerkin systems on a tensor-product basis: the EGG residual of
 //! paper eq. (8) with its exact Jacobian, the scaled variant `L / (g11 + g22)`, the mass
-//! matrix of eq. (30), the parametric Laplacian and linear elasticity (§6.3).
+//! matrix of eq. (30) and linear elasticity (§6.3).
 //!
 //! Symbolic work is done once per basis ([`Discretization::new`]): univariate basis
 //! tables at the Gauss points, the free/fixed [`DofMap`], and the fixed sparsity pattern
@@ -461,11 +461,6 @@ impl Discretization {
     /// Scalar mass matrix `int w_a w_b` (eq. 30) into `stencil` (length `stencil_len(1)`).
     pub fn mass(&self, stencil: &mut [f64]) {
         self.scalar_form(stencil, |b, c| b[0] * c[0]);
-    }
-
-    /// Parametric Laplacian `int grad w_a . grad w_b` (a preconditioner of eq. 8).
-    pub fn laplace(&self, stencil: &mut [f64]) {
-        self.scalar_form(stencil, |b, c| b[1] * c[1] + b[2] * c[2]);
     }
 
     fn scalar_form(&self, stencil: &mut [f64], form: impl Fn(&[f64; 6], &[f64; 6]) -> f64 + Sync) {

@@ -141,4 +141,33 @@ mod tests {
             }
         }
     }
+
+    /// Linear elasticity reproduces affine displacements exactly (constant strain, so
+    /// `div sigma = 0`): prolonging an affine map `A` onto a finer basis whose boundary is
+    /// that of another affine map `B` gives `B` itself.
+    #[test]
+    fn elasticity_prolongation_reproduces_affine_maps() {
+        let coarse_k = [KnotVector::open_uniform(3, 2), KnotVector::open_uniform(3, 2)];
+        let fine_k = [coarse_k[0].halved().halved(), coarse_k[1].halved()];
+        let affine = |m: [f64; 6], k: &[KnotVector; 2]| -> Vec<Point> {
+            let (gu, gv) = (k[0].greville(), k[1].greville());
+            gv.iter()
+                .flat_map(|&v| gu.iter().map(move |&u| [m[0] + m[1] * u + m[2] * v, m[3] + m[4] * u + m[5] * v]))
+                .collect()
+        };
+        let a = [0.0, 2.0, 0.3, 1.0, -0.2, 1.5];
+        let b = [0.1, 2.4, 0.1, 0.9, 0.3, 1.2];
+        let coarse = Surface {
+            knots: coarse_k,
+            control_points: affine(a, &[KnotVector::open_uniform(3, 2), KnotVector::open_uniform(3, 2)]),
+            weights: None,
+        };
+        let target = Surface { knots: fine_k.clone(), control_points: affine(b, &fine_k), weights: None };
+        let sides = Side::ALL.map(|s| target.boundary(s));
+        let disc = Discretization::new(fine_k);
+        let cps = elasticity_prolongation(&coarse, &disc, &sides).unwrap();
+        for (c, t) in cps.iter().zip(&target.control_points) {
+            assert!((c[0] - t[0]).abs() < 1e-12 && (c[1] - t[1]).abs() < 1e-12, "{c:?} vs {t:?}");
+        }
+    }
 }

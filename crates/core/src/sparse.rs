@@ -161,19 +161,6 @@ impl Csr {
         Self::from_rows(other.ncols, rows)
     }
 
-    /// Keep the rows `rows` and columns `cols` (given as old index -> new index maps,
-    /// `usize::MAX` for dropped ones).
-    pub fn submatrix(&self, row_map: &[usize], col_map: &[usize], ncols: usize) -> Self {
-        let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
-        let mut order: Vec<(usize, usize)> =
-            row_map.iter().enumerate().filter(|(_, &n)| n != usize::MAX).map(|(o, &n)| (n, o)).collect();
-        order.sort();
-        for (_, old) in order {
-            rows.push(self.row(old).filter(|(j, _)| col_map[*j] != usize::MAX).map(|(j, v)| (col_map[j], v)).collect());
-        }
-        Self::from_rows(ncols, rows)
-    }
-
     /// A dense copy (row-major), for tests and small problems.
     pub fn to_dense(&self) -> Vec<Vec<f64>> {
         let mut d = vec![vec![0.0; self.ncols]; self.nrows];
