@@ -481,6 +481,52 @@ impl Discretization {
         });
     }
 
+    /// The symmetric principal part of the EGG Jacobian, `K_ab = int grad w_a . A grad w_b / s`
+    /// with `A = [[g22, -g12], [-g12, g11]]` (`s = 1` for [`Operator::Plain`], `s = g11 + g22`
+    /// for [`Operator::Scaled`]), plus `shift` times the mass matrix, into `stencil` (length
+    /// `stencil_len(1)`).
+    ///
+    /// Integrating eq. (8) by parts against `w_a` (zero on the boundary) gives
+    /// `int w_a L(w_b) = -int grad w_a . A grad w_b + (first-order terms)`, and the
+    /// derivatives of the metric add first-order terms only, so `dF/dc = -diag(K, K) + B`
+    /// with `B` of lower order: `diag(K, K)` is a mesh-independent preconditioner of the
+    /// Newton systems. `det A = (det J)^2 >= 0` and `tr A > 0`: `K` is symmetric positive
+    /// (semi)definite even on a folded map; a relative `1e-10 tr A` is added to the diagonal
+    /// of `A` to keep it definite.
+    pub fn metric_laplace(&self, cps: &[[f64; 2]], op: Operator, shift: f64, stencil: &mut [f64]) {
+        let nq = [self.tables[0].nq, self.tables[1].nq];
+        self.assemble(1, &mut [], stencil, |ex, ey, s| {
+            let nloc = s.nloc;
+            s.ke.fill(0.0);
+            for kv in 0..nq[1] {
+                for ku in 0..nq[0] {
+                    let wq = self.tensor_basis(ex, ey, ku, kv, s);
+                    let g = self.geometry(ex, ey, cps, s);
+                    let g11 = g.xu[0] * g.xu[0] + g.xu[1] * g.xu[1];
+                    let g12 = g.xu[0] * g.xv[0] + g.xu[1] * g.xv[1];
+                    let g22 = g.xv[0] * g.xv[0] + g.xv[1] * g.xv[1];
+                    let tr = g11 + g22;
+                    let scale = match op {
+                        Operator::Plain => 1.0,
+                        Operator::Scaled if tr > 0.0 => 1.0 / tr,
+                        Operator::Scaled => 1.0,
+                    };
+                    let eps = 1e-10 * tr;
+                    let (a11, a12, a22) = (scale * (g22 + eps), -scale * g12, scale * (g11 + eps));
+                    for a in 0..nloc {
+                        let ba = s.b[a];
+                        let (fu, fv) = (a11 * ba[1] + a12 * ba[2], a12 * ba[1] + a22 * ba[2]);
+                        let sa = shift * ba[0];
+                        let row = &mut s.ke[a * nloc..(a + 1) * nloc];
+                        for (r, bb) in row.iter_mut().zip(&s.b) {
+                            *r += wq * (fu * bb[1] + fv * bb[2] + sa * bb[0]);
+                        }
+                    }
+                }
+            }
+        });
+    }
+
     /// Linear elasticity on the physical domain of the map `cps` (Lamé `lambda`, `mu`):
     /// `a(u, v) = int_Omega lambda div u div v + 2 mu eps(u):eps(v) dx`, pulled back with
     /// `grad_x w = J^{-T} grad_xi w` and `dx = |det J| dxi`. Where `det J` vanishes the

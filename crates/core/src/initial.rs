@@ -82,8 +82,12 @@ pub fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[
     disc.elasticity(base, LAME.0, LAME.1, &mut st);
     let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
-    let mut lin = LinearSolver::new(LinearMethod::Auto);
-    lin.factor(&k)?;
+    // symmetric positive definite: Cholesky, with LU/GMRES as a safety net
+    let mut lin = LinearSolver::new(LinearMethod::Cholesky);
+    if lin.factor(&k).is_err() {
+        lin = LinearSolver::new(LinearMethod::Auto);
+        lin.factor(&k)?;
+    }
     let u = lin.solve(&rhs)?;
     let m = disc.dofs.num_free();
     for (f, &kk) in disc.dofs.free().iter().enumerate() {

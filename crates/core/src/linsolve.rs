@@ -1,10 +1,14 @@
 //! Linear solvers behind one interface: sparse LU (faer; the symbolic factorization is
-//! computed once per sparsity pattern and reused for every numeric factorization) and
-//! restarted GMRES with an ILU(0) preconditioner for systems past what LU handles.
+//! computed once per sparsity pattern and reused for every numeric factorization), sparse
+//! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
+//! what LU handles, preconditioned either by the problem's own SPD approximation
+//! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
+//! [`crate::assembly::Discretization::metric_laplace`]) or by ILU(0).
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::Side;
 
 use crate::error::{Error, Result};
 use crate::sparse::Csr;
@@ -15,39 +19,125 @@ pub enum LinearMethod {
     /// Sparse direct LU.
     #[default]
     Lu,
-    /// Restarted GMRES(50) with ILU(0), relative tolerance 1e-10.
+    /// Restarted GMRES(50), relative tolerance 1e-10, preconditioned by the problem's
+    /// SPD approximation when it offers one, by ILU(0) otherwise.
     Gmres,
     /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
     /// does not converge.
     Auto,
+    /// Sparse Cholesky `L L^T` (symmetric positive definite systems only).
+    Cholesky,
 }
 
 /// Largest system that [`LinearMethod::Auto`] factorizes directly.
 pub const AUTO_LU_LIMIT: usize = 5_000;
+
+/// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
+pub const REFRESH_KRYLOV: usize = 30;
+
+/// A GMRES preconditioner.
+#[derive(Debug)]
+enum Preconditioner {
+    Ilu(Ilu0),
+    /// `P = -diag(K, ..., K)`, `K = L L^T`.
+    NegBlockLlt(Llt<usize, f64>, usize),
+}
+
+impl Preconditioner {
+    /// `x = P^{-1} b`.
+    fn apply(&self, b: &[f64], x: &mut [f64]) {
+        match self {
+            Self::Ilu(ilu) => ilu.apply(b, x),
+            Self::NegBlockLlt(llt, m) => {
+                let nb = b.len() / m;
+                let mut rhs = faer::Mat::<f64>::from_fn(*m, nb, |i, j| b[j * m + i]);
+                llt.solve_in_place(rhs.as_mut());
+                for j in 0..nb {
+                    for i in 0..*m {
+                        x[j * m + i] = -rhs[(i, j)];
+                    }
+                }
+            }
+        }
+    }
+}
 
 /// A factorization-capable solver bound to one sparsity pattern.
 #[derive(Debug)]
 pub struct LinearSolver {
     method: LinearMethod,
     symbolic: Option<SymbolicLu<usize>>,
+    symbolic_llt: Option<SymbolicLlt<usize>>,
     lu: Option<Lu<usize, f64>>,
-    ilu: Option<Ilu0>,
+    llt: Option<Llt<usize, f64>>,
+    precond: Option<Preconditioner>,
     matrix: Option<Csr>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
+    last_krylov: usize,
     fallback: bool,
+}
+
+/// `L L^T` of the SPD matrix `a` (only its lower triangle is read), reusing `symbolic`.
+fn cholesky(a: &Csr, symbolic: &mut Option<SymbolicLlt<usize>>) -> Result<Llt<usize, f64>> {
+    // CSR of a symmetric matrix = CSC of the same matrix
+    let sym = SymbolicSparseColMatRef::new_checked(a.nrows, a.ncols, &a.row_ptr, None, &a.col_idx);
+    if symbolic.is_none() {
+        *symbolic = Some(
+            SymbolicLlt::try_new(sym, Side::Lower)
+                .map_err(|e| Error::LinearSolver(format!("symbolic Cholesky: {e:?}")))?,
+        );
+    }
+    let s = symbolic.clone().expect("set above");
+    Llt::try_new_with_symbolic(s, SparseColMatRef::new(sym, &a.values), Side::Lower)
+        .map_err(|e| Error::LinearSolver(format!("Cholesky: matrix not positive definite ({e:?})")))
 }
 
 impl LinearSolver {
     /// A solver using `method`.
     pub fn new(method: LinearMethod) -> Self {
         let fallback = method == LinearMethod::Auto;
-        Self { method, symbolic: None, lu: None, ilu: None, matrix: None, krylov_iterations: 0, fallback }
+        Self {
+            method,
+            symbolic: None,
+            symbolic_llt: None,
+            lu: None,
+            llt: None,
+            precond: None,
+            matrix: None,
+            krylov_iterations: 0,
+            last_krylov: 0,
+            fallback,
+        }
     }
 
-    /// Factorize (LU) or precondition (GMRES) the matrix `a`. The CSR storage of `a` is
-    /// the CSC storage of `a^T`; faer factors `a^T` and we solve with its transpose.
+    /// The method in use ([`LinearMethod::Auto`] until the first factorization).
+    pub fn method(&self) -> LinearMethod {
+        self.method
+    }
+
+    /// Whether [`LinearSolver::factor_preconditioned`] needs a (new) SPD approximation
+    /// for a system of `n` unknowns: only GMRES uses one, and it keeps the last one
+    /// (a frozen preconditioner across Newton steps) while GMRES needs at most
+    /// [`REFRESH_KRYLOV`] iterations with it.
+    pub fn wants_preconditioner(&self, n: usize) -> bool {
+        let fresh = !matches!(self.precond, Some(Preconditioner::NegBlockLlt(..))) || self.last_krylov > REFRESH_KRYLOV;
+        match self.method {
+            LinearMethod::Gmres => fresh,
+            LinearMethod::Auto => n > AUTO_LU_LIMIT,
+            LinearMethod::Lu | LinearMethod::Cholesky => false,
+        }
+    }
+
+    /// Factorize (LU, Cholesky) or precondition (GMRES, with ILU(0)) the matrix `a`.
     pub fn factor(&mut self, a: &Csr) -> Result<()> {
+        self.factor_preconditioned(a, None)
+    }
+
+    /// As [`LinearSolver::factor`]; GMRES uses `P = -diag(K, K)` as preconditioner when
+    /// `k` (SPD, `a.nrows` a multiple of its size) is given. The CSR storage of `a` is
+    /// the CSC storage of `a^T`; faer factors `a^T` and we solve with its transpose.
+    pub fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
         if self.method == LinearMethod::Auto {
             self.method = if a.nrows <= AUTO_LU_LIMIT { LinearMethod::Lu } else { LinearMethod::Gmres };
         }
@@ -65,9 +155,19 @@ impl LinearSolver {
                         .map_err(|e| Error::LinearSolver(format!("numeric LU: {e:?}")))?,
                 );
             }
+            LinearMethod::Cholesky => self.llt = Some(cholesky(a, &mut self.symbolic_llt)?),
             LinearMethod::Gmres => {
-                self.ilu = Some(Ilu0::new(a)?);
-                self.matrix = Some(a.clone());
+                let block = k.filter(|k| k.nrows > 0 && a.nrows % k.nrows == 0);
+                let spd = block.map(|k| cholesky(k, &mut self.symbolic_llt).map(|l| (l, k.nrows)));
+                self.precond = match (spd, self.precond.take()) {
+                    (Some(Ok((llt, m))), _) => Some(Preconditioner::NegBlockLlt(llt, m)),
+                    // no new approximation: keep the previous one (frozen preconditioner)
+                    (None, Some(p @ Preconditioner::NegBlockLlt(..))) => Some(p),
+                    // none at all (or not definite): ILU(0)
+                    _ => Some(Preconditioner::Ilu(Ilu0::new(a)?)),
+                };
+                self.last_krylov = 0;
+                self.matrix.get_or_insert_with(Csr::default).assign(a);
             }
             LinearMethod::Auto => unreachable!("resolved above"),
         }
@@ -83,12 +183,19 @@ impl LinearSolver {
                 lu.solve_transpose_in_place(x.as_mut());
                 (0..b.len()).map(|i| x[(i, 0)]).collect::<Vec<_>>()
             }
+            LinearMethod::Cholesky => {
+                let llt = self.llt.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
+                let mut x = faer::Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
+                llt.solve_in_place(x.as_mut());
+                (0..b.len()).map(|i| x[(i, 0)]).collect::<Vec<_>>()
+            }
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let ilu = self.ilu.as_ref().expect("set with matrix");
-                match gmres(a, b, ilu, 50, 1e-10, 2000) {
+                let pc = self.precond.as_ref().expect("set with matrix");
+                match gmres(a, b, |r, z| pc.apply(r, z), 50, 1e-10, 2000) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
+                        self.last_krylov = it;
                         x
                     }
                     Err(e) if self.fallback => {
@@ -185,8 +292,16 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Right-preconditioned restarted GMRES(`restart`) for `a x = b` from `x = 0`, stopping
-/// at `||b - a x|| <= tol ||b||`. Returns the solution and the iteration count.
-pub fn gmres(a: &Csr, b: &[f64], m: &Ilu0, restart: usize, tol: f64, max_iter: usize) -> Result<(Vec<f64>, usize)> {
+/// at `||b - a x|| <= tol ||b||`; `m(r, z)` applies the preconditioner `z = P^{-1} r`.
+/// Returns the solution and the iteration count.
+pub fn gmres(
+    a: &Csr,
+    b: &[f64],
+    m: impl Fn(&[f64], &mut [f64]),
+    restart: usize,
+    tol: f64,
+    max_iter: usize,
+) -> Result<(Vec<f64>, usize)> {
     let n = b.len();
     let bnorm = dot(b, b).sqrt();
     let mut x = vec![0.0; n];
@@ -209,7 +324,7 @@ pub fn gmres(a: &Csr, b: &[f64], m: &Ilu0, restart: usize, tol: f64, max_iter: u
         g[0] = beta;
         let mut k = 0;
         while k < restart {
-            m.apply(&v[k], &mut z);
+            m(&v[k], &mut z);
             a.mul_vec(&z, &mut w);
             for i in 0..=k {
                 h[i][k] = dot(&w, &v[i]);
@@ -254,7 +369,7 @@ pub fn gmres(a: &Csr, b: &[f64], m: &Ilu0, restart: usize, tol: f64, max_iter: u
                 *d += yj * vj;
             }
         }
-        m.apply(&dx, &mut z);
+        m(&dx, &mut z);
         for (xi, zi) in x.iter_mut().zip(&z) {
             *xi += zi;
         }
@@ -305,6 +420,32 @@ mod tests {
             assert!((r[i] - b[i]).abs() < 1e-12);
             assert!((x1[i] - x2[i]).abs() < 1e-8);
         }
+        // an SPD system through Cholesky
+        let spd = Csr::from_triplets(
+            200,
+            200,
+            &(0..200)
+                .flat_map(|i| {
+                    let mut t = vec![(i, i, 2.5)];
+                    if i > 0 {
+                        t.push((i, i - 1, -1.0));
+                    }
+                    if i + 1 < 200 {
+                        t.push((i, i + 1, -1.0));
+                    }
+                    t
+                })
+                .collect::<Vec<_>>(),
+        );
+        let mut ch = LinearSolver::new(LinearMethod::Cholesky);
+        ch.factor(&spd).unwrap();
+        let x4 = ch.solve(&b).unwrap();
+        let r4 = spd.apply(&x4);
+        assert!(r4.iter().zip(&b).all(|(r, b)| (r - b).abs() < 1e-12));
+        // a negative definite matrix has no Cholesky factor: typed error
+        let mut neg = spd.clone();
+        neg.values.iter_mut().for_each(|v| *v = -*v);
+        assert!(LinearSolver::new(LinearMethod::Cholesky).factor(&neg).is_err());
         // a second numeric factorization reuses the symbolic one
         let mut a2 = a.clone();
         a2.values.iter_mut().for_each(|v| *v *= 2.0);

@@ -12,6 +12,7 @@ use serde::Serialize;
 use crate::egg::NonlinearProblem;
 use crate::error::Result;
 use crate::linsolve::{LinearMethod, LinearSolver};
+use crate::sparse::Csr;
 
 /// Nonlinear iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
@@ -117,6 +118,7 @@ pub struct NonlinearSolver<P: NonlinearProblem> {
     method: Method,
     dt: f64,
     lin: LinearSolver,
+    a: Csr,
     status: Status,
     started: bool,
     /// Timings so far.
@@ -154,6 +156,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             method: opts.method,
             dt: 0.0,
             lin: LinearSolver::new(opts.linear),
+            a: Csr::default(),
             status: Status::Running,
             started: false,
             timings: Timings { assembly, linear: Duration::ZERO },
@@ -168,6 +171,11 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
     /// Current unknowns.
     pub fn solution(&self) -> &[f64] {
         &self.c
+    }
+
+    /// Krylov (GMRES) iterations spent so far; 0 with direct solves.
+    pub fn krylov_iterations(&self) -> usize {
+        self.lin.krylov_iterations
     }
 
     /// Current `||F||`.
@@ -232,26 +240,31 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
     fn linear_step(&mut self, shift: Option<f64>) -> Result<Vec<f64>> {
         let t = Instant::now();
         let mut f = std::mem::take(&mut self.f);
-        let jac = self.problem.jacobian(&self.c, &mut f).clone();
+        // the system matrix lives in `self.a` between steps: no allocation per step
+        let mut a = std::mem::take(&mut self.a);
+        a.assign(self.problem.jacobian(&self.c, &mut f));
         self.f = f;
         self.timings.assembly += t.elapsed();
-        let a = match shift {
-            None => jac,
-            Some(dt) => {
-                // F_i = int w_i L(x) and L is elliptic (like the Laplacian), so dF/dc is
-                // negative definite near a solution; the dissipative pseudo-transient
-                // form of eq. (30)-(32) is therefore M dc/dt = +F, i.e.
-                // [M / dt - dF/dc] dc = F, written as [-(M / dt) + dF/dc] dc = -F.
-                let m = self.problem.mass();
-                let mut a = jac;
-                for (v, mv) in a.values.iter_mut().zip(&m.values) {
-                    *v -= mv / dt;
-                }
-                a
+        if let Some(dt) = shift {
+            // F_i = int w_i L(x) and L is elliptic (like the Laplacian), so dF/dc is
+            // negative definite near a solution; the dissipative pseudo-transient
+            // form of eq. (30)-(32) is therefore M dc/dt = +F, i.e.
+            // [M / dt - dF/dc] dc = F, written as [-(M / dt) + dF/dc] dc = -F.
+            let m = self.problem.mass();
+            for (v, mv) in a.values.iter_mut().zip(&m.values) {
+                *v -= mv / dt;
             }
-        };
+        }
         let t = Instant::now();
-        self.lin.factor(&a)?;
+        // the pseudo-time shift changes with every step: no frozen preconditioner then
+        let k = if shift.is_some() || self.lin.wants_preconditioner(a.nrows) {
+            self.problem.preconditioner(shift.map_or(0.0, |dt| 1.0 / dt))
+        } else {
+            None
+        };
+        let factored = self.lin.factor_preconditioned(&a, k);
+        self.a = a;
+        factored?;
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
         let dx = self.lin.solve(&rhs);
         self.timings.linear += t.elapsed();

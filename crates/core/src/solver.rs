@@ -110,6 +110,8 @@ pub struct LevelReport {
     pub assembly_seconds: f64,
     /// Seconds spent in linear solves.
     pub linear_seconds: f64,
+    /// GMRES iterations over all linear solves of the level (0 with direct LU).
+    pub krylov_iterations: usize,
     /// Seconds for the whole level (set-up, initial guess, iterations).
     pub seconds: f64,
 }
@@ -557,6 +559,7 @@ impl EggSolver {
             scaled_residuals: Vec::new(),
             assembly_seconds: 0.0,
             linear_seconds: 0.0,
+            krylov_iterations: 0,
             seconds: 0.0,
         };
         self.active = Some(Active { level: k, solver, report, started: t0 });
@@ -573,6 +576,7 @@ impl EggSolver {
         let timings = a.solver.timings;
         a.report.assembly_seconds = timings.assembly.as_secs_f64();
         a.report.linear_seconds = timings.linear.as_secs_f64();
+        a.report.krylov_iterations = a.solver.krylov_iterations();
         a.report.seconds = a.started.elapsed().as_secs_f64();
         let (problem, c) = a.solver.into_parts();
         let mut cps = problem.cps.clone();

@@ -1,8 +1,10 @@
 //! Compressed sparse row matrices: prolongation operators, assembled operators and
 //! their fixed sparsity patterns. Factorizations go through faer.
 
+use rayon::prelude::*;
+
 /// A real CSR matrix with sorted, unique column indices per row.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Csr {
     /// Number of rows.
     pub nrows: usize,
@@ -81,12 +83,30 @@ impl Csr {
         self.col_idx[r.clone()].binary_search(&j).ok().map(|k| r.start + k)
     }
 
+    /// Overwrite with a copy of `src`, reusing this matrix's allocations.
+    pub fn assign(&mut self, src: &Csr) {
+        self.nrows = src.nrows;
+        self.ncols = src.ncols;
+        self.row_ptr.clone_from(&src.row_ptr);
+        self.col_idx.clone_from(&src.col_idx);
+        self.values.clone_from(&src.values);
+    }
+
     /// `y = A x`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         debug_assert_eq!(x.len(), self.ncols);
-        for i in 0..self.nrows {
-            y[i] = self.row(i).map(|(j, v)| v * x[j]).sum();
+        const CHUNK: usize = 2048;
+        if self.nnz() < 1 << 16 {
+            for i in 0..self.nrows {
+                y[i] = self.row(i).map(|(j, v)| v * x[j]).sum();
+            }
+            return;
         }
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, ys)| {
+            for (k, yi) in ys.iter_mut().enumerate() {
+                *yi = self.row(c * CHUNK + k).map(|(j, v)| v * x[j]).sum();
+            }
+        });
     }
 
     /// `A x` as a new vector.
