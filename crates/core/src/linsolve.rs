@@ -157,7 +157,7 @@ impl LinearSolver {
             }
             LinearMethod::Cholesky => self.llt = Some(cholesky(a, &mut self.symbolic_llt)?),
             LinearMethod::Gmres => {
-                let block = k.filter(|k| k.nrows > 0 && a.nrows % k.nrows == 0);
+                let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
                 let spd = block.map(|k| cholesky(k, &mut self.symbolic_llt).map(|l| (l, k.nrows)));
                 self.precond = match (spd, self.precond.take()) {
                     (Some(Ok((llt, m))), _) => Some(Preconditioner::NegBlockLlt(llt, m)),
