@@ -67,11 +67,8 @@ fn puzzle3() {
 fn puzzle4() {
     assert_bijective("gismo/puzzle4.json");
 }
-/// Ends bijective after two automatic refinements (267x267 basis), but takes several
-/// minutes on 2 cores: run with `cargo test --workspace -- --ignored`; `winslow bench`
-/// measures it.
+/// Ends bijective after automatic refinement of a folded level (267x267 basis).
 #[test]
-#[ignore = "slow (minutes on 2 cores); run with --ignored"]
 fn jigsaw01() {
     assert_bijective("gismo/jigsaw01.json");
 }

@@ -477,6 +477,12 @@ impl EggSolver {
         // displacement from `base` to the full target; linear in the boundary motion, so
         // a fraction `f` of the remaining motion is `f * u`
         let mut u = elasticity_displacement(disc, &base, target)?;
+        if det_j_min(disc, &base) <= 0.0 {
+            // the prolonged map itself is not positive on this level's (denser) sample:
+            // damping the boundary motion cannot make the guess positive, Newton starts
+            // from the full elasticity guess
+            return Ok(displaced(&base, &u, 1.0));
+        }
         loop {
             let a = (done + step).min(1.0);
             let f = (a - done) / (1.0 - done);
