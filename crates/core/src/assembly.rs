@@ -188,8 +188,10 @@ struct Scratch {
     nloc: usize,
     /// `b[k][a]` for k in (w, w_u, w_v, w_uu, w_uv, w_vv).
     b: Vec<[f64; 6]>,
-    /// Per trial function: the four `dL_z/dc^d_b` values.
+    /// Per trial function: physical gradients (elasticity).
     t: Vec<[f64; 4]>,
+    /// `dL_z/dc^d_b` at `(z * 2 + d) * nloc + b`: contiguous in `b` for the outer products.
+    tz: Vec<f64>,
     re: Vec<f64>,
     ke: Vec<f64>,
 }
@@ -201,6 +203,7 @@ impl Scratch {
             nloc,
             b: vec![[0.0; 6]; nloc],
             t: vec![[0.0; 4]; nloc],
+            tz: vec![0.0; 4 * nloc],
             re: vec![0.0; ncomp * nloc],
             ke: vec![0.0; ncomp * ncomp * nloc * nloc],
         }
@@ -425,7 +428,6 @@ impl Discretization {
                     for b in 0..nloc {
                         let wb = &s.b[b];
                         let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
-                        let mut t = [0.0; 4];
                         for d in 0..2 {
                             let dg11 = 2.0 * g.xu[d] * wb[1];
                             let dg12 = g.xu[d] * wb[2] + g.xv[d] * wb[1];
@@ -439,17 +441,17 @@ impl Discretization {
                                 if op == Operator::Scaled {
                                     v -= l[z] * ds / sden;
                                 }
-                                t[z * 2 + d] = v;
+                                s.tz[(z * 2 + d) * nloc + b] = v;
                             }
                         }
-                        s.t[b] = t;
                     }
                     for zd in 0..4 {
+                        let tz = &s.tz[zd * nloc..(zd + 1) * nloc];
                         for a in 0..nloc {
                             let wa = wq * s.b[a][0] * scale;
                             let row = &mut s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
-                            for (r, t) in row.iter_mut().zip(&s.t) {
-                                *r += wa * t[zd];
+                            for (r, t) in row.iter_mut().zip(tz) {
+                                *r += wa * t;
                             }
                         }
                     }

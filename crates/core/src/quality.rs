@@ -1,6 +1,7 @@
 //! Map quality on samples and by quadrature: the Jacobian determinant (eq. 43) on a
 //! grid, and the Winslow functional (eq. 15-16).
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::basis::BasisDerivs;
@@ -24,29 +25,30 @@ pub struct DetJSample {
     pub min_interior: f64,
 }
 
-/// Sample `det J` on an `(n+1)^2` grid (boundary included).
+/// Sample `det J` on an `(n+1)^2` grid (boundary included). The `xi` basis is
+/// evaluated once per column, rows run in parallel.
 pub fn sample_det_j(map: &Surface, n: usize) -> DetJSample {
     let n = n.max(1);
-    let mut values = Vec::with_capacity((n + 1) * (n + 1));
-    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+    let grid = |i: usize| i as f64 / n as f64;
+    let bu: Vec<BasisDerivs> = (0..=n).map(|i| BasisDerivs::at(&map.knots[0], grid(i), 1)).collect();
+    let mut values = vec![0.0; (n + 1) * (n + 1)];
+    values.par_chunks_mut(n + 1).enumerate().for_each(|(j, row)| {
+        let bv = BasisDerivs::at(&map.knots[1], grid(j), 1);
+        for (d, bu) in row.iter_mut().zip(&bu) {
+            *d = map.derivs_with(bu, &bv, 1).det_j();
+        }
+    });
     let (mut min, mut max, mut argmin, mut min_interior) = (f64::INFINITY, f64::NEG_INFINITY, [0.0; 2], f64::INFINITY);
-    for j in 0..=n {
-        let v = j as f64 / n as f64;
-        bv.eval(&map.knots[1], v, 1);
-        for i in 0..=n {
-            let u = i as f64 / n as f64;
-            bu.eval(&map.knots[0], u, 1);
-            let d = map.derivs_with(&bu, &bv, 1).det_j();
-            values.push(d);
-            if d < min {
-                min = d;
-                argmin = [u, v];
-            }
-            max = max.max(d);
-            let corner = (i == 0 || i == n) && (j == 0 || j == n);
-            if !corner {
-                min_interior = min_interior.min(d);
-            }
+    for (k, &d) in values.iter().enumerate() {
+        let (i, j) = (k % (n + 1), k / (n + 1));
+        if d < min {
+            min = d;
+            argmin = [grid(i), grid(j)];
+        }
+        max = max.max(d);
+        let corner = (i == 0 || i == n) && (j == 0 || j == n);
+        if !corner {
+            min_interior = min_interior.min(d);
         }
     }
     DetJSample { n, values, min, max, argmin, min_interior }
