@@ -24,32 +24,49 @@ pub struct DetJSample {
     pub min_interior: f64,
 }
 
+impl DetJSample {
+    /// The summary of grid values `values[j * (n + 1) + i]` at `(i/n, j/n)`, `n >= 1`.
+    pub fn from_values(n: usize, values: Vec<f64>) -> Self {
+        debug_assert_eq!(values.len(), (n + 1) * (n + 1));
+        let (mut min, mut max, mut argmin, mut min_interior) =
+            (f64::INFINITY, f64::NEG_INFINITY, [0.0; 2], f64::INFINITY);
+        for j in 0..=n {
+            for i in 0..=n {
+                let d = values[j * (n + 1) + i];
+                if d < min {
+                    min = d;
+                    argmin = [i as f64 / n as f64, j as f64 / n as f64];
+                }
+                max = max.max(d);
+                let corner = (i == 0 || i == n) && (j == 0 || j == n);
+                if !corner {
+                    min_interior = min_interior.min(d);
+                }
+            }
+        }
+        Self { n, values, min, max, argmin, min_interior }
+    }
+}
+
+/// The grid abscissae `t_i = i / n`, `i = 0..=n`, of [`sample_det_j`] and
+/// [`crate::picture::render`].
+pub fn grid_abscissae(n: usize) -> impl Iterator<Item = f64> {
+    (0..=n).map(move |i| i as f64 / n as f64)
+}
+
 /// Sample `det J` on an `(n+1)^2` grid (boundary included).
 pub fn sample_det_j(map: &Surface, n: usize) -> DetJSample {
     let n = n.max(1);
     let mut values = Vec::with_capacity((n + 1) * (n + 1));
     let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-    let (mut min, mut max, mut argmin, mut min_interior) = (f64::INFINITY, f64::NEG_INFINITY, [0.0; 2], f64::INFINITY);
-    for j in 0..=n {
-        let v = j as f64 / n as f64;
+    for v in grid_abscissae(n) {
         bv.eval(&map.knots[1], v, 1);
-        for i in 0..=n {
-            let u = i as f64 / n as f64;
+        for u in grid_abscissae(n) {
             bu.eval(&map.knots[0], u, 1);
-            let d = map.derivs_with(&bu, &bv, 1).det_j();
-            values.push(d);
-            if d < min {
-                min = d;
-                argmin = [u, v];
-            }
-            max = max.max(d);
-            let corner = (i == 0 || i == n) && (j == 0 || j == n);
-            if !corner {
-                min_interior = min_interior.min(d);
-            }
+            values.push(map.derivs_with(&bu, &bv, 1).det_j());
         }
     }
-    DetJSample { n, values, min, max, argmin, min_interior }
+    DetJSample::from_values(n, values)
 }
 
 /// Integrals of the map by Gauss quadrature on every element.
