@@ -9,14 +9,15 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use winslow::assembly::Operator;
-use winslow::egg::CpuAssembler;
+use winslow::egg::EggAssembler;
 use winslow::fit::{build_hierarchy, FitOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
 use winslow::linsolve::LinearMethod;
 use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
 use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
-use winslow::{Boundary, Side};
+use winslow::{Boundary, Side, Surface};
+use winslow_gpu::{Backend, Precision, Selected};
 
 mod output;
 
@@ -84,6 +85,62 @@ enum LinearArg {
     Lu,
     Gmres,
     Auto,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum BackendArg {
+    Cpu,
+    Gpu,
+    Auto,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum PrecisionArg {
+    Auto,
+    F64,
+    F32,
+}
+
+/// Where the quadrature runs.
+#[derive(Args, Debug, Clone)]
+struct BackendArgs {
+    /// Quadrature back end: the CPU; a GPU through wgpu (any adapter, lavapipe included;
+    /// none is an error); or auto (a hardware GPU with f64 shaders, else the CPU).
+    #[arg(long, value_enum, default_value = "cpu")]
+    backend: BackendArg,
+    /// GPU precision: f64 where the adapter offers it, else f32 matrices with the
+    /// residual in f64 on the CPU; or forced.
+    #[arg(long, value_enum, default_value = "auto")]
+    precision: PrecisionArg,
+}
+
+impl BackendArgs {
+    /// Open the back end and say which one runs (stderr unless `quiet`).
+    fn select(&self, quiet: bool) -> Result<Selected> {
+        let backend = match self.backend {
+            BackendArg::Cpu => Backend::Cpu,
+            BackendArg::Gpu => Backend::Gpu,
+            BackendArg::Auto => Backend::Auto,
+        };
+        let precision = match self.precision {
+            PrecisionArg::Auto => None,
+            PrecisionArg::F64 => Some(Precision::F64),
+            PrecisionArg::F32 => Some(Precision::F32),
+        };
+        let sel = winslow_gpu::assembler(backend, precision).context("opening the GPU")?;
+        if !quiet {
+            eprintln!("backend: {}", sel.describe());
+        }
+        Ok(sel)
+    }
+}
+
+/// The picture of `map`, sampled on the GPU when one is selected.
+fn picture(sel: &Selected, map: &Surface, opts: &PictureOptions) -> Result<winslow::picture::Image> {
+    Ok(match sel.gpu() {
+        Some(g) => g.render(map, opts).context("sampling det J on the GPU")?,
+        None => render(map, opts),
+    })
 }
 
 #[derive(Args, Debug, Clone)]
@@ -183,6 +240,8 @@ struct SolveArgs {
     /// No progress output.
     #[arg(short, long)]
     quiet: bool,
+    #[command(flatten)]
+    backend: BackendArgs,
 }
 
 #[derive(Args, Debug)]
@@ -198,6 +257,8 @@ struct RenderArgs {
     /// Longer image side in pixels.
     #[arg(long, default_value_t = 900)]
     size: usize,
+    #[command(flatten)]
+    backend: BackendArgs,
 }
 
 #[derive(Args, Debug)]
@@ -213,6 +274,16 @@ struct BenchArgs {
     /// Print the rows as JSON lines instead of a table.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    backend: BackendArgs,
+    /// Quadrature throughput (residual and Jacobian, CPU versus the selected back end)
+    /// at these sizes in scalar DOFs, comma-separated; default 1000,10000,100000,1000000
+    /// when the back end is a GPU. With a GPU and no FILES only this table is printed.
+    #[arg(long, value_delimiter = ',')]
+    sizes: Vec<usize>,
+    /// Degree of the quadrature benchmark's basis.
+    #[arg(long, default_value_t = 3)]
+    bench_degree: usize,
 }
 
 fn main() {
@@ -237,7 +308,8 @@ fn run(cli: Cli) -> Result<i32> {
                 bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
             };
             let opts = PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, ..Default::default() };
-            output::write_png(&a.png, &render(&map, &opts))?;
+            let sel = a.backend.select(false)?;
+            output::write_png(&a.png, &picture(&sel, &map, &opts)?)?;
             println!("wrote {}", a.png.display());
             Ok(0)
         }
@@ -288,7 +360,12 @@ fn inspect(a: InspectArgs) -> Result<i32> {
 }
 
 /// Run the solver stream, printing progress.
-fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<Solution> {
+fn run_solver(
+    boundary: &Boundary,
+    opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    quiet: bool,
+) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
     if !quiet {
         let tol = h.tol_abs;
@@ -308,7 +385,7 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
             }
         }
     }
-    let mut solver = EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?;
+    let mut solver = EggSolver::new(&h, opts.clone(), assembler)?;
     let stderr = std::io::stderr();
     for event in solver.by_ref() {
         let event = event?;
@@ -361,13 +438,14 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
 fn solve(a: SolveArgs) -> Result<i32> {
     let opts = a.solver.options()?;
     let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
-    let sol = run_solver(&boundary, &opts, a.quiet || a.json)?;
+    let sel = a.backend.select(a.quiet || a.json)?;
+    let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
     output::ensure_parent(&a.output)?;
     write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
         .with_context(|| format!("writing {}", a.output.display()))?;
     if let Some(p) = &a.png {
-        output::write_png(p, &render(&sol.map, &PictureOptions::default()))?;
+        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions::default())?)?;
     }
     if let Some(p) = &a.vtk {
         output::write_vtk(p, &sol.map, 128)?;
@@ -386,6 +464,15 @@ fn solve(a: SolveArgs) -> Result<i32> {
 
 fn bench(a: BenchArgs) -> Result<i32> {
     let opts = a.solver.options()?;
+    let sel = a.backend.select(a.json)?;
+    let on_gpu = sel.gpu().is_some();
+    let sizes = if a.sizes.is_empty() && on_gpu { vec![1_000, 10_000, 100_000, 1_000_000] } else { a.sizes.clone() };
+    if !sizes.is_empty() {
+        quadrature_bench(&sel, &sizes, a.bench_degree, opts.operator, a.json)?;
+        if a.files.is_empty() {
+            return Ok(0);
+        }
+    }
     let files = if a.files.is_empty() { output::default_bench_files()? } else { a.files.clone() };
     let mut rows = Vec::new();
     for f in &files {
@@ -400,7 +487,7 @@ fn bench(a: BenchArgs) -> Result<i32> {
             let o = SolveOptions { refine: r, ..opts.clone() };
             output::reset_peak_memory();
             let t = Instant::now();
-            let sol = run_solver(&boundary, &o, true)?;
+            let sol = run_solver(&boundary, &o, sel.as_assembler(), true)?;
             let total = t.elapsed().as_secs_f64();
             let row = output::BenchRow::new(&sol, r, total);
             if a.json {
@@ -413,6 +500,32 @@ fn bench(a: BenchArgs) -> Result<i32> {
         print!("{}", output::bench_table(&rows));
     }
     Ok(0)
+}
+
+/// Quadrature throughput at the given sizes, CPU versus the selected GPU.
+fn quadrature_bench(sel: &Selected, sizes: &[usize], degree: usize, op: Operator, json: bool) -> Result<()> {
+    if !(2..=8).contains(&degree) {
+        bail!("--bench-degree must be in 2..=8, got {degree}");
+    }
+    let gpu = match sel {
+        Selected::Gpu(g) => Some(g.as_ref()),
+        Selected::Cpu => None,
+    };
+    let mut rows = Vec::new();
+    for &dofs in sizes {
+        let (disc, cps) = winslow_gpu::bench::quadrature_case(dofs, degree);
+        let row = winslow_gpu::bench::measure(&disc, &cps, op, gpu, 1.0).context("GPU quadrature")?;
+        if json {
+            println!("{}", serde_json::to_string(&row)?);
+        } else {
+            eprintln!("  {} DOFs done", row.dofs);
+        }
+        rows.push(row);
+    }
+    if !json {
+        print!("{}", output::quadrature_table(&sel.describe(), &rows));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

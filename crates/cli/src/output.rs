@@ -60,6 +60,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     let last = r.levels.last();
     let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
     let _ = writeln!(s, "  {}", r.message);
+    let _ = writeln!(s, "  backend: {}", r.backend);
     if let Some(l) = last {
         let _ = writeln!(
             s,
@@ -289,6 +290,51 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
             "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:?} |",
             r.geometry, r.refine, r.dofs, r.levels, its, r.assembly_s, r.solve_s, r.total_s, r.peak_mib, r.verdict
         );
+    }
+    s
+}
+
+/// The quadrature throughput table of `winslow bench --backend gpu`: per size and
+/// assembly (residual `F`, Jacobian `J` with `F`), the CPU and GPU seconds per call,
+/// quadrature points per second, GB/s of control points in and results out, and where
+/// the GPU time goes.
+pub fn quadrature_table(backend: &str, rows: &[winslow_gpu::bench::QuadratureRow]) -> String {
+    use winslow_gpu::bench::Measured;
+    let mut s = String::new();
+    let _ = writeln!(s, "quadrature throughput; back end {backend}");
+    let _ = writeln!(
+        s,
+        "| DOFs | basis | qp | kind | CPU s | CPU Mqp/s | CPU GB/s | GPU s | GPU Mqp/s | GPU GB/s | upload s | dispatch s | readback s | CPU part s | scatter s | GPU setup s | max rel diff |"
+    );
+    let _ = writeln!(s, "|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let f = |m: &Measured| format!("{:.3e} | {:.2} | {:.3}", m.seconds, m.qp_per_second / 1e6, m.gb_per_second);
+    for r in rows {
+        for (kind, cpu, gpu) in [("F", &r.cpu_residual, &r.gpu_residual), ("J", &r.cpu_jacobian, &r.gpu_jacobian)] {
+            let g = match gpu {
+                Some(g) => format!(
+                    "{} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3e}",
+                    f(g),
+                    g.upload,
+                    g.dispatch,
+                    g.readback,
+                    g.cpu,
+                    if kind == "J" { g.scatter } else { 0.0 }
+                ),
+                None => "- | - | - | - | - | - | - | -".to_string(),
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {}x{} p={} | {} | {kind} | {} | {g} | {} | {} |",
+                r.dofs,
+                r.shape[0],
+                r.shape[1],
+                r.degree,
+                r.quadrature_points,
+                f(cpu),
+                r.gpu_setup.map_or("-".into(), |v| format!("{v:.3}")),
+                r.max_rel_diff.map_or("-".into(), |v| format!("{v:.1e}")),
+            );
+        }
     }
     s
 }

@@ -137,3 +137,80 @@ fn bench_prints_a_table() {
         "{text}"
     );
 }
+
+/// Whether a GPU test may run: an adapter is there, or `WINSLOW_REQUIRE_GPU=1` demands
+/// one (then its absence fails the test through the command's error).
+fn gpu_available_or_required() -> bool {
+    if std::env::var("WINSLOW_REQUIRE_GPU").is_ok_and(|v| v == "1") {
+        return true;
+    }
+    let out = bin().args(["bench", "--backend", "gpu", "--sizes", "200"]).output().unwrap();
+    if !out.status.success() {
+        eprintln!("note: skipping, no GPU: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    out.status.success()
+}
+
+#[test]
+fn solve_on_the_gpu_writes_the_cpu_map() {
+    if !gpu_available_or_required() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("winslow-gpu-{}", std::process::id()));
+    let mut maps = Vec::new();
+    for backend in ["cpu", "gpu"] {
+        let map = dir.join(format!("{backend}.json"));
+        let png = dir.join(format!("{backend}.png"));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join("quarter_annulus.json"))
+            .arg("-o")
+            .arg(&map)
+            .arg("--png")
+            .arg(&png)
+            .args(["--backend", backend, "--min-elements", "6"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{backend}: {err}");
+        assert!(err.contains(&format!("backend: {backend}")), "{backend}: {err}");
+        assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+        let backend_field = doc["report"]["backend"].as_str().unwrap().to_string();
+        assert!(backend_field.starts_with(backend), "{backend_field}");
+        assert!(!backend_field.contains("fell back"), "{backend_field}");
+        maps.push(doc["map"].clone());
+    }
+    assert_eq!(maps[0]["knots"], maps[1]["knots"]);
+    let pts = |m: &serde_json::Value| -> Vec<f64> {
+        m["control_points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|p| p.as_array().unwrap().clone())
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (pts(&maps[0]), pts(&maps[1]));
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(err <= 1e-9 * scale, "GPU and CPU maps differ by {err:e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bench_on_the_gpu_prints_throughput_and_the_time_split() {
+    if !gpu_available_or_required() {
+        return;
+    }
+    let out = bin().args(["bench", "--backend", "gpu", "--sizes", "1000,4000"]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("quadrature throughput; back end gpu: "), "{text}");
+    for col in ["CPU Mqp/s", "GPU Mqp/s", "GPU GB/s", "upload s", "dispatch s", "readback s", "scatter s"] {
+        assert!(text.contains(col), "missing {col}: {text}");
+    }
+    // two sizes, residual and Jacobian rows each
+    assert_eq!(text.lines().filter(|l| l.contains(" | F | ") || l.contains(" | J | ")).count(), 4, "{text}");
+}

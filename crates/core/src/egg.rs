@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use crate::assembly::{Discretization, Operator};
 use crate::curve::Point;
+use crate::quality::{sample_det_j, DetJSample};
 use crate::sparse::Csr;
+use crate::surface::Surface;
 
 /// A nonlinear system `F(c) = 0` with a Jacobian and a mass matrix (for pseudo time).
 pub trait NonlinearProblem {
@@ -25,11 +27,27 @@ pub trait NonlinearProblem {
     }
 }
 
-/// Quadrature back end of the EGG assembly (CPU here; the GPU crate implements it too).
+/// Quadrature back end of the solver (CPU here; the GPU crate implements it too): the
+/// EGG residual and Jacobian, and the operators and samples the hierarchy uses (mass,
+/// linear elasticity, `det J` on a grid). Every method writes exactly what the CPU
+/// method of the same name writes (same vector and stencil layout), so patterns,
+/// gathers and linear solvers are shared.
 pub trait EggAssembler: Send + Sync {
     /// Residual (full, interleaved, length `2 n`) and, if `stencil` is non-empty, the
     /// Jacobian in stencil storage; see [`Discretization::egg`].
     fn egg(&self, disc: &Discretization, cps: &[Point], op: Operator, res: &mut [f64], stencil: &mut [f64]);
+    /// Scalar mass matrix in stencil storage; see [`Discretization::mass`].
+    fn mass(&self, disc: &Discretization, stencil: &mut [f64]) {
+        disc.mass(stencil);
+    }
+    /// Linear elasticity on the domain of `cps`; see [`Discretization::elasticity`].
+    fn elasticity(&self, disc: &Discretization, cps: &[Point], lambda: f64, mu: f64, stencil: &mut [f64]) {
+        disc.elasticity(cps, lambda, mu, stencil);
+    }
+    /// `det J` on an `(n+1)^2` grid; see [`sample_det_j`].
+    fn sample_det_j(&self, map: &Surface, n: usize) -> DetJSample {
+        sample_det_j(map, n)
+    }
     /// Human-readable name of the back end ("cpu", "gpu: <adapter>").
     fn name(&self) -> String;
 }
@@ -126,7 +144,7 @@ impl NonlinearProblem for EggProblem {
     fn mass(&mut self) -> &Csr {
         if self.mass.is_none() {
             let mut st = vec![0.0; self.disc.stencil_len(1)];
-            self.disc.mass(&mut st);
+            self.assembler.mass(&self.disc, &mut st);
             let m = self.disc.scalar.matrix(&st);
             // block diag(M, M) in the vector pattern
             let ms = self.disc.dofs.num_free();

@@ -4,6 +4,7 @@
 
 use crate::assembly::Discretization;
 use crate::curve::{Curve, Point};
+use crate::egg::{CpuAssembler, EggAssembler};
 use crate::error::{Error, Result};
 use crate::linsolve::{LinearMethod, LinearSolver};
 use crate::surface::{Side, Surface};
@@ -67,6 +68,16 @@ pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 /// every control point (the fixed ones carry `target - base`). It is linear in the
 /// boundary displacement, so `base + alpha u` moves the boundary by `alpha`.
 pub fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
+    elasticity_displacement_with(&CpuAssembler, disc, base, target)
+}
+
+/// [`elasticity_displacement`] with the elasticity operator assembled by `assembler`.
+pub fn elasticity_displacement_with(
+    assembler: &dyn EggAssembler,
+    disc: &Discretization,
+    base: &[Point],
+    target: &[Point],
+) -> Result<Vec<Point>> {
     let mut diff = vec![[0.0; 2]; base.len()];
     let mut moved = false;
     for k in 0..base.len() {
@@ -79,7 +90,7 @@ pub fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[
         return Ok(diff);
     }
     let mut st = vec![0.0; disc.stencil_len(2)];
-    disc.elasticity(base, LAME.0, LAME.1, &mut st);
+    assembler.elasticity(disc, base, LAME.0, LAME.1, &mut st);
     let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
     // symmetric positive definite: Cholesky, with LU/GMRES as a safety net

@@ -5,6 +5,7 @@
 
 use crate::basis::BasisDerivs;
 use crate::curve::Point;
+use crate::quality::grid_abscissae;
 use crate::surface::Surface;
 
 /// An RGBA8 image, row-major from the top-left.
@@ -119,21 +120,35 @@ impl Canvas {
 /// Render `map`; the colour scale is logarithmic from the smallest positive to the
 /// largest sampled `det J` (at most four decades).
 pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
-    let n = opts.resolution.max(8);
+    let n = render_resolution(opts);
     let mut pts = Vec::with_capacity((n + 1) * (n + 1));
     let mut det = Vec::with_capacity((n + 1) * (n + 1));
     let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-    for j in 0..=n {
-        bv.eval(&map.knots[1], j as f64 / n as f64, 1);
-        for i in 0..=n {
-            bu.eval(&map.knots[0], i as f64 / n as f64, 1);
+    for v in grid_abscissae(n) {
+        bv.eval(&map.knots[1], v, 1);
+        for u in grid_abscissae(n) {
+            bu.eval(&map.knots[0], u, 1);
             let d = map.derivs_with(&bu, &bv, 1);
             pts.push(d.x);
             det.push(d.det_j());
         }
     }
+    render_sampled(n, &pts, &det, opts)
+}
+
+/// Grid cells per direction that [`render`] samples for `opts`.
+pub fn render_resolution(opts: &PictureOptions) -> usize {
+    opts.resolution.max(8)
+}
+
+/// Draw from samples on the `(n+1)^2` grid of [`render`] (`n` from
+/// [`render_resolution`]): points `pts` and `det J` values `det`, row-major with `eta`
+/// outer. Lets another back end (the GPU) do the sampling.
+pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOptions) -> Image {
+    assert_eq!(pts.len(), (n + 1) * (n + 1), "render_sampled: {} points for n = {n}", pts.len());
+    assert_eq!(det.len(), pts.len(), "render_sampled: det and points differ in length");
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for p in &pts {
+    for p in pts {
         xmin = xmin.min(p[0]);
         xmax = xmax.max(p[0]);
         ymin = ymin.min(p[1]);

@@ -25,33 +25,49 @@ pub struct DetJSample {
     pub min_interior: f64,
 }
 
+impl DetJSample {
+    /// The summary of grid values `values[j * (n + 1) + i]` at `(i/n, j/n)`, `n >= 1`.
+    pub fn from_values(n: usize, values: Vec<f64>) -> Self {
+        debug_assert_eq!(values.len(), (n + 1) * (n + 1));
+        let (mut min, mut max, mut argmin, mut min_interior) =
+            (f64::INFINITY, f64::NEG_INFINITY, [0.0; 2], f64::INFINITY);
+        for j in 0..=n {
+            for i in 0..=n {
+                let d = values[j * (n + 1) + i];
+                if d < min {
+                    min = d;
+                    argmin = [i as f64 / n as f64, j as f64 / n as f64];
+                }
+                max = max.max(d);
+                let corner = (i == 0 || i == n) && (j == 0 || j == n);
+                if !corner {
+                    min_interior = min_interior.min(d);
+                }
+            }
+        }
+        Self { n, values, min, max, argmin, min_interior }
+    }
+}
+
+/// The grid abscissae `t_i = i / n`, `i = 0..=n`, of [`sample_det_j`] and
+/// [`crate::picture::render`].
+pub fn grid_abscissae(n: usize) -> impl Iterator<Item = f64> {
+    (0..=n).map(move |i| i as f64 / n as f64)
+}
+
 /// Sample `det J` on an `(n+1)^2` grid (boundary included). The `xi` basis is
 /// evaluated once per column, rows run in parallel.
 pub fn sample_det_j(map: &Surface, n: usize) -> DetJSample {
     let n = n.max(1);
-    let grid = |i: usize| i as f64 / n as f64;
-    let bu: Vec<BasisDerivs> = (0..=n).map(|i| BasisDerivs::at(&map.knots[0], grid(i), 1)).collect();
+    let bu: Vec<BasisDerivs> = grid_abscissae(n).map(|u| BasisDerivs::at(&map.knots[0], u, 1)).collect();
     let mut values = vec![0.0; (n + 1) * (n + 1)];
-    values.par_chunks_mut(n + 1).enumerate().for_each(|(j, row)| {
-        let bv = BasisDerivs::at(&map.knots[1], grid(j), 1);
+    values.par_chunks_mut(n + 1).zip(grid_abscissae(n).collect::<Vec<_>>()).for_each(|(row, v)| {
+        let bv = BasisDerivs::at(&map.knots[1], v, 1);
         for (d, bu) in row.iter_mut().zip(&bu) {
             *d = map.derivs_with(bu, &bv, 1).det_j();
         }
     });
-    let (mut min, mut max, mut argmin, mut min_interior) = (f64::INFINITY, f64::NEG_INFINITY, [0.0; 2], f64::INFINITY);
-    for (k, &d) in values.iter().enumerate() {
-        let (i, j) = (k % (n + 1), k / (n + 1));
-        if d < min {
-            min = d;
-            argmin = [grid(i), grid(j)];
-        }
-        max = max.max(d);
-        let corner = (i == 0 || i == n) && (j == 0 || j == n);
-        if !corner {
-            min_interior = min_interior.min(d);
-        }
-    }
-    DetJSample { n, values, min, max, argmin, min_interior }
+    DetJSample::from_values(n, values)
 }
 
 /// Integrals of the map by Gauss quadrature on every element.

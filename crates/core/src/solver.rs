@@ -13,7 +13,7 @@ use crate::curve::Curve;
 use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
 use crate::error::{Error, Result};
 use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
-use crate::initial::{coons, displaced, elasticity_displacement, set_boundary};
+use crate::initial::{coons, displaced, elasticity_displacement_with, set_boundary};
 use crate::knots::KnotVector;
 use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
 use crate::quality::{functionals, sample_det_j};
@@ -371,10 +371,10 @@ struct Continuation {
 
 /// Smallest `det J` on a sample of `4 max(n_xi, n_eta)` points per direction, away
 /// from the corners.
-fn det_j_min(disc: &Discretization, cps: &[crate::curve::Point]) -> f64 {
+fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[crate::curve::Point]) -> f64 {
     let shape = disc.shape();
     let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: None };
-    sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
+    assembler.sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
 }
 
 /// Largest tensor basis the solver accepts (about 8 million unknowns).
@@ -476,8 +476,8 @@ impl EggSolver {
         nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
         // displacement from `base` to the full target; linear in the boundary motion, so
         // a fraction `f` of the remaining motion is `f * u`
-        let mut u = elasticity_displacement(disc, &base, target)?;
-        if det_j_min(disc, &base) <= 0.0 {
+        let mut u = elasticity_displacement_with(&*self.assembler, disc, &base, target)?;
+        if det_j_min(&*self.assembler, disc, &base) <= 0.0 {
             // the prolonged map itself is not positive on this level's (denser) sample:
             // damping the boundary motion cannot make the guess positive, Newton starts
             // from the full elasticity guess
@@ -487,7 +487,7 @@ impl EggSolver {
             let a = (done + step).min(1.0);
             let f = (a - done) / (1.0 - done);
             let guess = displaced(&base, &u, f);
-            let positive = det_j_min(disc, &guess) > 0.0;
+            let positive = det_j_min(&*self.assembler, disc, &guess) > 0.0;
             let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
             if a >= 1.0 && (positive || exhausted) {
                 return Ok(guess);
@@ -510,11 +510,11 @@ impl EggSolver {
             let mut sol = problem.cps.clone();
             problem.disc.dofs.scatter(&c, &mut sol);
             cont.iterations += iterations;
-            if converged && det_j_min(disc, &sol) > 0.0 {
+            if converged && det_j_min(&*self.assembler, disc, &sol) > 0.0 {
                 base = sol;
                 done = a;
                 step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
-                u = elasticity_displacement(disc, &base, target)?;
+                u = elasticity_displacement_with(&*self.assembler, disc, &base, target)?;
             } else if exhausted {
                 return Ok(guess);
             } else {
@@ -539,7 +539,7 @@ impl EggSolver {
             }
         };
         let shape = disc.shape();
-        let initial_det_j_min = det_j_min(&disc, &cps);
+        let initial_det_j_min = det_j_min(&*self.assembler, &disc, &cps);
         let m = disc.dofs.num_free();
         let mut nl = self.opts.nonlinear;
         nl.scale = self.residual_scale(m);
@@ -617,7 +617,7 @@ impl EggSolver {
     fn folds(&self) -> bool {
         let (Some(map), Some(level)) = (&self.previous, self.plan.last()) else { return false };
         let forced = corner_report(&level.sides);
-        let s = sample_det_j(map, self.opts.sample);
+        let s = self.assembler.sample_det_j(map, self.opts.sample);
         min_away_from_corners(map, &s, &forced) <= 0.0
     }
 }
