@@ -17,7 +17,7 @@ fn run(file: &str, opts: &SolveOptions) -> Solution {
 fn assert_bijective(file: &str) {
     let sol = run(file, &SolveOptions::default());
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::PositiveOnSample, "{file}: {}", r.message);
+    assert_eq!(r.verdict, Verdict::Certified, "{file}: {}", r.message);
     let last = r.levels.last().unwrap();
     assert!(last.converged, "{file}: {last:?}");
     // the map's boundary is the input boundary up to the fit tolerance (point clouds are
@@ -92,7 +92,7 @@ fn degenerate_corners_are_named() {
         let sol = run(file, &SolveOptions::default());
         let r = &sol.report;
         assert_eq!(r.verdict, Verdict::DegenerateCorner, "{file}: {}", r.message);
-        let forced: Vec<_> = r.corners.iter().filter(|c| c.forces_nonpositive_det_j).collect();
+        let forced: Vec<_> = r.certificate.corners.iter().filter(|c| c.forbids_positivity).collect();
         assert!(!forced.is_empty(), "{file}");
         assert!(
             forced.iter().all(|c| c.angle_degrees >= 179.0 && r.message.contains(c.corner)),
@@ -117,7 +117,7 @@ fn kinks_in_spline_sides_are_named() {
         (k.turning_degrees - 90.0).abs() < 1.0 && (k.point[0] + 4.0).abs() < 1e-12 && (k.point[1] - 4.0).abs() < 1e-12
     );
     assert!(r.message.contains("kink") && r.message.contains("north"), "{}", r.message);
-    assert_eq!(r.verdict, Verdict::PositiveOnSample);
+    assert_eq!(r.verdict, Verdict::Certified);
 }
 
 /// The geometries that need the reparameterization and defect-correction issues still
@@ -130,7 +130,7 @@ fn hard_geometries_run_and_report() {
         assert!(!r.levels.is_empty() && !r.message.is_empty());
         // the verdict agrees with an independent dense sample
         let s = sample_det_j(&sol.map, 400);
-        if r.verdict == Verdict::PositiveOnSample {
+        if r.verdict == Verdict::Certified {
             assert!(s.min > 0.0, "{file}");
         }
     }
@@ -164,4 +164,27 @@ fn quarter_annulus_converges_under_refinement() {
     let d1 = diff(&maps[0], &maps[1]);
     let d2 = diff(&maps[1], &maps[2]);
     assert!(d2 < d1 / 4.0, "no convergence: {d1:.3e} then {d2:.3e}");
+}
+
+/// Defect correction (paper §8.2): with the plain operator wavy_lid folds at the default
+/// resolution; local refinement around the offending elements and a re-solve from the
+/// prolonged map end with a certified map, refining only part of the spans.
+#[test]
+fn local_repair_certifies_a_folded_map() {
+    let plain = SolveOptions { operator: winslow::assembly::Operator::Plain, repair: 0, ..Default::default() };
+    let folded = run("wavy_lid.json", &plain);
+    assert_eq!(folded.report.verdict, Verdict::Folded, "{}", folded.report.message);
+    assert!(folded.report.repair_rounds.is_empty());
+    let sol = run("wavy_lid.json", &SolveOptions { repair: 4, ..plain });
+    let r = &sol.report;
+    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+    assert!(!r.repair_rounds.is_empty() && r.repairs == r.repair_rounds.len());
+    let before = folded.map.knots.clone().map(|k| k.num_elements());
+    let first = &r.repair_rounds[0];
+    assert_eq!(first.verdict, "folded");
+    // local: fewer spans bisected than a uniform refinement would
+    assert!(first.spans_refined[0] < before[0] || first.spans_refined[1] < before[1], "{first:?}");
+    assert_eq!(first.elements, [before[0] + first.spans_refined[0], before[1] + first.spans_refined[1]]);
+    // the certificate agrees with a dense sample
+    assert!(sample_det_j(&sol.map, 600).min > 0.0);
 }

@@ -9,12 +9,15 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use winslow::assembly::Operator;
+use winslow::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::egg::CpuAssembler;
 use winslow::fit::{build_hierarchy, FitOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
 use winslow::linsolve::LinearMethod;
 use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
+use winslow::poisson::poisson_benchmark;
+use winslow::quality::{boundary_deviation, quality};
 use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
 use winslow::{Boundary, Side};
 
@@ -41,6 +44,31 @@ enum Command {
     Render(RenderArgs),
     /// Run the solver on a list of geometries and sizes and print a table.
     Bench(BenchArgs),
+    /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
+    /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
+    Check(CheckArgs),
+}
+
+#[derive(Args, Debug)]
+struct CheckArgs {
+    /// Map file (JSON map document or G+Smo XML).
+    map: PathBuf,
+    /// The input boundary: report the largest deviation of the map's boundary from it.
+    #[arg(long)]
+    boundary: Option<PathBuf>,
+    /// Also solve the grid-quality benchmark -Δu = -Δu* (paper eq. 44-45) and report Q(x).
+    #[arg(long)]
+    poisson: bool,
+    /// Length scales a1,a2 of u* = sin(pi x / a1) sin(pi y / a2) (default: half the
+    /// bounding box extents).
+    #[arg(long, value_delimiter = ',', num_args = 2)]
+    poisson_scales: Option<Vec<f64>>,
+    /// Most bisections per element in the certificate.
+    #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
+    max_depth: usize,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -115,10 +143,11 @@ struct SolverArgs {
     /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 5000 unknowns).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
-    /// When the finest map folds, halve the basis and solve again, at most this often.
+    /// Rounds of defect correction: while the certificate says folded or undecided,
+    /// refine around the offending elements and solve again, at most this often.
     #[arg(long, default_value_t = SolveOptions::default().repair)]
     repair: usize,
-    /// Do not refine a folded map (same as --repair 0).
+    /// Do not repair a folded map (same as --repair 0).
     #[arg(long)]
     no_repair: bool,
 }
@@ -242,6 +271,7 @@ fn run(cli: Cli) -> Result<i32> {
             Ok(0)
         }
         Command::Bench(a) => bench(a),
+        Command::Check(a) => check(a),
     }
 }
 
@@ -377,10 +407,50 @@ fn solve(a: SolveArgs) -> Result<i32> {
     } else {
         print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
     }
-    Ok(match sol.report.verdict {
-        Verdict::PositiveOnSample | Verdict::DegenerateCorner => 0,
+    Ok(exit_code(sol.report.verdict))
+}
+
+/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
+fn exit_code(v: Verdict) -> i32 {
+    match v {
+        Verdict::Certified | Verdict::DegenerateCorner => 0,
         Verdict::Folded => 3,
         Verdict::NotConverged => 4,
+        Verdict::Undecided => 5,
+    }
+}
+
+fn check(a: CheckArgs) -> Result<i32> {
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+    };
+    let opts = CertifyOptions { max_depth: a.max_depth.clamp(1, 40), ..Default::default() };
+    let certificate = certify(&map, &opts).context("certifying the map")?;
+    let quality = quality(&map);
+    let deviation = match &a.boundary {
+        Some(p) => {
+            let b = load_boundary(p, &FitArgs { degree: 3, fit_tol: 1e-4, reorient: false })?;
+            Some(boundary_deviation(&map, &b, 400))
+        }
+        None => None,
+    };
+    let poisson = if a.poisson {
+        let scales = a.poisson_scales.as_ref().map(|v| [v[0], v[1]]);
+        Some(poisson_benchmark(&map, scales).context("Poisson benchmark")?)
+    } else {
+        None
+    };
+    let report = output::CheckReport { name, certificate, quality, boundary_deviation: deviation, poisson };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", output::check_text(&report));
+    }
+    Ok(match report.certificate.verdict {
+        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
+        CertVerdict::Folded { .. } => 3,
+        CertVerdict::Undecided { .. } => 5,
     })
 }
 

@@ -69,11 +69,11 @@ fn solve_writes_map_report_png_and_vtk() {
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["verdict"], "positive-on-sample");
+    assert_eq!(report["verdict"], "certified");
     assert!(report["levels"].as_array().unwrap().last().unwrap()["newton_iterations"].as_u64().unwrap() <= 5);
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
     assert_eq!(doc["map"]["degree"], serde_json::json!([3, 3]));
-    assert_eq!(doc["report"]["verdict"], "positive-on-sample");
+    assert_eq!(doc["report"]["verdict"], "certified");
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     assert!(std::fs::read_to_string(&vtk).unwrap().starts_with("# vtk DataFile"));

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::assembly::{Discretization, Operator};
 use crate::boundary::Boundary;
+use crate::certificate::{certify, Certificate, CertifyOptions};
 use crate::curve::Curve;
 use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
 use crate::error::{Error, Result};
@@ -16,7 +17,7 @@ use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
 use crate::initial::{coons, displaced, elasticity_displacement, set_boundary};
 use crate::knots::KnotVector;
 use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
-use crate::quality::{functionals, sample_det_j};
+use crate::quality::{quality, sample_det_j, Quality};
 use crate::surface::{Side, Surface};
 
 /// Options of a complete solve.
@@ -41,8 +42,14 @@ pub struct SolveOptions {
     pub aspect: f64,
     /// `det J` is sampled on an `(n+1)^2` grid for the report.
     pub sample: usize,
-    /// When the finest map folds, halve it and solve again, at most this many times.
+    /// Rounds of defect correction (paper §8.2): while the certificate of the finest
+    /// map says folded or undecided, refine around the offending elements and solve
+    /// again, at most this many times.
     pub repair: usize,
+    /// Spans around each offending element that a repair round also bisects.
+    pub repair_halo: usize,
+    /// Options of the bijectivity certificate.
+    pub certify: CertifyOptions,
 }
 
 impl Default for SolveOptions {
@@ -57,7 +64,9 @@ impl Default for SolveOptions {
             growth: 4.0,
             aspect: 2.0,
             sample: 200,
-            repair: 2,
+            repair: 3,
+            repair_halo: 1,
+            certify: CertifyOptions::default(),
         }
     }
 }
@@ -403,6 +412,9 @@ pub struct EggSolver {
     started: Instant,
     failed: bool,
     repairs: usize,
+    rounds: Vec<RepairRound>,
+    /// Certificate of the last solved map (the finest level so far).
+    certificate: Option<Certificate>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -430,6 +442,8 @@ impl EggSolver {
             started: Instant::now(),
             failed: false,
             repairs: 0,
+            rounds: Vec::new(),
+            certificate: None,
         })
     }
 
@@ -589,6 +603,10 @@ impl EggSolver {
             e?;
         }
         let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let certificate = match self.certificate.take() {
+            Some(c) => c,
+            None => certify(&map, &self.certify_options())?,
+        };
         let finest = self.plan.last().expect("non-empty plan");
         let ctx = ReportContext {
             hierarchy,
@@ -598,17 +616,66 @@ impl EggSolver {
             opts: &self.opts,
             backend: self.assembler.name(),
             repairs: self.repairs,
+            rounds: self.rounds.clone(),
+            certificate,
             elapsed: self.started.elapsed(),
         };
         Ok(Solution::new(&boundary.name, map, self.reports, ctx))
     }
 
-    /// Whether the last solved map folds away from the corners its boundary forces.
-    fn folds(&self) -> bool {
-        let (Some(map), Some(level)) = (&self.previous, self.plan.last()) else { return false };
-        let forced = corner_report(&level.sides);
-        let s = sample_det_j(map, self.opts.sample);
-        min_away_from_corners(map, &s, &forced) <= 0.0
+    fn certify_options(&self) -> CertifyOptions {
+        self.opts.certify
+    }
+
+    /// Certify the last solved map (once) and, when it folds or is undecided, plan a
+    /// defect-correction level: the offending elements (and `repair_halo` spans around
+    /// them) bisected in both directions. Returns `Ok(true)` when a level was added.
+    fn plan_repair(&mut self) -> Result<bool> {
+        let (Some(map), Some(last)) = (&self.previous, self.plan.last()) else { return Ok(false) };
+        if self.certificate.is_none() {
+            self.certificate = Some(certify(map, &self.certify_options())?);
+        }
+        let cert = self.certificate.as_ref().expect("set above");
+        let offending = cert.offending_elements();
+        if offending.is_empty() || self.repairs >= self.opts.repair {
+            return Ok(false);
+        }
+        let halo = self.opts.repair_halo;
+        let mut knots = last.knots.clone();
+        let mut spans_refined = [0usize; 2];
+        for d in 0..2 {
+            let elems = last.knots[d].elements();
+            let n = elems.len();
+            let mut mark = vec![false; n];
+            for e in &offending {
+                let i = e[d];
+                for k in i.saturating_sub(halo)..=(i + halo).min(n - 1) {
+                    mark[k] = true;
+                }
+            }
+            let mids: Vec<f64> =
+                elems.iter().zip(&mark).filter(|(_, &m)| m).map(|(&(_, a, b), _)| 0.5 * (a + b)).collect();
+            spans_refined[d] = mids.len();
+            knots[d] = knots[d].with_inserted(&mids);
+        }
+        let size = knots[0].num_basis() * knots[1].num_basis();
+        if size > MAX_BASIS {
+            return Ok(false);
+        }
+        let sides = Side::ALL.map(|s| last.sides[s as usize].refined(&knots[s.direction()]));
+        let sides: [Curve; 4] = sides.into_iter().collect::<Result<Vec<_>>>()?.try_into().expect("four sides");
+        self.rounds.push(RepairRound {
+            round: self.repairs + 1,
+            verdict: cert.verdict.name(),
+            offending_elements: offending.len(),
+            spans_refined,
+            shape: [knots[0].num_basis(), knots[1].num_basis()],
+            elements: [knots[0].num_elements(), knots[1].num_elements()],
+        });
+        self.plan.push(Level { knots, sides });
+        self.repairs += 1;
+        self.certificate = None;
+        Ok(true)
     }
 }
 
@@ -640,25 +707,11 @@ impl Iterator for EggSolver {
                 }
             }
         }
-        if self.next_level == self.plan.len()
-            && self.repairs < self.opts.repair
-            && !self.plan.is_empty()
-            && self.folds()
-        {
-            // defect correction by refinement: halve the finest level and solve again
-            let last = self.plan.last().expect("non-empty");
-            let knots = [last.knots[0].halved(), last.knots[1].halved()];
-            let sides = Side::ALL.map(|s| last.sides[s as usize].refined(&knots[s.direction()]));
-            match sides.into_iter().collect::<Result<Vec<_>>>() {
-                Ok(v) => {
-                    let sides: [Curve; 4] = v.try_into().expect("four sides");
-                    self.plan.push(Level { knots, sides });
-                    self.repairs += 1;
-                }
-                Err(e) => {
-                    self.failed = true;
-                    return Some(Err(e));
-                }
+        if self.next_level == self.plan.len() && !self.plan.is_empty() && self.previous.is_some() {
+            // defect correction (§8.2): certify, refine around the defects, solve again
+            if let Err(e) = self.plan_repair() {
+                self.failed = true;
+                return Some(Err(e));
             }
         }
         if self.next_level < self.plan.len() {
@@ -674,19 +727,39 @@ impl Iterator for EggSolver {
     }
 }
 
-/// Overall outcome of a solve, as seen on a dense sample of `det J`.
+/// Overall outcome of a solve: the bijectivity certificate of the final map
+/// ([`crate::certificate`]), unless the solver did not converge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
-    /// Converged and `det J > 0` on the whole sample.
-    PositiveOnSample,
-    /// Converged, `det J > 0` inside, but a corner angle of the boundary forces
-    /// `det J <= 0` there: the best map the boundary allows.
+    /// Converged and `det J > 0` proven on the whole map.
+    Certified,
+    /// Converged, `det J > 0` proven except near corners whose angle forces
+    /// `det J <= 0`: the best map the boundary allows.
     DegenerateCorner,
-    /// `det J <= 0` somewhere away from forced corners: the map folds.
+    /// `det J <= 0` at a point away from forced corners: the map folds.
     Folded,
+    /// Neither proven positive nor shown to fold within the subdivision budget.
+    Undecided,
     /// The finest level did not converge.
     NotConverged,
+}
+
+/// One round of defect correction.
+#[derive(Debug, Clone, Serialize)]
+pub struct RepairRound {
+    /// Round number (1-based).
+    pub round: usize,
+    /// Certificate verdict of the map that was repaired.
+    pub verdict: &'static str,
+    /// Folded or undecided elements.
+    pub offending_elements: usize,
+    /// Spans bisected per direction (offending ones and their halo).
+    pub spans_refined: [usize; 2],
+    /// Basis shape after refinement.
+    pub shape: [usize; 2],
+    /// Elements per direction after refinement.
+    pub elements: [usize; 2],
 }
 
 /// Contour-fit summary per side.
@@ -723,9 +796,16 @@ pub struct Report {
     pub fit: Vec<FitReport>,
     /// Per-level summaries.
     pub levels: Vec<LevelReport>,
-    /// Refinements added because the finest map folded.
+    /// Defect-correction rounds run because the finest map folded or was undecided.
     pub repairs: usize,
-    /// `det J` minimum on the sample grid (corners included).
+    /// Each defect-correction round.
+    pub repair_rounds: Vec<RepairRound>,
+    /// The bijectivity certificate of the map.
+    pub certificate: Certificate,
+    /// Quality functionals and cell statistics.
+    pub quality: Quality,
+    /// `det J` minimum on the sample grid (corners included; the sample is additional
+    /// information, the verdict comes from the certificate).
     pub det_j_min: f64,
     /// `det J` minimum away from the four corners.
     pub det_j_min_interior: f64,
@@ -803,6 +883,8 @@ struct ReportContext<'a> {
     opts: &'a SolveOptions,
     backend: String,
     repairs: usize,
+    rounds: Vec<RepairRound>,
+    certificate: Certificate,
     elapsed: Duration,
 }
 
@@ -810,9 +892,10 @@ impl Solution {
     fn new(name: &str, map: Surface, levels: Vec<LevelReport>, ctx: ReportContext<'_>) -> Self {
         let (h, opts) = (ctx.hierarchy, ctx.opts);
         let sample = sample_det_j(&map, opts.sample);
-        let fun = functionals(&map);
+        let quality = quality(&map);
+        let fun = quality.functionals;
+        let certificate = ctx.certificate;
         let corners = corner_report(ctx.sides);
-        let forced: Vec<&str> = corners.iter().filter(|c| c.forces_nonpositive_det_j).map(|c| c.corner).collect();
         let converged = levels.last().is_some_and(|l| l.converged);
         let away = min_away_from_corners(&map, &sample, &corners);
         let kinks = ctx.kinks;
@@ -824,24 +907,14 @@ impl Solution {
                     levels.last().and_then(|l| l.failure.clone()).unwrap_or_default()
                 ),
             )
-        } else if away <= 0.0 {
-            let [u, v] = sample.argmin;
-            (Verdict::Folded, format!("det J <= 0 at (xi, eta) = ({u:.4}, {v:.4}): the map folds at this resolution"))
-        } else if !forced.is_empty() {
-            let why: Vec<String> = corners
-                .iter()
-                .filter(|c| c.forces_nonpositive_det_j)
-                .map(|c| format!("the {} corner (angle {:.1} degrees)", c.corner, c.angle_degrees))
-                .collect();
-            (
-                Verdict::DegenerateCorner,
-                format!(
-                    "the boundary itself forces det J <= 0 at {}; det J > 0 everywhere else: this is the best map this boundary admits",
-                    why.join(" and ")
-                ),
-            )
         } else {
-            (Verdict::PositiveOnSample, format!("det J > 0 on the {}x{} sample grid", sample.n + 1, sample.n + 1))
+            let v = match certificate.verdict {
+                crate::certificate::Verdict::Certified { .. } => Verdict::Certified,
+                crate::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+                crate::certificate::Verdict::Folded { .. } => Verdict::Folded,
+                crate::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
+            };
+            (v, certificate.message())
         };
         let mut message = message;
         for k in &kinks {
@@ -877,6 +950,9 @@ impl Solution {
             fit,
             levels,
             repairs: ctx.repairs,
+            repair_rounds: ctx.rounds,
+            certificate,
+            quality,
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: away,
@@ -925,7 +1001,7 @@ mod tests {
         let b = annulus(1.0, 2.0, std::f64::consts::FRAC_PI_2);
         let sol = solve(&b, &SolveOptions::default()).unwrap();
         let r = &sol.report;
-        assert_eq!(r.verdict, Verdict::PositiveOnSample, "{}", r.message);
+        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
         let last = r.levels.last().unwrap();
         assert!(last.converged && last.newton_iterations <= 5, "{last:?}");
         assert!((r.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit_tolerance * r.diameter, "area {}", r.area);
