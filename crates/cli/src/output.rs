@@ -83,7 +83,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
         r.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
         r.seconds
     );
-    certificate_lines(&mut s, &r.certificate);
+    certificate_lines(&mut s, &r.certificate, false);
     quality_lines(&mut s, &r.quality);
     for round in &r.repair_rounds {
         let _ = writeln!(
@@ -155,11 +155,13 @@ fn quality_lines(s: &mut String, q: &Quality) {
     );
 }
 
-fn certificate_lines(s: &mut String, c: &Certificate) {
-    let _ = writeln!(s, "  certificate: {}", c.message());
+fn certificate_lines(s: &mut String, c: &Certificate, with_message: bool) {
+    if with_message {
+        let _ = writeln!(s, "  certificate: {}", c.message());
+    }
     let _ = writeln!(
         s,
-        "    det J degree {:?}, {} elements ({}x{}), {} Bernstein boxes, depth {}, {:.3} s",
+        "  certificate: det J degree {:?}, {} elements ({}x{}), {} Bernstein boxes, depth {}, {:.3} s",
         c.det_degree, c.elements, c.element_shape[0], c.element_shape[1], c.boxes, c.max_depth, c.seconds
     );
     for k in c.corners.iter().filter(|k| k.forbids_positivity) {
@@ -175,7 +177,7 @@ fn certificate_lines(s: &mut String, c: &Certificate) {
 pub fn check_text(r: &CheckReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{}: {}", r.name, r.certificate.verdict.name());
-    certificate_lines(&mut s, &r.certificate);
+    certificate_lines(&mut s, &r.certificate, true);
     quality_lines(&mut s, &r.quality);
     if let Some(d) = r.boundary_deviation {
         let _ = writeln!(

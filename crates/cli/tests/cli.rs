@@ -82,6 +82,61 @@ fn solve_writes_map_report_png_and_vtk() {
     assert!(again.status.success());
     let render = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
     assert!(render.status.success());
+    // the report carries the certificate and the quality numbers
+    assert_eq!(report["certificate"]["verdict"]["kind"], "certified");
+    let bound = report["certificate"]["verdict"]["lower_bound"].as_f64().unwrap();
+    assert!(bound > 0.0 && bound <= report["det_j_min"].as_f64().unwrap());
+    assert!(report["quality"]["scaled_jacobian"]["min"].as_f64().unwrap() > 0.0);
+    // `check` agrees with the solve report and adds boundary deviation and Q(x)
+    let out = bin()
+        .arg("check")
+        .arg(&map)
+        .arg("--boundary")
+        .arg(data().join("wavy_lid.json"))
+        .args(["--poisson", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let check: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(check["certificate"]["verdict"], report["certificate"]["verdict"]);
+    assert_eq!(check["quality"]["functionals"], report["quality"]["functionals"]);
+    let dev = check["boundary_deviation"].as_array().unwrap();
+    assert!(dev.iter().all(|d| d.as_f64().unwrap() <= 4.0 * report["fit_tolerance"].as_f64().unwrap()));
+    let q = check["poisson"]["q"].as_f64().unwrap();
+    assert!(q > 0.0 && q < 1.0, "{q}");
+    let text = bin().arg("check").arg(&map).output().unwrap();
+    assert!(String::from_utf8_lossy(&text.stdout).contains("certified"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A map with a fold planted by hand: `check` finds it, says where, exits with 3.
+#[test]
+fn check_finds_a_planted_fold() {
+    let dir = std::env::temp_dir().join(format!("winslow-fold-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // identity map of the unit square, p = 2, 4x4 elements; control point (3, 3)
+    // pushed past its right neighbour
+    let g = [0.0, 0.125, 0.375, 0.625, 0.875, 1.0];
+    let mut cps = Vec::new();
+    for (j, &y) in g.iter().enumerate() {
+        for (i, &x) in g.iter().enumerate() {
+            cps.push(if (i, j) == (3, 3) { [1.2, y] } else { [x, y] });
+        }
+    }
+    let knots = [0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0];
+    let doc = serde_json::json!({ "name": "planted", "map": { "degree": [2, 2], "knots": [knots, knots],
+        "control_points": cps, "weights": null, "periodic": [false, false] } });
+    let path = dir.join("planted.json");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let out = bin().arg("check").arg(&path).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = &r["certificate"]["verdict"];
+    assert_eq!(v["kind"], "folded");
+    let (u, w) = (v["param"][0].as_f64().unwrap(), v["param"][1].as_f64().unwrap());
+    // inside the support of the moved function [0.25, 1] x [0.25, 1]
+    assert!((0.25..=1.0).contains(&u) && (0.25..=1.0).contains(&w), "{v}");
+    assert!(v["value"].as_f64().unwrap() <= 0.0);
     std::fs::remove_dir_all(&dir).ok();
 }
 

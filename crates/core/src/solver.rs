@@ -914,7 +914,17 @@ impl Solution {
                 crate::certificate::Verdict::Folded { .. } => Verdict::Folded,
                 crate::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
             };
-            (v, certificate.message())
+            let mut m = certificate.message();
+            if v == Verdict::Certified {
+                for c in corners.iter().filter(|c| c.forces_nonpositive_det_j) {
+                    m.push_str(&format!(
+                        "; note: the {} corner has an angle of {:.2} degrees, where the exact boundary forbids det J > 0; \
+                         the fitted boundary rounds it within the fit tolerance",
+                        c.corner, c.angle_degrees
+                    ));
+                }
+            }
+            (v, m)
         };
         let mut message = message;
         for k in &kinks {
