@@ -198,3 +198,29 @@ fn local_repair_removes_a_fold() {
     // away from the forced corner the dense sample agrees with the certificate
     assert!(r.det_j_min_away_from_forced_corners > 0.0);
 }
+
+/// The same defect correction with frozen DOFs (paper §8.2): only the control points near
+/// the fold are unknowns; the others keep the prolonged map's values exactly.
+#[test]
+fn local_repair_with_frozen_dofs() {
+    let coarse = SolveOptions {
+        fit: winslow::FitOptions { tol: 1e-3, ..Default::default() },
+        max_levels: Some(1),
+        min_elements: 2,
+        repair: 0,
+        ..Default::default()
+    };
+    let folded = run("gismo/butterfly.json", &coarse);
+    let sol = run("gismo/butterfly.json", &SolveOptions { repair: 3, repair_freeze: Some(2), ..coarse });
+    let r = &sol.report;
+    assert_eq!(r.verdict, Verdict::DegenerateCorner, "{}", r.message);
+    assert_eq!(r.repair_rounds.len(), 1, "{:?}", r.repair_rounds);
+    // fewer unknowns than the full interior
+    let last = r.levels.last().unwrap();
+    let [nx, ny] = last.shape;
+    assert!(last.unknowns < 2 * (nx - 2) * (ny - 2) / 4, "{} of {}", last.unknowns, 2 * (nx - 2) * (ny - 2));
+    // control points far from the fold are those of the prolonged folded map
+    let prolonged = folded.map.refined(&sol.map.knots).unwrap();
+    let same = prolonged.control_points.iter().zip(&sol.map.control_points).filter(|(a, b)| a == b).count();
+    assert!(same >= nx * ny - last.unknowns / 2, "{same} unchanged of {}", nx * ny);
+}

@@ -150,6 +150,10 @@ struct SolverArgs {
     /// Do not repair a folded map (same as --repair 0).
     #[arg(long)]
     no_repair: bool,
+    /// In repair rounds, solve only for the control points within this many spans of
+    /// the offending elements (the rest stay frozen at the prolonged map).
+    #[arg(long)]
+    repair_freeze: Option<usize>,
 }
 
 impl SolverArgs {
@@ -175,6 +179,7 @@ impl SolverArgs {
             LinearArg::Auto => LinearMethod::Auto,
         };
         o.repair = if self.no_repair { 0 } else { self.repair };
+        o.repair_freeze = self.repair_freeze;
         o.operator = match self.operator {
             OperatorArg::Plain => Operator::Plain,
             OperatorArg::Scaled => Operator::Scaled,

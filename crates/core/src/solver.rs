@@ -48,6 +48,10 @@ pub struct SolveOptions {
     pub repair: usize,
     /// Spans around each offending element that a repair round also bisects.
     pub repair_halo: usize,
+    /// When set, a repair round solves only for the control points whose support meets
+    /// the offending elements widened by this many spans; the others keep the values of
+    /// the prolonged map (paper §8.2: fewer unknowns).
+    pub repair_freeze: Option<usize>,
     /// Options of the bijectivity certificate.
     pub certify: CertifyOptions,
 }
@@ -66,6 +70,7 @@ impl Default for SolveOptions {
             sample: 200,
             repair: 3,
             repair_halo: 1,
+            repair_freeze: None,
             certify: CertifyOptions::default(),
         }
     }
@@ -384,6 +389,23 @@ fn det_j_min(disc: &Discretization, cps: &[crate::curve::Point]) -> f64 {
     sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
 }
 
+/// A discretization whose free DOFs are the interior functions with support meeting one
+/// of `boxes` (`[u0, u1, v0, v1]`); all interior ones when that leaves none.
+fn frozen_discretization(knots: &[KnotVector; 2], boxes: &[[f64; 4]]) -> Discretization {
+    let shape = [knots[0].num_basis(), knots[1].num_basis()];
+    let (p, q) = (knots[0].degree(), knots[1].degree());
+    let (tu, tv) = (knots[0].knots(), knots[1].knots());
+    let interior = |i: usize, j: usize| i > 0 && j > 0 && i + 1 < shape[0] && j + 1 < shape[1];
+    let near = |i: usize, j: usize| {
+        boxes.iter().any(|b| tu[i] < b[1] && tu[i + p + 1] > b[0] && tv[j] < b[3] && tv[j + q + 1] > b[2])
+    };
+    let dofs = crate::dofs::DofMap::from_predicate(shape, |i, j| interior(i, j) && near(i, j));
+    if dofs.num_free() == 0 {
+        return Discretization::new(knots.clone());
+    }
+    Discretization::with_dofs(knots.clone(), p.max(q) + 2, dofs)
+}
+
 /// Largest tensor basis the solver accepts (about 8 million unknowns).
 pub const MAX_BASIS: usize = 1 << 22;
 
@@ -415,6 +437,9 @@ pub struct EggSolver {
     rounds: Vec<RepairRound>,
     /// Certificate of the last solved map (the finest level so far).
     certificate: Option<Certificate>,
+    /// For repair levels solved with frozen DOFs: plan index and the parameter boxes
+    /// `[u0, u1, v0, v1]` whose control points stay free.
+    free_boxes: Vec<(usize, Vec<[f64; 4]>)>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -444,6 +469,7 @@ impl EggSolver {
             repairs: 0,
             rounds: Vec::new(),
             certificate: None,
+            free_boxes: Vec::new(),
         })
     }
 
@@ -532,7 +558,10 @@ impl EggSolver {
     fn start_level(&mut self, k: usize) -> Result<Event> {
         let t0 = Instant::now();
         let level = &self.plan[k];
-        let disc = Arc::new(Discretization::new(level.knots.clone()));
+        let disc = Arc::new(match self.free_boxes.iter().find(|(i, _)| *i == k) {
+            Some((_, boxes)) => frozen_discretization(&level.knots, boxes),
+            None => Discretization::new(level.knots.clone()),
+        });
         let mut cont = Continuation::default();
         let (cps, guess) = match &self.previous {
             None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
@@ -672,6 +701,18 @@ impl EggSolver {
             shape: [knots[0].num_basis(), knots[1].num_basis()],
             elements: [knots[0].num_elements(), knots[1].num_elements()],
         });
+        if let Some(r) = self.opts.repair_freeze {
+            let (ex, ey) = (last.knots[0].elements(), last.knots[1].elements());
+            let boxes = offending
+                .iter()
+                .map(|e| {
+                    let (i0, i1) = (e[0].saturating_sub(r), (e[0] + r).min(ex.len() - 1));
+                    let (j0, j1) = (e[1].saturating_sub(r), (e[1] + r).min(ey.len() - 1));
+                    [ex[i0].1, ex[i1].2, ey[j0].1, ey[j1].2]
+                })
+                .collect();
+            self.free_boxes.push((self.plan.len(), boxes));
+        }
         self.plan.push(Level { knots, sides });
         self.repairs += 1;
         self.certificate = None;
