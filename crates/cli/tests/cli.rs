@@ -192,3 +192,19 @@ fn bench_prints_a_table() {
         "{text}"
     );
 }
+
+/// G+Smo's disk patch has 180-degree corners (det J = 0 there) at all four corners:
+/// `check` proves det J > 0 everywhere except at those points and names them all.
+#[test]
+fn check_names_degenerate_corners() {
+    let out = bin().arg("check").arg(data().join("gismo/xml/disk.xml")).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = &r["certificate"]["verdict"];
+    assert_eq!(v["kind"], "degenerate-corner");
+    assert_eq!(v["corners"].as_array().unwrap().len(), 4, "{v}");
+    assert!(v["lower_bound"].as_f64().unwrap() > 0.0);
+    for c in r["certificate"]["corners"].as_array().unwrap() {
+        assert!((c["angle_degrees"].as_f64().unwrap() - 180.0).abs() < 1e-6 && c["forbids_positivity"] == true);
+    }
+}

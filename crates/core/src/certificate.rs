@@ -182,9 +182,14 @@ impl Certificate {
                     .filter(|c| corners.contains(&c.corner))
                     .map(|c| format!("{} (angle {:.2} degrees, det J there {:.3e})", c.corner, c.angle_degrees, c.det_j))
                     .collect();
+                let elsewhere = if lower_bound.is_finite() {
+                    format!("det J >= {lower_bound:.4e} ({relative:.3e} of its mean) is proven everywhere else")
+                } else {
+                    "det J > 0 is proven everywhere else".to_string()
+                };
                 format!(
-                    "degenerate corner: the boundary forces det J <= 0 at the {} corner; det J >= {lower_bound:.4e} \
-                     ({relative:.3e} of its mean) is proven everywhere else: the best map this boundary admits",
+                    "degenerate corner: the boundary forces det J <= 0 at the {} corner; {elsewhere}: the best map this \
+                     boundary admits",
                     why.join(" and ")
                 )
             }
@@ -495,6 +500,9 @@ struct ElementResult {
     boxes: usize,
     depth: usize,
     wmax: f64,
+    /// Forced corners (bit k: corner k) where `det J = 0` was shown to be the only
+    /// non-positive value of the box touching them.
+    zero_corners: u8,
 }
 
 /// A sub-box of an element: coefficients, local `u` and `v` ranges, depth.
@@ -502,10 +510,15 @@ type SubBox = (Vec<f64>, [f64; 2], [f64; 2], usize);
 
 /// Examine one element: subdivide until proven, a non-positive value is found, or the
 /// budget is spent.
+/// `forced[c]` is the index of the forced domain corner at the element's local corner
+/// `c` (0: `(0, 0)`, 1: `(1, 0)`, 2: `(1, 1)`, 3: `(0, 1)`), if any. `det J <= 0` exactly
+/// at such a point is no fold; a box touching it whose only non-positive coefficient is
+/// that corner's (zero within rounding) is proven positive except at the corner.
 fn examine(
     dj: &DetJElements<'_>,
     e: [usize; 2],
     excused: bool,
+    forced: [Option<usize>; 4],
     opts: &CertifyOptions,
     w: &mut Work,
     stack: &mut Vec<SubBox>,
@@ -524,8 +537,9 @@ fn examine(
         boxes: 0,
         depth: 0,
         wmax,
+        zero_corners: 0,
     };
-    let max_depth = if excused { opts.max_depth.min(4) } else { opts.max_depth };
+    let max_depth = if excused { opts.max_depth.min(6) } else { opts.max_depth };
     stack.clear();
     stack.push((coef, [0.0, 1.0], [0.0, 1.0], 0));
     let [du, dv] = d.0;
@@ -557,11 +571,35 @@ fn examine(
             (1.0, 1.0, c[dv * w_ + du]),
             (gs, gt, bern_eval(&c, d, gs, gt, &mut w.tmp)),
         ];
+        // which box corners are forced domain corners: (index into c, forced corner)
+        let local = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let box_corner = |s: f64, t: f64| -> Option<usize> {
+            let (ls, lt) = (if s == 0.0 { su[0] } else { su[1] }, if t == 0.0 { sv[0] } else { sv[1] });
+            (0..4).find(|&k| local[k] == (ls, lt)).and_then(|k| forced[k])
+        };
         let mut worst: Option<(f64, f64, f64)> = None;
+        let mut at_forced: Option<(usize, usize)> = None;
         for (s, t, v) in cands {
             res.min_value = res.min_value.min(v);
+            let on_corner = (s == 0.0 || s == 1.0) && (t == 0.0 || t == 1.0);
+            if let Some(k) = box_corner(s, t).filter(|_| on_corner) {
+                let ci = if t == 1.0 { dv * w_ } else { 0 } + if s == 1.0 { du } else { 0 };
+                at_forced = Some((k, ci));
+                continue;
+            }
             if v <= 0.0 && worst.is_none_or(|x| v < x.2) {
                 worst = Some((s, t, v));
+            }
+        }
+        if let (None, Some((k, ci))) = (worst, at_forced) {
+            // zero at the forced corner, positive elsewhere in the box
+            let rest = c.iter().enumerate().filter(|&(i, _)| i != ci).all(|(_, &v)| v > err);
+            if rest && c[ci] >= -err {
+                res.zero_corners |= 1 << k;
+                // a few more bisections bound det J away from the corner
+                if depth >= 3 {
+                    continue;
+                }
             }
         }
         if let Some((s, t, v)) = worst {
@@ -652,10 +690,31 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
             forced[k] && inx && iny
         })
     };
+    // forced domain corners at the element's local corners (none in strict mode)
+    let forced_local = |e: [usize; 2]| -> [Option<usize>; 4] {
+        let (x0, x1) = (e[0] == 0, e[0] + 1 == shape[0]);
+        let (y0, y1) = (e[1] == 0, e[1] + 1 == shape[1]);
+        let at = [x0 && y0, x1 && y0, x1 && y1, x0 && y1];
+        std::array::from_fn(|k| (cs > 0 && at[k] && forced[k]).then_some(k))
+    };
+    let near_all = |e: [usize; 2]| -> Vec<usize> {
+        let ends = [(false, false), (true, false), (true, true), (false, true)];
+        (0..4)
+            .filter(|&k| {
+                let (xe, ye) = ends[k];
+                let inx = if xe { e[0] + cs >= shape[0] } else { e[0] < cs };
+                let iny = if ye { e[1] + cs >= shape[1] } else { e[1] < cs };
+                cs > 0 && forced[k] && inx && iny
+            })
+            .collect()
+    };
     let all: Vec<[usize; 2]> = (0..shape[1]).flat_map(|j| (0..shape[0]).map(move |i| [i, j])).collect();
     let results: Vec<ElementResult> = all
         .par_iter()
-        .map_init(|| (dj.work(), Vec::new()), |(w, stack), &e| examine(&dj, e, near(e).is_some(), opts, w, stack))
+        .map_init(
+            || (dj.work(), Vec::new()),
+            |(w, stack), &e| examine(&dj, e, near(e).is_some(), forced_local(e), opts, w, stack),
+        )
         .collect();
     let rational = map.weights.is_some();
     let wmax = results.iter().fold(0.0f64, |m, r| m.max(r.wmax));
@@ -678,7 +737,9 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         seconds: 0.0,
     };
     let mut integral = 0.0;
+    let mut zero_corners = 0u8;
     for (e, r) in all.iter().zip(&results) {
+        zero_corners |= r.zero_corners;
         cert.boxes += r.boxes;
         cert.max_depth = cert.max_depth.max(r.depth);
         integral += r.integral;
@@ -716,9 +777,14 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         Verdict::Folded { param: f.param, point: map.eval(f.param[0], f.param[1]), value: f.value }
     } else if !cert.undecided.is_empty() {
         Verdict::Undecided { elements: cert.undecided.clone() }
-    } else if !cert.excused.is_empty() {
-        let mut names: Vec<&'static str> =
-            cert.excused.iter().filter_map(|&e| near(e)).map(|k| cert.corners[k].corner).collect();
+    } else if !cert.excused.is_empty() || zero_corners != 0 {
+        let mut names: Vec<&'static str> = cert
+            .excused
+            .iter()
+            .flat_map(|&e| near_all(e))
+            .chain((0..4).filter(|k| zero_corners & (1 << k) != 0))
+            .map(|k| cert.corners[k].corner)
+            .collect();
         names.dedup();
         names.sort_unstable();
         names.dedup();
