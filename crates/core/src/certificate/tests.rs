@@ -180,6 +180,37 @@ fn certified_is_never_wrong_on_random_maps() {
     assert!(undecided < 50, "undecided {undecided}");
 }
 
+/// The same for rational maps (random weights): the numerator `N` of `det J = N / W^3`
+/// is certified; a `certified` verdict is checked against a dense sample and the
+/// branch-and-bound minimum of `N` (same sign as `det J`).
+#[test]
+fn certified_is_never_wrong_on_random_rational_maps() {
+    let mut rng = Lcg::new(77);
+    let (mut certified, mut folded) = (0, 0);
+    let opts = CertifyOptions { corner_spans: 0, ..Default::default() };
+    for k in 0..3000 {
+        let (p, q) = [(2, 2), (3, 2)][k % 2];
+        let amp = 0.2 + 1.2 * rng.uniform();
+        let map = perturbed(&mut rng, p, q, [3, 3], amp, true);
+        let c = certify(&map, &opts).unwrap();
+        match c.verdict {
+            Verdict::Certified { lower_bound, .. } => {
+                certified += 1;
+                let (_, hi) = det_j_min_bounds(&map, 1e-9, 20_000).unwrap();
+                assert!(hi > 0.0, "map {k}: certified but the numerator is {hi} somewhere");
+                let m = dense_min(&map, 24);
+                assert!(m > 0.0 && lower_bound <= m * (1.0 + 1e-12), "map {k}: bound {lower_bound}, sample {m}");
+            }
+            Verdict::Folded { param, .. } => {
+                folded += 1;
+                assert!(map.derivs(param[0], param[1], 1).det_j() <= 1e-13, "map {k}");
+            }
+            _ => {}
+        }
+    }
+    assert!(certified > 500 && folded > 500, "certified {certified} folded {folded}");
+}
+
 /// A map whose south-west corner has an angle of exactly 180 degrees: `det J = 0`
 /// there, positive elsewhere; it is a degenerate corner, not a fold.
 #[test]
