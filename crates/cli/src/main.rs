@@ -214,6 +214,10 @@ struct SolveArgs {
     /// Print the report as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
+    /// Also solve the grid-quality benchmark (paper eq. 44-45) on the map; Q(x) goes
+    /// into the report.
+    #[arg(long)]
+    poisson: bool,
     /// No progress output.
     #[arg(short, long)]
     quiet: bool,
@@ -394,7 +398,8 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
 }
 
 fn solve(a: SolveArgs) -> Result<i32> {
-    let opts = a.solver.options()?;
+    let mut opts = a.solver.options()?;
+    opts.poisson = a.poisson;
     let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
     let sol = run_solver(&boundary, &opts, a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;

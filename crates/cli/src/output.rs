@@ -85,6 +85,9 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     );
     certificate_lines(&mut s, &r.certificate, false);
     quality_lines(&mut s, &r.quality);
+    if let Some(p) = &r.poisson {
+        poisson_line(&mut s, p);
+    }
     for round in &r.repair_rounds {
         let _ = writeln!(
             s,
@@ -187,13 +190,17 @@ pub fn check_text(r: &CheckReport) -> String {
         );
     }
     if let Some(p) = &r.poisson {
-        let _ = writeln!(
-            s,
-            "  Poisson benchmark (a = {:.4}, {:.4}; {} unknowns): Q(x) = {:.6e}, L2 error {:.3e}, H1 error {:.3e}, {:.3} s",
-            p.a[0], p.a[1], p.unknowns, p.q, p.errors.l2, p.errors.h1, p.seconds
-        );
+        poisson_line(&mut s, p);
     }
     s
+}
+
+fn poisson_line(s: &mut String, p: &PoissonReport) {
+    let _ = writeln!(
+        s,
+        "  Poisson benchmark (a = {:.4}, {:.4}; {} unknowns): Q(x) = {:.6e}, L2 error {:.3e}, H1 error {:.3e}, {:.3} s",
+        p.a[0], p.a[1], p.unknowns, p.q, p.errors.l2, p.errors.h1, p.seconds
+    );
 }
 
 fn knot_list(k: &[f64]) -> String {

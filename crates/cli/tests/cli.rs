@@ -104,6 +104,18 @@ fn solve_writes_map_report_png_and_vtk() {
     assert!(dev.iter().all(|d| d.as_f64().unwrap() <= 4.0 * report["fit_tolerance"].as_f64().unwrap()));
     let q = check["poisson"]["q"].as_f64().unwrap();
     assert!(q > 0.0 && q < 1.0, "{q}");
+    // `solve --poisson` puts the same Q(x) into its report
+    let again = dir.join("lid2.json");
+    let out = bin()
+        .arg("solve")
+        .arg(data().join("wavy_lid.json"))
+        .arg("-o")
+        .arg(&again)
+        .args(["--poisson", "--json"])
+        .output()
+        .unwrap();
+    let r2: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((r2["poisson"]["q"].as_f64().unwrap() - q).abs() <= 1e-12 * q);
     let text = bin().arg("check").arg(&map).output().unwrap();
     assert!(String::from_utf8_lossy(&text.stdout).contains("certified"));
     std::fs::remove_dir_all(&dir).ok();

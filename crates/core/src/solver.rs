@@ -54,6 +54,8 @@ pub struct SolveOptions {
     pub repair_freeze: Option<usize>,
     /// Options of the bijectivity certificate.
     pub certify: CertifyOptions,
+    /// Run the grid-quality benchmark Q(x) of §10 on the final map.
+    pub poisson: bool,
 }
 
 impl Default for SolveOptions {
@@ -72,6 +74,7 @@ impl Default for SolveOptions {
             repair_halo: 1,
             repair_freeze: None,
             certify: CertifyOptions::default(),
+            poisson: false,
         }
     }
 }
@@ -845,6 +848,8 @@ pub struct Report {
     pub certificate: Certificate,
     /// Quality functionals and cell statistics.
     pub quality: Quality,
+    /// The Poisson benchmark of §10 (when asked for, and when it could be solved).
+    pub poisson: Option<crate::poisson::PoissonReport>,
     /// `det J` minimum on the sample grid (corners included; the sample is additional
     /// information, the verdict comes from the certificate).
     pub det_j_min: f64,
@@ -1004,6 +1009,7 @@ impl Solution {
             repair_rounds: ctx.rounds,
             certificate,
             quality,
+            poisson: if opts.poisson { crate::poisson::poisson_benchmark(&map, None).ok() } else { None },
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: away,
