@@ -277,3 +277,25 @@ fn straight_corner_is_degenerate_not_folded() {
         v => panic!("{v:?}"),
     }
 }
+
+/// A positive map whose proof needs bisections is `undecided` when the budget forbids
+/// them, naming the elements left open; the defect correction would refine those.
+#[test]
+fn spent_budget_is_undecided() {
+    let mut rng = Lcg::new(31);
+    let found = (0..2000).find_map(|_| {
+        let amp = 0.4 + 0.8 * rng.uniform();
+        let map = perturbed(&mut rng, 3, 3, [3, 3], amp, false);
+        let c = certify(&map, &CertifyOptions { corner_spans: 0, ..Default::default() }).unwrap();
+        (matches!(c.verdict, Verdict::Certified { .. }) && c.max_depth >= 2).then_some((map, c))
+    });
+    let (map, full) = found.expect("a map that needs two bisections");
+    let c = certify(&map, &CertifyOptions { corner_spans: 0, max_depth: 1, ..Default::default() }).unwrap();
+    let Verdict::Undecided { elements } = &c.verdict else { panic!("{:?}", c.verdict) };
+    assert!(!elements.is_empty() && elements.len() < c.elements);
+    assert_eq!(&c.offending_elements(), elements);
+    assert!(c.folds.is_empty());
+    // the full certificate's bound is below every exact value the truncated one met
+    let Verdict::Certified { lower_bound, .. } = full.verdict else { unreachable!() };
+    assert!(lower_bound <= c.min_value_found);
+}
