@@ -9,12 +9,15 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use winslow::assembly::Operator;
+use winslow::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::egg::EggAssembler;
 use winslow::fit::{build_hierarchy, FitOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
 use winslow::linsolve::LinearMethod;
 use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
+use winslow::poisson::poisson_benchmark;
+use winslow::quality::{boundary_deviation, quality};
 use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
@@ -42,6 +45,31 @@ enum Command {
     Render(RenderArgs),
     /// Run the solver on a list of geometries and sizes and print a table.
     Bench(BenchArgs),
+    /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
+    /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
+    Check(CheckArgs),
+}
+
+#[derive(Args, Debug)]
+struct CheckArgs {
+    /// Map file (JSON map document or G+Smo XML).
+    map: PathBuf,
+    /// The input boundary: report the largest deviation of the map's boundary from it.
+    #[arg(long)]
+    boundary: Option<PathBuf>,
+    /// Also solve the grid-quality benchmark -Δu = -Δu* (paper eq. 44-45) and report Q(x).
+    #[arg(long)]
+    poisson: bool,
+    /// Length scales a1,a2 of u* = sin(pi x / a1) sin(pi y / a2) (default: half the
+    /// bounding box extents).
+    #[arg(long, value_delimiter = ',', num_args = 2)]
+    poisson_scales: Option<Vec<f64>>,
+    /// Most bisections per element in the certificate.
+    #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
+    max_depth: usize,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -172,12 +200,17 @@ struct SolverArgs {
     /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 5000 unknowns).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
-    /// When the finest map folds, halve the basis and solve again, at most this often.
+    /// Rounds of defect correction: while the certificate says folded or undecided,
+    /// refine around the offending elements and solve again, at most this often.
     #[arg(long, default_value_t = SolveOptions::default().repair)]
     repair: usize,
-    /// Do not refine a folded map (same as --repair 0).
+    /// Do not repair a folded map (same as --repair 0).
     #[arg(long)]
     no_repair: bool,
+    /// In repair rounds, solve only for the control points within this many spans of
+    /// the offending elements (the rest stay frozen at the prolonged map).
+    #[arg(long)]
+    repair_freeze: Option<usize>,
 }
 
 impl SolverArgs {
@@ -203,6 +236,7 @@ impl SolverArgs {
             LinearArg::Auto => LinearMethod::Auto,
         };
         o.repair = if self.no_repair { 0 } else { self.repair };
+        o.repair_freeze = self.repair_freeze;
         o.operator = match self.operator {
             OperatorArg::Plain => Operator::Plain,
             OperatorArg::Scaled => Operator::Scaled,
@@ -237,6 +271,10 @@ struct SolveArgs {
     /// Print the report as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
+    /// Also solve the grid-quality benchmark (paper eq. 44-45) on the map; Q(x) goes
+    /// into the report.
+    #[arg(long)]
+    poisson: bool,
     /// No progress output.
     #[arg(short, long)]
     quiet: bool,
@@ -314,6 +352,7 @@ fn run(cli: Cli) -> Result<i32> {
             Ok(0)
         }
         Command::Bench(a) => bench(a),
+        Command::Check(a) => check(a),
     }
 }
 
@@ -436,7 +475,8 @@ fn run_solver(
 }
 
 fn solve(a: SolveArgs) -> Result<i32> {
-    let opts = a.solver.options()?;
+    let mut opts = a.solver.options()?;
+    opts.poisson = a.poisson;
     let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
     let sel = a.backend.select(a.quiet || a.json)?;
     let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
@@ -455,10 +495,56 @@ fn solve(a: SolveArgs) -> Result<i32> {
     } else {
         print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
     }
-    Ok(match sol.report.verdict {
-        Verdict::PositiveOnSample | Verdict::DegenerateCorner => 0,
+    Ok(exit_code(sol.report.verdict))
+}
+
+/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
+fn exit_code(v: Verdict) -> i32 {
+    match v {
+        Verdict::Certified | Verdict::DegenerateCorner => 0,
         Verdict::Folded => 3,
         Verdict::NotConverged => 4,
+        Verdict::Undecided => 5,
+    }
+}
+
+fn check(a: CheckArgs) -> Result<i32> {
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+    };
+    let opts = CertifyOptions { max_depth: a.max_depth.clamp(1, 40), ..Default::default() };
+    let certificate = certify(&map, &opts).context("certifying the map")?;
+    let quality = quality(&map);
+    let deviation = match &a.boundary {
+        Some(p) => {
+            let b = load_boundary(p, &FitArgs { degree: 3, fit_tol: 1e-4, reorient: false })?;
+            Some(boundary_deviation(&map, &b, 400))
+        }
+        None => None,
+    };
+    let poisson = if a.poisson {
+        let scales = a.poisson_scales.as_ref().map(|v| [v[0], v[1]]);
+        match poisson_benchmark(&map, scales) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                eprintln!("warning: the Poisson benchmark could not be solved on this map: {e}");
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let report = output::CheckReport { name, certificate, quality, boundary_deviation: deviation, poisson };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", output::check_text(&report));
+    }
+    Ok(match report.certificate.verdict {
+        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
+        CertVerdict::Folded { .. } => 3,
+        CertVerdict::Undecided { .. } => 5,
     })
 }
 

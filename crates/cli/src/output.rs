@@ -6,9 +6,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
+use winslow::certificate::Certificate;
 use winslow::fit::Hierarchy;
 use winslow::picture::Image;
+use winslow::poisson::PoissonReport;
 use winslow::quality::sample_det_j;
+use winslow::quality::Quality;
 use winslow::solver::{Solution, Verdict};
 use winslow::validate::ValidationReport;
 use winslow::{Boundary, Side, SideCurve, Surface};
@@ -81,8 +84,23 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
         r.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
         r.seconds
     );
-    for c in r.corners.iter().filter(|c| c.forces_nonpositive_det_j) {
-        let _ = writeln!(s, "  corner {}: angle {:.1} deg forces det J <= 0 there", c.corner, c.angle_degrees);
+    certificate_lines(&mut s, &r.certificate, false);
+    quality_lines(&mut s, &r.quality);
+    if let Some(p) = &r.poisson {
+        poisson_line(&mut s, p);
+    }
+    for round in &r.repair_rounds {
+        let _ = writeln!(
+            s,
+            "  repair round {}: {} with {} offending element(s); bisected {}x{} spans -> {}x{} basis",
+            round.round,
+            round.verdict,
+            round.offending_elements,
+            round.spans_refined[0],
+            round.spans_refined[1],
+            round.shape[0],
+            round.shape[1]
+        );
     }
     let _ = writeln!(s, "  wrote {}", out.display());
     if let Some(p) = png {
@@ -93,11 +111,97 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
 
 fn verdict_word(v: Verdict) -> &'static str {
     match v {
-        Verdict::PositiveOnSample => "bijective (det J > 0 on the sample)",
+        Verdict::Certified => "certified bijective (det J > 0 proven)",
         Verdict::DegenerateCorner => "best possible map: degenerate corner forced by the boundary",
         Verdict::Folded => "FOLDED",
+        Verdict::Undecided => "UNDECIDED (certificate budget spent)",
         Verdict::NotConverged => "NOT CONVERGED",
     }
+}
+
+/// What `winslow check` reports.
+#[derive(Debug, Serialize)]
+pub struct CheckReport {
+    /// Name of the map.
+    pub name: String,
+    /// Bijectivity certificate.
+    pub certificate: Certificate,
+    /// Functionals and cell statistics.
+    pub quality: Quality,
+    /// Largest deviation of the map's boundary from the input, per side (south, east,
+    /// north, west), when a boundary was given.
+    pub boundary_deviation: Option<[f64; 4]>,
+    /// The Poisson benchmark, when asked for.
+    pub poisson: Option<PoissonReport>,
+}
+
+fn quality_lines(s: &mut String, q: &Quality) {
+    let f = &q.functionals;
+    let _ = writeln!(
+        s,
+        "  functionals: Winslow {}, area orthogonality {:.6e}, Liao {:.6e}, uniformity {:.6e}, harmonic {:.6e}, area {:.6e}",
+        if f.winslow.is_finite() { format!("{:.6}", f.winslow) } else { "infinite (det J <= 0)".into() },
+        f.area_orthogonality,
+        f.liao,
+        f.uniformity,
+        f.harmonic,
+        f.area
+    );
+    let _ = writeln!(
+        s,
+        "  scaled Jacobian (per-element min): min {:.4}, mean {:.4}, max {:.4}; mean over the map {:.4}",
+        q.scaled_jacobian.min, q.scaled_jacobian.mean, q.scaled_jacobian.max, q.scaled_jacobian_mean
+    );
+    let _ = writeln!(
+        s,
+        "  orthogonality (deviation from 90 deg, per-element max): max {:.2}, mean {:.2}; aspect ratio: max {:.3}, mean {:.3} ({} elements)",
+        q.orthogonality_degrees.max, q.orthogonality_degrees.mean, q.aspect_ratio.max, q.aspect_ratio.mean, q.elements
+    );
+}
+
+fn certificate_lines(s: &mut String, c: &Certificate, with_message: bool) {
+    if with_message {
+        let _ = writeln!(s, "  certificate: {}", c.message());
+    }
+    let _ = writeln!(
+        s,
+        "  certificate: det J degree {:?}, {} elements ({}x{}), {} Bernstein boxes, depth {}, {:.3} s",
+        c.det_degree, c.elements, c.element_shape[0], c.element_shape[1], c.boxes, c.max_depth, c.seconds
+    );
+    for k in c.corners.iter().filter(|k| k.forbids_positivity) {
+        let _ = writeln!(
+            s,
+            "    corner {}: angle {:.2} deg forbids det J > 0 there (det J = {:.3e})",
+            k.corner, k.angle_degrees, k.det_j
+        );
+    }
+}
+
+/// `winslow check` as text.
+pub fn check_text(r: &CheckReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "{}: {}", r.name, r.certificate.verdict.name());
+    certificate_lines(&mut s, &r.certificate, true);
+    quality_lines(&mut s, &r.quality);
+    if let Some(d) = r.boundary_deviation {
+        let _ = writeln!(
+            s,
+            "  boundary deviation: south {:.3e}, east {:.3e}, north {:.3e}, west {:.3e}",
+            d[0], d[1], d[2], d[3]
+        );
+    }
+    if let Some(p) = &r.poisson {
+        poisson_line(&mut s, p);
+    }
+    s
+}
+
+fn poisson_line(s: &mut String, p: &PoissonReport) {
+    let _ = writeln!(
+        s,
+        "  Poisson benchmark (a = {:.4}, {:.4}; {} unknowns): Q(x) = {:.6e}, L2 error {:.3e}, H1 error {:.3e}, {:.3} s",
+        p.a[0], p.a[1], p.unknowns, p.q, p.errors.l2, p.errors.h1, p.seconds
+    );
 }
 
 fn knot_list(k: &[f64]) -> String {
@@ -250,6 +354,13 @@ pub struct BenchRow {
     pub total_s: f64,
     /// Peak resident memory in MiB.
     pub peak_mib: f64,
+    /// Elements of the final map.
+    pub elements: usize,
+    /// Seconds to certify the final map.
+    pub certify_s: f64,
+    /// Seconds of one Newton iteration on the finest level (assembly plus linear solve,
+    /// averaged over its iterations).
+    pub newton_iteration_s: f64,
     /// Verdict.
     pub verdict: Verdict,
 }
@@ -270,6 +381,10 @@ impl BenchRow {
             solve_s: r.levels.iter().map(|l| l.linear_seconds).sum(),
             total_s,
             peak_mib: peak_memory_mib(),
+            elements: r.certificate.elements,
+            certify_s: r.certificate.seconds,
+            newton_iteration_s: last
+                .map_or(0.0, |l| (l.assembly_seconds + l.linear_seconds) / l.iterations.max(1) as f64),
             verdict: r.verdict,
         }
     }
@@ -280,15 +395,27 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict |"
+        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | elements | certify s | Newton it s | verdict |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:?} |",
-            r.geometry, r.refine, r.dofs, r.levels, its, r.assembly_s, r.solve_s, r.total_s, r.peak_mib, r.verdict
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {} | {:.4} | {:.4} | {:?} |",
+            r.geometry,
+            r.refine,
+            r.dofs,
+            r.levels,
+            its,
+            r.assembly_s,
+            r.solve_s,
+            r.total_s,
+            r.peak_mib,
+            r.elements,
+            r.certify_s,
+            r.newton_iteration_s,
+            r.verdict
         );
     }
     s

@@ -69,11 +69,11 @@ fn solve_writes_map_report_png_and_vtk() {
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(report["verdict"], "positive-on-sample");
+    assert_eq!(report["verdict"], "certified");
     assert!(report["levels"].as_array().unwrap().last().unwrap()["newton_iterations"].as_u64().unwrap() <= 5);
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
     assert_eq!(doc["map"]["degree"], serde_json::json!([3, 3]));
-    assert_eq!(doc["report"]["verdict"], "positive-on-sample");
+    assert_eq!(doc["report"]["verdict"], "certified");
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     assert!(std::fs::read_to_string(&vtk).unwrap().starts_with("# vtk DataFile"));
@@ -82,6 +82,73 @@ fn solve_writes_map_report_png_and_vtk() {
     assert!(again.status.success());
     let render = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
     assert!(render.status.success());
+    // the report carries the certificate and the quality numbers
+    assert_eq!(report["certificate"]["verdict"]["kind"], "certified");
+    let bound = report["certificate"]["verdict"]["lower_bound"].as_f64().unwrap();
+    assert!(bound > 0.0 && bound <= report["det_j_min"].as_f64().unwrap());
+    assert!(report["quality"]["scaled_jacobian"]["min"].as_f64().unwrap() > 0.0);
+    // `check` agrees with the solve report and adds boundary deviation and Q(x)
+    let out = bin()
+        .arg("check")
+        .arg(&map)
+        .arg("--boundary")
+        .arg(data().join("wavy_lid.json"))
+        .args(["--poisson", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let check: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(check["certificate"]["verdict"], report["certificate"]["verdict"]);
+    assert_eq!(check["quality"]["functionals"], report["quality"]["functionals"]);
+    let dev = check["boundary_deviation"].as_array().unwrap();
+    assert!(dev.iter().all(|d| d.as_f64().unwrap() <= 4.0 * report["fit_tolerance"].as_f64().unwrap()));
+    let q = check["poisson"]["q"].as_f64().unwrap();
+    assert!(q > 0.0 && q < 1.0, "{q}");
+    // `solve --poisson` puts the same Q(x) into its report
+    let again = dir.join("lid2.json");
+    let out = bin()
+        .arg("solve")
+        .arg(data().join("wavy_lid.json"))
+        .arg("-o")
+        .arg(&again)
+        .args(["--poisson", "--json"])
+        .output()
+        .unwrap();
+    let r2: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((r2["poisson"]["q"].as_f64().unwrap() - q).abs() <= 1e-12 * q);
+    let text = bin().arg("check").arg(&map).output().unwrap();
+    assert!(String::from_utf8_lossy(&text.stdout).contains("certified"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A map with a fold planted by hand: `check` finds it, says where, exits with 3.
+#[test]
+fn check_finds_a_planted_fold() {
+    let dir = std::env::temp_dir().join(format!("winslow-fold-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // identity map of the unit square, p = 2, 4x4 elements; control point (3, 3)
+    // pushed past its right neighbour
+    let g = [0.0, 0.125, 0.375, 0.625, 0.875, 1.0];
+    let mut cps = Vec::new();
+    for (j, &y) in g.iter().enumerate() {
+        for (i, &x) in g.iter().enumerate() {
+            cps.push(if (i, j) == (3, 3) { [1.2, y] } else { [x, y] });
+        }
+    }
+    let knots = [0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0];
+    let doc = serde_json::json!({ "name": "planted", "map": { "degree": [2, 2], "knots": [knots, knots],
+        "control_points": cps, "weights": null, "periodic": [false, false] } });
+    let path = dir.join("planted.json");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let out = bin().arg("check").arg(&path).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = &r["certificate"]["verdict"];
+    assert_eq!(v["kind"], "folded");
+    let (u, w) = (v["param"][0].as_f64().unwrap(), v["param"][1].as_f64().unwrap());
+    // inside the support of the moved function [0.25, 1] x [0.25, 1]
+    assert!((0.25..=1.0).contains(&u) && (0.25..=1.0).contains(&w), "{v}");
+    assert!(v["value"].as_f64().unwrap() <= 0.0);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -213,4 +280,20 @@ fn bench_on_the_gpu_prints_throughput_and_the_time_split() {
     }
     // two sizes, residual and Jacobian rows each
     assert_eq!(text.lines().filter(|l| l.contains(" | F | ") || l.contains(" | J | ")).count(), 4, "{text}");
+}
+
+/// G+Smo's disk patch has 180-degree corners (det J = 0 there) at all four corners:
+/// `check` proves det J > 0 everywhere except at those points and names them all.
+#[test]
+fn check_names_degenerate_corners() {
+    let out = bin().arg("check").arg(data().join("gismo/xml/disk.xml")).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = &r["certificate"]["verdict"];
+    assert_eq!(v["kind"], "degenerate-corner");
+    assert_eq!(v["corners"].as_array().unwrap().len(), 4, "{v}");
+    assert!(v["lower_bound"].as_f64().unwrap() > 0.0);
+    for c in r["certificate"]["corners"].as_array().unwrap() {
+        assert!((c["angle_degrees"].as_f64().unwrap() - 180.0).abs() < 1e-6 && c["forbids_positivity"] == true);
+    }
 }

@@ -184,16 +184,16 @@ struct Geo {
 }
 
 /// Scratch of one element: tensor basis values and element vector/matrix.
-struct Scratch {
-    nloc: usize,
+pub(crate) struct Scratch {
+    pub(crate) nloc: usize,
     /// `b[k][a]` for k in (w, w_u, w_v, w_uu, w_uv, w_vv).
-    b: Vec<[f64; 6]>,
+    pub(crate) b: Vec<[f64; 6]>,
     /// Per trial function: physical gradients (elasticity).
-    t: Vec<[f64; 4]>,
+    pub(crate) t: Vec<[f64; 4]>,
     /// `dL_z/dc^d_b` at `(z * 2 + d) * nloc + b`: contiguous in `b` for the outer products.
     tz: Vec<f64>,
-    re: Vec<f64>,
-    ke: Vec<f64>,
+    pub(crate) re: Vec<f64>,
+    pub(crate) ke: Vec<f64>,
 }
 
 impl Scratch {
@@ -273,7 +273,7 @@ impl Discretization {
     /// (`re`, `ncomp` per function) and matrices (`ke`) into full-size `res` (length
     /// `n * ncomp`, may be empty) and stencil storage `stencil` (may be empty). Element
     /// rows run in parallel, in `q + 1` colours.
-    fn assemble<K>(&self, ncomp: usize, res: &mut [f64], stencil: &mut [f64], kernel: K)
+    pub(crate) fn assemble<K>(&self, ncomp: usize, res: &mut [f64], stencil: &mut [f64], kernel: K)
     where
         K: Fn(usize, usize, &mut Scratch) + Sync,
     {
@@ -342,7 +342,7 @@ impl Discretization {
 
     /// Fill `s.b` with the tensor-product basis values at point `(ku, kv)` of element
     /// `(ex, ey)` and return the quadrature weight.
-    fn tensor_basis(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
+    pub(crate) fn tensor_basis(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
         let (p, q) = self.degrees();
         let tu = self.tables[0].at(ex, ku);
         let tv = self.tables[1].at(ey, kv);
@@ -586,6 +586,22 @@ impl Discretization {
         for (f, &k) in self.dofs.free().iter().enumerate() {
             for z in 0..ncomp {
                 out[z * m + f] = full[k * ncomp + z];
+            }
+        }
+        out
+    }
+
+    /// `K_free,fixed * u_fixed` for a scalar stencil operator: the right-hand side
+    /// contribution of Dirichlet data `u` (full, per basis function).
+    pub fn apply_to_fixed_scalar(&self, stencil: &[f64], u: &[f64]) -> Vec<f64> {
+        let (p, q) = self.degrees();
+        let sw = self.stencil_width();
+        let mut out = vec![0.0; self.dofs.num_free()];
+        for (f, &k) in self.dofs.free().iter().enumerate() {
+            for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
+                if self.dofs.free_index(kk) == FIXED {
+                    out[f] += stencil[k * sw + s] * u[kk];
+                }
             }
         }
         out

@@ -15,13 +15,16 @@
 //! The solver (paper §4-§6): [`assembly`] discretizes eq. (8) on a tensor basis with the
 //! free/fixed split of [`dofs`]; [`egg`] poses `F(c) = 0`; [`newton`] iterates (damped
 //! Newton, pseudo time); [`initial`] makes initial guesses; [`solver`] walks the
-//! hierarchy coarse to fine and yields its iterates; [`quality`] and [`picture`] measure
-//! and draw the result.
+//! hierarchy coarse to fine and yields its iterates, certifies the result with
+//! [`certificate`] (exact Bernstein bounds of `det J`, §8.1) and repairs defects by local
+//! refinement (§8.2); [`quality`], [`poisson`] (the grid-quality benchmark of §10) and
+//! [`picture`] measure and draw the result.
 
 pub mod assembly;
 pub mod basis;
 pub mod bezier;
 pub mod boundary;
+pub mod certificate;
 pub mod curve;
 pub mod dofs;
 pub mod egg;
@@ -33,6 +36,7 @@ pub mod knots;
 pub mod linsolve;
 pub mod newton;
 pub mod picture;
+pub mod poisson;
 pub mod quadrature;
 pub mod quality;
 pub mod refine;

@@ -1,5 +1,8 @@
 //! Map quality on samples and by quadrature: the Jacobian determinant (eq. 43) on a
-//! grid, and the Winslow functional (eq. 15-16).
+//! grid, the quality functionals of paper §2 (eq. 3: area orthogonality, Liao,
+//! uniformity, harmonic energy) with the Winslow functional (eq. 15-16), and the cell
+//! measures used in the meshing literature: scaled Jacobian `det J / (|x_xi| |x_eta|)`,
+//! orthogonality (the angle between `x_xi` and `x_eta`) and aspect ratio.
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -80,6 +83,12 @@ pub struct Functionals {
     pub winslow: f64,
     /// Harmonic energy `int L(x)^2 + L(y)^2` (eq. 3).
     pub harmonic: f64,
+    /// Area orthogonality `int g11^2 + g22^2` (eq. 3).
+    pub area_orthogonality: f64,
+    /// Liao functional `int g11^2 + g22^2 + 2 g12^2` (eq. 3).
+    pub liao: f64,
+    /// Uniformity `int |x_xixi|^2 + |x_etaeta|^2 + |x_xieta|^2` (eq. 3).
+    pub uniformity: f64,
     /// Smallest `det J` at the quadrature points.
     pub min_det_j_qp: f64,
 }
@@ -90,6 +99,7 @@ pub fn functionals(map: &Surface) -> Functionals {
     let gx = GaussLegendre::new(p + 2);
     let gy = GaussLegendre::new(q + 2);
     let (mut area, mut winslow, mut harmonic, mut min_det) = (0.0, 0.0, 0.0, f64::INFINITY);
+    let (mut area_orthogonality, mut liao, mut uniformity) = (0.0, 0.0, 0.0);
     let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
     for (sy, ya, yb) in map.knots[1].elements() {
         for (v, wv) in gy.on(ya, yb) {
@@ -104,6 +114,10 @@ pub fn functionals(map: &Surface) -> Functionals {
                     let g12 = d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1];
                     let g22 = d.xv[0] * d.xv[0] + d.xv[1] * d.xv[1];
                     area += w * det;
+                    area_orthogonality += w * (g11 * g11 + g22 * g22);
+                    liao += w * (g11 * g11 + g22 * g22 + 2.0 * g12 * g12);
+                    let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
+                    uniformity += w * (n2(d.xuu) + n2(d.xvv) + n2(d.xuv));
                     winslow += if det > 0.0 { w * (g11 + g22) / det } else { f64::INFINITY };
                     for c in 0..2 {
                         let l = g22 * d.xuu[c] - 2.0 * g12 * d.xuv[c] + g11 * d.xvv[c];
@@ -114,7 +128,96 @@ pub fn functionals(map: &Surface) -> Functionals {
             }
         }
     }
-    Functionals { area, winslow, harmonic, min_det_j_qp: min_det }
+    Functionals { area, winslow, harmonic, area_orthogonality, liao, uniformity, min_det_j_qp: min_det }
+}
+
+/// Minimum, mean and maximum of a per-element quantity.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Stats {
+    /// Smallest value.
+    pub min: f64,
+    /// Mean over the elements.
+    pub mean: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Stats {
+    fn of(v: &[f64]) -> Self {
+        let n = v.len().max(1) as f64;
+        Self {
+            min: v.iter().copied().fold(f64::INFINITY, f64::min),
+            mean: v.iter().sum::<f64>() / n,
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+}
+
+/// Cell quality of a map, per element, at the `(p + 2) x (q + 2)` Gauss points.
+#[derive(Debug, Clone, Serialize)]
+pub struct Quality {
+    /// The functionals of eq. (3) and (15-16).
+    pub functionals: Functionals,
+    /// Scaled Jacobian `det J / (|x_xi| |x_eta|)` in `[-1, 1]` (1: orthogonal cell):
+    /// statistics of the per-element minimum.
+    pub scaled_jacobian: Stats,
+    /// Mean scaled Jacobian over all quadrature points (area of parameter space weighted).
+    pub scaled_jacobian_mean: f64,
+    /// Deviation of the angle between `x_xi` and `x_eta` from 90 degrees: statistics of
+    /// the per-element maximum, in degrees.
+    pub orthogonality_degrees: Stats,
+    /// Aspect ratio of the elements, `max(l_xi / l_eta, l_eta / l_xi)` with the physical
+    /// element edge lengths `l_xi = |x_xi| h_xi`, `l_eta = |x_eta| h_eta` at the element
+    /// centre.
+    pub aspect_ratio: Stats,
+    /// Number of elements.
+    pub elements: usize,
+}
+
+/// Functionals and cell statistics of a map.
+pub fn quality(map: &Surface) -> Quality {
+    let [p, q] = map.degrees();
+    let gx = GaussLegendre::new(p + 2);
+    let gy = GaussLegendre::new(q + 2);
+    let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
+    let (mut sj_min, mut orth, mut aspect) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut sj_int, mut wsum) = (0.0, 0.0);
+    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+    for &(sy, ya, yb) in &ey {
+        for &(sx, xa, xb) in &ex {
+            let (mut smin, mut omax) = (f64::INFINITY, 0.0f64);
+            for (v, wv) in gy.on(ya, yb) {
+                bv.eval_in_span(&map.knots[1], sy, v, 1);
+                for (u, wu) in gx.on(xa, xb) {
+                    bu.eval_in_span(&map.knots[0], sx, u, 1);
+                    let d = map.derivs_with(&bu, &bv, 1);
+                    let (a, b) = (d.xu[0].hypot(d.xu[1]), d.xv[0].hypot(d.xv[1]));
+                    let sj = if a * b > 0.0 { d.det_j() / (a * b) } else { 0.0 };
+                    smin = smin.min(sj);
+                    sj_int += wu * wv * sj;
+                    wsum += wu * wv;
+                    let cos = if a * b > 0.0 { (d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1]) / (a * b) } else { 1.0 };
+                    omax = omax.max((cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs());
+                }
+            }
+            sj_min.push(smin);
+            orth.push(omax);
+            let (uc, vc) = (0.5 * (xa + xb), 0.5 * (ya + yb));
+            bu.eval_in_span(&map.knots[0], sx, uc, 1);
+            bv.eval_in_span(&map.knots[1], sy, vc, 1);
+            let d = map.derivs_with(&bu, &bv, 1);
+            let (lx, ly) = (d.xu[0].hypot(d.xu[1]) * (xb - xa), d.xv[0].hypot(d.xv[1]) * (yb - ya));
+            aspect.push(if lx > 0.0 && ly > 0.0 { (lx / ly).max(ly / lx) } else { f64::INFINITY });
+        }
+    }
+    Quality {
+        functionals: functionals(map),
+        scaled_jacobian: Stats::of(&sj_min),
+        scaled_jacobian_mean: sj_int / wsum,
+        orthogonality_degrees: Stats::of(&orth),
+        aspect_ratio: Stats::of(&aspect),
+        elements: sj_min.len(),
+    }
 }
 
 /// Largest distance from the map's boundary to the input boundary, per side (south,
@@ -155,4 +258,34 @@ fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
     (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::knots::KnotVector;
+
+    /// The affine map `(xi, eta) -> (2 xi + eta, 3 eta)`: all functionals in closed form.
+    #[test]
+    fn functionals_and_cells_of_an_affine_map() {
+        let k = KnotVector::open_uniform(2, 3);
+        let g = k.greville();
+        let cps = g.iter().flat_map(|&v| g.iter().map(move |&u| [2.0 * u + v, 3.0 * v])).collect();
+        let map = Surface::new([k.clone(), k], cps, None).unwrap();
+        let qy = quality(&map);
+        let f = qy.functionals;
+        // x_xi = (2, 0), x_eta = (1, 3): g11 = 4, g12 = 2, g22 = 10, det J = 6
+        assert!((f.area - 6.0).abs() < 1e-12);
+        assert!((f.winslow - 14.0 / 6.0).abs() < 1e-12);
+        assert!((f.area_orthogonality - 116.0).abs() < 1e-11);
+        assert!((f.liao - 124.0).abs() < 1e-11);
+        assert!(f.uniformity.abs() < 1e-20 && f.harmonic.abs() < 1e-20);
+        let sj = 6.0 / (2.0 * 10f64.sqrt());
+        assert!((qy.scaled_jacobian.min - sj).abs() < 1e-12 && (qy.scaled_jacobian_mean - sj).abs() < 1e-12);
+        let angle = (2.0 / (2.0 * 10f64.sqrt())).acos().to_degrees();
+        assert!((qy.orthogonality_degrees.max - (90.0 - angle)).abs() < 1e-9);
+        // element edges: 2/3 and sqrt(10)/3
+        assert!((qy.aspect_ratio.mean - 10f64.sqrt() / 2.0).abs() < 1e-12);
+        assert_eq!(qy.elements, 9);
+    }
 }

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::assembly::{Discretization, Operator};
 use crate::boundary::Boundary;
+use crate::certificate::{certify, Certificate, CertifyOptions};
 use crate::curve::Curve;
 use crate::egg::{CpuAssembler, EggAssembler, EggProblem};
 use crate::error::{Error, Result};
@@ -16,7 +17,7 @@ use crate::fit::{build_hierarchy, FitOptions, Hierarchy, Level};
 use crate::initial::{coons, displaced, elasticity_displacement_with, set_boundary};
 use crate::knots::KnotVector;
 use crate::newton::{Iterate, Method, NonlinearOptions, NonlinearSolver, Status};
-use crate::quality::{functionals, sample_det_j};
+use crate::quality::{quality, sample_det_j, Quality};
 use crate::surface::{Side, Surface};
 
 /// Options of a complete solve.
@@ -41,8 +42,20 @@ pub struct SolveOptions {
     pub aspect: f64,
     /// `det J` is sampled on an `(n+1)^2` grid for the report.
     pub sample: usize,
-    /// When the finest map folds, halve it and solve again, at most this many times.
+    /// Rounds of defect correction (paper §8.2): while the certificate of the finest
+    /// map says folded or undecided, refine around the offending elements and solve
+    /// again, at most this many times.
     pub repair: usize,
+    /// Spans around each offending element that a repair round also bisects.
+    pub repair_halo: usize,
+    /// When set, a repair round solves only for the control points whose support meets
+    /// the offending elements widened by this many spans; the others keep the values of
+    /// the prolonged map (paper §8.2: fewer unknowns).
+    pub repair_freeze: Option<usize>,
+    /// Options of the bijectivity certificate.
+    pub certify: CertifyOptions,
+    /// Run the grid-quality benchmark Q(x) of §10 on the final map.
+    pub poisson: bool,
 }
 
 impl Default for SolveOptions {
@@ -57,7 +70,11 @@ impl Default for SolveOptions {
             growth: 4.0,
             aspect: 2.0,
             sample: 200,
-            repair: 2,
+            repair: 3,
+            repair_halo: 1,
+            repair_freeze: None,
+            certify: CertifyOptions::default(),
+            poisson: false,
         }
     }
 }
@@ -377,6 +394,23 @@ fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[crate::
     assembler.sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
 }
 
+/// A discretization whose free DOFs are the interior functions with support meeting one
+/// of `boxes` (`[u0, u1, v0, v1]`); all interior ones when that leaves none.
+fn frozen_discretization(knots: &[KnotVector; 2], boxes: &[[f64; 4]]) -> Discretization {
+    let shape = [knots[0].num_basis(), knots[1].num_basis()];
+    let (p, q) = (knots[0].degree(), knots[1].degree());
+    let (tu, tv) = (knots[0].knots(), knots[1].knots());
+    let interior = |i: usize, j: usize| i > 0 && j > 0 && i + 1 < shape[0] && j + 1 < shape[1];
+    let near = |i: usize, j: usize| {
+        boxes.iter().any(|b| tu[i] < b[1] && tu[i + p + 1] > b[0] && tv[j] < b[3] && tv[j + q + 1] > b[2])
+    };
+    let dofs = crate::dofs::DofMap::from_predicate(shape, |i, j| interior(i, j) && near(i, j));
+    if dofs.num_free() == 0 {
+        return Discretization::new(knots.clone());
+    }
+    Discretization::with_dofs(knots.clone(), p.max(q) + 2, dofs)
+}
+
 /// Largest tensor basis the solver accepts (about 8 million unknowns).
 pub const MAX_BASIS: usize = 1 << 22;
 
@@ -405,6 +439,12 @@ pub struct EggSolver {
     started: Instant,
     failed: bool,
     repairs: usize,
+    rounds: Vec<RepairRound>,
+    /// Certificate of the last solved map (the finest level so far).
+    certificate: Option<Certificate>,
+    /// For repair levels solved with frozen DOFs: plan index and the parameter boxes
+    /// `[u0, u1, v0, v1]` whose control points stay free.
+    free_boxes: Vec<(usize, Vec<[f64; 4]>)>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -432,6 +472,9 @@ impl EggSolver {
             started: Instant::now(),
             failed: false,
             repairs: 0,
+            rounds: Vec::new(),
+            certificate: None,
+            free_boxes: Vec::new(),
         })
     }
 
@@ -526,7 +569,10 @@ impl EggSolver {
     fn start_level(&mut self, k: usize) -> Result<Event> {
         let t0 = Instant::now();
         let level = &self.plan[k];
-        let disc = Arc::new(Discretization::new(level.knots.clone()));
+        let disc = Arc::new(match self.free_boxes.iter().find(|(i, _)| *i == k) {
+            Some((_, boxes)) => frozen_discretization(&level.knots, boxes),
+            None => Discretization::new(level.knots.clone()),
+        });
         let mut cont = Continuation::default();
         let (cps, guess) = match &self.previous {
             None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
@@ -599,6 +645,10 @@ impl EggSolver {
             e?;
         }
         let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let certificate = match self.certificate.take() {
+            Some(c) => c,
+            None => certify(&map, &self.certify_options())?,
+        };
         let finest = self.plan.last().expect("non-empty plan");
         let ctx = ReportContext {
             hierarchy,
@@ -608,17 +658,78 @@ impl EggSolver {
             opts: &self.opts,
             backend: self.assembler.name(),
             repairs: self.repairs,
+            rounds: self.rounds.clone(),
+            certificate,
             elapsed: self.started.elapsed(),
         };
         Ok(Solution::new(&boundary.name, map, self.reports, ctx))
     }
 
-    /// Whether the last solved map folds away from the corners its boundary forces.
-    fn folds(&self) -> bool {
-        let (Some(map), Some(level)) = (&self.previous, self.plan.last()) else { return false };
-        let forced = corner_report(&level.sides);
-        let s = self.assembler.sample_det_j(map, self.opts.sample);
-        min_away_from_corners(map, &s, &forced) <= 0.0
+    fn certify_options(&self) -> CertifyOptions {
+        self.opts.certify
+    }
+
+    /// Certify the last solved map (once) and, when it folds or is undecided, plan a
+    /// defect-correction level: the offending elements (and `repair_halo` spans around
+    /// them) bisected in both directions. Returns `Ok(true)` when a level was added.
+    fn plan_repair(&mut self) -> Result<bool> {
+        let (Some(map), Some(last)) = (&self.previous, self.plan.last()) else { return Ok(false) };
+        if self.certificate.is_none() {
+            self.certificate = Some(certify(map, &self.certify_options())?);
+        }
+        let cert = self.certificate.as_ref().expect("set above");
+        let offending = cert.offending_elements();
+        if offending.is_empty() || self.repairs >= self.opts.repair {
+            return Ok(false);
+        }
+        let halo = self.opts.repair_halo;
+        let mut knots = last.knots.clone();
+        let mut spans_refined = [0usize; 2];
+        for d in 0..2 {
+            let elems = last.knots[d].elements();
+            let n = elems.len();
+            let mut mark = vec![false; n];
+            for e in &offending {
+                let i = e[d];
+                for k in i.saturating_sub(halo)..=(i + halo).min(n - 1) {
+                    mark[k] = true;
+                }
+            }
+            let mids: Vec<f64> =
+                elems.iter().zip(&mark).filter(|(_, &m)| m).map(|(&(_, a, b), _)| 0.5 * (a + b)).collect();
+            spans_refined[d] = mids.len();
+            knots[d] = knots[d].with_inserted(&mids);
+        }
+        let size = knots[0].num_basis() * knots[1].num_basis();
+        if size > MAX_BASIS {
+            return Ok(false);
+        }
+        let sides = Side::ALL.map(|s| last.sides[s as usize].refined(&knots[s.direction()]));
+        let sides: [Curve; 4] = sides.into_iter().collect::<Result<Vec<_>>>()?.try_into().expect("four sides");
+        self.rounds.push(RepairRound {
+            round: self.repairs + 1,
+            verdict: cert.verdict.name(),
+            offending_elements: offending.len(),
+            spans_refined,
+            shape: [knots[0].num_basis(), knots[1].num_basis()],
+            elements: [knots[0].num_elements(), knots[1].num_elements()],
+        });
+        if let Some(r) = self.opts.repair_freeze {
+            let (ex, ey) = (last.knots[0].elements(), last.knots[1].elements());
+            let boxes = offending
+                .iter()
+                .map(|e| {
+                    let (i0, i1) = (e[0].saturating_sub(r), (e[0] + r).min(ex.len() - 1));
+                    let (j0, j1) = (e[1].saturating_sub(r), (e[1] + r).min(ey.len() - 1));
+                    [ex[i0].1, ex[i1].2, ey[j0].1, ey[j1].2]
+                })
+                .collect();
+            self.free_boxes.push((self.plan.len(), boxes));
+        }
+        self.plan.push(Level { knots, sides });
+        self.repairs += 1;
+        self.certificate = None;
+        Ok(true)
     }
 }
 
@@ -650,25 +761,11 @@ impl Iterator for EggSolver {
                 }
             }
         }
-        if self.next_level == self.plan.len()
-            && self.repairs < self.opts.repair
-            && !self.plan.is_empty()
-            && self.folds()
-        {
-            // defect correction by refinement: halve the finest level and solve again
-            let last = self.plan.last().expect("non-empty");
-            let knots = [last.knots[0].halved(), last.knots[1].halved()];
-            let sides = Side::ALL.map(|s| last.sides[s as usize].refined(&knots[s.direction()]));
-            match sides.into_iter().collect::<Result<Vec<_>>>() {
-                Ok(v) => {
-                    let sides: [Curve; 4] = v.try_into().expect("four sides");
-                    self.plan.push(Level { knots, sides });
-                    self.repairs += 1;
-                }
-                Err(e) => {
-                    self.failed = true;
-                    return Some(Err(e));
-                }
+        if self.next_level == self.plan.len() && !self.plan.is_empty() && self.previous.is_some() {
+            // defect correction (§8.2): certify, refine around the defects, solve again
+            if let Err(e) = self.plan_repair() {
+                self.failed = true;
+                return Some(Err(e));
             }
         }
         if self.next_level < self.plan.len() {
@@ -684,19 +781,39 @@ impl Iterator for EggSolver {
     }
 }
 
-/// Overall outcome of a solve, as seen on a dense sample of `det J`.
+/// Overall outcome of a solve: the bijectivity certificate of the final map
+/// ([`crate::certificate`]), unless the solver did not converge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
-    /// Converged and `det J > 0` on the whole sample.
-    PositiveOnSample,
-    /// Converged, `det J > 0` inside, but a corner angle of the boundary forces
-    /// `det J <= 0` there: the best map the boundary allows.
+    /// Converged and `det J > 0` proven on the whole map.
+    Certified,
+    /// Converged, `det J > 0` proven except near corners whose angle forces
+    /// `det J <= 0`: the best map the boundary allows.
     DegenerateCorner,
-    /// `det J <= 0` somewhere away from forced corners: the map folds.
+    /// `det J <= 0` at a point away from forced corners: the map folds.
     Folded,
+    /// Neither proven positive nor shown to fold within the subdivision budget.
+    Undecided,
     /// The finest level did not converge.
     NotConverged,
+}
+
+/// One round of defect correction.
+#[derive(Debug, Clone, Serialize)]
+pub struct RepairRound {
+    /// Round number (1-based).
+    pub round: usize,
+    /// Certificate verdict of the map that was repaired.
+    pub verdict: &'static str,
+    /// Folded or undecided elements.
+    pub offending_elements: usize,
+    /// Spans bisected per direction (offending ones and their halo).
+    pub spans_refined: [usize; 2],
+    /// Basis shape after refinement.
+    pub shape: [usize; 2],
+    /// Elements per direction after refinement.
+    pub elements: [usize; 2],
 }
 
 /// Contour-fit summary per side.
@@ -733,9 +850,18 @@ pub struct Report {
     pub fit: Vec<FitReport>,
     /// Per-level summaries.
     pub levels: Vec<LevelReport>,
-    /// Refinements added because the finest map folded.
+    /// Defect-correction rounds run because the finest map folded or was undecided.
     pub repairs: usize,
-    /// `det J` minimum on the sample grid (corners included).
+    /// Each defect-correction round.
+    pub repair_rounds: Vec<RepairRound>,
+    /// The bijectivity certificate of the map.
+    pub certificate: Certificate,
+    /// Quality functionals and cell statistics.
+    pub quality: Quality,
+    /// The Poisson benchmark of §10 (when asked for, and when it could be solved).
+    pub poisson: Option<crate::poisson::PoissonReport>,
+    /// `det J` minimum on the sample grid (corners included; the sample is additional
+    /// information, the verdict comes from the certificate).
     pub det_j_min: f64,
     /// `det J` minimum away from the four corners.
     pub det_j_min_interior: f64,
@@ -813,6 +939,8 @@ struct ReportContext<'a> {
     opts: &'a SolveOptions,
     backend: String,
     repairs: usize,
+    rounds: Vec<RepairRound>,
+    certificate: Certificate,
     elapsed: Duration,
 }
 
@@ -820,9 +948,10 @@ impl Solution {
     fn new(name: &str, map: Surface, levels: Vec<LevelReport>, ctx: ReportContext<'_>) -> Self {
         let (h, opts) = (ctx.hierarchy, ctx.opts);
         let sample = sample_det_j(&map, opts.sample);
-        let fun = functionals(&map);
+        let quality = quality(&map);
+        let fun = quality.functionals;
+        let certificate = ctx.certificate;
         let corners = corner_report(ctx.sides);
-        let forced: Vec<&str> = corners.iter().filter(|c| c.forces_nonpositive_det_j).map(|c| c.corner).collect();
         let converged = levels.last().is_some_and(|l| l.converged);
         let away = min_away_from_corners(&map, &sample, &corners);
         let kinks = ctx.kinks;
@@ -834,24 +963,24 @@ impl Solution {
                     levels.last().and_then(|l| l.failure.clone()).unwrap_or_default()
                 ),
             )
-        } else if away <= 0.0 {
-            let [u, v] = sample.argmin;
-            (Verdict::Folded, format!("det J <= 0 at (xi, eta) = ({u:.4}, {v:.4}): the map folds at this resolution"))
-        } else if !forced.is_empty() {
-            let why: Vec<String> = corners
-                .iter()
-                .filter(|c| c.forces_nonpositive_det_j)
-                .map(|c| format!("the {} corner (angle {:.1} degrees)", c.corner, c.angle_degrees))
-                .collect();
-            (
-                Verdict::DegenerateCorner,
-                format!(
-                    "the boundary itself forces det J <= 0 at {}; det J > 0 everywhere else: this is the best map this boundary admits",
-                    why.join(" and ")
-                ),
-            )
         } else {
-            (Verdict::PositiveOnSample, format!("det J > 0 on the {}x{} sample grid", sample.n + 1, sample.n + 1))
+            let v = match certificate.verdict {
+                crate::certificate::Verdict::Certified { .. } => Verdict::Certified,
+                crate::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+                crate::certificate::Verdict::Folded { .. } => Verdict::Folded,
+                crate::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
+            };
+            let mut m = certificate.message();
+            if v == Verdict::Certified {
+                for c in corners.iter().filter(|c| c.forces_nonpositive_det_j) {
+                    m.push_str(&format!(
+                        "; note: the {} corner has an angle of {:.2} degrees, where the exact boundary forbids det J > 0; \
+                         the fitted boundary rounds it within the fit tolerance",
+                        c.corner, c.angle_degrees
+                    ));
+                }
+            }
+            (v, m)
         };
         let mut message = message;
         for k in &kinks {
@@ -887,6 +1016,10 @@ impl Solution {
             fit,
             levels,
             repairs: ctx.repairs,
+            repair_rounds: ctx.rounds,
+            certificate,
+            quality,
+            poisson: if opts.poisson { crate::poisson::poisson_benchmark(&map, None).ok() } else { None },
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: away,
@@ -935,7 +1068,7 @@ mod tests {
         let b = annulus(1.0, 2.0, std::f64::consts::FRAC_PI_2);
         let sol = solve(&b, &SolveOptions::default()).unwrap();
         let r = &sol.report;
-        assert_eq!(r.verdict, Verdict::PositiveOnSample, "{}", r.message);
+        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
         let last = r.levels.last().unwrap();
         assert!(last.converged && last.newton_iterations <= 5, "{last:?}");
         assert!((r.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit_tolerance * r.diameter, "area {}", r.area);
