@@ -15,6 +15,7 @@ use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Docu
 use winslow::linsolve::LinearMethod;
 use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
+use winslow::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
 use winslow::{Boundary, Side};
 
@@ -54,6 +55,35 @@ struct FitArgs {
     /// Turn a clockwise boundary counter-clockwise (swaps xi and eta) instead of failing.
     #[arg(long)]
     reorient: bool,
+    /// Boundary reparameterization (paper §7): auto = constrained cord length on
+    /// opposite sides closer than --reparam-gap times their length, none elsewhere.
+    #[arg(long, value_enum, default_value = "auto")]
+    reparam: ReparamArg,
+    /// Narrow-gap threshold (auto) and matching distance (constrained), relative to the
+    /// mean length of the two opposite sides.
+    #[arg(long, default_value_t = ReparamOptions::default().gap)]
+    reparam_gap: f64,
+    /// Minimum separation of two matched pairs, in cord length of each side.
+    #[arg(long, default_value_t = ReparamOptions::default().separation)]
+    reparam_separation: f64,
+    /// How unmatched parameters are filled: cord length between matches (eq. 41-42) or a
+    /// Fritsch-Carlson monotone cubic.
+    #[arg(long, value_enum, default_value = "cord-length")]
+    reparam_fill: FillArg,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum ReparamArg {
+    Auto,
+    None,
+    Arclength,
+    Constrained,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum FillArg {
+    CordLength,
+    MonotoneCubic,
 }
 
 #[derive(Args, Debug)]
@@ -159,7 +189,22 @@ impl SolverArgs {
 }
 
 fn fit_options(f: &FitArgs) -> FitOptions {
-    FitOptions { degree: f.degree, tol: f.fit_tol, ..Default::default() }
+    let reparam = ReparamOptions {
+        method: match f.reparam {
+            ReparamArg::Auto => Reparam::Auto,
+            ReparamArg::None => Reparam::None,
+            ReparamArg::Arclength => Reparam::ArcLength,
+            ReparamArg::Constrained => Reparam::Constrained,
+        },
+        gap: f.reparam_gap,
+        separation: f.reparam_separation,
+        fill: match f.reparam_fill {
+            FillArg::CordLength => Fill::CordLength,
+            FillArg::MonotoneCubic => Fill::MonotoneCubic,
+        },
+        ..Default::default()
+    };
+    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, ..Default::default() }
 }
 
 #[derive(Args, Debug)]
@@ -171,9 +216,13 @@ struct SolveArgs {
     output: PathBuf,
     #[command(flatten)]
     solver: SolverArgs,
-    /// Write a picture of the map (grid lines coloured by det J).
+    /// Write a picture of the map (grid lines coloured by det J; the matched pairs of
+    /// the constrained reparameterization drawn as segments).
     #[arg(long)]
     png: Option<PathBuf>,
+    /// Do not draw the matched pairs into the PNG.
+    #[arg(long)]
+    no_png_matches: bool,
     /// Write a VTK structured grid with det J.
     #[arg(long)]
     vtk: Option<PathBuf>,
@@ -367,7 +416,8 @@ fn solve(a: SolveArgs) -> Result<i32> {
     write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
         .with_context(|| format!("writing {}", a.output.display()))?;
     if let Some(p) = &a.png {
-        output::write_png(p, &render(&sol.map, &PictureOptions::default()))?;
+        let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
+        output::write_png(p, &render(&sol.map, &PictureOptions { segments, ..Default::default() }))?;
     }
     if let Some(p) = &a.vtk {
         output::write_vtk(p, &sol.map, 128)?;

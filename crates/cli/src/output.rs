@@ -80,6 +80,31 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
         r.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
         r.seconds
     );
+    let _ = writeln!(
+        s,
+        "  basis functions: {}; min scaled Jacobian det J/(|x_xi||x_eta|) {:.4e}",
+        r.basis_functions, r.scaled_jacobian_min
+    );
+    let rp = &r.reparam;
+    let gap = |g: f64| if g.is_finite() { format!("{g:.2e}") } else { "-".into() };
+    let _ = writeln!(
+        s,
+        "  reparameterization: {} (requested {}); gap/length south-north {} ({}), west-east {} ({}); {} matched pairs",
+        rp.used.name(),
+        rp.requested.name(),
+        gap(rp.gap_ratio[0]),
+        rp.pair_methods[0].name(),
+        gap(rp.gap_ratio[1]),
+        rp.pair_methods[1].name(),
+        rp.matches.len()
+    );
+    for m in &rp.matches {
+        let _ = writeln!(
+            s,
+            "    {}/{} at {:.6}: ({:.6}, {:.6}) - ({:.6}, {:.6})",
+            m.sides[0], m.sides[1], m.parameter, m.points[0][0], m.points[0][1], m.points[1][0], m.points[1][1]
+        );
+    }
     for c in r.corners.iter().filter(|c| c.forces_nonpositive_det_j) {
         let _ = writeln!(s, "  corner {}: angle {:.1} deg forces det J <= 0 there", c.corner, c.angle_degrees);
     }
@@ -251,6 +276,16 @@ pub struct BenchRow {
     pub peak_mib: f64,
     /// Verdict.
     pub verdict: Verdict,
+    /// Tensor-product basis functions of the map.
+    pub basis: usize,
+    /// Winslow functional (`null` when det J <= 0 at a quadrature point).
+    pub winslow: Option<f64>,
+    /// Smallest scaled Jacobian on the sample grid.
+    pub scaled_jacobian_min: f64,
+    /// Reparameterization used.
+    pub reparam: &'static str,
+    /// Matched pairs.
+    pub matches: usize,
 }
 
 impl BenchRow {
@@ -270,6 +305,11 @@ impl BenchRow {
             total_s,
             peak_mib: peak_memory_mib(),
             verdict: r.verdict,
+            basis: r.basis_functions,
+            winslow: r.winslow,
+            scaled_jacobian_min: r.scaled_jacobian_min,
+            reparam: r.reparam.used.name(),
+            matches: r.reparam.matches.len(),
         }
     }
 }
@@ -279,15 +319,29 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict |"
+        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | verdict | reparam (matches) | basis | Winslow | min scaled J |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|");
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:?} |",
-            r.geometry, r.refine, r.dofs, r.levels, its, r.assembly_s, r.solve_s, r.total_s, r.peak_mib, r.verdict
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:?} | {} ({}) | {} | {} | {:.4} |",
+            r.geometry,
+            r.refine,
+            r.dofs,
+            r.levels,
+            its,
+            r.assembly_s,
+            r.solve_s,
+            r.total_s,
+            r.peak_mib,
+            r.verdict,
+            r.reparam,
+            r.matches,
+            r.basis,
+            r.winslow.map_or("inf".to_string(), |w| format!("{w:.4}")),
+            r.scaled_jacobian_min
         );
     }
     s

@@ -36,6 +36,7 @@ pub mod picture;
 pub mod quadrature;
 pub mod quality;
 pub mod refine;
+pub mod reparam;
 pub mod solver;
 pub mod sparse;
 pub mod surface;

@@ -138,3 +138,26 @@ fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
     (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
 }
+
+/// Smallest scaled Jacobian `det J / (|x_ξ| |x_η|)` (the sine of the angle between the
+/// grid lines; 1 for orthogonal lines, `<= 0` where the map folds) on a uniform
+/// `(n+1) x (n+1)` grid, boundary included and corners excluded (a corner of the domain
+/// may force it to 0). Points where a tangent vanishes count as 0.
+pub fn min_scaled_jacobian(map: &Surface, n: usize) -> f64 {
+    let n = n.max(1);
+    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+    let mut min = f64::INFINITY;
+    for j in 0..=n {
+        bv.eval(&map.knots[1], j as f64 / n as f64, 1);
+        for i in 0..=n {
+            if (i == 0 || i == n) && (j == 0 || j == n) {
+                continue;
+            }
+            bu.eval(&map.knots[0], i as f64 / n as f64, 1);
+            let d = map.derivs_with(&bu, &bv, 1);
+            let s = d.xu[0].hypot(d.xu[1]) * d.xv[0].hypot(d.xv[1]);
+            min = min.min(if s > 0.0 { d.det_j() / s } else { 0.0 });
+        }
+    }
+    min
+}

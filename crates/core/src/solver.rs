@@ -279,10 +279,27 @@ fn polyline_length(c: &Curve) -> f64 {
     c.sample(n).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
 }
 
+/// Mean distance `|b(t) - a(t)|` between two opposite sides at equal parameters: the
+/// mean length of the straight lines joining them, which is the extent of the domain
+/// across them when the sides joining them are much shorter (a ring cut along a seam).
+fn mean_gap(a: &Curve, b: &Curve) -> f64 {
+    let n = 16 * a.knots.num_elements().max(b.knots.num_elements()).max(4);
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let (p, q) = (a.eval(t), b.eval(t));
+            (p[0] - q[0]).hypot(p[1] - q[1])
+        })
+        .sum::<f64>()
+        / (n + 1) as f64
+}
+
 /// Prepare the hierarchy for solving (paper §5.4 builds each level from the side fits
 /// alone, so a straight side keeps a single element however fine its opposite is):
 /// 1. *balance* every level, halving a direction until its elements are on average no
-///    more than `aspect` times longer (physically) than those of the other direction,
+///    more than `aspect` times longer (physically) than those of the other direction
+///    (the extent of a direction is the mean length of its two sides, or the mean
+///    distance between the two other sides at equal parameters when that is larger),
 ///    and until it has `min_elements` elements; each level then takes the union with
 ///    the coarser one so the hierarchy stays nested;
 /// 2. append `refine` uniformly halved copies of the finest level.
@@ -295,6 +312,9 @@ pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize
         0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
     let len_eta =
         0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
+    // a seam (short sides joining long ones far apart) understates the extent across
+    let len_xi = len_xi.max(mean_gap(&last.sides[Side::West as usize], &last.sides[Side::East as usize]));
+    let len_eta = len_eta.max(mean_gap(&last.sides[Side::South as usize], &last.sides[Side::North as usize]));
     let mut previous: Option<[KnotVector; 2]> = None;
     for level in levels.iter_mut() {
         let mut knots = level.knots.clone();
@@ -755,6 +775,13 @@ pub struct Report {
     pub message: String,
     /// Total seconds.
     pub seconds: f64,
+    /// Tensor-product basis functions of the map (`n_xi * n_eta`).
+    pub basis_functions: usize,
+    /// Smallest scaled Jacobian `det J / (|x_xi| |x_eta|)` on the sample grid, corners
+    /// excluded ([`crate::quality::min_scaled_jacobian`]).
+    pub scaled_jacobian_min: f64,
+    /// The boundary reparameterization (paper §7): method used and matched pairs.
+    pub reparam: crate::reparam::ReparamReport,
 }
 
 /// A solved map and its report.
@@ -891,6 +918,9 @@ impl Solution {
             verdict,
             message,
             seconds: ctx.elapsed.as_secs_f64(),
+            basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
+            scaled_jacobian_min: crate::quality::min_scaled_jacobian(&map, opts.sample),
+            reparam: h.reparam.clone(),
         };
         Self { name: name.to_string(), map, report }
     }
