@@ -88,15 +88,15 @@ fn arc_length_on_spline_sides() {
     let sol = solve(&b, &with(Reparam::ArcLength)).unwrap();
     let r = &sol.report;
     assert_eq!(r.reparam.used, Reparam::ArcLength);
-    assert!(r.reparam.arc_length_ratio.iter().flatten().all(|&a| (1.0..1.01).contains(&a)), "{:?}", r.reparam);
+    assert!(r.reparam.arc_length_ratio.iter().flatten().all(|&a| (1.0 - 1e-9..1.01).contains(&a)), "{:?}", r.reparam);
     let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
     assert!(dev <= 2.0 * r.fit_tolerance, "deviation {dev:e}");
     assert_positive("rotor_sector", &sol);
 }
 
-/// male_casing_ring (G+Smo): a ring cut open with clearances of 1e-3 of the diameter.
+/// male_casing_ring (G+Smo): a ring cut open with clearances of 1e-3 of the diameter;
+/// with `--reparam none` it does not finish within minutes (BENCHMARKS.md).
 #[test]
-#[ignore = "slow (minutes on 2 cores); run with --ignored"]
 fn male_casing_ring_auto_is_bijective() {
     let b = boundary("gismo/male_casing_ring.json");
     let sol = solve(&b, &SolveOptions::default()).unwrap();

@@ -247,6 +247,9 @@ struct RenderArgs {
     /// Longer image side in pixels.
     #[arg(long, default_value_t = 900)]
     size: usize,
+    /// Do not draw the matched pairs of the reparameterization stored in the report.
+    #[arg(long)]
+    no_matches: bool,
 }
 
 #[derive(Args, Debug)]
@@ -285,7 +288,9 @@ fn run(cli: Cli) -> Result<i32> {
             let Document::Map { map, .. } = doc else {
                 bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
             };
-            let opts = PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, ..Default::default() };
+            let segments = if a.no_matches { Vec::new() } else { output::report_matches(&a.map) };
+            let opts =
+                PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, segments, ..Default::default() };
             output::write_png(&a.png, &render(&map, &opts))?;
             println!("wrote {}", a.png.display());
             Ok(0)

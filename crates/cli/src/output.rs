@@ -200,6 +200,18 @@ pub fn inspect_text(
                 let _ = writeln!(s, "           fitted knots {}", knot_list(c.knots.knots()));
             }
         }
+        let rp = &h.reparam;
+        let _ = writeln!(
+            s,
+            "  reparameterization: {} (requested {}); gap/length south-north {:.2e} ({}), west-east {:.2e} ({}); {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.gap_ratio[0],
+            rp.pair_methods[0].name(),
+            rp.gap_ratio[1],
+            rp.pair_methods[1].name(),
+            rp.matches.len()
+        );
         let sizes: Vec<String> =
             h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
         let _ = writeln!(s, "    basis per level: {}", sizes.join(" -> "));
@@ -212,6 +224,21 @@ pub fn inspect_text(
         }
     }
     s
+}
+
+/// The matched pairs (`report.reparam.matches[].points`) of a map file written by
+/// `winslow solve`, as segments; empty when the file has none or cannot be read.
+pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
+    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+    let Some(matches) = doc["report"]["reparam"]["matches"].as_array() else { return Vec::new() };
+    matches
+        .iter()
+        .filter_map(|m| {
+            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
+            Some((p[0], p[1]))
+        })
+        .collect()
 }
 
 /// `winslow inspect --json`.
@@ -246,6 +273,7 @@ pub fn inspect_json(
         "signed_area": report.map(|r| r.signed_area),
         "corner_angles": report.map(|r| r.corner_angles),
         "fit_tolerance": fit.map(|h| h.tol_abs),
+        "reparam": fit.map(|h| &h.reparam),
         "fit": fits,
         "problems": problems,
     })

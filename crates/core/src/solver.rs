@@ -279,6 +279,10 @@ fn polyline_length(c: &Curve) -> f64 {
     c.sample(n).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
 }
 
+/// Two sides count as a seam (see [`prepare_levels`]) when the mean distance between
+/// the other two sides exceeds their mean length by this factor.
+pub const SEAM_FACTOR: f64 = 4.0;
+
 /// Mean distance `|b(t) - a(t)|` between two opposite sides at equal parameters: the
 /// mean length of the straight lines joining them, which is the extent of the domain
 /// across them when the sides joining them are much shorter (a ring cut along a seam).
@@ -299,7 +303,8 @@ fn mean_gap(a: &Curve, b: &Curve) -> f64 {
 /// 1. *balance* every level, halving a direction until its elements are on average no
 ///    more than `aspect` times longer (physically) than those of the other direction
 ///    (the extent of a direction is the mean length of its two sides, or the mean
-///    distance between the two other sides at equal parameters when that is larger),
+///    distance between the two other sides at equal parameters when that is more than
+///    [`SEAM_FACTOR`] times larger: a ring cut open along a seam),
 ///    and until it has `min_elements` elements; each level then takes the union with
 ///    the coarser one so the hierarchy stays nested;
 /// 2. append `refine` uniformly halved copies of the finest level.
@@ -312,9 +317,11 @@ pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize
         0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
     let len_eta =
         0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
-    // a seam (short sides joining long ones far apart) understates the extent across
-    let len_xi = len_xi.max(mean_gap(&last.sides[Side::West as usize], &last.sides[Side::East as usize]));
-    let len_eta = len_eta.max(mean_gap(&last.sides[Side::South as usize], &last.sides[Side::North as usize]));
+    // a seam (short sides joining long ones far apart) understates the extent across:
+    // there the mean distance between the other two sides is used instead
+    let across = |len: f64, gap: f64| if gap > SEAM_FACTOR * len { gap } else { len };
+    let len_xi = across(len_xi, mean_gap(&last.sides[Side::West as usize], &last.sides[Side::East as usize]));
+    let len_eta = across(len_eta, mean_gap(&last.sides[Side::South as usize], &last.sides[Side::North as usize]));
     let mut previous: Option<[KnotVector; 2]> = None;
     for level in levels.iter_mut() {
         let mut knots = level.knots.clone();
