@@ -28,6 +28,10 @@ fn assert_positive(file: &str, sol: &Solution) {
     let s = sample_det_j(&sol.map, 600);
     assert!(s.min_interior > 0.0, "{file}: det J min {} at {:?}", s.min_interior, s.argmin);
     assert!(r.scaled_jacobian_min > 0.0);
+    // the contour is preserved: the map's boundary is the input's to the fit tolerance
+    // (measured against the input's polyline, whose corners a smooth fit may cut a little)
+    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(dev <= 4.0 * r.fit_tolerance, "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}", r.fit_tolerance);
 }
 
 /// Matched pairs lie at the same parameter on the two fitted sides: evaluating both
@@ -102,4 +106,23 @@ fn male_casing_ring_auto_is_bijective() {
     let sol = solve(&b, &SolveOptions::default()).unwrap();
     assert_eq!(sol.report.reparam.used, Reparam::Constrained);
     assert_positive("male_casing_ring", &sol);
+}
+
+/// The scaled Jacobian of a sheared square `x = xi + s eta, y = eta` is
+/// `1 / sqrt(1 + s^2)` everywhere (the sine of the angle between the grid lines).
+#[test]
+fn scaled_jacobian_of_a_shear() {
+    let kv = winslow::KnotVector::open_uniform(1, 1);
+    let s = 0.75;
+    let map = winslow::Surface {
+        knots: [kv.clone(), kv],
+        control_points: vec![[0.0, 0.0], [1.0, 0.0], [s, 1.0], [1.0 + s, 1.0]],
+        weights: None,
+    };
+    let v = winslow::quality::min_scaled_jacobian(&map, 10);
+    assert!((v - 1.0 / (1.0f64 + s * s).sqrt()).abs() < 1e-14, "{v}");
+    // folded: the mirrored map has det J < 0 and a negative scaled Jacobian
+    let mut folded = map.clone();
+    folded.control_points.iter_mut().for_each(|p| p[0] = -p[0]);
+    assert!((winslow::quality::min_scaled_jacobian(&folded, 10) + 1.0 / (1.0f64 + s * s).sqrt()).abs() < 1e-14);
 }
