@@ -701,7 +701,15 @@ pub fn constrained_params(p1: &[Point], p2: &[Point], eps: f64, sep: f64, fill: 
         .ok_or_else(|| Error::Invalid("constrained cord length: first side has zero length".into()))?;
     let c2 = cord_length_params(p2)
         .ok_or_else(|| Error::Invalid("constrained cord length: second side has zero length".into()))?;
-    let mut pairs = match_pairs(p1, &c1, p2, &c2, eps, sep);
+    // the closest-pair search is quadratic: on very dense clouds it runs on every k-th point
+    let (i1, i2) = (thinned(p1.len()), thinned(p2.len()));
+    let pick = |idx: &[usize], v: &[Point]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
+    let pickc = |idx: &[usize], v: &[f64]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
+    let mut pairs: Vec<(usize, usize)> =
+        match_pairs(&pick(&i1, p1), &pickc(&i1, &c1), &pick(&i2, p2), &pickc(&i2, &c2), eps, sep)
+            .into_iter()
+            .map(|(a, b)| (i1[a], i2[b]))
+            .collect();
     // repeated points on side 1 can give equal abscissae: keep strictly increasing ones
     let mut last = 0.0;
     pairs.retain(|&(i, _)| {
@@ -716,12 +724,28 @@ pub fn constrained_params(p1: &[Point], p2: &[Point], eps: f64, sep: f64, fill: 
     Ok((c1, xi2, pairs))
 }
 
-/// Smallest distance between two point sets (brute force), used to detect narrow gaps.
+/// Most points per side that the quadratic searches ([`match_pairs`], [`min_distance`])
+/// look at; denser clouds are thinned to every k-th point (ends kept).
+pub const MAX_SEARCH_POINTS: usize = 4096;
+
+/// Indices `0, k, 2k, ..., n-1` with `k` the smallest stride leaving at most
+/// [`MAX_SEARCH_POINTS`] points.
+fn thinned(n: usize) -> Vec<usize> {
+    let k = n.div_ceil(MAX_SEARCH_POINTS).max(1);
+    let mut v: Vec<usize> = (0..n).step_by(k).collect();
+    if v.last() != Some(&(n - 1)) {
+        v.push(n - 1);
+    }
+    v
+}
+
+/// Smallest distance between two point sets (brute force on at most
+/// [`MAX_SEARCH_POINTS`] points of each), used to detect narrow gaps.
 pub fn min_distance(p1: &[Point], p2: &[Point]) -> f64 {
     let mut best = f64::INFINITY;
-    for a in p1 {
-        for b in p2 {
-            best = best.min(dist2(*a, *b));
+    for &i in &thinned(p1.len()) {
+        for &j in &thinned(p2.len()) {
+            best = best.min(dist2(p1[i], p2[j]));
         }
     }
     best.sqrt()
@@ -1036,6 +1060,28 @@ mod tests {
         let (_, x2, pairs) = constrained_params(&south, &north, 0.01, 0.01, Fill::CordLength).unwrap();
         assert!(pairs.is_empty());
         assert_eq!(x2, cord_length_params(&north).unwrap());
+    }
+
+    #[test]
+    fn dense_clouds_are_thinned_for_the_search() {
+        assert_eq!(thinned(5), vec![0, 1, 2, 3, 4]);
+        let t = thinned(3 * MAX_SEARCH_POINTS + 7);
+        assert!(t.len() <= MAX_SEARCH_POINTS + 1 && t[0] == 0 && *t.last().unwrap() == 3 * MAX_SEARCH_POINTS + 6);
+        // a dense tube: matches still lie at the gap and at equal abscissae
+        let n = 3 * MAX_SEARCH_POINTS;
+        let south: Vec<Point> = (0..=n).map(|k| [10.0 * k as f64 / n as f64, 0.0]).collect();
+        let north: Vec<Point> = (0..=n)
+            .map(|k| {
+                let x = 10.0 * k as f64 / n as f64;
+                [x, 1.0 - 0.95 * (-((x - 6.0) / 0.2).powi(2)).exp()]
+            })
+            .collect();
+        let (x1, x2, pairs) = constrained_params(&south, &north, 0.1, 0.01, Fill::CordLength).unwrap();
+        assert!(!pairs.is_empty());
+        for &(i, j) in &pairs {
+            assert_eq!(x1[i], x2[j]);
+            assert!((south[i][0] - 6.0).abs() < 0.3 && dist2(south[i], north[j]).sqrt() <= 0.1);
+        }
     }
 
     #[test]
