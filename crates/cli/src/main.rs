@@ -352,6 +352,13 @@ fn run_solver(boundary: &Boundary, opts: &SolveOptions, quiet: bool) -> Result<S
             h.levels.len(),
             h.diameter
         );
+        let rp = &h.reparam;
+        eprintln!(
+            "  reparameterization: {} (requested {}), {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.matches.len()
+        );
         for s in Side::ALL {
             let f = &h.fits[s as usize];
             if !f.converged {
