@@ -18,6 +18,7 @@ use winslow::newton::Method;
 use winslow::picture::{render, PictureOptions};
 use winslow::poisson::poisson_benchmark;
 use winslow::quality::{boundary_deviation, quality};
+use winslow::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
@@ -83,6 +84,35 @@ struct FitArgs {
     /// Turn a clockwise boundary counter-clockwise (swaps xi and eta) instead of failing.
     #[arg(long)]
     reorient: bool,
+    /// Boundary reparameterization (paper §7): auto = constrained cord length on
+    /// opposite sides closer than --reparam-gap times their length, none elsewhere.
+    #[arg(long, value_enum, default_value = "auto")]
+    reparam: ReparamArg,
+    /// Narrow-gap threshold (auto) and matching distance (constrained), relative to the
+    /// mean length of the two opposite sides.
+    #[arg(long, default_value_t = ReparamOptions::default().gap)]
+    reparam_gap: f64,
+    /// Minimum separation of two matched pairs, in cord length of each side.
+    #[arg(long, default_value_t = ReparamOptions::default().separation)]
+    reparam_separation: f64,
+    /// How unmatched parameters are filled: cord length between matches (eq. 41-42) or a
+    /// Fritsch-Carlson monotone cubic.
+    #[arg(long, value_enum, default_value = "cord-length")]
+    reparam_fill: FillArg,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum ReparamArg {
+    Auto,
+    None,
+    Arclength,
+    Constrained,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum FillArg {
+    CordLength,
+    MonotoneCubic,
 }
 
 #[derive(Args, Debug)]
@@ -250,7 +280,22 @@ impl SolverArgs {
 }
 
 fn fit_options(f: &FitArgs) -> FitOptions {
-    FitOptions { degree: f.degree, tol: f.fit_tol, ..Default::default() }
+    let reparam = ReparamOptions {
+        method: match f.reparam {
+            ReparamArg::Auto => Reparam::Auto,
+            ReparamArg::None => Reparam::None,
+            ReparamArg::Arclength => Reparam::ArcLength,
+            ReparamArg::Constrained => Reparam::Constrained,
+        },
+        gap: f.reparam_gap,
+        separation: f.reparam_separation,
+        fill: match f.reparam_fill {
+            FillArg::CordLength => Fill::CordLength,
+            FillArg::MonotoneCubic => Fill::MonotoneCubic,
+        },
+        ..Default::default()
+    };
+    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, ..Default::default() }
 }
 
 #[derive(Args, Debug)]
@@ -262,9 +307,13 @@ struct SolveArgs {
     output: PathBuf,
     #[command(flatten)]
     solver: SolverArgs,
-    /// Write a picture of the map (grid lines coloured by det J).
+    /// Write a picture of the map (grid lines coloured by det J; the matched pairs of
+    /// the constrained reparameterization drawn as segments).
     #[arg(long)]
     png: Option<PathBuf>,
+    /// Do not draw the matched pairs into the PNG.
+    #[arg(long)]
+    no_png_matches: bool,
     /// Write a VTK structured grid with det J.
     #[arg(long)]
     vtk: Option<PathBuf>,
@@ -297,6 +346,9 @@ struct RenderArgs {
     size: usize,
     #[command(flatten)]
     backend: BackendArgs,
+    /// Do not draw the matched pairs of the reparameterization stored in the report.
+    #[arg(long)]
+    no_matches: bool,
 }
 
 #[derive(Args, Debug)]
@@ -345,7 +397,9 @@ fn run(cli: Cli) -> Result<i32> {
             let Document::Map { map, .. } = doc else {
                 bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
             };
-            let opts = PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, ..Default::default() };
+            let segments = if a.no_matches { Vec::new() } else { output::report_matches(&a.map) };
+            let opts =
+                PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, segments, ..Default::default() };
             let sel = a.backend.select(false)?;
             output::write_png(&a.png, &picture(&sel, &map, &opts)?)?;
             println!("wrote {}", a.png.display());
@@ -356,9 +410,9 @@ fn run(cli: Cli) -> Result<i32> {
     }
 }
 
-fn load_boundary(path: &Path, fit: &FitArgs) -> Result<Boundary> {
+fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
     let doc = read_document(path).with_context(|| format!("reading {}", path.display()))?;
-    let (b, _) = checked_boundary(doc.into_boundary(), &ReadOptions { reorient: fit.reorient })
+    let (b, _) = checked_boundary(doc.into_boundary(), &ReadOptions { reorient })
         .with_context(|| format!("validating {}", path.display()))?;
     Ok(b)
 }
@@ -413,6 +467,13 @@ fn run_solver(
             boundary.name,
             h.levels.len(),
             h.diameter
+        );
+        let rp = &h.reparam;
+        eprintln!(
+            "  reparameterization: {} (requested {}), {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.matches.len()
         );
         for s in Side::ALL {
             let f = &h.fits[s as usize];
@@ -477,7 +538,7 @@ fn run_solver(
 fn solve(a: SolveArgs) -> Result<i32> {
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
-    let boundary = load_boundary(&a.boundary, &a.solver.fit)?;
+    let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
     let sel = a.backend.select(a.quiet || a.json)?;
     let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
@@ -485,7 +546,8 @@ fn solve(a: SolveArgs) -> Result<i32> {
     write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
         .with_context(|| format!("writing {}", a.output.display()))?;
     if let Some(p) = &a.png {
-        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions::default())?)?;
+        let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
+        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, ..Default::default() })?)?;
     }
     if let Some(p) = &a.vtk {
         output::write_vtk(p, &sol.map, 128)?;
@@ -518,7 +580,7 @@ fn check(a: CheckArgs) -> Result<i32> {
     let quality = quality(&map);
     let deviation = match &a.boundary {
         Some(p) => {
-            let b = load_boundary(p, &FitArgs { degree: 3, fit_tol: 1e-4, reorient: false })?;
+            let b = load_boundary(p, false)?;
             Some(boundary_deviation(&map, &b, 400))
         }
         None => None,
@@ -562,7 +624,7 @@ fn bench(a: BenchArgs) -> Result<i32> {
     let files = if a.files.is_empty() { output::default_bench_files()? } else { a.files.clone() };
     let mut rows = Vec::new();
     for f in &files {
-        let boundary = match load_boundary(f, &a.solver.fit) {
+        let boundary = match load_boundary(f, a.solver.fit.reorient) {
             Ok(b) => b,
             Err(e) => {
                 eprintln!("skipping {}: {e:#}", f.display());

@@ -102,6 +102,27 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
             round.shape[1]
         );
     }
+    let _ = writeln!(s, "  basis functions: {}", r.basis_functions);
+    let rp = &r.reparam;
+    let gap = |g: f64| if g.is_finite() { format!("{g:.2e}") } else { "-".into() };
+    let _ = writeln!(
+        s,
+        "  reparameterization: {} (requested {}); gap/length south-north {} ({}), west-east {} ({}); {} matched pairs",
+        rp.used.name(),
+        rp.requested.name(),
+        gap(rp.gap_ratio[0]),
+        rp.pair_methods[0].name(),
+        gap(rp.gap_ratio[1]),
+        rp.pair_methods[1].name(),
+        rp.matches.len()
+    );
+    for m in &rp.matches {
+        let _ = writeln!(
+            s,
+            "    {}/{} at {:.6}: ({:.6}, {:.6}) - ({:.6}, {:.6})",
+            m.sides[0], m.sides[1], m.parameter, m.points[0][0], m.points[0][1], m.points[1][0], m.points[1][1]
+        );
+    }
     let _ = writeln!(s, "  wrote {}", out.display());
     if let Some(p) = png {
         let _ = writeln!(s, "  wrote {}", p.display());
@@ -280,6 +301,18 @@ pub fn inspect_text(
                 let _ = writeln!(s, "           fitted knots {}", knot_list(c.knots.knots()));
             }
         }
+        let rp = &h.reparam;
+        let _ = writeln!(
+            s,
+            "  reparameterization: {} (requested {}); gap/length south-north {:.2e} ({}), west-east {:.2e} ({}); {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.gap_ratio[0],
+            rp.pair_methods[0].name(),
+            rp.gap_ratio[1],
+            rp.pair_methods[1].name(),
+            rp.matches.len()
+        );
         let sizes: Vec<String> =
             h.levels.iter().map(|l| format!("{}x{}", l.knots[0].num_basis(), l.knots[1].num_basis())).collect();
         let _ = writeln!(s, "    basis per level: {}", sizes.join(" -> "));
@@ -292,6 +325,21 @@ pub fn inspect_text(
         }
     }
     s
+}
+
+/// The matched pairs (`report.reparam.matches[].points`) of a map file written by
+/// `winslow solve`, as segments; empty when the file has none or cannot be read.
+pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
+    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+    let Some(matches) = doc["report"]["reparam"]["matches"].as_array() else { return Vec::new() };
+    matches
+        .iter()
+        .filter_map(|m| {
+            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
+            Some((p[0], p[1]))
+        })
+        .collect()
 }
 
 /// `winslow inspect --json`.
@@ -326,6 +374,7 @@ pub fn inspect_json(
         "signed_area": report.map(|r| r.signed_area),
         "corner_angles": report.map(|r| r.corner_angles),
         "fit_tolerance": fit.map(|h| h.tol_abs),
+        "reparam": fit.map(|h| &h.reparam),
         "fit": fits,
         "problems": problems,
     })
@@ -363,6 +412,16 @@ pub struct BenchRow {
     pub newton_iteration_s: f64,
     /// Verdict.
     pub verdict: Verdict,
+    /// Tensor-product basis functions of the map.
+    pub basis: usize,
+    /// Winslow functional (`null` when det J <= 0 at a quadrature point).
+    pub winslow: Option<f64>,
+    /// Smallest scaled Jacobian on the sample grid.
+    pub scaled_jacobian_min: f64,
+    /// Reparameterization used.
+    pub reparam: &'static str,
+    /// Matched pairs.
+    pub matches: usize,
 }
 
 impl BenchRow {
@@ -386,6 +445,11 @@ impl BenchRow {
             newton_iteration_s: last
                 .map_or(0.0, |l| (l.assembly_seconds + l.linear_seconds) / l.iterations.max(1) as f64),
             verdict: r.verdict,
+            basis: r.basis_functions,
+            winslow: r.winslow,
+            scaled_jacobian_min: r.quality.scaled_jacobian.min,
+            reparam: r.reparam.used.name(),
+            matches: r.reparam.matches.len(),
         }
     }
 }
@@ -395,14 +459,14 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | elements | certify s | Newton it s | verdict |"
+        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | elements | certify s | Newton it s | verdict | reparam (matches) | basis | Winslow | min scaled J |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|");
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {} | {:.4} | {:.4} | {:?} |",
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {} | {:.4} | {:.4} | {:?} | {} ({}) | {} | {} | {:.4} |",
             r.geometry,
             r.refine,
             r.dofs,
@@ -415,7 +479,12 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
             r.elements,
             r.certify_s,
             r.newton_iteration_s,
-            r.verdict
+            r.verdict,
+            r.reparam,
+            r.matches,
+            r.basis,
+            r.winslow.map_or("inf".to_string(), |w| format!("{w:.4}")),
+            r.scaled_jacobian_min
         );
     }
     s

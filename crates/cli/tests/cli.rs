@@ -297,3 +297,56 @@ fn check_names_degenerate_corners() {
         assert!((c["angle_degrees"].as_f64().unwrap() - 180.0).abs() < 1e-6 && c["forbids_positivity"] == true);
     }
 }
+
+/// `--reparam`: the default `auto` picks constrained cord length on the narrow tube, the
+/// report carries the matched pairs (same parameter, a point on each side, within the
+/// matching distance), the summary prints them, and the PNG is written with them drawn;
+/// `--reparam none` reports no matches.
+#[test]
+fn solve_reports_reparameterization_and_matches() {
+    let dir = std::env::temp_dir().join(format!("winslow-reparam-{}", std::process::id()));
+    let map = dir.join("tube.json");
+    let png = dir.join("tube.png");
+    let out = bin()
+        .arg("solve")
+        .arg(data().join("narrow_tube.json"))
+        .arg("-o")
+        .arg(&map)
+        .arg("--png")
+        .arg(&png)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("reparameterization: constrained (requested auto)") && text.contains("basis functions:"),
+        "{text}"
+    );
+    assert!(text.contains("south/north at "), "{text}");
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+    let rp = &doc["report"]["reparam"];
+    assert_eq!(rp["used"], "constrained");
+    let matches = rp["matches"].as_array().unwrap();
+    assert!(!matches.is_empty());
+    for m in matches {
+        let t = m["parameter"].as_f64().unwrap();
+        assert!(t > 0.0 && t < 1.0);
+        let p: Vec<Vec<f64>> = serde_json::from_value(m["points"].clone()).unwrap();
+        // the tube's gaps are narrow: matched points are close (the threshold is a
+        // fraction of the tube's length)
+        assert!((p[0][0] - p[1][0]).hypot(p[0][1] - p[1][1]) < 0.05 * doc["report"]["diameter"].as_f64().unwrap());
+    }
+    assert!(doc["report"]["basis_functions"].as_u64().unwrap() > 0);
+    let none = bin()
+        .arg("solve")
+        .arg(data().join("narrow_tube.json"))
+        .args(["--reparam", "none", "--json", "-o"])
+        .arg(dir.join("none.json"))
+        .output()
+        .unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&none.stdout).unwrap();
+    assert_eq!(report["reparam"]["used"], "none");
+    assert!(report["reparam"]["matches"].as_array().unwrap().is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -52,6 +52,7 @@ use crate::curve::{Curve, Point};
 use crate::error::{Error, Result, MAX_DEGREE};
 use crate::knots::KnotVector;
 use crate::quadrature::GaussLegendre;
+use crate::reparam::{ParamMap, ReparamOptions, ReparamReport, SideParam};
 use crate::surface::Side;
 
 /// Relative weight `ε` of the smoothing term of point-cloud fits: `λ = ε · tr(B^T B) /
@@ -82,11 +83,20 @@ pub struct FitOptions {
     pub max_levels: usize,
     /// Largest number of elements per side (safety cap). Default 4096.
     pub max_elements: usize,
+    /// Reparameterization of the sides before the fit (paper §7). Default `auto`.
+    pub reparam: ReparamOptions,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self { degree: 3, tol: 1e-4, initial_elements: 1, max_levels: 14, max_elements: 4096 }
+        Self {
+            degree: 3,
+            tol: 1e-4,
+            initial_elements: 1,
+            max_levels: 14,
+            max_elements: 4096,
+            reparam: ReparamOptions::default(),
+        }
     }
 }
 
@@ -115,7 +125,7 @@ impl FitOptions {
                 self.max_elements, self.initial_elements
             )));
         }
-        Ok(())
+        self.reparam.validate()
     }
 }
 
@@ -160,7 +170,8 @@ pub struct SideFit {
     pub max_error: Vec<f64>,
     /// RMS deviation of each level (absolute).
     pub rms_error: Vec<f64>,
-    /// The cord-length abscissae (eq. 36-37) when the side is a point cloud.
+    /// The abscissae of the points when the side is a point cloud: cord length (eq.
+    /// 36-37) or the constrained cord length of §7.2.
     pub params: Option<Vec<f64>>,
     /// Whether the finest level is within the tolerance on every element.
     pub converged: bool,
@@ -212,6 +223,8 @@ pub struct Hierarchy {
     pub tol_abs: f64,
     /// Diameter of the boundary's bounding box.
     pub diameter: f64,
+    /// The reparameterization applied before the fit (paper §7).
+    pub reparam: ReparamReport,
 }
 
 impl Hierarchy {
@@ -291,18 +304,23 @@ pub fn diameter(boundary: &Boundary) -> f64 {
 
 /// The function (or data) being approximated on one side.
 enum Target<'a> {
-    /// A spline side, evaluated at `a + t (b - a)`; `breaks` are its element boundaries
-    /// mapped to `[0, 1]`.
+    /// A spline side, evaluated at `a + g(t) (b - a)` (`g` the identity unless the side
+    /// is reparameterized); `breaks` are its element boundaries mapped to `[0, 1]` and
+    /// pulled back by `g`, together with the breaks of `g`.
     Spline {
         curve: &'a Curve,
         a: f64,
         len: f64,
         breaks: Vec<f64>,
         nq: usize,
+        g: Option<&'a ParamMap>,
     },
+    /// An analytic side evaluated at `g(t)`; `breaks` are those of `g` (or empty).
     Analytic {
         f: &'a Analytic,
         nq: usize,
+        g: Option<&'a ParamMap>,
+        breaks: Vec<f64>,
     },
     Points {
         params: Vec<f64>,
@@ -311,25 +329,57 @@ enum Target<'a> {
 }
 
 impl<'a> Target<'a> {
-    fn new(curve: &'a SideCurve, p: usize, side: &str) -> Result<Self> {
+    fn new(curve: &'a SideCurve, param: &'a SideParam, p: usize, side: &str) -> Result<Self> {
+        let g = match param {
+            SideParam::Map(g) => Some(g),
+            _ => None,
+        };
+        let g_breaks = || g.map(ParamMap::breaks).unwrap_or_default();
         Ok(match curve {
             SideCurve::Spline(c) => {
                 let (a, b) = c.domain();
                 let len = b - a;
-                let breaks = c.knots.breaks().into_iter().map(|u| ((u - a) / len).clamp(0.0, 1.0)).collect();
-                let nq = p + c.degree() + 2 + if c.is_rational() { 2 } else { 0 };
-                Target::Spline { curve: c, a, len, breaks, nq }
+                let mut breaks: Vec<f64> = c
+                    .knots
+                    .breaks()
+                    .into_iter()
+                    .map(|u| {
+                        let t = ((u - a) / len).clamp(0.0, 1.0);
+                        g.map_or(t, |g| g.inverse(t))
+                    })
+                    .collect();
+                breaks.extend(g_breaks());
+                breaks.sort_by(f64::total_cmp);
+                breaks.dedup();
+                // a reparameterized side is only C^1 at the breaks of g: two more points
+                let nq = p + c.degree() + 2 + if c.is_rational() { 2 } else { 0 } + if g.is_some() { 2 } else { 0 };
+                Target::Spline { curve: c, a, len, breaks, nq, g }
             }
-            SideCurve::Analytic(f) => Target::Analytic { f, nq: p + 6 },
+            SideCurve::Analytic(f) => Target::Analytic { f, nq: p + 6, g, breaks: g_breaks() },
             SideCurve::Points(pts) => {
                 if pts.len() < 2 {
                     return Err(Error::TooFewPoints { side: side.to_string(), found: pts.len(), needed: 2 });
                 }
-                let params = cord_length_params(pts).ok_or_else(|| Error::DegenerateSide {
-                    side: side.to_string(),
-                    length: 0.0,
-                    tol: 0.0,
-                })?;
+                let params = match param {
+                    SideParam::Abscissae(x) => {
+                        if x.len() != pts.len()
+                            || x.first() != Some(&0.0)
+                            || x.last() != Some(&1.0)
+                            || x.iter().any(|v| v.is_nan())
+                            || x.windows(2).any(|w| w[1] < w[0])
+                        {
+                            return Err(Error::Invalid(format!(
+                                "{side}: reparameterized abscissae must rise from 0 to 1, one per point"
+                            )));
+                        }
+                        x.clone()
+                    }
+                    _ => cord_length_params(pts).ok_or_else(|| Error::DegenerateSide {
+                        side: side.to_string(),
+                        length: 0.0,
+                        tol: 0.0,
+                    })?,
+                };
                 Target::Points { params, points: pts }
             }
         })
@@ -338,8 +388,11 @@ impl<'a> Target<'a> {
     /// `f̄(t)` for curve targets.
     fn eval(&self, t: f64) -> Point {
         match self {
-            Target::Spline { curve, a, len, .. } => curve.eval(a + t.clamp(0.0, 1.0) * len),
-            Target::Analytic { f, .. } => f.eval(t),
+            Target::Spline { curve, a, len, g, .. } => {
+                let t = t.clamp(0.0, 1.0);
+                curve.eval(a + g.map_or(t, |g| g.eval(t)) * len)
+            }
+            Target::Analytic { f, g, .. } => f.eval(g.map_or(t, |g| g.eval(t))),
             Target::Points { .. } => unreachable!("point clouds are not evaluated"),
         }
     }
@@ -356,7 +409,7 @@ impl<'a> Target<'a> {
         out.clear();
         let tol = 1e-13;
         let mut left = a;
-        if let Target::Spline { breaks, .. } = self {
+        if let Target::Spline { breaks, .. } | Target::Analytic { breaks, .. } = self {
             let start = breaks.partition_point(|&u| u <= a + tol);
             for &u in &breaks[start..] {
                 if u >= b - tol {
@@ -611,7 +664,7 @@ pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Poin
             knots.domain()
         )));
     }
-    let target = Target::new(curve, knots.degree(), "side")?;
+    let target = Target::new(curve, &SideParam::Native, knots.degree(), "side")?;
     let fit = solve_fit(&target, knots, corners)?;
     Ok(fit_errors(&target, &fit))
 }
@@ -630,11 +683,24 @@ pub fn fit_side(
     opts: &FitOptions,
     tol_abs: f64,
 ) -> Result<SideFit> {
+    fit_side_with(side, curve, &SideParam::Native, corners, opts, tol_abs)
+}
+
+/// [`fit_side`] with the side parameterized by `param` (paper §7): point clouds at the
+/// given abscissae, parametric sides as `f̄ ∘ g`.
+pub fn fit_side_with(
+    side: Side,
+    curve: &SideCurve,
+    param: &SideParam,
+    corners: (Point, Point),
+    opts: &FitOptions,
+    tol_abs: f64,
+) -> Result<SideFit> {
     opts.validate()?;
     if !(tol_abs.is_finite() && tol_abs > 0.0) {
         return Err(Error::Invalid(format!("absolute fit tolerance must be positive and finite, got {tol_abs}")));
     }
-    let target = Target::new(curve, opts.degree, side.name())?;
+    let target = Target::new(curve, param, opts.degree, side.name())?;
     let mut kv = KnotVector::open_uniform(opts.degree, opts.initial_elements);
     let mut out = SideFit {
         side,
@@ -726,9 +792,10 @@ pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
     }
 }
 
-/// Fit the four sides adaptively (see [`fit_side`]) with `tol_abs = tol * diameter` and
-/// the corners of [`corners`], then build the nested hierarchy of tensor-product bases
-/// (paper §5.4) with [`hierarchy_from_fits`].
+/// Reparameterize the sides as `opts.reparam` says ([`crate::reparam::plan`], paper
+/// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
+/// diameter` and the corners of [`corners`], then build the nested hierarchy of
+/// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
 pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
     opts.validate()?;
     let diameter = diameter(boundary);
@@ -737,12 +804,16 @@ pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarc
     }
     let tol_abs = opts.tol * diameter;
     let corners = corners(boundary, diameter)?;
+    let plan = crate::reparam::plan(boundary, &opts.reparam)?;
     let mut fits = Vec::with_capacity(4);
     for side in Side::ALL {
-        fits.push(fit_side(side, boundary.side(side), side_corners(&corners, side), opts, tol_abs)?);
+        let param = &plan.sides[side as usize];
+        fits.push(fit_side_with(side, boundary.side(side), param, side_corners(&corners, side), opts, tol_abs)?);
     }
     let fits: [SideFit; 4] = fits.try_into().expect("four sides");
-    hierarchy_from_fits(fits, tol_abs, diameter)
+    let mut h = hierarchy_from_fits(fits, tol_abs, diameter)?;
+    h.reparam = plan.report;
+    Ok(h)
 }
 
 /// The hierarchy of tensor-product bases from the four side fits (south, east, north,
@@ -791,7 +862,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
             _ => levels.push(level),
         }
     }
-    Ok(Hierarchy { levels, fits, tol_abs, diameter })
+    Ok(Hierarchy { levels, fits, tol_abs, diameter, reparam: ReparamReport::native() })
 }
 
 #[cfg(test)]

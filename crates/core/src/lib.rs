@@ -40,6 +40,7 @@ pub mod poisson;
 pub mod quadrature;
 pub mod quality;
 pub mod refine;
+pub mod reparam;
 pub mod solver;
 pub mod sparse;
 pub mod surface;

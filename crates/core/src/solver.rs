@@ -298,10 +298,32 @@ fn polyline_length(c: &Curve) -> f64 {
     c.sample(n).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
 }
 
+/// Two sides count as a seam (see [`prepare_levels`]) when the mean distance between
+/// the other two sides exceeds their mean length by this factor.
+pub const SEAM_FACTOR: f64 = 4.0;
+
+/// Mean distance `|b(t) - a(t)|` between two opposite sides at equal parameters: the
+/// mean length of the straight lines joining them, which is the extent of the domain
+/// across them when the sides joining them are much shorter (a ring cut along a seam).
+fn mean_gap(a: &Curve, b: &Curve) -> f64 {
+    let n = 16 * a.knots.num_elements().max(b.knots.num_elements()).max(4);
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let (p, q) = (a.eval(t), b.eval(t));
+            (p[0] - q[0]).hypot(p[1] - q[1])
+        })
+        .sum::<f64>()
+        / (n + 1) as f64
+}
+
 /// Prepare the hierarchy for solving (paper §5.4 builds each level from the side fits
 /// alone, so a straight side keeps a single element however fine its opposite is):
 /// 1. *balance* every level, halving a direction until its elements are on average no
-///    more than `aspect` times longer (physically) than those of the other direction,
+///    more than `aspect` times longer (physically) than those of the other direction
+///    (the extent of a direction is the mean length of its two sides, or the mean
+///    distance between the two other sides at equal parameters when that is more than
+///    [`SEAM_FACTOR`] times larger: a ring cut open along a seam),
 ///    and until it has `min_elements` elements; each level then takes the union with
 ///    the coarser one so the hierarchy stays nested;
 /// 2. append `refine` uniformly halved copies of the finest level.
@@ -314,6 +336,11 @@ pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize
         0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
     let len_eta =
         0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
+    // a seam (short sides joining long ones far apart) understates the extent across:
+    // there the mean distance between the other two sides is used instead
+    let across = |len: f64, gap: f64| if gap > SEAM_FACTOR * len { gap } else { len };
+    let len_xi = across(len_xi, mean_gap(&last.sides[Side::West as usize], &last.sides[Side::East as usize]));
+    let len_eta = across(len_eta, mean_gap(&last.sides[Side::South as usize], &last.sides[Side::North as usize]));
     let mut previous: Option<[KnotVector; 2]> = None;
     for level in levels.iter_mut() {
         let mut knots = level.knots.clone();
@@ -891,6 +918,10 @@ pub struct Report {
     pub message: String,
     /// Total seconds.
     pub seconds: f64,
+    /// Tensor-product basis functions of the map (`n_xi * n_eta`).
+    pub basis_functions: usize,
+    /// The boundary reparameterization (paper §7): method used and matched pairs.
+    pub reparam: crate::reparam::ReparamReport,
 }
 
 /// A solved map and its report.
@@ -1034,6 +1065,8 @@ impl Solution {
             verdict,
             message,
             seconds: ctx.elapsed.as_secs_f64(),
+            basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
+            reparam: h.reparam.clone(),
         };
         Self { name: name.to_string(), map, report }
     }

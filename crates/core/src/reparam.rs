@@ -1,0 +1,1123 @@
+//! Boundary reparameterization (paper §7): the parametric speed of the four contours is
+//! a Dirichlet condition of eq. (8), so it decides whether hard geometries (narrow gaps,
+//! extreme aspect ratios) come out bijective at all.
+//!
+//! * **Arc length** (§7.1). Point clouds get the cord-length abscissae of eq. 36-37
+//!   ([`crate::fit::cord_length_params`]). A parametric side `f̄: [0,1] -> R^2` gets a
+//!   monotone reparameterization `g(ξ) = Σ_i c_i B_i(ξ)` (eq. 38) on a cubic B-spline
+//!   basis with `c_0 = 0`, `c_n = 1`, minimizing (eq. 39)
+//!   `A(c) = ∫_0^1 ||(f̄ ∘ g)'(ξ)||^2 dξ`; by Cauchy-Schwarz `A >= L^2` (`L` the length of
+//!   the side) with equality exactly for the arc-length parameterization. See
+//!   [`arc_length_map`]. The contour is then re-fitted in the solver's basis as
+//!   `f̄ ∘ g` ([`crate::fit`]).
+//! * **Constrained cord length** (§7.2, eq. 40-42). For two opposite sides `P_1` (cord
+//!   length, `Ξ_1`) and `P_2`, the closest pair `(p^1_i, p^2_j)` within the threshold
+//!   distance `ε` is matched (eq. 40) and gets `ξ^2_j = ξ^1_i`; the search recurses on the
+//!   index ranges below and above the match, after removing the points within a minimum
+//!   cord-length separation `δ` of it. The unmatched abscissae of `P_2` are filled either
+//!   by a Fritsch-Carlson monotone cubic through the matched values or by piecewise cord
+//!   length between consecutive matches (eq. 41-42). See [`constrained_params`].
+//!
+//! Parametric sides are turned into point clouds by dense sampling
+//! ([`sample_side`]); the resulting abscissae `ξ_k` of the samples `t_k` define
+//! `g` as the monotone cubic through `(ξ_k, t_k)`.
+
+use serde::Serialize;
+
+use crate::boundary::{Boundary, SideCurve};
+use crate::curve::Point;
+use crate::error::{Error, Result};
+use crate::fit::cord_length_params;
+use crate::knots::KnotVector;
+use crate::quadrature::GaussLegendre;
+use crate::surface::Side;
+
+/// Which reparameterization the contour fit applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Reparam {
+    /// The input's own parameterization (cord length for point clouds).
+    None,
+    /// Arc length: cord length for point clouds, eq. 38-39 for parametric sides.
+    ArcLength,
+    /// Constrained cord length on both pairs of opposite sides (eq. 40-42).
+    Constrained,
+    /// Constrained cord length on every pair of opposite sides that come closer than
+    /// [`ReparamOptions::gap`] times their mean length; `None` elsewhere.
+    #[default]
+    Auto,
+}
+
+impl Reparam {
+    /// Lower-case name, as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reparam::None => "none",
+            Reparam::ArcLength => "arclength",
+            Reparam::Constrained => "constrained",
+            Reparam::Auto => "auto",
+        }
+    }
+}
+
+/// How the unmatched abscissae of the second side are filled (§7.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Fill {
+    /// Cord length between consecutive matches (eq. 41-42).
+    #[default]
+    CordLength,
+    /// Fritsch-Carlson monotone cubic through the matched `(cord length of P_2, ξ)`.
+    MonotoneCubic,
+}
+
+/// Options of the reparameterization.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReparamOptions {
+    /// The method. Default [`Reparam::Auto`].
+    pub method: Reparam,
+    /// Threshold distance `ε` of eq. 40 relative to the mean length of the two opposite
+    /// sides; `Auto` uses constrained cord length on a pair whose distance is below it.
+    /// Default `0.02`.
+    pub gap: f64,
+    /// Minimum separation of two matches, in the cord-length parameter of each side.
+    /// Default `0.01`.
+    pub separation: f64,
+    /// Fill of the unmatched abscissae. Default [`Fill::CordLength`].
+    pub fill: Fill,
+    /// Samples per input element (spline sides) used to turn a parametric side into a
+    /// point cloud; analytic sides get `64` times as many in total. Default 16.
+    pub samples: usize,
+}
+
+impl Default for ReparamOptions {
+    fn default() -> Self {
+        Self { method: Reparam::Auto, gap: 0.02, separation: 0.01, fill: Fill::CordLength, samples: 16 }
+    }
+}
+
+impl ReparamOptions {
+    /// Check the ranges.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.gap.is_finite() && self.gap > 0.0) {
+            return Err(Error::Invalid(format!("reparameterization gap must be positive, got {}", self.gap)));
+        }
+        if !(self.separation.is_finite() && self.separation >= 0.0 && self.separation < 0.5) {
+            return Err(Error::Invalid(format!(
+                "reparameterization separation must be in [0, 0.5), got {}",
+                self.separation
+            )));
+        }
+        if self.samples < 2 {
+            return Err(Error::Invalid(format!(
+                "reparameterization needs >= 2 samples per element, got {}",
+                self.samples
+            )));
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Fritsch-Carlson monotone cubic interpolation
+// ---------------------------------------------------------------------------------------
+
+/// Monotone piecewise cubic Hermite interpolant (Fritsch and Carlson 1980) of data
+/// `(x_k, y_k)` with strictly increasing `x` and non-decreasing `y`. Node slopes are the
+/// weighted harmonic means of the adjacent secants (zero where a secant is zero) and are
+/// then scaled so that `α^2 + β^2 <= 9` on every interval, the Fritsch-Carlson sufficient
+/// condition for monotonicity; strictly increasing data give a strictly increasing
+/// interpolant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MonotoneCubic {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    m: Vec<f64>,
+}
+
+impl MonotoneCubic {
+    /// The interpolant; errors unless `x` strictly and `y` weakly increase (>= 2 points).
+    pub fn new(x: Vec<f64>, y: Vec<f64>) -> Result<Self> {
+        let n = x.len();
+        if n < 2 || y.len() != n {
+            return Err(Error::Invalid(format!(
+                "monotone cubic needs >= 2 points and equal lengths, got {n} and {}",
+                y.len()
+            )));
+        }
+        if x.iter().chain(&y).any(|v| !v.is_finite()) {
+            return Err(Error::Invalid("monotone cubic: non-finite data".into()));
+        }
+        if x.windows(2).any(|w| w[1] <= w[0]) || y.windows(2).any(|w| w[1] < w[0]) {
+            return Err(Error::Invalid("monotone cubic needs strictly increasing x and non-decreasing y".into()));
+        }
+        let h: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
+        let d: Vec<f64> = (0..n - 1).map(|k| (y[k + 1] - y[k]) / h[k]).collect();
+        let mut m = vec![0.0; n];
+        if n == 2 {
+            m[0] = d[0];
+            m[1] = d[0];
+        } else {
+            for k in 1..n - 1 {
+                if d[k - 1] > 0.0 && d[k] > 0.0 {
+                    let (w1, w2) = (2.0 * h[k] + h[k - 1], h[k] + 2.0 * h[k - 1]);
+                    m[k] = (w1 + w2) / (w1 / d[k - 1] + w2 / d[k]);
+                }
+            }
+            // one-sided three-point ends, kept within [0, 3 d]
+            let end = |h0: f64, h1: f64, d0: f64, d1: f64| {
+                let v = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+                if v <= 0.0 || d0 <= 0.0 {
+                    if d0 > 0.0 {
+                        0.5 * d0
+                    } else {
+                        0.0
+                    }
+                } else {
+                    v.min(3.0 * d0)
+                }
+            };
+            m[0] = end(h[0], h[1], d[0], d[1]);
+            m[n - 1] = end(h[n - 2], h[n - 3], d[n - 2], d[n - 3]);
+        }
+        // Fritsch-Carlson step 5: restrict (α, β) to the disc of radius 3.
+        for k in 0..n - 1 {
+            if d[k] == 0.0 {
+                m[k] = 0.0;
+                m[k + 1] = 0.0;
+                continue;
+            }
+            let (a, b) = (m[k] / d[k], m[k + 1] / d[k]);
+            let s = a * a + b * b;
+            if s > 9.0 {
+                let t = 3.0 / s.sqrt();
+                m[k] = t * a * d[k];
+                m[k + 1] = t * b * d[k];
+            }
+        }
+        Ok(Self { x, y, m })
+    }
+
+    /// The nodes `x_k` (the breaks of the interpolant).
+    pub fn nodes(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// The data values `y_k`.
+    pub fn values(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn interval(&self, t: f64) -> usize {
+        self.x.partition_point(|&v| v <= t).clamp(1, self.x.len() - 1) - 1
+    }
+
+    /// Value at `t` (clamped to `[x_0, x_{n-1}]`).
+    pub fn eval(&self, t: f64) -> f64 {
+        self.eval_d(t).0
+    }
+
+    /// Value and first derivative at `t` (clamped).
+    pub fn eval_d(&self, t: f64) -> (f64, f64) {
+        let n = self.x.len();
+        let t = t.clamp(self.x[0], self.x[n - 1]);
+        let k = self.interval(t);
+        let h = self.x[k + 1] - self.x[k];
+        let s = (t - self.x[k]) / h;
+        let (y0, y1, m0, m1) = (self.y[k], self.y[k + 1], self.m[k] * h, self.m[k + 1] * h);
+        let (s2, s3) = (s * s, s * s * s);
+        let v =
+            (2.0 * s3 - 3.0 * s2 + 1.0) * y0 + (s3 - 2.0 * s2 + s) * m0 + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * m1;
+        let dv = ((6.0 * s2 - 6.0 * s) * y0
+            + (3.0 * s2 - 4.0 * s + 1.0) * m0
+            + (-6.0 * s2 + 6.0 * s) * y1
+            + (3.0 * s2 - 2.0 * s) * m1)
+            / h;
+        (v, dv)
+    }
+
+    /// The `t` with `eval(t) = y` (bisection; the interpolant is monotone).
+    pub fn inverse(&self, y: f64) -> f64 {
+        let n = self.x.len();
+        let k = self.y.partition_point(|&v| v < y).clamp(1, n - 1) - 1;
+        let (mut lo, mut hi) = (self.x[k], self.x[k + 1]);
+        if y <= self.y[k] {
+            return lo;
+        }
+        if y >= self.y[k + 1] {
+            return hi;
+        }
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.eval(mid) < y {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Reparameterization functions of parametric sides
+// ---------------------------------------------------------------------------------------
+
+/// A strictly increasing map `g: [0, 1] -> [0, 1]` from the new parameter `ξ` to the
+/// input's (normalized) parameter `t`; the side is re-fitted as `f̄ ∘ g`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamMap {
+    /// Monotone cubic through `(ξ_k, t_k)` (constrained cord length of a sampled side).
+    Monotone(MonotoneCubic),
+    /// `g = Σ c_i B_i` with increasing `c`, `c_0 = 0`, `c_n = 1` (eq. 38).
+    Spline {
+        /// The basis of `g`.
+        knots: KnotVector,
+        /// The coefficients `c_i`.
+        coefs: Vec<f64>,
+    },
+}
+
+impl ParamMap {
+    /// `g(ξ)`.
+    pub fn eval(&self, xi: f64) -> f64 {
+        self.eval_d(xi).0
+    }
+
+    /// `g(ξ)` and `g'(ξ)`.
+    pub fn eval_d(&self, xi: f64) -> (f64, f64) {
+        match self {
+            ParamMap::Monotone(m) => m.eval_d(xi),
+            ParamMap::Spline { knots, coefs } => {
+                let b = crate::basis::BasisDerivs::at(knots, xi.clamp(0.0, 1.0), 1);
+                let f = b.first();
+                let (mut v, mut d) = (0.0, 0.0);
+                for j in 0..=knots.degree() {
+                    v += b.d[0][j] * coefs[f + j];
+                    d += b.d[1][j] * coefs[f + j];
+                }
+                (v, d)
+            }
+        }
+    }
+
+    /// The breaks of `g` (where it is only finitely smooth), `0` and `1` included.
+    pub fn breaks(&self) -> Vec<f64> {
+        match self {
+            ParamMap::Monotone(m) => m.nodes().to_vec(),
+            ParamMap::Spline { knots, .. } => knots.breaks(),
+        }
+    }
+
+    /// `g^{-1}(t)` by bisection.
+    pub fn inverse(&self, t: f64) -> f64 {
+        if let ParamMap::Monotone(m) = self {
+            return m.inverse(t);
+        }
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if self.eval(mid) < t {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+/// A parametric side on the normalized parameter `t ∈ [0, 1]`: value, first and second
+/// derivative, and the breaks of its smoothness.
+struct Parametric<'a> {
+    side: &'a SideCurve,
+    breaks: Vec<f64>,
+}
+
+impl<'a> Parametric<'a> {
+    fn new(side: &'a SideCurve) -> Option<Self> {
+        let breaks = match side {
+            SideCurve::Spline(c) => {
+                let (a, b) = c.domain();
+                c.knots.breaks().into_iter().map(|u| ((u - a) / (b - a)).clamp(0.0, 1.0)).collect()
+            }
+            SideCurve::Analytic(_) => vec![0.0, 1.0],
+            SideCurve::Points(_) => return None,
+        };
+        Some(Self { side, breaks })
+    }
+
+    fn eval(&self, t: f64) -> Point {
+        match self.side {
+            SideCurve::Spline(c) => {
+                let (a, b) = c.domain();
+                c.eval(a + t.clamp(0.0, 1.0) * (b - a))
+            }
+            SideCurve::Analytic(f) => f.eval(t.clamp(0.0, 1.0)),
+            SideCurve::Points(_) => unreachable!("point clouds are not parametric"),
+        }
+    }
+
+    /// `(f, f', f'')` at `t`; analytic sides by central differences.
+    fn derivs(&self, t: f64) -> [Point; 3] {
+        match self.side {
+            SideCurve::Spline(c) => {
+                let (a, b) = c.domain();
+                let l = b - a;
+                let d = c.derivs(a + t.clamp(0.0, 1.0) * l, 2);
+                [d.x, [d.d1[0] * l, d.d1[1] * l], [d.d2[0] * l * l, d.d2[1] * l * l]]
+            }
+            SideCurve::Analytic(f) => {
+                let h = 1e-4;
+                let c = t.clamp(h, 1.0 - h);
+                let (m, z, p) = (f.eval(c - h), f.eval(c), f.eval(c + h));
+                let d1 = [(p[0] - m[0]) / (2.0 * h), (p[1] - m[1]) / (2.0 * h)];
+                let d2 = [(p[0] - 2.0 * z[0] + m[0]) / (h * h), (p[1] - 2.0 * z[1] + m[1]) / (h * h)];
+                let x = f.eval(t.clamp(0.0, 1.0));
+                [x, [d1[0] + (t - c) * d2[0], d1[1] + (t - c) * d2[1]], d2]
+            }
+            SideCurve::Points(_) => unreachable!("point clouds are not parametric"),
+        }
+    }
+}
+
+/// Dense samples of a side: its points and, for parametric sides, their parameters
+/// `t_k ∈ [0, 1]` (strictly increasing, every input break included).
+#[derive(Debug, Clone)]
+pub struct SideSample {
+    /// Parameters of the samples (`None` for point clouds).
+    pub t: Option<Vec<f64>>,
+    /// The points.
+    pub points: Vec<Point>,
+}
+
+/// Sample a side: point clouds as they are, spline sides at `per_element` points per
+/// input element (breaks included), analytic sides at `64 per_element` uniform points.
+pub fn sample_side(side: &SideCurve, per_element: usize) -> SideSample {
+    let Some(f) = Parametric::new(side) else {
+        let SideCurve::Points(p) = side else { unreachable!() };
+        return SideSample { t: None, points: p.clone() };
+    };
+    let per = per_element.max(2);
+    let mut t = vec![0.0];
+    let pieces: Vec<(f64, f64)> = if matches!(side, SideCurve::Analytic(_)) {
+        let n = 64 * per;
+        (0..n).map(|k| (k as f64 / n as f64, (k + 1) as f64 / n as f64)).collect()
+    } else {
+        f.breaks.windows(2).filter(|w| w[1] > w[0]).map(|w| (w[0], w[1])).collect()
+    };
+    let sub = if matches!(side, SideCurve::Analytic(_)) { 1 } else { per };
+    for (a, b) in pieces {
+        for k in 1..=sub {
+            t.push(if k == sub { b } else { a + (b - a) * k as f64 / sub as f64 });
+        }
+    }
+    let points = t.iter().map(|&u| f.eval(u)).collect();
+    SideSample { t: Some(t), points }
+}
+
+/// Monotone map `g` with `g(ξ_k) = t_k` from abscissae `ξ_k` of samples at parameters
+/// `t_k` (both non-decreasing, from 0 to 1); samples whose `ξ` or `t` repeats the previous
+/// one are dropped (a stationary stretch of the curve).
+pub fn interpolating_map(xi: &[f64], t: &[f64]) -> Result<ParamMap> {
+    let (mut x, mut y) = (Vec::with_capacity(xi.len()), Vec::with_capacity(xi.len()));
+    for (&a, &b) in xi.iter().zip(t) {
+        if let (Some(&pa), Some(&pb)) = (x.last(), y.last()) {
+            if a <= pa || b <= pb {
+                continue;
+            }
+        }
+        x.push(a);
+        y.push(b);
+    }
+    // make sure the ends are exactly 0 and 1
+    if let (Some(lx), Some(ly)) = (x.last_mut(), y.last_mut()) {
+        *lx = 1.0;
+        *ly = 1.0;
+    }
+    Ok(ParamMap::Monotone(MonotoneCubic::new(x, y)?))
+}
+
+/// Approximate arc-length reparameterization of a parametric side (eq. 38-39): `g` is a
+/// cubic B-spline on `elements` uniform elements with `c_0 = 0`, `c_n = 1`, started from
+/// the Schoenberg (variation-diminishing) approximation of the inverse cord length
+/// `c_i = s^{-1}(γ_i)` at the Greville points `γ_i` (increasing, so `g' > 0`), then
+/// improved by Gauss-Newton steps on `A(c) = ∫ ||f̄'(g) g'||^2 dξ`; a step is accepted
+/// only when it lowers `A` and keeps the coefficients strictly increasing, so `g` stays
+/// strictly monotone (its derivative is a spline with positive coefficients). Returns
+/// `g` and `A / L^2 >= 1` (1 for exact arc length). `None` for point clouds.
+pub fn arc_length_map(side: &SideCurve, elements: usize, samples: usize) -> Result<Option<(ParamMap, f64)>> {
+    arc_length_iterations(side, elements, samples, 30)
+}
+
+/// [`arc_length_map`] with at most `iterations` Gauss-Newton steps.
+fn arc_length_iterations(
+    side: &SideCurve,
+    elements: usize,
+    samples: usize,
+    iterations: usize,
+) -> Result<Option<(ParamMap, f64)>> {
+    let Some(f) = Parametric::new(side) else { return Ok(None) };
+    let sample = sample_side(side, samples);
+    let t = sample.t.expect("parametric");
+    let s = cord_length_params(&sample.points)
+        .ok_or_else(|| Error::Invalid("arc-length reparameterization of a side of zero length".into()))?;
+    let length: f64 = sample.points.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum();
+    let inv = interpolating_map(&s, &t)?;
+    let kv = KnotVector::open_uniform(3, elements.max(1));
+    let n = kv.num_basis();
+    let mut c: Vec<f64> = kv.greville().iter().map(|&g| inv.eval(g)).collect();
+    c[0] = 0.0;
+    c[n - 1] = 1.0;
+    if c.windows(2).any(|w| w[1] <= w[0]) {
+        // a stationary stretch: fall back to uniform increments there
+        for i in 1..n {
+            c[i] = c[i].max(c[i - 1] + 1e-9);
+        }
+        let top = c[n - 1];
+        c.iter_mut().for_each(|v| *v /= top);
+    }
+    let gauss = GaussLegendre::new(8);
+    // A(c) and, when asked, the Gauss-Newton system on the free coefficients.
+    // the Gauss-Newton matrix in band storage: `band[i][j + 3 - i] = (J^T J)_{ij}`
+    let functional = |c: &[f64], sys: Option<(&mut Vec<[f64; 7]>, &mut Vec<f64>)>| -> f64 {
+        let g = ParamMap::Spline { knots: kv.clone(), coefs: c.to_vec() };
+        // pieces: g's breaks and the preimages of the side's breaks
+        let mut br = g.breaks();
+        br.extend(f.breaks.iter().map(|&u| g.inverse(u)));
+        br.sort_by(f64::total_cmp);
+        br.dedup_by(|a, b| (*a - *b).abs() < 1e-14);
+        let mut total = 0.0;
+        let mut sys = sys;
+        let mut b = crate::basis::BasisDerivs::default();
+        for w in br.windows(2) {
+            for (xi, wt) in gauss.on(w[0], w[1]) {
+                b.eval(&kv, xi, 1);
+                let first = b.first();
+                let (mut gv, mut gd) = (0.0, 0.0);
+                for j in 0..=3 {
+                    gv += b.d[0][j] * c[first + j];
+                    gd += b.d[1][j] * c[first + j];
+                }
+                let [_, d1, d2] = f.derivs(gv);
+                let r = [d1[0] * gd, d1[1] * gd];
+                total += wt * (r[0] * r[0] + r[1] * r[1]);
+                if let Some((jtj, jtr)) = sys.as_mut() {
+                    let mut jac = [[0.0; 2]; 4];
+                    for j in 0..=3 {
+                        for k in 0..2 {
+                            jac[j][k] = d2[k] * gd * b.d[0][j] + d1[k] * b.d[1][j];
+                        }
+                    }
+                    for j in 0..=3 {
+                        let gj = first + j;
+                        jtr[gj] += wt * (jac[j][0] * r[0] + jac[j][1] * r[1]);
+                        for k in 0..=3 {
+                            jtj[gj][k + 3 - j] += wt * (jac[j][0] * jac[k][0] + jac[j][1] * jac[k][1]);
+                        }
+                    }
+                }
+            }
+        }
+        total
+    };
+    let mut a = functional(&c, None);
+    for _ in 0..iterations {
+        let mut jtj = vec![[0.0; 7]; n];
+        let mut jtr = vec![0.0; n];
+        functional(&c, Some((&mut jtj, &mut jtr)));
+        // free unknowns 1..n-1 (c_0 and c_n are fixed), with a tiny shift
+        let m = n - 2;
+        if m == 0 {
+            break;
+        }
+        let mut mat: Vec<[f64; 7]> = jtj[1..n - 1].to_vec();
+        for (i, row) in mat.iter_mut().enumerate() {
+            for (d, v) in row.iter_mut().enumerate() {
+                if i + d < 3 || i + d >= m + 3 {
+                    *v = 0.0; // couplings to the fixed ends
+                }
+            }
+        }
+        let tr = mat.iter().map(|r| r[3]).sum::<f64>() / m as f64;
+        mat.iter_mut().for_each(|r| r[3] += 1e-12 * tr);
+        let mut rhs: Vec<f64> = (1..n - 1).map(|i| -jtr[i]).collect();
+        if !solve_band(&mut mat, &mut rhs) {
+            break;
+        }
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        while alpha > 1e-6 {
+            let mut trial = c.clone();
+            for i in 0..m {
+                trial[i + 1] += alpha * rhs[i];
+            }
+            if trial.windows(2).all(|w| w[1] > w[0]) {
+                let at = functional(&trial, None);
+                if at < a {
+                    let rel = (a - at) / a;
+                    c = trial;
+                    a = at;
+                    accepted = rel > 1e-12;
+                    break;
+                }
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    let ratio = if length > 0.0 { a / (length * length) } else { f64::NAN };
+    Ok(Some((ParamMap::Spline { knots: kv, coefs: c }, ratio)))
+}
+
+/// Gaussian elimination without pivoting on a symmetric positive definite matrix of
+/// half-bandwidth 3 in band storage (`a[i][j + 3 - i] = A_{ij}`); `false` on a
+/// non-positive pivot.
+fn solve_band(a: &mut [[f64; 7]], b: &mut [f64]) -> bool {
+    let n = b.len();
+    for k in 0..n {
+        let piv = a[k][3];
+        if !(piv > 0.0 && piv.is_finite()) {
+            return false;
+        }
+        for i in k + 1..n.min(k + 4) {
+            let f = a[i][k + 3 - i] / piv;
+            if f == 0.0 {
+                continue;
+            }
+            for j in k..n.min(k + 4) {
+                a[i][j + 3 - i] -= f * a[k][j + 3 - k];
+            }
+            b[i] -= f * b[k];
+        }
+    }
+    for k in (0..n).rev() {
+        let mut s = b[k];
+        for j in k + 1..n.min(k + 4) {
+            s -= a[k][j + 3 - k] * b[j];
+        }
+        b[k] = s / a[k][3];
+    }
+    true
+}
+
+// ---------------------------------------------------------------------------------------
+// Constrained cord length
+// ---------------------------------------------------------------------------------------
+
+fn dist2(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Closest-pair matching of eq. 40, recursively: among `p1[i]`, `p2[j]` with `c1[i]` in
+/// `(lo1, hi1)` and `c2[j]` in `(lo2, hi2)` (cord-length parameters of each side, the
+/// open intervals shrunk by `sep` at both ends), the closest pair within `eps` is matched
+/// and the search continues below and above it. Returns the pairs `(i, j)` ordered by
+/// `i` (and then also by `j`).
+pub fn match_pairs(p1: &[Point], c1: &[f64], p2: &[Point], c2: &[f64], eps: f64, sep: f64) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    // explicit stack of boxes (lo1, hi1, lo2, hi2) in parameter space
+    let mut stack = vec![(0.0f64, 1.0f64, 0.0f64, 1.0f64)];
+    let eps2 = eps * eps;
+    while let Some((lo1, hi1, lo2, hi2)) = stack.pop() {
+        let r1 = c1.partition_point(|&v| v <= lo1 + sep)..c1.partition_point(|&v| v < hi1 - sep);
+        let r2 = c2.partition_point(|&v| v <= lo2 + sep)..c2.partition_point(|&v| v < hi2 - sep);
+        if r1.is_empty() || r2.is_empty() {
+            continue;
+        }
+        let mut best = (f64::INFINITY, 0, 0);
+        for i in r1.clone() {
+            for j in r2.clone() {
+                let d = dist2(p1[i], p2[j]);
+                if d < best.0 {
+                    best = (d, i, j);
+                }
+            }
+        }
+        if best.0 > eps2 {
+            continue;
+        }
+        let (_, i, j) = best;
+        out.push((i, j));
+        stack.push((lo1, c1[i], lo2, c2[j]));
+        stack.push((c1[i], hi1, c2[j], hi2));
+    }
+    out.sort_unstable();
+    out
+}
+
+/// Abscissae of the second side from matched values (eq. 41-42 or monotone cubic):
+/// `known` holds `(index, ξ)` pairs with increasing index and strictly increasing `ξ`,
+/// `c2` the side's own cord-length parameters. The ends are `ξ = 0` and `ξ = 1`.
+pub fn fill_abscissae(c2: &[f64], known: &[(usize, f64)], fill: Fill) -> Result<Vec<f64>> {
+    let m = c2.len();
+    let mut anchors: Vec<(usize, f64)> = vec![(0, 0.0)];
+    anchors.extend(known.iter().copied().filter(|&(j, _)| j > 0 && j + 1 < m));
+    anchors.push((m - 1, 1.0));
+    if anchors.windows(2).any(|w| w[1].0 <= w[0].0 || w[1].1 <= w[0].1) {
+        return Err(Error::Invalid("constrained cord length: matched abscissae are not increasing".into()));
+    }
+    let mut xi = vec![0.0; m];
+    match fill {
+        Fill::CordLength => {
+            for w in anchors.windows(2) {
+                let ((a, xa), (b, xb)) = (w[0], w[1]);
+                let span = c2[b] - c2[a];
+                for j in a..=b {
+                    // eq. 41: local cord length mapped onto [ξ_α, ξ_β]
+                    let loc = if span > 0.0 { (c2[j] - c2[a]) / span } else { (j - a) as f64 / (b - a) as f64 };
+                    xi[j] = xa + loc * (xb - xa);
+                }
+            }
+        }
+        Fill::MonotoneCubic => {
+            // abscissa of the interpolant: the side's own cord length (strictly increasing
+            // over the anchors; falls back to the index where points repeat)
+            let x: Vec<f64> = anchors.iter().map(|&(j, _)| c2[j] + j as f64 * 1e-12).collect();
+            let y: Vec<f64> = anchors.iter().map(|a| a.1).collect();
+            let mc = MonotoneCubic::new(x, y)?;
+            for (j, v) in xi.iter_mut().enumerate() {
+                *v = mc.eval(c2[j] + j as f64 * 1e-12);
+            }
+        }
+    }
+    for &(j, v) in &anchors {
+        xi[j] = v;
+    }
+    Ok(xi)
+}
+
+/// Abscissae of the two sides and the matched index pairs.
+pub type Constrained = (Vec<f64>, Vec<f64>, Vec<(usize, usize)>);
+
+/// The constrained cord-length abscissae of two opposite sides (§7.2): `Ξ_1` is the cord
+/// length of `p1`; `Ξ_2` takes the value of `Ξ_1` at every matched pair (eq. 40, threshold
+/// `eps`, minimum separation `sep`) and is filled in between by `fill`. Returns
+/// `(Ξ_1, Ξ_2, matches)`.
+pub fn constrained_params(p1: &[Point], p2: &[Point], eps: f64, sep: f64, fill: Fill) -> Result<Constrained> {
+    let c1 = cord_length_params(p1)
+        .ok_or_else(|| Error::Invalid("constrained cord length: first side has zero length".into()))?;
+    let c2 = cord_length_params(p2)
+        .ok_or_else(|| Error::Invalid("constrained cord length: second side has zero length".into()))?;
+    // the closest-pair search is quadratic: on very dense clouds it runs on every k-th point
+    let (i1, i2) = (thinned(p1.len()), thinned(p2.len()));
+    let pick = |idx: &[usize], v: &[Point]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
+    let pickc = |idx: &[usize], v: &[f64]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
+    let mut pairs: Vec<(usize, usize)> =
+        match_pairs(&pick(&i1, p1), &pickc(&i1, &c1), &pick(&i2, p2), &pickc(&i2, &c2), eps, sep)
+            .into_iter()
+            .map(|(a, b)| (i1[a], i2[b]))
+            .collect();
+    // repeated points on side 1 can give equal abscissae: keep strictly increasing ones
+    let mut last = 0.0;
+    pairs.retain(|&(i, _)| {
+        let ok = c1[i] > last && c1[i] < 1.0;
+        if ok {
+            last = c1[i];
+        }
+        ok
+    });
+    let known: Vec<(usize, f64)> = pairs.iter().map(|&(i, j)| (j, c1[i])).collect();
+    let xi2 = fill_abscissae(&c2, &known, fill)?;
+    Ok((c1, xi2, pairs))
+}
+
+/// Most points per side that the quadratic searches ([`match_pairs`], [`min_distance`])
+/// look at; denser clouds are thinned to every k-th point (ends kept).
+pub const MAX_SEARCH_POINTS: usize = 4096;
+
+/// Indices `0, k, 2k, ..., n-1` with `k` the smallest stride leaving at most
+/// [`MAX_SEARCH_POINTS`] points.
+fn thinned(n: usize) -> Vec<usize> {
+    let k = n.div_ceil(MAX_SEARCH_POINTS).max(1);
+    let mut v: Vec<usize> = (0..n).step_by(k).collect();
+    if v.last() != Some(&(n - 1)) {
+        v.push(n - 1);
+    }
+    v
+}
+
+/// Smallest distance between two point sets (brute force on at most
+/// [`MAX_SEARCH_POINTS`] points of each), used to detect narrow gaps.
+pub fn min_distance(p1: &[Point], p2: &[Point]) -> f64 {
+    let mut best = f64::INFINITY;
+    for &i in &thinned(p1.len()) {
+        for &j in &thinned(p2.len()) {
+            best = best.min(dist2(p1[i], p2[j]));
+        }
+    }
+    best.sqrt()
+}
+
+fn polyline_length(p: &[Point]) -> f64 {
+    p.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
+}
+
+// ---------------------------------------------------------------------------------------
+// The plan for a boundary
+// ---------------------------------------------------------------------------------------
+
+/// How one side is parameterized for the fit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SideParam {
+    /// The input's own parameterization (cord length for point clouds).
+    Native,
+    /// Abscissae of the points of a point-cloud side.
+    Abscissae(Vec<f64>),
+    /// A parametric side re-fitted as `f̄ ∘ g`.
+    Map(ParamMap),
+}
+
+/// A matched pair of points on two opposite sides, at the same parameter.
+#[derive(Debug, Clone, Serialize)]
+pub struct Match {
+    /// The two sides ("south", "north") or ("west", "east").
+    pub sides: [&'static str; 2],
+    /// The common parameter (`xi` for south/north, `eta` for west/east).
+    pub parameter: f64,
+    /// The physical points on the two sides.
+    pub points: [Point; 2],
+}
+
+/// What the reparameterization did, for the solve report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReparamReport {
+    /// The requested method.
+    pub requested: Reparam,
+    /// The method applied: `constrained` when any pair was constrained, else the request
+    /// (`none` for `auto` without narrow gaps).
+    pub used: Reparam,
+    /// Per pair (south/north, west/east): smallest distance between the two sides over
+    /// their mean length.
+    pub gap_ratio: [f64; 2],
+    /// Per pair: the method applied to it.
+    pub pair_methods: [Reparam; 2],
+    /// Threshold of `auto` and of the matching, relative to the mean length of a pair.
+    pub gap_threshold: f64,
+    /// Fill of the unmatched abscissae.
+    pub fill: Fill,
+    /// For arc length on parametric sides: `A / L^2` per side (south, east, north, west;
+    /// 1 is exact arc length); `null` where not applicable.
+    pub arc_length_ratio: [Option<f64>; 4],
+    /// The matched pairs.
+    pub matches: Vec<Match>,
+}
+
+impl ReparamReport {
+    /// The report of the input's own parameterization.
+    pub fn native() -> Self {
+        Self {
+            requested: Reparam::None,
+            used: Reparam::None,
+            gap_ratio: [f64::NAN; 2],
+            pair_methods: [Reparam::None; 2],
+            gap_threshold: 0.0,
+            fill: Fill::CordLength,
+            arc_length_ratio: [None; 4],
+            matches: Vec::new(),
+        }
+    }
+
+    /// The matched pairs as segments (for pictures).
+    pub fn segments(&self) -> Vec<(Point, Point)> {
+        self.matches.iter().map(|m| (m.points[0], m.points[1])).collect()
+    }
+}
+
+/// The parameterization of all four sides and its report.
+#[derive(Debug, Clone)]
+pub struct ReparamPlan {
+    /// South, east, north, west.
+    pub sides: [SideParam; 4],
+    /// What was done.
+    pub report: ReparamReport,
+}
+
+/// Decide and compute the reparameterization of `boundary` (sides south, east, north,
+/// west): for each opposite pair (south/north in `xi`, west/east in `eta`) the sides are
+/// sampled ([`sample_side`]), their smallest distance over their mean length is the
+/// pair's gap ratio, and the pair is treated by `opts.method` (`auto`: constrained when
+/// the gap ratio is below `opts.gap`, else native). Side 1 of a pair is south or west.
+pub fn plan(boundary: &Boundary, opts: &ReparamOptions) -> Result<ReparamPlan> {
+    opts.validate()?;
+    let mut sides = [SideParam::Native, SideParam::Native, SideParam::Native, SideParam::Native];
+    let mut report = ReparamReport {
+        requested: opts.method,
+        used: if opts.method == Reparam::Auto { Reparam::None } else { opts.method },
+        gap_ratio: [f64::NAN; 2],
+        pair_methods: [Reparam::None; 2],
+        gap_threshold: opts.gap,
+        fill: opts.fill,
+        arc_length_ratio: [None; 4],
+        matches: Vec::new(),
+    };
+    for (k, (s1, s2)) in [(Side::South, Side::North), (Side::West, Side::East)].into_iter().enumerate() {
+        let (a, b) = (boundary.side(s1), boundary.side(s2));
+        let (sa, sb) = (sample_side(a, opts.samples), sample_side(b, opts.samples));
+        let mean = 0.5 * (polyline_length(&sa.points) + polyline_length(&sb.points));
+        let gap = min_distance(&sa.points, &sb.points);
+        let ratio = if mean > 0.0 { gap / mean } else { f64::INFINITY };
+        report.gap_ratio[k] = ratio;
+        let method = match opts.method {
+            Reparam::Auto if ratio < opts.gap => Reparam::Constrained,
+            Reparam::Auto => Reparam::None,
+            m => m,
+        };
+        report.pair_methods[k] = method;
+        match method {
+            Reparam::None | Reparam::Auto => {}
+            Reparam::ArcLength => {
+                for s in [s1, s2] {
+                    let side = boundary.side(s);
+                    let elements = match side {
+                        SideCurve::Spline(c) => (2 * c.knots.num_elements()).clamp(8, 2048),
+                        _ => 64,
+                    };
+                    if let Some((g, r)) = arc_length_map(side, elements, opts.samples)? {
+                        sides[s as usize] = SideParam::Map(g);
+                        report.arc_length_ratio[s as usize] = Some(r);
+                    }
+                }
+            }
+            Reparam::Constrained => {
+                let eps = opts.gap * mean;
+                let (x1, x2, pairs) = constrained_params(&sa.points, &sb.points, eps, opts.separation, opts.fill)
+                    .map_err(|e| e.within(&format!("{}/{} reparameterization", s1.name(), s2.name())))?;
+                for (i, j) in pairs {
+                    report.matches.push(Match {
+                        sides: [s1.name(), s2.name()],
+                        parameter: x1[i],
+                        points: [sa.points[i], sb.points[j]],
+                    });
+                }
+                for (s, smp, x) in [(s1, &sa, x1), (s2, &sb, x2)] {
+                    sides[s as usize] = match &smp.t {
+                        None => SideParam::Abscissae(x),
+                        Some(t) => SideParam::Map(interpolating_map(&x, t)?),
+                    };
+                }
+            }
+        }
+    }
+    if opts.method == Reparam::Auto && report.pair_methods.contains(&Reparam::Constrained) {
+        report.used = Reparam::Constrained;
+    }
+    Ok(ReparamPlan { sides, report })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::Analytic;
+    use crate::curve::Curve;
+
+    fn strictly_monotone_onto(f: impl Fn(f64) -> f64, n: usize) {
+        assert!(f(0.0).abs() < 1e-14 && (f(1.0) - 1.0).abs() < 1e-14, "ends {} {}", f(0.0), f(1.0));
+        let mut prev = f(0.0);
+        for k in 1..=n {
+            let v = f(k as f64 / n as f64);
+            assert!(v > prev, "not strictly increasing at {}: {prev} then {v}", k as f64 / n as f64);
+            prev = v;
+        }
+    }
+
+    #[test]
+    fn monotone_cubic_is_monotone_and_interpolates() {
+        // data with a flat part and steep jumps: a plain cubic spline would overshoot
+        let x = vec![0.0, 0.1, 0.2, 0.5, 0.55, 0.9, 1.0];
+        let y = vec![0.0, 0.0, 0.01, 0.02, 0.9, 0.95, 1.0];
+        let m = MonotoneCubic::new(x.clone(), y.clone()).unwrap();
+        for (a, b) in x.iter().zip(&y) {
+            assert!((m.eval(*a) - b).abs() < 1e-15);
+        }
+        let mut prev = -1.0;
+        for k in 0..=10000 {
+            let v = m.eval(k as f64 / 10000.0);
+            assert!(v >= prev - 1e-15 && (-1e-15..=1.0 + 1e-15).contains(&v));
+            prev = v;
+        }
+        // flat where the data are flat
+        assert_eq!(m.eval(0.05), 0.0);
+        // strictly increasing data: strictly increasing interpolant, exact on lines
+        let y2 = vec![0.0, 0.05, 0.3, 0.4, 0.8, 0.85, 1.0];
+        let m2 = MonotoneCubic::new(x.clone(), y2).unwrap();
+        strictly_monotone_onto(|t| m2.eval(t), 20000);
+        let lin = MonotoneCubic::new(x.clone(), x.iter().map(|v| 2.0 * v + 1.0).collect()).unwrap();
+        assert!((lin.eval(0.37) - 1.74).abs() < 1e-14 && (lin.eval_d(0.61).1 - 2.0).abs() < 1e-13);
+        assert!((m2.inverse(m2.eval(0.333)) - 0.333).abs() < 1e-12);
+        assert!(MonotoneCubic::new(vec![0.0, 0.0], vec![0.0, 1.0]).is_err());
+        assert!(MonotoneCubic::new(vec![0.0, 1.0], vec![1.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn arc_length_map_is_monotone_and_nearly_arc_length() {
+        // a quarter circle traversed with uneven speed (1 : 5.7): angle (pi/2)(0.3t + 0.7t^2)
+        let side = SideCurve::Analytic(Analytic::new(|t| {
+            let a = std::f64::consts::FRAC_PI_2 * (0.3 * t + 0.7 * t * t);
+            [a.cos(), a.sin()]
+        }));
+        let (g, ratio) = arc_length_map(&side, 16, 16).unwrap().unwrap();
+        strictly_monotone_onto(|x| g.eval(x), 5000);
+        // A / L^2 = 1 for exact arc length; the native parameterization has 9/5
+        assert!((1.0 - 1e-9..1.0 + 1e-5).contains(&ratio), "A/L^2 = {ratio}");
+        // speed of f(g(xi)) is close to the length pi/2 everywhere
+        for k in 1..100 {
+            let xi = k as f64 / 100.0;
+            let (gv, gd) = g.eval_d(xi);
+            let speed = std::f64::consts::FRAC_PI_2 * (0.3 + 1.4 * gv) * gd;
+            assert!((speed / std::f64::consts::FRAC_PI_2 - 1.0).abs() < 0.02, "speed {speed} at {xi}");
+        }
+        // a spline side: same statement through the spline derivatives
+        let kv = KnotVector::new(3, vec![0., 0., 0., 0., 0.1, 1., 1., 1., 1.]).unwrap();
+        let c = Curve::new(kv, vec![[0., 0.], [0.01, 0.0], [0.02, 0.01], [1.0, 0.5], [2.0, 0.0]], None).unwrap();
+        // (its speed varies by orders of magnitude near t = 0: A/L^2 ~ 1e-3 above 1)
+        let side = SideCurve::Spline(c);
+        let (g, ratio) = arc_length_map(&side, 16, 16).unwrap().unwrap();
+        let (_, start) = arc_length_iterations(&side, 16, 16, 0).unwrap().unwrap();
+        strictly_monotone_onto(|x| g.eval(x), 5000);
+        assert!(ratio >= 1.0 - 1e-9 && ratio <= start && ratio < 1.01, "A/L^2 = {ratio} (start {start})");
+    }
+
+    #[test]
+    fn gauss_newton_improves_on_the_initial_guess() {
+        // x = t^4 has g = xi^(1/4) as exact arc length, which no spline reproduces: the
+        // Greville start is coarse and the Gauss-Newton steps must lower A; A / L^2 stays
+        // above 1 and approaches it under refinement
+        let side = SideCurve::Analytic(Analytic::new(|t| [t.powi(4), 0.0]));
+        for n in [4, 16] {
+            let (_, start) = arc_length_iterations(&side, n, 16, 0).unwrap().unwrap();
+            let (g, opt) = arc_length_map(&side, n, 16).unwrap().unwrap();
+            assert!(opt < start && opt > 1.0, "{n} elements: {start} -> {opt}");
+            strictly_monotone_onto(|x| g.eval(x), 2000);
+        }
+        let (_, r4) = arc_length_map(&side, 4, 16).unwrap().unwrap();
+        let (_, r16) = arc_length_map(&side, 16, 16).unwrap().unwrap();
+        assert!(r16 < r4 && r16 < 1.02, "{r4} {r16}");
+    }
+
+    /// A synthetic tube: south is the line y = 0 from x = 0 to 10; north runs at height 1
+    /// except for two narrow constrictions down to y = 0.05 at x = 3 and x = 7, and is
+    /// wavy on `x < 2` so that cord length alone puts the constrictions at other
+    /// parameters than south's; north is also sampled unevenly.
+    fn tube() -> (Vec<Point>, Vec<Point>) {
+        let south: Vec<Point> = (0..=400).map(|k| [10.0 * k as f64 / 400.0, 0.0]).collect();
+        let height = |x: f64| {
+            let wave = if x < 2.0 { 0.3 * (5.0 * std::f64::consts::PI * x).sin() } else { 0.0 };
+            1.0 + wave - 0.95 * (-((x - 3.0) / 0.15).powi(2)).exp() - 0.95 * (-((x - 7.0) / 0.15).powi(2)).exp()
+        };
+        let north: Vec<Point> = (0..=600)
+            .map(|k| {
+                let s = k as f64 / 600.0;
+                let x = 10.0 * s * s; // dense near x = 0
+                [x, height(x)]
+            })
+            .collect();
+        (south, north)
+    }
+
+    #[test]
+    fn synthetic_tube_matches_at_the_gaps() {
+        let (south, north) = tube();
+        let mean = 0.5 * (polyline_length(&south) + polyline_length(&north));
+        let eps = 0.02 * mean;
+        for fill in [Fill::CordLength, Fill::MonotoneCubic] {
+            let (x1, x2, pairs) = constrained_params(&south, &north, eps, 0.01, fill).unwrap();
+            assert!(!pairs.is_empty());
+            // every match is within the threshold and close to one of the constrictions
+            for &(i, j) in &pairs {
+                let d = dist2(south[i], north[j]).sqrt();
+                assert!(d <= eps);
+                assert!((south[i][0] - 3.0).abs() < 0.2 || (south[i][0] - 7.0).abs() < 0.2, "{:?}", south[i]);
+                // the pair is at the same parameter on both sides
+                assert_eq!(x1[i], x2[j]);
+            }
+            // the closest points of the constrictions are matched
+            for gx in [3.0, 7.0] {
+                let best = pairs
+                    .iter()
+                    .map(|&(i, j)| (south[i][0] - gx).abs() + (north[j][0] - gx).abs())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(best < 0.06, "no match at x = {gx}: {best}");
+            }
+            // strictly increasing abscissae from 0 to 1 on both sides
+            for x in [&x1, &x2] {
+                assert!(x[0] == 0.0 && *x.last().unwrap() == 1.0);
+                assert!(x.windows(2).all(|w| w[1] > w[0]));
+            }
+            // without constraints the constriction of north would be elsewhere
+            let c2 = cord_length_params(&north).unwrap();
+            let (i, j) = pairs[0];
+            assert!((c2[j] - x1[i]).abs() > 0.05);
+        }
+        // minimum separation: matches are at least `sep` apart in cord length
+        let (x1, _, pairs) = constrained_params(&south, &north, eps, 0.05, Fill::CordLength).unwrap();
+        for w in pairs.windows(2) {
+            assert!(x1[w[1].0] - x1[w[0].0] >= 0.05);
+        }
+        // nothing closer than the threshold: plain cord length, no matches
+        let (_, x2, pairs) = constrained_params(&south, &north, 0.01, 0.01, Fill::CordLength).unwrap();
+        assert!(pairs.is_empty());
+        assert_eq!(x2, cord_length_params(&north).unwrap());
+    }
+
+    #[test]
+    fn dense_clouds_are_thinned_for_the_search() {
+        assert_eq!(thinned(5), vec![0, 1, 2, 3, 4]);
+        let t = thinned(3 * MAX_SEARCH_POINTS + 7);
+        assert!(t.len() <= MAX_SEARCH_POINTS + 1 && t[0] == 0 && *t.last().unwrap() == 3 * MAX_SEARCH_POINTS + 6);
+        // a dense tube: matches still lie at the gap and at equal abscissae
+        let n = 3 * MAX_SEARCH_POINTS;
+        let south: Vec<Point> = (0..=n).map(|k| [10.0 * k as f64 / n as f64, 0.0]).collect();
+        let north: Vec<Point> = (0..=n)
+            .map(|k| {
+                let x = 10.0 * k as f64 / n as f64;
+                [x, 1.0 - 0.95 * (-((x - 6.0) / 0.2).powi(2)).exp()]
+            })
+            .collect();
+        let (x1, x2, pairs) = constrained_params(&south, &north, 0.1, 0.01, Fill::CordLength).unwrap();
+        assert!(!pairs.is_empty());
+        for &(i, j) in &pairs {
+            assert_eq!(x1[i], x2[j]);
+            assert!((south[i][0] - 6.0).abs() < 0.3 && dist2(south[i], north[j]).sqrt() <= 0.1);
+        }
+    }
+
+    #[test]
+    fn constrained_curves_keep_shape_and_match_parameters() {
+        // the tube's sides as analytic curves: g maps onto [0,1] monotonically and the
+        // matched physical points are f(g(xi)) on both sides at the common xi
+        let height = |x: f64| 1.0 - 0.95 * (-((x - 4.0) / 0.2).powi(2)).exp();
+        let south = SideCurve::Analytic(Analytic::new(|t| [10.0 * t, 0.0]));
+        let north = SideCurve::Analytic(Analytic::new(move |t| {
+            let x = 10.0 * t * t;
+            [x, height(x)]
+        }));
+        let west = SideCurve::Points(vec![[0.0, 0.0], [0.0, 1.0]]);
+        let east = SideCurve::Points(vec![[10.0, 0.0], [10.0, 1.0]]);
+        let b = Boundary { name: "tube".into(), sides: [south.clone(), east, north.clone(), west] };
+        let p = plan(&b, &ReparamOptions::default()).unwrap();
+        assert_eq!(p.report.used, Reparam::Constrained);
+        assert_eq!(p.report.pair_methods, [Reparam::Constrained, Reparam::None]);
+        assert!(!p.report.matches.is_empty());
+        let (SideParam::Map(gs), SideParam::Map(gn)) = (&p.sides[0], &p.sides[2]) else { panic!("maps") };
+        strictly_monotone_onto(|x| gs.eval(x), 4000);
+        strictly_monotone_onto(|x| gn.eval(x), 4000);
+        let (Some(fs), Some(fn_)) = (Parametric::new(&south), Parametric::new(&north)) else { panic!() };
+        for m in &p.report.matches {
+            let (a, c) = (fs.eval(gs.eval(m.parameter)), fn_.eval(gn.eval(m.parameter)));
+            assert!(dist2(a, m.points[0]).sqrt() < 1e-9 && dist2(c, m.points[1]).sqrt() < 1e-9, "{m:?}");
+            assert!((a[0] - 4.0).abs() < 0.5);
+        }
+        // the shape is unchanged: every point of f(g(xi)) lies on the curve, and f(g)
+        // runs through all of it (the image of a fine xi grid is dense on the curve)
+        let mut prev = fn_.eval(0.0);
+        for k in 1..=2000 {
+            let q = fn_.eval(gn.eval(k as f64 / 2000.0));
+            assert!((q[1] - height(q[0])).abs() < 1e-12);
+            assert!(dist2(prev, q).sqrt() < 0.1);
+            prev = q;
+        }
+    }
+}
