@@ -254,7 +254,7 @@ impl ViewerApp {
             match &self.state.probe {
                 Some(p) => ui.monospace(p.text()),
                 None => ui.label(
-                    "hover a view for (ξ, η) ↔ (x, y) and det J; drag to pan, scroll to zoom, double-click to fit",
+                    "hover a view for (ξ, η) <-> (x, y) and det J; drag to pan, scroll to zoom, double-click to fit",
                 ),
             };
             if let Some(s) = &self.state.status {
@@ -270,7 +270,7 @@ impl ViewerApp {
     fn side_panel(&mut self, ui: &mut Ui) {
         ui.add_space(4.0);
         let Some(scene) = &self.state.scene else {
-            ui.label("Open a boundary or map file: File → Open, drag and drop, or a path on the command line.");
+            ui.label("Open a boundary or map file: File > Open, drag and drop, or a path on the command line.");
             return;
         };
         file_section(ui, scene);
@@ -380,11 +380,24 @@ impl ViewerApp {
             return;
         }
         let gap = 8.0;
+        let title = 18.0;
+        let full_views = Rect::from_min_max(full.min + Vec2::new(0.0, title), full.max);
         let views_w = (full.width() - BAR_WIDTH - gap).max(10.0);
         let param_w = (0.4 * views_w).min(full.height());
-        let phys = Rect::from_min_size(full.min, Vec2::new(views_w - param_w - gap, full.height()));
-        let side = param_w.min(full.height());
-        let param = Rect::from_min_size(Pos2::new(phys.max.x + gap, full.min.y), Vec2::new(param_w, side));
+        let phys = Rect::from_min_size(full_views.min, Vec2::new(views_w - param_w - gap, full_views.height()));
+        let side = param_w.min(full_views.height());
+        let param = Rect::from_min_size(Pos2::new(phys.max.x + gap, full_views.min.y), Vec2::new(param_w, side));
+        let label = |ui: &Ui, r: Rect, text: &str| {
+            ui.painter().text(
+                r.left_top() + Vec2::new(2.0, -3.0),
+                Align2::LEFT_BOTTOM,
+                text,
+                FontId::proportional(13.0),
+                ui.visuals().text_color(),
+            );
+        };
+        label(ui, phys, "physical domain (x, y)");
+        label(ui, param, "parameter square (ξ, η)");
         let bar = Rect::from_min_max(Pos2::new(full.max.x - BAR_WIDTH, full.min.y), full.max);
         self.views_rect = Some(full);
         self.physical_rect = Some(phys);
@@ -491,13 +504,6 @@ impl ViewerApp {
                 }
             }
         }
-        painter.text(
-            rect.left_top() + Vec2::new(6.0, 4.0),
-            Align2::LEFT_TOP,
-            "physical (x, y)",
-            FontId::proportional(13.0),
-            Color32::from_gray(60),
-        );
         resp.hovered()
     }
 
@@ -569,13 +575,6 @@ impl ViewerApp {
         for (k, (a, b)) in [(0, 1), (1, 2), (3, 2), (0, 3)].into_iter().enumerate() {
             painter.line_segment([to(corners[a]), to(corners[b])], Stroke::new(1.6, colours[k]));
         }
-        painter.text(
-            rect.left_top() + Vec2::new(6.0, 4.0),
-            Align2::LEFT_TOP,
-            "parameters (ξ, η)",
-            FontId::proportional(13.0),
-            Color32::from_gray(60),
-        );
         resp.hovered()
     }
 
@@ -628,7 +627,7 @@ impl ViewerApp {
         painter.text(
             Pos2::new(swatch.right() + 6.0, swatch.center().y),
             Align2::LEFT_CENTER,
-            "≤ 0 (fold)",
+            "<= 0 (fold)",
             FontId::proportional(12.0),
             text,
         );
@@ -736,7 +735,8 @@ fn file_section(ui: &mut Ui, scene: &Scene) {
         ui.end_row();
         if let Some(p) = &scene.path {
             ui.label("file");
-            ui.label(p.display().to_string());
+            let name = p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
+            ui.label(name).on_hover_text(p.display().to_string());
             ui.end_row();
         }
         if let Some(mv) = &scene.map {
@@ -778,10 +778,14 @@ fn certificate_section(ui: &mut Ui, mv: &MapView) {
     ui.heading("Certificate");
     let c = &mv.certificate;
     ui.label(
-        RichText::new(format!("{} {}", if verdict_is_good(c.verdict) { "✔" } else { "✘" }, verdict_name(c.verdict)))
-            .color(verdict_colour(c))
-            .strong()
-            .size(16.0),
+        RichText::new(format!(
+            "{} {}",
+            if verdict_is_good(c.verdict) { "OK:" } else { "BAD:" },
+            verdict_name(c.verdict)
+        ))
+        .color(verdict_colour(c))
+        .strong()
+        .size(16.0),
     );
     ui.label(&c.message);
     ui.label(RichText::new(format!("from the {}", c.source.label())).weak());
@@ -824,7 +828,7 @@ fn quality_section(ui: &mut Ui, mv: &MapView) {
         row("area", format!("{:.6}", f.area));
         row(
             "Winslow functional",
-            if f.winslow.is_finite() { format!("{:.6}", f.winslow) } else { "∞ (det J ≤ 0)".into() },
+            if f.winslow.is_finite() { format!("{:.6}", f.winslow) } else { "infinite (det J <= 0)".into() },
         );
         row("harmonic energy", format!("{:.4e}", f.harmonic));
         row("sample", format!("{grid} ({})", mv.sampler));
@@ -835,7 +839,7 @@ fn quality_section(ui: &mut Ui, mv: &MapView) {
                 "{}: {:.1}°{}",
                 c.corner,
                 c.angle_degrees,
-                if c.forces_nonpositive_det_j { " (forces det J ≤ 0)" } else { "" }
+                if c.forces_nonpositive_det_j { " (forces det J <= 0)" } else { "" }
             ));
         }
     });
@@ -847,7 +851,7 @@ fn folds_section(ui: &mut Ui, mv: &MapView, selected: Option<usize>) -> Option<u
     let forced = mv.folds.len() - folds;
     ui.heading(format!("Folded elements: {folds}"));
     if forced > 0 {
-        ui.label(format!("{forced} element(s) at corners whose angle forces det J ≤ 0"));
+        ui.label(format!("{forced} element(s) at corners whose angle forces det J <= 0"));
     }
     if mv.folds.is_empty() {
         ui.label("none: det J > 0 on every sample");

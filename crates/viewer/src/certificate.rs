@@ -138,7 +138,6 @@ impl Certificate {
             "boundary deviation".to_string(),
             format!("{:.2e}", r.boundary_deviation.iter().copied().fold(0.0, f64::max)),
         ));
-        details.push(("seconds".to_string(), format!("{:.2}", r.seconds)));
         Self { verdict: r.verdict, message: r.message.clone(), source: CertificateSource::Solver, details }
     }
 
@@ -147,7 +146,7 @@ impl Certificate {
         let verdict = verdict_from_name(report.get("verdict")?.as_str()?)?;
         let message = report.get("message").and_then(|m| m.as_str()).unwrap_or_default().to_string();
         let mut details = Vec::new();
-        for key in ["backend", "operator", "repairs", "seconds", "det_j_min_away_from_forced_corners"] {
+        for key in ["backend", "operator", "repairs", "det_j_min_away_from_forced_corners"] {
             if let Some(v) = report.get(key).filter(|v| !v.is_null()) {
                 details.push((key.replace('_', " "), v.to_string().trim_matches('"').to_string()));
             }

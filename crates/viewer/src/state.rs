@@ -100,7 +100,7 @@ impl Probe {
     pub fn text(&self) -> String {
         let [x, y] = self.point;
         match (self.param, self.det_j) {
-            (Some([u, v]), Some(d)) => format!("ξ = {u:.4}, η = {v:.4}  ↔  x = {x:.5}, y = {y:.5};  det J = {d:.4e}"),
+            (Some([u, v]), Some(d)) => format!("ξ = {u:.4}, η = {v:.4}  <->  x = {x:.5}, y = {y:.5};  det J = {d:.4e}"),
             _ => format!("x = {x:.5}, y = {y:.5} (outside the map)"),
         }
     }
@@ -172,7 +172,10 @@ impl ViewerState {
         match Scene::open(path, self.sampler.as_ref(), self.settings) {
             Ok(scene) => {
                 self.set_scene(scene);
-                self.status = Some(format!("opened {}", path.display()));
+                self.status = Some(format!(
+                    "opened {}",
+                    path.file_name().map_or(path.display().to_string(), |n| n.to_string_lossy().into_owned())
+                ));
                 Ok(())
             }
             Err(e) => {
