@@ -105,7 +105,10 @@ impl ViewerApp {
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_line(ui));
         egui::Panel::left("side").exact_size(PANEL_WIDTH).resizable(false).show(ui, |ui| {
-            egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| self.side_panel(ui));
+            egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+                ui.set_max_width(PANEL_WIDTH - 28.0);
+                self.side_panel(ui)
+            });
         });
         egui::CentralPanel::default().show(ui, |ui| self.central(ui));
         self.screenshots(&ctx);
@@ -274,24 +277,25 @@ impl ViewerApp {
             return;
         };
         file_section(ui, scene);
-        ui.separator();
-        self.display_section(ui);
-        ui.separator();
         if let Some(mv) = self.state.scene.as_ref().and_then(|s| s.map.as_ref()) {
-            certificate_section(ui, mv);
-            ui.separator();
-            quality_section(ui, mv);
-            ui.separator();
-            if let Some(k) = folds_section(ui, mv, self.state.selected_fold) {
+            section(ui, "Certificate", |ui| certificate_section(ui, mv));
+            let folds = mv.folds.iter().filter(|f| !f.forced_corner).count();
+            let mut clicked = None;
+            section(ui, &format!("Folded elements: {folds}"), |ui| {
+                clicked = folds_section(ui, mv, self.state.selected_fold);
+            });
+            if let Some(k) = clicked {
                 self.state.selected_fold = if self.state.selected_fold == Some(k) { None } else { Some(k) };
             }
-            ui.separator();
         }
-        self.solve_section(ui);
+        section(ui, "Solve", |ui| self.solve_section(ui));
+        section(ui, "Display", |ui| self.display_section(ui));
+        if let Some(mv) = self.state.scene.as_ref().and_then(|s| s.map.as_ref()) {
+            section(ui, "Quality", |ui| quality_section(ui, mv));
+        }
     }
 
     fn display_section(&mut self, ui: &mut Ui) {
-        ui.heading("Display");
         let d = &mut self.state.display;
         ui.horizontal_wrapped(|ui| {
             ui.checkbox(&mut d.heat, "det J heat map");
@@ -321,7 +325,6 @@ impl ViewerApp {
     }
 
     fn solve_section(&mut self, ui: &mut Ui) {
-        ui.heading("Solve");
         let Some(scene) = &self.state.scene else { return };
         if let Some(p) = &scene.boundary.problem {
             ui.colored_label(Color32::from_rgb(200, 40, 40), format!("cannot solve: {p}"));
@@ -640,6 +643,11 @@ impl eframe::App for ViewerApp {
     }
 }
 
+/// A collapsible section of the side panel, open by default.
+fn section(ui: &mut Ui, title: &str, body: impl FnOnce(&mut Ui)) {
+    egui::CollapsingHeader::new(RichText::new(title).heading()).default_open(true).show(ui, body);
+}
+
 /// Colours of the sides south, east, north, west.
 fn side_colours() -> [Color32; 4] {
     [
@@ -744,7 +752,7 @@ fn file_section(ui: &mut Ui, scene: &Scene) {
             let [nx, ny] = mv.map.shape();
             ui.label("map");
             ui.label(format!(
-                "degree ({p}, {q}), {nx}x{ny} control points, {}x{} elements{}",
+                "p = ({p}, {q}), {nx}x{ny} control points,\n{}x{} elements{}",
                 mv.map.knots[0].num_elements(),
                 mv.map.knots[1].num_elements(),
                 if mv.map.weights.is_some() { ", rational" } else { "" }
@@ -775,7 +783,6 @@ fn verdict_colour(c: &Certificate) -> Color32 {
 
 /// The verdict, in one place (an exact certificate would be shown here too).
 fn certificate_section(ui: &mut Ui, mv: &MapView) {
-    ui.heading("Certificate");
     let c = &mv.certificate;
     ui.label(
         RichText::new(format!(
@@ -808,7 +815,6 @@ fn certificate_section(ui: &mut Ui, mv: &MapView) {
 }
 
 fn quality_section(ui: &mut Ui, mv: &MapView) {
-    ui.heading("Quality");
     let q = &mv.quality;
     let f = &q.functionals;
     let grid = format!("{0}x{0}", q.sample_n + 1);
@@ -847,9 +853,7 @@ fn quality_section(ui: &mut Ui, mv: &MapView) {
 
 /// The folded-element list; returns the index clicked.
 fn folds_section(ui: &mut Ui, mv: &MapView, selected: Option<usize>) -> Option<usize> {
-    let folds = mv.folds.iter().filter(|f| !f.forced_corner).count();
-    let forced = mv.folds.len() - folds;
-    ui.heading(format!("Folded elements: {folds}"));
+    let forced = mv.folds.iter().filter(|f| f.forced_corner).count();
     if forced > 0 {
         ui.label(format!("{forced} element(s) at corners whose angle forces det J <= 0"));
     }
@@ -889,6 +893,7 @@ fn residual_plot(ui: &mut Ui, history: &[crate::solve_job::ResidualPoint]) {
     }
     let plot = Plot::new("residuals")
         .height(170.0)
+        .width((ui.available_width() - 12.0).max(120.0))
         .allow_scroll(false)
         .allow_zoom(false)
         .allow_drag(false)

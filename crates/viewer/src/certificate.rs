@@ -125,11 +125,11 @@ impl Certificate {
             details.push((
                 "finest level".to_string(),
                 format!(
-                    "{}x{} basis, {} iterations, {}",
+                    "{}x{} basis, {} iterations{}",
                     l.shape[0],
                     l.shape[1],
                     l.iterations,
-                    if l.converged { "converged" } else { "not converged" }
+                    if l.converged { "" } else { ", not converged" }
                 ),
             ));
         }
