@@ -52,6 +52,8 @@ pub struct ViewerApp {
     views_rect: Option<Rect>,
     /// Screen rectangle of the physical view (last frame).
     physical_rect: Option<Rect>,
+    /// Screen rectangle of the parameter view (last frame).
+    parameter_rect: Option<Rect>,
     /// For `--screenshot`: frames to draw after everything is ready before the shot.
     settle_frames: usize,
 }
@@ -73,6 +75,7 @@ impl ViewerApp {
             shot_slot: Arc::new(Mutex::new(None)),
             views_rect: None,
             physical_rect: None,
+            parameter_rect: None,
             settle_frames: 0,
         }
     }
@@ -146,6 +149,18 @@ impl ViewerApp {
         if self.open_dialog.is_some() || self.export_dialog.is_some() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
+        // the point under the pointer, in the views as laid out in the last frame
+        let pointer = ctx.input(|i| i.pointer.hover_pos());
+        let st = &self.state;
+        self.state.probe = match (pointer, self.physical_rect, self.parameter_rect) {
+            (Some(p), Some(r), _) if r.contains(p) && st.scene.is_some() => {
+                Some(st.probe_physical(st.physical.to_world(r, p)))
+            }
+            (Some(p), _, Some(r)) if r.contains(p) && st.scene.is_some() => {
+                st.probe_parameter(st.parameter.to_world(r, p))
+            }
+            _ => None,
+        };
     }
 
     fn pick_file(&mut self, ctx: &egui::Context) {
@@ -404,14 +419,12 @@ impl ViewerApp {
         let bar = Rect::from_min_max(Pos2::new(full.max.x - BAR_WIDTH, full.min.y), full.max);
         self.views_rect = Some(full);
         self.physical_rect = Some(phys);
+        self.parameter_rect = Some(param);
         if self.state.refit {
             self.state.fit_views(phys.size(), param.size());
         }
-        let r1 = self.physical_view(ui, phys);
-        let r2 = self.parameter_view(ui, param);
-        if !r1 && !r2 {
-            self.state.probe = None;
-        }
+        self.physical_view(ui, phys);
+        self.parameter_view(ui, param);
         self.colour_bar(ui, bar);
         self.drop_hint(ui, full);
     }
@@ -448,13 +461,9 @@ impl ViewerApp {
         resp
     }
 
-    /// The physical domain; returns whether the pointer is over it.
-    fn physical_view(&mut self, ui: &mut Ui, rect: Rect) -> bool {
-        let resp = Self::interact(ui, rect, "physical", &mut self.state.physical, &mut self.state.refit);
-        let hover = resp.hover_pos().map(|p| self.state.physical.to_world(rect, p));
-        if let Some(p) = hover {
-            self.state.probe = Some(self.state.probe_physical(p));
-        }
+    /// The physical domain.
+    fn physical_view(&mut self, ui: &mut Ui, rect: Rect) {
+        Self::interact(ui, rect, "physical", &mut self.state.physical, &mut self.state.refit);
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 2.0, Color32::from_gray(250));
         let view = self.state.physical;
@@ -507,16 +516,11 @@ impl ViewerApp {
                 }
             }
         }
-        resp.hovered()
     }
 
-    /// The parameter square; returns whether the pointer is over it.
-    fn parameter_view(&mut self, ui: &mut Ui, rect: Rect) -> bool {
-        let resp = Self::interact(ui, rect, "parameter", &mut self.state.parameter, &mut self.state.refit);
-        if let Some(p) = resp.hover_pos() {
-            let q = self.state.parameter.to_world(rect, p);
-            self.state.probe = self.state.probe_parameter(q);
-        }
+    /// The parameter square.
+    fn parameter_view(&mut self, ui: &mut Ui, rect: Rect) {
+        Self::interact(ui, rect, "parameter", &mut self.state.parameter, &mut self.state.refit);
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 2.0, Color32::from_gray(250));
         let view = self.state.parameter;
@@ -578,7 +582,6 @@ impl ViewerApp {
         for (k, (a, b)) in [(0, 1), (1, 2), (3, 2), (0, 3)].into_iter().enumerate() {
             painter.line_segment([to(corners[a]), to(corners[b])], Stroke::new(1.6, colours[k]));
         }
-        resp.hovered()
     }
 
     fn colour_bar(&self, ui: &mut Ui, rect: Rect) {

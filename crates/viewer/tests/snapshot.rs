@@ -126,3 +126,36 @@ fn hover_zoom_and_export() {
     assert!(info.width > 300 && (info.width as f32) < SIZE.x && (info.height as f32) < SIZE.y, "{info:?}");
     std::fs::remove_file(&path).ok();
 }
+
+/// A file dropped on the window, as an integration would hand it over.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_a_file_opens_it() {
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), ViewerApp::new(Arc::new(CpuSampler)));
+    h.run();
+    assert!(h.state().state.scene.is_none());
+    h.input_mut().dropped_files.push(Arc::new(Dropped(data("horseshoe.json"))));
+    h.run();
+    let scene = h.state().state.scene.as_ref().expect("opened");
+    assert_eq!(scene.name, "horseshoe");
+    assert_eq!(scene.kind, "boundary");
+    // a file that is not a geometry leaves the scene and says why
+    h.input_mut().dropped_files.push(Arc::new(Dropped(data("../fit.rs"))));
+    h.run();
+    assert_eq!(h.state().state.scene.as_ref().unwrap().name, "horseshoe");
+    assert!(h.state().state.status.as_deref().unwrap_or_default().contains("fit.rs"));
+}
