@@ -496,8 +496,12 @@ impl ViewerApp {
                 let c = to(x);
                 painter.circle_stroke(c, 6.0, Stroke::new(2.0, Color32::RED));
             }
-            if let Some(Probe { view: ViewKind::Parameter, point, .. }) = self.state.probe {
-                crosshair(&painter, to(point));
+            match self.state.probe {
+                Some(Probe { view: ViewKind::Parameter, point, .. }) => crosshair(&painter, to(point)),
+                Some(Probe { view: ViewKind::Physical, point, param: Some(_), .. }) => {
+                    painter.circle_stroke(to(point), 3.0, Stroke::new(1.5, Color32::RED));
+                }
+                _ => {}
             }
         }
         if d.boundary || scene.map.is_none() {
