@@ -54,6 +54,8 @@ pub struct ViewerApp {
     physical_rect: Option<Rect>,
     /// Screen rectangle of the parameter view (last frame).
     parameter_rect: Option<Rect>,
+    /// Display settings being dragged, applied on release.
+    pending_settings: Option<crate::scene::SceneSettings>,
     /// For `--screenshot`: frames to draw after everything is ready before the shot.
     settle_frames: usize,
 }
@@ -76,6 +78,7 @@ impl ViewerApp {
             views_rect: None,
             physical_rect: None,
             parameter_rect: None,
+            pending_settings: None,
             settle_frames: 0,
         }
     }
@@ -324,19 +327,23 @@ impl ViewerApp {
             ui.selectable_value(&mut d.scale, ScaleKind::Log, ScaleKind::Log.label());
             ui.selectable_value(&mut d.scale, ScaleKind::Linear, ScaleKind::Linear.label());
         });
-        let mut settings = self.state.settings;
+        // while a slider is dragged the new value waits: resampling is not free
+        let mut settings = self.pending_settings.unwrap_or(self.state.settings);
         let current = self.state.scene.as_ref().and_then(|s| s.map.as_ref()).map(|m| m.resolution());
         let mut density = settings.density;
-        ui.add(egui::Slider::new(&mut density, 2..=64).text("grid lines per direction"));
+        let r1 = ui.add(egui::Slider::new(&mut density, 2..=64).text("grid lines per direction"));
         let mut res = settings.resolution.or(current).unwrap_or(128);
-        let changed_res = ui
-            .add(egui::Slider::new(&mut res, RESOLUTION_RANGE.0..=RESOLUTION_RANGE.1).text("heat-map cells"))
-            .changed();
-        if changed_res {
+        let r2 = ui.add(egui::Slider::new(&mut res, RESOLUTION_RANGE.0..=RESOLUTION_RANGE.1).text("heat-map cells"));
+        if r2.changed() {
             settings.resolution = Some(res);
         }
         settings.density = density;
-        self.state.set_settings(settings);
+        if r1.dragged() || r2.dragged() {
+            self.pending_settings = Some(settings);
+        } else {
+            self.pending_settings = None;
+            self.state.set_settings(settings);
+        }
     }
 
     fn solve_section(&mut self, ui: &mut Ui) {
