@@ -421,6 +421,22 @@ mod tests {
     }
 
     #[test]
+    fn opens_a_gismo_patch_as_a_map() {
+        let mut s = state();
+        s.open(&data("gismo/xml/disk.xml")).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "map");
+        let mv = scene.map.as_ref().unwrap();
+        // the sample is the core's, on the chosen grid, and the verdict is read from it
+        let n = mv.resolution();
+        assert_eq!(mv.sample.values.len(), (n + 1) * (n + 1));
+        assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Sample);
+        assert_eq!(mv.quality.det_j_min, mv.sample.min);
+        // the map's own boundary can be solved again
+        assert_eq!(scene.boundary.problem.is_none(), s.can_solve());
+    }
+
+    #[test]
     fn views_fit_the_scene() {
         let mut s = state();
         s.open(&data("quarter_annulus.json")).unwrap();
