@@ -132,6 +132,23 @@ impl ViewerApp {
         if let Some(path) = crate::state::first_path(dropped) {
             let _ = self.state.open(&path);
         }
+        // keyboard: Ctrl+O open, Ctrl+E export, Ctrl+F fit the views
+        let (open, export, fit) = ctx.input_mut(|i| {
+            (
+                i.consume_key(egui::Modifiers::COMMAND, egui::Key::O),
+                i.consume_key(egui::Modifiers::COMMAND, egui::Key::E),
+                i.consume_key(egui::Modifiers::COMMAND, egui::Key::F),
+            )
+        });
+        if open && self.open_dialog.is_none() {
+            self.pick_file(ctx);
+        }
+        if export && self.export_dialog.is_none() && self.state.scene.is_some() {
+            self.pick_export(ctx);
+        }
+        if fit {
+            self.state.refit = true;
+        }
         // file dialogs run in their own threads
         if let Some(rx) = &self.open_dialog {
             if let Ok(r) = rx.try_recv() {
@@ -243,12 +260,13 @@ impl ViewerApp {
     fn menu_bar(&mut self, ui: &mut Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("Open…").clicked() {
+                if ui.add(egui::Button::new("Open…").shortcut_text("Ctrl+O")).clicked() {
                     self.pick_file(ui.ctx());
                     ui.close();
                 }
                 let has_scene = self.state.scene.is_some();
-                if ui.add_enabled(has_scene, egui::Button::new("Export view as PNG…")).clicked() {
+                if ui.add_enabled(has_scene, egui::Button::new("Export view as PNG…").shortcut_text("Ctrl+E")).clicked()
+                {
                     self.pick_export(ui.ctx());
                     ui.close();
                 }
@@ -257,7 +275,7 @@ impl ViewerApp {
                 }
             });
             ui.menu_button("View", |ui| {
-                if ui.button("Fit views").clicked() {
+                if ui.add(egui::Button::new("Fit views").shortcut_text("Ctrl+F")).clicked() {
                     self.state.refit = true;
                     ui.close();
                 }

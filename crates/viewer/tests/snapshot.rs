@@ -159,3 +159,19 @@ fn dropping_a_file_opens_it() {
     assert_eq!(h.state().state.scene.as_ref().unwrap().name, "horseshoe");
     assert!(h.state().state.status.as_deref().unwrap_or_default().contains("fit.rs"));
 }
+
+#[test]
+fn ctrl_f_fits_the_views_again() {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("horseshoe.json")).unwrap();
+    let mut h = Harness::builder().with_size(SIZE).build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
+    h.run();
+    let fitted = h.state().state.physical;
+    h.state_mut().state.physical.pan(Vec2::new(40.0, -25.0));
+    h.state_mut().state.physical.scale *= 2.0;
+    h.run();
+    assert_ne!(h.state().state.physical, fitted);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::F);
+    h.run();
+    assert_eq!(h.state().state.physical, fitted);
+}
