@@ -183,6 +183,53 @@ impl Surface {
         d
     }
 
+    /// The parameter point of a physical point: solves `x(u, v) = p` by Newton's method
+    /// from `start`, `J (du, dv) = p - x` with `J = [x_u | x_v]` (`det J`, eq. 43, as in
+    /// [`SurfaceDerivs::det_j`]), halving a step until `|p - x|` decreases and clamping
+    /// to the parameter domain. Returns `None` when `|p - x| <= tol` is not reached: `p`
+    /// lies outside the image, `J` is singular on the way, or `start` is too far off.
+    /// On a folded map the answer is one of several preimages, the one Newton finds.
+    pub fn invert(&self, p: Point, start: [f64; 2], tol: f64) -> Option<[f64; 2]> {
+        let dom = [self.knots[0].domain(), self.knots[1].domain()];
+        let clamp = |q: [f64; 2]| [q[0].clamp(dom[0].0, dom[0].1), q[1].clamp(dom[1].0, dom[1].1)];
+        let residual = |q: [f64; 2]| {
+            let x = self.eval(q[0], q[1]);
+            [p[0] - x[0], p[1] - x[1]]
+        };
+        let norm = |r: [f64; 2]| r[0].hypot(r[1]);
+        let mut q = clamp(start);
+        let mut r = residual(q);
+        for _ in 0..60 {
+            let size = norm(r);
+            if size.is_nan() {
+                return None;
+            }
+            if size <= tol {
+                return Some(q);
+            }
+            let d = self.derivs(q[0], q[1], 1);
+            let det = d.det_j();
+            if det == 0.0 || !det.is_finite() {
+                return None;
+            }
+            let step = [(r[0] * d.xv[1] - d.xv[0] * r[1]) / det, (d.xu[0] * r[1] - r[0] * d.xu[1]) / det];
+            let mut lambda = 1.0;
+            loop {
+                let trial = clamp([q[0] + lambda * step[0], q[1] + lambda * step[1]]);
+                let rt = residual(trial);
+                if norm(rt) < norm(r) {
+                    (q, r) = (trial, rt);
+                    break;
+                }
+                lambda *= 0.5;
+                if lambda < 1e-6 {
+                    return None;
+                }
+            }
+        }
+        (norm(r) <= tol).then_some(q)
+    }
+
     /// Linear indices of the control points on a side, in the side's orientation.
     pub fn side_indices(shape: [usize; 2], side: Side) -> Vec<usize> {
         let [nx, ny] = shape;
@@ -219,5 +266,64 @@ impl Surface {
             }
         }
         Self { knots: [self.knots[1].clone(), self.knots[0].clone()], control_points: cp, weights: w }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A curved degree-2 map of the unit square (no fold): `x = u + 0.2 v^2 + ...`.
+    fn warped() -> Surface {
+        let kv = KnotVector::open_uniform(2, 3);
+        let n = kv.num_basis();
+        let g = kv.greville();
+        let mut cps = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (u, v) = (g[i], g[j]);
+                cps.push([2.0 * u + 0.3 * v * v, v + 0.2 * u * u]);
+            }
+        }
+        Surface::new([kv.clone(), kv], cps, None).unwrap()
+    }
+
+    #[test]
+    fn invert_recovers_parameters() {
+        let s = warped();
+        for &(u, v) in &[(0.3, 0.7), (0.0, 0.0), (1.0, 0.5), (0.91, 0.05), (0.5, 1.0)] {
+            let p = s.eval(u, v);
+            let q = s.invert(p, [0.5, 0.5], 1e-12).expect("inside");
+            assert!((q[0] - u).abs() < 1e-10 && (q[1] - v).abs() < 1e-10, "{q:?} vs ({u}, {v})");
+        }
+    }
+
+    #[test]
+    fn invert_quarter_circle_nurbs() {
+        // quarter annulus r in [1, 2], exact circular arcs (degree 2 NURBS in u)
+        let ku = KnotVector::open_uniform(2, 1);
+        let kv = KnotVector::open_uniform(1, 1);
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let mut cps = Vec::new();
+        let mut ws = Vec::new();
+        for r in [1.0, 2.0] {
+            cps.extend([[r, 0.0], [r, r], [0.0, r]]);
+            ws.extend([1.0, w, 1.0]);
+        }
+        let s = Surface::new([ku, kv], cps, Some(ws)).unwrap();
+        // the point at radius 1.5, angle 30 degrees has v = 0.5
+        let a = 30f64.to_radians();
+        let q = s.invert([1.5 * a.cos(), 1.5 * a.sin()], [0.5, 0.5], 1e-13).expect("inside");
+        assert!((q[1] - 0.5).abs() < 1e-12, "{q:?}");
+        let x = s.eval(q[0], q[1]);
+        assert!((x[1].atan2(x[0]) - a).abs() < 1e-12);
+    }
+
+    #[test]
+    fn invert_rejects_points_outside() {
+        let s = warped();
+        assert_eq!(s.invert([-1.0, 0.5], [0.5, 0.5], 1e-10), None);
+        assert_eq!(s.invert([1.0, 3.0], [0.5, 0.5], 1e-10), None);
+        assert_eq!(s.invert([f64::NAN, 0.0], [0.5, 0.5], 1e-10), None);
     }
 }

@@ -1,0 +1,25 @@
+//! # winslow-viewer
+//!
+//! The desktop viewer of winslow: open a boundary or a map, look at its `det J` heat
+//! map (paper eq. 43) in the physical domain and in the parameter square, its grid
+//! lines and control net, the folded elements and the verdict of the solver, and solve
+//! a boundary in a background thread while watching the residuals.
+//!
+//! The numbers all come from the core crate `winslow`; this crate only arranges and
+//! draws them. State and logic (loading, the view transform, the colour scale, the
+//! folded-element list, the solve job) live in modules without drawing code and are
+//! unit-tested; [`app`] draws them with egui.
+
+pub mod app;
+pub mod certificate;
+pub mod colour;
+pub mod folds;
+pub mod sampler;
+pub mod scene;
+pub mod solve_job;
+pub mod state;
+pub mod view;
+
+pub use app::ViewerApp;
+pub use sampler::{CpuSampler, DetJSampler};
+pub use state::ViewerState;

@@ -1,0 +1,332 @@
+//! What is loaded, with everything the views draw computed once: the boundary as
+//! polylines, and for a map its `det J` sample (from a [`DetJSampler`]), the images of
+//! the sample grid and of the iso-lines of `xi` and `eta`, the control net, the folded
+//! elements, the quality numbers and the verdict.
+
+use std::path::{Path, PathBuf};
+
+use winslow::io::{checked_boundary, parse_document, read_text, Document, ReadOptions};
+use winslow::quality::DetJSample;
+use winslow::solver::Solution;
+use winslow::validate::sample_side;
+use winslow::{Boundary, Point, Side, SideCurve, Surface};
+
+use crate::certificate::{Certificate, Quality};
+use crate::folds::{folded_elements, FoldedElement};
+use crate::sampler::DetJSampler;
+use crate::view::{bounds_of, Bounds};
+
+/// Heat-map resolution bounds (cells per direction).
+pub const RESOLUTION_RANGE: (usize, usize) = (16, 512);
+
+/// A boundary as drawn: four polylines and the control polygons of spline sides.
+#[derive(Debug, Clone)]
+pub struct BoundaryView {
+    /// The boundary (validated and counter-clockwise when `problem` is `None`).
+    pub boundary: Boundary,
+    /// South, east, north, west as polylines.
+    pub polylines: [Vec<Point>; 4],
+    /// Control polygons of the spline sides.
+    pub control_polygons: Vec<Vec<Point>>,
+    /// Why the boundary cannot be solved (validation error), if so.
+    pub problem: Option<String>,
+    /// Whether a clockwise input was transposed to make it counter-clockwise.
+    pub reoriented: bool,
+}
+
+impl BoundaryView {
+    /// Validate (transposing a clockwise contour) and sample a boundary.
+    pub fn new(boundary: Boundary) -> Self {
+        let (boundary, problem, reoriented) = match checked_boundary(boundary.clone(), &ReadOptions { reorient: true })
+        {
+            Ok((b, _)) => {
+                let reoriented = !same_corners(&b, &boundary);
+                (b, None, reoriented)
+            }
+            Err(e) => (boundary, Some(e.to_string()), false),
+        };
+        let polylines = Side::ALL.map(|s| sample_side(boundary.side(s), f64::INFINITY));
+        let control_polygons = boundary
+            .sides
+            .iter()
+            .filter_map(|s| match s {
+                SideCurve::Spline(c) => Some(c.control_points.clone()),
+                _ => None,
+            })
+            .collect();
+        Self { boundary, polylines, control_polygons, problem, reoriented }
+    }
+
+    /// Bounds of the polylines.
+    pub fn bounds(&self) -> Option<Bounds> {
+        bounds_of(self.polylines.iter().flatten())
+    }
+}
+
+fn same_corners(a: &Boundary, b: &Boundary) -> bool {
+    a.side(Side::South).endpoints() == b.side(Side::South).endpoints()
+}
+
+/// Iso-lines of a map: images of `xi = const` and `eta = const`.
+#[derive(Debug, Clone, Default)]
+pub struct IsoLines {
+    /// Lines per direction (the parameter square is cut into this many strips).
+    pub density: usize,
+    /// `xi = k / density`, `k = 1 .. density - 1`: curves along `eta`.
+    pub xi: Vec<Vec<Point>>,
+    /// `eta = k / density`: curves along `xi`.
+    pub eta: Vec<Vec<Point>>,
+}
+
+impl IsoLines {
+    /// Evaluate `density - 1` interior iso-lines per direction with `points` points each.
+    pub fn new(map: &Surface, density: usize, points: usize) -> Self {
+        let points = points.max(2);
+        let (du, dv) = (map.knots[0].domain(), map.knots[1].domain());
+        let at = |d: (f64, f64), t: f64| d.0 + (d.1 - d.0) * t;
+        let line = |fixed_xi: Option<f64>, fixed_eta: Option<f64>| -> Vec<Point> {
+            (0..points)
+                .map(|k| {
+                    let t = k as f64 / (points - 1) as f64;
+                    let u = fixed_xi.unwrap_or_else(|| at(du, t));
+                    let v = fixed_eta.unwrap_or_else(|| at(dv, t));
+                    map.eval(u, v)
+                })
+                .collect()
+        };
+        let ts: Vec<f64> = (1..density).map(|k| k as f64 / density as f64).collect();
+        Self {
+            density,
+            xi: ts.iter().map(|&t| line(Some(at(du, t)), None)).collect(),
+            eta: ts.iter().map(|&t| line(None, Some(at(dv, t)))).collect(),
+        }
+    }
+}
+
+/// A map as drawn.
+#[derive(Debug, Clone)]
+pub struct MapView {
+    /// The map.
+    pub map: Surface,
+    /// Name of the sampler that produced `sample`.
+    pub sampler: String,
+    /// `det J` on the `(n+1)^2` grid.
+    pub sample: DetJSample,
+    /// `x` at the same grid points (same layout).
+    pub positions: Vec<Point>,
+    /// Bounds of the image.
+    pub bounds: Bounds,
+    /// The map's four sides as polylines (south, east, north, west).
+    pub sides: [Vec<Point>; 4],
+    /// Iso-lines.
+    pub iso: IsoLines,
+    /// Interior knot lines in the parameter square, `xi` then `eta`.
+    pub breaks: [Vec<f64>; 2],
+    /// Elements with `det J <= 0` samples.
+    pub folds: Vec<FoldedElement>,
+    /// Quality numbers.
+    pub quality: Quality,
+    /// The verdict shown.
+    pub certificate: Certificate,
+    /// The verdict of the viewer's own sample (shown too when `certificate` is from a report).
+    pub exact_certificate: Certificate,
+    /// The solver's level reports, when the map was solved in the viewer.
+    pub report: Option<winslow::solver::Report>,
+}
+
+/// Default heat-map resolution: eight cells per element in the finer direction, within
+/// `[96, 256]`.
+pub fn default_resolution(map: &Surface) -> usize {
+    let e = map.knots[0].num_elements().max(map.knots[1].num_elements());
+    (8 * e).clamp(96, 256)
+}
+
+impl MapView {
+    /// Sample and prepare `map`; `certificate` is the verdict of a report if there is one.
+    pub fn new(
+        map: Surface,
+        sampler: &dyn DetJSampler,
+        resolution: usize,
+        density: usize,
+        certificate: Option<Certificate>,
+    ) -> Self {
+        let n = resolution.clamp(RESOLUTION_RANGE.0, RESOLUTION_RANGE.1);
+        let sample = sampler.sample(&map, n);
+        let (du, dv) = (map.knots[0].domain(), map.knots[1].domain());
+        let mut positions = Vec::with_capacity((n + 1) * (n + 1));
+        for j in 0..=n {
+            let v = dv.0 + (dv.1 - dv.0) * j as f64 / n as f64;
+            for i in 0..=n {
+                positions.push(map.eval(du.0 + (du.1 - du.0) * i as f64 / n as f64, v));
+            }
+        }
+        let bounds = bounds_of(&positions).unwrap_or([[0.0, 0.0], [1.0, 1.0]]);
+        let sides = Side::ALL.map(|s| map.boundary(s).sample(4 * n));
+        let iso = IsoLines::new(&map, density, 2 * n + 1);
+        let inner = |b: Vec<f64>| b[1..b.len().saturating_sub(1)].to_vec();
+        let breaks = [inner(map.knots[0].breaks()), inner(map.knots[1].breaks())];
+        let quality = Quality::of(&map, &sample);
+        let folds = folded_elements(&map, &sample, quality.forced_corners());
+        let exact_certificate = Certificate::exact(&map, &quality);
+        let certificate = certificate.unwrap_or_else(|| exact_certificate.clone());
+        Self {
+            map,
+            sampler: sampler.name().to_string(),
+            sample,
+            positions,
+            bounds,
+            sides,
+            iso,
+            breaks,
+            folds,
+            quality,
+            certificate,
+            exact_certificate,
+            report: None,
+        }
+    }
+
+    /// Heat-map cells per direction.
+    pub fn resolution(&self) -> usize {
+        self.sample.n
+    }
+
+    /// `det J` and `x` at a parameter point (core evaluation).
+    pub fn probe(&self, q: [f64; 2]) -> (Point, f64) {
+        let d = self.map.derivs(q[0], q[1], 1);
+        (d.x, d.det_j())
+    }
+
+    /// The parameter point of a physical point, if it lies in the image: Newton
+    /// inversion ([`Surface::invert`]) started from the nearest sample-grid point.
+    pub fn invert(&self, p: Point) -> Option<[f64; 2]> {
+        let n = self.sample.n;
+        let (mut best, mut arg) = (f64::INFINITY, 0);
+        for (k, x) in self.positions.iter().enumerate() {
+            let d = (x[0] - p[0]).powi(2) + (x[1] - p[1]).powi(2);
+            if d < best {
+                (best, arg) = (d, k);
+            }
+        }
+        let start = [(arg % (n + 1)) as f64 / n as f64, (arg / (n + 1)) as f64 / n as f64];
+        let diam = (self.bounds[1][0] - self.bounds[0][0]).hypot(self.bounds[1][1] - self.bounds[0][1]);
+        self.map.invert(p, start, 1e-10 * diam.max(f64::MIN_POSITIVE))
+    }
+}
+
+/// Everything loaded from one file (or solved in the viewer).
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Geometry name.
+    pub name: String,
+    /// File it came from.
+    pub path: Option<PathBuf>,
+    /// What the file was ("boundary", "map").
+    pub kind: &'static str,
+    /// The boundary (of a boundary file, or the sides of a map): what `solve` uses.
+    pub boundary: BoundaryView,
+    /// The map, if any.
+    pub map: Option<MapView>,
+}
+
+/// Display settings that change what the scene computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SceneSettings {
+    /// Heat-map cells per direction (`None`: [`default_resolution`]).
+    pub resolution: Option<usize>,
+    /// Iso-lines per direction.
+    pub density: usize,
+}
+
+impl Default for SceneSettings {
+    fn default() -> Self {
+        Self { resolution: None, density: 16 }
+    }
+}
+
+impl Scene {
+    /// Read a boundary or map file (JSON or G+Smo XML, detected by content).
+    pub fn open(path: &Path, sampler: &dyn DetJSampler, settings: SceneSettings) -> anyhow::Result<Self> {
+        use anyhow::Context;
+        let text = read_text(path).with_context(|| format!("reading {}", path.display()))?;
+        let mut doc = parse_document(&text).with_context(|| format!("reading {}", path.display()))?;
+        if doc.name().is_empty() {
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            match &mut doc {
+                Document::Boundary(b) => b.name = stem,
+                Document::Map { name, .. } => *name = stem,
+            }
+        }
+        // a map file may carry the solver's report
+        let stored = match &doc {
+            Document::Map { .. } => serde_json::from_str::<serde_json::Value>(&text)
+                .ok()
+                .and_then(|v| v.get("report").and_then(Certificate::from_stored)),
+            Document::Boundary(_) => None,
+        };
+        let mut scene = Self::from_document(doc, sampler, settings, stored);
+        scene.path = Some(path.to_path_buf());
+        Ok(scene)
+    }
+
+    /// A scene of a document.
+    pub fn from_document(
+        doc: Document,
+        sampler: &dyn DetJSampler,
+        settings: SceneSettings,
+        certificate: Option<Certificate>,
+    ) -> Self {
+        match doc {
+            Document::Boundary(b) => {
+                Self { name: b.name.clone(), path: None, kind: "boundary", boundary: BoundaryView::new(b), map: None }
+            }
+            Document::Map { name, map } => {
+                let doc = Document::Map { name: name.clone(), map: map.clone() };
+                let res = settings.resolution.unwrap_or_else(|| default_resolution(&map));
+                Self {
+                    name,
+                    path: None,
+                    kind: "map",
+                    boundary: BoundaryView::new(doc.into_boundary()),
+                    map: Some(MapView::new(map, sampler, res, settings.density, certificate)),
+                }
+            }
+        }
+    }
+
+    /// Put a solver's map into the scene (keeps the input boundary).
+    pub fn set_solution(&mut self, solution: Solution, sampler: &dyn DetJSampler, settings: SceneSettings) {
+        let res = settings.resolution.unwrap_or_else(|| default_resolution(&solution.map));
+        let cert = Certificate::from_report(&solution.report);
+        let mut mv = MapView::new(solution.map, sampler, res, settings.density, Some(cert));
+        mv.report = Some(solution.report);
+        self.map = Some(mv);
+    }
+
+    /// Recompute what depends on the settings (after a change of resolution or density).
+    pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
+        if let Some(mv) = self.map.take() {
+            let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
+            let report = mv.report;
+            let cert =
+                (mv.certificate.source != crate::certificate::CertificateSource::Sample).then_some(mv.certificate);
+            let mut new = MapView::new(mv.map, sampler, res, settings.density, cert);
+            new.report = report;
+            self.map = Some(new);
+        }
+    }
+
+    /// Bounds of what is drawn in the physical view.
+    pub fn bounds(&self) -> Bounds {
+        let b = self.boundary.bounds();
+        match (&self.map, b) {
+            (Some(m), Some(b)) => [
+                [m.bounds[0][0].min(b[0][0]), m.bounds[0][1].min(b[0][1])],
+                [m.bounds[1][0].max(b[1][0]), m.bounds[1][1].max(b[1][1])],
+            ],
+            (Some(m), None) => m.bounds,
+            (None, Some(b)) => b,
+            (None, None) => [[0.0, 0.0], [1.0, 1.0]],
+        }
+    }
+}

@@ -1,0 +1,381 @@
+//! A solve in a background thread: the core's [`EggSolver`] event stream is forwarded
+//! over a channel to the UI, which keeps the progress (level, iteration, residual) and
+//! the residual history for the live plot. A cancel flag is checked between events;
+//! dropping the solver cancels it.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{channel, Receiver, TryRecvError};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+
+use winslow::egg::CpuAssembler;
+use winslow::fit::build_hierarchy;
+use winslow::solver::{EggSolver, Event, InitialGuess, Solution, SolveOptions};
+use winslow::Boundary;
+
+/// A message from the solving thread.
+#[derive(Debug)]
+pub enum Msg {
+    /// The boundary was fitted: this many hierarchy levels, at this absolute tolerance.
+    Fitted {
+        /// Hierarchy levels of the fit.
+        levels: usize,
+        /// Absolute fit tolerance.
+        tolerance: f64,
+    },
+    /// An event of the solver stream.
+    Event(Event),
+    /// The solve finished.
+    Finished(Box<Solution>),
+    /// The solve failed.
+    Failed(String),
+    /// The cancel flag was seen; the solver was dropped.
+    Cancelled,
+}
+
+/// Fit and solve `boundary`, sending every step to `send`; checks `cancel` before the
+/// fit and between events. Always ends with `Finished`, `Failed` or `Cancelled`.
+pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
+    let cancelled = || cancel.load(Ordering::Relaxed);
+    if cancelled() {
+        return send(Msg::Cancelled);
+    }
+    let h = match build_hierarchy(boundary, &opts.fit) {
+        Ok(h) => h,
+        Err(e) => return send(Msg::Failed(format!("fitting the boundary: {e}"))),
+    };
+    send(Msg::Fitted { levels: h.levels.len(), tolerance: h.tol_abs });
+    let mut solver = match EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler)) {
+        Ok(s) => s,
+        Err(e) => return send(Msg::Failed(e.to_string())),
+    };
+    loop {
+        if cancelled() {
+            return send(Msg::Cancelled);
+        }
+        match solver.next() {
+            Some(Ok(e)) => send(Msg::Event(e)),
+            Some(Err(e)) => return send(Msg::Failed(e.to_string())),
+            None => break,
+        }
+    }
+    match solver.finish(boundary, &h) {
+        Ok(s) => send(Msg::Finished(Box::new(s))),
+        Err(e) => send(Msg::Failed(e.to_string())),
+    }
+}
+
+/// One point of the residual history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResidualPoint {
+    /// Iterate number over the whole solve (for the plot's x axis).
+    pub step: usize,
+    /// Level index.
+    pub level: usize,
+    /// Iteration within the level (0 = initial guess).
+    pub iteration: usize,
+    /// `||F||`.
+    pub residual: f64,
+    /// Scaled (dimensionless) residual.
+    pub scaled_residual: f64,
+}
+
+/// Where the solve stands.
+#[derive(Debug, Clone, Default)]
+pub struct Progress {
+    /// Fit levels, once fitted.
+    pub fit_levels: Option<usize>,
+    /// Current level index and the number of levels.
+    pub level: Option<(usize, usize)>,
+    /// Basis shape and unknowns of the current level.
+    pub shape: [usize; 2],
+    /// Scalar unknowns of the current level.
+    pub unknowns: usize,
+    /// Initial guess of the current level.
+    pub initial_guess: Option<InitialGuess>,
+    /// Every iterate so far.
+    pub history: Vec<ResidualPoint>,
+    /// Levels finished (converged or not).
+    pub levels_done: usize,
+}
+
+impl Progress {
+    /// Take one message into account.
+    pub fn apply(&mut self, msg: &Msg) {
+        match msg {
+            Msg::Fitted { levels, .. } => self.fit_levels = Some(*levels),
+            Msg::Event(Event::LevelStarted { level, levels, shape, unknowns, initial_guess }) => {
+                self.level = Some((*level, *levels));
+                self.shape = *shape;
+                self.unknowns = *unknowns;
+                self.initial_guess = Some(*initial_guess);
+            }
+            Msg::Event(Event::Iterate { level, iterate }) => self.history.push(ResidualPoint {
+                step: self.history.len(),
+                level: *level,
+                iteration: iterate.iteration,
+                residual: iterate.residual,
+                scaled_residual: iterate.scaled_residual,
+            }),
+            Msg::Event(Event::LevelFinished(_)) => self.levels_done += 1,
+            Msg::Finished(_) | Msg::Failed(_) | Msg::Cancelled => {}
+        }
+    }
+
+    /// The last iterate.
+    pub fn last(&self) -> Option<&ResidualPoint> {
+        self.history.last()
+    }
+
+    /// One line of text: level, iteration, residual.
+    pub fn text(&self) -> String {
+        let Some((level, levels)) = self.level else {
+            return match self.fit_levels {
+                Some(n) => format!("fitted {n} hierarchy levels; starting"),
+                None => "fitting the boundary".to_string(),
+            };
+        };
+        let mut s = format!(
+            "level {}/{levels}: {}x{} basis, {} unknowns",
+            level + 1,
+            self.shape[0],
+            self.shape[1],
+            self.unknowns
+        );
+        if let Some(p) = self.last().filter(|p| p.level == level) {
+            s.push_str(&format!(
+                "; iteration {}, |F| = {:.3e} (scaled {:.3e})",
+                p.iteration, p.residual, p.scaled_residual
+            ));
+        }
+        s
+    }
+}
+
+/// State of a solve job.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum JobState {
+    /// The thread is working.
+    Running,
+    /// Cancel was asked; waiting for the thread to see it.
+    Cancelling,
+    /// Finished with a map (taken by [`SolveJob::poll`]).
+    Finished,
+    /// Failed with this message.
+    Failed(String),
+    /// Cancelled.
+    Cancelled,
+}
+
+/// A background solve.
+#[derive(Debug)]
+pub struct SolveJob {
+    /// Name of the geometry.
+    pub name: String,
+    /// Where it stands.
+    pub state: JobState,
+    /// Progress and residual history.
+    pub progress: Progress,
+    rx: Receiver<Msg>,
+    cancel: Arc<AtomicBool>,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl SolveJob {
+    /// Start solving `boundary` in a new thread; `notify` is called after every message
+    /// (the UI passes `request_repaint`).
+    pub fn start(boundary: Boundary, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
+        let (tx, rx) = channel();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = cancel.clone();
+        let name = boundary.name.clone();
+        let handle = std::thread::Builder::new()
+            .name("winslow-solve".into())
+            .spawn(move || {
+                run(&boundary, &opts, &flag, &mut |m| {
+                    // the UI may have gone away: then nobody listens and we stop at the next check
+                    if tx.send(m).is_err() {
+                        flag.store(true, Ordering::Relaxed);
+                    }
+                    notify();
+                })
+            })
+            .ok();
+        let state =
+            if handle.is_some() { JobState::Running } else { JobState::Failed("could not start a thread".into()) };
+        Self { name, state, progress: Progress::default(), rx, cancel, handle }
+    }
+
+    /// Ask the thread to stop at the next event.
+    pub fn cancel(&mut self) {
+        if self.state == JobState::Running {
+            self.cancel.store(true, Ordering::Relaxed);
+            self.state = JobState::Cancelling;
+        }
+    }
+
+    /// Whether the thread is still at work.
+    pub fn is_active(&self) -> bool {
+        matches!(self.state, JobState::Running | JobState::Cancelling)
+    }
+
+    /// Take the messages that arrived; returns the solution once, when it arrives.
+    pub fn poll(&mut self) -> Option<Solution> {
+        let mut solution = None;
+        loop {
+            match self.rx.try_recv() {
+                Ok(msg) => {
+                    self.progress.apply(&msg);
+                    match msg {
+                        Msg::Finished(s) => {
+                            self.state = JobState::Finished;
+                            solution = Some(*s);
+                        }
+                        Msg::Failed(e) => self.state = JobState::Failed(e),
+                        Msg::Cancelled => self.state = JobState::Cancelled,
+                        _ => {}
+                    }
+                }
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => {
+                    if self.is_active() {
+                        self.state = JobState::Failed("the solver thread stopped without a result".into());
+                    }
+                    break;
+                }
+            }
+        }
+        if !self.is_active() {
+            if let Some(h) = self.handle.take() {
+                let _ = h.join();
+            }
+        }
+        solution
+    }
+
+    /// Block until the job ends (tests, `--screenshot`), then [`Self::poll`].
+    pub fn wait(&mut self) -> Option<Solution> {
+        let mut solution = None;
+        while self.is_active() {
+            match self.rx.recv() {
+                Ok(msg) => {
+                    self.progress.apply(&msg);
+                    match msg {
+                        Msg::Finished(s) => {
+                            self.state = JobState::Finished;
+                            solution = Some(*s);
+                        }
+                        Msg::Failed(e) => self.state = JobState::Failed(e),
+                        Msg::Cancelled => self.state = JobState::Cancelled,
+                        _ => {}
+                    }
+                }
+                Err(_) => {
+                    self.state = JobState::Failed("the solver thread stopped without a result".into());
+                }
+            }
+        }
+        solution.or_else(|| self.poll())
+    }
+}
+
+impl Drop for SolveJob {
+    fn drop(&mut self) {
+        // stop the thread at its next event; it ends on its own
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use winslow::boundary::{Analytic, SideCurve};
+    use winslow::solver::Verdict;
+
+    /// Quarter annulus `1 <= r <= 2`, a solve of a fraction of a second.
+    fn annulus() -> Boundary {
+        let arc = |r: f64| {
+            SideCurve::Analytic(Analytic::new(move |t| {
+                let a = std::f64::consts::FRAC_PI_2 * t;
+                [r * a.cos(), r * a.sin()]
+            }))
+        };
+        let ray = |a: f64| SideCurve::Analytic(Analytic::new(move |t| [(1.0 + t) * a.cos(), (1.0 + t) * a.sin()]));
+        Boundary { name: "annulus".into(), sides: [ray(0.0), arc(2.0), ray(std::f64::consts::FRAC_PI_2), arc(1.0)] }
+    }
+
+    fn quick() -> SolveOptions {
+        SolveOptions { min_elements: 4, sample: 64, ..Default::default() }
+    }
+
+    #[test]
+    fn run_streams_levels_iterates_and_the_solution() {
+        let mut msgs = Vec::new();
+        run(&annulus(), &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
+        assert!(matches!(msgs.first(), Some(Msg::Fitted { levels, .. }) if *levels >= 1));
+        assert!(matches!(msgs.get(1), Some(Msg::Event(Event::LevelStarted { level: 0, .. }))));
+        let Some(Msg::Finished(sol)) = msgs.last() else { panic!("{:?}", msgs.last()) };
+        assert_eq!(sol.report.verdict, Verdict::Certified);
+        let mut p = Progress::default();
+        for m in &msgs {
+            p.apply(m);
+        }
+        // the history is the solver's own residual record, level by level
+        let recorded: Vec<f64> = sol.report.levels.iter().flat_map(|l| l.residuals.clone()).collect();
+        let streamed: Vec<f64> = p.history.iter().map(|h| h.residual).collect();
+        assert_eq!(streamed, recorded);
+        assert_eq!(p.levels_done, sol.report.levels.len());
+        assert!(p.history.windows(2).all(|w| w[1].step == w[0].step + 1));
+        // converged: the last scaled residual is below the tolerance
+        assert!(p.last().unwrap().scaled_residual < quick().nonlinear.tol);
+        assert!(p.text().starts_with(&format!("level {}/{}", sol.report.levels.len(), sol.report.levels.len())));
+    }
+
+    #[test]
+    fn cancel_flag_stops_between_events() {
+        let cancel = AtomicBool::new(false);
+        let mut msgs = Vec::new();
+        run(&annulus(), &quick(), &cancel, &mut |m| {
+            if matches!(m, Msg::Event(Event::Iterate { .. })) {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            msgs.push(m);
+        });
+        // exactly one iterate got through, then the flag was seen
+        let iterates = msgs.iter().filter(|m| matches!(m, Msg::Event(Event::Iterate { .. }))).count();
+        assert_eq!(iterates, 1);
+        assert!(matches!(msgs.last(), Some(Msg::Cancelled)));
+        assert!(!msgs.iter().any(|m| matches!(m, Msg::Finished(_))));
+    }
+
+    #[test]
+    fn fit_failure_is_reported() {
+        // a side that is not a curve: all four corners at one point
+        let dot = SideCurve::Analytic(Analytic::new(|_| [0.0, 0.0]));
+        let b = Boundary { name: "dot".into(), sides: [dot.clone(), dot.clone(), dot.clone(), dot] };
+        let mut msgs = Vec::new();
+        run(&b, &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
+        assert!(matches!(msgs.last(), Some(Msg::Failed(_))), "{msgs:?}");
+    }
+
+    #[test]
+    fn job_state_machine() {
+        let mut job = SolveJob::start(annulus(), quick(), || {});
+        assert!(job.is_active());
+        let sol = job.wait().expect("a solution");
+        assert_eq!(job.state, JobState::Finished);
+        assert_eq!(sol.name, "annulus");
+        assert!(job.poll().is_none(), "the solution is handed out once");
+        // cancel after the end changes nothing
+        job.cancel();
+        assert_eq!(job.state, JobState::Finished);
+
+        let mut job = SolveJob::start(annulus(), SolveOptions { refine: 2, ..quick() }, || {});
+        job.cancel();
+        assert_eq!(job.state, JobState::Cancelling);
+        // the flag is set long before a refined solve could end
+        assert!(job.wait().is_none());
+        assert_eq!(job.state, JobState::Cancelled);
+        assert!(!job.is_active());
+    }
+}

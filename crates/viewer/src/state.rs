@@ -1,0 +1,449 @@
+//! The viewer's state and everything it does that is not drawing: opening files,
+//! the two view transforms, display settings, hovering, the solve job. The egui code in
+//! [`crate::app`] reads and changes this state; the unit tests drive it directly.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use egui::Vec2;
+use winslow::assembly::Operator;
+use winslow::solver::SolveOptions;
+use winslow::Point;
+
+use crate::colour::{ColourScale, ScaleKind};
+use crate::sampler::DetJSampler;
+use crate::scene::{Scene, SceneSettings};
+use crate::solve_job::{JobState, SolveJob};
+use crate::view::ViewTransform;
+
+/// What is drawn (no effect on what is computed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DisplayOptions {
+    /// `det J` heat map.
+    pub heat: bool,
+    /// Iso-lines of `xi` and `eta`.
+    pub grid: bool,
+    /// Control net of the map (control polygons of a boundary's spline sides).
+    pub net: bool,
+    /// Knot lines (element boundaries) in the parameter view.
+    pub knots: bool,
+    /// The input boundary over the map.
+    pub boundary: bool,
+    /// Colour scale kind.
+    pub scale: ScaleKind,
+}
+
+impl Default for DisplayOptions {
+    fn default() -> Self {
+        Self { heat: true, grid: true, net: false, knots: true, boundary: true, scale: ScaleKind::Log }
+    }
+}
+
+/// The solver settings offered in the viewer (the rest are the core's defaults).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveSettings {
+    /// Operator of eq. (8).
+    pub operator: Operator,
+    /// Smallest number of elements per direction of the finest level.
+    pub min_elements: usize,
+    /// Extra uniform refinements of the finest level.
+    pub refine: usize,
+    /// Fit tolerance relative to the diameter.
+    pub fit_tol: f64,
+}
+
+impl Default for SolveSettings {
+    fn default() -> Self {
+        let d = SolveOptions::default();
+        Self { operator: d.operator, min_elements: d.min_elements, refine: d.refine, fit_tol: d.fit.tol }
+    }
+}
+
+impl SolveSettings {
+    /// The core's options with these settings.
+    pub fn options(&self) -> SolveOptions {
+        let mut o = SolveOptions {
+            operator: self.operator,
+            min_elements: self.min_elements.max(1),
+            refine: self.refine,
+            ..Default::default()
+        };
+        o.fit.tol = self.fit_tol;
+        o
+    }
+}
+
+/// Which view the pointer is over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ViewKind {
+    /// The physical domain, `(x, y)`.
+    Physical,
+    /// The parameter square, `(xi, eta)`.
+    Parameter,
+}
+
+/// The point under the pointer in both spaces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Probe {
+    /// View the pointer is over.
+    pub view: ViewKind,
+    /// Parameter point, if the pointer is over the map's image (physical view) or the square.
+    pub param: Option<[f64; 2]>,
+    /// Physical point.
+    pub point: Point,
+    /// `det J` there.
+    pub det_j: Option<f64>,
+}
+
+impl Probe {
+    /// One line of text.
+    pub fn text(&self) -> String {
+        let [x, y] = self.point;
+        match (self.param, self.det_j) {
+            (Some([u, v]), Some(d)) => format!("ξ = {u:.4}, η = {v:.4}  <->  x = {x:.5}, y = {y:.5};  det J = {d:.4e}"),
+            _ => format!("x = {x:.5}, y = {y:.5} (outside the map)"),
+        }
+    }
+}
+
+/// The viewer's whole state.
+pub struct ViewerState {
+    /// What is loaded.
+    pub scene: Option<Scene>,
+    /// Resolution and iso-line density.
+    pub settings: SceneSettings,
+    /// What is drawn.
+    pub display: DisplayOptions,
+    /// Solver settings.
+    pub solve: SolveSettings,
+    /// The running or last solve.
+    pub job: Option<SolveJob>,
+    /// Physical view transform.
+    pub physical: ViewTransform,
+    /// Parameter view transform.
+    pub parameter: ViewTransform,
+    /// Fit both views to their rectangles at the next frame.
+    pub refit: bool,
+    /// Last message for the status line (errors, exports).
+    pub status: Option<String>,
+    /// The point under the pointer.
+    pub probe: Option<Probe>,
+    /// Index into the folded-element list of the highlighted element.
+    pub selected_fold: Option<usize>,
+    sampler: Arc<dyn DetJSampler>,
+}
+
+impl std::fmt::Debug for ViewerState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ViewerState")
+            .field("scene", &self.scene.as_ref().map(|s| &s.name))
+            .field("sampler", &self.sampler.name())
+            .finish_non_exhaustive()
+    }
+}
+
+impl ViewerState {
+    /// An empty viewer sampling `det J` with `sampler`.
+    pub fn new(sampler: Arc<dyn DetJSampler>) -> Self {
+        Self {
+            scene: None,
+            settings: SceneSettings::default(),
+            display: DisplayOptions::default(),
+            solve: SolveSettings::default(),
+            job: None,
+            physical: ViewTransform::default(),
+            parameter: ViewTransform::default(),
+            refit: true,
+            status: None,
+            probe: None,
+            selected_fold: None,
+            sampler,
+        }
+    }
+
+    /// The sampler's name.
+    pub fn sampler_name(&self) -> &str {
+        self.sampler.name()
+    }
+
+    /// Open a file; on failure the current scene stays and the error goes to the status
+    /// line (and is returned).
+    pub fn open(&mut self, path: &Path) -> Result<(), String> {
+        match Scene::open(path, self.sampler.as_ref(), self.settings) {
+            Ok(scene) => {
+                self.set_scene(scene);
+                self.status = Some(format!(
+                    "opened {}",
+                    path.file_name().map_or(path.display().to_string(), |n| n.to_string_lossy().into_owned())
+                ));
+                Ok(())
+            }
+            Err(e) => {
+                let msg = format!("{e:#}");
+                self.status = Some(msg.clone());
+                Err(msg)
+            }
+        }
+    }
+
+    /// Replace the scene (cancels a running solve).
+    pub fn set_scene(&mut self, scene: Scene) {
+        if let Some(job) = self.job.as_mut() {
+            job.cancel();
+        }
+        self.job = None;
+        self.scene = Some(scene);
+        self.refit = true;
+        self.probe = None;
+        self.selected_fold = None;
+    }
+
+    /// Change resolution or density, recomputing the map's data.
+    pub fn set_settings(&mut self, settings: SceneSettings) {
+        if settings == self.settings {
+            return;
+        }
+        self.settings = settings;
+        if let Some(s) = self.scene.as_mut() {
+            s.apply_settings(self.sampler.as_ref(), settings);
+        }
+        self.selected_fold = None;
+    }
+
+    /// Whether a solve can start: a valid boundary and no solve running.
+    pub fn can_solve(&self) -> bool {
+        self.scene.as_ref().is_some_and(|s| s.boundary.problem.is_none()) && !self.solving()
+    }
+
+    /// Whether a solve is running.
+    pub fn solving(&self) -> bool {
+        self.job.as_ref().is_some_and(|j| j.is_active())
+    }
+
+    /// Start solving the scene's boundary; `notify` is called from the solving thread
+    /// after each event (to wake the UI).
+    pub fn start_solve(&mut self, notify: impl Fn() + Send + 'static) -> bool {
+        if !self.can_solve() {
+            return false;
+        }
+        let scene = self.scene.as_ref().expect("can_solve");
+        self.job = Some(SolveJob::start(scene.boundary.boundary.clone(), self.solve.options(), notify));
+        self.status = Some(format!("solving {}", scene.name));
+        true
+    }
+
+    /// Ask the running solve to stop.
+    pub fn cancel_solve(&mut self) {
+        if let Some(j) = self.job.as_mut() {
+            j.cancel();
+        }
+    }
+
+    /// Take the solve's messages; puts a finished map into the scene. Returns whether
+    /// anything changed.
+    pub fn poll_job(&mut self) -> bool {
+        let Some(job) = self.job.as_mut() else { return false };
+        let before = (job.state.clone(), job.progress.history.len());
+        let solution = job.poll();
+        let changed = solution.is_some() || before != (job.state.clone(), job.progress.history.len());
+        match (&job.state, solution) {
+            (JobState::Finished, Some(sol)) => {
+                self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
+                if let Some(scene) = self.scene.as_mut() {
+                    scene.set_solution(sol, self.sampler.as_ref(), self.settings);
+                    self.refit = true;
+                    self.selected_fold = None;
+                }
+            }
+            (JobState::Failed(e), _) if changed => self.status = Some(format!("solve failed: {e}")),
+            (JobState::Cancelled, _) if changed => self.status = Some("solve cancelled".into()),
+            _ => {}
+        }
+        changed
+    }
+
+    /// Block until a running solve ends and take its result (for `--screenshot`).
+    pub fn wait_for_solve(&mut self) {
+        if let Some(job) = self.job.as_mut() {
+            if let Some(sol) = job.wait() {
+                self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
+                if let Some(scene) = self.scene.as_mut() {
+                    scene.set_solution(sol, self.sampler.as_ref(), self.settings);
+                    self.refit = true;
+                }
+            }
+        }
+    }
+
+    /// The colour scale of the current heat map.
+    pub fn colour_scale(&self) -> Option<ColourScale> {
+        let mv = self.scene.as_ref()?.map.as_ref()?;
+        Some(ColourScale::for_values(&mv.sample.values, self.display.scale))
+    }
+
+    /// Fit both views to their rectangles.
+    pub fn fit_views(&mut self, physical: Vec2, parameter: Vec2) {
+        if let Some(s) = &self.scene {
+            self.physical = ViewTransform::fit(s.bounds(), physical, 0.05);
+        }
+        self.parameter = ViewTransform::fit([[0.0, 0.0], [1.0, 1.0]], parameter, 0.06);
+        self.refit = false;
+    }
+
+    /// The probe at a physical point (inverting the map).
+    pub fn probe_physical(&self, p: Point) -> Probe {
+        let mv = self.scene.as_ref().and_then(|s| s.map.as_ref());
+        let param = mv.and_then(|m| m.invert(p));
+        let det_j = match (mv, param) {
+            (Some(m), Some(q)) => Some(m.probe(q).1),
+            _ => None,
+        };
+        Probe { view: ViewKind::Physical, param, point: p, det_j }
+    }
+
+    /// The probe at a parameter point (`None` outside the square or without a map).
+    pub fn probe_parameter(&self, q: [f64; 2]) -> Option<Probe> {
+        let mv = self.scene.as_ref()?.map.as_ref()?;
+        if !(0.0..=1.0).contains(&q[0]) || !(0.0..=1.0).contains(&q[1]) {
+            return None;
+        }
+        let (x, d) = mv.probe(q);
+        Some(Probe { view: ViewKind::Parameter, param: Some(q), point: x, det_j: Some(d) })
+    }
+}
+
+/// Paths given on the command line or dropped on the window, first usable one.
+pub fn first_path(paths: impl IntoIterator<Item = Option<PathBuf>>) -> Option<PathBuf> {
+    paths.into_iter().flatten().next()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::CpuSampler;
+    use winslow::solver::Verdict;
+
+    fn data(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
+    }
+
+    fn state() -> ViewerState {
+        ViewerState::new(Arc::new(CpuSampler))
+    }
+
+    #[test]
+    fn opens_a_boundary_file() {
+        let mut s = state();
+        s.open(&data("quarter_annulus.json")).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "boundary");
+        assert!(scene.map.is_none());
+        assert!(scene.boundary.problem.is_none(), "{:?}", scene.boundary.problem);
+        // corners agree: south ends where east starts
+        let (s_end, e_start) = (scene.boundary.polylines[0].last().unwrap(), scene.boundary.polylines[1][0]);
+        assert!((s_end[0] - e_start[0]).abs() < 1e-9 && (s_end[1] - e_start[1]).abs() < 1e-9);
+        assert!(s.can_solve());
+        assert!(s.refit);
+        assert!(s.colour_scale().is_none());
+    }
+
+    #[test]
+    fn bad_files_keep_the_scene_and_report() {
+        let mut s = state();
+        s.open(&data("quarter_annulus.json")).unwrap();
+        let err = s.open(Path::new("/nonexistent/winslow/x.json")).unwrap_err();
+        assert!(err.contains("x.json"), "{err}");
+        assert_eq!(s.status.as_deref(), Some(err.as_str()));
+        assert_eq!(s.scene.as_ref().unwrap().name, "quarter_annulus");
+    }
+
+    #[test]
+    fn solve_then_map_round_trip_through_a_file() {
+        let mut s = state();
+        s.open(&data("quarter_annulus.json")).unwrap();
+        s.solve.min_elements = 4;
+        assert!(s.start_solve(|| {}));
+        assert!(s.solving() && !s.can_solve());
+        s.wait_for_solve();
+        assert!(!s.solving());
+        let mv = s.scene.as_ref().unwrap().map.as_ref().unwrap();
+        assert_eq!(mv.certificate.verdict, Verdict::Certified);
+        assert!(mv.folds.is_empty());
+        assert!(mv.quality.det_j_min > 0.0);
+        // quarter annulus 1 <= r <= 2 (up to the fit): area 3 pi / 4
+        assert!((mv.quality.functionals.area - 0.75 * std::f64::consts::PI).abs() < 1e-3);
+        // the heat map's scale spans the sample
+        let scale = s.colour_scale().unwrap();
+        assert_eq!(scale.hi, mv.quality.det_j_max);
+
+        // write the map as the CLI does and open it: same map, the stored verdict
+        let report = serde_json::to_value(mv.report.as_ref().unwrap()).unwrap();
+        let doc = winslow::io::map_to_json("qa", &mv.map, Some(serde_json::json!({ "report": report })));
+        let dir = std::env::temp_dir().join(format!("winslow-viewer-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("qa.json");
+        winslow::io::write_json(&path, &doc).unwrap();
+        let mut t = state();
+        t.open(&path).unwrap();
+        let scene = t.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "map");
+        let mv2 = scene.map.as_ref().unwrap();
+        assert_eq!(mv2.map, mv.map);
+        assert_eq!(mv2.certificate.source, crate::certificate::CertificateSource::File);
+        assert_eq!(mv2.certificate.verdict, Verdict::Certified);
+        assert_eq!(mv2.exact_certificate.verdict, Verdict::Certified);
+        std::fs::remove_dir_all(&dir).ok();
+
+        // probes: parameter -> physical -> parameter
+        for q in [[0.25, 0.75], [0.5, 0.5], [0.9, 0.1]] {
+            let p = t.probe_parameter(q).unwrap();
+            let back = t.probe_physical(p.point);
+            let r = back.param.unwrap();
+            assert!((r[0] - q[0]).abs() < 1e-8 && (r[1] - q[1]).abs() < 1e-8, "{r:?} {q:?}");
+            assert!((back.det_j.unwrap() - p.det_j.unwrap()).abs() <= 1e-9 * p.det_j.unwrap().abs());
+        }
+        // the hole of the annulus is outside the map
+        let hole = t.probe_physical([0.3, 0.3]);
+        assert!(hole.param.is_none() && hole.det_j.is_none());
+        assert!(hole.text().contains("outside"));
+        assert!(t.probe_parameter([1.5, 0.5]).is_none());
+
+        // changing the resolution resamples; the stored verdict stays
+        let mut settings = t.settings;
+        settings.resolution = Some(40);
+        settings.density = 4;
+        t.set_settings(settings);
+        let mv3 = t.scene.as_ref().unwrap().map.as_ref().unwrap();
+        assert_eq!(mv3.resolution(), 40);
+        assert_eq!(mv3.sample.values.len(), 41 * 41);
+        assert_eq!(mv3.iso.xi.len(), 3);
+        assert_eq!(mv3.certificate.source, crate::certificate::CertificateSource::File);
+    }
+
+    #[test]
+    fn opens_a_gismo_patch_as_a_map() {
+        let mut s = state();
+        s.open(&data("gismo/xml/disk.xml")).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "map");
+        let mv = scene.map.as_ref().unwrap();
+        // the sample is the core's, on the chosen grid, and the verdict is read from it
+        let n = mv.resolution();
+        assert_eq!(mv.sample.values.len(), (n + 1) * (n + 1));
+        assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Sample);
+        assert_eq!(mv.quality.det_j_min, mv.sample.min);
+        // the map's own boundary can be solved again
+        assert_eq!(scene.boundary.problem.is_none(), s.can_solve());
+    }
+
+    #[test]
+    fn views_fit_the_scene() {
+        let mut s = state();
+        s.open(&data("quarter_annulus.json")).unwrap();
+        s.fit_views(Vec2::new(400.0, 300.0), Vec2::new(200.0, 200.0));
+        assert!(!s.refit);
+        // the quarter annulus spans [0, 2]^2: 270 px for 2 units
+        assert!((s.physical.scale - 135.0).abs() < 0.1, "{}", s.physical.scale);
+        assert!((s.parameter.scale - 176.0).abs() < 1e-6);
+    }
+}

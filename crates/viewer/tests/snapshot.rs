@@ -1,0 +1,177 @@
+//! Headless snapshots of the viewer's main views, rendered by egui_kittest through wgpu
+//! (lavapipe on a machine without a GPU; run with `WGPU_BACKEND=vulkan`). Update the
+//! images after an intended change with `UPDATE_SNAPSHOTS=1`.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use egui::Vec2;
+use egui_kittest::Harness;
+use winslow::io::Document;
+use winslow_viewer::scene::Scene;
+use winslow_viewer::state::ViewKind;
+use winslow_viewer::{CpuSampler, ViewerApp};
+
+const SIZE: Vec2 = Vec2::new(1180.0, 720.0);
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
+}
+
+fn harness(app: ViewerApp) -> Harness<'static, ViewerApp> {
+    Harness::builder().with_size(SIZE).wgpu().build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app)
+}
+
+/// The wavy-lid boundary solved in the viewer's background job (a second or two).
+fn solved_wavy_lid() -> ViewerApp {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("wavy_lid.json")).unwrap();
+    assert!(app.state.start_solve(|| {}));
+    app.state.wait_for_solve();
+    app
+}
+
+#[test]
+fn map_view_snapshot() {
+    let mut app = solved_wavy_lid();
+    app.state.settings.density = 16;
+    let mut h = harness(app);
+    h.run();
+    let mv = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    assert!(mv.quality.det_j_min > 0.0, "{}", mv.certificate.message);
+    h.snapshot("map_view");
+}
+
+#[test]
+fn folded_map_snapshot() {
+    // the solved quarter annulus with one interior control point dragged across its
+    // neighbours: the fold is painted magenta and listed
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("quarter_annulus.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    app.state.start_solve(|| {});
+    app.state.wait_for_solve();
+    let scene = app.state.scene.as_ref().unwrap();
+    let mut map = scene.map.as_ref().unwrap().map.clone();
+    let nx = map.shape()[0];
+    let k = 2 * nx + 2;
+    let [x, y] = map.control_points[k];
+    map.control_points[k] = [x + 0.9, y + 0.9];
+    let folded =
+        Scene::from_document(Document::Map { name: "folded".into(), map }, &CpuSampler, app.state.settings, None);
+    app.state.set_scene(folded);
+    app.state.display.net = true;
+    app.state.selected_fold = Some(0);
+    let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    assert!(!mv.folds.is_empty());
+    assert_eq!(mv.certificate.verdict, winslow::solver::Verdict::Folded);
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("folded_map");
+}
+
+#[test]
+fn boundary_view_snapshot() {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("horseshoe.json")).unwrap();
+    app.state.display.net = true;
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("boundary_view");
+}
+
+#[test]
+fn hover_zoom_and_export() {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("quarter_annulus.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    app.state.start_solve(|| {});
+    app.state.wait_for_solve();
+    let mut h = harness(app);
+    h.run();
+    // hover the image of (xi, eta) = (0.5, 0.5) in the physical view
+    let target = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().probe([0.5, 0.5]).0;
+    let phys_rect = h.state().last_physical_rect().expect("drawn");
+    let pos = h.state().state.physical.to_screen(phys_rect, target);
+    h.event(egui::Event::PointerMoved(pos));
+    h.run();
+    let probe = h.state().state.probe.expect("a probe under the pointer");
+    assert_eq!(probe.view, ViewKind::Physical);
+    let q = probe.param.expect("inside the map");
+    // one pixel of slack in the pointer position
+    assert!((q[0] - 0.5).abs() < 0.02 && (q[1] - 0.5).abs() < 0.02, "{q:?}");
+
+    // scrolling zooms about the pointer: the world point under it stays put
+    let before = h.state().state.physical;
+    h.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: Vec2::new(0.0, 120.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Unknown,
+        modifiers: Default::default(),
+    });
+    h.run();
+    let after = h.state().state.physical;
+    assert!(after.scale > before.scale, "{before:?} -> {after:?}");
+    let (w0, w1) = (before.to_world(phys_rect, pos), after.to_world(phys_rect, pos));
+    assert!((w0[0] - w1[0]).abs() < 1e-3 && (w0[1] - w1[1]).abs() < 1e-3);
+
+    // export the views to a PNG through the integration's screenshot
+    let path = std::env::temp_dir().join(format!("winslow-viewer-export-{}.png", std::process::id()));
+    h.state_mut().export_views(path.clone());
+    h.run_steps(8);
+    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).expect("exported")));
+    let info = dec.read_info().unwrap().info().clone();
+    // the views are narrower than the window (side panel) and not taller
+    assert!(info.width > 300 && (info.width as f32) < SIZE.x && (info.height as f32) < SIZE.y, "{info:?}");
+    std::fs::remove_file(&path).ok();
+}
+
+/// A file dropped on the window, as an integration would hand it over.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_a_file_opens_it() {
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), ViewerApp::new(Arc::new(CpuSampler)));
+    h.run();
+    assert!(h.state().state.scene.is_none());
+    h.input_mut().dropped_files.push(Arc::new(Dropped(data("horseshoe.json"))));
+    h.run();
+    let scene = h.state().state.scene.as_ref().expect("opened");
+    assert_eq!(scene.name, "horseshoe");
+    assert_eq!(scene.kind, "boundary");
+    // a file that is not a geometry leaves the scene and says why
+    h.input_mut().dropped_files.push(Arc::new(Dropped(data("../fit.rs"))));
+    h.run();
+    assert_eq!(h.state().state.scene.as_ref().unwrap().name, "horseshoe");
+    assert!(h.state().state.status.as_deref().unwrap_or_default().contains("fit.rs"));
+}
+
+#[test]
+fn ctrl_f_fits_the_views_again() {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("horseshoe.json")).unwrap();
+    let mut h = Harness::builder().with_size(SIZE).build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
+    h.run();
+    let fitted = h.state().state.physical;
+    h.state_mut().state.physical.pan(Vec2::new(40.0, -25.0));
+    h.state_mut().state.physical.scale *= 2.0;
+    h.run();
+    assert_ne!(h.state().state.physical, fitted);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::F);
+    h.run();
+    assert_eq!(h.state().state.physical, fitted);
+}
