@@ -271,3 +271,24 @@ fn chunked_assembly_equals_one_piece() {
         assert!(small.chunks(&disc) > 1 || disc.shape()[1] == 1, "{name}: not chunked");
     }
 }
+
+#[test]
+fn backend_selection_follows_the_rules() {
+    use winslow_gpu::{assembler, Backend, Selected};
+    // cpu is always the CPU
+    assert!(matches!(assembler(Backend::Cpu, None).unwrap(), Selected::Cpu));
+    assert_eq!(assembler(Backend::Cpu, None).unwrap().describe(), "cpu");
+    // auto never picks a software adapter, and picks f64 when it picks a GPU
+    match assembler(Backend::Auto, None).expect("auto never fails for want of an adapter") {
+        Selected::Cpu => {}
+        Selected::Gpu(g) => {
+            assert!(!g.gpu().is_software(), "{}", g.gpu().describe());
+            assert_eq!(g.gpu().precision(), Precision::F64);
+        }
+    }
+    // gpu with a forced precision reports it
+    if gpu(Precision::F32).is_some() {
+        let s = assembler(Backend::Gpu, Some(Precision::F32)).expect("gpu");
+        assert!(s.describe().starts_with("gpu: ") && s.describe().ends_with("f32)"), "{}", s.describe());
+    }
+}
