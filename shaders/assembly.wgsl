@@ -63,8 +63,10 @@ struct Params {
 @group(0) @binding(6) var<storage, read_write> res: array<real>;
 
 const WG: u32 = 64u;
-// values stored per quadrature point by `geometry`
-const GEO: u32 = 10u;
+// values stored per quadrature point by `geometry`: x_xi, x_eta, x_xixi, x_xieta,
+// x_etaeta (2 each), g11, g12, g22, L(x), L(y), the scale (1 or 1 / (g11 + g22)) and the
+// scaling denominator (0 or g11 + g22)
+const GEO: u32 = 17u;
 
 fn linear_id(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
@@ -116,7 +118,7 @@ fn geometry(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     let ey = P.ey0 + e / P.nex;
     let fx = idx[P.first_x + ex];
     let fy = idx[P.first_y + ey];
-    var g: array<real, 10>;
+    var g: array<real, 17>;
     for (var t = 0u; t < GEO; t++) {
         g[t] = 0.0;
     }
@@ -143,6 +145,20 @@ fn geometry(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
                 g[8u + d] += b5 * cd;
             }
         }
+    }
+    let g11 = g[0] * g[0] + g[1] * g[1];
+    let g12 = g[0] * g[2] + g[1] * g[3];
+    let g22 = g[2] * g[2] + g[3] * g[3];
+    g[10] = g11;
+    g[11] = g12;
+    g[12] = g22;
+    g[13] = g22 * g[4] - 2.0 * g12 * g[6] + g11 * g[8];
+    g[14] = g22 * g[5] - 2.0 * g12 * g[7] + g11 * g[9];
+    g[15] = 1.0;
+    g[16] = 0.0;
+    if P.op == 1u {
+        g[16] = g11 + g22;
+        g[15] = 1.0 / g[16];
     }
     let o = geo_base(ex, ey, ku, kv);
     for (var t = 0u; t < GEO; t++) {
@@ -192,17 +208,9 @@ fn egg_residual(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
                     for (var ku = 0u; ku < P.nq_u; ku++) {
                         let wq = wx_(ex, ku) * wv;
                         let o = geo_base(ex, ey, ku, kv);
-                        let xu = vec2<real>(geo[o], geo[o + 1u]);
-                        let xv = vec2<real>(geo[o + 2u], geo[o + 3u]);
-                        let g11 = xu.x * xu.x + xu.y * xu.y;
-                        let g12 = xu.x * xv.x + xu.y * xv.y;
-                        let g22 = xv.x * xv.x + xv.y * xv.y;
-                        let l0 = g22 * geo[o + 4u] - 2.0 * g12 * geo[o + 6u] + g11 * geo[o + 8u];
-                        let l1 = g22 * geo[o + 5u] - 2.0 * g12 * geo[o + 7u] + g11 * geo[o + 9u];
-                        var scale: real = 1.0;
-                        if P.op == 1u {
-                            scale = 1.0 / (g11 + g22);
-                        }
+                        let l0 = geo[o + 13u];
+                        let l1 = geo[o + 14u];
+                        let scale = geo[o + 15u];
                         let wa = wq * (nx_(ex, ku, 0u, ia) * va) * scale;
                         e0 += wa * l0;
                         e1 += wa * l1;
@@ -303,19 +311,12 @@ fn egg_stencil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                             var xuu = vec2<real>(geo[o + 4u], geo[o + 5u]);
                             var xuv = vec2<real>(geo[o + 6u], geo[o + 7u]);
                             var xvv = vec2<real>(geo[o + 8u], geo[o + 9u]);
-                            let g11 = xu.x * xu.x + xu.y * xu.y;
-                            let g12 = xu.x * xv.x + xu.y * xv.y;
-                            let g22 = xv.x * xv.x + xv.y * xv.y;
-                            var l = vec2<real>(
-                                g22 * xuu.x - 2.0 * g12 * xuv.x + g11 * xvv.x,
-                                g22 * xuu.y - 2.0 * g12 * xuv.y + g11 * xvv.y
-                            );
-                            var scale: real = 1.0;
-                            var sden: real = 0.0;
-                            if P.op == 1u {
-                                sden = g11 + g22;
-                                scale = 1.0 / sden;
-                            }
+                            let g11 = geo[o + 10u];
+                            let g12 = geo[o + 11u];
+                            let g22 = geo[o + 12u];
+                            var l = vec2<real>(geo[o + 13u], geo[o + 14u]);
+                            let scale = geo[o + 15u];
+                            let sden = geo[o + 16u];
                             let wa = wq * a0 * scale;
                             let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
                             for (var d = 0u; d < 2u; d++) {

@@ -136,6 +136,9 @@ struct BasisData {
     upload_bytes: u64,
 }
 
+/// Values per quadrature point written by the `geometry` kernel (`GEO` in the shader).
+const GEO: usize = 17;
+
 /// Cached bases (the solver alternates between at most two or three).
 const CACHE: usize = 4;
 
@@ -298,7 +301,7 @@ impl GpuAssembler {
         // geometry of the element rows they touch must fit the binding budget
         let budget = self.chunk_bytes;
         let row_bytes = gpu.real_bytes((nx * 4 * sw) as u64);
-        let geo_row_bytes = gpu.real_bytes((nex * tx.nq * ty.nq * 10) as u64);
+        let geo_row_bytes = gpu.real_bytes((nex * tx.nq * ty.nq * GEO) as u64);
         let rows_by_stencil = (budget / row_bytes.max(1)) as usize;
         let rows_by_geo = ((budget / geo_row_bytes.max(1)) as usize).saturating_sub(q + 1);
         let rows = rows_by_stencil.min(rows_by_geo).clamp(1, ny.max(1));
@@ -315,7 +318,7 @@ impl GpuAssembler {
         let max_erows = chunks.iter().map(|c| c.ey1 - c.ey0).max().unwrap_or(0);
         let out_len = (max_rows * nx * 4 * sw) as u64;
         let res_len = (max_rows * nx * 2) as u64;
-        let geo_len = (max_erows * nex * tx.nq * ty.nq * 10) as u64;
+        let geo_len = (max_erows * nex * tx.nq * ty.nq * GEO) as u64;
         let max_binding = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         for (what, len) in [("stencil chunk", out_len), ("geometry chunk", geo_len), ("tables", tab.len() as u64)] {
             if gpu.real_bytes(len) > max_binding {
@@ -344,7 +347,7 @@ impl GpuAssembler {
             ..Default::default()
         };
         to_u32(max_rows * nx * 4 * sw, "stencil entries per chunk")?;
-        to_u32(max_erows * nex * tx.nq * ty.nq * 10, "geometry values per chunk")?;
+        to_u32(max_erows * nex * tx.nq * ty.nq * GEO, "geometry values per chunk")?;
         let upload_bytes = gpu.real_bytes(tab.len() as u64) + 4 * idx.len() as u64;
         let tab_buf = gpu.storage_real("tables", &tab);
         let idx_buf = gpu.storage_init("indices", bytemuck::cast_slice(&idx));
