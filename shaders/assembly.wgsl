@@ -61,6 +61,8 @@ struct Params {
 @group(0) @binding(4) var<storage, read_write> geo: array<real>;
 @group(0) @binding(5) var<storage, read_write> out: array<real>;
 @group(0) @binding(6) var<storage, read_write> res: array<real>;
+// element matrices of the chunk's elements (egg_element), 4 (p+1)^2 (q+1)^2 per element
+@group(0) @binding(7) var<storage, read_write> elm: array<real>;
 
 const WG: u32 = 64u;
 // values stored per quadrature point by `geometry`: x_xi, x_eta, x_xixi, x_xieta,
@@ -472,4 +474,127 @@ fn mass_stencil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         }
     }
     out[en.kl * sw + en.s] = acc;
+}
+
+// The Jacobian terms dL_z/dc^d_b of the current quadrature point, per local function b
+// (at most (MAX_DEGREE + 1)^2 = 169 of them, MAX_DEGREE = 12).
+var<workgroup> tshared: array<real, 676>;
+
+// Pass 2e: EGG element matrices, one workgroup per element of the chunk. Per quadrature
+// point the threads first compute t_b = dL/dc_b for the local functions b (shared), then
+// each thread adds w_a t_b to its rows a of the element matrix: the CPU's element loop
+// (Discretization::egg) with the terms shared as on the CPU.
+@compute @workgroup_size(64)
+fn egg_element(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let e = wid.x + wid.y * nwg.x;
+    // uniform per workgroup: the whole group returns together
+    if e >= (P.ey1 - P.ey0) * P.nex {
+        return;
+    }
+    let ex = e % P.nex;
+    let ey = P.ey0 + e / P.nex;
+    let nloc = (P.p + 1u) * (P.q + 1u);
+    let base = e * 4u * nloc * nloc;
+    for (var r = lid; r < 4u * nloc * nloc; r += WG) {
+        elm[base + r] = 0.0;
+    }
+    for (var kv = 0u; kv < P.nq_v; kv++) {
+        let wv = wy_(ey, kv);
+        for (var ku = 0u; ku < P.nq_u; ku++) {
+            let wq = wx_(ex, ku) * wv;
+            let o = geo_base(ex, ey, ku, kv);
+            var xu = vec2<real>(geo[o], geo[o + 1u]);
+            var xv = vec2<real>(geo[o + 2u], geo[o + 3u]);
+            var xuu = vec2<real>(geo[o + 4u], geo[o + 5u]);
+            var xuv = vec2<real>(geo[o + 6u], geo[o + 7u]);
+            var xvv = vec2<real>(geo[o + 8u], geo[o + 9u]);
+            let g11 = geo[o + 10u];
+            let g12 = geo[o + 11u];
+            let g22 = geo[o + 12u];
+            var l = vec2<real>(geo[o + 13u], geo[o + 14u]);
+            let scale = geo[o + 15u];
+            let sden = geo[o + 16u];
+            for (var b = lid; b < nloc; b += WG) {
+                let wb = tensor(ex, ey, ku, kv, b % (P.p + 1u), b / (P.p + 1u));
+                let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
+                for (var d = 0u; d < 2u; d++) {
+                    let dg11 = 2.0 * xu[d] * wb[1];
+                    let dg12 = xu[d] * wb[2] + xv[d] * wb[1];
+                    let dg22 = 2.0 * xv[d] * wb[2];
+                    let ds = 2.0 * (xu[d] * wb[1] + xv[d] * wb[2]);
+                    for (var z = 0u; z < 2u; z++) {
+                        var v = dg22 * xuu[z] - 2.0 * dg12 * xuv[z] + dg11 * xvv[z];
+                        if z == d {
+                            v += lw;
+                        }
+                        if P.op == 1u {
+                            v -= l[z] * ds / sden;
+                        }
+                        tshared[b * 4u + z * 2u + d] = v;
+                    }
+                }
+            }
+            workgroupBarrier();
+            // one thread per row (zd, a) of the element matrix
+            for (var r = lid; r < 4u * nloc; r += WG) {
+                let zd = r / nloc;
+                let a = r % nloc;
+                let wa = wq * (nx_(ex, ku, 0u, a % (P.p + 1u)) * ny_(ey, kv, 0u, a / (P.p + 1u))) * scale;
+                let row = base + r * nloc;
+                for (var b = 0u; b < nloc; b++) {
+                    elm[row + b] += wa * tshared[b * 4u + zd];
+                }
+            }
+            workgroupBarrier();
+        }
+    }
+}
+
+// Pass 2f: the stencil entries of the EGG Jacobian from the element matrices, summed over
+// the elements of the common support in the CPU's order.
+@compute @workgroup_size(64)
+fn egg_gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let id = linear_id(gid, nwg);
+    let sw = stencil_width();
+    if id >= (P.j1 - P.j0) * P.nx * sw {
+        return;
+    }
+    let en = entry(id);
+    let nloc = (P.p + 1u) * (P.q + 1u);
+    var acc = array<real, 4>(0.0, 0.0, 0.0, 0.0);
+    if en.valid {
+        let ra = erange(0u, en.i);
+        let rb = erange(0u, en.ii);
+        let sa = erange(1u, en.j);
+        let sb = erange(1u, en.jj);
+        let lox = max(ra.x, rb.x);
+        let hix = min(ra.y, rb.y);
+        let loy = max(sa.x, sb.x);
+        let hiy = min(sa.y, sb.y);
+        for (var c = 0u; c <= P.q; c++) {
+            for (var ey = loy; ey <= hiy; ey++) {
+                if !in_colour(ey, c) {
+                    continue;
+                }
+                let fy = idx[P.first_y + ey];
+                for (var ex = lox; ex <= hix; ex++) {
+                    let fx = idx[P.first_x + ex];
+                    let a = (en.j - fy) * (P.p + 1u) + en.i - fx;
+                    let b = (en.jj - fy) * (P.p + 1u) + en.ii - fx;
+                    let base = ((ey - P.ey0) * P.nex + ex) * 4u * nloc * nloc;
+                    for (var zd = 0u; zd < 4u; zd++) {
+                        acc[zd] += elm[base + (zd * nloc + a) * nloc + b];
+                    }
+                }
+            }
+        }
+    }
+    let base = en.kl * 4u * sw + en.s;
+    for (var zd = 0u; zd < 4u; zd++) {
+        out[base + zd * sw] = acc[zd];
+    }
 }

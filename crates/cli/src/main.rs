@@ -285,6 +285,16 @@ struct BenchArgs {
     /// Degree of the quadrature benchmark's basis.
     #[arg(long, default_value_t = 3)]
     bench_degree: usize,
+    /// GPU Jacobian kernel of the quadrature benchmark: element matrices (one workgroup
+    /// per element, then a gather; the solver's) or one invocation per stencil entry.
+    #[arg(long, value_enum, default_value = "element")]
+    gpu_kernel: KernelArg,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+enum KernelArg {
+    Element,
+    Entry,
 }
 
 fn main() {
@@ -477,7 +487,7 @@ fn bench(a: BenchArgs) -> Result<i32> {
         None => Vec::new(),
     };
     if !sizes.is_empty() {
-        quadrature_bench(&sel, &sizes, a.bench_degree, opts.operator, a.json)?;
+        quadrature_bench(&sel, &sizes, a.bench_degree, opts.operator, a.gpu_kernel == KernelArg::Entry, a.json)?;
         if a.files.is_empty() {
             return Ok(0);
         }
@@ -512,14 +522,19 @@ fn bench(a: BenchArgs) -> Result<i32> {
 }
 
 /// Quadrature throughput at the given sizes, CPU versus the selected GPU.
-fn quadrature_bench(sel: &Selected, sizes: &[usize], degree: usize, op: Operator, json: bool) -> Result<()> {
+fn quadrature_bench(
+    sel: &Selected,
+    sizes: &[usize],
+    degree: usize,
+    op: Operator,
+    per_entry: bool,
+    json: bool,
+) -> Result<()> {
     if !(2..=8).contains(&degree) {
         bail!("--bench-degree must be in 2..=8, got {degree}");
     }
-    let gpu = match sel {
-        Selected::Gpu(g) => Some(g.as_ref()),
-        Selected::Cpu => None,
-    };
+    let gpu = sel.gpu().map(|g| winslow_gpu::GpuAssembler::new(g.clone()).with_per_entry_jacobian(per_entry));
+    let gpu = gpu.as_ref();
     let mut rows = Vec::new();
     for &dofs in sizes {
         let (disc, cps) = winslow_gpu::bench::quadrature_case(dofs, degree);

@@ -120,6 +120,13 @@ fn egg_residual_and_jacobian_match_the_cpu_in_f64() {
             eprintln!("{name} {op:?}: residual {er:.2e}, Jacobian {es:.2e}");
             assert!(er <= 1e-12, "{name} {op:?}: residual differs by {er:e}");
             assert!(es <= 1e-12, "{name} {op:?}: Jacobian differs by {es:e}");
+            // the per-entry Jacobian kernel gives the same numbers
+            let pe = GpuAssembler::new(g.gpu().clone()).with_per_entry_jacobian(true);
+            let (mut r3, mut s3) = (vec![f64::NAN; 2 * n], vec![f64::NAN; disc.stencil_len(2)]);
+            pe.try_egg(&disc, &cps, op, &mut r3, &mut s3).expect("per-entry kernel");
+            let e3 = rel_err(&s3, &sc);
+            eprintln!("{name} {op:?}: per-entry Jacobian {e3:.2e}");
+            assert!(e3 <= 1e-12, "{name} {op:?}: per-entry Jacobian differs by {e3:e}");
             // the residual-only call gives the same residual
             let mut r2 = vec![f64::NAN; 2 * n];
             g.try_egg(&disc, &cps, op, &mut r2, &mut []).expect("GPU residual");
