@@ -14,6 +14,11 @@ alias real = f64;
 //    in the same order as the CPU's coloured element loop (colour of the element row,
 //    then elements along xi; quadrature points eta-outer inside each element), and
 //    writes the entry of the stencil storage directly. Deterministic, race free.
+// 3. The solver's EGG Jacobian instead runs `egg_element` (one workgroup per element:
+//    the terms of each quadrature point computed once in workgroup memory, the element
+//    matrix accumulated row-wise) and `egg_gather` (per stencil entry, the element
+//    matrices of the common support summed in the CPU's order); `egg_stencil` remains
+//    as the per-entry alternative.
 //
 // EGG (paper eq. 4, 8): with g11 = x_xi.x_xi, g12 = x_xi.x_eta, g22 = x_eta.x_eta,
 // L(z) = g22 z_xixi - 2 g12 z_xieta + g11 z_etaeta, F^z_a = int w_a L(z) (divided by
