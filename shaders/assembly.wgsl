@@ -14,6 +14,11 @@ alias real = f64;
 //    in the same order as the CPU's coloured element loop (colour of the element row,
 //    then elements along xi; quadrature points eta-outer inside each element), and
 //    writes the entry of the stencil storage directly. Deterministic, race free.
+// 3. The solver's EGG Jacobian instead runs `egg_element` (one workgroup per element:
+//    the terms of each quadrature point computed once in workgroup memory, the element
+//    matrix accumulated row-wise) and `egg_gather` (per stencil entry, the element
+//    matrices of the common support summed in the CPU's order); `egg_stencil` remains
+//    as the per-entry alternative.
 //
 // EGG (paper eq. 4, 8): with g11 = x_xi.x_xi, g12 = x_xi.x_eta, g22 = x_eta.x_eta,
 // L(z) = g22 z_xixi - 2 g12 z_xieta + g11 z_etaeta, F^z_a = int w_a L(z) (divided by
@@ -61,10 +66,14 @@ struct Params {
 @group(0) @binding(4) var<storage, read_write> geo: array<real>;
 @group(0) @binding(5) var<storage, read_write> out: array<real>;
 @group(0) @binding(6) var<storage, read_write> res: array<real>;
+// element matrices of the chunk's elements (egg_element), 4 (p+1)^2 (q+1)^2 per element
+@group(0) @binding(7) var<storage, read_write> elm: array<real>;
 
 const WG: u32 = 64u;
-// values stored per quadrature point by `geometry`
-const GEO: u32 = 10u;
+// values stored per quadrature point by `geometry`: x_xi, x_eta, x_xixi, x_xieta,
+// x_etaeta (2 each), g11, g12, g22, L(x), L(y), the scale (1 or 1 / (g11 + g22)) and the
+// scaling denominator (0 or g11 + g22)
+const GEO: u32 = 17u;
 
 fn linear_id(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
@@ -116,7 +125,7 @@ fn geometry(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     let ey = P.ey0 + e / P.nex;
     let fx = idx[P.first_x + ex];
     let fy = idx[P.first_y + ey];
-    var g: array<real, 10>;
+    var g: array<real, 17>;
     for (var t = 0u; t < GEO; t++) {
         g[t] = 0.0;
     }
@@ -143,6 +152,20 @@ fn geometry(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
                 g[8u + d] += b5 * cd;
             }
         }
+    }
+    let g11 = g[0] * g[0] + g[1] * g[1];
+    let g12 = g[0] * g[2] + g[1] * g[3];
+    let g22 = g[2] * g[2] + g[3] * g[3];
+    g[10] = g11;
+    g[11] = g12;
+    g[12] = g22;
+    g[13] = g22 * g[4] - 2.0 * g12 * g[6] + g11 * g[8];
+    g[14] = g22 * g[5] - 2.0 * g12 * g[7] + g11 * g[9];
+    g[15] = 1.0;
+    g[16] = 0.0;
+    if P.op == 1u {
+        g[16] = g11 + g22;
+        g[15] = 1.0 / g[16];
     }
     let o = geo_base(ex, ey, ku, kv);
     for (var t = 0u; t < GEO; t++) {
@@ -192,17 +215,9 @@ fn egg_residual(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
                     for (var ku = 0u; ku < P.nq_u; ku++) {
                         let wq = wx_(ex, ku) * wv;
                         let o = geo_base(ex, ey, ku, kv);
-                        let xu = vec2<real>(geo[o], geo[o + 1u]);
-                        let xv = vec2<real>(geo[o + 2u], geo[o + 3u]);
-                        let g11 = xu.x * xu.x + xu.y * xu.y;
-                        let g12 = xu.x * xv.x + xu.y * xv.y;
-                        let g22 = xv.x * xv.x + xv.y * xv.y;
-                        let l0 = g22 * geo[o + 4u] - 2.0 * g12 * geo[o + 6u] + g11 * geo[o + 8u];
-                        let l1 = g22 * geo[o + 5u] - 2.0 * g12 * geo[o + 7u] + g11 * geo[o + 9u];
-                        var scale: real = 1.0;
-                        if P.op == 1u {
-                            scale = 1.0 / (g11 + g22);
-                        }
+                        let l0 = geo[o + 13u];
+                        let l1 = geo[o + 14u];
+                        let scale = geo[o + 15u];
                         let wa = wq * (nx_(ex, ku, 0u, ia) * va) * scale;
                         e0 += wa * l0;
                         e1 += wa * l1;
@@ -303,19 +318,12 @@ fn egg_stencil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
                             var xuu = vec2<real>(geo[o + 4u], geo[o + 5u]);
                             var xuv = vec2<real>(geo[o + 6u], geo[o + 7u]);
                             var xvv = vec2<real>(geo[o + 8u], geo[o + 9u]);
-                            let g11 = xu.x * xu.x + xu.y * xu.y;
-                            let g12 = xu.x * xv.x + xu.y * xv.y;
-                            let g22 = xv.x * xv.x + xv.y * xv.y;
-                            var l = vec2<real>(
-                                g22 * xuu.x - 2.0 * g12 * xuv.x + g11 * xvv.x,
-                                g22 * xuu.y - 2.0 * g12 * xuv.y + g11 * xvv.y
-                            );
-                            var scale: real = 1.0;
-                            var sden: real = 0.0;
-                            if P.op == 1u {
-                                sden = g11 + g22;
-                                scale = 1.0 / sden;
-                            }
+                            let g11 = geo[o + 10u];
+                            let g12 = geo[o + 11u];
+                            let g22 = geo[o + 12u];
+                            var l = vec2<real>(geo[o + 13u], geo[o + 14u]);
+                            let scale = geo[o + 15u];
+                            let sden = geo[o + 16u];
                             let wa = wq * a0 * scale;
                             let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
                             for (var d = 0u; d < 2u; d++) {
@@ -471,4 +479,127 @@ fn mass_stencil(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         }
     }
     out[en.kl * sw + en.s] = acc;
+}
+
+// The Jacobian terms dL_z/dc^d_b of the current quadrature point, per local function b
+// (at most (MAX_DEGREE + 1)^2 = 169 of them, MAX_DEGREE = 12).
+var<workgroup> tshared: array<real, 676>;
+
+// Pass 2e: EGG element matrices, one workgroup per element of the chunk. Per quadrature
+// point the threads first compute t_b = dL/dc_b for the local functions b (shared), then
+// each thread adds w_a t_b to its rows a of the element matrix: the CPU's element loop
+// (Discretization::egg) with the terms shared as on the CPU.
+@compute @workgroup_size(64)
+fn egg_element(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let e = wid.x + wid.y * nwg.x;
+    // uniform per workgroup: the whole group returns together
+    if e >= (P.ey1 - P.ey0) * P.nex {
+        return;
+    }
+    let ex = e % P.nex;
+    let ey = P.ey0 + e / P.nex;
+    let nloc = (P.p + 1u) * (P.q + 1u);
+    let base = e * 4u * nloc * nloc;
+    for (var r = lid; r < 4u * nloc * nloc; r += WG) {
+        elm[base + r] = 0.0;
+    }
+    for (var kv = 0u; kv < P.nq_v; kv++) {
+        let wv = wy_(ey, kv);
+        for (var ku = 0u; ku < P.nq_u; ku++) {
+            let wq = wx_(ex, ku) * wv;
+            let o = geo_base(ex, ey, ku, kv);
+            var xu = vec2<real>(geo[o], geo[o + 1u]);
+            var xv = vec2<real>(geo[o + 2u], geo[o + 3u]);
+            var xuu = vec2<real>(geo[o + 4u], geo[o + 5u]);
+            var xuv = vec2<real>(geo[o + 6u], geo[o + 7u]);
+            var xvv = vec2<real>(geo[o + 8u], geo[o + 9u]);
+            let g11 = geo[o + 10u];
+            let g12 = geo[o + 11u];
+            let g22 = geo[o + 12u];
+            var l = vec2<real>(geo[o + 13u], geo[o + 14u]);
+            let scale = geo[o + 15u];
+            let sden = geo[o + 16u];
+            for (var b = lid; b < nloc; b += WG) {
+                let wb = tensor(ex, ey, ku, kv, b % (P.p + 1u), b / (P.p + 1u));
+                let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
+                for (var d = 0u; d < 2u; d++) {
+                    let dg11 = 2.0 * xu[d] * wb[1];
+                    let dg12 = xu[d] * wb[2] + xv[d] * wb[1];
+                    let dg22 = 2.0 * xv[d] * wb[2];
+                    let ds = 2.0 * (xu[d] * wb[1] + xv[d] * wb[2]);
+                    for (var z = 0u; z < 2u; z++) {
+                        var v = dg22 * xuu[z] - 2.0 * dg12 * xuv[z] + dg11 * xvv[z];
+                        if z == d {
+                            v += lw;
+                        }
+                        if P.op == 1u {
+                            v -= l[z] * ds / sden;
+                        }
+                        tshared[b * 4u + z * 2u + d] = v;
+                    }
+                }
+            }
+            workgroupBarrier();
+            // one thread per row (zd, a) of the element matrix
+            for (var r = lid; r < 4u * nloc; r += WG) {
+                let zd = r / nloc;
+                let a = r % nloc;
+                let wa = wq * (nx_(ex, ku, 0u, a % (P.p + 1u)) * ny_(ey, kv, 0u, a / (P.p + 1u))) * scale;
+                let row = base + r * nloc;
+                for (var b = 0u; b < nloc; b++) {
+                    elm[row + b] += wa * tshared[b * 4u + zd];
+                }
+            }
+            workgroupBarrier();
+        }
+    }
+}
+
+// Pass 2f: the stencil entries of the EGG Jacobian from the element matrices, summed over
+// the elements of the common support in the CPU's order.
+@compute @workgroup_size(64)
+fn egg_gather(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let id = linear_id(gid, nwg);
+    let sw = stencil_width();
+    if id >= (P.j1 - P.j0) * P.nx * sw {
+        return;
+    }
+    let en = entry(id);
+    let nloc = (P.p + 1u) * (P.q + 1u);
+    var acc = array<real, 4>(0.0, 0.0, 0.0, 0.0);
+    if en.valid {
+        let ra = erange(0u, en.i);
+        let rb = erange(0u, en.ii);
+        let sa = erange(1u, en.j);
+        let sb = erange(1u, en.jj);
+        let lox = max(ra.x, rb.x);
+        let hix = min(ra.y, rb.y);
+        let loy = max(sa.x, sb.x);
+        let hiy = min(sa.y, sb.y);
+        for (var c = 0u; c <= P.q; c++) {
+            for (var ey = loy; ey <= hiy; ey++) {
+                if !in_colour(ey, c) {
+                    continue;
+                }
+                let fy = idx[P.first_y + ey];
+                for (var ex = lox; ex <= hix; ex++) {
+                    let fx = idx[P.first_x + ex];
+                    let a = (en.j - fy) * (P.p + 1u) + en.i - fx;
+                    let b = (en.jj - fy) * (P.p + 1u) + en.ii - fx;
+                    let base = ((ey - P.ey0) * P.nex + ex) * 4u * nloc * nloc;
+                    for (var zd = 0u; zd < 4u; zd++) {
+                        acc[zd] += elm[base + (zd * nloc + a) * nloc + b];
+                    }
+                }
+            }
+        }
+    }
+    let base = en.kl * 4u * sw + en.s;
+    for (var zd = 0u; zd < 4u; zd++) {
+        out[base + zd * sw] = acc[zd];
+    }
 }

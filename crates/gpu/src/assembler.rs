@@ -136,6 +136,20 @@ struct BasisData {
     upload_bytes: u64,
 }
 
+/// Values per quadrature point written by the `geometry` kernel (`GEO` in the shader).
+const GEO: usize = 17;
+
+/// What a kernel of a chunk writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Out {
+    /// The residual, one invocation per basis function.
+    Residual,
+    /// Stencil storage, one invocation per (function, slot).
+    Stencil,
+    /// Element matrices (kept on the GPU), one workgroup per element.
+    Element,
+}
+
 /// Cached bases (the solver alternates between at most two or three).
 const CACHE: usize = 4;
 
@@ -149,6 +163,8 @@ pub struct GpuAssembler {
     busy: Mutex<()>,
     /// Largest buffer bound at once (bytes).
     chunk_bytes: u64,
+    /// Jacobian by the per-entry kernel instead of element matrices.
+    per_entry: bool,
 }
 
 fn key_of(disc: &Discretization) -> (Vec<f64>, usize, Vec<f64>, usize, usize, usize) {
@@ -199,6 +215,7 @@ impl GpuAssembler {
             stats: Mutex::new(Stats::default()),
             busy: Mutex::new(()),
             chunk_bytes,
+            per_entry: false,
         }
     }
 
@@ -206,6 +223,15 @@ impl GpuAssembler {
     /// problems run in more chunks of basis rows.
     pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
         self.chunk_bytes = bytes.clamp(1024, self.gpu.chunk_bytes());
+        self
+    }
+
+    /// Assemble the EGG Jacobian with the per-entry kernel (`egg_stencil`: every stencil
+    /// entry integrates its own terms) instead of the default element matrices
+    /// (`egg_element`, one workgroup per element sharing the terms of each quadrature
+    /// point, then `egg_gather`). Both give the CPU's numbers; kept for measurement.
+    pub fn with_per_entry_jacobian(mut self, per_entry: bool) -> Self {
+        self.per_entry = per_entry;
         self
     }
 
@@ -298,10 +324,13 @@ impl GpuAssembler {
         // geometry of the element rows they touch must fit the binding budget
         let budget = self.chunk_bytes;
         let row_bytes = gpu.real_bytes((nx * 4 * sw) as u64);
-        let geo_row_bytes = gpu.real_bytes((nex * tx.nq * ty.nq * 10) as u64);
+        let geo_row_bytes = gpu.real_bytes((nex * tx.nq * ty.nq * GEO) as u64);
         let rows_by_stencil = (budget / row_bytes.max(1)) as usize;
         let rows_by_geo = ((budget / geo_row_bytes.max(1)) as usize).saturating_sub(q + 1);
-        let rows = rows_by_stencil.min(rows_by_geo).clamp(1, ny.max(1));
+        let nloc = (p + 1) * (q + 1);
+        let elm_row_bytes = gpu.real_bytes((nex * 4 * nloc * nloc) as u64);
+        let rows_by_elm = ((budget / elm_row_bytes.max(1)) as usize).saturating_sub(q + 1);
+        let rows = rows_by_stencil.min(rows_by_geo).min(rows_by_elm).clamp(1, ny.max(1));
         let mut chunks = Vec::new();
         let mut j0 = 0;
         while j0 < ny {
@@ -315,9 +344,15 @@ impl GpuAssembler {
         let max_erows = chunks.iter().map(|c| c.ey1 - c.ey0).max().unwrap_or(0);
         let out_len = (max_rows * nx * 4 * sw) as u64;
         let res_len = (max_rows * nx * 2) as u64;
-        let geo_len = (max_erows * nex * tx.nq * ty.nq * 10) as u64;
+        let geo_len = (max_erows * nex * tx.nq * ty.nq * GEO) as u64;
+        let elm_len = (max_erows * nex * 4 * nloc * nloc) as u64;
         let max_binding = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
-        for (what, len) in [("stencil chunk", out_len), ("geometry chunk", geo_len), ("tables", tab.len() as u64)] {
+        for (what, len) in [
+            ("stencil chunk", out_len),
+            ("geometry chunk", geo_len),
+            ("element matrices", elm_len),
+            ("tables", tab.len() as u64),
+        ] {
             if gpu.real_bytes(len) > max_binding {
                 return Err(GpuError::TooLarge(format!(
                     "{what} needs {} bytes, the adapter binds at most {max_binding}",
@@ -344,7 +379,7 @@ impl GpuAssembler {
             ..Default::default()
         };
         to_u32(max_rows * nx * 4 * sw, "stencil entries per chunk")?;
-        to_u32(max_erows * nex * tx.nq * ty.nq * 10, "geometry values per chunk")?;
+        to_u32(max_erows * nex * tx.nq * ty.nq * GEO, "geometry values per chunk")?;
         let upload_bytes = gpu.real_bytes(tab.len() as u64) + 4 * idx.len() as u64;
         let tab_buf = gpu.storage_real("tables", &tab);
         let idx_buf = gpu.storage_init("indices", bytemuck::cast_slice(&idx));
@@ -352,6 +387,7 @@ impl GpuAssembler {
         let geo = gpu.storage_empty("geometry", geo_len);
         let out = gpu.storage_empty("stencil", out_len);
         let res = gpu.storage_empty("residual", res_len);
+        let elm = gpu.storage_empty("element matrices", elm_len);
         let staging = gpu.staging(gpu.real_bytes(out_len.max(res_len)));
         let params_buf = gpu.uniform("params", bytemuck::bytes_of(&params));
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -365,6 +401,7 @@ impl GpuAssembler {
                 wgpu::BindGroupEntry { binding: 4, resource: geo.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: out.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: res.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: elm.as_entire_binding() },
             ],
         });
         gpu.submit_wait(None)?;
@@ -406,7 +443,7 @@ impl GpuAssembler {
         b: &BasisData,
         op: u32,
         geometry: bool,
-        kernels: &[(&wgpu::ComputePipeline, bool)],
+        kernels: &[(&wgpu::ComputePipeline, Out)],
         ncomp: usize,
         res: &mut [f64],
         stencil: &mut [f64],
@@ -427,15 +464,22 @@ impl GpuAssembler {
                 let n = (c.ey1 - c.ey0) as u64 * b.params.nex as u64 * nqp;
                 gpu.dispatch(&mut enc, &gpu.assembly.geometry, &b.bind, n)?;
             }
-            for &(k, is_stencil) in kernels {
-                let n = if is_stencil { rows * b.sw as u64 } else { rows };
+            for &(k, out) in kernels {
+                let n = match out {
+                    Out::Residual => rows,
+                    Out::Stencil => rows * b.sw as u64,
+                    Out::Element => (c.ey1 - c.ey0) as u64 * b.params.nex as u64 * 64,
+                };
                 gpu.dispatch(&mut enc, k, &b.bind, n)?;
             }
             gpu.submit_wait(Some(enc.finish()))?;
             t.dispatch += t0.elapsed().as_secs_f64();
             let t1 = Instant::now();
-            for &(_, is_stencil) in kernels {
-                if is_stencil {
+            for &(_, out) in kernels {
+                if out == Out::Element {
+                    continue;
+                }
+                if out == Out::Stencil {
                     let (lo, len) = (c.j0 * nx * row_len, (c.j1 - c.j0) * nx * row_len);
                     gpu.read_into(&b.out, &b.staging, len, &mut stencil[lo..lo + len])?;
                     t.bytes_down += gpu.real_bytes(len as u64);
@@ -491,10 +535,13 @@ impl GpuAssembler {
                 let a = &self.gpu.assembly;
                 let mut kernels = Vec::new();
                 if want_res {
-                    kernels.push((&a.egg_residual, false));
+                    kernels.push((&a.egg_residual, Out::Residual));
                 }
-                if want_mat {
-                    kernels.push((&a.egg_stencil, true));
+                if want_mat && self.per_entry {
+                    kernels.push((&a.egg_stencil, Out::Stencil));
+                } else if want_mat {
+                    kernels.push((&a.egg_element, Out::Element));
+                    kernels.push((&a.egg_gather, Out::Stencil));
                 }
                 self.run_chunks(&b, op_code, true, &kernels, 2, res, stencil, &mut t)
             })?;
@@ -510,7 +557,7 @@ impl GpuAssembler {
         self.gpu.scoped(|| {
             let b = self.basis(disc, &mut t)?;
             t.quadrature_points += b.qp_per_call;
-            let k = [(&self.gpu.assembly.mass_stencil, true)];
+            let k = [(&self.gpu.assembly.mass_stencil, Out::Stencil)];
             self.run_chunks(&b, 0, false, &k, 1, &mut [], stencil, &mut t)
         })?;
         self.record(|s| s.mass.add(&t));
@@ -535,7 +582,7 @@ impl GpuAssembler {
             let lame = self.gpu.to_bytes(&[lambda, mu]);
             self.gpu.queue.write_buffer(&b.tab, self.gpu.real_bytes(b.params.lame as u64), &lame);
             self.upload_cps(&b, cps, &mut t)?;
-            let k = [(&self.gpu.assembly.elasticity_stencil, true)];
+            let k = [(&self.gpu.assembly.elasticity_stencil, Out::Stencil)];
             self.run_chunks(&b, 0, true, &k, 2, &mut [], stencil, &mut t)
         })?;
         self.record(|s| s.elasticity.add(&t));

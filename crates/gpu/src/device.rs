@@ -24,6 +24,8 @@ pub(crate) struct AssemblyKernels {
     pub geometry: wgpu::ComputePipeline,
     pub egg_residual: wgpu::ComputePipeline,
     pub egg_stencil: wgpu::ComputePipeline,
+    pub egg_element: wgpu::ComputePipeline,
+    pub egg_gather: wgpu::ComputePipeline,
     pub elasticity_stencil: wgpu::ComputePipeline,
     pub mass_stencil: wgpu::ComputePipeline,
 }
@@ -344,6 +346,7 @@ fn assembly_kernels(device: &wgpu::Device, precision: Precision) -> AssemblyKern
             storage_entry(4, false),
             storage_entry(5, false),
             storage_entry(6, false),
+            storage_entry(7, false),
         ],
     });
     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -355,6 +358,8 @@ fn assembly_kernels(device: &wgpu::Device, precision: Precision) -> AssemblyKern
         geometry: pipeline(device, &pl, &module, "geometry"),
         egg_residual: pipeline(device, &pl, &module, "egg_residual"),
         egg_stencil: pipeline(device, &pl, &module, "egg_stencil"),
+        egg_element: pipeline(device, &pl, &module, "egg_element"),
+        egg_gather: pipeline(device, &pl, &module, "egg_gather"),
         elasticity_stencil: pipeline(device, &pl, &module, "elasticity_stencil"),
         mass_stencil: pipeline(device, &pl, &module, "mass_stencil"),
         layout,

@@ -120,6 +120,13 @@ fn egg_residual_and_jacobian_match_the_cpu_in_f64() {
             eprintln!("{name} {op:?}: residual {er:.2e}, Jacobian {es:.2e}");
             assert!(er <= 1e-12, "{name} {op:?}: residual differs by {er:e}");
             assert!(es <= 1e-12, "{name} {op:?}: Jacobian differs by {es:e}");
+            // the per-entry Jacobian kernel gives the same numbers
+            let pe = GpuAssembler::new(g.gpu().clone()).with_per_entry_jacobian(true);
+            let (mut r3, mut s3) = (vec![f64::NAN; 2 * n], vec![f64::NAN; disc.stencil_len(2)]);
+            pe.try_egg(&disc, &cps, op, &mut r3, &mut s3).expect("per-entry kernel");
+            let e3 = rel_err(&s3, &sc);
+            eprintln!("{name} {op:?}: per-entry Jacobian {e3:.2e}");
+            assert!(e3 <= 1e-12, "{name} {op:?}: per-entry Jacobian differs by {e3:e}");
             // the residual-only call gives the same residual
             let mut r2 = vec![f64::NAN; 2 * n];
             g.try_egg(&disc, &cps, op, &mut r2, &mut []).expect("GPU residual");
@@ -269,5 +276,26 @@ fn chunked_assembly_equals_one_piece() {
         small.try_mass(&disc, &mut m2).expect("chunked mass");
         assert_eq!(m1, m2, "{name}");
         assert!(small.chunks(&disc) > 1 || disc.shape()[1] == 1, "{name}: not chunked");
+    }
+}
+
+#[test]
+fn backend_selection_follows_the_rules() {
+    use winslow_gpu::{assembler, Backend, Selected};
+    // cpu is always the CPU
+    assert!(matches!(assembler(Backend::Cpu, None).unwrap(), Selected::Cpu));
+    assert_eq!(assembler(Backend::Cpu, None).unwrap().describe(), "cpu");
+    // auto never picks a software adapter, and picks f64 when it picks a GPU
+    match assembler(Backend::Auto, None).expect("auto never fails for want of an adapter") {
+        Selected::Cpu => {}
+        Selected::Gpu(g) => {
+            assert!(!g.gpu().is_software(), "{}", g.gpu().describe());
+            assert_eq!(g.gpu().precision(), Precision::F64);
+        }
+    }
+    // gpu with a forced precision reports it
+    if gpu(Precision::F32).is_some() {
+        let s = assembler(Backend::Gpu, Some(Precision::F32)).expect("gpu");
+        assert!(s.describe().starts_with("gpu: ") && s.describe().ends_with("f32)"), "{}", s.describe());
     }
 }

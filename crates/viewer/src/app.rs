@@ -512,6 +512,12 @@ impl ViewerApp {
             for side in &mv.sides {
                 painter.add(Shape::line(side.iter().map(|&p| to(p)).collect(), Stroke::new(1.6, Color32::BLACK)));
             }
+            // matched pairs of the constrained reparameterization (§7.2)
+            for &(a, b) in &mv.matches {
+                painter.line_segment([to(a), to(b)], Stroke::new(1.4, Color32::from_rgb(30, 90, 220)));
+                painter.circle_filled(to(a), 2.2, Color32::from_rgb(30, 90, 220));
+                painter.circle_filled(to(b), 2.2, Color32::from_rgb(30, 90, 220));
+            }
             if let Some(f) = self.state.selected_fold.and_then(|k| mv.folds.get(k)) {
                 let edge = element_outline(mv, f.xi, f.eta);
                 painter.add(Shape::closed_line(edge.iter().map(|&p| to(p)).collect(), Stroke::new(2.5, Color32::RED)));

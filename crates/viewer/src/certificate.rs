@@ -174,10 +174,7 @@ impl Certificate {
             ("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)),
             ("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)),
             ("det J degree".to_string(), format!("{}x{}", c.det_degree[0], c.det_degree[1])),
-            (
-                "elements / boxes / depth".to_string(),
-                format!("{} / {} / {}", c.elements, c.boxes, c.max_depth),
-            ),
+            ("elements / boxes / depth".to_string(), format!("{} / {} / {}", c.elements, c.boxes, c.max_depth)),
         ];
         Self { verdict, message: c.message(), source: CertificateSource::Exact, details }
     }
@@ -268,7 +265,9 @@ mod tests {
         assert_eq!(c.details, vec![("repairs".to_string(), "1".to_string())]);
         assert!(Certificate::from_stored(&serde_json::json!({ "verdict": "maybe" })).is_none());
         assert!(Certificate::from_stored(&serde_json::json!(3)).is_none());
-        for v in [Verdict::PositiveOnSample, Verdict::DegenerateCorner, Verdict::Folded, Verdict::NotConverged] {
+        for v in
+            [Verdict::Certified, Verdict::DegenerateCorner, Verdict::Folded, Verdict::Undecided, Verdict::NotConverged]
+        {
             // the names are the serde names of the core
             assert_eq!(serde_json::to_value(v).unwrap(), serde_json::json!(verdict_name(v)));
             assert_eq!(verdict_from_name(verdict_name(v)), Some(v));

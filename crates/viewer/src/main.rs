@@ -4,12 +4,12 @@
 //! machine without a display).
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use anyhow::{anyhow, Context, Result};
 use clap::Parser;
 use winslow_viewer::colour::ScaleKind;
-use winslow_viewer::{CpuSampler, ViewerApp};
+use winslow_viewer::sampler::sampler_for;
+use winslow_viewer::ViewerApp;
 
 /// Desktop viewer of winslow boundaries and maps: det J heat maps, grid lines,
 /// certificate, live solves.
@@ -39,6 +39,11 @@ struct Args {
     /// Window size in points, WIDTHxHEIGHT.
     #[arg(long, default_value = "1400x860")]
     size: String,
+    /// Where det J heat maps are sampled: cpu (the core), gpu (the WGSL kernel on any
+    /// adapter, lavapipe included; none is an error) or auto (a hardware GPU with f64, else
+    /// the CPU).
+    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu", "auto"])]
+    backend: String,
     /// Write a PNG of the window once everything is drawn (after --solve finished), then exit.
     #[arg(long, value_name = "PNG")]
     screenshot: Option<PathBuf>,
@@ -66,7 +71,13 @@ fn main() {
 
 fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
-    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    let backend = match args.backend.as_str() {
+        "gpu" => winslow_gpu::Backend::Gpu,
+        "auto" => winslow_gpu::Backend::Auto,
+        _ => winslow_gpu::Backend::Cpu,
+    };
+    let sampler = sampler_for(backend).context("opening the GPU for --backend")?;
+    let mut app = ViewerApp::new(sampler);
     let st = &mut app.state;
     st.settings.density = args.grid.clamp(2, 256);
     st.settings.resolution = args.resolution;

@@ -128,10 +128,25 @@ pub struct MapView {
     pub quality: Quality,
     /// The verdict shown.
     pub certificate: Certificate,
-    /// The verdict of the viewer's own sample (shown too when `certificate` is from a report).
+    /// The core's exact certificate of this map (shown too when `certificate` is from a report).
     pub exact_certificate: Certificate,
     /// The solver's level reports, when the map was solved in the viewer.
     pub report: Option<winslow::solver::Report>,
+    /// Matched point pairs of the constrained reparameterization (paper §7.2), from the
+    /// solver's report or the one stored in the map file.
+    pub matches: Vec<(Point, Point)>,
+}
+
+/// The matched pairs stored in a map file's `"report"` (`reparam.matches[].points`).
+pub fn stored_matches(report: &serde_json::Value) -> Vec<(Point, Point)> {
+    let Some(matches) = report["reparam"]["matches"].as_array() else { return Vec::new() };
+    matches
+        .iter()
+        .filter_map(|m| {
+            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
+            Some((p[0], p[1]))
+        })
+        .collect()
 }
 
 /// Default heat-map resolution: eight cells per element in the finer direction, within
@@ -183,6 +198,7 @@ impl MapView {
             certificate,
             exact_certificate,
             report: None,
+            matches: Vec::new(),
         }
     }
 
@@ -258,13 +274,17 @@ impl Scene {
             }
         }
         // a map file may carry the solver's report
-        let stored = match &doc {
-            Document::Map { .. } => serde_json::from_str::<serde_json::Value>(&text)
-                .ok()
-                .and_then(|v| v.get("report").and_then(Certificate::from_stored)),
+        let report = match &doc {
+            Document::Map { .. } => {
+                serde_json::from_str::<serde_json::Value>(&text).ok().and_then(|v| v.get("report").cloned())
+            }
             Document::Boundary(_) => None,
         };
+        let stored = report.as_ref().and_then(Certificate::from_stored);
         let mut scene = Self::from_document(doc, sampler, settings, stored);
+        if let (Some(mv), Some(r)) = (scene.map.as_mut(), &report) {
+            mv.matches = stored_matches(r);
+        }
         scene.path = Some(path.to_path_buf());
         Ok(scene)
     }
@@ -299,6 +319,7 @@ impl Scene {
         let res = settings.resolution.unwrap_or_else(|| default_resolution(&solution.map));
         let cert = Certificate::from_report(&solution.report);
         let mut mv = MapView::new(solution.map, sampler, res, settings.density, Some(cert));
+        mv.matches = solution.report.reparam.segments();
         mv.report = Some(solution.report);
         self.map = Some(mv);
     }
@@ -307,11 +328,13 @@ impl Scene {
     pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
         if let Some(mv) = self.map.take() {
             let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
-            let report = mv.report;
-            let cert =
-                (mv.certificate.source != crate::certificate::CertificateSource::Sample).then_some(mv.certificate);
+            let (report, matches) = (mv.report, mv.matches);
+            use crate::certificate::CertificateSource;
+            let cert = matches!(mv.certificate.source, CertificateSource::Solver | CertificateSource::File)
+                .then_some(mv.certificate);
             let mut new = MapView::new(mv.map, sampler, res, settings.density, cert);
             new.report = report;
+            new.matches = matches;
             self.map = Some(new);
         }
     }
@@ -328,5 +351,20 @@ impl Scene {
             (None, Some(b)) => b,
             (None, None) => [[0.0, 0.0], [1.0, 1.0]],
         }
+    }
+}
+
+#[cfg(test)]
+mod matches_tests {
+    use super::stored_matches;
+
+    #[test]
+    fn matches_are_read_from_a_stored_report() {
+        let r = serde_json::json!({ "reparam": { "matches": [
+            { "sides": ["south", "north"], "parameter": 0.5, "points": [[0.0, 1.0], [0.0, 1.1]] },
+            { "sides": ["south", "north"], "parameter": 0.7, "points": "malformed" }
+        ] } });
+        assert_eq!(stored_matches(&r), vec![([0.0, 1.0], [0.0, 1.1])]);
+        assert!(stored_matches(&serde_json::json!({ "verdict": "certified" })).is_empty());
     }
 }

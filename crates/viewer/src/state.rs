@@ -427,10 +427,12 @@ mod tests {
         let scene = s.scene.as_ref().unwrap();
         assert_eq!(scene.kind, "map");
         let mv = scene.map.as_ref().unwrap();
-        // the sample is the core's, on the chosen grid, and the verdict is read from it
+        // the sample is the core's, on the chosen grid, and the verdict is the core's exact
+        // certificate: G+Smo's disk has four 180-degree corners
         let n = mv.resolution();
         assert_eq!(mv.sample.values.len(), (n + 1) * (n + 1));
-        assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Sample);
+        assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Exact);
+        assert_eq!(mv.certificate.verdict, winslow::solver::Verdict::DegenerateCorner, "{}", mv.certificate.message);
         assert_eq!(mv.quality.det_j_min, mv.sample.min);
         // the map's own boundary can be solved again
         assert_eq!(scene.boundary.problem.is_none(), s.can_solve());
