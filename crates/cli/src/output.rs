@@ -332,14 +332,7 @@ pub fn inspect_text(
 pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
     let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
     let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
-    let Some(matches) = doc["report"]["reparam"]["matches"].as_array() else { return Vec::new() };
-    matches
-        .iter()
-        .filter_map(|m| {
-            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
-            Some((p[0], p[1]))
-        })
-        .collect()
+    winslow::reparam::matches_in_report(&doc["report"])
 }
 
 /// `winslow inspect --json`.

@@ -639,32 +639,13 @@ pub fn corner_info(map: &Surface, forced_angle: f64) -> Vec<CornerInfo> {
         let (a, b) = c.domain();
         c.derivs(if end { b } else { a }, 1).d1
     };
-    let corners = [
-        ("south-west", d(Side::South, false), d(Side::West, false)),
-        ("south-east", d(Side::South, true), d(Side::East, false)),
-        ("north-east", d(Side::North, true), d(Side::East, true)),
-        ("north-west", d(Side::North, false), d(Side::West, true)),
-    ];
-    corners
+    crate::solver::corner_geometry(d)
         .into_iter()
-        .enumerate()
-        .map(|(k, (name, a, b))| {
-            let cross = a[0] * b[1] - a[1] * b[0];
-            let (din, dout) = match k {
-                0 => ([-b[0], -b[1]], a),
-                1 => (a, b),
-                2 => (b, [-a[0], -a[1]]),
-                _ => ([-a[0], -a[1]], [-b[0], -b[1]]),
-            };
-            let turn = (din[0] * dout[1] - din[1] * dout[0]).atan2(din[0] * dout[0] + din[1] * dout[1]).to_degrees();
-            let angle = 180.0 - turn;
-            let speed = a[0].hypot(a[1]) * b[0].hypot(b[1]);
-            CornerInfo {
-                corner: name,
-                angle_degrees: angle,
-                det_j: cross,
-                forbids_positivity: speed == 0.0 || cross <= 1e-12 * speed || angle >= forced_angle,
-            }
+        .map(|c| CornerInfo {
+            corner: c.name,
+            angle_degrees: c.angle_degrees,
+            det_j: c.cross,
+            forbids_positivity: c.speed == 0.0 || c.cross <= 1e-12 * c.speed || c.angle_degrees >= forced_angle,
         })
         .collect()
 }

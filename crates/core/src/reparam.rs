@@ -826,6 +826,19 @@ impl ReparamReport {
     }
 }
 
+/// The matched point pairs stored in a map document's `"report"` (the JSON of
+/// [`ReparamReport`] under `reparam.matches[].points`); malformed entries are skipped.
+pub fn matches_in_report(report: &serde_json::Value) -> Vec<(Point, Point)> {
+    let Some(matches) = report["reparam"]["matches"].as_array() else { return Vec::new() };
+    matches
+        .iter()
+        .filter_map(|m| {
+            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
+            Some((p[0], p[1]))
+        })
+        .collect()
+}
+
 /// The parameterization of all four sides and its report.
 #[derive(Debug, Clone)]
 pub struct ReparamPlan {

@@ -234,39 +234,57 @@ pub fn boundary_kinks(boundary: &Boundary) -> Vec<KinkReport> {
     out
 }
 
+/// Geometry of one corner of a patch: interior angle, `x_xi x x_eta` (det J there) and
+/// `|x_xi| |x_eta|`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CornerGeometry {
+    pub name: &'static str,
+    pub angle_degrees: f64,
+    pub cross: f64,
+    pub speed: f64,
+}
+
+/// The four corners (south-west, south-east, north-east, north-west) from the side
+/// tangents `d(side, at_end)`: the interior angle is 180 degrees minus the turning angle
+/// between the incoming and outgoing tangents of the counter-clockwise traversal (south,
+/// east, reversed north, reversed west).
+pub(crate) fn corner_geometry(d: impl Fn(Side, bool) -> crate::curve::Point) -> [CornerGeometry; 4] {
+    // (name, x_xi, x_eta) at the corner; det J = x_xi x x_eta.
+    let corners = [
+        ("south-west", d(Side::South, false), d(Side::West, false)),
+        ("south-east", d(Side::South, true), d(Side::East, false)),
+        ("north-east", d(Side::North, true), d(Side::East, true)),
+        ("north-west", d(Side::North, false), d(Side::West, true)),
+    ];
+    std::array::from_fn(|k| {
+        let (name, a, b) = corners[k];
+        let (din, dout) = match k {
+            0 => ([-b[0], -b[1]], a),
+            1 => (a, b),
+            2 => (b, [-a[0], -a[1]]),
+            _ => ([-a[0], -a[1]], [-b[0], -b[1]]),
+        };
+        let turn = (din[0] * dout[1] - din[1] * dout[0]).atan2(din[0] * dout[0] + din[1] * dout[1]).to_degrees();
+        CornerGeometry {
+            name,
+            angle_degrees: 180.0 - turn,
+            cross: a[0] * b[1] - a[1] * b[0],
+            speed: a[0].hypot(a[1]) * b[0].hypot(b[1]),
+        }
+    })
+}
+
 /// Corners in the order south-west, south-east, north-east, north-west with their
 /// angles, from the side curves of a level.
 pub fn corner_report(sides: &[Curve; 4]) -> Vec<CornerReport> {
-    let d = |s: Side, t: f64| sides[s as usize].derivs(t, 1).d1;
-    // (name, x_xi, x_eta) at the corner; det J = x_xi x x_eta.
-    let corners = [
-        ("south-west", d(Side::South, 0.0), d(Side::West, 0.0)),
-        ("south-east", d(Side::South, 1.0), d(Side::East, 0.0)),
-        ("north-east", d(Side::North, 1.0), d(Side::East, 1.0)),
-        ("north-west", d(Side::North, 0.0), d(Side::West, 1.0)),
-    ];
-    corners
+    let d = |s: Side, end: bool| sides[s as usize].derivs(if end { 1.0 } else { 0.0 }, 1).d1;
+    corner_geometry(d)
         .into_iter()
-        .enumerate()
-        .map(|(k, (name, a, b))| {
-            let cross = a[0] * b[1] - a[1] * b[0];
-            // incoming and outgoing tangents of the counter-clockwise traversal
-            // (south, east, reversed north, reversed west)
-            let (din, dout) = match k {
-                0 => ([-b[0], -b[1]], a),
-                1 => (a, b),
-                2 => (b, [-a[0], -a[1]]),
-                _ => ([-a[0], -a[1]], [-b[0], -b[1]]),
-            };
-            let turn = (din[0] * dout[1] - din[1] * dout[0]).atan2(din[0] * dout[0] + din[1] * dout[1]).to_degrees();
-            let ang = 180.0 - turn;
-            let speed = a[0].hypot(a[1]) * b[0].hypot(b[1]);
-            CornerReport {
-                corner: name,
-                angle_degrees: ang,
-                // 180 degrees within the fit tolerance also counts: det J -> 0 there
-                forces_nonpositive_det_j: speed == 0.0 || cross <= 1e-10 * speed || ang >= FORCED_ANGLE,
-            }
+        .map(|c| CornerReport {
+            corner: c.name,
+            angle_degrees: c.angle_degrees,
+            // 180 degrees within the fit tolerance also counts: det J -> 0 there
+            forces_nonpositive_det_j: c.speed == 0.0 || c.cross <= 1e-10 * c.speed || c.angle_degrees >= FORCED_ANGLE,
         })
         .collect()
 }

@@ -139,14 +139,7 @@ pub struct MapView {
 
 /// The matched pairs stored in a map file's `"report"` (`reparam.matches[].points`).
 pub fn stored_matches(report: &serde_json::Value) -> Vec<(Point, Point)> {
-    let Some(matches) = report["reparam"]["matches"].as_array() else { return Vec::new() };
-    matches
-        .iter()
-        .filter_map(|m| {
-            let p: [[f64; 2]; 2] = serde_json::from_value(m["points"].clone()).ok()?;
-            Some((p[0], p[1]))
-        })
-        .collect()
+    winslow::reparam::matches_in_report(report)
 }
 
 /// Default heat-map resolution: eight cells per element in the finer direction, within
