@@ -170,12 +170,17 @@ impl Certificate {
             Exact::Folded { .. } => Verdict::Folded,
             Exact::Undecided { .. } => Verdict::Undecided,
         };
-        let details = vec![
-            ("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)),
+        let mut details = Vec::new();
+        if verdict_is_good(verdict) {
+            details.push(("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)));
+        } else {
+            details.push(("smallest det J found".to_string(), format!("{:.4e}", c.min_value_found)));
+        }
+        details.extend([
             ("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)),
             ("det J degree".to_string(), format!("{}x{}", c.det_degree[0], c.det_degree[1])),
             ("elements / boxes / depth".to_string(), format!("{} / {} / {}", c.elements, c.boxes, c.max_depth)),
-        ];
+        ]);
         Self { verdict, message: c.message(), source: CertificateSource::Exact, details }
     }
 
