@@ -32,6 +32,9 @@ pub enum LinearMethod {
 /// Largest system that [`LinearMethod::Auto`] factorizes directly.
 pub const AUTO_LU_LIMIT: usize = 5_000;
 
+/// Default relative residual at which GMRES stops.
+pub const KRYLOV_TOL: f64 = 1e-10;
+
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
 pub const REFRESH_KRYLOV: usize = 30;
 
@@ -76,6 +79,8 @@ pub struct LinearSolver {
     pub krylov_iterations: usize,
     last_krylov: usize,
     fallback: bool,
+    /// Relative residual at which GMRES stops.
+    pub krylov_tol: f64,
 }
 
 /// `L L^T` of the SPD matrix `a` (only its lower triangle is read), reusing `symbolic`.
@@ -108,6 +113,7 @@ impl LinearSolver {
             krylov_iterations: 0,
             last_krylov: 0,
             fallback,
+            krylov_tol: KRYLOV_TOL,
         }
     }
 
@@ -192,7 +198,7 @@ impl LinearSolver {
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let pc = self.precond.as_ref().expect("set with matrix");
-                match gmres(a, b, |r, z| pc.apply(r, z), 50, 1e-10, 2000) {
+                match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, 2000) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
                         self.last_krylov = it;

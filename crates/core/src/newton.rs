@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::egg::NonlinearProblem;
 use crate::error::Result;
-use crate::linsolve::{LinearMethod, LinearSolver};
+use crate::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
 use crate::sparse::Csr;
 
 /// Nonlinear iteration.
@@ -262,6 +262,10 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         } else {
             None
         };
+        // inexact Newton: the Krylov tolerance follows the residual (forcing term
+        // eta = 1e-2 |F| / |F_0| in [1e-10, 1e-4]), which keeps the convergence
+        // superlinear while the first steps need far fewer GMRES iterations
+        self.lin.krylov_tol = (1e-2 * self.norm / self.r0.max(f64::MIN_POSITIVE)).clamp(KRYLOV_TOL, 1e-4);
         let factored = self.lin.factor_preconditioned(&a, k);
         self.a = a;
         factored?;

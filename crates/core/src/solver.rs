@@ -453,7 +453,7 @@ fn frozen_discretization(knots: &[KnotVector; 2], boxes: &[[f64; 4]]) -> Discret
     if dofs.num_free() == 0 {
         return Discretization::new(knots.clone());
     }
-    Discretization::with_dofs(knots.clone(), p.max(q) + 2, dofs)
+    Discretization::with_dofs(knots.clone(), p.max(q) + 1, dofs)
 }
 
 /// Largest tensor basis the solver accepts (about 8 million unknowns).
