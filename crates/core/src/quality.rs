@@ -93,42 +93,63 @@ pub struct Functionals {
     pub min_det_j_qp: f64,
 }
 
-/// Evaluate the functionals with `p + 2` Gauss points per direction and element.
+/// Evaluate the functionals with `p + 2` Gauss points per direction and element; rows of
+/// elements run in parallel and their sums are added in order (deterministic).
 pub fn functionals(map: &Surface) -> Functionals {
     let [p, q] = map.degrees();
     let gx = GaussLegendre::new(p + 2);
     let gy = GaussLegendre::new(q + 2);
-    let (mut area, mut winslow, mut harmonic, mut min_det) = (0.0, 0.0, 0.0, f64::INFINITY);
-    let (mut area_orthogonality, mut liao, mut uniformity) = (0.0, 0.0, 0.0);
-    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-    for (sy, ya, yb) in map.knots[1].elements() {
-        for (v, wv) in gy.on(ya, yb) {
-            bv.eval_in_span(&map.knots[1], sy, v, 2);
-            for (sx, xa, xb) in map.knots[0].elements() {
-                for (u, wu) in gx.on(xa, xb) {
-                    bu.eval_in_span(&map.knots[0], sx, u, 2);
-                    let d = map.derivs_with(&bu, &bv, 2);
-                    let det = d.det_j();
-                    let w = wu * wv;
-                    let g11 = d.xu[0] * d.xu[0] + d.xu[1] * d.xu[1];
-                    let g12 = d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1];
-                    let g22 = d.xv[0] * d.xv[0] + d.xv[1] * d.xv[1];
-                    area += w * det;
-                    area_orthogonality += w * (g11 * g11 + g22 * g22);
-                    liao += w * (g11 * g11 + g22 * g22 + 2.0 * g12 * g12);
-                    let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
-                    uniformity += w * (n2(d.xuu) + n2(d.xvv) + n2(d.xuv));
-                    winslow += if det > 0.0 { w * (g11 + g22) / det } else { f64::INFINITY };
-                    for c in 0..2 {
-                        let l = g22 * d.xuu[c] - 2.0 * g12 * d.xuv[c] + g11 * d.xvv[c];
-                        harmonic += w * l * l;
+    let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
+    // area, winslow, harmonic, area orthogonality, liao, uniformity, min det J
+    let rows: Vec<[f64; 7]> = ey
+        .par_iter()
+        .map(|&(sy, ya, yb)| {
+            let mut acc = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY];
+            let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+            for (v, wv) in gy.on(ya, yb) {
+                bv.eval_in_span(&map.knots[1], sy, v, 2);
+                for &(sx, xa, xb) in &ex {
+                    for (u, wu) in gx.on(xa, xb) {
+                        bu.eval_in_span(&map.knots[0], sx, u, 2);
+                        let d = map.derivs_with(&bu, &bv, 2);
+                        let det = d.det_j();
+                        let w = wu * wv;
+                        let g11 = d.xu[0] * d.xu[0] + d.xu[1] * d.xu[1];
+                        let g12 = d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1];
+                        let g22 = d.xv[0] * d.xv[0] + d.xv[1] * d.xv[1];
+                        acc[0] += w * det;
+                        acc[1] += if det > 0.0 { w * (g11 + g22) / det } else { f64::INFINITY };
+                        for c in 0..2 {
+                            let l = g22 * d.xuu[c] - 2.0 * g12 * d.xuv[c] + g11 * d.xvv[c];
+                            acc[2] += w * l * l;
+                        }
+                        acc[3] += w * (g11 * g11 + g22 * g22);
+                        acc[4] += w * (g11 * g11 + g22 * g22 + 2.0 * g12 * g12);
+                        let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
+                        acc[5] += w * (n2(d.xuu) + n2(d.xvv) + n2(d.xuv));
+                        acc[6] = acc[6].min(det);
                     }
-                    min_det = min_det.min(det);
                 }
             }
+            acc
+        })
+        .collect();
+    let mut t = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY];
+    for r in &rows {
+        for k in 0..6 {
+            t[k] += r[k];
         }
+        t[6] = t[6].min(r[6]);
     }
-    Functionals { area, winslow, harmonic, area_orthogonality, liao, uniformity, min_det_j_qp: min_det }
+    Functionals {
+        area: t[0],
+        winslow: t[1],
+        harmonic: t[2],
+        area_orthogonality: t[3],
+        liao: t[4],
+        uniformity: t[5],
+        min_det_j_qp: t[6],
+    }
 }
 
 /// Minimum, mean and maximum of a per-element quantity.
@@ -174,49 +195,57 @@ pub struct Quality {
     pub elements: usize,
 }
 
-/// Functionals and cell statistics of a map.
+/// Functionals and cell statistics of a map (rows of elements in parallel).
 pub fn quality(map: &Surface) -> Quality {
     let [p, q] = map.degrees();
     let gx = GaussLegendre::new(p + 2);
     let gy = GaussLegendre::new(q + 2);
     let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
-    let (mut sj_min, mut orth, mut aspect) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut sj_int, mut wsum) = (0.0, 0.0);
-    let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-    for &(sy, ya, yb) in &ey {
-        for &(sx, xa, xb) in &ex {
-            let (mut smin, mut omax) = (f64::INFINITY, 0.0f64);
-            for (v, wv) in gy.on(ya, yb) {
-                bv.eval_in_span(&map.knots[1], sy, v, 1);
-                for (u, wu) in gx.on(xa, xb) {
-                    bu.eval_in_span(&map.knots[0], sx, u, 1);
-                    let d = map.derivs_with(&bu, &bv, 1);
-                    let (a, b) = (d.xu[0].hypot(d.xu[1]), d.xv[0].hypot(d.xv[1]));
-                    let sj = if a * b > 0.0 { d.det_j() / (a * b) } else { 0.0 };
-                    smin = smin.min(sj);
-                    sj_int += wu * wv * sj;
-                    wsum += wu * wv;
-                    let cos = if a * b > 0.0 { (d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1]) / (a * b) } else { 1.0 };
-                    omax = omax.max((cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs());
+    // per row: (scaled-Jacobian minimum, orthogonality maximum, aspect ratio) per element,
+    // and the integral of the scaled Jacobian and the weight
+    type Row = (Vec<[f64; 3]>, f64, f64);
+    let rows: Vec<Row> = ey
+        .par_iter()
+        .map(|&(sy, ya, yb)| {
+            let (mut cells, mut sj_int, mut wsum) = (Vec::with_capacity(ex.len()), 0.0, 0.0);
+            let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
+            for &(sx, xa, xb) in &ex {
+                let (mut smin, mut omax) = (f64::INFINITY, 0.0f64);
+                for (v, wv) in gy.on(ya, yb) {
+                    bv.eval_in_span(&map.knots[1], sy, v, 1);
+                    for (u, wu) in gx.on(xa, xb) {
+                        bu.eval_in_span(&map.knots[0], sx, u, 1);
+                        let d = map.derivs_with(&bu, &bv, 1);
+                        let (a, b) = (d.xu[0].hypot(d.xu[1]), d.xv[0].hypot(d.xv[1]));
+                        let sj = if a * b > 0.0 { d.det_j() / (a * b) } else { 0.0 };
+                        smin = smin.min(sj);
+                        sj_int += wu * wv * sj;
+                        wsum += wu * wv;
+                        let cos = if a * b > 0.0 { (d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1]) / (a * b) } else { 1.0 };
+                        omax = omax.max((cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs());
+                    }
                 }
+                let (uc, vc) = (0.5 * (xa + xb), 0.5 * (ya + yb));
+                bu.eval_in_span(&map.knots[0], sx, uc, 1);
+                bv.eval_in_span(&map.knots[1], sy, vc, 1);
+                let d = map.derivs_with(&bu, &bv, 1);
+                let (lx, ly) = (d.xu[0].hypot(d.xu[1]) * (xb - xa), d.xv[0].hypot(d.xv[1]) * (yb - ya));
+                let aspect = if lx > 0.0 && ly > 0.0 { (lx / ly).max(ly / lx) } else { f64::INFINITY };
+                cells.push([smin, omax, aspect]);
             }
-            sj_min.push(smin);
-            orth.push(omax);
-            let (uc, vc) = (0.5 * (xa + xb), 0.5 * (ya + yb));
-            bu.eval_in_span(&map.knots[0], sx, uc, 1);
-            bv.eval_in_span(&map.knots[1], sy, vc, 1);
-            let d = map.derivs_with(&bu, &bv, 1);
-            let (lx, ly) = (d.xu[0].hypot(d.xu[1]) * (xb - xa), d.xv[0].hypot(d.xv[1]) * (yb - ya));
-            aspect.push(if lx > 0.0 && ly > 0.0 { (lx / ly).max(ly / lx) } else { f64::INFINITY });
-        }
-    }
+            (cells, sj_int, wsum)
+        })
+        .collect();
+    let cells: Vec<[f64; 3]> = rows.iter().flat_map(|r| r.0.iter().copied()).collect();
+    let (sj_int, wsum) = rows.iter().fold((0.0, 0.0), |(a, b), r| (a + r.1, b + r.2));
+    let column = |k: usize| cells.iter().map(|c| c[k]).collect::<Vec<f64>>();
     Quality {
         functionals: functionals(map),
-        scaled_jacobian: Stats::of(&sj_min),
+        scaled_jacobian: Stats::of(&column(0)),
         scaled_jacobian_mean: sj_int / wsum,
-        orthogonality_degrees: Stats::of(&orth),
-        aspect_ratio: Stats::of(&aspect),
-        elements: sj_min.len(),
+        orthogonality_degrees: Stats::of(&column(1)),
+        aspect_ratio: Stats::of(&column(2)),
+        elements: cells.len(),
     }
 }
 

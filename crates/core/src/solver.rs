@@ -431,12 +431,12 @@ struct Continuation {
     iterations: usize,
 }
 
-/// Smallest `det J` on a sample of `4 max(n_xi, n_eta)` points per direction, away
+/// Smallest `det J` on a sample of `2 max(n_xi, n_eta)` points per direction, away
 /// from the corners.
 fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[crate::curve::Point]) -> f64 {
     let shape = disc.shape();
     let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: None };
-    assembler.sample_det_j(&map, 4 * shape[0].max(shape[1])).min_interior
+    assembler.sample_det_j(&map, 2 * shape[0].max(shape[1])).min_interior
 }
 
 /// A discretization whose free DOFs are the interior functions with support meeting one
