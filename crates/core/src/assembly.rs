@@ -183,6 +183,15 @@ struct Geo {
     xvv: [f64; 2],
 }
 
+impl Geo {
+    /// The metric terms `(g11, g12, g22)`: `g11 = x_xi.x_xi`, `g12 = x_xi.x_eta`,
+    /// `g22 = x_eta.x_eta`.
+    fn metric(&self) -> (f64, f64, f64) {
+        let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+        (dot(self.xu, self.xu), dot(self.xu, self.xv), dot(self.xv, self.xv))
+    }
+}
+
 /// Scratch of one element: tensor basis values and element vector/matrix.
 pub(crate) struct Scratch {
     pub(crate) nloc: usize,
@@ -406,9 +415,7 @@ impl Discretization {
                 for ku in 0..nq[0] {
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
-                    let g11 = g.xu[0] * g.xu[0] + g.xu[1] * g.xu[1];
-                    let g12 = g.xu[0] * g.xv[0] + g.xu[1] * g.xv[1];
-                    let g22 = g.xv[0] * g.xv[0] + g.xv[1] * g.xv[1];
+                    let (g11, g12, g22) = g.metric();
                     let l = [
                         g22 * g.xuu[0] - 2.0 * g12 * g.xuv[0] + g11 * g.xvv[0],
                         g22 * g.xuu[1] - 2.0 * g12 * g.xuv[1] + g11 * g.xvv[1],
@@ -507,9 +514,7 @@ impl Discretization {
                 for ku in 0..nq[0] {
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
-                    let g11 = g.xu[0] * g.xu[0] + g.xu[1] * g.xu[1];
-                    let g12 = g.xu[0] * g.xv[0] + g.xu[1] * g.xv[1];
-                    let g22 = g.xv[0] * g.xv[0] + g.xv[1] * g.xv[1];
+                    let (g11, g12, g22) = g.metric();
                     let tr = g11 + g22;
                     let scale = match op {
                         Operator::Plain => 1.0,

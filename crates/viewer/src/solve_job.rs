@@ -219,21 +219,29 @@ impl SolveJob {
         matches!(self.state, JobState::Running | JobState::Cancelling)
     }
 
+    /// Apply one message of the solver thread; the solution when it is the last one.
+    fn take(&mut self, msg: Msg) -> Option<Solution> {
+        self.progress.apply(&msg);
+        match msg {
+            Msg::Finished(s) => {
+                self.state = JobState::Finished;
+                return Some(*s);
+            }
+            Msg::Failed(e) => self.state = JobState::Failed(e),
+            Msg::Cancelled => self.state = JobState::Cancelled,
+            _ => {}
+        }
+        None
+    }
+
     /// Take the messages that arrived; returns the solution once, when it arrives.
     pub fn poll(&mut self) -> Option<Solution> {
         let mut solution = None;
         loop {
             match self.rx.try_recv() {
                 Ok(msg) => {
-                    self.progress.apply(&msg);
-                    match msg {
-                        Msg::Finished(s) => {
-                            self.state = JobState::Finished;
-                            solution = Some(*s);
-                        }
-                        Msg::Failed(e) => self.state = JobState::Failed(e),
-                        Msg::Cancelled => self.state = JobState::Cancelled,
-                        _ => {}
+                    if let Some(sol) = self.take(msg) {
+                        solution = Some(sol);
                     }
                 }
                 Err(TryRecvError::Empty) => break,
@@ -259,15 +267,8 @@ impl SolveJob {
         while self.is_active() {
             match self.rx.recv() {
                 Ok(msg) => {
-                    self.progress.apply(&msg);
-                    match msg {
-                        Msg::Finished(s) => {
-                            self.state = JobState::Finished;
-                            solution = Some(*s);
-                        }
-                        Msg::Failed(e) => self.state = JobState::Failed(e),
-                        Msg::Cancelled => self.state = JobState::Cancelled,
-                        _ => {}
+                    if let Some(sol) = self.take(msg) {
+                        solution = Some(sol);
                     }
                 }
                 Err(_) => {
