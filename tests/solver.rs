@@ -165,18 +165,23 @@ fn quarter_annulus_converges_under_refinement() {
     assert!(d2 < d1 / 4.0, "no convergence: {d1:.3e} then {d2:.3e}");
 }
 
-/// Defect correction (paper §8.2): puzzle3 on a coarse basis (one level, fit tolerance
-/// 1e-3) folds; local refinement around the offending elements and a re-solve from the
-/// prolonged map remove the fold, and the map ends certified.
-#[test]
-fn local_repair_removes_a_fold() {
-    let coarse = SolveOptions {
+/// One level on a coarse basis (fit tolerance 1e-3, at least 2 elements), no repair.
+fn coarse_one_level() -> SolveOptions {
+    SolveOptions {
         fit: winslow::FitOptions { tol: 1e-3, ..Default::default() },
         max_levels: Some(1),
         min_elements: 2,
         repair: 0,
         ..Default::default()
-    };
+    }
+}
+
+/// Defect correction (paper §8.2): puzzle3 on a coarse basis (one level, fit tolerance
+/// 1e-3) folds; local refinement around the offending elements and a re-solve from the
+/// prolonged map remove the fold, and the map ends certified.
+#[test]
+fn local_repair_removes_a_fold() {
+    let coarse = coarse_one_level();
     let folded = run("gismo/puzzle3.json", &coarse);
     assert_eq!(folded.report.verdict, Verdict::Folded, "{}", folded.report.message);
     assert!(folded.report.repair_rounds.is_empty());
@@ -198,13 +203,7 @@ fn local_repair_removes_a_fold() {
 /// the fold are unknowns; the others keep the prolonged map's values exactly.
 #[test]
 fn local_repair_with_frozen_dofs() {
-    let coarse = SolveOptions {
-        fit: winslow::FitOptions { tol: 1e-3, ..Default::default() },
-        max_levels: Some(1),
-        min_elements: 2,
-        repair: 0,
-        ..Default::default()
-    };
+    let coarse = coarse_one_level();
     let folded = run("gismo/puzzle3.json", &coarse);
     let sol = run("gismo/puzzle3.json", &SolveOptions { repair: 3, repair_freeze: Some(2), ..coarse });
     let r = &sol.report;

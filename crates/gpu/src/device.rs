@@ -330,30 +330,38 @@ fn pipeline(
     })
 }
 
-fn assembly_kernels(device: &wgpu::Device, precision: Precision) -> AssemblyKernels {
-    let src = shader_source(ASSEMBLY_WGSL, precision);
+/// The shader module of `source` and its bind-group and pipeline layouts: binding 0 a
+/// uniform, then one storage buffer per entry of `read_only`.
+fn module_and_layouts(
+    device: &wgpu::Device,
+    label: &str,
+    source: String,
+    read_only: &[bool],
+) -> (wgpu::ShaderModule, wgpu::BindGroupLayout, wgpu::PipelineLayout) {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("assembly.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(src.into()),
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("assembly"),
-        entries: &[
-            uniform_entry(0),
-            storage_entry(1, true),
-            storage_entry(2, true),
-            storage_entry(3, true),
-            storage_entry(4, false),
-            storage_entry(5, false),
-            storage_entry(6, false),
-            storage_entry(7, false),
-        ],
-    });
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(uniform_entry(0))
+        .chain(read_only.iter().enumerate().map(|(k, &ro)| storage_entry(k as u32 + 1, ro)))
+        .collect();
+    let layout =
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("assembly"),
+        label: Some(label),
         bind_group_layouts: &[Some(&layout)],
         immediate_size: 0,
     });
+    (module, layout, pl)
+}
+
+fn assembly_kernels(device: &wgpu::Device, precision: Precision) -> AssemblyKernels {
+    let (module, layout, pl) = module_and_layouts(
+        device,
+        "assembly.wgsl",
+        shader_source(ASSEMBLY_WGSL, precision),
+        &[true, true, true, false, false, false, false],
+    );
     AssemblyKernels {
         geometry: pipeline(device, &pl, &module, "geometry"),
         egg_residual: pipeline(device, &pl, &module, "egg_residual"),
@@ -367,25 +375,7 @@ fn assembly_kernels(device: &wgpu::Device, precision: Precision) -> AssemblyKern
 }
 
 fn det_j_kernel(device: &wgpu::Device, precision: Precision) -> DetJKernel {
-    let src = shader_source(DET_J_WGSL, precision);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("det_j.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(src.into()),
-    });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("det_j"),
-        entries: &[
-            uniform_entry(0),
-            storage_entry(1, true),
-            storage_entry(2, true),
-            storage_entry(3, true),
-            storage_entry(4, false),
-        ],
-    });
-    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("det_j"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
+    let (module, layout, pl) =
+        module_and_layouts(device, "det_j.wgsl", shader_source(DET_J_WGSL, precision), &[true, true, true, false]);
     DetJKernel { sample: pipeline(device, &pl, &module, "sample"), layout }
 }
