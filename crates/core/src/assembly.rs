@@ -161,6 +161,9 @@ pub struct Discretization {
     pub vector: SystemPattern,
     /// Pattern of scalar systems (mass, Laplacian).
     pub scalar: SystemPattern,
+    /// Fill-reducing (nested-dissection) order of the free scalar unknowns for sparse
+    /// Cholesky factorizations, `ordering[new] = old`; see [`crate::ordering`].
+    pub ordering: Vec<usize>,
 }
 
 /// Which operator [`Discretization::egg`] discretizes.
@@ -199,8 +202,11 @@ pub(crate) struct Scratch {
     pub(crate) b: Vec<[f64; 6]>,
     /// Per trial function: physical gradients (elasticity).
     pub(crate) t: Vec<[f64; 4]>,
-    /// `dL_z/dc^d_b` at `(z * 2 + d) * nloc + b`: contiguous in `b` for the outer products.
+    /// `dL_z/dc^d_b` at quadrature point `k` at `((z * 2 + d) * nqp + k) * nloc + b`:
+    /// contiguous in `b` for the element-matrix product.
     tz: Vec<f64>,
+    /// Test-function weights `w_k w_a(k) / s(k)` at `k * nloc + a`.
+    wa: Vec<f64>,
     pub(crate) re: Vec<f64>,
     pub(crate) ke: Vec<f64>,
 }
@@ -212,9 +218,45 @@ impl Scratch {
             nloc,
             b: vec![[0.0; 6]; nloc],
             t: vec![[0.0; 4]; nloc],
-            tz: vec![0.0; 4 * nloc],
+            tz: Vec::new(),
+            wa: Vec::new(),
             re: vec![0.0; ncomp * nloc],
             ke: vec![0.0; ncomp * ncomp * nloc * nloc],
+        }
+    }
+}
+
+/// `out[a][b] = sum_k w[k][a] t[k][b]` for `nloc x nloc` element blocks (`w`, `t` with
+/// `nqp` rows of `nloc`): the quadrature sum of an element matrix as one matrix
+/// product, each output row accumulated in registers for the common sizes.
+fn element_product(out: &mut [f64], w: &[f64], t: &[f64], nloc: usize) {
+    fn fixed<const N: usize>(out: &mut [f64], w: &[f64], t: &[f64]) {
+        for (a, row) in out.chunks_exact_mut(N).enumerate() {
+            let mut acc = [0.0f64; N];
+            for (wk, tk) in w.chunks_exact(N).zip(t.chunks_exact(N)) {
+                let wa = wk[a];
+                let tk: &[f64; N] = tk.try_into().expect("chunk of N");
+                for (r, v) in acc.iter_mut().zip(tk) {
+                    *r += wa * v;
+                }
+            }
+            row.copy_from_slice(&acc);
+        }
+    }
+    match nloc {
+        9 => fixed::<9>(out, w, t),
+        16 => fixed::<16>(out, w, t),
+        25 => fixed::<25>(out, w, t),
+        36 => fixed::<36>(out, w, t),
+        _ => {
+            out.fill(0.0);
+            for (wk, tk) in w.chunks_exact(nloc).zip(t.chunks_exact(nloc)) {
+                for (row, &wa) in out.chunks_exact_mut(nloc).zip(wk) {
+                    for (r, v) in row.iter_mut().zip(tk) {
+                        *r += wa * v;
+                    }
+                }
+            }
         }
     }
 }
@@ -242,7 +284,10 @@ impl Discretization {
         let (p, q) = (knots[0].degree(), knots[1].degree());
         let vector = SystemPattern::new(&dofs, p, q, 2);
         let scalar = SystemPattern::new(&dofs, p, q, 1);
-        Self { knots, tables, dofs, vector, scalar }
+        let nx = dofs.shape()[0];
+        let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();
+        let ordering = crate::ordering::nested_dissection(&nodes, [p, q]);
+        Self { knots, tables, dofs, vector, scalar, ordering }
     }
 
     /// Interior DOFs free, `max(p, q) + 1` Gauss points per direction: exact for the mass
@@ -404,15 +449,18 @@ impl Discretization {
     /// [`Discretization::stencil_len`]`(2)` or is empty.
     pub fn egg(&self, cps: &[[f64; 2]], op: Operator, res: &mut [f64], stencil: &mut [f64]) {
         let nq = [self.tables[0].nq, self.tables[1].nq];
+        let nqp = nq[0] * nq[1];
         let want_mat = !stencil.is_empty();
         self.assemble(2, res, stencil, |ex, ey, s| {
             let nloc = s.nloc;
             s.re.fill(0.0);
-            if want_mat {
-                s.ke.fill(0.0);
+            if want_mat && s.tz.len() != 4 * nqp * nloc {
+                s.tz = vec![0.0; 4 * nqp * nloc];
+                s.wa = vec![0.0; nqp * nloc];
             }
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
+                    let k = kv * nq[0] + ku;
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
                     let (g11, g12, g22) = g.metric();
@@ -435,6 +483,9 @@ impl Discretization {
                     if !want_mat {
                         continue;
                     }
+                    for (a, w) in s.wa[k * nloc..(k + 1) * nloc].iter_mut().enumerate() {
+                        *w = wq * s.b[a][0] * scale;
+                    }
                     for b in 0..nloc {
                         let wb = &s.b[b];
                         let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
@@ -451,20 +502,18 @@ impl Discretization {
                                 if op == Operator::Scaled {
                                     v -= l[z] * ds / sden;
                                 }
-                                s.tz[(z * 2 + d) * nloc + b] = v;
+                                s.tz[((z * 2 + d) * nqp + k) * nloc + b] = v;
                             }
                         }
                     }
-                    for zd in 0..4 {
-                        let tz = &s.tz[zd * nloc..(zd + 1) * nloc];
-                        for a in 0..nloc {
-                            let wa = wq * s.b[a][0] * scale;
-                            let row = &mut s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
-                            for (r, t) in row.iter_mut().zip(tz) {
-                                *r += wa * t;
-                            }
-                        }
-                    }
+                }
+            }
+            if want_mat {
+                // K^{zd}_{ab} = sum_k wa_{ka} tz^{zd}_{kb}: one small matrix product per block
+                for zd in 0..4 {
+                    let tz = &s.tz[zd * nqp * nloc..(zd + 1) * nqp * nloc];
+                    let ke = &mut s.ke[zd * nloc * nloc..(zd + 1) * nloc * nloc];
+                    element_product(ke, &s.wa, tz, nloc);
                 }
             }
         });
@@ -507,11 +556,19 @@ impl Discretization {
     /// of `A` to keep it definite.
     pub fn metric_laplace(&self, cps: &[[f64; 2]], op: Operator, shift: f64, stencil: &mut [f64]) {
         let nq = [self.tables[0].nq, self.tables[1].nq];
+        let nqp = nq[0] * nq[1];
+        // K_ab = sum_k (A grad w_a)_u w_b,u + (A grad w_a)_v w_b,v (+ shift w_a w_b): one
+        // product of (2 or 3) nqp rows
+        let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
         self.assemble(1, &mut [], stencil, |ex, ey, s| {
             let nloc = s.nloc;
-            s.ke.fill(0.0);
+            if s.wa.len() != nrows * nloc {
+                s.wa = vec![0.0; nrows * nloc];
+                s.tz = vec![0.0; nrows * nloc];
+            }
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
+                    let k = kv * nq[0] + ku;
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
                     let (g11, g12, g22) = g.metric();
@@ -522,18 +579,21 @@ impl Discretization {
                         Operator::Scaled => 1.0,
                     };
                     let eps = 1e-10 * tr;
-                    let (a11, a12, a22) = (scale * (g22 + eps), -scale * g12, scale * (g11 + eps));
-                    for a in 0..nloc {
-                        let ba = s.b[a];
-                        let (fu, fv) = (a11 * ba[1] + a12 * ba[2], a12 * ba[1] + a22 * ba[2]);
-                        let sa = shift * ba[0];
-                        let row = &mut s.ke[a * nloc..(a + 1) * nloc];
-                        for (r, bb) in row.iter_mut().zip(&s.b) {
-                            *r += wq * (fu * bb[1] + fv * bb[2] + sa * bb[0]);
+                    let w = wq * scale;
+                    let (a11, a12, a22) = (w * (g22 + eps), -w * g12, w * (g11 + eps));
+                    for (a, ba) in s.b.iter().enumerate() {
+                        s.wa[k * nloc + a] = a11 * ba[1] + a12 * ba[2];
+                        s.tz[k * nloc + a] = ba[1];
+                        s.wa[(nqp + k) * nloc + a] = a12 * ba[1] + a22 * ba[2];
+                        s.tz[(nqp + k) * nloc + a] = ba[2];
+                        if shift != 0.0 {
+                            s.wa[(2 * nqp + k) * nloc + a] = wq * shift * ba[0];
+                            s.tz[(2 * nqp + k) * nloc + a] = ba[0];
                         }
                     }
                 }
             }
+            element_product(&mut s.ke, &s.wa, &s.tz, nloc);
         });
     }
 

@@ -25,6 +25,11 @@ pub trait NonlinearProblem {
     fn preconditioner(&mut self, _shift: f64) -> Option<&Csr> {
         None
     }
+    /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
+    /// factorizations (see [`crate::linsolve::LinearSolver::set_ordering`]).
+    fn ordering(&self) -> Option<&[usize]> {
+        None
+    }
 }
 
 /// Quadrature back end of the solver (CPU here; the GPU crate implements it too): the
@@ -160,6 +165,10 @@ impl NonlinearProblem for EggProblem {
             self.mass = Some(out);
         }
         self.mass.as_ref().expect("set above")
+    }
+
+    fn ordering(&self) -> Option<&[usize]> {
+        Some(&self.disc.ordering)
     }
 
     /// `K` of [`Discretization::metric_laplace`] on the current control points.

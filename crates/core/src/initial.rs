@@ -95,6 +95,7 @@ pub fn elasticity_displacement_with(
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
     // symmetric positive definite: Cholesky, with LU/GMRES as a safety net
     let mut lin = LinearSolver::new(LinearMethod::Cholesky);
+    lin.set_ordering(&disc.ordering);
     if lin.factor(&k).is_err() {
         lin = LinearSolver::new(LinearMethod::Auto);
         lin.factor(&k)?;

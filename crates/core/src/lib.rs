@@ -35,6 +35,7 @@ pub mod io;
 pub mod knots;
 pub mod linsolve;
 pub mod newton;
+pub mod ordering;
 pub mod picture;
 pub mod poisson;
 pub mod quadrature;

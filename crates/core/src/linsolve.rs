@@ -4,13 +4,26 @@
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
 //! [`crate::assembly::Discretization::metric_laplace`]) or by ILU(0).
+//!
+//! The Cholesky factorizations follow the problem's fill-reducing order when it gives one
+//! ([`LinearSolver::set_ordering`], nested dissection of the spline grid, see
+//! [`crate::ordering`]), approximate minimum degree otherwise; their symbolic analysis,
+//! numeric storage and scratch memory are allocated once and reused by every
+//! refactorization and solve.
 
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::Side;
+use faer::{Conj, Par, Side};
+use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::ordering;
 use crate::sparse::Csr;
 
 /// Which linear solver the nonlinear solvers use.
@@ -38,28 +51,103 @@ pub const KRYLOV_TOL: f64 = 1e-10;
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
 pub const REFRESH_KRYLOV: usize = 30;
 
+/// Sparse Cholesky `A = L L^T` of an SPD matrix with a fixed sparsity pattern: symbolic
+/// analysis (ordering, elimination tree, supernodes) once, then numeric factorizations
+/// and solves into storage allocated up front.
+struct Cholesky {
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    factor_scratch: MemBuffer,
+    /// One scratch per right-hand side, so that columns are solved in parallel.
+    solve_scratch: Vec<MemBuffer>,
+}
+
+impl std::fmt::Debug for Cholesky {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cholesky").field("n", &self.symbolic.nrows()).field("nnz_l", &self.values.len()).finish()
+    }
+}
+
+/// The pattern of the symmetric `a` as faer's column storage (CSR of a symmetric matrix
+/// is the CSC of the same matrix).
+fn symmetric_pattern(a: &Csr) -> SymbolicSparseColMatRef<'_, usize> {
+    SymbolicSparseColMatRef::new_checked(a.nrows, a.ncols, &a.row_ptr, None, &a.col_idx)
+}
+
+impl Cholesky {
+    /// Symbolic analysis of the SPD pattern of `a` (only its lower triangle is read) in
+    /// the fill-reducing order `order` (`order[new] = old`), or approximate minimum degree.
+    fn analyze(a: &Csr, order: Option<&[usize]>) -> Result<Self> {
+        let inverse = order.map(ordering::inverse);
+        let ord = match (order, &inverse) {
+            (Some(fwd), Some(inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows)),
+            _ => SymmetricOrdering::Amd,
+        };
+        let symbolic =
+            factorize_symbolic_cholesky(symmetric_pattern(a), Side::Lower, ord, CholeskySymbolicParams::default())
+                .map_err(|e| Error::LinearSolver(format!("symbolic Cholesky: {e:?}")))?;
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::rayon(0), Default::default());
+        let factor_scratch =
+            MemBuffer::try_new(scratch).map_err(|_| Error::LinearSolver("Cholesky: out of memory".into()))?;
+        Ok(Self { values: vec![0.0; symbolic.len_val()], symbolic, factor_scratch, solve_scratch: Vec::new() })
+    }
+
+    /// Numeric factorization of `a` (same pattern as analyzed).
+    fn factor(&mut self, a: &Csr) -> Result<()> {
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut self.values,
+                SparseColMatRef::new(symmetric_pattern(a), &a.values),
+                Side::Lower,
+                Default::default(),
+                Par::rayon(0),
+                MemStack::new(&mut self.factor_scratch),
+                Default::default(),
+            )
+            .map(|_| ())
+            .map_err(|e| Error::LinearSolver(format!("Cholesky: matrix not positive definite ({e:?})")))
+    }
+
+    /// Overwrite each of the columns `x = [x_0, x_1, ...]` (each of length `n`) with
+    /// `A^{-1} x_j`, the columns in parallel. A supernodal triangular solve is bound by
+    /// memory bandwidth and gains nothing from threads inside one column; two columns on
+    /// two threads take the time of one.
+    fn solve_columns(&mut self, x: &mut [f64]) {
+        let n = self.symbolic.nrows();
+        let cols = x.len() / n;
+        while self.solve_scratch.len() < cols {
+            self.solve_scratch.push(MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)));
+        }
+        let llt = LltRef::new(&self.symbolic, &self.values);
+        x.par_chunks_mut(n).zip(self.solve_scratch.par_iter_mut()).for_each(|(col, scratch)| {
+            let rhs = faer::MatMut::from_column_major_slice_mut(col, n, 1);
+            llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(scratch));
+        });
+    }
+
+    fn dim(&self) -> usize {
+        self.symbolic.nrows()
+    }
+}
+
 /// A GMRES preconditioner.
 #[derive(Debug)]
 enum Preconditioner {
     Ilu(Ilu0),
     /// `P = -diag(K, ..., K)`, `K = L L^T`.
-    NegBlockLlt(Llt<usize, f64>, usize),
+    NegBlock(Box<Cholesky>),
 }
 
 impl Preconditioner {
     /// `x = P^{-1} b`.
-    fn apply(&self, b: &[f64], x: &mut [f64]) {
+    fn apply(&mut self, b: &[f64], x: &mut [f64]) {
         match self {
             Self::Ilu(ilu) => ilu.apply(b, x),
-            Self::NegBlockLlt(llt, m) => {
-                let nb = b.len() / m;
-                let mut rhs = faer::Mat::<f64>::from_fn(*m, nb, |i, j| b[j * m + i]);
-                llt.solve_in_place(rhs.as_mut());
-                for j in 0..nb {
-                    for i in 0..*m {
-                        x[j * m + i] = -rhs[(i, j)];
-                    }
+            Self::NegBlock(k) => {
+                for (xi, bi) in x.iter_mut().zip(b) {
+                    *xi = -bi;
                 }
+                k.solve_columns(x);
             }
         }
     }
@@ -70,32 +158,18 @@ impl Preconditioner {
 pub struct LinearSolver {
     method: LinearMethod,
     symbolic: Option<SymbolicLu<usize>>,
-    symbolic_llt: Option<SymbolicLlt<usize>>,
     lu: Option<Lu<usize, f64>>,
-    llt: Option<Llt<usize, f64>>,
+    llt: Option<Cholesky>,
     precond: Option<Preconditioner>,
     matrix: Option<Csr>,
+    /// Fill-reducing order of the `m` scalar unknowns (see [`LinearSolver::set_ordering`]).
+    order: Option<Vec<usize>>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
     last_krylov: usize,
     fallback: bool,
     /// Relative residual at which GMRES stops.
     pub krylov_tol: f64,
-}
-
-/// `L L^T` of the SPD matrix `a` (only its lower triangle is read), reusing `symbolic`.
-fn cholesky(a: &Csr, symbolic: &mut Option<SymbolicLlt<usize>>) -> Result<Llt<usize, f64>> {
-    // CSR of a symmetric matrix = CSC of the same matrix
-    let sym = SymbolicSparseColMatRef::new_checked(a.nrows, a.ncols, &a.row_ptr, None, &a.col_idx);
-    if symbolic.is_none() {
-        *symbolic = Some(
-            SymbolicLlt::try_new(sym, Side::Lower)
-                .map_err(|e| Error::LinearSolver(format!("symbolic Cholesky: {e:?}")))?,
-        );
-    }
-    let s = symbolic.clone().expect("set above");
-    Llt::try_new_with_symbolic(s, SparseColMatRef::new(sym, &a.values), Side::Lower)
-        .map_err(|e| Error::LinearSolver(format!("Cholesky: matrix not positive definite ({e:?})")))
 }
 
 impl LinearSolver {
@@ -105,16 +179,42 @@ impl LinearSolver {
         Self {
             method,
             symbolic: None,
-            symbolic_llt: None,
             lu: None,
             llt: None,
             precond: None,
             matrix: None,
+            order: None,
             krylov_iterations: 0,
             last_krylov: 0,
             fallback,
             krylov_tol: KRYLOV_TOL,
         }
+    }
+
+    /// Use `order` (`order[new] = old`, a permutation of the `m` scalar unknowns, e.g.
+    /// [`crate::ordering::nested_dissection`] of the spline grid) for the Cholesky
+    /// factorizations: of the scalar preconditioner `K` (size `m`) directly, of a system
+    /// of `c` component blocks (size `c m`) point by point ([`crate::ordering::interleave`]).
+    /// Without it, approximate minimum degree.
+    pub fn set_ordering(&mut self, order: &[usize]) {
+        self.order = Some(order.to_vec());
+    }
+
+    /// The fill-reducing order for a matrix of `n` unknowns, if one is known.
+    fn order_for(&self, n: usize) -> Option<Vec<usize>> {
+        let order = self.order.as_ref()?;
+        let m = order.len();
+        (m > 0 && n.is_multiple_of(m)).then(|| ordering::interleave(order, n / m))
+    }
+
+    /// Factorize the SPD `a` into `slot`, reusing its analysis when the size matches.
+    fn cholesky(&self, a: &Csr, slot: Option<Cholesky>) -> Result<Cholesky> {
+        let mut chol = match slot {
+            Some(c) if c.dim() == a.nrows => c,
+            _ => Cholesky::analyze(a, self.order_for(a.nrows).as_deref())?,
+        };
+        chol.factor(a)?;
+        Ok(chol)
     }
 
     /// The method in use ([`LinearMethod::Auto`] until the first factorization).
@@ -127,7 +227,7 @@ impl LinearSolver {
     /// (a frozen preconditioner across Newton steps) while GMRES needs at most
     /// [`REFRESH_KRYLOV`] iterations with it.
     pub fn wants_preconditioner(&self, n: usize) -> bool {
-        let fresh = !matches!(self.precond, Some(Preconditioner::NegBlockLlt(..))) || self.last_krylov > REFRESH_KRYLOV;
+        let fresh = !matches!(self.precond, Some(Preconditioner::NegBlock(..))) || self.last_krylov > REFRESH_KRYLOV;
         match self.method {
             LinearMethod::Gmres => fresh,
             LinearMethod::Auto => n > AUTO_LU_LIMIT,
@@ -141,12 +241,45 @@ impl LinearSolver {
     }
 
     /// As [`LinearSolver::factor`]; GMRES uses `P = -diag(K, K)` as preconditioner when
+    /// `k` (SPD, `a.nrows` a multiple of its size) is given.
+    pub fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
+        self.resolve(a.nrows);
+        if self.method == LinearMethod::Gmres {
+            // GMRES multiplies with `a`: keep it
+            self.matrix_mut().update(a);
+            self.factor_stored(k)
+        } else {
+            self.factor_matrix(a, k)
+        }
+    }
+
+    /// Resolve [`LinearMethod::Auto`] for a system of `n` unknowns.
+    fn resolve(&mut self, n: usize) {
+        if self.method == LinearMethod::Auto {
+            self.method = if n <= AUTO_LU_LIMIT { LinearMethod::Lu } else { LinearMethod::Gmres };
+        }
+    }
+
+    /// The solver's storage of the system matrix: fill it (with
+    /// [`Csr::update`] the pattern is copied once) and call
+    /// [`LinearSolver::factor_stored`], without a copy of the matrix per factorization.
+    pub fn matrix_mut(&mut self) -> &mut Csr {
+        self.matrix.get_or_insert_with(Csr::default)
+    }
+
+    /// Factorize (LU, Cholesky) or precondition (GMRES) the matrix in
+    /// [`LinearSolver::matrix_mut`]; GMRES uses `P = -diag(K, K)` as preconditioner when
     /// `k` (SPD, `a.nrows` a multiple of its size) is given. The CSR storage of `a` is
     /// the CSC storage of `a^T`; faer factors `a^T` and we solve with its transpose.
-    pub fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
-        if self.method == LinearMethod::Auto {
-            self.method = if a.nrows <= AUTO_LU_LIMIT { LinearMethod::Lu } else { LinearMethod::Gmres };
-        }
+    pub fn factor_stored(&mut self, k: Option<&Csr>) -> Result<()> {
+        let a = self.matrix.take().ok_or_else(|| Error::LinearSolver("no matrix to factor".into()))?;
+        let r = self.factor_matrix(&a, k);
+        self.matrix = Some(a);
+        r
+    }
+
+    fn factor_matrix(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
+        self.resolve(a.nrows);
         match self.method {
             LinearMethod::Lu => {
                 let sym = SymbolicSparseColMatRef::new_checked(a.ncols, a.nrows, &a.row_ptr, None, &a.col_idx);
@@ -161,19 +294,32 @@ impl LinearSolver {
                         .map_err(|e| Error::LinearSolver(format!("numeric LU: {e:?}")))?,
                 );
             }
-            LinearMethod::Cholesky => self.llt = Some(cholesky(a, &mut self.symbolic_llt)?),
+            LinearMethod::Cholesky => {
+                let slot = self.llt.take();
+                self.llt = Some(self.cholesky(a, slot)?);
+            }
             LinearMethod::Gmres => {
                 let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
-                let spd = block.map(|k| cholesky(k, &mut self.symbolic_llt).map(|l| (l, k.nrows)));
-                self.precond = match (spd, self.precond.take()) {
-                    (Some(Ok((llt, m))), _) => Some(Preconditioner::NegBlockLlt(llt, m)),
-                    // no new approximation: keep the previous one (frozen preconditioner)
-                    (None, Some(p @ Preconditioner::NegBlockLlt(..))) => Some(p),
-                    // none at all (or not definite): ILU(0)
-                    _ => Some(Preconditioner::Ilu(Ilu0::new(a)?)),
+                let previous = self.precond.take();
+                self.precond = match (block, previous) {
+                    // a new approximation: refactor in place (same pattern) ...
+                    (Some(k), previous) => {
+                        let slot = match previous {
+                            Some(Preconditioner::NegBlock(c)) => Some(*c),
+                            _ => None,
+                        };
+                        match self.cholesky(k, slot) {
+                            Ok(c) => Some(Preconditioner::NegBlock(Box::new(c))),
+                            // not definite: ILU(0)
+                            Err(_) => Some(Preconditioner::Ilu(Ilu0::new(a)?)),
+                        }
+                    }
+                    // ... or keep the previous one (frozen preconditioner)
+                    (None, Some(p @ Preconditioner::NegBlock(..))) => Some(p),
+                    // none at all: ILU(0)
+                    (None, _) => Some(Preconditioner::Ilu(Ilu0::new(a)?)),
                 };
                 self.last_krylov = 0;
-                self.matrix.get_or_insert_with(Csr::default).assign(a);
             }
             LinearMethod::Auto => unreachable!("resolved above"),
         }
@@ -190,14 +336,14 @@ impl LinearSolver {
                 (0..b.len()).map(|i| x[(i, 0)]).collect::<Vec<_>>()
             }
             LinearMethod::Cholesky => {
-                let llt = self.llt.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let mut x = faer::Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
-                llt.solve_in_place(x.as_mut());
-                (0..b.len()).map(|i| x[(i, 0)]).collect::<Vec<_>>()
+                let llt = self.llt.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
+                let mut x = b.to_vec();
+                llt.solve_columns(&mut x);
+                x
             }
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let pc = self.precond.as_ref().expect("set with matrix");
+                let pc = self.precond.as_mut().expect("set with matrix");
                 match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, 2000) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
@@ -206,10 +352,9 @@ impl LinearSolver {
                     }
                     Err(e) if self.fallback => {
                         // GMRES did not converge: factorize this matrix directly instead
-                        let a = self.matrix.take().expect("set above");
                         self.method = LinearMethod::Lu;
                         self.fallback = false;
-                        self.factor(&a).map_err(|f| Error::LinearSolver(format!("{e}; LU fallback: {f}")))?;
+                        self.factor_stored(None).map_err(|f| Error::LinearSolver(format!("{e}; LU fallback: {f}")))?;
                         return self.solve(b);
                     }
                     Err(e) => return Err(e),
@@ -303,7 +448,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 pub fn gmres(
     a: &Csr,
     b: &[f64],
-    m: impl Fn(&[f64], &mut [f64]),
+    mut m: impl FnMut(&[f64], &mut [f64]),
     restart: usize,
     tol: f64,
     max_iter: usize,

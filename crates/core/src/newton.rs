@@ -12,9 +12,11 @@ use serde::Serialize;
 use crate::egg::NonlinearProblem;
 use crate::error::Result;
 use crate::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
-use crate::sparse::Csr;
 
 /// Nonlinear iteration.
+/// Largest forcing term of the inexact Newton method (see `NonlinearSolver::forcing`).
+pub const ETA_MAX: f64 = 1e-2;
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
@@ -112,13 +114,14 @@ pub struct NonlinearSolver<P: NonlinearProblem> {
     f: Vec<f64>,
     norm: f64,
     r0: f64,
+    /// `||F||` before the last Newton step and the forcing term used for it.
+    previous: Option<(f64, f64)>,
     iteration: usize,
     newton_its: usize,
     pseudo_its: usize,
     method: Method,
     dt: f64,
     lin: LinearSolver,
-    a: Csr,
     status: Status,
     started: bool,
     /// Timings so far.
@@ -143,6 +146,10 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         problem.residual(&c0, &mut f);
         let assembly = t.elapsed();
         let norm = norm2(&f);
+        let mut lin = LinearSolver::new(opts.linear);
+        if let Some(order) = problem.ordering() {
+            lin.set_ordering(order);
+        }
         Self {
             problem,
             opts,
@@ -150,13 +157,13 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             f,
             norm,
             r0: norm,
+            previous: None,
             iteration: 0,
             newton_its: 0,
             pseudo_its: 0,
             method: opts.method,
             dt: 0.0,
-            lin: LinearSolver::new(opts.linear),
-            a: Csr::default(),
+            lin,
             status: Status::Running,
             started: false,
             timings: Timings { assembly, linear: Duration::ZERO },
@@ -240,9 +247,9 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
     fn linear_step(&mut self, shift: Option<f64>) -> Result<Vec<f64>> {
         let t = Instant::now();
         let mut f = std::mem::take(&mut self.f);
-        // the system matrix lives in `self.a` between steps: no allocation per step
-        let mut a = std::mem::take(&mut self.a);
-        a.assign(self.problem.jacobian(&self.c, &mut f));
+        // the system matrix lives in the linear solver between steps: no allocation and,
+        // the pattern being fixed, only the values are copied
+        self.lin.matrix_mut().update(self.problem.jacobian(&self.c, &mut f));
         self.f = f;
         self.timings.assembly += t.elapsed();
         if let Some(dt) = shift {
@@ -251,28 +258,48 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             // form of eq. (30)-(32) is therefore M dc/dt = +F, i.e.
             // [M / dt - dF/dc] dc = F, written as [-(M / dt) + dF/dc] dc = -F.
             let m = self.problem.mass();
-            for (v, mv) in a.values.iter_mut().zip(&m.values) {
+            for (v, mv) in self.lin.matrix_mut().values.iter_mut().zip(&m.values) {
                 *v -= mv / dt;
             }
         }
         let t = Instant::now();
+        self.lin.krylov_tol = if shift.is_some() { KRYLOV_TOL } else { self.forcing() };
         // the pseudo-time shift changes with every step: no frozen preconditioner then
-        let k = if shift.is_some() || self.lin.wants_preconditioner(a.nrows) {
+        let n = self.c.len();
+        let k = if shift.is_some() || self.lin.wants_preconditioner(n) {
             self.problem.preconditioner(shift.map_or(0.0, |dt| 1.0 / dt))
         } else {
             None
         };
-        // inexact Newton: the Krylov tolerance follows the residual (forcing term
-        // eta = 1e-2 |F| / |F_0| in [1e-10, 1e-4]), which keeps the convergence
-        // superlinear while the first steps need far fewer GMRES iterations
-        self.lin.krylov_tol = (1e-2 * self.norm / self.r0.max(f64::MIN_POSITIVE)).clamp(KRYLOV_TOL, 1e-4);
-        let factored = self.lin.factor_preconditioned(&a, k);
-        self.a = a;
-        factored?;
+        self.lin.factor_stored(k)?;
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
         let dx = self.lin.solve(&rhs);
         self.timings.linear += t.elapsed();
         dx
+    }
+
+    /// Forcing term `eta_k` of the inexact Newton method, the relative residual at which
+    /// the Krylov solver stops: Eisenstat & Walker's choice 2, `eta_k = 0.9 (|F_k| /
+    /// |F_{k-1}|)^2`, safeguarded by `0.9 eta_{k-1}^2` when that exceeds 0.1, within
+    /// `[KRYLOV_TOL, ETA_MAX]`, and never tighter than needed to reach the tolerance:
+    /// the step leaves `|F_{k+1}| ~ eta_k |F_k|`, so `eta_k >= tol / (2 |F_k|)` (scaled)
+    /// suffices. Keeps the quadratic convergence of Newton's method while the first
+    /// steps and the last one need few Krylov iterations.
+    fn forcing(&self) -> f64 {
+        let eta = match self.previous {
+            None => ETA_MAX,
+            Some((norm, eta)) => {
+                let ew = 0.9 * (self.norm / norm).powi(2);
+                let safeguard = 0.9 * eta * eta;
+                if safeguard > 0.1 {
+                    ew.max(safeguard)
+                } else {
+                    ew
+                }
+            }
+        };
+        let enough = 0.5 * self.opts.tol / self.scaled().max(f64::MIN_POSITIVE);
+        eta.min(ETA_MAX).max(enough).clamp(KRYLOV_TOL, ETA_MAX)
     }
 
     fn eval(&mut self, c: &[f64], f: &mut [f64]) -> f64 {
@@ -289,6 +316,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             Ok(dx) => dx,
             Err(e) => return Ok(self.stall(format!("Newton linear solve failed: {e}"))),
         };
+        self.previous = Some((self.norm, self.lin.krylov_tol));
         // Backtracking on phi = ||F||^2 / 2 with Armijo constant 1e-4; the slope along
         // the Newton direction is -||F||^2.
         let phi0 = 0.5 * self.norm * self.norm;

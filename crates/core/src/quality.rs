@@ -96,22 +96,61 @@ pub struct Functionals {
 /// Evaluate the functionals with `p + 2` Gauss points per direction and element; rows of
 /// elements run in parallel and their sums are added in order (deterministic).
 pub fn functionals(map: &Surface) -> Functionals {
+    integrate(map).functionals
+}
+
+/// Everything one pass over the Gauss points of every element gives: the functionals
+/// and the per-element cell measures of [`Quality`].
+struct Pass {
+    functionals: Functionals,
+    /// Per element (row-major, `xi` fastest): scaled-Jacobian minimum, orthogonality
+    /// maximum, aspect ratio.
+    cells: Vec<[f64; 3]>,
+    /// Integral of the scaled Jacobian over the parameter square, and its weight.
+    sj_int: f64,
+    wsum: f64,
+}
+
+/// One pass over `(p + 2) x (q + 2)` Gauss points per element; the `xi` basis is
+/// tabulated once, rows of elements run in parallel and are summed in order.
+fn integrate(map: &Surface) -> Pass {
     let [p, q] = map.degrees();
     let gx = GaussLegendre::new(p + 2);
     let gy = GaussLegendre::new(q + 2);
     let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
-    // area, winslow, harmonic, area orthogonality, liao, uniformity, min det J
-    let rows: Vec<[f64; 7]> = ey
+    let nu = p + 2;
+    let bus: Vec<(BasisDerivs, f64)> = ex
+        .iter()
+        .flat_map(|&(sx, xa, xb)| {
+            gx.on(xa, xb).map(move |(u, wu)| {
+                let mut b = BasisDerivs::default();
+                b.eval_in_span(&map.knots[0], sx, u, 2);
+                (b, wu)
+            })
+        })
+        .collect();
+    // per row: area, winslow, harmonic, area orthogonality, liao, uniformity, min det J,
+    // scaled-Jacobian integral, weight; and the row's cells
+    type Row = ([f64; 9], Vec<[f64; 3]>);
+    let rows: Vec<Row> = ey
         .par_iter()
         .map(|&(sy, ya, yb)| {
-            let mut acc = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY];
+            let mut acc = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY, 0.0, 0.0];
+            let mut cells = Vec::with_capacity(ex.len());
+            let bvs: Vec<(BasisDerivs, f64)> = gy
+                .on(ya, yb)
+                .map(|(v, wv)| {
+                    let mut b = BasisDerivs::default();
+                    b.eval_in_span(&map.knots[1], sy, v, 2);
+                    (b, wv)
+                })
+                .collect();
             let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-            for (v, wv) in gy.on(ya, yb) {
-                bv.eval_in_span(&map.knots[1], sy, v, 2);
-                for &(sx, xa, xb) in &ex {
-                    for (u, wu) in gx.on(xa, xb) {
-                        bu.eval_in_span(&map.knots[0], sx, u, 2);
-                        let d = map.derivs_with(&bu, &bv, 2);
+            for (e, &(sx, xa, xb)) in ex.iter().enumerate() {
+                let (mut smin, mut omax) = (f64::INFINITY, 0.0f64);
+                for (bv, wv) in &bvs {
+                    for (bu, wu) in &bus[e * nu..(e + 1) * nu] {
+                        let d = map.derivs_with(bu, bv, 2);
                         let det = d.det_j();
                         let w = wu * wv;
                         let g11 = d.xu[0] * d.xu[0] + d.xu[1] * d.xu[1];
@@ -128,27 +167,51 @@ pub fn functionals(map: &Surface) -> Functionals {
                         let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
                         acc[5] += w * (n2(d.xuu) + n2(d.xvv) + n2(d.xuv));
                         acc[6] = acc[6].min(det);
+                        // cell measures
+                        let ab = (g11 * g22).sqrt();
+                        let sj = if ab > 0.0 { det / ab } else { 0.0 };
+                        smin = smin.min(sj);
+                        acc[7] += w * sj;
+                        acc[8] += w;
+                        let cos = if ab > 0.0 { g12 / ab } else { 1.0 };
+                        omax = omax.max((cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs());
                     }
                 }
+                let (uc, vc) = (0.5 * (xa + xb), 0.5 * (ya + yb));
+                bu.eval_in_span(&map.knots[0], sx, uc, 1);
+                bv.eval_in_span(&map.knots[1], sy, vc, 1);
+                let d = map.derivs_with(&bu, &bv, 1);
+                let (lx, ly) = (d.xu[0].hypot(d.xu[1]) * (xb - xa), d.xv[0].hypot(d.xv[1]) * (yb - ya));
+                let aspect = if lx > 0.0 && ly > 0.0 { (lx / ly).max(ly / lx) } else { f64::INFINITY };
+                cells.push([smin, omax, aspect]);
             }
-            acc
+            (acc, cells)
         })
         .collect();
-    let mut t = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY];
-    for r in &rows {
-        for k in 0..6 {
-            t[k] += r[k];
+    let mut t = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY, 0.0, 0.0];
+    for (r, _) in &rows {
+        for k in 0..9 {
+            if k == 6 {
+                t[6] = t[6].min(r[6]);
+            } else {
+                t[k] += r[k];
+            }
         }
-        t[6] = t[6].min(r[6]);
     }
-    Functionals {
-        area: t[0],
-        winslow: t[1],
-        harmonic: t[2],
-        area_orthogonality: t[3],
-        liao: t[4],
-        uniformity: t[5],
-        min_det_j_qp: t[6],
+    let cells = rows.into_iter().flat_map(|r| r.1).collect();
+    Pass {
+        functionals: Functionals {
+            area: t[0],
+            winslow: t[1],
+            harmonic: t[2],
+            area_orthogonality: t[3],
+            liao: t[4],
+            uniformity: t[5],
+            min_det_j_qp: t[6],
+        },
+        cells,
+        sj_int: t[7],
+        wsum: t[8],
     }
 }
 
@@ -197,55 +260,15 @@ pub struct Quality {
 
 /// Functionals and cell statistics of a map (rows of elements in parallel).
 pub fn quality(map: &Surface) -> Quality {
-    let [p, q] = map.degrees();
-    let gx = GaussLegendre::new(p + 2);
-    let gy = GaussLegendre::new(q + 2);
-    let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
-    // per row: (scaled-Jacobian minimum, orthogonality maximum, aspect ratio) per element,
-    // and the integral of the scaled Jacobian and the weight
-    type Row = (Vec<[f64; 3]>, f64, f64);
-    let rows: Vec<Row> = ey
-        .par_iter()
-        .map(|&(sy, ya, yb)| {
-            let (mut cells, mut sj_int, mut wsum) = (Vec::with_capacity(ex.len()), 0.0, 0.0);
-            let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
-            for &(sx, xa, xb) in &ex {
-                let (mut smin, mut omax) = (f64::INFINITY, 0.0f64);
-                for (v, wv) in gy.on(ya, yb) {
-                    bv.eval_in_span(&map.knots[1], sy, v, 1);
-                    for (u, wu) in gx.on(xa, xb) {
-                        bu.eval_in_span(&map.knots[0], sx, u, 1);
-                        let d = map.derivs_with(&bu, &bv, 1);
-                        let (a, b) = (d.xu[0].hypot(d.xu[1]), d.xv[0].hypot(d.xv[1]));
-                        let sj = if a * b > 0.0 { d.det_j() / (a * b) } else { 0.0 };
-                        smin = smin.min(sj);
-                        sj_int += wu * wv * sj;
-                        wsum += wu * wv;
-                        let cos = if a * b > 0.0 { (d.xu[0] * d.xv[0] + d.xu[1] * d.xv[1]) / (a * b) } else { 1.0 };
-                        omax = omax.max((cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs());
-                    }
-                }
-                let (uc, vc) = (0.5 * (xa + xb), 0.5 * (ya + yb));
-                bu.eval_in_span(&map.knots[0], sx, uc, 1);
-                bv.eval_in_span(&map.knots[1], sy, vc, 1);
-                let d = map.derivs_with(&bu, &bv, 1);
-                let (lx, ly) = (d.xu[0].hypot(d.xu[1]) * (xb - xa), d.xv[0].hypot(d.xv[1]) * (yb - ya));
-                let aspect = if lx > 0.0 && ly > 0.0 { (lx / ly).max(ly / lx) } else { f64::INFINITY };
-                cells.push([smin, omax, aspect]);
-            }
-            (cells, sj_int, wsum)
-        })
-        .collect();
-    let cells: Vec<[f64; 3]> = rows.iter().flat_map(|r| r.0.iter().copied()).collect();
-    let (sj_int, wsum) = rows.iter().fold((0.0, 0.0), |(a, b), r| (a + r.1, b + r.2));
-    let column = |k: usize| cells.iter().map(|c| c[k]).collect::<Vec<f64>>();
+    let pass = integrate(map);
+    let column = |k: usize| pass.cells.iter().map(|c| c[k]).collect::<Vec<f64>>();
     Quality {
-        functionals: functionals(map),
+        functionals: pass.functionals,
         scaled_jacobian: Stats::of(&column(0)),
-        scaled_jacobian_mean: sj_int / wsum,
+        scaled_jacobian_mean: pass.sj_int / pass.wsum,
         orthogonality_degrees: Stats::of(&column(1)),
         aspect_ratio: Stats::of(&column(2)),
-        elements: cells.len(),
+        elements: pass.cells.len(),
     }
 }
 
