@@ -40,9 +40,10 @@ fn bench(c: &mut Criterion) {
             let c0 = prob.unknowns();
             let mut f = vec![0.0; c0.len()];
             let mut lin = LinearSolver::new(LinearMethod::Lu);
+            let mut j = winslow::sparse::Csr::default();
             g.bench_with_input(BenchmarkId::new("newton-iteration-lu", ne), &ne, |b, _| {
                 b.iter(|| {
-                    let j = prob.jacobian(&c0, &mut f).clone();
+                    prob.jacobian(&c0, &mut f, &mut j);
                     lin.factor(&j).unwrap();
                     lin.solve(&f).unwrap()
                 })

@@ -133,9 +133,19 @@ impl SystemPattern {
 
     /// Copy the stencil storage into the CSR values.
     pub fn gather(&mut self, stencil: &[f64]) {
-        for (v, &s) in self.csr.values.iter_mut().zip(&self.src) {
-            *v = stencil[s];
-        }
+        let mut values = std::mem::take(&mut self.csr.values);
+        self.gather_into(stencil, &mut values);
+        self.csr.values = values;
+    }
+
+    /// Copy the stencil storage into `values` (this pattern's entries), in parallel.
+    pub fn gather_into(&self, stencil: &[f64], values: &mut [f64]) {
+        const CHUNK: usize = 1 << 14;
+        values.par_chunks_mut(CHUNK).zip(self.src.par_chunks(CHUNK)).for_each(|(v, src)| {
+            for (v, &s) in v.iter_mut().zip(src) {
+                *v = stencil[s];
+            }
+        });
     }
 
     /// A fresh matrix with the values gathered from `stencil`.

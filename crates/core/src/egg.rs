@@ -15,8 +15,10 @@ pub trait NonlinearProblem {
     fn size(&self) -> usize;
     /// `F(c)` into `f`.
     fn residual(&mut self, c: &[f64], f: &mut [f64]);
-    /// `F(c)` into `f` and the Jacobian `dF/dc` (in a fixed pattern).
-    fn jacobian(&mut self, c: &[f64], f: &mut [f64]) -> &Csr;
+    /// `F(c)` into `f` and the Jacobian `dF/dc` into `jac`, which is empty or holds
+    /// this problem's fixed pattern from an earlier call (then only the values are
+    /// written: no allocation, no copy of the pattern per Newton step).
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr);
     /// The block mass matrix `diag(M, M)` of eq. (30), in the Jacobian's pattern.
     fn mass(&mut self) -> &Csr;
     /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
@@ -82,7 +84,6 @@ pub struct EggProblem {
     assembler: Arc<dyn EggAssembler>,
     res_full: Vec<f64>,
     stencil: Vec<f64>,
-    jac: Csr,
     mass: Option<Csr>,
     pstencil: Vec<f64>,
     prec: Csr,
@@ -104,7 +105,6 @@ impl EggProblem {
             assembler,
             res_full: vec![0.0; 2 * n],
             stencil: Vec::new(),
-            jac: disc.vector.csr.clone(),
             mass: None,
             pstencil: Vec::new(),
             prec: disc.scalar.csr.clone(),
@@ -133,17 +133,18 @@ impl NonlinearProblem for EggProblem {
         f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
     }
 
-    fn jacobian(&mut self, c: &[f64], f: &mut [f64]) -> &Csr {
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
         self.load(c);
         if self.stencil.is_empty() {
             self.stencil = vec![0.0; self.disc.stencil_len(2)];
         }
         self.assembler.egg(&self.disc, &self.cps, self.op, &mut self.res_full, &mut self.stencil);
         f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
-        for (v, &s) in self.jac.values.iter_mut().zip(&self.disc.vector.src) {
-            *v = self.stencil[s];
+        let pattern = &self.disc.vector;
+        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
+            jac.assign(&pattern.csr);
         }
-        &self.jac
+        pattern.gather_into(&self.stencil, &mut jac.values);
     }
 
     fn mass(&mut self) -> &Csr {
@@ -216,7 +217,8 @@ mod tests {
             let c = prob.unknowns();
             let n = c.len();
             let mut f = vec![0.0; n];
-            let jac = prob.jacobian(&c, &mut f).clone();
+            let mut jac = Csr::default();
+            prob.jacobian(&c, &mut f, &mut jac);
             let dense = jac.to_dense();
             let h = 1e-6;
             let mut max_err: f64 = 0.0;
@@ -251,7 +253,8 @@ mod tests {
             let mut prob = EggProblem::new(Arc::new(disc), cps, Operator::Scaled, Arc::new(CpuAssembler));
             let c = prob.unknowns();
             let mut f = vec![0.0; c.len()];
-            let jac = prob.jacobian(&c, &mut f).clone();
+            let mut jac = Csr::default();
+            prob.jacobian(&c, &mut f, &mut jac);
             let b: Vec<f64> = (0..c.len()).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.5).collect();
             let k = prob.preconditioner(0.0).expect("EGG has a preconditioner").clone();
             assert_eq!(2 * k.nrows, jac.nrows);

@@ -247,9 +247,9 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
     fn linear_step(&mut self, shift: Option<f64>) -> Result<Vec<f64>> {
         let t = Instant::now();
         let mut f = std::mem::take(&mut self.f);
-        // the system matrix lives in the linear solver between steps: no allocation and,
-        // the pattern being fixed, only the values are copied
-        self.lin.matrix_mut().update(self.problem.jacobian(&self.c, &mut f));
+        // the problem writes the Jacobian straight into the linear solver's matrix: no
+        // allocation and no copy per step (the pattern is written on the first step only)
+        self.problem.jacobian(&self.c, &mut f, self.lin.matrix_mut());
         self.f = f;
         self.timings.assembly += t.elapsed();
         if let Some(dt) = shift {
@@ -379,7 +379,9 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         if self.dt == 0.0 {
             // initial pseudo time step: make M / dt comparable to the Jacobian
             let mut f = std::mem::take(&mut self.f);
-            let jmax = self.problem.jacobian(&self.c, &mut f).values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let jac = self.lin.matrix_mut();
+            self.problem.jacobian(&self.c, &mut f, jac);
+            let jmax = jac.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             self.f = f;
             let mmax = self.problem.mass().values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             self.dt = if jmax > 0.0 { mmax / jmax } else { 1.0 };
