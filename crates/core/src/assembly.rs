@@ -613,45 +613,47 @@ impl Discretization {
     /// parametric gradients are used instead, so the operator stays definite.
     pub fn elasticity(&self, cps: &[[f64; 2]], lambda: f64, mu: f64, stencil: &mut [f64]) {
         let nq = [self.tables[0].nq, self.tables[1].nq];
+        let nqp = nq[0] * nq[1];
+        // block (z, d): K_ab = sum_k dx [c^{zd}_x(a) w_b,x + c^{zd}_y(a) w_b,y] with the
+        // physical gradients w_,x, w_,y: for each block one product of 2 nqp rows
         self.assemble(2, &mut [], stencil, |ex, ey, s| {
             let nloc = s.nloc;
-            s.ke.fill(0.0);
+            if s.tz.len() != 2 * nqp * nloc {
+                s.tz = vec![0.0; 2 * nqp * nloc];
+                s.wa = vec![0.0; 8 * nqp * nloc];
+            }
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
+                    let k = kv * nq[0] + ku;
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
                     let det = g.xu[0] * g.xv[1] - g.xv[0] * g.xu[1];
                     let scale = g.xu[0].hypot(g.xu[1]) * g.xv[0].hypot(g.xv[1]);
-                    // physical gradient of w_b stored in s.t[b][0..2]
-                    if det.abs() > 1e-12 * scale && scale > 0.0 {
-                        for b in 0..nloc {
-                            let (bu, bv) = (s.b[b][1], s.b[b][2]);
-                            s.t[b] =
-                                [(g.xv[1] * bu - g.xu[1] * bv) / det, (-g.xv[0] * bu + g.xu[0] * bv) / det, 0.0, 0.0];
-                        }
-                    } else {
-                        for b in 0..nloc {
-                            s.t[b] = [s.b[b][1], s.b[b][2], 0.0, 0.0];
-                        }
-                    }
-                    let dx = wq * if det.abs() > 1e-12 * scale { det.abs() } else { 1.0 };
-                    for z in 0..2 {
-                        for d in 0..2 {
-                            for a in 0..nloc {
-                                let ga = s.t[a];
-                                let row =
-                                    &mut s.ke[((z * 2 + d) * nloc + a) * nloc..((z * 2 + d) * nloc + a + 1) * nloc];
-                                for (r, gb) in row.iter_mut().zip(&s.t) {
-                                    let mut v = lambda * ga[z] * gb[d] + mu * ga[d] * gb[z];
-                                    if z == d {
-                                        v += mu * (ga[0] * gb[0] + ga[1] * gb[1]);
-                                    }
-                                    *r += dx * v;
-                                }
-                            }
+                    let regular = det.abs() > 1e-12 * scale && scale > 0.0;
+                    let dx = wq * if regular { det.abs() } else { 1.0 };
+                    let (l2m, l, m) = (dx * (lambda + 2.0 * mu), dx * lambda, dx * mu);
+                    for a in 0..nloc {
+                        let (bu, bv) = (s.b[a][1], s.b[a][2]);
+                        // physical gradient of w_a
+                        let (gx, gy) = if regular {
+                            ((g.xv[1] * bu - g.xu[1] * bv) / det, (-g.xv[0] * bu + g.xu[0] * bv) / det)
+                        } else {
+                            (bu, bv)
+                        };
+                        s.tz[k * nloc + a] = gx;
+                        s.tz[(nqp + k) * nloc + a] = gy;
+                        // coefficients of w_b,x (rows k) and w_b,y (rows nqp + k) per block
+                        let c = [[l2m * gx, m * gy], [m * gy, l * gx], [l * gy, m * gx], [m * gx, l2m * gy]];
+                        for (zd, [cx, cy]) in c.into_iter().enumerate() {
+                            s.wa[(2 * zd * nqp + k) * nloc + a] = cx;
+                            s.wa[((2 * zd + 1) * nqp + k) * nloc + a] = cy;
                         }
                     }
                 }
+            }
+            for zd in 0..4 {
+                let w = &s.wa[2 * zd * nqp * nloc..2 * (zd + 1) * nqp * nloc];
+                element_product(&mut s.ke[zd * nloc * nloc..(zd + 1) * nloc * nloc], w, &s.tz, nloc);
             }
         });
     }

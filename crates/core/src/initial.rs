@@ -60,6 +60,14 @@ pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Resul
     Ok(cps)
 }
 
+/// Unknowns above which the elasticity system is solved by CG ([`LinearMethod::Pcg`]).
+pub const ITERATIVE_ELASTICITY: usize = 20_000;
+
+/// Relative residual of the iterative elasticity solve: the displacement is an initial
+/// guess, but it moves the boundary control points onto the fitted contour exactly
+/// (they are Dirichlet data), so only the interior carries this error.
+pub const ELASTICITY_TOL: f64 = 1e-8;
+
 /// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).
 pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 
@@ -93,9 +101,12 @@ pub fn elasticity_displacement_with(
     assembler.elasticity(disc, base, LAME.0, LAME.1, &mut st);
     let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
-    // symmetric positive definite: Cholesky, with LU/GMRES as a safety net
-    let mut lin = LinearSolver::new(LinearMethod::Cholesky);
+    // symmetric positive definite: Cholesky, or block-Jacobi CG on large systems (whose
+    // vector Cholesky factor costs 8 times a scalar one), with LU/GMRES as a safety net
+    let method = if k.nrows > ITERATIVE_ELASTICITY { LinearMethod::Pcg } else { LinearMethod::Cholesky };
+    let mut lin = LinearSolver::new(method);
     lin.set_ordering(&disc.ordering);
+    lin.krylov_tol = ELASTICITY_TOL;
     if lin.factor(&k).is_err() {
         lin = LinearSolver::new(LinearMethod::Auto);
         lin.factor(&k)?;

@@ -290,14 +290,19 @@ pub fn corner_report(sides: &[Curve; 4]) -> Vec<CornerReport> {
 }
 
 /// Choose the levels to solve: from the coarsest, each next one at least `growth` times
-/// larger, always ending with the finest.
+/// larger, always ending with the finest. A level of nearly the finest's size (less than
+/// [`SAME_SIZE`] times smaller) is replaced by the finest: solving twice at one size
+/// costs a full solve and gains nothing. The coarsest level always stays.
 pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) -> Vec<usize> {
     let last = sizes.len() - 1;
     let mut out = vec![0];
     for (k, &s) in sizes.iter().enumerate().skip(1) {
-        if k == last || s as f64 >= growth * sizes[*out.last().expect("non-empty")] as f64 {
-            if k == last && *out.last().expect("non-empty") == last {
-                continue;
+        let previous = *out.last().expect("non-empty");
+        if s as f64 >= growth * sizes[previous] as f64 {
+            out.push(k);
+        } else if k == last {
+            if out.len() > 1 && (s as f64) < SAME_SIZE * sizes[previous] as f64 {
+                out.pop();
             }
             out.push(k);
         }
@@ -310,6 +315,9 @@ pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) ->
     }
     out
 }
+
+/// Size ratio below which two levels count as one size in [`select_levels`].
+pub const SAME_SIZE: f64 = 1.5;
 
 fn polyline_length(c: &Curve) -> f64 {
     let n = 16 * c.knots.num_elements().max(4);
@@ -1127,7 +1135,12 @@ mod tests {
 
     #[test]
     fn level_selection_quadruples() {
-        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None), vec![0, 2, 4, 5]);
+        // 310 replaces 300: both would be solved at nearly one size
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None), vec![0, 2, 5]);
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300], 4.0, None), vec![0, 2, 4]);
+        assert_eq!(select_levels(&[16, 20], 4.0, None), vec![0, 1]);
+        // a finest level well above the previous one (here 1.67 times) keeps it
+        assert_eq!(select_levels(&[162, 1122, 1870], 4.0, None), vec![0, 1, 2]);
         assert_eq!(select_levels(&[16], 4.0, None), vec![0]);
         assert_eq!(select_levels(&[16, 64, 256, 1024], 4.0, Some(2)), vec![0, 3]);
     }
