@@ -227,7 +227,7 @@ struct SolverArgs {
     /// shared geometries, see BENCHMARKS.md).
     #[arg(long, value_enum, default_value = "scaled")]
     operator: OperatorArg,
-    /// Linear solver: sparse LU, GMRES with ILU(0), or auto (LU up to 5000 unknowns).
+    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), or auto (LU up to 1000 unknowns).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
     /// Rounds of defect correction: while the certificate says folded or undecided,

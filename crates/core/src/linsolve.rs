@@ -54,7 +54,7 @@ pub enum LinearMethod {
 pub const MAX_PCG: usize = 500;
 
 /// Largest system that [`LinearMethod::Auto`] factorizes directly.
-pub const AUTO_LU_LIMIT: usize = 5_000;
+pub const AUTO_LU_LIMIT: usize = 1_000;
 
 /// Default relative residual at which GMRES stops.
 pub const KRYLOV_TOL: f64 = 1e-10;
