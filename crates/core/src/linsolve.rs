@@ -604,8 +604,7 @@ pub fn cg(
     max_iter: usize,
 ) -> Result<(Vec<f64>, usize)> {
     let n = b.len();
-    let bnorm = dot(b, b).sqrt();
-    let mut x = vec![0.0; n];
+    let (bnorm, mut x) = krylov_start(b);
     if bnorm == 0.0 {
         return Ok((x, 0));
     }
@@ -640,6 +639,11 @@ pub fn cg(
     Err(Error::LinearSolver(format!("CG: no convergence in {max_iter} iterations")))
 }
 
+/// `||b||` and the start `x = 0` of the Krylov methods.
+fn krylov_start(b: &[f64]) -> (f64, Vec<f64>) {
+    (dot(b, b).sqrt(), vec![0.0; b.len()])
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -660,8 +664,7 @@ pub fn gmres(
     max_iter: usize,
 ) -> Result<(Vec<f64>, usize)> {
     let n = b.len();
-    let bnorm = dot(b, b).sqrt();
-    let mut x = vec![0.0; n];
+    let (bnorm, mut x) = krylov_start(b);
     if bnorm == 0.0 {
         return Ok((x, 0));
     }
