@@ -493,6 +493,8 @@ impl Discretization {
                     if !want_mat {
                         continue;
                     }
+                    // quotient-rule factor L(z) / s, once per point (no division per entry)
+                    let ls = if op == Operator::Scaled { [l[0] / sden, l[1] / sden] } else { [0.0; 2] };
                     for (a, w) in s.wa[k * nloc..(k + 1) * nloc].iter_mut().enumerate() {
                         *w = wq * s.b[a][0] * scale;
                     }
@@ -509,9 +511,7 @@ impl Discretization {
                                 if z == d {
                                     v += lw;
                                 }
-                                if op == Operator::Scaled {
-                                    v -= l[z] * ds / sden;
-                                }
+                                v -= ls[z] * ds;
                                 s.tz[((z * 2 + d) * nqp + k) * nloc + b] = v;
                             }
                         }
