@@ -178,9 +178,7 @@ impl NonlinearProblem for EggProblem {
             self.pstencil = vec![0.0; self.disc.stencil_len(1)];
         }
         self.disc.metric_laplace(&self.cps, self.op, shift, &mut self.pstencil);
-        for (v, &s) in self.prec.values.iter_mut().zip(&self.disc.scalar.src) {
-            *v = self.pstencil[s];
-        }
+        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
         Some(&self.prec)
     }
 }
