@@ -63,9 +63,9 @@ pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Resul
 /// Unknowns above which the elasticity system is solved by CG ([`LinearMethod::Pcg`]).
 pub const ITERATIVE_ELASTICITY: usize = 20_000;
 
-/// Relative residual of the iterative elasticity solve: the displacement is an initial
-/// guess, but it moves the boundary control points onto the fitted contour exactly
-/// (they are Dirichlet data), so only the interior carries this error.
+/// Relative residual of the iterative elasticity solve. The displacement is only an
+/// initial guess, and the boundary control points are Dirichlet data set exactly, so
+/// this error reaches the interior only.
 pub const ELASTICITY_TOL: f64 = 1e-8;
 
 /// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).

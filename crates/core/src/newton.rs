@@ -13,10 +13,10 @@ use crate::egg::NonlinearProblem;
 use crate::error::Result;
 use crate::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
 
-/// Nonlinear iteration.
 /// Largest forcing term of the inexact Newton method (see `NonlinearSolver::forcing`).
 pub const ETA_MAX: f64 = 1e-2;
 
+/// Nonlinear iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
