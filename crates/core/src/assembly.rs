@@ -222,6 +222,15 @@ pub(crate) struct Scratch {
 }
 
 impl Scratch {
+    /// Size the operands of [`element_product`] (`wa` and `tz`): allocated on a thread's
+    /// first element, reused by the others.
+    fn reserve_products(&mut self, wa: usize, tz: usize) {
+        if self.wa.len() != wa || self.tz.len() != tz {
+            self.wa = vec![0.0; wa];
+            self.tz = vec![0.0; tz];
+        }
+    }
+
     fn new(p: usize, q: usize, ncomp: usize) -> Self {
         let nloc = (p + 1) * (q + 1);
         Self {
@@ -464,9 +473,8 @@ impl Discretization {
         self.assemble(2, res, stencil, |ex, ey, s| {
             let nloc = s.nloc;
             s.re.fill(0.0);
-            if want_mat && s.tz.len() != 4 * nqp * nloc {
-                s.tz = vec![0.0; 4 * nqp * nloc];
-                s.wa = vec![0.0; nqp * nloc];
+            if want_mat {
+                s.reserve_products(nqp * nloc, 4 * nqp * nloc);
             }
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
@@ -572,10 +580,7 @@ impl Discretization {
         let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
         self.assemble(1, &mut [], stencil, |ex, ey, s| {
             let nloc = s.nloc;
-            if s.wa.len() != nrows * nloc {
-                s.wa = vec![0.0; nrows * nloc];
-                s.tz = vec![0.0; nrows * nloc];
-            }
+            s.reserve_products(nrows * nloc, nrows * nloc);
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
                     let k = kv * nq[0] + ku;
@@ -618,10 +623,7 @@ impl Discretization {
         // physical gradients w_,x, w_,y: for each block one product of 2 nqp rows
         self.assemble(2, &mut [], stencil, |ex, ey, s| {
             let nloc = s.nloc;
-            if s.tz.len() != 2 * nqp * nloc {
-                s.tz = vec![0.0; 2 * nqp * nloc];
-                s.wa = vec![0.0; 8 * nqp * nloc];
-            }
+            s.reserve_products(8 * nqp * nloc, 2 * nqp * nloc);
             for kv in 0..nq[1] {
                 for ku in 0..nq[0] {
                     let k = kv * nq[0] + ku;
