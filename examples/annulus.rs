@@ -6,8 +6,9 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use winslow::egg::CpuAssembler;
-use winslow::solver::{EggSolver, Event, SolveOptions, Verdict};
+use winslow::methods::egg::CpuAssembler;
+use winslow::solve::report::Verdict;
+use winslow::solve::solver::{EggSolver, Event, SolveOptions};
 use winslow::{build_hierarchy, Analytic, Boundary, SideCurve};
 
 fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {

@@ -5,7 +5,8 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use winslow::fit::{cord_length_params, project_side};
+use winslow::boundary::cord_length::cord_length_params;
+use winslow::boundary::fit::project_side;
 use winslow::{build_hierarchy, Analytic, Boundary, Curve, FitOptions, Hierarchy, KnotVector, Point, Side, SideCurve};
 
 fn data_dir() -> PathBuf {
@@ -139,7 +140,7 @@ fn shared_geometries_fit_within_tolerance() {
 fn point_clouds_use_cord_length_and_meet_tolerance() {
     // without reparameterization (the default `auto` would constrain the narrow pairs)
     let mut opts = FitOptions::default();
-    opts.reparam.method = winslow::reparam::Reparam::None;
+    opts.reparam.method = winslow::boundary::reparam::Reparam::None;
     for rel in ["narrow_tube.json", "notched_square.json", "spiral_channel.json"] {
         let b = load(rel);
         let h = build_hierarchy(&b, &opts).unwrap();

@@ -4,13 +4,13 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
+use winslow::boundary::validate::{inspect, Orientation};
 use winslow::error::MAX_CONTROL_POINTS;
 use winslow::io::{
     boundary_to_contour_json, boundary_to_json, checked_boundary, map_to_json, parse_document, parse_gismo_xml,
     parse_json, write_json, MAX_FILE_BYTES,
 };
 use winslow::testutil::Lcg;
-use winslow::validate::{inspect, Orientation};
 use winslow::{read_boundary, read_document, validate, Boundary, Document, Error, Point, ReadOptions, Side, SideCurve};
 
 fn data(rel: &str) -> PathBuf {

@@ -5,10 +5,11 @@
 
 use std::path::Path;
 
+use winslow::boundary::reparam::Reparam;
 use winslow::io::{read_boundary, ReadOptions};
-use winslow::quality::sample_det_j;
-use winslow::reparam::Reparam;
-use winslow::solver::{solve, Solution, SolveOptions, Verdict};
+use winslow::solve::report::{Solution, Verdict};
+use winslow::solve::solver::{solve, SolveOptions};
+use winslow::verify::quality::sample_det_j;
 use winslow::{build_hierarchy, Boundary, FitOptions, Side};
 
 fn boundary(file: &str) -> Boundary {
@@ -119,10 +120,12 @@ fn scaled_jacobian_of_a_shear() {
         control_points: vec![[0.0, 0.0], [1.0, 0.0], [s, 1.0], [1.0 + s, 1.0]],
         weights: None,
     };
-    let v = winslow::quality::quality(&map).scaled_jacobian.min;
+    let v = winslow::verify::quality::quality(&map).scaled_jacobian.min;
     assert!((v - 1.0 / (1.0f64 + s * s).sqrt()).abs() < 1e-14, "{v}");
     // folded: the mirrored map has det J < 0 and a negative scaled Jacobian
     let mut folded = map.clone();
     folded.control_points.iter_mut().for_each(|p| p[0] = -p[0]);
-    assert!((winslow::quality::quality(&folded).scaled_jacobian.min + 1.0 / (1.0f64 + s * s).sqrt()).abs() < 1e-14);
+    assert!(
+        (winslow::verify::quality::quality(&folded).scaled_jacobian.min + 1.0 / (1.0f64 + s * s).sqrt()).abs() < 1e-14
+    );
 }

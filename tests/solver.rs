@@ -5,8 +5,9 @@
 use std::path::Path;
 
 use winslow::io::{read_boundary, ReadOptions};
-use winslow::quality::sample_det_j;
-use winslow::solver::{solve, Solution, SolveOptions, Verdict};
+use winslow::solve::report::{Solution, Verdict};
+use winslow::solve::solver::{solve, SolveOptions};
+use winslow::verify::quality::sample_det_j;
 
 fn run(file: &str, opts: &SolveOptions) -> Solution {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);

@@ -8,18 +8,20 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use winslow::assembly::Operator;
-use winslow::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
-use winslow::egg::EggAssembler;
-use winslow::fit::{build_hierarchy, FitOptions};
+use winslow::boundary::fit::FitOptions;
+use winslow::boundary::hierarchy::build_hierarchy;
+use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
+use winslow::discrete::assembly::Operator;
+use winslow::io::picture::{render, PictureOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
-use winslow::linsolve::LinearMethod;
-use winslow::newton::Method;
-use winslow::picture::{render, PictureOptions};
-use winslow::poisson::poisson_benchmark;
-use winslow::quality::{boundary_deviation, quality};
-use winslow::reparam::{Fill, Reparam, ReparamOptions};
-use winslow::solver::{EggSolver, Event, Solution, SolveOptions, Verdict};
+use winslow::linalg::linsolve::LinearMethod;
+use winslow::methods::egg::EggAssembler;
+use winslow::solve::newton::NonlinearMethod;
+use winslow::solve::report::{Solution, Verdict};
+use winslow::solve::solver::{EggSolver, Event, SolveOptions};
+use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
+use winslow::verify::poisson::poisson_benchmark;
+use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
@@ -194,7 +196,7 @@ impl BackendArgs {
 }
 
 /// The picture of `map`, sampled on the GPU when one is selected.
-fn picture(sel: &Selected, map: &Surface, opts: &PictureOptions) -> Result<winslow::picture::Image> {
+fn picture(sel: &Selected, map: &Surface, opts: &PictureOptions) -> Result<winslow::io::picture::Image> {
     Ok(match sel.gpu() {
         Some(g) => g.render(map, opts).context("sampling det J on the GPU")?,
         None => render(map, opts),
@@ -257,8 +259,8 @@ impl SolverArgs {
         let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
         o.nonlinear.tol = self.tol;
         o.nonlinear.method = match self.method {
-            MethodArg::Newton => Method::Newton,
-            MethodArg::PseudoTime => Method::PseudoTime,
+            MethodArg::Newton => NonlinearMethod::Newton,
+            MethodArg::PseudoTime => NonlinearMethod::PseudoTime,
         };
         o.nonlinear.linear = match self.linear {
             LinearArg::Lu => LinearMethod::Lu,
@@ -497,6 +499,10 @@ fn run_solver(
         }
     }
     let mut solver = EggSolver::new(&h, opts.clone(), assembler)?;
+    if !quiet {
+        let m = solver.method();
+        eprintln!("  method: {} (start: {:?})", m.name(), m.start());
+    }
     let stderr = std::io::stderr();
     for event in solver.by_ref() {
         let event = event?;
@@ -517,14 +523,15 @@ fn run_solver(
             Event::Iterate { iterate: it, .. } => {
                 writeln!(
                     e,
-                    "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}",
+                    "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
                     it.iteration,
                     format!("{:?}", it.method),
                     it.residual,
                     it.scaled_residual,
                     it.step,
                     it.damping,
-                    it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default()
+                    it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
+                    it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
                 )?;
             }
             Event::LevelFinished(r) => {

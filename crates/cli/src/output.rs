@@ -6,14 +6,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use winslow::certificate::Certificate;
-use winslow::fit::Hierarchy;
-use winslow::picture::Image;
-use winslow::poisson::PoissonReport;
-use winslow::quality::sample_det_j;
-use winslow::quality::Quality;
-use winslow::solver::{Solution, Verdict};
-use winslow::validate::ValidationReport;
+use winslow::boundary::hierarchy::Hierarchy;
+use winslow::boundary::validate::ValidationReport;
+use winslow::io::picture::Image;
+use winslow::solve::report::{Solution, Verdict};
+use winslow::verify::certificate::Certificate;
+use winslow::verify::poisson::PoissonReport;
+use winslow::verify::quality::sample_det_j;
+use winslow::verify::quality::Quality;
 use winslow::{Boundary, Side, SideCurve, Surface};
 
 /// Encode an RGBA image as PNG.
@@ -332,7 +332,7 @@ pub fn inspect_text(
 pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
     let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
     let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
-    winslow::reparam::matches_in_report(&doc["report"])
+    winslow::boundary::reparam::matches_in_report(&doc["report"])
 }
 
 /// `winslow inspect --json`.

@@ -5,9 +5,10 @@
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use winslow::assembly::{Discretization, Operator};
-use winslow::egg::{CpuAssembler, EggProblem, NonlinearProblem};
-use winslow::linsolve::{LinearMethod, LinearSolver};
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::linalg::linsolve::{LinearMethod, LinearSolver};
+use winslow::methods::egg::{CpuAssembler, EggProblem};
+use winslow::methods::DiscreteProblem;
 use winslow::KnotVector;
 
 fn annulus(ne: usize) -> (Arc<Discretization>, Vec<[f64; 2]>) {
@@ -40,7 +41,7 @@ fn bench(c: &mut Criterion) {
             let c0 = prob.unknowns();
             let mut f = vec![0.0; c0.len()];
             let mut lin = LinearSolver::new(LinearMethod::Lu);
-            let mut j = winslow::sparse::Csr::default();
+            let mut j = winslow::linalg::sparse::Csr::default();
             g.bench_with_input(BenchmarkId::new("newton-iteration-lu", ne), &ne, |b, _| {
                 b.iter(|| {
                     prob.jacobian(&c0, &mut f, &mut j);

@@ -4,8 +4,8 @@
 //! elements, p = 3. Run with `cargo bench --workspace --bench certificate`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use winslow::assembly::{Discretization, Operator};
-use winslow::certificate::{certify, CertifyOptions};
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::verify::certificate::{certify, CertifyOptions};
 use winslow::{KnotVector, Surface};
 
 fn annulus(ne: usize) -> Surface {

@@ -66,6 +66,13 @@ pub enum Error {
     /// The nonlinear solver gave up.
     #[error("no convergence: {0}")]
     NoConvergence(String),
+    /// A side's boundary condition is inconsistent or not supported by the caller.
+    #[error("boundary condition of the {side} side: {reason}")]
+    Topology { side: String, reason: String },
+    /// A method that needs a bijective start (paper eq. 14, 16) was given a map that is
+    /// not certified.
+    #[error("{method} needs a bijective start: {reason}")]
+    InfeasibleStart { method: String, reason: String },
 }
 
 fn at(context: &str) -> String {

@@ -3,57 +3,83 @@
 //! Elliptic grid generation (EGG) discretized with isogeometric analysis: from the
 //! boundary of a planar four-sided domain to a bijective tensor-product spline map of
 //! the unit square (Hinz, Möller, Vuik, *Elliptic grid generation techniques in the
-//! framework of isogeometric analysis applications*).
+//! framework of isogeometric analysis applications*; section and equation numbers below
+//! are the paper's).
 //!
-//! A geometry is a basis plus coefficients: [`knots::KnotVector`] and
-//! [`basis::BasisDerivs`] hold the univariate B-spline bases, [`curve::Curve`] and
-//! [`surface::Surface`] the geometries, [`refine`] and [`bezier`] the exact changes of
-//! basis. [`fit`] approximates the boundary contours adaptively and builds the nested
-//! hierarchy of tensor-product bases (paper §5). [`io`] reads and writes the exchange formats (JSON, G+Smo XML) and
-//! [`mod@validate`] checks boundaries.
+//! ## The pipeline, one module group per step
 //!
-//! The solver (paper §4-§6): [`assembly`] discretizes eq. (8) on a tensor basis with the
-//! free/fixed split of [`dofs`]; [`egg`] poses `F(c) = 0`; [`newton`] iterates (damped
-//! Newton, pseudo time); [`initial`] makes initial guesses; [`solver`] walks the
-//! hierarchy coarse to fine and yields its iterates, certifies the result with
-//! [`certificate`] (exact Bernstein bounds of `det J`, §8.1) and repairs defects by local
-//! refinement (§8.2); [`quality`], [`poisson`] (the grid-quality benchmark of §10) and
-//! [`picture`] measure and draw the result.
+//! | group | what lives there |
+//! |---|---|
+//! | [`linalg`] | sparse storage, orderings, linear solvers (LU, Cholesky, GMRES, CG, ILU) |
+//! | [`spline`] | knot vectors, bases, curves, tensor-product maps, refinement, Bézier extraction, quadrature (§3) |
+//! | [`boundary`] | the boundary, its validation, corners and kinks, reparameterization (§7), contour fit (§5), the nested hierarchy (§5.4) |
+//! | [`discrete`] | topology (boundary conditions per side), DOF map, assembly kernels on one basis (§4, §6) |
+//! | [`methods`] | the parameterization methods behind one interface ([`Method`], [`DiscreteProblem`]): EGG (eq. 8) |
+//! | [`solve`] | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
+//! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
+//! | [`io`] | readers and writers: JSON exchange formats, G+Smo XML, pictures |
+//!
+//! Dependencies point one way, down this table read from the bottom: `io` uses
+//! `verify`, `solve` uses `methods`, which use `verify`, `discrete`, `spline` and
+//! `linalg`; no module imports a module that imports it back. Two places differ from a
+//! plain "one folder per pipeline step": sparse storage sits in [`linalg`], *below*
+//! [`spline`], because the refinement operators of the splines (knot insertion,
+//! degree elevation) are sparse matrices; and the quadrature back end of EGG
+//! ([`methods::egg::EggAssembler`], implemented by the GPU crate) lives with the method
+//! it assembles, not in [`discrete`], because it also samples `det J` for the report
+//! ([`verify::quality`]), which in turn uses the assembly kernels.
+//!
+//! ## Where is …
+//!
+//! | paper | what | where |
+//! |---|---|---|
+//! | §3, eq. (1) | B-splines, NURBS, tensor-product maps | [`spline::basis`], [`spline::curve`], [`spline::surface`] |
+//! | §5.1-§5.3, eq. (17)-(18), (36)-(37) | contour fit of one side, cord length | [`boundary::fit`], [`boundary::cord_length`] |
+//! | §5.4 | nested hierarchy of bases | [`boundary::hierarchy`], [`spline::refine`] |
+//! | §4, eq. (8), (12), (23) | EGG Galerkin form, residual, exact Jacobian | [`methods::egg`], kernels in [`discrete::assembly`] |
+//! | eq. (9)-(10) | free / fixed DOFs, unknowns `c` | [`discrete::dofs`], [`discrete::topology`] |
+//! | eq. (14) | weak form with `det J` (needs a bijective start) | behind [`Method`] with [`methods::Start::Bijective`] (not yet implemented) |
+//! | eq. (15)-(16) | Winslow functional | value: [`verify::quality::functionals`]; as a method: behind [`Method`] (not yet implemented) |
+//! | §6.1, eq. (24)-(27) | damped Newton, line search | [`solve::newton`] |
+//! | §6.2, eq. (28)-(33) | pseudo time-stepping, SER | [`solve::newton`] |
+//! | §6.3, §9 | Coons start, prolongation plus elasticity, continuation | [`solve::initial`], levels in [`solve::levels`], the walk in [`solve::solver`] |
+//! | §7, eq. (38)-(42) | reparameterization | [`boundary::reparam`] |
+//! | §8.1, eq. (43) | bijectivity certificate | [`verify::certificate`]; corners that force `det J <= 0`: [`boundary::corners`] |
+//! | §8.2 | local defect correction | [`solve::repair`] |
+//! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
+//! | §2 | quality functionals, cell statistics | [`verify::quality`] |
+//!
+//! A geometry is a basis plus coefficients ([`Surface`], [`Curve`]); one DOF map
+//! ([`discrete::dofs::DofMap`], built from the patch's [`Topology`]) of free versus fixed
+//! DOFs serves every assembler; symbolic work is done once per basis
+//! ([`discrete::assembly::Discretization`]) and numeric work per Newton step; solvers
+//! are objects that yield their iterates ([`EggSolver`] is an `Iterator` of
+//! [`solve::solver::Event`]s).
 
-pub mod assembly;
-pub mod basis;
-pub mod bezier;
 pub mod boundary;
-pub mod certificate;
-pub mod curve;
-pub mod dofs;
-pub mod egg;
+pub mod discrete;
 pub mod error;
-pub mod fit;
-pub mod initial;
 pub mod io;
-pub mod knots;
-pub mod linsolve;
-pub mod newton;
-pub mod ordering;
-pub mod picture;
-pub mod poisson;
-pub mod quadrature;
-pub mod quality;
-pub mod refine;
-pub mod reparam;
-pub mod solver;
-pub mod sparse;
-pub mod surface;
+pub mod linalg;
+pub mod methods;
+pub mod solve;
+pub mod spline;
 #[doc(hidden)]
 pub mod testutil;
-pub mod validate;
+pub mod verify;
 
+pub use boundary::fit::{fit_side, FitOptions, SideFit};
+pub use boundary::hierarchy::{build_hierarchy, hierarchy_from_fits, Hierarchy, Level};
+pub use boundary::validate::{validate, ValidationReport};
 pub use boundary::{Analytic, Boundary, SideCurve};
-pub use curve::{Curve, Point};
+pub use discrete::topology::{SideCondition, Topology};
 pub use error::{Error, Result};
-pub use fit::{build_hierarchy, fit_side, hierarchy_from_fits, FitOptions, Hierarchy, Level, SideFit};
 pub use io::{read_boundary, read_document, Document, ReadOptions};
-pub use knots::KnotVector;
-pub use surface::{Side, Surface};
-pub use validate::{validate, ValidationReport};
+pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
+pub use methods::{DiscreteProblem, Method};
+pub use solve::report::{Report, Solution, Verdict};
+pub use solve::solver::{solve, EggSolver, Event, SolveOptions};
+pub use spline::curve::{Curve, Point};
+pub use spline::knots::KnotVector;
+pub use spline::surface::{Side, Surface};
+pub use verify::certificate::{certify, Certificate};

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use winslow::assembly::Operator;
+use winslow::discrete::assembly::Operator;
 use winslow_gpu::bench::quadrature_case;
 use winslow_gpu::{Gpu, GpuAssembler, GpuOptions};
 

@@ -11,11 +11,11 @@
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use winslow::assembly::{DirTable, Discretization, Operator};
-use winslow::curve::Point;
-use winslow::egg::{CpuAssembler, EggAssembler};
-use winslow::quality::DetJSample;
-use winslow::surface::Surface;
+use winslow::discrete::assembly::{DirTable, Discretization, Operator};
+use winslow::methods::egg::{CpuAssembler, EggAssembler};
+use winslow::spline::curve::Point;
+use winslow::spline::surface::Surface;
+use winslow::verify::quality::DetJSample;
 
 use crate::device::Gpu;
 use crate::{GpuError, Precision};
@@ -589,7 +589,7 @@ impl GpuAssembler {
         Ok(())
     }
 
-    /// `det J` on the `(n+1)^2` grid of [`winslow::quality::sample_det_j`], on the GPU.
+    /// `det J` on the `(n+1)^2` grid of [`winslow::verify::quality::sample_det_j`], on the GPU.
     pub fn try_sample_det_j(&self, map: &Surface, n: usize) -> Result<DetJSample, GpuError> {
         let t0 = Instant::now();
         let s = self.gpu.sample_map(map, n)?;
@@ -637,7 +637,7 @@ impl EggAssembler for GpuAssembler {
             Ok(s) => s,
             Err(e) => {
                 self.fallback("det J sampling", e);
-                winslow::quality::sample_det_j(map, n)
+                winslow::verify::quality::sample_det_j(map, n)
             }
         }
     }

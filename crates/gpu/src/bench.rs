@@ -5,9 +5,9 @@
 use std::time::Instant;
 
 use serde::Serialize;
-use winslow::assembly::{Discretization, Operator};
-use winslow::curve::Point;
-use winslow::knots::KnotVector;
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::spline::curve::Point;
+use winslow::spline::knots::KnotVector;
 
 use crate::assembler::{GpuAssembler, Timings};
 

@@ -4,13 +4,13 @@
 //! (`shaders/*.wgsl` at the workspace root), running on real GPUs and on Mesa's lavapipe
 //! (a CPU Vulkan driver) in CI.
 //!
-//! [`GpuAssembler`] implements [`winslow::egg::EggAssembler`], the back-end hook of the
+//! [`GpuAssembler`] implements [`winslow::methods::egg::EggAssembler`], the back-end hook of the
 //! core solver: the EGG residual and exact Jacobian of paper eq. (8), the mass matrix of
 //! eq. (30), linear elasticity (§6.3) and `det J` sampling (eq. 43). It writes exactly
-//! the vectors and *stencil storage* of the CPU assembler ([`winslow::assembly`]), so
+//! the vectors and *stencil storage* of the CPU assembler ([`winslow::discrete::assembly`]), so
 //! the sparsity patterns, gathers and linear solvers are shared, and the two back ends
 //! are interchangeable. The univariate basis tables come from the core
-//! ([`winslow::assembly::DirTable`], [`winslow::basis::BasisDerivs`]) and are uploaded
+//! ([`winslow::discrete::assembly::DirTable`], [`winslow::spline::basis::BasisDerivs`]) and are uploaded
 //! once per basis; the GPU only runs the tensor-product sums.
 //!
 //! Precision: f64 where the adapter offers `SHADER_F64` (lavapipe does); otherwise (or
@@ -23,7 +23,7 @@
 //! let gpu = Arc::new(Gpu::new(&GpuOptions::default())?);
 //! println!("{}", gpu.describe());
 //! let assembler = Arc::new(GpuAssembler::new(gpu));
-//! // winslow::solver::EggSolver::new(&hierarchy, opts, assembler) ...
+//! // winslow::solve::solver::EggSolver::new(&hierarchy, opts, assembler) ...
 //! # Ok::<(), winslow_gpu::GpuError>(())
 //! ```
 
@@ -38,7 +38,7 @@ pub use sample::MapSample;
 
 use std::sync::Arc;
 
-use winslow::egg::{CpuAssembler, EggAssembler};
+use winslow::methods::egg::{CpuAssembler, EggAssembler};
 
 /// WGSL source of the assembly kernels (f64; see [`shader_source`]).
 pub const ASSEMBLY_WGSL: &str = include_str!("../../../shaders/assembly.wgsl");

@@ -1,12 +1,12 @@
 //! The map and `det J` on a grid (`shaders/det_j.wgsl`): the samples of
-//! [`winslow::quality::sample_det_j`] and [`winslow::picture::render`], for pictures,
+//! [`winslow::verify::quality::sample_det_j`] and [`winslow::io::picture::render`], for pictures,
 //! the solver's positivity checks and the viewer.
 
-use winslow::basis::BasisDerivs;
-use winslow::curve::Point;
-use winslow::picture::{render_resolution, render_sampled, Image, PictureOptions};
-use winslow::quality::{grid_abscissae, DetJSample};
-use winslow::surface::Surface;
+use winslow::io::picture::{render_resolution, render_sampled, Image, PictureOptions};
+use winslow::spline::basis::BasisDerivs;
+use winslow::spline::curve::Point;
+use winslow::spline::surface::Surface;
+use winslow::verify::quality::{grid_abscissae, DetJSample};
 
 use crate::device::Gpu;
 use crate::GpuError;
@@ -107,13 +107,13 @@ impl Gpu {
         Ok(MapSample { n, points, det })
     }
 
-    /// [`winslow::quality::sample_det_j`] on the GPU.
+    /// [`winslow::verify::quality::sample_det_j`] on the GPU.
     pub fn sample_det_j(&self, map: &Surface, n: usize) -> Result<DetJSample, GpuError> {
         let s = self.sample_map(map, n)?;
         Ok(DetJSample::from_values(s.n, s.det))
     }
 
-    /// [`winslow::picture::render`] with the sampling on the GPU.
+    /// [`winslow::io::picture::render`] with the sampling on the GPU.
     pub fn render(&self, map: &Surface, opts: &PictureOptions) -> Result<Image, GpuError> {
         let s = self.sample_map(map, render_resolution(opts))?;
         Ok(render_sampled(s.n, &s.points, &s.det, opts))

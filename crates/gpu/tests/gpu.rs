@@ -6,14 +6,15 @@
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
 
-use winslow::assembly::{Discretization, Operator};
-use winslow::curve::Point;
-use winslow::egg::{CpuAssembler, EggAssembler};
-use winslow::fit::{build_hierarchy, FitOptions};
-use winslow::initial::coons;
-use winslow::knots::KnotVector;
-use winslow::quality::sample_det_j;
-use winslow::solver::{EggSolver, SolveOptions};
+use winslow::boundary::fit::FitOptions;
+use winslow::boundary::hierarchy::build_hierarchy;
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::methods::egg::{CpuAssembler, EggAssembler};
+use winslow::solve::initial::coons;
+use winslow::solve::solver::{EggSolver, SolveOptions};
+use winslow::spline::curve::Point;
+use winslow::spline::knots::KnotVector;
+use winslow::verify::quality::sample_det_j;
 use winslow::{read_boundary, ReadOptions, Surface};
 use winslow_gpu::{gpu_required, Gpu, GpuAssembler, GpuOptions, Precision};
 
@@ -57,7 +58,7 @@ fn shared_case(file: &str, degree: usize, level: usize) -> (Discretization, Vec<
     let disc = Discretization::new(l.knots.clone());
     let [nx, _] = disc.shape();
     for (k, c) in cps.iter_mut().enumerate() {
-        if disc.dofs.free_index(k) != winslow::dofs::FIXED {
+        if disc.dofs.free_index(k) != winslow::discrete::dofs::FIXED {
             let (i, j) = ((k % nx) as f64, (k / nx) as f64);
             c[0] += 0.01 * h.diameter * (0.7 * i + 1.3 * j).sin();
             c[1] += 0.01 * h.diameter * (1.1 * i - 0.4 * j).cos();
@@ -166,7 +167,7 @@ fn mass_and_elasticity_match_the_cpu() {
         disc.mass(&mut mc);
         g.try_mass(&disc, &mut mg).expect("GPU mass");
         let em = rel_err(&mg, &mc);
-        let (lambda, mu) = winslow::initial::LAME;
+        let (lambda, mu) = winslow::solve::initial::LAME;
         let (mut ec, mut eg) = (vec![0.0; disc.stencil_len(2)], vec![f64::NAN; disc.stencil_len(2)]);
         disc.elasticity(&cps, lambda, mu, &mut ec);
         g.try_elasticity(&disc, &cps, lambda, mu, &mut eg).expect("GPU elasticity");
@@ -228,8 +229,8 @@ fn gpu_render_equals_cpu_render_geometry() {
     let Some(g) = gpu(Precision::F64) else { return };
     let (_, d, c) = cases().remove(1);
     let map = Surface { knots: d.knots.clone(), control_points: c, weights: None };
-    let opts = winslow::picture::PictureOptions { size: 200, resolution: 40, ..Default::default() };
-    let cpu = winslow::picture::render(&map, &opts);
+    let opts = winslow::io::picture::PictureOptions { size: 200, resolution: 40, ..Default::default() };
+    let cpu = winslow::io::picture::render(&map, &opts);
     let gpu = g.gpu().render(&map, &opts).expect("GPU render");
     assert_eq!((cpu.width, cpu.height), (gpu.width, gpu.height));
     // identical sampling up to round-off: at most a handful of pixels may round apart

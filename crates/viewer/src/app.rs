@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use egui::epaint::{Mesh, Vertex, WHITE_UV};
 use egui::{Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Sense, Shape, Stroke, Ui, Vec2};
 use egui_plot::{Line, Plot, PlotPoints};
-use winslow::assembly::Operator;
+use winslow::discrete::assembly::Operator;
 use winslow::Point;
 
 use crate::certificate::{verdict_is_good, verdict_name, Certificate};
@@ -813,8 +813,8 @@ fn file_section(ui: &mut Ui, scene: &Scene) {
 
 fn verdict_colour(c: &Certificate) -> Color32 {
     match c.verdict {
-        winslow::solver::Verdict::Certified => Color32::from_rgb(20, 140, 50),
-        winslow::solver::Verdict::DegenerateCorner => Color32::from_rgb(190, 130, 0),
+        winslow::solve::report::Verdict::Certified => Color32::from_rgb(20, 140, 50),
+        winslow::solve::report::Verdict::DegenerateCorner => Color32::from_rgb(190, 130, 0),
         _ => Color32::from_rgb(200, 30, 30),
     }
 }

@@ -1,11 +1,12 @@
 //! What the viewer says about a map's bijectivity, in one place: the verdict of the
 //! solver's [`Report`] (this session's solve, or the `"report"` stored in a map file)
-//! and the core's exact certificate of the loaded map ([`winslow::certificate::certify`]:
+//! and the core's exact certificate of the loaded map ([`winslow::verify::certificate::certify`]:
 //! Bernstein bounds of det J with adaptive subdivision); the sample rules only when the
 //! certificate cannot be computed.
 
-use winslow::quality::{DetJSample, Functionals};
-use winslow::solver::{corner_report, min_away_from_corners, CornerReport, Report, Verdict};
+use winslow::boundary::corners::{corner_report, CornerReport};
+use winslow::solve::report::{min_away_from_corners, Report, Verdict};
+use winslow::verify::quality::{DetJSample, Functionals};
 use winslow::{Side, Surface};
 
 /// Quality numbers of a map, all computed by the core.
@@ -42,7 +43,7 @@ impl Quality {
             det_j_argmin: sample.argmin,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: min_away_from_corners(map, sample, &corners),
-            functionals: winslow::quality::functionals(map),
+            functionals: winslow::verify::quality::functionals(map),
             corners,
         }
     }
@@ -162,7 +163,7 @@ impl Certificate {
     /// The core's exact certificate of `map`; the sample rules ([`Certificate::from_sample`])
     /// when it cannot be computed (e.g. a degree past the certificate's limit).
     pub fn exact(map: &Surface, q: &Quality) -> Self {
-        use winslow::certificate::{certify, CertifyOptions, Verdict as Exact};
+        use winslow::verify::certificate::{certify, CertifyOptions, Verdict as Exact};
         let Ok(c) = certify(map, &CertifyOptions::default()) else { return Self::from_sample(q) };
         let verdict = match c.verdict {
             Exact::Certified { .. } => Verdict::Certified,
@@ -216,7 +217,7 @@ impl Certificate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use winslow::quality::sample_det_j;
+    use winslow::verify::quality::sample_det_j;
     use winslow::KnotVector;
 
     fn square(scale: f64) -> Surface {

@@ -1,10 +1,10 @@
 //! The colour scale of the heat map: positive `det J` through the core's viridis-like
-//! map ([`winslow::picture::colormap`]), logarithmic or linear between the smallest and
+//! map ([`winslow::io::picture::colormap`]), logarithmic or linear between the smallest and
 //! the largest positive sample; non-positive (and non-finite) values in the core's
-//! [`winslow::picture::FOLD_COLOUR`] (magenta), which no positive value uses.
+//! [`winslow::io::picture::FOLD_COLOUR`] (magenta), which no positive value uses.
 
 use egui::Color32;
-use winslow::picture::{colormap, FOLD_COLOUR};
+use winslow::io::picture::{colormap, FOLD_COLOUR};
 
 /// Largest ratio the logarithmic scale spans (four decades, as the core's pictures).
 pub const MAX_DECADES: f64 = 4.0;

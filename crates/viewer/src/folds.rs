@@ -3,7 +3,7 @@
 //! away from corners its boundary forces). Read off the sampler's grid, never
 //! recomputed here.
 
-use winslow::quality::DetJSample;
+use winslow::verify::quality::DetJSample;
 use winslow::Surface;
 
 /// One element with at least one non-positive `det J` sample.
@@ -39,7 +39,7 @@ fn spans_containing(breaks: &[f64], t: f64) -> impl Iterator<Item = usize> + '_ 
 
 /// The elements of `map` with non-positive samples in `sample`, worst first.
 /// `forced` lists the corners (south-west, south-east, north-east, north-west) where the
-/// boundary forces `det J <= 0` ([`winslow::solver::CornerReport`]); a non-positive
+/// boundary forces `det J <= 0` ([`winslow::boundary::corners::CornerReport`]); a non-positive
 /// sample counts as forced when it lies in the element at such a corner.
 pub fn folded_elements(map: &Surface, sample: &DetJSample, forced: [bool; 4]) -> Vec<FoldedElement> {
     let bu = map.knots[0].breaks();
@@ -102,7 +102,7 @@ pub fn folded_elements(map: &Surface, sample: &DetJSample, forced: [bool; 4]) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use winslow::quality::sample_det_j;
+    use winslow::verify::quality::sample_det_j;
     use winslow::KnotVector;
 
     /// Degree-2 map of the square `[0, 3]^2` on 3x3 elements, control points at the

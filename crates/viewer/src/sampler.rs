@@ -2,12 +2,12 @@
 //! sampler can be swapped for another back end (the GPU crate) without touching the
 //! viewer. The viewer never computes `det J` samples itself.
 
-use winslow::quality::DetJSample;
+use winslow::verify::quality::DetJSample;
 use winslow::Surface;
 
 /// Samples `det J = x_xi y_eta - x_eta y_xi` (paper eq. 43) of a map on the uniform
 /// `(n+1) x (n+1)` grid of the parameter square, in the layout of
-/// [`winslow::quality::sample_det_j`] (`eta` outer, boundary included).
+/// [`winslow::verify::quality::sample_det_j`] (`eta` outer, boundary included).
 pub trait DetJSampler: Send + Sync {
     /// Short name shown in the viewer ("cpu", "gpu", ...).
     fn name(&self) -> &str;
@@ -15,7 +15,7 @@ pub trait DetJSampler: Send + Sync {
     fn sample(&self, map: &Surface, n: usize) -> DetJSample;
 }
 
-/// The core's sampler, [`winslow::quality::sample_det_j`].
+/// The core's sampler, [`winslow::verify::quality::sample_det_j`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct CpuSampler;
 
@@ -25,7 +25,7 @@ impl DetJSampler for CpuSampler {
     }
 
     fn sample(&self, map: &Surface, n: usize) -> DetJSample {
-        winslow::quality::sample_det_j(map, n)
+        winslow::verify::quality::sample_det_j(map, n)
     }
 }
 
@@ -56,7 +56,7 @@ impl DetJSampler for GpuSampler {
             Ok(s) => s,
             Err(e) => {
                 eprintln!("warning: GPU det J sampling failed ({e}); sampled on the CPU instead");
-                winslow::quality::sample_det_j(map, n)
+                winslow::verify::quality::sample_det_j(map, n)
             }
         }
     }

@@ -5,10 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
+use winslow::boundary::validate::sample_side;
 use winslow::io::{checked_boundary, parse_document, read_text, Document, ReadOptions};
-use winslow::quality::DetJSample;
-use winslow::solver::Solution;
-use winslow::validate::sample_side;
+use winslow::solve::report::Solution;
+use winslow::verify::quality::DetJSample;
 use winslow::{Boundary, Point, Side, SideCurve, Surface};
 
 use crate::certificate::{Certificate, Quality};
@@ -131,7 +131,7 @@ pub struct MapView {
     /// The core's exact certificate of this map (shown too when `certificate` is from a report).
     pub exact_certificate: Certificate,
     /// The solver's level reports, when the map was solved in the viewer.
-    pub report: Option<winslow::solver::Report>,
+    pub report: Option<winslow::solve::report::Report>,
     /// Matched point pairs of the constrained reparameterization (paper §7.2), from the
     /// solver's report or the one stored in the map file.
     pub matches: Vec<(Point, Point)>,
@@ -139,7 +139,7 @@ pub struct MapView {
 
 /// The matched pairs stored in a map file's `"report"` (`reparam.matches[].points`).
 pub fn stored_matches(report: &serde_json::Value) -> Vec<(Point, Point)> {
-    winslow::reparam::matches_in_report(report)
+    winslow::boundary::reparam::matches_in_report(report)
 }
 
 /// Default heat-map resolution: eight cells per element in the finer direction, within

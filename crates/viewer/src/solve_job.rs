@@ -8,9 +8,10 @@ use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use winslow::egg::CpuAssembler;
-use winslow::fit::build_hierarchy;
-use winslow::solver::{EggSolver, Event, InitialGuess, Solution, SolveOptions};
+use winslow::boundary::hierarchy::build_hierarchy;
+use winslow::methods::egg::CpuAssembler;
+use winslow::solve::report::Solution;
+use winslow::solve::solver::{EggSolver, Event, InitialGuess, SolveOptions};
 use winslow::Boundary;
 
 /// A message from the solving thread.
@@ -291,7 +292,7 @@ impl Drop for SolveJob {
 mod tests {
     use super::*;
     use winslow::boundary::{Analytic, SideCurve};
-    use winslow::solver::Verdict;
+    use winslow::solve::report::Verdict;
 
     /// Quarter annulus `1 <= r <= 2`, a solve of a fraction of a second.
     fn annulus() -> Boundary {

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
-use winslow::assembly::Operator;
-use winslow::solver::SolveOptions;
+use winslow::discrete::assembly::Operator;
+use winslow::solve::solver::SolveOptions;
 use winslow::Point;
 
 use crate::colour::{ColourScale, ScaleKind};
@@ -321,7 +321,7 @@ pub fn first_path(paths: impl IntoIterator<Item = Option<PathBuf>>) -> Option<Pa
 mod tests {
     use super::*;
     use crate::sampler::CpuSampler;
-    use winslow::solver::Verdict;
+    use winslow::solve::report::Verdict;
 
     fn data(name: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
@@ -432,7 +432,12 @@ mod tests {
         let n = mv.resolution();
         assert_eq!(mv.sample.values.len(), (n + 1) * (n + 1));
         assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Exact);
-        assert_eq!(mv.certificate.verdict, winslow::solver::Verdict::DegenerateCorner, "{}", mv.certificate.message);
+        assert_eq!(
+            mv.certificate.verdict,
+            winslow::solve::report::Verdict::DegenerateCorner,
+            "{}",
+            mv.certificate.message
+        );
         assert_eq!(mv.quality.det_j_min, mv.sample.min);
         // the map's own boundary can be solved again
         assert_eq!(scene.boundary.problem.is_none(), s.can_solve());

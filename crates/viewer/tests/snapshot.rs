@@ -64,7 +64,7 @@ fn folded_map_snapshot() {
     app.state.selected_fold = Some(0);
     let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
     assert!(!mv.folds.is_empty());
-    assert_eq!(mv.certificate.verdict, winslow::solver::Verdict::Folded);
+    assert_eq!(mv.certificate.verdict, winslow::solve::report::Verdict::Folded);
     let mut h = harness(app);
     h.run();
     h.snapshot("folded_map");

@@ -18,12 +18,12 @@
 use roxmltree::Node;
 
 use super::{normalized_curve, normalized_knots, reversed_curve, surface_boundary_area, Document};
+use crate::boundary::validate::sample_side;
 use crate::boundary::{Boundary, SideCurve};
-use crate::curve::{Curve, Point};
 use crate::error::{Error, Result, MAX_CONTROL_POINTS};
-use crate::knots::KnotVector;
-use crate::surface::Surface;
-use crate::validate::sample_side;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Surface;
 
 /// Largest number of XML nodes parsed (a guard against absurd inputs).
 const MAX_NODES: u32 = 1 << 24;
@@ -410,7 +410,7 @@ fn permutations4() -> impl Iterator<Item = [usize; 4]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::surface::Side;
+    use crate::spline::surface::Side;
 
     const SQUARE_CURVES: &str = r#"<?xml version="1.0"?>
 <xml>
@@ -444,7 +444,7 @@ mod tests {
             .replace("<coefs geoDim=\"2\">0 1 1 1</coefs>", "<coefs geoDim=\"2\">1 1 0 1</coefs>")
             .replace("<coefs geoDim=\"2\">0 0 0 1</coefs>", "<coefs geoDim=\"2\">0 1 0 0</coefs>");
         let Document::Boundary(b) = parse_gismo_xml(&xml).unwrap() else { panic!() };
-        let r = crate::validate::validate(&b).unwrap();
+        let r = crate::boundary::validate::validate(&b).unwrap();
         assert!((r.signed_area - 1.0).abs() < 1e-12);
     }
 
@@ -457,7 +457,7 @@ mod tests {
         let b =
             assign_sides([c([0., 0.], [1., 0.]), c([0., 1.], [1., 1.]), c([0., 0.], [0., 1.]), c([1., 0.], [1., 1.])])
                 .unwrap();
-        assert!(crate::validate::validate(&b).is_ok());
+        assert!(crate::boundary::validate::validate(&b).is_ok());
         assert_eq!(b.side(Side::South).endpoints(), ([0., 0.], [1., 0.]));
     }
 

@@ -12,10 +12,10 @@ use serde_json::{json, Value};
 
 use super::{normalized_curve, normalized_knots, Document};
 use crate::boundary::{Boundary, SideCurve};
-use crate::curve::{Curve, Point};
 use crate::error::{Error, Result, MAX_CONTROL_POINTS};
-use crate::knots::KnotVector;
-use crate::surface::{Side, Surface};
+use crate::spline::curve::{Curve, Point};
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::{Side, Surface};
 
 /// Number of points an analytic side is sampled with when written (`t = k / 1024`).
 pub const ANALYTIC_WRITE_POINTS: usize = 1025;
@@ -191,7 +191,7 @@ impl SideJson {
     }
 
     /// Convert to a side: curves are validated and normalized to `[0, 1]`; point clouds
-    /// are only checked for size here (the rest is [`crate::validate::validate`]'s job).
+    /// are only checked for size here (the rest is [`crate::boundary::validate::validate`]'s job).
     pub fn to_side(self) -> Result<SideCurve> {
         match self {
             SideJson::Curve(c) => c.to_curve().map(SideCurve::Spline),

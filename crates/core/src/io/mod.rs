@@ -1,5 +1,6 @@
-//! Reading and writing geometries: the JSON exchange formats of `formats.md`
-//! ([`json`]) and G+Smo XML files ([`gismo`]).
+//! Reading and writing: the JSON exchange formats of `formats.md` ([`json`]), G+Smo
+//! XML files ([`gismo`]) and pictures of a map, grid lines coloured by `det J`
+//! ([`picture`], PNG through the CLI).
 //!
 //! [`read_document`] detects the kind of file by its content (a JSON object or an XML
 //! document); [`read_boundary`] turns any accepted document into a validated,
@@ -8,16 +9,17 @@
 
 pub mod gismo;
 pub mod json;
+pub mod picture;
 
 use std::io::Read;
 use std::path::Path;
 
+use crate::boundary::validate::{inspect, validate, Orientation, ValidationReport};
 use crate::boundary::{Boundary, SideCurve};
-use crate::curve::Curve;
 use crate::error::{Error, Result};
-use crate::knots::KnotVector;
-use crate::surface::{Side, Surface};
-use crate::validate::{inspect, validate, Orientation, ValidationReport};
+use crate::spline::curve::Curve;
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::{Side, Surface};
 
 pub use gismo::parse_gismo_xml;
 pub use json::{
@@ -154,7 +156,7 @@ pub fn checked_boundary(boundary: Boundary, opts: &ReadOptions) -> Result<(Bound
 }
 
 /// Read a boundary from any accepted document (boundary, contour or map JSON; G+Smo
-/// XML with four curves or one patch), validate it ([`crate::validate::validate`]) and
+/// XML with four curves or one patch), validate it ([`crate::boundary::validate::validate`]) and
 /// return it counter-clockwise (see [`ReadOptions::reorient`]).
 pub fn read_boundary(path: &Path, opts: &ReadOptions) -> Result<Boundary> {
     let doc = read_document(path)?;
@@ -203,7 +205,7 @@ pub(crate) fn surface_boundary_area(s: &Surface) -> f64 {
     let sides = Side::ALL.map(|side| SideCurve::Spline(s.boundary(side)));
     let mut area = 0.0;
     for (k, side) in sides.iter().enumerate() {
-        let poly = crate::validate::sample_side(side, f64::INFINITY);
+        let poly = crate::boundary::validate::sample_side(side, f64::INFINITY);
         let sign = if k < 2 { 1.0 } else { -1.0 };
         area += sign * poly.windows(2).map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0]).sum::<f64>();
     }

@@ -46,14 +46,15 @@
 //! `converged` imply that the reported `max_error` of the finest level is within
 //! `tol_abs`.
 
-use crate::basis::BasisDerivs;
-use crate::boundary::{Analytic, Boundary, SideCurve};
-use crate::curve::{Curve, Point};
+use super::cord_length::cord_length_params;
+use crate::boundary::reparam::{ParamMap, ReparamOptions, SideParam};
+use crate::boundary::{Analytic, SideCurve};
 use crate::error::{Error, Result, MAX_DEGREE};
-use crate::knots::KnotVector;
-use crate::quadrature::GaussLegendre;
-use crate::reparam::{ParamMap, ReparamOptions, ReparamReport, SideParam};
-use crate::surface::Side;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::surface::Side;
 
 /// Relative weight `ε` of the smoothing term of point-cloud fits: `λ = ε · tr(B^T B) /
 /// tr(R)` on the free unknowns, with `B` the collocation matrix and `R` the matrix of
@@ -65,10 +66,6 @@ pub const REGULARIZATION: f64 = 1e-10;
 /// Samples per input piece and fit element used to estimate the maximal deviation of a
 /// curve fit (the piece's end points included).
 pub const SAMPLES_PER_PIECE: usize = 8;
-
-/// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
-/// relative to the diameter (readers enforce the stricter `1e-9` of `formats.md`).
-pub const CORNER_GAP_TOL: f64 = 1e-6;
 
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,119 +184,6 @@ impl SideFit {
     pub fn final_max_error(&self) -> f64 {
         *self.max_error.last().expect("a side fit has at least one level")
     }
-}
-
-/// One level of the hierarchy: a tensor-product basis and the four side fits on it.
-#[derive(Debug, Clone)]
-pub struct Level {
-    /// Knot vectors in `xi` (union of the south and north fits) and `eta` (union of the
-    /// east and west fits).
-    pub knots: [KnotVector; 2],
-    /// South, east, north, west: each side's fit, prolonged exactly onto
-    /// `knots[side.direction()]` (so opposite sides share one knot vector).
-    pub sides: [Curve; 4],
-}
-
-impl Level {
-    /// Number of tensor-product basis functions `n_xi * n_eta`.
-    pub fn num_basis(&self) -> usize {
-        self.knots[0].num_basis() * self.knots[1].num_basis()
-    }
-
-    /// The side `s` on this level's basis.
-    pub fn side(&self, s: Side) -> &Curve {
-        &self.sides[s as usize]
-    }
-}
-
-/// The nested hierarchy of tensor-product bases with the boundary fits (paper §5.4).
-#[derive(Debug, Clone)]
-pub struct Hierarchy {
-    /// Coarse to fine; knot vectors are nested from one level to the next.
-    pub levels: Vec<Level>,
-    /// The adaptive fits of south, east, north, west.
-    pub fits: [SideFit; 4],
-    /// Absolute tolerance `tol * diameter`.
-    pub tol_abs: f64,
-    /// Diameter of the boundary's bounding box.
-    pub diameter: f64,
-    /// The reparameterization applied before the fit (paper §7).
-    pub reparam: ReparamReport,
-}
-
-impl Hierarchy {
-    /// The finest level.
-    pub fn finest(&self) -> &Level {
-        self.levels.last().expect("a hierarchy has at least one level")
-    }
-
-    /// Whether all four sides met the tolerance.
-    pub fn converged(&self) -> bool {
-        self.fits.iter().all(|f| f.converged)
-    }
-
-    /// The largest final deviation over the four sides.
-    pub fn max_error(&self) -> f64 {
-        self.fits.iter().map(SideFit::final_max_error).fold(0.0, f64::max)
-    }
-}
-
-/// Cord-length abscissae of a point cloud (paper eq. 36-37): `ξ_1 = 0`,
-/// `ξ_i = l_i / l_K` with `l_i = l_{i-1} + ||p_i - p_{i-1}||`, and `ξ_K = 1` exactly.
-/// `None` when the cloud has fewer than two points or zero total length.
-pub fn cord_length_params(points: &[Point]) -> Option<Vec<f64>> {
-    if points.len() < 2 {
-        return None;
-    }
-    let mut l = Vec::with_capacity(points.len());
-    l.push(0.0);
-    for w in points.windows(2) {
-        let d = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
-        l.push(l.last().unwrap() + d);
-    }
-    let total = *l.last().unwrap();
-    if !(total.is_finite() && total > 0.0) {
-        return None;
-    }
-    for v in &mut l {
-        *v /= total;
-    }
-    *l.last_mut().unwrap() = 1.0;
-    Some(l)
-}
-
-/// Lower-left and upper-right corner of a bounding box of the boundary: point clouds
-/// exactly, spline sides sampled at 16 points per input element, analytic sides at 1025
-/// points.
-pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    let mut add = |p: Point| {
-        for c in 0..2 {
-            lo[c] = lo[c].min(p[c]);
-            hi[c] = hi[c].max(p[c]);
-        }
-    };
-    for side in &boundary.sides {
-        match side {
-            SideCurve::Points(pts) => pts.iter().for_each(|&p| add(p)),
-            SideCurve::Spline(c) => {
-                for (_, a, b) in c.knots.elements() {
-                    for k in 0..=16 {
-                        add(c.eval(a + (b - a) * k as f64 / 16.0));
-                    }
-                }
-            }
-            SideCurve::Analytic(f) => (0..=1024).for_each(|k| add(f.eval(k as f64 / 1024.0))),
-        }
-    }
-    (lo, hi)
-}
-
-/// Diameter of [`bounding_box`].
-pub fn diameter(boundary: &Boundary) -> f64 {
-    let (lo, hi) = bounding_box(boundary);
-    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }
 
 /// The function (or data) being approximated on one side.
@@ -749,122 +633,6 @@ pub fn fit_side_with(
     Ok(out)
 }
 
-/// The four corners south-west, south-east, north-east, north-west, each the average of
-/// the two adjacent sides' end points; errors when two ends are further apart than
-/// [`CORNER_GAP_TOL`]` * diameter`.
-pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
-    let ends = boundary.sides.each_ref().map(SideCurve::endpoints);
-    let [s, e, n, w] = ends;
-    // (side a, its end, side b, its end)
-    let pairs = [
-        ("south", s.0, "west", w.0),
-        ("south", s.1, "east", e.0),
-        ("east", e.1, "north", n.1),
-        ("north", n.0, "west", w.1),
-    ];
-    let tol = CORNER_GAP_TOL * diameter;
-    let mut out = [[0.0; 2]; 4];
-    for (k, &(na, a, nb, b)) in pairs.iter().enumerate() {
-        let gap = dist(a, b);
-        if gap.is_nan() || gap > tol {
-            return Err(Error::CornerGap {
-                side_a: na.into(),
-                side_b: nb.into(),
-                gap,
-                tol,
-                x: 0.5 * (a[0] + b[0]),
-                y: 0.5 * (a[1] + b[1]),
-            });
-        }
-        out[k] = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
-    }
-    Ok(out)
-}
-
-/// The (start, end) corners of a side in its orientation.
-pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
-    let [sw, se, ne, nw] = *corners;
-    match side {
-        Side::South => (sw, se),
-        Side::East => (se, ne),
-        Side::North => (nw, ne),
-        Side::West => (sw, nw),
-    }
-}
-
-/// Reparameterize the sides as `opts.reparam` says ([`crate::reparam::plan`], paper
-/// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
-/// diameter` and the corners of [`corners`], then build the nested hierarchy of
-/// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
-pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
-    opts.validate()?;
-    let diameter = diameter(boundary);
-    if !(diameter.is_finite() && diameter > 0.0) {
-        return Err(Error::Invalid(format!("boundary '{}' has diameter {diameter}", boundary.name)));
-    }
-    let tol_abs = opts.tol * diameter;
-    let corners = corners(boundary, diameter)?;
-    let plan = crate::reparam::plan(boundary, &opts.reparam)?;
-    let mut fits = Vec::with_capacity(4);
-    for side in Side::ALL {
-        let param = &plan.sides[side as usize];
-        fits.push(fit_side_with(side, boundary.side(side), param, side_corners(&corners, side), opts, tol_abs)?);
-    }
-    let fits: [SideFit; 4] = fits.try_into().expect("four sides");
-    let mut h = hierarchy_from_fits(fits, tol_abs, diameter)?;
-    h.reparam = plan.report;
-    Ok(h)
-}
-
-/// The hierarchy of tensor-product bases from the four side fits (south, east, north,
-/// west, in that order; paper §5.4): with `m` the largest number of levels over the sides
-/// (shorter sequences padded with their last fit), level `k` has `xi` knots = union of the
-/// south and north level-`k` knot vectors and `eta` knots = union of east and west, and
-/// each side's level-`k` fit prolonged exactly onto them, so opposite sides share one knot
-/// vector. Consecutive levels with identical knot vectors are merged (the later, more
-/// accurate fits are kept). All fits must be open, of one degree, on `[0, 1]`, with nested
-/// levels.
-pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> Result<Hierarchy> {
-    for (k, f) in fits.iter().enumerate() {
-        if f.side != Side::ALL[k] || f.levels.is_empty() {
-            return Err(Error::Invalid(format!(
-                "hierarchy needs non-empty fits of south, east, north, west in that order; position {k} holds {} with {} levels",
-                f.side,
-                f.levels.len()
-            )));
-        }
-    }
-    let m = fits.iter().map(|f| f.levels.len()).max().unwrap_or(1);
-    let pick = |s: Side, k: usize| {
-        let l = &fits[s as usize].levels;
-        &l[k.min(l.len() - 1)]
-    };
-    let mut levels: Vec<Level> = Vec::with_capacity(m);
-    for k in 0..m {
-        let xi = pick(Side::South, k).knots.union(&pick(Side::North, k).knots)?;
-        let eta = pick(Side::East, k).knots.union(&pick(Side::West, k).knots)?;
-        let knots = [xi, eta];
-        let sides = [
-            pick(Side::South, k).refined(&knots[0])?,
-            pick(Side::East, k).refined(&knots[1])?,
-            pick(Side::North, k).refined(&knots[0])?,
-            pick(Side::West, k).refined(&knots[1])?,
-        ];
-        let level = Level { knots, sides };
-        match levels.last_mut() {
-            Some(prev) if prev.knots == level.knots => *prev = level,
-            Some(prev) if !(level.knots[0].contains(&prev.knots[0]) && level.knots[1].contains(&prev.knots[1])) => {
-                return Err(Error::Invalid(format!(
-                    "side fits are not nested: level {k} does not refine level {}",
-                    k - 1
-                )));
-            }
-            _ => levels.push(level),
-        }
-    }
-    Ok(Hierarchy { levels, fits, tol_abs, diameter, reparam: ReparamReport::native() })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1009,41 +777,5 @@ mod tests {
         let fit = fit_side(Side::South, &f, f.endpoints(), &o, 1e-9).unwrap();
         assert!(!fit.converged);
         assert!(fit.finest().knots.num_elements() <= 6);
-    }
-
-    fn synthetic_fit(side: Side, breaks: &[&[f64]]) -> SideFit {
-        let levels: Vec<Curve> = breaks
-            .iter()
-            .map(|b| {
-                let kv = KnotVector::open_from_breaks(3, b, 1);
-                let n = kv.num_basis();
-                let g = kv.greville();
-                let cps = (0..n).map(|i| [g[i], (3.0 * g[i]).sin()]).collect();
-                Curve::polynomial(kv, cps)
-            })
-            .collect();
-        let k = levels.len();
-        SideFit { side, levels, max_error: vec![0.0; k], rms_error: vec![0.0; k], params: None, converged: true }
-    }
-
-    #[test]
-    fn hierarchy_pads_unifies_and_merges_levels() {
-        // south refines at 0.5 then 0.75; north has 0.75 from level 1 on; so the xi
-        // unions of levels 1 and 2 coincide and are merged (keeping the later fits).
-        let s = synthetic_fit(Side::South, &[&[0.0, 1.0], &[0.0, 0.5, 1.0], &[0.0, 0.5, 0.75, 1.0]]);
-        let n = synthetic_fit(Side::North, &[&[0.0, 1.0], &[0.0, 0.5, 0.75, 1.0]]);
-        let e = synthetic_fit(Side::East, &[&[0.0, 1.0]]);
-        let w = synthetic_fit(Side::West, &[&[0.0, 1.0], &[0.0, 0.25, 1.0]]);
-        let h = hierarchy_from_fits([s.clone(), e, n, w], 1e-3, 1.0).unwrap();
-        assert_eq!(h.levels.len(), 2);
-        assert_eq!(h.levels[0].num_basis(), 16);
-        assert_eq!(h.levels[1].knots[0].breaks(), vec![0.0, 0.5, 0.75, 1.0]);
-        assert_eq!(h.levels[1].knots[1].breaks(), vec![0.0, 0.25, 1.0]);
-        assert_eq!(h.levels[1].num_basis(), 6 * 5);
-        // the merged level carries south's level-2 fit, unchanged by the prolongation
-        assert_eq!(h.levels[1].side(Side::South), &s.levels[2]);
-        // wrong order is an error
-        let [a, b, c, d] = h.fits.clone();
-        assert!(hierarchy_from_fits([b, a, c, d], 1e-3, 1.0).is_err());
     }
 }

@@ -2,7 +2,7 @@
 //! (Piegl & Tiller, *The NURBS Book*, algorithms A2.2 and A2.3), without heap allocation.
 
 use crate::error::MAX_DEGREE;
-use crate::knots::KnotVector;
+use crate::spline::knots::KnotVector;
 
 /// Highest derivative order evaluated by [`BasisDerivs`].
 pub const MAX_DERIV: usize = 2;

@@ -3,11 +3,11 @@
 //! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
-//! [`crate::assembly::Discretization::metric_laplace`]) or by ILU(0).
+//! [`crate::discrete::assembly::Discretization::metric_laplace`]) or by ILU(0).
 //!
 //! The Cholesky factorizations follow the problem's fill-reducing order when it gives one
 //! ([`LinearSolver::set_ordering`], nested dissection of the spline grid, see
-//! [`crate::ordering`]), approximate minimum degree otherwise; their symbolic analysis,
+//! [`crate::linalg::ordering`]), approximate minimum degree otherwise; their symbolic analysis,
 //! numeric storage and scratch memory are allocated once and reused by every
 //! refactorization and solve.
 
@@ -23,8 +23,8 @@ use faer::{Conj, Par, Side};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::ordering;
-use crate::sparse::Csr;
+use crate::linalg::ordering;
+use crate::linalg::sparse::Csr;
 
 /// Which linear solver the nonlinear solvers use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -283,9 +283,9 @@ impl LinearSolver {
     }
 
     /// Use `order` (`order[new] = old`, a permutation of the `m` scalar unknowns, e.g.
-    /// [`crate::ordering::nested_dissection`] of the spline grid) for the Cholesky
+    /// [`crate::linalg::ordering::nested_dissection`] of the spline grid) for the Cholesky
     /// factorizations: of the scalar preconditioner `K` (size `m`) directly, of a system
-    /// of `c` component blocks (size `c m`) point by point ([`crate::ordering::interleave`]).
+    /// of `c` component blocks (size `c m`) point by point ([`crate::linalg::ordering::interleave`]).
     /// Without it, approximate minimum degree.
     pub fn set_ordering(&mut self, order: &[usize]) {
         self.order = Some(order.to_vec());

@@ -7,19 +7,19 @@
 //! parameter square with `grad_x w = J^{-T} grad_xi w` and `dx = |det J| dxi`; the
 //! discrete space is the map's tensor B-spline basis (free = interior functions, the
 //! boundary coefficients interpolate `g` at the Greville points of each side). The
-//! assembly reuses the EGG machinery of [`crate::assembly`]: basis tables, the scalar
-//! [`crate::assembly::SystemPattern`] and stencil storage.
+//! assembly reuses the EGG machinery of [`crate::discrete::assembly`]: basis tables, the scalar
+//! [`crate::discrete::assembly::SystemPattern`] and stencil storage.
 
 use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::assembly::Discretization;
-use crate::basis::BasisDerivs;
+use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
-use crate::linsolve::{LinearMethod, LinearSolver};
-use crate::quadrature::GaussLegendre;
-use crate::surface::{Side, Surface};
+use crate::linalg::linsolve::{LinearMethod, LinearSolver};
+use crate::spline::basis::BasisDerivs;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::surface::{Side, Surface};
 
 /// Geometry of a (possibly rational) map at one quadrature point from the tensor basis
 /// values `b[a] = (w, w_u, w_v, ..)` and the element's control points.
@@ -73,7 +73,7 @@ fn side_interpolant(map: &Surface, side: Side, g: &dyn Fn([f64; 2]) -> f64) -> V
         }
         rhs[i][0] = g(curve.eval(u));
     }
-    crate::refine::dense_solve(&a, &rhs).into_iter().map(|r| r[0]).collect()
+    crate::spline::refine::dense_solve(&a, &rhs).into_iter().map(|r| r[0]).collect()
 }
 
 /// Solve `-Δu = f` in the mapped domain with `u = g` on its boundary; returns the
@@ -254,7 +254,7 @@ pub fn poisson_benchmark(map: &Surface, a: Option<[f64; 2]>) -> Result<PoissonRe
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::knots::KnotVector;
+    use crate::spline::knots::KnotVector;
 
     /// A polynomial map of degree 2 (exact on every refinement) or the identity.
     fn map(p: usize, ne: usize, curved: bool) -> Surface {

@@ -3,10 +3,10 @@
 //! `eta`, and the boundary. Non-positive `det J` is painted magenta, a colour that no
 //! positive value uses. Output is an RGBA buffer; the CLI encodes it as PNG.
 
-use crate::basis::BasisDerivs;
-use crate::curve::Point;
-use crate::quality::grid_abscissae;
-use crate::surface::Surface;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::curve::Point;
+use crate::spline::surface::Surface;
+use crate::verify::quality::grid_abscissae;
 
 /// An RGBA8 image, row-major from the top-left.
 #[derive(Debug, Clone)]

@@ -7,9 +7,9 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::basis::BasisDerivs;
-use crate::quadrature::GaussLegendre;
-use crate::surface::Surface;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::surface::Surface;
 
 /// `det J` sampled on a uniform `(n+1) x (n+1)` grid of the parameter square.
 #[derive(Debug, Clone, Serialize)]
@@ -53,7 +53,7 @@ impl DetJSample {
 }
 
 /// The grid abscissae `t_i = i / n`, `i = 0..=n`, of [`sample_det_j`] and
-/// [`crate::picture::render`].
+/// [`crate::io::picture::render`].
 pub fn grid_abscissae(n: usize) -> impl Iterator<Item = f64> {
     (0..=n).map(move |i| i as f64 / n as f64)
 }
@@ -276,10 +276,12 @@ pub fn quality(map: &Surface) -> Quality {
 /// east, north, west): each side of the map is sampled at `n + 1` points and the
 /// distance to the input side's polyline (chords within `1e-6` of the diameter) taken.
 pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n: usize) -> [f64; 4] {
-    use crate::surface::Side;
+    use crate::spline::surface::Side;
     let diam = {
-        let pts: Vec<[f64; 2]> =
-            Side::ALL.iter().flat_map(|&s| crate::validate::sample_side(boundary.side(s), f64::INFINITY)).collect();
+        let pts: Vec<[f64; 2]> = Side::ALL
+            .iter()
+            .flat_map(|&s| crate::boundary::validate::sample_side(boundary.side(s), f64::INFINITY))
+            .collect();
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in &pts {
             for d in 0..2 {
@@ -290,7 +292,7 @@ pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n
         (hi[0] - lo[0]).hypot(hi[1] - lo[1])
     };
     Side::ALL.map(|s| {
-        let poly = crate::validate::sample_side(boundary.side(s), 1e-6 * diam);
+        let poly = crate::boundary::validate::sample_side(boundary.side(s), 1e-6 * diam);
         let curve = map.boundary(s);
         let mut worst: f64 = 0.0;
         for k in 0..=n {
@@ -315,7 +317,7 @@ fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::knots::KnotVector;
+    use crate::spline::knots::KnotVector;
 
     /// The affine map `(xi, eta) -> (2 xi + eta, 3 eta)`: all functionals in closed form.
     #[test]

@@ -3,13 +3,13 @@
 //! extreme aspect ratios) come out bijective at all.
 //!
 //! * **Arc length** (§7.1). Point clouds get the cord-length abscissae of eq. 36-37
-//!   ([`crate::fit::cord_length_params`]). A parametric side `f̄: [0,1] -> R^2` gets a
+//!   ([`crate::boundary::cord_length::cord_length_params`]). A parametric side `f̄: [0,1] -> R^2` gets a
 //!   monotone reparameterization `g(ξ) = Σ_i c_i B_i(ξ)` (eq. 38) on a cubic B-spline
 //!   basis with `c_0 = 0`, `c_n = 1`, minimizing (eq. 39)
 //!   `A(c) = ∫_0^1 ||(f̄ ∘ g)'(ξ)||^2 dξ`; by Cauchy-Schwarz `A >= L^2` (`L` the length of
 //!   the side) with equality exactly for the arc-length parameterization. See
 //!   [`arc_length_map`]. The contour is then re-fitted in the solver's basis as
-//!   `f̄ ∘ g` ([`crate::fit`]).
+//!   `f̄ ∘ g` ([`crate::boundary::fit`]).
 //! * **Constrained cord length** (§7.2, eq. 40-42). For two opposite sides `P_1` (cord
 //!   length, `Ξ_1`) and `P_2`, the closest pair `(p^1_i, p^2_j)` within the threshold
 //!   distance `ε` is matched (eq. 40) and gets `ξ^2_j = ξ^1_i`; the search recurses on the
@@ -24,13 +24,13 @@
 
 use serde::Serialize;
 
+use crate::boundary::cord_length::cord_length_params;
 use crate::boundary::{Boundary, SideCurve};
-use crate::curve::Point;
 use crate::error::{Error, Result};
-use crate::fit::cord_length_params;
-use crate::knots::KnotVector;
-use crate::quadrature::GaussLegendre;
-use crate::surface::Side;
+use crate::spline::curve::Point;
+use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::surface::Side;
 
 /// Which reparameterization the contour fit applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
@@ -289,7 +289,7 @@ impl ParamMap {
         match self {
             ParamMap::Monotone(m) => m.eval_d(xi),
             ParamMap::Spline { knots, coefs } => {
-                let b = crate::basis::BasisDerivs::at(knots, xi.clamp(0.0, 1.0), 1);
+                let b = crate::spline::basis::BasisDerivs::at(knots, xi.clamp(0.0, 1.0), 1);
                 let f = b.first();
                 let (mut v, mut d) = (0.0, 0.0);
                 for j in 0..=knots.degree() {
@@ -489,7 +489,7 @@ fn arc_length_iterations(
         br.dedup_by(|a, b| (*a - *b).abs() < 1e-14);
         let mut total = 0.0;
         let mut sys = sys;
-        let mut b = crate::basis::BasisDerivs::default();
+        let mut b = crate::spline::basis::BasisDerivs::default();
         for w in br.windows(2) {
             for (xi, wt) in gauss.on(w[0], w[1]) {
                 b.eval(&kv, xi, 1);
@@ -924,7 +924,7 @@ pub fn plan(boundary: &Boundary, opts: &ReparamOptions) -> Result<ReparamPlan> {
 mod tests {
     use super::*;
     use crate::boundary::Analytic;
-    use crate::curve::Curve;
+    use crate::spline::curve::Curve;
 
     fn strictly_monotone_onto(f: impl Fn(f64) -> f64, n: usize) {
         assert!(f(0.0).abs() < 1e-14 && (f(1.0) - 1.0).abs() < 1e-14, "ends {} {}", f(0.0), f(1.0));

@@ -1,8 +1,8 @@
 //! B-spline and NURBS curves in the plane: a basis (knot vector) plus control points.
 
-use crate::basis::BasisDerivs;
 use crate::error::{Error, Result};
-use crate::knots::KnotVector;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::knots::KnotVector;
 
 /// A point or vector in the plane.
 pub type Point = [f64; 2];

@@ -4,14 +4,20 @@
 //! automatically when Newton stalls. Because `dF/dc` of eq. (8) is negative definite
 //! (L behaves like the Laplacian), the pseudo-time flow is taken as `M dc/dt = F`, the
 //! dissipative sign; eq. (28) states it for `G = -L`.
+//!
+//! The solver reads any [`DiscreteProblem`]: for a minimization method (`F = -∇J`,
+//! [`DiscreteProblem::objective`]) the Newton direction solves `-∇²J δ = ∇J` and the line
+//! search asks for the Armijo decrease `J(c + t δ) <= J(c) + 10^-4 t ∇J·δ`; convergence
+//! is on `|F| = |∇J|` for both kinds. Steps outside the feasible set (an objective of
+//! `+∞`, or [`DiscreteProblem::admissible`] false) are never accepted.
 
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
-use crate::egg::NonlinearProblem;
 use crate::error::Result;
-use crate::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
+use crate::linalg::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
+use crate::methods::DiscreteProblem;
 
 /// Largest forcing term of the inexact Newton method (see `NonlinearSolver::forcing`).
 pub const ETA_MAX: f64 = 1e-2;
@@ -19,7 +25,7 @@ pub const ETA_MAX: f64 = 1e-2;
 /// Nonlinear iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "kebab-case")]
-pub enum Method {
+pub enum NonlinearMethod {
     /// Damped Newton with line search (§6.1), falling back to pseudo time on a stall.
     #[default]
     Newton,
@@ -31,7 +37,7 @@ pub enum Method {
 #[derive(Debug, Clone, Copy)]
 pub struct NonlinearOptions {
     /// Iteration to start with.
-    pub method: Method,
+    pub method: NonlinearMethod,
     /// Converged when the scaled residual `||F|| * scale` is below this.
     pub tol: f64,
     /// ... or when `||F||` fell below `rtol` times the initial residual.
@@ -54,7 +60,7 @@ pub struct NonlinearOptions {
 impl Default for NonlinearOptions {
     fn default() -> Self {
         Self {
-            method: Method::Newton,
+            method: NonlinearMethod::Newton,
             tol: 1e-9,
             rtol: 1e-13,
             step_tol: 1e-13,
@@ -73,11 +79,13 @@ pub struct Iterate {
     /// Iteration number (0 is the initial guess).
     pub iteration: usize,
     /// Method that produced it.
-    pub method: Method,
+    pub method: NonlinearMethod,
     /// `||F||_2`.
     pub residual: f64,
     /// Scaled residual `||F|| * scale` (dimensionless).
     pub scaled_residual: f64,
+    /// The objective `J` of a minimization method; `None` for root-finding.
+    pub objective: Option<f64>,
     /// Max-norm of the step taken.
     pub step: f64,
     /// Line-search damping `delta` (1 for a full step), eq. (25).
@@ -107,19 +115,21 @@ pub struct Timings {
 }
 
 /// An iterative solve in progress; `Iterator` over its [`Iterate`]s.
-pub struct NonlinearSolver<P: NonlinearProblem> {
+pub struct NonlinearSolver<P: DiscreteProblem> {
     problem: P,
     opts: NonlinearOptions,
     c: Vec<f64>,
     f: Vec<f64>,
     norm: f64,
+    /// `J(c)` of a minimization method.
+    objective: Option<f64>,
     r0: f64,
     /// `||F||` before the last Newton step and the forcing term used for it.
     previous: Option<(f64, f64)>,
     iteration: usize,
     newton_its: usize,
     pseudo_its: usize,
-    method: Method,
+    method: NonlinearMethod,
     dt: f64,
     lin: LinearSolver,
     status: Status,
@@ -128,7 +138,7 @@ pub struct NonlinearSolver<P: NonlinearProblem> {
     pub timings: Timings,
 }
 
-impl<P: NonlinearProblem> std::fmt::Debug for NonlinearSolver<P> {
+impl<P: DiscreteProblem> std::fmt::Debug for NonlinearSolver<P> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NonlinearSolver").field("iteration", &self.iteration).field("status", &self.status).finish()
     }
@@ -138,7 +148,7 @@ fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-impl<P: NonlinearProblem> NonlinearSolver<P> {
+impl<P: DiscreteProblem> NonlinearSolver<P> {
     /// Start from `c0`.
     pub fn new(mut problem: P, c0: Vec<f64>, opts: NonlinearOptions) -> Self {
         let mut f = vec![0.0; problem.size()];
@@ -146,6 +156,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         problem.residual(&c0, &mut f);
         let assembly = t.elapsed();
         let norm = norm2(&f);
+        let objective = problem.objective(&c0);
         let mut lin = LinearSolver::new(opts.linear);
         if let Some(order) = problem.ordering() {
             lin.set_ordering(order);
@@ -156,6 +167,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             c: c0,
             f,
             norm,
+            objective,
             r0: norm,
             previous: None,
             iteration: 0,
@@ -217,9 +229,10 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             method: self.method,
             residual: self.norm,
             scaled_residual: self.scaled(),
+            objective: self.objective,
             step,
             damping,
-            dt: (self.method == Method::PseudoTime).then_some(self.dt),
+            dt: (self.method == NonlinearMethod::PseudoTime).then_some(self.dt),
         }
     }
 
@@ -229,6 +242,8 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             self.started = true;
             if !self.norm.is_finite() {
                 self.status = Status::Failed("non-finite initial residual".into());
+            } else if self.objective.is_some_and(|j| !j.is_finite()) || !self.problem.admissible(&self.c) {
+                self.status = Status::Failed("the start is outside the feasible set of the method".into());
             } else if self.converged(f64::INFINITY) {
                 self.status = Status::Converged;
             }
@@ -238,8 +253,8 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             return Ok(None);
         }
         let it = match self.method {
-            Method::Newton => self.newton_step()?,
-            Method::PseudoTime => self.pseudo_step()?,
+            NonlinearMethod::Newton => self.newton_step()?,
+            NonlinearMethod::PseudoTime => self.pseudo_step()?,
         };
         Ok(Some(it))
     }
@@ -317,6 +332,9 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             Err(e) => return Ok(self.stall(format!("Newton linear solve failed: {e}"))),
         };
         self.previous = Some((self.norm, self.lin.krylov_tol));
+        if let Some(j0) = self.objective {
+            return Ok(self.descent_step(j0, &dx));
+        }
         // Backtracking on phi = ||F||^2 / 2 with Armijo constant 1e-4; the slope along
         // the Newton direction is -||F||^2.
         let phi0 = 0.5 * self.norm * self.norm;
@@ -327,7 +345,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
             for ((t, c), d) in trial.iter_mut().zip(&self.c).zip(&dx) {
                 *t = c + delta * d;
             }
-            let nt = self.eval(&trial, &mut ft);
+            let nt = if self.problem.admissible(&trial) { self.eval(&trial, &mut ft) } else { f64::NAN };
             let phi = 0.5 * nt * nt;
             if nt.is_finite() && phi <= phi0 * (1.0 - 2e-4 * delta) {
                 let step = dx.iter().fold(0.0f64, |m, d| m.max((delta * d).abs()));
@@ -358,14 +376,61 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
         }
     }
 
+    /// The line search of a minimization method along the Newton direction `dx`:
+    /// backtracking (quadratic interpolation, factors within `[0.1, 0.5]`) until the
+    /// Armijo condition `J(c + t dx) <= J(c) + 10^-4 t ∇J·dx` holds at a feasible point.
+    fn descent_step(&mut self, j0: f64, dx: &[f64]) -> Iterate {
+        // ∇J·dx = -F·dx; the Newton direction of a positive definite Hessian descends
+        let slope = -self.f.iter().zip(dx).map(|(f, d)| f * d).sum::<f64>();
+        if slope.is_nan() || slope >= 0.0 {
+            return self.stall("the Newton direction does not descend (Hessian not positive definite)".into());
+        }
+        let mut delta = 1.0;
+        let mut trial = vec![0.0; self.c.len()];
+        let mut ft = vec![0.0; self.c.len()];
+        loop {
+            for ((t, c), d) in trial.iter_mut().zip(&self.c).zip(dx) {
+                *t = c + delta * d;
+            }
+            let t0 = Instant::now();
+            let jt = match self.problem.admissible(&trial) {
+                true => self.problem.objective(&trial).unwrap_or(f64::NAN),
+                false => f64::INFINITY,
+            };
+            self.timings.assembly += t0.elapsed();
+            if jt.is_finite() && jt <= j0 + 1e-4 * delta * slope {
+                let nt = self.eval(&trial, &mut ft);
+                let step = dx.iter().fold(0.0f64, |m, d| m.max((delta * d).abs()));
+                std::mem::swap(&mut self.c, &mut trial);
+                std::mem::swap(&mut self.f, &mut ft);
+                self.norm = nt;
+                self.objective = Some(jt);
+                if self.converged(step) {
+                    self.status = Status::Converged;
+                } else if self.newton_its >= self.opts.max_newton {
+                    return self.stall_with(format!("Newton reached {} iterations", self.opts.max_newton), step, delta);
+                }
+                return self.iterate(step, delta);
+            }
+            // minimiser of the quadratic through J(0) = j0, J'(0) = slope and J(delta)
+            let q =
+                if jt.is_finite() { -slope * delta * delta / (2.0 * (jt - j0 - slope * delta)) } else { 0.1 * delta };
+            delta = q.clamp(0.1 * delta, 0.5 * delta);
+            if delta < 1e-10 {
+                return self
+                    .stall("line search failed (no decrease of the objective along the Newton direction)".into());
+            }
+        }
+    }
+
     fn stall(&mut self, why: String) -> Iterate {
         self.stall_with(why, 0.0, 0.0)
     }
 
     fn stall_with(&mut self, why: String, step: f64, damping: f64) -> Iterate {
         let it = self.iterate(step, damping);
-        if self.opts.fallback && self.method == Method::Newton {
-            self.method = Method::PseudoTime;
+        if self.opts.fallback && self.method == NonlinearMethod::Newton {
+            self.method = NonlinearMethod::PseudoTime;
             self.dt = 0.0;
         } else {
             self.status = Status::Failed(why);
@@ -396,11 +461,17 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
                     for (t, d) in trial.iter_mut().zip(dx) {
                         *t += d;
                     }
-                    self.eval(&trial, &mut ft)
+                    if self.problem.admissible(&trial) {
+                        self.eval(&trial, &mut ft)
+                    } else {
+                        f64::NAN
+                    }
                 }
                 Err(_) => f64::NAN,
             };
-            if nt.is_finite() && nt <= 10.0 * self.norm {
+            // a minimization method must stay where its objective is finite
+            let jt = if nt.is_finite() { self.problem.objective(&trial) } else { None };
+            if nt.is_finite() && nt <= 10.0 * self.norm && jt.is_none_or(f64::is_finite) {
                 let step = dx.as_ref().map_or(0.0, |dx| dx.iter().fold(0.0f64, |m, d| m.max(d.abs())));
                 // SER rule, eq. (33), with the growth limited to a factor 10 per step
                 let ratio = (self.norm / nt).clamp(0.1, 10.0);
@@ -408,6 +479,7 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
                 self.c = trial;
                 self.f = ft;
                 self.norm = nt;
+                self.objective = jt;
                 if self.converged(step) {
                     self.status = Status::Converged;
                 } else if self.pseudo_its >= self.opts.max_pseudo {
@@ -426,9 +498,123 @@ impl<P: NonlinearProblem> NonlinearSolver<P> {
     }
 }
 
-impl<P: NonlinearProblem> Iterator for NonlinearSolver<P> {
+impl<P: DiscreteProblem> Iterator for NonlinearSolver<P> {
     type Item = Result<Iterate>;
     fn next(&mut self) -> Option<Self::Item> {
         self.step().transpose()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::sparse::Csr;
+    use crate::spline::curve::Point;
+
+    /// `J(c) = Σ (c_i - a_i)² / 2 - b ln c_i` on `c > 0` (`+∞` elsewhere), minimised at
+    /// `c_i = (a_i + sqrt(a_i² + 4 b)) / 2`; `F = -∇J`, `dF/dc = -diag(1 + b / c²)`.
+    /// As a root-finding problem (`minimize == false`) the same `F` with `c > 0` as the
+    /// admissible set.
+    struct Barrier {
+        a: Vec<f64>,
+        b: f64,
+        minimize: bool,
+        mass: Csr,
+        /// Infeasible points the solver asked about.
+        rejected: usize,
+        /// Whether the residual was ever evaluated outside the feasible set.
+        evaluated_outside: bool,
+    }
+
+    impl Barrier {
+        fn new(a: Vec<f64>, b: f64, minimize: bool) -> Self {
+            let n = a.len();
+            Self { a, b, minimize, mass: Csr::identity(n), rejected: 0, evaluated_outside: false }
+        }
+        fn exact(&self) -> Vec<f64> {
+            self.a.iter().map(|a| 0.5 * (a + (a * a + 4.0 * self.b).sqrt())).collect()
+        }
+    }
+
+    impl DiscreteProblem for Barrier {
+        fn size(&self) -> usize {
+            self.a.len()
+        }
+        fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+            self.evaluated_outside |= c.iter().any(|&x| x <= 0.0);
+            for ((f, &x), a) in f.iter_mut().zip(c).zip(&self.a) {
+                *f = -(x - a - self.b / x);
+            }
+        }
+        fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
+            self.residual(c, f);
+            let rows = c.iter().enumerate().map(|(i, &x)| vec![(i, -(1.0 + self.b / (x * x)))]).collect();
+            *jac = Csr::from_rows(c.len(), rows);
+        }
+        fn mass(&mut self) -> &Csr {
+            &self.mass
+        }
+        fn objective(&mut self, c: &[f64]) -> Option<f64> {
+            self.minimize.then(|| {
+                if c.iter().any(|&x| x <= 0.0) {
+                    self.rejected += 1;
+                    return f64::INFINITY;
+                }
+                c.iter().zip(&self.a).map(|(&x, a)| 0.5 * (x - a) * (x - a) - self.b * x.ln()).sum()
+            })
+        }
+        fn admissible(&mut self, c: &[f64]) -> bool {
+            let ok = c.iter().all(|&x| x > 0.0);
+            self.rejected += usize::from(!ok);
+            ok
+        }
+        fn control_points(&self, c: &[f64]) -> Vec<Point> {
+            c.iter().map(|&x| [x, 0.0]).collect()
+        }
+    }
+
+    /// Newton on a minimization problem and on a root-finding problem with an admissible
+    /// set: full steps would leave `c > 0` (the minimisers for negative `a_i` lie near
+    /// `b / |a_i|`), the line search backtracks instead, every accepted iterate stays
+    /// feasible, and both converge to the closed-form minimiser with a descending
+    /// objective.
+    #[test]
+    fn line_search_keeps_iterates_feasible() {
+        let a: Vec<f64> = (0..12).map(|i| -3.0 + 0.5 * i as f64).collect();
+        for minimize in [true, false] {
+            let problem = Barrier::new(a.clone(), 1e-2, minimize);
+            let exact = problem.exact();
+            // a barrier slows damped Newton down near the boundary: allow the iterations
+            let opts = NonlinearOptions { fallback: false, max_newton: 200, ..Default::default() };
+            let mut solver = NonlinearSolver::new(problem, vec![1.0; a.len()], opts);
+            let mut last = f64::INFINITY;
+            for it in solver.by_ref() {
+                let it = it.unwrap();
+                if minimize {
+                    let j = it.objective.expect("a minimization method reports J");
+                    assert!(j <= last, "objective rose: {j} > {last}");
+                    last = j;
+                } else {
+                    assert!(it.objective.is_none());
+                }
+            }
+            assert_eq!(solver.status(), &Status::Converged, "minimize = {minimize}");
+            let err = solver.solution().iter().zip(&exact).fold(0.0f64, |m, (x, e)| m.max((x - e).abs()));
+            assert!(err < 1e-10, "minimize = {minimize}: error {err}");
+            let (problem, _) = solver.into_parts();
+            assert!(problem.rejected > 0, "the test must exercise infeasible trial steps");
+            assert!(!problem.evaluated_outside, "F evaluated outside the admissible set");
+        }
+    }
+
+    /// A start outside the feasible set is refused, not iterated from.
+    #[test]
+    fn infeasible_start_fails() {
+        let problem = Barrier::new(vec![1.0, 2.0], 1e-2, true);
+        let mut solver = NonlinearSolver::new(problem, vec![1.0, -1.0], NonlinearOptions::default());
+        for it in solver.by_ref() {
+            it.unwrap();
+        }
+        assert!(matches!(solver.status(), Status::Failed(why) if why.contains("feasible")));
     }
 }

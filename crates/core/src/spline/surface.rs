@@ -1,13 +1,14 @@
 //! Tensor-product B-spline / NURBS maps of the unit square: a geometry is a basis
 //! (two knot vectors) plus control points, `x(xi, eta) = sum_ij c_ij N_i(xi) M_j(eta)`.
 
-use crate::basis::BasisDerivs;
-use crate::curve::{check_points, check_weights, Curve, Point};
 use crate::error::{Error, Result};
-use crate::knots::KnotVector;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::curve::{check_points, check_weights, Curve, Point};
+use crate::spline::knots::KnotVector;
 
 /// The four sides of the parameter square, in the order south, east, north, west.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Side {
     /// `eta = 0`, increasing `xi`.
     South = 0,
@@ -30,6 +31,16 @@ impl Side {
             Side::East => "east",
             Side::North => "north",
             Side::West => "west",
+        }
+    }
+
+    /// The opposite side (south and north, east and west).
+    pub fn opposite(self) -> Side {
+        match self {
+            Side::South => Side::North,
+            Side::East => Side::West,
+            Side::North => Side::South,
+            Side::West => Side::East,
         }
     }
 

@@ -3,8 +3,8 @@
 //! prolongation onto the knot vector in which every break has multiplicity `p`.
 
 use crate::error::{Error, Result};
-use crate::knots::KnotVector;
-use crate::refine::prolongation;
+use crate::spline::knots::KnotVector;
+use crate::spline::refine::prolongation;
 
 /// Bernstein polynomials `B_k^p(t) = binom(p, k) t^k (1 - t)^(p - k)`, `k = 0..=p`, at `t`.
 pub fn bernstein(p: usize, t: f64, out: &mut [f64]) {
@@ -64,7 +64,7 @@ impl BezierExtraction {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::basis::BasisDerivs;
+    use crate::spline::basis::BasisDerivs;
 
     #[test]
     fn extraction_reproduces_bsplines() {

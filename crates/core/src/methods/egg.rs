@@ -1,38 +1,18 @@
-//! The discrete EGG problem on one basis: unknown interior control points, Dirichlet
-//! boundary control points, residual `F(c)` of eq. (12) and its Jacobian (eq. 23).
+//! Elliptic grid generation in Galerkin form (paper eq. 8): the residual `F(c)` of
+//! eq. (12) and its exact Jacobian (eq. 23) in the free control points of one basis,
+//! with the plain operator `L` or the scaled `L / (g11 + g22)`; [`EggMethod`] is the
+//! method, [`EggProblem`] the problem on one level, [`EggAssembler`] the quadrature back
+//! end (the CPU kernels of [`crate::discrete::assembly`], or the GPU crate's WGSL).
 
 use std::sync::Arc;
 
-use crate::assembly::{Discretization, Operator};
-use crate::curve::Point;
-use crate::quality::{sample_det_j, DetJSample};
-use crate::sparse::Csr;
-use crate::surface::Surface;
+use super::{DiscreteProblem, Method};
 
-/// A nonlinear system `F(c) = 0` with a Jacobian and a mass matrix (for pseudo time).
-pub trait NonlinearProblem {
-    /// Number of unknowns.
-    fn size(&self) -> usize;
-    /// `F(c)` into `f`.
-    fn residual(&mut self, c: &[f64], f: &mut [f64]);
-    /// `F(c)` into `f` and the Jacobian `dF/dc` into `jac`, which is empty or holds
-    /// this problem's fixed pattern from an earlier call (then only the values are
-    /// written: no allocation, no copy of the pattern per Newton step).
-    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr);
-    /// The block mass matrix `diag(M, M)` of eq. (30), in the Jacobian's pattern.
-    fn mass(&mut self) -> &Csr;
-    /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
-    /// approximates the last Jacobian minus `shift` times the mass matrix (a
-    /// preconditioner for Krylov solvers), or `None` when the problem has none.
-    fn preconditioner(&mut self, _shift: f64) -> Option<&Csr> {
-        None
-    }
-    /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
-    /// factorizations (see [`crate::linsolve::LinearSolver::set_ordering`]).
-    fn ordering(&self) -> Option<&[usize]> {
-        None
-    }
-}
+use crate::discrete::assembly::{Discretization, Operator};
+use crate::linalg::sparse::Csr;
+use crate::spline::curve::Point;
+use crate::spline::surface::Surface;
+use crate::verify::quality::{sample_det_j, DetJSample};
 
 /// Quadrature back end of the solver (CPU here; the GPU crate implements it too): the
 /// EGG residual and Jacobian, and the operators and samples the hierarchy uses (mass,
@@ -69,6 +49,52 @@ impl EggAssembler for CpuAssembler {
     }
     fn name(&self) -> String {
         "cpu".into()
+    }
+}
+
+/// The EGG method of eq. (8) with operator `operator`, its quadrature on `assembler`.
+#[derive(Clone)]
+pub struct EggMethod {
+    /// Plain `L` or scaled `L / (g11 + g22)`.
+    pub operator: Operator,
+    /// Quadrature back end.
+    pub assembler: Arc<dyn EggAssembler>,
+}
+
+impl std::fmt::Debug for EggMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EggMethod")
+            .field("operator", &self.operator)
+            .field("assembler", &self.assembler.name())
+            .finish()
+    }
+}
+
+impl EggMethod {
+    /// EGG with `operator`, assembled on the CPU.
+    pub fn cpu(operator: Operator) -> Self {
+        Self { operator, assembler: Arc::new(CpuAssembler) }
+    }
+}
+
+impl Method for EggMethod {
+    fn name(&self) -> &'static str {
+        match self.operator {
+            Operator::Plain => "egg-plain",
+            Operator::Scaled => "egg-scaled",
+        }
+    }
+
+    /// `F_i = ∫ w_i L` with `L ~ diam^3` (plain) or `L / (g11 + g22) ~ diam` (scaled).
+    fn residual_size(&self, diameter: f64) -> f64 {
+        match self.operator {
+            Operator::Plain => diameter.powi(3),
+            Operator::Scaled => diameter,
+        }
+    }
+
+    fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send> {
+        Box::new(EggProblem::new(disc, control_points, self.operator, self.assembler.clone()))
     }
 }
 
@@ -122,7 +148,7 @@ impl EggProblem {
     }
 }
 
-impl NonlinearProblem for EggProblem {
+impl DiscreteProblem for EggProblem {
     fn size(&self) -> usize {
         2 * self.disc.dofs.num_free()
     }
@@ -172,6 +198,12 @@ impl NonlinearProblem for EggProblem {
         Some(&self.disc.ordering)
     }
 
+    fn control_points(&self, c: &[f64]) -> Vec<Point> {
+        let mut cps = self.cps.clone();
+        self.disc.dofs.scatter(c, &mut cps);
+        cps
+    }
+
     /// `K` of [`Discretization::metric_laplace`] on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         if self.pstencil.is_empty() {
@@ -186,8 +218,8 @@ impl NonlinearProblem for EggProblem {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::knots::KnotVector;
-    use crate::newton::{NonlinearOptions, NonlinearSolver, Status};
+    use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
+    use crate::spline::knots::KnotVector;
     use crate::testutil::Lcg;
 
     /// A curved map: the bilinear-plus-bump image of Greville points, perturbed.
@@ -244,7 +276,7 @@ mod tests {
     /// the direct solution.
     #[test]
     fn metric_preconditioner_is_mesh_independent() {
-        use crate::linsolve::{LinearMethod, LinearSolver};
+        use crate::linalg::linsolve::{LinearMethod, LinearSolver};
         let mut counts = Vec::new();
         for ne in [8, 16, 32] {
             let (disc, cps) = setup(3, [ne, ne], 3, 0.0);

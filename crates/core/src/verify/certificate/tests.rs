@@ -1,5 +1,5 @@
 use super::*;
-use crate::knots::KnotVector;
+use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
 
 /// The identity map of the unit square on an open uniform basis, control points at the
@@ -20,7 +20,7 @@ fn perturbed(rng: &mut Lcg, p: usize, q: usize, ne: [usize; 2], amp: f64, ration
 }
 
 fn dense_min(map: &Surface, n: usize) -> f64 {
-    crate::quality::sample_det_j(map, n).min
+    crate::verify::quality::sample_det_j(map, n).min
 }
 
 #[test]
@@ -42,8 +42,8 @@ fn bernstein_det_j_equals_det_j() {
                         let exact = map.derivs(u, v, 1).det_j();
                         let mut val = bern_eval(&c, dj.deg, s, t, &mut w.tmp);
                         if rational {
-                            let wsum = crate::basis::BasisDerivs::at(&map.knots[0], u, 0);
-                            let wv = crate::basis::BasisDerivs::at(&map.knots[1], v, 0);
+                            let wsum = crate::spline::basis::BasisDerivs::at(&map.knots[0], u, 0);
+                            let wv = crate::spline::basis::BasisDerivs::at(&map.knots[1], v, 0);
                             let nx = map.shape()[0];
                             let mut wt = 0.0;
                             for b in 0..=q {
@@ -103,7 +103,7 @@ fn certificate_agrees_with_dense_sampling_on_smooth_maps() {
                     v => panic!("p={p} q={q}: {v:?}"),
                 }
                 // area = 1 up to the perturbation of the boundary
-                assert!((c.mean_det_j - crate::quality::functionals(&map).area).abs() < 1e-10);
+                assert!((c.mean_det_j - crate::verify::quality::functionals(&map).area).abs() < 1e-10);
             }
         }
     }

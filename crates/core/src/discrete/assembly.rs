@@ -13,12 +13,13 @@
 
 use rayon::prelude::*;
 
-use crate::basis::BasisDerivs;
-use crate::dofs::{DofMap, FIXED};
-use crate::error::MAX_DEGREE;
-use crate::knots::KnotVector;
-use crate::quadrature::GaussLegendre;
-use crate::sparse::Csr;
+use crate::discrete::dofs::{DofMap, FIXED};
+use crate::discrete::topology::Topology;
+use crate::error::{Result, MAX_DEGREE};
+use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
 
 const W: usize = MAX_DEGREE + 1;
 
@@ -172,7 +173,7 @@ pub struct Discretization {
     /// Pattern of scalar systems (mass, Laplacian).
     pub scalar: SystemPattern,
     /// Fill-reducing (nested-dissection) order of the free scalar unknowns for sparse
-    /// Cholesky factorizations, `ordering[new] = old`; see [`crate::ordering`].
+    /// Cholesky factorizations, `ordering[new] = old`; see [`crate::linalg::ordering`].
     pub ordering: Vec<usize>,
 }
 
@@ -305,7 +306,7 @@ impl Discretization {
         let scalar = SystemPattern::new(&dofs, p, q, 1);
         let nx = dofs.shape()[0];
         let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();
-        let ordering = crate::ordering::nested_dissection(&nodes, [p, q]);
+        let ordering = crate::linalg::ordering::nested_dissection(&nodes, [p, q]);
         Self { knots, tables, dofs, vector, scalar, ordering }
     }
 
@@ -318,6 +319,14 @@ impl Discretization {
         let nq = knots[0].degree().max(knots[1].degree()) + 1;
         let dofs = DofMap::interior([knots[0].num_basis(), knots[1].num_basis()]);
         Self::with_dofs(knots, nq, dofs)
+    }
+
+    /// [`Self::new`] with the free / fixed split of `topology`
+    /// ([`DofMap::for_topology`]).
+    pub fn for_topology(knots: [KnotVector; 2], topology: &Topology) -> Result<Self> {
+        let nq = knots[0].degree().max(knots[1].degree()) + 1;
+        let dofs = DofMap::for_topology([knots[0].num_basis(), knots[1].num_basis()], topology)?;
+        Ok(Self::with_dofs(knots, nq, dofs))
     }
 
     /// Basis shape.

@@ -4,7 +4,9 @@
 //! boundary control points, or frozen control points during defect correction);
 //! free ones are the unknowns `c = (c^x, c^y)` of paper eq. (9)-(10).
 
-use crate::surface::{Side, Surface};
+use super::topology::{SideCondition, Topology};
+use crate::error::{Error, Result};
+use crate::spline::surface::{Side, Surface};
 
 /// Free/fixed split of the tensor basis functions.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,6 +24,26 @@ impl DofMap {
     pub fn interior(shape: [usize; 2]) -> Self {
         let [nx, ny] = shape;
         Self::from_predicate(shape, |i, j| i > 0 && j > 0 && i + 1 < nx && j + 1 < ny)
+    }
+
+    /// The free / fixed split of a patch with boundary conditions `topology`: the
+    /// functions on Dirichlet sides are fixed, all others free. Periodic and interface
+    /// sides need shared DOFs, which this single-patch map does not number yet: they are
+    /// a [`Error::Topology`] naming the side.
+    pub fn for_topology(shape: [usize; 2], topology: &Topology) -> Result<Self> {
+        topology.validate(None)?;
+        for s in Side::ALL {
+            let what = match topology.side(s) {
+                SideCondition::Dirichlet => continue,
+                SideCondition::Periodic => "periodic",
+                SideCondition::Interface { .. } => "an interface",
+            };
+            return Err(Error::Topology {
+                side: s.name().into(),
+                reason: format!("{what}; the single-patch DOF map has Dirichlet sides only"),
+            });
+        }
+        Ok(Self::interior(shape))
     }
 
     /// Free where `is_free(i, j)` holds.
@@ -106,5 +128,11 @@ mod tests {
         d.scatter(&c, &mut back);
         assert_eq!(back[6], cps[6]);
         assert!(d.on_side(3, Side::South) && d.on_side(19, Side::East));
+        assert_eq!(DofMap::for_topology([5, 4], &Topology::dirichlet()).unwrap(), d);
+        let mut t = Topology::dirichlet();
+        t.sides =
+            [SideCondition::Periodic, SideCondition::Dirichlet, SideCondition::Periodic, SideCondition::Dirichlet];
+        let e = DofMap::for_topology([5, 4], &t).unwrap_err().to_string();
+        assert!(e.contains("south") && e.contains("periodic"), "{e}");
     }
 }

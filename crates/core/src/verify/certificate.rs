@@ -25,9 +25,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::bezier::BezierExtraction;
 use crate::error::Result;
-use crate::surface::{Side, Surface};
+use crate::spline::bezier::BezierExtraction;
+use crate::spline::surface::{Side, Surface};
 
 /// Options of [`certify`].
 #[derive(Debug, Clone, Copy)]
@@ -639,7 +639,7 @@ pub fn corner_info(map: &Surface, forced_angle: f64) -> Vec<CornerInfo> {
         let (a, b) = c.domain();
         c.derivs(if end { b } else { a }, 1).d1
     };
-    crate::solver::corner_geometry(d)
+    crate::boundary::corners::corner_geometry(d)
         .into_iter()
         .map(|c| CornerInfo {
             corner: c.name,
@@ -747,7 +747,8 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let (ua, ub) = map.knots[0].domain();
     let (va, vb) = map.knots[1].domain();
     let par_area = (ub - ua) * (vb - va);
-    cert.mean_det_j = if rational { crate::quality::functionals(map).area / par_area } else { integral / par_area };
+    cert.mean_det_j =
+        if rational { crate::verify::quality::functionals(map).area / par_area } else { integral / par_area };
     // exact values of the folds: recompute from the map (the rational numerator is not det J)
     for f in cert.folds.iter_mut() {
         f.value = map.derivs(f.param[0], f.param[1], 1).det_j();

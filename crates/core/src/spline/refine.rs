@@ -2,12 +2,12 @@
 //! matrix, and degree elevation. Both keep the geometry exactly: the coarse space is a
 //! subspace of the fine one, so `c_fine = P c_coarse` reproduces the same map.
 
-use crate::basis::BasisDerivs;
-use crate::curve::{Curve, Point};
 use crate::error::{Error, Result};
-use crate::knots::KnotVector;
-use crate::sparse::Csr;
-use crate::surface::Surface;
+use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Surface;
 
 type SparseRow = Vec<(usize, f64)>;
 

@@ -1,13 +1,18 @@
-//! Initial guesses (paper §6.3): transfinite (Coons) interpolation of the boundary
+//! Initial guesses (paper §6.3, §9): transfinite (Coons) interpolation of the boundary
 //! control points on the coarsest level, and prolongation plus a linear-elasticity
-//! correction of the boundary discrepancy on finer levels.
+//! correction of the boundary discrepancy on finer levels, with a continuation in the
+//! boundary displacement when that guess is not positive.
 
-use crate::assembly::Discretization;
-use crate::curve::{Curve, Point};
-use crate::egg::{CpuAssembler, EggAssembler};
+use std::sync::Arc;
+
+use super::newton::{NonlinearOptions, NonlinearSolver, Status};
+use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
-use crate::linsolve::{LinearMethod, LinearSolver};
-use crate::surface::{Side, Surface};
+use crate::linalg::linsolve::{LinearMethod, LinearSolver};
+use crate::methods::egg::{CpuAssembler, EggAssembler};
+use crate::methods::Method;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::surface::{Side, Surface};
 
 /// Write the four side curves' control points into the boundary positions of a
 /// control net of shape `shape`. The curves must live on the net's knot vectors.
@@ -32,7 +37,7 @@ pub fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) ->
 /// Discrete Coons patch at the Greville abscissae `(u_i, v_j)`:
 /// `c_ij = (1-u) W_j + u E_j + (1-v) S_i + v N_i - [(1-u)(1-v) SW + u(1-v) SE + (1-u)v NW + uv NE]`.
 /// Reproduces every bilinear map exactly.
-pub fn coons(knots: &[crate::knots::KnotVector; 2], sides: &[Curve; 4]) -> Result<Vec<Point>> {
+pub fn coons(knots: &[crate::spline::knots::KnotVector; 2], sides: &[Curve; 4]) -> Result<Vec<Point>> {
     let shape = [knots[0].num_basis(), knots[1].num_basis()];
     let [nx, ny] = shape;
     let (gu, gv) = (knots[0].greville(), knots[1].greville());
@@ -89,7 +94,7 @@ pub fn elasticity_displacement_with(
     let mut diff = vec![[0.0; 2]; base.len()];
     let mut moved = false;
     for k in 0..base.len() {
-        if disc.dofs.free_index(k) == crate::dofs::FIXED {
+        if disc.dofs.free_index(k) == crate::discrete::dofs::FIXED {
             diff[k] = [target[k][0] - base[k][0], target[k][1] - base[k][1]];
             moved |= diff[k] != [0.0, 0.0];
         }
@@ -142,10 +147,109 @@ pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &
     elasticity_correction(disc, &fine.control_points, &target)
 }
 
+/// Bookkeeping of the boundary continuation of one level.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Continuation {
+    /// Damped boundary solves.
+    pub steps: usize,
+    /// Nonlinear iterations spent in them.
+    pub iterations: usize,
+}
+
+/// Smallest `det J` on a sample of `2 max(n_xi, n_eta)` points per direction, away
+/// from the corners.
+pub fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[Point]) -> f64 {
+    let shape = disc.shape();
+    let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: None };
+    assembler.sample_det_j(&map, 2 * shape[0].max(shape[1])).min_interior
+}
+
+/// Smallest fraction of the boundary displacement tried in one continuation step.
+pub const MIN_CONTINUATION_STEP: f64 = 1.0 / 64.0;
+
+/// Most damped boundary solves per level.
+pub const MAX_CONTINUATION_STEPS: usize = 24;
+
+/// Initial guess of a finer level (§6.3, §9): the elasticity correction of the
+/// prolonged map `base` towards the fitted boundary `target`. When that guess is not
+/// positive on a sample, the boundary displacement is damped by `alpha < 1`, the EGG
+/// equations are solved with the damped boundary from the (positive) elasticity
+/// guess, and the remaining displacement is applied from that solution, until the
+/// target contour is reached (at most [`MAX_CONTINUATION_STEPS`] damped solves, steps
+/// no shorter than [`MIN_CONTINUATION_STEP`]).
+///
+/// `method` poses the damped solves, `assembler` samples `det J` and assembles the
+/// elasticity operator; `nl` are the level's nonlinear options (scaled as the level's
+/// final solve), `diameter` the domain's.
+pub fn continuation(
+    method: &dyn Method,
+    assembler: &dyn EggAssembler,
+    disc: &Arc<Discretization>,
+    base: Vec<Point>,
+    target: &[Point],
+    nl: NonlinearOptions,
+    diameter: f64,
+    cont: &mut Continuation,
+) -> Result<Vec<Point>> {
+    let tol = 1e-12 * diameter;
+    if base.iter().zip(target).all(|(b, t)| (b[0] - t[0]).abs() <= tol && (b[1] - t[1]).abs() <= tol) {
+        // same boundary (e.g. a refinement of the previous level): nothing to move
+        return Ok(base);
+    }
+    let mut base = base;
+    let (mut done, mut step) = (0.0f64, 1.0f64);
+    // displacement from `base` to the full target; linear in the boundary motion, so
+    // a fraction `f` of the remaining motion is `f * u`
+    let mut u = elasticity_displacement_with(assembler, disc, &base, target)?;
+    if det_j_min(assembler, disc, &base) <= 0.0 {
+        // the prolonged map itself is not positive on this level's (denser) sample:
+        // damping the boundary motion cannot make the guess positive, Newton starts
+        // from the full elasticity guess
+        return Ok(displaced(&base, &u, 1.0));
+    }
+    loop {
+        let a = (done + step).min(1.0);
+        let f = (a - done) / (1.0 - done);
+        let guess = displaced(&base, &u, f);
+        let positive = det_j_min(assembler, disc, &guess) > 0.0;
+        let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
+        if a >= 1.0 && (positive || exhausted) {
+            return Ok(guess);
+        }
+        if !positive && !exhausted {
+            step *= 0.5;
+            continue;
+        }
+        // solve with the damped boundary
+        let c0 = disc.dofs.gather(&guess);
+        let problem = method.problem(disc.clone(), guess.clone());
+        let mut solver = NonlinearSolver::new(problem, c0, nl);
+        let mut iterations = 0;
+        for it in solver.by_ref() {
+            iterations = it?.iteration;
+        }
+        cont.steps += 1;
+        let converged = *solver.status() == Status::Converged;
+        let (problem, c) = solver.into_parts();
+        let sol = problem.control_points(&c);
+        cont.iterations += iterations;
+        if converged && det_j_min(assembler, disc, &sol) > 0.0 {
+            base = sol;
+            done = a;
+            step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
+            u = elasticity_displacement_with(assembler, disc, &base, target)?;
+        } else if exhausted {
+            return Ok(guess);
+        } else {
+            step *= 0.5;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::knots::KnotVector;
+    use crate::spline::knots::KnotVector;
 
     #[test]
     fn coons_reproduces_bilinear_maps() {

@@ -13,9 +13,9 @@
 //! appear to cross when `g < 2 * FLATNESS * diameter`).
 
 use crate::boundary::{Boundary, SideCurve};
-use crate::curve::{check_points, check_weights, Curve, Point};
 use crate::error::{Error, Result, MAX_CONTROL_POINTS};
-use crate::surface::Side;
+use crate::spline::curve::{check_points, check_weights, Curve, Point};
+use crate::spline::surface::Side;
 
 /// Corner gaps and side lengths are compared against this times the bounding-box diameter.
 pub const CORNER_TOL: f64 = 1e-9;
@@ -567,7 +567,7 @@ fn check_self_intersection(pts: &[Point], owner: &[Side], corners: &[Point; 4], 
 mod tests {
     use super::*;
     use crate::boundary::Analytic;
-    use crate::knots::KnotVector;
+    use crate::spline::knots::KnotVector;
 
     fn line(a: Point, b: Point) -> SideCurve {
         SideCurve::Spline(Curve::new(KnotVector::new(1, vec![0., 0., 1., 1.]).unwrap(), vec![a, b], None).unwrap())

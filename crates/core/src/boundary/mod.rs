@@ -1,12 +1,34 @@
-//! The boundary of a four-sided domain: four sides, each a spline curve, an ordered
-//! point cloud or an analytic curve (paper §5), in the orientation of `formats.md`:
-//! south `eta = 0` and north `eta = 1` run with increasing `xi`, west `xi = 0` and east
-//! `xi = 1` with increasing `eta`.
+//! The boundary of a four-sided domain and everything made from it before a solve:
+//! the boundary types (this module), their validation, the singular points, the
+//! reparameterization (§7), the contour fit (§5) and the nested hierarchy (§5.4).
+//!
+//! | module | holds | paper |
+//! |---|---|---|
+//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`] | §5 |
+//! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
+//! | [`corners`] | corner angles and the `det J` they force, kinks inside sides | §8.1 |
+//! | [`cord_length`] | cord-length abscissae of point clouds | eq. (36)-(37) |
+//! | [`reparam`] | arc-length and constrained cord-length reparameterization | §7, eq. (38)-(42) |
+//! | [`fit`] | adaptive least-squares fit of one side | §5.1-§5.3, eq. (17)-(18) |
+//! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
+//!
+//! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
+//! `f ∘ g`), both use `cord_length`; `hierarchy` uses `fit`.
+//!
+//! Sides are oriented as in `formats.md`: south `eta = 0` and north `eta = 1` run with
+//! increasing `xi`, west `xi = 0` and east `xi = 1` with increasing `eta`.
+
+pub mod cord_length;
+pub mod corners;
+pub mod fit;
+pub mod hierarchy;
+pub mod reparam;
+pub mod validate;
 
 use std::sync::Arc;
 
-use crate::curve::{Curve, Point};
-use crate::surface::Side;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::surface::Side;
 
 /// An analytic side `t in [0, 1] -> (x, y)` given as a Rust closure.
 #[derive(Clone)]
@@ -99,4 +121,38 @@ impl Boundary {
         let [s, e, n, w] = self.sides.clone();
         Boundary { name: self.name.clone(), sides: [w, n, e, s] }
     }
+}
+
+/// Lower-left and upper-right corner of a bounding box of the boundary: point clouds
+/// exactly, spline sides sampled at 16 points per input element, analytic sides at 1025
+/// points.
+pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let mut add = |p: Point| {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    };
+    for side in &boundary.sides {
+        match side {
+            SideCurve::Points(pts) => pts.iter().for_each(|&p| add(p)),
+            SideCurve::Spline(c) => {
+                for (_, a, b) in c.knots.elements() {
+                    for k in 0..=16 {
+                        add(c.eval(a + (b - a) * k as f64 / 16.0));
+                    }
+                }
+            }
+            SideCurve::Analytic(f) => (0..=1024).for_each(|k| add(f.eval(k as f64 / 1024.0))),
+        }
+    }
+    (lo, hi)
+}
+
+/// Diameter of [`bounding_box`].
+pub fn diameter(boundary: &Boundary) -> f64 {
+    let (lo, hi) = bounding_box(boundary);
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }

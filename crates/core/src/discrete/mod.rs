@@ -1,0 +1,17 @@
+//! The discrete spaces every method assembles in: which tensor-product functions are
+//! free, fixed (Dirichlet), shared (periodic) or interface DOFs, and the quadrature
+//! tables, sparsity patterns and element kernels on one basis.
+//!
+//! | module | holds | paper |
+//! |---|---|---|
+//! | [`topology`] | [`Topology`](topology::Topology): the boundary condition of each side of a patch (Dirichlet, periodic, interface) | §4, §11.1, §11.2 |
+//! | [`dofs`] | [`DofMap`](dofs::DofMap): free versus fixed DOFs, gather and scatter of the unknowns `c` | eq. (9)-(10) |
+//! | [`assembly`] | [`Discretization`](assembly::Discretization): basis tables, patterns, the EGG residual and Jacobian kernels (eq. 8, 12, 23), mass, elasticity, metric Laplacian | §4, §6 |
+//!
+//! Symbolic work (tables, patterns, orderings) is done once per basis when a
+//! [`Discretization`](assembly::Discretization) is made; numeric work (one pass over the
+//! elements per Newton step) writes into storage requested up front.
+
+pub mod assembly;
+pub mod dofs;
+pub mod topology;

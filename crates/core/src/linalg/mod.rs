@@ -1,0 +1,17 @@
+//! Sparse linear algebra, below everything else: compressed sparse row storage, fill-
+//! reducing orderings and the linear solvers (sparse LU and Cholesky through faer,
+//! restarted flexible GMRES, conjugate gradients, ILU(0)).
+//!
+//! | module | holds |
+//! |---|---|
+//! | [`sparse`] | [`Csr`](sparse::Csr): storage, products, pattern unions |
+//! | [`ordering`] | nested dissection of a grid of points, interleaving of component blocks |
+//! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver) (LU / GMRES / Cholesky preconditioners), CG, ILU(0) |
+//!
+//! Why here and not in [`crate::discrete`]: the refinement operators of the spline layer
+//! (knot insertion, degree elevation, [`crate::spline::refine`]) are sparse matrices, so
+//! sparse storage must sit below the splines; none of these modules knows what a spline is.
+
+pub mod linsolve;
+pub mod ordering;
+pub mod sparse;

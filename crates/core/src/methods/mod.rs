@@ -1,0 +1,144 @@
+//! The parameterization methods: each poses a discrete problem on one basis, behind one
+//! interface that the solver, the hierarchy, the repair loop and the CLI talk to.
+//!
+//! | module | method | paper |
+//! |---|---|---|
+//! | [`egg`] | EGG, Galerkin form with the plain operator `L` or the scaled `L / (g11 + g22)`: [`EggMethod`](egg::EggMethod) | eq. (8), (12), (23) |
+//!
+//! # The interface
+//!
+//! A [`Method`] is given a basis with its DOF map (a
+//! [`Discretization`]) and all control points, the fixed ones holding the boundary
+//! values and the free ones the start; it returns a [`DiscreteProblem`] in the unknowns
+//! `c = (c^x, c^y)` of the free control points (eq. 9-10). There are two kinds:
+//!
+//! * **root-finding** methods (eq. 8, and the weak form eq. 14) provide `F(c)` and the
+//!   Jacobian `dF/dc`;
+//! * **minimization** methods (the Winslow functional eq. 16, the variational methods of
+//!   §10) provide an objective `J(c)` through [`DiscreteProblem::objective`], and present
+//!   `F = -∇J` with `dF/dc = -∇²J`.
+//!
+//! The sign convention makes both kinds look alike to the solver: near a solution the
+//! Jacobian is negative definite, as for EGG, whose `L` behaves like the Laplacian, so
+//! the pseudo-time flow `M dc/dt = F` (eq. 30) is dissipative for both and the Krylov
+//! preconditioner `-diag(K, K)` of [`DiscreteProblem::preconditioner`] keeps its sign.
+//! For a minimization method the Newton step of [`crate::solve::newton`] is then
+//! `-∇²J δ = ∇J`, its line search asks for a sufficient decrease of `J` instead of `|F|`,
+//! and convergence is measured on `|∇J|`.
+//!
+//! A method whose integrand needs `det J > 0` at every quadrature point (eq. 14, 16)
+//! says so with [`Start::Bijective`]: the solver refuses a start that the certificate
+//! does not prove bijective, and [`DiscreteProblem::admissible`] (for root-finding
+//! methods) or an objective of `+∞` (for minimization) makes the line search reject
+//! every step that leaves the feasible set.
+//!
+//! The quadrature back end (CPU here, WGSL in the GPU crate) sits behind the EGG method:
+//! [`EggAssembler`](egg::EggAssembler).
+
+pub mod egg;
+
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use crate::discrete::assembly::Discretization;
+use crate::linalg::sparse::Csr;
+use crate::spline::curve::Point;
+
+/// What a method needs of its start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Start {
+    /// Any start (a Coons patch, a prolonged map that folds): eq. (8) is defined for
+    /// every map.
+    Any,
+    /// A start with `det J > 0` everywhere, proven by the certificate (eq. 14 and 16
+    /// divide by `det J`).
+    Bijective,
+}
+
+/// A nonlinear system `F(c) = 0` in the free unknowns of one basis, with its Jacobian,
+/// a mass matrix (for pseudo time) and, for minimization methods, the objective whose
+/// negative gradient `F` is (see the module documentation for the sign convention).
+pub trait DiscreteProblem {
+    /// Number of unknowns.
+    fn size(&self) -> usize;
+    /// `F(c)` into `f`.
+    fn residual(&mut self, c: &[f64], f: &mut [f64]);
+    /// `F(c)` into `f` and the Jacobian `dF/dc` into `jac`, which is empty or holds
+    /// this problem's fixed pattern from an earlier call (then only the values are
+    /// written: no allocation, no copy of the pattern per Newton step).
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr);
+    /// The block mass matrix `diag(M, M)` of eq. (30), in the Jacobian's pattern.
+    fn mass(&mut self) -> &Csr;
+    /// The objective `J(c)` of a minimization method (`F = -∇J`), `+∞` outside the
+    /// feasible set; `None` for a root-finding method.
+    fn objective(&mut self, _c: &[f64]) -> Option<f64> {
+        None
+    }
+    /// Whether `c` is in the set where the method is defined (e.g. `det J > 0` at every
+    /// quadrature point for eq. 14); the line search never accepts a step outside it.
+    fn admissible(&mut self, _c: &[f64]) -> bool {
+        true
+    }
+    /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
+    /// approximates the last Jacobian minus `shift` times the mass matrix (a
+    /// preconditioner for Krylov solvers), or `None` when the problem has none.
+    fn preconditioner(&mut self, _shift: f64) -> Option<&Csr> {
+        None
+    }
+    /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
+    /// factorizations (see [`crate::linalg::linsolve::LinearSolver::set_ordering`]).
+    fn ordering(&self) -> Option<&[usize]> {
+        None
+    }
+    /// All control points of the map with unknowns `c` (fixed ones as given).
+    fn control_points(&self, c: &[f64]) -> Vec<Point>;
+}
+
+impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
+    fn size(&self) -> usize {
+        (**self).size()
+    }
+    fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+        (**self).residual(c, f)
+    }
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
+        (**self).jacobian(c, f, jac)
+    }
+    fn mass(&mut self) -> &Csr {
+        (**self).mass()
+    }
+    fn objective(&mut self, c: &[f64]) -> Option<f64> {
+        (**self).objective(c)
+    }
+    fn admissible(&mut self, c: &[f64]) -> bool {
+        (**self).admissible(c)
+    }
+    fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
+        (**self).preconditioner(shift)
+    }
+    fn ordering(&self) -> Option<&[usize]> {
+        (**self).ordering()
+    }
+    fn control_points(&self, c: &[f64]) -> Vec<Point> {
+        (**self).control_points(c)
+    }
+}
+
+/// A parameterization method: turns a basis, its DOF map and the control points (fixed
+/// ones the boundary values, free ones the start) into a [`DiscreteProblem`].
+pub trait Method: Send + Sync + std::fmt::Debug {
+    /// Short name ("egg-scaled", ...), for reports and progress.
+    fn name(&self) -> &'static str;
+    /// What the start must satisfy.
+    fn start(&self) -> Start {
+        Start::Any
+    }
+    /// Typical size of `F` for a domain of diameter `diameter`, when the control points
+    /// are off by about the domain size: `|F| sqrt(m) / residual_size` is the relative
+    /// residual the stopping rule compares with the tolerance.
+    fn residual_size(&self, diameter: f64) -> f64;
+    /// The discrete problem on `disc` starting from `control_points`.
+    fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
+}

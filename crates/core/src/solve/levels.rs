@@ -1,0 +1,173 @@
+//! The levels a solve walks through (paper §5.4, §6.3): the fitted hierarchy balanced
+//! so that elements are not much longer in one direction than in the other, extended by
+//! uniform refinements, and thinned to levels that grow by a factor (the paper advises
+//! 4), always ending with the finest.
+
+use crate::boundary::hierarchy::Level;
+use crate::error::{Error, Result};
+use crate::spline::curve::Curve;
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Side;
+
+/// Choose the levels to solve: from the coarsest, each next one at least `growth` times
+/// larger, always ending with the finest. A level of nearly the finest's size (less than
+/// [`SAME_SIZE`] times smaller) is replaced by the finest: solving twice at one size
+/// costs a full solve and gains nothing. The coarsest level always stays.
+pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) -> Vec<usize> {
+    let last = sizes.len() - 1;
+    let mut out = vec![0];
+    for (k, &s) in sizes.iter().enumerate().skip(1) {
+        let previous = *out.last().expect("non-empty");
+        if s as f64 >= growth * sizes[previous] as f64 {
+            out.push(k);
+        } else if k == last {
+            if out.len() > 1 && (s as f64) < SAME_SIZE * sizes[previous] as f64 {
+                out.pop();
+            }
+            out.push(k);
+        }
+    }
+    if let Some(m) = max_levels {
+        let m = m.max(1);
+        while out.len() > m {
+            out.remove(out.len() - 2);
+        }
+    }
+    out
+}
+
+/// Size ratio below which two levels count as one size in [`select_levels`].
+pub const SAME_SIZE: f64 = 1.5;
+
+fn polyline_length(c: &Curve) -> f64 {
+    let n = 16 * c.knots.num_elements().max(4);
+    c.sample(n).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
+}
+
+/// Two sides count as a seam (see [`prepare_levels`]) when the mean distance between
+/// the other two sides exceeds their mean length by this factor.
+pub const SEAM_FACTOR: f64 = 4.0;
+
+/// Mean distance `|b(t) - a(t)|` between two opposite sides at equal parameters: the
+/// mean length of the straight lines joining them, which is the extent of the domain
+/// across them when the sides joining them are much shorter (a ring cut along a seam).
+fn mean_gap(a: &Curve, b: &Curve) -> f64 {
+    let n = 16 * a.knots.num_elements().max(b.knots.num_elements()).max(4);
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let (p, q) = (a.eval(t), b.eval(t));
+            (p[0] - q[0]).hypot(p[1] - q[1])
+        })
+        .sum::<f64>()
+        / (n + 1) as f64
+}
+
+/// Prepare the hierarchy for solving (paper §5.4 builds each level from the side fits
+/// alone, so a straight side keeps a single element however fine its opposite is):
+/// 1. *balance* every level, halving a direction until its elements are on average no
+///    more than `aspect` times longer (physically) than those of the other direction
+///    (the extent of a direction is the mean length of its two sides, or the mean
+///    distance between the two other sides at equal parameters when that is more than
+///    [`SEAM_FACTOR`] times larger: a ring cut open along a seam),
+///    and until it has `min_elements` elements; each level then takes the union with
+///    the coarser one so the hierarchy stays nested;
+/// 2. append `refine` uniformly halved copies of the finest level.
+///
+/// Sides are refined exactly (knot insertion), so the fitted contours are unchanged.
+pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize, aspect: f64) -> Result<Vec<Level>> {
+    let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
+    // mean physical length of the xi sides (south, north) and of the eta sides (west, east)
+    let len_xi =
+        0.5 * (polyline_length(&last.sides[Side::South as usize]) + polyline_length(&last.sides[Side::North as usize]));
+    let len_eta =
+        0.5 * (polyline_length(&last.sides[Side::West as usize]) + polyline_length(&last.sides[Side::East as usize]));
+    // a seam (short sides joining long ones far apart) understates the extent across:
+    // there the mean distance between the other two sides is used instead
+    let across = |len: f64, gap: f64| if gap > SEAM_FACTOR * len { gap } else { len };
+    let len_xi = across(len_xi, mean_gap(&last.sides[Side::West as usize], &last.sides[Side::East as usize]));
+    let len_eta = across(len_eta, mean_gap(&last.sides[Side::South as usize], &last.sides[Side::North as usize]));
+    let mut previous: Option<[KnotVector; 2]> = None;
+    for level in levels.iter_mut() {
+        let mut knots = level.knots.clone();
+        // balance the mean physical element sizes of the two directions ...
+        loop {
+            let h = [len_xi / knots[0].num_elements() as f64, len_eta / knots[1].num_elements() as f64];
+            let d = if h[1] > aspect * h[0] {
+                1
+            } else if h[0] > aspect * h[1] {
+                0
+            } else {
+                break;
+            };
+            knots[d] = knots[d].halved();
+        }
+        // ... then give each direction its minimum number of elements
+        for kv in knots.iter_mut() {
+            while kv.num_elements() < min_elements {
+                *kv = kv.halved();
+            }
+        }
+        let size = knots[0].num_basis() * knots[1].num_basis();
+        if size > MAX_BASIS {
+            return Err(Error::TooLarge {
+                context: "solver hierarchy".into(),
+                what: "tensor basis size".into(),
+                found: size,
+                limit: MAX_BASIS,
+            });
+        }
+        // contain the coarser level: keeps the hierarchy nested
+        if let Some(prev) = &previous {
+            for d in 0..2 {
+                knots[d] = knots[d].union(&prev[d])?;
+            }
+        }
+        if knots != level.knots {
+            for s in Side::ALL {
+                level.sides[s as usize] = level.sides[s as usize].refined(&knots[s.direction()])?;
+            }
+            level.knots = knots.clone();
+        }
+        previous = Some(knots);
+    }
+    for _ in 0..refine {
+        let last = levels.last().expect("non-empty");
+        let knots = [last.knots[0].halved(), last.knots[1].halved()];
+        let mut sides = last.sides.clone();
+        for s in Side::ALL {
+            sides[s as usize] = sides[s as usize].refined(&knots[s.direction()])?;
+        }
+        levels.push(Level { knots, sides });
+    }
+    // levels made identical by balancing: keep the last of each run, whose sides are
+    // the most accurate fits on that basis
+    let mut out: Vec<Level> = Vec::with_capacity(levels.len());
+    for l in levels {
+        match out.last_mut() {
+            Some(prev) if prev.knots == l.knots => *prev = l,
+            _ => out.push(l),
+        }
+    }
+    Ok(out)
+}
+
+/// Largest tensor basis the solver accepts (about 8 million unknowns).
+pub const MAX_BASIS: usize = 1 << 22;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_selection_quadruples() {
+        // 310 replaces 300: both would be solved at nearly one size
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None), vec![0, 2, 5]);
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300], 4.0, None), vec![0, 2, 4]);
+        assert_eq!(select_levels(&[16, 20], 4.0, None), vec![0, 1]);
+        // a finest level well above the previous one (here 1.67 times) keeps it
+        assert_eq!(select_levels(&[162, 1122, 1870], 4.0, None), vec![0, 1, 2]);
+        assert_eq!(select_levels(&[16], 4.0, None), vec![0]);
+        assert_eq!(select_levels(&[16, 64, 256, 1024], 4.0, Some(2)), vec![0, 3]);
+    }
+}

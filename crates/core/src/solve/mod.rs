@@ -1,0 +1,19 @@
+//! Solving: the nonlinear iterations, the initial guesses, the coarse-to-fine walk over
+//! the hierarchy, defect correction, and the event stream that the CLI progress, the
+//! viewer's live plot and the tests all read.
+//!
+//! | module | holds | paper |
+//! |---|---|---|
+//! | [`newton`] | [`NonlinearSolver`](newton::NonlinearSolver): damped Newton with line search, pseudo time-stepping with the SER rule; an `Iterator` of iterates | §6.1, §6.2, eq. (24)-(33) |
+//! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
+//! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
+//! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
+//! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
+//! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict) | §8.1, §10 |
+
+pub mod initial;
+pub mod levels;
+pub mod newton;
+pub mod repair;
+pub mod report;
+pub mod solver;

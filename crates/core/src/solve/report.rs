@@ -1,0 +1,265 @@
+//! The outcome of a solve: the map and its report (stored in the map file and printed
+//! by the CLI): the verdict of the certificate (§8.1), the quality functionals (§2,
+//! §4.1), corners and kinks, the fit, per-level iterations and timings, the repair
+//! rounds (§8.2) and, when asked for, the Poisson benchmark of §10.
+
+use std::time::Duration;
+
+use serde::Serialize;
+
+use super::repair::RepairRound;
+use super::solver::{LevelReport, SolveOptions};
+use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
+use crate::boundary::hierarchy::Hierarchy;
+use crate::discrete::assembly::Operator;
+use crate::spline::curve::Curve;
+use crate::spline::surface::{Side, Surface};
+use crate::verify::certificate::Certificate;
+use crate::verify::quality::{quality, sample_det_j, Quality};
+
+/// Overall outcome of a solve: the bijectivity certificate of the final map
+/// ([`crate::verify::certificate`]), unless the solver did not converge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// Converged and `det J > 0` proven on the whole map.
+    Certified,
+    /// Converged, `det J > 0` proven except near corners whose angle forces
+    /// `det J <= 0`: the best map the boundary allows.
+    DegenerateCorner,
+    /// `det J <= 0` at a point away from forced corners: the map folds.
+    Folded,
+    /// Neither proven positive nor shown to fold within the subdivision budget.
+    Undecided,
+    /// The finest level did not converge.
+    NotConverged,
+}
+
+/// Contour-fit summary per side.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitReport {
+    /// Side name.
+    pub side: &'static str,
+    /// Number of fit levels.
+    pub levels: usize,
+    /// Elements on the finest fit.
+    pub elements: usize,
+    /// Max deviation of the finest fit.
+    pub max_error: f64,
+    /// Whether the tolerance was met.
+    pub converged: bool,
+}
+
+/// The report stored in the map file and printed by the CLI.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Crate version.
+    pub version: &'static str,
+    /// Assembly back end.
+    pub backend: String,
+    /// Degree of the map.
+    pub degree: [usize; 2],
+    /// Operator.
+    pub operator: &'static str,
+    /// Absolute fit tolerance and the diameter it is relative to.
+    pub fit_tolerance: f64,
+    /// Bounding-box diameter of the boundary.
+    pub diameter: f64,
+    /// Per-side fit summary.
+    pub fit: Vec<FitReport>,
+    /// Per-level summaries.
+    pub levels: Vec<LevelReport>,
+    /// Defect-correction rounds run because the finest map folded or was undecided.
+    pub repairs: usize,
+    /// Each defect-correction round.
+    pub repair_rounds: Vec<RepairRound>,
+    /// The bijectivity certificate of the map.
+    pub certificate: Certificate,
+    /// Quality functionals and cell statistics.
+    pub quality: Quality,
+    /// The Poisson benchmark of §10 (when asked for, and when it could be solved).
+    pub poisson: Option<crate::verify::poisson::PoissonReport>,
+    /// `det J` minimum on the sample grid (corners included; the sample is additional
+    /// information, the verdict comes from the certificate).
+    pub det_j_min: f64,
+    /// `det J` minimum away from the four corners.
+    pub det_j_min_interior: f64,
+    /// `det J` minimum away from the corners the boundary forces (two spans around
+    /// each); the verdict is `folded` when this is not positive.
+    pub det_j_min_away_from_forced_corners: f64,
+    /// `det J` maximum on the sample grid.
+    pub det_j_max: f64,
+    /// Parameter point of the minimum.
+    pub det_j_argmin: [f64; 2],
+    /// Sample grid size.
+    pub det_j_sample: usize,
+    /// Winslow functional (eq. 15-16); `null` when `det J <= 0` at a quadrature point.
+    pub winslow: Option<f64>,
+    /// Area of the mapped domain.
+    pub area: f64,
+    /// Corner angles.
+    pub corners: Vec<CornerReport>,
+    /// Kinks inside the input's spline sides.
+    pub kinks: Vec<KinkReport>,
+    /// Largest distance of the map's boundary from the input boundary, per side
+    /// (south, east, north, west).
+    pub boundary_deviation: [f64; 4],
+    /// The outcome.
+    pub verdict: Verdict,
+    /// Plain-language summary of the verdict.
+    pub message: String,
+    /// Total seconds.
+    pub seconds: f64,
+    /// Tensor-product basis functions of the map (`n_xi * n_eta`).
+    pub basis_functions: usize,
+    /// The boundary reparameterization (paper §7): method used and matched pairs.
+    pub reparam: crate::boundary::reparam::ReparamReport,
+}
+
+/// A solved map and its report.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Name of the geometry.
+    pub name: String,
+    /// The map of the finest level.
+    pub map: Surface,
+    /// The report.
+    pub report: Report,
+}
+
+/// Smallest sampled `det J` outside the neighbourhoods of the corners that the
+/// boundary forces to `det J <= 0`: the first two knot spans in each direction there.
+pub fn min_away_from_corners(map: &Surface, s: &crate::verify::quality::DetJSample, corners: &[CornerReport]) -> f64 {
+    let span = |d: usize, at_end: bool| {
+        let b = map.knots[d].breaks();
+        let k = b.len();
+        let w = if at_end { b[k - 1] - b[k.saturating_sub(3)] } else { b[2.min(k - 1)] - b[0] };
+        w.max(0.0)
+    };
+    let centres = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let n = s.n;
+    let mut min = f64::INFINITY;
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+            let near = corners.iter().zip(centres).any(|(c, (cu, cv))| {
+                c.forces_nonpositive_det_j && (u - cu).abs() <= span(0, cu > 0.5) && (v - cv).abs() <= span(1, cv > 0.5)
+            });
+            if !near {
+                min = min.min(s.values[j * (n + 1) + i]);
+            }
+        }
+    }
+    min
+}
+
+/// What the report is made from besides the map.
+pub(crate) struct ReportContext<'a> {
+    pub hierarchy: &'a Hierarchy,
+    pub sides: &'a [Curve; 4],
+    pub kinks: Vec<KinkReport>,
+    pub boundary_deviation: [f64; 4],
+    pub opts: &'a SolveOptions,
+    pub backend: String,
+    pub repairs: usize,
+    pub rounds: Vec<RepairRound>,
+    pub certificate: Certificate,
+    pub elapsed: Duration,
+}
+
+impl Solution {
+    pub(crate) fn new(name: &str, map: Surface, levels: Vec<LevelReport>, ctx: ReportContext<'_>) -> Self {
+        let (h, opts) = (ctx.hierarchy, ctx.opts);
+        let sample = sample_det_j(&map, opts.sample);
+        let quality = quality(&map);
+        let fun = quality.functionals;
+        let certificate = ctx.certificate;
+        let corners = corner_report(ctx.sides);
+        let converged = levels.last().is_some_and(|l| l.converged);
+        let away = min_away_from_corners(&map, &sample, &corners);
+        let kinks = ctx.kinks;
+        let (verdict, message) = if !converged {
+            (
+                Verdict::NotConverged,
+                format!(
+                    "the nonlinear solver did not converge on the finest level ({}); the map is the last iterate",
+                    levels.last().and_then(|l| l.failure.clone()).unwrap_or_default()
+                ),
+            )
+        } else {
+            let v = match certificate.verdict {
+                crate::verify::certificate::Verdict::Certified { .. } => Verdict::Certified,
+                crate::verify::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+                crate::verify::certificate::Verdict::Folded { .. } => Verdict::Folded,
+                crate::verify::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
+            };
+            let mut m = certificate.message();
+            if v == Verdict::Certified {
+                for c in corners.iter().filter(|c| c.forces_nonpositive_det_j) {
+                    m.push_str(&format!(
+                        "; note: the {} corner has an angle of {:.2} degrees, where the exact boundary forbids det J > 0; \
+                         the fitted boundary rounds it within the fit tolerance",
+                        c.corner, c.angle_degrees
+                    ));
+                }
+            }
+            (v, m)
+        };
+        let mut message = message;
+        for k in &kinks {
+            message.push_str(&format!(
+                "; note: the input's {} side has a kink at ({:.6}, {:.6}) (tangent turns {:.1} degrees), where any C1 map of the \
+                 exact boundary has det J = 0; this map follows the fitted boundary, which rounds the kink within the fit tolerance",
+                k.side, k.point[0], k.point[1], k.turning_degrees
+            ));
+        }
+        let fit = Side::ALL
+            .iter()
+            .map(|&s| {
+                let f = &h.fits[s as usize];
+                FitReport {
+                    side: s.name(),
+                    levels: f.levels.len(),
+                    elements: f.levels.last().map_or(0, |c| c.knots.num_elements()),
+                    max_error: f.max_error.last().copied().unwrap_or(0.0),
+                    converged: f.converged,
+                }
+            })
+            .collect();
+        let report = Report {
+            version: env!("CARGO_PKG_VERSION"),
+            backend: ctx.backend,
+            degree: map.degrees(),
+            operator: match opts.operator {
+                Operator::Plain => "plain",
+                Operator::Scaled => "scaled",
+            },
+            fit_tolerance: h.tol_abs,
+            diameter: h.diameter,
+            fit,
+            levels,
+            repairs: ctx.repairs,
+            repair_rounds: ctx.rounds,
+            certificate,
+            quality,
+            poisson: if opts.poisson { crate::verify::poisson::poisson_benchmark(&map, None).ok() } else { None },
+            det_j_min: sample.min,
+            det_j_min_interior: sample.min_interior,
+            det_j_min_away_from_forced_corners: away,
+            det_j_max: sample.max,
+            det_j_argmin: sample.argmin,
+            det_j_sample: sample.n,
+            winslow: fun.winslow.is_finite().then_some(fun.winslow),
+            area: fun.area,
+            corners,
+            kinks,
+            boundary_deviation: ctx.boundary_deviation,
+            verdict,
+            message,
+            seconds: ctx.elapsed.as_secs_f64(),
+            basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
+            reparam: h.reparam.clone(),
+        };
+        Self { name: name.to_string(), map, report }
+    }
+}

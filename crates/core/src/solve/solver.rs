@@ -1,0 +1,496 @@
+//! The coarse-to-fine solver (paper §6.3) as an object that yields its iterates: level
+//! starts, nonlinear iterates and level summaries come out of one stream that the CLI
+//! progress, the viewer's live plot and the tests all read.
+//!
+//! The solver talks to the discrete problem only through [`Method`] and
+//! [`DiscreteProblem`](crate::methods::DiscreteProblem): EGG (eq. 8) by default, any
+//! other method through [`EggSolver::with_method`]. The patch's boundary conditions are
+//! data ([`SolveOptions::topology`]), read by the DOF map of every level.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
+use super::levels::{prepare_levels, select_levels};
+use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use super::repair::{frozen_discretization, plan_repair, RepairRound};
+use super::report::{ReportContext, Solution};
+use crate::boundary::corners::boundary_kinks;
+use crate::boundary::fit::FitOptions;
+use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
+use crate::boundary::Boundary;
+use crate::discrete::assembly::{Discretization, Operator};
+use crate::discrete::topology::Topology;
+use crate::error::{Error, Result};
+use crate::methods::egg::{CpuAssembler, EggAssembler, EggMethod};
+use crate::methods::{DiscreteProblem, Method, Start};
+use crate::spline::surface::Surface;
+use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict as CertVerdict};
+
+/// Options of a complete solve.
+#[derive(Debug, Clone)]
+pub struct SolveOptions {
+    /// Contour fitting (degree, tolerance).
+    pub fit: FitOptions,
+    /// Nonlinear iteration on every level.
+    pub nonlinear: NonlinearOptions,
+    /// Operator of eq. (8), plain or scaled.
+    pub operator: Operator,
+    /// The finest level has at least this many elements per direction.
+    pub min_elements: usize,
+    /// Extra uniform halvings of the finest level.
+    pub refine: usize,
+    /// Solve at most this many levels (the finest is always solved).
+    pub max_levels: Option<usize>,
+    /// Basis growth factor between solved levels (the paper advises 4).
+    pub growth: f64,
+    /// Largest mean physical aspect ratio of the elements; the coarser direction of a
+    /// level is halved until it is met (see [`prepare_levels`]).
+    pub aspect: f64,
+    /// `det J` is sampled on an `(n+1)^2` grid for the report.
+    pub sample: usize,
+    /// Rounds of defect correction (paper §8.2): while the certificate of the finest
+    /// map says folded or undecided, refine around the offending elements and solve
+    /// again, at most this many times.
+    pub repair: usize,
+    /// Spans around each offending element that a repair round also bisects.
+    pub repair_halo: usize,
+    /// When set, a repair round solves only for the control points whose support meets
+    /// the offending elements widened by this many spans; the others keep the values of
+    /// the prolonged map (paper §8.2: fewer unknowns).
+    pub repair_freeze: Option<usize>,
+    /// Options of the bijectivity certificate.
+    pub certify: CertifyOptions,
+    /// Run the grid-quality benchmark Q(x) of §10 on the final map.
+    pub poisson: bool,
+    /// The boundary condition of each side of the patch (four Dirichlet sides by
+    /// default; see [`Topology`]).
+    pub topology: Topology,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        Self {
+            fit: FitOptions::default(),
+            nonlinear: NonlinearOptions::default(),
+            operator: Operator::Scaled,
+            min_elements: 8,
+            refine: 0,
+            max_levels: None,
+            growth: 4.0,
+            aspect: 2.0,
+            sample: 200,
+            repair: 3,
+            repair_halo: 1,
+            repair_freeze: None,
+            certify: CertifyOptions::default(),
+            poisson: false,
+            topology: Topology::dirichlet(),
+        }
+    }
+}
+
+/// How a level's initial guess was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialGuess {
+    /// Transfinite interpolation (coarsest level).
+    Coons,
+    /// Prolongation of the previous level plus linear elasticity.
+    Elasticity,
+}
+
+/// Summary of one solved level.
+#[derive(Debug, Clone, Serialize)]
+pub struct LevelReport {
+    /// Index among the solved levels.
+    pub level: usize,
+    /// Basis functions per direction.
+    pub shape: [usize; 2],
+    /// Elements per direction.
+    pub elements: [usize; 2],
+    /// Number of scalar unknowns (`2 m`).
+    pub unknowns: usize,
+    /// Initial guess used.
+    pub initial_guess: InitialGuess,
+    /// Smallest sampled `det J` of the initial guess.
+    pub initial_det_j_min: f64,
+    /// Damped boundary steps solved before the full boundary (paper §9); 0 when the
+    /// elasticity guess was already positive.
+    pub continuation_steps: usize,
+    /// Nonlinear iterations spent in those steps.
+    pub continuation_iterations: usize,
+    /// Nonlinear iterations (excluding the initial residual evaluation).
+    pub iterations: usize,
+    /// Newton iterations among them.
+    pub newton_iterations: usize,
+    /// Pseudo-time iterations among them.
+    pub pseudo_time_iterations: usize,
+    /// Whether the stopping rule was met.
+    pub converged: bool,
+    /// Failure reason, if any.
+    pub failure: Option<String>,
+    /// `||F||` per iterate, initial guess first.
+    pub residuals: Vec<f64>,
+    /// Scaled residuals per iterate.
+    pub scaled_residuals: Vec<f64>,
+    /// Seconds spent assembling.
+    pub assembly_seconds: f64,
+    /// Seconds spent in linear solves.
+    pub linear_seconds: f64,
+    /// GMRES iterations over all linear solves of the level (0 with direct LU).
+    pub krylov_iterations: usize,
+    /// Seconds for the whole level (set-up, initial guess, iterations).
+    pub seconds: f64,
+}
+
+/// One item of the solver's stream.
+#[derive(Debug, Clone)]
+pub enum Event {
+    /// A level begins.
+    LevelStarted {
+        /// Index among the solved levels.
+        level: usize,
+        /// Number of levels that will be solved.
+        levels: usize,
+        /// Basis shape.
+        shape: [usize; 2],
+        /// Scalar unknowns.
+        unknowns: usize,
+        /// Initial guess.
+        initial_guess: InitialGuess,
+    },
+    /// A nonlinear iterate.
+    Iterate {
+        /// Level index.
+        level: usize,
+        /// The iterate.
+        iterate: Iterate,
+    },
+    /// A level is done.
+    LevelFinished(LevelReport),
+}
+
+struct Active {
+    level: usize,
+    solver: NonlinearSolver<Box<dyn DiscreteProblem + Send>>,
+    report: LevelReport,
+    started: Instant,
+}
+
+/// The coarse-to-fine solver; an `Iterator` over [`Event`]s. Drop it to cancel.
+pub struct EggSolver {
+    plan: Vec<Level>,
+    opts: SolveOptions,
+    /// The discrete problem on every level.
+    method: Arc<dyn Method>,
+    /// Quadrature back end of the hierarchy's operators (elasticity, mass, `det J`
+    /// samples).
+    assembler: Arc<dyn EggAssembler>,
+    diameter: f64,
+    next_level: usize,
+    active: Option<Active>,
+    previous: Option<Surface>,
+    reports: Vec<LevelReport>,
+    started: Instant,
+    failed: bool,
+    repairs: usize,
+    rounds: Vec<RepairRound>,
+    /// Certificate of the last solved map (the finest level so far).
+    certificate: Option<Certificate>,
+    /// For repair levels solved with frozen DOFs: plan index and the parameter boxes
+    /// `[u0, u1, v0, v1]` whose control points stay free.
+    free_boxes: Vec<(usize, Vec<[f64; 4]>)>,
+}
+
+impl std::fmt::Debug for EggSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EggSolver").field("levels", &self.plan.len()).field("next_level", &self.next_level).finish()
+    }
+}
+
+impl EggSolver {
+    /// A solver of EGG (eq. 8, `opts.operator`) over the levels of `hierarchy` (extended
+    /// and selected by `opts`), assembled on `assembler`.
+    pub fn new(hierarchy: &Hierarchy, opts: SolveOptions, assembler: Arc<dyn EggAssembler>) -> Result<Self> {
+        let method = Arc::new(EggMethod { operator: opts.operator, assembler: assembler.clone() });
+        Self::with_method(hierarchy, opts, assembler, method)
+    }
+
+    /// A solver of `method` over the levels of `hierarchy`; `assembler` assembles the
+    /// hierarchy's operators (elasticity, continuation samples).
+    pub fn with_method(
+        hierarchy: &Hierarchy,
+        opts: SolveOptions,
+        assembler: Arc<dyn EggAssembler>,
+        method: Arc<dyn Method>,
+    ) -> Result<Self> {
+        opts.topology.validate(None)?;
+        let levels = prepare_levels(hierarchy.levels.clone(), opts.min_elements, opts.refine, opts.aspect)?;
+        let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
+        let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
+        let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
+        Ok(Self {
+            plan,
+            opts,
+            method,
+            assembler,
+            diameter: hierarchy.diameter,
+            next_level: 0,
+            active: None,
+            previous: None,
+            reports: Vec::new(),
+            started: Instant::now(),
+            failed: false,
+            repairs: 0,
+            rounds: Vec::new(),
+            certificate: None,
+            free_boxes: Vec::new(),
+        })
+    }
+
+    /// The levels that will be solved.
+    pub fn plan(&self) -> &[Level] {
+        &self.plan
+    }
+
+    /// The method solved on every level.
+    pub fn method(&self) -> &dyn Method {
+        &*self.method
+    }
+
+    /// Nonlinear options of a level with `m` free functions: the residual made
+    /// dimensionless (`F_i = ∫ w_i L` with `∫ w_i ~ 1/m`, so `||F|| sqrt(m)` divided by
+    /// [`Method::residual_size`] is the relative residual) and the step tolerance in
+    /// length units.
+    fn level_options(&self, m: usize) -> NonlinearOptions {
+        let mut nl = self.opts.nonlinear;
+        nl.scale = (m.max(1) as f64).sqrt() / self.method.residual_size(self.diameter);
+        nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
+        nl
+    }
+
+    /// A method that needs a bijective start gets one the certificate proves (or one
+    /// positive away from corners the boundary forces to `det J <= 0`).
+    fn check_start(&self, level: &Level, cps: &[crate::spline::curve::Point]) -> Result<()> {
+        if self.method.start() != Start::Bijective {
+            return Ok(());
+        }
+        let map = Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: None };
+        let cert = certify(&map, &self.opts.certify)?;
+        match cert.verdict {
+            CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => Ok(()),
+            _ => Err(Error::InfeasibleStart { method: self.method.name().into(), reason: cert.message() }),
+        }
+    }
+
+    fn start_level(&mut self, k: usize) -> Result<Event> {
+        let t0 = Instant::now();
+        let level = &self.plan[k];
+        let topology = &self.opts.topology;
+        let disc = Arc::new(match self.free_boxes.iter().find(|(i, _)| *i == k) {
+            Some((_, boxes)) => frozen_discretization(&level.knots, boxes, topology)?,
+            None => Discretization::for_topology(level.knots.clone(), topology)?,
+        });
+        let mut cont = Continuation::default();
+        let (cps, guess) = match &self.previous {
+            None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
+            Some(prev) => {
+                let fine = prev.refined(&level.knots)?.control_points;
+                let mut target = fine.clone();
+                set_boundary(disc.shape(), &level.sides, &mut target)?;
+                let nl = self.level_options(disc.dofs.num_free());
+                let (method, assembler) = (&*self.method, &*self.assembler);
+                let cps = continuation(method, assembler, &disc, fine, &target, nl, self.diameter, &mut cont)?;
+                (cps, InitialGuess::Elasticity)
+            }
+        };
+        let shape = disc.shape();
+        let initial_det_j_min = det_j_min(&*self.assembler, &disc, &cps);
+        self.check_start(level, &cps)?;
+        let m = disc.dofs.num_free();
+        let nl = self.level_options(m);
+        let c0 = disc.dofs.gather(&cps);
+        let problem = self.method.problem(disc, cps);
+        let solver = NonlinearSolver::new(problem, c0, nl);
+        let report = LevelReport {
+            level: k,
+            shape,
+            elements: [level.knots[0].num_elements(), level.knots[1].num_elements()],
+            unknowns: 2 * m,
+            initial_guess: guess,
+            initial_det_j_min,
+            continuation_steps: cont.steps,
+            continuation_iterations: cont.iterations,
+            iterations: 0,
+            newton_iterations: 0,
+            pseudo_time_iterations: 0,
+            converged: false,
+            failure: None,
+            residuals: Vec::new(),
+            scaled_residuals: Vec::new(),
+            assembly_seconds: 0.0,
+            linear_seconds: 0.0,
+            krylov_iterations: 0,
+            seconds: 0.0,
+        };
+        self.active = Some(Active { level: k, solver, report, started: t0 });
+        Ok(Event::LevelStarted { level: k, levels: self.plan.len(), shape, unknowns: 2 * m, initial_guess: guess })
+    }
+
+    fn finish_level(&mut self) -> Event {
+        let mut a = self.active.take().expect("active level");
+        let status = a.solver.status().clone();
+        a.report.converged = status == Status::Converged;
+        if let Status::Failed(why) = status {
+            a.report.failure = Some(why);
+        }
+        let timings = a.solver.timings;
+        a.report.assembly_seconds = timings.assembly.as_secs_f64();
+        a.report.linear_seconds = timings.linear.as_secs_f64();
+        a.report.krylov_iterations = a.solver.krylov_iterations();
+        a.report.seconds = a.started.elapsed().as_secs_f64();
+        let (problem, c) = a.solver.into_parts();
+        let knots = self.plan[a.level].knots.clone();
+        self.previous = Some(Surface { knots, control_points: problem.control_points(&c), weights: None });
+        self.reports.push(a.report.clone());
+        Event::LevelFinished(a.report)
+    }
+
+    /// Finish: the map of the finest level and the full report. Runs the remaining
+    /// iterations first if the stream was not drained.
+    pub fn finish(mut self, boundary: &Boundary, hierarchy: &Hierarchy) -> Result<Solution> {
+        for e in self.by_ref() {
+            e?;
+        }
+        let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let certificate = match self.certificate.take() {
+            Some(c) => c,
+            None => certify(&map, &self.opts.certify)?,
+        };
+        let finest = self.plan.last().expect("non-empty plan");
+        let ctx = ReportContext {
+            hierarchy,
+            sides: &finest.sides,
+            kinks: boundary_kinks(boundary),
+            boundary_deviation: crate::verify::quality::boundary_deviation(&map, boundary, 400),
+            opts: &self.opts,
+            backend: self.assembler.name(),
+            repairs: self.repairs,
+            rounds: self.rounds.clone(),
+            certificate,
+            elapsed: self.started.elapsed(),
+        };
+        Ok(Solution::new(&boundary.name, map, self.reports, ctx))
+    }
+
+    /// Certify the last solved map (once) and, when it folds or is undecided and rounds
+    /// are left, append the defect-correction level of [`plan_repair`]. Returns
+    /// `Ok(true)` when a level was added.
+    fn repair(&mut self) -> Result<bool> {
+        let (Some(map), Some(last)) = (&self.previous, self.plan.last()) else { return Ok(false) };
+        if self.certificate.is_none() {
+            self.certificate = Some(certify(map, &self.opts.certify)?);
+        }
+        let cert = self.certificate.as_ref().expect("set above");
+        if self.repairs >= self.opts.repair {
+            return Ok(false);
+        }
+        let Some(r) = plan_repair(last, cert, self.repairs + 1, &self.opts)? else { return Ok(false) };
+        if let Some(boxes) = r.free_boxes {
+            self.free_boxes.push((self.plan.len(), boxes));
+        }
+        self.rounds.push(r.round);
+        self.plan.push(r.level);
+        self.repairs += 1;
+        self.certificate = None;
+        Ok(true)
+    }
+}
+
+impl Iterator for EggSolver {
+    type Item = Result<Event>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        if let Some(a) = self.active.as_mut() {
+            match a.solver.step() {
+                Ok(Some(it)) => {
+                    a.report.residuals.push(it.residual);
+                    a.report.scaled_residuals.push(it.scaled_residual);
+                    if it.iteration > 0 {
+                        a.report.iterations = it.iteration;
+                        match it.method {
+                            NonlinearMethod::Newton => a.report.newton_iterations += 1,
+                            NonlinearMethod::PseudoTime => a.report.pseudo_time_iterations += 1,
+                        }
+                    }
+                    return Some(Ok(Event::Iterate { level: a.level, iterate: it }));
+                }
+                Ok(None) => return Some(Ok(self.finish_level())),
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
+                }
+            }
+        }
+        if self.next_level == self.plan.len() && !self.plan.is_empty() && self.previous.is_some() {
+            // defect correction (§8.2): certify, refine around the defects, solve again
+            if let Err(e) = self.repair() {
+                self.failed = true;
+                return Some(Err(e));
+            }
+        }
+        if self.next_level < self.plan.len() {
+            let k = self.next_level;
+            self.next_level += 1;
+            let r = self.start_level(k);
+            if r.is_err() {
+                self.failed = true;
+            }
+            return Some(r);
+        }
+        None
+    }
+}
+
+/// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream.
+pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
+    let h = build_hierarchy(boundary, &opts.fit)?;
+    EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(boundary, &h)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::{Analytic, SideCurve};
+    use crate::solve::report::Verdict;
+
+    fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
+        let arc =
+            move |r: f64| SideCurve::Analytic(Analytic::new(move |t| [r * (angle * t).cos(), r * (angle * t).sin()]));
+        let ray = move |a: f64| {
+            SideCurve::Analytic(Analytic::new(move |t| {
+                [(r0 + (r1 - r0) * t) * a.cos(), (r0 + (r1 - r0) * t) * a.sin()]
+            }))
+        };
+        // south: inner radius? use south = ray at angle 0, north = ray at `angle`,
+        // west = inner arc, east = outer arc (counter-clockwise).
+        Boundary { name: "annulus".into(), sides: [ray(0.0), arc(r1), ray(angle), arc(r0)] }
+    }
+
+    #[test]
+    fn quarter_annulus_solves_and_is_positive() {
+        let b = annulus(1.0, 2.0, std::f64::consts::FRAC_PI_2);
+        let sol = solve(&b, &SolveOptions::default()).unwrap();
+        let r = &sol.report;
+        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+        let last = r.levels.last().unwrap();
+        assert!(last.converged && last.newton_iterations <= 5, "{last:?}");
+        assert!((r.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit_tolerance * r.diameter, "area {}", r.area);
+    }
+}

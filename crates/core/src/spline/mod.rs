@@ -1,0 +1,19 @@
+//! Splines: a geometry is a basis plus coefficients.
+//!
+//! | module | holds | paper |
+//! |---|---|---|
+//! | [`knots`] | [`KnotVector`](knots::KnotVector): open, uniform and periodic; spans, Greville points, dyadic halving, unions | §3 |
+//! | [`basis`] | [`BasisDerivs`](basis::BasisDerivs): non-allocating B-spline values and derivatives (Piegl–Tiller) | §3 |
+//! | [`curve`] | [`Curve`](curve::Curve): B-spline and NURBS curves | §3 |
+//! | [`surface`] | [`Surface`](surface::Surface): tensor-product maps `x: [0,1]² → R²`, sides, inversion | §3, eq. (1) |
+//! | [`refine`] | knot insertion and degree elevation as sparse prolongation matrices | §5.4, §6.3 |
+//! | [`bezier`] | Bézier extraction of a tensor basis | §8.1 |
+//! | [`quadrature`] | Gauss–Legendre rules | §4 |
+
+pub mod basis;
+pub mod bezier;
+pub mod curve;
+pub mod knots;
+pub mod quadrature;
+pub mod refine;
+pub mod surface;
