@@ -7,8 +7,9 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use winslow::methods::egg::CpuAssembler;
+use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
-use winslow::solve::solver::{EggSolver, Event, SolveOptions};
+use winslow::solve::solver::{EggSolver, Event};
 use winslow::{build_hierarchy, Analytic, Boundary, SideCurve};
 
 fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {

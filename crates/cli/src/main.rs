@@ -17,8 +17,9 @@ use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Docu
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::EggAssembler;
 use winslow::solve::newton::NonlinearMethod;
+use winslow::solve::options::SolveOptions;
 use winslow::solve::report::{Solution, Verdict};
-use winslow::solve::solver::{EggSolver, Event, SolveOptions};
+use winslow::solve::solver::{EggSolver, Event};
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::verify::poisson::poisson_benchmark;
 use winslow::verify::quality::{boundary_deviation, quality};

@@ -10,8 +10,10 @@ use std::thread::JoinHandle;
 
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::methods::egg::CpuAssembler;
+use winslow::solve::options::SolveOptions;
+use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
-use winslow::solve::solver::{EggSolver, Event, InitialGuess, SolveOptions};
+use winslow::solve::solver::{EggSolver, Event};
 use winslow::Boundary;
 
 /// A message from the solving thread.

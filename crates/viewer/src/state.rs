@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use egui::Vec2;
 use winslow::discrete::assembly::Operator;
-use winslow::solve::solver::SolveOptions;
+use winslow::solve::options::SolveOptions;
 use winslow::Point;
 
 use crate::colour::{ColourScale, ScaleKind};

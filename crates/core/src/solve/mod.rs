@@ -8,12 +8,14 @@
 //! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
+//! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
-//! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict) | §8.1, §10 |
+//! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod initial;
 pub mod levels;
 pub mod newton;
+pub mod options;
 pub mod repair;
 pub mod report;
 pub mod solver;

@@ -6,7 +6,6 @@
 use serde::Serialize;
 
 use super::levels::MAX_BASIS;
-use super::solver::SolveOptions;
 use crate::boundary::hierarchy::Level;
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::{DofMap, FIXED};
@@ -49,14 +48,20 @@ pub struct Repair {
 /// The defect-correction level (§8.2) after `last`, whose map has certificate `cert`:
 /// the offending (folded or undecided) elements and `opts.repair_halo` spans around
 /// them bisected in both directions, the sides refined exactly. `None` when nothing
-/// offends or the refined basis would exceed [`MAX_BASIS`]. With `opts.repair_freeze`
-/// the round also gives the parameter boxes whose control points stay free.
-pub fn plan_repair(last: &Level, cert: &Certificate, round: usize, opts: &SolveOptions) -> Result<Option<Repair>> {
+/// offends or the refined basis would exceed [`MAX_BASIS`]. With `freeze = Some(r)` the
+/// round also gives the parameter boxes (the offending elements widened by `r` spans)
+/// whose control points stay free.
+pub fn plan_repair(
+    last: &Level,
+    cert: &Certificate,
+    round: usize,
+    halo: usize,
+    freeze: Option<usize>,
+) -> Result<Option<Repair>> {
     let offending = cert.offending_elements();
     if offending.is_empty() {
         return Ok(None);
     }
-    let halo = opts.repair_halo;
     let mut knots = last.knots.clone();
     let mut spans_refined = [0usize; 2];
     for d in 0..2 {
@@ -87,7 +92,7 @@ pub fn plan_repair(last: &Level, cert: &Certificate, round: usize, opts: &SolveO
         shape: [knots[0].num_basis(), knots[1].num_basis()],
         elements: [knots[0].num_elements(), knots[1].num_elements()],
     };
-    let free_boxes = opts.repair_freeze.map(|r| {
+    let free_boxes = freeze.map(|r| {
         let (ex, ey) = (last.knots[0].elements(), last.knots[1].elements());
         offending
             .iter()

@@ -7,8 +7,8 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use super::options::SolveOptions;
 use super::repair::RepairRound;
-use super::solver::{LevelReport, SolveOptions};
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
 use crate::boundary::hierarchy::Hierarchy;
 use crate::discrete::assembly::Operator;
@@ -16,6 +16,60 @@ use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::Certificate;
 use crate::verify::quality::{quality, sample_det_j, Quality};
+
+/// How a level's initial guess was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialGuess {
+    /// Transfinite interpolation (coarsest level).
+    Coons,
+    /// Prolongation of the previous level plus linear elasticity.
+    Elasticity,
+}
+
+/// Summary of one solved level.
+#[derive(Debug, Clone, Serialize)]
+pub struct LevelReport {
+    /// Index among the solved levels.
+    pub level: usize,
+    /// Basis functions per direction.
+    pub shape: [usize; 2],
+    /// Elements per direction.
+    pub elements: [usize; 2],
+    /// Number of scalar unknowns (`2 m`).
+    pub unknowns: usize,
+    /// Initial guess used.
+    pub initial_guess: InitialGuess,
+    /// Smallest sampled `det J` of the initial guess.
+    pub initial_det_j_min: f64,
+    /// Damped boundary steps solved before the full boundary (paper §9); 0 when the
+    /// elasticity guess was already positive.
+    pub continuation_steps: usize,
+    /// Nonlinear iterations spent in those steps.
+    pub continuation_iterations: usize,
+    /// Nonlinear iterations (excluding the initial residual evaluation).
+    pub iterations: usize,
+    /// Newton iterations among them.
+    pub newton_iterations: usize,
+    /// Pseudo-time iterations among them.
+    pub pseudo_time_iterations: usize,
+    /// Whether the stopping rule was met.
+    pub converged: bool,
+    /// Failure reason, if any.
+    pub failure: Option<String>,
+    /// `||F||` per iterate, initial guess first.
+    pub residuals: Vec<f64>,
+    /// Scaled residuals per iterate.
+    pub scaled_residuals: Vec<f64>,
+    /// Seconds spent assembling.
+    pub assembly_seconds: f64,
+    /// Seconds spent in linear solves.
+    pub linear_seconds: f64,
+    /// GMRES iterations over all linear solves of the level (0 with direct LU).
+    pub krylov_iterations: usize,
+    /// Seconds for the whole level (set-up, initial guess, iterations).
+    pub seconds: f64,
+}
 
 /// Overall outcome of a solve: the bijectivity certificate of the final map
 /// ([`crate::verify::certificate`]), unless the solver did not converge.

@@ -10,141 +10,21 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use serde::Serialize;
-
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
 use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
-use super::report::{ReportContext, Solution};
+use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
 use crate::boundary::corners::boundary_kinks;
-use crate::boundary::fit::FitOptions;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
 use crate::boundary::Boundary;
-use crate::discrete::assembly::{Discretization, Operator};
-use crate::discrete::topology::Topology;
+use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 use crate::methods::{DiscreteProblem, Method, Start};
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict as CertVerdict};
-
-/// Options of a complete solve.
-#[derive(Debug, Clone)]
-pub struct SolveOptions {
-    /// Contour fitting (degree, tolerance).
-    pub fit: FitOptions,
-    /// Nonlinear iteration on every level.
-    pub nonlinear: NonlinearOptions,
-    /// Operator of eq. (8), plain or scaled.
-    pub operator: Operator,
-    /// The finest level has at least this many elements per direction.
-    pub min_elements: usize,
-    /// Extra uniform halvings of the finest level.
-    pub refine: usize,
-    /// Solve at most this many levels (the finest is always solved).
-    pub max_levels: Option<usize>,
-    /// Basis growth factor between solved levels (the paper advises 4).
-    pub growth: f64,
-    /// Largest mean physical aspect ratio of the elements; the coarser direction of a
-    /// level is halved until it is met (see [`prepare_levels`]).
-    pub aspect: f64,
-    /// `det J` is sampled on an `(n+1)^2` grid for the report.
-    pub sample: usize,
-    /// Rounds of defect correction (paper §8.2): while the certificate of the finest
-    /// map says folded or undecided, refine around the offending elements and solve
-    /// again, at most this many times.
-    pub repair: usize,
-    /// Spans around each offending element that a repair round also bisects.
-    pub repair_halo: usize,
-    /// When set, a repair round solves only for the control points whose support meets
-    /// the offending elements widened by this many spans; the others keep the values of
-    /// the prolonged map (paper §8.2: fewer unknowns).
-    pub repair_freeze: Option<usize>,
-    /// Options of the bijectivity certificate.
-    pub certify: CertifyOptions,
-    /// Run the grid-quality benchmark Q(x) of §10 on the final map.
-    pub poisson: bool,
-    /// The boundary condition of each side of the patch (four Dirichlet sides by
-    /// default; see [`Topology`]).
-    pub topology: Topology,
-}
-
-impl Default for SolveOptions {
-    fn default() -> Self {
-        Self {
-            fit: FitOptions::default(),
-            nonlinear: NonlinearOptions::default(),
-            operator: Operator::Scaled,
-            min_elements: 8,
-            refine: 0,
-            max_levels: None,
-            growth: 4.0,
-            aspect: 2.0,
-            sample: 200,
-            repair: 3,
-            repair_halo: 1,
-            repair_freeze: None,
-            certify: CertifyOptions::default(),
-            poisson: false,
-            topology: Topology::dirichlet(),
-        }
-    }
-}
-
-/// How a level's initial guess was made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum InitialGuess {
-    /// Transfinite interpolation (coarsest level).
-    Coons,
-    /// Prolongation of the previous level plus linear elasticity.
-    Elasticity,
-}
-
-/// Summary of one solved level.
-#[derive(Debug, Clone, Serialize)]
-pub struct LevelReport {
-    /// Index among the solved levels.
-    pub level: usize,
-    /// Basis functions per direction.
-    pub shape: [usize; 2],
-    /// Elements per direction.
-    pub elements: [usize; 2],
-    /// Number of scalar unknowns (`2 m`).
-    pub unknowns: usize,
-    /// Initial guess used.
-    pub initial_guess: InitialGuess,
-    /// Smallest sampled `det J` of the initial guess.
-    pub initial_det_j_min: f64,
-    /// Damped boundary steps solved before the full boundary (paper §9); 0 when the
-    /// elasticity guess was already positive.
-    pub continuation_steps: usize,
-    /// Nonlinear iterations spent in those steps.
-    pub continuation_iterations: usize,
-    /// Nonlinear iterations (excluding the initial residual evaluation).
-    pub iterations: usize,
-    /// Newton iterations among them.
-    pub newton_iterations: usize,
-    /// Pseudo-time iterations among them.
-    pub pseudo_time_iterations: usize,
-    /// Whether the stopping rule was met.
-    pub converged: bool,
-    /// Failure reason, if any.
-    pub failure: Option<String>,
-    /// `||F||` per iterate, initial guess first.
-    pub residuals: Vec<f64>,
-    /// Scaled residuals per iterate.
-    pub scaled_residuals: Vec<f64>,
-    /// Seconds spent assembling.
-    pub assembly_seconds: f64,
-    /// Seconds spent in linear solves.
-    pub linear_seconds: f64,
-    /// GMRES iterations over all linear solves of the level (0 with direct LU).
-    pub krylov_iterations: usize,
-    /// Seconds for the whole level (set-up, initial guess, iterations).
-    pub seconds: f64,
-}
+use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
 
 /// One item of the solver's stream.
 #[derive(Debug, Clone)]
@@ -398,7 +278,8 @@ impl EggSolver {
         if self.repairs >= self.opts.repair {
             return Ok(false);
         }
-        let Some(r) = plan_repair(last, cert, self.repairs + 1, &self.opts)? else { return Ok(false) };
+        let (halo, freeze) = (self.opts.repair_halo, self.opts.repair_freeze);
+        let Some(r) = plan_repair(last, cert, self.repairs + 1, halo, freeze)? else { return Ok(false) };
         if let Some(boxes) = r.free_boxes {
             self.free_boxes.push((self.plan.len(), boxes));
         }

@@ -1,0 +1,72 @@
+//! The options of a complete solve: fit, nonlinear iteration, operator, levels,
+//! repair, certificate, topology.
+
+use crate::boundary::fit::FitOptions;
+use crate::discrete::assembly::Operator;
+use crate::discrete::topology::Topology;
+use crate::verify::certificate::CertifyOptions;
+
+use super::newton::NonlinearOptions;
+
+/// Options of a complete solve.
+#[derive(Debug, Clone)]
+pub struct SolveOptions {
+    /// Contour fitting (degree, tolerance).
+    pub fit: FitOptions,
+    /// Nonlinear iteration on every level.
+    pub nonlinear: NonlinearOptions,
+    /// Operator of eq. (8), plain or scaled.
+    pub operator: Operator,
+    /// The finest level has at least this many elements per direction.
+    pub min_elements: usize,
+    /// Extra uniform halvings of the finest level.
+    pub refine: usize,
+    /// Solve at most this many levels (the finest is always solved).
+    pub max_levels: Option<usize>,
+    /// Basis growth factor between solved levels (the paper advises 4).
+    pub growth: f64,
+    /// Largest mean physical aspect ratio of the elements; the coarser direction of a
+    /// level is halved until it is met (see [`prepare_levels`](super::levels::prepare_levels)).
+    pub aspect: f64,
+    /// `det J` is sampled on an `(n+1)^2` grid for the report.
+    pub sample: usize,
+    /// Rounds of defect correction (paper §8.2): while the certificate of the finest
+    /// map says folded or undecided, refine around the offending elements and solve
+    /// again, at most this many times.
+    pub repair: usize,
+    /// Spans around each offending element that a repair round also bisects.
+    pub repair_halo: usize,
+    /// When set, a repair round solves only for the control points whose support meets
+    /// the offending elements widened by this many spans; the others keep the values of
+    /// the prolonged map (paper §8.2: fewer unknowns).
+    pub repair_freeze: Option<usize>,
+    /// Options of the bijectivity certificate.
+    pub certify: CertifyOptions,
+    /// Run the grid-quality benchmark Q(x) of §10 on the final map.
+    pub poisson: bool,
+    /// The boundary condition of each side of the patch (four Dirichlet sides by
+    /// default; see [`Topology`]).
+    pub topology: Topology,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        Self {
+            fit: FitOptions::default(),
+            nonlinear: NonlinearOptions::default(),
+            operator: Operator::Scaled,
+            min_elements: 8,
+            refine: 0,
+            max_levels: None,
+            growth: 4.0,
+            aspect: 2.0,
+            sample: 200,
+            repair: 3,
+            repair_halo: 1,
+            repair_freeze: None,
+            certify: CertifyOptions::default(),
+            poisson: false,
+            topology: Topology::dirichlet(),
+        }
+    }
+}
