@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of the workspace on a fresh Debian machine with only Rust installed.
 # Installs what the suite needs when it is missing and we are root (Mesa's lavapipe
-# Vulkan driver for the GPU tests), then: format check, clippy, the whole test suite.
+# Vulkan driver for the GPU tests), then: format check, clippy, the docs (no broken
+# intra-doc links), the whole test suite.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,5 +26,7 @@ echo "== cargo fmt --check =="
 cargo fmt --all -- --check
 echo "== cargo clippy =="
 cargo clippy --workspace --all-targets -- -D warnings
+echo "== cargo doc (no broken intra-doc links) =="
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 echo "== cargo test =="
 cargo test --workspace

@@ -15,7 +15,7 @@
 //! | [`boundary`] | the boundary, its validation, corners and kinks, reparameterization (§7), contour fit (§5), the nested hierarchy (§5.4) |
 //! | [`discrete`] | topology (boundary conditions per side), DOF map, assembly kernels on one basis (§4, §6) |
 //! | [`methods`] | the parameterization methods behind one interface ([`Method`], [`DiscreteProblem`]): EGG (eq. 8) |
-//! | [`solve`] | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
+//! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
 //! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
 //! | [`io`] | readers and writers: JSON exchange formats, G+Smo XML, pictures |
 //!

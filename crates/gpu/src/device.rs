@@ -116,7 +116,7 @@ impl Gpu {
         is_software(&self.info)
     }
 
-    /// One line: "gpu: <adapter> (<backend>, <type>, f64)".
+    /// One line: `"gpu: <adapter> (<backend>, <type>, f64)"`.
     pub fn describe(&self) -> String {
         let i = &self.info;
         let kind = match i.device_type {

@@ -35,7 +35,7 @@ pub trait EggAssembler: Send + Sync {
     fn sample_det_j(&self, map: &Surface, n: usize) -> DetJSample {
         sample_det_j(map, n)
     }
-    /// Human-readable name of the back end ("cpu", "gpu: <adapter>").
+    /// Human-readable name of the back end (`"cpu"`, `"gpu: <adapter>"`).
     fn name(&self) -> String;
 }
 

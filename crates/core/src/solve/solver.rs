@@ -3,7 +3,7 @@
 //! progress, the viewer's live plot and the tests all read.
 //!
 //! The solver talks to the discrete problem only through [`Method`] and
-//! [`DiscreteProblem`](crate::methods::DiscreteProblem): EGG (eq. 8) by default, any
+//! [`DiscreteProblem`]: EGG (eq. 8) by default, any
 //! other method through [`EggSolver::with_method`]. The patch's boundary conditions are
 //! data ([`SolveOptions::topology`]), read by the DOF map of every level.
 
