@@ -13,7 +13,7 @@ use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::discrete::assembly::Operator;
 use winslow::io::picture::{render, PictureOptions};
-use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
+use winslow::io::{checked_boundary, map_to_json, read_document, Document, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::EggAssembler;
 use winslow::solve::newton::NonlinearMethod;
@@ -52,6 +52,19 @@ enum Command {
     /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
     /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
     Check(CheckArgs),
+    /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
+    /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
+    /// Bézier cells), .vtk (sampled structured grid).
+    Convert(ConvertArgs),
+}
+
+#[derive(Args, Debug)]
+struct ConvertArgs {
+    /// Map file (JSON map document, G+Smo XML or IGES).
+    map: PathBuf,
+    /// Output file; the format follows its extension.
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -305,7 +318,8 @@ fn fit_options(f: &FitArgs) -> FitOptions {
 struct SolveArgs {
     /// Boundary file.
     boundary: PathBuf,
-    /// Output map file (JSON, with a "report").
+    /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
+    /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
@@ -320,6 +334,15 @@ struct SolveArgs {
     /// Write a VTK structured grid with det J.
     #[arg(long)]
     vtk: Option<PathBuf>,
+    /// Also write the map as G+Smo XML (TensorBSpline2 / TensorNurbs2).
+    #[arg(long)]
+    gismo: Option<PathBuf>,
+    /// Also write the map as IGES 5.3 (rational B-spline surface, entity 128).
+    #[arg(long)]
+    iges: Option<PathBuf>,
+    /// Also write the exact map as VTK Bézier quadrilaterals (.vtu, det J as point data).
+    #[arg(long)]
+    vtu: Option<PathBuf>,
     /// Print the report as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
@@ -421,6 +444,7 @@ fn run(cli: Cli) -> Result<i32> {
         }
         Command::Bench(a) => bench(a),
         Command::Check(a) => check(a),
+        Command::Convert(a) => convert(a),
     }
 }
 
@@ -561,15 +585,20 @@ fn solve(a: SolveArgs) -> Result<i32> {
     let sel = a.backend.select(a.quiet || a.json)?;
     let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
-    output::ensure_parent(&a.output)?;
-    write_json(&a.output, &map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report }))))
-        .with_context(|| format!("writing {}", a.output.display()))?;
+    let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+    let json = || map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report })));
+    output::write_map(&a.output, &sol.name, &sol.map, &label, json)?;
+    for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu")] {
+        if let Some(p) = path {
+            output::write_map_as(p, ext, &sol.name, &sol.map, &label, json)?;
+        }
+    }
     if let Some(p) = &a.png {
         let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
         output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, ..Default::default() })?)?;
     }
     if let Some(p) = &a.vtk {
-        output::write_vtk(p, &sol.map, 128)?;
+        output::write_map_as(p, "vtk", &sol.name, &sol.map, &label, json)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -587,6 +616,24 @@ fn exit_code(v: Verdict) -> i32 {
         Verdict::NotConverged => 4,
         Verdict::Undecided => 5,
     }
+}
+
+fn convert(a: ConvertArgs) -> Result<i32> {
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+    };
+    // the verdict travels with the map: certify it again (the input may carry none)
+    let certificate = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
+    let label = format!("certificate: {}", certificate.message());
+    let json = || map_to_json(&name, &map, Some(serde_json::json!({ "certificate": &certificate })));
+    output::write_map(&a.output, &name, &map, &label, json)?;
+    println!("wrote {} ({label})", a.output.display());
+    Ok(match certificate.verdict {
+        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
+        CertVerdict::Folded { .. } => 3,
+        CertVerdict::Undecided { .. } => 5,
+    })
 }
 
 fn check(a: CheckArgs) -> Result<i32> {

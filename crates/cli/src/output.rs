@@ -8,11 +8,10 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use winslow::boundary::hierarchy::Hierarchy;
 use winslow::boundary::validate::ValidationReport;
-use winslow::io::picture::Image;
+use winslow::io::{self, picture::Image};
 use winslow::solve::report::{Solution, Verdict};
 use winslow::verify::certificate::Certificate;
 use winslow::verify::poisson::PoissonReport;
-use winslow::verify::quality::sample_det_j;
 use winslow::verify::quality::Quality;
 use winslow::{Boundary, Side, SideCurve, Surface};
 
@@ -35,24 +34,43 @@ pub fn ensure_parent(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Legacy-VTK structured grid of the map sampled on `(n+1)^2` points with `det J`.
-pub fn write_vtk(path: &Path, map: &Surface, n: usize) -> Result<()> {
+/// Write `map` to `path` in the format of its extension (see [`write_map_as`]); JSON
+/// when the extension is none of those.
+pub fn write_map(
+    path: &Path,
+    name: &str,
+    map: &Surface,
+    label: &str,
+    json: impl Fn() -> serde_json::Value,
+) -> Result<()> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    write_map_as(path, &ext, name, map, label, json)
+}
+
+/// Write `map` as `ext`: `xml` (G+Smo), `igs`/`iges` (IGES 5.3), `vtu` (VTK Bézier cells),
+/// `vtk` (sampled structured grid), anything else the JSON document `json()`. `label`
+/// (the verdict) goes into the file's comment where the format has one.
+pub fn write_map_as(
+    path: &Path,
+    ext: &str,
+    name: &str,
+    map: &Surface,
+    label: &str,
+    json: impl Fn() -> serde_json::Value,
+) -> Result<()> {
     ensure_parent(path)?;
-    let s = sample_det_j(map, n);
-    let mut out = String::new();
-    writeln!(out, "# vtk DataFile Version 3.0\nwinslow map\nASCII\nDATASET STRUCTURED_GRID")?;
-    writeln!(out, "DIMENSIONS {} {} 1\nPOINTS {} double", n + 1, n + 1, (n + 1) * (n + 1))?;
-    for j in 0..=n {
-        for i in 0..=n {
-            let p = map.eval(i as f64 / n as f64, j as f64 / n as f64);
-            writeln!(out, "{:?} {:?} 0", p[0], p[1])?;
+    let file_name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_else(|| name.to_string());
+    let text = match ext {
+        "xml" => io::gismo_writer::surface_to_gismo_xml(map, label),
+        "igs" | "iges" => io::iges::surface_to_iges(map, &file_name, label),
+        "vtu" => io::vtk::bezier_vtu(map, label)?,
+        "vtk" => io::vtk::structured_grid_vtk(map, 128),
+        _ => {
+            io::write_json(path, &json()).with_context(|| format!("writing {}", path.display()))?;
+            return Ok(());
         }
-    }
-    writeln!(out, "POINT_DATA {}\nSCALARS det_J double 1\nLOOKUP_TABLE default", (n + 1) * (n + 1))?;
-    for v in &s.values {
-        writeln!(out, "{v:?}")?;
-    }
-    std::fs::write(path, out).with_context(|| format!("writing {}", path.display()))?;
+    };
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
     Ok(())
 }
 

@@ -1,5 +1,7 @@
 //! Reading and writing: the JSON exchange formats of `formats.md` ([`json`]), G+Smo
-//! XML files ([`gismo`]) and pictures of a map, grid lines coloured by `det J`
+//! XML files ([`gismo`] reads, [`gismo_writer`] writes), IGES 5.3 rational B-spline
+//! surfaces ([`iges`], both ways), VTK files ([`vtk`]: a sampled structured grid, and the
+//! exact map as Bézier cells) and pictures of a map, grid lines coloured by `det J`
 //! ([`picture`], PNG through the CLI).
 //!
 //! [`read_document`] detects the kind of file by its content (a JSON object or an XML
@@ -8,8 +10,11 @@
 //! an [`Error`] naming what is wrong and where, never a panic.
 
 pub mod gismo;
+pub mod gismo_writer;
+pub mod iges;
 pub mod json;
 pub mod picture;
+pub mod vtk;
 
 use std::io::Read;
 use std::path::Path;
@@ -116,8 +121,17 @@ pub fn read_text(path: &Path) -> Result<String> {
 }
 
 /// Parse a document from text: JSON when it starts with `{`, G+Smo XML when it starts
-/// with `<` (after a byte-order mark and white space).
+/// with `<` (after a byte-order mark and white space), IGES when its first record has the
+/// Start-section letter in column 73 (a map, transposed when its boundary runs
+/// clockwise, as for G+Smo patches).
 pub fn parse_document(text: &str) -> Result<Document> {
+    if iges::is_iges(text) {
+        let mut map = iges::parse_iges(text)?;
+        if surface_boundary_area(&map) < 0.0 {
+            map = map.transposed();
+        }
+        return Ok(Document::Map { name: String::new(), map });
+    }
     let body = text.trim_start_matches('\u{feff}').trim_start();
     match body.chars().next() {
         Some('{') => parse_json(body),
