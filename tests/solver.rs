@@ -228,3 +228,40 @@ fn local_repair_with_frozen_dofs() {
     let moved: usize = r.levels.iter().skip(1).map(|l| l.unknowns / 2).sum();
     assert!(same >= nx * ny - moved, "{same} unchanged of {}, {moved} unknowns in the repairs", nx * ny);
 }
+
+/// `basis: Input` (paper §5.2): duck's quadratic B-spline sides are the map's boundary
+/// exactly, the map is certified, the finest basis is the input's (8 x 10 functions, no
+/// balancing), the coarse levels are a real hierarchy; NURBS sides fall back to the
+/// fitted basis and say why.
+#[test]
+fn input_basis_keeps_the_boundary_exactly() {
+    use winslow::boundary::fit::BasisChoice;
+    use winslow::{Side, SideCurve};
+    let mut opts = SolveOptions::default();
+    opts.fit.basis = BasisChoice::Input;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/duck.json");
+    let b = read_boundary(&path, &ReadOptions::default()).unwrap();
+    let sol = solve(&b, &opts).unwrap();
+    let r = &sol.report;
+    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+    assert_eq!((r.basis.used, r.basis.fallback.as_deref()), (BasisChoice::Input, None));
+    assert_eq!(sol.map.shape(), [8, 10]);
+    assert!(r.levels.len() >= 2, "a coarse-to-fine solve: {:?}", r.levels.iter().map(|l| l.shape).collect::<Vec<_>>());
+    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(dev <= 1e-14 * r.diameter, "boundary deviation {dev:.3e}");
+    // control points of each side: the input's, after the same (here: no) insertions
+    for s in Side::ALL {
+        let SideCurve::Spline(c) = b.side(s) else { panic!("duck has spline sides") };
+        let mine = sol.map.boundary(s);
+        assert_eq!(mine.control_points.len(), c.control_points.len(), "{s}");
+        for (p, q) in mine.control_points.iter().zip(&c.control_points) {
+            assert!((p[0] - q[0]).abs() <= 1e-14 * r.diameter && (p[1] - q[1]).abs() <= 1e-14 * r.diameter, "{s}");
+        }
+    }
+    // the disk's sides are NURBS arcs: fitted basis, with the reason
+    let disk = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/disk.json");
+    let b = read_boundary(&disk, &ReadOptions::default()).unwrap();
+    let h = winslow::build_hierarchy(&b, &opts.fit).unwrap();
+    assert_eq!(h.basis.used, BasisChoice::Fitted);
+    assert!(h.basis.fallback.as_deref().is_some_and(|w| w.contains("NURBS")), "{:?}", h.basis);
+}

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use winslow::boundary::fit::FitOptions;
+use winslow::boundary::fit::{BasisChoice, FitOptions};
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::discrete::assembly::Operator;
@@ -115,6 +115,17 @@ struct FitArgs {
     /// Fritsch-Carlson monotone cubic.
     #[arg(long, value_enum, default_value = "cord-length")]
     reparam_fill: FillArg,
+    /// Basis of the map: `fitted` (dyadic C^{p-1} fits of the sides within --fit-tol) or
+    /// `input` (the B-spline sides' own basis, boundary kept exactly; falls back to
+    /// `fitted` with a message for point clouds, analytic or NURBS sides and C0 knots).
+    #[arg(long, value_enum, default_value = "fitted")]
+    basis: BasisArg,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum BasisArg {
+    Fitted,
+    Input,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
@@ -311,7 +322,11 @@ fn fit_options(f: &FitArgs) -> FitOptions {
         },
         ..Default::default()
     };
-    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, ..Default::default() }
+    let basis = match f.basis {
+        BasisArg::Fitted => BasisChoice::Fitted,
+        BasisArg::Input => BasisChoice::Input,
+    };
+    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis, ..Default::default() }
 }
 
 #[derive(Args, Debug)]
@@ -501,11 +516,20 @@ fn run_solver(
     if !quiet {
         let tol = h.tol_abs;
         eprintln!(
-            "{}: fitted {} hierarchy levels (tolerance {tol:.3e}, diameter {:.4})",
+            "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
             boundary.name,
             h.levels.len(),
             h.diameter
         );
+        match (&h.basis.fallback, h.basis.used) {
+            (Some(why), _) => eprintln!("  basis: fitted (the input basis cannot be used: {why})"),
+            (None, BasisChoice::Input) => eprintln!(
+                "  basis: input, {}x{} functions, boundary kept exactly",
+                h.finest().knots[0].num_basis(),
+                h.finest().knots[1].num_basis()
+            ),
+            (None, BasisChoice::Fitted) => {}
+        }
         let rp = &h.reparam;
         eprintln!(
             "  reparameterization: {} (requested {}), {} matched pairs",

@@ -120,7 +120,16 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
             round.shape[1]
         );
     }
-    let _ = writeln!(s, "  basis functions: {}", r.basis_functions);
+    let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    let _ = writeln!(
+        s,
+        "  basis functions: {} ({} basis{}); boundary deviation from the input {:.3e} ({:.1e} of the diameter)",
+        r.basis_functions,
+        r.basis.used.name(),
+        r.basis.fallback.as_ref().map_or(String::new(), |why| format!(", input basis not used: {why}")),
+        dev,
+        dev / r.diameter
+    );
     let rp = &r.reparam;
     let gap = |g: f64| if g.is_finite() { format!("{g:.2e}") } else { "-".into() };
     let _ = writeln!(

@@ -67,6 +67,27 @@ pub const REGULARIZATION: f64 = 1e-10;
 /// curve fit (the piece's end points included).
 pub const SAMPLES_PER_PIECE: usize = 8;
 
+/// The basis a map is solved in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BasisChoice {
+    /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
+    #[default]
+    Fitted,
+    /// The basis of the input's spline sides, boundary kept exactly (§5.2).
+    Input,
+}
+
+impl BasisChoice {
+    /// `"fitted"` or `"input"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            BasisChoice::Fitted => "fitted",
+            BasisChoice::Input => "input",
+        }
+    }
+}
+
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
@@ -82,6 +103,9 @@ pub struct FitOptions {
     pub max_elements: usize,
     /// Reparameterization of the sides before the fit (paper §7). Default `auto`.
     pub reparam: ReparamOptions,
+    /// Solve in the fitted basis (default) or in the input's own basis, keeping the
+    /// boundary exactly ([`super::input_basis`], §5.2).
+    pub basis: BasisChoice,
 }
 
 impl Default for FitOptions {
@@ -93,6 +117,7 @@ impl Default for FitOptions {
             max_levels: 14,
             max_elements: 4096,
             reparam: ReparamOptions::default(),
+            basis: BasisChoice::Fitted,
         }
     }
 }

@@ -3,7 +3,10 @@
 //! opposite sides, `Σ^0 ⊂ Σ^1 ⊂ ...`, on which the solves and their initial guesses
 //! (§6.3) are built.
 
-use super::fit::{fit_side_with, FitOptions, SideFit};
+use serde::Serialize;
+
+use super::fit::{fit_side_with, BasisChoice, FitOptions, SideFit};
+use super::input_basis::input_levels;
 use super::reparam::ReparamReport;
 use super::{diameter, Boundary, SideCurve};
 use crate::error::{Error, Result};
@@ -14,6 +17,24 @@ use crate::spline::surface::Side;
 /// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
 /// relative to the diameter (readers enforce the stricter `1e-9` of `formats.md`).
 pub const CORNER_GAP_TOL: f64 = 1e-6;
+
+/// Which basis was asked for, which was used, and why they differ.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct BasisReport {
+    /// What was asked for.
+    pub requested: BasisChoice,
+    /// What was used.
+    pub used: BasisChoice,
+    /// Why the input basis was not used (`None` when the request was met).
+    pub fallback: Option<String>,
+}
+
+impl BasisReport {
+    /// The fitted basis, as requested.
+    pub fn fitted() -> Self {
+        Self { requested: BasisChoice::Fitted, used: BasisChoice::Fitted, fallback: None }
+    }
+}
 
 /// One level of the hierarchy: a tensor-product basis and the four side fits on it.
 #[derive(Debug, Clone)]
@@ -51,6 +72,8 @@ pub struct Hierarchy {
     pub diameter: f64,
     /// The reparameterization applied before the fit (paper §7).
     pub reparam: ReparamReport,
+    /// The basis used: fitted, or the input's (§5.2), and why not when asked for.
+    pub basis: BasisReport,
 }
 
 impl Hierarchy {
@@ -70,7 +93,9 @@ impl Hierarchy {
     }
 }
 
-/// Reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
+/// With `opts.basis` = [`BasisChoice::Input`], the hierarchy on the input's own basis
+/// ([`input_levels`]) when the sides allow it; otherwise (and by default):
+/// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
 /// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
@@ -82,6 +107,18 @@ pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarc
     }
     let tol_abs = opts.tol * diameter;
     let corners = corners(boundary, diameter)?;
+    let mut fallback = None;
+    if opts.basis == BasisChoice::Input {
+        match input_levels(boundary)? {
+            Ok(input) => {
+                let levels = input.levels.into_iter().map(|(knots, sides)| Level { knots, sides }).collect();
+                let basis = BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None };
+                let reparam = ReparamReport::native();
+                return Ok(Hierarchy { levels, fits: input.fits, tol_abs, diameter, reparam, basis });
+            }
+            Err(why) => fallback = Some(why),
+        }
+    }
     let plan = crate::boundary::reparam::plan(boundary, &opts.reparam)?;
     let mut fits = Vec::with_capacity(4);
     for side in Side::ALL {
@@ -91,6 +128,7 @@ pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarc
     let fits: [SideFit; 4] = fits.try_into().expect("four sides");
     let mut h = hierarchy_from_fits(fits, tol_abs, diameter)?;
     h.reparam = plan.report;
+    h.basis = BasisReport { requested: opts.basis, used: BasisChoice::Fitted, fallback };
     Ok(h)
 }
 
@@ -140,7 +178,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
             _ => levels.push(level),
         }
     }
-    Ok(Hierarchy { levels, fits, tol_abs, diameter, reparam: ReparamReport::native() })
+    Ok(Hierarchy { levels, fits, tol_abs, diameter, reparam: ReparamReport::native(), basis: BasisReport::fitted() })
 }
 
 /// The four corners south-west, south-east, north-east, north-west, each the average of

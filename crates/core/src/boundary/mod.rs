@@ -11,9 +11,11 @@
 //! | [`reparam`] | arc-length and constrained cord-length reparameterization | §7, eq. (38)-(42) |
 //! | [`fit`] | adaptive least-squares fit of one side | §5.1-§5.3, eq. (17)-(18) |
 //! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
+//! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
-//! `f ∘ g`), both use `cord_length`; `hierarchy` uses `fit`.
+//! `f ∘ g`), both use `cord_length`; `input_basis` uses `fit` (its coarse levels are
+//! projections); `hierarchy` uses both.
 //!
 //! Sides are oriented as in `formats.md`: south `eta = 0` and north `eta = 1` run with
 //! increasing `xi`, west `xi = 0` and east `xi = 1` with increasing `eta`.
@@ -22,6 +24,7 @@ pub mod cord_length;
 pub mod corners;
 pub mod fit;
 pub mod hierarchy;
+pub mod input_basis;
 pub mod reparam;
 pub mod validate;
 

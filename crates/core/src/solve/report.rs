@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::options::SolveOptions;
 use super::repair::RepairRound;
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
-use crate::boundary::hierarchy::Hierarchy;
+use crate::boundary::hierarchy::{BasisReport, Hierarchy};
 use crate::discrete::assembly::Operator;
 use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
@@ -156,7 +156,8 @@ pub struct Report {
     /// Kinks inside the input's spline sides.
     pub kinks: Vec<KinkReport>,
     /// Largest distance of the map's boundary from the input boundary, per side
-    /// (south, east, north, west).
+    /// (south, east, north, west): from the input's polyline (resolution `1e-6` of the
+    /// diameter) on the fitted basis, at equal parameters on the input basis.
     pub boundary_deviation: [f64; 4],
     /// The outcome.
     pub verdict: Verdict,
@@ -168,6 +169,9 @@ pub struct Report {
     pub basis_functions: usize,
     /// The boundary reparameterization (paper §7): method used and matched pairs.
     pub reparam: crate::boundary::reparam::ReparamReport,
+    /// The basis of the map: fitted (§5) or the input's own (§5.2), and why the input
+    /// basis was not used when it was asked for.
+    pub basis: BasisReport,
 }
 
 /// A solved map and its report.
@@ -313,6 +317,7 @@ impl Solution {
             seconds: ctx.elapsed.as_secs_f64(),
             basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
             reparam: h.reparam.clone(),
+            basis: h.basis.clone(),
         };
         Self { name: name.to_string(), map, report }
     }

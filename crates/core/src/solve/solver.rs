@@ -17,6 +17,7 @@ use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
 use crate::boundary::corners::boundary_kinks;
+use crate::boundary::fit::BasisChoice;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
@@ -25,6 +26,7 @@ use crate::methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 use crate::methods::{DiscreteProblem, Method, Start};
 use crate::spline::surface::Surface;
 use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
+use crate::verify::quality::{boundary_deviation, parametric_boundary_deviation};
 
 /// One item of the solver's stream.
 #[derive(Debug, Clone)]
@@ -108,7 +110,13 @@ impl EggSolver {
         method: Arc<dyn Method>,
     ) -> Result<Self> {
         opts.topology.validate(None)?;
-        let levels = prepare_levels(hierarchy.levels.clone(), opts.min_elements, opts.refine, opts.aspect)?;
+        // the input basis is solved as given (only `refine` halves it): no balancing and
+        // no minimum element count, which would change the basis the user chose
+        let (min_elements, aspect) = match hierarchy.basis.used {
+            BasisChoice::Input => (1, f64::INFINITY),
+            BasisChoice::Fitted => (opts.min_elements, opts.aspect),
+        };
+        let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.refine, aspect)?;
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
         let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
@@ -255,7 +263,12 @@ impl EggSolver {
             hierarchy,
             sides: &finest.sides,
             kinks: boundary_kinks(boundary),
-            boundary_deviation: crate::verify::quality::boundary_deviation(&map, boundary, 400),
+            boundary_deviation: match hierarchy.basis.used {
+                // the same curve at equal parameters: measured exactly, not by a polyline
+                BasisChoice::Input => parametric_boundary_deviation(&map, boundary, 400),
+                BasisChoice::Fitted => None,
+            }
+            .unwrap_or_else(|| boundary_deviation(&map, boundary, 400)),
             opts: &self.opts,
             backend: self.assembler.name(),
             repairs: self.repairs,

@@ -307,6 +307,34 @@ pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n
     })
 }
 
+/// Largest distance `max_t |x(t) - f(t)|` between each side of the map and the input's
+/// spline side at *equal parameters* (both domains mapped to `[0, 1]`), on `n + 1`
+/// points per side; `None` when a side is not a spline. For a map in the input's own
+/// basis (§5.2) the two are the same curve and this is at rounding level, where the
+/// geometric [`boundary_deviation`] is limited by its polyline's resolution.
+pub fn parametric_boundary_deviation(
+    map: &Surface,
+    boundary: &crate::boundary::Boundary,
+    n: usize,
+) -> Option<[f64; 4]> {
+    use crate::boundary::SideCurve;
+    use crate::spline::surface::Side;
+    let mut out = [0.0; 4];
+    for s in Side::ALL {
+        let SideCurve::Spline(c) = boundary.side(s) else { return None };
+        let (a, b) = c.domain();
+        let curve = map.boundary(s);
+        out[s as usize] = (0..=n)
+            .map(|k| {
+                let t = k as f64 / n as f64;
+                let (p, q) = (curve.eval(t), c.eval(a + t * (b - a)));
+                (p[0] - q[0]).hypot(p[1] - q[1])
+            })
+            .fold(0.0, f64::max);
+    }
+    Some(out)
+}
+
 fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;

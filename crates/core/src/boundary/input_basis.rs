@@ -1,0 +1,230 @@
+//! The input basis (paper §5.2, and the artificial hierarchy of §6.3's last paragraph):
+//! the map is discretized in the basis of the given spline sides, so that its boundary
+//! *is* the input, not a fit of it.
+//!
+//! Opposite sides are brought to one degree (`p = max(p_south, p_north, 2)` in `xi`,
+//! `q = max(p_west, p_east, 2)` in `eta`) by exact degree elevation and to one knot vector
+//! (the union of the two, each mapped to `[0, 1]`) by exact knot insertion; the finest
+//! level of the hierarchy is that tensor basis with the sides' control points as its
+//! boundary. Coarser levels are made by removing every other distinct interior break of
+//! each direction, down to one element, and projecting each side onto the coarse space by
+//! the constrained least squares of [`super::fit::project_side`] (corners kept), so the
+//! solve walks coarse to fine with the elasticity prolongation exactly as on fitted
+//! hierarchies, and its finest level has the input boundary exactly (knot insertion by
+//! `--refine` or by defect correction keeps it exact).
+//!
+//! Not every input can be kept this way; [`input_levels`] says why and the caller
+//! falls back to the fitted basis:
+//! * point clouds and analytic sides have no basis;
+//! * NURBS sides need a rational tensor basis, which the EGG assembly does not have yet;
+//! * an interior knot whose multiplicity reaches the degree (after elevation) makes the
+//!   side only `C^0` there: the Galerkin form (8) needs `C^1`, and a kink must not be
+//!   rounded silently (the `C^0` route of §9 keeps it).
+
+use super::fit::{project_side, SideFit};
+use super::{Boundary, SideCurve};
+use crate::error::Result;
+use crate::spline::curve::Curve;
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Side;
+
+/// The side as a polynomial curve on `[0, 1]` of degree at least `degree`, or why not.
+fn polynomial_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Result<Curve, String> {
+    let c = match side {
+        SideCurve::Spline(c) => c,
+        SideCurve::Points(_) => return Err(format!("the {s} side is a point cloud, which has no basis")),
+        SideCurve::Analytic(_) => return Err(format!("the {s} side is analytic, which has no basis")),
+    };
+    if c.weights.as_ref().is_some_and(|w| w.iter().any(|&x| x != 1.0)) {
+        return Err(format!(
+            "the {s} side is a NURBS curve: a rational tensor basis is not available in the EGG assembly yet"
+        ));
+    }
+    let mut c = Curve { weights: None, ..c.normalized() };
+    while c.degree() < degree {
+        c = c.elevated().map_err(|e| format!("the {s} side could not be elevated: {e}"))?;
+    }
+    let p = c.degree();
+    if let Some(&(u, m)) = c
+        .knots
+        .breaks_with_multiplicity()
+        .iter()
+        .skip(1)
+        .take(c.knots.num_elements().saturating_sub(1))
+        .find(|b| b.1 >= p)
+    {
+        return Err(format!(
+            "the {s} side is only C0 at its interior knot {u} (multiplicity {m} at degree {p}): \
+             the Galerkin form (8) needs C1 and a kink is not rounded silently"
+        ));
+    }
+    Ok(c)
+}
+
+/// Remove every other distinct interior break (with all its multiplicity).
+fn coarsened(kv: &KnotVector) -> KnotVector {
+    let bm = kv.breaks_with_multiplicity();
+    let p = kv.degree();
+    let last = bm.len() - 1;
+    let mut knots = Vec::new();
+    for (k, &(u, m)) in bm.iter().enumerate() {
+        let keep = k == 0 || k == last || k % 2 == 0;
+        if keep {
+            knots.extend(std::iter::repeat_n(u, if k == 0 || k == last { p + 1 } else { m }));
+        }
+    }
+    KnotVector::new(p, knots).expect("a subsequence of an open knot vector is one")
+}
+
+/// The sequence `coarsest, ..., kv`, each a subset of the next, the coarsest with one
+/// element.
+fn coarsening(kv: &KnotVector) -> Vec<KnotVector> {
+    let mut out = vec![kv.clone()];
+    while out.last().expect("non-empty").num_elements() > 1 {
+        let c = coarsened(out.last().expect("non-empty"));
+        out.push(c);
+    }
+    out.reverse();
+    out
+}
+
+/// The levels on the input basis, coarse to fine, and the four sides' sequences of
+/// projections (the last one exact).
+#[derive(Debug, Clone)]
+pub struct InputLevels {
+    /// Knot vectors (`xi`, `eta`) and the four sides (south, east, north, west) on them.
+    pub levels: Vec<([KnotVector; 2], [Curve; 4])>,
+    /// Per side: the projections onto the coarse levels and the exact side last, with
+    /// their deviations (0 for the exact one).
+    pub fits: [SideFit; 4],
+}
+
+/// The levels on the input basis (see the module documentation), or the reason why the
+/// boundary cannot be kept in it.
+pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLevels, String>> {
+    let side_degree = |s: Side| match boundary.side(s) {
+        SideCurve::Spline(c) => c.degree(),
+        _ => 0,
+    };
+    let degree = [Side::South, Side::East]
+        .map(|s| side_degree(s).max(side_degree(s.opposite())).clamp(2, crate::error::MAX_DEGREE));
+    let mut exact: Vec<Curve> = Vec::with_capacity(4);
+    for s in Side::ALL {
+        match polynomial_side(boundary.side(s), s, degree[s.direction()]) {
+            Ok(c) => exact.push(c),
+            Err(why) => return Ok(Err(why)),
+        }
+    }
+    let union = |a: Side, b: Side| exact[a as usize].knots.union(&exact[b as usize].knots);
+    let finest = [union(Side::South, Side::North)?, union(Side::West, Side::East)?];
+    let chains = [coarsening(&finest[0]), coarsening(&finest[1])];
+    let m = chains[0].len().max(chains[1].len());
+    // level k of a direction with fewer levels stays at its coarsest
+    let pick = |d: usize, k: usize| chains[d][k.saturating_sub(m - chains[d].len())].clone();
+    let mut levels = Vec::with_capacity(m);
+    let mut fit_levels: [Vec<Curve>; 4] = Default::default();
+    let mut max_error: [Vec<f64>; 4] = Default::default();
+    let mut rms_error: [Vec<f64>; 4] = Default::default();
+    for k in 0..m {
+        let knots = [pick(0, k), pick(1, k)];
+        let mut sides = Vec::with_capacity(4);
+        for s in Side::ALL {
+            let kv = &knots[s.direction()];
+            let c = &exact[s as usize];
+            let (curve, max, rms) = if k + 1 == m {
+                (c.refined(kv)?, 0.0, 0.0)
+            } else {
+                let pr = project_side(&SideCurve::Spline(c.clone()), kv, c.endpoints())?;
+                (pr.curve, pr.max_error, pr.rms_error)
+            };
+            fit_levels[s as usize].push(curve.clone());
+            max_error[s as usize].push(max);
+            rms_error[s as usize].push(rms);
+            sides.push(curve);
+        }
+        let sides: [Curve; 4] = sides.try_into().expect("four sides");
+        levels.push((knots, sides));
+    }
+    let fits = Side::ALL.map(|s| SideFit {
+        side: s,
+        levels: std::mem::take(&mut fit_levels[s as usize]),
+        max_error: std::mem::take(&mut max_error[s as usize]),
+        rms_error: std::mem::take(&mut rms_error[s as usize]),
+        params: None,
+        converged: true,
+    });
+    Ok(Ok(InputLevels { levels, fits }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::Analytic;
+
+    fn side(p: usize, knots: Vec<f64>, cps: Vec<[f64; 2]>) -> SideCurve {
+        SideCurve::Spline(Curve::polynomial(KnotVector::new(p, knots).unwrap(), cps))
+    }
+
+    /// A square with a cubic wavy south side on a non-uniform knot vector, a quadratic
+    /// north side on another domain, linear east and west sides.
+    fn boundary() -> Boundary {
+        let south = side(
+            3,
+            vec![0., 0., 0., 0., 0.3, 0.55, 1., 1., 1., 1.],
+            vec![[0., 0.], [0.2, 0.1], [0.4, -0.1], [0.6, 0.12], [0.8, 0.0], [1., 0.]],
+        );
+        let north = side(2, vec![2., 2., 2., 2.5, 3., 3., 3.], vec![[0., 1.], [0.3, 1.2], [0.7, 0.9], [1., 1.]]);
+        let east = side(1, vec![0., 0., 1., 1.], vec![[1., 0.], [1., 1.]]);
+        let west = side(1, vec![0., 0., 1., 1.], vec![[0., 0.], [0., 1.]]);
+        Boundary { name: "wavy".into(), sides: [south, east, north, west] }
+    }
+
+    /// The finest level's sides are the input curves exactly (same curve after elevation
+    /// and insertion: equal at every sample to rounding), the levels are nested and
+    /// coarsen to one element, and degrees are raised to 2 at least.
+    #[test]
+    fn finest_level_is_the_input() {
+        let b = boundary();
+        let h = input_levels(&b).unwrap().unwrap();
+        let (knots, sides) = h.levels.last().unwrap();
+        assert_eq!([knots[0].degree(), knots[1].degree()], [3, 2]);
+        for s in Side::ALL {
+            let SideCurve::Spline(c) = b.side(s) else { unreachable!() };
+            let (a, bb) = c.domain();
+            for k in 0..=50 {
+                let t = k as f64 / 50.0;
+                let (x, y) = (c.eval(a + t * (bb - a)), sides[s as usize].eval(t));
+                assert!((x[0] - y[0]).abs() < 1e-14 && (x[1] - y[1]).abs() < 1e-14, "{s} at {t}: {x:?} vs {y:?}");
+            }
+        }
+        for w in h.levels.windows(2) {
+            assert!(w[1].0[0].contains(&w[0].0[0]) && w[1].0[1].contains(&w[0].0[1]));
+        }
+        assert_eq!(h.levels[0].0[0].num_elements(), 1);
+        assert_eq!(h.fits[0].max_error.last(), Some(&0.0));
+        assert!(h.fits[0].max_error[0] > 0.0, "a coarse projection of the wavy side is not exact");
+    }
+
+    #[test]
+    fn unsuitable_sides_say_why() {
+        let mut b = boundary();
+        b.sides[1] = SideCurve::Points(vec![[1., 0.], [1., 1.]]);
+        assert!(input_levels(&b).unwrap().unwrap_err().contains("east side is a point cloud"));
+        let mut b = boundary();
+        b.sides[3] = SideCurve::Analytic(Analytic::new(|t| [0.0, t]));
+        assert!(input_levels(&b).unwrap().unwrap_err().contains("analytic"));
+        let mut b = boundary();
+        let SideCurve::Spline(c) = &b.sides[2] else { unreachable!() };
+        b.sides[2] = SideCurve::Spline(Curve { weights: Some(vec![1.0, 0.8, 1.2, 1.0]), ..c.clone() });
+        assert!(input_levels(&b).unwrap().unwrap_err().contains("NURBS"));
+        // a C0 knot (multiplicity 3 at degree 3) is not rounded silently
+        let mut b = boundary();
+        b.sides[0] = side(
+            3,
+            vec![0., 0., 0., 0., 0.5, 0.5, 0.5, 1., 1., 1., 1.],
+            vec![[0., 0.], [0.2, 0.1], [0.4, -0.1], [0.5, 0.0], [0.6, 0.12], [0.8, 0.0], [1., 0.]],
+        );
+        let why = input_levels(&b).unwrap().unwrap_err();
+        assert!(why.contains("south") && why.contains("C0") && why.contains("0.5"), "{why}");
+    }
+}
