@@ -60,6 +60,10 @@ pub enum Error {
     /// A parameter is outside the domain or a request is inconsistent.
     #[error("invalid argument: {0}")]
     Invalid(String),
+    /// A knot of a map repeated more than the degree inside the domain: the map is
+    /// discontinuous across that knot line, so `det J` is undefined there.
+    #[error("knot {knot} in the {direction} direction has multiplicity {multiplicity} > degree {degree}: the map is discontinuous across it (split it into patches there, or lower the multiplicity to at most {degree})")]
+    KnotMultiplicity { direction: String, knot: f64, multiplicity: usize, degree: usize },
     /// A linear system could not be solved (singular, or not converged).
     #[error("linear solver failed: {0}")]
     LinearSolver(String),

@@ -38,8 +38,10 @@ impl BezierExtraction {
     pub fn new(kv: &KnotVector) -> Result<Self> {
         let p = kv.degree();
         let bm = kv.breaks_with_multiplicity();
-        if bm[1..bm.len() - 1].iter().any(|&(_, m)| m > p) {
-            return Err(Error::Invalid("Bézier extraction needs interior multiplicities <= p".into()));
+        if let Some(&(u, m)) = bm[1..bm.len() - 1].iter().find(|&&(_, m)| m > p) {
+            return Err(Error::Invalid(format!(
+                "Bézier extraction needs interior multiplicities <= p: knot {u} has multiplicity {m} > {p}"
+            )));
         }
         let inner: Vec<f64> = bm[1..bm.len() - 1].iter().flat_map(|&(u, m)| std::iter::repeat_n(u, p - m)).collect();
         let bez = kv.with_inserted(&inner);
