@@ -426,3 +426,4 @@ fn extreme_scales_keep_clear_verdicts() {
         }
     }
 }
+
