@@ -81,9 +81,17 @@ struct CheckArgs {
     /// bounding box extents).
     #[arg(long, value_delimiter = ',', num_args = 2)]
     poisson_scales: Option<Vec<f64>>,
-    /// Most bisections per element in the certificate.
+    /// Most bisections per element in the certificate (also the depth of the excused
+    /// neighbourhood of a forced corner: 2^-depth of the element).
     #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
     max_depth: usize,
+    /// Most Bernstein boxes examined per element.
+    #[arg(long, default_value_t = CertifyOptions::default().max_boxes)]
+    max_boxes: usize,
+    /// Excuse no corner: corners of 180 degrees or more leave the verdict undecided (or
+    /// folded) instead of degenerate-corner.
+    #[arg(long)]
+    strict_corners: bool,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -665,7 +673,11 @@ fn check(a: CheckArgs) -> Result<i32> {
     let Document::Map { name, map, .. } = doc else {
         bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
     };
-    let opts = CertifyOptions { max_depth: a.max_depth.clamp(1, 40), ..Default::default() };
+    let opts = CertifyOptions {
+        max_depth: a.max_depth.clamp(1, 40),
+        max_boxes: a.max_boxes.clamp(1, 1 << 24),
+        excuse_corners: !a.strict_corners,
+    };
     let certificate = certify(&map, &opts).context("certifying the map")?;
     let quality = quality(&map);
     let deviation = match &a.boundary {

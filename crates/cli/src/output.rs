@@ -217,10 +217,43 @@ fn certificate_lines(s: &mut String, c: &Certificate, with_message: bool) {
         c.det_degree, c.elements, c.element_shape[0], c.element_shape[1], c.boxes, c.max_depth, c.seconds
     );
     for k in c.corners.iter().filter(|k| k.forbids_positivity) {
+        let ext = match k.excused_extent {
+            Some(e) => {
+                format!("; excused neighbourhood {:.3e} x {:.3e} in (xi, eta), det J > 0 proven outside", e[0], e[1])
+            }
+            None => String::new(),
+        };
         let _ = writeln!(
             s,
-            "    corner {}: angle {:.2} deg forbids det J > 0 there (det J = {:.3e})",
+            "    corner {}: angle {:.8} deg forbids det J > 0 there (det J = {:.3e}){ext}",
             k.corner, k.angle_degrees, k.det_j
+        );
+    }
+    for f in c.folds.iter().take(5) {
+        let _ = writeln!(
+            s,
+            "    fold in element ({}, {}): det J = {:.4e} (rounding bound {:.1e}) at (xi, eta) = ({:.6}, {:.6}){}",
+            f.element[0],
+            f.element[1],
+            f.value,
+            f.error_bound,
+            f.param[0],
+            f.param[1],
+            f.one_sided.as_ref().map(|o| format!(", {o}")).unwrap_or_default()
+        );
+    }
+    for u in c.undecided_info.iter().take(5) {
+        let why = if u.smallest_coefficient.abs() <= u.error_bound {
+            "det J is zero within its rounding bound there"
+        } else if u.reason == "box-budget" {
+            "the box budget (--max-boxes) was spent"
+        } else {
+            "the bisection depth (--max-depth) was reached"
+        };
+        let _ = writeln!(
+            s,
+            "    undecided element ({}, {}): {why} (depth {}, {} boxes, smallest coefficient {:.3e}, rounding bound {:.1e})",
+            u.element[0], u.element[1], u.depth, u.boxes, u.smallest_coefficient, u.error_bound
         );
     }
 }

@@ -182,6 +182,15 @@ impl Certificate {
             ("det J degree".to_string(), format!("{}x{}", c.det_degree[0], c.det_degree[1])),
             ("elements / boxes / depth".to_string(), format!("{} / {} / {}", c.elements, c.boxes, c.max_depth)),
         ]);
+        for k in &c.corners {
+            if let Some(e) = k.excused_extent {
+                details.push((format!("excused near {}", k.corner), format!("{:.3e} x {:.3e} (xi, eta)", e[0], e[1])));
+            }
+        }
+        if let Some(u) = c.undecided_info.first() {
+            let why = if u.smallest_coefficient.abs() <= u.error_bound { "zero within rounding" } else { u.reason };
+            details.push((format!("undecided ({} elements)", c.undecided_info.len()), why.to_string()));
+        }
         Self { verdict, message: c.message(), source: CertificateSource::Exact, details }
     }
 

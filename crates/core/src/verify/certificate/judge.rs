@@ -257,7 +257,7 @@ impl Exact {
         let mut val = self.poly(e).eval(&s, &t) * Q::from_integer(BigInt::from(pq)) / ((q(b) - q(a)) * (q(d) - q(c)));
         if let Some(w) = &self.weights[e[1] * self.nx + e[0]] {
             let wv = w.eval(&s, &t);
-            val = val / (&wv * &wv * &wv);
+            val /= &wv * &wv * &wv;
         }
         to_f64(&val)
     }
