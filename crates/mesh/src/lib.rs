@@ -31,7 +31,7 @@ pub use error::{MeshError, Result};
 pub use glam::DVec2;
 pub use quality::{CellQuality, Quality};
 pub use structured::{structured, StructuredOptions};
-pub use unstructured::{unstructured, UnstructuredOptions};
+pub use unstructured::{parameter_scale, unstructured, UnstructuredOptions};
 pub use winslow::Side;
 
 /// The cell shape of a mesh.

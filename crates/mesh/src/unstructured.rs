@@ -2,6 +2,10 @@
 //! square made with `spade`, refined against limits measured **in physical space**
 //! through the map, its vertices mapped by the spline.
 //!
+//! 0. The triangulation lives in the parameter rectangle `[0, L_xi] x [0, L_eta]`, the
+//!    square stretched by the mean physical lengths of opposite sides
+//!    ([`parameter_scale`]), so that a map much longer than wide (a channel) does not
+//!    turn well-shaped parameter triangles into slivers.
 //! 1. The boundary of the square is split so that each side's segments have physical
 //!    length about `size` (equal arc length along the mapped side).
 //! 2. Rounds of: spade's Delaunay refinement with the angle limit (in the parameter
@@ -11,8 +15,8 @@
 //!    midpoint; so does every boundary segment whose image deviates from the mapped
 //!    curve by more than `chord_tol` at its midpoint. Stop when no triangle asks.
 //!
-//! The minimum angle holds in the parameter square (spade's guarantee); the physical
-//! angles are reported by [`crate::quality`].
+//! The minimum angle holds in the stretched parameter rectangle (spade's guarantee);
+//! the physical angles are reported by [`crate::quality`].
 
 use std::collections::HashSet;
 
@@ -85,6 +89,25 @@ fn side_points(map: &Surface, side: Side, size: f64) -> Vec<DVec2> {
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
+/// Physical length of a side (polyline of 2048 chords).
+fn side_length(map: &Surface, side: Side) -> f64 {
+    let c = map.boundary(side);
+    let p = c.sample(2048);
+    p.windows(2).map(|w| DVec2::from(w[0]).distance(DVec2::from(w[1]))).sum()
+}
+
+/// `(L_xi, L_eta)`: the means of the physical lengths of south and north, and of west
+/// and east; the triangulation is made in `[0, L_xi] x [0, L_eta]`.
+pub fn parameter_scale(map: &Surface) -> DVec2 {
+    let l = Side::ALL.map(|s| side_length(map, s));
+    let s = DVec2::new(0.5 * (l[0] + l[2]), 0.5 * (l[1] + l[3]));
+    if s.x > 0.0 && s.y > 0.0 && s.is_finite() {
+        s
+    } else {
+        DVec2::ONE
+    }
+}
+
 /// A triangulation of `map`'s image (linear triangles, counter-clockwise).
 pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     if !(opts.size.is_finite() && opts.size > 0.0) {
@@ -100,7 +123,8 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     }
     let nb = boundary.len();
     let edges: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
-    let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x, q.y)).collect();
+    let scale = parameter_scale(map);
+    let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x * scale.x, q.y * scale.y)).collect();
     let mut cdt = Cdt::bulk_load_cdt(verts, edges).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
     let mut phys: Vec<DVec2> = Vec::new();
     let mut det: Vec<f64> = Vec::new();
@@ -117,7 +141,7 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
         }
         for v in cdt.vertices().skip(phys.len()) {
             let p = v.position();
-            let d = map.derivs(p.x, p.y, 1);
+            let d = map.derivs(p.x / scale.x, p.y / scale.y, 1);
             phys.push(DVec2::from(d.x));
             det.push(d.det_j());
         }
@@ -150,13 +174,13 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
             if phys[a].distance(phys[b]) <= opts.size / 64.0 {
                 continue;
             }
-            let mid = at(map, DVec2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y)));
+            let mid = at(map, DVec2::new(0.5 * (pa.x + pb.x) / scale.x, 0.5 * (pa.y + pb.y) / scale.y));
             if mid.distance(0.5 * (phys[a] + phys[b])) > chord_tol {
                 split.insert((a.min(b), a.max(b)));
             }
         }
         if split.is_empty() {
-            return build(&cdt, phys);
+            return build(&cdt, phys, scale);
         }
         if cdt.num_vertices() + split.len() > opts.max_vertices {
             return Err(MeshError::Triangulation(format!(
@@ -190,8 +214,10 @@ fn side_of(a: DVec2, b: DVec2) -> Option<Side> {
     }
 }
 
-fn build(cdt: &Cdt, points: Vec<DVec2>) -> Result<Mesh> {
-    let params: Vec<DVec2> = cdt.vertices().map(|v| DVec2::new(v.position().x, v.position().y)).collect();
+fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
+    // x / L is exactly 0 or 1 on the sides (their points are exactly 0 or L)
+    let params: Vec<DVec2> =
+        cdt.vertices().map(|v| DVec2::new(v.position().x / scale.x, v.position().y / scale.y)).collect();
     let mut cells = Vec::with_capacity(3 * cdt.num_inner_faces());
     for f in cdt.inner_faces() {
         cells.extend(f.vertices().map(|h| h.fix().index()));
