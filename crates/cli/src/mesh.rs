@@ -146,6 +146,7 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             min_angle: spec.min_angle,
             chord_tol: spec.chord_tol,
             det_j_ratio: (spec.det_j_ratio > 0.0).then_some(spec.det_j_ratio),
+            order: spec.order as usize,
             ..Default::default()
         };
         unstructured(map, &opts)?

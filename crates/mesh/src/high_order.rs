@@ -137,34 +137,75 @@ fn check_points(kind: ElementKind, p: usize) -> Vec<[f64; 2]> {
     pts
 }
 
-/// Smallest and largest `det dX/d(r, s)` of element `c` over its check points.
-fn element_det_range(mesh: &Mesh, c: usize, lat: &[[usize; 2]], pts: &[[f64; 2]]) -> [f64; 2] {
-    let nodes = mesh.cell(c);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &[r, s] in pts {
-        let sh = shapes(mesh.kind, mesh.order, lat, r, s);
-        let (mut xr, mut xs) = (DVec2::ZERO, DVec2::ZERO);
-        for (k, n) in sh.iter().zip(nodes) {
-            xr += mesh.points[*n] * k.d[0];
-            xs += mesh.points[*n] * k.d[1];
-        }
-        let det = xr.perp_dot(xs);
-        let det = if det.is_nan() { f64::NEG_INFINITY } else { det };
-        lo = lo.min(det);
-        hi = hi.max(det);
+/// The Jacobian of a curved element of one kind and order at its check points (nodes
+/// and Gauss points), shape-function derivatives tabulated once.
+#[derive(Debug, Clone)]
+pub struct JacobianProbe {
+    kind: ElementKind,
+    order: usize,
+    lattice: Vec<[usize; 2]>,
+    derivs: Vec<Vec<[f64; 2]>>,
+}
+
+impl JacobianProbe {
+    /// Tabulate for elements of `kind` and order `p`.
+    pub fn new(kind: ElementKind, p: usize) -> Self {
+        let lattice = lattice(kind, p);
+        let derivs = check_points(kind, p)
+            .iter()
+            .map(|&[r, s]| shapes(kind, p, &lattice, r, s).iter().map(|f| f.d).collect())
+            .collect();
+        Self { kind, order: p, lattice, derivs }
     }
-    [lo, hi]
+
+    /// Smallest and largest `det dX/d(r, s)` over the check points of the element with
+    /// node positions `x` (Gmsh order).
+    pub fn range(&self, x: &[DVec2]) -> [f64; 2] {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for d in &self.derivs {
+            let (mut xr, mut xs) = (DVec2::ZERO, DVec2::ZERO);
+            for (k, p) in d.iter().zip(x) {
+                xr += *p * k[0];
+                xs += *p * k[1];
+            }
+            let det = xr.perp_dot(xs);
+            let det = if det.is_nan() { f64::NEG_INFINITY } else { det };
+            lo = lo.min(det);
+            hi = hi.max(det);
+        }
+        [lo, hi]
+    }
+
+    /// Smallest Jacobian of the curved element with corner parameters `q` whose nodes
+    /// are evaluated on `map` (what [`elevate`] would make of that cell).
+    pub fn curved_min(&self, map: &Surface, q: &[DVec2]) -> f64 {
+        let p = self.order as f64;
+        let x: Vec<DVec2> = self
+            .lattice
+            .iter()
+            .map(|&[i, j]| {
+                let t = reference_to_parameter(self.kind, q, i as f64 / p, j as f64 / p);
+                DVec2::from(map.eval(t.x, t.y))
+            })
+            .collect();
+        self.range(&x)[0]
+    }
+}
+
+/// Smallest and largest `det dX/d(r, s)` of element `c` over its check points.
+fn element_det_range(mesh: &Mesh, c: usize, probe: &JacobianProbe) -> [f64; 2] {
+    let x: Vec<DVec2> = mesh.cell(c).iter().map(|&n| mesh.points[n]).collect();
+    probe.range(&x)
 }
 
 /// Refuse a curved mesh with an element whose Jacobian is not positive at a node or a
 /// Gauss point.
 pub fn check_jacobians(mesh: &Mesh) -> Result<()> {
-    let lat = lattice(mesh.kind, mesh.order);
-    let pts = check_points(mesh.kind, mesh.order);
+    let probe = JacobianProbe::new(mesh.kind, mesh.order);
     let mut first = None;
     let mut count = 0;
     for c in 0..mesh.num_cells() {
-        let [lo, _] = element_det_range(mesh, c, &lat, &pts);
+        let [lo, _] = element_det_range(mesh, c, &probe);
         if lo.is_nan() || lo <= 0.0 {
             count += 1;
             first.get_or_insert((c, lo));
@@ -182,11 +223,10 @@ pub fn check_jacobians(mesh: &Mesh) -> Result<()> {
 
 /// Smallest `min det / max det` of an element's Jacobian over the mesh.
 pub fn min_jacobian_ratio(mesh: &Mesh) -> f64 {
-    let lat = lattice(mesh.kind, mesh.order);
-    let pts = check_points(mesh.kind, mesh.order);
+    let probe = JacobianProbe::new(mesh.kind, mesh.order);
     (0..mesh.num_cells())
         .map(|c| {
-            let [lo, hi] = element_det_range(mesh, c, &lat, &pts);
+            let [lo, hi] = element_det_range(mesh, c, &probe);
             lo / hi
         })
         .fold(f64::INFINITY, f64::min)

@@ -25,6 +25,7 @@ use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementPara
 use winslow::{Side, Surface};
 
 use crate::error::{MeshError, Result};
+use crate::high_order::JacobianProbe;
 use crate::{BoundaryEdge, ElementKind, Mesh};
 
 /// Options of an unstructured mesh.
@@ -43,11 +44,15 @@ pub struct UnstructuredOptions {
     pub det_j_ratio: Option<f64>,
     /// Most vertices (a guard against a size too small for the memory).
     pub max_vertices: usize,
+    /// Order of the elements that will be made of the triangles (1-3): for order > 1,
+    /// a triangle whose curved element ([`crate::high_order::elevate`]) would have a
+    /// Jacobian <= 0 at a node or Gauss point is split too (down to `size / 64`).
+    pub order: usize,
 }
 
 impl Default for UnstructuredOptions {
     fn default() -> Self {
-        Self { size: 0.1, min_angle: 28.0, chord_tol: None, det_j_ratio: Some(4.0), max_vertices: 20_000_000 }
+        Self { size: 0.1, min_angle: 28.0, chord_tol: None, det_j_ratio: Some(4.0), max_vertices: 20_000_000, order: 1 }
     }
 }
 
@@ -89,6 +94,10 @@ fn side_points(map: &Surface, side: Side, size: f64) -> Vec<DVec2> {
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
+fn pos_of(cdt: &Cdt, i: usize) -> Point2<f64> {
+    cdt.vertex(spade::handles::FixedVertexHandle::from_index(i)).position()
+}
+
 /// Physical length of a side (polyline of 2048 chords).
 fn side_length(map: &Surface, side: Side) -> f64 {
     let c = map.boundary(side);
@@ -129,6 +138,7 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     let mut phys: Vec<DVec2> = Vec::new();
     let mut det: Vec<f64> = Vec::new();
     let limit = AngleLimit::from_deg(opts.min_angle);
+    let probe = (opts.order > 1).then(|| JacobianProbe::new(ElementKind::Triangle, opts.order.min(3)));
     for _round in 0..200 {
         let budget = opts.max_vertices.saturating_sub(cdt.num_vertices());
         let r = cdt.refine(RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget));
@@ -163,7 +173,16 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
             let varies = opts.det_j_ratio.is_some_and(|r| longest > opts.size / 8.0 && dmin > 0.0 && dmax > r * dmin);
             // an inverted image is split while it is not tiny (a folded map stays folded)
             let inverted = (area.is_nan() || area <= 0.0) && longest > opts.size / 64.0;
-            if longest > opts.size || inverted || varies {
+            let curved_bad = || {
+                probe.as_ref().is_some_and(|pr| {
+                    let q = v.map(|i| {
+                        let p = pos_of(&cdt, i);
+                        DVec2::new(p.x / scale.x, p.y / scale.y)
+                    });
+                    longest > opts.size / 64.0 && pr.curved_min(map, &q) <= 0.0
+                })
+            };
+            if longest > opts.size || inverted || varies || curved_bad() {
                 let (a, b) = (v[e], v[(e + 1) % 3]);
                 split.insert((a.min(b), a.max(b)));
             }
