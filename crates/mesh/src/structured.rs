@@ -89,10 +89,26 @@ fn direction(map: &Surface, dir: usize, n: usize, d: &Distribution, others: &[f6
     let [s0, s1] = sides(dir);
     let h0 = start.map(|h| parameter_height(map, dir, true, h, others, s0)).transpose()?;
     let h1 = end.map(|h| parameter_height(map, dir, false, h, others, s1)).transpose()?;
-    let sizes = layer_sizes(n - 1, h0, h1, *growth, [s0.name(), s1.name()]).map_err(|e| match e {
+    let names = [s0.name(), s1.name()];
+    let sizes = layer_sizes(n - 1, h0, h1, *growth, names).map_err(|e| match e {
         MeshError::Layer { side, why, growth, .. } => {
             let height = if side == s0.name() { start.unwrap_or(0.0) } else { end.unwrap_or(0.0) };
-            MeshError::Layer { side, height, growth, why }
+            // the fewest points that would do, when more points help
+            let fits = |m: usize| layer_sizes(m, h0, h1, growth, names).is_ok();
+            let mut hint = String::new();
+            if let Some(hi) = (0..24).map(|k| (n - 1) << k).find(|&m| fits(m)) {
+                let (mut lo, mut hi) = (hi / 2, hi);
+                while hi - lo > 1 {
+                    let mid = (lo + hi) / 2;
+                    if fits(mid) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                hint = format!(" (at least {} points in {})", hi + 1, ["xi", "eta"][dir]);
+            }
+            MeshError::Layer { side, height, growth, why: format!("{why}{hint}") }
         }
         e => e,
     })?;
