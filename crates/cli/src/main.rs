@@ -26,6 +26,7 @@ use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
+mod mesh;
 mod output;
 
 #[derive(Parser, Debug)]
@@ -44,11 +45,15 @@ enum Command {
     /// Print sides, degrees, knots, corner angles, orientation and fit tolerance per side.
     Inspect(InspectArgs),
     /// Solve the EGG equations for a boundary and write the map (with a report).
-    Solve(SolveArgs),
+    Solve(Box<SolveArgs>),
     /// Draw an existing map file as a PNG (grid lines coloured by det J).
     Render(RenderArgs),
     /// Run the solver on a list of geometries and sizes and print a table.
     Bench(BenchArgs),
+    /// Classical meshes from a map (paper §11.3): structured with clustering and
+    /// boundary layers, or unstructured triangulations; linear or curved; written as
+    /// Gmsh, VTU, SU2, PLOT3D or OpenFOAM, with a quality table.
+    Mesh(mesh::MeshArgs),
     /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
     /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
     Check(CheckArgs),
@@ -378,6 +383,12 @@ struct SolveArgs {
     quiet: bool,
     #[command(flatten)]
     backend: BackendArgs,
+    /// Also write a mesh of the solved map (same options as `winslow mesh`): .msh,
+    /// .su2, .xyz, .vtu or a directory (OpenFOAM).
+    #[arg(long, value_name = "OUT")]
+    mesh: Option<PathBuf>,
+    #[command(flatten)]
+    mesh_spec: mesh::MeshSpec,
 }
 
 #[derive(Args, Debug)]
@@ -451,7 +462,7 @@ fn main() {
 fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Inspect(a) => inspect(a),
-        Command::Solve(a) => solve(a),
+        Command::Solve(a) => solve(*a),
         Command::Render(a) => {
             let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
             let Document::Map { map, .. } = doc else {
@@ -468,6 +479,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Bench(a) => bench(a),
         Command::Check(a) => check(a),
         Command::Convert(a) => convert(a),
+        Command::Mesh(a) => mesh::run(a),
     }
 }
 
@@ -611,6 +623,13 @@ fn run_solver(
 }
 
 fn solve(a: SolveArgs) -> Result<i32> {
+    let wants_mesh = a.mesh_spec.structured.is_some() || a.mesh_spec.unstructured;
+    if wants_mesh != a.mesh.is_some() {
+        bail!("--mesh OUT and one of --structured NXxNY / --unstructured --size H go together");
+    }
+    if let Some(out) = &a.mesh {
+        winslow_mesh::formats::Format::from_path(out)?;
+    }
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
@@ -636,6 +655,10 @@ fn solve(a: SolveArgs) -> Result<i32> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
+    }
+    if let Some(out) = &a.mesh {
+        // a folded map gives inverted cells, which the writers refuse
+        mesh::make_and_write(&sol.map, &a.mesh_spec, out, a.json)?;
     }
     Ok(exit_code(sol.report.verdict))
 }

@@ -1,0 +1,209 @@
+//! `winslow mesh`: classical meshes from a map (paper §11.3), and the mesh step of
+//! `winslow solve --mesh`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use winslow::Surface;
+use winslow_mesh::formats::{write, Format};
+use winslow_mesh::high_order::elevate;
+use winslow_mesh::quality::quality;
+use winslow_mesh::{structured, unstructured, Distribution, End, StructuredOptions, UnstructuredOptions};
+
+/// What mesh to make (shared by `mesh` and `solve --mesh`).
+#[derive(Args, Debug, Clone)]
+pub struct MeshSpec {
+    /// A structured mesh of NXxNY points (e.g. 401x35), sampled at xi_i x eta_j.
+    #[arg(long, value_name = "NXxNY", conflicts_with = "unstructured")]
+    pub structured: Option<String>,
+    /// Point distribution of a structured mesh, repeatable: DIR:uniform, DIR:arctan:A
+    /// (eq. 50, A = 6 in the paper), DIR:tanh:D (two-sided), SIDE:tanh:D (one-sided,
+    /// clustered at SIDE), SIDE:first-height:H[:GROWTH] (geometric layers whose first
+    /// cell is H long in physical units, growth ratio limit GROWTH, default 1.2).
+    /// DIR is xi or eta; SIDE is south, east, north or west.
+    #[arg(long, value_name = "SPEC")]
+    pub cluster: Vec<String>,
+    /// An unstructured triangulation (spade, refined in physical space).
+    #[arg(long, requires = "size")]
+    pub unstructured: bool,
+    /// Target physical edge length of the unstructured mesh.
+    #[arg(long, value_name = "H")]
+    pub size: Option<f64>,
+    /// Smallest angle of the triangulation in the parameter square, degrees.
+    #[arg(long, default_value_t = 28.0)]
+    pub min_angle: f64,
+    /// Largest distance of a boundary segment's midpoint from the mapped side (physical
+    /// units; default size/20).
+    #[arg(long)]
+    pub chord_tol: Option<f64>,
+    /// Split triangles over which det J varies by more than this factor (0: off).
+    #[arg(long, default_value_t = 4.0)]
+    pub det_j_ratio: f64,
+    /// Element order: 1 linear, 2 quadratic, 3 cubic (Gmsh types 10/36 quads, 9/21
+    /// triangles; nodes on the map; .msh and .vtu only).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=3))]
+    pub order: u8,
+}
+
+/// `winslow mesh` arguments.
+#[derive(Args, Debug)]
+pub struct MeshArgs {
+    /// Map file (JSON map document or G+Smo XML).
+    pub map: PathBuf,
+    /// Output: .msh (Gmsh 4.1), .su2, .xyz (PLOT3D), .vtu, or a directory (OpenFOAM
+    /// case; polyMesh goes to DIR/constant/polyMesh).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub spec: MeshSpec,
+}
+
+fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
+    s.parse::<f64>().with_context(|| format!("--cluster {spec}: {what} '{s}' is not a number"))
+}
+
+/// The distributions of `xi` and `eta` from the `--cluster` specs.
+pub fn distributions(specs: &[String]) -> Result<[Distribution; 2]> {
+    let mut out = [Distribution::Uniform, Distribution::Uniform];
+    let mut set = [false, false];
+    for spec in specs {
+        let parts: Vec<&str> = spec.split(':').collect();
+        let (dir, end) = match parts[0] {
+            "xi" => (0, None),
+            "eta" => (1, None),
+            "west" => (0, Some(End::Start)),
+            "east" => (0, Some(End::End)),
+            "south" => (1, Some(End::Start)),
+            "north" => (1, Some(End::End)),
+            o => bail!("--cluster {spec}: '{o}' is not xi, eta, south, east, north or west"),
+        };
+        let arg = |k: usize, what: &str| -> Result<f64> {
+            let s = parts.get(k).with_context(|| format!("--cluster {spec}: missing {what}"))?;
+            parse_num(s, what, spec)
+        };
+        let d = match (parts.get(1).copied(), end) {
+            (Some("uniform"), None) => Distribution::Uniform,
+            (Some("arctan"), None) => Distribution::Arctan { strength: arg(2, "strength")? },
+            (Some("tanh"), None) => Distribution::TanhTwoSided { strength: arg(2, "strength")? },
+            (Some("tanh"), Some(at)) => Distribution::TanhOneSided { strength: arg(2, "strength")?, at },
+            (Some("first-height"), Some(at)) => {
+                let h = arg(2, "height")?;
+                let g = if parts.len() > 3 { arg(3, "growth")? } else { 1.2 };
+                // a layer at the other end of the same direction joins this one
+                let (mut start, mut end) = (None, None);
+                if let (true, Distribution::Layers { start: s0, end: e0, growth }) = (set[dir], &out[dir]) {
+                    if *growth != g {
+                        bail!("--cluster {spec}: growth {g} differs from {growth} given for the other end");
+                    }
+                    (start, end) = (*s0, *e0);
+                } else if set[dir] {
+                    bail!("--cluster {spec}: the {} direction already has a distribution", ["xi", "eta"][dir]);
+                }
+                match at {
+                    End::Start => start = Some(h),
+                    End::End => end = Some(h),
+                }
+                out[dir] = Distribution::Layers { start, end, growth: g };
+                set[dir] = true;
+                continue;
+            }
+            _ => bail!(
+                "--cluster {spec}: expected DIR:uniform, DIR:arctan:A, DIR:tanh:D, SIDE:tanh:D or SIDE:first-height:H[:GROWTH]"
+            ),
+        };
+        if set[dir] {
+            bail!("--cluster {spec}: the {} direction already has a distribution", ["xi", "eta"][dir]);
+        }
+        d.validate(["xi", "eta"][dir])?;
+        out[dir] = d;
+        set[dir] = true;
+    }
+    Ok(out)
+}
+
+fn parse_points(s: &str) -> Result<[usize; 2]> {
+    let (a, b) = s.split_once(['x', 'X']).with_context(|| format!("--structured {s}: expected NXxNY, e.g. 401x35"))?;
+    let n = |t: &str| t.trim().parse::<usize>().with_context(|| format!("--structured {s}: '{t}' is not a count"));
+    Ok([n(a)?, n(b)?])
+}
+
+/// Build the mesh `spec` asks for, write it, print the quality table; returns 0.
+pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
+    let format = Format::from_path(output)?;
+    let t = Instant::now();
+    let linear = if let Some(s) = &spec.structured {
+        let opts = StructuredOptions { points: parse_points(s)?, distribution: distributions(&spec.cluster)? };
+        structured(map, &opts)?
+    } else if spec.unstructured {
+        if !spec.cluster.is_empty() {
+            bail!("--cluster applies to --structured meshes only");
+        }
+        let size = spec.size.context("--unstructured needs --size H")?;
+        let opts = UnstructuredOptions {
+            size,
+            min_angle: spec.min_angle,
+            chord_tol: spec.chord_tol,
+            det_j_ratio: (spec.det_j_ratio > 0.0).then_some(spec.det_j_ratio),
+            order: spec.order as usize,
+            ..Default::default()
+        };
+        unstructured(map, &opts)?
+    } else {
+        bail!("say which mesh: --structured NXxNY or --unstructured --size H");
+    };
+    let mesh = elevate(&linear, map, spec.order as usize)?;
+    let built = t.elapsed().as_secs_f64();
+    let q = quality(&mesh)?;
+    let t = Instant::now();
+    let files = write(&mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
+    let written = t.elapsed().as_secs_f64();
+    if !quiet {
+        println!(
+            "{} mesh, {} {}s of order {} ({}):",
+            if mesh.structured.is_some() { "structured" } else { "unstructured" },
+            mesh.num_cells(),
+            mesh.kind.name(),
+            mesh.order,
+            format.name()
+        );
+        print!("{}", q.table());
+        println!("  built in {built:.3} s, written in {written:.3} s");
+        for f in files {
+            println!("wrote {}", f.display());
+        }
+    }
+    Ok(())
+}
+
+/// `winslow mesh`.
+pub fn run(a: MeshArgs) -> Result<i32> {
+    let doc = winslow::read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let winslow::Document::Map { map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first (or `solve --mesh`)", a.map.display())
+    };
+    make_and_write(&map, &a.spec, &a.output, false)?;
+    Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cluster_specs_parse() {
+        let d = distributions(&["eta:arctan:6".into()]).unwrap();
+        assert_eq!(d[1], Distribution::Arctan { strength: 6.0 });
+        let d = distributions(&["south:first-height:1e-4:1.1".into(), "north:first-height:2e-4:1.1".into()]).unwrap();
+        assert_eq!(d[1], Distribution::Layers { start: Some(1e-4), end: Some(2e-4), growth: 1.1 });
+        let d = distributions(&["west:tanh:2".into()]).unwrap();
+        assert_eq!(d[0], Distribution::TanhOneSided { strength: 2.0, at: End::Start });
+        assert!(distributions(&["eta:arctan:x".into()]).is_err());
+        assert!(distributions(&["eta:arctan:6".into(), "south:first-height:1e-3".into()]).is_err());
+        assert!(distributions(&["south:first-height:1e-3:1.1".into(), "north:first-height:1e-3:1.2".into()]).is_err());
+        assert!(distributions(&["up:uniform".into()]).is_err());
+        assert_eq!(parse_points("401x35").unwrap(), [401, 35]);
+        assert!(parse_points("401").is_err());
+    }
+}

@@ -1,0 +1,152 @@
+//! Gmsh MSH 4.1 ASCII.
+//!
+//! Entities: points 1-4 at the parameter corners `(0,0), (1,0), (1,1), (0,1)`, curves 1-4
+//! = south, east, north, west (counter-clockwise, physical groups 1-4 of those names),
+//! surface 1 bounded by them (physical group 5 "domain"). Every node is classified on
+//! the entity its parameters lie on (corner, side or interior), one node block per
+//! entity; elements: lines on the curves (types 1, 8, 26 for order 1, 2, 3), the cells
+//! on the surface (triangles 2, 9, 21; quadrilaterals 3, 10, 36). Node tag = index + 1.
+
+use std::fmt::Write;
+
+use winslow::Side;
+
+use crate::error::Result;
+use crate::{ElementKind, Mesh};
+
+/// Entity `(dim, tag)` of a node from its parameters.
+pub fn entity(q: glam::DVec2) -> (usize, usize) {
+    let (u0, u1, v0, v1) = (q.x == 0.0, q.x == 1.0, q.y == 0.0, q.y == 1.0);
+    match (u0, u1, v0, v1) {
+        (true, _, true, _) => (0, 1),
+        (_, true, true, _) => (0, 2),
+        (_, true, _, true) => (0, 3),
+        (true, _, _, true) => (0, 4),
+        (_, _, true, _) => (1, 1),
+        (_, true, _, _) => (1, 2),
+        (_, _, _, true) => (1, 3),
+        (true, _, _, _) => (1, 4),
+        _ => (2, 1),
+    }
+}
+
+/// Gmsh element type of a cell kind and order.
+pub fn cell_type(kind: ElementKind, order: usize) -> usize {
+    match (kind, order) {
+        (ElementKind::Triangle, 1) => 2,
+        (ElementKind::Triangle, 2) => 9,
+        (ElementKind::Triangle, _) => 21,
+        (ElementKind::Quad, 1) => 3,
+        (ElementKind::Quad, 2) => 10,
+        (ElementKind::Quad, _) => 36,
+    }
+}
+
+/// Gmsh line type of an order.
+pub fn line_type(order: usize) -> usize {
+    match order {
+        1 => 1,
+        2 => 8,
+        _ => 26,
+    }
+}
+
+/// The file's text.
+pub fn to_string(mesh: &Mesh) -> Result<String> {
+    let mut s = String::with_capacity(64 * mesh.points.len() + 16 * mesh.cells.len());
+    let w = |s: &mut String, a: std::fmt::Arguments| {
+        let _ = s.write_fmt(a);
+    };
+    w(&mut s, format_args!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n5\n"));
+    for side in Side::ALL {
+        w(&mut s, format_args!("1 {} \"{}\"\n", side as usize + 1, side.name()));
+    }
+    w(&mut s, format_args!("2 5 \"domain\"\n$EndPhysicalNames\n"));
+    // corner positions and bounding boxes from the nodes classified on each entity
+    let mut buckets: Vec<Vec<usize>> = vec![Vec::new(); 9]; // points 1-4, curves 1-4, surface
+    let slot = |(d, t): (usize, usize)| match d {
+        0 => t - 1,
+        1 => 3 + t,
+        _ => 8,
+    };
+    for (n, q) in mesh.params.iter().enumerate() {
+        buckets[slot(entity(*q))].push(n);
+    }
+    let bbox = |nodes: &[usize]| {
+        let mut lo = glam::DVec2::splat(f64::INFINITY);
+        let mut hi = glam::DVec2::splat(f64::NEG_INFINITY);
+        for &n in nodes {
+            lo = lo.min(mesh.points[n]);
+            hi = hi.max(mesh.points[n]);
+        }
+        (lo, hi)
+    };
+    w(&mut s, format_args!("$Entities\n4 4 1 0\n"));
+    for t in 0..4 {
+        let p = buckets[t].first().map_or(glam::DVec2::ZERO, |&n| mesh.points[n]);
+        w(&mut s, format_args!("{} {} {} 0 0\n", t + 1, p.x, p.y));
+    }
+    let curve_points = [[1, 2], [2, 3], [3, 4], [4, 1]];
+    for t in 0..4 {
+        let mut nodes = buckets[4 + t].clone();
+        nodes.extend(curve_points[t].iter().flat_map(|&c| buckets[c - 1].iter().copied()));
+        let (lo, hi) = bbox(&nodes);
+        let [a, b] = curve_points[t];
+        w(&mut s, format_args!("{} {} {} 0 {} {} 0 1 {} 2 {a} -{b}\n", t + 1, lo.x, lo.y, hi.x, hi.y, t + 1));
+    }
+    let all: Vec<usize> = (0..mesh.points.len()).collect();
+    let (lo, hi) = bbox(&all);
+    w(&mut s, format_args!("1 {} {} 0 {} {} 0 1 5 4 1 2 3 4\n$EndEntities\n", lo.x, lo.y, hi.x, hi.y));
+    let entities = |k: usize| match k {
+        0..=3 => (0, k + 1),
+        4..=7 => (1, k - 3),
+        _ => (2, 1),
+    };
+    let blocks = buckets.iter().filter(|b| !b.is_empty()).count();
+    let n = mesh.points.len();
+    w(&mut s, format_args!("$Nodes\n{blocks} {n} 1 {n}\n"));
+    for (k, b) in buckets.iter().enumerate().filter(|(_, b)| !b.is_empty()) {
+        let (d, t) = entities(k);
+        w(&mut s, format_args!("{d} {t} 0 {}\n", b.len()));
+        for &i in b {
+            w(&mut s, format_args!("{}\n", i + 1));
+        }
+        for &i in b {
+            let p = mesh.points[i];
+            w(&mut s, format_args!("{} {} 0\n", p.x, p.y));
+        }
+    }
+    w(&mut s, format_args!("$EndNodes\n"));
+    let per_side: Vec<Vec<&crate::BoundaryEdge>> =
+        Side::ALL.iter().map(|&sd| mesh.boundary.iter().filter(|e| e.side == sd).collect()).collect();
+    let lines: usize = per_side.iter().map(Vec::len).sum();
+    let cells = mesh.num_cells();
+    let total = lines + cells;
+    let blocks = per_side.iter().filter(|v| !v.is_empty()).count() + usize::from(cells > 0);
+    w(&mut s, format_args!("$Elements\n{blocks} {total} 1 {total}\n"));
+    let mut tag = 0;
+    for (k, edges) in per_side.iter().enumerate().filter(|(_, v)| !v.is_empty()) {
+        w(&mut s, format_args!("1 {} {} {}\n", k + 1, line_type(mesh.order), edges.len()));
+        for e in edges {
+            tag += 1;
+            s.push_str(&tag.to_string());
+            for &v in &e.nodes {
+                w(&mut s, format_args!(" {}", v + 1));
+            }
+            s.push('\n');
+        }
+    }
+    if cells > 0 {
+        w(&mut s, format_args!("2 1 {} {cells}\n", cell_type(mesh.kind, mesh.order)));
+        for c in 0..cells {
+            tag += 1;
+            s.push_str(&tag.to_string());
+            for &v in mesh.cell(c) {
+                w(&mut s, format_args!(" {}", v + 1));
+            }
+            s.push('\n');
+        }
+    }
+    s.push_str("$EndElements\n");
+    Ok(s)
+}

@@ -1,0 +1,42 @@
+//! SU2 native mesh (`.su2`, ASCII): `NDIME= 2`, the cells as VTK types (5 triangle,
+//! 9 quad) with their index, the points with their index, and one marker per side
+//! (`MARKER_TAG= south`, ...) of line elements (VTK type 3). Linear cells only.
+
+use std::fmt::Write;
+
+use winslow::Side;
+
+use crate::error::Result;
+use crate::{ElementKind, Mesh};
+
+/// The file's text.
+pub fn to_string(mesh: &Mesh) -> Result<String> {
+    super::linear_only(mesh, "SU2")?;
+    let cells = mesh.num_cells();
+    let mut s = String::with_capacity(48 * mesh.points.len() + 24 * cells);
+    let t = match mesh.kind {
+        ElementKind::Triangle => 5,
+        ElementKind::Quad => 9,
+    };
+    let _ = writeln!(s, "% winslow mesh\nNDIME= 2\nNELEM= {cells}");
+    for c in 0..cells {
+        let _ = write!(s, "{t}");
+        for v in mesh.cell(c) {
+            let _ = write!(s, " {v}");
+        }
+        let _ = writeln!(s, " {c}");
+    }
+    let _ = writeln!(s, "NPOIN= {}", mesh.points.len());
+    for (i, p) in mesh.points.iter().enumerate() {
+        let _ = writeln!(s, "{} {} {i}", p.x, p.y);
+    }
+    let _ = writeln!(s, "NMARK= 4");
+    for side in Side::ALL {
+        let edges: Vec<_> = mesh.boundary.iter().filter(|e| e.side == side).collect();
+        let _ = writeln!(s, "MARKER_TAG= {}\nMARKER_ELEMS= {}", side.name(), edges.len());
+        for e in edges {
+            let _ = writeln!(s, "3 {} {}", e.nodes[0], e.nodes[1]);
+        }
+    }
+    Ok(s)
+}

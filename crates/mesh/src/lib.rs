@@ -1,0 +1,152 @@
+//! # winslow-mesh
+//!
+//! Classical meshes from a certified spline map `x(xi, eta)` (paper §11.3): the map is
+//! sampled, never re-solved, so any density costs only function evaluations.
+//!
+//! | module | what lives there |
+//! |---|---|
+//! | [`distribution`] | point distributions per direction: uniform, arctan (eq. 50), tanh, geometric layers |
+//! | [`structured`] | structured quadrilateral meshes at `xi_i x eta_j`, first-cell heights in physical units |
+//! | [`unstructured`] | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
+//! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
+//! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
+//! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
+//! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
+//!
+//! Every mesh is a [`Mesh`]: nodes (physical and parameter coordinates), cells of one
+//! [`ElementKind`] and order with nodes in Gmsh's ordering, and boundary edges labelled
+//! by [`Side`]. Writers refuse a mesh with an inverted cell ([`Mesh::check`]).
+
+pub mod distribution;
+pub mod error;
+pub mod formats;
+pub mod high_order;
+pub mod quality;
+pub mod structured;
+pub mod topology;
+pub mod unstructured;
+
+pub use distribution::{Distribution, End};
+pub use error::{MeshError, Result};
+pub use glam::DVec2;
+pub use quality::{CellQuality, Quality};
+pub use structured::{structured, StructuredOptions};
+pub use unstructured::{parameter_scale, unstructured, UnstructuredOptions};
+pub use winslow::Side;
+
+/// The cell shape of a mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ElementKind {
+    /// Triangles.
+    Triangle,
+    /// Quadrilaterals.
+    Quad,
+}
+
+impl ElementKind {
+    /// Corner count.
+    pub fn corners(self) -> usize {
+        match self {
+            ElementKind::Triangle => 3,
+            ElementKind::Quad => 4,
+        }
+    }
+
+    /// Nodes of an element of order `p`: `(p + 1)(p + 2) / 2` or `(p + 1)^2`.
+    pub fn nodes(self, order: usize) -> usize {
+        match self {
+            ElementKind::Triangle => (order + 1) * (order + 2) / 2,
+            ElementKind::Quad => (order + 1) * (order + 1),
+        }
+    }
+
+    /// Name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ElementKind::Triangle => "triangle",
+            ElementKind::Quad => "quadrilateral",
+        }
+    }
+}
+
+/// One boundary edge: its side and its nodes (the two ends in counter-clockwise order
+/// around the domain, then the interior nodes from the first end on, as Gmsh orders
+/// lines).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundaryEdge {
+    /// Side of the parameter square the edge lies on.
+    pub side: Side,
+    /// Node indices.
+    pub nodes: Vec<usize>,
+}
+
+/// A mesh of the map's image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Physical node coordinates `x(xi, eta)`.
+    pub points: Vec<DVec2>,
+    /// Parameter coordinates `(xi, eta)` of each node; boundary nodes lie exactly on
+    /// `xi in {0, 1}` or `eta in {0, 1}`.
+    pub params: Vec<DVec2>,
+    /// Cell shape.
+    pub kind: ElementKind,
+    /// Polynomial order of the elements (1, 2 or 3).
+    pub order: usize,
+    /// Cell connectivity, `kind.nodes(order)` indices per cell in Gmsh's node ordering
+    /// (corners counter-clockwise first).
+    pub cells: Vec<usize>,
+    /// Boundary edges, counter-clockwise around the domain.
+    pub boundary: Vec<BoundaryEdge>,
+    /// Points per direction `[nx, ny]` when the nodes are a structured grid stored
+    /// `xi` fastest (linear structured meshes only).
+    pub structured: Option<[usize; 2]>,
+}
+
+impl Mesh {
+    /// Nodes per cell.
+    pub fn nodes_per_cell(&self) -> usize {
+        self.kind.nodes(self.order)
+    }
+
+    /// Number of cells.
+    pub fn num_cells(&self) -> usize {
+        self.cells.len() / self.nodes_per_cell()
+    }
+
+    /// The nodes of cell `c`.
+    pub fn cell(&self, c: usize) -> &[usize] {
+        let n = self.nodes_per_cell();
+        &self.cells[c * n..(c + 1) * n]
+    }
+
+    /// The corner nodes of cell `c`, counter-clockwise.
+    pub fn corners(&self, c: usize) -> &[usize] {
+        &self.cell(c)[..self.kind.corners()]
+    }
+
+    /// Refuse a mesh with an inverted or degenerate cell: every corner of every cell must
+    /// turn left (`(b - a) x (c - b) > 0`), and curved elements must have a positive
+    /// Jacobian at their nodes and quadrature points ([`high_order::check_jacobians`]).
+    pub fn check(&self) -> Result<()> {
+        let mut bad: Option<(usize, String)> = None;
+        let mut count = 0;
+        for c in 0..self.num_cells() {
+            if let Some(why) = quality::corner_defect(self, c) {
+                count += 1;
+                bad.get_or_insert((c, why));
+            }
+        }
+        if let Some((cell, why)) = bad {
+            return Err(MeshError::Inverted { cell, why, count });
+        }
+        if self.order > 1 {
+            high_order::check_jacobians(self)?;
+        }
+        Ok(())
+    }
+}
+
+/// The nodes of the map's image with parameters `params`.
+pub fn map_points(map: &winslow::Surface, params: &[DVec2]) -> Vec<DVec2> {
+    params.iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect()
+}

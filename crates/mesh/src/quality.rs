@@ -1,0 +1,209 @@
+//! Mesh quality, measured on the straight-sided cells through the corner nodes.
+//!
+//! Per cell: signed area (shoelace), interior angles, aspect ratio (longest over
+//! shortest edge), equiangular skewness `max((t_max - t_e) / (180 - t_e), (t_e - t_min) / t_e)`
+//! with `t_e` = 90° (quads) or 60° (triangles), growth (largest area ratio to an edge
+//! neighbour, >= 1) and non-orthogonality (largest angle between an edge's normal and
+//! the line joining the centroids of the cells on either side, OpenFOAM's measure).
+
+use glam::DVec2;
+
+use crate::error::Result;
+use crate::topology::Faces;
+use crate::Mesh;
+
+/// Quality of one cell.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CellQuality {
+    /// Signed area (positive for counter-clockwise cells).
+    pub area: f64,
+    /// Smallest interior angle, degrees.
+    pub min_angle: f64,
+    /// Largest interior angle, degrees.
+    pub max_angle: f64,
+    /// Longest over shortest edge.
+    pub aspect: f64,
+    /// Equiangular skewness in `[0, 1]`.
+    pub skewness: f64,
+    /// Largest area ratio to an edge neighbour (>= 1).
+    pub growth: f64,
+    /// Largest non-orthogonality of the cell's internal edges, degrees.
+    pub non_orthogonality: f64,
+}
+
+/// The mesh's quality table.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Quality {
+    /// Number of nodes.
+    pub nodes: usize,
+    /// Number of cells.
+    pub cells: usize,
+    /// Smallest and largest cell area.
+    pub area: [f64; 2],
+    /// Smallest and largest interior angle, degrees.
+    pub angle: [f64; 2],
+    /// Largest aspect ratio.
+    pub max_aspect: f64,
+    /// Largest skewness.
+    pub max_skewness: f64,
+    /// Largest growth ratio between neighbours.
+    pub max_growth: f64,
+    /// Largest and mean non-orthogonality over internal edges, degrees.
+    pub non_orthogonality: [f64; 2],
+    /// Cells that are inverted or degenerate (see [`Mesh::check`]).
+    pub inverted: usize,
+    /// Smallest ratio `min det J / max det J` of a curved element's own Jacobian over
+    /// its nodes and quadrature points (order > 1 only).
+    pub min_jacobian_ratio: Option<f64>,
+    /// Per-cell values.
+    pub per_cell: Vec<CellQuality>,
+}
+
+fn cross(a: DVec2, b: DVec2) -> f64 {
+    a.perp_dot(b)
+}
+
+/// Signed area and centroid of a polygon.
+fn area_centroid(p: &[DVec2]) -> (f64, DVec2) {
+    let (mut a, mut c) = (0.0, DVec2::ZERO);
+    for k in 0..p.len() {
+        let (u, v) = (p[k], p[(k + 1) % p.len()]);
+        let w = cross(u, v);
+        a += w;
+        c += (u + v) * w;
+    }
+    if a == 0.0 {
+        (0.0, p.iter().copied().sum::<DVec2>() / p.len() as f64)
+    } else {
+        (0.5 * a, c / (3.0 * a))
+    }
+}
+
+/// Why cell `c` is inverted or degenerate, if it is: a corner that does not turn left.
+pub fn corner_defect(mesh: &Mesh, c: usize) -> Option<String> {
+    let v = mesh.corners(c);
+    let k = v.len();
+    for i in 0..k {
+        let (a, b, d) = (mesh.points[v[(i + k - 1) % k]], mesh.points[v[i]], mesh.points[v[(i + 1) % k]]);
+        let t = cross(b - a, d - b);
+        if t.is_nan() || t <= 0.0 {
+            return Some(format!("corner {i} (node {}) at ({}, {}) has turn {t:.3e}", v[i], b.x, b.y));
+        }
+    }
+    None
+}
+
+/// Quality of every cell and the table (the faces of `faces` give growth and
+/// non-orthogonality).
+pub fn quality_with(mesh: &Mesh, faces: &Faces) -> Quality {
+    let n = mesh.num_cells();
+    let k = mesh.kind.corners();
+    let ideal = if k == 3 { 60.0 } else { 90.0 };
+    let mut per = Vec::with_capacity(n);
+    let mut centroid = Vec::with_capacity(n);
+    let mut inverted = 0;
+    let mut pts = [DVec2::ZERO; 4];
+    for c in 0..n {
+        let v = mesh.corners(c);
+        for i in 0..k {
+            pts[i] = mesh.points[v[i]];
+        }
+        let p = &pts[..k];
+        let (area, cen) = area_centroid(p);
+        centroid.push(cen);
+        let (mut amin, mut amax, mut emin, mut emax) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+        for i in 0..k {
+            let (prev, cur, next) = (p[(i + k - 1) % k], p[i], p[(i + 1) % k]);
+            let (e1, e0) = (next - cur, prev - cur);
+            let mut ang = cross(e1, e0).atan2(e1.dot(e0)).to_degrees();
+            if ang < 0.0 {
+                ang += 360.0;
+            }
+            amin = amin.min(ang);
+            amax = amax.max(ang);
+            let len = e1.length();
+            emin = emin.min(len);
+            emax = emax.max(len);
+        }
+        if corner_defect(mesh, c).is_some() {
+            inverted += 1;
+        }
+        let skewness = ((amax - ideal) / (180.0 - ideal)).max((ideal - amin) / ideal).max(0.0);
+        per.push(CellQuality {
+            area,
+            min_angle: amin,
+            max_angle: amax,
+            aspect: emax / emin,
+            skewness,
+            growth: 1.0,
+            non_orthogonality: 0.0,
+        });
+    }
+    let (mut no_max, mut no_sum) = (0.0f64, 0.0);
+    for f in &faces.internal {
+        let (o, nb) = (f.owner, f.neighbour);
+        let (a, b) = (mesh.points[f.nodes[0]], mesh.points[f.nodes[1]]);
+        let normal = DVec2::new((b - a).y, -(b - a).x);
+        let d = centroid[nb] - centroid[o];
+        let cosang = (normal.dot(d) / (normal.length() * d.length())).clamp(-1.0, 1.0);
+        let ang = if cosang.is_nan() { 90.0 } else { cosang.acos().to_degrees() };
+        no_max = no_max.max(ang);
+        no_sum += ang;
+        let (ao, an) = (per[o].area.abs(), per[nb].area.abs());
+        let g = ao.max(an) / ao.min(an);
+        let g = if g.is_nan() { f64::INFINITY } else { g };
+        for c in [o, nb] {
+            per[c].growth = per[c].growth.max(g);
+            per[c].non_orthogonality = per[c].non_orthogonality.max(ang);
+        }
+    }
+    let fold = |f: fn(&CellQuality) -> f64, init: f64, op: fn(f64, f64) -> f64| per.iter().map(f).fold(init, op);
+    Quality {
+        nodes: mesh.points.len(),
+        cells: n,
+        area: [fold(|q| q.area, f64::INFINITY, f64::min), fold(|q| q.area, f64::NEG_INFINITY, f64::max)],
+        angle: [fold(|q| q.min_angle, f64::INFINITY, f64::min), fold(|q| q.max_angle, 0.0, f64::max)],
+        max_aspect: fold(|q| q.aspect, 0.0, f64::max),
+        max_skewness: fold(|q| q.skewness, 0.0, f64::max),
+        max_growth: fold(|q| q.growth, 1.0, f64::max),
+        non_orthogonality: [no_max, if faces.internal.is_empty() { 0.0 } else { no_sum / faces.internal.len() as f64 }],
+        inverted,
+        min_jacobian_ratio: None,
+        per_cell: per,
+    }
+}
+
+/// Quality of a mesh (faces built here; curved elements also get their Jacobian ratio).
+pub fn quality(mesh: &Mesh) -> Result<Quality> {
+    let faces = crate::topology::faces(mesh)?;
+    let mut q = quality_with(mesh, &faces);
+    if mesh.order > 1 {
+        q.min_jacobian_ratio = Some(crate::high_order::min_jacobian_ratio(mesh));
+    }
+    Ok(q)
+}
+
+impl Quality {
+    /// The quality table as text.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let mut row = |k: &str, v: String| {
+            s.push_str(&format!("  {k:<28} {v}\n"));
+        };
+        row("nodes / cells", format!("{} / {}", self.nodes, self.cells));
+        row("cell area min / max", format!("{:.4e} / {:.4e}", self.area[0], self.area[1]));
+        row("angle min / max (deg)", format!("{:.2} / {:.2}", self.angle[0], self.angle[1]));
+        row("max aspect ratio", format!("{:.3}", self.max_aspect));
+        row("max skewness", format!("{:.4}", self.max_skewness));
+        row("max growth ratio", format!("{:.4}", self.max_growth));
+        row(
+            "non-orthogonality max / mean",
+            format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
+        );
+        if let Some(r) = self.min_jacobian_ratio {
+            row("min det J ratio (curved)", format!("{r:.4}"));
+        }
+        row("inverted cells", format!("{}", self.inverted));
+        s
+    }
+}

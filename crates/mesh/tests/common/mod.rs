@@ -1,0 +1,48 @@
+//! Maps with closed forms for the tests.
+#![allow(dead_code)]
+
+use winslow::{KnotVector, Surface};
+use winslow_mesh::DVec2;
+
+/// `x = b + A (u, v)` as a bilinear spline (degree 1, one element), and its closed form.
+pub fn affine() -> (Surface, impl Fn(f64, f64) -> DVec2) {
+    let (b, a1, a2) = (DVec2::new(0.5, -1.0), DVec2::new(3.0, 0.5), DVec2::new(0.75, 2.0));
+    let kv = KnotVector::open_uniform(1, 1);
+    let cps = vec![b, b + a1, b + a2, b + a1 + a2].into_iter().map(|p| [p.x, p.y]).collect();
+    (Surface::new([kv.clone(), kv], cps, None).unwrap(), move |u, v| b + a1 * u + a2 * v)
+}
+
+/// Quarter annulus `1 <= r <= 2`: `u` radial (radius `1 + u`), `v` the angle along exact
+/// NURBS circles, counter-clockwise (`det J > 0`).
+pub fn annulus() -> Surface {
+    let ku = KnotVector::open_uniform(1, 1);
+    let kv = KnotVector::open_uniform(2, 1);
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    let mut cps = Vec::new();
+    let mut ws = Vec::new();
+    for (c, wj) in [([1.0, 0.0], 1.0), ([1.0, 1.0], w), ([0.0, 1.0], 1.0)] {
+        for r in [1.0, 2.0] {
+            cps.push([r * c[0], r * c[1]]);
+            ws.push(wj);
+        }
+    }
+    Surface::new([ku, kv], cps, Some(ws)).unwrap()
+}
+
+/// A map that folds: one interior control point pulled across the domain.
+pub fn folded() -> Surface {
+    let kv = KnotVector::open_uniform(2, 1);
+    let mut cps = Vec::new();
+    for j in 0..3 {
+        for i in 0..3 {
+            cps.push([i as f64 * 0.5, j as f64 * 0.5]);
+        }
+    }
+    cps[4] = [2.5, 2.5];
+    Surface::new([kv.clone(), kv], cps, None).unwrap()
+}
+
+/// Twice the signed area of the corners of a cell.
+pub fn signed_area(p: &[DVec2]) -> f64 {
+    (0..p.len()).map(|k| p[k].perp_dot(p[(k + 1) % p.len()])).sum()
+}

@@ -1,0 +1,226 @@
+//! Structured, unstructured and curved meshes checked against closed forms.
+
+mod common;
+
+use common::{affine, annulus, folded, signed_area};
+use winslow_mesh::distribution::End;
+use winslow_mesh::high_order::elevate;
+use winslow_mesh::quality::quality;
+use winslow_mesh::structured::parameters;
+use winslow_mesh::{
+    structured, unstructured, DVec2, Distribution, MeshError, Side, StructuredOptions, UnstructuredOptions,
+};
+
+fn close(a: DVec2, b: DVec2, tol: f64) -> bool {
+    a.distance(b) <= tol * (1.0 + b.length())
+}
+
+#[test]
+fn affine_map_reproduces_the_affine_grid() {
+    let (map, exact) = affine();
+    for dist in [
+        [Distribution::Uniform, Distribution::Arctan { strength: 6.0 }],
+        [Distribution::TanhTwoSided { strength: 3.0 }, Distribution::TanhOneSided { strength: 2.0, at: End::Start }],
+    ] {
+        let opts = StructuredOptions { points: [17, 9], distribution: dist.clone() };
+        let mesh = structured(&map, &opts).unwrap();
+        let xi = dist[0].points(16).unwrap();
+        let eta = dist[1].points(8).unwrap();
+        assert_eq!(mesh.points.len(), 17 * 9);
+        assert_eq!(mesh.num_cells(), 16 * 8);
+        for j in 0..9 {
+            for i in 0..17 {
+                let p = mesh.points[j * 17 + i];
+                assert!(close(p, exact(xi[i], eta[j]), 4e-16), "({i}, {j}): {p} vs {}", exact(xi[i], eta[j]));
+            }
+        }
+        mesh.check().unwrap();
+        // a parallelogram grid: every angle equals the angle between the two columns of A
+        let q = quality(&mesh).unwrap();
+        let a = (DVec2::new(3.0, 0.5).angle_to(DVec2::new(0.75, 2.0))).to_degrees();
+        assert!((q.angle[0] - a).abs() < 1e-9 && (q.angle[1] - (180.0 - a)).abs() < 1e-9, "{:?}", q.angle);
+        assert_eq!(q.inverted, 0);
+        assert_eq!(mesh.boundary.len(), 2 * (16 + 8));
+    }
+}
+
+#[test]
+fn first_cell_height_and_growth_are_met_on_an_affine_map() {
+    let (map, _) = affine();
+    let (h, g) = (1e-3, 1.12);
+    let opts = StructuredOptions {
+        points: [41, 90],
+        distribution: [
+            Distribution::Layers { start: None, end: Some(2e-3), growth: 1.2 },
+            Distribution::Layers { start: Some(h), end: Some(h), growth: g },
+        ],
+    };
+    let mesh = structured(&map, &opts).unwrap();
+    let [nx, ny] = mesh.structured.unwrap();
+    let p = |i: usize, j: usize| mesh.points[j * nx + i];
+    // lengths are of order 1 here: heights to 1e-12 absolute, ratios to 1e-12 relative
+    for i in 0..nx {
+        // south and north: the first edge off the wall is H
+        assert!((p(i, 1).distance(p(i, 0)) - h).abs() < 1e-12);
+        assert!((p(i, ny - 1).distance(p(i, ny - 2)) - h).abs() < 1e-12);
+        let e: Vec<f64> = (0..ny - 1).map(|j| p(i, j + 1).distance(p(i, j))).collect();
+        assert!((e[1] / e[0] - g).abs() < 1e-12 * g, "{}", e[1] / e[0]);
+        for w in e.windows(2) {
+            assert!((w[1] / w[0]).max(w[0] / w[1]) <= g * (1.0 + 1e-12));
+        }
+    }
+    for j in 0..ny {
+        let e = p(nx - 1, j).distance(p(nx - 2, j));
+        assert!((e - 2e-3).abs() < 1e-12, "{e}");
+    }
+    mesh.check().unwrap();
+    let q = quality(&mesh).unwrap();
+    assert!(q.max_growth <= 1.2 * (1.0 + 1e-9), "{}", q.max_growth);
+}
+
+#[test]
+fn first_cell_height_on_a_curved_map_is_the_largest_over_the_grid_lines() {
+    let map = annulus();
+    let h = 2e-3;
+    let opts = StructuredOptions {
+        points: [31, 25],
+        distribution: [
+            Distribution::Layers { start: Some(5e-3), end: None, growth: 1.3 },
+            Distribution::Layers { start: Some(h), end: None, growth: 1.3 },
+        ],
+    };
+    let [xi, eta] = parameters(&map, &opts).unwrap();
+    let x = |u: f64, v: f64| DVec2::from(map.eval(u, v));
+    let first = xi.iter().map(|&u| x(u, eta[1]).distance(x(u, 0.0))).fold(0.0, f64::max);
+    assert!((first - h).abs() < 1e-12 * h, "{first}");
+    // on the annulus the xi-lines are radial: the height is the radius step, 1 + u
+    assert!((xi[1] - 5e-3).abs() < 1e-12);
+    let west = eta.iter().map(|&v| x(xi[1], v).distance(x(0.0, v))).fold(0.0, f64::max);
+    assert!((west - 5e-3).abs() < 1e-12 * 5e-3, "{west}");
+}
+
+#[test]
+fn impossible_layers_are_refused() {
+    let (map, _) = affine();
+    let opts = StructuredOptions {
+        points: [5, 6],
+        distribution: [Distribution::Uniform, Distribution::Layers { start: Some(1e-5), end: None, growth: 1.1 }],
+    };
+    assert!(matches!(structured(&map, &opts), Err(MeshError::Layer { .. })));
+    let opts = StructuredOptions {
+        points: [5, 6],
+        distribution: [Distribution::Uniform, Distribution::Layers { start: Some(50.0), end: None, growth: 1.1 }],
+    };
+    assert!(matches!(structured(&map, &opts), Err(MeshError::Layer { .. })));
+}
+
+#[test]
+fn a_folded_map_gives_a_mesh_that_is_refused() {
+    let mesh = structured(&folded(), &StructuredOptions::uniform(41, 41)).unwrap();
+    let err = mesh.check().unwrap_err();
+    assert!(matches!(err, MeshError::Inverted { count, .. } if count > 0), "{err}");
+    assert!(quality(&mesh).unwrap().inverted > 0);
+    let dir = std::env::temp_dir().join(format!("winslow-mesh-folded-{}", std::process::id()));
+    let path = dir.join("folded.msh");
+    let r = winslow_mesh::formats::write(&mesh, &path, winslow_mesh::formats::Format::Gmsh);
+    assert!(matches!(r, Err(MeshError::Inverted { .. })));
+    assert!(!path.exists());
+}
+
+/// Interior angle at each corner of a triangle.
+fn angles(p: [DVec2; 3]) -> [f64; 3] {
+    let ang = |a: DVec2, b: DVec2, c: DVec2| (b - a).angle_to(c - a).abs().to_degrees();
+    [ang(p[0], p[1], p[2]), ang(p[1], p[2], p[0]), ang(p[2], p[0], p[1])]
+}
+
+#[test]
+fn triangulation_meets_the_angle_in_parameter_space_and_the_size_in_physical_space() {
+    let map = annulus();
+    let opts = UnstructuredOptions { size: 0.08, min_angle: 28.0, ..Default::default() };
+    let mesh = unstructured(&map, &opts).unwrap();
+    mesh.check().unwrap();
+    // the triangulation's own space: the square stretched by the mean side lengths
+    let scale = winslow_mesh::parameter_scale(&map);
+    assert!((scale.x - 1.0).abs() < 1e-12 && (scale.y - 0.75 * std::f64::consts::PI).abs() < 1e-5, "{scale}");
+    let (mut pmin, mut xmin) = (f64::INFINITY, f64::INFINITY);
+    for c in 0..mesh.num_cells() {
+        let v = mesh.corners(c);
+        let q = [mesh.params[v[0]] * scale, mesh.params[v[1]] * scale, mesh.params[v[2]] * scale];
+        let x = [mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]]];
+        assert!(signed_area(&q) > 0.0 && signed_area(&x) > 0.0, "cell {c} is not counter-clockwise");
+        pmin = angles(q).into_iter().fold(pmin, f64::min);
+        xmin = angles(x).into_iter().fold(xmin, f64::min);
+        for k in 0..3 {
+            assert!(x[k].distance(x[(k + 1) % 3]) <= opts.size * (1.0 + 1e-12));
+        }
+    }
+    assert!(pmin >= 28.0 - 1e-6, "parameter-space min angle {pmin}");
+    let q = quality(&mesh).unwrap();
+    assert!((q.angle[0] - xmin).abs() < 1e-9, "report {} vs {xmin}", q.angle[0]);
+    // nodes are the map's: on the annulus |x| = 1 + v
+    for (x, p) in mesh.points.iter().zip(&mesh.params) {
+        assert!((x.length() - (1.0 + p.x)).abs() < 1e-13);
+    }
+    // boundary labels: every labelled edge lies on its side, and the sides are closed
+    for side in Side::ALL {
+        let edges: Vec<_> = mesh.boundary.iter().filter(|e| e.side == side).collect();
+        assert!(!edges.is_empty());
+        for e in &edges {
+            for &n in &e.nodes {
+                let p = mesh.params[n];
+                let on = match side {
+                    Side::South => p.y == 0.0,
+                    Side::East => p.x == 1.0,
+                    Side::North => p.y == 1.0,
+                    Side::West => p.x == 0.0,
+                };
+                assert!(on, "{side}: node {n} at {p}");
+            }
+        }
+        for w in edges.windows(2) {
+            assert_eq!(w[0].nodes[1], w[1].nodes[0], "{side} edges are not consecutive");
+        }
+    }
+    // Euler: V - E + F = 1 for a disc
+    let e = (3 * mesh.num_cells() + mesh.boundary.len()) / 2;
+    assert_eq!(mesh.points.len() + mesh.num_cells(), e + 1);
+}
+
+#[test]
+fn curved_elements_have_their_nodes_on_the_map() {
+    let map = annulus();
+    let lin = [
+        structured(&map, &StructuredOptions::uniform(9, 5)).unwrap(),
+        unstructured(&map, &UnstructuredOptions { size: 0.3, ..Default::default() }).unwrap(),
+    ];
+    for mesh in &lin {
+        for p in [2, 3] {
+            let hi = elevate(mesh, &map, p).unwrap();
+            assert_eq!(hi.order, p);
+            assert_eq!(hi.nodes_per_cell(), hi.kind.nodes(p));
+            hi.check().unwrap();
+            for (x, q) in hi.points.iter().zip(&hi.params) {
+                assert_eq!(*x, DVec2::from(map.eval(q.x, q.y)));
+                assert!((x.length() - (1.0 + q.x)).abs() < 1e-13);
+            }
+            // edge nodes shared: each interior edge's nodes appear in two cells
+            let mut uses = vec![0usize; hi.points.len()];
+            for &n in &hi.cells {
+                uses[n] += 1;
+            }
+            for b in &hi.boundary {
+                assert_eq!(b.nodes.len(), p + 1);
+                for &n in &b.nodes[2..] {
+                    assert_eq!(uses[n], 1, "a boundary edge node belongs to one cell");
+                }
+            }
+            let r = quality(&hi).unwrap().min_jacobian_ratio.unwrap();
+            assert!(r > 0.0 && r <= 1.0);
+        }
+    }
+    // a folded map gives curved elements that are refused
+    let f = structured(&folded(), &StructuredOptions::uniform(3, 3)).unwrap();
+    if f.check().is_ok() {
+        assert!(elevate(&f, &folded(), 3).unwrap().check().is_err());
+    }
+}
