@@ -33,8 +33,7 @@ fn code(text: &str) -> String {
     let mut out = String::new();
     let mut skip_depth: Option<i32> = None;
     let mut depth = 0i32;
-    let mut lines = text.lines().peekable();
-    while let Some(line) = lines.next() {
+    for line in text.lines() {
         let t = line.trim_start();
         if t.starts_with("//") {
             continue;
