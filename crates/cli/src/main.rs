@@ -16,6 +16,7 @@ use winslow::io::picture::{render, PictureOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, write_json, Document, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::EggAssembler;
+use winslow::solve::improve::Improve;
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::report::{Solution, Verdict};
 use winslow::solve::solver::{EggSolver, Event, SolveOptions};
@@ -243,6 +244,16 @@ struct SolverArgs {
     /// the offending elements (the rest stay frozen at the prolonged map).
     #[arg(long)]
     repair_freeze: Option<usize>,
+    /// After the solve and its certificate, improve the map on the same basis:
+    /// minimize the Winslow functional (eq. 16) from the certified map, certify again,
+    /// keep the improved map only when it is certified.
+    #[arg(long, value_enum)]
+    improve: Option<ImproveArg>,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum ImproveArg {
+    Winslow,
 }
 
 impl SolverArgs {
@@ -277,6 +288,9 @@ impl SolverArgs {
         o.min_elements = self.min_elements.max(1);
         o.refine = self.refine;
         o.growth = self.growth.max(1.0);
+        o.improve = self.improve.map(|i| match i {
+            ImproveArg::Winslow => Improve::Winslow,
+        });
         Ok(o)
     }
 }

@@ -152,6 +152,14 @@ pub trait Method: Send + Sync + std::fmt::Debug {
     /// are off by about the domain size: `|F| sqrt(m) / residual_size` is the relative
     /// residual the stopping rule compares with the tolerance.
     fn residual_size(&self, diameter: f64) -> f64;
+    /// The multiplier that turns `|F|` into the dimensionless residual the stopping
+    /// rule compares with the tolerance, for `m` free functions: `sqrt(m) /
+    /// residual_size` for forms `∫ w_i (...)` (`∫ w_i ~ 1/m`, the default); a form
+    /// `∫ ∇w_i · G` whose `G` is dimensionless (eq. 14) or of size `1 / diameter`
+    /// (eq. 16's gradient) has `|F| ~ 1 / diameter` at any `m` and overrides this.
+    fn residual_scale(&self, diameter: f64, m: usize) -> f64 {
+        (m.max(1) as f64).sqrt() / self.residual_size(diameter)
+    }
     /// The discrete problem on `disc` starting from `control_points`.
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
 }

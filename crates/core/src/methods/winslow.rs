@@ -58,9 +58,14 @@ impl Method for WinslowMethod {
         Start::Bijective
     }
 
-    /// `W` is dimensionless and `∂J/∂c_i ~ ∫ |∇w_i| / diam ~ 1 / (m diam)`.
+    /// `∂W/∂e ~ 1 / diam`, so `∂J/∂c_i ~ ∫ |∇w_i| / diam ~ 1 / (sqrt(m) diam)`.
     fn residual_size(&self, diameter: f64) -> f64 {
         1.0 / diameter
+    }
+
+    /// `|∇J| ~ 1 / diam` whatever `m`: the scaled residual is `|∇J| diam`.
+    fn residual_scale(&self, diameter: f64, _m: usize) -> f64 {
+        diameter
     }
 
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send> {

@@ -9,8 +9,10 @@
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
+//! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified | §4.1, §9 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict) | §8.1, §10 |
 
+pub mod improve;
 pub mod initial;
 pub mod levels;
 pub mod newton;

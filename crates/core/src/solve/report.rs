@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use super::improve::Improvement;
 use super::repair::RepairRound;
 use super::solver::{LevelReport, SolveOptions};
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
@@ -114,6 +115,9 @@ pub struct Report {
     pub basis_functions: usize,
     /// The boundary reparameterization (paper §7): method used and matched pairs.
     pub reparam: crate::boundary::reparam::ReparamReport,
+    /// The improvement stage after the solve (`--improve winslow`): quality before and
+    /// after, iterations, time; `null` when none was asked for.
+    pub improvement: Option<Improvement>,
 }
 
 /// A solved map and its report.
@@ -164,6 +168,7 @@ pub(crate) struct ReportContext<'a> {
     pub repairs: usize,
     pub rounds: Vec<RepairRound>,
     pub certificate: Certificate,
+    pub improvement: Option<Improvement>,
     pub elapsed: Duration,
 }
 
@@ -213,6 +218,9 @@ impl Solution {
                 k.side, k.point[0], k.point[1], k.turning_degrees
             ));
         }
+        if let Some(imp) = &ctx.improvement {
+            message.push_str(&format!("; improvement: {}", imp.message));
+        }
         let fit = Side::ALL
             .iter()
             .map(|&s| {
@@ -259,6 +267,7 @@ impl Solution {
             seconds: ctx.elapsed.as_secs_f64(),
             basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
             reparam: h.reparam.clone(),
+            improvement: ctx.improvement,
         };
         Self { name: name.to_string(), map, report }
     }

@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::improve::{improve, Improve, Improvement};
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
 use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
@@ -68,6 +69,10 @@ pub struct SolveOptions {
     /// The boundary condition of each side of the patch (four Dirichlet sides by
     /// default; see [`Topology`]).
     pub topology: Topology,
+    /// After the solve and its certificate, improve the map on the same basis (e.g.
+    /// minimize the Winslow functional, eq. 16) and certify again; the improved map is
+    /// kept only when certified ([`crate::solve::improve`]).
+    pub improve: Option<Improve>,
 }
 
 impl Default for SolveOptions {
@@ -88,6 +93,7 @@ impl Default for SolveOptions {
             certify: CertifyOptions::default(),
             poisson: false,
             topology: Topology::dirichlet(),
+            improve: None,
         }
     }
 }
@@ -267,7 +273,7 @@ impl EggSolver {
     /// length units.
     fn level_options(&self, m: usize) -> NonlinearOptions {
         let mut nl = self.opts.nonlinear;
-        nl.scale = (m.max(1) as f64).sqrt() / self.method.residual_size(self.diameter);
+        nl.scale = self.method.residual_scale(self.diameter, m);
         nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
         nl
     }
@@ -365,10 +371,33 @@ impl EggSolver {
         for e in self.by_ref() {
             e?;
         }
-        let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
-        let certificate = match self.certificate.take() {
+        let mut map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let mut certificate = match self.certificate.take() {
             Some(c) => c,
             None => certify(&map, &self.opts.certify)?,
+        };
+        let improvement = match self.opts.improve {
+            None => None,
+            Some(imp) => {
+                let method = imp.method();
+                if self.reports.last().is_some_and(|l| l.converged) {
+                    let (topology, certify_opts) = (&self.opts.topology, &self.opts.certify);
+                    let nl = self.opts.nonlinear;
+                    match improve(&map, &certificate, &*method, topology, nl, certify_opts, self.diameter) {
+                        Ok(out) => {
+                            map = out.map;
+                            certificate = out.certificate;
+                            Some(out.report)
+                        }
+                        Err(Error::InfeasibleStart { reason, .. }) => {
+                            Some(Improvement::skipped(&*method, &map, format!("the map is not certified ({reason})")))
+                        }
+                        Err(e) => return Err(e),
+                    }
+                } else {
+                    Some(Improvement::skipped(&*method, &map, "the solve did not converge".into()))
+                }
+            }
         };
         let finest = self.plan.last().expect("non-empty plan");
         let ctx = ReportContext {
@@ -381,6 +410,7 @@ impl EggSolver {
             repairs: self.repairs,
             rounds: self.rounds.clone(),
             certificate,
+            improvement,
             elapsed: self.started.elapsed(),
         };
         Ok(Solution::new(&boundary.name, map, self.reports, ctx))
