@@ -244,16 +244,19 @@ struct SolverArgs {
     /// the offending elements (the rest stay frozen at the prolonged map).
     #[arg(long)]
     repair_freeze: Option<usize>,
-    /// After the solve and its certificate, improve the map on the same basis:
-    /// minimize the Winslow functional (eq. 16) from the certified map, certify again,
-    /// keep the improved map only when it is certified.
+    /// After the solve and its certificate, improve the map on the same basis, from the
+    /// certified map: minimize the Winslow functional (eq. 16) or solve the weak form
+    /// (eq. 14); certify again and keep the improved map only when it is certified.
     #[arg(long, value_enum)]
     improve: Option<ImproveArg>,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
 enum ImproveArg {
+    /// Minimize the Winslow functional (eq. 16).
     Winslow,
+    /// Solve the weak form (eq. 14) from the certified map.
+    Weak,
 }
 
 impl SolverArgs {
@@ -290,6 +293,7 @@ impl SolverArgs {
         o.growth = self.growth.max(1.0);
         o.improve = self.improve.map(|i| match i {
             ImproveArg::Winslow => Improve::Winslow,
+            ImproveArg::Weak => Improve::WeakForm,
         });
         Ok(o)
     }

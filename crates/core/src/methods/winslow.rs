@@ -40,6 +40,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::flux::{flux_form, gradient_at};
 use super::{block_mass, DiscreteProblem, Method, Start};
 use crate::discrete::assembly::{element_product, Discretization, Scratch};
 use crate::linalg::sparse::Csr;
@@ -100,25 +101,6 @@ pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
     (w, g, h)
 }
 
-/// `e = (x_ξ, x_η, y_ξ, y_η)` at the point whose tensor basis is in `s.b`.
-fn gradient_at(disc: &Discretization, ex: usize, ey: usize, cps: &[Point], s: &Scratch) -> [f64; 4] {
-    let (p, q) = disc.degrees();
-    let nx = disc.shape()[0];
-    let (fx, fy) = (disc.tables[0].first[ex], disc.tables[1].first[ey]);
-    let mut e = [0.0; 4];
-    for jb in 0..=q {
-        for ib in 0..=p {
-            let c = cps[(fy + jb) * nx + fx + ib];
-            let b = &s.b[jb * (p + 1) + ib];
-            e[0] += b[1] * c[0];
-            e[1] += b[2] * c[0];
-            e[2] += b[1] * c[1];
-            e[3] += b[2] * c[1];
-        }
-    }
-    e
-}
-
 /// `J = ∫ W` (eq. 16) of the map with control points `cps` by the quadrature of `disc`;
 /// `+∞` when `det J <= 0` at a quadrature point. Element rows in parallel, summed in
 /// order (deterministic).
@@ -153,54 +135,12 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
 }
 
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
-/// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`.
+/// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
+/// form of [`flux_form`] with `G = -∂W/∂e`.
 pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
-    let nq = [disc.tables[0].nq, disc.tables[1].nq];
-    let nqp = nq[0] * nq[1];
-    let want_mat = !stencil.is_empty();
-    disc.assemble(2, res, stencil, |ex, ey, s| {
-        let nloc = s.nloc;
-        s.re.fill(0.0);
-        if want_mat {
-            // per block (z, d): rows (j, k) of test weights, rows (j, k) of w_b,j
-            s.reserve_products(8 * nqp * nloc, 2 * nqp * nloc);
-        }
-        for kv in 0..nq[1] {
-            for ku in 0..nq[0] {
-                let k = kv * nq[0] + ku;
-                let wq = disc.tensor_basis(ex, ey, ku, kv, s);
-                let e = gradient_at(disc, ex, ey, cps, s);
-                let (_, g, h) = winslow_density(e);
-                for a in 0..nloc {
-                    let (bu, bv) = (s.b[a][1], s.b[a][2]);
-                    s.re[a] -= wq * (g[0] * bu + g[1] * bv);
-                    s.re[nloc + a] -= wq * (g[2] * bu + g[3] * bv);
-                }
-                if !want_mat {
-                    continue;
-                }
-                for a in 0..nloc {
-                    let phi = [s.b[a][1], s.b[a][2]];
-                    s.tz[k * nloc + a] = phi[0];
-                    s.tz[(nqp + k) * nloc + a] = phi[1];
-                    for z in 0..2 {
-                        for d in 0..2 {
-                            let zd = z * 2 + d;
-                            for j in 0..2 {
-                                let v = phi[0] * h[2 * z][2 * d + j] + phi[1] * h[2 * z + 1][2 * d + j];
-                                s.wa[((2 * zd + j) * nqp + k) * nloc + a] = -wq * v;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        if want_mat {
-            for zd in 0..4 {
-                let w = &s.wa[2 * zd * nqp * nloc..2 * (zd + 1) * nqp * nloc];
-                element_product(&mut s.ke[zd * nloc * nloc..(zd + 1) * nloc * nloc], w, &s.tz, nloc);
-            }
-        }
+    flux_form(disc, cps, res, stencil, |e| {
+        let (_, g, h) = winslow_density(e);
+        (g.map(|v| -v), h.map(|row| row.map(|v| -v)))
     });
 }
 

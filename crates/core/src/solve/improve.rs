@@ -19,6 +19,7 @@ use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::DofMap;
 use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
+use crate::methods::weak_form::WeakFormMethod;
 use crate::methods::winslow::WinslowMethod;
 use crate::methods::Method;
 use crate::spline::surface::Surface;
@@ -31,6 +32,8 @@ use crate::verify::quality::quality;
 pub enum Improve {
     /// Minimize the Winslow functional (eq. 16): [`WinslowMethod`].
     Winslow,
+    /// Solve the weak form (eq. 14) from the map: [`WeakFormMethod`].
+    WeakForm,
 }
 
 impl Improve {
@@ -38,6 +41,7 @@ impl Improve {
     pub fn method(self) -> Arc<dyn Method> {
         match self {
             Improve::Winslow => Arc::new(WinslowMethod),
+            Improve::WeakForm => Arc::new(WeakFormMethod),
         }
     }
 }
@@ -150,7 +154,8 @@ fn bijective(c: &Certificate) -> bool {
 /// Run `method` from the certified map `map` (certificate `certificate`) on the same
 /// basis, the control points on the sides fixed by `topology` kept; certify the result
 /// and return it when it is at least as well certified as the start (a certified start
-/// needs a certified result) and its Winslow value is not larger, the start otherwise.
+/// needs a certified result) and, for a minimization, its Winslow value is not larger,
+/// for a root-finding method, the solver converged; the start otherwise.
 ///
 /// Errors: [`Error::InfeasibleStart`] when the certificate does not prove the start
 /// bijective, [`Error::Invalid`] for a rational map (the kernels are polynomial).
@@ -186,6 +191,7 @@ pub fn improve(
     let c0 = disc.dofs.gather(&map.control_points);
     let problem = method.problem(disc, map.control_points.clone());
     let mut solver = NonlinearSolver::new(problem, c0, nl);
+    let minimizes = solver.objective().is_some();
     let (mut residuals, mut objective, mut iterations) = (Vec::new(), Vec::new(), 0);
     for it in solver.by_ref() {
         let it = it?;
@@ -214,7 +220,10 @@ pub fn improve(
         (Some(_), None) => true,
         (None, _) => false,
     };
-    let accepted = as_good && lower;
+    let converged = status == Status::Converged;
+    // a minimization only lowers its objective (the line search sees to it): keep any
+    // certified result with a lower Winslow value; a root-finding method must converge
+    let accepted = as_good && if minimizes { lower } else { converged };
     let fmt = |w: Option<f64>| w.map_or("undefined".to_string(), |w| format!("{w:.6}"));
     let message = if accepted {
         format!(
@@ -228,6 +237,15 @@ pub fn improve(
         )
     } else if !as_good {
         format!("{}: the minimized map is not certified ({}); the start is kept", method.name(), cert.message())
+    } else if !minimizes {
+        format!(
+            "{}: the solver did not converge ({}); the start is kept",
+            method.name(),
+            match &status {
+                Status::Failed(why) => why.as_str(),
+                _ => "stopped",
+            }
+        )
     } else {
         format!(
             "{}: the minimized map's Winslow value {} is not below the start's {}; the start is kept",
@@ -241,7 +259,7 @@ pub fn improve(
         before,
         after,
         accepted,
-        converged: status == Status::Converged,
+        converged,
         failure: match status {
             Status::Failed(why) => Some(why),
             _ => None,

@@ -199,6 +199,11 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         self.lin.krylov_iterations
     }
 
+    /// The current objective `J` of a minimization method (`None` for root-finding).
+    pub fn objective(&self) -> Option<f64> {
+        self.objective
+    }
+
     /// Current `||F||`.
     pub fn residual(&self) -> f64 {
         self.norm
