@@ -7,11 +7,13 @@
 #
 #   cargo build --release -p winslow-cli
 #   bash scripts/improve-bench.sh target/release/winslow
+#   IMPROVE=weak bash scripts/improve-bench.sh target/release/winslow   # the weak form (eq. 14)
 #
 # Needs jq. A benchmark: CI does not run it.
 set -euo pipefail
 bin=$(realpath "$1")
 shift
+improve=${IMPROVE:-winslow}
 cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -20,7 +22,7 @@ echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"
 for f in tests/data/*.json tests/data/gismo/*.json; do
   name=$(basename "$f" .json)
   rc=0
-  "$bin" solve "$f" -o "$tmp/$name.json" --improve winslow --json -q "$@" >"$tmp/$name.report.json" 2>"$tmp/$name.log" || rc=$?
+  "$bin" solve "$f" -o "$tmp/$name.json" --improve "$improve" --json -q "$@" >"$tmp/$name.report.json" 2>"$tmp/$name.log" || rc=$?
   if [ ! -s "$tmp/$name.report.json" ]; then
     echo "| $name | error (exit $rc) | | | | | | | | | | | | | |"
     continue

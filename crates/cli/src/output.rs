@@ -133,7 +133,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     s
 }
 
-fn verdict_word(v: Verdict) -> &'static str {
+pub fn verdict_word(v: Verdict) -> &'static str {
     match v {
         Verdict::Certified => "certified bijective (det J > 0 proven)",
         Verdict::DegenerateCorner => "best possible map: degenerate corner forced by the boundary",
@@ -451,7 +451,7 @@ impl BenchRow {
 }
 
 /// The improvement stage (`--improve`): before and after, iterations, time.
-fn improvement_lines(s: &mut String, imp: &winslow::solve::improve::Improvement, total_s: f64) {
+pub fn improvement_lines(s: &mut String, imp: &winslow::solve::improve::Improvement, total_s: f64) {
     let w = |v: Option<f64>| v.map_or("infinite".to_string(), |w| format!("{w:.8}"));
     let (b, a) = (&imp.before, &imp.after);
     let _ = writeln!(
