@@ -144,10 +144,11 @@ pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], s
     });
 }
 
-/// The principal part of the Winslow Hessian, `K_ab = ∫ (2 / det J) ∇w_a·∇w_b` (the
-/// `2 I / D` term of `∂²W/∂e²`), plus `shift` times the mass matrix, into a scalar
-/// stencil: `-diag(K, K)` preconditions the Newton systems like the metric Laplacian
-/// does EGG's. `|det J|` where it is not positive (never at a feasible point).
+/// A scalar approximation of the Winslow Hessian for `-diag(K, K)` preconditioning:
+/// `K_ab = ∫ ∇w_a · A ∇w_b` with `A` the mean of the two diagonal `2 x 2` blocks of
+/// `∂²W/∂e²` (the `x`-`x` and `y`-`y` couplings, which carry the cell's anisotropy),
+/// its eigenvalues raised to at least `10⁻³` of its trace so that `K` is definite, plus
+/// `shift` times the mass matrix, into a scalar stencil.
 pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
@@ -159,13 +160,13 @@ pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil
             for ku in 0..nq[0] {
                 let k = kv * nq[0] + ku;
                 let wq = disc.tensor_basis(ex, ey, ku, kv, s);
-                let [a, b, c, d] = gradient_at(disc, ex, ey, cps, s);
-                let det = (a * d - b * c).abs().max(1e-300);
-                let w = 2.0 * wq / det;
+                let e = gradient_at(disc, ex, ey, cps, s);
+                let [a11, a12, a22] = definite_mean_block(e);
+                let (a11, a12, a22) = (wq * a11, wq * a12, wq * a22);
                 for (i, ba) in s.b.iter().enumerate() {
-                    s.wa[k * nloc + i] = w * ba[1];
+                    s.wa[k * nloc + i] = a11 * ba[1] + a12 * ba[2];
                     s.tz[k * nloc + i] = ba[1];
-                    s.wa[(nqp + k) * nloc + i] = w * ba[2];
+                    s.wa[(nqp + k) * nloc + i] = a12 * ba[1] + a22 * ba[2];
                     s.tz[(nqp + k) * nloc + i] = ba[2];
                     if shift != 0.0 {
                         s.wa[(2 * nqp + k) * nloc + i] = wq * shift * ba[0];
@@ -176,6 +177,32 @@ pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil
         }
         element_product(&mut s.ke, &s.wa, &s.tz, nloc);
     });
+}
+
+/// `(A_11, A_12, A_22)` of the mean diagonal block of `∂²W/∂e²` at `e`, eigenvalues
+/// raised to `10⁻³` of the trace (`2 I / |D|` where `D <= 0`).
+fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
+    let [a, b, c, d] = e;
+    let det = a * d - b * c;
+    if det.is_nan() || det <= 0.0 {
+        let v = 2.0 / det.abs().max(1e-300);
+        return [v, 0.0, v];
+    }
+    let (_, _, h) = winslow_density(e);
+    let m11 = 0.5 * (h[0][0] + h[2][2]);
+    let m12 = 0.25 * (h[0][1] + h[1][0] + h[2][3] + h[3][2]);
+    let m22 = 0.5 * (h[1][1] + h[3][3]);
+    let (mean, diff) = (0.5 * (m11 + m22), 0.5 * (m11 - m22));
+    let r = diff.hypot(m12);
+    let floor = 1e-3 * (m11.abs() + m22.abs()).max(f64::MIN_POSITIVE);
+    let (l1, l2) = ((mean + r).max(floor), (mean - r).max(floor));
+    if r == 0.0 {
+        return [l1, 0.0, l2];
+    }
+    // eigenvector of l1: (cos t, sin t) with tan 2t = m12 / diff
+    let t = 0.5 * m12.atan2(diff);
+    let (co, si) = (t.cos(), t.sin());
+    [l1 * co * co + l2 * si * si, (l1 - l2) * co * si, l1 * si * si + l2 * co * co]
 }
 
 /// Smallest and largest relative diagonal shift `τ` of the Hessian.
@@ -553,5 +580,22 @@ mod tests {
         assert!(prob.infeasible > 0, "the line search met folded trial points");
         let err = max_abs(prob.control_points(&c).iter().zip(&exact).flat_map(|(a, b)| [a[0] - b[0], a[1] - b[1]]));
         assert!(err < 1e-9, "distance to the identity {err}");
+    }
+
+    /// The preconditioner's block is the eigenvalue-floored mean of the Hessian's
+    /// diagonal blocks: equal to it where that is definite, definite always.
+    #[test]
+    fn preconditioner_block_is_the_definite_mean_block() {
+        for e in [[1.3, 0.4, -0.2, 0.9], [2.0, 0.0, 0.0, 0.5], [1.0, 3.0, -0.1, 0.4]] {
+            let (_, _, h) = winslow_density(e);
+            let [a11, a12, a22] = definite_mean_block(e);
+            assert!(a11 > 0.0 && a22 > 0.0 && a11 * a22 - a12 * a12 > 0.0, "{e:?}");
+            let m = [0.5 * (h[0][0] + h[2][2]), 0.5 * (h[0][1] + h[2][3]), 0.5 * (h[1][1] + h[3][3])];
+            if m[0] > 0.0 && m[0] * m[2] - m[1] * m[1] > 1e-3 * (m[0] + m[2]).powi(2) {
+                for (x, y) in [a11, a12, a22].iter().zip(m) {
+                    assert!((x - y).abs() < 1e-12 * (m[0] + m[2]), "{e:?}: {x} vs {y}");
+                }
+            }
+        }
     }
 }
