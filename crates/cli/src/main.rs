@@ -15,7 +15,9 @@ use winslow::discrete::assembly::Operator;
 use winslow::io::picture::{render, PictureOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, Document, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
-use winslow::methods::egg::EggAssembler;
+use winslow::methods::egg::{EggAssembler, EggMethod};
+use winslow::methods::Method;
+use winslow::solve::improve::{improve, Improve};
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::{Solution, Verdict};
@@ -167,8 +169,25 @@ struct InspectArgs {
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
-enum MethodArg {
+enum IterationArg {
     Newton,
+    PseudoTime,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+enum MethodArg {
+    /// Elliptic grid generation, eq. (8): from the boundary (or from --start).
+    Egg,
+    /// The weak form, eq. (14), from a certified map (the EGG map, or --start).
+    Weak,
+    /// Minimize the Winslow functional, eq. (16), from a certified map (the EGG map, or
+    /// --start).
+    Winslow,
+    /// Old spelling of `--iteration newton`.
+    #[value(hide = true)]
+    Newton,
+    /// Old spelling of `--iteration pseudo-time`.
+    #[value(hide = true)]
     PseudoTime,
 }
 
@@ -260,8 +279,13 @@ struct SolverArgs {
     /// Basis growth factor between solved levels (1 solves every level of the hierarchy).
     #[arg(long, default_value_t = SolveOptions::default().growth)]
     growth: f64,
-    /// Nonlinear method (Newton falls back to pseudo time-stepping when it stalls).
+    /// Nonlinear iteration (Newton falls back to pseudo time-stepping when it stalls).
     #[arg(long, value_enum, default_value = "newton")]
+    iteration: IterationArg,
+    /// Method: egg (eq. 8) from the boundary; weak (eq. 14) or winslow (eq. 16) from a
+    /// certified map: the EGG map of the boundary (same as `--improve`), or the map of
+    /// `--start`. (`--method newton|pseudo-time` is the old spelling of `--iteration`.)
+    #[arg(long, value_enum, default_value = "egg")]
     method: MethodArg,
     /// Operator: L of eq. (4), or L / (g11 + g22) as in G+Smo (converges better on the
     /// shared geometries, see BENCHMARKS.md).
@@ -281,9 +305,31 @@ struct SolverArgs {
     /// the offending elements (the rest stay frozen at the prolonged map).
     #[arg(long)]
     repair_freeze: Option<usize>,
+    /// After the solve and its certificate, improve the map on the same basis, from the
+    /// certified map: minimize the Winslow functional (eq. 16) or solve the weak form
+    /// (eq. 14); certify again and keep the improved map only when it is certified.
+    #[arg(long, value_enum)]
+    improve: Option<ImproveArg>,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum ImproveArg {
+    /// Minimize the Winslow functional (eq. 16).
+    Winslow,
+    /// Solve the weak form (eq. 14) from the certified map.
+    Weak,
 }
 
 impl SolverArgs {
+    /// The method of `--method` when it needs a bijective start.
+    fn improvement_method(&self) -> Option<Improve> {
+        match self.method {
+            MethodArg::Weak => Some(Improve::WeakForm),
+            MethodArg::Winslow => Some(Improve::Winslow),
+            _ => None,
+        }
+    }
+
     fn options(&self) -> Result<SolveOptions> {
         if self.fit.degree < 2 {
             bail!("--degree must be at least 2 (the EGG equations need C1 maps), got {}", self.fit.degree);
@@ -296,9 +342,11 @@ impl SolverArgs {
         }
         let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
         o.nonlinear.tol = self.tol;
-        o.nonlinear.method = match self.method {
-            MethodArg::Newton => NonlinearMethod::Newton,
-            MethodArg::PseudoTime => NonlinearMethod::PseudoTime,
+        o.nonlinear.method = match (self.method, self.iteration) {
+            (MethodArg::Newton, _) => NonlinearMethod::Newton,
+            (MethodArg::PseudoTime, _) => NonlinearMethod::PseudoTime,
+            (_, IterationArg::Newton) => NonlinearMethod::Newton,
+            (_, IterationArg::PseudoTime) => NonlinearMethod::PseudoTime,
         };
         o.nonlinear.linear = match self.linear {
             LinearArg::Lu => LinearMethod::Lu,
@@ -315,6 +363,17 @@ impl SolverArgs {
         o.min_elements = self.min_elements.max(1);
         o.refine = self.refine;
         o.growth = self.growth.max(1.0);
+        o.improve = self.improve.map(|i| match i {
+            ImproveArg::Winslow => Improve::Winslow,
+            ImproveArg::Weak => Improve::WeakForm,
+        });
+        // a method that needs a bijective start runs after the EGG solve
+        if let Some(m) = self.improvement_method() {
+            if o.improve.is_some_and(|i| i != m) {
+                bail!("--method {:?} and --improve {:?} ask for two different improvements", self.method, o.improve);
+            }
+            o.improve = Some(m);
+        }
         Ok(o)
     }
 }
@@ -344,8 +403,16 @@ fn fit_options(f: &FitArgs) -> FitOptions {
 
 #[derive(Args, Debug)]
 struct SolveArgs {
-    /// Boundary file.
-    boundary: PathBuf,
+    /// Boundary file (with `--start`: optional, the map's boundary deviation from it is
+    /// reported).
+    #[arg(required_unless_present = "start")]
+    boundary: Option<PathBuf>,
+    /// Start from this map document (made by `winslow solve` or another tool) instead of
+    /// solving from the boundary: the certificate must prove it bijective, its boundary
+    /// control points stay fixed, `--method` (winslow, weak or egg) runs on its basis,
+    /// and the result is kept only when certified.
+    #[arg(long)]
+    start: Option<PathBuf>,
     /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
     /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
     #[arg(short, long)]
@@ -630,9 +697,13 @@ fn solve(a: SolveArgs) -> Result<i32> {
     if let Some(out) = &a.mesh {
         winslow_mesh::formats::Format::from_path(out)?;
     }
+    if let Some(start) = &a.start {
+        return solve_from_start(&a, start);
+    }
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
-    let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
+    let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
+    let boundary = load_boundary(path, a.solver.fit.reorient)?;
     let sel = a.backend.select(a.quiet || a.json)?;
     let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
@@ -661,6 +732,101 @@ fn solve(a: SolveArgs) -> Result<i32> {
         mesh::make_and_write(&sol.map, &a.mesh_spec, out, a.json)?;
     }
     Ok(exit_code(sol.report.verdict))
+}
+
+/// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: improve a
+/// certified map on its own basis (its boundary fixed), certify the result, keep it
+/// only when certified.
+fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
+    let opts = a.solver.options()?;
+    let doc = read_document(start).with_context(|| format!("reading {}", start.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: --start needs a map document", start.display())
+    };
+    let method: Arc<dyn Method> = match a.solver.method {
+        MethodArg::Winslow => Improve::Winslow.method(),
+        MethodArg::Weak => Improve::WeakForm.method(),
+        MethodArg::Egg => Arc::new(EggMethod::cpu(opts.operator)),
+        MethodArg::Newton | MethodArg::PseudoTime => {
+            bail!("--start needs --method winslow, weak or egg (use --iteration for newton or pseudo-time)")
+        }
+    };
+    let boundary = match &a.boundary {
+        Some(p) => Some(load_boundary(p, a.solver.fit.reorient)?),
+        None => None,
+    };
+    let diameter = {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &map.control_points {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+    };
+    let t0 = std::time::Instant::now();
+    let cert = certify(&map, &opts.certify).context("certifying the start")?;
+    let out = improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)
+        .with_context(|| format!("improving {}", start.display()))?;
+    let deviation = boundary.as_ref().map(|b| boundary_deviation(&out.map, b, 400));
+    let verdict = match out.certificate.verdict {
+        CertVerdict::Certified { .. } => Verdict::Certified,
+        CertVerdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+        CertVerdict::Folded { .. } => Verdict::Folded,
+        CertVerdict::Undecided { .. } => Verdict::Undecided,
+    };
+    let q = quality(&out.map);
+    let w = q.functionals.winslow;
+    let report = serde_json::json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "start": start.display().to_string(),
+        "method": method.name(),
+        "verdict": verdict,
+        "message": format!("{}; {}", out.certificate.message(), out.report.message),
+        "certificate": out.certificate,
+        "quality": q,
+        "winslow": w.is_finite().then_some(w),
+        "boundary_deviation": deviation,
+        "improvement": out.report,
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    let label = format!("verdict {verdict:?}: {}", out.certificate.message());
+    let json = || map_to_json(&name, &out.map, Some(serde_json::json!({ "report": report })));
+    output::write_map(&a.output, &name, &out.map, &label, json)?;
+    for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu"), (&a.vtk, "vtk")] {
+        if let Some(p) = path {
+            output::write_map_as(p, ext, &name, &out.map, &label, json)?;
+        }
+    }
+    if let Some(p) = &a.png {
+        let sel = a.backend.select(a.quiet || a.json)?;
+        output::write_png(p, &picture(&sel, &out.map, &PictureOptions::default())?)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        let mut s = format!(
+            "{name}: {} from {}\n  {}\n",
+            output::verdict_word(verdict),
+            start.display(),
+            out.certificate.message()
+        );
+        output::improvement_lines(&mut s, &out.report, t0.elapsed().as_secs_f64());
+        if let Some(d) = deviation {
+            s.push_str(&format!(
+                "  boundary deviation from {} (S, E, N, W): {:.3e} {:.3e} {:.3e} {:.3e}\n",
+                a.boundary.as_ref().map_or(String::new(), |p| p.display().to_string()),
+                d[0],
+                d[1],
+                d[2],
+                d[3]
+            ));
+        }
+        s.push_str(&format!("  wrote {}\n", a.output.display()));
+        print!("{s}");
+    }
+    Ok(exit_code(verdict))
 }
 
 /// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.

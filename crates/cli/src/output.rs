@@ -107,6 +107,9 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     if let Some(p) = &r.poisson {
         poisson_line(&mut s, p);
     }
+    if let Some(imp) = &r.improvement {
+        improvement_lines(&mut s, imp, r.seconds);
+    }
     for round in &r.repair_rounds {
         let _ = writeln!(
             s,
@@ -157,7 +160,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     s
 }
 
-fn verdict_word(v: Verdict) -> &'static str {
+pub fn verdict_word(v: Verdict) -> &'static str {
     match v {
         Verdict::Certified => "certified bijective (det J > 0 proven)",
         Verdict::DegenerateCorner => "best possible map: degenerate corner forced by the boundary",
@@ -504,6 +507,38 @@ impl BenchRow {
             reparam: r.reparam.used.name(),
             matches: r.reparam.matches.len(),
         }
+    }
+}
+
+/// The improvement stage (`--improve`): before and after, iterations, time.
+pub fn improvement_lines(s: &mut String, imp: &winslow::solve::improve::Improvement, total_s: f64) {
+    let w = |v: Option<f64>| v.map_or("infinite".to_string(), |w| format!("{w:.8}"));
+    let (b, a) = (&imp.before, &imp.after);
+    let _ = writeln!(
+        s,
+        "  improvement ({}): {}; Winslow {} -> {}, min scaled Jacobian {:.4} -> {:.4}, orthogonality max {:.2} -> {:.2} deg (mean {:.2} -> {:.2})",
+        imp.method,
+        if imp.accepted { "map improved" } else { "map of the solve kept" },
+        w(b.winslow),
+        w(a.winslow),
+        b.scaled_jacobian_min,
+        a.scaled_jacobian_min,
+        b.orthogonality_max_degrees,
+        a.orthogonality_max_degrees,
+        b.orthogonality_mean_degrees,
+        a.orthogonality_mean_degrees,
+    );
+    let _ = writeln!(
+        s,
+        "    {} iterations ({}), max control-point move {:.3e} of the diameter, {:.3} s of {:.3} s in all",
+        imp.iterations,
+        if imp.converged { "converged".to_string() } else { imp.failure.clone().unwrap_or_default() },
+        imp.max_displacement,
+        imp.seconds,
+        total_s
+    );
+    if !imp.accepted {
+        let _ = writeln!(s, "    {}", imp.message);
     }
 }
 

@@ -38,8 +38,8 @@
 //! | §5.4 | nested hierarchy of bases | [`boundary::hierarchy`], [`spline::refine`] |
 //! | §4, eq. (8), (12), (23) | EGG Galerkin form, residual, exact Jacobian | [`methods::egg`], kernels in [`discrete::assembly`] |
 //! | eq. (9)-(10) | free / fixed DOFs, unknowns `c` | [`discrete::dofs`], [`discrete::topology`] |
-//! | eq. (14) | weak form with `det J` (needs a bijective start) | behind [`Method`] with [`methods::Start::Bijective`] (not yet implemented) |
-//! | eq. (15)-(16) | Winslow functional | value: [`verify::quality::functionals`]; as a method: behind [`Method`] (not yet implemented) |
+//! | eq. (14) | weak form with `det J` (needs a bijective start) | [`methods::weak_form::WeakFormMethod`] ([`methods::Start::Bijective`]; residual and exact Jacobian in [`methods::flux`]) |
+//! | eq. (15)-(16) | Winslow functional | value: [`verify::quality::functionals`]; as a minimization method: [`methods::winslow::WinslowMethod`] (objective, exact gradient and Hessian) |
 //! | §6.1, eq. (24)-(27) | damped Newton, line search | [`solve::newton`] |
 //! | §6.2, eq. (28)-(33) | pseudo time-stepping, SER | [`solve::newton`] |
 //! | §6.3, §9 | Coons start, prolongation plus elasticity, continuation | [`solve::initial`], levels in [`solve::levels`], the walk in [`solve::solver`] |

@@ -215,9 +215,9 @@ pub(crate) struct Scratch {
     pub(crate) t: Vec<[f64; 4]>,
     /// `dL_z/dc^d_b` at quadrature point `k` at `((z * 2 + d) * nqp + k) * nloc + b`:
     /// contiguous in `b` for the element-matrix product.
-    tz: Vec<f64>,
+    pub(crate) tz: Vec<f64>,
     /// Test-function weights `w_k w_a(k) / s(k)` at `k * nloc + a`.
-    wa: Vec<f64>,
+    pub(crate) wa: Vec<f64>,
     pub(crate) re: Vec<f64>,
     pub(crate) ke: Vec<f64>,
 }
@@ -225,14 +225,14 @@ pub(crate) struct Scratch {
 impl Scratch {
     /// Size the operands of [`element_product`] (`wa` and `tz`): allocated on a thread's
     /// first element, reused by the others.
-    fn reserve_products(&mut self, wa: usize, tz: usize) {
+    pub(crate) fn reserve_products(&mut self, wa: usize, tz: usize) {
         if self.wa.len() != wa || self.tz.len() != tz {
             self.wa = vec![0.0; wa];
             self.tz = vec![0.0; tz];
         }
     }
 
-    fn new(p: usize, q: usize, ncomp: usize) -> Self {
+    pub(crate) fn new(p: usize, q: usize, ncomp: usize) -> Self {
         let nloc = (p + 1) * (q + 1);
         Self {
             nloc,
@@ -249,7 +249,7 @@ impl Scratch {
 /// `out[a][b] = sum_k w[k][a] t[k][b]` for `nloc x nloc` element blocks (`w`, `t` with
 /// `nqp` rows of `nloc`): the quadrature sum of an element matrix as one matrix
 /// product, each output row accumulated in registers for the common sizes.
-fn element_product(out: &mut [f64], w: &[f64], t: &[f64], nloc: usize) {
+pub(crate) fn element_product(out: &mut [f64], w: &[f64], t: &[f64], nloc: usize) {
     fn fixed<const N: usize>(out: &mut [f64], w: &[f64], t: &[f64]) {
         for (a, row) in out.chunks_exact_mut(N).enumerate() {
             let mut acc = [0.0f64; N];
@@ -344,7 +344,7 @@ impl Discretization {
         self.tables[0].num_elements() * self.tables[1].num_elements()
     }
 
-    fn stencil_width(&self) -> usize {
+    pub(crate) fn stencil_width(&self) -> usize {
         let (p, q) = self.degrees();
         (2 * p + 1) * (2 * q + 1)
     }

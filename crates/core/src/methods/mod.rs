@@ -4,6 +4,9 @@
 //! | module | method | paper |
 //! |---|---|---|
 //! | [`egg`] | EGG, Galerkin form with the plain operator `L` or the scaled `L / (g11 + g22)`: [`EggMethod`](egg::EggMethod) | eq. (8), (12), (23) |
+//! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
+//! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
+//! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
 //!
@@ -36,6 +39,9 @@
 //! [`EggAssembler`](egg::EggAssembler).
 
 pub mod egg;
+pub mod flux;
+pub mod weak_form;
+pub mod winslow;
 
 use std::sync::Arc;
 
@@ -81,6 +87,14 @@ pub trait DiscreteProblem {
     fn admissible(&mut self, _c: &[f64]) -> bool {
         true
     }
+    /// For a minimization method whose last Jacobian gave a Newton direction `δ` that
+    /// does not descend (`∇J·δ >= 0`, which proves `δᵀ ∇²J δ <= 0`): modify the presented
+    /// Hessian towards a positive definite one (e.g. a larger diagonal shift) for the
+    /// next [`DiscreteProblem::jacobian`] call at the same point. `false` when the
+    /// problem has no (further) modification.
+    fn raise_shift(&mut self) -> bool {
+        false
+    }
     /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
     /// approximates the last Jacobian minus `shift` times the mass matrix (a
     /// preconditioner for Krylov solvers), or `None` when the problem has none.
@@ -115,6 +129,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     fn admissible(&mut self, c: &[f64]) -> bool {
         (**self).admissible(c)
     }
+    fn raise_shift(&mut self) -> bool {
+        (**self).raise_shift()
+    }
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         (**self).preconditioner(shift)
     }
@@ -139,6 +156,30 @@ pub trait Method: Send + Sync + std::fmt::Debug {
     /// are off by about the domain size: `|F| sqrt(m) / residual_size` is the relative
     /// residual the stopping rule compares with the tolerance.
     fn residual_size(&self, diameter: f64) -> f64;
+    /// The multiplier that turns `|F|` into the dimensionless residual the stopping
+    /// rule compares with the tolerance, for `m` free functions: `sqrt(m) /
+    /// residual_size` for forms `∫ w_i (...)` (`∫ w_i ~ 1/m`, the default); a form
+    /// `∫ ∇w_i · G` whose `G` is dimensionless (eq. 14) or of size `1 / diameter`
+    /// (eq. 16's gradient) has `|F| ~ 1 / diameter` at any `m` and overrides this.
+    fn residual_scale(&self, diameter: f64, m: usize) -> f64 {
+        (m.max(1) as f64).sqrt() / self.residual_size(diameter)
+    }
     /// The discrete problem on `disc` starting from `control_points`.
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
+}
+
+/// The block mass matrix `diag(M, M)` of eq. (30) in the vector pattern of `disc`, from
+/// the scalar mass matrix `m` (in the scalar pattern).
+pub(crate) fn block_mass(disc: &Discretization, m: &Csr) -> Csr {
+    let ms = disc.dofs.num_free();
+    let mut out = disc.vector.csr.clone();
+    for r in 0..out.nrows {
+        let (z, f) = (r / ms, r % ms);
+        for k in out.row_ptr[r]..out.row_ptr[r + 1] {
+            let cidx = out.col_idx[k];
+            let (d, g) = (cidx / ms, cidx % ms);
+            out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
+        }
+    }
+    out
 }

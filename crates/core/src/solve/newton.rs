@@ -8,7 +8,9 @@
 //! The solver reads any [`DiscreteProblem`]: for a minimization method (`F = -∇J`,
 //! [`DiscreteProblem::objective`]) the Newton direction solves `-∇²J δ = ∇J` and the line
 //! search asks for the Armijo decrease `J(c + t δ) <= J(c) + 10^-4 t ∇J·δ`; convergence
-//! is on `|F| = |∇J|` for both kinds. Steps outside the feasible set (an objective of
+//! is on `|F| = |∇J|` for both kinds. A direction that does not descend (`∇J·δ >= 0`,
+//! the Hessian is not positive definite along it) is solved again after
+//! [`DiscreteProblem::raise_shift`]. Steps outside the feasible set (an objective of
 //! `+∞`, or [`DiscreteProblem::admissible`] false) are never accepted.
 
 use std::time::{Duration, Instant};
@@ -197,6 +199,11 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         self.lin.krylov_iterations
     }
 
+    /// The current objective `J` of a minimization method (`None` for root-finding).
+    pub fn objective(&self) -> Option<f64> {
+        self.objective
+    }
+
     /// Current `||F||`.
     pub fn residual(&self) -> f64 {
         self.norm
@@ -327,10 +334,21 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     fn newton_step(&mut self) -> Result<Iterate> {
         self.iteration += 1;
         self.newton_its += 1;
-        let dx = match self.linear_step(None) {
+        let mut dx = match self.linear_step(None) {
             Ok(dx) => dx,
             Err(e) => return Ok(self.stall(format!("Newton linear solve failed: {e}"))),
         };
+        // a minimization method whose Hessian is not positive definite along dx (the
+        // direction does not descend): shift the Hessian and solve again
+        while self.objective.is_some() && self.f.iter().zip(&dx).map(|(f, d)| f * d).sum::<f64>() <= 0.0 {
+            if !self.problem.raise_shift() {
+                break;
+            }
+            dx = match self.linear_step(None) {
+                Ok(dx) => dx,
+                Err(e) => return Ok(self.stall(format!("Newton linear solve failed: {e}"))),
+            };
+        }
         self.previous = Some((self.norm, self.lin.krylov_tol));
         if let Some(j0) = self.objective {
             return Ok(self.descent_step(j0, &dx));

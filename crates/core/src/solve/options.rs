@@ -6,6 +6,7 @@ use crate::discrete::assembly::Operator;
 use crate::discrete::topology::Topology;
 use crate::verify::certificate::CertifyOptions;
 
+use super::improve::Improve;
 use super::newton::NonlinearOptions;
 
 /// Options of a complete solve.
@@ -47,6 +48,10 @@ pub struct SolveOptions {
     /// The boundary condition of each side of the patch (four Dirichlet sides by
     /// default; see [`Topology`]).
     pub topology: Topology,
+    /// After the solve and its certificate, improve the map on the same basis (e.g.
+    /// minimize the Winslow functional, eq. 16) and certify again; the improved map is
+    /// kept only when certified ([`crate::solve::improve`]).
+    pub improve: Option<Improve>,
 }
 
 impl Default for SolveOptions {
@@ -67,6 +72,7 @@ impl Default for SolveOptions {
             certify: CertifyOptions::default(),
             poisson: false,
             topology: Topology::dirichlet(),
+            improve: None,
         }
     }
 }

@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use super::improve::Improvement;
 use super::options::SolveOptions;
 use super::repair::RepairRound;
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
@@ -172,6 +173,9 @@ pub struct Report {
     /// The basis of the map: fitted (§5) or the input's own (§5.2), and why the input
     /// basis was not used when it was asked for.
     pub basis: BasisReport,
+    /// The improvement stage after the solve (`--improve winslow`): quality before and
+    /// after, iterations, time; `null` when none was asked for.
+    pub improvement: Option<Improvement>,
 }
 
 /// A solved map and its report.
@@ -222,6 +226,7 @@ pub(crate) struct ReportContext<'a> {
     pub repairs: usize,
     pub rounds: Vec<RepairRound>,
     pub certificate: Certificate,
+    pub improvement: Option<Improvement>,
     pub elapsed: Duration,
 }
 
@@ -271,6 +276,9 @@ impl Solution {
                 k.side, k.point[0], k.point[1], k.turning_degrees
             ));
         }
+        if let Some(imp) = &ctx.improvement {
+            message.push_str(&format!("; improvement: {}", imp.message));
+        }
         let fit = Side::ALL
             .iter()
             .map(|&s| {
@@ -318,6 +326,7 @@ impl Solution {
             basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
             reparam: h.reparam.clone(),
             basis: h.basis.clone(),
+            improvement: ctx.improvement,
         };
         Self { name: name.to_string(), map, report }
     }

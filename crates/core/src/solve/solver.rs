@@ -10,6 +10,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::improve::{improve, Improvement};
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
 use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
@@ -155,7 +156,7 @@ impl EggSolver {
     /// length units.
     fn level_options(&self, m: usize) -> NonlinearOptions {
         let mut nl = self.opts.nonlinear;
-        nl.scale = (m.max(1) as f64).sqrt() / self.method.residual_size(self.diameter);
+        nl.scale = self.method.residual_scale(self.diameter, m);
         nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
         nl
     }
@@ -253,10 +254,33 @@ impl EggSolver {
         for e in self.by_ref() {
             e?;
         }
-        let map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
-        let certificate = match self.certificate.take() {
+        let mut map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        let mut certificate = match self.certificate.take() {
             Some(c) => c,
             None => certify(&map, &self.opts.certify)?,
+        };
+        let improvement = match self.opts.improve {
+            None => None,
+            Some(imp) => {
+                let method = imp.method();
+                if self.reports.last().is_some_and(|l| l.converged) {
+                    let (topology, certify_opts) = (&self.opts.topology, &self.opts.certify);
+                    let nl = self.opts.nonlinear;
+                    match improve(&map, &certificate, &*method, topology, nl, certify_opts, self.diameter) {
+                        Ok(out) => {
+                            map = out.map;
+                            certificate = out.certificate;
+                            Some(out.report)
+                        }
+                        Err(Error::InfeasibleStart { reason, .. }) => {
+                            Some(Improvement::skipped(&*method, &map, format!("the map is not certified ({reason})")))
+                        }
+                        Err(e) => return Err(e),
+                    }
+                } else {
+                    Some(Improvement::skipped(&*method, &map, "the solve did not converge".into()))
+                }
+            }
         };
         let finest = self.plan.last().expect("non-empty plan");
         let ctx = ReportContext {
@@ -274,6 +298,7 @@ impl EggSolver {
             repairs: self.repairs,
             rounds: self.rounds.clone(),
             certificate,
+            improvement,
             elapsed: self.started.elapsed(),
         };
         Ok(Solution::new(&boundary.name, map, self.reports, ctx))

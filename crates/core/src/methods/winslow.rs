@@ -1,0 +1,601 @@
+//! The Winslow functional (paper eq. 15-16) as a minimization method:
+//!
+//! `J(c) = ∫ W(∇x) dξ`, `W = (x_ξ² + x_η² + y_ξ² + y_η²) / det J`,
+//!
+//! over the free control points `c` of one basis, `+∞` when `det J <= 0` at a
+//! quadrature point (a barrier: the line search never leaves the bijective maps).
+//! [`WinslowProblem`] presents `F = -∇J` and `dF/dc = -∇²J` with the exact gradient and
+//! Hessian, assembled into the same vector pattern and stencil storage as EGG (the
+//! [`Discretization`]'s tables and patterns, element rows in parallel).
+//!
+//! # Derivatives
+//!
+//! With `e = (a, b, c, d) = (x_ξ, x_η, y_ξ, y_η)`, `N = |e|²`, `D = ad - bc` and
+//! `D' = ∂D/∂e = (d, -c, -b, a)`:
+//!
+//! * `∂W/∂e = 2 e / D - N D' / D²`,
+//! * `∂²W/∂e² = 2 I / D - 2 (e D'ᵀ + D' eᵀ) / D² + 2 N D' D'ᵀ / D³ - N S / D²`, where `S`
+//!   is the (constant) Hessian of `D` (`S_ad = S_da = 1`, `S_bc = S_cb = -1`).
+//!
+//! `e` is linear in `c` (`∂(a, b)/∂c^x_j = (w_j,ξ, w_j,η)`, `∂(c, d)/∂c^y_j` likewise), so
+//! `∇²J` is the quadrature sum of `∂²W/∂e²` between the basis gradients: no other term.
+//!
+//! # Positive definiteness
+//!
+//! `W` is homogeneous of degree 0 and invariant under rotations, so `∂²W/∂e²` is only
+//! positive semidefinite at conformal points (`x_ξ ⊥ x_η`, equal lengths) and indefinite
+//! at every other (in the singular values `s₁ ≠ s₂` of `∇x`, `W = s₁/s₂ + s₂/s₁` has a
+//! Hessian of determinant `-(1/s₁² - 1/s₂²)² < 0`): the assembled Hessian is positive
+//! definite near a minimizer (the fixed boundary and the sum over points make it so), but
+//! need not be far from one. The Newton solver finds out along its direction: `δ` solves
+//! `∇²J δ = -∇J`, so a slope `∇J·δ >= 0` proves `δᵀ ∇²J δ <= 0`. It then calls
+//! [`DiscreteProblem::raise_shift`] and solves again with the diagonal shift
+//! `∇²J + τ diag(|∇²J_ii|)` (Levenberg-Marquardt in the Hessian's own scaling, so `τ`
+//! is dimensionless; `τ = 10⁻⁴, 10⁻³, ...`), and lowers `τ` tenfold per step while the
+//! directions descend, back to the exact Newton step (quadratic convergence) near the
+//! minimizer. A diagonal shift rather than a per-point eigenvalue projection: it leaves
+//! the exact Hessian wherever that is already definite.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::flux::{flux_form, gradient_at};
+use super::{block_mass, DiscreteProblem, Method, Start};
+use crate::discrete::assembly::{element_product, Discretization, Scratch};
+use crate::linalg::sparse::Csr;
+use crate::spline::curve::Point;
+
+/// The Winslow functional (eq. 16), minimized from a bijective start.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct WinslowMethod;
+
+impl Method for WinslowMethod {
+    fn name(&self) -> &'static str {
+        "winslow"
+    }
+
+    fn start(&self) -> Start {
+        Start::Bijective
+    }
+
+    /// `∂W/∂e ~ 1 / diam`, so `∂J/∂c_i ~ ∫ |∇w_i| / diam ~ 1 / (sqrt(m) diam)`.
+    fn residual_size(&self, diameter: f64) -> f64 {
+        1.0 / diameter
+    }
+
+    /// `|∇J| ~ 1 / diam` whatever `m`: the scaled residual is `|∇J| diam`.
+    fn residual_scale(&self, diameter: f64, _m: usize) -> f64 {
+        diameter
+    }
+
+    fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send> {
+        Box::new(WinslowProblem::new(disc, control_points))
+    }
+}
+
+/// The Winslow density `W = N / D` of `e = (x_ξ, x_η, y_ξ, y_η)` with its gradient and
+/// Hessian in `e` (formulas in the module documentation). Not finite when `D <= 0`.
+pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
+    let [a, b, c, d] = e;
+    let n = a * a + b * b + c * c + d * d;
+    let det = a * d - b * c;
+    let dd = [d, -c, -b, a];
+    let inv = 1.0 / det;
+    let w = n * inv;
+    let g: [f64; 4] = std::array::from_fn(|i| 2.0 * e[i] * inv - w * dd[i] * inv);
+    let inv2 = inv * inv;
+    let mut h = [[0.0; 4]; 4];
+    for (i, row) in h.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = -2.0 * (e[i] * dd[j] + dd[i] * e[j]) * inv2 + 2.0 * w * dd[i] * dd[j] * inv2;
+        }
+        row[i] += 2.0 * inv;
+    }
+    // - N S / D²
+    let ns = w * inv;
+    h[0][3] -= ns;
+    h[3][0] -= ns;
+    h[1][2] += ns;
+    h[2][1] += ns;
+    (w, g, h)
+}
+
+/// `J = ∫ W` (eq. 16) of the map with control points `cps` by the quadrature of `disc`;
+/// `+∞` when `det J <= 0` at a quadrature point. Element rows in parallel, summed in
+/// order (deterministic).
+pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
+    let (p, q) = disc.degrees();
+    let nq = [disc.tables[0].nq, disc.tables[1].nq];
+    let (nex, ney) = (disc.tables[0].num_elements(), disc.tables[1].num_elements());
+    let rows: Vec<f64> = (0..ney)
+        .into_par_iter()
+        .map_init(
+            || Scratch::new(p, q, 1),
+            |s, ey| {
+                let mut sum = 0.0;
+                for ex in 0..nex {
+                    for kv in 0..nq[1] {
+                        for ku in 0..nq[0] {
+                            let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                            let [a, b, c, d] = gradient_at(disc, ex, ey, cps, s);
+                            let det = a * d - b * c;
+                            if det.is_nan() || det <= 0.0 {
+                                return f64::INFINITY;
+                            }
+                            sum += wq * (a * a + b * b + c * c + d * d) / det;
+                        }
+                    }
+                }
+                sum
+            },
+        )
+        .collect();
+    rows.iter().sum()
+}
+
+/// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
+/// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
+/// form of [`flux_form`] with `G = -∂W/∂e`.
+pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
+    flux_form(disc, cps, res, stencil, |e| {
+        let (_, g, h) = winslow_density(e);
+        (g.map(|v| -v), h.map(|row| row.map(|v| -v)))
+    });
+}
+
+/// A scalar approximation of the Winslow Hessian for `-diag(K, K)` preconditioning:
+/// `K_ab = ∫ ∇w_a · A ∇w_b` with `A` the mean of the two diagonal `2 x 2` blocks of
+/// `∂²W/∂e²` (the `x`-`x` and `y`-`y` couplings, which carry the cell's anisotropy),
+/// its eigenvalues raised to at least `10⁻³` of its trace so that `K` is definite, plus
+/// `shift` times the mass matrix, into a scalar stencil.
+pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
+    let nq = [disc.tables[0].nq, disc.tables[1].nq];
+    let nqp = nq[0] * nq[1];
+    let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
+    disc.assemble(1, &mut [], stencil, |ex, ey, s| {
+        let nloc = s.nloc;
+        s.reserve_products(nrows * nloc, nrows * nloc);
+        for kv in 0..nq[1] {
+            for ku in 0..nq[0] {
+                let k = kv * nq[0] + ku;
+                let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                let e = gradient_at(disc, ex, ey, cps, s);
+                let [a11, a12, a22] = definite_mean_block(e);
+                let (a11, a12, a22) = (wq * a11, wq * a12, wq * a22);
+                for (i, ba) in s.b.iter().enumerate() {
+                    s.wa[k * nloc + i] = a11 * ba[1] + a12 * ba[2];
+                    s.tz[k * nloc + i] = ba[1];
+                    s.wa[(nqp + k) * nloc + i] = a12 * ba[1] + a22 * ba[2];
+                    s.tz[(nqp + k) * nloc + i] = ba[2];
+                    if shift != 0.0 {
+                        s.wa[(2 * nqp + k) * nloc + i] = wq * shift * ba[0];
+                        s.tz[(2 * nqp + k) * nloc + i] = ba[0];
+                    }
+                }
+            }
+        }
+        element_product(&mut s.ke, &s.wa, &s.tz, nloc);
+    });
+}
+
+/// `(A_11, A_12, A_22)` of the mean diagonal block of `∂²W/∂e²` at `e`, eigenvalues
+/// raised to `10⁻³` of the trace (`2 I / |D|` where `D <= 0`).
+fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
+    let [a, b, c, d] = e;
+    let det = a * d - b * c;
+    if det.is_nan() || det <= 0.0 {
+        let v = 2.0 / det.abs().max(1e-300);
+        return [v, 0.0, v];
+    }
+    let (_, _, h) = winslow_density(e);
+    let m11 = 0.5 * (h[0][0] + h[2][2]);
+    let m12 = 0.25 * (h[0][1] + h[1][0] + h[2][3] + h[3][2]);
+    let m22 = 0.5 * (h[1][1] + h[3][3]);
+    let (mean, diff) = (0.5 * (m11 + m22), 0.5 * (m11 - m22));
+    let r = diff.hypot(m12);
+    let floor = 1e-3 * (m11.abs() + m22.abs()).max(f64::MIN_POSITIVE);
+    let (l1, l2) = ((mean + r).max(floor), (mean - r).max(floor));
+    if r == 0.0 {
+        return [l1, 0.0, l2];
+    }
+    // eigenvector of l1: (cos t, sin t) with tan 2t = m12 / diff
+    let t = 0.5 * m12.atan2(diff);
+    let (co, si) = (t.cos(), t.sin());
+    [l1 * co * co + l2 * si * si, (l1 - l2) * co * si, l1 * si * si + l2 * co * co]
+}
+
+/// Smallest and largest relative diagonal shift `τ` of the Hessian.
+const SHIFT_MIN: f64 = 1e-4;
+const SHIFT_MAX: f64 = 1e8;
+
+/// The Winslow functional on one level: discretization, control points (fixed ones hold
+/// the boundary) and storage requested once.
+pub struct WinslowProblem {
+    /// Tables, DOF map and patterns of the basis.
+    pub disc: Arc<Discretization>,
+    /// All control points; the free ones are overwritten from `c` on every call.
+    pub cps: Vec<Point>,
+    res_full: Vec<f64>,
+    stencil: Vec<f64>,
+    mass: Option<Csr>,
+    pstencil: Vec<f64>,
+    prec: Csr,
+    /// Positions of the diagonal entries in the vector pattern's values.
+    diag: Vec<usize>,
+    /// Relative diagonal shift `τ` of the presented Hessian.
+    shift: f64,
+    /// The stencil holds the Hessian at `assembled` (for a re-shift without assembly).
+    assembled: Option<Vec<f64>>,
+    raised: bool,
+}
+
+impl std::fmt::Debug for WinslowProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WinslowProblem").field("unknowns", &self.size()).field("shift", &self.shift).finish()
+    }
+}
+
+impl WinslowProblem {
+    /// Set up with all control points `cps` (free ones are the start).
+    pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
+        let n = disc.dofs.num_total();
+        let pat = &disc.vector.csr;
+        let diag = (0..pat.nrows).map(|r| pat.position(r, r).expect("the pattern holds the diagonal")).collect();
+        Self {
+            cps,
+            res_full: vec![0.0; 2 * n],
+            stencil: Vec::new(),
+            mass: None,
+            pstencil: Vec::new(),
+            prec: disc.scalar.csr.clone(),
+            diag,
+            shift: 0.0,
+            assembled: None,
+            raised: false,
+            disc,
+        }
+    }
+
+    /// The current unknown vector.
+    pub fn unknowns(&self) -> Vec<f64> {
+        self.disc.dofs.gather(&self.cps)
+    }
+
+    /// The relative diagonal shift `τ` the last Jacobian carried.
+    pub fn shift(&self) -> f64 {
+        self.shift
+    }
+
+    fn load(&mut self, c: &[f64]) {
+        self.disc.dofs.scatter(c, &mut self.cps);
+    }
+}
+
+impl DiscreteProblem for WinslowProblem {
+    fn size(&self) -> usize {
+        2 * self.disc.dofs.num_free()
+    }
+
+    fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+        self.load(c);
+        winslow_gradient(&self.disc, &self.cps, &mut self.res_full, &mut []);
+        self.assembled = None;
+        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+    }
+
+    fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
+        if !std::mem::take(&mut self.raised) {
+            // a new point: back towards the exact Hessian
+            self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
+        }
+        if self.assembled.as_deref() != Some(c) {
+            self.load(c);
+            if self.stencil.is_empty() {
+                self.stencil = vec![0.0; self.disc.stencil_len(2)];
+            }
+            winslow_gradient(&self.disc, &self.cps, &mut self.res_full, &mut self.stencil);
+            self.assembled = Some(c.to_vec());
+        }
+        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+        let pattern = &self.disc.vector;
+        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
+            jac.assign(&pattern.csr);
+        }
+        pattern.gather_into(&self.stencil, &mut jac.values);
+        if self.shift > 0.0 {
+            let mean = self.diag.iter().map(|&k| jac.values[k].abs()).sum::<f64>() / self.diag.len().max(1) as f64;
+            for &k in &self.diag {
+                // jac = -H: H_ii + τ max(|H_ii|, 1e-8 mean)
+                jac.values[k] -= self.shift * jac.values[k].abs().max(1e-8 * mean);
+            }
+        }
+    }
+
+    fn mass(&mut self) -> &Csr {
+        if self.mass.is_none() {
+            let mut st = vec![0.0; self.disc.stencil_len(1)];
+            self.disc.mass(&mut st);
+            self.mass = Some(block_mass(&self.disc, &self.disc.scalar.matrix(&st)));
+        }
+        self.mass.as_ref().expect("set above")
+    }
+
+    fn objective(&mut self, c: &[f64]) -> Option<f64> {
+        let mut cps = self.cps.clone();
+        self.disc.dofs.scatter(c, &mut cps);
+        Some(winslow_objective(&self.disc, &cps))
+    }
+
+    fn raise_shift(&mut self) -> bool {
+        let next = if self.shift == 0.0 { SHIFT_MIN } else { 10.0 * self.shift };
+        if next > SHIFT_MAX {
+            return false;
+        }
+        self.shift = next;
+        self.raised = true;
+        true
+    }
+
+    /// `K` of [`winslow_laplace`] on the current control points.
+    fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
+        if self.pstencil.is_empty() {
+            self.pstencil = vec![0.0; self.disc.stencil_len(1)];
+        }
+        winslow_laplace(&self.disc, &self.cps, shift, &mut self.pstencil);
+        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
+        Some(&self.prec)
+    }
+
+    fn ordering(&self) -> Option<&[usize]> {
+        Some(&self.disc.ordering)
+    }
+
+    fn control_points(&self, c: &[f64]) -> Vec<Point> {
+        let mut cps = self.cps.clone();
+        self.disc.dofs.scatter(c, &mut cps);
+        cps
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
+    use crate::spline::knots::KnotVector;
+    use crate::testutil::Lcg;
+
+    /// The affine map `(ξ, η) -> (2ξ + 0.5η + 1, -0.3ξ + 1.5η)` on a `p`, `ne` basis
+    /// (Greville interpolation reproduces it), interior control points moved by up to
+    /// `noise / 2`.
+    fn affine(p: usize, ne: usize, seed: u64, noise: f64) -> (Arc<Discretization>, Vec<Point>, Vec<Point>) {
+        let kx = KnotVector::open_uniform(p, ne);
+        let ky = KnotVector::open_uniform(p, ne).with_inserted(&[0.37]);
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let exact: Vec<Point> =
+            gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
+        let disc = Discretization::new([kx, ky]);
+        let mut rng = Lcg::new(seed);
+        let mut cps = exact.clone();
+        for &k in disc.dofs.free() {
+            for d in 0..2 {
+                cps[k][d] += noise * (rng.uniform() - 0.5);
+            }
+        }
+        (Arc::new(disc), cps, exact)
+    }
+
+    /// A curved map (a perturbed annulus sector).
+    fn curved(seed: u64, noise: f64) -> (Arc<Discretization>, Vec<Point>) {
+        let kx = KnotVector::open_uniform(3, 4);
+        let ky = KnotVector::open_uniform(2, 3).with_inserted(&[0.3]);
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let mut rng = Lcg::new(seed);
+        let mut cps = Vec::new();
+        for &v in &gy {
+            for &u in &gx {
+                let (r, t) = (1.0 + u, 1.2 * v);
+                cps.push([r * t.cos() + noise * (rng.uniform() - 0.5), r * t.sin() + noise * (rng.uniform() - 0.5)]);
+            }
+        }
+        (Arc::new(Discretization::new([kx, ky])), cps)
+    }
+
+    fn max_abs(v: impl IntoIterator<Item = f64>) -> f64 {
+        v.into_iter().fold(0.0f64, |m, x| m.max(x.abs()))
+    }
+
+    #[test]
+    fn density_derivatives_match_finite_differences() {
+        let e = [1.3, 0.4, -0.2, 0.9];
+        let (w, g, h) = winslow_density(e);
+        assert!((w - (1.69 + 0.16 + 0.04 + 0.81) / (1.17 + 0.08)).abs() < 1e-14);
+        let step = 1e-6;
+        for i in 0..4 {
+            let (mut ep, mut em) = (e, e);
+            ep[i] += step;
+            em[i] -= step;
+            let (wp, gp, _) = winslow_density(ep);
+            let (wm, gm, _) = winslow_density(em);
+            assert!(((wp - wm) / (2.0 * step) - g[i]).abs() < 1e-8, "gradient {i}");
+            for j in 0..4 {
+                assert!(((gp[j] - gm[j]) / (2.0 * step) - h[j][i]).abs() < 1e-7, "Hessian ({j}, {i})");
+                assert!((h[i][j] - h[j][i]).abs() < 1e-14 * w);
+            }
+        }
+    }
+
+    /// `F = -∇J` against central differences of the objective, `dF/dc` against central
+    /// differences of `F`, on a curved map with every kind of basis function.
+    #[test]
+    fn gradient_and_hessian_match_finite_differences() {
+        let (disc, cps) = curved(7, 0.05);
+        let mut prob = WinslowProblem::new(disc, cps);
+        let c = prob.unknowns();
+        let n = c.len();
+        let mut f = vec![0.0; n];
+        let mut jac = Csr::default();
+        prob.jacobian(&c, &mut f, &mut jac);
+        assert_eq!(prob.shift(), 0.0);
+        let dense = jac.to_dense();
+        let j0 = prob.objective(&c).unwrap();
+        assert!(j0.is_finite() && j0 > 2.0, "J = {j0}");
+        let h = 1e-6;
+        let (mut err_g, mut err_h, mut scale_g, mut scale_h) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for j in 0..n {
+            let (mut cp, mut cm) = (c.clone(), c.clone());
+            cp[j] += h;
+            cm[j] -= h;
+            let jp = prob.objective(&cp).unwrap();
+            let jm = prob.objective(&cm).unwrap();
+            let fd = -(jp - jm) / (2.0 * h);
+            err_g = err_g.max((fd - f[j]).abs());
+            scale_g = scale_g.max(fd.abs());
+            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            prob.residual(&cp, &mut fp);
+            prob.residual(&cm, &mut fm);
+            for i in 0..n {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                err_h = err_h.max((fd - dense[i][j]).abs());
+                scale_h = scale_h.max(fd.abs());
+            }
+        }
+        assert!(err_g < 1e-7 * scale_g, "gradient: {err_g} (scale {scale_g})");
+        assert!(err_h < 1e-7 * scale_h, "Hessian: {err_h} (scale {scale_h})");
+        // symmetric
+        for (i, row) in dense.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                assert!((v - dense[j][i]).abs() <= 1e-12 * scale_h, "({i}, {j})");
+            }
+        }
+    }
+
+    /// The affine map is a critical point, and Newton from a perturbed interior
+    /// converges to it (the minimiser of eq. 16 with an affine boundary).
+    #[test]
+    fn minimiser_of_an_affine_boundary_is_the_affine_map() {
+        for p in [2, 3] {
+            let (disc, cps, exact) = affine(p, 5, 3, 0.04);
+            let mut at_exact = WinslowProblem::new(disc.clone(), exact.clone());
+            let ce = at_exact.unknowns();
+            let mut f = vec![0.0; ce.len()];
+            at_exact.residual(&ce, &mut f);
+            assert!(max_abs(f.iter().copied()) < 1e-13, "p = {p}: |∇J| = {}", max_abs(f));
+            let prob = WinslowProblem::new(disc.clone(), cps);
+            let c0 = prob.unknowns();
+            let m = disc.dofs.num_free();
+            let opts = NonlinearOptions { scale: (m as f64).sqrt() * 2.5, fallback: false, ..Default::default() };
+            let mut s = NonlinearSolver::new(prob, c0, opts);
+            let mut last = f64::INFINITY;
+            for it in s.by_ref() {
+                let j = it.unwrap().objective.unwrap();
+                assert!(j <= last);
+                last = j;
+            }
+            assert_eq!(s.status(), &Status::Converged);
+            let (prob, c) = s.into_parts();
+            let err = max_abs(prob.control_points(&c).iter().zip(&exact).flat_map(|(a, b)| [a[0] - b[0], a[1] - b[1]]));
+            assert!(err < 1e-9, "p = {p}: distance to the affine map {err}");
+        }
+    }
+
+    /// The unit square with its interior twisted by `θ(ξ, η) = alpha 16 ξ(1-ξ)η(1-η)`
+    /// about the centre: bijective, far from the minimiser (the identity).
+    fn twisted(p: usize, ne: usize, alpha: f64) -> (Arc<Discretization>, Vec<Point>, Vec<Point>) {
+        let k = KnotVector::open_uniform(p, ne);
+        let g = k.greville();
+        let exact: Vec<Point> = g.iter().flat_map(|&v| g.iter().map(move |&u| [u, v])).collect();
+        let disc = Arc::new(Discretization::new([k.clone(), k]));
+        let mut cps = exact.clone();
+        for &kk in disc.dofs.free() {
+            let [u, v] = exact[kk];
+            let th = alpha * 16.0 * u * (1.0 - u) * v * (1.0 - v);
+            let (x, y) = (u - 0.5, v - 0.5);
+            cps[kk] = [0.5 + th.cos() * x - th.sin() * y, 0.5 + th.sin() * x + th.cos() * y];
+        }
+        (disc, cps, exact)
+    }
+
+    /// Counts the trial points whose objective is `+∞` (folded at a quadrature point).
+    struct Counting {
+        inner: WinslowProblem,
+        infeasible: usize,
+    }
+
+    impl DiscreteProblem for Counting {
+        fn size(&self) -> usize {
+            self.inner.size()
+        }
+        fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+            self.inner.residual(c, f)
+        }
+        fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
+            self.inner.jacobian(c, f, jac)
+        }
+        fn mass(&mut self) -> &Csr {
+            self.inner.mass()
+        }
+        fn objective(&mut self, c: &[f64]) -> Option<f64> {
+            let j = self.inner.objective(c);
+            self.infeasible += usize::from(j.is_some_and(|j| j.is_infinite()));
+            j
+        }
+        fn raise_shift(&mut self) -> bool {
+            self.inner.raise_shift()
+        }
+        fn control_points(&self, c: &[f64]) -> Vec<Point> {
+            self.inner.control_points(c)
+        }
+    }
+
+    /// From a strongly twisted square the first full Newton step folds the map (checked
+    /// here: `J = +∞` there although the direction descends); the line search rejects it
+    /// and every accepted iterate stays bijective, down to the identity map.
+    #[test]
+    fn line_search_rejects_a_folding_step() {
+        use crate::linalg::linsolve::{LinearMethod, LinearSolver};
+        let (disc, cps, exact) = twisted(2, 6, 1.65);
+        let mut prob = WinslowProblem::new(disc.clone(), cps);
+        let c = prob.unknowns();
+        assert!(prob.objective(&c).unwrap().is_finite(), "the start is bijective");
+        let mut f = vec![0.0; c.len()];
+        let mut jac = Csr::default();
+        prob.jacobian(&c, &mut f, &mut jac);
+        let mut lu = LinearSolver::new(LinearMethod::Lu);
+        lu.factor(&jac).unwrap();
+        let dx = lu.solve(&f.iter().map(|v| -v).collect::<Vec<_>>()).unwrap();
+        assert!(f.iter().zip(&dx).map(|(a, b)| a * b).sum::<f64>() > 0.0, "a descent direction");
+        let full: Vec<f64> = c.iter().zip(&dx).map(|(a, b)| a + b).collect();
+        assert_eq!(prob.objective(&full), Some(f64::INFINITY), "the full step folds the map");
+
+        let m = disc.dofs.num_free();
+        let opts = NonlinearOptions { scale: (m as f64).sqrt(), fallback: false, ..Default::default() };
+        let mut s = NonlinearSolver::new(Counting { inner: prob, infeasible: 0 }, c, opts);
+        for it in s.by_ref() {
+            let it = it.unwrap();
+            assert!(it.objective.unwrap().is_finite(), "iterate {} folds", it.iteration);
+        }
+        assert_eq!(s.status(), &Status::Converged);
+        let (prob, c) = s.into_parts();
+        assert!(prob.infeasible > 0, "the line search met folded trial points");
+        let err = max_abs(prob.control_points(&c).iter().zip(&exact).flat_map(|(a, b)| [a[0] - b[0], a[1] - b[1]]));
+        assert!(err < 1e-9, "distance to the identity {err}");
+    }
+
+    /// The preconditioner's block is the eigenvalue-floored mean of the Hessian's
+    /// diagonal blocks: equal to it where that is definite, definite always.
+    #[test]
+    fn preconditioner_block_is_the_definite_mean_block() {
+        for e in [[1.3, 0.4, -0.2, 0.9], [2.0, 0.0, 0.0, 0.5], [1.0, 3.0, -0.1, 0.4]] {
+            let (_, _, h) = winslow_density(e);
+            let [a11, a12, a22] = definite_mean_block(e);
+            assert!(a11 > 0.0 && a22 > 0.0 && a11 * a22 - a12 * a12 > 0.0, "{e:?}");
+            let m = [0.5 * (h[0][0] + h[2][2]), 0.5 * (h[0][1] + h[2][3]), 0.5 * (h[1][1] + h[3][3])];
+            if m[0] > 0.0 && m[0] * m[2] - m[1] * m[1] > 1e-3 * (m[0] + m[2]).powi(2) {
+                for (x, y) in [a11, a12, a22].iter().zip(m) {
+                    assert!((x - y).abs() < 1e-12 * (m[0] + m[2]), "{e:?}: {x} vs {y}");
+                }
+            }
+        }
+    }
+}
