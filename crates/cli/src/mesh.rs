@@ -20,7 +20,7 @@ pub struct MeshSpec {
     pub structured: Option<String>,
     /// Point distribution of a structured mesh, repeatable: DIR:uniform, DIR:arctan:A
     /// (eq. 50, A = 6 in the paper), DIR:tanh:D (two-sided), SIDE:tanh:D (one-sided,
-    /// clustered at SIDE), SIDE:first-height:H[:GROWTH] (geometric layers whose first
+    /// clustered at SIDE), `SIDE:first-height:H[:GROWTH]` (geometric layers whose first
     /// cell is H long in physical units, growth ratio limit GROWTH, default 1.2).
     /// DIR is xi or eta; SIDE is south, east, north or west.
     #[arg(long, value_name = "SPEC")]

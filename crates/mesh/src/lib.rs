@@ -6,8 +6,8 @@
 //! | module | what lives there |
 //! |---|---|
 //! | [`distribution`] | point distributions per direction: uniform, arctan (eq. 50), tanh, geometric layers |
-//! | [`structured`] | structured quadrilateral meshes at `xi_i x eta_j`, first-cell heights in physical units |
-//! | [`unstructured`] | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
+//! | [`structured`](mod@structured) | structured quadrilateral meshes at `xi_i x eta_j`, first-cell heights in physical units |
+//! | [`unstructured`](mod@unstructured) | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |

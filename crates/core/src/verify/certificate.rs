@@ -17,12 +17,12 @@
 //! **Rounding.** The verdict holds for the exact map given by the `f64` data, not for
 //! its floating-point image: every coefficient `ĉ_k` comes with a bound `e` of its
 //! rounding error, `|ĉ_k - c_k| <= e`, by running error analysis with the constants
-//! `γ_n = n u / (1 - n u)`, `u = 2^-53` ([`bernstein`]): the net is taken relative to
+//! `γ_n = n u / (1 - n u)`, `u = 2^-53` (module `bernstein`): the net is taken relative to
 //! the element's first control point (so the rounding scales with the element, not
-//! with `|x|`) and scaled to unit size by a power of two ([`element`]); de Casteljau
+//! with `|x|`) and scaled to unit size by a power of two (module `element`); de Casteljau
 //! bisection adds `γ_{du+dv} max|ĉ|` per level. A box is proven when
 //! `min_k ĉ_k - e > 0`; a fold is reported only at a point where the value is
-//! `< -(its bound)`, re-evaluated at the reported parameter point ([`search`]); what is
+//! `< -(its bound)`, re-evaluated at the reported parameter point (module `search`); what is
 //! neither is bisected, and left `undecided` when the budget is spent.
 //!
 //! **Corners.** A corner whose `det J` coefficient (exact up to `e`) is not provably
