@@ -598,4 +598,33 @@ mod tests {
             }
         }
     }
+
+    /// `raise_shift` re-presents the Hessian at the same point with `τ |H_ii|` added to
+    /// its diagonal (no other entry changes, no reassembly needed), `τ` grows tenfold per
+    /// call, and falls back tenfold per new point.
+    #[test]
+    fn raised_shift_adds_to_the_diagonal_only() {
+        let (disc, cps, _) = twisted(2, 4, 1.0);
+        let mut prob = WinslowProblem::new(disc, cps);
+        let c = prob.unknowns();
+        let n = c.len();
+        let (mut f, mut jac0, mut jac1) = (vec![0.0; n], Csr::default(), Csr::default());
+        prob.jacobian(&c, &mut f, &mut jac0);
+        assert!(prob.raise_shift() && prob.raise_shift());
+        prob.jacobian(&c, &mut f, &mut jac1);
+        let tau = prob.shift();
+        assert!((tau - 10.0 * SHIFT_MIN).abs() < 1e-18, "{tau}");
+        let (d0, d1) = (jac0.to_dense(), jac1.to_dense());
+        for i in 0..n {
+            for j in 0..n {
+                let expect = if i == j { d0[i][i] - tau * d0[i][i].abs() } else { d0[i][j] };
+                assert!((d1[i][j] - expect).abs() <= 1e-14 * d0[i][i].abs(), "({i}, {j})");
+            }
+        }
+        // a new point: back towards the exact Hessian
+        let mut c2 = c.clone();
+        c2[0] += 1e-3;
+        prob.jacobian(&c2, &mut f, &mut jac1);
+        assert!(prob.shift() < tau);
+    }
 }

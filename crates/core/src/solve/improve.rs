@@ -186,6 +186,9 @@ pub fn improve(
     let m = disc.dofs.num_free();
     let mut nl = nonlinear;
     nl.method = NonlinearMethod::Newton;
+    // from a certified start only Newton with its line search: pseudo time-stepping is for
+    // starts far from a solution (and 400 of its steps cost minutes on a fine basis)
+    nl.fallback = false;
     nl.scale = method.residual_scale(diameter, m);
     nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
     let c0 = disc.dofs.gather(&map.control_points);
