@@ -426,4 +426,3 @@ fn extreme_scales_keep_clear_verdicts() {
         }
     }
 }
-
