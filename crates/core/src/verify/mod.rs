@@ -3,7 +3,7 @@
 //!
 //! | module | holds | paper |
 //! |---|---|---|
-//! | [`certificate`] | [`certify`](certificate::certify): exact Bernstein bounds of `det J` with subdivision; verdicts certified / degenerate corner / folded / undecided | §8.1, eq. (43) |
+//! | [`certificate`] | [`certify`](certificate::certify): Bernstein bounds of `det J` with a rigorous rounding bound (`bernstein`: the error arithmetic; `element`: local origin, blossom extraction, coefficients; `search`: proof, fold witnesses, corner neighbourhoods) and subdivision; verdicts certified / degenerate corner / folded / undecided | §8.1, eq. (43) |
 //! | [`quality`] | sampled `det J`, the functionals (Winslow eq. 15-16, area orthogonality, Liao, uniformity, harmonic energy), cell statistics, boundary deviation | §2, §4.1 |
 //! | [`poisson`] | the Poisson benchmark `Q(x)` solved by IGA on the map | §10, eq. (44)-(45) |
 //!

@@ -18,7 +18,8 @@
 //! - de Casteljau bisection at `1/2` (halving is exact; `du + dv` additions per
 //!   coefficient, convex weights): `e_child = e_parent + γ_{du+dv} max|ĉ_parent|`;
 //! - evaluation at a point whose local coordinates `s`, `1 - s` are known with relative
-//!   error `θ_k` (de Casteljau, convex weights): `e = e_coeffs + γ_{(k+2)(du+dv)} max|ĉ|`.
+//!   error `θ_k` (de Casteljau, convex weights, three roundings per level):
+//!   `e = e_coeffs + γ_{(k+3)(du+dv)} max|ĉ|`.
 //!
 //! Underflow (possible only far below the element's scale, since every element's net is
 //! scaled to unit size by a power of two, which is exact) adds at most `2^-1075` per
@@ -199,7 +200,8 @@ pub fn eval(c: &[f64], d: Deg, s: [f64; 2], t: [f64; 2], tmp: &mut [f64]) -> f64
 /// `(1 - s, s)`, `(1 - t, t)` to a relative `θ_k` each (`k = 0`: exact, as at dyadic
 /// points).
 pub fn eval_error(c: &[f64], d: Deg, e: f64, k: usize) -> f64 {
-    e + gamma((k + 2) * (d.0[0] + d.0[1])) * amax(c) + TINY
+    // per level: two products (each with its weight's θ_k) and one addition
+    e + gamma((k + 3) * (d.0[0] + d.0[1])) * amax(c) + TINY
 }
 
 #[cfg(test)]
