@@ -13,7 +13,9 @@
 //!    is inverted (down to `size / 64`), or over which `det J` (eq. 43) varies by more than `det_j_ratio`
 //!    between its vertices, gets its physically longest edge split at the parameter
 //!    midpoint; so does every boundary segment whose image deviates from the mapped
-//!    curve by more than `chord_tol` at its midpoint. Stop when no triangle asks.
+//!    curve by more than `chord_tol` at its midpoint. Stop when no triangle asks; give
+//!    up (error) past 50 times the vertex count an equilateral mesh of the area needs,
+//!    which happens where the map stretches parameter triangles into slivers.
 //!
 //! The minimum angle holds in the stretched parameter rectangle (spade's guarantee);
 //! the physical angles are reported by [`crate::quality`].
@@ -133,6 +135,13 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     let nb = boundary.len();
     let edges: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
     let scale = parameter_scale(map);
+    // vertices of an equilateral mesh of edge `size` over the area (shoelace of the
+    // boundary points), the yardstick of the guard against refinement that does not settle
+    let area = {
+        let x: Vec<DVec2> = boundary.iter().map(|q| at(map, *q)).collect();
+        0.5 * (0..x.len()).map(|k| x[k].perp_dot(x[(k + 1) % x.len()])).sum::<f64>()
+    };
+    let expected = (area.abs() / (0.433 * opts.size * opts.size) / 2.0) as usize + nb;
     let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x * scale.x, q.y * scale.y)).collect();
     let mut cdt = Cdt::bulk_load_cdt(verts, edges).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
     let mut phys: Vec<DVec2> = Vec::new();
@@ -200,6 +209,14 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
         }
         if split.is_empty() {
             return build(&cdt, phys, scale);
+        }
+        if cdt.num_vertices() > 50 * expected + 10_000 {
+            return Err(MeshError::Triangulation(format!(
+                "{} vertices and {} edges still to split, against about {expected} for triangles of size {} over the area: the map stretches parameter triangles into slivers (strong local anisotropy, e.g. a narrow gap); isotropic refinement in the parameter square does not settle here: use --structured or a larger size",
+                cdt.num_vertices(),
+                split.len(),
+                opts.size
+            )));
         }
         if cdt.num_vertices() + split.len() > opts.max_vertices {
             return Err(MeshError::Triangulation(format!(

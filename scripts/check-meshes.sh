@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Open winslow's mesh files in a reference reader (meshio, from PyPI, in a venv): solve
+# the shared geometries, write .msh/.vtu/.su2 (structured, unstructured, curved) and
+# load each with meshio, printing its point and cell counts. Run by hand, not by CI.
+#   scripts/check-meshes.sh [WINSLOW_BINARY]
+set -euo pipefail
+W=${1:-./target/release/winslow}
+OUT=${OUT:-out/check-meshes}
+VENV=${VENV:-/tmp/winslow-meshio-venv}
+mkdir -p "$OUT"
+[ -x "$VENV/bin/python" ] || { python3 -m venv "$VENV" && "$VENV/bin/pip" install -q meshio; }
+for g in tests/data/spiral_channel.json tests/data/wavy_lid.json tests/data/quarter_annulus.json \
+         tests/data/gismo/male_casing_ring.json tests/data/gismo/puzzle3.json; do
+  n=$(basename "$g" .json)
+  "$W" solve "$g" -o "$OUT/$n.json" -q > /dev/null || { echo "$n: solve failed, skipped"; continue; }
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-s.msh" --structured 101x33 --cluster eta:arctan:6 > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-s.su2" --structured 101x33 --cluster eta:arctan:6 > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-s.vtu" --structured 101x33 --cluster eta:arctan:6 > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-q2.msh" --structured 41x17 --order 2 > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-q3.vtu" --structured 41x17 --order 3 > /dev/null || echo "  (refused, see the error above)"
+  size=$("$VENV/bin/python" -c "import json,math;m=json.load(open('$OUT/$n.json'))['map']['control_points'];xs=[p[0] for p in m];ys=[p[1] for p in m];print(math.hypot(max(xs)-min(xs),max(ys)-min(ys))/60)")
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-u.msh" --unstructured --size "$size" > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-u.su2" --unstructured --size "$size" > /dev/null || echo "  (refused, see the error above)"
+  "$W" mesh "$OUT/$n.json" -o "$OUT/$n-t3.msh" --unstructured --size "$size" --order 3 > /dev/null || echo "  (refused, see the error above)"
+done
+"$VENV/bin/python" - "$OUT" <<'PY'
+import sys, glob, meshio
+for f in sorted(glob.glob(sys.argv[1] + "/*.msh") + glob.glob(sys.argv[1] + "/*.vtu") + glob.glob(sys.argv[1] + "/*.su2")):
+    m = meshio.read(f)
+    cells = ", ".join(f"{b.type} {len(b.data)}" for b in m.cells)
+    tags = sorted(m.field_data) if m.field_data else []
+    print(f"{f}: {len(m.points)} points; {cells}" + (f"; groups {tags}" if tags else ""))
+PY
