@@ -148,9 +148,15 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     let mut det: Vec<f64> = Vec::new();
     let limit = AngleLimit::from_deg(opts.min_angle);
     let probe = (opts.order > 1).then(|| JacobianProbe::new(ElementKind::Triangle, opts.order.min(3)));
-    for _round in 0..200 {
+    for round in 0..200 {
         let budget = opts.max_vertices.saturating_sub(cdt.num_vertices());
-        let r = cdt.refine(RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget));
+        // the first round also bounds the area by the equilateral triangle of edge `size`
+        // in the stretched rectangle: most vertices come from spade's own refinement
+        let mut params = RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget);
+        if round == 0 {
+            params = params.with_max_allowed_area(0.433 * opts.size * opts.size);
+        }
+        let r = cdt.refine(params);
         if !r.refinement_complete {
             return Err(MeshError::Triangulation(format!(
                 "refinement stopped at {} vertices (the limit) before meeting the angle {}°; use a larger size or a smaller angle",
