@@ -1,0 +1,251 @@
+//! `winslow solve`: the coarse-to-fine solve with its progress on stderr, the map and
+//! report writers, and `--start MAP` (improve a certified map on its own basis).
+
+use super::*;
+
+/// Run the solver stream, printing progress.
+pub(super) fn run_solver(
+    boundary: &Boundary,
+    opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    quiet: bool,
+) -> Result<Solution> {
+    let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
+    if !quiet {
+        let tol = h.tol_abs;
+        eprintln!(
+            "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
+            boundary.name,
+            h.levels.len(),
+            h.diameter
+        );
+        match (&h.basis.fallback, h.basis.used) {
+            (Some(why), _) => eprintln!("  basis: fitted (the input basis cannot be used: {why})"),
+            (None, BasisChoice::Input) => eprintln!(
+                "  basis: input, {}x{} functions, boundary kept exactly",
+                h.finest().knots[0].num_basis(),
+                h.finest().knots[1].num_basis()
+            ),
+            (None, BasisChoice::Fitted) => {}
+        }
+        let rp = &h.reparam;
+        eprintln!(
+            "  reparameterization: {} (requested {}), {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.matches.len()
+        );
+        for s in Side::ALL {
+            let f = &h.fits[s as usize];
+            if !f.converged {
+                eprintln!(
+                    "  warning: {s} side fit did not reach the tolerance (max error {:.3e})",
+                    f.max_error.last().copied().unwrap_or(0.0)
+                );
+            }
+        }
+    }
+    let mut solver = EggSolver::new(&h, opts.clone(), assembler)?;
+    if !quiet {
+        let m = solver.method();
+        eprintln!("  method: {} (start: {:?})", m.name(), m.start());
+    }
+    let stderr = std::io::stderr();
+    for event in solver.by_ref() {
+        let event = event?;
+        if quiet {
+            continue;
+        }
+        let mut e = stderr.lock();
+        match event {
+            Event::LevelStarted { level, levels, shape, unknowns, initial_guess } => {
+                writeln!(
+                    e,
+                    "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}",
+                    level + 1,
+                    shape[0],
+                    shape[1]
+                )?;
+            }
+            Event::Iterate { iterate: it, .. } => {
+                writeln!(
+                    e,
+                    "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
+                    it.iteration,
+                    format!("{:?}", it.method),
+                    it.residual,
+                    it.scaled_residual,
+                    it.step,
+                    it.damping,
+                    it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
+                    it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
+                )?;
+            }
+            Event::LevelFinished(r) => {
+                writeln!(
+                    e,
+                    "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
+                    r.iterations,
+                    if r.converged {
+                        "converged".to_string()
+                    } else {
+                        format!("NOT converged ({})", r.failure.unwrap_or_default())
+                    },
+                    r.initial_det_j_min,
+                    r.seconds
+                )?;
+            }
+        }
+    }
+    Ok(solver.finish(boundary, &h)?)
+}
+
+pub(super) fn solve(a: SolveArgs) -> Result<i32> {
+    let wants_mesh = a.mesh_spec.structured.is_some() || a.mesh_spec.unstructured;
+    if wants_mesh != a.mesh.is_some() {
+        bail!("--mesh OUT and one of --structured NXxNY / --unstructured --size H go together");
+    }
+    if let Some(out) = &a.mesh {
+        winslow_mesh::formats::Format::from_path(out)?;
+    }
+    if let Some(start) = &a.start {
+        return solve_from_start(&a, start);
+    }
+    let mut opts = a.solver.options()?;
+    opts.poisson = a.poisson;
+    let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
+    let boundary = load_boundary(path, a.solver.fit.reorient)?;
+    let sel = a.backend.select(a.quiet || a.json)?;
+    let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
+    let report = serde_json::to_value(&sol.report)?;
+    let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+    let json = || map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report })));
+    output::write_map(&a.output, &sol.name, &sol.map, &label, json)?;
+    for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu")] {
+        if let Some(p) = path {
+            output::write_map_as(p, ext, &sol.name, &sol.map, &label, json)?;
+        }
+    }
+    if let Some(p) = &a.png {
+        let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
+        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, ..Default::default() })?)?;
+    }
+    if let Some(p) = &a.vtk {
+        output::write_map_as(p, "vtk", &sol.name, &sol.map, &label, json)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
+    }
+    if let Some(out) = &a.mesh {
+        // a folded map gives inverted cells, which the writers refuse
+        mesh::make_and_write(&sol.map, &a.mesh_spec, out, a.json)?;
+    }
+    Ok(exit_code(sol.report.verdict))
+}
+
+/// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: improve a
+/// certified map on its own basis (its boundary fixed), certify the result, keep it
+/// only when certified.
+pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
+    let opts = a.solver.options()?;
+    let doc = read_document(start).with_context(|| format!("reading {}", start.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: --start needs a map document", start.display())
+    };
+    let method: Arc<dyn Method> = match a.solver.method {
+        MethodArg::Winslow => Improve::Winslow.method(),
+        MethodArg::Weak => Improve::WeakForm.method(),
+        MethodArg::Egg => Arc::new(EggMethod::cpu(opts.operator)),
+        MethodArg::Newton | MethodArg::PseudoTime => {
+            bail!("--start needs --method winslow, weak or egg (use --iteration for newton or pseudo-time)")
+        }
+    };
+    let boundary = match &a.boundary {
+        Some(p) => Some(load_boundary(p, a.solver.fit.reorient)?),
+        None => None,
+    };
+    let diameter = {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &map.control_points {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+    };
+    let t0 = std::time::Instant::now();
+    let cert = certify(&map, &opts.certify).context("certifying the start")?;
+    let out = improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)
+        .with_context(|| format!("improving {}", start.display()))?;
+    let deviation = boundary.as_ref().map(|b| boundary_deviation(&out.map, b, 400));
+    let verdict = match out.certificate.verdict {
+        CertVerdict::Certified { .. } => Verdict::Certified,
+        CertVerdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+        CertVerdict::Folded { .. } => Verdict::Folded,
+        CertVerdict::Undecided { .. } => Verdict::Undecided,
+    };
+    let q = quality(&out.map);
+    let w = q.functionals.winslow;
+    let report = serde_json::json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "start": start.display().to_string(),
+        "method": method.name(),
+        "verdict": verdict,
+        "message": format!("{}; {}", out.certificate.message(), out.report.message),
+        "certificate": out.certificate,
+        "quality": q,
+        "winslow": w.is_finite().then_some(w),
+        "boundary_deviation": deviation,
+        "improvement": out.report,
+        "seconds": t0.elapsed().as_secs_f64(),
+    });
+    let label = format!("verdict {verdict:?}: {}", out.certificate.message());
+    let json = || map_to_json(&name, &out.map, Some(serde_json::json!({ "report": report })));
+    output::write_map(&a.output, &name, &out.map, &label, json)?;
+    for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu"), (&a.vtk, "vtk")] {
+        if let Some(p) = path {
+            output::write_map_as(p, ext, &name, &out.map, &label, json)?;
+        }
+    }
+    if let Some(p) = &a.png {
+        let sel = a.backend.select(a.quiet || a.json)?;
+        output::write_png(p, &picture(&sel, &out.map, &PictureOptions::default())?)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        let mut s = format!(
+            "{name}: {} from {}\n  {}\n",
+            output::verdict_word(verdict),
+            start.display(),
+            out.certificate.message()
+        );
+        output::improvement_lines(&mut s, &out.report, t0.elapsed().as_secs_f64());
+        if let Some(d) = deviation {
+            s.push_str(&format!(
+                "  boundary deviation from {} (S, E, N, W): {:.3e} {:.3e} {:.3e} {:.3e}\n",
+                a.boundary.as_ref().map_or(String::new(), |p| p.display().to_string()),
+                d[0],
+                d[1],
+                d[2],
+                d[3]
+            ));
+        }
+        s.push_str(&format!("  wrote {}\n", a.output.display()));
+        print!("{s}");
+    }
+    Ok(exit_code(verdict))
+}
+
+/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
+fn exit_code(v: Verdict) -> i32 {
+    match v {
+        Verdict::Certified | Verdict::DegenerateCorner => 0,
+        Verdict::Folded => 3,
+        Verdict::NotConverged => 4,
+        Verdict::Undecided => 5,
+    }
+}
