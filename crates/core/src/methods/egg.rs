@@ -6,6 +6,7 @@
 
 use std::sync::Arc;
 
+use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
 
 use crate::discrete::assembly::{Discretization, Operator};
@@ -98,21 +99,14 @@ impl Method for EggMethod {
     }
 }
 
-/// EGG on one level: the discretization, the control points (fixed ones hold the
-/// Dirichlet data) and storage requested once up front.
+/// EGG on one level: the [`GalerkinState`] (discretization, control points, storage
+/// requested once up front), the operator and the quadrature back end.
 pub struct EggProblem {
-    /// Tables, DOF map and patterns of the basis.
-    pub disc: Arc<Discretization>,
-    /// All control points; the free ones are overwritten from `c` on every call.
-    pub cps: Vec<Point>,
+    /// Basis, control points and storage.
+    pub state: GalerkinState,
     /// Which operator.
     pub op: Operator,
     assembler: Arc<dyn EggAssembler>,
-    res_full: Vec<f64>,
-    stencil: Vec<f64>,
-    mass: Option<Csr>,
-    pstencil: Vec<f64>,
-    prec: Csr,
 }
 
 impl std::fmt::Debug for EggProblem {
@@ -124,94 +118,52 @@ impl std::fmt::Debug for EggProblem {
 impl EggProblem {
     /// Set up with all control points `cps` (free ones are the initial guess).
     pub fn new(disc: Arc<Discretization>, cps: Vec<Point>, op: Operator, assembler: Arc<dyn EggAssembler>) -> Self {
-        let n = disc.dofs.num_total();
-        Self {
-            cps,
-            op,
-            assembler,
-            res_full: vec![0.0; 2 * n],
-            stencil: Vec::new(),
-            mass: None,
-            pstencil: Vec::new(),
-            prec: disc.scalar.csr.clone(),
-            disc,
-        }
+        Self { state: GalerkinState::new(disc, cps), op, assembler }
     }
 
     /// The current unknown vector.
     pub fn unknowns(&self) -> Vec<f64> {
-        self.disc.dofs.gather(&self.cps)
-    }
-
-    fn load(&mut self, c: &[f64]) {
-        self.disc.dofs.scatter(c, &mut self.cps);
+        self.state.unknowns()
     }
 }
 
 impl DiscreteProblem for EggProblem {
     fn size(&self) -> usize {
-        2 * self.disc.dofs.num_free()
+        self.state.size()
     }
 
     fn residual(&mut self, c: &[f64], f: &mut [f64]) {
-        self.load(c);
-        self.assembler.egg(&self.disc, &self.cps, self.op, &mut self.res_full, &mut []);
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+        let s = &mut self.state;
+        s.load(c);
+        self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut []);
+        s.restrict_residual(f);
     }
 
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
-        self.load(c);
-        if self.stencil.is_empty() {
-            self.stencil = vec![0.0; self.disc.stencil_len(2)];
-        }
-        self.assembler.egg(&self.disc, &self.cps, self.op, &mut self.res_full, &mut self.stencil);
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
-        let pattern = &self.disc.vector;
-        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
-            jac.assign(&pattern.csr);
-        }
-        pattern.gather_into(&self.stencil, &mut jac.values);
+        let s = &mut self.state;
+        s.load_for_jacobian(c);
+        self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
+        s.restrict_residual(f);
+        s.gather_jacobian(jac);
     }
 
     fn mass(&mut self) -> &Csr {
-        if self.mass.is_none() {
-            let mut st = vec![0.0; self.disc.stencil_len(1)];
-            self.assembler.mass(&self.disc, &mut st);
-            let m = self.disc.scalar.matrix(&st);
-            // block diag(M, M) in the vector pattern
-            let ms = self.disc.dofs.num_free();
-            let mut out = self.disc.vector.csr.clone();
-            for r in 0..out.nrows {
-                let (z, f) = (r / ms, r % ms);
-                for k in out.row_ptr[r]..out.row_ptr[r + 1] {
-                    let cidx = out.col_idx[k];
-                    let (d, g) = (cidx / ms, cidx % ms);
-                    out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
-                }
-            }
-            self.mass = Some(out);
-        }
-        self.mass.as_ref().expect("set above")
+        let assembler = &self.assembler;
+        self.state.mass(|disc, st| assembler.mass(disc, st))
     }
 
     fn ordering(&self) -> Option<&[usize]> {
-        Some(&self.disc.ordering)
+        Some(&self.state.disc.ordering)
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
-        let mut cps = self.cps.clone();
-        self.disc.dofs.scatter(c, &mut cps);
-        cps
+        self.state.control_points(c)
     }
 
     /// `K` of [`Discretization::metric_laplace`] on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
-        if self.pstencil.is_empty() {
-            self.pstencil = vec![0.0; self.disc.stencil_len(1)];
-        }
-        self.disc.metric_laplace(&self.cps, self.op, shift, &mut self.pstencil);
-        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
-        Some(&self.prec)
+        let op = self.op;
+        Some(self.state.preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))
     }
 }
 

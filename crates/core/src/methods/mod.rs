@@ -40,6 +40,7 @@
 
 pub mod egg;
 pub mod flux;
+pub mod galerkin;
 pub mod weak_form;
 pub mod winslow;
 
@@ -166,20 +167,4 @@ pub trait Method: Send + Sync + std::fmt::Debug {
     }
     /// The discrete problem on `disc` starting from `control_points`.
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
-}
-
-/// The block mass matrix `diag(M, M)` of eq. (30) in the vector pattern of `disc`, from
-/// the scalar mass matrix `m` (in the scalar pattern).
-pub(crate) fn block_mass(disc: &Discretization, m: &Csr) -> Csr {
-    let ms = disc.dofs.num_free();
-    let mut out = disc.vector.csr.clone();
-    for r in 0..out.nrows {
-        let (z, f) = (r / ms, r % ms);
-        for k in out.row_ptr[r]..out.row_ptr[r + 1] {
-            let cidx = out.col_idx[k];
-            let (d, g) = (cidx / ms, cidx % ms);
-            out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
-        }
-    }
-    out
 }

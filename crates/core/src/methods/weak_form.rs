@@ -21,7 +21,8 @@
 use std::sync::Arc;
 
 use super::flux::{flux_form, gradient_at, min_det_j};
-use super::{block_mass, DiscreteProblem, Method, Start};
+use super::galerkin::GalerkinState;
+use super::{DiscreteProblem, Method, Start};
 use crate::discrete::assembly::{element_product, Discretization};
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
@@ -107,17 +108,11 @@ pub fn weak_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &
     });
 }
 
-/// Eq. (14) on one level.
+/// Eq. (14) on one level: the [`GalerkinState`] and a scratch net for the feasibility
+/// test.
 pub struct WeakFormProblem {
-    /// Tables, DOF map and patterns of the basis.
-    pub disc: Arc<Discretization>,
-    /// All control points; the free ones are overwritten from `c` on every call.
-    pub cps: Vec<Point>,
-    res_full: Vec<f64>,
-    stencil: Vec<f64>,
-    mass: Option<Csr>,
-    pstencil: Vec<f64>,
-    prec: Csr,
+    /// Basis, control points and storage.
+    pub state: GalerkinState,
     scratch: Vec<Point>,
 }
 
@@ -130,87 +125,56 @@ impl std::fmt::Debug for WeakFormProblem {
 impl WeakFormProblem {
     /// Set up with all control points `cps` (free ones are the start).
     pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
-        let n = disc.dofs.num_total();
-        Self {
-            scratch: cps.clone(),
-            cps,
-            res_full: vec![0.0; 2 * n],
-            stencil: Vec::new(),
-            mass: None,
-            pstencil: Vec::new(),
-            prec: disc.scalar.csr.clone(),
-            disc,
-        }
+        Self { scratch: cps.clone(), state: GalerkinState::new(disc, cps) }
     }
 
     /// The current unknown vector.
     pub fn unknowns(&self) -> Vec<f64> {
-        self.disc.dofs.gather(&self.cps)
-    }
-
-    fn load(&mut self, c: &[f64]) {
-        self.disc.dofs.scatter(c, &mut self.cps);
+        self.state.unknowns()
     }
 }
 
 impl DiscreteProblem for WeakFormProblem {
     fn size(&self) -> usize {
-        2 * self.disc.dofs.num_free()
+        self.state.size()
     }
 
     fn residual(&mut self, c: &[f64], f: &mut [f64]) {
-        self.load(c);
-        flux_form(&self.disc, &self.cps, &mut self.res_full, &mut [], weak_flux);
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+        let s = &mut self.state;
+        s.load(c);
+        flux_form(&s.disc, &s.cps, &mut s.res_full, &mut [], weak_flux);
+        s.restrict_residual(f);
     }
 
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
-        self.load(c);
-        if self.stencil.is_empty() {
-            self.stencil = vec![0.0; self.disc.stencil_len(2)];
-        }
-        flux_form(&self.disc, &self.cps, &mut self.res_full, &mut self.stencil, weak_flux);
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
-        let pattern = &self.disc.vector;
-        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
-            jac.assign(&pattern.csr);
-        }
-        pattern.gather_into(&self.stencil, &mut jac.values);
+        let s = &mut self.state;
+        s.load_for_jacobian(c);
+        flux_form(&s.disc, &s.cps, &mut s.res_full, &mut s.stencil, weak_flux);
+        s.restrict_residual(f);
+        s.gather_jacobian(jac);
     }
 
     fn mass(&mut self) -> &Csr {
-        if self.mass.is_none() {
-            let mut st = vec![0.0; self.disc.stencil_len(1)];
-            self.disc.mass(&mut st);
-            self.mass = Some(block_mass(&self.disc, &self.disc.scalar.matrix(&st)));
-        }
-        self.mass.as_ref().expect("set above")
+        self.state.mass(|disc, st| disc.mass(st))
     }
 
     /// `det J > 0` at every quadrature point.
     fn admissible(&mut self, c: &[f64]) -> bool {
-        self.disc.dofs.scatter(c, &mut self.scratch);
-        min_det_j(&self.disc, &self.scratch) > 0.0
+        self.state.disc.dofs.scatter(c, &mut self.scratch);
+        min_det_j(&self.state.disc, &self.scratch) > 0.0
     }
 
     /// `K` of [`weak_laplace`] on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
-        if self.pstencil.is_empty() {
-            self.pstencil = vec![0.0; self.disc.stencil_len(1)];
-        }
-        weak_laplace(&self.disc, &self.cps, shift, &mut self.pstencil);
-        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
-        Some(&self.prec)
+        Some(self.state.preconditioner(|disc, cps, st| weak_laplace(disc, cps, shift, st)))
     }
 
     fn ordering(&self) -> Option<&[usize]> {
-        Some(&self.disc.ordering)
+        Some(&self.state.disc.ordering)
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
-        let mut cps = self.cps.clone();
-        self.disc.dofs.scatter(c, &mut cps);
-        cps
+        self.state.control_points(c)
     }
 }
 

@@ -41,7 +41,8 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::flux::{flux_form, gradient_at};
-use super::{block_mass, DiscreteProblem, Method, Start};
+use super::galerkin::GalerkinState;
+use super::{DiscreteProblem, Method, Start};
 use crate::discrete::assembly::{element_product, Discretization, Scratch};
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
@@ -212,15 +213,8 @@ const SHIFT_MAX: f64 = 1e8;
 /// The Winslow functional on one level: discretization, control points (fixed ones hold
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
-    /// Tables, DOF map and patterns of the basis.
-    pub disc: Arc<Discretization>,
-    /// All control points; the free ones are overwritten from `c` on every call.
-    pub cps: Vec<Point>,
-    res_full: Vec<f64>,
-    stencil: Vec<f64>,
-    mass: Option<Csr>,
-    pstencil: Vec<f64>,
-    prec: Csr,
+    /// Basis, control points and storage.
+    pub state: GalerkinState,
     /// Positions of the diagonal entries in the vector pattern's values.
     diag: Vec<usize>,
     /// Relative diagonal shift `τ` of the presented Hessian.
@@ -239,49 +233,33 @@ impl std::fmt::Debug for WinslowProblem {
 impl WinslowProblem {
     /// Set up with all control points `cps` (free ones are the start).
     pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
-        let n = disc.dofs.num_total();
         let pat = &disc.vector.csr;
         let diag = (0..pat.nrows).map(|r| pat.position(r, r).expect("the pattern holds the diagonal")).collect();
-        Self {
-            cps,
-            res_full: vec![0.0; 2 * n],
-            stencil: Vec::new(),
-            mass: None,
-            pstencil: Vec::new(),
-            prec: disc.scalar.csr.clone(),
-            diag,
-            shift: 0.0,
-            assembled: None,
-            raised: false,
-            disc,
-        }
+        Self { state: GalerkinState::new(disc, cps), diag, shift: 0.0, assembled: None, raised: false }
     }
 
     /// The current unknown vector.
     pub fn unknowns(&self) -> Vec<f64> {
-        self.disc.dofs.gather(&self.cps)
+        self.state.unknowns()
     }
 
     /// The relative diagonal shift `τ` the last Jacobian carried.
     pub fn shift(&self) -> f64 {
         self.shift
     }
-
-    fn load(&mut self, c: &[f64]) {
-        self.disc.dofs.scatter(c, &mut self.cps);
-    }
 }
 
 impl DiscreteProblem for WinslowProblem {
     fn size(&self) -> usize {
-        2 * self.disc.dofs.num_free()
+        self.state.size()
     }
 
     fn residual(&mut self, c: &[f64], f: &mut [f64]) {
-        self.load(c);
-        winslow_gradient(&self.disc, &self.cps, &mut self.res_full, &mut []);
+        let s = &mut self.state;
+        s.load(c);
+        winslow_gradient(&s.disc, &s.cps, &mut s.res_full, &mut []);
         self.assembled = None;
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+        s.restrict_residual(f);
     }
 
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
@@ -289,20 +267,14 @@ impl DiscreteProblem for WinslowProblem {
             // a new point: back towards the exact Hessian
             self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
         }
+        let s = &mut self.state;
         if self.assembled.as_deref() != Some(c) {
-            self.load(c);
-            if self.stencil.is_empty() {
-                self.stencil = vec![0.0; self.disc.stencil_len(2)];
-            }
-            winslow_gradient(&self.disc, &self.cps, &mut self.res_full, &mut self.stencil);
+            s.load_for_jacobian(c);
+            winslow_gradient(&s.disc, &s.cps, &mut s.res_full, &mut s.stencil);
             self.assembled = Some(c.to_vec());
         }
-        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
-        let pattern = &self.disc.vector;
-        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
-            jac.assign(&pattern.csr);
-        }
-        pattern.gather_into(&self.stencil, &mut jac.values);
+        s.restrict_residual(f);
+        s.gather_jacobian(jac);
         if self.shift > 0.0 {
             let mean = self.diag.iter().map(|&k| jac.values[k].abs()).sum::<f64>() / self.diag.len().max(1) as f64;
             for &k in &self.diag {
@@ -313,18 +285,11 @@ impl DiscreteProblem for WinslowProblem {
     }
 
     fn mass(&mut self) -> &Csr {
-        if self.mass.is_none() {
-            let mut st = vec![0.0; self.disc.stencil_len(1)];
-            self.disc.mass(&mut st);
-            self.mass = Some(block_mass(&self.disc, &self.disc.scalar.matrix(&st)));
-        }
-        self.mass.as_ref().expect("set above")
+        self.state.mass(|disc, st| disc.mass(st))
     }
 
     fn objective(&mut self, c: &[f64]) -> Option<f64> {
-        let mut cps = self.cps.clone();
-        self.disc.dofs.scatter(c, &mut cps);
-        Some(winslow_objective(&self.disc, &cps))
+        Some(winslow_objective(&self.state.disc, &self.state.control_points(c)))
     }
 
     fn raise_shift(&mut self) -> bool {
@@ -339,22 +304,15 @@ impl DiscreteProblem for WinslowProblem {
 
     /// `K` of [`winslow_laplace`] on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
-        if self.pstencil.is_empty() {
-            self.pstencil = vec![0.0; self.disc.stencil_len(1)];
-        }
-        winslow_laplace(&self.disc, &self.cps, shift, &mut self.pstencil);
-        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
-        Some(&self.prec)
+        Some(self.state.preconditioner(|disc, cps, st| winslow_laplace(disc, cps, shift, st)))
     }
 
     fn ordering(&self) -> Option<&[usize]> {
-        Some(&self.disc.ordering)
+        Some(&self.state.disc.ordering)
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
-        let mut cps = self.cps.clone();
-        self.disc.dofs.scatter(c, &mut cps);
-        cps
+        self.state.control_points(c)
     }
 }
 

@@ -1,0 +1,127 @@
+//! The storage every Galerkin problem on one basis keeps, requested once up front: the
+//! control points (fixed ones hold the boundary data, free ones are overwritten from the
+//! unknowns `c` on every call), the full residual vector, the stencil storage of the
+//! vector system (eq. 23's Jacobian, or a Hessian), the block mass matrix `diag(M, M)` of
+//! eq. (30) and the scalar preconditioner `K`. [`super::egg`], [`super::weak_form`] and
+//! [`super::winslow`] differ only in their kernels.
+
+use std::sync::Arc;
+
+use crate::discrete::assembly::Discretization;
+use crate::linalg::sparse::Csr;
+use crate::spline::curve::Point;
+
+/// See the module documentation.
+#[derive(Debug)]
+pub struct GalerkinState {
+    /// Tables, DOF map and patterns of the basis.
+    pub disc: Arc<Discretization>,
+    /// All control points; the free ones are overwritten from `c` on every call.
+    pub cps: Vec<Point>,
+    /// The residual of every basis function (interleaved, length `2 n`).
+    pub res_full: Vec<f64>,
+    /// Stencil storage of the vector system; empty until the first Jacobian.
+    pub stencil: Vec<f64>,
+    mass: Option<Csr>,
+    pstencil: Vec<f64>,
+    prec: Csr,
+}
+
+impl GalerkinState {
+    /// Storage for the basis `disc` with all control points `cps`.
+    pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
+        let n = disc.dofs.num_total();
+        Self {
+            cps,
+            res_full: vec![0.0; 2 * n],
+            stencil: Vec::new(),
+            mass: None,
+            pstencil: Vec::new(),
+            prec: disc.scalar.csr.clone(),
+            disc,
+        }
+    }
+
+    /// Number of unknowns `2 m`.
+    pub fn size(&self) -> usize {
+        2 * self.disc.dofs.num_free()
+    }
+
+    /// The current unknown vector.
+    pub fn unknowns(&self) -> Vec<f64> {
+        self.disc.dofs.gather(&self.cps)
+    }
+
+    /// Scatter the unknowns `c` into the control points.
+    pub fn load(&mut self, c: &[f64]) {
+        self.disc.dofs.scatter(c, &mut self.cps);
+    }
+
+    /// All control points with unknowns `c` (the stored ones untouched).
+    pub fn control_points(&self, c: &[f64]) -> Vec<Point> {
+        let mut cps = self.cps.clone();
+        self.disc.dofs.scatter(c, &mut cps);
+        cps
+    }
+
+    /// Load `c` and make sure the stencil storage of the vector system exists.
+    pub fn load_for_jacobian(&mut self, c: &[f64]) {
+        self.load(c);
+        if self.stencil.is_empty() {
+            self.stencil = vec![0.0; self.disc.stencil_len(2)];
+        }
+    }
+
+    /// The free rows of the full residual into `f`.
+    pub fn restrict_residual(&self, f: &mut [f64]) {
+        f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
+    }
+
+    /// The stencil storage gathered into `jac` (the vector pattern is written into it
+    /// on the first call only).
+    pub fn gather_jacobian(&self, jac: &mut Csr) {
+        let pattern = &self.disc.vector;
+        if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
+            jac.assign(&pattern.csr);
+        }
+        pattern.gather_into(&self.stencil, &mut jac.values);
+    }
+
+    /// `diag(M, M)` (eq. 30) in the vector pattern, the scalar mass matrix written into
+    /// stencil storage by `fill` on the first call.
+    pub fn mass(&mut self, fill: impl FnOnce(&Discretization, &mut [f64])) -> &Csr {
+        if self.mass.is_none() {
+            let mut st = vec![0.0; self.disc.stencil_len(1)];
+            fill(&self.disc, &mut st);
+            self.mass = Some(block_mass(&self.disc, &self.disc.scalar.matrix(&st)));
+        }
+        self.mass.as_ref().expect("set above")
+    }
+
+    /// The scalar preconditioner `K`, its stencil storage filled by `fill(disc, cps, st)`
+    /// on the current control points.
+    pub fn preconditioner(&mut self, fill: impl FnOnce(&Discretization, &[Point], &mut [f64])) -> &Csr {
+        if self.pstencil.is_empty() {
+            self.pstencil = vec![0.0; self.disc.stencil_len(1)];
+        }
+        fill(&self.disc, &self.cps, &mut self.pstencil);
+        self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
+        &self.prec
+    }
+}
+
+/// The block mass matrix `diag(M, M)` of eq. (30) in the vector pattern of `disc`, from
+/// the scalar mass matrix `m` (in the scalar pattern).
+fn block_mass(disc: &Discretization, m: &Csr) -> Csr {
+    let ms = disc.dofs.num_free();
+    let mut out = disc.vector.csr.clone();
+    for r in 0..out.nrows {
+        let (z, f) = (r / ms, r % ms);
+        for k in out.row_ptr[r]..out.row_ptr[r + 1] {
+            let cidx = out.col_idx[k];
+            let (d, g) = (cidx / ms, cidx % ms);
+            out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
+        }
+    }
+    out
+}
