@@ -197,28 +197,7 @@ mod tests {
             let (disc, cps) = setup(3, [4, 3], 11, 0.05);
             let mut prob = EggProblem::new(Arc::new(disc), cps, op, Arc::new(CpuAssembler));
             let c = prob.unknowns();
-            let n = c.len();
-            let mut f = vec![0.0; n];
-            let mut jac = Csr::default();
-            prob.jacobian(&c, &mut f, &mut jac);
-            let dense = jac.to_dense();
-            let h = 1e-6;
-            let mut max_err: f64 = 0.0;
-            let mut max_val: f64 = 0.0;
-            for j in 0..n {
-                let mut cp = c.clone();
-                let mut cm = c.clone();
-                cp[j] += h;
-                cm[j] -= h;
-                let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-                prob.residual(&cp, &mut fp);
-                prob.residual(&cm, &mut fm);
-                for i in 0..n {
-                    let fd = (fp[i] - fm[i]) / (2.0 * h);
-                    max_err = max_err.max((fd - dense[i][j]).abs());
-                    max_val = max_val.max(fd.abs());
-                }
-            }
+            let (max_err, max_val) = crate::methods::jacobian_fd_mismatch(&mut prob, &c, 1e-6);
             assert!(max_err < 1e-7 * max_val, "{op:?}: FD mismatch {max_err} (scale {max_val})");
         }
     }

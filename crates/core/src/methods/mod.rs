@@ -168,3 +168,30 @@ pub trait Method: Send + Sync + std::fmt::Debug {
     /// The discrete problem on `disc` starting from `control_points`.
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
 }
+
+/// Largest difference between the Jacobian at `c` and central differences of the
+/// residual with step `h`, and the largest difference quotient (its scale): the
+/// finite-difference check every method's tests run.
+#[cfg(test)]
+pub(crate) fn jacobian_fd_mismatch(prob: &mut dyn DiscreteProblem, c: &[f64], h: f64) -> (f64, f64) {
+    let n = c.len();
+    let mut f = vec![0.0; n];
+    let mut jac = Csr::default();
+    prob.jacobian(c, &mut f, &mut jac);
+    let dense = jac.to_dense();
+    let (mut err, mut scale) = (0.0f64, 0.0f64);
+    for j in 0..n {
+        let (mut cp, mut cm) = (c.to_vec(), c.to_vec());
+        cp[j] += h;
+        cm[j] -= h;
+        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+        prob.residual(&cp, &mut fp);
+        prob.residual(&cm, &mut fm);
+        for i in 0..n {
+            let fd = (fp[i] - fm[i]) / (2.0 * h);
+            err = err.max((fd - dense[i][j]).abs());
+            scale = scale.max(fd.abs());
+        }
+    }
+    (err, scale)
+}

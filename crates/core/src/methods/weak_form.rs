@@ -225,26 +225,7 @@ mod tests {
         let mut prob = WeakFormProblem::new(disc, cps);
         let c = prob.unknowns();
         assert!(prob.admissible(&c));
-        let n = c.len();
-        let mut f = vec![0.0; n];
-        let mut jac = Csr::default();
-        prob.jacobian(&c, &mut f, &mut jac);
-        let dense = jac.to_dense();
-        let h = 1e-6;
-        let (mut err, mut scale) = (0.0f64, 0.0f64);
-        for j in 0..n {
-            let (mut cp, mut cm) = (c.clone(), c.clone());
-            cp[j] += h;
-            cm[j] -= h;
-            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-            prob.residual(&cp, &mut fp);
-            prob.residual(&cm, &mut fm);
-            for i in 0..n {
-                let fd = (fp[i] - fm[i]) / (2.0 * h);
-                err = err.max((fd - dense[i][j]).abs());
-                scale = scale.max(fd.abs());
-            }
-        }
+        let (err, scale) = crate::methods::jacobian_fd_mismatch(&mut prob, &c, 1e-6);
         assert!(err < 1e-7 * scale, "{err} (scale {scale})");
     }
 
