@@ -235,7 +235,7 @@ fn local_repair_with_frozen_dofs() {
 /// fitted basis and say why.
 #[test]
 fn input_basis_keeps_the_boundary_exactly() {
-    use winslow::boundary::fit::BasisChoice;
+    use winslow::boundary::BasisChoice;
     use winslow::{Side, SideCurve};
     let mut opts = SolveOptions::default();
     opts.fit.basis = BasisChoice::Input;

@@ -8,9 +8,10 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use winslow::boundary::fit::{BasisChoice, FitOptions};
+use winslow::boundary::fit::FitOptions;
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
+use winslow::boundary::BasisChoice;
 use winslow::discrete::assembly::Operator;
 use winslow::io::picture::{render, PictureOptions};
 use winslow::io::{checked_boundary, map_to_json, read_document, Document, ReadOptions};

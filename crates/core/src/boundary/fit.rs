@@ -47,6 +47,7 @@
 //! `tol_abs`.
 
 use super::cord_length::cord_length_params;
+use super::BasisChoice;
 use crate::boundary::reparam::{ParamMap, ReparamOptions, SideParam};
 use crate::boundary::{Analytic, SideCurve};
 use crate::error::{Error, Result, MAX_DEGREE};
@@ -66,27 +67,6 @@ pub const REGULARIZATION: f64 = 1e-10;
 /// Samples per input piece and fit element used to estimate the maximal deviation of a
 /// curve fit (the piece's end points included).
 pub const SAMPLES_PER_PIECE: usize = 8;
-
-/// The basis a map is solved in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BasisChoice {
-    /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
-    #[default]
-    Fitted,
-    /// The basis of the input's spline sides, boundary kept exactly (§5.2).
-    Input,
-}
-
-impl BasisChoice {
-    /// `"fitted"` or `"input"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            BasisChoice::Fitted => "fitted",
-            BasisChoice::Input => "input",
-        }
-    }
-}
 
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,9 +5,10 @@
 
 use serde::Serialize;
 
-use super::fit::{fit_side_with, BasisChoice, FitOptions, SideFit};
+use super::fit::{fit_side_with, FitOptions, SideFit};
 use super::input_basis::input_levels;
 use super::reparam::ReparamReport;
+use super::BasisChoice;
 use super::{diameter, Boundary, SideCurve};
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};

@@ -4,7 +4,7 @@
 //!
 //! | module | holds | paper |
 //! |---|---|---|
-//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`] | §5 |
+//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
 //! | [`corners`] | corner angles and the `det J` they force, kinks inside sides | §8.1 |
 //! | [`cord_length`] | cord-length abscissae of point clouds | eq. (36)-(37) |
@@ -32,6 +32,27 @@ use std::sync::Arc;
 
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
+
+/// The basis a map is solved in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BasisChoice {
+    /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
+    #[default]
+    Fitted,
+    /// The basis of the input's spline sides, boundary kept exactly (§5.2).
+    Input,
+}
+
+impl BasisChoice {
+    /// `"fitted"` or `"input"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            BasisChoice::Fitted => "fitted",
+            BasisChoice::Input => "input",
+        }
+    }
+}
 
 /// An analytic side `t in [0, 1] -> (x, y)` given as a Rust closure.
 #[derive(Clone)]
