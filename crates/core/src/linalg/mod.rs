@@ -6,12 +6,14 @@
 //! |---|---|
 //! | [`sparse`] | [`Csr`](sparse::Csr): storage, products, pattern unions |
 //! | [`ordering`] | nested dissection of a grid of points, interleaving of component blocks |
-//! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver) (LU / GMRES / Cholesky preconditioners), CG, ILU(0) |
+//! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver): LU, Cholesky preconditioners (f32/f64), the choice of method |
+//! | [`krylov`] | flexible GMRES, preconditioned CG, ILU(0) |
 //!
 //! Why here and not in [`crate::discrete`]: the refinement operators of the spline layer
 //! (knot insertion, degree elevation, [`crate::spline::refine`]) are sparse matrices, so
 //! sparse storage must sit below the splines; none of these modules knows what a spline is.
 
+pub mod krylov;
 pub mod linsolve;
 pub mod ordering;
 pub mod sparse;
