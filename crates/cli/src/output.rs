@@ -344,7 +344,7 @@ pub fn inspect_text(
         let _ = writeln!(
             s,
             "  contour fit: tolerance {:.3e} (relative {:.1e} of the diameter), {} hierarchy levels",
-            h.tol_abs,
+            h.physical_tol_abs(),
             h.tol_abs / h.diameter,
             h.levels.len()
         );
@@ -357,7 +357,7 @@ pub fn inspect_text(
                 f.levels.len(),
                 last.map_or(0, |c| c.knots.num_elements()),
                 last.map_or(0, |c| c.degree()),
-                f.max_error.last().copied().unwrap_or(0.0),
+                h.similarity.length(f.max_error.last().copied().unwrap_or(0.0)),
                 if f.converged { "" } else { "  (tolerance NOT met)" }
             );
             if let Some(c) = last {
@@ -416,7 +416,7 @@ pub fn inspect_json(
                     "side": s.name(),
                     "levels": f.levels.len(),
                     "elements": f.levels.last().map_or(0, |c| c.knots.num_elements()),
-                    "max_error": f.max_error.last(),
+                    "max_error": f.max_error.last().map(|&e| h.similarity.length(e)),
                     "converged": f.converged,
                 })
             })

@@ -12,12 +12,12 @@ pub(super) fn run_solver(
 ) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
     if !quiet {
-        let tol = h.tol_abs;
+        let tol = h.physical_tol_abs();
         eprintln!(
             "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
             boundary.name,
             h.levels.len(),
-            h.diameter
+            h.physical_diameter()
         );
         match (&h.basis.fallback, h.basis.used) {
             (Some(why), _) => eprintln!("  basis: fitted (the input basis cannot be used: {why})"),

@@ -57,6 +57,10 @@ pub enum Error {
     /// A contour document's corner indices are unusable.
     #[error("invalid corners: {reason}")]
     Corners { reason: String },
+    /// Coordinates whose size or position leaves the range `f64` can compute with (see
+    /// `boundary::normalise`).
+    #[error("coordinates out of range: {what}")]
+    Range { what: String },
     /// A parameter is outside the domain or a request is inconsistent.
     #[error("invalid argument: {0}")]
     Invalid(String),

@@ -47,7 +47,7 @@ pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: 
         Ok(h) => h,
         Err(e) => return send(Msg::Failed(format!("fitting the boundary: {e}"))),
     };
-    send(Msg::Fitted { levels: h.levels.len(), tolerance: h.tol_abs });
+    send(Msg::Fitted { levels: h.levels.len(), tolerance: h.physical_tol_abs() });
     let mut solver = match EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler)) {
         Ok(s) => s,
         Err(e) => return send(Msg::Failed(e.to_string())),

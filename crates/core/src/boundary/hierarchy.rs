@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use super::fit::{fit_side_with, FitOptions, SideFit};
 use super::input_basis::input_levels;
+use super::normalise::Similarity;
 use super::reparam::ReparamReport;
 use super::BasisChoice;
 use super::{diameter, Boundary, SideCurve};
@@ -61,6 +62,10 @@ impl Level {
 }
 
 /// The nested hierarchy of tensor-product bases with the boundary fits (paper §5.4).
+///
+/// Everything in it (levels, fits, tolerance, diameter, reparameterization) is in the
+/// normalised coordinates `x̂ = (x − c) / s` of [`Hierarchy::similarity`], which the
+/// solver works in; [`Hierarchy::physical_tol_abs`] and friends convert back.
 #[derive(Debug, Clone)]
 pub struct Hierarchy {
     /// Coarse to fine; knot vectors are nested from one level to the next.
@@ -75,6 +80,9 @@ pub struct Hierarchy {
     pub reparam: ReparamReport,
     /// The basis used: fitted, or the input's (§5.2), and why not when asked for.
     pub basis: BasisReport,
+    /// The input's coordinates from the normalised ones: `x = c + s x̂` (the identity for
+    /// a well-placed boundary).
+    pub similarity: Similarity,
 }
 
 impl Hierarchy {
@@ -92,6 +100,25 @@ impl Hierarchy {
     pub fn max_error(&self) -> f64 {
         self.fits.iter().map(SideFit::final_max_error).fold(0.0, f64::max)
     }
+
+    /// [`Hierarchy::tol_abs`] in the input's units.
+    pub fn physical_tol_abs(&self) -> f64 {
+        self.similarity.length(self.tol_abs)
+    }
+
+    /// [`Hierarchy::diameter`] in the input's units.
+    pub fn physical_diameter(&self) -> f64 {
+        self.similarity.length(self.diameter)
+    }
+
+    /// The reparameterization report with its matched points in the input's coordinates.
+    pub fn physical_reparam(&self) -> ReparamReport {
+        let mut r = self.reparam.clone();
+        for m in &mut r.matches {
+            m.points = m.points.map(|p| self.similarity.to_physical(p));
+        }
+        r
+    }
 }
 
 /// With `opts.basis` = [`BasisChoice::Input`], the hierarchy on the input's own basis
@@ -100,8 +127,23 @@ impl Hierarchy {
 /// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
+///
+/// The boundary is first brought to unit size at the origin ([`Similarity`]); the
+/// hierarchy is built, and lives, in those coordinates.
 pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
     opts.validate()?;
+    let similarity = Similarity::for_boundary(boundary)?;
+    let mut h = if similarity.is_identity() {
+        normalised_hierarchy(boundary, opts)?
+    } else {
+        normalised_hierarchy(&similarity.unit_boundary(boundary), opts)?
+    };
+    h.similarity = similarity;
+    Ok(h)
+}
+
+/// [`build_hierarchy`] of a boundary already in normalised coordinates.
+fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
     let diameter = diameter(boundary);
     if !(diameter.is_finite() && diameter > 0.0) {
         return Err(Error::Invalid(format!("boundary '{}' has diameter {diameter}", boundary.name)));
@@ -115,7 +157,15 @@ pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarc
                 let levels = input.levels.into_iter().map(|(knots, sides)| Level { knots, sides }).collect();
                 let basis = BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None };
                 let reparam = ReparamReport::native();
-                return Ok(Hierarchy { levels, fits: input.fits, tol_abs, diameter, reparam, basis });
+                return Ok(Hierarchy {
+                    levels,
+                    fits: input.fits,
+                    tol_abs,
+                    diameter,
+                    reparam,
+                    basis,
+                    similarity: Similarity::IDENTITY,
+                });
             }
             Err(why) => fallback = Some(why),
         }
@@ -179,7 +229,15 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
             _ => levels.push(level),
         }
     }
-    Ok(Hierarchy { levels, fits, tol_abs, diameter, reparam: ReparamReport::native(), basis: BasisReport::fitted() })
+    Ok(Hierarchy {
+        levels,
+        fits,
+        tol_abs,
+        diameter,
+        reparam: ReparamReport::native(),
+        basis: BasisReport::fitted(),
+        similarity: Similarity::IDENTITY,
+    })
 }
 
 /// The four corners south-west, south-east, north-east, north-west, each the average of

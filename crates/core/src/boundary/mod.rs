@@ -5,6 +5,7 @@
 //! | module | holds | paper |
 //! |---|---|---|
 //! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
+//! | [`normalise`] | the similarity to unit size at the origin, and back | |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
 //! | [`corners`] | corner angles and the `det J` they force, kinks inside sides | §8.1 |
 //! | [`cord_length`] | cord-length abscissae of point clouds | eq. (36)-(37) |
@@ -25,6 +26,7 @@ pub mod corners;
 pub mod fit;
 pub mod hierarchy;
 pub mod input_basis;
+pub mod normalise;
 pub mod reparam;
 pub mod validate;
 

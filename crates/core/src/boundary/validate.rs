@@ -12,6 +12,7 @@
 //! chords cannot create false crossings in narrow gaps (two sides `g` apart can only
 //! appear to cross when `g < 2 * FLATNESS * diameter`).
 
+use crate::boundary::normalise::Similarity;
 use crate::boundary::{Boundary, SideCurve};
 use crate::error::{Error, Result, MAX_CONTROL_POINTS};
 use crate::spline::curve::{check_points, check_weights, Curve, Point};
@@ -253,7 +254,9 @@ fn within_side(e: Error, s: Side) -> Error {
 /// Errors: [`Error::TooLarge`], [`Error::TooFewPoints`], [`Error::NonFinite`],
 /// [`Error::Length`]/[`Error::Weight`] (spline sides built by hand), [`Error::CornerGap`]
 /// (gap above `CORNER_TOL` times the bounding-box diameter), [`Error::DegenerateSide`]
-/// (side shorter than that tolerance) and [`Error::SelfIntersection`].
+/// (side shorter than that tolerance), [`Error::SelfIntersection`] and [`Error::Range`]
+/// (a size whose `det J` leaves `f64`'s range). The geometry is measured in the
+/// normalised coordinates of [`Similarity`] and reported in the input's.
 pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
     for s in Side::ALL {
         let side = boundary.side(s);
@@ -264,6 +267,50 @@ pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
             }
         }
     }
+    // Measured in normalised coordinates (exact lengths and areas back: `s = 2^k`), so
+    // that a domain far from the origin or of extreme size is judged as at unit size.
+    let sim = Similarity::for_boundary(boundary)?;
+    if sim.is_identity() {
+        return measure(boundary);
+    }
+    let r = measure(&sim.unit_boundary(boundary)).map_err(|e| physical_error(e, &sim))?;
+    Ok(ValidationReport {
+        bbox_min: sim.to_physical(r.bbox_min),
+        bbox_max: sim.to_physical(r.bbox_max),
+        diameter: sim.length(r.diameter),
+        tolerance: sim.length(r.tolerance),
+        corners: r.corners.map(|p| sim.to_physical(p)),
+        corner_gaps: r.corner_gaps.map(|g| sim.length(g)),
+        corner_angles: r.corner_angles,
+        side_lengths: r.side_lengths.map(|l| sim.length(l)),
+        signed_area: sim.area(r.signed_area),
+        orientation: r.orientation,
+        polyline_points: r.polyline_points,
+    })
+}
+
+/// An error of [`measure`] on the normalised boundary with its lengths and points in
+/// the input's coordinates.
+fn physical_error(e: Error, sim: &Similarity) -> Error {
+    let at = |x: f64, y: f64| sim.to_physical([x, y]);
+    match e {
+        Error::CornerGap { side_a, side_b, gap, tol, x, y } => {
+            let [x, y] = at(x, y);
+            Error::CornerGap { side_a, side_b, gap: sim.length(gap), tol: sim.length(tol), x, y }
+        }
+        Error::DegenerateSide { side, length, tol } => {
+            Error::DegenerateSide { side, length: sim.length(length), tol: sim.length(tol) }
+        }
+        Error::SelfIntersection { side_a, side_b, x, y } => {
+            let [x, y] = at(x, y);
+            Error::SelfIntersection { side_a, side_b, x, y }
+        }
+        e => e,
+    }
+}
+
+/// The measurements of [`inspect`] in the boundary's own coordinates.
+fn measure(boundary: &Boundary) -> Result<ValidationReport> {
     // Coarse sampling to size the problem, then adaptive sampling relative to it.
     let coarse: Vec<Vec<Point>> = Side::ALL.iter().map(|&s| sample_side(boundary.side(s), f64::INFINITY)).collect();
     for (k, poly) in coarse.iter().enumerate() {

@@ -176,6 +176,9 @@ pub struct Report {
     /// The improvement stage after the solve (`--improve winslow`): quality before and
     /// after, iterations, time; `null` when none was asked for.
     pub improvement: Option<Improvement>,
+    /// The similarity `x = centre + scale x̂` from the normalised coordinates the solve ran
+    /// in (`boundary::normalise`); `null` when the input was solved as given.
+    pub normalisation: Option<crate::boundary::normalise::Similarity>,
 }
 
 /// A solved map and its report.
@@ -287,7 +290,7 @@ impl Solution {
                     side: s.name(),
                     levels: f.levels.len(),
                     elements: f.levels.last().map_or(0, |c| c.knots.num_elements()),
-                    max_error: f.max_error.last().copied().unwrap_or(0.0),
+                    max_error: h.similarity.length(f.max_error.last().copied().unwrap_or(0.0)),
                     converged: f.converged,
                 }
             })
@@ -300,8 +303,8 @@ impl Solution {
                 Operator::Plain => "plain",
                 Operator::Scaled => "scaled",
             },
-            fit_tolerance: h.tol_abs,
-            diameter: h.diameter,
+            fit_tolerance: h.physical_tol_abs(),
+            diameter: h.physical_diameter(),
             fit,
             levels,
             repairs: ctx.repairs,
@@ -324,9 +327,10 @@ impl Solution {
             message,
             seconds: ctx.elapsed.as_secs_f64(),
             basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
-            reparam: h.reparam.clone(),
+            reparam: h.physical_reparam(),
             basis: h.basis.clone(),
             improvement: ctx.improvement,
+            normalisation: (!h.similarity.is_identity()).then_some(h.similarity),
         };
         Self { name: name.to_string(), map, report }
     }

@@ -248,8 +248,10 @@ impl EggSolver {
         Event::LevelFinished(a.report)
     }
 
-    /// Finish: the map of the finest level and the full report. Runs the remaining
-    /// iterations first if the stream was not drained.
+    /// Finish: the map of the finest level and the full report, in the input's
+    /// coordinates (the solve ran in the normalised ones of
+    /// [`Hierarchy::similarity`]; a map brought back is certified again). Runs the
+    /// remaining iterations first if the stream was not drained.
     pub fn finish(mut self, boundary: &Boundary, hierarchy: &Hierarchy) -> Result<Solution> {
         for e in self.by_ref() {
             e?;
@@ -282,10 +284,20 @@ impl EggSolver {
                 }
             }
         };
+        // back to the input's coordinates; the verdict is that of the map written
+        let sim = hierarchy.similarity;
+        if !sim.is_identity() {
+            map = sim.physical_surface(&map)?;
+            certificate = certify(&map, &self.opts.certify)?;
+            for l in &mut self.reports {
+                l.initial_det_j_min = sim.area(l.initial_det_j_min);
+            }
+        }
         let finest = self.plan.last().expect("non-empty plan");
+        let sides = finest.sides.each_ref().map(|c| sim.physical_curve(c));
         let ctx = ReportContext {
             hierarchy,
-            sides: &finest.sides,
+            sides: &sides,
             kinks: boundary_kinks(boundary),
             boundary_deviation: match hierarchy.basis.used {
                 // the same curve at equal parameters: measured exactly, not by a polyline
