@@ -29,6 +29,7 @@ use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
+mod corpus;
 mod mesh;
 mod output;
 mod solve_cmd;
@@ -65,6 +66,10 @@ enum Command {
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
     /// Bézier cells), .vtk (sampled structured grid).
     Convert(ConvertArgs),
+    /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,
+    /// sharp corners, puzzle tabs, thin strips, CAD sides, noisy and sparse clouds);
+    /// write them, and with --solve solve each and print a table per family.
+    Corpus(corpus::CorpusArgs),
 }
 
 #[derive(Args, Debug)]
@@ -549,6 +554,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Check(a) => check(a),
         Command::Convert(a) => convert(a),
         Command::Mesh(a) => mesh::run(a),
+        Command::Corpus(a) => corpus::run(a),
     }
 }
 

@@ -68,6 +68,19 @@ pub const REGULARIZATION: f64 = 1e-10;
 /// curve fit (the piece's end points included).
 pub const SAMPLES_PER_PIECE: usize = 8;
 
+/// A point cloud's fit stops refining when bisecting the marked elements keeps more than
+/// this fraction of their points' squared deviation (an RMS ratio of 0.8) and that
+/// deviation is uncorrelated ([`NOISE_LAG_ONE`]): the rest is noise ([`fit_side_with`]).
+pub const NOISE_STALL: f64 = 0.64;
+
+/// ... and when the residual's lag-one autocorrelation there is below this (white noise:
+/// about 0; a smooth residual sampled densely: about 1).
+pub const NOISE_LAG_ONE: f64 = 0.5;
+
+/// ... judged only where the bisected elements hold this many points each on average
+/// (fewer say nothing about noise: a cubic through a handful of points interpolates).
+pub const NOISE_MIN_POINTS: usize = 12;
+
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitOptions {
@@ -145,6 +158,13 @@ pub struct ElementError {
     pub indicator: f64,
     /// Largest deviation on the element (sampled for curves, at the points for clouds).
     pub max: f64,
+    /// Point clouds: `Σ r_j · r_{j-1}` over consecutive points of the element, `r_j =
+    /// f̄(ξ_j) - p_j` (the lag-one autocovariance of the residual: near
+    /// [`ElementError::indicator`] for a smooth, unresolved shape, near zero for noise);
+    /// curves: 0.
+    pub lag_one: f64,
+    /// Point clouds: the number of points on the element; curves: 0.
+    pub points: usize,
 }
 
 /// One constrained least-squares fit on a given knot vector.
@@ -487,21 +507,31 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
 fn fit_errors(target: &Target, fit: &Curve) -> Projection {
     let kv = &fit.knots;
     let elements = kv.elements();
-    let mut errs: Vec<ElementError> =
-        elements.iter().map(|&(span, a, b)| ElementError { span, a, b, indicator: 0.0, max: 0.0 }).collect();
+    let mut errs: Vec<ElementError> = elements
+        .iter()
+        .map(|&(span, a, b)| ElementError { span, a, b, indicator: 0.0, max: 0.0, lag_one: 0.0, points: 0 })
+        .collect();
     let mut basis = BasisDerivs::default();
     let (max_error, rms_error) = match target {
         Target::Points { params, points } => {
             let mut sum = 0.0;
             let mut max = 0.0f64;
+            let mut last: Option<(usize, Point)> = None;
             for (&t, &pt) in params.iter().zip(points.iter()) {
                 basis.eval(kv, t, 0);
-                let d2 = dist2(fit.derivs_with(&basis, 0).x, pt);
+                let x = fit.derivs_with(&basis, 0).x;
+                let r = [x[0] - pt[0], x[1] - pt[1]];
+                let d2 = dist2(x, pt);
                 let d = d2.sqrt();
                 sum += d2;
                 max = max.max(d);
                 // element of the span; a point on a break also counts for the left element
                 let e = elements.partition_point(|el| el.0 < basis.span).min(elements.len() - 1);
+                if let Some((le, lr)) = last.filter(|l| l.0 == e) {
+                    errs[le].lag_one += r[0] * lr[0] + r[1] * lr[1];
+                }
+                last = Some((e, r));
+                errs[e].points += 1;
                 errs[e].indicator += d2;
                 errs[e].max = errs[e].max.max(d);
                 if e > 0 && t <= elements[e].1 {
@@ -564,7 +594,9 @@ pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Poin
 /// `tol_abs`, refit, and repeat until no element is marked or `max_levels` /
 /// `max_elements` is reached (then `converged` is false and the finest fit is the best
 /// one). When more elements are marked than `max_elements` allows, the worst ones are
-/// bisected first.
+/// bisected first. A point cloud also stops at its noise floor (see [`NOISE_STALL`];
+/// `converged` is then false and the last fit is the one before the bisection that did
+/// not help).
 pub fn fit_side(
     side: Side,
     curve: &SideCurve,
@@ -603,9 +635,29 @@ pub fn fit_side_with(
         converged: false,
     };
     let points = matches!(target, Target::Points { .. });
+    // the bisected elements of the last level (parameter intervals) and their points'
+    // summed squared deviation, for the noise floor of point clouds
+    let mut bisected: Option<(Vec<(f64, f64)>, f64)> = None;
     loop {
         let fit = solve_fit(&target, &kv, corners).map_err(|e| e.within(side.name()))?;
         let proj = fit_errors(&target, &fit);
+        // Noise floor: when bisecting did not lower the squared deviation of the points
+        // in the bisected elements below NOISE_STALL of what it was, and what is left is
+        // uncorrelated from point to point (lag-one autocorrelation below NOISE_LAG_ONE, on
+        // elements with NOISE_MIN_POINTS points or more),
+        // it is noise, not shape (an unresolved feature's residual is smooth, so
+        // correlated); fitting it would only grow the basis. Keep the coarser fit.
+        if let Some((intervals, before)) = bisected.take() {
+            let (after, lag_one, points, elements) = proj
+                .elements
+                .iter()
+                .filter(|e| intervals.iter().any(|&(a, b)| e.a >= a && e.b <= b))
+                .fold((0.0, 0.0, 0, 0), |(s, l, p, n), e| (s + e.indicator, l + e.lag_one, p + e.points, n + 1));
+            let enough = points >= NOISE_MIN_POINTS * elements;
+            if enough && before > 0.0 && after > NOISE_STALL * before && lag_one < NOISE_LAG_ONE * after {
+                break;
+            }
+        }
         out.levels.push(proj.curve);
         out.max_error.push(proj.max_error);
         out.rms_error.push(proj.rms_error);
@@ -633,6 +685,11 @@ pub fn fit_side_with(
             marked.sort_by_key(|m| m.0);
         }
         let spans: Vec<usize> = marked.iter().map(|m| m.0).collect();
+        if points {
+            let chosen = proj.elements.iter().filter(|e| spans.contains(&e.span));
+            let (intervals, sse): (Vec<(f64, f64)>, Vec<f64>) = chosen.map(|e| ((e.a, e.b), e.indicator)).unzip();
+            bisected = Some((intervals, sse.iter().sum()));
+        }
         kv = kv.with_inserted(&kv.midpoints_of(&spans));
     }
     Ok(out)

@@ -5,6 +5,7 @@
 //! | module | holds | paper |
 //! |---|---|---|
 //! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
+//! | [`families`] | seeded families of hard domains (the hard corpus) | |
 //! | [`normalise`] | the similarity to unit size at the origin, and back | |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
 //! | [`corners`] | corner angles and the `det J` they force, kinks inside sides | §8.1 |
@@ -23,6 +24,7 @@
 
 pub mod cord_length;
 pub mod corners;
+pub mod families;
 pub mod fit;
 pub mod hierarchy;
 pub mod input_basis;

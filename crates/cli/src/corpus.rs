@@ -1,0 +1,136 @@
+//! `winslow corpus`: the hard corpus of seeded domain families
+//! (`winslow::boundary::families`): write the boundaries, and optionally solve each at
+//! the default settings and print, per family, how many were certified and why the
+//! others were not.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use winslow::boundary::families::{corpus, Family};
+use winslow::io::json::{boundary_to_json, write_json};
+use winslow::solve::options::SolveOptions;
+use winslow::solve::report::Verdict;
+use winslow::solve::solver::solve;
+
+#[derive(Args, Debug)]
+pub struct CorpusArgs {
+    /// Directory the boundary documents are written to (one `FAMILY-SEED.json` each).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Domains per family.
+    #[arg(long, default_value_t = 6)]
+    per_family: usize,
+    /// First seed (domains use `seed, seed + 1, ...`).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
+    /// strip, cad, noisy-cloud, sparse-cloud.
+    #[arg(long, value_delimiter = ',')]
+    families: Vec<String>,
+    /// Solve every domain (default settings) and print the verdicts and a table per
+    /// family; exits 1 when any domain is not certified.
+    #[arg(long)]
+    solve: bool,
+}
+
+#[derive(Default)]
+struct Tally {
+    domains: usize,
+    by_verdict: BTreeMap<String, usize>,
+    seconds: f64,
+    failures: Vec<String>,
+}
+
+pub fn run(a: CorpusArgs) -> Result<i32> {
+    let families: Vec<Family> = a
+        .families
+        .iter()
+        .map(|n| Family::parse(n).with_context(|| format!("unknown family '{n}'")))
+        .collect::<Result<_>>()?;
+    if a.per_family == 0 || a.per_family > 10_000 {
+        bail!("--per-family must be in 1..=10000, not {}", a.per_family);
+    }
+    if a.output.is_none() && !a.solve {
+        bail!("nothing to do: give -o DIR to write the domains, --solve to solve them, or both");
+    }
+    let domains: Vec<_> =
+        corpus(a.per_family, a.seed).into_iter().filter(|(f, _)| families.is_empty() || families.contains(f)).collect();
+    if let Some(dir) = &a.output {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (_, b) in &domains {
+            let path = dir.join(format!("{}.json", b.name));
+            write_json(&path, &boundary_to_json(b)).with_context(|| format!("writing {}", path.display()))?;
+        }
+        println!("wrote {} boundaries to {}", domains.len(), dir.display());
+    }
+    if !a.solve {
+        return Ok(0);
+    }
+    let mut tally: BTreeMap<&str, Tally> = BTreeMap::new();
+    let opts = SolveOptions::default();
+    for (family, b) in &domains {
+        let t0 = Instant::now();
+        let (verdict, detail) = match solve(b, &opts) {
+            Ok(sol) => {
+                let r = &sol.report;
+                let its: Vec<String> = r.levels.iter().map(|l| l.iterations.to_string()).collect();
+                (
+                    verdict_name(r.verdict).to_string(),
+                    format!("{} functions, iterations {}", r.basis_functions, its.join("/")),
+                )
+            }
+            Err(e) => ("error".to_string(), e.to_string()),
+        };
+        let secs = t0.elapsed().as_secs_f64();
+        println!("{:<18} {:<18} {secs:7.2} s  {detail}", b.name, verdict);
+        let t = tally.entry(family.name()).or_default();
+        t.domains += 1;
+        t.seconds += secs;
+        if verdict != verdict_name(Verdict::Certified) {
+            t.failures.push(format!("{}: {verdict} ({detail})", b.name));
+        }
+        *t.by_verdict.entry(verdict).or_default() += 1;
+    }
+    println!();
+    println!(
+        "| family | domains | certified | degenerate corner | folded | undecided | not converged | error | time s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let (mut all, mut ok) = (0, 0);
+    for (name, t) in &tally {
+        let n = |v: &str| t.by_verdict.get(v).copied().unwrap_or(0);
+        println!(
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
+            t.domains,
+            n("certified"),
+            n("degenerate-corner"),
+            n("folded"),
+            n("undecided"),
+            n("not-converged"),
+            n("error"),
+            t.seconds
+        );
+        all += t.domains;
+        ok += n("certified");
+    }
+    println!("\ncertified {ok} of {all} ({:.1} %)", 100.0 * ok as f64 / all.max(1) as f64);
+    for t in tally.values() {
+        for f in &t.failures {
+            println!("  not certified: {f}");
+        }
+    }
+    Ok(if ok == all { 0 } else { 1 })
+}
+
+fn verdict_name(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Certified => "certified",
+        Verdict::DegenerateCorner => "degenerate-corner",
+        Verdict::Folded => "folded",
+        Verdict::Undecided => "undecided",
+        Verdict::NotConverged => "not-converged",
+    }
+}
