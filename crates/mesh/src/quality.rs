@@ -184,26 +184,30 @@ pub fn quality(mesh: &Mesh) -> Result<Quality> {
 }
 
 impl Quality {
+    /// The quality table as `(name, value)` rows (the CLI prints them, the viewer shows
+    /// them in a grid).
+    pub fn rows(&self) -> Vec<(&'static str, String)> {
+        let mut rows = vec![
+            ("nodes / cells", format!("{} / {}", self.nodes, self.cells)),
+            ("cell area min / max", format!("{:.4e} / {:.4e}", self.area[0], self.area[1])),
+            ("angle min / max (deg)", format!("{:.2} / {:.2}", self.angle[0], self.angle[1])),
+            ("max aspect ratio", format!("{:.3}", self.max_aspect)),
+            ("max skewness", format!("{:.4}", self.max_skewness)),
+            ("max growth ratio", format!("{:.4}", self.max_growth)),
+            (
+                "non-orthogonality max / mean",
+                format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
+            ),
+        ];
+        if let Some(r) = self.min_jacobian_ratio {
+            rows.push(("min det J ratio (curved)", format!("{r:.4}")));
+        }
+        rows.push(("inverted cells", format!("{}", self.inverted)));
+        rows
+    }
+
     /// The quality table as text.
     pub fn table(&self) -> String {
-        let mut s = String::new();
-        let mut row = |k: &str, v: String| {
-            s.push_str(&format!("  {k:<28} {v}\n"));
-        };
-        row("nodes / cells", format!("{} / {}", self.nodes, self.cells));
-        row("cell area min / max", format!("{:.4e} / {:.4e}", self.area[0], self.area[1]));
-        row("angle min / max (deg)", format!("{:.2} / {:.2}", self.angle[0], self.angle[1]));
-        row("max aspect ratio", format!("{:.3}", self.max_aspect));
-        row("max skewness", format!("{:.4}", self.max_skewness));
-        row("max growth ratio", format!("{:.4}", self.max_growth));
-        row(
-            "non-orthogonality max / mean",
-            format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
-        );
-        if let Some(r) = self.min_jacobian_ratio {
-            row("min det J ratio (curved)", format!("{r:.4}"));
-        }
-        row("inverted cells", format!("{}", self.inverted));
-        s
+        self.rows().iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
     }
 }

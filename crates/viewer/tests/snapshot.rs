@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
+use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use winslow::io::Document;
 use winslow_viewer::scene::Scene;
@@ -40,6 +41,24 @@ fn map_view_snapshot() {
     let mv = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap();
     assert!(mv.quality.det_j_min > 0.0, "{}", mv.certificate.message);
     h.snapshot("map_view");
+}
+
+#[test]
+fn mesh_overlay_snapshot() {
+    // the Fig. 31 kind of mesh (eq. 50 in eta) over the det J heat map, with its quality
+    // table in the side panel
+    let mut app = solved_wavy_lid();
+    app.state.display.grid = false;
+    app.state.mesh.settings.points = [41, 13];
+    app.state.build_mesh().unwrap();
+    let o = app.state.mesh.drawn(&app.state.scene.as_ref().unwrap().map.as_ref().unwrap().map).expect("built");
+    assert_eq!(o.mesh.num_cells(), 40 * 12);
+    assert_eq!(o.quality.inverted, 0);
+    let mut h = harness(app);
+    h.run();
+    // the quality table is on the panel
+    h.get_by_label("inverted cells");
+    h.snapshot("mesh_overlay");
 }
 
 #[test]
