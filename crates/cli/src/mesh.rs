@@ -10,7 +10,9 @@ use winslow::Surface;
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::quality::quality;
-use winslow_mesh::{structured, unstructured, Distribution, End, StructuredOptions, UnstructuredOptions};
+use winslow_mesh::{
+    structured, unstructured_with_stats, Distribution, End, MeshingStats, StructuredOptions, UnstructuredOptions,
+};
 
 /// What mesh to make (shared by `mesh` and `solve --mesh`).
 #[derive(Args, Debug, Clone)]
@@ -133,6 +135,7 @@ fn parse_points(s: &str) -> Result<[usize; 2]> {
 pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
     let format = Format::from_path(output)?;
     let t = Instant::now();
+    let mut stats: Option<MeshingStats> = None;
     let linear = if let Some(s) = &spec.structured {
         let opts = StructuredOptions { points: parse_points(s)?, distribution: distributions(&spec.cluster)? };
         structured(map, &opts)?
@@ -149,13 +152,17 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             order: spec.order as usize,
             ..Default::default()
         };
-        unstructured(map, &opts)?
+        let (mesh, st) = unstructured_with_stats(map, &opts)?;
+        stats = Some(st);
+        mesh
     } else {
         bail!("say which mesh: --structured NXxNY or --unstructured --size H");
     };
     let mesh = elevate(&linear, map, spec.order as usize)?;
     let built = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     let q = quality(&mesh)?;
+    let measured = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let files = write(&mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
     let written = t.elapsed().as_secs_f64();
@@ -169,7 +176,13 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             format.name()
         );
         print!("{}", q.table());
-        println!("  built in {built:.3} s, written in {written:.3} s");
+        println!("  built in {built:.3} s, quality in {measured:.3} s, checked and written in {written:.3} s");
+        if let Some(st) = stats {
+            println!(
+                "  meshing: boundary {:.3} s, spade refinement {:.3} s ({} of {} rounds), mapping {:.3} s, criteria {:.3} s, insertion {:.3} s, mesh {:.3} s",
+                st.boundary, st.refine, st.spade_refinements, st.rounds, st.map, st.criteria, st.insert, st.build
+            );
+        }
         for f in files {
             println!("wrote {}", f.display());
         }

@@ -30,8 +30,9 @@ pub use distribution::{Distribution, End};
 pub use error::{MeshError, Result};
 pub use glam::DVec2;
 pub use quality::{CellQuality, Quality};
+use rayon::prelude::*;
 pub use structured::{structured, StructuredOptions};
-pub use unstructured::{parameter_scale, unstructured, UnstructuredOptions};
+pub use unstructured::{parameter_scale, unstructured, unstructured_with_stats, MeshingStats, UnstructuredOptions};
 pub use winslow::Side;
 
 /// The cell shape of a mesh.
@@ -128,16 +129,11 @@ impl Mesh {
     /// turn left (`(b - a) x (c - b) > 0`), and curved elements must have a positive
     /// Jacobian at their nodes and quadrature points ([`high_order::check_jacobians`]).
     pub fn check(&self) -> Result<()> {
-        let mut bad: Option<(usize, String)> = None;
-        let mut count = 0;
-        for c in 0..self.num_cells() {
-            if let Some(why) = quality::corner_defect(self, c) {
-                count += 1;
-                bad.get_or_insert((c, why));
-            }
-        }
-        if let Some((cell, why)) = bad {
-            return Err(MeshError::Inverted { cell, why, count });
+        let bad: Vec<usize> =
+            (0..self.num_cells()).into_par_iter().filter(|&c| quality::corner_defect(self, c).is_some()).collect();
+        if let Some(&cell) = bad.first() {
+            let why = quality::corner_defect(self, cell).unwrap_or_default();
+            return Err(MeshError::Inverted { cell, why, count: bad.len() });
         }
         if self.order > 1 {
             high_order::check_jacobians(self)?;
@@ -148,5 +144,5 @@ impl Mesh {
 
 /// The nodes of the map's image with parameters `params`.
 pub fn map_points(map: &winslow::Surface, params: &[DVec2]) -> Vec<DVec2> {
-    params.iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect()
+    params.par_iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect()
 }
