@@ -6,6 +6,7 @@
 //! | module | what lives there |
 //! |---|---|
 //! | [`distribution`] | point distributions per direction: uniform, arctan (eq. 50), tanh, geometric layers |
+//! | [`equidistribution`] | points equidistributing boundary arc length or curvature (a chord tolerance with the fewest points) |
 //! | [`structured`](mod@structured) | structured quadrilateral meshes at `xi_i x eta_j`, first-cell heights in physical units |
 //! | [`unstructured`](mod@unstructured) | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
@@ -18,6 +19,7 @@
 //! by [`Side`]. Writers refuse a mesh with an inverted cell ([`Mesh::check`]).
 
 pub mod distribution;
+pub mod equidistribution;
 pub mod error;
 pub mod formats;
 pub mod high_order;
@@ -27,6 +29,7 @@ pub mod topology;
 pub mod unstructured;
 
 pub use distribution::{Distribution, End};
+pub use equidistribution::Equidistribution;
 pub use error::{MeshError, Result};
 pub use glam::DVec2;
 pub use quality::{CellQuality, Quality};

@@ -12,8 +12,11 @@
 //!    square); then every triangle whose straight image has an edge longer than `size`,
 //!    is inverted (down to `size / 64`), or over which `det J` (eq. 43) varies by more than `det_j_ratio`
 //!    between its vertices, gets its physically longest edge split at the parameter
-//!    midpoint; so does every boundary segment whose image deviates from the mapped
-//!    curve by more than `chord_tol` at its midpoint. Stop when no triangle asks; give
+//!    midpoint (the paper's criterion: "the value of the Jacobian determinant in the
+//!    vertices can in turn serve as a refinement criterion"); so does every boundary
+//!    segment whose chord deviates from the mapped side by more than `chord_tol` (the
+//!    largest distance, measured: where the boundary's curvature `kappa` is high, since
+//!    the deviation is `kappa h^2 / 8`). Stop when no triangle asks; give
 //!    up (error) past 50 times the vertex count an equilateral mesh of the area needs,
 //!    which happens where the map stretches parameter triangles into slivers. A round
 //!    skips spade's refinement (a scan of every triangle) when the triangles around the
@@ -34,6 +37,7 @@ use rayon::prelude::*;
 use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
 use winslow::{Side, Surface};
 
+use crate::equidistribution::{segment_deviation, SideCurve};
 use crate::error::{MeshError, Result};
 use crate::high_order::JacobianProbe;
 use crate::{BoundaryEdge, ElementKind, Mesh};
@@ -46,7 +50,7 @@ pub struct UnstructuredOptions {
     /// Smallest angle in the parameter square, degrees (at most 34; spade's refinement
     /// may not terminate above about 30).
     pub min_angle: f64,
-    /// Largest distance between a boundary segment's midpoint and the mapped side
+    /// Largest distance between a boundary segment (chord) and the mapped side
     /// (physical units); `None`: `size / 20`.
     pub chord_tol: Option<f64>,
     /// Largest ratio of `det J` between a triangle's vertices (applied to triangles
@@ -188,6 +192,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
     // whether the triangles made by the last round's insertions all meet spade's limits
     // (then spade's refinement, a scan of every triangle, would add nothing)
     let mut settled = false;
+    let sides = Side::ALL.map(|s| SideCurve::new(map, s));
     stats.boundary = lap();
     for round in 0..200 {
         stats.rounds = round + 1;
@@ -259,16 +264,28 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
                 })
             })
             .collect();
-        for edge in cdt.undirected_edges().filter(|e| e.is_constraint_edge()) {
-            let [a, b] = edge.vertices().map(|h| h.fix().index());
-            if phys[a].distance(phys[b]) <= opts.size / 64.0 {
-                continue;
-            }
-            let mid = at(map, 0.5 * (param(a) + param(b)));
-            if mid.distance(0.5 * (phys[a] + phys[b])) > chord_tol {
-                split.push((a.min(b), a.max(b)));
-            }
-        }
+        // boundary segments farther than `chord_tol` from their side (largest distance
+        // between the mapped side and the chord, in parallel)
+        let segments: Vec<[usize; 2]> = cdt
+            .undirected_edges()
+            .filter(|e| e.is_constraint_edge())
+            .map(|e| e.vertices().map(|h| h.fix().index()))
+            .filter(|&[a, b]| phys[a].distance(phys[b]) > opts.size / 64.0)
+            .collect();
+        let far: Vec<(usize, usize)> = segments
+            .par_iter()
+            .filter_map(|&[a, b]| {
+                let (p, q) = (param(a), param(b));
+                let side = side_of(p, q)?;
+                let (t0, t1) = match side {
+                    Side::South | Side::North => (p.x, q.x),
+                    Side::East | Side::West => (p.y, q.y),
+                };
+                let dev = segment_deviation(&sides[side as usize], t0.min(t1), t0.max(t1));
+                (dev > chord_tol).then_some((a.min(b), a.max(b)))
+            })
+            .collect();
+        split.extend(far);
         split.sort_unstable();
         split.dedup();
         stats.criteria += lap();

@@ -12,7 +12,9 @@ use egui::{Color32, Pos2, RichText, Stroke, Ui};
 use winslow::Surface;
 use winslow_mesh::quality::{corner_defect, quality, Quality};
 use winslow_mesh::topology::faces;
-use winslow_mesh::{structured, unstructured, Distribution, Mesh, Side, StructuredOptions, UnstructuredOptions};
+use winslow_mesh::{
+    structured, unstructured, Distribution, Equidistribution, Mesh, Side, StructuredOptions, UnstructuredOptions,
+};
 
 /// Most vertices of an unstructured overlay (it is built in the UI thread).
 pub const MAX_OVERLAY_VERTICES: usize = 200_000;
@@ -41,6 +43,11 @@ pub enum Clustering {
     /// Geometric layers at south and north whose first cell is `strength` times the
     /// map's diameter long (growth limit 1.2).
     Layers,
+    /// Equal arc length along the west and east sides.
+    ArcLength,
+    /// Curvature equidistribution with a chord tolerance of `strength` times the
+    /// diameter (the fewest points, at least NY, that meet it).
+    Curvature,
 }
 
 impl Clustering {
@@ -51,6 +58,8 @@ impl Clustering {
             Clustering::Arctan => "arctan (eq. 50)",
             Clustering::Tanh => "tanh",
             Clustering::Layers => "first-cell height",
+            Clustering::ArcLength => "arc length",
+            Clustering::Curvature => "curvature",
         }
     }
 }
@@ -104,6 +113,10 @@ impl MeshSettings {
             Clustering::Layers => {
                 let h = self.strength * diameter(map);
                 Distribution::Layers { start: Some(h), end: Some(h), growth: 1.2 }
+            }
+            Clustering::ArcLength => Distribution::Equidistributed(Equidistribution::ArcLength),
+            Clustering::Curvature => {
+                Distribution::Equidistributed(Equidistribution::Curvature { tol: self.strength * diameter(map) })
             }
         };
         StructuredOptions { points: self.points, distribution: [Distribution::Uniform, eta] }
@@ -229,14 +242,31 @@ pub fn mesh_section(ui: &mut Ui, st: &mut MeshOverlayState, map: &Surface) {
             ui.add(egui::Slider::new(&mut s.points[1], 2..=201).text("NY (η points)"));
             ui.horizontal_wrapped(|ui| {
                 ui.label("η:");
-                for c in [Clustering::Uniform, Clustering::Arctan, Clustering::Tanh, Clustering::Layers] {
+                for c in [
+                    Clustering::Uniform,
+                    Clustering::Arctan,
+                    Clustering::Tanh,
+                    Clustering::Layers,
+                    Clustering::ArcLength,
+                    Clustering::Curvature,
+                ] {
                     if ui.selectable_value(&mut s.clustering, c, c.label()).changed() {
-                        s.strength = if c == Clustering::Layers { 1e-3 } else { 6.0 };
+                        s.strength = match c {
+                            Clustering::Layers | Clustering::Curvature => 1e-3,
+                            _ => 6.0,
+                        };
                     }
                 }
             });
             match s.clustering {
-                Clustering::Uniform => {}
+                Clustering::Uniform | Clustering::ArcLength => {}
+                Clustering::Curvature => {
+                    ui.add(
+                        egui::Slider::new(&mut s.strength, 1e-6..=1e-1)
+                            .logarithmic(true)
+                            .text("chord tolerance / diameter"),
+                    );
+                }
                 Clustering::Arctan | Clustering::Tanh => {
                     ui.add(egui::Slider::new(&mut s.strength, 0.1..=20.0).text("strength"));
                 }
@@ -339,6 +369,13 @@ mod tests {
         assert!((area - 2.0).abs() < 1e-13, "{area}");
         assert!(o.quality.rows().iter().any(|(k, v)| *k == "inverted cells" && v == "0"));
         assert!(o.is_current(&s, &map));
+        // arc length on the affine map: equal spacings (uniform eta)
+        let a = MeshSettings { points: [3, 5], clustering: Clustering::ArcLength, ..Default::default() }
+            .build(&map)
+            .unwrap();
+        for j in 0..5 {
+            assert!((a.mesh.points[3 * j].y - 1.0 - j as f64 / 4.0).abs() < 1e-12);
+        }
         assert!(!o.is_current(&MeshSettings { points: [9, 6], ..s }, &map));
     }
 
