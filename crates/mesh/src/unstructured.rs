@@ -219,6 +219,10 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         }
         // map the new vertices (in parallel: one spline evaluation each)
         let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| v.position()).collect();
+        // vertices from `first_new` on are new since the last scan: a triangle or segment of
+        // older vertices only existed then and passed (inserting a point only makes
+        // triangles that have it as a vertex; a split edge's triangles are gone)
+        let first_new = phys.len();
         let fresh: Vec<(DVec2, f64)> = pos[phys.len()..]
             .par_iter()
             .map(|p| {
@@ -232,7 +236,11 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         }
         stats.map += lap();
         let param = |i: usize| DVec2::new(pos[i].x / scale.x, pos[i].y / scale.y);
-        let faces: Vec<[usize; 3]> = cdt.inner_faces().map(|f| f.vertices().map(|h| h.fix().index())).collect();
+        let faces: Vec<[usize; 3]> = cdt
+            .inner_faces()
+            .map(|f| f.vertices().map(|h| h.fix().index()))
+            .filter(|v| v.iter().any(|&i| i >= first_new))
+            .collect();
         // the edge to split of each triangle that asks (in parallel)
         let mut split: Vec<(usize, usize)> = faces
             .par_iter()
@@ -270,7 +278,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             .undirected_edges()
             .filter(|e| e.is_constraint_edge())
             .map(|e| e.vertices().map(|h| h.fix().index()))
-            .filter(|&[a, b]| phys[a].distance(phys[b]) > opts.size / 64.0)
+            .filter(|&[a, b]| a.max(b) >= first_new && phys[a].distance(phys[b]) > opts.size / 64.0)
             .collect();
         let far: Vec<(usize, usize)> = segments
             .par_iter()
