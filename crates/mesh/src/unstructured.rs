@@ -10,18 +10,20 @@
 //!    length about `size` (equal arc length along the mapped side).
 //! 2. Rounds of: spade's Delaunay refinement with the angle limit (in the parameter
 //!    square); then every triangle whose straight image has an edge longer than `size`,
-//!    is inverted (down to `size / 64`), or over which `det J` (eq. 43) varies by more than `det_j_ratio`
-//!    between its vertices, gets its physically longest edge split at the parameter
-//!    midpoint (cut into `ceil(len / size)` equal pieces when longer than `2 size`, which
-//!    saves rounds where the map stretches) (the paper's criterion: "the value of the Jacobian determinant in the
-//!    vertices can in turn serve as a refinement criterion"); so does every boundary
-//!    segment whose chord deviates from the mapped side by more than `chord_tol` (the
-//!    largest distance, measured: where the boundary's curvature `kappa` is high, since
-//!    the deviation is `kappa h^2 / 8`). Stop when no triangle asks; give
-//!    up (error) past 50 times the vertex count an equilateral mesh of the area needs,
-//!    which happens where the map stretches parameter triangles into slivers. A round
-//!    skips spade's refinement (a scan of every triangle) when the triangles around the
-//!    points just inserted already meet its limits (`star_meets_limits`).
+//!    is inverted (down to `size / 64`), or over which `det J` (eq. 43) varies by more
+//!    than `det_j_ratio` between its vertices (the paper's criterion: "the value of the
+//!    Jacobian determinant in the vertices can in turn serve as a refinement
+//!    criterion") gets its physically longest edge split at the parameter midpoint (cut
+//!    into `ceil(len / size)` equal pieces when longer than `2 size`, which saves rounds
+//!    where the map stretches); so does every boundary segment whose chord deviates
+//!    from the mapped side by more than `chord_tol` (the largest distance, measured:
+//!    this refines where the boundary's curvature `kappa` is high, the deviation being
+//!    `kappa h^2 / 8`). Stop when no triangle asks; give up (error) past 50 times the
+//!    vertex count an equilateral mesh of the area needs, which happens where the map
+//!    stretches parameter triangles into slivers. A round skips spade's refinement (a
+//!    scan of every triangle) when the triangles around the points just inserted
+//!    already meet its limits (`star_meets_limits`), and checks only the triangles and
+//!    segments with a vertex new since the last round.
 //!
 //! Speed: the criteria and the mapping of new vertices run in parallel (rayon), each
 //! midpoint is inserted with a walk from an end of its edge (not from the last vertex
