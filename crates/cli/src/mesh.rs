@@ -29,8 +29,8 @@ pub struct MeshSpec {
     #[arg(long, value_name = "SPEC")]
     pub cluster: Vec<String>,
     /// Equidistribute a structured mesh's points along the boundary, repeatable:
-    /// [DIR:]arclength (equal arc length of the two sides along DIR) or
-    /// [DIR:]curvature:TOL (sqrt(curvature) times arc length, with the fewest points, at
+    /// `[DIR:]arclength` (equal arc length of the two sides along DIR) or
+    /// `[DIR:]curvature:TOL` (sqrt(curvature) times arc length, with the fewest points, at
     /// least NX or NY, that keep every boundary chord within TOL of its side). DIR is xi
     /// or eta; without it, both directions.
     #[arg(long, value_name = "SPEC")]
