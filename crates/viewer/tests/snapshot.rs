@@ -194,3 +194,36 @@ fn ctrl_f_fits_the_views_again() {
     h.run();
     assert_eq!(h.state().state.physical, fitted);
 }
+
+#[test]
+fn the_mesh_section_builds_the_overlay() {
+    // the buttons of the side panel's Mesh section, clicked as a user would
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("quarter_annulus.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    app.state.start_solve(|| {});
+    app.state.wait_for_solve();
+    // tall enough for the whole side panel: clicks land where the widgets are drawn
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(SIZE.x, 2400.0))
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
+    h.run();
+    assert!(h.state().state.mesh.built.is_none());
+    h.get_by_label("Build mesh").click();
+    h.run();
+    let o = h.state().state.mesh.built.as_ref().unwrap().as_ref().expect("a structured mesh");
+    let [nx, ny] = h.state().state.mesh.settings.points;
+    assert_eq!(o.mesh.num_cells(), (nx - 1) * (ny - 1));
+    h.get_by_label("inverted cells");
+    // unstructured: the button offers a build again (settings changed)
+    h.get_by_label("unstructured").click();
+    h.run();
+    h.get_by_label("Build mesh").click();
+    h.run();
+    let o = h.state().state.mesh.built.as_ref().unwrap().as_ref().expect("a triangulation");
+    assert_eq!(o.mesh.kind, winslow_mesh::ElementKind::Triangle);
+    assert!(o.inverted.is_empty());
+    // drawn over the current map only
+    let map = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().map.clone();
+    assert!(h.state().state.mesh.drawn(&map).is_some());
+}
