@@ -10,7 +10,10 @@ use winslow::Surface;
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::quality::quality;
-use winslow_mesh::{structured, unstructured, Distribution, End, StructuredOptions, UnstructuredOptions};
+use winslow_mesh::{
+    structured, unstructured_with_stats, Distribution, End, Equidistribution, MeshingStats, StructuredOptions,
+    UnstructuredOptions,
+};
 
 /// What mesh to make (shared by `mesh` and `solve --mesh`).
 #[derive(Args, Debug, Clone)]
@@ -25,6 +28,13 @@ pub struct MeshSpec {
     /// DIR is xi or eta; SIDE is south, east, north or west.
     #[arg(long, value_name = "SPEC")]
     pub cluster: Vec<String>,
+    /// Equidistribute a structured mesh's points along the boundary, repeatable:
+    /// `[DIR:]arclength` (equal arc length of the two sides along DIR) or
+    /// `[DIR:]curvature:TOL` (sqrt(curvature) times arc length, with the fewest points, at
+    /// least NX or NY, that keep every boundary chord within TOL of its side). DIR is xi
+    /// or eta; without it, both directions.
+    #[arg(long, value_name = "SPEC")]
+    pub equidistribute: Vec<String>,
     /// An unstructured triangulation (spade, refined in physical space).
     #[arg(long, requires = "size")]
     pub unstructured: bool,
@@ -64,8 +74,8 @@ fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
     s.parse::<f64>().with_context(|| format!("--cluster {spec}: {what} '{s}' is not a number"))
 }
 
-/// The distributions of `xi` and `eta` from the `--cluster` specs.
-pub fn distributions(specs: &[String]) -> Result<[Distribution; 2]> {
+/// The distributions of `xi` and `eta` from the `--cluster` and `--equidistribute` specs.
+pub fn distributions(specs: &[String], equi: &[String]) -> Result<[Distribution; 2]> {
     let mut out = [Distribution::Uniform, Distribution::Uniform];
     let mut set = [false, false];
     for spec in specs {
@@ -120,6 +130,31 @@ pub fn distributions(specs: &[String]) -> Result<[Distribution; 2]> {
         out[dir] = d;
         set[dir] = true;
     }
+    for spec in equi {
+        let (dirs, rest) = match spec.split_once(':') {
+            Some(("xi", r)) => (vec![0], r),
+            Some(("eta", r)) => (vec![1], r),
+            _ => (vec![0, 1], spec.as_str()),
+        };
+        let e = match rest.split_once(':') {
+            None if rest == "arclength" => Equidistribution::ArcLength,
+            Some(("curvature", tol)) => Equidistribution::Curvature {
+                tol: tol
+                    .parse()
+                    .with_context(|| format!("--equidistribute {spec}: tolerance '{tol}' is not a number"))?,
+            },
+            _ => bail!("--equidistribute {spec}: expected [xi:|eta:]arclength or [xi:|eta:]curvature:TOL"),
+        };
+        for dir in dirs {
+            if set[dir] {
+                bail!("--equidistribute {spec}: the {} direction already has a distribution", ["xi", "eta"][dir]);
+            }
+            let d = Distribution::Equidistributed(e);
+            d.validate(["xi", "eta"][dir])?;
+            out[dir] = d;
+            set[dir] = true;
+        }
+    }
     Ok(out)
 }
 
@@ -133,12 +168,16 @@ fn parse_points(s: &str) -> Result<[usize; 2]> {
 pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
     let format = Format::from_path(output)?;
     let t = Instant::now();
+    let mut stats: Option<MeshingStats> = None;
     let linear = if let Some(s) = &spec.structured {
-        let opts = StructuredOptions { points: parse_points(s)?, distribution: distributions(&spec.cluster)? };
+        let opts = StructuredOptions {
+            points: parse_points(s)?,
+            distribution: distributions(&spec.cluster, &spec.equidistribute)?,
+        };
         structured(map, &opts)?
     } else if spec.unstructured {
-        if !spec.cluster.is_empty() {
-            bail!("--cluster applies to --structured meshes only");
+        if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {
+            bail!("--cluster and --equidistribute apply to --structured meshes only");
         }
         let size = spec.size.context("--unstructured needs --size H")?;
         let opts = UnstructuredOptions {
@@ -149,13 +188,17 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             order: spec.order as usize,
             ..Default::default()
         };
-        unstructured(map, &opts)?
+        let (mesh, st) = unstructured_with_stats(map, &opts)?;
+        stats = Some(st);
+        mesh
     } else {
         bail!("say which mesh: --structured NXxNY or --unstructured --size H");
     };
     let mesh = elevate(&linear, map, spec.order as usize)?;
     let built = t.elapsed().as_secs_f64();
+    let t = Instant::now();
     let q = quality(&mesh)?;
+    let measured = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let files = write(&mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
     let written = t.elapsed().as_secs_f64();
@@ -169,7 +212,13 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             format.name()
         );
         print!("{}", q.table());
-        println!("  built in {built:.3} s, written in {written:.3} s");
+        println!("  built in {built:.3} s, quality in {measured:.3} s, checked and written in {written:.3} s");
+        if let Some(st) = stats {
+            println!(
+                "  meshing: boundary {:.3} s, spade refinement {:.3} s ({} of {} rounds), mapping {:.3} s, criteria {:.3} s, insertion {:.3} s, mesh {:.3} s",
+                st.boundary, st.refine, st.spade_refinements, st.rounds, st.map, st.criteria, st.insert, st.build
+            );
+        }
         for f in files {
             println!("wrote {}", f.display());
         }
@@ -191,18 +240,37 @@ pub fn run(a: MeshArgs) -> Result<i32> {
 mod tests {
     use super::*;
 
+    fn distributions_of(specs: &[String]) -> Result<[Distribution; 2]> {
+        distributions(specs, &[])
+    }
+
+    #[test]
+    fn equidistribute_specs_parse() {
+        let d = distributions(&[], &["arclength".into()]).unwrap();
+        assert_eq!(d, [0, 1].map(|_| Distribution::Equidistributed(Equidistribution::ArcLength)));
+        let d = distributions(&["xi:arctan:3".into()], &["eta:curvature:1e-3".into()]).unwrap();
+        assert_eq!(d[1], Distribution::Equidistributed(Equidistribution::Curvature { tol: 1e-3 }));
+        assert!(distributions(&["eta:arctan:3".into()], &["eta:arclength".into()]).is_err());
+        assert!(distributions(&[], &["curvature:0".into()]).is_err());
+        assert!(distributions(&[], &["curvature:x".into()]).is_err());
+        assert!(distributions(&[], &["eta:spline".into()]).is_err());
+    }
+
     #[test]
     fn cluster_specs_parse() {
-        let d = distributions(&["eta:arctan:6".into()]).unwrap();
+        let d = distributions_of(&["eta:arctan:6".into()]).unwrap();
         assert_eq!(d[1], Distribution::Arctan { strength: 6.0 });
-        let d = distributions(&["south:first-height:1e-4:1.1".into(), "north:first-height:2e-4:1.1".into()]).unwrap();
+        let d =
+            distributions_of(&["south:first-height:1e-4:1.1".into(), "north:first-height:2e-4:1.1".into()]).unwrap();
         assert_eq!(d[1], Distribution::Layers { start: Some(1e-4), end: Some(2e-4), growth: 1.1 });
-        let d = distributions(&["west:tanh:2".into()]).unwrap();
+        let d = distributions_of(&["west:tanh:2".into()]).unwrap();
         assert_eq!(d[0], Distribution::TanhOneSided { strength: 2.0, at: End::Start });
-        assert!(distributions(&["eta:arctan:x".into()]).is_err());
-        assert!(distributions(&["eta:arctan:6".into(), "south:first-height:1e-3".into()]).is_err());
-        assert!(distributions(&["south:first-height:1e-3:1.1".into(), "north:first-height:1e-3:1.2".into()]).is_err());
-        assert!(distributions(&["up:uniform".into()]).is_err());
+        assert!(distributions_of(&["eta:arctan:x".into()]).is_err());
+        assert!(distributions_of(&["eta:arctan:6".into(), "south:first-height:1e-3".into()]).is_err());
+        assert!(
+            distributions_of(&["south:first-height:1e-3:1.1".into(), "north:first-height:1e-3:1.2".into()]).is_err()
+        );
+        assert!(distributions_of(&["up:uniform".into()]).is_err());
         assert_eq!(parse_points("401x35").unwrap(), [401, 35]);
         assert!(parse_points("401").is_err());
     }

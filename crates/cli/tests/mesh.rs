@@ -44,14 +44,25 @@ fn solve_then_mesh_in_every_format() {
         ("lid.xyz", vec!["--structured", "11x9", "--cluster", "xi:tanh:2"]),
         ("lid.vtu", vec!["--unstructured", "--size", "0.1", "--order", "2"]),
         ("lid-case/", vec!["--unstructured", "--size", "0.1", "--min-angle", "25"]),
+        ("lid-eq.msh", vec!["--structured", "5x5", "--equidistribute", "xi:curvature:1e-3"]),
+        ("lid-arc.msh", vec!["--structured", "11x5", "--equidistribute", "arclength"]),
     ] {
         let mut args = vec!["mesh", &*Box::leak(d("lid.json").into_boxed_str()), "-o"];
         let o = Box::leak(d(o).into_boxed_str());
         args.push(o);
-        args.extend(extra);
+        args.extend(extra.iter().copied());
         let (ok, out, err) = run(&args);
         assert!(ok, "{args:?}: {err}");
         assert!(out.contains("wrote"), "{out}");
+        if extra.contains(&"--unstructured") {
+            assert!(out.contains("meshing: boundary"), "{out}");
+        }
+        if extra.contains(&"xi:curvature:1e-3") {
+            // the wavy lid (north) needs more than 5 points along xi for a chord of 1e-3
+            let nodes: usize =
+                out.split("nodes / cells").nth(1).unwrap().split('/').next().unwrap().trim().parse().unwrap();
+            assert!(nodes > 25 && nodes.is_multiple_of(5), "{out}");
+        }
     }
     assert!(dir.join("lid-case/constant/polyMesh/owner").exists());
     // refusals: a boundary is not a map; PLOT3D holds no triangles; bad specs
@@ -62,6 +73,18 @@ fn solve_then_mesh_in_every_format() {
     let (ok, _, err) =
         run(&["mesh", &d("lid.json"), "-o", &d("x.msh"), "--structured", "5x5", "--cluster", "up:arctan:2"]);
     assert!(!ok && err.contains("--cluster"), "{err}");
+    let (ok, _, err) = run(&[
+        "mesh",
+        &d("lid.json"),
+        "-o",
+        &d("x.msh"),
+        "--unstructured",
+        "--size",
+        "0.2",
+        "--equidistribute",
+        "arclength",
+    ]);
+    assert!(!ok && err.contains("--equidistribute"), "{err}");
     let (ok, _, err) = run(&["mesh", &d("lid.json"), "-o", &d("x.stl"), "--structured", "5x5"]);
     assert!(!ok && err.contains("unknown mesh format"), "{err}");
     assert!(!dir.join("x.msh").exists());

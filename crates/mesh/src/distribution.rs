@@ -7,6 +7,7 @@
 //! [`crate::structured::StructuredOptions`]; this module builds them once the heights
 //! are known in parameter units.
 
+use crate::equidistribution::Equidistribution;
 use crate::error::{MeshError, Result};
 
 /// One end of a parameter direction.
@@ -53,6 +54,9 @@ pub enum Distribution {
         /// Growth-ratio limit `> 1` between neighbouring cells.
         growth: f64,
     },
+    /// Points equidistributing arc length or curvature along the two sides of the
+    /// direction ([`crate::equidistribution`]); a curvature tolerance may add points.
+    Equidistributed(Equidistribution),
 }
 
 impl Distribution {
@@ -82,10 +86,13 @@ impl Distribution {
                 }
                 Ok(())
             }
+            Distribution::Equidistributed(Equidistribution::ArcLength) => Ok(()),
+            Distribution::Equidistributed(Equidistribution::Curvature { tol }) => pos(*tol, "chord tolerance"),
         }
     }
 
-    /// `s(t)` of the closed-form distributions (`None` for [`Distribution::Layers`]).
+    /// `s(t)` of the closed-form distributions (`None` for those that need the map,
+    /// [`Distribution::Layers`] and [`Distribution::Equidistributed`]).
     pub fn eval(&self, t: f64) -> Option<f64> {
         Some(match *self {
             Distribution::Uniform => t,
@@ -93,7 +100,7 @@ impl Distribution {
             Distribution::TanhTwoSided { strength: d } => 0.5 * (1.0 + (d * (t - 0.5)).tanh() / (0.5 * d).tanh()),
             Distribution::TanhOneSided { strength: d, at: End::Start } => 1.0 + (d * (t - 1.0)).tanh() / d.tanh(),
             Distribution::TanhOneSided { strength: d, at: End::End } => (d * t).tanh() / d.tanh(),
-            Distribution::Layers { .. } => return None,
+            Distribution::Layers { .. } | Distribution::Equidistributed(_) => return None,
         })
     }
 

@@ -6,6 +6,7 @@
 //! | module | what lives there |
 //! |---|---|
 //! | [`distribution`] | point distributions per direction: uniform, arctan (eq. 50), tanh, geometric layers |
+//! | [`equidistribution`] | points equidistributing boundary arc length or curvature (a chord tolerance with the fewest points) |
 //! | [`structured`](mod@structured) | structured quadrilateral meshes at `xi_i x eta_j`, first-cell heights in physical units |
 //! | [`unstructured`](mod@unstructured) | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
@@ -18,6 +19,7 @@
 //! by [`Side`]. Writers refuse a mesh with an inverted cell ([`Mesh::check`]).
 
 pub mod distribution;
+pub mod equidistribution;
 pub mod error;
 pub mod formats;
 pub mod high_order;
@@ -27,11 +29,13 @@ pub mod topology;
 pub mod unstructured;
 
 pub use distribution::{Distribution, End};
+pub use equidistribution::Equidistribution;
 pub use error::{MeshError, Result};
 pub use glam::DVec2;
 pub use quality::{CellQuality, Quality};
+use rayon::prelude::*;
 pub use structured::{structured, StructuredOptions};
-pub use unstructured::{parameter_scale, unstructured, UnstructuredOptions};
+pub use unstructured::{parameter_scale, unstructured, unstructured_with_stats, MeshingStats, UnstructuredOptions};
 pub use winslow::Side;
 
 /// The cell shape of a mesh.
@@ -128,16 +132,11 @@ impl Mesh {
     /// turn left (`(b - a) x (c - b) > 0`), and curved elements must have a positive
     /// Jacobian at their nodes and quadrature points ([`high_order::check_jacobians`]).
     pub fn check(&self) -> Result<()> {
-        let mut bad: Option<(usize, String)> = None;
-        let mut count = 0;
-        for c in 0..self.num_cells() {
-            if let Some(why) = quality::corner_defect(self, c) {
-                count += 1;
-                bad.get_or_insert((c, why));
-            }
-        }
-        if let Some((cell, why)) = bad {
-            return Err(MeshError::Inverted { cell, why, count });
+        let bad: Vec<usize> =
+            (0..self.num_cells()).into_par_iter().filter(|&c| quality::corner_defect(self, c).is_some()).collect();
+        if let Some(&cell) = bad.first() {
+            let why = quality::corner_defect(self, cell).unwrap_or_default();
+            return Err(MeshError::Inverted { cell, why, count: bad.len() });
         }
         if self.order > 1 {
             high_order::check_jacobians(self)?;
@@ -148,5 +147,5 @@ impl Mesh {
 
 /// The nodes of the map's image with parameters `params`.
 pub fn map_points(map: &winslow::Surface, params: &[DVec2]) -> Vec<DVec2> {
-    params.iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect()
+    params.par_iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect()
 }

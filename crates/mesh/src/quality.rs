@@ -7,6 +7,7 @@
 //! the line joining the centroids of the cells on either side, OpenFOAM's measure).
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::topology::Faces;
@@ -99,60 +100,69 @@ pub fn quality_with(mesh: &Mesh, faces: &Faces) -> Quality {
     let n = mesh.num_cells();
     let k = mesh.kind.corners();
     let ideal = if k == 3 { 60.0 } else { 90.0 };
-    let mut per = Vec::with_capacity(n);
-    let mut centroid = Vec::with_capacity(n);
-    let mut inverted = 0;
-    let mut pts = [DVec2::ZERO; 4];
-    for c in 0..n {
-        let v = mesh.corners(c);
-        for i in 0..k {
-            pts[i] = mesh.points[v[i]];
-        }
-        let p = &pts[..k];
-        let (area, cen) = area_centroid(p);
-        centroid.push(cen);
-        let (mut amin, mut amax, mut emin, mut emax) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-        for i in 0..k {
-            let (prev, cur, next) = (p[(i + k - 1) % k], p[i], p[(i + 1) % k]);
-            let (e1, e0) = (next - cur, prev - cur);
-            let mut ang = cross(e1, e0).atan2(e1.dot(e0)).to_degrees();
-            if ang < 0.0 {
-                ang += 360.0;
+    // per cell, in parallel: its quality, centroid and whether it is inverted
+    let cells: Vec<(CellQuality, DVec2, bool)> = (0..n)
+        .into_par_iter()
+        .map(|c| {
+            let mut pts = [DVec2::ZERO; 4];
+            let v = mesh.corners(c);
+            for i in 0..k {
+                pts[i] = mesh.points[v[i]];
             }
-            amin = amin.min(ang);
-            amax = amax.max(ang);
-            let len = e1.length();
-            emin = emin.min(len);
-            emax = emax.max(len);
-        }
-        if corner_defect(mesh, c).is_some() {
-            inverted += 1;
-        }
-        let skewness = ((amax - ideal) / (180.0 - ideal)).max((ideal - amin) / ideal).max(0.0);
-        per.push(CellQuality {
-            area,
-            min_angle: amin,
-            max_angle: amax,
-            aspect: emax / emin,
-            skewness,
-            growth: 1.0,
-            non_orthogonality: 0.0,
-        });
-    }
+            let p = &pts[..k];
+            let (area, cen) = area_centroid(p);
+            let (mut amin, mut amax, mut emin, mut emax) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+            for i in 0..k {
+                let (prev, cur, next) = (p[(i + k - 1) % k], p[i], p[(i + 1) % k]);
+                let (e1, e0) = (next - cur, prev - cur);
+                let mut ang = cross(e1, e0).atan2(e1.dot(e0)).to_degrees();
+                if ang < 0.0 {
+                    ang += 360.0;
+                }
+                amin = amin.min(ang);
+                amax = amax.max(ang);
+                let len = e1.length();
+                emin = emin.min(len);
+                emax = emax.max(len);
+            }
+            let skewness = ((amax - ideal) / (180.0 - ideal)).max((ideal - amin) / ideal).max(0.0);
+            let q = CellQuality {
+                area,
+                min_angle: amin,
+                max_angle: amax,
+                aspect: emax / emin,
+                skewness,
+                growth: 1.0,
+                non_orthogonality: 0.0,
+            };
+            (q, cen, corner_defect(mesh, c).is_some())
+        })
+        .collect();
+    let inverted = cells.iter().filter(|c| c.2).count();
+    let centroid: Vec<DVec2> = cells.iter().map(|c| c.1).collect();
+    let mut per: Vec<CellQuality> = cells.into_iter().map(|c| c.0).collect();
+    // per internal edge, in parallel: non-orthogonality and the area ratio; then each
+    // cell takes the largest of its edges
+    let edge: Vec<(f64, f64)> = faces
+        .internal
+        .par_iter()
+        .map(|f| {
+            let (o, nb) = (f.owner, f.neighbour);
+            let (a, b) = (mesh.points[f.nodes[0]], mesh.points[f.nodes[1]]);
+            let normal = DVec2::new((b - a).y, -(b - a).x);
+            let d = centroid[nb] - centroid[o];
+            let cosang = (normal.dot(d) / (normal.length() * d.length())).clamp(-1.0, 1.0);
+            let ang = if cosang.is_nan() { 90.0 } else { cosang.acos().to_degrees() };
+            let (ao, an) = (per[o].area.abs(), per[nb].area.abs());
+            let g = ao.max(an) / ao.min(an);
+            (ang, if g.is_nan() { f64::INFINITY } else { g })
+        })
+        .collect();
     let (mut no_max, mut no_sum) = (0.0f64, 0.0);
-    for f in &faces.internal {
-        let (o, nb) = (f.owner, f.neighbour);
-        let (a, b) = (mesh.points[f.nodes[0]], mesh.points[f.nodes[1]]);
-        let normal = DVec2::new((b - a).y, -(b - a).x);
-        let d = centroid[nb] - centroid[o];
-        let cosang = (normal.dot(d) / (normal.length() * d.length())).clamp(-1.0, 1.0);
-        let ang = if cosang.is_nan() { 90.0 } else { cosang.acos().to_degrees() };
+    for (f, &(ang, g)) in faces.internal.iter().zip(&edge) {
         no_max = no_max.max(ang);
         no_sum += ang;
-        let (ao, an) = (per[o].area.abs(), per[nb].area.abs());
-        let g = ao.max(an) / ao.min(an);
-        let g = if g.is_nan() { f64::INFINITY } else { g };
-        for c in [o, nb] {
+        for c in [f.owner, f.neighbour] {
             per[c].growth = per[c].growth.max(g);
             per[c].non_orthogonality = per[c].non_orthogonality.max(ang);
         }
@@ -184,26 +194,30 @@ pub fn quality(mesh: &Mesh) -> Result<Quality> {
 }
 
 impl Quality {
+    /// The quality table as `(name, value)` rows (the CLI prints them, the viewer shows
+    /// them in a grid).
+    pub fn rows(&self) -> Vec<(&'static str, String)> {
+        let mut rows = vec![
+            ("nodes / cells", format!("{} / {}", self.nodes, self.cells)),
+            ("cell area min / max", format!("{:.4e} / {:.4e}", self.area[0], self.area[1])),
+            ("angle min / max (deg)", format!("{:.2} / {:.2}", self.angle[0], self.angle[1])),
+            ("max aspect ratio", format!("{:.3}", self.max_aspect)),
+            ("max skewness", format!("{:.4}", self.max_skewness)),
+            ("max growth ratio", format!("{:.4}", self.max_growth)),
+            (
+                "non-orthogonality max / mean",
+                format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
+            ),
+        ];
+        if let Some(r) = self.min_jacobian_ratio {
+            rows.push(("min det J ratio (curved)", format!("{r:.4}")));
+        }
+        rows.push(("inverted cells", format!("{}", self.inverted)));
+        rows
+    }
+
     /// The quality table as text.
     pub fn table(&self) -> String {
-        let mut s = String::new();
-        let mut row = |k: &str, v: String| {
-            s.push_str(&format!("  {k:<28} {v}\n"));
-        };
-        row("nodes / cells", format!("{} / {}", self.nodes, self.cells));
-        row("cell area min / max", format!("{:.4e} / {:.4e}", self.area[0], self.area[1]));
-        row("angle min / max (deg)", format!("{:.2} / {:.2}", self.angle[0], self.angle[1]));
-        row("max aspect ratio", format!("{:.3}", self.max_aspect));
-        row("max skewness", format!("{:.4}", self.max_skewness));
-        row("max growth ratio", format!("{:.4}", self.max_growth));
-        row(
-            "non-orthogonality max / mean",
-            format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
-        );
-        if let Some(r) = self.min_jacobian_ratio {
-            row("min det J ratio (curved)", format!("{r:.4}"));
-        }
-        row("inverted cells", format!("{}", self.inverted));
-        s
+        self.rows().iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
     }
 }

@@ -12,6 +12,7 @@ use glam::DVec2;
 use winslow::{Side, Surface};
 
 use crate::distribution::{layer_sizes, points_from_sizes, Distribution};
+use crate::equidistribution::equidistributed;
 use crate::error::{MeshError, Result};
 use crate::{map_points, BoundaryEdge, ElementKind, Mesh};
 
@@ -85,7 +86,11 @@ fn direction(map: &Surface, dir: usize, n: usize, d: &Distribution, others: &[f6
     if let Some(p) = d.points(n - 1) {
         return Ok(p);
     }
-    let Distribution::Layers { start, end, growth } = d else { unreachable!("closed forms handled above") };
+    let (start, end, growth) = match d {
+        Distribution::Layers { start, end, growth } => (start, end, growth),
+        Distribution::Equidistributed(e) => return equidistributed(map, dir, *e, n),
+        _ => return Err(MeshError::param(["xi", "eta"][dir], "a closed-form distribution without points")),
+    };
     let [s0, s1] = sides(dir);
     let h0 = start.map(|h| parameter_height(map, dir, true, h, others, s0)).transpose()?;
     let h1 = end.map(|h| parameter_height(map, dir, false, h, others, s1)).transpose()?;
@@ -131,7 +136,8 @@ pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<[Vec<f64>; 
         opts.distribution[1].points(opts.points[1] - 1).unwrap_or_else(|| uniform(opts.points[1])),
     ];
     let physical = [opts.distribution[0].eval(0.0).is_none(), opts.distribution[1].eval(0.0).is_none()];
-    let sweeps = if physical[0] && physical[1] { 4 } else { 1 };
+    let layers = opts.distribution.iter().filter(|d| matches!(d, Distribution::Layers { .. })).count();
+    let sweeps = if layers == 2 { 4 } else { 1 };
     for _ in 0..sweeps {
         for dir in 0..2 {
             if physical[dir] {

@@ -1,5 +1,6 @@
 //! Edges shared by cells: the faces of the finite-volume view of a 2D mesh.
 
+use rayon::prelude::*;
 use winslow::Side;
 
 use crate::error::{MeshError, Result};
@@ -47,15 +48,17 @@ fn key(a: usize, b: usize) -> u128 {
 pub fn faces(mesh: &Mesh) -> Result<Faces> {
     let k = mesh.kind.corners();
     let n = mesh.num_cells();
-    let mut all: Vec<(u128, usize, usize, usize)> = Vec::with_capacity(n * k);
-    for c in 0..n {
-        let v = mesh.corners(c);
-        for e in 0..k {
-            let (a, b) = (v[e], v[(e + 1) % k]);
-            all.push((key(a, b), c, a, b));
-        }
-    }
-    all.sort_unstable_by_key(|t| (t.0, t.1));
+    let mut all: Vec<(u128, usize, usize, usize)> = (0..n)
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            let v = mesh.corners(c);
+            (0..k).map(move |e| {
+                let (a, b) = (v[e], v[(e + 1) % k]);
+                (key(a, b), c, a, b)
+            })
+        })
+        .collect();
+    all.par_sort_unstable_by_key(|t| (t.0, t.1));
     let mut internal = Vec::with_capacity(all.len() / 2);
     let mut open = std::collections::HashMap::new();
     let mut i = 0;
@@ -75,7 +78,7 @@ pub fn faces(mesh: &Mesh) -> Result<Faces> {
         }
         i = j;
     }
-    internal.sort_unstable_by_key(|f| (f.owner, f.neighbour));
+    internal.par_sort_unstable_by_key(|f| (f.owner, f.neighbour));
     let mut boundary = Vec::with_capacity(mesh.boundary.len());
     for e in &mesh.boundary {
         let (a, b) = (e.nodes[0], e.nodes[1]);

@@ -7,16 +7,18 @@ use std::path::PathBuf;
 use std::sync::mpsc::{channel, Receiver};
 use std::sync::{Arc, Mutex};
 
-use egui::epaint::{Mesh, Vertex, WHITE_UV};
+use egui::epaint::Mesh;
 use egui::{Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Sense, Shape, Stroke, Ui, Vec2};
-use egui_plot::{Line, Plot, PlotPoints};
 use winslow::discrete::assembly::Operator;
 use winslow::Point;
 
-use crate::certificate::{verdict_is_good, verdict_name, Certificate};
 use crate::colour::{colour_at, fold_colour, is_positive, ColourScale, ScaleKind};
+use crate::export::write_png;
+use crate::mesh_overlay::{mesh_section, paint_overlay};
+use crate::paint::{control_net, crosshair, element_outline, heat_mesh, side_colours};
 use crate::sampler::DetJSampler;
-use crate::scene::{MapView, Scene, RESOLUTION_RANGE};
+use crate::scene::RESOLUTION_RANGE;
+use crate::sections::{certificate_section, file_section, folds_section, quality_section, residual_plot, section};
 use crate::solve_job::JobState;
 use crate::state::{Probe, ViewKind, ViewerState};
 use crate::view::ViewTransform;
@@ -25,8 +27,6 @@ use crate::view::ViewTransform;
 const BAR_WIDTH: f32 = 96.0;
 /// Width of the side panel in points.
 const PANEL_WIDTH: f32 = 340.0;
-/// Folded elements listed at most.
-const MAX_LISTED_FOLDS: usize = 200;
 
 /// A screenshot in progress: where to write it and which part of the window to keep.
 #[derive(Debug)]
@@ -328,6 +328,7 @@ impl ViewerApp {
         section(ui, "Display", |ui| self.display_section(ui));
         if let Some(mv) = self.state.scene.as_ref().and_then(|s| s.map.as_ref()) {
             section(ui, "Quality", |ui| quality_section(ui, mv));
+            section(ui, "Mesh", |ui| mesh_section(ui, &mut self.state.mesh, &mv.map));
         }
     }
 
@@ -506,6 +507,9 @@ impl ViewerApp {
                     painter.add(Shape::line(line.iter().map(|&p| to(p)).collect(), stroke));
                 }
             }
+            if let Some(o) = self.state.mesh.drawn(&mv.map) {
+                paint_overlay(&painter, o, side_colours(), |k| to(o.mesh.points[k].to_array()));
+            }
             if d.net {
                 control_net(&painter, &mv.map, &to);
             }
@@ -589,6 +593,9 @@ impl ViewerApp {
                         painter.line_segment([to([t, 0.0]), to([t, 1.0])], stroke);
                         painter.line_segment([to([0.0, t]), to([1.0, t])], stroke);
                     }
+                }
+                if let Some(o) = self.state.mesh.drawn(&mv.map) {
+                    paint_overlay(&painter, o, side_colours(), |k| to(o.mesh.params[k].to_array()));
                 }
                 for f in &mv.folds {
                     let r = Rect::from_two_pos(to([f.xi[0], f.eta[0]]), to([f.xi[1], f.eta[1]]));
@@ -678,344 +685,5 @@ impl ViewerApp {
 impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut Ui, _frame: &mut eframe::Frame) {
         self.show(ui);
-    }
-}
-
-/// A collapsible section of the side panel, open by default.
-fn section(ui: &mut Ui, title: &str, body: impl FnOnce(&mut Ui)) {
-    egui::CollapsingHeader::new(RichText::new(title).heading()).default_open(true).show(ui, body);
-}
-
-/// Colours of the sides south, east, north, west.
-fn side_colours() -> [Color32; 4] {
-    [
-        Color32::from_rgb(200, 40, 40),
-        Color32::from_rgb(40, 140, 40),
-        Color32::from_rgb(40, 70, 200),
-        Color32::from_rgb(200, 140, 0),
-    ]
-}
-
-fn crosshair(painter: &egui::Painter, c: Pos2) {
-    let s = Stroke::new(1.5, Color32::RED);
-    painter.line_segment([c - Vec2::new(8.0, 0.0), c + Vec2::new(8.0, 0.0)], s);
-    painter.line_segment([c - Vec2::new(0.0, 8.0), c + Vec2::new(0.0, 8.0)], s);
-    painter.circle_stroke(c, 4.0, s);
-}
-
-/// The heat map over the sample grid: Gouraud-shaded cells with the colours of the
-/// samples at their corners, and every cell with a non-positive corner painted flat in
-/// the fold colour on top (no blend of fold and scale colours).
-fn heat_mesh(mv: &MapView, scale: &ColourScale, pos: impl Fn(usize) -> Pos2) -> Shape {
-    let n = mv.sample.n;
-    let values = &mv.sample.values;
-    let mut mesh = Mesh::default();
-    mesh.vertices.reserve((n + 1) * (n + 1));
-    for (k, &v) in values.iter().enumerate() {
-        mesh.vertices.push(Vertex { pos: pos(k), uv: WHITE_UV, color: scale.colour(v) });
-    }
-    let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut folded = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let ks = [idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)];
-            if ks.iter().any(|&k| !is_positive(values[k as usize])) {
-                folded.push(ks);
-                continue;
-            }
-            mesh.add_triangle(ks[0], ks[1], ks[2]);
-            mesh.add_triangle(ks[0], ks[2], ks[3]);
-        }
-    }
-    let fold = fold_colour();
-    for ks in folded {
-        let base = mesh.vertices.len() as u32;
-        for k in ks {
-            mesh.vertices.push(Vertex { pos: pos(k as usize), uv: WHITE_UV, color: fold });
-        }
-        mesh.add_triangle(base, base + 1, base + 2);
-        mesh.add_triangle(base, base + 2, base + 3);
-    }
-    Shape::mesh(mesh)
-}
-
-fn control_net(painter: &egui::Painter, map: &winslow::Surface, to: &impl Fn(Point) -> Pos2) {
-    let [nx, ny] = map.shape();
-    let stroke = Stroke::new(0.8, Color32::from_rgb(90, 90, 90));
-    for j in 0..ny {
-        painter.add(Shape::line((0..nx).map(|i| to(map.cp(i, j))).collect(), stroke));
-    }
-    for i in 0..nx {
-        painter.add(Shape::line((0..ny).map(|j| to(map.cp(i, j))).collect(), stroke));
-    }
-    for p in &map.control_points {
-        painter.circle_filled(to(*p), 2.0, Color32::from_rgb(60, 60, 60));
-    }
-}
-
-/// The image of an element's boundary (core evaluation of the map).
-fn element_outline(mv: &MapView, xi: [f64; 2], eta: [f64; 2]) -> Vec<Point> {
-    let m = 24;
-    let mut out = Vec::with_capacity(4 * m);
-    let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
-    for k in 0..m {
-        out.push(mv.map.eval(lerp(xi[0], xi[1], k as f64 / m as f64), eta[0]));
-    }
-    for k in 0..m {
-        out.push(mv.map.eval(xi[1], lerp(eta[0], eta[1], k as f64 / m as f64)));
-    }
-    for k in 0..m {
-        out.push(mv.map.eval(lerp(xi[1], xi[0], k as f64 / m as f64), eta[1]));
-    }
-    for k in 0..m {
-        out.push(mv.map.eval(xi[0], lerp(eta[1], eta[0], k as f64 / m as f64)));
-    }
-    out
-}
-
-fn file_section(ui: &mut Ui, scene: &Scene) {
-    ui.heading(&scene.name);
-    egui::Grid::new("file").num_columns(2).show(ui, |ui| {
-        ui.label("kind");
-        ui.label(scene.kind);
-        ui.end_row();
-        if let Some(p) = &scene.path {
-            ui.label("file");
-            let name = p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
-            ui.label(name).on_hover_text(p.display().to_string());
-            ui.end_row();
-        }
-        if let Some(mv) = &scene.map {
-            let [p, q] = mv.map.degrees();
-            let [nx, ny] = mv.map.shape();
-            ui.label("map");
-            ui.label(format!(
-                "p = ({p}, {q}), {nx}x{ny} control points,\n{}x{} elements{}",
-                mv.map.knots[0].num_elements(),
-                mv.map.knots[1].num_elements(),
-                if mv.map.weights.is_some() { ", rational" } else { "" }
-            ));
-            ui.end_row();
-        }
-    });
-    egui::CollapsingHeader::new("boundary sides").default_open(scene.map.is_none()).show(ui, |ui| {
-        for (s, side) in winslow::Side::ALL.iter().zip(&scene.boundary.boundary.sides) {
-            ui.label(format!("{s}: {}", side.describe()));
-        }
-        if scene.boundary.reoriented {
-            ui.label("the contour was clockwise: transposed to counter-clockwise");
-        }
-    });
-    if let Some(p) = &scene.boundary.problem {
-        ui.colored_label(Color32::from_rgb(200, 40, 40), p);
-    }
-}
-
-fn verdict_colour(c: &Certificate) -> Color32 {
-    match c.verdict {
-        winslow::solve::report::Verdict::Certified => Color32::from_rgb(20, 140, 50),
-        winslow::solve::report::Verdict::DegenerateCorner => Color32::from_rgb(190, 130, 0),
-        _ => Color32::from_rgb(200, 30, 30),
-    }
-}
-
-/// The verdict, in one place: the solver's or the stored report, and the exact certificate.
-fn certificate_section(ui: &mut Ui, mv: &MapView) {
-    let c = &mv.certificate;
-    ui.label(
-        RichText::new(format!(
-            "{} {}",
-            if verdict_is_good(c.verdict) { "OK:" } else { "BAD:" },
-            verdict_name(c.verdict)
-        ))
-        .color(verdict_colour(c))
-        .strong()
-        .size(16.0),
-    );
-    ui.label(&c.message);
-    ui.label(RichText::new(format!("from the {}", c.source.label())).weak());
-    if !c.details.is_empty() {
-        egui::Grid::new("cert-details").num_columns(2).show(ui, |ui| {
-            for (k, v) in &c.details {
-                ui.label(k);
-                ui.label(v);
-                ui.end_row();
-            }
-        });
-    }
-    if c.source != mv.exact_certificate.source {
-        let s = &mv.exact_certificate;
-        ui.label(
-            RichText::new(format!("exact certificate: {} ({})", verdict_name(s.verdict), s.message))
-                .color(verdict_colour(s)),
-        );
-    }
-}
-
-fn quality_section(ui: &mut Ui, mv: &MapView) {
-    let q = &mv.quality;
-    let f = &q.functionals;
-    let grid = format!("{0}x{0}", q.sample_n + 1);
-    egui::Grid::new("quality").num_columns(2).striped(true).show(ui, |ui| {
-        let mut row = |k: &str, v: String| {
-            ui.label(k);
-            ui.monospace(v);
-            ui.end_row();
-        };
-        row("det J min", format!("{:.4e}", q.det_j_min));
-        row("  at (ξ, η)", format!("({:.4}, {:.4})", q.det_j_argmin[0], q.det_j_argmin[1]));
-        row("det J max", format!("{:.4e}", q.det_j_max));
-        row("min / max", format!("{:.3e}", q.det_j_min / q.det_j_max));
-        row("min away from corners", format!("{:.4e}", q.det_j_min_interior));
-        row("min away from forced corners", format!("{:.4e}", q.det_j_min_away_from_forced_corners));
-        row("det J min at Gauss points", format!("{:.4e}", f.min_det_j_qp));
-        row("area", format!("{:.6}", f.area));
-        row(
-            "Winslow functional",
-            if f.winslow.is_finite() { format!("{:.6}", f.winslow) } else { "infinite (det J <= 0)".into() },
-        );
-        row("harmonic energy", format!("{:.4e}", f.harmonic));
-        row("sample", format!("{grid} ({})", mv.sampler));
-    });
-    egui::CollapsingHeader::new("corners").default_open(false).show(ui, |ui| {
-        for c in &q.corners {
-            ui.label(format!(
-                "{}: {:.1}°{}",
-                c.corner,
-                c.angle_degrees,
-                if c.forces_nonpositive_det_j { " (forces det J <= 0)" } else { "" }
-            ));
-        }
-    });
-}
-
-/// The folded-element list; returns the index clicked.
-fn folds_section(ui: &mut Ui, mv: &MapView, selected: Option<usize>) -> Option<usize> {
-    let forced = mv.folds.iter().filter(|f| f.forced_corner).count();
-    if forced > 0 {
-        ui.label(format!("{forced} element(s) at corners whose angle forces det J <= 0"));
-    }
-    if mv.folds.is_empty() {
-        ui.label("none: det J > 0 on every sample");
-        return None;
-    }
-    let mut clicked = None;
-    egui::ScrollArea::vertical().id_salt("folds").max_height(160.0).show(ui, |ui| {
-        for (k, f) in mv.folds.iter().enumerate().take(MAX_LISTED_FOLDS) {
-            let text = format!(
-                "({:>3}, {:>3})  ξ [{:.3}, {:.3}]  η [{:.3}, {:.3}]  min {:.2e}{}",
-                f.element[0],
-                f.element[1],
-                f.xi[0],
-                f.xi[1],
-                f.eta[0],
-                f.eta[1],
-                f.min_det_j,
-                if f.forced_corner { "  corner" } else { "" }
-            );
-            if ui.selectable_label(selected == Some(k), RichText::new(text).monospace().size(11.0)).clicked() {
-                clicked = Some(k);
-            }
-        }
-        if mv.folds.len() > MAX_LISTED_FOLDS {
-            ui.label(format!("… and {} more", mv.folds.len() - MAX_LISTED_FOLDS));
-        }
-    });
-    clicked
-}
-
-/// `log10` of the scaled residual against the iterate number, one line per level.
-fn residual_plot(ui: &mut Ui, history: &[crate::solve_job::ResidualPoint]) {
-    if history.is_empty() {
-        return;
-    }
-    let plot = Plot::new("residuals")
-        .height(170.0)
-        .width((ui.available_width() - 12.0).max(120.0))
-        .allow_scroll(false)
-        .allow_zoom(false)
-        .allow_drag(false)
-        .x_axis_label("iterate")
-        .y_axis_label("scaled |F|")
-        .y_axis_formatter(|mark, _| format!("1e{}", mark.value.round() as i64));
-    plot.show(ui, |p| {
-        let mut start = 0;
-        while start < history.len() {
-            let level = history[start].level;
-            let end = history[start..].iter().position(|h| h.level != level).map_or(history.len(), |k| start + k);
-            let pts: Vec<[f64; 2]> = history[start..end]
-                .iter()
-                .filter(|h| h.scaled_residual > 0.0)
-                .map(|h| [h.step as f64, h.scaled_residual.log10()])
-                .collect();
-            p.line(Line::new(format!("level {}", level + 1), PlotPoints::from(pts)));
-            start = end;
-        }
-    });
-}
-
-/// Crop (in pixels) and write a screenshot as PNG.
-pub fn write_png(path: &std::path::Path, image: &ColorImage, crop: Option<Rect>) -> anyhow::Result<()> {
-    let (x0, y0, w, h) = crop_box(image.size, crop);
-    let mut rgba = Vec::with_capacity(4 * w * h);
-    for y in y0..y0 + h {
-        for x in x0..x0 + w {
-            rgba.extend_from_slice(&image.pixels[y * image.size[0] + x].to_srgba_unmultiplied());
-        }
-    }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut enc = png::Encoder::new(file, w as u32, h as u32);
-    enc.set_color(png::ColorType::Rgba);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.write_header()?.write_image_data(&rgba)?;
-    Ok(())
-}
-
-/// The pixel box `(x, y, width, height)` of `crop` within an image of `size`, clamped
-/// (the whole image without a crop or when the crop misses it).
-pub fn crop_box(size: [usize; 2], crop: Option<Rect>) -> (usize, usize, usize, usize) {
-    let whole = (0, 0, size[0], size[1]);
-    let Some(r) = crop else { return whole };
-    let clamp = |v: f32, hi: usize| (v.round().max(0.0) as usize).min(hi);
-    let (x0, x1) = (clamp(r.min.x, size[0]), clamp(r.max.x, size[0]));
-    let (y0, y1) = (clamp(r.min.y, size[1]), clamp(r.max.y, size[1]));
-    if x1 <= x0 || y1 <= y0 {
-        return whole;
-    }
-    (x0, y0, x1 - x0, y1 - y0)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn crop_boxes_are_clamped() {
-        assert_eq!(crop_box([100, 50], None), (0, 0, 100, 50));
-        let r = Rect::from_min_max(Pos2::new(10.2, 5.0), Pos2::new(60.0, 80.0));
-        assert_eq!(crop_box([100, 50], Some(r)), (10, 5, 50, 45));
-        let off = Rect::from_min_max(Pos2::new(200.0, 5.0), Pos2::new(300.0, 80.0));
-        assert_eq!(crop_box([100, 50], Some(off)), (0, 0, 100, 50));
-    }
-
-    #[test]
-    fn png_round_trip() {
-        let mut img = ColorImage::filled([4, 3], Color32::from_rgb(10, 20, 30));
-        img.pixels[4 + 2] = fold_colour();
-        let path = std::env::temp_dir().join(format!("winslow-viewer-png-{}.png", std::process::id()));
-        let crop = Rect::from_min_max(Pos2::new(1.0, 1.0), Pos2::new(3.0, 3.0));
-        write_png(&path, &img, Some(crop)).unwrap();
-        let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
-        let mut reader = dec.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        assert_eq!((info.width, info.height), (2, 2));
-        // pixel (2, 1) of the image is (1, 0) of the crop
-        assert_eq!(&buf[4..8], &[255, 0, 255, 255]);
-        assert_eq!(&buf[0..4], &[10, 20, 30, 255]);
-        std::fs::remove_file(&path).ok();
     }
 }

@@ -13,9 +13,13 @@
 pub mod app;
 pub mod certificate;
 pub mod colour;
+pub mod export;
 pub mod folds;
+pub mod mesh_overlay;
+mod paint;
 pub mod sampler;
 pub mod scene;
+mod sections;
 pub mod solve_job;
 pub mod state;
 pub mod view;

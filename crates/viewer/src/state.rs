@@ -11,6 +11,7 @@ use winslow::solve::options::SolveOptions;
 use winslow::Point;
 
 use crate::colour::{ColourScale, ScaleKind};
+use crate::mesh_overlay::MeshOverlayState;
 use crate::sampler::DetJSampler;
 use crate::scene::{Scene, SceneSettings};
 use crate::solve_job::{JobState, SolveJob};
@@ -130,6 +131,8 @@ pub struct ViewerState {
     pub probe: Option<Probe>,
     /// Index into the folded-element list of the highlighted element.
     pub selected_fold: Option<usize>,
+    /// The mesh overlay (winslow-mesh): settings and the last build.
+    pub mesh: MeshOverlayState,
     sampler: Arc<dyn DetJSampler>,
 }
 
@@ -157,6 +160,7 @@ impl ViewerState {
             status: None,
             probe: None,
             selected_fold: None,
+            mesh: MeshOverlayState::default(),
             sampler,
         }
     }
@@ -279,6 +283,19 @@ impl ViewerState {
     pub fn colour_scale(&self) -> Option<ColourScale> {
         let mv = self.scene.as_ref()?.map.as_ref()?;
         Some(ColourScale::for_values(&mv.sample.values, self.display.scale))
+    }
+
+    /// Build the mesh overlay on the current map (the error goes to the overlay's panel
+    /// and is returned).
+    pub fn build_mesh(&mut self) -> Result<(), String> {
+        let Some(mv) = self.scene.as_ref().and_then(|s| s.map.as_ref()) else {
+            return Err("no map to mesh: solve the boundary first".into());
+        };
+        self.mesh.build(&mv.map);
+        match &self.mesh.built {
+            Some(Err(e)) => Err(e.clone()),
+            _ => Ok(()),
+        }
     }
 
     /// Fit both views to their rectangles.

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
+use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use winslow::io::Document;
 use winslow_viewer::scene::Scene;
@@ -40,6 +41,24 @@ fn map_view_snapshot() {
     let mv = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap();
     assert!(mv.quality.det_j_min > 0.0, "{}", mv.certificate.message);
     h.snapshot("map_view");
+}
+
+#[test]
+fn mesh_overlay_snapshot() {
+    // the Fig. 31 kind of mesh (eq. 50 in eta) over the det J heat map, with its quality
+    // table in the side panel
+    let mut app = solved_wavy_lid();
+    app.state.display.grid = false;
+    app.state.mesh.settings.points = [41, 13];
+    app.state.build_mesh().unwrap();
+    let o = app.state.mesh.drawn(&app.state.scene.as_ref().unwrap().map.as_ref().unwrap().map).expect("built");
+    assert_eq!(o.mesh.num_cells(), 40 * 12);
+    assert_eq!(o.quality.inverted, 0);
+    let mut h = harness(app);
+    h.run();
+    // the quality table is on the panel
+    h.get_by_label("inverted cells");
+    h.snapshot("mesh_overlay");
 }
 
 #[test]
@@ -174,4 +193,37 @@ fn ctrl_f_fits_the_views_again() {
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::F);
     h.run();
     assert_eq!(h.state().state.physical, fitted);
+}
+
+#[test]
+fn the_mesh_section_builds_the_overlay() {
+    // the buttons of the side panel's Mesh section, clicked as a user would
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("quarter_annulus.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    app.state.start_solve(|| {});
+    app.state.wait_for_solve();
+    // tall enough for the whole side panel: clicks land where the widgets are drawn
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(SIZE.x, 2400.0))
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
+    h.run();
+    assert!(h.state().state.mesh.built.is_none());
+    h.get_by_label("Build mesh").click();
+    h.run();
+    let o = h.state().state.mesh.built.as_ref().unwrap().as_ref().expect("a structured mesh");
+    let [nx, ny] = h.state().state.mesh.settings.points;
+    assert_eq!(o.mesh.num_cells(), (nx - 1) * (ny - 1));
+    h.get_by_label("inverted cells");
+    // unstructured: the button offers a build again (settings changed)
+    h.get_by_label("unstructured").click();
+    h.run();
+    h.get_by_label("Build mesh").click();
+    h.run();
+    let o = h.state().state.mesh.built.as_ref().unwrap().as_ref().expect("a triangulation");
+    assert_eq!(o.mesh.kind, winslow_mesh::ElementKind::Triangle);
+    assert!(o.inverted.is_empty());
+    // drawn over the current map only
+    let map = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().map.clone();
+    assert!(h.state().state.mesh.drawn(&map).is_some());
 }

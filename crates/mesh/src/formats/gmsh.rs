@@ -108,13 +108,13 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
     for (k, b) in buckets.iter().enumerate().filter(|(_, b)| !b.is_empty()) {
         let (d, t) = entities(k);
         w(&mut s, format_args!("{d} {t} 0 {}\n", b.len()));
-        for &i in b {
-            w(&mut s, format_args!("{}\n", i + 1));
-        }
-        for &i in b {
-            let p = mesh.points[i];
-            w(&mut s, format_args!("{} {} 0\n", p.x, p.y));
-        }
+        s.push_str(&super::par_text(b.len(), |s, k| {
+            let _ = writeln!(s, "{}", b[k] + 1);
+        }));
+        s.push_str(&super::par_text(b.len(), |s, k| {
+            let p = mesh.points[b[k]];
+            let _ = writeln!(s, "{} {} 0", p.x, p.y);
+        }));
     }
     w(&mut s, format_args!("$EndNodes\n"));
     let per_side: Vec<Vec<&crate::BoundaryEdge>> =
@@ -138,14 +138,13 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
     }
     if cells > 0 {
         w(&mut s, format_args!("2 1 {} {cells}\n", cell_type(mesh.kind, mesh.order)));
-        for c in 0..cells {
-            tag += 1;
-            s.push_str(&tag.to_string());
+        s.push_str(&super::par_text(cells, |s, c| {
+            let _ = write!(s, "{}", tag + c + 1);
             for &v in mesh.cell(c) {
-                w(&mut s, format_args!(" {}", v + 1));
+                let _ = write!(s, " {}", v + 1);
             }
             s.push('\n');
-        }
+        }));
     }
     s.push_str("$EndElements\n");
     Ok(s)

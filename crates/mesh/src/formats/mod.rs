@@ -105,6 +105,25 @@ pub fn write(mesh: &Mesh, path: &Path, format: Format) -> Result<Vec<PathBuf>> {
     }
 }
 
+/// The text of items `0..n`, each written by `item` (which appends to the string),
+/// formatted in parallel chunks and concatenated in order: float formatting dominates
+/// writing a large mesh.
+pub(crate) fn par_text(n: usize, item: impl Fn(&mut String, usize) + Sync) -> String {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1 << 14;
+    let parts: Vec<String> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut s = String::with_capacity(48 * CHUNK);
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                item(&mut s, i);
+            }
+            s
+        })
+        .collect();
+    parts.concat()
+}
+
 /// Refuse curved elements in a format that holds only linear ones.
 pub(crate) fn linear_only(mesh: &Mesh, format: &'static str) -> Result<()> {
     if mesh.order != 1 {

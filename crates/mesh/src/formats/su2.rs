@@ -19,17 +19,18 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         ElementKind::Quad => 9,
     };
     let _ = writeln!(s, "% winslow mesh\nNDIME= 2\nNELEM= {cells}");
-    for c in 0..cells {
+    s.push_str(&super::par_text(cells, |s, c| {
         let _ = write!(s, "{t}");
         for v in mesh.cell(c) {
             let _ = write!(s, " {v}");
         }
         let _ = writeln!(s, " {c}");
-    }
+    }));
     let _ = writeln!(s, "NPOIN= {}", mesh.points.len());
-    for (i, p) in mesh.points.iter().enumerate() {
+    s.push_str(&super::par_text(mesh.points.len(), |s, i| {
+        let p = mesh.points[i];
         let _ = writeln!(s, "{} {} {i}", p.x, p.y);
-    }
+    }));
     let _ = writeln!(s, "NMARK= 4");
     for side in Side::ALL {
         let edges: Vec<_> = mesh.boundary.iter().filter(|e| e.side == side).collect();

@@ -38,19 +38,20 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         s,
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{cells}\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n"
     );
-    for p in &mesh.points {
+    s.push_str(&super::par_text(n, |s, i| {
+        let p = mesh.points[i];
         let _ = writeln!(s, "{} {} 0", p.x, p.y);
-    }
+    }));
     s.push_str("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
     let cubic_quad = mesh.kind == ElementKind::Quad && mesh.order == 3;
-    for c in 0..cells {
+    s.push_str(&super::par_text(cells, |s, c| {
         let v = mesh.cell(c);
         for k in 0..npc {
             let g = if cubic_quad { QUAD16_FROM_GMSH[k] } else { k };
             let _ = write!(s, "{} ", v[g]);
         }
         s.push('\n');
-    }
+    }));
     s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
     for c in 1..=cells {
         let _ = writeln!(s, "{}", c * npc);
@@ -73,15 +74,16 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
     ];
     for (name, f) in fields {
         let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">");
-        for c in &q.per_cell {
-            let _ = writeln!(s, "{}", f(c));
-        }
+        s.push_str(&super::par_text(cells, |s, c| {
+            let _ = writeln!(s, "{}", f(&q.per_cell[c]));
+        }));
         s.push_str("</DataArray>\n");
     }
     s.push_str("</CellData>\n<PointData>\n<DataArray type=\"Float64\" Name=\"parameter\" NumberOfComponents=\"2\" format=\"ascii\">\n");
-    for p in &mesh.params {
+    s.push_str(&super::par_text(n, |s, i| {
+        let p = mesh.params[i];
         let _ = writeln!(s, "{} {}", p.x, p.y);
-    }
+    }));
     s.push_str("</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     Ok(s)
 }
