@@ -8,12 +8,51 @@ pub(super) fn dist2(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
 }
 
+/// Which opposite sides a search runs across; it fixes on which side of each the domain
+/// lies (south: left of its direction, north: right; west: right, east: left).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Across {
+    /// Side 1 south, side 2 north.
+    SouthNorth,
+    /// Side 1 west, side 2 east.
+    WestEast,
+}
+
+/// The left normal (not normalised) of the polyline `p` at point `i`.
+fn left_normal(p: &[Point], i: usize) -> Point {
+    let (a, b) = (p[i.saturating_sub(1)], p[(i + 1).min(p.len() - 1)]);
+    [a[1] - b[1], b[0] - a[0]]
+}
+
+/// Whether `p1[i]` and `p2[j]` face each other across the domain: the segment between
+/// them leaves each side towards the domain, `s (p2_j − p1_i) · n1_i > 0` and `s (p2_j −
+/// p1_i) · n2_j > 0` with `n` the left normals and `s = ±1` from [`Across`]. Points close
+/// across the *outside* (the turns of a spiral channel, the two lips of a slot) are not a
+/// narrow gap of the domain and are never matched.
+pub fn facing(p1: &[Point], i: usize, p2: &[Point], j: usize, across: Across) -> bool {
+    let d = [p2[j][0] - p1[i][0], p2[j][1] - p1[i][1]];
+    let s = match across {
+        Across::SouthNorth => 1.0,
+        Across::WestEast => -1.0,
+    };
+    let (n1, n2) = (left_normal(p1, i), left_normal(p2, j));
+    s * (d[0] * n1[0] + d[1] * n1[1]) > 0.0 && s * (d[0] * n2[0] + d[1] * n2[1]) > 0.0
+}
+
 /// Closest-pair matching of eq. 40, recursively: among `p1[i]`, `p2[j]` with `c1[i]` in
 /// `(lo1, hi1)` and `c2[j]` in `(lo2, hi2)` (cord-length parameters of each side, the
 /// open intervals shrunk by `sep` at both ends), the closest pair within `eps` is matched
-/// and the search continues below and above it. Returns the pairs `(i, j)` ordered by
-/// `i` (and then also by `j`).
-pub fn match_pairs(p1: &[Point], c1: &[f64], p2: &[Point], c2: &[f64], eps: f64, sep: f64) -> Vec<(usize, usize)> {
+/// and the search continues below and above it. Only pairs [`facing`] each other across
+/// the domain count. Returns the pairs `(i, j)` ordered by `i` (and then also by `j`).
+pub fn match_pairs(
+    p1: &[Point],
+    c1: &[f64],
+    p2: &[Point],
+    c2: &[f64],
+    eps: f64,
+    sep: f64,
+    across: Across,
+) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
     // explicit stack of boxes (lo1, hi1, lo2, hi2) in parameter space
     let mut stack = vec![(0.0f64, 1.0f64, 0.0f64, 1.0f64)];
@@ -28,7 +67,7 @@ pub fn match_pairs(p1: &[Point], c1: &[f64], p2: &[Point], c2: &[f64], eps: f64,
         for i in r1.clone() {
             for j in r2.clone() {
                 let d = dist2(p1[i], p2[j]);
-                if d < best.0 {
+                if d < best.0 && facing(p1, i, p2, j, across) {
                     best = (d, i, j);
                 }
             }
@@ -93,7 +132,14 @@ pub type Constrained = (Vec<f64>, Vec<f64>, Vec<(usize, usize)>);
 /// length of `p1`; `Ξ_2` takes the value of `Ξ_1` at every matched pair (eq. 40, threshold
 /// `eps`, minimum separation `sep`) and is filled in between by `fill`. Returns
 /// `(Ξ_1, Ξ_2, matches)`.
-pub fn constrained_params(p1: &[Point], p2: &[Point], eps: f64, sep: f64, fill: Fill) -> Result<Constrained> {
+pub fn constrained_params(
+    p1: &[Point],
+    p2: &[Point],
+    eps: f64,
+    sep: f64,
+    fill: Fill,
+    across: Across,
+) -> Result<Constrained> {
     let c1 = cord_length_params(p1)
         .ok_or_else(|| Error::Invalid("constrained cord length: first side has zero length".into()))?;
     let c2 = cord_length_params(p2)
@@ -103,7 +149,7 @@ pub fn constrained_params(p1: &[Point], p2: &[Point], eps: f64, sep: f64, fill: 
     let pick = |idx: &[usize], v: &[Point]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
     let pickc = |idx: &[usize], v: &[f64]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
     let mut pairs: Vec<(usize, usize)> =
-        match_pairs(&pick(&i1, p1), &pickc(&i1, &c1), &pick(&i2, p2), &pickc(&i2, &c2), eps, sep)
+        match_pairs(&pick(&i1, p1), &pickc(&i1, &c1), &pick(&i2, p2), &pickc(&i2, &c2), eps, sep, across)
             .into_iter()
             .map(|(a, b)| (i1[a], i2[b]))
             .collect();
@@ -136,13 +182,17 @@ pub(super) fn thinned(n: usize) -> Vec<usize> {
     v
 }
 
-/// Smallest distance between two point sets (brute force on at most
-/// [`MAX_SEARCH_POINTS`] points of each), used to detect narrow gaps.
-pub fn min_distance(p1: &[Point], p2: &[Point]) -> f64 {
+/// Smallest distance between points of two opposite sides that are [`facing`] each
+/// other across the domain (brute force on at most [`MAX_SEARCH_POINTS`] points of
+/// each), used to detect narrow gaps; infinite when no pair faces.
+pub fn min_distance(p1: &[Point], p2: &[Point], across: Across) -> f64 {
     let mut best = f64::INFINITY;
     for &i in &thinned(p1.len()) {
         for &j in &thinned(p2.len()) {
-            best = best.min(dist2(p1[i], p2[j]));
+            let d = dist2(p1[i], p2[j]);
+            if d < best && facing(p1, i, p2, j, across) {
+                best = d;
+            }
         }
     }
     best.sqrt()

@@ -501,11 +501,12 @@ pub fn plan(boundary: &Boundary, opts: &ReparamOptions) -> Result<ReparamPlan> {
         arc_length_ratio: [None; 4],
         matches: Vec::new(),
     };
-    for (k, (s1, s2)) in [(Side::South, Side::North), (Side::West, Side::East)].into_iter().enumerate() {
+    let pairs = [(Side::South, Side::North, Across::SouthNorth), (Side::West, Side::East, Across::WestEast)];
+    for (k, (s1, s2, across)) in pairs.into_iter().enumerate() {
         let (a, b) = (boundary.side(s1), boundary.side(s2));
         let (sa, sb) = (sample_side(a, opts.samples), sample_side(b, opts.samples));
         let mean = 0.5 * (polyline_length(&sa.points) + polyline_length(&sb.points));
-        let gap = min_distance(&sa.points, &sb.points);
+        let gap = min_distance(&sa.points, &sb.points, across);
         let ratio = if mean > 0.0 { gap / mean } else { f64::INFINITY };
         report.gap_ratio[k] = ratio;
         let method = match opts.method {
@@ -531,8 +532,9 @@ pub fn plan(boundary: &Boundary, opts: &ReparamOptions) -> Result<ReparamPlan> {
             }
             Reparam::Constrained => {
                 let eps = opts.gap * mean;
-                let (x1, x2, pairs) = constrained_params(&sa.points, &sb.points, eps, opts.separation, opts.fill)
-                    .map_err(|e| e.within(&format!("{}/{} reparameterization", s1.name(), s2.name())))?;
+                let (x1, x2, pairs) =
+                    constrained_params(&sa.points, &sb.points, eps, opts.separation, opts.fill, across)
+                        .map_err(|e| e.within(&format!("{}/{} reparameterization", s1.name(), s2.name())))?;
                 for (i, j) in pairs {
                     report.matches.push(Match {
                         sides: [s1.name(), s2.name()],
@@ -671,7 +673,7 @@ mod tests {
         let mean = 0.5 * (polyline_length(&south) + polyline_length(&north));
         let eps = 0.02 * mean;
         for fill in [Fill::CordLength, Fill::MonotoneCubic] {
-            let (x1, x2, pairs) = constrained_params(&south, &north, eps, 0.01, fill).unwrap();
+            let (x1, x2, pairs) = constrained_params(&south, &north, eps, 0.01, fill, Across::SouthNorth).unwrap();
             assert!(!pairs.is_empty());
             // every match is within the threshold and close to one of the constrictions
             for &(i, j) in &pairs {
@@ -700,12 +702,14 @@ mod tests {
             assert!((c2[j] - x1[i]).abs() > 0.05);
         }
         // minimum separation: matches are at least `sep` apart in cord length
-        let (x1, _, pairs) = constrained_params(&south, &north, eps, 0.05, Fill::CordLength).unwrap();
+        let (x1, _, pairs) =
+            constrained_params(&south, &north, eps, 0.05, Fill::CordLength, Across::SouthNorth).unwrap();
         for w in pairs.windows(2) {
             assert!(x1[w[1].0] - x1[w[0].0] >= 0.05);
         }
         // nothing closer than the threshold: plain cord length, no matches
-        let (_, x2, pairs) = constrained_params(&south, &north, 0.01, 0.01, Fill::CordLength).unwrap();
+        let (_, x2, pairs) =
+            constrained_params(&south, &north, 0.01, 0.01, Fill::CordLength, Across::SouthNorth).unwrap();
         assert!(pairs.is_empty());
         assert_eq!(x2, cord_length_params(&north).unwrap());
     }
@@ -724,7 +728,8 @@ mod tests {
                 [x, 1.0 - 0.95 * (-((x - 6.0) / 0.2).powi(2)).exp()]
             })
             .collect();
-        let (x1, x2, pairs) = constrained_params(&south, &north, 0.1, 0.01, Fill::CordLength).unwrap();
+        let (x1, x2, pairs) =
+            constrained_params(&south, &north, 0.1, 0.01, Fill::CordLength, Across::SouthNorth).unwrap();
         assert!(!pairs.is_empty());
         for &(i, j) in &pairs {
             assert_eq!(x1[i], x2[j]);
@@ -767,5 +772,26 @@ mod tests {
             assert!(dist2(prev, q).sqrt() < 0.1);
             prev = q;
         }
+    }
+
+    /// Points close across the outside of the domain (the turns of a spiral) are no
+    /// narrow gap: neither measured by `min_distance` nor matched.
+    #[test]
+    fn only_points_facing_across_the_domain_count() {
+        let line = |y: f64, n: usize| (0..=n).map(|k| [k as f64 / n as f64, y]).collect::<Vec<Point>>();
+        let south = line(0.0, 50);
+        // north above the south side: the domain lies between them
+        assert!(facing(&south, 10, &line(0.2, 50), 10, Across::SouthNorth));
+        assert!((min_distance(&south, &line(0.2, 50), Across::SouthNorth) - 0.2).abs() < 1e-12);
+        // a "north" 0.01 below the south side lies across the outside
+        let below = line(-0.01, 50);
+        assert!(!facing(&south, 10, &below, 10, Across::SouthNorth));
+        assert_eq!(min_distance(&south, &below, Across::SouthNorth), f64::INFINITY);
+        let c: Vec<f64> = (0..=50).map(|k| k as f64 / 50.0).collect();
+        assert!(match_pairs(&south, &c, &below, &c, 0.1, 0.01, Across::SouthNorth).is_empty());
+        // west/east: west at x = 0 and east at x = 0.3, both running up
+        let up = |x: f64| (0..=20).map(|k| [x, k as f64 / 20.0]).collect::<Vec<Point>>();
+        assert!(facing(&up(0.0), 5, &up(0.3), 5, Across::WestEast));
+        assert!(!facing(&up(0.3), 5, &up(0.0), 5, Across::WestEast));
     }
 }
