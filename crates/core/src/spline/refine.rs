@@ -33,9 +33,10 @@ fn combine(a: &SparseRow, wa: f64, b: &SparseRow, wb: f64) -> SparseRow {
 /// The prolongation `P` (`n_fine x n_coarse`) with `N_coarse_j = sum_i P_ij N_fine_i`,
 /// so that coarse control points `c` become `P c` on the fine basis. `fine` must contain
 /// every knot of `coarse`; the knots are inserted one by one with Boehm's algorithm.
+/// Periodic vectors go to [`crate::spline::periodic::periodic_prolongation`].
 pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
-    if coarse.is_periodic() {
-        return Err(Error::Invalid("refinement of periodic knot vectors is not supported".into()));
+    if coarse.is_periodic() || fine.is_periodic() {
+        return crate::spline::periodic::periodic_prolongation(coarse, fine);
     }
     let new = fine.difference(coarse).ok_or_else(|| {
         Error::Invalid(format!(
@@ -89,10 +90,11 @@ pub(crate) fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// The operator `E` (`n_elevated x n`) that writes a degree-`p` spline in the basis of
 /// degree `p + 1` with the same continuity (knot multiplicities raised by one). It is
 /// obtained by interpolation at the Greville abscissae of the elevated space, which is
-/// exact because the spaces are nested.
+/// exact because the spaces are nested. Periodic vectors go to
+/// [`crate::spline::periodic::periodic_elevation`].
 pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if kv.is_periodic() {
-        return Err(Error::Invalid("degree elevation of periodic knot vectors is not supported".into()));
+        return crate::spline::periodic::periodic_elevation(kv);
     }
     let fine = kv.elevated();
     let g = fine.greville();
