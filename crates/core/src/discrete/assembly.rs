@@ -103,10 +103,16 @@ pub struct SystemPattern {
     pub csr: Csr,
     /// For each CSR entry, its position in the stencil storage.
     pub src: Vec<usize>,
+    /// Further `(entry, stencil position)` sources added to an entry: the rows and
+    /// columns of periodic replicas (empty without a periodic direction).
+    pub extra: Vec<(usize, usize)>,
 }
 
 impl SystemPattern {
     fn new(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
+        if !dofs.replicas().is_empty() {
+            return Self::shared(dofs, p, q, ncomp);
+        }
         let m = dofs.num_free();
         let sw = (2 * p + 1) * (2 * q + 1);
         let row_len = ncomp * ncomp * sw;
@@ -129,7 +135,49 @@ impl SystemPattern {
         }
         let nnz = col_idx.len();
         let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
-        Self { ncomp, csr, src }
+        Self { ncomp, csr, src, extra: Vec::new() }
+    }
+
+    /// The pattern with periodic replicas: row `f` sums the stencil rows of every stored
+    /// function with free index `f`, and each column collects every neighbour with the
+    /// same free index (sorted columns; first source in `src`, the others in `extra`).
+    fn shared(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
+        let m = dofs.num_free();
+        let sw = (2 * p + 1) * (2 * q + 1);
+        let row_len = ncomp * ncomp * sw;
+        let mut stored: Vec<Vec<usize>> = dofs.free().iter().map(|&k| vec![k]).collect();
+        for &(k, _) in dofs.replicas() {
+            let f = dofs.free_index(k);
+            if f != FIXED {
+                stored[f].push(k);
+            }
+        }
+        let mut row_ptr = vec![0];
+        let (mut col_idx, mut src, mut extra) = (Vec::new(), Vec::new(), Vec::new());
+        for z in 0..ncomp {
+            for ks in &stored {
+                let mut row: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+                for &k in ks {
+                    for d in 0..ncomp {
+                        for (s, kk) in stencil_neighbours(dofs.shape(), p, q, k) {
+                            let fc = dofs.free_index(kk);
+                            if fc != FIXED {
+                                row.entry(d * m + fc).or_default().push(k * row_len + (z * ncomp + d) * sw + s);
+                            }
+                        }
+                    }
+                }
+                for (col, sources) in row {
+                    extra.extend(sources[1..].iter().map(|&st| (col_idx.len(), st)));
+                    col_idx.push(col);
+                    src.push(sources[0]);
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        let nnz = col_idx.len();
+        let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
+        Self { ncomp, csr, src, extra }
     }
 
     /// Copy the stencil storage into the CSR values.
@@ -147,6 +195,9 @@ impl SystemPattern {
                 *v = stencil[s];
             }
         });
+        for &(e, s) in &self.extra {
+            values[e] += stencil[s];
+        }
     }
 
     /// A fresh matrix with the values gathered from `stencil`.
@@ -154,6 +205,9 @@ impl SystemPattern {
         let mut m = self.csr.clone();
         for (v, &s) in m.values.iter_mut().zip(&self.src) {
             *v = stencil[s];
+        }
+        for &(e, s) in &self.extra {
+            m.values[e] += stencil[s];
         }
         m
     }
@@ -321,11 +375,11 @@ impl Discretization {
         Self::with_dofs(knots, nq, dofs)
     }
 
-    /// [`Self::new`] with the free / fixed split of `topology`
-    /// ([`DofMap::for_topology`]).
+    /// [`Self::new`] with the free / fixed / shared split of `topology` on this basis
+    /// ([`DofMap::for_basis`]: a periodic knot vector goes with periodic sides).
     pub fn for_topology(knots: [KnotVector; 2], topology: &Topology) -> Result<Self> {
         let nq = knots[0].degree().max(knots[1].degree()) + 1;
-        let dofs = DofMap::for_topology([knots[0].num_basis(), knots[1].num_basis()], topology)?;
+        let dofs = DofMap::for_basis(&knots, topology)?;
         Ok(Self::with_dofs(knots, nq, dofs))
     }
 
@@ -670,7 +724,7 @@ impl Discretization {
     }
 
     /// Restrict a full component-interleaved vector (length `ncomp n`) to the free
-    /// unknowns `(z * m + f)`.
+    /// unknowns `(z * m + f)`, summing the rows of periodic replicas into their primary's.
     pub fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
         let m = self.dofs.num_free();
         let mut out = vec![0.0; ncomp * m];
@@ -679,7 +733,23 @@ impl Discretization {
                 out[z * m + f] = full[k * ncomp + z];
             }
         }
+        for &(k, _) in self.dofs.replicas() {
+            let f = self.dofs.free_index(k);
+            if f != FIXED {
+                for z in 0..ncomp {
+                    out[z * m + f] += full[k * ncomp + z];
+                }
+            }
+        }
         out
+    }
+
+    /// Every stored function of a free one: `(f, k)` for the primaries, then for the
+    /// periodic replicas.
+    fn free_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let d = &self.dofs;
+        let replicas = d.replicas().iter().map(|&(k, _)| (d.free_index(k), k)).filter(|&(f, _)| f != FIXED);
+        d.free().iter().copied().enumerate().chain(replicas)
     }
 
     /// `K_free,fixed * u_fixed` for a scalar stencil operator: the right-hand side
@@ -688,7 +758,7 @@ impl Discretization {
         let (p, q) = self.degrees();
         let sw = self.stencil_width();
         let mut out = vec![0.0; self.dofs.num_free()];
-        for (f, &k) in self.dofs.free().iter().enumerate() {
+        for (f, k) in self.free_rows() {
             for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
                 if self.dofs.free_index(kk) == FIXED {
                     out[f] += stencil[k * sw + s] * u[kk];
@@ -706,7 +776,7 @@ impl Discretization {
         let row_len = 4 * sw;
         let m = self.dofs.num_free();
         let mut out = vec![0.0; 2 * m];
-        for (f, &k) in self.dofs.free().iter().enumerate() {
+        for (f, k) in self.free_rows() {
             for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
                 if self.dofs.free_index(kk) != FIXED {
                     continue;

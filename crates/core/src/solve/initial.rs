@@ -117,10 +117,7 @@ pub fn elasticity_displacement_with(
         lin.factor(&k)?;
     }
     let u = lin.solve(&rhs)?;
-    let m = disc.dofs.num_free();
-    for (f, &kk) in disc.dofs.free().iter().enumerate() {
-        diff[kk] = [u[f], u[m + f]];
-    }
+    disc.dofs.scatter(&u, &mut diff);
     Ok(diff)
 }
 
