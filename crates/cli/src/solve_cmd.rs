@@ -41,6 +41,17 @@ pub(super) fn run_ring_solver(
             "  eta = 0 from ({:.6}, {:.6}) on the inner to ({:.6}, {:.6}) on the outer contour",
             seam.0[0], seam.0[1], seam.1[0], seam.1[1]
         );
+        for (s, what) in [(Side::West, "inner"), (Side::East, "outer")] {
+            let f = &h.fits[s as usize];
+            if !f.converged {
+                eprintln!(
+                    "  warning: the {what} contour's fit did not reach the tolerance {:.3e} (max error {:.3e} on {} elements)",
+                    h.tol_abs,
+                    f.final_max_error(),
+                    h.finest().knots[1].num_elements()
+                );
+            }
+        }
     }
     drive(&cut, &h, &ring_options(opts), assembler, quiet)
 }

@@ -477,3 +477,48 @@ fn improve_and_start_from_a_map() {
     assert!(r["levels"][0]["pseudo_time_iterations"].as_u64().unwrap() > 0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `winslow solve ring.json` (paper §11.1): two closed contours fitted on one periodic
+/// knot vector, EGG with `eta` periodic; the map reads back with `"periodic": [false,
+/// true]`, wraps, and is certified; the PNG is written.
+#[test]
+fn solve_a_ring_end_to_end() {
+    let dir = std::env::temp_dir().join(format!("winslow-ring-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["eccentric_annulus", "annulus_periodic"] {
+        let (map, png) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.png")));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join("rings").join(format!("{name}.json")))
+            .arg("-o")
+            .arg(&map)
+            .arg("--png")
+            .arg(&png)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{name}: {text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("certified bijective"), "{text}");
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+        assert_eq!(v["map"]["periodic"], serde_json::json!([false, true]));
+        assert_eq!(v["report"]["verdict"], "certified");
+        assert_eq!(v["report"]["corners"], serde_json::json!([]));
+        let m = match winslow::read_document(&map).unwrap() {
+            winslow::Document::Map { map, .. } => map,
+            _ => panic!("not a map"),
+        };
+        assert!(m.knots[1].is_periodic());
+        // the seam: eta = 0 and eta = 1 are the same curve
+        for k in 0..=10 {
+            let u = k as f64 / 10.0;
+            let (a, b) = (m.eval(u, 0.0), m.eval(u, 1.0));
+            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12);
+        }
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    }
+    let bad = dir.join("bad_ring.json");
+    std::fs::write(&bad, r#"{"ring": {"inner": {"points": [[0,0],[2,0],[2,2],[0,2]]}, "outer": {"points": [[0.5,0.5],[1,0.5],[1,1],[0.5,1]]}}}"#).unwrap();
+    let out = bin().arg("solve").arg(&bad).arg("-o").arg(dir.join("bad_map.json")).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("inner contour is not inside"), "{err}");
+}

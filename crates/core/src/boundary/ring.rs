@@ -257,6 +257,19 @@ fn fit_periodic(kv: &KnotVector, smp: &Samples) -> Result<(Curve, f64)> {
     Ok((curve, err))
 }
 
+/// The least-squares fit of `contour`, parameterized by arc length from its own start,
+/// on the periodic vector `kv` (on `[0, 1]`), and its largest deviation at the samples.
+pub fn fit_contour(contour: &ClosedContour, kv: &KnotVector) -> Result<(Curve, f64)> {
+    if !kv.is_periodic() || kv.domain() != (0.0, 1.0) {
+        return Err(Error::Invalid(format!(
+            "a closed contour is fitted on a periodic knot vector on [0, 1], got periodic {} on {:?}",
+            kv.is_periodic(),
+            kv.domain()
+        )));
+    }
+    fit_periodic(kv, &contour.arc_length_samples())
+}
+
 /// Validate a ring (closed contours, counter-clockwise, the inner inside the outer),
 /// reparameterize both contours by arc length with the seam of the module
 /// documentation, and fit them on dyadic periodic knot vectors of degree `degree`
@@ -344,8 +357,8 @@ pub fn ring_hierarchy(ring: &Ring, opts: &FitOptions) -> Result<(Hierarchy, Boun
     let fit = fit_ring(ring, opts.degree, opts.tol, opts.max_elements)?;
     let p = opts.degree;
     let xi = KnotVector::open_uniform(p, 1);
-    let first = &fit.levels[0].curves;
-    let seam = [first[0].eval(0.0), first[1].eval(0.0)];
+    let finest = &fit.levels.last().expect("at least one fit").curves;
+    let seam = [finest[0].eval(0.0), finest[1].eval(0.0)];
     let line = {
         let g = xi.greville();
         let cps = g.iter().map(|&u| [(1.0 - u) * seam[0][0] + u * seam[1][0], (1.0 - u) * seam[0][1] + u * seam[1][1]]);
