@@ -247,7 +247,7 @@ fn fit_periodic(kv: &KnotVector, smp: &Samples) -> Result<(Curve, f64)> {
             }
         }
     }
-    let c = crate::spline::refine::dense_solve(&n, &rhs);
+    let c = crate::linalg::linsolve::dense_solve(&n, &rhs);
     if c.iter().flatten().any(|v| !v.is_finite()) {
         return Err(Error::LinearSolver(format!("the periodic least-squares fit with {d} control points is singular")));
     }

@@ -162,7 +162,7 @@ pub fn periodic_elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
             bm[i][(bc.first() + j) % d] += v;
         }
     }
-    let x = crate::spline::refine::dense_solve(&am, &bm);
+    let x = crate::linalg::linsolve::dense_solve(&am, &bm);
     let rows = x.into_iter().map(|r| r.into_iter().enumerate().filter(|(_, v)| v.abs() > 1e-15).collect()).collect();
     Ok((fine.clone(), expand(rows, fine.num_basis(), kv.num_basis())))
 }
