@@ -270,6 +270,58 @@ pub fn fit_contour(contour: &ClosedContour, kv: &KnotVector) -> Result<(Curve, f
     fit_periodic(kv, &contour.arc_length_samples())
 }
 
+/// Like [`fit_contour`], with `eta = 0` put where the ray from `origin` towards `toward`
+/// first crosses the contour (the arc-length parameter shifted by that crossing's
+/// fraction; the contour's own start when the ray misses it).
+pub fn fit_contour_seam(
+    contour: &ClosedContour,
+    kv: &KnotVector,
+    origin: Point,
+    toward: Point,
+) -> Result<(Curve, f64)> {
+    let smp = contour.arc_length_samples();
+    let dir = [toward[0] - origin[0], toward[1] - origin[1]];
+    let shift = ray_crossing(&smp.x, &smp.s, origin, dir).unwrap_or(0.0);
+    fit_contour_shifted(kv, smp, shift)
+}
+
+fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Curve, f64)> {
+    let mut pairs: Vec<(f64, Point)> =
+        smp.s.iter().zip(&smp.x).map(|(&s, &x)| ((s - shift).rem_euclid(1.0), x)).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    fit_periodic(kv, &Samples { s: pairs.iter().map(|p| p.0).collect(), x: pairs.iter().map(|p| p.1).collect() })
+}
+
+impl ClosedContour {
+    /// The contour turned rigidly by `angle` (radians, counter-clockwise) about `center`.
+    pub fn rotated(&self, center: Point, angle: f64) -> ClosedContour {
+        let (c, s) = (angle.cos(), angle.sin());
+        let rot = move |p: Point| {
+            let (x, y) = (p[0] - center[0], p[1] - center[1]);
+            [center[0] + c * x - s * y, center[1] + s * x + c * y]
+        };
+        match self {
+            ClosedContour::Spline(cv) => ClosedContour::Spline(Curve {
+                control_points: cv.control_points.iter().map(|&p| rot(p)).collect(),
+                ..cv.clone()
+            }),
+            ClosedContour::Points(p) => ClosedContour::Points(p.iter().map(|&q| rot(q)).collect()),
+            ClosedContour::Analytic(f) => {
+                let f = f.clone();
+                ClosedContour::Analytic(Analytic::new(move |t| rot(f.eval(t))))
+            }
+        }
+    }
+
+    /// The mean of the contour's arc-length samples (its centroid, for point clouds the
+    /// mean of the points).
+    pub fn centroid(&self) -> Point {
+        let x = self.arc_length_samples().x;
+        let m = x.len() as f64;
+        [x.iter().map(|p| p[0]).sum::<f64>() / m, x.iter().map(|p| p[1]).sum::<f64>() / m]
+    }
+}
+
 /// Validate a ring (closed contours, counter-clockwise, the inner inside the outer),
 /// reparameterize both contours by arc length with the seam of the module
 /// documentation, and fit them on dyadic periodic knot vectors of degree `degree`
