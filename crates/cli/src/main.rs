@@ -32,6 +32,7 @@ use winslow_gpu::{Backend, Precision, Selected};
 mod mesh;
 mod output;
 mod solve_cmd;
+mod sweep_cmd;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -65,6 +66,9 @@ enum Command {
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
     /// Bézier cells), .vtk (sampled structured grid).
     Convert(ConvertArgs),
+    /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
+    /// angle per step, one certified map per frame from extrapolated initial guesses.
+    Sweep(Box<sweep_cmd::SweepArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -549,6 +553,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Check(a) => check(a),
         Command::Convert(a) => convert(a),
         Command::Mesh(a) => mesh::run(a),
+        Command::Sweep(a) => sweep_cmd::run(*a),
     }
 }
 
