@@ -33,6 +33,7 @@ mod corpus;
 mod mesh;
 mod output;
 mod solve_cmd;
+mod sweep_cmd;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -70,6 +71,9 @@ enum Command {
     /// sharp corners, puzzle tabs, thin strips, CAD sides, noisy and sparse clouds);
     /// write them, and with --solve solve each and print a table per family.
     Corpus(corpus::CorpusArgs),
+    /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
+    /// angle per step, one certified map per frame from extrapolated initial guesses.
+    Sweep(Box<sweep_cmd::SweepArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -555,6 +559,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Convert(a) => convert(a),
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
+        Command::Sweep(a) => sweep_cmd::run(*a),
     }
 }
 

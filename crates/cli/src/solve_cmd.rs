@@ -2,6 +2,10 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
+use winslow::boundary::hierarchy::Hierarchy;
+use winslow::boundary::ring::{ring_hierarchy, Ring};
+use winslow::io::ring::read_ring;
+use winslow::solve::solver::ring_options;
 
 /// Run the solver stream, printing progress.
 pub(super) fn run_solver(
@@ -11,7 +15,56 @@ pub(super) fn run_solver(
     quiet: bool,
 ) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
+    drive(boundary, &h, opts, assembler, quiet)
+}
+
+/// Fit a ring's contours on one periodic knot vector and solve with `eta` periodic
+/// (`winslow solve ring.json`, paper §11.1), printing progress.
+pub(super) fn run_ring_solver(
+    ring: &Ring,
+    opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    quiet: bool,
+) -> Result<Solution> {
+    let (h, cut) = ring_hierarchy(ring, &opts.fit).context("fitting the ring's contours")?;
     if !quiet {
+        eprintln!(
+            "{}: ring (O-grid, eta periodic), contours fitted on {} periodic levels up to {} elements in eta, by arc length",
+            ring.name,
+            h.levels.len(),
+            h.finest().knots[1].num_elements()
+        );
+        let (s, e) = (&cut.sides[Side::West as usize], &cut.sides[Side::East as usize]);
+        eprintln!("  inner: {}; outer: {}", s.describe(), e.describe());
+        let seam = cut.side(Side::South).endpoints();
+        eprintln!(
+            "  eta = 0 from ({:.6}, {:.6}) on the inner to ({:.6}, {:.6}) on the outer contour",
+            seam.0[0], seam.0[1], seam.1[0], seam.1[1]
+        );
+        for (s, what) in [(Side::West, "inner"), (Side::East, "outer")] {
+            let f = &h.fits[s as usize];
+            if !f.converged {
+                eprintln!(
+                    "  warning: the {what} contour's fit did not reach the tolerance {:.3e} (max error {:.3e} on {} elements)",
+                    h.physical_tol_abs(),
+                    f.final_max_error(),
+                    h.finest().knots[1].num_elements()
+                );
+            }
+        }
+    }
+    drive(&cut, &h, &ring_options(opts), assembler, quiet)
+}
+
+/// Run the solver stream over the hierarchy `h` of `boundary`, printing progress.
+fn drive(
+    boundary: &Boundary,
+    h: &Hierarchy,
+    opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    quiet: bool,
+) -> Result<Solution> {
+    if !quiet && !opts.topology.eta_periodic() {
         let tol = h.physical_tol_abs();
         eprintln!(
             "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
@@ -45,7 +98,7 @@ pub(super) fn run_solver(
             }
         }
     }
-    let mut solver = EggSolver::new(&h, opts.clone(), assembler)?;
+    let mut solver = EggSolver::new(h, opts.clone(), assembler)?;
     if !quiet {
         let m = solver.method();
         eprintln!("  method: {} (start: {:?})", m.name(), m.start());
@@ -97,7 +150,7 @@ pub(super) fn run_solver(
             }
         }
     }
-    Ok(solver.finish(boundary, &h)?)
+    Ok(solver.finish(boundary, h)?)
 }
 
 pub(super) fn solve(a: SolveArgs) -> Result<i32> {
@@ -114,9 +167,15 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
-    let boundary = load_boundary(path, a.solver.fit.reorient)?;
+    let ring = read_ring(path).with_context(|| format!("reading {}", path.display()))?;
     let sel = a.backend.select(a.quiet || a.json)?;
-    let sol = run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?;
+    let sol = match ring {
+        Some(ring) => run_ring_solver(&ring, &opts, sel.as_assembler(), a.quiet || a.json)?,
+        None => {
+            let boundary = load_boundary(path, a.solver.fit.reorient)?;
+            run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?
+        }
+    };
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let json = || map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report })));

@@ -224,45 +224,48 @@ fn solve_on_the_gpu_writes_the_cpu_map() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("winslow-gpu-{}", std::process::id()));
-    let mut maps = Vec::new();
-    for backend in ["cpu", "gpu"] {
-        let map = dir.join(format!("{backend}.json"));
-        let png = dir.join(format!("{backend}.png"));
-        let out = bin()
-            .arg("solve")
-            .arg(data().join("quarter_annulus.json"))
-            .arg("-o")
-            .arg(&map)
-            .arg("--png")
-            .arg(&png)
-            .args(["--backend", backend, "--min-elements", "6"])
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success(), "{backend}: {err}");
-        assert!(err.contains(&format!("backend: {backend}")), "{backend}: {err}");
-        assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
-        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
-        let backend_field = doc["report"]["backend"].as_str().unwrap().to_string();
-        assert!(backend_field.starts_with(backend), "{backend_field}");
-        assert!(!backend_field.contains("fell back"), "{backend_field}");
-        maps.push(doc["map"].clone());
+    // a four-sided domain and a ring (eta periodic: replicas summed the same on both back ends)
+    for geom in ["quarter_annulus.json", "rings/eccentric_annulus.json"] {
+        let mut maps = Vec::new();
+        for backend in ["cpu", "gpu"] {
+            let map = dir.join(format!("{backend}.json"));
+            let png = dir.join(format!("{backend}.png"));
+            let out = bin()
+                .arg("solve")
+                .arg(data().join(geom))
+                .arg("-o")
+                .arg(&map)
+                .arg("--png")
+                .arg(&png)
+                .args(["--backend", backend, "--min-elements", "6"])
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{backend}: {err}");
+            assert!(err.contains(&format!("backend: {backend}")), "{backend}: {err}");
+            assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+            let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+            let backend_field = doc["report"]["backend"].as_str().unwrap().to_string();
+            assert!(backend_field.starts_with(backend), "{backend_field}");
+            assert!(!backend_field.contains("fell back"), "{backend_field}");
+            maps.push(doc["map"].clone());
+        }
+        assert_eq!(maps[0]["knots"], maps[1]["knots"]);
+        let pts = |m: &serde_json::Value| -> Vec<f64> {
+            m["control_points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|p| p.as_array().unwrap().clone())
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        };
+        let (a, b) = (pts(&maps[0]), pts(&maps[1]));
+        assert_eq!(a.len(), b.len());
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(err <= 1e-9 * scale, "{geom}: GPU and CPU maps differ by {err:e}");
     }
-    assert_eq!(maps[0]["knots"], maps[1]["knots"]);
-    let pts = |m: &serde_json::Value| -> Vec<f64> {
-        m["control_points"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|p| p.as_array().unwrap().clone())
-            .map(|v| v.as_f64().unwrap())
-            .collect()
-    };
-    let (a, b) = (pts(&maps[0]), pts(&maps[1]));
-    assert_eq!(a.len(), b.len());
-    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-    assert!(err <= 1e-9 * scale, "GPU and CPU maps differ by {err:e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -476,4 +479,93 @@ fn improve_and_start_from_a_map() {
     let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(r["levels"][0]["pseudo_time_iterations"].as_u64().unwrap() > 0);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `winslow solve ring.json` (paper §11.1): two closed contours fitted on one periodic
+/// knot vector, EGG with `eta` periodic; the map reads back with `"periodic": [false,
+/// true]`, wraps, and is certified; the PNG is written.
+#[test]
+fn solve_a_ring_end_to_end() {
+    let dir = std::env::temp_dir().join(format!("winslow-ring-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["eccentric_annulus", "annulus_periodic"] {
+        let (map, png) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.png")));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join("rings").join(format!("{name}.json")))
+            .arg("-o")
+            .arg(&map)
+            .arg("--png")
+            .arg(&png)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{name}: {text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("certified bijective"), "{text}");
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+        assert_eq!(v["map"]["periodic"], serde_json::json!([false, true]));
+        assert_eq!(v["report"]["verdict"], "certified");
+        assert_eq!(v["report"]["corners"], serde_json::json!([]));
+        let m = match winslow::read_document(&map).unwrap() {
+            winslow::Document::Map { map, .. } => map,
+            _ => panic!("not a map"),
+        };
+        assert!(m.knots[1].is_periodic());
+        // the seam: eta = 0 and eta = 1 are the same curve
+        for k in 0..=10 {
+            let u = k as f64 / 10.0;
+            let (a, b) = (m.eval(u, 0.0), m.eval(u, 1.0));
+            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12);
+        }
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    }
+    let bad = dir.join("bad_ring.json");
+    std::fs::write(&bad, r#"{"ring": {"inner": {"points": [[0,0],[2,0],[2,2],[0,2]]}, "outer": {"points": [[0.5,0.5],[1,0.5],[1,1],[0.5,1]]}}}"#).unwrap();
+    let out = bin().arg("solve").arg(&bad).arg("-o").arg(dir.join("bad_map.json")).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("inner contour is not inside"), "{err}");
+}
+
+/// `winslow sweep`: frames, ParaView series and table are written, every frame is
+/// certified, and from frame 6 one Newton iteration per frame suffices on the rotating
+/// eccentric ring; bad arguments are clear errors.
+#[test]
+fn sweep_writes_frames_series_and_table() {
+    let dir = std::env::temp_dir().join(format!("winslow-sweep-{}", std::process::id()));
+    let out = bin()
+        .arg("sweep")
+        .arg(data().join("rings/eccentric_annulus.json"))
+        .args(["--rotate-inner", "0.5", "--steps", "8", "--center", "0,0", "--quiet", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    for k in 0..=8 {
+        assert!(dir.join(format!("frame_{k:04}.json")).exists() && dir.join(format!("frame_{k:04}.vtu")).exists());
+    }
+    let pvd = std::fs::read_to_string(dir.join("sweep.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 9);
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 10);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("sweep.json")).unwrap()).unwrap();
+    assert_eq!(v["failures"], 0);
+    assert_eq!(v["from_frame_6"]["max_newton"], 1);
+    let frames = v["frames"].as_array().unwrap();
+    assert!(frames.iter().all(|f| f["verdict"] == "certified"));
+    // a frame map reads back as a periodic map
+    let m = match winslow::read_document(&dir.join("frame_0005.json")).unwrap() {
+        winslow::Document::Map { map, .. } => map,
+        _ => panic!("not a map"),
+    };
+    assert!(m.knots[1].is_periodic());
+    let bad = bin()
+        .arg("sweep")
+        .arg(data().join("wavy_lid.json"))
+        .args(["--rotate-inner", "1", "--steps", "2", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success() && err.contains("not a ring document"), "{err}");
 }

@@ -13,6 +13,7 @@
 //! | [`reparam`] | arc-length and constrained cord-length reparameterization | §7, eq. (38)-(42) |
 //! | [`fit`] | adaptive least-squares fit of one side | §5.1-§5.3, eq. (17)-(18) |
 //! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
+//! | [`ring`] | ring (O-type) domains: two closed contours fitted on one periodic knot vector by arc length, and their hierarchy | §11.1 |
 //! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
@@ -30,6 +31,7 @@ pub mod hierarchy;
 pub mod input_basis;
 pub mod normalise;
 pub mod reparam;
+pub mod ring;
 pub mod validate;
 
 use std::sync::Arc;

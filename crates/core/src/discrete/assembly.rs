@@ -14,9 +14,10 @@
 use rayon::prelude::*;
 
 use crate::discrete::dofs::{DofMap, FIXED};
+use crate::discrete::pattern::stencil_neighbours;
+pub use crate::discrete::pattern::SystemPattern;
 use crate::discrete::topology::Topology;
 use crate::error::{Result, MAX_DEGREE};
-use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::knots::KnotVector;
 use crate::spline::quadrature::GaussLegendre;
@@ -78,84 +79,6 @@ impl DirTable {
     /// Table of point `k` of element `e`.
     pub fn at(&self, e: usize, k: usize) -> &QpTab {
         &self.qp[e * self.nq + k]
-    }
-}
-
-/// The basis functions whose supports overlap that of function `k` (tensor index
-/// `(i, j)`): `(s, kk)` with the stencil slot `s = dj (2p + 1) + di` of
-/// `kk = (j + dj - q) n_xi + (i + di - p)`, for all offsets inside the basis.
-fn stencil_neighbours(shape: [usize; 2], p: usize, q: usize, k: usize) -> impl Iterator<Item = (usize, usize)> {
-    let [nx, ny] = shape;
-    let (i, j) = (k % nx, k / nx);
-    (0..=2 * q).flat_map(move |dj| (0..=2 * p).map(move |di| (di, dj))).filter_map(move |(di, dj)| {
-        let (ii, jj) = ((i + di).checked_sub(p)?, (j + dj).checked_sub(q)?);
-        (ii < nx && jj < ny).then_some((dj * (2 * p + 1) + di, jj * nx + ii))
-    })
-}
-
-/// Fixed sparsity pattern of a free-free system with `ncomp` components per basis
-/// function (unknown `z * m + f`), and the gather map from stencil storage.
-#[derive(Debug, Clone)]
-pub struct SystemPattern {
-    /// Components (1 scalar, 2 vector).
-    pub ncomp: usize,
-    /// Pattern (values are overwritten by [`SystemPattern::gather`]).
-    pub csr: Csr,
-    /// For each CSR entry, its position in the stencil storage.
-    pub src: Vec<usize>,
-}
-
-impl SystemPattern {
-    fn new(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
-        let m = dofs.num_free();
-        let sw = (2 * p + 1) * (2 * q + 1);
-        let row_len = ncomp * ncomp * sw;
-        let mut row_ptr = vec![0];
-        let mut col_idx = Vec::new();
-        let mut src = Vec::new();
-        for z in 0..ncomp {
-            for &k in dofs.free() {
-                for d in 0..ncomp {
-                    for (s, kk) in stencil_neighbours(dofs.shape(), p, q, k) {
-                        let fc = dofs.free_index(kk);
-                        if fc != FIXED {
-                            col_idx.push(d * m + fc);
-                            src.push(k * row_len + (z * ncomp + d) * sw + s);
-                        }
-                    }
-                }
-                row_ptr.push(col_idx.len());
-            }
-        }
-        let nnz = col_idx.len();
-        let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
-        Self { ncomp, csr, src }
-    }
-
-    /// Copy the stencil storage into the CSR values.
-    pub fn gather(&mut self, stencil: &[f64]) {
-        let mut values = std::mem::take(&mut self.csr.values);
-        self.gather_into(stencil, &mut values);
-        self.csr.values = values;
-    }
-
-    /// Copy the stencil storage into `values` (this pattern's entries), in parallel.
-    pub fn gather_into(&self, stencil: &[f64], values: &mut [f64]) {
-        const CHUNK: usize = 1 << 14;
-        values.par_chunks_mut(CHUNK).zip(self.src.par_chunks(CHUNK)).for_each(|(v, src)| {
-            for (v, &s) in v.iter_mut().zip(src) {
-                *v = stencil[s];
-            }
-        });
-    }
-
-    /// A fresh matrix with the values gathered from `stencil`.
-    pub fn matrix(&self, stencil: &[f64]) -> Csr {
-        let mut m = self.csr.clone();
-        for (v, &s) in m.values.iter_mut().zip(&self.src) {
-            *v = stencil[s];
-        }
-        m
     }
 }
 
@@ -321,11 +244,11 @@ impl Discretization {
         Self::with_dofs(knots, nq, dofs)
     }
 
-    /// [`Self::new`] with the free / fixed split of `topology`
-    /// ([`DofMap::for_topology`]).
+    /// [`Self::new`] with the free / fixed / shared split of `topology` on this basis
+    /// ([`DofMap::for_basis`]: a periodic knot vector goes with periodic sides).
     pub fn for_topology(knots: [KnotVector; 2], topology: &Topology) -> Result<Self> {
         let nq = knots[0].degree().max(knots[1].degree()) + 1;
-        let dofs = DofMap::for_topology([knots[0].num_basis(), knots[1].num_basis()], topology)?;
+        let dofs = DofMap::for_basis(&knots, topology)?;
         Ok(Self::with_dofs(knots, nq, dofs))
     }
 
@@ -670,7 +593,7 @@ impl Discretization {
     }
 
     /// Restrict a full component-interleaved vector (length `ncomp n`) to the free
-    /// unknowns `(z * m + f)`.
+    /// unknowns `(z * m + f)`, summing the rows of periodic replicas into their primary's.
     pub fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
         let m = self.dofs.num_free();
         let mut out = vec![0.0; ncomp * m];
@@ -679,7 +602,23 @@ impl Discretization {
                 out[z * m + f] = full[k * ncomp + z];
             }
         }
+        for &(k, _) in self.dofs.replicas() {
+            let f = self.dofs.free_index(k);
+            if f != FIXED {
+                for z in 0..ncomp {
+                    out[z * m + f] += full[k * ncomp + z];
+                }
+            }
+        }
         out
+    }
+
+    /// Every stored function of a free one: `(f, k)` for the primaries, then for the
+    /// periodic replicas.
+    fn free_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let d = &self.dofs;
+        let replicas = d.replicas().iter().map(|&(k, _)| (d.free_index(k), k)).filter(|&(f, _)| f != FIXED);
+        d.free().iter().copied().enumerate().chain(replicas)
     }
 
     /// `K_free,fixed * u_fixed` for a scalar stencil operator: the right-hand side
@@ -688,7 +627,7 @@ impl Discretization {
         let (p, q) = self.degrees();
         let sw = self.stencil_width();
         let mut out = vec![0.0; self.dofs.num_free()];
-        for (f, &k) in self.dofs.free().iter().enumerate() {
+        for (f, k) in self.free_rows() {
             for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
                 if self.dofs.free_index(kk) == FIXED {
                     out[f] += stencil[k * sw + s] * u[kk];
@@ -706,7 +645,7 @@ impl Discretization {
         let row_len = 4 * sw;
         let m = self.dofs.num_free();
         let mut out = vec![0.0; 2 * m];
-        for (f, &k) in self.dofs.free().iter().enumerate() {
+        for (f, k) in self.free_rows() {
             for (s, kk) in stencil_neighbours(self.shape(), p, q, k) {
                 if self.dofs.free_index(kk) != FIXED {
                     continue;

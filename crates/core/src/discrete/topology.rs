@@ -8,9 +8,12 @@
 //! [`DofMap::for_topology`](super::dofs::DofMap::for_topology) turns it into the free /
 //! fixed split every assembler reads, so methods and solvers see data, not cases.
 //!
-//! The single-patch solver supports four Dirichlet sides; the other conditions are
-//! checked for consistency here and refused with a typed error by the DOF map until the
-//! periodic and multipatch DOF numbering exists.
+//! The single-patch solver supports four Dirichlet sides, and periodic pairs on a basis
+//! whose knot vector across is periodic ([`Topology::ring`]: the O-grid of §11.1, `eta`
+//! periodic, `xi = 0` inner and `xi = 1` outer contour), numbered with shared DOFs by
+//! [`DofMap::for_basis`](super::dofs::DofMap::for_basis). Interfaces are checked for
+//! consistency here and refused with a typed error by the DOF map until the multipatch
+//! numbering exists.
 
 use serde::Serialize;
 
@@ -55,6 +58,20 @@ impl Topology {
     /// Four Dirichlet sides: one patch whose whole boundary is given.
     pub fn dirichlet() -> Self {
         Self { sides: [SideCondition::Dirichlet; 4] }
+    }
+
+    /// An O-grid (§11.1): south and north periodic (`eta` periodic), west (`xi = 0`, the
+    /// inner contour) and east (`xi = 1`, the outer contour) Dirichlet.
+    pub fn ring() -> Self {
+        let mut t = Self::dirichlet();
+        t.sides[Side::South as usize] = SideCondition::Periodic;
+        t.sides[Side::North as usize] = SideCondition::Periodic;
+        t
+    }
+
+    /// Whether the `eta` direction is periodic (south and north glued).
+    pub fn eta_periodic(&self) -> bool {
+        self.side(Side::South) == SideCondition::Periodic
     }
 
     /// The condition of side `s`.

@@ -325,7 +325,7 @@ pub fn parse_json(text: &str) -> Result<Document> {
         let contour: ContourJson = serde_json::from_value(c).map_err(json_err("contour"))?;
         return ContourDoc { name, contour }.to_boundary().map(Document::Boundary);
     }
-    Err(Error::Json { context: String::new(), message: "expected a \"boundary\", \"contour\" or \"map\" field".into() })
+    Err(Error::Json { context: String::new(), message: "expected a \"boundary\", \"contour\" or \"map\" field (a \"ring\" document is read by io::ring and solved by `winslow solve`)".into() })
 }
 
 /// Split a closed polygon at its corners `[i_sw, i_se, i_ne, i_nw]` into the sides of

@@ -2,7 +2,7 @@
 //! XML files ([`gismo`] reads, [`gismo_writer`] writes), IGES 5.3 rational B-spline
 //! surfaces ([`iges`], both ways), VTK files ([`vtk`]: a sampled structured grid, and the
 //! exact map as Bézier cells) and pictures of a map, grid lines coloured by `det J`
-//! ([`picture`], PNG through the CLI).
+//! ([`picture`], PNG through the CLI); ring (O-type) documents ([`ring`]).
 //!
 //! [`read_document`] detects the kind of file by its content (a JSON object or an XML
 //! document); [`read_boundary`] turns any accepted document into a validated,
@@ -14,6 +14,7 @@ pub mod gismo_writer;
 pub mod iges;
 pub mod json;
 pub mod picture;
+pub mod ring;
 pub mod vtk;
 
 use std::io::Read;

@@ -525,6 +525,18 @@ fn diagonal_block(a: &Csr, first: usize, m: usize) -> Csr {
     Csr { nrows: m, ncols: m, row_ptr, col_idx, values }
 }
 
+/// Dense solve `A X = B` (`A` is `n x n`, row-major; `B` is `n x m`) by faer's LU with
+/// partial pivoting.
+pub fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    use faer::linalg::solvers::Solve;
+    let n = a.len();
+    let m = b.first().map_or(0, |r| r.len());
+    let am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[i][j]);
+    let bm = faer::Mat::<f64>::from_fn(n, m, |i, j| b[i][j]);
+    let x = am.partial_piv_lu().solve(&bm);
+    (0..n).map(|i| (0..m).map(|j| x[(i, j)]).collect()).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

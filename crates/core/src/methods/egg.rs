@@ -235,6 +235,44 @@ mod tests {
         assert!(counts[2] < 40, "{counts:?}");
     }
 
+    /// A ring `r = 1 + xi`, `θ = 2π eta` on a periodic `eta` basis (control points at the
+    /// Greville points, free ones perturbed and wrapped).
+    fn ring(p: usize, ne: [usize; 2], noise: f64) -> (Discretization, Vec<Point>) {
+        let kx = KnotVector::open_uniform(p, ne[0]);
+        let ky = KnotVector::periodic_uniform(p, ne[1]).with_inserted(&[0.3]);
+        let t = crate::discrete::topology::Topology::ring();
+        let disc = Discretization::for_topology([kx.clone(), ky.clone()], &t).unwrap();
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let mut rng = Lcg::new(7);
+        let mut cps: Vec<Point> = gy
+            .iter()
+            .flat_map(|&v| {
+                gx.iter().map(move |&u| {
+                    let th = 2.0 * std::f64::consts::PI * v;
+                    [(1.0 + u) * th.cos(), (1.0 + u) * th.sin()]
+                })
+            })
+            .collect();
+        for &k in disc.dofs.free() {
+            cps[k][0] += noise * (rng.uniform() - 0.5);
+            cps[k][1] += noise * (rng.uniform() - 0.5);
+        }
+        disc.dofs.wrap(&mut cps);
+        (disc, cps)
+    }
+
+    #[test]
+    fn periodic_jacobian_matches_finite_differences() {
+        for op in [Operator::Plain, Operator::Scaled] {
+            let (disc, cps) = ring(3, [3, 6], 0.05);
+            assert_eq!(disc.dofs.replicas().len(), 3 * disc.shape()[0]);
+            let mut prob = EggProblem::new(Arc::new(disc), cps, op, Arc::new(CpuAssembler));
+            let c = prob.unknowns();
+            let (max_err, max_val) = crate::methods::jacobian_fd_mismatch(&mut prob, &c, 1e-6);
+            assert!(max_err < 1e-7 * max_val, "{op:?}: FD mismatch {max_err} (scale {max_val})");
+        }
+    }
+
     #[test]
     fn affine_map_is_a_fixed_point() {
         let kx = KnotVector::open_uniform(3, 5);

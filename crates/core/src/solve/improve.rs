@@ -179,8 +179,7 @@ pub fn improve(
         )));
     }
     let [p, q] = map.degrees();
-    let shape = [map.knots[0].num_basis(), map.knots[1].num_basis()];
-    let dofs = DofMap::for_topology(shape, topology)?;
+    let dofs = DofMap::for_basis(&map.knots, topology)?;
     // the quadrature of the report's Winslow value, (p + 2) points
     let disc = Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs));
     let m = disc.dofs.num_free();

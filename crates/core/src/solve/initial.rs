@@ -15,9 +15,15 @@ use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::{Side, Surface};
 
 /// Write the four side curves' control points into the boundary positions of a
-/// control net of shape `shape`. The curves must live on the net's knot vectors.
+/// control net of shape `shape`. The curves must live on the net's knot vectors. When
+/// west and east live on a periodic vector (a ring, §11.1), `eta` is periodic: south and
+/// north are no boundary and are skipped.
 pub fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) -> Result<()> {
+    let eta_periodic = sides[Side::West as usize].knots.is_periodic();
     for s in Side::ALL {
+        if eta_periodic && s.direction() == 0 {
+            continue;
+        }
         let idx = Surface::side_indices(shape, s);
         let c = &sides[s as usize];
         if c.control_points.len() != idx.len() {
@@ -36,12 +42,25 @@ pub fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) ->
 
 /// Discrete Coons patch at the Greville abscissae `(u_i, v_j)`:
 /// `c_ij = (1-u) W_j + u E_j + (1-v) S_i + v N_i - [(1-u)(1-v) SW + u(1-v) SE + (1-u)v NW + uv NE]`.
-/// Reproduces every bilinear map exactly.
+/// Reproduces every bilinear map exactly. With `eta` periodic (a ring) it is the linear
+/// interpolation in `xi` between west and east, `c_ij = (1-u) W_j + u E_j`.
 pub fn coons(knots: &[crate::spline::knots::KnotVector; 2], sides: &[Curve; 4]) -> Result<Vec<Point>> {
     let shape = [knots[0].num_basis(), knots[1].num_basis()];
     let [nx, ny] = shape;
     let (gu, gv) = (knots[0].greville(), knots[1].greville());
     let (a0, a1) = knots[0].domain();
+    if knots[1].is_periodic() {
+        let mut cps = vec![[0.0; 2]; nx * ny];
+        set_boundary(shape, sides, &mut cps)?;
+        let (w, e) = (&sides[Side::West as usize].control_points, &sides[Side::East as usize].control_points);
+        for j in 0..ny {
+            for i in 1..nx - 1 {
+                let u = (gu[i] - a0) / (a1 - a0);
+                cps[j * nx + i] = [(1.0 - u) * w[j][0] + u * e[j][0], (1.0 - u) * w[j][1] + u * e[j][1]];
+            }
+        }
+        return Ok(cps);
+    }
     let (b0, b1) = knots[1].domain();
     let s = &sides[Side::South as usize].control_points;
     let n = &sides[Side::North as usize].control_points;
@@ -117,10 +136,7 @@ pub fn elasticity_displacement_with(
         lin.factor(&k)?;
     }
     let u = lin.solve(&rhs)?;
-    let m = disc.dofs.num_free();
-    for (f, &kk) in disc.dofs.free().iter().enumerate() {
-        diff[kk] = [u[f], u[m + f]];
-    }
+    disc.dofs.scatter(&u, &mut diff);
     Ok(diff)
 }
 

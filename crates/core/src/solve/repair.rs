@@ -108,7 +108,7 @@ pub fn plan_repair(
 
 /// A discretization whose free DOFs are the functions free under `topology` whose
 /// support meets one of `boxes` (`[u0, u1, v0, v1]`); all free ones when that leaves
-/// none (paper §8.2: fewer unknowns in a repair round).
+/// none (paper §8.2: fewer unknowns in a repair round), and on a periodic basis.
 pub fn frozen_discretization(
     knots: &[KnotVector; 2],
     boxes: &[[f64; 4]],
@@ -117,7 +117,11 @@ pub fn frozen_discretization(
     let shape = [knots[0].num_basis(), knots[1].num_basis()];
     let (p, q) = (knots[0].degree(), knots[1].degree());
     let (tu, tv) = (knots[0].knots(), knots[1].knots());
-    let all = DofMap::for_topology(shape, topology)?;
+    let all = DofMap::for_basis(knots, topology)?;
+    if !all.replicas().is_empty() {
+        // a periodic basis shares DOFs across the seam: the repair round frees them all
+        return Discretization::for_topology(knots.clone(), topology);
+    }
     let interior = |i: usize, j: usize| all.free_index(j * shape[0] + i) != FIXED;
     let near = |i: usize, j: usize| {
         boxes.iter().any(|b| tu[i] < b[1] && tu[i + p + 1] > b[0] && tv[j] < b[3] && tv[j + q + 1] > b[2])

@@ -240,7 +240,8 @@ impl Solution {
         let quality = quality(&map);
         let fun = quality.functionals;
         let certificate = ctx.certificate;
-        let corners = corner_report(ctx.sides);
+        // a ring (eta periodic) has no corners
+        let corners = if opts.topology.eta_periodic() { Vec::new() } else { corner_report(ctx.sides) };
         let converged = levels.last().is_some_and(|l| l.converged);
         let away = min_away_from_corners(&map, &sample, &corners);
         let kinks = ctx.kinks;

@@ -35,8 +35,14 @@ pub struct BezierExtraction {
 
 impl BezierExtraction {
     /// Extraction operators of an open knot vector with interior multiplicities `<= p`.
+    /// Periodic vectors are extracted by blossoming
+    /// ([`crate::spline::periodic::periodic_extraction`]).
     pub fn new(kv: &KnotVector) -> Result<Self> {
         let p = kv.degree();
+        if kv.is_periodic() {
+            let (elements, ops) = crate::spline::periodic::periodic_extraction(kv);
+            return Ok(Self { degree: p, elements, ops });
+        }
         let bm = kv.breaks_with_multiplicity();
         if let Some(&(u, m)) = bm[1..bm.len() - 1].iter().find(|&&(_, m)| m > p) {
             return Err(Error::Invalid(format!(

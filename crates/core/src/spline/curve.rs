@@ -57,8 +57,36 @@ pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
     Ok(())
 }
 
+/// For a periodic basis of dimension `d` with `n` stored functions: the stored control
+/// points (and weights) `k >= d` must repeat `k - d` (wrapped indices, see
+/// [`crate::spline::periodic`]), to `1e-12` relative to the largest coordinate. `at`
+/// maps a stored index to its position in `pts` (`stride` apart for tensor maps).
+pub(crate) fn check_wrapped(
+    pts: &[Point],
+    weights: Option<&[f64]>,
+    n: usize,
+    d: usize,
+    at: impl Fn(usize) -> Vec<usize>,
+) -> Result<()> {
+    let scale = pts.iter().fold(1.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+    for k in d..n {
+        for (a, b) in at(k).into_iter().zip(at(k - d)) {
+            let gap = (pts[a][0] - pts[b][0]).abs().max((pts[a][1] - pts[b][1]).abs());
+            let wgap = weights.map_or(0.0, |w| (w[a] - w[b]).abs() / w[b]);
+            if gap > 1e-12 * scale || wgap > 1e-12 {
+                return Err(Error::Invalid(format!(
+                    "periodic control points must wrap: stored point {a} ({}, {}) must repeat point {b} ({}, {}) (the last p of {n} repeat the first p)",
+                    pts[a][0], pts[a][1], pts[b][0], pts[b][1]
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 impl Curve {
-    /// Validate lengths, finiteness and weights.
+    /// Validate lengths, finiteness and weights; for a periodic knot vector, that the
+    /// last `p` control points repeat the first `p` ([`crate::spline::periodic`]).
     pub fn new(knots: KnotVector, control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots.num_basis();
         if control_points.len() != n {
@@ -72,6 +100,9 @@ impl Curve {
         check_points(&control_points, "control point")?;
         if let Some(w) = &weights {
             check_weights(w, n)?;
+        }
+        if knots.is_periodic() {
+            check_wrapped(&control_points, weights.as_deref(), n, knots.dim(), |k| vec![k])?;
         }
         let weights = weights.filter(|w| w.iter().any(|&x| x != w[0]) || w[0] != 1.0);
         Ok(Self { knots, control_points, weights })

@@ -58,6 +58,9 @@ impl KnotVector {
         }
         // No interior knot may exceed multiplicity p + 1 (basis would be discontinuous and singular).
         let kv = Self { degree, knots, periodic };
+        if periodic {
+            kv.check_periodic()?;
+        }
         for (u, m) in kv.breaks_with_multiplicity() {
             if m > degree + 1 {
                 return Err(bad(format!("knot {u} has multiplicity {m} > degree + 1 = {}", degree + 1)));
@@ -92,6 +95,75 @@ impl KnotVector {
         let h = 1.0 / elements as f64;
         let knots = (0..(elements + 2 * degree + 1)).map(|i| (i as f64 - degree as f64) * h).collect();
         Self { degree, knots, periodic: true }
+    }
+
+    /// A periodic knot vector from the knots of one period: `period_knots` are
+    /// `t_p <= ... <= t_{p + d - 1}` in `[a, a + period)` with `t_p = a`, `d` of them (the
+    /// dimension of the periodic space); the stored vector continues them periodically,
+    /// `t_{k + d} = t_k + period`, `p` knots past both ends (`d + 2p + 1` knots in all).
+    pub fn periodic_from_period(degree: usize, period_knots: &[f64], period: f64) -> Result<Self> {
+        let d = period_knots.len();
+        if d == 0 || period.is_nan() || period <= 0.0 {
+            return Err(Error::Knots {
+                context: String::new(),
+                reason: format!("a periodic knot vector needs knots in one period and a period > 0, got {d} knots and period {period}"),
+            });
+        }
+        let ext = |k: isize| {
+            let (q, r) = (k.div_euclid(d as isize), k.rem_euclid(d as isize) as usize);
+            period_knots[r] + q as f64 * period
+        };
+        let p = degree as isize;
+        let knots: Vec<f64> = (-p..(d as isize) + p + 1).map(ext).collect();
+        Self::with_periodic(degree, knots, true)
+    }
+
+    /// For a periodic vector: `t_{k + d} - t_k` equals the period `t_{p+d} - t_p` for every
+    /// stored `k` (to [`KNOT_TOL`]), `d = n - p >= 1`.
+    fn check_periodic(&self) -> Result<()> {
+        let (p, n) = (self.degree, self.num_basis());
+        let bad = |reason: String| Err(Error::Knots { context: String::new(), reason });
+        if n <= p {
+            return bad(format!("periodic degree-{p} vector with {n} basis functions: need more than {p}"));
+        }
+        let d = n - p;
+        let period = self.knots[p + d] - self.knots[p];
+        for k in 0..self.knots.len() - d {
+            let gap = self.knots[k + d] - self.knots[k];
+            if (gap - period).abs() > KNOT_TOL * period.abs().max(1.0) * 16.0 {
+                return bad(format!("not periodic: knots {k} and {} differ by {gap}, the period is {period}", k + d));
+            }
+        }
+        Ok(())
+    }
+
+    /// Dimension of the spline space: `n` for an open vector, `n - p` distinct
+    /// functions for a periodic one (the last `p` of the `n` stored functions repeat the
+    /// first `p`: control point `k >= n - p` equals control point `k - (n - p)`).
+    pub fn dim(&self) -> usize {
+        if self.periodic {
+            self.num_basis() - self.degree
+        } else {
+            self.num_basis()
+        }
+    }
+
+    /// The knots of one period of a periodic vector, `t_p, ..., t_{p + d - 1}`.
+    pub fn period_knots(&self) -> &[f64] {
+        &self.knots[self.degree..self.degree + self.dim()]
+    }
+
+    /// The bi-infinite periodic continuation `t_k` for any integer `k` of a periodic
+    /// vector (`t_{k + d} = t_k + L`), equal to the stored knot for `0 <= k < len`.
+    pub fn extended(&self, k: isize) -> f64 {
+        if !self.periodic || (k >= 0 && (k as usize) < self.knots.len()) {
+            return self.knots[k.clamp(0, self.knots.len() as isize - 1) as usize];
+        }
+        let d = self.dim() as isize;
+        let p = self.degree as isize;
+        let j = k - p;
+        let (q, r) = (j.div_euclid(d), j.rem_euclid(d));
+        self.knots[(r + p) as usize] + q as f64 * self.length()
     }
 
     /// Polynomial degree `p`.
@@ -215,8 +287,20 @@ impl KnotVector {
         (0..self.num_basis()).map(|i| self.knots[i + 1..=i + p].iter().sum::<f64>() / p as f64).collect()
     }
 
-    /// A copy with the knots `new` inserted (kept sorted).
+    /// A copy with the knots `new` inserted (kept sorted). In a periodic vector each new
+    /// knot is inserted once per period (`u` taken modulo the period).
     pub fn with_inserted(&self, new: &[f64]) -> Self {
+        if self.periodic {
+            let (a, l) = (self.domain().0, self.length());
+            let mut period: Vec<f64> = self.period_knots().to_vec();
+            for &u in new {
+                let w = a + (u - a).rem_euclid(l);
+                period.push(if w >= a + l { a } else { w });
+            }
+            period.sort_by(f64::total_cmp);
+            return Self::periodic_from_period(self.degree, &period, l)
+                .expect("inserting keeps a valid periodic vector");
+        }
         let mut knots = self.knots.clone();
         knots.extend_from_slice(new);
         knots.sort_by(f64::total_cmp);
@@ -256,7 +340,7 @@ impl KnotVector {
     /// Union of two open vectors of the same degree and domain: every break with the
     /// larger of its two multiplicities (knots closer than [`KNOT_TOL`] merge).
     pub fn union(&self, other: &Self) -> Result<Self> {
-        if self.degree != other.degree || self.domain() != other.domain() {
+        if self.degree != other.degree || self.domain() != other.domain() || self.periodic != other.periodic {
             return Err(Error::Invalid(format!(
                 "knot union needs equal degree and domain, got p={} on {:?} and p={} on {:?}",
                 self.degree,
@@ -284,6 +368,12 @@ impl KnotVector {
             }
         }
         let p = self.degree;
+        if self.periodic {
+            // the end break repeats the start break of the period
+            let period: Vec<f64> =
+                merged[..merged.len() - 1].iter().flat_map(|&(u, m)| std::iter::repeat_n(u, m)).collect();
+            return Self::periodic_from_period(p, &period, self.length());
+        }
         let mut knots = Vec::new();
         let last = merged.len() - 1;
         for (k, (u, m)) in merged.into_iter().enumerate() {
@@ -296,16 +386,20 @@ impl KnotVector {
     /// Whether every knot of `coarse` (with multiplicity) occurs in `self`: the coarse
     /// spline space is then nested in this one.
     pub fn contains(&self, coarse: &Self) -> bool {
-        if coarse.degree != self.degree {
+        if coarse.degree != self.degree || coarse.periodic != self.periodic {
             return false;
         }
         let tol = KNOT_TOL * self.length().max(coarse.length());
+        if self.periodic && (self.domain().0 != coarse.domain().0 || (self.length() - coarse.length()).abs() > tol) {
+            return false;
+        }
+        let (mine, theirs) = self.compared_knots(coarse);
         let mut j = 0;
-        for &t in &coarse.knots {
-            while j < self.knots.len() && self.knots[j] < t - tol {
+        for &t in theirs {
+            while j < mine.len() && mine[j] < t - tol {
                 j += 1;
             }
-            if j >= self.knots.len() || (self.knots[j] - t).abs() > tol {
+            if j >= mine.len() || (mine[j] - t).abs() > tol {
                 return false;
             }
             j += 1;
@@ -313,17 +407,29 @@ impl KnotVector {
         true
     }
 
+    /// The knots that nesting compares: all stored knots of open vectors, one period of
+    /// periodic ones.
+    fn compared_knots<'a>(&'a self, coarse: &'a Self) -> (&'a [f64], &'a [f64]) {
+        if self.periodic {
+            (self.period_knots(), coarse.period_knots())
+        } else {
+            (&self.knots, &coarse.knots)
+        }
+    }
+
     /// Multiset difference `self \ coarse`: the knots to insert into `coarse` to obtain
-    /// `self`, or `None` when `coarse` is not contained in `self`.
+    /// `self` (one period of them for periodic vectors), or `None` when `coarse` is not
+    /// contained in `self`.
     pub fn difference(&self, coarse: &Self) -> Option<Vec<f64>> {
         if !self.contains(coarse) {
             return None;
         }
         let tol = KNOT_TOL * self.length().max(coarse.length());
+        let (mine, theirs) = self.compared_knots(coarse);
         let mut out = Vec::new();
         let mut j = 0;
-        for &t in &self.knots {
-            if j < coarse.knots.len() && (coarse.knots[j] - t).abs() <= tol {
+        for &t in mine {
+            if j < theirs.len() && (theirs[j] - t).abs() <= tol {
                 j += 1;
             } else {
                 out.push(t);
@@ -338,7 +444,20 @@ impl KnotVector {
         let mut knots = Vec::with_capacity(self.knots.len() + self.num_elements() + 1);
         let bm = self.breaks_with_multiplicity();
         let p = self.degree;
-        if self.periodic || !self.is_open() {
+        if self.periodic {
+            // one more copy of every distinct knot of the period
+            let mut period = Vec::with_capacity(2 * self.dim());
+            let mut prev = f64::NAN;
+            for &t in self.period_knots() {
+                if t != prev {
+                    period.push(t);
+                    prev = t;
+                }
+                period.push(t);
+            }
+            return Self::periodic_from_period(p + 1, &period, self.length()).expect("elevation keeps periodicity");
+        }
+        if !self.is_open() {
             // Raise every distinct knot (also those outside the domain).
             let mut prev = f64::NAN;
             for &t in &self.knots {

@@ -8,12 +8,14 @@
 //! | [`surface`] | [`Surface`](surface::Surface): tensor-product maps `x: [0,1]² → R²`, sides, inversion | §3, eq. (1) |
 //! | [`refine`] | knot insertion and degree elevation as sparse prolongation matrices | §5.4, §6.3 |
 //! | [`bezier`] | Bézier extraction of a tensor basis | §8.1 |
+//! | [`periodic`] | periodic splines (wrapped control points): knot insertion, elevation and Bézier extraction by blossoming | §11.1 |
 //! | [`quadrature`] | Gauss–Legendre rules | §4 |
 
 pub mod basis;
 pub mod bezier;
 pub mod curve;
 pub mod knots;
+pub mod periodic;
 pub mod quadrature;
 pub mod refine;
 pub mod surface;

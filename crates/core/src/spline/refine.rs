@@ -33,9 +33,10 @@ fn combine(a: &SparseRow, wa: f64, b: &SparseRow, wb: f64) -> SparseRow {
 /// The prolongation `P` (`n_fine x n_coarse`) with `N_coarse_j = sum_i P_ij N_fine_i`,
 /// so that coarse control points `c` become `P c` on the fine basis. `fine` must contain
 /// every knot of `coarse`; the knots are inserted one by one with Boehm's algorithm.
+/// Periodic vectors go to [`crate::spline::periodic::periodic_prolongation`].
 pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
-    if coarse.is_periodic() {
-        return Err(Error::Invalid("refinement of periodic knot vectors is not supported".into()));
+    if coarse.is_periodic() || fine.is_periodic() {
+        return crate::spline::periodic::periodic_prolongation(coarse, fine);
     }
     let new = fine.difference(coarse).ok_or_else(|| {
         Error::Invalid(format!(
@@ -74,25 +75,14 @@ pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
     Ok(Csr::from_rows(coarse.num_basis(), rows))
 }
 
-/// Dense solve `A X = B` (`A` is `n x n`, row-major; `B` is `n x m`) by faer's LU with
-/// partial pivoting.
-pub(crate) fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    use faer::linalg::solvers::Solve;
-    let n = a.len();
-    let m = b.first().map_or(0, |r| r.len());
-    let am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[i][j]);
-    let bm = faer::Mat::<f64>::from_fn(n, m, |i, j| b[i][j]);
-    let x = am.partial_piv_lu().solve(&bm);
-    (0..n).map(|i| (0..m).map(|j| x[(i, j)]).collect()).collect()
-}
-
 /// The operator `E` (`n_elevated x n`) that writes a degree-`p` spline in the basis of
 /// degree `p + 1` with the same continuity (knot multiplicities raised by one). It is
 /// obtained by interpolation at the Greville abscissae of the elevated space, which is
-/// exact because the spaces are nested.
+/// exact because the spaces are nested. Periodic vectors go to
+/// [`crate::spline::periodic::periodic_elevation`].
 pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if kv.is_periodic() {
-        return Err(Error::Invalid("degree elevation of periodic knot vectors is not supported".into()));
+        return crate::spline::periodic::periodic_elevation(kv);
     }
     let fine = kv.elevated();
     let g = fine.greville();
@@ -110,7 +100,7 @@ pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
             bmat[i][bc.first() + j] = v;
         }
     }
-    let x = dense_solve(&a, &bmat);
+    let x = crate::linalg::linsolve::dense_solve(&a, &bmat);
     let rows = x.into_iter().map(|r| r.into_iter().enumerate().filter(|(_, v)| v.abs() > 1e-15).collect()).collect();
     Ok((fine, Csr::from_rows(n_c, rows)))
 }

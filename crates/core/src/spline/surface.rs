@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::spline::basis::BasisDerivs;
-use crate::spline::curve::{check_points, check_weights, Curve, Point};
+use crate::spline::curve::{check_points, check_weights, check_wrapped, Curve, Point};
 use crate::spline::knots::KnotVector;
 
 /// The four sides of the parameter square, in the order south, east, north, west.
@@ -95,7 +95,8 @@ impl SurfaceDerivs {
 }
 
 impl Surface {
-    /// Validate lengths, finiteness and weights.
+    /// Validate lengths, finiteness and weights, and that the control points of a
+    /// periodic direction wrap ([`crate::spline::periodic`]).
     pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots[0].num_basis() * knots[1].num_basis();
         if control_points.len() != n {
@@ -109,6 +110,17 @@ impl Surface {
         check_points(&control_points, "control point")?;
         if let Some(w) = &weights {
             check_weights(w, n)?;
+        }
+        let [nx, ny] = [knots[0].num_basis(), knots[1].num_basis()];
+        if knots[0].is_periodic() {
+            check_wrapped(&control_points, weights.as_deref(), nx, knots[0].dim(), |i| {
+                (0..ny).map(|j| j * nx + i).collect()
+            })?;
+        }
+        if knots[1].is_periodic() {
+            check_wrapped(&control_points, weights.as_deref(), ny, knots[1].dim(), |j| {
+                (0..nx).map(|i| j * nx + i).collect()
+            })?;
         }
         let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
         Ok(Self { knots, control_points, weights })

@@ -73,7 +73,7 @@ fn side_interpolant(map: &Surface, side: Side, g: &dyn Fn([f64; 2]) -> f64) -> V
         }
         rhs[i][0] = g(curve.eval(u));
     }
-    crate::spline::refine::dense_solve(&a, &rhs).into_iter().map(|r| r[0]).collect()
+    crate::linalg::linsolve::dense_solve(&a, &rhs).into_iter().map(|r| r[0]).collect()
 }
 
 /// Solve `-Δu = f` in the mapped domain with `u = g` on its boundary; returns the

@@ -1,0 +1,135 @@
+//! Ring (O-type) documents of `formats.md`: `{"name", "ring": {"inner": CLOSED,
+//! "outer": CLOSED}}`, read into a [`Ring`] and written back.
+//!
+//! `CLOSED` is a periodic Curve (`"periodic": true`, the last `degree` control points
+//! repeating the first), a clamped Curve whose two ends coincide (accepted in addition:
+//! a closed loop exported by CAD systems, e.g. the G+Smo loops), or `{"points": [...]}`,
+//! an ordered closed point cloud; a last point equal to the first (within `1e-12` of
+//! the cloud's extent) is dropped. Closedness, orientation and nesting are checked by
+//! [`crate::boundary::ring::fit_ring`].
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+
+use super::json::{CurveJson, PointsJson};
+use crate::boundary::ring::{ClosedContour, Ring};
+use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+
+fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
+    let jerr = |e: serde_json::Error| Error::Json { context: ctx.into(), message: e.to_string() };
+    match &v {
+        Value::Object(o) if o.contains_key("points") => {
+            let mut p: PointsJson = serde_json::from_value(v).map_err(jerr)?;
+            if p.points.len() > MAX_CONTROL_POINTS {
+                return Err(Error::TooLarge {
+                    context: ctx.into(),
+                    what: "number of points".into(),
+                    found: p.points.len(),
+                    limit: MAX_CONTROL_POINTS,
+                });
+            }
+            let extent = p.points.iter().fold(0.0f64, |m, q| m.max(q[0].abs()).max(q[1].abs()));
+            if p.points.len() > 1 {
+                let (a, b) = (p.points[0], p.points[p.points.len() - 1]);
+                if (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) <= 1e-12 * extent {
+                    p.points.pop();
+                }
+            }
+            Ok(ClosedContour::Points(p.points))
+        }
+        Value::Object(_) => {
+            let c: CurveJson = serde_json::from_value(v).map_err(jerr)?;
+            Ok(ClosedContour::Spline(c.to_curve().map_err(|e| e.within(ctx))?))
+        }
+        other => Err(Error::Json {
+            context: ctx.into(),
+            message: format!("a closed contour must be a Curve object or {{\"points\": [...]}}, found {other}"),
+        }),
+    }
+}
+
+/// The ring of a JSON document with a top-level `"ring"` field, `None` for any other
+/// document. Errors name the place (`ring.inner.knots`, ...).
+pub fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
+    let text = text.trim_start_matches('\u{feff}').trim_start();
+    if !text.starts_with('{') {
+        return Ok(None);
+    }
+    let v: Value =
+        serde_json::from_str(text).map_err(|e| Error::Json { context: String::new(), message: e.to_string() })?;
+    let Value::Object(mut obj) = v else { return Ok(None) };
+    let Some(r) = obj.remove("ring") else { return Ok(None) };
+    let name = match obj.remove("name") {
+        Some(Value::String(s)) => s,
+        _ => String::new(),
+    };
+    let Value::Object(mut r) = r else {
+        return Err(Error::Json { context: "ring".into(), message: "must be an object with inner and outer".into() });
+    };
+    let mut take = |k: &str| {
+        r.remove(k).ok_or_else(|| Error::Json { context: "ring".into(), message: format!("missing contour \"{k}\"") })
+    };
+    let (inner, outer) = (take("inner")?, take("outer")?);
+    Ok(Some(Ring { name, inner: closed(inner, "ring.inner")?, outer: closed(outer, "ring.outer")? }))
+}
+
+/// Read a ring document; `None` when the file is another kind of document. A ring
+/// without a name is named after the file stem.
+pub fn read_ring(path: &Path) -> Result<Option<Ring>> {
+    let text = super::read_text(path)?;
+    let mut ring = parse_ring_json(&text)?;
+    if let Some(r) = ring.as_mut().filter(|r| r.name.is_empty()) {
+        r.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    }
+    Ok(ring)
+}
+
+/// The JSON form of a ring; analytic contours become point clouds of 1024 points.
+pub fn ring_to_json(ring: &Ring) -> Value {
+    let c = |c: &ClosedContour| match c {
+        ClosedContour::Spline(c) => serde_json::to_value(CurveJson::from_curve(c)).expect("serializable"),
+        ClosedContour::Points(p) => json!({ "points": p }),
+        ClosedContour::Analytic(f) => {
+            json!({ "points": (0..1024).map(|k| f.eval(k as f64 / 1024.0)).collect::<Vec<_>>() })
+        }
+    };
+    json!({ "name": ring.name, "ring": { "inner": c(&ring.inner), "outer": c(&ring.outer) } })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spline::curve::Curve;
+    use crate::spline::knots::KnotVector;
+
+    #[test]
+    fn rings_round_trip_and_errors_name_the_place() {
+        let kv = KnotVector::periodic_uniform(2, 4);
+        let d = kv.dim();
+        let base = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]];
+        let cps = (0..kv.num_basis()).map(|k| base[k % d]).collect();
+        let inner = Curve::new(kv, cps, None).unwrap();
+        let ring = Ring {
+            name: "r".into(),
+            inner: ClosedContour::Spline(inner.clone()),
+            outer: ClosedContour::Points(vec![[3.0, 0.0], [0.0, 3.0], [-3.0, 0.0], [0.0, -3.0]]),
+        };
+        let text = ring_to_json(&ring).to_string();
+        let back = parse_ring_json(&text).unwrap().unwrap();
+        match (&back.inner, &back.outer) {
+            (ClosedContour::Spline(c), ClosedContour::Points(p)) => {
+                assert_eq!(c, &inner);
+                assert_eq!(p.len(), 4);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(parse_ring_json(r#"{"boundary": {}}"#).unwrap().is_none());
+        let e = parse_ring_json(r#"{"ring": {"inner": {"points": [[0,0]]}}}"#).unwrap_err().to_string();
+        assert!(e.contains("outer"), "{e}");
+        let bad = r#"{"ring": {"inner": {"degree": 2, "knots": [0,1,2,3,4,5,7], "control_points": [[0,0],[1,0],[1,1],[0,0]], "periodic": true},
+                      "outer": {"points": [[0,0],[1,0],[1,1]]}}}"#;
+        let e = parse_ring_json(bad).unwrap_err().to_string();
+        assert!(e.contains("ring.inner") && e.contains("periodic"), "{e}");
+    }
+}
