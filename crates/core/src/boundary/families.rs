@@ -215,8 +215,8 @@ fn tabbed_side(rng: &mut Rng) -> Vec<[f64; 2]> {
         pts.push([c - n, 0.0]);
         pts.push([c - n, dir * neck]);
         let (a0, a1) = (-std::f64::consts::FRAC_PI_2 - delta, -2.5 * std::f64::consts::PI + delta);
-        for j in 1..40 {
-            let a = a0 + (a1 - a0) * j as f64 / 40.0;
+        for j in 1..16 {
+            let a = a0 + (a1 - a0) * j as f64 / 16.0;
             pts.push([c + r * a.cos(), dir * (yc + r * a.sin())]);
         }
         pts.push([c + n, dir * neck]);
@@ -226,14 +226,14 @@ fn tabbed_side(rng: &mut Rng) -> Vec<[f64; 2]> {
     // baseline segments sampled like the tabs
     let mut out = vec![pts[0]];
     for w in pts.windows(2) {
-        let m = ((w[1][0] - w[0][0]).abs() / 0.01).ceil().max(1.0) as usize;
+        let m = ((w[1][0] - w[0][0]).abs() / 0.04).ceil().max(1.0) as usize;
         for j in 1..=m {
             let t = j as f64 / m as f64;
             out.push([w[0][0] + t * (w[1][0] - w[0][0]), w[0][1] + t * (w[1][1] - w[0][1])]);
         }
     }
-    // rounded like a cut piece: three rounds of Chaikin's corner cutting (the ends kept)
-    for _ in 0..3 {
+    // rounded like a cut piece: five rounds of Chaikin's corner cutting (the ends kept)
+    for _ in 0..5 {
         let mut cut = vec![out[0]];
         for w in out.windows(2) {
             let at = |t: f64| [w[0][0] + t * (w[1][0] - w[0][0]), w[0][1] + t * (w[1][1] - w[0][1])];
@@ -285,7 +285,8 @@ fn spline(degree: usize, knots: Vec<f64>, cps: Vec<Point>, weights: Option<Vec<f
 /// east an exact circular arc (rational quadratic), north a quadratic with a double knot
 /// (a `C0` kink), west a line.
 fn cad(rng: &mut Rng) -> [SideCurve; 4] {
-    // south: p = 3, three interior knots at least 0.12 apart
+    // south: p = 3, three interior knots at least 0.12 apart; horizontal at both ends,
+    // so that the corners with the arc stay below 180 degrees (a four-sided CAD patch)
     let mut k = [between(rng, 0.1, 0.3), between(rng, 0.42, 0.58), between(rng, 0.7, 0.9)];
     k.sort_by(f64::total_cmp);
     let knots = [vec![0.0; 4], k.to_vec(), vec![1.0; 4]].concat();
@@ -294,7 +295,7 @@ fn cad(rng: &mut Rng) -> [SideCurve; 4] {
     let cps: Vec<Point> = g
         .iter()
         .enumerate()
-        .map(|(i, &x)| [x, if i == 0 || i + 1 == g.len() { 0.0 } else { between(rng, -0.08, 0.08) }])
+        .map(|(i, &x)| [x, if i <= 1 || i + 2 >= g.len() { 0.0 } else { between(rng, -0.08, 0.08) }])
         .collect();
     let south = spline(3, knots, cps, None);
     // east: arc from (1, 0) to (1, 1) of half-angle phi bulging outwards
