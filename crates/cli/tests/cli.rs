@@ -569,3 +569,29 @@ fn sweep_writes_frames_series_and_table() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(!bad.status.success() && err.contains("not a ring document"), "{err}");
 }
+
+/// `winslow corpus` writes the seeded hard domains, which read back as boundaries, and
+/// with `--solve` prints the per-family table and exits 0 only when all are certified.
+#[test]
+fn corpus_writes_and_solves_the_hard_families() {
+    let dir = std::env::temp_dir().join(format!("winslow-corpus-{}", std::process::id()));
+    let out = bin()
+        .args(["corpus", "--per-family", "2", "--families", "sharp-corner,sparse-cloud", "--solve", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("| sharp-corner | 2 | 2 |") && stdout.contains("| sparse-cloud | 2 | 2 |"), "{stdout}");
+    assert!(stdout.contains("certified 4 of 4"), "{stdout}");
+    let written = files(&dir, "json");
+    assert_eq!(written.len(), 4, "{written:?}");
+    for f in &written {
+        let o = bin().arg("inspect").arg(f).output().unwrap();
+        assert!(o.status.success(), "{}: {}", f.display(), String::from_utf8_lossy(&o.stderr));
+    }
+    // an unknown family is an error naming it
+    let o = bin().args(["corpus", "--families", "hexagon", "--solve"]).output().unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("hexagon"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -33,7 +33,11 @@ pub struct SolveOptions {
     pub sample: usize,
     /// Rounds of defect correction (paper §8.2): while the certificate of the finest
     /// map says folded or undecided, refine around the offending elements and solve
-    /// again, at most this many times.
+    /// again, at most this many times. Default 6: the folds next to the necks of puzzle
+    /// tabs in the hard corpus (`boundary::families`) need four rounds, and the
+    /// offending-element count is not monotone from round to round (54, 74, 77, 46, then
+    /// certified), so no earlier stopping rule is safe; inputs that certify sooner never
+    /// see the difference.
     pub repair: usize,
     /// Spans around each offending element that a repair round also bisects.
     pub repair_halo: usize,
@@ -66,7 +70,7 @@ impl Default for SolveOptions {
             growth: 4.0,
             aspect: 2.0,
             sample: 200,
-            repair: 3,
+            repair: 6,
             repair_halo: 1,
             repair_freeze: None,
             certify: CertifyOptions::default(),
