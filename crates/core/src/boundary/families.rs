@@ -248,7 +248,7 @@ fn tabbed_side(rng: &mut Rng) -> Vec<[f64; 2]> {
 
 /// The unit square with rounded jigsaw tabs on every side.
 fn puzzle(rng: &mut Rng) -> [SideCurve; 4] {
-    let south = tabbed_side(rng).into_iter().map(|[s, h]| [s, h]).collect();
+    let south = tabbed_side(rng);
     let east = tabbed_side(rng).into_iter().map(|[s, h]| [1.0 - h, s]).collect();
     let north = tabbed_side(rng).into_iter().map(|[s, h]| [s, 1.0 - h]).collect();
     let west = tabbed_side(rng).into_iter().map(|[s, h]| [h, s]).collect();
