@@ -77,10 +77,7 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
             Ok(sol) => {
                 let r = &sol.report;
                 let its: Vec<String> = r.levels.iter().map(|l| l.iterations.to_string()).collect();
-                (
-                    verdict_name(r.verdict).to_string(),
-                    format!("{} functions, iterations {}", r.basis_functions, its.join("/")),
-                )
+                (r.verdict.name().to_string(), format!("{} functions, iterations {}", r.basis_functions, its.join("/")))
             }
             Err(e) => ("error".to_string(), e.to_string()),
         };
@@ -89,7 +86,7 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         let t = tally.entry(family.name()).or_default();
         t.domains += 1;
         t.seconds += secs;
-        if verdict != verdict_name(Verdict::Certified) {
+        if verdict != Verdict::Certified.name() {
             t.failures.push(format!("{}: {verdict} ({detail})", b.name));
         }
         *t.by_verdict.entry(verdict).or_default() += 1;
@@ -123,14 +120,4 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         }
     }
     Ok(if ok == all { 0 } else { 1 })
-}
-
-fn verdict_name(v: Verdict) -> &'static str {
-    match v {
-        Verdict::Certified => "certified",
-        Verdict::DegenerateCorner => "degenerate-corner",
-        Verdict::Folded => "folded",
-        Verdict::Undecided => "undecided",
-        Verdict::NotConverged => "not-converged",
-    }
 }

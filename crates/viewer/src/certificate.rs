@@ -96,17 +96,6 @@ pub struct Certificate {
     pub details: Vec<(String, String)>,
 }
 
-/// Short name of a verdict, as in the JSON report.
-pub fn verdict_name(v: Verdict) -> &'static str {
-    match v {
-        Verdict::Certified => "certified",
-        Verdict::DegenerateCorner => "degenerate-corner",
-        Verdict::Folded => "folded",
-        Verdict::Undecided => "undecided",
-        Verdict::NotConverged => "not-converged",
-    }
-}
-
 /// Whether the verdict means the map can be used (proven bijective, or the best map the
 /// boundary admits).
 pub fn verdict_is_good(v: Verdict) -> bool {
@@ -116,7 +105,7 @@ pub fn verdict_is_good(v: Verdict) -> bool {
 fn verdict_from_name(s: &str) -> Option<Verdict> {
     [Verdict::Certified, Verdict::DegenerateCorner, Verdict::Folded, Verdict::Undecided, Verdict::NotConverged]
         .into_iter()
-        .find(|&v| verdict_name(v) == s)
+        .find(|&v| v.name() == s)
 }
 
 impl Certificate {
@@ -284,8 +273,8 @@ mod tests {
             [Verdict::Certified, Verdict::DegenerateCorner, Verdict::Folded, Verdict::Undecided, Verdict::NotConverged]
         {
             // the names are the serde names of the core
-            assert_eq!(serde_json::to_value(v).unwrap(), serde_json::json!(verdict_name(v)));
-            assert_eq!(verdict_from_name(verdict_name(v)), Some(v));
+            assert_eq!(serde_json::to_value(v).unwrap(), serde_json::json!(v.name()));
+            assert_eq!(verdict_from_name(v.name()), Some(v));
         }
     }
 }

@@ -4,7 +4,7 @@
 use egui::{Color32, RichText, Ui};
 use egui_plot::{Line, Plot, PlotPoints};
 
-use crate::certificate::{verdict_is_good, verdict_name, Certificate};
+use crate::certificate::{verdict_is_good, Certificate};
 use crate::scene::{MapView, Scene};
 
 /// Folded elements listed at most.
@@ -65,14 +65,10 @@ pub(crate) fn verdict_colour(c: &Certificate) -> Color32 {
 pub(crate) fn certificate_section(ui: &mut Ui, mv: &MapView) {
     let c = &mv.certificate;
     ui.label(
-        RichText::new(format!(
-            "{} {}",
-            if verdict_is_good(c.verdict) { "OK:" } else { "BAD:" },
-            verdict_name(c.verdict)
-        ))
-        .color(verdict_colour(c))
-        .strong()
-        .size(16.0),
+        RichText::new(format!("{} {}", if verdict_is_good(c.verdict) { "OK:" } else { "BAD:" }, c.verdict.name()))
+            .color(verdict_colour(c))
+            .strong()
+            .size(16.0),
     );
     ui.label(&c.message);
     ui.label(RichText::new(format!("from the {}", c.source.label())).weak());
@@ -88,8 +84,7 @@ pub(crate) fn certificate_section(ui: &mut Ui, mv: &MapView) {
     if c.source != mv.exact_certificate.source {
         let s = &mv.exact_certificate;
         ui.label(
-            RichText::new(format!("exact certificate: {} ({})", verdict_name(s.verdict), s.message))
-                .color(verdict_colour(s)),
+            RichText::new(format!("exact certificate: {} ({})", s.verdict.name(), s.message)).color(verdict_colour(s)),
         );
     }
 }

@@ -90,6 +90,20 @@ pub enum Verdict {
     NotConverged,
 }
 
+impl Verdict {
+    /// The name in the JSON report (`"certified"`, `"degenerate-corner"`, `"folded"`,
+    /// `"undecided"`, `"not-converged"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Certified => "certified",
+            Verdict::DegenerateCorner => "degenerate-corner",
+            Verdict::Folded => "folded",
+            Verdict::Undecided => "undecided",
+            Verdict::NotConverged => "not-converged",
+        }
+    }
+}
+
 /// Contour-fit summary per side.
 #[derive(Debug, Clone, Serialize)]
 pub struct FitReport {
