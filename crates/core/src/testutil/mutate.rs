@@ -178,7 +178,7 @@ fn edit_text(text: &mut String, rng: &mut Lcg) -> &'static str {
     let splice = |text: &mut String, (a, b): (usize, usize), with: &str| text.replace_range(a..b, with);
     let choice = rng.below(12);
     match choice {
-        0 | 1 | 2 => {
+        0..=2 => {
             if let Some(t) = pick(rng, &numbers).copied() {
                 let s = SPECIAL_NUMBERS[rng.below(SPECIAL_NUMBERS.len())];
                 splice(text, (t.start, t.end), s);
