@@ -12,7 +12,7 @@ use winslow::error::Error;
 use winslow::testutil::exercise::{exercise_text, Reader, Trace};
 use winslow::testutil::mutate::{run_mutants, Failure};
 
-/// Mutants per file (about 30 files).
+/// Mutants per file (about 30 files); `WINSLOW_MUTANTS=N` runs more (a long run by hand).
 const PER_FILE: usize = 150;
 const SEED: u64 = 0x5eed_2026;
 /// Files larger than this are left out (mutants of large files cost more and teach little).
@@ -62,6 +62,10 @@ fn traces(name: &str, text: &str) -> [Trace; 2] {
     [exercise_text(Reader::Document, text), exercise_text(reader_for(name), text)]
 }
 
+fn per_file() -> usize {
+    std::env::var("WINSLOW_MUTANTS").ok().and_then(|n| n.parse().ok()).unwrap_or(PER_FILE)
+}
+
 fn report(failures: &[Failure]) -> String {
     failures
         .iter()
@@ -96,7 +100,8 @@ fn the_valid_files_are_valid() {
 fn mutants_fail_cleanly() {
     let files = valid_files();
     let (accepted, rejected, maps) = (Cell::new(0), Cell::new(0), Cell::new(0));
-    let failures = run_mutants(&files, PER_FILE, SEED, |name, text| {
+    let per_file = per_file();
+    let failures = run_mutants(&files, per_file, SEED, |name, text| {
         let mut violations = Vec::new();
         for t in traces(name, text) {
             maps.set(maps.get() + t.maps);
@@ -111,7 +116,7 @@ fn mutants_fail_cleanly() {
     });
     assert!(failures.is_empty(), "{} failures; the first:\n{}", failures.len(), report(&failures));
     // the edits must reach past the parsers: some mutants are still valid, maps are read
-    let runs = 2 * PER_FILE * files.len();
+    let runs = 2 * per_file * files.len();
     let (a, r, m) = (accepted.get(), rejected.get(), maps.get());
     assert_eq!(a + r, runs);
     assert!(a > runs / 20 && r > runs / 5 && m > runs / 50, "accepted {a}, rejected {r}, maps {m} of {runs}");
