@@ -27,3 +27,6 @@ impl Lcg {
         }
     }
 }
+
+pub mod exercise;
+pub mod mutate;
