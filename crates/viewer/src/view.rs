@@ -3,6 +3,7 @@
 //! Zoom keeps the world point under the cursor fixed; pan moves by screen pixels.
 
 use egui::{Pos2, Rect, Vec2};
+use glam::{DAffine2, DVec2};
 
 /// Smallest and largest zoom relative to the fitted view.
 pub const ZOOM_RANGE: (f64, f64) = (0.05, 1e5);
@@ -52,19 +53,24 @@ impl ViewTransform {
         Self { centre, scale, fitted_scale: scale }
     }
 
+    /// The world-to-screen map of this view in `rect` as an affine map,
+    /// `screen = rect.center + diag(s, −s) (w − c)`.
+    pub fn affine(&self, rect: Rect) -> DAffine2 {
+        let c = rect.center();
+        DAffine2::from_translation(DVec2::new(c.x as f64, c.y as f64))
+            * DAffine2::from_scale(DVec2::new(self.scale, -self.scale))
+            * DAffine2::from_translation(-DVec2::from(self.centre))
+    }
+
     /// Screen point of a world point.
     pub fn to_screen(&self, rect: Rect, w: [f64; 2]) -> Pos2 {
-        let c = rect.center();
-        Pos2::new(
-            c.x + ((w[0] - self.centre[0]) * self.scale) as f32,
-            c.y - ((w[1] - self.centre[1]) * self.scale) as f32,
-        )
+        let p = self.affine(rect).transform_point2(DVec2::from(w));
+        Pos2::new(p.x as f32, p.y as f32)
     }
 
     /// World point of a screen point.
     pub fn to_world(&self, rect: Rect, p: Pos2) -> [f64; 2] {
-        let c = rect.center();
-        [self.centre[0] + (p.x - c.x) as f64 / self.scale, self.centre[1] - (p.y - c.y) as f64 / self.scale]
+        self.affine(rect).inverse().transform_point2(DVec2::new(p.x as f64, p.y as f64)).into()
     }
 
     /// Multiply the scale by `factor` (clamped to [`ZOOM_RANGE`] of the fitted scale),
