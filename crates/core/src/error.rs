@@ -51,6 +51,9 @@ pub enum Error {
     /// The boundary is traversed clockwise (signed area negative).
     #[error("clockwise contour (signed area {area:.6e}): south, east, reversed north, reversed west must run counter-clockwise; pass the reorient option to flip it")]
     Clockwise { area: f64 },
+    /// The contour encloses (numerically) no area: its orientation is undetermined.
+    #[error("degenerate contour: signed area {area:.3e} is within {bound:.3e} of zero (the corner gaps times the diameter, and rounding), so it encloses no domain and has no orientation")]
+    DegenerateContour { area: f64, bound: f64 },
     /// An input exceeds the sizes the library accepts.
     #[error("absurd size{}: {what} is {found}, the limit is {limit}", at(.context))]
     TooLarge { context: String, what: String, found: usize, limit: usize },

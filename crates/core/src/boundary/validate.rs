@@ -254,7 +254,8 @@ fn within_side(e: Error, s: Side) -> Error {
 /// Errors: [`Error::TooLarge`], [`Error::TooFewPoints`], [`Error::NonFinite`],
 /// [`Error::Length`]/[`Error::Weight`] (spline sides built by hand), [`Error::CornerGap`]
 /// (gap above `CORNER_TOL` times the bounding-box diameter), [`Error::DegenerateSide`]
-/// (side shorter than that tolerance), [`Error::SelfIntersection`] and [`Error::Range`]
+/// (side shorter than that tolerance), [`Error::SelfIntersection`],
+/// [`Error::DegenerateContour`] (no area, so no orientation) and [`Error::Range`]
 /// (a size whose `det J` leaves `f64`'s range). The geometry is measured in the
 /// normalised coordinates of [`Similarity`] and reported in the input's.
 pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
@@ -304,6 +305,9 @@ fn physical_error(e: Error, sim: &Similarity) -> Error {
         Error::SelfIntersection { side_a, side_b, x, y } => {
             let [x, y] = at(x, y);
             Error::SelfIntersection { side_a, side_b, x, y }
+        }
+        Error::DegenerateContour { area, bound } => {
+            Error::DegenerateContour { area: sim.area(area), bound: sim.area(bound) }
         }
         e => e,
     }
@@ -398,6 +402,14 @@ fn measure(boundary: &Boundary) -> Result<ValidationReport> {
     let signed_area = shoelace(&pts);
     let orientation = if signed_area > 0.0 { Orientation::CounterClockwise } else { Orientation::Clockwise };
     check_self_intersection(&pts, &owner, &corners, CORNER_NEIGHBOURHOOD * diameter)?;
+    // Which end stands for a corner moves a vertex by up to its gap, which changes the
+    // area by up to gap × diameter; an area within that (and the shoelace's rounding) of
+    // zero has no orientation.
+    let bound =
+        2.0 * corner_gaps.iter().sum::<f64>() * diameter + 8.0 * f64::EPSILON * pts.len() as f64 * diameter * diameter;
+    if !(signed_area.abs() > bound) {
+        return Err(Error::DegenerateContour { area: signed_area, bound });
+    }
 
     // Corner angles from the one-sided tangents in the traversal direction.
     let t = |s: Side, end: bool| end_tangent(boundary.side(s), &polys[s as usize], end);
@@ -630,6 +642,31 @@ mod tests {
                 line([0., 0.], [0., 1.]),
             ],
         }
+    }
+
+    /// A contour as thin as its corner gaps encloses nothing: no orientation is guessed.
+    #[test]
+    fn a_contour_as_thin_as_its_corner_gaps_is_degenerate() {
+        let (h, g) = (1.5e-9, 9e-10);
+        let b = Boundary {
+            name: "sliver".into(),
+            sides: [
+                line([0., 0.], [1., 0.]),
+                line([1., g], [1., h + g]),
+                line([0., h], [1., h + g]),
+                line([0., g], [0., h + g]),
+            ],
+        };
+        let e = validate(&b).unwrap_err();
+        assert!(matches!(e, Error::DegenerateContour { .. }), "{e}");
+        assert!(matches!(inspect(&b.transposed()), Err(Error::DegenerateContour { .. })));
+        // the same sliver with closed corners and 100x the thickness is a domain
+        let h = 1.5e-7;
+        let b = Boundary {
+            name: "strip".into(),
+            sides: [line([0., 0.], [1., 0.]), line([1., 0.], [1., h]), line([0., h], [1., h]), line([0., 0.], [0., h])],
+        };
+        assert!(validate(&b).is_ok());
     }
 
     #[test]

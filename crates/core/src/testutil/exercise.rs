@@ -87,6 +87,20 @@ pub fn exercise_text(reader: Reader, text: &str) -> Trace {
     trace
 }
 
+/// Read `text` as a ring (O-type) document (`io::ring`) and validate and fit it coarsely
+/// (`boundary::ring::fit_ring`: closed, counter-clockwise, nested contours); an accepted
+/// ring counts as a valid boundary.
+pub fn exercise_ring_text(text: &str) -> Trace {
+    let mut trace = Trace::default();
+    if let Some(Some(ring)) = trace.record("read", crate::io::ring::parse_ring_json(text)) {
+        trace.boundaries += 1;
+        if trace.record("fit", crate::boundary::ring::fit_ring(&ring, 3, 1e-2, 64)).is_some() {
+            trace.valid_boundaries += 1;
+        }
+    }
+    trace
+}
+
 /// A boundary: validated; a map: certified, written and read back, and its boundary validated.
 pub fn exercise_document(doc: Document, trace: &mut Trace) {
     match doc {
