@@ -407,7 +407,7 @@ fn measure(boundary: &Boundary) -> Result<ValidationReport> {
     // zero has no orientation.
     let bound =
         2.0 * corner_gaps.iter().sum::<f64>() * diameter + 8.0 * f64::EPSILON * pts.len() as f64 * diameter * diameter;
-    if !(signed_area.abs() > bound) {
+    if signed_area.is_nan() || signed_area.abs() <= bound {
         return Err(Error::DegenerateContour { area: signed_area, bound });
     }
 
