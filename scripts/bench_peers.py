@@ -22,8 +22,10 @@ _value_policy = copy, but type is non-copyable") is the Coons patch, built here 
 * one patch (TensorBSpline2 / TensorNurbs2): its basis and weights are kept, its interior
   control points are replaced by the same Coons blend of its boundary control points.
 A direction of degree 1 is elevated to 2 on both sides (winslow does so; G+Smo crashes
-on a bilinear single element). winslow falls back to a fitted basis for NURBS sides and interior C0 knots; the table
-then shows different function counts (the "winslow basis" column says which was used).
+on a bilinear single element). winslow falls back to a fitted basis for NURBS sides and
+interior C0 knots, and its defect correction adds knots where the certificate finds a
+fold; the table then shows different function counts (the "winslow basis" column says
+which basis was used and how many repair rounds ran).
 
 Usage: python scripts/bench_peers.py WINSLOW_BIN OUT_DIR [--refine 0,1,2] [--only a,b]
 """
@@ -232,15 +234,14 @@ def certify(winslow, path):
 def run_gismo(_winslow, name, refine, out):
     """G+Smo on the refined input basis: (number of functions, seconds of compute())."""
     init = os.path.join(out, f"{name}-init.xml")
+    patch = initial_patch(os.path.join(XML_DIR, name + ".xml"))
     with open(init, "w") as f:
-        f.write(patch_xml(initial_patch(os.path.join(XML_DIR, name + ".xml"))))
+        f.write(patch_xml(patch))
     mp = gs.core.gsMultiPatch()
     mp.addPatch(gs.io.gsFileData(init).getAll()[0])
-    patch = mp.patch(0)
     for d in range(2):  # winslow elevates sides of degree 1 to 2 (cooks_membrane); so does this
-        if patch.degree(d) < 2:
-            mp.degreeElevate(2 - patch.degree(d), d)
-            patch = mp.patch(0)
+        if patch["deg"][d] < 2:
+            mp.degreeElevate(2 - patch["deg"][d], d)
     if refine:
         mp.uniformRefine(2 ** refine - 1)
     functions = mp.basis(0).size()
@@ -263,9 +264,9 @@ def run_gismo_isolated(winslow, name, refine, out):
                        capture_output=True, text=True)
     lines = r.stdout.strip().splitlines()
     if r.returncode != 0 or not lines:
-        why = f"signal {-r.returncode}" if r.returncode < 0 else f"exit {r.returncode}"
         detail = (r.stderr.strip().splitlines() or [""])[-1][:60]
-        return "-", None, f"G+Smo crashed ({why}{': ' + detail if detail else ''})"
+        why = f"crashed (signal {-r.returncode})" if r.returncode < 0 else f"failed (exit {r.returncode})"
+        return "-", None, f"G+Smo {why}{': ' + detail if detail else ''}"
     functions, seconds = json.loads(lines[-1])
     return functions, seconds, certify(winslow, os.path.join(out, f"{name}-r{refine}-gismo.xml"))
 
