@@ -4,6 +4,7 @@
 //!
 //! | module | holds |
 //! |---|---|
+//! | [`banded`] | [`Banded`](banded::Banded): symmetric banded matrices, banded Cholesky |
 //! | [`sparse`] | [`Csr`](sparse::Csr): storage, products, pattern unions |
 //! | [`ordering`] | nested dissection of a grid of points, interleaving of component blocks |
 //! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver): LU, Cholesky preconditioners (f32/f64), the choice of method |
@@ -13,6 +14,7 @@
 //! (knot insertion, degree elevation, [`crate::spline::refine`]) are sparse matrices, so
 //! sparse storage must sit below the splines; none of these modules knows what a spline is.
 
+pub mod banded;
 pub mod krylov;
 pub mod linsolve;
 pub mod ordering;
