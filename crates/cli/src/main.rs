@@ -14,6 +14,7 @@ use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::boundary::BasisChoice;
 use winslow::discrete::assembly::Operator;
 use winslow::io::picture::{render, PictureOptions};
+use winslow::io::ring::read_ring;
 use winslow::io::{checked_boundary, map_to_json, read_document, Document, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::{EggAssembler, EggMethod};
@@ -30,6 +31,7 @@ use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
 mod corpus;
+mod inspect_ring;
 mod mesh;
 mod output;
 mod solve_cmd;
@@ -571,6 +573,9 @@ fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
 }
 
 fn inspect(a: InspectArgs) -> Result<i32> {
+    if let Some(ring) = read_ring(&a.file).with_context(|| format!("reading {}", a.file.display()))? {
+        return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
+    }
     let doc = read_document(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
     let kind = match &doc {
         Document::Boundary(_) => "boundary",

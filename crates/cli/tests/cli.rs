@@ -595,3 +595,28 @@ fn corpus_writes_and_solves_the_hard_families() {
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("hexagon"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `winslow inspect` reads ring (O-type) documents: contours described, checked and
+/// fitted as `solve` fits them; an invalid ring is a problem (exit 2) that says why.
+#[test]
+fn inspect_reads_rings() {
+    for f in files(&data().join("rings"), "json") {
+        let o = bin().arg("inspect").arg(&f).output().unwrap();
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{}: {out}{}", f.display(), String::from_utf8_lossy(&o.stderr));
+        assert!(out.contains("(ring, O-type") && out.contains("periodic levels"), "{out}");
+        let o = bin().args(["inspect", "--json"]).arg(&f).output().unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["kind"], "ring");
+        assert!(v["levels"].as_u64().unwrap() >= 1 && v["problems"].as_array().unwrap().is_empty(), "{v}");
+    }
+    let dir = std::env::temp_dir().join(format!("winslow-inspect-ring-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("outside.json");
+    std::fs::write(&bad, r#"{"ring": {"inner": {"points": [[0,0],[2,0],[2,2],[0,2]]}, "outer": {"points": [[0.5,0.5],[1,0.5],[1,1],[0.5,1]]}}}"#).unwrap();
+    let o = bin().arg("inspect").arg(&bad).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(2), "{out}");
+    assert!(out.contains("PROBLEM") && out.contains("inner contour is not inside"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
