@@ -231,8 +231,8 @@ fn local_repair_with_frozen_dofs() {
 
 /// `basis: Input` (paper §5.2): duck's quadratic B-spline sides are the map's boundary
 /// exactly, the map is certified, the finest basis is the input's (8 x 10 functions, no
-/// balancing), the coarse levels are a real hierarchy; NURBS sides fall back to the
-/// fitted basis and say why.
+/// balancing), the coarse levels are a real hierarchy; a C0 knot inside a side falls
+/// back to the fitted basis and says why (NURBS sides: `tests/rational_basis.rs`).
 #[test]
 fn input_basis_keeps_the_boundary_exactly() {
     use winslow::boundary::BasisChoice;
@@ -258,10 +258,10 @@ fn input_basis_keeps_the_boundary_exactly() {
             assert!((p[0] - q[0]).abs() <= 1e-14 * r.diameter && (p[1] - q[1]).abs() <= 1e-14 * r.diameter, "{s}");
         }
     }
-    // the disk's sides are NURBS arcs: fitted basis, with the reason
-    let disk = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/disk.json");
-    let b = read_boundary(&disk, &ReadOptions::default()).unwrap();
+    // a C0 knot inside a side is not rounded silently: fitted basis, with the reason
+    let rotor = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/rotor_sector.json");
+    let b = read_boundary(&rotor, &ReadOptions::default()).unwrap();
     let h = winslow::build_hierarchy(&b, &opts.fit).unwrap();
     assert_eq!(h.basis.used, BasisChoice::Fitted);
-    assert!(h.basis.fallback.as_deref().is_some_and(|w| w.contains("NURBS")), "{:?}", h.basis);
+    assert!(h.basis.fallback.as_deref().is_some_and(|w| w.contains("C0")), "{:?}", h.basis);
 }

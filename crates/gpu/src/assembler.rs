@@ -610,8 +610,14 @@ impl GpuAssembler {
     }
 }
 
+/// The WGSL kernels tabulate polynomial B-splines; a rational basis
+/// ([`Discretization::with_weights`], NURBS sides on the input basis) is assembled on the
+/// CPU, whose kernels apply the quotient rule.
 impl EggAssembler for GpuAssembler {
     fn egg(&self, disc: &Discretization, cps: &[Point], op: Operator, res: &mut [f64], stencil: &mut [f64]) {
+        if disc.is_rational() {
+            return CpuAssembler.egg(disc, cps, op, res, stencil);
+        }
         if let Err(e) = self.try_egg(disc, cps, op, res, stencil) {
             self.fallback("EGG assembly", e);
             CpuAssembler.egg(disc, cps, op, res, stencil);
@@ -619,6 +625,9 @@ impl EggAssembler for GpuAssembler {
     }
 
     fn mass(&self, disc: &Discretization, stencil: &mut [f64]) {
+        if disc.is_rational() {
+            return disc.mass(stencil);
+        }
         if let Err(e) = self.try_mass(disc, stencil) {
             self.fallback("mass assembly", e);
             disc.mass(stencil);
@@ -626,6 +635,9 @@ impl EggAssembler for GpuAssembler {
     }
 
     fn elasticity(&self, disc: &Discretization, cps: &[Point], lambda: f64, mu: f64, stencil: &mut [f64]) {
+        if disc.is_rational() {
+            return disc.elasticity(cps, lambda, mu, stencil);
+        }
         if let Err(e) = self.try_elasticity(disc, cps, lambda, mu, stencil) {
             self.fallback("elasticity assembly", e);
             disc.elasticity(cps, lambda, mu, stencil);

@@ -16,7 +16,9 @@
 //! Not every input can be kept this way; [`input_levels`] says why and the caller
 //! falls back to the fitted basis:
 //! * point clouds and analytic sides have no basis;
-//! * NURBS sides need a rational tensor basis, which the EGG assembly does not have yet;
+//! * NURBS sides whose corner weights cannot be made to agree by scaling each side's
+//!   weights (a rational curve is unchanged when all its weights are scaled): the corner
+//!   control point has one weight in the tensor basis;
 //! * an interior knot whose multiplicity reaches the degree (after elevation) makes the
 //!   side only `C^0` there: the Galerkin form (8) needs `C^1`, and a kink must not be
 //!   rounded silently (the `C^0` route of §9 keeps it).
@@ -28,19 +30,18 @@ use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Side;
 
-/// The side as a polynomial curve on `[0, 1]` of degree at least `degree`, or why not.
-fn polynomial_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Result<Curve, String> {
+/// The side as a B-spline or NURBS curve on `[0, 1]` of degree at least `degree`, or why
+/// not.
+fn spline_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Result<Curve, String> {
     let c = match side {
         SideCurve::Spline(c) => c,
         SideCurve::Points(_) => return Err(format!("the {s} side is a point cloud, which has no basis")),
         SideCurve::Analytic(_) => return Err(format!("the {s} side is analytic, which has no basis")),
     };
-    if c.weights.as_ref().is_some_and(|w| w.iter().any(|&x| x != 1.0)) {
-        return Err(format!(
-            "the {s} side is a NURBS curve: a rational tensor basis is not available in the EGG assembly yet"
-        ));
+    let mut c = c.normalized();
+    if c.weights.as_ref().is_some_and(|w| w.iter().all(|&x| x == 1.0)) {
+        c.weights = None;
     }
-    let mut c = Curve { weights: None, ..c.normalized() };
     while c.degree() < degree {
         c = c.elevated().map_err(|e| format!("the {s} side could not be elevated: {e}"))?;
     }
@@ -59,6 +60,39 @@ fn polynomial_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Res
         ));
     }
     Ok(c)
+}
+
+/// Scale each side's weights (which leaves its curve unchanged) so that the two sides
+/// meeting at a corner give its control point one weight: south is kept, west and east
+/// take south's corner weights, north takes west's; then north's east end must agree
+/// with east's north end (to 1e-12), else the corners' weights are inconsistent.
+fn harmonise_corner_weights(sides: &mut [Curve]) -> std::result::Result<(), String> {
+    if sides.iter().all(|c| c.weights.is_none()) {
+        return Ok(());
+    }
+    let ends = |c: &Curve| match &c.weights {
+        Some(w) => (w[0], w[w.len() - 1]),
+        None => (1.0, 1.0),
+    };
+    let [s, e, n, w] = [0, 1, 2, 3].map(|k| ends(&sides[k]));
+    let lambda_w = s.0 / w.0;
+    let lambda_e = s.1 / e.0;
+    let lambda_n = lambda_w * w.1 / n.0;
+    let (ne_north, ne_east) = (lambda_n * n.1, lambda_e * e.1);
+    if (ne_north - ne_east).abs() > 1e-12 * ne_north.abs().max(ne_east.abs()) {
+        return Err(format!(
+            "the NURBS sides' corner weights cannot be made to agree by scaling (north-east corner: {ne_north} \
+             from north, {ne_east} from east): the corner control point has one weight in a tensor basis"
+        ));
+    }
+    for (k, lambda) in [(1, lambda_e), (2, lambda_n), (3, lambda_w)] {
+        if lambda != 1.0 {
+            let c = &mut sides[k];
+            let w = c.weights.get_or_insert_with(|| vec![1.0; c.control_points.len()]);
+            w.iter_mut().for_each(|x| *x *= lambda);
+        }
+    }
+    Ok(())
 }
 
 /// Remove every other distinct interior break (with all its multiplicity).
@@ -110,10 +144,13 @@ pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLeve
         .map(|s| side_degree(s).max(side_degree(s.opposite())).clamp(2, crate::error::MAX_DEGREE));
     let mut exact: Vec<Curve> = Vec::with_capacity(4);
     for s in Side::ALL {
-        match polynomial_side(boundary.side(s), s, degree[s.direction()]) {
+        match spline_side(boundary.side(s), s, degree[s.direction()]) {
             Ok(c) => exact.push(c),
             Err(why) => return Ok(Err(why)),
         }
+    }
+    if let Err(why) = harmonise_corner_weights(&mut exact) {
+        return Ok(Err(why));
     }
     let union = |a: Side, b: Side| exact[a as usize].knots.union(&exact[b as usize].knots);
     let finest = [union(Side::South, Side::North)?, union(Side::West, Side::East)?];
@@ -215,8 +252,9 @@ mod tests {
         assert!(input_levels(&b).unwrap().unwrap_err().contains("analytic"));
         let mut b = boundary();
         let SideCurve::Spline(c) = &b.sides[2] else { unreachable!() };
-        b.sides[2] = SideCurve::Spline(Curve { weights: Some(vec![1.0, 0.8, 1.2, 1.0]), ..c.clone() });
-        assert!(input_levels(&b).unwrap().unwrap_err().contains("NURBS"));
+        b.sides[2] = SideCurve::Spline(Curve { weights: Some(vec![2.0, 0.8, 1.2, 1.0]), ..c.clone() });
+        let why = input_levels(&b).unwrap().unwrap_err();
+        assert!(why.contains("NURBS") && why.contains("corner weights"), "{why}");
         // a C0 knot (multiplicity 3 at degree 3) is not rounded silently
         let mut b = boundary();
         b.sides[0] = side(

@@ -98,6 +98,10 @@ pub struct Discretization {
     /// Fill-reducing (nested-dissection) order of the free scalar unknowns for sparse
     /// Cholesky factorizations, `ordering[new] = old`; see [`crate::linalg::ordering`].
     pub ordering: Vec<usize>,
+    /// Weights `w_b` of a rational (NURBS) basis `R_b = w_b N_b / W`, `W = sum w_b N_b`,
+    /// in control-net order, or `None` for the polynomial B-spline basis; see
+    /// [`Discretization::with_weights`].
+    pub weights: Option<Vec<f64>>,
 }
 
 /// Which operator [`Discretization::egg`] discretizes.
@@ -230,7 +234,37 @@ impl Discretization {
         let nx = dofs.shape()[0];
         let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();
         let ordering = crate::linalg::ordering::nested_dissection(&nodes, [p, q]);
-        Self { knots, tables, dofs, vector, scalar, ordering }
+        Self { knots, tables, dofs, vector, scalar, ordering, weights: None }
+    }
+
+    /// The rational basis `R_b = w_b N_b / W` with `W = sum_b w_b N_b` (NURBS, §5.2) on
+    /// the same knots, DOF map and patterns: every kernel (EGG eq. 8, mass, elasticity,
+    /// the Winslow functional and the weak form) then discretizes in it, trial and test
+    /// functions alike, through [`Discretization::tensor_basis`]. `None`, or weights all
+    /// equal to one, give the polynomial basis back. Weights must be finite and positive.
+    pub fn with_weights(mut self, weights: Option<Vec<f64>>) -> Result<Self> {
+        let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
+        if let Some(w) = &weights {
+            if w.len() != self.dofs.num_total() {
+                return Err(crate::error::Error::Invalid(format!(
+                    "{} weights for a basis of {} functions",
+                    w.len(),
+                    self.dofs.num_total()
+                )));
+            }
+            if let Some((k, x)) = w.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x > 0.0)) {
+                return Err(crate::error::Error::Invalid(format!(
+                    "weight {k} of the rational basis is {x}: weights must be finite and positive"
+                )));
+            }
+        }
+        self.weights = weights;
+        Ok(self)
+    }
+
+    /// Whether the basis is rational.
+    pub fn is_rational(&self) -> bool {
+        self.weights.is_some()
     }
 
     /// Interior DOFs free, `max(p, q) + 1` Gauss points per direction: exact for the mass
@@ -350,6 +384,11 @@ impl Discretization {
 
     /// Fill `s.b` with the tensor-product basis values at point `(ku, kv)` of element
     /// `(ex, ey)` and return the quadrature weight.
+    ///
+    /// For a rational basis ([`Discretization::with_weights`]) the B-spline products
+    /// `N_b` become `R_b = w_b N_b / W` by the quotient rule, with `W = sum_b w_b N_b`:
+    /// `R_u = (w N_u - R W_u) / W`, `R_uu = (w N_uu - 2 R_u W_u - R W_uu) / W`,
+    /// `R_uv = (w N_uv - R_u W_v - R_v W_u - R W_uv) / W` (and likewise in `v`).
     pub(crate) fn tensor_basis(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
         let (p, q) = self.degrees();
         let tu = self.tables[0].at(ex, ku);
@@ -359,6 +398,29 @@ impl Discretization {
                 let (u0, u1, u2) = (tu.n[0][ib], tu.n[1][ib], tu.n[2][ib]);
                 let (v0, v1, v2) = (tv.n[0][jb], tv.n[1][jb], tv.n[2][jb]);
                 s.b[jb * (p + 1) + ib] = [u0 * v0, u1 * v0, u0 * v1, u2 * v0, u1 * v1, u0 * v2];
+            }
+        }
+        if let Some(w) = &self.weights {
+            let nx = self.shape()[0];
+            let (fx, fy) = (self.tables[0].first[ex], self.tables[1].first[ey]);
+            let weight = |a: usize| w[(fy + a / (p + 1)) * nx + fx + a % (p + 1)];
+            let mut ww = [0.0; 6];
+            for (a, b) in s.b.iter().enumerate() {
+                let wa = weight(a);
+                for (t, v) in ww.iter_mut().zip(b) {
+                    *t += wa * v;
+                }
+            }
+            let [w0, wu, wv, wuu, wuv, wvv] = ww;
+            for (a, b) in s.b.iter_mut().enumerate() {
+                let wa = weight(a);
+                let r = wa * b[0] / w0;
+                let ru = (wa * b[1] - r * wu) / w0;
+                let rv = (wa * b[2] - r * wv) / w0;
+                let ruu = (wa * b[3] - 2.0 * ru * wu - r * wuu) / w0;
+                let ruv = (wa * b[4] - ru * wv - rv * wu - r * wuv) / w0;
+                let rvv = (wa * b[5] - 2.0 * rv * wv - r * wvv) / w0;
+                *b = [r, ru, rv, ruu, ruv, rvv];
             }
         }
         tu.w * tv.w

@@ -202,6 +202,91 @@ mod tests {
         }
     }
 
+    /// Random positive weights in `[0.5, 2]` for a rational basis of `n` functions.
+    fn weights(n: usize, seed: u64) -> Vec<f64> {
+        let mut rng = Lcg::new(seed);
+        (0..n).map(|_| 0.5 + 1.5 * rng.uniform()).collect()
+    }
+
+    /// The exact Jacobian also holds on a rational (NURBS) basis, where every basis
+    /// function and derivative goes through the quotient rule.
+    #[test]
+    fn jacobian_matches_finite_differences_on_a_rational_basis() {
+        for op in [Operator::Plain, Operator::Scaled] {
+            let (disc, cps) = setup(3, [4, 3], 11, 0.05);
+            let n = disc.dofs.num_total();
+            let disc = disc.with_weights(Some(weights(n, 5))).unwrap();
+            assert!(disc.is_rational());
+            let mut prob = EggProblem::new(Arc::new(disc), cps, op, Arc::new(CpuAssembler));
+            let c = prob.unknowns();
+            let (max_err, max_val) = crate::methods::jacobian_fd_mismatch(&mut prob, &c, 1e-6);
+            assert!(max_err < 1e-7 * max_val, "{op:?}: FD mismatch {max_err} (scale {max_val})");
+        }
+    }
+
+    /// The rational basis values of [`Discretization::tensor_basis`] summed with the
+    /// control points give the NURBS surface (position from `Surface::eval`) and its first
+    /// and second derivatives (central differences of it); the `R_b` sum to one.
+    #[test]
+    fn rational_basis_reproduces_the_nurbs_surface() {
+        use crate::discrete::assembly::Scratch;
+        use crate::spline::surface::Surface;
+        let (disc, cps) = setup(2, [3, 4], 2, 0.1);
+        let w = weights(disc.dofs.num_total(), 9);
+        let disc = disc.with_weights(Some(w.clone())).unwrap();
+        let map = Surface::new(disc.knots.clone(), cps.clone(), Some(w)).unwrap();
+        let (p, q) = disc.degrees();
+        let nx = disc.shape()[0];
+        let mut s = Scratch::new(p, q, 1);
+        let (h1, h) = (1e-6, 1e-4);
+        for (ex, ey, ku, kv) in [(0, 0, 0, 1), (1, 2, 2, 0), (2, 3, 1, 2)] {
+            disc.tensor_basis(ex, ey, ku, kv, &mut s);
+            let (u, v) = (disc.tables[0].at(ex, ku).u, disc.tables[1].at(ey, kv).u);
+            let (fx, fy) = (disc.tables[0].first[ex], disc.tables[1].first[ey]);
+            let mut g = [[0.0; 2]; 6];
+            let mut sum = [0.0; 6];
+            for jb in 0..=q {
+                for ib in 0..=p {
+                    let b = s.b[jb * (p + 1) + ib];
+                    let c = cps[(fy + jb) * nx + fx + ib];
+                    for k in 0..6 {
+                        sum[k] += b[k];
+                        for d in 0..2 {
+                            g[k][d] += b[k] * c[d];
+                        }
+                    }
+                }
+            }
+            assert!((sum[0] - 1.0).abs() < 1e-14 && sum[1..].iter().all(|x| x.abs() < 1e-12), "{sum:?}");
+            let e = |du: f64, dv: f64| map.eval(u + du, v + dv);
+            for d in 0..2 {
+                let want = [
+                    e(0.0, 0.0)[d],
+                    (e(h1, 0.0)[d] - e(-h1, 0.0)[d]) / (2.0 * h1),
+                    (e(0.0, h1)[d] - e(0.0, -h1)[d]) / (2.0 * h1),
+                    (e(h, 0.0)[d] - 2.0 * e(0.0, 0.0)[d] + e(-h, 0.0)[d]) / (h * h),
+                    (e(h, h)[d] - e(h, -h)[d] - e(-h, h)[d] + e(-h, -h)[d]) / (4.0 * h * h),
+                    (e(0.0, h)[d] - 2.0 * e(0.0, 0.0)[d] + e(0.0, -h)[d]) / (h * h),
+                ];
+                for k in 0..6 {
+                    let tol = if k == 0 {
+                        1e-13
+                    } else if k < 3 {
+                        1e-8
+                    } else {
+                        1e-5
+                    };
+                    assert!(
+                        (g[k][d] - want[k]).abs() < tol * (1.0 + want[k].abs()),
+                        "k {k} d {d}: {} vs {}",
+                        g[k][d],
+                        want[k]
+                    );
+                }
+            }
+        }
+    }
+
     /// `-diag(K, K)` of the metric Laplacian preconditions the Newton systems with
     /// GMRES iteration counts that do not grow under refinement, and GMRES reproduces
     /// the direct solution.

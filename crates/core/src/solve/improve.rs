@@ -172,16 +172,12 @@ pub fn improve(
     if !bijective(certificate) {
         return Err(Error::InfeasibleStart { method: method.name().into(), reason: certificate.message() });
     }
-    if map.weights.is_some() {
-        return Err(Error::Invalid(format!(
-            "{} improves polynomial maps only; the start is rational (NURBS weights)",
-            method.name()
-        )));
-    }
     let [p, q] = map.degrees();
     let dofs = DofMap::for_basis(&map.knots, topology)?;
     // the quadrature of the report's Winslow value, (p + 2) points
-    let disc = Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs));
+    // a rational map keeps its weights: the method moves its control points only
+    let disc =
+        Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs).with_weights(map.weights.clone())?);
     let m = disc.dofs.num_free();
     let mut nl = nonlinear;
     nl.method = NonlinearMethod::Newton;
@@ -203,7 +199,8 @@ pub fn improve(
     }
     let status = solver.status().clone();
     let (problem, c) = solver.into_parts();
-    let candidate = Surface { knots: map.knots.clone(), control_points: problem.control_points(&c), weights: None };
+    let candidate =
+        Surface { knots: map.knots.clone(), control_points: problem.control_points(&c), weights: map.weights.clone() };
     let max_displacement = candidate
         .control_points
         .iter()

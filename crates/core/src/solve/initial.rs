@@ -176,7 +176,7 @@ pub struct Continuation {
 /// from the corners.
 pub fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[Point]) -> f64 {
     let shape = disc.shape();
-    let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: None };
+    let map = Surface { knots: disc.knots.clone(), control_points: cps.to_vec(), weights: disc.weights.clone() };
     assembler.sample_det_j(&map, 2 * shape[0].max(shape[1])).min_interior
 }
 

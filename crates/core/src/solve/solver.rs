@@ -61,6 +61,8 @@ struct Active {
     solver: NonlinearSolver<Box<dyn DiscreteProblem + Send>>,
     report: LevelReport,
     started: Instant,
+    /// The level's rational weights ([`Level::weights`]), `None` when polynomial.
+    weights: Option<Vec<f64>>,
 }
 
 /// The coarse-to-fine solver; an `Iterator` over [`Event`]s. Drop it to cancel.
@@ -163,11 +165,16 @@ impl EggSolver {
 
     /// A method that needs a bijective start gets one the certificate proves (or one
     /// positive away from corners the boundary forces to `det J <= 0`).
-    fn check_start(&self, level: &Level, cps: &[crate::spline::curve::Point]) -> Result<()> {
+    fn check_start(
+        &self,
+        level: &Level,
+        weights: &Option<Vec<f64>>,
+        cps: &[crate::spline::curve::Point],
+    ) -> Result<()> {
         if self.method.start() != Start::Bijective {
             return Ok(());
         }
-        let map = Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: None };
+        let map = Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
         let cert = certify(&map, &self.opts.certify)?;
         match cert.verdict {
             CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => Ok(()),
@@ -179,10 +186,14 @@ impl EggSolver {
         let t0 = Instant::now();
         let level = &self.plan[k];
         let topology = &self.opts.topology;
-        let disc = Arc::new(match self.free_boxes.iter().find(|(i, _)| *i == k) {
-            Some((_, boxes)) => frozen_discretization(&level.knots, boxes, topology)?,
-            None => Discretization::for_topology(level.knots.clone(), topology)?,
-        });
+        let weights = level.weights()?;
+        let disc = Arc::new(
+            match self.free_boxes.iter().find(|(i, _)| *i == k) {
+                Some((_, boxes)) => frozen_discretization(&level.knots, boxes, topology)?,
+                None => Discretization::for_topology(level.knots.clone(), topology)?,
+            }
+            .with_weights(weights.clone())?,
+        );
         let mut cont = Continuation::default();
         let (cps, guess) = match &self.previous {
             None => (coons(&level.knots, &level.sides)?, InitialGuess::Coons),
@@ -198,7 +209,7 @@ impl EggSolver {
         };
         let shape = disc.shape();
         let initial_det_j_min = det_j_min(&*self.assembler, &disc, &cps);
-        self.check_start(level, &cps)?;
+        self.check_start(level, &weights, &cps)?;
         let m = disc.dofs.num_free();
         let nl = self.level_options(m);
         let c0 = disc.dofs.gather(&cps);
@@ -225,7 +236,7 @@ impl EggSolver {
             krylov_iterations: 0,
             seconds: 0.0,
         };
-        self.active = Some(Active { level: k, solver, report, started: t0 });
+        self.active = Some(Active { level: k, solver, report, started: t0, weights });
         Ok(Event::LevelStarted { level: k, levels: self.plan.len(), shape, unknowns: 2 * m, initial_guess: guess })
     }
 
@@ -243,7 +254,7 @@ impl EggSolver {
         a.report.seconds = a.started.elapsed().as_secs_f64();
         let (problem, c) = a.solver.into_parts();
         let knots = self.plan[a.level].knots.clone();
-        self.previous = Some(Surface { knots, control_points: problem.control_points(&c), weights: None });
+        self.previous = Some(Surface { knots, control_points: problem.control_points(&c), weights: a.weights });
         self.reports.push(a.report.clone());
         Event::LevelFinished(a.report)
     }
