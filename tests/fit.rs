@@ -62,6 +62,12 @@ const GEOMETRIES: [&str; 19] = [
     "gismo/rotor_sector.json",
 ];
 
+/// The fitted basis (§5): what these tests are about (the default `Auto` keeps spline
+/// sides in their own basis).
+fn fitted() -> FitOptions {
+    FitOptions { basis: winslow::boundary::BasisChoice::Fitted, ..FitOptions::default() }
+}
+
 fn dist(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
@@ -123,7 +129,7 @@ fn check_hierarchy(name: &str, b: &Boundary, h: &Hierarchy) {
 
 #[test]
 fn shared_geometries_fit_within_tolerance() {
-    let opts = FitOptions::default();
+    let opts = fitted();
     let mut table = String::from("geometry            levels  basis sizes (n_xi x n_eta) per level\n");
     for rel in GEOMETRIES {
         let b = load(rel);
@@ -139,7 +145,7 @@ fn shared_geometries_fit_within_tolerance() {
 #[test]
 fn point_clouds_use_cord_length_and_meet_tolerance() {
     // without reparameterization (the default `auto` would constrain the narrow pairs)
-    let mut opts = FitOptions::default();
+    let mut opts = fitted();
     opts.reparam.method = winslow::boundary::reparam::Reparam::None;
     for rel in ["narrow_tube.json", "notched_square.json", "spiral_channel.json"] {
         let b = load(rel);
@@ -212,7 +218,7 @@ fn low_degree_sides_are_reproduced_on_the_coarsest_level() {
         name: "polynomial".into(),
         sides: [SideCurve::Spline(south), SideCurve::Spline(east), SideCurve::Spline(north), west],
     };
-    let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
+    let h = build_hierarchy(&b, &fitted()).unwrap();
     assert_eq!(h.levels.len(), 1);
     assert_eq!(h.finest().num_basis(), 16);
     for fit in &h.fits {
@@ -224,7 +230,7 @@ fn low_degree_sides_are_reproduced_on_the_coarsest_level() {
 #[test]
 fn other_degrees_and_initial_meshes_converge() {
     for (p, ie) in [(2, 1), (4, 3), (5, 2)] {
-        let opts = FitOptions { degree: p, initial_elements: ie, ..Default::default() };
+        let opts = FitOptions { degree: p, initial_elements: ie, ..fitted() };
         for rel in GEOMETRIES {
             let h = build_hierarchy(&load(rel), &opts).unwrap();
             assert!(h.converged(), "{rel} p={p} ie={ie}");
@@ -242,7 +248,7 @@ fn point_cloud_fits_stay_near_the_polyline_between_points() {
     // smooth fit overshoots the polyline slightly (a few tolerances).
     for (rel, factor) in [("narrow_tube.json", 1.0), ("spiral_channel.json", 1.0), ("notched_square.json", 4.0)] {
         let b = load(rel);
-        let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
+        let h = build_hierarchy(&b, &fitted()).unwrap();
         for fit in &h.fits {
             let SideCurve::Points(pts) = b.side(fit.side) else {
                 continue;

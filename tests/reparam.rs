@@ -18,8 +18,16 @@ fn boundary(file: &str) -> Boundary {
     read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 
-fn with(method: Reparam) -> SolveOptions {
+/// The fitted basis, where the reparameterization (§7) applies (the default `Auto` keeps
+/// spline sides in their own basis, parameterization included).
+fn fitted() -> SolveOptions {
     let mut o = SolveOptions::default();
+    o.fit.basis = winslow::boundary::BasisChoice::Fitted;
+    o
+}
+
+fn with(method: Reparam) -> SolveOptions {
+    let mut o = fitted();
     o.fit.reparam.method = method;
     o
 }
@@ -58,28 +66,28 @@ fn assert_matches_on_fit(b: &Boundary, opts: &FitOptions) -> usize {
 #[test]
 fn narrow_tube_auto_is_constrained_and_bijective() {
     let b = boundary("narrow_tube.json");
-    let sol = solve(&b, &SolveOptions::default()).unwrap();
+    let sol = solve(&b, &fitted()).unwrap();
     let r = &sol.report;
     assert_eq!(r.reparam.requested, Reparam::Auto);
     assert_eq!(r.reparam.used, Reparam::Constrained, "gap ratios {:?}", r.reparam.gap_ratio);
     assert!(!r.reparam.matches.is_empty());
     assert_positive("narrow_tube", &sol);
-    assert!(assert_matches_on_fit(&b, &FitOptions::default()) > 0);
+    assert!(assert_matches_on_fit(&b, &fitted().fit) > 0);
 }
 
 #[test]
 fn spiral_channel_auto_is_bijective() {
     let b = boundary("spiral_channel.json");
-    let sol = solve(&b, &SolveOptions::default()).unwrap();
+    let sol = solve(&b, &fitted()).unwrap();
     assert_positive("spiral_channel", &sol);
-    assert_matches_on_fit(&b, &FitOptions::default());
+    assert_matches_on_fit(&b, &fitted().fit);
 }
 
 /// A geometry without narrow gaps keeps its own parameterization under `auto`.
 #[test]
 fn auto_leaves_wide_geometries_alone() {
     let b = boundary("quarter_annulus.json");
-    let h = build_hierarchy(&b, &FitOptions::default()).unwrap();
+    let h = build_hierarchy(&b, &fitted().fit).unwrap();
     assert_eq!(h.reparam.used, Reparam::None);
     assert!(h.reparam.matches.is_empty());
     let h0 = build_hierarchy(&b, &with(Reparam::None).fit).unwrap();
@@ -105,7 +113,7 @@ fn arc_length_on_spline_sides() {
 #[test]
 fn male_casing_ring_auto_is_bijective() {
     let b = boundary("gismo/male_casing_ring.json");
-    let sol = solve(&b, &SolveOptions::default()).unwrap();
+    let sol = solve(&b, &fitted()).unwrap();
     assert_eq!(sol.report.reparam.used, Reparam::Constrained);
     assert_positive("male_casing_ring", &sol);
 }

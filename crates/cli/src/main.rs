@@ -143,16 +143,25 @@ struct FitArgs {
     /// Fritsch-Carlson monotone cubic.
     #[arg(long, value_enum, default_value = "cord-length")]
     reparam_fill: FillArg,
-    /// Basis of the map: `fitted` (dyadic C^{p-1} fits of the sides within --fit-tol) or
-    /// `input` (the B-spline sides' own basis, boundary kept exactly; falls back to
-    /// `fitted` with a message for point clouds, analytic or NURBS sides and C0 knots).
-    #[arg(long, value_enum, default_value = "fitted")]
+    /// Basis of the map: `auto` (the default: the input's own basis, boundary kept
+    /// exactly, when its map is certified; else solved again on the fitted basis, with the
+    /// reason in the report), `fitted` (dyadic C^{p-1} fits of the sides within --fit-tol,
+    /// which with --degree applies to fitted bases only) or `input` (the B-spline or NURBS
+    /// sides' own basis whatever the verdict; falls back to `fitted` with a message for
+    /// point clouds, analytic sides and C0 knots).
+    #[arg(long, value_enum, default_value = "auto")]
     basis: BasisArg,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
 enum BasisArg {
+    /// The input's own basis when the sides allow it and its map is certified, else the
+    /// fitted basis
+    Auto,
+    /// Dyadic bases fitted to the boundary within --fit-tol (§5)
     Fitted,
+    /// The input's own basis, boundary kept exactly (§5.2), falling back to fitted only
+    /// when the sides have no usable basis
     Input,
 }
 
@@ -408,6 +417,7 @@ fn fit_options(f: &FitArgs) -> FitOptions {
         ..Default::default()
     };
     let basis = match f.basis {
+        BasisArg::Auto => BasisChoice::Auto,
         BasisArg::Fitted => BasisChoice::Fitted,
         BasisArg::Input => BasisChoice::Input,
     };

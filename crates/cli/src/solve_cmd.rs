@@ -15,7 +15,19 @@ pub(super) fn run_solver(
     quiet: bool,
 ) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
-    drive(boundary, &h, opts, assembler, quiet)
+    let sol = drive(boundary, &h, opts, assembler.clone(), quiet)?;
+    let Some((fitted, why)) = winslow::solve::solver::auto_fallback(&sol, &opts.fit) else { return Ok(sol) };
+    if !quiet {
+        eprintln!("basis auto: {why}");
+    }
+    let opts = SolveOptions { fit: fitted, ..opts.clone() };
+    let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
+    let mut again = drive(boundary, &h, &opts, assembler, quiet)?;
+    again.report.basis.requested = BasisChoice::Auto;
+    again.report.basis.fallback = Some(why);
+    // the time of the attempt on the input basis counts
+    again.report.seconds += sol.report.seconds;
+    Ok(again)
 }
 
 /// Fit a ring's contours on one periodic knot vector and solve with `eta` periodic
@@ -74,6 +86,7 @@ fn drive(
         );
         match (&h.basis.fallback, h.basis.used) {
             (Some(why), _) => eprintln!("  basis: fitted (the input basis cannot be used: {why})"),
+            (None, BasisChoice::Auto) => {}
             (None, BasisChoice::Input) => eprintln!(
                 "  basis: input, {}x{} functions, boundary kept exactly",
                 h.finest().knots[0].num_basis(),

@@ -64,7 +64,7 @@ fn solve_writes_map_report_png_and_vtk() {
         .arg(&png)
         .arg("--vtk")
         .arg(&vtk)
-        .arg("--json")
+        .args(["--json", "--basis", "fitted"])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -111,7 +111,7 @@ fn solve_writes_map_report_png_and_vtk() {
         .arg(data().join("wavy_lid.json"))
         .arg("-o")
         .arg(&again)
-        .args(["--poisson", "--json"])
+        .args(["--poisson", "--json", "--basis", "fitted"])
         .output()
         .unwrap();
     let r2: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -424,7 +424,7 @@ fn improve_and_start_from_a_map() {
         .arg(data().join("gismo/disk.json"))
         .arg("-o")
         .arg(&map)
-        .args(["--json", "--improve", "winslow"])
+        .args(["--json", "--improve", "winslow", "--basis", "fitted"])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -619,4 +619,43 @@ fn inspect_reads_rings() {
     assert_eq!(o.status.code(), Some(2), "{out}");
     assert!(out.contains("PROBLEM") && out.contains("inner contour is not inside"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The default basis is `auto`: a spline boundary keeps its own basis (duck's 8 x 10
+/// B-spline functions, balanced by exact knot insertion, boundary at rounding level); a
+/// point cloud has none and is fitted, with the reason in the report.
+#[test]
+fn default_basis_keeps_spline_boundaries() {
+    let dir = std::env::temp_dir().join(format!("winslow-cli-auto-{}", std::process::id()));
+    let out = bin()
+        .args(["solve"])
+        .arg(data().join("gismo/xml/duck.xml"))
+        .arg("-o")
+        .arg(dir.join("duck.json"))
+        .args(["--json", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["verdict"], "certified");
+    assert_eq!(
+        (r["basis"]["requested"].as_str(), r["basis"]["used"].as_str()),
+        (Some("auto"), Some("input")),
+        "{}",
+        r["basis"]
+    );
+    let dev = r["boundary_deviation"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(dev < 1e-14 * r["diameter"].as_f64().unwrap(), "{dev}");
+    let out = bin()
+        .args(["solve"])
+        .arg(data().join("narrow_tube.json"))
+        .arg("-o")
+        .arg(dir.join("tube.json"))
+        .args(["--json", "-q"])
+        .output()
+        .unwrap();
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["basis"]["used"], "fitted");
+    assert!(r["basis"]["fallback"].as_str().unwrap().contains("point cloud"), "{}", r["basis"]);
+    std::fs::remove_dir_all(&dir).ok();
 }

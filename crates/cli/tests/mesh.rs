@@ -25,6 +25,8 @@ fn solve_then_mesh_in_every_format() {
     let (ok, out, err) = run(&[
         "solve",
         &lid,
+        "--basis",
+        "fitted",
         "-o",
         &d("lid.json"),
         "-q",

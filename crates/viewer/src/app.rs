@@ -9,6 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use egui::epaint::Mesh;
 use egui::{Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Sense, Shape, Stroke, Ui, Vec2};
+use winslow::boundary::BasisChoice;
 use winslow::discrete::assembly::Operator;
 use winslow::Point;
 
@@ -378,6 +379,15 @@ impl ViewerApp {
                 ui.label("operator");
                 ui.selectable_value(&mut s.operator, Operator::Scaled, "scaled");
                 ui.selectable_value(&mut s.operator, Operator::Plain, "plain");
+            });
+            ui.horizontal(|ui| {
+                ui.label("basis").on_hover_text(
+                    "auto: the input's own basis (boundary exact) when its map is certified, else fitted; \
+                     input: always the input's basis; fitted: fits within the tolerance",
+                );
+                for b in [BasisChoice::Auto, BasisChoice::Input, BasisChoice::Fitted] {
+                    ui.selectable_value(&mut s.basis, b, b.name());
+                }
             });
             ui.add(egui::Slider::new(&mut s.min_elements, 1..=64).text("min elements"));
             ui.add(egui::Slider::new(&mut s.refine, 0..=4).text("extra refinements"));

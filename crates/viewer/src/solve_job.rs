@@ -9,11 +9,12 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use winslow::boundary::hierarchy::build_hierarchy;
+use winslow::boundary::BasisChoice;
 use winslow::methods::egg::CpuAssembler;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
-use winslow::solve::solver::{EggSolver, Event};
+use winslow::solve::solver::{auto_fallback, EggSolver, Event};
 use winslow::Boundary;
 
 /// A message from the solving thread.
@@ -37,34 +38,70 @@ pub enum Msg {
 }
 
 /// Fit and solve `boundary`, sending every step to `send`; checks `cancel` before the
-/// fit and between events. Always ends with `Finished`, `Failed` or `Cancelled`.
+/// fit and between events. Always ends with `Finished`, `Failed` or `Cancelled`. With the
+/// default basis `auto`, a map on the input basis that is not certified is solved again on
+/// the fitted basis ([`auto_fallback`]), as the CLI does.
 pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
+    let Some(sol) = attempt(boundary, opts, cancel, send) else { return };
+    let Some((fitted, why)) = auto_fallback(&sol, &opts.fit) else {
+        return send(Msg::Finished(Box::new(sol)));
+    };
+    let again = SolveOptions { fit: fitted, ..opts.clone() };
+    if let Some(mut s) = attempt(boundary, &again, cancel, send) {
+        s.report.basis.requested = BasisChoice::Auto;
+        s.report.basis.fallback = Some(why);
+        s.report.seconds += sol.report.seconds;
+        send(Msg::Finished(Box::new(s)));
+    }
+}
+
+/// One fit and solve; `None` once `Failed` or `Cancelled` was sent.
+fn attempt(
+    boundary: &Boundary,
+    opts: &SolveOptions,
+    cancel: &AtomicBool,
+    send: &mut dyn FnMut(Msg),
+) -> Option<Solution> {
     let cancelled = || cancel.load(Ordering::Relaxed);
     if cancelled() {
-        return send(Msg::Cancelled);
+        send(Msg::Cancelled);
+        return None;
     }
     let h = match build_hierarchy(boundary, &opts.fit) {
         Ok(h) => h,
-        Err(e) => return send(Msg::Failed(format!("fitting the boundary: {e}"))),
+        Err(e) => {
+            send(Msg::Failed(format!("fitting the boundary: {e}")));
+            return None;
+        }
     };
     send(Msg::Fitted { levels: h.levels.len(), tolerance: h.physical_tol_abs() });
     let mut solver = match EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler)) {
         Ok(s) => s,
-        Err(e) => return send(Msg::Failed(e.to_string())),
+        Err(e) => {
+            send(Msg::Failed(e.to_string()));
+            return None;
+        }
     };
     loop {
         if cancelled() {
-            return send(Msg::Cancelled);
+            send(Msg::Cancelled);
+            return None;
         }
         match solver.next() {
             Some(Ok(e)) => send(Msg::Event(e)),
-            Some(Err(e)) => return send(Msg::Failed(e.to_string())),
+            Some(Err(e)) => {
+                send(Msg::Failed(e.to_string()));
+                return None;
+            }
             None => break,
         }
     }
     match solver.finish(boundary, &h) {
-        Ok(s) => send(Msg::Finished(Box::new(s))),
-        Err(e) => send(Msg::Failed(e.to_string())),
+        Ok(s) => Some(s),
+        Err(e) => {
+            send(Msg::Failed(e.to_string()));
+            None
+        }
     }
 }
 

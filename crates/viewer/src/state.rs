@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
+use winslow::boundary::BasisChoice;
 use winslow::discrete::assembly::Operator;
 use winslow::solve::options::SolveOptions;
 use winslow::Point;
@@ -51,12 +52,20 @@ pub struct SolveSettings {
     pub refine: usize,
     /// Fit tolerance relative to the diameter.
     pub fit_tol: f64,
+    /// The basis: auto (the input's own when certified), input or fitted.
+    pub basis: BasisChoice,
 }
 
 impl Default for SolveSettings {
     fn default() -> Self {
         let d = SolveOptions::default();
-        Self { operator: d.operator, min_elements: d.min_elements, refine: d.refine, fit_tol: d.fit.tol }
+        Self {
+            operator: d.operator,
+            min_elements: d.min_elements,
+            refine: d.refine,
+            fit_tol: d.fit.tol,
+            basis: d.fit.basis,
+        }
     }
 }
 
@@ -70,6 +79,7 @@ impl SolveSettings {
             ..Default::default()
         };
         o.fit.tol = self.fit_tol;
+        o.fit.basis = self.basis;
         o
     }
 }

@@ -97,8 +97,8 @@ pub struct FitOptions {
     pub max_elements: usize,
     /// Reparameterization of the sides before the fit (paper §7). Default `auto`.
     pub reparam: ReparamOptions,
-    /// Solve in the fitted basis (default) or in the input's own basis, keeping the
-    /// boundary exactly ([`super::input_basis`], §5.2).
+    /// The basis: `Auto` (default: the input's own basis, boundary kept exactly, when its
+    /// map certifies, else fitted), `Fitted` or `Input` ([`super::input_basis`], §5.2).
     pub basis: BasisChoice,
 }
 
@@ -111,7 +111,7 @@ impl Default for FitOptions {
             max_levels: 14,
             max_elements: 4096,
             reparam: ReparamOptions::default(),
-            basis: BasisChoice::Fitted,
+            basis: BasisChoice::Auto,
         }
     }
 }

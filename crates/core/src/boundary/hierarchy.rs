@@ -191,8 +191,9 @@ impl Hierarchy {
     }
 }
 
-/// With `opts.basis` = [`BasisChoice::Input`], the hierarchy on the input's own basis
-/// ([`input_levels`]) when the sides allow it; otherwise (and by default):
+/// With `opts.basis` = [`BasisChoice::Input`] or [`BasisChoice::Auto`] (the default), the
+/// hierarchy on the input's own basis ([`input_levels`]) when the sides allow it;
+/// otherwise, and with [`BasisChoice::Fitted`]:
 /// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
 /// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
@@ -221,11 +222,11 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
     let tol_abs = opts.tol * diameter;
     let corners = corners(boundary, diameter)?;
     let mut fallback = None;
-    if opts.basis == BasisChoice::Input {
+    if opts.basis != BasisChoice::Fitted {
         match input_levels(boundary)? {
             Ok(input) => {
                 let levels = input.levels.into_iter().map(|(knots, sides)| Level { knots, sides }).collect();
-                let basis = BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None };
+                let basis = BasisReport { requested: opts.basis, used: BasisChoice::Input, fallback: None };
                 let reparam = ReparamReport::native();
                 return Ok(Hierarchy {
                     levels,

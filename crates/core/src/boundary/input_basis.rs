@@ -11,7 +11,8 @@
 //! the constrained least squares of [`super::fit::project_side`] (corners kept), so the
 //! solve walks coarse to fine with the elasticity prolongation exactly as on fitted
 //! hierarchies, and its finest level has the input boundary exactly (knot insertion by
-//! `--refine` or by defect correction keeps it exact).
+//! `--refine` or by defect correction keeps it exact). Small input bases
+//! ([`DIRECT_SOLVE_MAX_FUNCTIONS`]) are solved directly from the Coons patch.
 //!
 //! Not every input can be kept this way; [`input_levels`] says why and the caller
 //! falls back to the fitted basis:
@@ -95,6 +96,15 @@ fn harmonise_corner_weights(sides: &mut [Curve]) -> std::result::Result<(), Stri
     Ok(())
 }
 
+/// Input bases with at most this many functions are solved directly from the Coons patch,
+/// without the coarse levels of §6.3: on the shared geometries the direct solve converges
+/// and certifies wherever the hierarchy does (same verdicts, same repair rounds), in
+/// 1.3–2.9x less time up to about a thousand functions (duck 80: 0.007 s against 0.018 s,
+/// butterfly 625: 0.24 s against 0.69 s), while from a few thousand functions on the
+/// hierarchy is faster (butterfly at 8281: 3.0 s against 8.3 s, puzzle3 at 17161: 4.0 s
+/// against 9.5 s): `bash scripts/bench-basis.sh`, BENCHMARKS.md.
+pub const DIRECT_SOLVE_MAX_FUNCTIONS: usize = 1024;
+
 /// Remove every other distinct interior break (with all its multiplicity).
 fn coarsened(kv: &KnotVector) -> KnotVector {
     let bm = kv.breaks_with_multiplicity();
@@ -136,6 +146,11 @@ pub struct InputLevels {
 /// The levels on the input basis (see the module documentation), or the reason why the
 /// boundary cannot be kept in it.
 pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLevels, String>> {
+    input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS)
+}
+
+/// [`input_levels`] with the coarse levels built only above `direct_max` functions.
+pub fn input_levels_with(boundary: &Boundary, direct_max: usize) -> Result<std::result::Result<InputLevels, String>> {
     let side_degree = |s: Side| match boundary.side(s) {
         SideCurve::Spline(c) => c.degree(),
         _ => 0,
@@ -154,7 +169,12 @@ pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLeve
     }
     let union = |a: Side, b: Side| exact[a as usize].knots.union(&exact[b as usize].knots);
     let finest = [union(Side::South, Side::North)?, union(Side::West, Side::East)?];
-    let chains = [coarsening(&finest[0]), coarsening(&finest[1])];
+    let functions = finest[0].num_basis() * finest[1].num_basis();
+    let chains = if functions <= direct_max {
+        [vec![finest[0].clone()], vec![finest[1].clone()]]
+    } else {
+        [coarsening(&finest[0]), coarsening(&finest[1])]
+    };
     let m = chains[0].len().max(chains[1].len());
     // level k of a direction with fewer levels stays at its coarsest
     let pick = |d: usize, k: usize| chains[d][k.saturating_sub(m - chains[d].len())].clone();
@@ -222,7 +242,8 @@ mod tests {
     #[test]
     fn finest_level_is_the_input() {
         let b = boundary();
-        let h = input_levels(&b).unwrap().unwrap();
+        assert_eq!(input_levels(&b).unwrap().unwrap().levels.len(), 1, "a small basis is solved directly");
+        let h = input_levels_with(&b, 0).unwrap().unwrap();
         let (knots, sides) = h.levels.last().unwrap();
         assert_eq!([knots[0].degree(), knots[1].degree()], [3, 2]);
         for s in Side::ALL {

@@ -43,17 +43,22 @@ use crate::spline::surface::Side;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BasisChoice {
-    /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
+    /// The input basis when the sides allow it and its map is certified, else the fitted
+    /// basis ([`crate::solve::solver::solve`] solves again): the boundary is kept exactly
+    /// wherever that gives a certified map (BASIS.md table in BENCHMARKS.md).
     #[default]
+    Auto,
+    /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
     Fitted,
     /// The basis of the input's spline sides, boundary kept exactly (§5.2).
     Input,
 }
 
 impl BasisChoice {
-    /// `"fitted"` or `"input"`.
+    /// `"auto"`, `"fitted"` or `"input"`.
     pub fn name(self) -> &'static str {
         match self {
+            BasisChoice::Auto => "auto",
             BasisChoice::Fitted => "fitted",
             BasisChoice::Input => "input",
         }

@@ -16,7 +16,7 @@ use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
-use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
+use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
 use crate::boundary::corners::boundary_kinks;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
 use crate::boundary::BasisChoice;
@@ -113,11 +113,13 @@ impl EggSolver {
         method: Arc<dyn Method>,
     ) -> Result<Self> {
         opts.topology.validate(None)?;
-        // the input basis is solved as given (only `refine` halves it): no balancing and
-        // no minimum element count, which would change the basis the user chose
-        let (min_elements, aspect) = match hierarchy.basis.used {
-            BasisChoice::Input => (1, f64::INFINITY),
-            BasisChoice::Fitted => (opts.min_elements, opts.aspect),
+        // `--basis input` is solved as given (only `refine` halves it): no balancing and
+        // no minimum element count, which would change the basis the user chose; `auto`
+        // balances the input basis as it does fitted ones, by exact knot insertion, so the
+        // boundary stays the input's
+        let (min_elements, aspect) = match (hierarchy.basis.requested, hierarchy.basis.used) {
+            (BasisChoice::Input, BasisChoice::Input) => (1, f64::INFINITY),
+            _ => (opts.min_elements, opts.aspect),
         };
         let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.refine, aspect)?;
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
@@ -314,7 +316,7 @@ impl EggSolver {
                 let mut dev = match hierarchy.basis.used {
                     // the same curve at equal parameters: measured exactly, not by a polyline
                     BasisChoice::Input => parametric_boundary_deviation(&map, boundary, 400),
-                    BasisChoice::Fitted => None,
+                    BasisChoice::Fitted | BasisChoice::Auto => None,
                 }
                 .unwrap_or_else(|| boundary_deviation(&map, boundary, 400));
                 if self.opts.topology.eta_periodic() {
@@ -408,10 +410,51 @@ impl Iterator for EggSolver {
     }
 }
 
-/// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream.
+/// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream. With
+/// [`BasisChoice::Auto`] a map on the input basis that is not certified is solved again
+/// on the fitted basis ([`auto_fallback`]).
 pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
     let h = build_hierarchy(boundary, &opts.fit)?;
-    EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(boundary, &h)
+    let sol = EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(boundary, &h)?;
+    match auto_fallback(&sol, &opts.fit) {
+        None => Ok(sol),
+        Some((fitted, why)) => {
+            let mut o = opts.clone();
+            o.fit = fitted;
+            let h = build_hierarchy(boundary, &o.fit)?;
+            let mut again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
+            again.report.basis.requested = BasisChoice::Auto;
+            again.report.basis.fallback = Some(why);
+            // the time of the attempt on the input basis counts
+            again.report.seconds += sol.report.seconds;
+            Ok(again)
+        }
+    }
+}
+
+/// With [`BasisChoice::Auto`]: when `sol` was solved on the input basis and its map is
+/// not certified (folded, undecided or not converged; `degenerate-corner` is the best
+/// map such a boundary allows and is kept), the fit options of the fitted basis and the
+/// reason to solve again with them. `None` when `sol` stands.
+pub fn auto_fallback(
+    sol: &Solution,
+    fit: &crate::boundary::fit::FitOptions,
+) -> Option<(crate::boundary::fit::FitOptions, String)> {
+    let r = &sol.report;
+    if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
+        return None;
+    }
+    if matches!(r.verdict, Verdict::Certified | Verdict::DegenerateCorner) {
+        return None;
+    }
+    let why = format!(
+        "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
+        r.basis_functions,
+        r.repairs,
+        r.verdict.name()
+    );
+    let fit = crate::boundary::fit::FitOptions { basis: BasisChoice::Fitted, ..*fit };
+    Some((fit, why))
 }
 
 /// The options of a ring solve (§11.1) made from `opts`: `eta` periodic
