@@ -27,7 +27,8 @@ on a bilinear single element). winslow solves NURBS sides in its rational tensor
 interior weights; same functions), falls back to a fitted basis for interior C0 knots,
 and its defect correction adds knots where the certificate finds a fold; the table then
 shows different function counts (the "winslow basis" column says which basis was used
-and how many repair rounds ran). The last column compares like for like: G+Smo's
+and how many repair rounds ran). Runs under 0.2 s are repeated five times on both sides
+and the fastest is kept. The last column compares like for like: G+Smo's
 `compute()` against the report's "seconds" (winslow's solve with its certificate and
 report, inside the process), both without process start-up and file I/O.
 
@@ -312,6 +313,16 @@ def main():
         for k in (int(x) for x in args.refine.split(",")):
             gf, gsec, gver = run_gismo_isolated(args.winslow, name, k, args.out)
             wf, wwall, wsec, wver, wbasis = run_winslow(args.winslow, name, k, args.out)
+            # runs under 0.2 s are at the mercy of the scheduler: repeat both sides (same
+            # inputs, same verdicts) and keep the fastest of five
+            if gsec is not None and gsec < 0.2:
+                for _ in range(4):
+                    t = run_gismo_isolated(args.winslow, name, k, args.out)[1]
+                    gsec = min(gsec, t) if t is not None else gsec
+            if wsec is not None and wwall < 0.2:
+                for _ in range(4):
+                    r = run_winslow(args.winslow, name, k, args.out)
+                    wwall, wsec = min(wwall, r[1]), min(wsec, r[2]) if r[2] is not None else wsec
             ratio = f"{gsec / wwall:.1f}" if gsec is not None and wwall else "-"
             # like for like: G+Smo's compute() against winslow's solve (hierarchy, Newton,
             # certificate and report) inside the process, both without start-up and I/O

@@ -263,6 +263,29 @@ mod tests {
         assert!(h.fits[0].max_error[0] > 0.0, "a coarse projection of the wavy side is not exact");
     }
 
+    /// Knot removal then insertion: a spline that lies in the coarse space (here: a
+    /// coarse curve refined by insertion onto the fine knots) is reproduced exactly by the
+    /// coarse level's projection, and the coarse knots are a subset of the fine ones.
+    #[test]
+    fn knot_removal_then_insertion_reproduces_coarse_splines() {
+        let fine = KnotVector::new(3, vec![0., 0., 0., 0., 0.1, 0.25, 0.3, 0.55, 0.7, 0.9, 1., 1., 1., 1.]).unwrap();
+        let chain = coarsening(&fine);
+        assert_eq!(chain.last(), Some(&fine));
+        assert_eq!(chain[0].num_elements(), 1);
+        for coarse in &chain[..chain.len() - 1] {
+            assert!(fine.contains(coarse));
+            let cps: Vec<[f64; 2]> =
+                (0..coarse.num_basis()).map(|i| [i as f64, ((i * 7) % 5) as f64 - 2.0 + 0.1 * i as f64]).collect();
+            let c = Curve::polynomial(coarse.clone(), cps.clone());
+            let on_fine = c.refined(&fine).unwrap();
+            let pr = project_side(&SideCurve::Spline(on_fine), coarse, c.endpoints()).unwrap();
+            for (a, b) in pr.curve.control_points.iter().zip(&cps) {
+                assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{a:?} vs {b:?}");
+            }
+            assert!(pr.max_error < 1e-12, "{}", pr.max_error);
+        }
+    }
+
     #[test]
     fn unsuitable_sides_say_why() {
         let mut b = boundary();
