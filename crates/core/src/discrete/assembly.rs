@@ -240,7 +240,7 @@ impl Discretization {
     /// The rational basis `R_b = w_b N_b / W` with `W = sum_b w_b N_b` (NURBS, §5.2) on
     /// the same knots, DOF map and patterns: every kernel (EGG eq. 8, mass, elasticity,
     /// the Winslow functional and the weak form) then discretizes in it, trial and test
-    /// functions alike, through [`Discretization::tensor_basis`]. `None`, or weights all
+    /// functions alike, through `Discretization::tensor_basis`. `None`, or weights all
     /// equal to one, give the polynomial basis back. Weights must be finite and positive.
     pub fn with_weights(mut self, weights: Option<Vec<f64>>) -> Result<Self> {
         let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
