@@ -178,7 +178,10 @@ pub struct Report {
     pub verdict: Verdict,
     /// Plain-language summary of the verdict.
     pub message: String,
-    /// Total seconds.
+    /// Seconds of the solve: the levels (initial guesses, iterations), repair rounds,
+    /// the improvement stage and the certificate of the map written; not the fit of
+    /// the boundary before it, nor the report's own measurements of the map after it
+    /// (boundary deviation, det J sample, quality functionals).
     pub seconds: f64,
     /// Tensor-product basis functions of the map (`n_xi * n_eta`).
     pub basis_functions: usize,
