@@ -10,6 +10,7 @@
 //! | [`bezier`] | Bézier extraction of a tensor basis | §8.1 |
 //! | [`periodic`] | periodic splines (wrapped control points): knot insertion, elevation and Bézier extraction by blossoming | §11.1 |
 //! | [`quadrature`] | Gauss–Legendre rules | §4 |
+//! | [`volume`] | [`Volume`](volume::Volume): trivariate tensor-product maps `x: [0,1]³ → R³`, knot insertion, elevation, Bézier nets | §11.1 |
 
 pub mod basis;
 pub mod bezier;
@@ -19,3 +20,4 @@ pub mod periodic;
 pub mod quadrature;
 pub mod refine;
 pub mod surface;
+pub mod volume;
