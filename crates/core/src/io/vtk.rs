@@ -63,7 +63,7 @@ pub fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
 
 /// Inverse of the Bernstein collocation matrix `B[a][k] = B_k^p(a / p)` (row-major),
 /// by Gauss–Jordan elimination with partial pivoting (the matrix is totally positive).
-fn bernstein_interpolation(p: usize) -> Vec<f64> {
+pub(super) fn bernstein_interpolation(p: usize) -> Vec<f64> {
     let n = p + 1;
     let mut a = vec![0.0; n * n];
     let mut b = vec![0.0; n];
