@@ -125,3 +125,39 @@ fn ring_slices_loft_with_a_periodic_direction() {
         assert_eq!(out.report.verdict, "certified", "{interpolation:?}: {}", out.certificate.message());
     }
 }
+
+/// The unit square's identity on a degree-3 basis with its interior turned by the
+/// swirl `φ(r) = a (1 - r / 0.5)²` about the centre (`r <= 0.5`; the boundary stays).
+fn swirl(a: f64) -> Surface {
+    let k = KnotVector::open_uniform(3, 16);
+    let g = k.greville();
+    let mut cps = Vec::new();
+    for &v in &g {
+        for &u in &g {
+            let (x, y) = (u - 0.5, v - 0.5);
+            let r = x.hypot(y);
+            let phi = if r < 0.5 { a * (1.0 - r / 0.5).powi(2) } else { 0.0 };
+            let (c, s) = (phi.cos(), phi.sin());
+            cps.push([0.5 + c * x - s * y, 0.5 + s * x + c * y]);
+        }
+    }
+    Surface::new([k.clone(), k], cps, None).unwrap()
+}
+
+/// Two swirls of opposite sense with the same boundary: each slice is bijective, their
+/// average turns the centre by `cos φ < 0` and folds. With only the maps given, the
+/// slice inserted in the middle takes the interpolated (here: the common) boundary, EGG
+/// gives it no swirl, and the volume certifies.
+#[test]
+fn an_inserted_slice_with_the_interpolated_boundary_unfolds_opposite_swirls() {
+    let a = 2.8; // 160 degrees at the centre
+    let slices = [swirl(a), swirl(-a)];
+    let out = loft(&slices, &[0.0, 1.0], &LoftOptions::default(), SliceBoundary::Interpolated).unwrap();
+    assert_eq!(out.report.rounds[0].verdict, "folded", "{:?}", out.report.rounds);
+    assert_eq!(out.report.verdict, "certified", "{:?}", out.report.rounds);
+    assert!(out.z.len() >= 3 && out.report.slices.iter().any(|s| s.boundary == Some("interpolated")));
+    // the inserted middle slice has (nearly) no swirl left: its centre stays put
+    let mid = &out.slices[out.z.iter().position(|&z| z == 0.5).expect("a slice at 0.5")];
+    let c = mid.eval(0.5, 0.5);
+    assert!((c[0] - 0.5).abs() < 1e-6 && (c[1] - 0.5).abs() < 1e-6, "{c:?}");
+}
