@@ -68,13 +68,7 @@ fn exit_code(v: &VolumeVerdict) -> i32 {
 }
 
 /// Write a volume in the format of the output's extension.
-fn write_volume(
-    path: &Path,
-    name: &str,
-    vol: &Volume,
-    label: &str,
-    json: impl Fn() -> serde_json::Value,
-) -> Result<()> {
+fn write_volume(path: &Path, vol: &Volume, label: &str, json: impl Fn() -> serde_json::Value) -> Result<()> {
     output::ensure_parent(path)?;
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let text = match ext.as_str() {
