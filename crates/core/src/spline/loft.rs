@@ -72,7 +72,7 @@ pub fn check_heights(z: &[f64], slices: usize) -> Result<()> {
     }
     let total = z[slices - 1] - z[0];
     for i in 1..slices {
-        if !(z[i] - z[i - 1] > 1e-9 * total.abs()) || total <= 0.0 {
+        if z[i] - z[i - 1] <= 1e-9 * total.abs() || total <= 0.0 {
             return Err(slices_err(
                 Some(i),
                 format!("the heights must increase strictly: z = {} follows z = {}", z[i], z[i - 1]),
