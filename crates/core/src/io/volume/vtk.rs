@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 use crate::error::Result;
-use crate::io::vtk::bernstein_interpolation;
+use crate::io::vtk::{bernstein_interpolation, cells_and_end};
 use crate::spline::basis::BasisDerivs;
 use crate::spline::volume::Volume;
 
@@ -172,18 +172,8 @@ pub fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
     }
     let _ = writeln!(out, "\n</DataArray>\n</CellData>\n<Points>");
     let _ = writeln!(out, "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n{pts}</DataArray>");
-    let _ = writeln!(out, "</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">");
-    for c in 0..ne {
-        let ids: Vec<String> = (c * npe..(c + 1) * npe).map(|i| i.to_string()).collect();
-        let _ = writeln!(out, "{}", ids.join(" "));
-    }
-    let _ = writeln!(out, "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">");
-    let offsets: Vec<String> = (1..=ne).map(|c| (c * npe).to_string()).collect();
-    let _ = writeln!(out, "{}", offsets.join(" "));
-    let _ = writeln!(out, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">");
-    let types: Vec<String> = (0..ne).map(|_| VTK_BEZIER_HEXAHEDRON.to_string()).collect();
-    let _ = writeln!(out, "{}", types.join(" "));
-    let _ = writeln!(out, "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>");
+    let _ = writeln!(out, "</Points>");
+    cells_and_end(&mut out, ne, npe, VTK_BEZIER_HEXAHEDRON);
     Ok(out)
 }
 
