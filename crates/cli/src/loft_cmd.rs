@@ -9,7 +9,7 @@ use winslow::io::volume::{read_volume, volume_to_json, VolumeDocument};
 use winslow::solve::loft::{loft, LoftOptions, SliceBoundary};
 use winslow::spline::loft::Interpolation;
 use winslow::spline::volume::Volume;
-use winslow::verify::certificate::volume::{certify_volume, volume_integral, VolumeCertificate, VolumeVerdict};
+use winslow::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeVerdict};
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
 pub(super) enum InterpolationArg {
@@ -188,7 +188,9 @@ pub(super) fn check_volume(doc: &VolumeDocument, max_depth: usize, max_boxes: us
         kind: "volume",
         degrees: vol.degrees(),
         shape: vol.shape(),
-        volume: volume_integral(vol),
+        // mean det J times the parameter volume (knot domains are [0, 1]): exact from the
+        // Bernstein coefficients for polynomial maps, Gauss quadrature for rational ones
+        volume: cert.mean_det_j * vol.knots.iter().map(|k| k.domain().1 - k.domain().0).product::<f64>(),
         certificate: &cert,
     };
     if json {
