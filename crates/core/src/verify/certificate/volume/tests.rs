@@ -206,3 +206,26 @@ fn multiplicity_above_degree_is_a_typed_error() {
         other => panic!("{:?}", other.map(|c| c.verdict)),
     }
 }
+
+/// An affine map has constant `det J = det A`: the proven bound is `det A` to rounding,
+/// and the mean is exact.
+#[test]
+fn affine_maps_are_certified_with_a_tight_bound() {
+    let mut rng = Lcg::new(12);
+    let a = [[2.0, 0.3, -0.1], [0.2, 1.5, 0.4], [-0.3, 0.1, 0.7]];
+    let det = crate::spline::volume::triple(
+        [a[0][0], a[1][0], a[2][0]],
+        [a[0][1], a[1][1], a[2][1]],
+        [a[0][2], a[1][2], a[2][2]],
+    );
+    let mut vol = perturbed(&mut rng, [2, 3, 1], [3, 2, 4], 0.0, false);
+    for p in vol.control_points.iter_mut() {
+        let x = *p;
+        *p = std::array::from_fn(|r| 5.0 + a[r][0] * x[0] + a[r][1] * x[1] + a[r][2] * x[2]);
+    }
+    let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
+    let VolumeVerdict::Certified { lower_bound, relative } = c.verdict else { panic!("{:?}", c.verdict) };
+    assert!(det > 0.0 && lower_bound <= det && lower_bound > det * (1.0 - 1e-11), "{lower_bound} vs {det}");
+    assert!((c.mean_det_j - det).abs() < 1e-12 * det && (relative - lower_bound / det).abs() < 1e-12);
+    assert_eq!(c.boxes, c.elements);
+}
