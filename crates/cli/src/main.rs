@@ -32,6 +32,7 @@ use winslow_gpu::{Backend, Precision, Selected};
 
 mod corpus;
 mod inspect_ring;
+mod loft_cmd;
 mod mesh;
 mod output;
 mod solve_cmd;
@@ -76,6 +77,9 @@ enum Command {
     /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
     /// angle per step, one certified map per frame from extrapolated initial guesses.
     Sweep(Box<sweep_cmd::SweepArgs>),
+    /// Volumes from planar slices (paper §11.1, Fig. 23): one basis, linear or C2 cubic
+    /// in z, certified (trivariate det J), slices inserted where it is not.
+    Loft(Box<loft_cmd::LoftArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -89,7 +93,7 @@ struct ConvertArgs {
 
 #[derive(Args, Debug)]
 struct CheckArgs {
-    /// Map file (JSON map document or G+Smo XML).
+    /// Map file (JSON map document or G+Smo XML; a volume: the trivariate certificate).
     map: PathBuf,
     /// The input boundary: report the largest deviation of the map's boundary from it.
     #[arg(long)]
@@ -572,6 +576,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
+        Command::Loft(a) => loft_cmd::run(*a),
     }
 }
 
@@ -621,6 +626,9 @@ fn inspect(a: InspectArgs) -> Result<i32> {
 }
 
 fn convert(a: ConvertArgs) -> Result<i32> {
+    if let Some(v) = loft_cmd::volume_in(&a.map)? {
+        return loft_cmd::convert_volume(&v, &a.output);
+    }
     let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
     let Document::Map { name, map, .. } = doc else {
         bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
@@ -639,6 +647,9 @@ fn convert(a: ConvertArgs) -> Result<i32> {
 }
 
 fn check(a: CheckArgs) -> Result<i32> {
+    if let Some(v) = loft_cmd::volume_in(&a.map)? {
+        return loft_cmd::check_volume(&v, a.max_depth, a.max_boxes, a.json);
+    }
     let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
     let Document::Map { name, map, .. } = doc else {
         bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())

@@ -80,6 +80,16 @@ pub enum Error {
     /// A side's boundary condition is inconsistent or not supported by the caller.
     #[error("boundary condition of the {side} side: {reason}")]
     Topology { side: String, reason: String },
+    /// Planar slices that cannot be lofted into one volume (paper §11.1): heights that
+    /// are not strictly increasing or not one per slice, bases that cannot be brought to
+    /// one (a ring and a four-sided slice, different parameter domains), a slice given
+    /// twice.
+    #[error("cannot loft the slices{}: {reason}", .slice.map(|s| format!(" (slice {s})")).unwrap_or_default())]
+    Slices { slice: Option<usize>, reason: String },
+    /// A slice of a loft (given, or inserted where the volume was not certified) whose
+    /// planar certificate is not `certified`.
+    #[error("slice {slice} at z = {z} is not certified ({verdict}): {message}")]
+    SliceNotCertified { slice: usize, z: f64, verdict: String, message: String },
     /// A method that needs a bijective start (paper eq. 14, 16) was given a map that is
     /// not certified.
     #[error("{method} needs a bijective start: {reason}")]

@@ -48,6 +48,7 @@
 //! | §8.2 | local defect correction | [`solve::repair`] |
 //! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
+//! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
 //!
 //! A geometry is a basis plus coefficients ([`Surface`], [`Curve`]); one DOF map
 //! ([`discrete::dofs::DofMap`], built from the patch's [`Topology`]) of free versus fixed

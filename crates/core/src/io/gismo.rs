@@ -26,15 +26,15 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
 
 /// Largest number of XML nodes parsed (a guard against absurd inputs).
-const MAX_NODES: u32 = 1 << 24;
+pub(super) const MAX_NODES: u32 = 1 << 24;
 /// Deepest element nesting accepted (G+Smo files nest about six levels; the XML parser
 /// recurses per level, so absurd nesting must be refused before parsing).
-const MAX_DEPTH: usize = 256;
+pub(super) const MAX_DEPTH: usize = 256;
 /// Relative corner tolerance used to *choose* the side assignment of four curves; the
 /// stricter check of `formats.md` is done by validation afterwards.
 pub const ASSIGN_TOL: f64 = 1e-6;
 
-fn xml_err(context: &str, message: impl Into<String>) -> Error {
+pub(super) fn xml_err(context: &str, message: impl Into<String>) -> Error {
     Error::Xml { context: context.to_string(), message: message.into() }
 }
 
@@ -43,11 +43,11 @@ fn is(node: &Node, name: &str) -> bool {
 }
 
 /// Element children with the given tag name.
-fn children<'a, 'i>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
+pub(super) fn children<'a, 'i>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
     node.children().filter(move |c| is(c, name))
 }
 
-fn only_child<'a, 'i>(node: Node<'a, 'i>, name: &str, ctx: &str) -> Result<Node<'a, 'i>> {
+pub(super) fn only_child<'a, 'i>(node: Node<'a, 'i>, name: &str, ctx: &str) -> Result<Node<'a, 'i>> {
     let mut it = node.children().filter(|c| is(c, name));
     match (it.next(), it.next()) {
         (Some(c), None) => Ok(c),
@@ -57,7 +57,7 @@ fn only_child<'a, 'i>(node: Node<'a, 'i>, name: &str, ctx: &str) -> Result<Node<
 }
 
 /// All text inside an element (comments skipped), as whitespace-separated numbers.
-fn numbers(node: Node, ctx: &str) -> Result<Vec<f64>> {
+pub(super) fn numbers(node: Node, ctx: &str) -> Result<Vec<f64>> {
     let mut out = Vec::new();
     for t in node.descendants().filter(|n| n.is_text()) {
         for tok in t.text().unwrap_or("").split_whitespace() {
@@ -82,12 +82,12 @@ fn numbers(node: Node, ctx: &str) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-fn basis_type<'a>(node: &Node<'a, '_>) -> &'a str {
+pub(super) fn basis_type<'a>(node: &Node<'a, '_>) -> &'a str {
     node.attribute("type").unwrap_or("")
 }
 
 /// `<Basis type="BSplineBasis"><KnotVector degree="p">...</KnotVector></Basis>`.
-fn bspline_basis(node: Node, ctx: &str) -> Result<KnotVector> {
+pub(super) fn bspline_basis(node: Node, ctx: &str) -> Result<KnotVector> {
     if basis_type(&node) != "BSplineBasis" {
         return Err(xml_err(ctx, format!("expected a BSplineBasis, found type {:?}", basis_type(&node))));
     }
@@ -124,7 +124,7 @@ fn coefs(geom: Node, n: usize, ctx: &str) -> Result<Vec<Point>> {
     Ok(vals.chunks_exact(dim).map(|c| [c[0], c[1]]).collect())
 }
 
-fn weights(basis: Node, n: usize, ctx: &str) -> Result<Vec<f64>> {
+pub(super) fn weights(basis: Node, n: usize, ctx: &str) -> Result<Vec<f64>> {
     let node = only_child(basis, "weights", ctx)?;
     let ctx = format!("{ctx}.weights");
     let w = numbers(node, &ctx)?;
@@ -342,7 +342,7 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
 /// Whether elements nest deeper than `limit` (a conservative scan: comments, CDATA,
 /// processing instructions, declarations and quoted attribute values are skipped;
 /// self-closing tags do not count).
-fn nesting_exceeds(text: &str, limit: usize) -> bool {
+pub(super) fn nesting_exceeds(text: &str, limit: usize) -> bool {
     let b = text.as_bytes();
     let find =
         |from: usize, pat: &[u8]| b[from.min(b.len())..].windows(pat.len()).position(|w| w == pat).map(|k| from + k);

@@ -1,4 +1,5 @@
-//! Writing a map as G+Smo XML: a `TensorBSpline2` (or `TensorNurbs2` with its weights)
+//! Writing a map as G+Smo XML: a `TensorBSpline2` (or `TensorNurbs2` with its weights;
+//! volumes: `TensorBSpline3` / `TensorNurbs3`, [`volume_to_gismo_xml`])
 //! in exactly the layout [`super::gismo`] reads, so that a map written here and read
 //! back is the same map, bit for bit (knots, control points, weights), and G+Smo
 //! (`gsReadFile`) loads it as a patch.
@@ -58,6 +59,42 @@ pub fn surface_to_gismo_xml(map: &Surface, comment: &str) -> String {
     let _ = writeln!(out, "    <coefs geoDim=\"2\">");
     for p in &map.control_points {
         let _ = writeln!(out, "      {} {}", number(p[0]), number(p[1]));
+    }
+    let _ = writeln!(out, "    </coefs>\n  </Geometry>\n</xml>");
+    out
+}
+
+/// The G+Smo XML document of a trivariate map: a `TensorBSpline3` (or `TensorNurbs3`
+/// with its weights), three `BSplineBasis` children of a `TensorBSplineBasis3` (`index`
+/// 0, 1, 2 for `xi`, `eta`, `zeta`), coefficients `xi` fastest then `eta`, `geoDim="3"`
+/// — the layout [`crate::io::volume`] reads back bit for bit.
+pub fn volume_to_gismo_xml(vol: &crate::spline::volume::Volume, comment: &str) -> String {
+    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<xml>\n");
+    if !comment.is_empty() {
+        let _ = writeln!(out, "  <!-- {} -->", comment.replace("--", "- -"));
+    }
+    let rational = vol.weights.is_some();
+    let geo = if rational { "TensorNurbs3" } else { "TensorBSpline3" };
+    let _ = writeln!(out, "  <Geometry type=\"{geo}\" id=\"0\">");
+    let mut indent = "    ".to_string();
+    if rational {
+        let _ = writeln!(out, "{indent}<Basis type=\"TensorNurbsBasis3\">");
+        indent.push_str("  ");
+    }
+    let _ = writeln!(out, "{indent}<Basis type=\"TensorBSplineBasis3\">");
+    for d in 0..3 {
+        knot_vector(&mut out, &vol.knots[d], d, &format!("{indent}  "));
+    }
+    let _ = writeln!(out, "{indent}</Basis>");
+    if let Some(w) = &vol.weights {
+        let w: Vec<String> = w.iter().map(|&v| number(v)).collect();
+        let _ = writeln!(out, "{indent}<weights>{}</weights>", w.join(" "));
+        indent.truncate(4);
+        let _ = writeln!(out, "{indent}</Basis>");
+    }
+    let _ = writeln!(out, "    <coefs geoDim=\"3\">");
+    for p in &vol.control_points {
+        let _ = writeln!(out, "      {} {} {}", number(p[0]), number(p[1]), number(p[2]));
     }
     let _ = writeln!(out, "    </coefs>\n  </Geometry>\n</xml>");
     out

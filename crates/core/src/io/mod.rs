@@ -2,7 +2,8 @@
 //! XML files ([`gismo`] reads, [`gismo_writer`] writes), IGES 5.3 rational B-spline
 //! surfaces ([`iges`], both ways), VTK files ([`vtk`]: a sampled structured grid, and the
 //! exact map as Bézier cells) and pictures of a map, grid lines coloured by `det J`
-//! ([`picture`], PNG through the CLI); ring (O-type) documents ([`ring`]).
+//! ([`picture`], PNG through the CLI); ring (O-type) documents ([`ring`]); trivariate
+//! maps (volumes) in JSON, G+Smo XML and VTK ([`volume`]).
 //!
 //! [`read_document`] detects the kind of file by its content (a JSON object or an XML
 //! document); [`read_boundary`] turns any accepted document into a validated,
@@ -15,6 +16,7 @@ pub mod iges;
 pub mod json;
 pub mod picture;
 pub mod ring;
+pub mod volume;
 pub mod vtk;
 
 use std::io::Read;

@@ -63,7 +63,7 @@ pub fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
 
 /// Inverse of the Bernstein collocation matrix `B[a][k] = B_k^p(a / p)` (row-major),
 /// by Gauss–Jordan elimination with partial pivoting (the matrix is totally positive).
-fn bernstein_interpolation(p: usize) -> Vec<f64> {
+pub(super) fn bernstein_interpolation(p: usize) -> Vec<f64> {
     let n = p + 1;
     let mut a = vec![0.0; n * n];
     let mut b = vec![0.0; n];
@@ -225,8 +225,15 @@ pub fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
         }
         out.push('\n');
     }
-    let _ = writeln!(out, "</DataArray>\n</Points>\n<Cells>");
-    let _ = writeln!(out, "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">");
+    let _ = writeln!(out, "</DataArray>\n</Points>");
+    cells_and_end(&mut out, ne, npe, VTK_BEZIER_QUADRILATERAL);
+    Ok(out)
+}
+
+/// The `<Cells>` of `ne` cells of type `cell_type` with `npe` consecutive points each,
+/// and the closing tags of the file.
+pub(super) fn cells_and_end(out: &mut String, ne: usize, npe: usize, cell_type: u8) {
+    let _ = writeln!(out, "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">");
     for c in 0..ne {
         let ids: Vec<String> = (c * npe..(c + 1) * npe).map(|i| i.to_string()).collect();
         let _ = writeln!(out, "{}", ids.join(" "));
@@ -235,10 +242,9 @@ pub fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     let offsets: Vec<String> = (1..=ne).map(|c| (c * npe).to_string()).collect();
     let _ = writeln!(out, "{}", offsets.join(" "));
     let _ = writeln!(out, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">");
-    let types: Vec<String> = (0..ne).map(|_| VTK_BEZIER_QUADRILATERAL.to_string()).collect();
+    let types: Vec<String> = (0..ne).map(|_| cell_type.to_string()).collect();
     let _ = writeln!(out, "{}", types.join(" "));
     let _ = writeln!(out, "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>");
-    Ok(out)
 }
 
 #[cfg(test)]

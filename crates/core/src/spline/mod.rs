@@ -10,12 +10,16 @@
 //! | [`bezier`] | Bézier extraction of a tensor basis | §8.1 |
 //! | [`periodic`] | periodic splines (wrapped control points): knot insertion, elevation and Bézier extraction by blossoming | §11.1 |
 //! | [`quadrature`] | Gauss–Legendre rules | §4 |
+//! | [`loft`] | volumes from planar slices: one common basis, linear or `C²` cubic interpolation in `z` | §11.1, Fig. 23 |
+//! | [`volume`] | [`Volume`](volume::Volume): trivariate tensor-product maps `x: [0,1]³ → R³`, knot insertion, elevation, Bézier nets | §11.1 |
 
 pub mod basis;
 pub mod bezier;
 pub mod curve;
 pub mod knots;
+pub mod loft;
 pub mod periodic;
 pub mod quadrature;
 pub mod refine;
 pub mod surface;
+pub mod volume;

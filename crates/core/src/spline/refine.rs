@@ -158,6 +158,17 @@ impl Surface {
         let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
         Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
     }
+
+    /// The same map with the degree of direction `dir` (0: `xi`, 1: `eta`) raised by one.
+    pub fn elevated_in(&self, dir: usize) -> Result<Surface> {
+        let (kv, e) = elevation(&self.knots[dir])?;
+        let [nx, ny] = self.shape();
+        let op = if dir == 0 { Csr::identity(ny).kron(&e) } else { e.kron(&Csr::identity(nx)) };
+        let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
+        let mut knots = self.knots.clone();
+        knots[dir] = kv;
+        Ok(Surface { knots, control_points: cp, weights: w })
+    }
 }
 
 #[cfg(test)]

@@ -31,10 +31,14 @@
 //! neighbourhood of that corner found by bisection, whose parameter extent is reported
 //! ([`CornerInfo::excused_extent`]); the verdict is then
 //! [`Verdict::DegenerateCorner`]. Nothing is excused at any other corner.
+//!
+//! **Volumes.** Trivariate maps have their own certificate, with the same arithmetic:
+//! [`volume::certify_volume`].
 
 mod bernstein;
 mod element;
 mod search;
+pub mod volume;
 
 use std::time::Instant;
 

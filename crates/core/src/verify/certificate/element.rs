@@ -281,7 +281,7 @@ impl<'a> DetJElements<'a> {
 
 /// The power of two `2^k` with `x 2^k` in `[0.5, 1)` (1 for `x = 0`; `k` clamped to
 /// `±1000` so that the factor itself is a normal number).
-fn pow2_unit(x: f64) -> f64 {
+pub(super) fn pow2_unit(x: f64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return 1.0;
     }

@@ -9,11 +9,11 @@ use num_traits::{One, Signed, Zero};
 
 use crate::spline::surface::Surface;
 
-fn q(x: f64) -> Q {
+pub(super) fn q(x: f64) -> Q {
     Q::from_float(x).expect("finite")
 }
 
-fn binom(n: usize, k: usize) -> Q {
+pub(super) fn binom(n: usize, k: usize) -> Q {
     let mut r = BigInt::one();
     for i in 0..k {
         r = r * BigInt::from(n - i) / BigInt::from(i + 1);
@@ -22,7 +22,7 @@ fn binom(n: usize, k: usize) -> Q {
 }
 
 /// Exact extraction operator of element `(s, a, b)`: `op[j][k]`.
-fn extraction(t: &[Q], p: usize, s: usize, a: &Q, b: &Q) -> Vec<Vec<Q>> {
+pub(super) fn extraction(t: &[Q], p: usize, s: usize, a: &Q, b: &Q) -> Vec<Vec<Q>> {
     let mut op = vec![vec![Q::zero(); p + 1]; p + 1];
     for k in 0..=p {
         let mut d: Vec<Vec<Q>> =

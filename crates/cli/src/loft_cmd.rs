@@ -1,0 +1,223 @@
+//! `winslow loft SLICES... --z z0,z1,... -o volume.json`: volumes from planar slices
+//! (paper §11.1, Fig. 23; [`winslow::solve::loft`]), certified by the trivariate
+//! certificate, with slices inserted where it fails; and the volume side of `check` and
+//! `convert` (JSON, G+Smo XML `TensorBSpline3`, VTK).
+
+use super::*;
+use winslow::io::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
+use winslow::io::volume::{read_volume, volume_to_json, VolumeDocument};
+use winslow::solve::loft::{loft, LoftOptions, SliceBoundary};
+use winslow::spline::loft::Interpolation;
+use winslow::spline::volume::Volume;
+use winslow::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeVerdict};
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+pub(super) enum InterpolationArg {
+    /// First order (the paper's): piecewise linear in z, C0 across the slices.
+    Linear,
+    /// The C2 cubic spline through the slices (not-a-knot ends).
+    Cubic,
+}
+
+#[derive(Args, Debug)]
+pub(super) struct LoftArgs {
+    /// Planar maps (JSON map documents or G+Smo XML), in the order of their heights.
+    #[arg(required = true, num_args = 2..)]
+    slices: Vec<PathBuf>,
+    /// Heights z0,z1,... of the slices, strictly increasing, one per slice.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with = "dz")]
+    z: Vec<f64>,
+    /// Uniform spacing instead of --z: slice k at z0 + k dz.
+    #[arg(long)]
+    dz: Option<f64>,
+    /// First height with --dz.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    z0: f64,
+    /// Interpolation in z. Linear is the default: each piece mixes only two neighbouring
+    /// slices (the paper's choice), so an inserted slice changes nothing beyond its two
+    /// intervals; cubic is smooth (C2) but couples all slices.
+    #[arg(long, value_enum, default_value = "linear")]
+    interpolation: InterpolationArg,
+    /// Most slices inserted where the volume is not certified.
+    #[arg(long, default_value_t = LoftOptions::default().max_inserted)]
+    max_inserted: usize,
+    /// Operator of inserted slices' EGG solves (as in `solve`).
+    #[arg(long, value_enum, default_value = "scaled")]
+    operator: OperatorArg,
+    /// Most bisections per element in the certificates.
+    #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
+    max_depth: usize,
+    /// Most Bernstein boxes examined per element.
+    #[arg(long, default_value_t = CertifyOptions::default().max_boxes)]
+    max_boxes: usize,
+    /// Output: .json (volume document with report and certificate), .xml (G+Smo
+    /// TensorBSpline3), .vtu (Bézier hexahedra with det J), .vtk (sampled grid).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+fn exit_code(v: &VolumeVerdict) -> i32 {
+    match v {
+        VolumeVerdict::Certified { .. } => 0,
+        VolumeVerdict::Folded { .. } => 3,
+        VolumeVerdict::Undecided { .. } => 5,
+    }
+}
+
+/// Write a volume in the format of the output's extension.
+fn write_volume(path: &Path, vol: &Volume, label: &str, json: impl Fn() -> serde_json::Value) -> Result<()> {
+    output::ensure_parent(path)?;
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let text = match ext.as_str() {
+        "xml" => winslow::io::gismo_writer::volume_to_gismo_xml(vol, label),
+        "vtu" => volume_bezier_vtu(vol, label)?,
+        "vtk" => {
+            let elems = vol.knots.each_ref().map(|k| (4 * k.num_elements()).clamp(8, 256));
+            volume_structured_vtk(vol, elems)
+        }
+        _ => {
+            winslow::io::write_json(path, &json()).with_context(|| format!("writing {}", path.display()))?;
+            return Ok(());
+        }
+    };
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+fn certify_options(max_depth: usize, max_boxes: usize) -> CertifyOptions {
+    CertifyOptions { max_depth: max_depth.clamp(1, 40), max_boxes: max_boxes.clamp(1, 1 << 24), excuse_corners: true }
+}
+
+pub(super) fn run(a: LoftArgs) -> Result<i32> {
+    let t0 = Instant::now();
+    output::reset_peak_memory();
+    let z = match a.dz {
+        Some(dz) if dz.is_finite() && dz > 0.0 => (0..a.slices.len()).map(|k| a.z0 + k as f64 * dz).collect(),
+        Some(dz) => bail!("--dz must be a positive number, got {dz}"),
+        None if a.z.is_empty() => bail!("give the heights with --z z0,z1,... or --dz"),
+        None => a.z.clone(),
+    };
+    let mut slices = Vec::with_capacity(a.slices.len());
+    let mut name = String::new();
+    for (i, p) in a.slices.iter().enumerate() {
+        let doc = read_document(p).with_context(|| format!("reading slice {i} ({})", p.display()))?;
+        let Document::Map { name: n, map } = doc else {
+            bail!("slice {i} ({}) is a boundary, not a map: solve it first", p.display())
+        };
+        if i == 0 {
+            name = format!("{n}-loft");
+        }
+        slices.push(map);
+    }
+    let interpolation = match a.interpolation {
+        InterpolationArg::Linear => Interpolation::Linear,
+        InterpolationArg::Cubic => Interpolation::Cubic,
+    };
+    let operator = match a.operator {
+        OperatorArg::Plain => Operator::Plain,
+        OperatorArg::Scaled => Operator::Scaled,
+    };
+    let opts = LoftOptions {
+        interpolation,
+        max_inserted: a.max_inserted,
+        certify: certify_options(a.max_depth, a.max_boxes),
+        operator,
+        ..Default::default()
+    };
+    // only maps are given: inserted slices take the interpolated boundary
+    let out = loft(&slices, &z, &opts, SliceBoundary::Interpolated).context("lofting the slices")?;
+    let cert = &out.certificate;
+    let label = format!("volume certificate: {}", cert.message());
+    let json =
+        || volume_to_json(&name, &out.volume, Some(serde_json::json!({ "report": &out.report, "certificate": cert })));
+    write_volume(&a.output, &out.volume, &label, json)?;
+    let inserted = out.report.slices.iter().filter(|s| s.given.is_none()).count();
+    if a.json {
+        let v = serde_json::json!({ "report": &out.report, "certificate": cert, "seconds": t0.elapsed().as_secs_f64(),
+            "peak_memory_mib": output::peak_memory_mib() });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        let d = out.volume.degrees();
+        let s = out.volume.shape();
+        println!(
+            "{name}: {} slices ({} given, {inserted} inserted, boundary of inserted slices interpolated), {} interpolation, \
+             degrees ({}, {}, {}), {} x {} x {} control points, {} elements",
+            out.slices.len(),
+            slices.len(),
+            interpolation.name(),
+            d[0],
+            d[1],
+            d[2],
+            s[0],
+            s[1],
+            s[2],
+            cert.elements
+        );
+        println!("{}", cert.message());
+        println!(
+            "{} round(s); volume certificate {:.3} s; total {:.3} s; peak memory {:.1} MiB; wrote {}",
+            out.report.rounds.len(),
+            cert.seconds,
+            t0.elapsed().as_secs_f64(),
+            output::peak_memory_mib(),
+            a.output.display()
+        );
+    }
+    Ok(exit_code(&cert.verdict))
+}
+
+/// The JSON report of `check` on a volume.
+#[derive(serde::Serialize)]
+struct VolumeCheck<'a> {
+    name: &'a str,
+    kind: &'static str,
+    degrees: [usize; 3],
+    shape: [usize; 3],
+    volume: f64,
+    certificate: &'a VolumeCertificate,
+}
+
+/// `winslow check` on a volume document (JSON or G+Smo XML): the trivariate certificate.
+pub(super) fn check_volume(doc: &VolumeDocument, max_depth: usize, max_boxes: usize, json: bool) -> Result<i32> {
+    let vol = &doc.volume;
+    let cert = certify_volume(vol, &certify_options(max_depth, max_boxes)).context("certifying the volume")?;
+    let report = VolumeCheck {
+        name: &doc.name,
+        kind: "volume",
+        degrees: vol.degrees(),
+        shape: vol.shape(),
+        // mean det J times the parameter volume (knot domains are [0, 1]): exact from the
+        // Bernstein coefficients for polynomial maps, Gauss quadrature for rational ones
+        volume: cert.mean_det_j * vol.knots.iter().map(|k| k.domain().1 - k.domain().0).product::<f64>(),
+        certificate: &cert,
+    };
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        let (d, s) = (report.degrees, report.shape);
+        println!(
+            "{}: volume of degrees ({}, {}, {}), {} x {} x {} control points, {} elements, det J of degree ({}, {}, {})",
+            doc.name, d[0], d[1], d[2], s[0], s[1], s[2], cert.elements, cert.det_degree[0], cert.det_degree[1], cert.det_degree[2]
+        );
+        println!("{}", cert.message());
+        println!("volume (integral of det J) {:.6e}; certificate {:.3} s", report.volume, cert.seconds);
+    }
+    Ok(exit_code(&cert.verdict))
+}
+
+/// `winslow convert` of a volume: certified again, written by the output's extension.
+pub(super) fn convert_volume(doc: &VolumeDocument, output: &Path) -> Result<i32> {
+    let cert = certify_volume(&doc.volume, &CertifyOptions::default()).context("certifying the volume")?;
+    let label = format!("volume certificate: {}", cert.message());
+    let json = || volume_to_json(&doc.name, &doc.volume, Some(serde_json::json!({ "certificate": &cert })));
+    write_volume(output, &doc.volume, &label, json)?;
+    println!("wrote {} ({label})", output.display());
+    Ok(exit_code(&cert.verdict))
+}
+
+/// A volume in `path`, if it holds one (JSON or G+Smo XML).
+pub(super) fn volume_in(path: &Path) -> Result<Option<VolumeDocument>> {
+    read_volume(path).with_context(|| format!("reading {}", path.display()))
+}
