@@ -33,6 +33,7 @@
 //! [`Verdict::DegenerateCorner`]. Nothing is excused at any other corner.
 
 mod bernstein;
+pub mod coefficients;
 mod element;
 mod search;
 
