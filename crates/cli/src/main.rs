@@ -33,6 +33,7 @@ use winslow_gpu::{Backend, Precision, Selected};
 mod corpus;
 mod inspect_ring;
 mod mesh;
+mod optimise_cmd;
 mod output;
 mod solve_cmd;
 mod sweep_cmd;
@@ -76,6 +77,10 @@ enum Command {
     /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
     /// angle per step, one certified map per frame from extrapolated initial guesses.
     Sweep(Box<sweep_cmd::SweepArgs>),
+    /// Constrained quality optimisation (paper §10.3, Gravesen et al.): minimise the Liao,
+    /// Winslow or area-orthogonality functional subject to positive Bernstein coefficients
+    /// of det J, from the EGG map or from the max-z point of eq. (49); or eq. (49) alone.
+    Optimise(Box<optimise_cmd::OptimiseArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -572,6 +577,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
+        Command::Optimise(a) => optimise_cmd::run(*a),
     }
 }
 
