@@ -134,6 +134,7 @@ pub fn optimise(
         let active: Vec<&Vec<(usize, f64)>> =
             rows.iter().zip(&lambda).filter(|(_, &l)| lmax > 0.0 && l > 1e-6 * lmax).map(|(r, _)| r).collect();
         let b = definite_model(n, dense, &active)?;
+        let p_model = qp::upper_csc(n, &b);
         let q: Vec<f64> = grad.iter().map(|g| g * scale_c / scale_f).collect();
         let g = Csr::from_rows(n, rows);
         // d_k + ∇d_k δ >= ε; where a violated constraint cannot reach ε in the trust
@@ -142,7 +143,7 @@ pub fn optimise(
         let mut sol = None;
         for relaxed in [false, true] {
             let h: Vec<f64> = d.iter().map(|&dk| (dk - if relaxed { eps.min(dk) } else { eps }) / scale_d).collect();
-            match qp::solve(Some(qp::upper_csc(n, &b)), &q, &g, &h, radius, n) {
+            match qp::solve(Some(p_model.clone()), &q, &g, &h, radius, n) {
                 Ok(x) => {
                     sol = Some(x);
                     break;
@@ -156,8 +157,9 @@ pub fn optimise(
         };
         let x = &sol.x;
         let step = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        lambda = sol.lambda.iter().map(|l| l.max(0.0) * scale_f / scale_d).collect();
-        mu = mu.max(2.0 * lambda.iter().copied().fold(0.0, f64::max));
+        // multipliers of this QP: the next model's, if its step is accepted
+        let lambda_qp: Vec<f64> = sol.lambda.iter().map(|l| l.max(0.0) * scale_f / scale_d).collect();
+        mu = mu.max(2.0 * lambda_qp.iter().copied().fold(0.0, f64::max));
         let bx: Vec<f64> = (0..n).map(|i| (0..n).map(|j| b[i * n + j] * x[j]).sum()).collect();
         let model: f64 =
             q.iter().zip(x).map(|(a, b)| a * b).sum::<f64>() + 0.5 * bx.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
@@ -166,18 +168,38 @@ pub fn optimise(
         let viol = |d: &[f64]| d.iter().map(|&dk| (eps - dk).max(0.0)).sum::<f64>();
         let viol_now = viol(&d);
         let viol_lin: f64 = d.iter().zip(&jd).map(|(dk, j)| (eps - dk - j).max(0.0)).sum();
-        let pred = -model * scale_f + mu * (viol_now - viol_lin);
+        // (the QP meets its constraints to its own tolerance: a violation it adds is noise)
+        let pred = -model * scale_f + mu * (viol_now - viol_lin).max(0.0);
         if pred <= opts.tol * f.abs() {
             let why =
                 format!("predicted decrease {pred:.2e} <= {:.0e} |J| (step {step:.2e} of the diameter)", opts.tol);
             return Ok(finish(report, cps, why, true));
         }
-        let trial_c: Vec<f64> = c.iter().zip(&delta).map(|(a, b)| a + b).collect();
-        let mut trial = cps.clone();
-        dofs.scatter(&trial_c, &mut trial);
-        let dt = cons.values(&trial);
-        let ft = if min_of(&dt) > 0.0 { prob.objective(&trial_c).unwrap_or(f64::INFINITY) } else { f64::INFINITY };
-        let rho = if ft.is_finite() { (f + mu * viol_now - ft - mu * viol(&dt)) / pred } else { -1.0 };
+        // the trial point: (unknowns, control points, d, J, ratio of actual to predicted decrease)
+        let evaluate = |delta: &[f64], prob: &mut Box<dyn DiscreteProblem + Send>| {
+            let trial_c: Vec<f64> = c.iter().zip(delta).map(|(a, b)| a + b).collect();
+            let mut trial = cps.clone();
+            dofs.scatter(&trial_c, &mut trial);
+            let dt = cons.values(&trial);
+            let ft = if min_of(&dt) > 0.0 { prob.objective(&trial_c).unwrap_or(f64::INFINITY) } else { f64::INFINITY };
+            let rho = if ft.is_finite() { (f + mu * viol_now - ft - mu * viol(&dt)) / pred } else { -1.0 };
+            (trial_c, trial, dt, ft, rho)
+        };
+        let (mut trial_c, mut trial, mut dt, mut ft, mut rho) = evaluate(&delta, &mut prob);
+        if rho < 0.25 && viol(&dt) > viol_lin {
+            // second-order correction: the same QP with the constraints shifted by the
+            // exact remainder r = d(c + δ) - d - ∇d δ (d is bilinear: r is the coefficients
+            // of the map δ), so that its step δ' keeps d(c + δ') >= ε to third order
+            let h: Vec<f64> = dt.iter().zip(&jd).map(|(t, j)| (t - j - eps) / scale_d).collect();
+            report.iterations += 1;
+            if let Ok(sol) = qp::solve(Some(p_model.clone()), &q, &g, &h, radius, n) {
+                let delta2: Vec<f64> = sol.x.iter().map(|v| v * scale_c).collect();
+                let second = evaluate(&delta2, &mut prob);
+                if second.4 > rho {
+                    (trial_c, trial, dt, ft, rho) = second;
+                }
+            }
+        }
         if rho < 0.25 {
             radius = 0.5 * step.min(radius);
         } else if rho > 0.75 && step >= 0.9 * radius {
@@ -190,6 +212,7 @@ pub fn optimise(
             d = dt;
             (grad, hess) = derivatives(&mut *prob, &c);
             jac = cons.jacobian(&cps);
+            lambda = lambda_qp;
             report.accepted += 1;
             report.objective_history.push(f);
         }
