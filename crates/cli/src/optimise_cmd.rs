@@ -38,6 +38,10 @@ pub(super) struct OptimiseArgs {
     /// Stop when the predicted decrease is below this fraction of the functional.
     #[arg(long, default_value_t = ConstrainedOptions::default().tol)]
     opt_tol: f64,
+    /// QP Hessian of the Lagrangian (exact constraint curvature, made semidefinite on the
+    /// active constraints) instead of the functional's.
+    #[arg(long)]
+    lagrangian_hessian: bool,
     /// Output map file (JSON with the report; .xml, .igs, .vtu, .vtk by extension).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -118,6 +122,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         eps: a.eps,
         max_iterations: a.max_iterations,
         tol: a.opt_tol,
+        lagrangian_hessian: a.lagrangian_hessian,
         certify: opts.certify,
         ..Default::default()
     };
@@ -131,20 +136,15 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         FromArg::Maxz => vec![StartFrom::MaxZ],
         FromArg::Both => vec![StartFrom::Egg, StartFrom::MaxZ],
     };
-    let coons = Surface::new(egg.knots.clone(), constrained::coons_start(egg)?, None)?;
     let mut rows = Vec::new();
     if a.maxz_only {
         let o = constrained::run_max_z(egg, &opts.topology, &copts).context("eq. (49)")?;
-        rows.push(Row { start_values: Values::of(&coons), values: Values::of(&o.map), outcome: o });
+        rows.push(Row { start_values: Values::of(&o.start_map), values: Values::of(&o.map), outcome: o });
     } else {
         for from in starts {
             let o = constrained::run(egg, from, functional, &opts.topology, &copts)
                 .with_context(|| format!("constrained optimisation from {}", from.name()))?;
-            let start = match from {
-                StartFrom::Egg => Values::of(egg),
-                StartFrom::MaxZ => Values::of(&coons),
-            };
-            rows.push(Row { start_values: start, values: Values::of(&o.map), outcome: o });
+            rows.push(Row { start_values: Values::of(&o.start_map), values: Values::of(&o.map), outcome: o });
         }
     }
     let egg_iterations: usize = sol.report.levels.iter().map(|l| l.iterations).sum();

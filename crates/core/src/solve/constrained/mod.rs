@@ -14,11 +14,11 @@
 //!   LP is solved by Clarabel.
 //! * **Constrained optimisation** ([`optimise`]): minimise `J(c)` (Liao, Winslow eq. 16,
 //!   or area orthogonality) subject to `d(c) >= ε`, `ε` a fraction of the mean `det J`,
-//!   by SQP with a trust region: each step solves the QP of the exact gradient and the
-//!   exact Hessian of the Lagrangian `J - λᵀ (d - ε)` (`∇²d` is constant: `d` is bilinear),
-//!   made positive definite by taking the absolute values of its eigenvalues, and is
-//!   accepted by the ℓ₁ merit function `J + μ Σ max(0, ε - d_k)`. A start with some
-//!   `d_k < ε` is first made feasible by [`max_z`] with target `ε`.
+//!   by SQP with a trust region: each step solves the QP of the exact gradient and
+//!   Hessian of `J` (optionally of the Lagrangian `J - λᵀ (d - ε)`; `∇²d` is constant:
+//!   `d` is bilinear), is corrected to second order with the exact constraint remainder,
+//!   and is accepted by the ℓ₁ merit function `J + μ Σ max(0, ε - d_k)`. A start with
+//!   some `d_k < ε` is first made feasible by [`max_z`] with target `ε`.
 //!
 //! [`run`] composes them as in the paper's Table 3: from the EGG map (G) or from the
 //! max-z point of the Coons patch (Z), on the EGG map's basis. Every result is
@@ -97,6 +97,9 @@ pub struct ConstrainedOptions {
     /// Initial trust-region radius (largest move of a control point coordinate),
     /// relative to the diameter of the control net.
     pub radius: f64,
+    /// The QP Hessian of [`optimise`]: the Lagrangian's (exact constraint curvature, made
+    /// semidefinite on the active constraints) instead of the functional's.
+    pub lagrangian_hessian: bool,
     /// The certificate of the result.
     pub certify: CertifyOptions,
 }
@@ -109,6 +112,7 @@ impl Default for ConstrainedOptions {
             max_z_iterations: 200,
             tol: 1e-10,
             radius: 0.05,
+            lagrangian_hessian: false,
             certify: CertifyOptions::default(),
         }
     }
@@ -327,6 +331,9 @@ pub struct Outcome {
     /// The result (the best iterate when a stage failed).
     #[serde(skip)]
     pub map: Surface,
+    /// The start: the EGG map (G), the max-z point (Z), the Coons patch (max-z alone).
+    #[serde(skip)]
+    pub start_map: Surface,
 }
 
 /// The discretization of `map`'s basis with the sides fixed by `topology` and `p + 2`
@@ -359,8 +366,10 @@ fn outcome_certificate(map: &Surface, opts: &ConstrainedOptions) -> Result<(Cert
 pub fn run_max_z(map: &Surface, topology: &Topology, opts: &ConstrainedOptions) -> Result<Outcome> {
     let t0 = Instant::now();
     let disc = discretization(map, topology)?;
-    let z = max_z(&disc, &coons_start(map)?, 0.0, opts)?;
+    let coons = coons_start(map)?;
+    let z = max_z(&disc, &coons, 0.0, opts)?;
     let result = Surface::new(map.knots.clone(), z.control_points, None)?;
+    let start_map = Surface::new(map.knots.clone(), coons, None)?;
     let (certificate, certified) = outcome_certificate(&result, opts)?;
     Ok(Outcome {
         name: "maxz".into(),
@@ -374,6 +383,7 @@ pub fn run_max_z(map: &Surface, topology: &Topology, opts: &ConstrainedOptions) 
         certified,
         seconds: t0.elapsed().as_secs_f64(),
         map: result,
+        start_map,
     })
 }
 
@@ -397,6 +407,7 @@ pub fn run(
         }
     };
     let name = format!("{}-from-{}", functional.name(), from.name());
+    let start_map = Surface::new(egg.knots.clone(), start.clone(), None)?;
     if let Some(z) = stage.as_ref().filter(|z| !z.converged) {
         // no feasible start: the max-z iterate is the best there is
         let result = Surface::new(egg.knots.clone(), start, None)?;
@@ -413,6 +424,7 @@ pub fn run(
             certified,
             seconds: t0.elapsed().as_secs_f64(),
             map: result,
+            start_map,
         });
     }
     let o = optimise(&disc, &start, functional, opts)?;
@@ -431,6 +443,7 @@ pub fn run(
         certified,
         seconds: t0.elapsed().as_secs_f64(),
         map: result,
+        start_map,
     })
 }
 

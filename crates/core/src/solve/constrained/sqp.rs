@@ -5,11 +5,19 @@
 //!
 //! `min ∇Jᵀ δ + ½ δᵀ B δ` subject to `d_k + ∇d_k δ >= min(ε, d_k)`, `|δ_i| <= Δ`,
 //!
-//! is solved by Clarabel, with `B` the Hessian of the Lagrangian
-//! `∇²J - Σ_k λ_k ∇²d_k` (both exact: the functional's from its method, the constraints'
-//! constant because `d` is bilinear) made positive definite by replacing its eigenvalues
-//! by their absolute values (floored at `10⁻⁸` of the largest). The step is judged by the
-//! ℓ₁ merit function `φ = J + μ Σ_k max(0, ε - d_k)`, `μ >= 2 max λ` (Fletcher's Sℓ₁QP):
+//! is solved by Clarabel, with `B` the exact Hessian `∇²J` of the functional (its
+//! eigenvalues replaced by their absolute values, floored at `10⁻⁸` of the largest: the
+//! Liao and area-orthogonality Hessians are semidefinite already, Winslow's is not far
+//! from its minimiser). The constraints' curvature (`∇²d` is constant: `d` is bilinear)
+//! enters through the second-order correction below; with
+//! [`ConstrainedOptions::lagrangian_hessian`] `B` is instead the Hessian of the Lagrangian
+//! `∇²J - Σ_k λ_k ∇²d_k` made semidefinite by `ρ J_Aᵀ J_A` on the active constraints
+//! (Newton's step on their tangent space; after a rejected step the next QP falls back to
+//! `∇²J`). Measured on the shared geometries (BENCHMARKS.md) the Lagrangian model stalls
+//! where hundreds of the coefficient constraints are active at once (more than there are
+//! unknowns: the multipliers are not unique), so it is not the default. The step is
+//! judged by the
+//! //! ℓ₁ merit function `φ = J + μ Σ_k max(0, ε - d_k)`, `μ >= 2 max λ` (Fletcher's Sℓ₁QP):
 //! accepted when the actual decrease of `φ` is at least a hundredth of the decrease the
 //! model predicts, and never when a coefficient `d_k` becomes non-positive (every
 //! accepted iterate has `det J > 0`) or `J` is infinite (Winslow at a fold). The radius
@@ -103,6 +111,7 @@ pub fn optimise(
     let mut lambda = vec![0.0; d.len()];
     let (mut mu, mut radius) = (scale_f / scale_d, opts.radius);
     let mut last_failure: Option<String> = None;
+    let mut lagrangian_model = opts.lagrangian_hessian;
     let s = scale_c / scale_d;
     loop {
         if report.iterations >= opts.max_iterations {
@@ -116,7 +125,7 @@ pub fn optimise(
             );
             return Ok(finish(report, cps, why, false));
         }
-        // B = (∇²J - Σ λ_k ∇²d_k) scaled, made definite
+        // B: ∇²J (absolute eigenvalues), or ∇²J - Σ λ_k ∇²d_k made definite; scaled
         let mut dense = vec![0.0; n * n];
         let add = |m: &Csr, sign: f64, dense: &mut Vec<f64>| {
             for r in 0..m.nrows {
@@ -126,6 +135,7 @@ pub fn optimise(
             }
         };
         add(&hess, 1.0, &mut dense);
+        let functional_only = dense.clone();
         add(&cons.weighted_hessian(&lambda), -1.0, &mut dense);
         let rows: Vec<Vec<(usize, f64)>> =
             (0..jac.nrows).map(|r| jac.row(r).map(|(col, v)| (col, -v * s)).collect()).collect();
@@ -133,7 +143,15 @@ pub fn optimise(
         let lmax = lambda.iter().copied().fold(0.0, f64::max);
         let active: Vec<&Vec<(usize, f64)>> =
             rows.iter().zip(&lambda).filter(|(_, &l)| lmax > 0.0 && l > 1e-6 * lmax).map(|(r, _)| r).collect();
-        let b = definite_model(n, dense, &active)?;
+        let lagrangian = if lagrangian_model { definite_model(n, dense, &active)? } else { None };
+        let used_lagrangian = lagrangian.is_some();
+        let b = match lagrangian {
+            Some(b) => b,
+            None => {
+                let (u, s) = eigen(n, &symmetric(n, functional_only))?;
+                rebuild(n, &u, &s, true)
+            }
+        };
         let p_model = qp::upper_csc(n, &b);
         let q: Vec<f64> = grad.iter().map(|g| g * scale_c / scale_f).collect();
         let g = Csr::from_rows(n, rows);
@@ -205,6 +223,8 @@ pub fn optimise(
         } else if rho > 0.75 && step >= 0.9 * radius {
             radius = (2.0 * radius).min(RADIUS_MAX);
         }
+        // a rejected step of the Lagrangian model: the next QP has the functional's Hessian
+        lagrangian_model = opts.lagrangian_hessian && (rho > 0.01 || !used_lagrangian);
         if rho > 0.01 {
             c = trial_c;
             cps = trial;
@@ -233,17 +253,10 @@ fn derivatives(prob: &mut dyn DiscreteProblem, c: &[f64]) -> (Vec<f64>, Csr) {
 /// row-major, `n x n`): `a + ρ J_Aᵀ J_A` with the rows `J_A` of the active constraints and
 /// the smallest `ρ` of `0, ρ₀, 10 ρ₀, ..., 10⁸ ρ₀` that makes it semidefinite (it equals
 /// `a` on the tangent space `J_A δ = 0`, so the SQP step stays Newton's there, Finsler's
-/// lemma giving such a `ρ` when the reduced Hessian is definite); failing that, `a` with
-/// its eigenvalues replaced by their absolute values. Eigenvalues are floored at `10⁻⁸` of
-/// the largest magnitude.
-fn definite_model(n: usize, mut a: Vec<f64>, active: &[&Vec<(usize, f64)>]) -> Result<Vec<f64>> {
-    for i in 0..n {
-        for j in 0..i {
-            let v = 0.5 * (a[i * n + j] + a[j * n + i]);
-            a[i * n + j] = v;
-            a[j * n + i] = v;
-        }
-    }
+/// lemma giving such a `ρ` when the reduced Hessian is definite), eigenvalues floored at
+/// `10⁻⁸` of the largest magnitude; `None` when no `ρ` does.
+fn definite_model(n: usize, a: Vec<f64>, active: &[&Vec<(usize, f64)>]) -> Result<Option<Vec<f64>>> {
+    let a = symmetric(n, a);
     let mut jtj = vec![0.0; n * n];
     for row in active {
         for &(i, vi) in row.iter() {
@@ -258,7 +271,6 @@ fn definite_model(n: usize, mut a: Vec<f64>, active: &[&Vec<(usize, f64)>]) -> R
     } else {
         diag_max(&a).max(f64::MIN_POSITIVE) / diag_max(&jtj).max(f64::MIN_POSITIVE)
     };
-    let mut last = None;
     for k in 0..10 {
         let rho = if k == 0 { 0.0 } else { rho0 * 10f64.powi(k - 1) };
         if k > 0 && rho0 == 0.0 {
@@ -268,14 +280,22 @@ fn definite_model(n: usize, mut a: Vec<f64>, active: &[&Vec<(usize, f64)>]) -> R
         let (u, s) = eigen(n, &m)?;
         let largest = s.iter().fold(0.0f64, |x, v| x.max(v.abs()));
         if s.iter().all(|&v| v >= -1e-10 * largest) {
-            return Ok(rebuild(n, &u, &s, false));
-        }
-        if k == 0 {
-            last = Some((u, s));
+            return Ok(Some(rebuild(n, &u, &s, false)));
         }
     }
-    let (u, s) = last.expect("the first candidate is always tried");
-    Ok(rebuild(n, &u, &s, true))
+    Ok(None)
+}
+
+/// The symmetric part of the dense `n x n` matrix `a`.
+fn symmetric(n: usize, mut a: Vec<f64>) -> Vec<f64> {
+    for i in 0..n {
+        for j in 0..i {
+            let v = 0.5 * (a[i * n + j] + a[j * n + i]);
+            a[i * n + j] = v;
+            a[j * n + i] = v;
+        }
+    }
+    a
 }
 
 /// Eigenvectors (column-major `n x n`) and eigenvalues of the symmetric `m`.
