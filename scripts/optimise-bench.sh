@@ -14,7 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 W=${1:-target/release/winslow}
 OUT=${2:-out/optimise-bench}
-GEOMS=${GEOMS:-"tests/data/gismo/duck.json tests/data/gismo/puzzle3.json tests/data/gismo/butterfly.json tests/data/notched_square.json tests/data/horseshoe.json"}
+GEOMS=${GEOMS:-"tests/data/gismo/duck.json tests/data/gismo/puzzle3.json tests/data/notched_square.json tests/data/horseshoe.json tests/data/narrow_tube.json"}
 FUNCTIONALS=${FUNCTIONALS:-"liao winslow ao"}
 FIT_TOL=${FIT_TOL:-1e-2}
 EPS=${EPS:-1e-2}
