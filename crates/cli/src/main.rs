@@ -34,6 +34,7 @@ mod corpus;
 mod inspect_ring;
 mod loft_cmd;
 mod mesh;
+mod optimise_cmd;
 mod output;
 mod solve_cmd;
 mod sweep_cmd;
@@ -80,6 +81,10 @@ enum Command {
     /// Volumes from planar slices (paper §11.1, Fig. 23): one basis, linear or C2 cubic
     /// in z, certified (trivariate det J), slices inserted where it is not.
     Loft(Box<loft_cmd::LoftArgs>),
+    /// Constrained quality optimisation (paper §10.3, Gravesen et al.): minimise the Liao,
+    /// Winslow or area-orthogonality functional subject to positive Bernstein coefficients
+    /// of det J, from the EGG map or from the max-z point of eq. (49); or eq. (49) alone.
+    Optimise(Box<optimise_cmd::OptimiseArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -577,6 +582,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
         Command::Loft(a) => loft_cmd::run(*a),
+        Command::Optimise(a) => optimise_cmd::run(*a),
     }
 }
 

@@ -47,6 +47,7 @@
 //! | §8.1, eq. (43) | bijectivity certificate | [`verify::certificate`]; corners that force `det J <= 0`: [`boundary::corners`] |
 //! | §8.2 | local defect correction | [`solve::repair`] |
 //! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
+//! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | [`verify::certificate::coefficients`], [`solve::constrained`], functionals in [`methods::metric_norms`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
 //!

@@ -6,6 +6,7 @@
 //! | [`egg`] | EGG, Galerkin form with the plain operator `L` or the scaled `L / (g11 + g22)`: [`EggMethod`](egg::EggMethod) | eq. (8), (12), (23) |
 //! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
 //! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
+//! | [`metric_norms`] | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): [`MetricNormMethod`](metric_norms::MetricNormMethod) | eq. (3), §10.3 |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
@@ -41,6 +42,7 @@
 pub mod egg;
 pub mod flux;
 pub mod galerkin;
+pub mod metric_norms;
 pub mod weak_form;
 pub mod winslow;
 

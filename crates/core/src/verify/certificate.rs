@@ -36,6 +36,7 @@
 //! [`volume::certify_volume`].
 
 mod bernstein;
+pub mod coefficients;
 mod element;
 mod search;
 pub mod volume;

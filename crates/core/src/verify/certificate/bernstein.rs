@@ -68,6 +68,7 @@ fn binom(n: usize, k: usize) -> f64 {
 }
 
 /// Binomial coefficients `binom(n, k)` for `n <= maxn`.
+#[derive(Debug)]
 pub struct Binom {
     rows: Vec<Vec<f64>>,
 }
