@@ -146,8 +146,26 @@ pub struct Improved {
     pub report: Improvement,
 }
 
+/// The nonlinear options of `method` run from a bijective start on `m` free functions:
+/// Newton with its line search only (pseudo time-stepping is for starts far from a
+/// solution, and 400 of its steps cost minutes on a fine basis), the residual scaled by
+/// [`Method::residual_scale`], the step tolerance in length units.
+pub fn from_bijective_start(
+    nonlinear: NonlinearOptions,
+    method: &dyn Method,
+    diameter: f64,
+    m: usize,
+) -> NonlinearOptions {
+    let mut nl = nonlinear;
+    nl.method = NonlinearMethod::Newton;
+    nl.fallback = false;
+    nl.scale = method.residual_scale(diameter, m);
+    nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
+    nl
+}
+
 /// Whether a certificate allows a method that needs `det J > 0` to start.
-fn bijective(c: &Certificate) -> bool {
+pub fn bijective(c: &Certificate) -> bool {
     matches!(c.verdict, Verdict::Certified { .. } | Verdict::DegenerateCorner { .. })
 }
 
@@ -179,13 +197,7 @@ pub fn improve(
     let disc =
         Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs).with_weights(map.weights.clone())?);
     let m = disc.dofs.num_free();
-    let mut nl = nonlinear;
-    nl.method = NonlinearMethod::Newton;
-    // from a certified start only Newton with its line search: pseudo time-stepping is for
-    // starts far from a solution (and 400 of its steps cost minutes on a fine basis)
-    nl.fallback = false;
-    nl.scale = method.residual_scale(diameter, m);
-    nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
+    let nl = from_bijective_start(nonlinear, method, diameter, m);
     let c0 = disc.dofs.gather(&map.control_points);
     let problem = method.problem(disc, map.control_points.clone());
     let mut solver = NonlinearSolver::new(problem, c0, nl);

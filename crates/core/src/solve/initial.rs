@@ -207,6 +207,25 @@ pub fn continuation(
     diameter: f64,
     cont: &mut Continuation,
 ) -> Result<Vec<Point>> {
+    let positive = |c: &[Point]| det_j_min(assembler, disc, c) > 0.0;
+    continuation_with(method, assembler, disc, base, target, nl, diameter, cont, &positive)
+}
+
+/// [`continuation`] with the test of a guess given: `positive(control points)` (the
+/// sampled `det J` for [`continuation`]; the certificate for the `C^0` route of §9,
+/// whose Winslow solves need a bijective start).
+#[allow(clippy::too_many_arguments)]
+pub fn continuation_with(
+    method: &dyn Method,
+    assembler: &dyn EggAssembler,
+    disc: &Arc<Discretization>,
+    base: Vec<Point>,
+    target: &[Point],
+    nl: NonlinearOptions,
+    diameter: f64,
+    cont: &mut Continuation,
+    positive: &dyn Fn(&[Point]) -> bool,
+) -> Result<Vec<Point>> {
     let tol = 1e-12 * diameter;
     if base.iter().zip(target).all(|(b, t)| (b[0] - t[0]).abs() <= tol && (b[1] - t[1]).abs() <= tol) {
         // same boundary (e.g. a refinement of the previous level): nothing to move
@@ -217,7 +236,7 @@ pub fn continuation(
     // displacement from `base` to the full target; linear in the boundary motion, so
     // a fraction `f` of the remaining motion is `f * u`
     let mut u = elasticity_displacement_with(assembler, disc, &base, target)?;
-    if det_j_min(assembler, disc, &base) <= 0.0 {
+    if !positive(&base) {
         // the prolonged map itself is not positive on this level's (denser) sample:
         // damping the boundary motion cannot make the guess positive, Newton starts
         // from the full elasticity guess
@@ -227,12 +246,12 @@ pub fn continuation(
         let a = (done + step).min(1.0);
         let f = (a - done) / (1.0 - done);
         let guess = displaced(&base, &u, f);
-        let positive = det_j_min(assembler, disc, &guess) > 0.0;
+        let guess_positive = positive(&guess);
         let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
-        if a >= 1.0 && (positive || exhausted) {
+        if a >= 1.0 && (guess_positive || exhausted) {
             return Ok(guess);
         }
-        if !positive && !exhausted {
+        if !guess_positive && !exhausted {
             step *= 0.5;
             continue;
         }
@@ -249,7 +268,7 @@ pub fn continuation(
         let (problem, c) = solver.into_parts();
         let sol = problem.control_points(&c);
         cont.iterations += iterations;
-        if converged && det_j_min(assembler, disc, &sol) > 0.0 {
+        if converged && positive(&sol) {
             base = sol;
             done = a;
             step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);

@@ -12,10 +12,12 @@
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
 //! | [`sweep`] | [`Sweep`](sweep::Sweep): the sliding O-grid, inner contour turned per frame, extrapolated initial guesses | §11.1, Fig. 22 |
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified | §4.1, §9 |
+//! | [`kinks`] | [`keep_kinks`](kinks::keep_kinks): the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod improve;
 pub mod initial;
+pub mod kinks;
 pub mod levels;
 pub mod newton;
 pub mod options;

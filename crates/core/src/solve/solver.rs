@@ -10,14 +10,14 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::improve::{improve, Improvement};
+use super::improve::{bijective, improve, Improvement};
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
+use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
-use crate::boundary::corners::boundary_kinks;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
@@ -274,6 +274,30 @@ impl EggSolver {
             Some(c) => c,
             None => certify(&map, &self.opts.certify)?,
         };
+        // the C0 route of §9: the kinks kept exactly on Σ⁰ from the Σ¹ map
+        let c0_route = match &hierarchy.kinked {
+            None => None,
+            Some(kinked) => {
+                let functions = map.knots[0].num_basis() * map.knots[1].num_basis();
+                if !self.reports.last().is_some_and(|l| l.converged) {
+                    Some(KinkStage::skipped(
+                        kinked,
+                        functions,
+                        "the solve on the smoothed basis did not converge".into(),
+                    ))
+                } else if !bijective(&certificate) {
+                    let why = format!("the map on the smoothed basis is not certified ({})", certificate.message());
+                    Some(KinkStage::skipped(kinked, functions, why))
+                } else {
+                    let out = keep_kinks(&map, kinked, &self.opts, &*self.assembler, self.diameter)?;
+                    if let (Some(m), Some(c)) = (out.map, out.certificate) {
+                        map = m;
+                        certificate = c;
+                    }
+                    Some(out.report)
+                }
+            }
+        };
         let improvement = match self.opts.improve {
             None => None,
             Some(imp) => {
@@ -306,12 +330,17 @@ impl EggSolver {
                 l.initial_det_j_min = sim.area(l.initial_det_j_min);
             }
         }
-        let finest = self.plan.last().expect("non-empty plan");
+        let kept = c0_route.as_ref().is_some_and(|r| r.kept);
+        let finest = match (&hierarchy.kinked, kept) {
+            (Some(k), true) => &k.level,
+            _ => self.plan.last().expect("non-empty plan"),
+        };
         let sides = finest.sides.each_ref().map(|c| sim.physical_curve(c));
         let ctx = ReportContext {
             hierarchy,
             sides: &sides,
-            kinks: boundary_kinks(boundary),
+            kinks: kink_reports(boundary, hierarchy, &map, kept),
+            c0_route,
             boundary_deviation: {
                 let mut dev = match hierarchy.basis.used {
                     // the same curve at equal parameters: measured exactly, not by a polyline
@@ -422,20 +451,39 @@ pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
             let mut o = opts.clone();
             o.fit = fitted;
             let h = build_hierarchy(boundary, &o.fit)?;
-            let mut again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
-            again.report.basis.requested = BasisChoice::Auto;
-            again.report.basis.fallback = Some(why);
-            // the time of the attempt on the input basis counts
-            again.report.seconds += sol.report.seconds;
-            Ok(again)
+            let again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
+            Ok(auto_choice(sol, again, why))
         }
     }
 }
 
+/// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
+/// basis) again as `again` (fitted basis) for the reason `why`: `again`, with the reason
+/// in its report; but a `degenerate-corner` map on the input basis stands when the fitted
+/// one is not certified either (its boundary is the exact one). The time of both solves
+/// counts.
+pub fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
+    if first.report.verdict == Verdict::DegenerateCorner && again.report.verdict != Verdict::Certified {
+        let mut first = first;
+        first.report.seconds += again.report.seconds;
+        first.report.message.push_str(&format!(
+            "; solved again on the fitted basis too, where the map is {}: the input basis' map is kept",
+            again.report.verdict.name()
+        ));
+        return first;
+    }
+    again.report.basis.requested = BasisChoice::Auto;
+    again.report.basis.fallback = Some(why);
+    again.report.seconds += first.report.seconds;
+    again
+}
+
 /// With [`BasisChoice::Auto`]: when `sol` was solved on the input basis and its map is
-/// not certified (folded, undecided or not converged; `degenerate-corner` is the best
-/// map such a boundary allows and is kept), the fit options of the fitted basis and the
-/// reason to solve again with them. `None` when `sol` stands.
+/// not certified (folded, undecided or not converged; `degenerate-corner` at corners of
+/// the domain is the best map such a boundary allows and is kept, but not when only
+/// zero-speed points of the input's parameterization are excused: the fitted basis
+/// reparameterizes them, see [`auto_choice`]), the fit options of the fitted basis and
+/// the reason to solve again with them. `None` when `sol` stands.
 pub fn auto_fallback(
     sol: &Solution,
     fit: &crate::boundary::fit::FitOptions,
@@ -444,15 +492,26 @@ pub fn auto_fallback(
     if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
         return None;
     }
-    if matches!(r.verdict, Verdict::Certified | Verdict::DegenerateCorner) {
+    let zero_speed_only = r.verdict == Verdict::DegenerateCorner
+        && !r.certificate.excused_points.is_empty()
+        && r.certificate.corners.iter().all(|c| c.excused_extent.is_none());
+    if r.verdict == Verdict::Certified || (r.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
         return None;
     }
-    let why = format!(
-        "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
-        r.basis_functions,
-        r.repairs,
-        r.verdict.name()
-    );
+    let why = if zero_speed_only {
+        format!(
+            "on the input basis ({} functions) det J = 0 where the input's parameterization has zero speed; solved \
+             again on the fitted basis, which reparameterizes the side there",
+            r.basis_functions
+        )
+    } else {
+        format!(
+            "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
+            r.basis_functions,
+            r.repairs,
+            r.verdict.name()
+        )
+    };
     let fit = crate::boundary::fit::FitOptions { basis: BasisChoice::Fitted, ..*fit };
     Some((fit, why))
 }
