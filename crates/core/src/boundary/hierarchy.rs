@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::cord_length::cord_length_params;
 use super::fit::{fit_side_kinked, FitOptions, SideFit};
 use super::input_basis::{input_levels_with, DIRECT_SOLVE_MAX_FUNCTIONS};
-use super::kinks::{detect, smoothed_levels, Kink, KinkKind, KinkedLevel};
+use super::kinks::{detect, Kink, KinkKind, KinkedLevel};
 pub use super::level::Level;
 use super::normalise::Similarity;
 use super::reparam::{sample_side, ReparamReport, SideParam};
@@ -65,9 +65,9 @@ pub struct Hierarchy {
     /// The input's coordinates from the normalised ones: `x = c + s x̂` (the identity for
     /// a well-placed boundary).
     pub similarity: Similarity,
-    /// Kinks kept exactly (paper §9): the `C^0` basis `Σ⁰` the map ends on and the kinks;
-    /// [`Hierarchy::levels`] are then the smoothed bases `Σ¹` the Galerkin form (8) is
-    /// solved on.
+    /// Kinks kept exactly (paper §9): the finest `C^0` level `Σ⁰` and the kinks;
+    /// [`Hierarchy::levels`] then hold the kinks at multiplicity `p`, and the solver
+    /// smooths them to `Σ¹` for the Galerkin form (8).
     pub kinked: Option<KinkedLevel>,
 }
 
@@ -218,15 +218,15 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
 pub const ZERO_SPEED_SAMPLES: usize = 64;
 
 /// The hierarchy `h` (levels `Σ⁰`, holding the kinks `kept` at multiplicity `p`) with its
-/// levels smoothed to `Σ¹` ([`smoothed_levels`]), `Σ⁰`'s finest level and the kinks in
-/// [`Hierarchy::kinked`], and [`BasisReport::kinks`] saying so; `h` as it is without
-/// kinks.
+/// finest level and the kinks in [`Hierarchy::kinked`], and [`BasisReport::kinks`] saying
+/// so; `h` as it is without kinks. The solver smooths the levels it solves on to `Σ¹`
+/// ([`crate::boundary::kinks::smoothed_levels`]) after balancing and refining them, so that
+/// the rounding of the kinks is confined to the final elements next to them.
 fn with_kinks(mut h: Hierarchy, kept: Vec<Kink>, notes: Vec<String>) -> Result<Hierarchy> {
     if kept.is_empty() {
         return Ok(h);
     }
     let finest = h.finest().clone();
-    h.levels = smoothed_levels(&h.levels)?;
     let list: Vec<String> = kept
         .iter()
         .map(|k| {

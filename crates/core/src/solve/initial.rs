@@ -208,13 +208,25 @@ pub fn continuation(
     cont: &mut Continuation,
 ) -> Result<Vec<Point>> {
     let positive = |c: &[Point]| det_j_min(assembler, disc, c) > 0.0;
-    continuation_with(method, assembler, disc, base, target, nl, diameter, cont, &positive)
+    Ok(continuation_with(method, assembler, disc, base, target, nl, diameter, cont, &positive)?.guess)
+}
+
+/// The outcome of [`continuation_with`].
+#[derive(Debug, Clone)]
+pub struct Continued {
+    /// The guess with the full target boundary (positive unless the steps ran out).
+    pub guess: Vec<Point>,
+    /// The last positive map reached (the start, or the solution of the last damped
+    /// solve that succeeded), whose boundary is moved by `alpha` of the way.
+    pub base: Vec<Point>,
+    /// The fraction of the boundary displacement `base` has reached.
+    pub alpha: f64,
 }
 
 /// [`continuation`] with the test of a guess given: `positive(control points)` (the
 /// sampled `det J` for [`continuation`]; the certificate for the `C^0` route of §9,
-/// whose Winslow solves need a bijective start).
-#[allow(clippy::too_many_arguments)]
+/// whose Winslow solves need a bijective start); also returns the last positive map
+/// reached, from which a caller may go on on a refined basis.
 pub fn continuation_with(
     method: &dyn Method,
     assembler: &dyn EggAssembler,
@@ -225,11 +237,11 @@ pub fn continuation_with(
     diameter: f64,
     cont: &mut Continuation,
     positive: &dyn Fn(&[Point]) -> bool,
-) -> Result<Vec<Point>> {
+) -> Result<Continued> {
     let tol = 1e-12 * diameter;
     if base.iter().zip(target).all(|(b, t)| (b[0] - t[0]).abs() <= tol && (b[1] - t[1]).abs() <= tol) {
         // same boundary (e.g. a refinement of the previous level): nothing to move
-        return Ok(base);
+        return Ok(Continued { guess: base.clone(), base, alpha: 1.0 });
     }
     let mut base = base;
     let (mut done, mut step) = (0.0f64, 1.0f64);
@@ -240,7 +252,7 @@ pub fn continuation_with(
         // the prolonged map itself is not positive on this level's (denser) sample:
         // damping the boundary motion cannot make the guess positive, Newton starts
         // from the full elasticity guess
-        return Ok(displaced(&base, &u, 1.0));
+        return Ok(Continued { guess: displaced(&base, &u, 1.0), base, alpha: 0.0 });
     }
     loop {
         let a = (done + step).min(1.0);
@@ -249,7 +261,7 @@ pub fn continuation_with(
         let guess_positive = positive(&guess);
         let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
         if a >= 1.0 && (guess_positive || exhausted) {
-            return Ok(guess);
+            return Ok(Continued { guess, base, alpha: done });
         }
         if !guess_positive && !exhausted {
             step *= 0.5;
@@ -264,7 +276,9 @@ pub fn continuation_with(
             iterations = it?.iteration;
         }
         cont.steps += 1;
-        let converged = *solver.status() == Status::Converged;
+        // a minimisation only lowers its objective from a feasible start: a positive
+        // result is a better base even before its stopping rule is met
+        let converged = *solver.status() == Status::Converged || solver.objective().is_some_and(f64::is_finite);
         let (problem, c) = solver.into_parts();
         let sol = problem.control_points(&c);
         cont.iterations += iterations;
@@ -274,7 +288,9 @@ pub fn continuation_with(
             step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
             u = elasticity_displacement_with(assembler, disc, &base, target)?;
         } else if exhausted {
-            return Ok(guess);
+            // out of steps: the full boundary from the last positive map (the damped
+            // guess would carry a wrong boundary into the level's solve)
+            return Ok(Continued { guess: displaced(&base, &u, 1.0), base, alpha: done });
         } else {
             step *= 0.5;
         }

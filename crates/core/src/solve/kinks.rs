@@ -16,6 +16,12 @@
 //! 4. certifies the result. The map is replaced only by a certified one (the minimised
 //!    map, else the certified start of step 3); otherwise the `Σ¹` map stays, with its
 //!    rounded kinks, and the report says why.
+//!
+//! Where the full step of 2. is not certified (next to a reflex kink the harmonic map is
+//! singular, `x_ξ → 0`, and a coarse basis cannot follow), the offending elements and a
+//! halo are bisected as in the defect correction (§8.2), the last certified map of the
+//! continuation is prolonged onto the refined basis and the continuation goes on from
+//! there, at most `repair` rounds.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -26,6 +32,7 @@ use super::improve::{bijective, from_bijective_start};
 use super::initial::{continuation_with, set_boundary, Continuation};
 use super::newton::{NonlinearSolver, Status};
 use super::options::SolveOptions;
+use super::repair::plan_repair;
 use crate::boundary::kinks::KinkedLevel;
 use crate::boundary::level::Level;
 use crate::discrete::assembly::Discretization;
@@ -54,6 +61,12 @@ pub struct KinkStage {
     pub continuation_steps: usize,
     /// Newton iterations spent in them.
     pub continuation_iterations: usize,
+    /// Rounds of local refinement (§8.2) around elements where the continuation's full
+    /// step was not certified (at most the solve's `repair`).
+    pub refinements: usize,
+    /// The largest fraction of the boundary displacement reached by a certified map (1
+    /// when the kinks were reached).
+    pub alpha: f64,
     /// Newton iterations of the final Winslow minimisation.
     pub iterations: usize,
     /// Whether it met its stopping rule.
@@ -82,6 +95,8 @@ impl KinkStage {
             boundary_shift: 0.0,
             continuation_steps: 0,
             continuation_iterations: 0,
+            refinements: 0,
+            alpha: 0.0,
             iterations: 0,
             converged: false,
             winslow: [None, None],
@@ -101,56 +116,49 @@ pub struct KinkOutcome {
     pub map: Option<Surface>,
     /// Its certificate.
     pub certificate: Option<Certificate>,
+    /// Its level (basis and sides).
+    pub level: Option<Level>,
     /// The stage report.
     pub report: KinkStage,
 }
 
-/// The `Σ⁰` level of `kinked` joined with the knots of `map` (the `Σ¹` map): the sides
-/// refined onto the union.
-fn joined_level(map: &Surface, kinked: &KinkedLevel) -> Result<Level> {
-    let knots = [map.knots[0].union(&kinked.level.knots[0])?, map.knots[1].union(&kinked.level.knots[1])?];
-    let mut sides = kinked.level.sides.clone();
+/// The `Σ⁰` level `c0` joined with the knots of `map` (the `Σ¹` map, which may hold
+/// knots of repair rounds): the sides refined onto the union.
+fn joined_level(map: &Surface, c0: &Level) -> Result<Level> {
+    let knots = [map.knots[0].union(&c0.knots[0])?, map.knots[1].union(&c0.knots[1])?];
+    let mut sides = c0.sides.clone();
     for s in Side::ALL {
         sides[s as usize] = sides[s as usize].refined(&knots[s.direction()])?;
     }
     Ok(Level { knots, sides })
 }
 
-/// The `C^0` route (module documentation) from the `Σ¹` map `map`, certified bijective:
-/// the map on `Σ⁰` with the kinks kept exactly, certified, or why not.
+/// The `C^0` route (module documentation) from the `Σ¹` map `map`, certified bijective,
+/// to the `C^0` level `c0` (the kinks `kinked` at multiplicity `p`): the map on `Σ⁰` with
+/// the kinks kept exactly, certified, or why not.
 pub fn keep_kinks(
     map: &Surface,
+    c0: &Level,
     kinked: &KinkedLevel,
     opts: &SolveOptions,
     assembler: &dyn EggAssembler,
     diameter: f64,
 ) -> Result<KinkOutcome> {
     let t0 = Instant::now();
-    let level = joined_level(map, kinked)?;
-    let weights = level.weights()?;
+    let mut level = joined_level(map, c0)?;
+    let mut base = map.refined(&level.knots)?.control_points;
     let [p, q] = map.degrees();
-    let dofs = DofMap::for_basis(&level.knots, &opts.topology)?;
-    let disc =
-        Arc::new(Discretization::with_dofs(level.knots.clone(), p.max(q) + 2, dofs).with_weights(weights.clone())?);
-    let fine = map.refined(&level.knots)?.control_points;
-    let mut target = fine.clone();
-    set_boundary(disc.shape(), &level.sides, &mut target)?;
-    let boundary_shift =
-        fine.iter().zip(&target).fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1]))) / diameter;
-    let surface =
-        |cps: &[Point]| Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
-    let certified = |cps: &[Point]| certify(&surface(cps), &opts.certify).is_ok_and(|c| bijective(&c));
     let method = WinslowMethod;
-    let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
     let mut cont = Continuation::default();
-    let start = continuation_with(&method, assembler, &disc, fine, &target, nl, diameter, &mut cont, &certified)?;
     let mut report = KinkStage {
         kinks: kinked.kinks.len(),
         smoothed_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
         functions: level.num_basis(),
-        boundary_shift,
-        continuation_steps: cont.steps,
-        continuation_iterations: cont.iterations,
+        boundary_shift: 0.0,
+        continuation_steps: 0,
+        continuation_iterations: 0,
+        refinements: 0,
+        alpha: 0.0,
         iterations: 0,
         converged: false,
         winslow: [None, None],
@@ -160,21 +168,68 @@ pub fn keep_kinks(
         seconds: 0.0,
         message: String::new(),
     };
-    let start_cert = certify(&surface(&start), &opts.certify)?;
+    // the damped elasticity continuation to the kinked boundary; where its full step is
+    // not certified, the offending elements are bisected (§8.2) and it goes on from the
+    // last certified map, prolonged
+    let (disc, weights, start, start_cert) = loop {
+        let weights = level.weights()?;
+        let dofs = DofMap::for_basis(&level.knots, &opts.topology)?;
+        let disc =
+            Arc::new(Discretization::with_dofs(level.knots.clone(), p.max(q) + 2, dofs).with_weights(weights.clone())?);
+        let mut target = base.clone();
+        set_boundary(disc.shape(), &level.sides, &mut target)?;
+        if report.refinements == 0 {
+            report.boundary_shift =
+                base.iter().zip(&target).fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1]))) / diameter;
+        }
+        let surface = |cps: &[Point]| Surface {
+            knots: level.knots.clone(),
+            control_points: cps.to_vec(),
+            weights: weights.clone(),
+        };
+        let certified = |cps: &[Point]| certify(&surface(cps), &opts.certify).is_ok_and(|c| bijective(&c));
+        let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
+        // the damped steps are counted per round (the cap of the continuation is per basis)
+        let mut round = Continuation::default();
+        let out = continuation_with(&method, assembler, &disc, base, &target, nl, diameter, &mut round, &certified)?;
+        cont.steps += round.steps;
+        cont.iterations += round.iterations;
+        report.alpha = report.alpha.max(out.alpha);
+        let cert = certify(&surface(&out.guess), &opts.certify)?;
+        if bijective(&cert) || report.refinements >= opts.repair {
+            break (disc, weights, out.guess, cert);
+        }
+        let Some(r) = plan_repair(&level, &cert, report.refinements + 1, opts.repair_halo, None)? else {
+            break (disc, weights, out.guess, cert);
+        };
+        let reached = surface(&out.base);
+        level = r.level;
+        base = reached.refined(&level.knots)?.control_points;
+        report.refinements += 1;
+    };
+    report.functions = level.num_basis();
+    report.continuation_steps = cont.steps;
+    report.continuation_iterations = cont.iterations;
+    let surface =
+        |cps: &[Point]| Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
     let finite = |j: f64| j.is_finite().then_some(j);
     report.winslow[0] = finite(winslow_objective(&disc, &start));
     if !bijective(&start_cert) {
         let why = format!(
-            "the elasticity step to the kinked boundary ({} damped Winslow solves) gave no bijective start: {}",
+            "the elasticity step to the kinked boundary ({} damped Winslow solves, {} refinement round(s), {:.3} of the \
+             boundary displacement reached with a certified map) gave no bijective start: {}",
             cont.steps,
+            report.refinements,
+            report.alpha,
             start_cert.message()
         );
         report.certificate = start_cert.message();
         report.message = format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹");
         report.failure = Some(why);
         report.seconds = t0.elapsed().as_secs_f64();
-        return Ok(KinkOutcome { map: None, certificate: None, report });
+        return Ok(KinkOutcome { map: None, certificate: None, level: None, report });
     }
+    let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
     let c0 = disc.dofs.gather(&start);
     let mut solver = NonlinearSolver::new(method.problem(disc.clone(), start.clone()), c0, nl);
     for it in solver.by_ref() {
@@ -197,11 +252,17 @@ pub fn keep_kinks(
     report.certificate = cert.message();
     report.message = format!(
         "{} kink(s) kept exactly: {which} on the C0 basis ({} functions, from the smoothed {}; boundary moved by \
-         {:.3e} of the diameter, {} damped step(s))",
-        report.kinks, report.functions, report.smoothed_functions, boundary_shift, cont.steps,
+         {:.3e} of the diameter, {} damped step(s), {} refinement round(s))",
+        report.kinks,
+        report.functions,
+        report.smoothed_functions,
+        report.boundary_shift,
+        cont.steps,
+        report.refinements
     );
     report.seconds = t0.elapsed().as_secs_f64();
-    Ok(KinkOutcome { map: Some(surface(&cps)), certificate: Some(cert), report })
+    let map = surface(&cps);
+    Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
 }
 
 /// Distance from `x` to the curve `c`: the closest of 32 samples per element, refined by

@@ -19,6 +19,7 @@ use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
+use crate::boundary::kinks::smoothed_levels;
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
@@ -88,6 +89,9 @@ pub struct EggSolver {
     /// For repair levels solved with frozen DOFs: plan index and the parameter boxes
     /// `[u0, u1, v0, v1]` whose control points stay free.
     free_boxes: Vec<(usize, Vec<[f64; 4]>)>,
+    /// With kinks kept (§9): the finest `C^0` level `Σ⁰` (balanced and refined like the
+    /// plan, whose levels are its smoothing `Σ¹`).
+    c0: Option<Level>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -122,6 +126,12 @@ impl EggSolver {
             _ => (opts.min_elements, opts.aspect),
         };
         let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.refine, aspect)?;
+        // kinks kept (§9): the levels hold them at multiplicity p (Σ⁰); solve on Σ¹, the
+        // finest prepared Σ⁰ is where the C0 route ends
+        let (levels, c0) = match hierarchy.kinked {
+            Some(_) => (smoothed_levels(&levels)?, levels.last().cloned()),
+            None => (levels, None),
+        };
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
         let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
@@ -141,6 +151,7 @@ impl EggSolver {
             rounds: Vec::new(),
             certificate: None,
             free_boxes: Vec::new(),
+            c0,
         })
     }
 
@@ -275,9 +286,9 @@ impl EggSolver {
             None => certify(&map, &self.opts.certify)?,
         };
         // the C0 route of §9: the kinks kept exactly on Σ⁰ from the Σ¹ map
-        let c0_route = match &hierarchy.kinked {
-            None => None,
-            Some(kinked) => {
+        let mut c0_level = None;
+        let c0_route = match (&hierarchy.kinked, &self.c0) {
+            (Some(kinked), Some(level)) => {
                 let functions = map.knots[0].num_basis() * map.knots[1].num_basis();
                 if !self.reports.last().is_some_and(|l| l.converged) {
                     Some(KinkStage::skipped(
@@ -289,14 +300,16 @@ impl EggSolver {
                     let why = format!("the map on the smoothed basis is not certified ({})", certificate.message());
                     Some(KinkStage::skipped(kinked, functions, why))
                 } else {
-                    let out = keep_kinks(&map, kinked, &self.opts, &*self.assembler, self.diameter)?;
-                    if let (Some(m), Some(c)) = (out.map, out.certificate) {
+                    let out = keep_kinks(&map, level, kinked, &self.opts, &*self.assembler, self.diameter)?;
+                    if let (Some(m), Some(c), Some(l)) = (out.map, out.certificate, out.level) {
                         map = m;
                         certificate = c;
+                        c0_level = Some(l);
                     }
                     Some(out.report)
                 }
             }
+            _ => None,
         };
         let improvement = match self.opts.improve {
             None => None,
@@ -330,11 +343,8 @@ impl EggSolver {
                 l.initial_det_j_min = sim.area(l.initial_det_j_min);
             }
         }
-        let kept = c0_route.as_ref().is_some_and(|r| r.kept);
-        let finest = match (&hierarchy.kinked, kept) {
-            (Some(k), true) => &k.level,
-            _ => self.plan.last().expect("non-empty plan"),
-        };
+        let kept = c0_level.is_some();
+        let finest = c0_level.as_ref().unwrap_or_else(|| self.plan.last().expect("non-empty plan"));
         let sides = finest.sides.each_ref().map(|c| sim.physical_curve(c));
         let ctx = ReportContext {
             hierarchy,
