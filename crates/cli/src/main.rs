@@ -572,8 +572,9 @@ fn run(cli: Cli) -> Result<i32> {
                 bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
             };
             let segments = if a.no_matches { Vec::new() } else { output::report_matches(&a.map) };
-            let opts =
-                PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, segments, ..Default::default() };
+            let kinks = output::report_kinks(&a.map);
+            let (size, grid_lines) = (a.size.clamp(64, 8192), a.lines);
+            let opts = PictureOptions { size, grid_lines, segments, kinks, ..Default::default() };
             let sel = a.backend.select(false)?;
             output::write_png(&a.png, &picture(&sel, &map, &opts)?)?;
             println!("wrote {}", a.png.display());

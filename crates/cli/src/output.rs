@@ -444,6 +444,13 @@ pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
     winslow::boundary::reparam::matches_in_report(&doc["report"])
 }
 
+/// The kinks stored in a map file's report (points, kept or not), for `render`.
+pub fn report_kinks(path: &Path) -> Vec<(winslow::Point, bool)> {
+    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+    winslow::boundary::kinks::kinks_in_report(&doc["report"])
+}
+
 /// `winslow inspect --json`.
 pub fn inspect_json(
     b: &Boundary,

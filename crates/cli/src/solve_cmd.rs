@@ -199,7 +199,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     }
     if let Some(p) = &a.png {
         let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
-        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, ..Default::default() })?)?;
+        let kinks = sol.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
+        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, kinks, ..Default::default() })?)?;
     }
     if let Some(p) = &a.vtk {
         output::write_map_as(p, "vtk", &sol.name, &sol.map, &label, json)?;

@@ -231,6 +231,20 @@ pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kin
     out
 }
 
+/// The kinks stored in a map document's `"report"` (`kinks[].point` and `kinks[].kept`
+/// of the solve report): points and whether the map keeps them; malformed entries are
+/// skipped.
+pub fn kinks_in_report(report: &serde_json::Value) -> Vec<(Point, bool)> {
+    let Some(kinks) = report["kinks"].as_array() else { return Vec::new() };
+    kinks
+        .iter()
+        .filter_map(|k| {
+            let p: Point = serde_json::from_value(k["point"].clone()).ok()?;
+            Some((p, k["kept"].as_bool().unwrap_or(false)))
+        })
+        .collect()
+}
+
 /// Every interior break of `kv` of multiplicity at least `p` (a kink's knot line) lowered
 /// to `p - 1` (paper §9: `Σ¹` from `Σ⁰`).
 pub fn lowered(kv: &KnotVector) -> KnotVector {
@@ -345,6 +359,17 @@ mod tests {
             })
             .collect();
         assert!(cloud_corners(&arc, 30.0).is_empty());
+    }
+
+    #[test]
+    fn kinks_are_read_from_a_stored_report() {
+        let r = serde_json::json!({ "kinks": [
+            { "side": "north", "point": [-4.0, 4.0], "kept": true },
+            { "side": "east", "point": [1.0, 2.0], "kept": false },
+            { "side": "east", "point": "malformed" }
+        ] });
+        assert_eq!(kinks_in_report(&r), vec![([-4.0, 4.0], true), ([1.0, 2.0], false)]);
+        assert!(kinks_in_report(&serde_json::json!({ "verdict": "certified" })).is_empty());
     }
 
     /// `C^0` knots and zero-speed knots of spline sides, with their turning.
