@@ -114,7 +114,7 @@ impl Default for FitOptions {
             max_elements: 4096,
             reparam: ReparamOptions::default(),
             basis: BasisChoice::Auto,
-            kinks: KinkMode::None,
+            kinks: KinkMode::Auto,
         }
     }
 }
