@@ -64,8 +64,14 @@ const GEOMETRIES: [&str; 19] = [
 
 /// The fitted basis (§5): what these tests are about (the default `Auto` keeps spline
 /// sides in their own basis).
+/// The fitted basis with the dyadic `C^{p-1}` fits of §5 only: these tests are about the
+/// fit itself (kinks kept by knots of multiplicity p: tests/kinks.rs).
 fn fitted() -> FitOptions {
-    FitOptions { basis: winslow::boundary::BasisChoice::Fitted, ..FitOptions::default() }
+    FitOptions {
+        basis: winslow::boundary::BasisChoice::Fitted,
+        kinks: winslow::boundary::KinkMode::None,
+        ..FitOptions::default()
+    }
 }
 
 fn dist(a: Point, b: Point) -> f64 {

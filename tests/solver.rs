@@ -266,9 +266,14 @@ fn input_basis_keeps_the_boundary_exactly() {
             assert!((p[0] - q[0]).abs() <= 1e-14 * r.diameter && (p[1] - q[1]).abs() <= 1e-14 * r.diameter, "{s}");
         }
     }
-    // a C0 knot inside a side is not rounded silently: fitted basis, with the reason
+    // a C0 knot inside a side is not rounded silently: kept by the C0 route of §9 (the
+    // default, tests/kinks.rs), or, with kinks not kept, the fitted basis with the reason
     let rotor = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/rotor_sector.json");
     let b = read_boundary(&rotor, &ReadOptions::default()).unwrap();
+    let h = winslow::build_hierarchy(&b, &opts.fit).unwrap();
+    assert_eq!(h.basis.used, BasisChoice::Input);
+    assert!(h.kinked.as_ref().is_some_and(|k| k.kinks.len() == 2) && h.basis.kinks.is_some(), "{:?}", h.basis);
+    opts.fit.kinks = winslow::boundary::KinkMode::None;
     let h = winslow::build_hierarchy(&b, &opts.fit).unwrap();
     assert_eq!(h.basis.used, BasisChoice::Fitted);
     assert!(h.basis.fallback.as_deref().is_some_and(|w| w.contains("C0")), "{:?}", h.basis);

@@ -11,7 +11,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use winslow::boundary::fit::FitOptions;
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
-use winslow::boundary::BasisChoice;
+use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
 use winslow::io::picture::{render, PictureOptions};
 use winslow::io::ring::read_ring;
@@ -160,6 +160,19 @@ struct FitArgs {
     /// point clouds, analytic sides and C0 knots).
     #[arg(long, value_enum, default_value = "auto")]
     basis: BasisArg,
+    /// Kinks inside the sides kept exactly (paper §9): `auto` (spline sides' C0 knots and
+    /// zero-speed knots turning more than 1 degree, point clouds' corners turning 30 degrees
+    /// or more), `none` (rounded by the C^{p-1} fit and reported; on the input basis a C0
+    /// knot then falls back to fitted) or an angle in degrees (every kink turning at least
+    /// that much). A kept kink gets a knot line of multiplicity p; EGG is solved on the
+    /// smoothed basis, the map moved to the kinked boundary by damped elasticity and
+    /// finished by the Winslow functional (16).
+    #[arg(long, default_value_t = FitOptions::default().kinks, value_parser = parse_kinks)]
+    kinks: KinkMode,
+}
+
+fn parse_kinks(s: &str) -> std::result::Result<KinkMode, String> {
+    KinkMode::parse(s).ok_or_else(|| format!("expected auto, none or an angle in (0, 180] degrees, got '{s}'"))
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
@@ -430,7 +443,7 @@ fn fit_options(f: &FitArgs) -> FitOptions {
         BasisArg::Fitted => BasisChoice::Fitted,
         BasisArg::Input => BasisChoice::Input,
     };
-    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis, ..Default::default() }
+    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis, kinks: f.kinks, ..Default::default() }
 }
 
 #[derive(Args, Debug)]
@@ -568,8 +581,9 @@ fn run(cli: Cli) -> Result<i32> {
                 bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
             };
             let segments = if a.no_matches { Vec::new() } else { output::report_matches(&a.map) };
-            let opts =
-                PictureOptions { size: a.size.clamp(64, 8192), grid_lines: a.lines, segments, ..Default::default() };
+            let kinks = output::report_kinks(&a.map);
+            let (size, grid_lines) = (a.size.clamp(64, 8192), a.lines);
+            let opts = PictureOptions { size, grid_lines, segments, kinks, ..Default::default() };
             let sel = a.backend.select(false)?;
             output::write_png(&a.png, &picture(&sel, &map, &opts)?)?;
             println!("wrote {}", a.png.display());

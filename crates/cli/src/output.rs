@@ -107,6 +107,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     if let Some(p) = &r.poisson {
         poisson_line(&mut s, p);
     }
+    kink_lines(&mut s, r);
     if let Some(imp) = &r.improvement {
         improvement_lines(&mut s, imp, r.seconds);
     }
@@ -208,6 +209,51 @@ fn quality_lines(s: &mut String, q: &Quality) {
         "  orthogonality (deviation from 90 deg, per-element max): max {:.2}, mean {:.2}; aspect ratio: max {:.3}, mean {:.3} ({} elements)",
         q.orthogonality_degrees.max, q.orthogonality_degrees.mean, q.aspect_ratio.max, q.aspect_ratio.mean, q.elements
     );
+}
+
+/// The kinks (kept or rounded, with the deviation at each) and the `C^0` route of §9.
+fn kink_lines(s: &mut String, r: &winslow::Report) {
+    if let Some(c) = &r.c0_route {
+        let w = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.6}"));
+        let _ = writeln!(
+            s,
+            "  C0 route (§9): {}; {} -> {} functions, {} damped step(s), {} Winslow iterations (Winslow {} -> {}), {:.3} s",
+            if c.kept { "kinks kept" } else { "kinks NOT kept" },
+            c.smoothed_functions,
+            c.functions,
+            c.continuation_steps,
+            c.iterations,
+            w(c.winslow[0]),
+            w(c.winslow[1]),
+            c.seconds
+        );
+        if let Some(why) = c.failure.as_ref().filter(|_| !c.kept) {
+            let _ = writeln!(s, "    why: {why}");
+        }
+    }
+    for k in &r.kinks {
+        let _ = writeln!(
+            s,
+            "    kink {} at {:.6} ({}, turns {:.1} deg) at ({:.6}, {:.6}): {}, deviation {:.2e} ({:.1e} of the diameter)",
+            k.side,
+            k.parameter,
+            serde_json::to_value(k.kind).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
+            k.turning_degrees,
+            k.point[0],
+            k.point[1],
+            if k.kept { "kept exactly" } else { "rounded" },
+            k.deviation,
+            k.deviation / r.diameter
+        );
+    }
+    for p in &r.certificate.excused_points {
+        let _ = writeln!(
+            s,
+            "    {} side's zero-speed point ({:.6}, {:.6}): det J = 0 there for every map of this boundary; excused \
+             neighbourhood {:.3e} x {:.3e} in (xi, eta)",
+            p.side, p.point[0], p.point[1], p.extent[0], p.extent[1]
+        );
+    }
 }
 
 fn certificate_lines(s: &mut String, c: &Certificate, with_message: bool) {
@@ -396,6 +442,13 @@ pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
     let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
     let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     winslow::boundary::reparam::matches_in_report(&doc["report"])
+}
+
+/// The kinks stored in a map file's report (points, kept or not), for `render`.
+pub fn report_kinks(path: &Path) -> Vec<(winslow::Point, bool)> {
+    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
+    winslow::boundary::kinks::kinks_in_report(&doc["report"])
 }
 
 /// `winslow inspect --json`.

@@ -22,12 +22,8 @@ pub(super) fn run_solver(
     }
     let opts = SolveOptions { fit: fitted, ..opts.clone() };
     let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
-    let mut again = drive(boundary, &h, &opts, assembler, quiet)?;
-    again.report.basis.requested = BasisChoice::Auto;
-    again.report.basis.fallback = Some(why);
-    // the time of the attempt on the input basis counts
-    again.report.seconds += sol.report.seconds;
-    Ok(again)
+    let again = drive(boundary, &h, &opts, assembler, quiet)?;
+    Ok(winslow::solve::solver::auto_choice(sol, again, why))
 }
 
 /// Fit a ring's contours on one periodic knot vector and solve with `eta` periodic
@@ -93,6 +89,9 @@ fn drive(
                 h.finest().knots[1].num_basis()
             ),
             (None, BasisChoice::Fitted) => {}
+        }
+        if let Some(k) = &h.basis.kinks {
+            eprintln!("  kinks: {k}");
         }
         let rp = &h.reparam;
         eprintln!(
@@ -200,7 +199,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     }
     if let Some(p) = &a.png {
         let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
-        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, ..Default::default() })?)?;
+        let kinks = sol.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
+        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, kinks, ..Default::default() })?)?;
     }
     if let Some(p) = &a.vtk {
         output::write_map_as(p, "vtk", &sol.name, &sol.map, &label, json)?;

@@ -659,3 +659,36 @@ fn default_basis_keeps_spline_boundaries() {
     assert!(r["basis"]["fallback"].as_str().unwrap().contains("point cloud"), "{}", r["basis"]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--kinks`: the star polygon keeps its twelve vertices exactly (the report lists them as
+/// kept, the summary says so, the PNG is written with their marks and `render` reads them
+/// back from the report); `--kinks none` rounds them and says so; a bad angle is a clear
+/// error.
+#[test]
+fn kinks_are_kept_reported_and_marked() {
+    let dir = std::env::temp_dir().join(format!("winslow-cli-kinks-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (map, png) = (dir.join("star.json"), dir.join("star.png"));
+    let star = data().join("contours/star8.json");
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).arg("--png").arg(&png).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("C0 route (§9): kinks kept") && text.contains("kept exactly"), "{text}");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+    let kinks = doc["report"]["kinks"].as_array().unwrap();
+    assert_eq!(kinks.len(), 12);
+    let d = doc["report"]["diameter"].as_f64().unwrap();
+    assert!(kinks.iter().all(|k| k["kept"] == true && k["deviation"].as_f64().unwrap() <= 1e-12 * d));
+    assert_eq!(doc["report"]["verdict"], "certified");
+    assert!(doc["report"]["c0_route"]["kept"] == true);
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    let out = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "none"]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("rounded") && !text.contains("C0 route"), "{text}");
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "200"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("angle in (0, 180]"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use egui::epaint::Mesh;
 use egui::{Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Sense, Shape, Stroke, Ui, Vec2};
-use winslow::boundary::BasisChoice;
+use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
 use winslow::Point;
 
@@ -389,6 +389,14 @@ impl ViewerApp {
                     ui.selectable_value(&mut s.basis, b, b.name());
                 }
             });
+            ui.horizontal(|ui| {
+                ui.label("kinks").on_hover_text(
+                    "auto: C0 knots, zero-speed knots and polygon corners inside the sides are kept exactly \
+                     (paper §9: EGG on the smoothed basis, Winslow on the C0 one); none: rounded by the fit",
+                );
+                ui.selectable_value(&mut s.kinks, KinkMode::Auto, "auto");
+                ui.selectable_value(&mut s.kinks, KinkMode::None, "none");
+            });
             ui.add(egui::Slider::new(&mut s.min_elements, 1..=64).text("min elements"));
             ui.add(egui::Slider::new(&mut s.refine, 0..=4).text("extra refinements"));
             ui.add(egui::Slider::new(&mut s.fit_tol, 1e-7..=1e-2).logarithmic(true).text("fit tolerance"));
@@ -532,6 +540,19 @@ impl ViewerApp {
                 painter.circle_filled(to(a), 2.2, Color32::from_rgb(30, 90, 220));
                 painter.circle_filled(to(b), 2.2, Color32::from_rgb(30, 90, 220));
             }
+            // kinks (§9): a diagonal cross where the map keeps them, an upright one where
+            // the fit rounds them
+            for &(x, kept) in &mv.kinks {
+                let (c, r) = (to(x), 5.0);
+                let (colour, arms) = if kept {
+                    (Color32::from_rgb(200, 0, 0), [egui::vec2(r, r), egui::vec2(r, -r)])
+                } else {
+                    (Color32::from_rgb(240, 140, 0), [egui::vec2(r, 0.0), egui::vec2(0.0, r)])
+                };
+                for a in arms {
+                    painter.line_segment([c - a, c + a], Stroke::new(2.0, colour));
+                }
+            }
             if let Some(f) = self.state.selected_fold.and_then(|k| mv.folds.get(k)) {
                 let edge = element_outline(mv, f.xi, f.eta);
                 painter.add(Shape::closed_line(edge.iter().map(|&p| to(p)).collect(), Stroke::new(2.5, Color32::RED)));
@@ -610,6 +631,19 @@ impl ViewerApp {
                 for f in &mv.folds {
                     let r = Rect::from_two_pos(to([f.xi[0], f.eta[0]]), to([f.xi[1], f.eta[1]]));
                     painter.rect_stroke(r, 0.0, Stroke::new(1.0, fold_colour()), egui::StrokeKind::Inside);
+                }
+                // kinks (§9): a diagonal cross where the map keeps them, an upright one where
+                // the fit rounds them
+                for &(x, kept) in &mv.kinks {
+                    let (c, r) = (to(x), 5.0);
+                    let (colour, arms) = if kept {
+                        (Color32::from_rgb(200, 0, 0), [egui::vec2(r, r), egui::vec2(r, -r)])
+                    } else {
+                        (Color32::from_rgb(240, 140, 0), [egui::vec2(r, 0.0), egui::vec2(0.0, r)])
+                    };
+                    for a in arms {
+                        painter.line_segment([c - a, c + a], Stroke::new(2.0, colour));
+                    }
                 }
                 if let Some(f) = self.state.selected_fold.and_then(|k| mv.folds.get(k)) {
                     let r = Rect::from_two_pos(to([f.xi[0], f.eta[0]]), to([f.xi[1], f.eta[1]]));

@@ -135,6 +135,9 @@ pub struct MapView {
     /// Matched point pairs of the constrained reparameterization (paper §7.2), from the
     /// solver's report or the one stored in the map file.
     pub matches: Vec<(Point, Point)>,
+    /// Kinks of the boundary (paper §9) and whether the map keeps them exactly, from the
+    /// solver's report or the one stored in the map file.
+    pub kinks: Vec<(Point, bool)>,
 }
 
 /// The matched pairs stored in a map file's `"report"` (`reparam.matches[].points`).
@@ -192,6 +195,7 @@ impl MapView {
             exact_certificate,
             report: None,
             matches: Vec::new(),
+            kinks: Vec::new(),
         }
     }
 
@@ -277,6 +281,7 @@ impl Scene {
         let mut scene = Self::from_document(doc, sampler, settings, stored);
         if let (Some(mv), Some(r)) = (scene.map.as_mut(), &report) {
             mv.matches = stored_matches(r);
+            mv.kinks = winslow::boundary::kinks::kinks_in_report(r);
         }
         scene.path = Some(path.to_path_buf());
         Ok(scene)
@@ -313,6 +318,7 @@ impl Scene {
         let cert = Certificate::from_report(&solution.report);
         let mut mv = MapView::new(solution.map, sampler, res, settings.density, Some(cert));
         mv.matches = solution.report.reparam.segments();
+        mv.kinks = solution.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
         mv.report = Some(solution.report);
         self.map = Some(mv);
     }
@@ -321,13 +327,14 @@ impl Scene {
     pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
         if let Some(mv) = self.map.take() {
             let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
-            let (report, matches) = (mv.report, mv.matches);
+            let (report, matches, kinks) = (mv.report, mv.matches, mv.kinks);
             use crate::certificate::CertificateSource;
             let cert = matches!(mv.certificate.source, CertificateSource::Solver | CertificateSource::File)
                 .then_some(mv.certificate);
             let mut new = MapView::new(mv.map, sampler, res, settings.density, cert);
             new.report = report;
             new.matches = matches;
+            new.kinks = kinks;
             self.map = Some(new);
         }
     }

@@ -9,7 +9,6 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use winslow::boundary::hierarchy::build_hierarchy;
-use winslow::boundary::BasisChoice;
 use winslow::methods::egg::CpuAssembler;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
@@ -47,11 +46,8 @@ pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: 
         return send(Msg::Finished(Box::new(sol)));
     };
     let again = SolveOptions { fit: fitted, ..opts.clone() };
-    if let Some(mut s) = attempt(boundary, &again, cancel, send) {
-        s.report.basis.requested = BasisChoice::Auto;
-        s.report.basis.fallback = Some(why);
-        s.report.seconds += sol.report.seconds;
-        send(Msg::Finished(Box::new(s)));
+    if let Some(s) = attempt(boundary, &again, cancel, send) {
+        send(Msg::Finished(Box::new(winslow::solve::solver::auto_choice(sol, s, why))));
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
-use winslow::boundary::BasisChoice;
+use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
 use winslow::solve::options::SolveOptions;
 use winslow::Point;
@@ -54,6 +54,8 @@ pub struct SolveSettings {
     pub fit_tol: f64,
     /// The basis: auto (the input's own when certified), input or fitted.
     pub basis: BasisChoice,
+    /// Kinks inside the sides kept exactly (paper §9): auto or none.
+    pub kinks: KinkMode,
 }
 
 impl Default for SolveSettings {
@@ -65,6 +67,7 @@ impl Default for SolveSettings {
             refine: d.refine,
             fit_tol: d.fit.tol,
             basis: d.fit.basis,
+            kinks: d.fit.kinks,
         }
     }
 }
@@ -80,6 +83,7 @@ impl SolveSettings {
         };
         o.fit.tol = self.fit_tol;
         o.fit.basis = self.basis;
+        o.fit.kinks = self.kinks;
         o
     }
 }

@@ -5,12 +5,11 @@
 //! interior angle of 180° or more (or a vanishing tangent) forces `det J ≤ 0` there
 //! whatever the interior control points; the certificate ([`crate::verify::certificate`])
 //! excuses such corners and the report names them. A kink (a `C^0` break where the
-//! tangent turns) forces `det J = 0` for every `C^1` map of the exact side.
+//! tangent turns) forces `det J = 0` for every `C^1` map of the exact side; where they are
+//! and how they are kept: [`super::kinks`].
 
 use serde::Serialize;
 
-use super::Boundary;
-use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
 
@@ -29,62 +28,28 @@ pub struct CornerReport {
 /// Corner angles at or above this (degrees) force `det J <= 0` up to the fit tolerance.
 pub const FORCED_ANGLE: f64 = 179.0;
 
-/// A kink inside a spline side: a break of continuity `C^0` where the tangent turns.
+/// A kink inside a side (paper §9, [`super::kinks`]): a spline side's `C^0` knot or
+/// zero-speed knot, or a point cloud's corner; kept exactly by the `C^0` route or rounded
+/// by the `C^1` fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct KinkReport {
     /// Side name.
     pub side: &'static str,
-    /// Parameter on the side, in `[0, 1]`.
+    /// Parameter on the input side, in `[0, 1]` (a point cloud's cord-length abscissa).
     pub parameter: f64,
     /// Physical point.
     pub point: [f64; 2],
-    /// Turning angle of the tangent in degrees (180 for a cusp or zero speed).
+    /// Turning angle of the tangent in degrees (180 for a cusp).
     pub turning_degrees: f64,
-}
-
-/// Kinks of the input's spline sides: at every interior knot the one-sided tangent
-/// directions are compared (just off the knot, so that a zero speed at the knot, as
-/// with coincident control points, still shows its turn); a turn of more than one
-/// degree is a kink. Any `C^1` map of the exact boundary has zero speed, so
-/// `det J = 0`, at such a point; the fitted boundary rounds it within the tolerance.
-pub fn boundary_kinks(boundary: &Boundary) -> Vec<KinkReport> {
-    let mut out = Vec::new();
-    for s in Side::ALL {
-        let super::SideCurve::Spline(c) = boundary.side(s) else { continue };
-        let bm = c.knots.breaks_with_multiplicity();
-        let spans: Vec<(usize, f64, f64)> = c.knots.elements();
-        for &(u, _) in &bm[1..bm.len().saturating_sub(1)] {
-            let left = spans.iter().find(|e| e.2 == u);
-            let right = spans.iter().find(|e| e.1 == u);
-            let (Some(l), Some(r)) = (left, right) else { continue };
-            // one-sided tangent directions just off the break (robust to zero speed at it)
-            let mut b = BasisDerivs::default();
-            let dl = {
-                b.eval_in_span(&c.knots, l.0, u - 1e-9 * (l.2 - l.1), 1);
-                c.derivs_with(&b, 1).d1
-            };
-            let dr = {
-                b.eval_in_span(&c.knots, r.0, u + 1e-9 * (r.2 - r.1), 1);
-                c.derivs_with(&b, 1).d1
-            };
-            let (sl, sr) = (dl[0].hypot(dl[1]), dr[0].hypot(dr[1]));
-            let turning = if sl == 0.0 || sr == 0.0 {
-                180.0
-            } else {
-                (dl[0] * dr[1] - dl[1] * dr[0]).atan2(dl[0] * dr[0] + dl[1] * dr[1]).to_degrees().abs()
-            };
-            if turning > 1.0 {
-                let (a, bb) = c.domain();
-                out.push(KinkReport {
-                    side: s.name(),
-                    parameter: (u - a) / (bb - a),
-                    point: c.eval(u),
-                    turning_degrees: turning,
-                });
-            }
-        }
-    }
-    out
+    /// `c0-knot`, `zero-speed` or `corner` (a point cloud's).
+    pub kind: super::kinks::KinkKind,
+    /// Whether the map keeps it exactly (a knot line of multiplicity `p` through it).
+    pub kept: bool,
+    /// Where it lies on the map's side (the knot line's parameter) when kept.
+    pub map_parameter: Option<f64>,
+    /// Distance of the map's boundary from the point: at `map_parameter` when kept
+    /// (rounding level), else to the nearest point of the side (the rounding).
+    pub deviation: f64,
 }
 
 /// Geometry of one corner of a patch: interior angle, `x_xi x x_eta` (det J there) and

@@ -47,7 +47,7 @@
 //! `tol_abs`.
 
 use super::cord_length::cord_length_params;
-use super::BasisChoice;
+use super::{BasisChoice, KinkMode};
 use crate::boundary::reparam::{ParamMap, ReparamOptions, SideParam};
 use crate::boundary::{Analytic, SideCurve};
 use crate::error::{Error, Result, MAX_DEGREE};
@@ -100,6 +100,8 @@ pub struct FitOptions {
     /// The basis: `Auto` (default: the input's own basis, boundary kept exactly, when its
     /// map certifies, else fitted), `Fitted` or `Input` ([`super::input_basis`], §5.2).
     pub basis: BasisChoice,
+    /// Which kinks inside the sides are kept exactly (paper §9, [`super::kinks`]).
+    pub kinks: KinkMode,
 }
 
 impl Default for FitOptions {
@@ -112,6 +114,7 @@ impl Default for FitOptions {
             max_elements: 4096,
             reparam: ReparamOptions::default(),
             basis: BasisChoice::Auto,
+            kinks: KinkMode::Auto,
         }
     }
 }
@@ -141,6 +144,7 @@ impl FitOptions {
                 self.max_elements, self.initial_elements
             )));
         }
+        self.kinks.validate()?;
         self.reparam.validate()
     }
 }
@@ -341,8 +345,44 @@ fn dist2(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
 }
 
-/// Assemble and solve the constrained least-squares problem on `kv`.
-fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Result<Curve> {
+/// The knot vector `kv` with every kink parameter `t` of `kinks` at multiplicity `p`
+/// (an existing break within `1e-12` of the length is taken as `t`).
+pub fn with_kink_knots(kv: &KnotVector, kinks: &[f64]) -> KnotVector {
+    let p = kv.degree();
+    let mut new = Vec::new();
+    for &t in kinks {
+        let t = kv.breaks().into_iter().find(|&u| (u - t).abs() <= 1e-12 * kv.length()).unwrap_or(t);
+        let m = kv.knots().iter().filter(|&&u| u == t).count();
+        new.extend(std::iter::repeat_n(t, p.saturating_sub(m)));
+    }
+    if new.is_empty() {
+        return kv.clone();
+    }
+    kv.with_inserted(&new)
+}
+
+/// The control points a fit on `kv` keeps fixed: the two corners and, at each kink `t`
+/// (a knot of multiplicity `p`, where the one function `N_i` with `N_i(t) = 1` is the
+/// only one not zero), the kink's point; sorted by index.
+fn fixed_points(kv: &KnotVector, corners: (Point, Point), kinks: &[(f64, Point)]) -> Vec<(usize, Point)> {
+    let n = kv.num_basis();
+    let mut fixed = vec![(0, corners.0), (n - 1, corners.1)];
+    for &(t, x) in kinks {
+        let tol = 1e-12 * kv.length();
+        let first = kv.knots().iter().position(|&u| u >= t - tol).expect("a kink lies inside the domain");
+        let t0 = kv.knots()[first];
+        if kv.knots().iter().filter(|&&u| u == t0).count() >= kv.degree() && first >= 1 && first - 1 < n - 1 {
+            fixed.push((first - 1, x));
+        }
+    }
+    fixed.sort_by_key(|f| f.0);
+    fixed.dedup_by_key(|f| f.0);
+    fixed
+}
+
+/// Assemble and solve the constrained least-squares problem on `kv`, with the control
+/// points of `kinks` (parameter and point, see [`fixed_points`]) fixed besides the corners.
+fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point), kinks: &[(f64, Point)]) -> Result<Curve> {
     let p = kv.degree();
     let n = kv.num_basis();
     let mut mat = Banded::new(n, p);
@@ -409,19 +449,32 @@ fn solve_fit(target: &Target, kv: &KnotVector, corners: (Point, Point)) -> Resul
             }
         }
     }
-    // Eliminate the corner unknowns c_0 and c_{n-1}.
-    let (c0, c1) = corners;
-    let mut free: Vec<Point> = (1..n - 1)
-        .map(|i| {
-            let (a, b) = (mat.get(i, 0), mat.get(i, n - 1));
-            [rhs[i][0] - a * c0[0] - b * c1[0], rhs[i][1] - a * c0[1] - b * c1[1]]
-        })
-        .collect();
-    mat.solve_block(1, n - 1, &mut free)?;
-    let mut cps = Vec::with_capacity(n);
-    cps.push(c0);
-    cps.extend(free);
-    cps.push(c1);
+    // Eliminate the fixed unknowns (corners c_0, c_{n-1} and the kinks' points); the
+    // free ones between two fixed ones form independent blocks (a kink's knot of
+    // multiplicity p separates them).
+    let fixed = fixed_points(kv, corners, kinks);
+    let mut cps = vec![[0.0; 2]; n];
+    for &(k, x) in &fixed {
+        cps[k] = x;
+    }
+    for w in fixed.windows(2) {
+        let (lo, hi) = (w[0].0 + 1, w[1].0);
+        if lo >= hi {
+            continue;
+        }
+        let mut free: Vec<Point> = (lo..hi)
+            .map(|i| {
+                let mut r = rhs[i];
+                for &(k, x) in &fixed {
+                    let a = if k.abs_diff(i) <= p { mat.get(i, k) } else { 0.0 };
+                    r = [r[0] - a * x[0], r[1] - a * x[1]];
+                }
+                r
+            })
+            .collect();
+        mat.solve_block(lo, hi, &mut free)?;
+        cps[lo..hi].copy_from_slice(&free);
+    }
     if let Some(i) = cps.iter().position(|c| !(c[0].is_finite() && c[1].is_finite())) {
         return Err(Error::NonFinite {
             context: "contour fit".into(),
@@ -512,7 +565,7 @@ pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Poin
         )));
     }
     let target = Target::new(curve, &SideParam::Native, knots.degree(), "side")?;
-    let fit = solve_fit(&target, knots, corners)?;
+    let fit = solve_fit(&target, knots, corners, &[])?;
     Ok(fit_errors(&target, &fit))
 }
 
@@ -545,12 +598,33 @@ pub fn fit_side_with(
     opts: &FitOptions,
     tol_abs: f64,
 ) -> Result<SideFit> {
+    fit_side_kinked(side, curve, param, corners, opts, tol_abs, &[])
+}
+
+/// [`fit_side_with`] keeping the kinks `(t, x)` exactly (paper §9): every fit's knot
+/// vector holds `t` with multiplicity `p` and the control point there is fixed to `x`
+/// (the curve interpolates `x` at `t`, only `C^0` there); the pieces between kinks are
+/// fitted independently, and refinement bisects elements as usual, so the kinks stay.
+/// `t` is in the fit's parameter (for a point cloud the abscissa of its vertex).
+pub fn fit_side_kinked(
+    side: Side,
+    curve: &SideCurve,
+    param: &SideParam,
+    corners: (Point, Point),
+    opts: &FitOptions,
+    tol_abs: f64,
+    kinks: &[(f64, Point)],
+) -> Result<SideFit> {
     opts.validate()?;
+    if let Some(&(t, _)) = kinks.iter().find(|k| !(k.0 > 0.0 && k.0 < 1.0)) {
+        return Err(Error::Invalid(format!("{side}: a kink's parameter must lie inside (0, 1), got {t}")));
+    }
     if !(tol_abs.is_finite() && tol_abs > 0.0) {
         return Err(Error::Invalid(format!("absolute fit tolerance must be positive and finite, got {tol_abs}")));
     }
     let target = Target::new(curve, param, opts.degree, side.name())?;
-    let mut kv = KnotVector::open_uniform(opts.degree, opts.initial_elements);
+    let ts: Vec<f64> = kinks.iter().map(|k| k.0).collect();
+    let mut kv = with_kink_knots(&KnotVector::open_uniform(opts.degree, opts.initial_elements), &ts);
     let mut out = SideFit {
         side,
         levels: Vec::new(),
@@ -567,7 +641,7 @@ pub fn fit_side_with(
     // summed squared deviation, for the noise floor of point clouds
     let mut bisected: Option<(Vec<(f64, f64)>, f64)> = None;
     loop {
-        let fit = solve_fit(&target, &kv, corners).map_err(|e| e.within(side.name()))?;
+        let fit = solve_fit(&target, &kv, corners, kinks).map_err(|e| e.within(side.name()))?;
         let proj = fit_errors(&target, &fit);
         // Noise floor: when bisecting did not lower the squared deviation of the points
         // in the bisected elements below NOISE_STALL of what it was, and what is left is
@@ -624,123 +698,4 @@ pub fn fit_side_with(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use std::f64::consts::PI;
-
-    fn uniform_fit_errors(f: &SideCurve, p: usize, sizes: &[usize]) -> Vec<f64> {
-        sizes
-            .iter()
-            .map(|&ne| {
-                let kv = KnotVector::open_uniform(p, ne);
-                let (a, b) = f.endpoints();
-                project_side(f, &kv, (a, b)).unwrap().max_error
-            })
-            .collect()
-    }
-
-    #[test]
-    fn polynomials_are_reproduced() {
-        // a cubic B-spline on one element and a quadratic curve with an inner knot at 0.3
-        let kv = KnotVector::new(3, vec![0., 0., 0., 0., 1., 1., 1., 1.]).unwrap();
-        let c = Curve::new(kv, vec![[0., 0.], [0.3, 0.4], [0.7, -0.2], [1., 0.1]], None).unwrap();
-        let side = SideCurve::Spline(c.clone());
-        for p in 3..=5 {
-            let fit =
-                fit_side(Side::South, &side, c.endpoints(), &FitOptions { degree: p, ..Default::default() }, 1e-6)
-                    .unwrap();
-            assert_eq!(fit.levels.len(), 1);
-            assert!(fit.converged);
-            assert!(fit.max_error[0] < 1e-13, "p={p}: {}", fit.max_error[0]);
-        }
-        let an = SideCurve::Analytic(Analytic::new(|t| [t, 2.0 * t * t - t]));
-        let fit =
-            fit_side(Side::West, &an, ([0., 0.], [1., 1.]), &FitOptions { degree: 2, ..Default::default() }, 1e-8)
-                .unwrap();
-        assert_eq!(fit.levels.len(), 1);
-        assert!(fit.max_error[0] < 1e-13);
-    }
-
-    #[test]
-    fn convergence_order_is_p_plus_one() {
-        let f = SideCurve::Analytic(Analytic::new(|t| [t, (2.0 * PI * t).sin()]));
-        for p in 2..=4 {
-            let sizes = [8, 16, 32, 64];
-            let e = uniform_fit_errors(&f, p, &sizes);
-            let orders: Vec<f64> = e.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-            let last = *orders.last().unwrap();
-            assert!((last - (p + 1) as f64).abs() < 0.5, "p={p} errors {e:?} orders {orders:?}");
-        }
-    }
-
-    #[test]
-    fn two_point_cloud_is_a_uniform_segment() {
-        let side = SideCurve::Points(vec![[0., 0.], [2., 1.]]);
-        let fit = fit_side(Side::East, &side, ([0., 0.], [2., 1.]), &FitOptions::default(), 1e-6).unwrap();
-        assert!(fit.converged);
-        let c = fit.finest();
-        for k in 0..=10 {
-            let t = k as f64 / 10.0;
-            let x = c.eval(t);
-            assert!((x[0] - 2.0 * t).abs() < 1e-12 && (x[1] - t).abs() < 1e-12, "{t} {x:?}");
-        }
-        assert_eq!(fit.params.as_deref(), Some(&[0.0, 1.0][..]));
-    }
-
-    #[test]
-    fn bad_options_and_inputs_are_errors() {
-        let side = SideCurve::Points(vec![[0., 0.]]);
-        let o = FitOptions::default();
-        assert!(matches!(
-            fit_side(Side::South, &side, ([0., 0.], [0., 0.]), &o, 1e-3),
-            Err(Error::TooFewPoints { .. })
-        ));
-        let side = SideCurve::Points(vec![[0., 0.], [0., 0.]]);
-        assert!(matches!(
-            fit_side(Side::South, &side, ([0., 0.], [0., 0.]), &o, 1e-3),
-            Err(Error::DegenerateSide { .. })
-        ));
-        let side = SideCurve::Points(vec![[0., 0.], [1., 0.]]);
-        for bad in [
-            FitOptions { degree: 1, ..o },
-            FitOptions { tol: 0.0, ..o },
-            FitOptions { tol: f64::NAN, ..o },
-            FitOptions { initial_elements: 0, ..o },
-            FitOptions { max_levels: 0, ..o },
-        ] {
-            assert!(fit_side(Side::South, &side, ([0., 0.], [1., 0.]), &bad, 1e-3).is_err());
-        }
-        let nan = SideCurve::Analytic(Analytic::new(|t| [t, if t > 0.5 { f64::NAN } else { 0.0 }]));
-        assert!(fit_side(Side::South, &nan, ([0., 0.], [1., 0.]), &o, 1e-3).is_err());
-    }
-
-    #[test]
-    fn adaptive_refinement_is_local_and_nested() {
-        // a curve with a sharp feature near t = 0.8 (a narrow Gaussian bump)
-        let f = SideCurve::Analytic(Analytic::new(|t| [t, 0.2 * (-((t - 0.8) / 0.03).powi(2)).exp()]));
-        let fit = fit_side(Side::South, &f, f.endpoints(), &FitOptions::default(), 1e-5).unwrap();
-        assert!(fit.converged);
-        assert!(fit.final_max_error() <= 1e-5);
-        for w in fit.levels.windows(2) {
-            assert!(w[1].knots.contains(&w[0].knots));
-        }
-        let el = fit.finest().knots.elements();
-        let h_min = el.iter().map(|e| e.2 - e.1).fold(1.0, f64::min);
-        let h_max = el.iter().map(|e| e.2 - e.1).fold(0.0, f64::max);
-        assert!(h_max >= 8.0 * h_min, "refinement should be local: h in [{h_min}, {h_max}]");
-        // dyadic knots
-        for &u in fit.finest().knots.knots() {
-            let s = u * 65536.0;
-            assert_eq!(s, s.round());
-        }
-    }
-
-    #[test]
-    fn element_cap_stops_refinement() {
-        let f = SideCurve::Analytic(Analytic::new(|t| [t, (40.0 * t).sin()]));
-        let o = FitOptions { max_elements: 6, ..Default::default() };
-        let fit = fit_side(Side::South, &f, f.endpoints(), &o, 1e-9).unwrap();
-        assert!(!fit.converged);
-        assert!(fit.finest().knots.num_elements() <= 6);
-    }
-}
+mod tests;

@@ -5,15 +5,17 @@
 
 use serde::Serialize;
 
-use super::fit::{fit_side_with, FitOptions, SideFit};
-use super::input_basis::input_levels;
+use super::cord_length::cord_length_params;
+use super::fit::{fit_side_kinked, FitOptions, SideFit};
+use super::input_basis::{input_levels_with, DIRECT_SOLVE_MAX_FUNCTIONS};
+use super::kinks::{detect, Kink, KinkKind, KinkedLevel};
+pub use super::level::Level;
 use super::normalise::Similarity;
-use super::reparam::ReparamReport;
+use super::reparam::{sample_side, ReparamReport, SideParam};
 use super::BasisChoice;
 use super::{diameter, Boundary, SideCurve};
 use crate::error::{Error, Result};
-use crate::spline::curve::{Curve, Point};
-use crate::spline::knots::KnotVector;
+use crate::spline::curve::Point;
 use crate::spline::surface::Side;
 
 /// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
@@ -29,105 +31,15 @@ pub struct BasisReport {
     pub used: BasisChoice,
     /// Why the input basis was not used (`None` when the request was met).
     pub fallback: Option<String>,
+    /// The kinks kept by the `C^0` route of §9 on this basis and how (`None` when there
+    /// are none).
+    pub kinks: Option<String>,
 }
 
 impl BasisReport {
     /// The fitted basis, as requested.
     pub fn fitted() -> Self {
-        Self { requested: BasisChoice::Fitted, used: BasisChoice::Fitted, fallback: None }
-    }
-}
-
-/// One level of the hierarchy: a tensor-product basis and the four side fits on it.
-#[derive(Debug, Clone)]
-pub struct Level {
-    /// Knot vectors in `xi` (union of the south and north fits) and `eta` (union of the
-    /// east and west fits).
-    pub knots: [KnotVector; 2],
-    /// South, east, north, west: each side's fit, prolonged exactly onto
-    /// `knots[side.direction()]` (so opposite sides share one knot vector).
-    pub sides: [Curve; 4],
-}
-
-impl Level {
-    /// Number of tensor-product basis functions `n_xi * n_eta`.
-    pub fn num_basis(&self) -> usize {
-        self.knots[0].num_basis() * self.knots[1].num_basis()
-    }
-
-    /// The side `s` on this level's basis.
-    pub fn side(&self, s: Side) -> &Curve {
-        &self.sides[s as usize]
-    }
-
-    /// Weights of the level's rational tensor basis, or `None` when every side is
-    /// polynomial (NURBS sides on the input basis, §5.2).
-    ///
-    /// The boundary weights are the sides' weights; the interior ones are the discrete
-    /// Coons blend of them at the Greville abscissae `(u_i, v_j)`,
-    /// `w_ij = (1-u) w^W_j + u w^E_j + (1-v) w^S_i + v w^N_i - [(1-u)(1-v) w_SW + ...]`.
-    /// By the linear precision of B-splines (`sum_i u_i N_i(xi) = xi`) the weight function
-    /// `W = sum w_ij N_i M_j` is then the continuous Coons interpolant of the four boundary
-    /// weight functions: it does not depend on the basis, so knot insertion commutes with
-    /// the blend, and a side pair with equal weights (`w^S = w^N`, `w^W = w^E = 1`: a
-    /// quarter annulus from two exact arcs) gives the tensor-product weights `w_i`
-    /// exactly. With `eta` periodic (a ring) it is the linear blend in `xi` of west and
-    /// east. A blend with a non-positive weight is an error: such sides need the fitted
-    /// basis.
-    pub fn weights(&self) -> Result<Option<Vec<f64>>> {
-        if self.sides.iter().all(|c| c.weights.is_none()) {
-            return Ok(None);
-        }
-        let [nx, ny] = [self.knots[0].num_basis(), self.knots[1].num_basis()];
-        let w = |s: Side| -> Vec<f64> {
-            let c = self.side(s);
-            c.weights.clone().unwrap_or_else(|| vec![1.0; c.control_points.len()])
-        };
-        let (ws, we, wn, ww) = (w(Side::South), w(Side::East), w(Side::North), w(Side::West));
-        let periodic = self.knots[1].is_periodic();
-        if we.len() != ny || ww.len() != ny || (!periodic && (ws.len() != nx || wn.len() != nx)) {
-            return Err(Error::Invalid("the sides' weights do not match the level's basis".into()));
-        }
-        let (gu, gv) = (self.knots[0].greville(), self.knots[1].greville());
-        let ((a0, a1), (b0, b1)) = (self.knots[0].domain(), self.knots[1].domain());
-        let mut out = vec![0.0; nx * ny];
-        for j in 0..ny {
-            let v = (gv[j] - b0) / (b1 - b0);
-            for i in 0..nx {
-                let u = (gu[i] - a0) / (a1 - a0);
-                out[j * nx + i] = if periodic {
-                    (1.0 - u) * ww[j] + u * we[j]
-                } else {
-                    (1.0 - u) * ww[j] + u * we[j] + (1.0 - v) * ws[i] + v * wn[i]
-                        - ((1.0 - u) * (1.0 - v) * ws[0]
-                            + u * (1.0 - v) * ws[nx - 1]
-                            + (1.0 - u) * v * wn[0]
-                            + u * v * wn[nx - 1])
-                };
-            }
-        }
-        // the boundary rows are the sides' weights exactly (the blend reproduces them up
-        // to rounding; the boundary must be the input curve bit for bit)
-        for i in 0..nx {
-            if !periodic {
-                out[i] = ws[i];
-                out[(ny - 1) * nx + i] = wn[i];
-            }
-        }
-        for j in 0..ny {
-            out[j * nx] = ww[j];
-            out[j * nx + nx - 1] = we[j];
-        }
-        if let Some(k) = out.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
-            return Err(Error::Invalid(format!(
-                "the Coons blend of the boundary weights is {} at control point ({}, {}): \
-                 the rational tensor basis needs positive weights",
-                out[k],
-                k % nx,
-                k / nx
-            )));
-        }
-        Ok(Some(out))
+        Self { requested: BasisChoice::Fitted, used: BasisChoice::Fitted, fallback: None, kinks: None }
     }
 }
 
@@ -153,6 +65,10 @@ pub struct Hierarchy {
     /// The input's coordinates from the normalised ones: `x = c + s x̂` (the identity for
     /// a well-placed boundary).
     pub similarity: Similarity,
+    /// Kinks kept exactly (paper §9): the finest `C^0` level `Σ⁰` and the kinks;
+    /// [`Hierarchy::levels`] then hold the kinks at multiplicity `p`, and the solver
+    /// smooths them to `Σ¹` for the Galerkin form (8).
+    pub kinked: Option<KinkedLevel>,
 }
 
 impl Hierarchy {
@@ -223,34 +139,117 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
     let corners = corners(boundary, diameter)?;
     let mut fallback = None;
     if opts.basis != BasisChoice::Fitted {
-        match input_levels(boundary)? {
+        let mut kept = detect(boundary, opts.kinks, true);
+        match input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS, &kept)? {
             Ok(input) => {
                 let levels = input.levels.into_iter().map(|(knots, sides)| Level { knots, sides }).collect();
-                let basis = BasisReport { requested: opts.basis, used: BasisChoice::Input, fallback: None };
-                let reparam = ReparamReport::native();
-                return Ok(Hierarchy {
+                let basis =
+                    BasisReport { requested: opts.basis, used: BasisChoice::Input, fallback: None, kinks: None };
+                for k in &mut kept {
+                    k.map_parameter = Some(k.parameter);
+                }
+                let h = Hierarchy {
                     levels,
                     fits: input.fits,
                     tol_abs,
                     diameter,
-                    reparam,
+                    reparam: ReparamReport::native(),
                     basis,
                     similarity: Similarity::IDENTITY,
-                });
+                    kinked: None,
+                };
+                return with_kinks(h, kept, Vec::new());
             }
             Err(why) => fallback = Some(why),
         }
     }
     let plan = crate::boundary::reparam::plan(boundary, &opts.reparam)?;
+    let mut kept = detect(boundary, opts.kinks, false);
+    let mut notes = Vec::new();
     let mut fits = Vec::with_capacity(4);
     for side in Side::ALL {
-        let param = &plan.sides[side as usize];
-        fits.push(fit_side_with(side, boundary.side(side), param, side_corners(&corners, side), opts, tol_abs)?);
+        let (mut curve, mut param) = (boundary.side(side).clone(), plan.sides[side as usize].clone());
+        let mine: Vec<&mut Kink> = kept.iter_mut().filter(|k| k.side == side).collect();
+        let mut at = Vec::with_capacity(mine.len());
+        if mine.iter().any(|k| k.kind == KinkKind::ZeroSpeed) {
+            // any parameterization g of the exact side keeps its zero speed at the kink
+            // (f'(t) g'(ξ) = 0): fit it by cord length from dense samples instead
+            let smp = sample_side(&curve, ZERO_SPEED_SAMPLES);
+            let t = smp.t.as_deref().unwrap_or_default();
+            let xs = cord_length_params(&smp.points).ok_or_else(|| Error::DegenerateSide {
+                side: side.name().into(),
+                length: 0.0,
+                tol: 0.0,
+            })?;
+            for k in mine {
+                let i = (0..t.len()).min_by(|&a, &b| (t[a] - k.parameter).abs().total_cmp(&(t[b] - k.parameter).abs()));
+                let x = xs[i.unwrap_or(0)];
+                k.map_parameter = Some(x);
+                at.push((x, k.point));
+            }
+            notes.push(format!(
+                "the {side} side's speed vanishes at a kink: fitted by cord length from {ZERO_SPEED_SAMPLES} samples per element"
+            ));
+            curve = SideCurve::Points(smp.points);
+            param = SideParam::Native;
+        } else {
+            for k in mine {
+                let x = match (&curve, &param) {
+                    (SideCurve::Spline(_), SideParam::Map(g)) => g.inverse(k.parameter),
+                    (SideCurve::Points(_), SideParam::Abscissae(x)) => k.index.map_or(k.parameter, |j| x[j]),
+                    _ => k.parameter,
+                };
+                k.map_parameter = Some(x);
+                at.push((x, k.point));
+            }
+        }
+        let ends = side_corners(&corners, side);
+        fits.push(fit_side_kinked(side, &curve, &param, ends, opts, tol_abs, &at)?);
     }
     let fits: [SideFit; 4] = fits.try_into().expect("four sides");
     let mut h = hierarchy_from_fits(fits, tol_abs, diameter)?;
     h.reparam = plan.report;
-    h.basis = BasisReport { requested: opts.basis, used: BasisChoice::Fitted, fallback };
+    h.basis = BasisReport { requested: opts.basis, used: BasisChoice::Fitted, fallback, kinks: None };
+    with_kinks(h, kept, notes)
+}
+
+/// Samples per input element of a spline side with a zero-speed kink, fitted as a point
+/// cloud on the fitted basis.
+pub const ZERO_SPEED_SAMPLES: usize = 64;
+
+/// The hierarchy `h` (levels `Σ⁰`, holding the kinks `kept` at multiplicity `p`) with its
+/// finest level and the kinks in [`Hierarchy::kinked`], and [`BasisReport::kinks`] saying
+/// so; `h` as it is without kinks. The solver smooths the levels it solves on to `Σ¹`
+/// ([`crate::boundary::kinks::smoothed_levels`]) after balancing and refining them, so that
+/// the rounding of the kinks is confined to the final elements next to them.
+fn with_kinks(mut h: Hierarchy, kept: Vec<Kink>, notes: Vec<String>) -> Result<Hierarchy> {
+    if kept.is_empty() {
+        return Ok(h);
+    }
+    let finest = h.finest().clone();
+    let list: Vec<String> = kept
+        .iter()
+        .map(|k| {
+            format!(
+                "{} at {:.6} ({}, {:.1} degrees)",
+                k.side,
+                k.parameter,
+                serde_json::to_value(k.kind).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
+                k.turning_degrees
+            )
+        })
+        .collect();
+    let mut msg = format!(
+        "{} kink(s) kept exactly by the C0 route of §9: {}; EGG (8) on the smoothed basis Σ¹ (multiplicity p - 1 \
+         there, the sides projected), then prolonged to the C0 basis Σ⁰ and the Winslow functional (16) minimised there",
+        kept.len(),
+        list.join(", "),
+    );
+    for n in notes {
+        msg.push_str(&format!("; {n}"));
+    }
+    h.basis.kinks = Some(msg);
+    h.kinked = Some(KinkedLevel { level: finest, kinks: kept });
     Ok(h)
 }
 
@@ -308,6 +307,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
         reparam: ReparamReport::native(),
         basis: BasisReport::fitted(),
         similarity: Similarity::IDENTITY,
+        kinked: None,
     })
 }
 
@@ -357,6 +357,8 @@ pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spline::curve::Curve;
+    use crate::spline::knots::KnotVector;
 
     fn synthetic_fit(side: Side, breaks: &[&[f64]]) -> SideFit {
         let levels: Vec<Curve> = breaks

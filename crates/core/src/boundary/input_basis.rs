@@ -22,9 +22,14 @@
 //!   control point has one weight in the tensor basis;
 //! * an interior knot whose multiplicity reaches the degree (after elevation) makes the
 //!   side only `C^0` there: the Galerkin form (8) needs `C^1`, and a kink must not be
-//!   rounded silently (the `C^0` route of §9 keeps it).
+//!   rounded silently. Unless kinks are not kept (`--kinks none`), such a knot, and a
+//!   zero-speed knot where the tangent turns, is kept by the `C^0` route of §9
+//!   ([`super::kinks`]): the levels built here hold it at multiplicity `p` (`Σ⁰`), the
+//!   hierarchy smooths them to `Σ¹` for the Galerkin form. A rational side with a kink is
+//!   refused (its smoothed side would need other weights).
 
 use super::fit::{project_side, SideFit};
+use super::kinks::Kink;
 use super::{Boundary, SideCurve};
 use crate::error::Result;
 use crate::spline::curve::Curve;
@@ -32,8 +37,11 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::Side;
 
 /// The side as a B-spline or NURBS curve on `[0, 1]` of degree at least `degree`, or why
-/// not.
-fn spline_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Result<Curve, String> {
+/// not. `kept`: the parameters (in `[0, 1]`) of the side's kinks kept by the `C^0` route
+/// (§9, [`super::kinks`]): there the knot is raised to multiplicity `p` (exact
+/// insertion: a zero-speed knot becomes a `C^0` knot of the same curve); any other `C^0`
+/// knot is refused.
+fn spline_side(side: &SideCurve, s: Side, degree: usize, kept: &[f64]) -> std::result::Result<Curve, String> {
     let c = match side {
         SideCurve::Spline(c) => c,
         SideCurve::Points(_) => return Err(format!("the {s} side is a point cloud, which has no basis")),
@@ -47,18 +55,26 @@ fn spline_side(side: &SideCurve, s: Side, degree: usize) -> std::result::Result<
         c = c.elevated().map_err(|e| format!("the {s} side could not be elevated: {e}"))?;
     }
     let p = c.degree();
-    if let Some(&(u, m)) = c
-        .knots
-        .breaks_with_multiplicity()
-        .iter()
-        .skip(1)
-        .take(c.knots.num_elements().saturating_sub(1))
-        .find(|b| b.1 >= p)
-    {
+    let is_kept = |u: f64| kept.iter().any(|&t| (t - u).abs() <= 1e-12);
+    let interior = c.knots.breaks_with_multiplicity();
+    let interior = &interior[1..interior.len() - 1];
+    if let Some(&(u, m)) = interior.iter().find(|b| b.1 > p || (b.1 == p && !is_kept(b.0))) {
+        let why = if m > p { "the curve is discontinuous there" } else { "kinks are not kept (--kinks none)" };
         return Err(format!(
             "the {s} side is only C0 at its interior knot {u} (multiplicity {m} at degree {p}): \
-             the Galerkin form (8) needs C1 and a kink is not rounded silently"
+             the Galerkin form (8) needs C1 and a kink is not rounded silently ({why})"
         ));
+    }
+    if !kept.is_empty() && c.weights.is_some() {
+        return Err(format!(
+            "the {s} side is rational with a kink inside: its smoothed basis would need other weights than the \
+             C0 one, so the C0 route of §9 is taken on the fitted basis"
+        ));
+    }
+    let raise: Vec<f64> =
+        interior.iter().filter(|b| is_kept(b.0)).flat_map(|&(u, m)| std::iter::repeat_n(u, p - m)).collect();
+    if !raise.is_empty() {
+        c = c.refined(&c.knots.with_inserted(&raise)).map_err(|e| format!("the {s} side: {e}"))?;
     }
     Ok(c)
 }
@@ -146,11 +162,17 @@ pub struct InputLevels {
 /// The levels on the input basis (see the module documentation), or the reason why the
 /// boundary cannot be kept in it.
 pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLevels, String>> {
-    input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS)
+    input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS, &[])
 }
 
-/// [`input_levels`] with the coarse levels built only above `direct_max` functions.
-pub fn input_levels_with(boundary: &Boundary, direct_max: usize) -> Result<std::result::Result<InputLevels, String>> {
+/// [`input_levels`] with the coarse levels built only above `direct_max` functions, and
+/// the kinks `kept` (their knots at multiplicity `p` on every level that holds them: the
+/// `C^0` bases `Σ⁰` of §9, smoothed by the caller).
+pub fn input_levels_with(
+    boundary: &Boundary,
+    direct_max: usize,
+    kept: &[Kink],
+) -> Result<std::result::Result<InputLevels, String>> {
     let side_degree = |s: Side| match boundary.side(s) {
         SideCurve::Spline(c) => c.degree(),
         _ => 0,
@@ -159,7 +181,8 @@ pub fn input_levels_with(boundary: &Boundary, direct_max: usize) -> Result<std::
         .map(|s| side_degree(s).max(side_degree(s.opposite())).clamp(2, crate::error::MAX_DEGREE));
     let mut exact: Vec<Curve> = Vec::with_capacity(4);
     for s in Side::ALL {
-        match spline_side(boundary.side(s), s, degree[s.direction()]) {
+        let at: Vec<f64> = kept.iter().filter(|k| k.side == s).map(|k| k.parameter).collect();
+        match spline_side(boundary.side(s), s, degree[s.direction()], &at) {
             Ok(c) => exact.push(c),
             Err(why) => return Ok(Err(why)),
         }
@@ -243,7 +266,7 @@ mod tests {
     fn finest_level_is_the_input() {
         let b = boundary();
         assert_eq!(input_levels(&b).unwrap().unwrap().levels.len(), 1, "a small basis is solved directly");
-        let h = input_levels_with(&b, 0).unwrap().unwrap();
+        let h = input_levels_with(&b, 0, &[]).unwrap().unwrap();
         let (knots, sides) = h.levels.last().unwrap();
         assert_eq!([knots[0].degree(), knots[1].degree()], [3, 2]);
         for s in Side::ALL {

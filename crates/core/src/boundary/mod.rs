@@ -12,13 +12,15 @@
 //! | [`cord_length`] | cord-length abscissae of point clouds | eq. (36)-(37) |
 //! | [`reparam`] | arc-length and constrained cord-length reparameterization | §7, eq. (38)-(42) |
 //! | [`fit`] | adaptive least-squares fit of one side | §5.1-§5.3, eq. (17)-(18) |
+//! | [`level`] | one level: a tensor basis, the four sides on it, its rational weights | §5.4, §5.2 |
 //! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
+//! | [`kinks`] | interior `C^0` points of the sides (`C^0` knots, zero speed, polygon corners), the smoothed basis `Σ¹` | §9 |
 //! | [`ring`] | ring (O-type) domains: two closed contours fitted on one periodic knot vector by arc length, and their hierarchy | §11.1 |
 //! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
 //! `f ∘ g`), both use `cord_length`; `input_basis` uses `fit` (its coarse levels are
-//! projections); `hierarchy` uses both.
+//! projections); `kinks` uses `fit` and `level`; `hierarchy` uses all of them.
 //!
 //! Sides are oriented as in `formats.md`: south `eta = 0` and north `eta = 1` run with
 //! increasing `xi`, west `xi = 0` and east `xi = 1` with increasing `eta`.
@@ -29,6 +31,8 @@ pub mod families;
 pub mod fit;
 pub mod hierarchy;
 pub mod input_basis;
+pub mod kinks;
+pub mod level;
 pub mod normalise;
 pub mod reparam;
 pub mod ring;
@@ -36,6 +40,7 @@ pub mod validate;
 
 use std::sync::Arc;
 
+use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
 
@@ -64,6 +69,88 @@ impl BasisChoice {
         }
     }
 }
+
+/// Which interior `C^0` points of the sides are kept exactly (`--kinks`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum KinkMode {
+    /// Spline sides: every `C^0` knot and zero-speed knot whose tangent turns more than
+    /// [`SPLINE_KINK_DEGREES`]; point clouds: every corner turning at least
+    /// [`CLOUD_CORNER_DEGREES`]. On the input basis every `C^0` knot in any case (the
+    /// basis is `C^0` there).
+    #[default]
+    Auto,
+    /// None: the fit rounds them (within the tolerance) and the report names them; on the
+    /// input basis a side with a `C^0` knot falls back to the fitted basis.
+    None,
+    /// Every kink (spline or point cloud) whose tangent turns at least this many degrees
+    /// (on the input basis every `C^0` knot in any case).
+    Angle(f64),
+}
+
+impl KinkMode {
+    /// `"auto"`, `"none"` or the angle.
+    pub fn name(self) -> String {
+        match self {
+            KinkMode::Auto => "auto".into(),
+            KinkMode::None => "none".into(),
+            KinkMode::Angle(a) => format!("{a}"),
+        }
+    }
+
+    /// `auto`, `none` or an angle in degrees in `(0, 180]`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(KinkMode::Auto),
+            "none" => Some(KinkMode::None),
+            _ => s.parse::<f64>().ok().filter(|a| *a > 0.0 && *a <= 180.0).map(KinkMode::Angle),
+        }
+    }
+
+    /// Check the angle.
+    pub fn validate(self) -> Result<()> {
+        match self {
+            KinkMode::Angle(a) if !(a > 0.0 && a <= 180.0) => {
+                Err(Error::Invalid(format!("the kink angle must be in (0, 180] degrees, got {a}")))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Smallest turning (degrees) of a spline kink kept; `None`: none kept.
+    pub fn spline_threshold(self) -> Option<f64> {
+        match self {
+            KinkMode::Auto => Some(SPLINE_KINK_DEGREES),
+            KinkMode::None => None,
+            KinkMode::Angle(a) => Some(a),
+        }
+    }
+
+    /// Smallest turning (degrees) of a point-cloud corner kept; `None`: none kept.
+    pub fn cloud_threshold(self) -> Option<f64> {
+        match self {
+            KinkMode::Auto => Some(CLOUD_CORNER_DEGREES),
+            KinkMode::None => None,
+            KinkMode::Angle(a) => Some(a),
+        }
+    }
+}
+
+impl std::fmt::Display for KinkMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// A spline side's tangent turning more than this (degrees) at a knot is a kink (the
+/// report names it; `--kinks auto` keeps it).
+pub const SPLINE_KINK_DEGREES: f64 = 1.0;
+
+/// A point cloud's turning of at least this (degrees), measured by [`kinks::cloud_corners`], is a
+/// corner (`--kinks auto` keeps it, the report names it otherwise). A sampled smooth
+/// curve turns less at the scale of [`CORNER_WINDOW`] unless its radius of curvature is
+/// below about twice the window.
+pub const CLOUD_CORNER_DEGREES: f64 = 30.0;
 
 /// An analytic side `t in [0, 1] -> (x, y)` given as a Rust closure.
 #[derive(Clone)]

@@ -455,6 +455,7 @@ pub fn ring_hierarchy(ring: &Ring, opts: &FitOptions) -> Result<(Hierarchy, Boun
         reparam,
         basis: BasisReport::fitted(),
         similarity: crate::boundary::normalise::Similarity::IDENTITY,
+        kinked: None,
     };
     Ok((h, cut_open(ring, seam)))
 }

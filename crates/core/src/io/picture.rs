@@ -30,13 +30,23 @@ pub struct PictureOptions {
     pub resolution: usize,
     /// Extra line segments to draw (e.g. matched pairs), physical coordinates.
     pub segments: Vec<(Point, Point)>,
+    /// Kinks of the boundary (paper §9), physical coordinates, and whether the map keeps
+    /// each exactly: a diagonal cross where kept (as the paper's Fig. 16 marks them), an
+    /// upright one where rounded.
+    pub kinks: Vec<(Point, bool)>,
 }
 
 impl Default for PictureOptions {
     fn default() -> Self {
-        Self { size: 900, grid_lines: 24, resolution: 240, segments: Vec::new() }
+        Self { size: 900, grid_lines: 24, resolution: 240, segments: Vec::new(), kinks: Vec::new() }
     }
 }
+
+/// Colour of a kink kept exactly ([`PictureOptions::kinks`]).
+pub const KEPT_KINK_COLOUR: [u8; 3] = [200, 0, 0];
+
+/// Colour of a kink rounded by the fit.
+pub const ROUNDED_KINK_COLOUR: [u8; 3] = [240, 140, 0];
 
 /// Colour of non-positive `det J`.
 pub const FOLD_COLOUR: [u8; 3] = [255, 0, 255];
@@ -213,6 +223,18 @@ pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOption
     for &(a, b) in &opts.segments {
         let (pa, pb) = (cv.to_px(a), cv.to_px(b));
         cv.line(pa, pb, [220, 30, 30], 1.0);
+    }
+    // kinks: crosses of 1.2 % of the image size, drawn twice as thick (one pixel apart)
+    let r = 0.006 * w.max(h) as f64 + 2.0;
+    for &(x, kept) in &opts.kinks {
+        let (cx, cy) = cv.to_px(x);
+        let (colour, arms) =
+            if kept { (KEPT_KINK_COLOUR, [(r, r), (r, -r)]) } else { (ROUNDED_KINK_COLOUR, [(r, 0.0), (0.0, r)]) };
+        for (dx, dy) in arms {
+            for o in [0.0, 0.7] {
+                cv.line((cx - dx + o, cy - dy), (cx + dx + o, cy + dy), colour, 1.0);
+            }
+        }
     }
     Image { width: w, height: h, rgba: cv.rgba }
 }

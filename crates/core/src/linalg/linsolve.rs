@@ -41,6 +41,11 @@ pub enum LinearMethod {
     Auto,
     /// Sparse Cholesky `L L^T` (symmetric positive definite systems only).
     Cholesky,
+    /// Sparse Cholesky of `-A` (symmetric negative definite systems: `A = -∇²J` of a
+    /// minimisation near its minimiser). Factorizing fails, with a typed error, exactly
+    /// when `-A` is not positive definite: the caller then modifies `A` (a larger
+    /// diagonal shift) and factorizes again.
+    NegCholesky,
     /// Conjugate gradients for symmetric positive definite systems of `c` components
     /// (`c m` unknowns in component blocks, `m` the length of the ordering given with
     /// [`LinearSolver::set_ordering`]), preconditioned by the single-precision Cholesky
@@ -260,6 +265,8 @@ pub struct LinearSolver {
     fallback: bool,
     /// Relative residual at which GMRES stops.
     pub krylov_tol: f64,
+    /// `-A` for [`LinearMethod::NegCholesky`] (pattern copied once).
+    negated: Csr,
 }
 
 impl LinearSolver {
@@ -280,6 +287,7 @@ impl LinearSolver {
             double: false,
             fallback,
             krylov_tol: KRYLOV_TOL,
+            negated: Csr::default(),
         }
     }
 
@@ -345,7 +353,7 @@ impl LinearSolver {
         match self.method {
             LinearMethod::Gmres => fresh,
             LinearMethod::Auto => n > AUTO_LU_LIMIT,
-            LinearMethod::Lu | LinearMethod::Cholesky | LinearMethod::Pcg => false,
+            LinearMethod::Lu | LinearMethod::Cholesky | LinearMethod::NegCholesky | LinearMethod::Pcg => false,
         }
     }
 
@@ -412,6 +420,17 @@ impl LinearSolver {
                 let slot = self.llt.take();
                 self.llt = Some(self.cholesky(a, slot)?);
             }
+            LinearMethod::NegCholesky => {
+                let mut neg = std::mem::take(&mut self.negated);
+                neg.update(a);
+                for v in neg.values.iter_mut() {
+                    *v = -*v;
+                }
+                let slot = self.llt.take();
+                let r = self.cholesky(&neg, slot);
+                self.negated = neg;
+                self.llt = Some(r?);
+            }
             LinearMethod::Gmres => {
                 let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
                 let previous = self.precond.take();
@@ -453,6 +472,13 @@ impl LinearSolver {
             LinearMethod::Cholesky => {
                 let llt = self.llt.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let mut x = b.to_vec();
+                llt.solve_columns(&mut x);
+                x
+            }
+            LinearMethod::NegCholesky => {
+                // A x = b  <=>  (-A) x = -b
+                let llt = self.llt.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
+                let mut x: Vec<f64> = b.iter().map(|v| -v).collect();
                 llt.solve_columns(&mut x);
                 x
             }

@@ -42,6 +42,22 @@ pub fn flux_form<G>(disc: &Discretization, cps: &[Point], res: &mut [f64], stenc
 where
     G: Fn([f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) + Sync,
 {
+    flux_form_with(disc, cps, res, stencil, false, flux);
+}
+
+/// [`flux_form`]; with `symmetric` (`∂G/∂e` symmetric, as for the gradient of a
+/// functional) the block `(1, 0)` of the Jacobian is the transpose of block `(0, 1)`
+/// and is not computed: a quarter of the element products saved.
+pub fn flux_form_with<G>(
+    disc: &Discretization,
+    cps: &[Point],
+    res: &mut [f64],
+    stencil: &mut [f64],
+    symmetric: bool,
+    flux: G,
+) where
+    G: Fn([f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) + Sync,
+{
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
     let want_mat = !stencil.is_empty();
@@ -72,6 +88,9 @@ where
                     s.tz[(nqp + k) * nloc + a] = phi[1];
                     for z in 0..2 {
                         for d in 0..2 {
+                            if symmetric && (z, d) == (1, 0) {
+                                continue;
+                            }
                             let zd = z * 2 + d;
                             for j in 0..2 {
                                 let v = phi[0] * h[2 * z][2 * d + j] + phi[1] * h[2 * z + 1][2 * d + j];
@@ -84,8 +103,21 @@ where
         }
         if want_mat {
             for zd in 0..4 {
+                if symmetric && zd == 2 {
+                    continue;
+                }
                 let w = &s.wa[2 * zd * nqp * nloc..2 * (zd + 1) * nqp * nloc];
                 element_product(&mut s.ke[zd * nloc * nloc..(zd + 1) * nloc * nloc], w, &s.tz, nloc);
+            }
+            if symmetric {
+                // block (1, 0) = block (0, 1) transposed
+                let (lo, hi) = s.ke.split_at_mut(2 * nloc * nloc);
+                let (b01, b10) = (&lo[nloc * nloc..], &mut hi[..nloc * nloc]);
+                for a in 0..nloc {
+                    for b in 0..nloc {
+                        b10[a * nloc + b] = b01[b * nloc + a];
+                    }
+                }
             }
         }
     });

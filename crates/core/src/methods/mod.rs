@@ -98,6 +98,12 @@ pub trait DiscreteProblem {
     fn raise_shift(&mut self) -> bool {
         false
     }
+    /// Whether the last [`DiscreteProblem::jacobian`] presented a modified matrix (not
+    /// the exact `dF/dc`, see [`DiscreteProblem::raise_shift`]): its Newton steps then
+    /// converge no faster than linearly.
+    fn modified(&self) -> bool {
+        false
+    }
     /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
     /// approximates the last Jacobian minus `shift` times the mass matrix (a
     /// preconditioner for Krylov solvers), or `None` when the problem has none.
@@ -134,6 +140,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn raise_shift(&mut self) -> bool {
         (**self).raise_shift()
+    }
+    fn modified(&self) -> bool {
+        (**self).modified()
     }
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         (**self).preconditioner(shift)

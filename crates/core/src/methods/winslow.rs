@@ -27,20 +27,26 @@
 //! at every other (in the singular values `s₁ ≠ s₂` of `∇x`, `W = s₁/s₂ + s₂/s₁` has a
 //! Hessian of determinant `-(1/s₁² - 1/s₂²)² < 0`): the assembled Hessian is positive
 //! definite near a minimizer (the fixed boundary and the sum over points make it so), but
-//! need not be far from one. The Newton solver finds out along its direction: `δ` solves
-//! `∇²J δ = -∇J`, so a slope `∇J·δ >= 0` proves `δᵀ ∇²J δ <= 0`. It then calls
-//! [`DiscreteProblem::raise_shift`] and solves again with the diagonal shift
-//! `∇²J + τ diag(|∇²J_ii|)` (Levenberg-Marquardt in the Hessian's own scaling, so `τ`
-//! is dimensionless; `τ = 10⁻⁴, 10⁻³, ...`), and lowers `τ` tenfold per step while the
-//! directions descend, back to the exact Newton step (quadratic convergence) near the
-//! minimizer. A diagonal shift rather than a per-point eigenvalue projection: it leaves
-//! the exact Hessian wherever that is already definite.
+//! need not be far from one. The Newton solver finds out: its Cholesky factorization of
+//! `∇²J` fails exactly when it is not positive definite (and a direction with `∇J·δ >=
+//! 0` proves `δᵀ ∇²J δ <= 0`). It then calls [`DiscreteProblem::raise_shift`], which
+//! modifies the presented Hessian step by step: first `∇²J + m (P - ∇²J)` with `P` the
+//! assembly of every quadrature point's `∂²W/∂e²` projected onto the positive
+//! semidefinite matrices ([`project_psd`]), `m = 0.3, 0.9, 1` (`m = 1` is positive
+//! semidefinite, definite with the boundary fixed, and its Newton step has a moderate
+//! length where a diagonal shift of an indefinite Hessian gives huge steps along its
+//! near-null directions, which fold the map and force the line search down to 1/10),
+//! then the diagonal shift `P + τ diag(|P_ii|)` (`τ = 10⁻⁴, 10⁻³, ...`). At a new point
+//! the modification steps back one stage (`m = 1` becomes `0.9`, then `0.3`, then the
+//! exact Hessian; diagonal shifts decay tenfold), so near the minimizer Newton converges
+//! quadratically, and where the exact Hessian is far from definite no assembly and
+//! factorization are spent on it at every step.
 
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::flux::{flux_form, gradient_at};
+use super::flux::{flux_form_with, gradient_at};
 use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method, Start};
 use crate::discrete::assembly::{element_product, Discretization, Scratch};
@@ -139,10 +145,143 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
 /// form of [`flux_form`] with `G = -∂W/∂e`.
 pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
-    flux_form(disc, cps, res, stencil, |e| {
+    winslow_gradient_with(disc, cps, res, stencil, 0.0);
+}
+
+/// [`winslow_gradient`] with the Hessian of the density at each quadrature point moved by
+/// the fraction `projected` towards its projection `P` onto the positive semidefinite
+/// matrices ([`project_psd`]): `H + projected (P - H)`. With `projected = 1` the
+/// assembled matrix is positive semidefinite (definite with the boundary fixed) wherever
+/// the map is, and its Newton direction descends.
+pub fn winslow_gradient_with(
+    disc: &Discretization,
+    cps: &[Point],
+    res: &mut [f64],
+    stencil: &mut [f64],
+    projected: f64,
+) {
+    flux_form_with(disc, cps, res, stencil, true, |e| {
         let (_, g, h) = winslow_density(e);
+        let h = if projected > 0.0 {
+            let p = projected_density_hessian(e);
+            std::array::from_fn(|i| std::array::from_fn(|j| h[i][j] + projected * (p[i][j] - h[i][j])))
+        } else {
+            h
+        };
         (g.map(|v| -v), h.map(|row| row.map(|v| -v)))
     });
+}
+
+/// The projection of the Winslow density's Hessian `∂²W/∂e²` at `e` (with `D > 0`) onto
+/// the positive semidefinite matrices, in closed form (Smith, de Goes, Kim 2019, analytic
+/// eigensystems of isotropic energies): with the singular value decomposition `∇x = U Σ
+/// Vᵀ`, `W = σ₁/σ₂ + σ₂/σ₁`, and the eigenvectors of the Hessian are the twist `U [[0,-1],
+/// [1,0]] Vᵀ/√2` with eigenvalue `(W_σ₁ + W_σ₂)/(σ₁ + σ₂) = -(σ₁ - σ₂)² / (σ₁σ₂)² <= 0`
+/// (zero at conformal points: W is invariant under rotations), the flip `U [[0,1],[1,0]]
+/// Vᵀ/√2` with `(W_σ₁ - W_σ₂)/(σ₁ - σ₂) = (σ₁ + σ₂)² / (σ₁σ₂)² > 0`, and two in the span of `U diag(1,0) Vᵀ`,
+/// `U diag(0,1) Vᵀ` from the `2 x 2` Hessian of `W(σ₁, σ₂)`, whose determinant is
+/// `-(1/σ₁² - 1/σ₂²)² <= 0`: one of each sign. Negative eigenvalues are dropped. The
+/// same as [`project_psd`] of [`winslow_density`]'s Hessian, about 20 times cheaper.
+pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
+    let [a, b, c, d] = e;
+    // F = [[a, b], [c, d]] = R(phi) diag(s1, s2) R(theta)
+    let (ee, ff, gg, hh) = (0.5 * (a + d), 0.5 * (a - d), 0.5 * (c + b), 0.5 * (c - b));
+    let (q, r) = (ee.hypot(hh), ff.hypot(gg));
+    let (s1, s2) = (q + r, q - r);
+    let (a1, a2) = (gg.atan2(ff), hh.atan2(ee));
+    let (theta, phi) = (0.5 * (a2 - a1), 0.5 * (a2 + a1));
+    let (cu, su, cv, sv) = (phi.cos(), phi.sin(), theta.cos(), theta.sin());
+    let u = [[cu, -su], [su, cu]];
+    let vt = [[cv, -sv], [sv, cv]];
+    // vec(U M Vᵀ) row-major, the layout of e
+    let mode = |m: [[f64; 2]; 2]| -> [f64; 4] {
+        let mut um = [[0.0; 2]; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                um[i][j] = u[i][0] * m[0][j] + u[i][1] * m[1][j];
+            }
+        }
+        let mut out = [0.0; 4];
+        for i in 0..2 {
+            for j in 0..2 {
+                out[2 * i + j] = um[i][0] * vt[0][j] + um[i][1] * vt[1][j];
+            }
+        }
+        out
+    };
+    let p = s1 * s2;
+    let r2 = std::f64::consts::FRAC_1_SQRT_2;
+    let mut modes: Vec<(f64, [f64; 4])> = vec![((s1 + s2) * (s1 + s2) / (p * p), mode([[0.0, r2], [r2, 0.0]]))];
+    // scaling block: [[2 s2 / s1³, -(1/s1² + 1/s2²)], [., 2 s1 / s2³]]
+    let (h11, h22, h12) = (2.0 * s2 / (s1 * s1 * s1), 2.0 * s1 / (s2 * s2 * s2), -(1.0 / (s1 * s1) + 1.0 / (s2 * s2)));
+    let (mean, half) = (0.5 * (h11 + h22), 0.5 * (h11 - h22));
+    let rad = half.hypot(h12);
+    let lambda = mean + rad;
+    if lambda > 0.0 {
+        // eigenvector of the larger eigenvalue
+        let t = 0.5 * h12.atan2(half);
+        let (ct, st) = (t.cos(), t.sin());
+        modes.push((lambda, mode([[ct, 0.0], [0.0, st]])));
+    }
+    let mut out = [[0.0; 4]; 4];
+    for (l, v) in modes {
+        for i in 0..4 {
+            for j in 0..4 {
+                out[i][j] += l * v[i] * v[j];
+            }
+        }
+    }
+    out
+}
+
+/// The symmetric `h` with its negative eigenvalues set to zero, `Q max(Λ, 0) Qᵀ`, by
+/// cyclic Jacobi rotations (to rounding).
+pub fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    let mut a = h;
+    let mut q = [[0.0; 4]; 4];
+    for (i, row) in q.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    let scale: f64 = a.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+    for _sweep in 0..50 {
+        let off: f64 = (0..4)
+            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i][j] * a[i][j])
+            .sum();
+        if off.sqrt() <= 1e-15 * scale {
+            break;
+        }
+        for p in 0..3 {
+            for r in p + 1..4 {
+                if a[p][r] == 0.0 {
+                    continue;
+                }
+                // rotation annihilating a[p][r]
+                let theta = (a[r][r] - a[p][p]) / (2.0 * a[p][r]);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let sn = t * c;
+                for k in 0..4 {
+                    let (akp, akr) = (a[k][p], a[k][r]);
+                    a[k][p] = c * akp - sn * akr;
+                    a[k][r] = sn * akp + c * akr;
+                }
+                for k in 0..4 {
+                    let (apk, ark) = (a[p][k], a[r][k]);
+                    a[p][k] = c * apk - sn * ark;
+                    a[r][k] = sn * apk + c * ark;
+                }
+                for row in q.iter_mut() {
+                    let (qp, qr) = (row[p], row[r]);
+                    row[p] = c * qp - sn * qr;
+                    row[r] = sn * qp + c * qr;
+                }
+            }
+        }
+    }
+    let lambda: [f64; 4] = std::array::from_fn(|i| a[i][i].max(0.0));
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..4).map(|k| q[i][k] * lambda[k] * q[j][k]).sum()))
 }
 
 /// A scalar approximation of the Winslow Hessian for `-diag(K, K)` preconditioning:
@@ -206,6 +345,10 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
     [l1 * co * co + l2 * si * si, (l1 - l2) * co * si, l1 * si * si + l2 * co * co]
 }
 
+/// The first partial projection of a modified Hessian (see
+/// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
+pub const PROJECTION_FIRST: f64 = 0.3;
+
 /// Smallest and largest relative diagonal shift `τ` of the Hessian.
 const SHIFT_MIN: f64 = 1e-4;
 const SHIFT_MAX: f64 = 1e8;
@@ -219,9 +362,13 @@ pub struct WinslowProblem {
     diag: Vec<usize>,
     /// Relative diagonal shift `τ` of the presented Hessian.
     shift: f64,
-    /// The stencil holds the Hessian at `assembled` (for a re-shift without assembly).
-    assembled: Option<Vec<f64>>,
+    /// The stencil holds the Hessian at `assembled`, projected or not (for a re-shift
+    /// without assembly).
+    assembled: Option<(Vec<f64>, f64)>,
     raised: bool,
+    /// The density Hessians are projected onto the semidefinite matrices
+    /// ([`winslow_gradient_with`]) at this point.
+    projected: f64,
 }
 
 impl std::fmt::Debug for WinslowProblem {
@@ -235,7 +382,7 @@ impl WinslowProblem {
     pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
         let pat = &disc.vector.csr;
         let diag = (0..pat.nrows).map(|r| pat.position(r, r).expect("the pattern holds the diagonal")).collect();
-        Self { state: GalerkinState::new(disc, cps), diag, shift: 0.0, assembled: None, raised: false }
+        Self { state: GalerkinState::new(disc, cps), diag, shift: 0.0, assembled: None, raised: false, projected: 0.0 }
     }
 
     /// The current unknown vector.
@@ -264,14 +411,21 @@ impl DiscreteProblem for WinslowProblem {
 
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
         if !std::mem::take(&mut self.raised) {
-            // a new point: back towards the exact Hessian
+            // a new point: one step back towards the exact Hessian (after a fully
+            // projected one the exact Hessian is rarely definite: trying it would cost
+            // an assembly and a failed factorization)
             self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
+            self.projected = match self.projected {
+                x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
+                x if x > PROJECTION_FIRST => PROJECTION_FIRST,
+                _ => 0.0,
+            };
         }
         let s = &mut self.state;
-        if self.assembled.as_deref() != Some(c) {
+        if !self.assembled.as_ref().is_some_and(|(at, pr)| at == c && *pr == self.projected) {
             s.load_for_jacobian(c);
-            winslow_gradient(&s.disc, &s.cps, &mut s.res_full, &mut s.stencil);
-            self.assembled = Some(c.to_vec());
+            winslow_gradient_with(&s.disc, &s.cps, &mut s.res_full, &mut s.stencil, self.projected);
+            self.assembled = Some((c.to_vec(), self.projected));
         }
         s.restrict_residual(f);
         s.gather_jacobian(jac);
@@ -292,13 +446,27 @@ impl DiscreteProblem for WinslowProblem {
         Some(winslow_objective(&self.state.disc, &self.state.control_points(c)))
     }
 
+    /// First the partly, then fully projected Hessian ([`winslow_gradient_with`] with
+    /// [`PROJECTION_FIRST`], then three times that, then 1: positive semidefinite per
+    /// point, a descent direction of moderate length where the exact one is indefinite),
+    /// then diagonal shifts on top of it.
+    fn modified(&self) -> bool {
+        self.projected > 0.0 || self.shift > 0.0
+    }
+
     fn raise_shift(&mut self) -> bool {
+        self.raised = true;
+        if self.projected < 1.0 {
+            self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
+            return true;
+        }
         let next = if self.shift == 0.0 { SHIFT_MIN } else { 10.0 * self.shift };
         if next > SHIFT_MAX {
             return false;
         }
         self.shift = next;
         self.raised = true;
+
         true
     }
 
@@ -557,32 +725,115 @@ mod tests {
         }
     }
 
-    /// `raise_shift` re-presents the Hessian at the same point with `τ |H_ii|` added to
-    /// its diagonal (no other entry changes, no reassembly needed), `τ` grows tenfold per
-    /// call, and falls back tenfold per new point.
+    /// `raise_shift` first re-presents the Hessian with every point's density Hessian
+    /// projected (in three steps, the last one fully) onto the semidefinite matrices (so
+    /// `-dF/dc` is semidefinite), then adds
+    /// `τ |H_ii|` to the diagonal of that (no other entry changes, no reassembly needed),
+    /// `τ` growing tenfold per call; a new point starts from the exact Hessian again.
     #[test]
-    fn raised_shift_adds_to_the_diagonal_only() {
+    fn raised_shift_projects_then_adds_to_the_diagonal() {
         let (disc, cps, _) = twisted(2, 4, 1.0);
         let mut prob = WinslowProblem::new(disc, cps);
         let c = prob.unknowns();
         let n = c.len();
-        let (mut f, mut jac0, mut jac1) = (vec![0.0; n], Csr::default(), Csr::default());
-        prob.jacobian(&c, &mut f, &mut jac0);
+        let (mut f, mut exact, mut proj, mut jac1) = (vec![0.0; n], Csr::default(), Csr::default(), Csr::default());
+        prob.jacobian(&c, &mut f, &mut exact);
+        assert!(prob.raise_shift() && prob.raise_shift() && prob.raise_shift());
+        assert_eq!(prob.projected, 1.0);
+        prob.jacobian(&c, &mut f, &mut proj);
+        assert_eq!(prob.shift(), 0.0);
+        let (de, dp) = (exact.to_dense(), proj.to_dense());
+        assert!(
+            de.iter().flatten().zip(dp.iter().flatten()).any(|(a, b)| (a - b).abs() > 1e-9),
+            "a twisted map is not conformal"
+        );
+        let mut rng = crate::testutil::Lcg::new(5);
+        for _ in 0..50 {
+            let x: Vec<f64> = (0..n).map(|_| rng.uniform() - 0.5).collect();
+            let q: f64 = (0..n).map(|i| x[i] * (0..n).map(|j| dp[i][j] * x[j]).sum::<f64>()).sum();
+            assert!(q <= 1e-12 * n as f64, "-dF/dc projected is semidefinite: {q}");
+        }
         assert!(prob.raise_shift() && prob.raise_shift());
         prob.jacobian(&c, &mut f, &mut jac1);
         let tau = prob.shift();
         assert!((tau - 10.0 * SHIFT_MIN).abs() < 1e-18, "{tau}");
-        let (d0, d1) = (jac0.to_dense(), jac1.to_dense());
+        let d1 = jac1.to_dense();
         for i in 0..n {
             for j in 0..n {
-                let expect = if i == j { d0[i][i] - tau * d0[i][i].abs() } else { d0[i][j] };
-                assert!((d1[i][j] - expect).abs() <= 1e-14 * d0[i][i].abs(), "({i}, {j})");
+                let expect = if i == j { dp[i][i] - tau * dp[i][i].abs() } else { dp[i][j] };
+                assert!((d1[i][j] - expect).abs() <= 1e-14 * dp[i][i].abs(), "({i}, {j})");
             }
         }
-        // a new point: back towards the exact Hessian
+        // a new point: one step back towards the exact Hessian, which comes back after
+        // three new points
         let mut c2 = c.clone();
         c2[0] += 1e-3;
         prob.jacobian(&c2, &mut f, &mut jac1);
-        assert!(prob.shift() < tau);
+        assert!(prob.shift() < tau && prob.projected == 3.0 * PROJECTION_FIRST && prob.modified());
+        for k in 0..2 {
+            c2[0] += 1e-3;
+            prob.jacobian(&c2, &mut f, &mut jac1);
+            assert_eq!(prob.modified(), k == 0);
+        }
+        assert_eq!(prob.projected, 0.0);
+    }
+
+    /// The closed-form projection of the density Hessian equals the projection by Jacobi
+    /// rotations, at random gradients with `D > 0` (conformal ones included).
+    #[test]
+    fn closed_form_projection_matches_jacobi() {
+        let mut rng = crate::testutil::Lcg::new(3);
+        let mut points = vec![[1.0, -0.5, 0.5, 1.0], [2.0, 0.0, 0.0, 0.5], [0.3, 0.0, 0.0, 0.3]];
+        while points.len() < 200 {
+            let e: [f64; 4] = std::array::from_fn(|_| 4.0 * rng.uniform() - 2.0);
+            if e[0] * e[3] - e[1] * e[2] > 1e-3 {
+                points.push(e);
+            }
+        }
+        for e in points {
+            let (w, _, h) = winslow_density(e);
+            let (a, b) = (projected_density_hessian(e), project_psd(h));
+            let scale = h.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            for i in 0..4 {
+                for j in 0..4 {
+                    assert!(
+                        (a[i][j] - b[i][j]).abs() <= 1e-9 * scale,
+                        "{e:?} (W = {w}): ({i}, {j}) {} vs {}",
+                        a[i][j],
+                        b[i][j]
+                    );
+                }
+            }
+        }
+    }
+
+    /// The projection keeps a semidefinite matrix, and of an indefinite one keeps the
+    /// eigenvectors: `P` is semidefinite, `h - P` negative semidefinite, `P (h - P) = 0`.
+    #[test]
+    fn psd_projection_of_the_density_hessian() {
+        let (_, _, conformal) = winslow_density([1.0, -0.5, 0.5, 1.0]);
+        let p = project_psd(conformal);
+        for i in 0..4 {
+            for j in 0..4 {
+                assert!((p[i][j] - conformal[i][j]).abs() < 1e-12, "a conformal point's Hessian is semidefinite");
+            }
+        }
+        let (_, _, h) = winslow_density([1.3, 0.4, -0.2, 0.9]);
+        let p = project_psd(h);
+        let r: [[f64; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| h[i][j] - p[i][j]));
+        assert!(r.iter().flatten().any(|v| v.abs() > 1e-6), "this point's Hessian is indefinite");
+        let mut rng = crate::testutil::Lcg::new(9);
+        for _ in 0..200 {
+            let x: [f64; 4] = std::array::from_fn(|_| rng.uniform() - 0.5);
+            let quad =
+                |m: &[[f64; 4]; 4]| (0..4).map(|i| x[i] * (0..4).map(|j| m[i][j] * x[j]).sum::<f64>()).sum::<f64>();
+            assert!(quad(&p) >= -1e-12 && quad(&r) <= 1e-12);
+        }
+        for i in 0..4 {
+            for j in 0..4 {
+                let pr: f64 = (0..4).map(|k| p[i][k] * r[k][j]).sum();
+                assert!(pr.abs() < 1e-10, "P (h - P) = 0: {pr}");
+            }
+        }
     }
 }

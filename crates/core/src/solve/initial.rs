@@ -207,32 +207,63 @@ pub fn continuation(
     diameter: f64,
     cont: &mut Continuation,
 ) -> Result<Vec<Point>> {
+    let positive = |c: &[Point]| det_j_min(assembler, disc, c) > 0.0;
+    Ok(continuation_with(method, assembler, disc, base, target, nl, diameter, cont, &positive)?.guess)
+}
+
+/// The outcome of [`continuation_with`].
+#[derive(Debug, Clone)]
+pub struct Continued {
+    /// The guess with the full target boundary (positive unless the steps ran out).
+    pub guess: Vec<Point>,
+    /// The last positive map reached (the start, or the solution of the last damped
+    /// solve that succeeded), whose boundary is moved by `alpha` of the way.
+    pub base: Vec<Point>,
+    /// The fraction of the boundary displacement `base` has reached.
+    pub alpha: f64,
+}
+
+/// [`continuation`] with the test of a guess given: `positive(control points)` (the
+/// sampled `det J` for [`continuation`]; the certificate for the `C^0` route of §9,
+/// whose Winslow solves need a bijective start); also returns the last positive map
+/// reached, from which a caller may go on on a refined basis.
+pub fn continuation_with(
+    method: &dyn Method,
+    assembler: &dyn EggAssembler,
+    disc: &Arc<Discretization>,
+    base: Vec<Point>,
+    target: &[Point],
+    nl: NonlinearOptions,
+    diameter: f64,
+    cont: &mut Continuation,
+    positive: &dyn Fn(&[Point]) -> bool,
+) -> Result<Continued> {
     let tol = 1e-12 * diameter;
     if base.iter().zip(target).all(|(b, t)| (b[0] - t[0]).abs() <= tol && (b[1] - t[1]).abs() <= tol) {
         // same boundary (e.g. a refinement of the previous level): nothing to move
-        return Ok(base);
+        return Ok(Continued { guess: base.clone(), base, alpha: 1.0 });
     }
     let mut base = base;
     let (mut done, mut step) = (0.0f64, 1.0f64);
     // displacement from `base` to the full target; linear in the boundary motion, so
     // a fraction `f` of the remaining motion is `f * u`
     let mut u = elasticity_displacement_with(assembler, disc, &base, target)?;
-    if det_j_min(assembler, disc, &base) <= 0.0 {
+    if !positive(&base) {
         // the prolonged map itself is not positive on this level's (denser) sample:
         // damping the boundary motion cannot make the guess positive, Newton starts
         // from the full elasticity guess
-        return Ok(displaced(&base, &u, 1.0));
+        return Ok(Continued { guess: displaced(&base, &u, 1.0), base, alpha: 0.0 });
     }
     loop {
         let a = (done + step).min(1.0);
         let f = (a - done) / (1.0 - done);
         let guess = displaced(&base, &u, f);
-        let positive = det_j_min(assembler, disc, &guess) > 0.0;
+        let guess_positive = positive(&guess);
         let exhausted = step <= MIN_CONTINUATION_STEP || cont.steps >= MAX_CONTINUATION_STEPS;
-        if a >= 1.0 && (positive || exhausted) {
-            return Ok(guess);
+        if a >= 1.0 && (guess_positive || exhausted) {
+            return Ok(Continued { guess, base, alpha: done });
         }
-        if !positive && !exhausted {
+        if !guess_positive && !exhausted {
             step *= 0.5;
             continue;
         }
@@ -245,17 +276,21 @@ pub fn continuation(
             iterations = it?.iteration;
         }
         cont.steps += 1;
-        let converged = *solver.status() == Status::Converged;
+        // a minimisation only lowers its objective from a feasible start: a positive
+        // result is a better base even before its stopping rule is met
+        let converged = *solver.status() == Status::Converged || solver.objective().is_some_and(f64::is_finite);
         let (problem, c) = solver.into_parts();
         let sol = problem.control_points(&c);
         cont.iterations += iterations;
-        if converged && det_j_min(assembler, disc, &sol) > 0.0 {
+        if converged && positive(&sol) {
             base = sol;
             done = a;
             step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
             u = elasticity_displacement_with(assembler, disc, &base, target)?;
         } else if exhausted {
-            return Ok(guess);
+            // out of steps: the full boundary from the last positive map (the damped
+            // guess would carry a wrong boundary into the level's solve)
+            return Ok(Continued { guess: displaced(&base, &u, 1.0), base, alpha: done });
         } else {
             step *= 0.5;
         }

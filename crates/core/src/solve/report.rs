@@ -8,6 +8,7 @@ use std::time::Duration;
 use serde::Serialize;
 
 use super::improve::Improvement;
+use super::kinks::KinkStage;
 use super::options::SolveOptions;
 use super::repair::RepairRound;
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
@@ -168,8 +169,13 @@ pub struct Report {
     pub area: f64,
     /// Corner angles.
     pub corners: Vec<CornerReport>,
-    /// Kinks inside the input's spline sides.
+    /// Kinks inside the sides (spline sides' `C^0` and zero-speed knots, point clouds'
+    /// corners): kept exactly by the `C^0` route of §9 or rounded, with the deviation of
+    /// the map's boundary at each.
     pub kinks: Vec<KinkReport>,
+    /// The `C^0` route of §9 (`--kinks`): EGG on the smoothed basis, elasticity to the
+    /// kinked boundary, Winslow on the `C^0` basis; `null` when no kink is kept.
+    pub c0_route: Option<KinkStage>,
     /// Largest distance of the map's boundary from the input boundary, per side
     /// (south, east, north, west): from the input's polyline (resolution `1e-6` of the
     /// diameter) on the fitted basis, at equal parameters on the input basis.
@@ -240,6 +246,7 @@ pub(crate) struct ReportContext<'a> {
     pub hierarchy: &'a Hierarchy,
     pub sides: &'a [Curve; 4],
     pub kinks: Vec<KinkReport>,
+    pub c0_route: Option<KinkStage>,
     pub boundary_deviation: [f64; 4],
     pub opts: &'a SolveOptions,
     pub backend: String,
@@ -290,12 +297,29 @@ impl Solution {
             (v, m)
         };
         let mut message = message;
+        if let Some(r) = &ctx.c0_route {
+            message.push_str(&format!("; {}", r.message));
+        }
+        let input = h.basis.used == crate::boundary::BasisChoice::Input;
         for k in &kinks {
-            message.push_str(&format!(
-                "; note: the input's {} side has a kink at ({:.6}, {:.6}) (tangent turns {:.1} degrees), where any C1 map of the \
-                 exact boundary has det J = 0; this map follows the fitted boundary, which rounds the kink within the fit tolerance",
+            let at = format!(
+                "the {} side's kink at ({:.6}, {:.6}) (tangent turns {:.1} degrees)",
                 k.side, k.point[0], k.point[1], k.turning_degrees
-            ));
+            );
+            message.push_str(&if k.kept {
+                format!("; {at} is kept exactly (deviation {:.1e})", k.deviation)
+            } else if input {
+                format!(
+                    "; note: {at} is not kept by a C0 knot line: the map's boundary is the input's, whose speed vanishes \
+                     there, so det J = 0 at that point"
+                )
+            } else {
+                format!(
+                    "; note: {at}, where any C1 map of the exact boundary has det J = 0, is rounded by the fitted boundary \
+                     (deviation {:.3e}; --kinks keeps it)",
+                    k.deviation
+                )
+            });
         }
         if let Some(imp) = &ctx.improvement {
             message.push_str(&format!("; improvement: {}", imp.message));
@@ -340,6 +364,7 @@ impl Solution {
             area: fun.area,
             corners,
             kinks,
+            c0_route: ctx.c0_route,
             boundary_deviation: ctx.boundary_deviation,
             verdict,
             message,

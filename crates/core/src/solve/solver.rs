@@ -10,15 +10,16 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::improve::{improve, Improvement};
+use super::improve::{bijective, improve, Improvement};
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
+use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
-use crate::boundary::corners::boundary_kinks;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
+use crate::boundary::kinks::smoothed_levels;
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
@@ -88,6 +89,9 @@ pub struct EggSolver {
     /// For repair levels solved with frozen DOFs: plan index and the parameter boxes
     /// `[u0, u1, v0, v1]` whose control points stay free.
     free_boxes: Vec<(usize, Vec<[f64; 4]>)>,
+    /// With kinks kept (§9): the finest `C^0` level `Σ⁰` (balanced and refined like the
+    /// plan, whose levels are its smoothing `Σ¹`).
+    c0: Option<Level>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -122,6 +126,12 @@ impl EggSolver {
             _ => (opts.min_elements, opts.aspect),
         };
         let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.refine, aspect)?;
+        // kinks kept (§9): the levels hold them at multiplicity p (Σ⁰); solve on Σ¹, the
+        // finest prepared Σ⁰ is where the C0 route ends
+        let (levels, c0) = match hierarchy.kinked {
+            Some(_) => (smoothed_levels(&levels)?, levels.last().cloned()),
+            None => (levels, None),
+        };
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
         let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
@@ -141,6 +151,7 @@ impl EggSolver {
             rounds: Vec::new(),
             certificate: None,
             free_boxes: Vec::new(),
+            c0,
         })
     }
 
@@ -274,6 +285,32 @@ impl EggSolver {
             Some(c) => c,
             None => certify(&map, &self.opts.certify)?,
         };
+        // the C0 route of §9: the kinks kept exactly on Σ⁰ from the Σ¹ map
+        let mut c0_level = None;
+        let c0_route = match (&hierarchy.kinked, &self.c0) {
+            (Some(kinked), Some(level)) => {
+                let functions = map.knots[0].num_basis() * map.knots[1].num_basis();
+                if !self.reports.last().is_some_and(|l| l.converged) {
+                    Some(KinkStage::skipped(
+                        kinked,
+                        functions,
+                        "the solve on the smoothed basis did not converge".into(),
+                    ))
+                } else if !bijective(&certificate) {
+                    let why = format!("the map on the smoothed basis is not certified ({})", certificate.message());
+                    Some(KinkStage::skipped(kinked, functions, why))
+                } else {
+                    let out = keep_kinks(&map, level, kinked, &self.opts, &*self.assembler, self.diameter)?;
+                    if let (Some(m), Some(c), Some(l)) = (out.map, out.certificate, out.level) {
+                        map = m;
+                        certificate = c;
+                        c0_level = Some(l);
+                    }
+                    Some(out.report)
+                }
+            }
+            _ => None,
+        };
         let improvement = match self.opts.improve {
             None => None,
             Some(imp) => {
@@ -309,12 +346,14 @@ impl EggSolver {
         // the solve ends here (levels, repair, improvement, certificate); what follows
         // measures the map for the report and is not part of `report.seconds`
         let elapsed = self.started.elapsed();
-        let finest = self.plan.last().expect("non-empty plan");
+        let kept = c0_level.is_some();
+        let finest = c0_level.as_ref().unwrap_or_else(|| self.plan.last().expect("non-empty plan"));
         let sides = finest.sides.each_ref().map(|c| sim.physical_curve(c));
         let ctx = ReportContext {
             hierarchy,
             sides: &sides,
-            kinks: boundary_kinks(boundary),
+            kinks: kink_reports(boundary, hierarchy, &map, kept),
+            c0_route,
             boundary_deviation: {
                 let mut dev = match hierarchy.basis.used {
                     // the same curve at equal parameters: measured exactly, not by a polyline
@@ -425,20 +464,39 @@ pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
             let mut o = opts.clone();
             o.fit = fitted;
             let h = build_hierarchy(boundary, &o.fit)?;
-            let mut again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
-            again.report.basis.requested = BasisChoice::Auto;
-            again.report.basis.fallback = Some(why);
-            // the time of the attempt on the input basis counts
-            again.report.seconds += sol.report.seconds;
-            Ok(again)
+            let again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
+            Ok(auto_choice(sol, again, why))
         }
     }
 }
 
+/// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
+/// basis) again as `again` (fitted basis) for the reason `why`: `again`, with the reason
+/// in its report; but a `degenerate-corner` map on the input basis stands when the fitted
+/// one is not certified either (its boundary is the exact one). The time of both solves
+/// counts.
+pub fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
+    if first.report.verdict == Verdict::DegenerateCorner && again.report.verdict != Verdict::Certified {
+        let mut first = first;
+        first.report.seconds += again.report.seconds;
+        first.report.message.push_str(&format!(
+            "; solved again on the fitted basis too, where the map is {}: the input basis' map is kept",
+            again.report.verdict.name()
+        ));
+        return first;
+    }
+    again.report.basis.requested = BasisChoice::Auto;
+    again.report.basis.fallback = Some(why);
+    again.report.seconds += first.report.seconds;
+    again
+}
+
 /// With [`BasisChoice::Auto`]: when `sol` was solved on the input basis and its map is
-/// not certified (folded, undecided or not converged; `degenerate-corner` is the best
-/// map such a boundary allows and is kept), the fit options of the fitted basis and the
-/// reason to solve again with them. `None` when `sol` stands.
+/// not certified (folded, undecided or not converged; `degenerate-corner` at corners of
+/// the domain is the best map such a boundary allows and is kept, but not when only
+/// zero-speed points of the input's parameterization are excused: the fitted basis
+/// reparameterizes them, see [`auto_choice`]), the fit options of the fitted basis and
+/// the reason to solve again with them. `None` when `sol` stands.
 pub fn auto_fallback(
     sol: &Solution,
     fit: &crate::boundary::fit::FitOptions,
@@ -447,15 +505,26 @@ pub fn auto_fallback(
     if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
         return None;
     }
-    if matches!(r.verdict, Verdict::Certified | Verdict::DegenerateCorner) {
+    let zero_speed_only = r.verdict == Verdict::DegenerateCorner
+        && !r.certificate.excused_points.is_empty()
+        && r.certificate.corners.iter().all(|c| c.excused_extent.is_none());
+    if r.verdict == Verdict::Certified || (r.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
         return None;
     }
-    let why = format!(
-        "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
-        r.basis_functions,
-        r.repairs,
-        r.verdict.name()
-    );
+    let why = if zero_speed_only {
+        format!(
+            "on the input basis ({} functions) det J = 0 where the input's parameterization has zero speed; solved \
+             again on the fitted basis, which reparameterizes the side there",
+            r.basis_functions
+        )
+    } else {
+        format!(
+            "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
+            r.basis_functions,
+            r.repairs,
+            r.verdict.name()
+        )
+    };
     let fit = crate::boundary::fit::FitOptions { basis: BasisChoice::Fitted, ..*fit };
     Some((fit, why))
 }

@@ -30,7 +30,11 @@
 //! `det J <= 0` there for every map: positivity is proven on everything except a
 //! neighbourhood of that corner found by bisection, whose parameter extent is reported
 //! ([`CornerInfo::excused_extent`]); the verdict is then
-//! [`Verdict::DegenerateCorner`]. Nothing is excused at any other corner.
+//! [`Verdict::DegenerateCorner`]. Nothing is excused at any other corner. A point of a
+//! side where the side's own tangent vanishes within rounding (a zero-speed knot, e.g.
+//! repeated control points, where `det J = x_ξ × x_η = 0` for every map of the boundary)
+//! is excused the same way when it is a corner of elements ([`ExcusedPoint`]); there no
+//! negative value is forced, so a fold next to it is a fold.
 //!
 //! **Volumes.** Trivariate maps have their own certificate, with the same arithmetic:
 //! [`volume::certify_volume`].
@@ -83,10 +87,15 @@ pub enum Verdict {
         /// `lower_bound / mean det J`.
         relative: f64,
     },
-    /// `det J > 0` proven everywhere except near corners whose angle forbids it.
+    /// `det J > 0` proven everywhere except near corners whose angle forbids it, and near
+    /// points of a side where the side's speed vanishes (a kink kept with its input
+    /// parameterization, [`ExcusedPoint`]).
     DegenerateCorner {
         /// The corners ("south-west", ...).
         corners: Vec<&'static str>,
+        /// The zero-speed points of the sides, in the parameter domain (`(xi, eta)`).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        points: Vec<[f64; 2]>,
         /// Proven lower bound of `det J` away from those corners.
         lower_bound: f64,
         /// `lower_bound / mean det J`.
@@ -141,6 +150,23 @@ pub struct CornerInfo {
     /// Parameter extent `(xi, eta)` of the neighbourhood of this corner excused from the
     /// proof (found by bisection; `None`: nothing excused here).
     pub excused_extent: Option<[f64; 2]>,
+}
+
+/// A point of a side (not a corner of the domain) where the side's own tangent vanishes,
+/// so `det J = x_ξ × x_η = 0` there for every map with that boundary (a zero-speed kink
+/// kept exactly, e.g. repeated control points): excused like a forced corner, by a
+/// neighbourhood shrunk by bisection.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExcusedPoint {
+    /// Side ("south", ...).
+    pub side: &'static str,
+    /// Parameter point `(xi, eta)`.
+    pub param: [f64; 2],
+    /// Physical point.
+    pub point: [f64; 2],
+    /// Parameter extent `(xi, eta)` of the excused neighbourhood (the largest over the
+    /// elements meeting there).
+    pub extent: [f64; 2],
 }
 
 /// An element where `det J < 0` was proven at a point.
@@ -202,6 +228,8 @@ pub struct Certificate {
     pub max_depth: usize,
     /// Elements near forced corners that could not be proven positive.
     pub excused: Vec<[usize; 2]>,
+    /// Zero-speed points of the sides excused like forced corners.
+    pub excused_points: Vec<ExcusedPoint>,
     /// Elements where a non-positive value was found (away from forced corners).
     pub folds: Vec<FoldInfo>,
     /// Elements left undecided.
@@ -230,7 +258,7 @@ impl Certificate {
                  ({} Bernstein boxes, rounding bounded)",
                 self.elements, self.boxes
             ),
-            Verdict::DegenerateCorner { corners, lower_bound, relative } => {
+            Verdict::DegenerateCorner { corners, lower_bound, relative, .. } => {
                 let why: Vec<String> = self
                     .corners
                     .iter()
@@ -243,15 +271,31 @@ impl Certificate {
                         format!("{} (angle {:.8} degrees, det J there {:.3e}{ext})", c.corner, c.angle_degrees, c.det_j)
                     })
                     .collect();
+                let points: Vec<String> = self
+                    .excused_points
+                    .iter()
+                    .map(|p| {
+                        format!(
+                            "the {} side's point ({:.6}, {:.6}) where its speed vanishes (det J = 0 there for every map of \
+                             this boundary; excused neighbourhood {:.3e} x {:.3e} in (xi, eta))",
+                            p.side, p.point[0], p.point[1], p.extent[0], p.extent[1]
+                        )
+                    })
+                    .collect();
+                let mut what = Vec::new();
+                if !why.is_empty() {
+                    what.push(format!("the {} corner", why.join(" and ")));
+                }
+                what.extend(points);
                 let elsewhere = if lower_bound.is_finite() {
                     format!("det J >= {lower_bound:.4e} ({relative:.3e} of its mean) is proven everywhere else")
                 } else {
                     "det J > 0 is proven everywhere else".to_string()
                 };
                 format!(
-                    "degenerate corner: the boundary forces det J <= 0 at the {} corner; {elsewhere}: the best map this \
-                     boundary admits",
-                    why.join(" and ")
+                    "degenerate corner: the boundary forces det J <= 0 at {}; {elsewhere}: the best map this boundary \
+                     admits",
+                    what.join(" and ")
                 )
             }
             Verdict::Folded { param, point, value, error_bound, one_sided } => format!(
@@ -278,6 +322,36 @@ impl Certificate {
             }
         }
     }
+}
+
+/// Record the excused neighbourhood of extent `ext` around local corner `k` of element
+/// `e` (a zero-speed point of a side), merged with the record of a neighbouring element.
+fn excuse_point(
+    out: &mut Vec<ExcusedPoint>,
+    map: &Surface,
+    dj: &DetJElements<'_>,
+    e: [usize; 2],
+    k: usize,
+    ext: [f64; 2],
+) {
+    let (bu, bv) = dj.bounds(e);
+    let local = [(0, 0), (1, 0), (1, 1), (0, 1)][k];
+    let param = [bu[local.0], bv[local.1]];
+    if let Some(p) = out.iter_mut().find(|p| p.param == param) {
+        p.extent = [p.extent[0].max(ext[0]), p.extent[1].max(ext[1])];
+        return;
+    }
+    let shape = dj.shape();
+    let side = if local.1 == 0 && e[1] == 0 {
+        Side::South
+    } else if local.1 == 1 && e[1] + 1 == shape[1] {
+        Side::North
+    } else if local.0 == 0 && e[0] == 0 {
+        Side::West
+    } else {
+        Side::East
+    };
+    out.push(ExcusedPoint { side: side.name(), param, point: map.eval(param[0], param[1]), extent: ext });
 }
 
 /// Angles and `det J` (cross product of the side tangents) at the four corners, in the
@@ -326,6 +400,7 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         boxes: 0,
         max_depth: 0,
         excused: Vec::new(),
+        excused_points: Vec::new(),
         folds: Vec::new(),
         undecided: Vec::new(),
         undecided_info: Vec::new(),
@@ -344,6 +419,9 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
             }
             if let Some(x) = r.excused[k] {
                 corners[k].excused_extent = Some(x);
+            }
+            if let Some(x) = r.excused[4 + k] {
+                excuse_point(&mut cert.excused_points, map, &dj, *e, k, x);
             }
         }
         if r.excused.iter().any(Option::is_some) {
@@ -366,6 +444,7 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let relative = cert.lower_bound / cert.mean_det_j;
     let degenerate: Vec<&'static str> =
         cert.corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
+    let points: Vec<[f64; 2]> = cert.excused_points.iter().map(|p| p.param).collect();
     cert.verdict = if let Some(f) = cert.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)) {
         Verdict::Folded {
             param: f.param,
@@ -376,8 +455,8 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         }
     } else if !cert.undecided.is_empty() {
         Verdict::Undecided { elements: cert.undecided.clone() }
-    } else if !degenerate.is_empty() {
-        Verdict::DegenerateCorner { corners: degenerate, lower_bound: cert.lower_bound, relative }
+    } else if !degenerate.is_empty() || !points.is_empty() {
+        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: cert.lower_bound, relative }
     } else {
         Verdict::Certified { lower_bound: cert.lower_bound, relative }
     };

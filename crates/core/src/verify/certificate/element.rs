@@ -101,6 +101,10 @@ pub(super) struct Work {
     pub net: [Vec<f64>; 3],
     du: [Vec<f64>; 3],
     dv: [Vec<f64>; 3],
+    /// Rounding bounds of `net`, `du` and `dv` per homogeneous component.
+    e_net: [f64; 3],
+    e_du: [f64; 3],
+    e_dv: [f64; 3],
     pub tmp: Vec<f64>,
     prod: Vec<f64>,
 }
@@ -137,6 +141,9 @@ impl<'a> DetJElements<'a> {
             net: std::array::from_fn(|_| vec![0.0; n]),
             du: std::array::from_fn(|_| vec![0.0; p * (q + 1)]),
             dv: std::array::from_fn(|_| vec![0.0; (p + 1) * q]),
+            e_net: [0.0; 3],
+            e_du: [0.0; 3],
+            e_dv: [0.0; 3],
             tmp: vec![0.0; 2 * (self.deg.0[0].max(self.deg.0[1]) + 2) + big],
             prod: vec![0.0; big],
         }
@@ -233,6 +240,7 @@ impl<'a> DetJElements<'a> {
             e_du[z] = (2.0 * e_net[z] + U * amax(&w.du[z])) * (1.0 + 1e-6);
             e_dv[z] = (2.0 * e_net[z] + U * amax(&w.dv[z])) * (1.0 + 1e-6);
         }
+        (w.e_net, w.e_du, w.e_dv) = (e_net, e_du, e_dv);
         let (du_deg, dv_deg, n_deg) = (Deg([p - 1, q]), Deg([p, q - 1]), Deg([p, q]));
         let bn = &self.binom;
         let factor = (p * q) as f64 / (hu * hv) / (sc * sc);
@@ -276,6 +284,32 @@ impl<'a> DetJElements<'a> {
         // W <= max of its Bernstein coefficients (each known to e_net[2])
         let wmax = (amax(&w.net[2]) + e_net[2]) * (1.0 + 1e-6);
         ElementScale { err, factor, wmax }
+    }
+}
+
+impl DetJElements<'_> {
+    /// Whether the tangent of the domain boundary along side `dir` (0: a side `eta =
+    /// const`, whose tangent is `x_ξ`; 1: `xi = const`, tangent `x_η`) vanishes within its
+    /// rounding bound at local corner `(s, t)` (`0` or `1` each) of the element whose net
+    /// [`DetJElements::coefficients`] left in `w`: one-sided from this element, from the
+    /// differences of the Bernstein net (for a rational map, of `X' W - X W'`, whose bound
+    /// is taken to first order).
+    pub fn zero_tangent(&self, w: &Work, dir: usize, s: usize, t: usize) -> bool {
+        let [p, q] = self.map.degrees();
+        let (d, e_d) = if dir == 0 { (&w.du, &w.e_du) } else { (&w.dv, &w.e_dv) };
+        // index of the difference at the corner, and of the net value there
+        let k = if dir == 0 { t * q * p + s * (p - 1) } else { t * (q - 1) * (p + 1) + s * p };
+        let at = t * q * (p + 1) + s * p;
+        if self.map.weights.is_none() {
+            return (0..2).all(|z| d[z][k].abs() <= e_d[z]);
+        }
+        let (wv, wd) = (w.net[2][at], d[2][k]);
+        (0..2).all(|z| {
+            let v = d[z][k] * wv - w.net[z][at] * wd;
+            let bound =
+                e_d[z] * wv.abs() + d[z][k].abs() * w.e_net[2] + w.net[z][at].abs() * e_d[2] + wd.abs() * w.e_net[z];
+            v.abs() <= 2.0 * bound
+        })
     }
 }
 

@@ -49,8 +49,9 @@ pub(super) struct ElementResult {
     pub depth: usize,
     /// Domain corners (bits) at this element where `det J > 0` is not provable.
     pub forced: u8,
-    /// Parameter extent of the excused neighbourhood per domain corner.
-    pub excused: [Option<[f64; 2]>; 4],
+    /// Parameter extent of the excused neighbourhood per domain corner (0..4) and per
+    /// zero-speed boundary point at local corner `k - 4` of the element (4..8).
+    pub excused: [Option<[f64; 2]>; 8],
 }
 
 /// State of a search (a tentative one for the siblings of a corner box).
@@ -62,7 +63,7 @@ struct Search {
     min_value: f64,
     boxes: usize,
     depth: usize,
-    excused: [Option<[f64; 2]>; 4],
+    excused: [Option<[f64; 2]>; 8],
 }
 
 impl Search {
@@ -74,7 +75,7 @@ impl Search {
             min_value: f64::INFINITY,
             boxes,
             depth: 0,
-            excused: [None; 4],
+            excused: [None; 8],
         }
     }
 }
@@ -296,6 +297,18 @@ fn corner(ctx: &Ctx<'_, '_>, w: &mut Work, mut b: SubBox, k: usize, st: &mut Sea
     st.excused[dom] = Some(ext);
 }
 
+/// Whether local corner `k` of element `e` lies on a side of the domain (not at one of
+/// its corners) where that side's tangent vanishes within rounding, one-sided from `e`.
+fn zero_speed_point(dj: &DetJElements<'_>, w: &Work, e: [usize; 2], k: usize) -> bool {
+    let shape = dj.shape();
+    let (s, t) = LOCAL[k];
+    let (s, t) = (s as usize, t as usize);
+    // on a side eta = const (south or north): the tangent is x_ξ; xi = const: x_η
+    let on_eta_side = (t == 0 && e[1] == 0) || (t == 1 && e[1] + 1 == shape[1]);
+    let on_xi_side = (s == 0 && e[0] == 0) || (s == 1 && e[0] + 1 == shape[0]);
+    (on_eta_side && dj.zero_tangent(w, 0, s, t)) || (on_xi_side && dj.zero_tangent(w, 1, s, t))
+}
+
 /// Examine element `e`.
 pub(super) fn examine(dj: &DetJElements<'_>, e: [usize; 2], opts: &CertifyOptions, w: &mut Work) -> ElementResult {
     let d = dj.deg;
@@ -321,6 +334,11 @@ pub(super) fn examine(dj: &DetJElements<'_>, e: [usize; 2], opts: &CertifyOption
                 forced[k] = Some(k);
                 negative[k] = corner_coef[k] < -sc.err;
             }
+        } else if !at[k] && opts.excuse_corners && corner_coef[k] <= sc.err && zero_speed_point(dj, w, e, k) {
+            // a point of a side where the side's own speed vanishes: det J = x_ξ × x_η = 0
+            // there for every map of that boundary (not a negative value: a fold nearby
+            // is still a fold)
+            forced[k] = Some(4 + k);
         }
     }
     let integral = if dj.map.weights.is_none() {

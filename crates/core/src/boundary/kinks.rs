@@ -1,0 +1,432 @@
+//! Kinks inside a side kept exactly (paper §9): where they are, and the smoothed basis
+//! `Σ¹` the Galerkin form (8) is solved on.
+//!
+//! A side may carry interior `C^0` points, where any `C^1` map of the exact side has
+//! `det J = 0` (its tangent turns, or its speed vanishes):
+//! * a **`C^0` knot** of a spline side (multiplicity at least the degree);
+//! * a **zero-speed knot** (repeated control points, e.g. plate_with_hole's north side):
+//!   the curve is `C^1` in its own parameter but its tangent turns where the speed
+//!   vanishes;
+//! * a **corner of a point cloud** (a polygon vertex), found by [`cloud_corners`].
+//!
+//! To keep them, the basis gets a knot of multiplicity `p` at each kink's parameter
+//! (`Σ⁰`; the knot line runs through the domain, so the opposite side's knot vector
+//! holds it too, as a regular knot line of a smooth curve); `Σ¹` is `Σ⁰` with that
+//! multiplicity lowered by one and the contour projected onto it ([`smoothed_level`]).
+//! The solver solves (8) on `Σ¹`, prolongs to `Σ⁰` and imposes the difference of the
+//! boundary control points by the damped elasticity step, then minimises the Winslow
+//! functional (16) on `Σ⁰` ([`crate::solve::kinks`]).
+
+use serde::Serialize;
+
+use super::fit::project_side;
+use super::level::Level;
+use super::{Boundary, SideCurve};
+pub use super::{KinkMode, CLOUD_CORNER_DEGREES, SPLINE_KINK_DEGREES};
+use crate::error::{Error, Result};
+use crate::spline::basis::BasisDerivs;
+use crate::spline::curve::{Curve, Point};
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Side;
+
+/// The window of [`cloud_corners`], relative to the side's length.
+pub const CORNER_WINDOW: f64 = 0.01;
+
+/// What makes a kink.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum KinkKind {
+    /// A knot of multiplicity at least the degree of a spline side.
+    C0Knot,
+    /// A knot of a spline side where its speed vanishes (repeated control points).
+    ZeroSpeed,
+    /// A corner of a point cloud (polygon vertex).
+    Corner,
+}
+
+/// An interior `C^0` point of a side.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Kink {
+    /// The side.
+    pub side: Side,
+    /// Parameter on the input side in `[0, 1]`: the normalised knot of a spline side, the
+    /// cord-length abscissa (eq. 36-37) of a point cloud's vertex.
+    pub parameter: f64,
+    /// The point (the input's, exactly).
+    pub point: Point,
+    /// Turning angle of the tangent in degrees (180 for a cusp).
+    pub turning_degrees: f64,
+    /// What makes it a kink.
+    pub kind: KinkKind,
+    /// The vertex of a point cloud.
+    #[serde(skip)]
+    pub index: Option<usize>,
+    /// Where the knot of multiplicity `p` lies in the map's parameter along the side (set
+    /// when the hierarchy places it; the input parameter pulled back through a
+    /// reparameterization, §7).
+    pub map_parameter: Option<f64>,
+}
+
+/// One interior knot of a spline side: the turning of the tangent (one-sided directions
+/// just off the knot, robust to a zero speed at it), whether the speed vanishes there and
+/// whether the basis is only `C^0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnotKink {
+    /// The knot in the curve's own parameter.
+    pub u: f64,
+    /// The knot normalised to `[0, 1]`.
+    pub t: f64,
+    /// The curve's point there.
+    pub point: Point,
+    /// Turning of the tangent in degrees.
+    pub turning_degrees: f64,
+    /// A one-sided speed at the knot is zero (relative `1e-10` of the control polygon's
+    /// length over the parameter domain).
+    pub zero_speed: bool,
+    /// Multiplicity at least the degree.
+    pub c0_knot: bool,
+}
+
+/// The interior knots of `c` that are `C^0` knots or where the tangent turns more than
+/// [`SPLINE_KINK_DEGREES`].
+pub fn spline_kinks(c: &Curve) -> Vec<KnotKink> {
+    let p = c.degree();
+    let (a, b) = c.domain();
+    let bm = c.knots.breaks_with_multiplicity();
+    let spans = c.knots.elements();
+    let polygon: f64 =
+        c.control_points.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum::<f64>() / (b - a);
+    let mut out = Vec::new();
+    let mut basis = BasisDerivs::default();
+    let mut d1 = |span: usize, u: f64| {
+        basis.eval_in_span(&c.knots, span, u, 1);
+        c.derivs_with(&basis, 1).d1
+    };
+    for &(u, m) in &bm[1..bm.len().saturating_sub(1)] {
+        let (Some(l), Some(r)) = (spans.iter().find(|e| e.2 == u), spans.iter().find(|e| e.1 == u)) else {
+            continue;
+        };
+        let (tl, tr) = (d1(l.0, u - 1e-9 * (l.2 - l.1)), d1(r.0, u + 1e-9 * (r.2 - r.1)));
+        let (sl, sr) = (d1(l.0, u), d1(r.0, u));
+        let zero_speed = sl[0].hypot(sl[1]) <= 1e-10 * polygon || sr[0].hypot(sr[1]) <= 1e-10 * polygon;
+        let turning = if tl[0].hypot(tl[1]) == 0.0 || tr[0].hypot(tr[1]) == 0.0 {
+            180.0
+        } else {
+            (tl[0] * tr[1] - tl[1] * tr[0]).atan2(tl[0] * tr[0] + tl[1] * tr[1]).to_degrees().abs()
+        };
+        let c0_knot = m >= p;
+        if c0_knot || turning > SPLINE_KINK_DEGREES {
+            out.push(KnotKink {
+                u,
+                t: (u - a) / (b - a),
+                point: c.eval(u),
+                turning_degrees: turning,
+                zero_speed,
+                c0_knot,
+            });
+        }
+    }
+    out
+}
+
+/// Turning angle (degrees) of the chords `p_i → p_j → p_k` with `p_i` the last point at
+/// least `w` (cord length) before `p_j` and `p_k` the first at least `w` after it (the
+/// ends when there is none); `s` the cumulative cord length.
+fn chord_turning(points: &[Point], s: &[f64], j: usize, w: f64) -> f64 {
+    let n = points.len();
+    let i = (0..j).rev().find(|&i| s[j] - s[i] >= w).unwrap_or(0);
+    let k = (j + 1..n).find(|&k| s[k] - s[j] >= w).unwrap_or(n - 1);
+    let (a, b) = (
+        [points[j][0] - points[i][0], points[j][1] - points[i][1]],
+        [points[k][0] - points[j][0], points[k][1] - points[j][1]],
+    );
+    if a[0].hypot(a[1]) == 0.0 || b[0].hypot(b[1]) == 0.0 {
+        return 0.0;
+    }
+    (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]).to_degrees().abs()
+}
+
+/// Corners of a point cloud: interior vertices `j` where the chords to the points a
+/// window `w` (= [`CORNER_WINDOW`] of the length) before and after turn at least
+/// `threshold` degrees, and so do the chords at the window `w / 4` (a corner turns at
+/// every scale; a bend of a sampled smooth curve turns less at the smaller one, and noise
+/// of amplitude `ε` moves the angles by about `ε / w` only). Of neighbouring candidates
+/// (closer than `w`) the one turning most at the window `w` is the vertex: at a polygon's
+/// vertex both chords lie along its edges. Returns `(index, turning degrees)`.
+pub fn cloud_corners(points: &[Point], threshold: f64) -> Vec<(usize, f64)> {
+    let n = points.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    let mut s = vec![0.0; n];
+    for j in 1..n {
+        s[j] = s[j - 1] + (points[j][0] - points[j - 1][0]).hypot(points[j][1] - points[j - 1][1]);
+    }
+    let w = CORNER_WINDOW * s[n - 1];
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for j in 1..n - 1 {
+        if s[j] == s[j - 1] || s[j + 1] == s[j] {
+            continue;
+        }
+        let turn = chord_turning(points, &s, j, w);
+        if turn < threshold || chord_turning(points, &s, j, 0.25 * w) < threshold {
+            continue;
+        }
+        match out.last_mut() {
+            Some(last) if s[j] - s[last.0] < w => {
+                if turn > last.1 {
+                    *last = (j, turn);
+                }
+            }
+            _ => out.push((j, turn)),
+        }
+    }
+    out
+}
+
+/// The kinks of `boundary` that `mode` keeps (south, east, north, west, each by
+/// parameter), or that the report names when `mode` is [`KinkMode::None`] and `report`
+/// is set (then with the thresholds of [`KinkMode::Auto`]). `input_basis`: every `C^0`
+/// knot of a spline side counts whatever its angle (the input basis is `C^0` there).
+/// Analytic sides have none.
+pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kink> {
+    let mut out = Vec::new();
+    let (Some(spline_min), Some(cloud_min)) = (mode.spline_threshold(), mode.cloud_threshold()) else {
+        return out;
+    };
+    for s in Side::ALL {
+        match boundary.side(s) {
+            SideCurve::Spline(c) => {
+                for k in spline_kinks(c) {
+                    if (input_basis && k.c0_knot) || k.turning_degrees > spline_min {
+                        out.push(Kink {
+                            side: s,
+                            parameter: k.t,
+                            point: k.point,
+                            turning_degrees: k.turning_degrees,
+                            kind: if k.zero_speed { KinkKind::ZeroSpeed } else { KinkKind::C0Knot },
+                            index: None,
+                            map_parameter: None,
+                        });
+                    }
+                }
+            }
+            SideCurve::Points(pts) => {
+                let Some(params) = crate::boundary::cord_length::cord_length_params(pts) else { continue };
+                for (j, turn) in cloud_corners(pts, cloud_min) {
+                    out.push(Kink {
+                        side: s,
+                        parameter: params[j],
+                        point: pts[j],
+                        turning_degrees: turn,
+                        kind: KinkKind::Corner,
+                        index: Some(j),
+                        map_parameter: None,
+                    });
+                }
+            }
+            SideCurve::Analytic(_) => {}
+        }
+    }
+    out
+}
+
+/// The kinks stored in a map document's `"report"` (`kinks[].point` and `kinks[].kept`
+/// of the solve report): points and whether the map keeps them; malformed entries are
+/// skipped.
+pub fn kinks_in_report(report: &serde_json::Value) -> Vec<(Point, bool)> {
+    let Some(kinks) = report["kinks"].as_array() else { return Vec::new() };
+    kinks
+        .iter()
+        .filter_map(|k| {
+            let p: Point = serde_json::from_value(k["point"].clone()).ok()?;
+            Some((p, k["kept"].as_bool().unwrap_or(false)))
+        })
+        .collect()
+}
+
+/// Every interior break of `kv` of multiplicity at least `p` (a kink's knot line) lowered
+/// to `p - 1` (paper §9: `Σ¹` from `Σ⁰`).
+pub fn lowered(kv: &KnotVector) -> KnotVector {
+    let p = kv.degree();
+    let bm = kv.breaks_with_multiplicity();
+    let last = bm.len() - 1;
+    let mut knots = Vec::with_capacity(kv.knots().len());
+    for (k, &(u, m)) in bm.iter().enumerate() {
+        let m = if k == 0 || k == last { p + 1 } else { m.min(p - 1) };
+        knots.extend(std::iter::repeat_n(u, m));
+    }
+    KnotVector::new(p, knots).expect("lowering multiplicities keeps an open knot vector")
+}
+
+/// The least-squares projection (§5.2, corners kept) of `c` onto the space of `kv`; a
+/// rational curve is projected in homogeneous coordinates (`w x`, `w y` and `w`), so a
+/// curve that lies in the space is reproduced with its weights.
+pub fn project_curve(c: &Curve, kv: &KnotVector) -> Result<Curve> {
+    let Some(w) = &c.weights else {
+        let ends = c.endpoints();
+        return Ok(project_side(&SideCurve::Spline(c.clone()), kv, ends)?.curve);
+    };
+    let homogeneous =
+        Curve::polynomial(c.knots.clone(), c.control_points.iter().zip(w).map(|(p, w)| [w * p[0], w * p[1]]).collect());
+    let weight = Curve::polynomial(c.knots.clone(), w.iter().map(|&w| [w, 0.0]).collect());
+    let ends = |c: &Curve| c.endpoints();
+    let h = project_side(&SideCurve::Spline(homogeneous.clone()), kv, ends(&homogeneous))?.curve;
+    let wt = project_side(&SideCurve::Spline(weight.clone()), kv, ends(&weight))?.curve;
+    let weights: Vec<f64> = wt.control_points.iter().map(|p| p[0]).collect();
+    if let Some(k) = weights.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(Error::Invalid(format!(
+            "the smoothed rational side has weight {} at control point {k}: a rational side cannot be smoothed there",
+            weights[k]
+        )));
+    }
+    let cps = h.control_points.iter().zip(&weights).map(|(p, w)| [p[0] / w, p[1] / w]).collect();
+    Curve::new(kv.clone(), cps, Some(weights))
+}
+
+/// `Σ¹` of a level (paper §9): the kink lines' multiplicity lowered by one
+/// ([`lowered`]) and every side whose knot vector changed projected onto it
+/// ([`project_curve`]: a smooth side, in the space already, is reproduced; a kinked one is
+/// rounded).
+pub fn smoothed_level(level: &Level) -> Result<Level> {
+    let knots = [lowered(&level.knots[0]), lowered(&level.knots[1])];
+    if knots == level.knots {
+        return Ok(level.clone());
+    }
+    let mut sides = level.sides.clone();
+    for s in Side::ALL {
+        let d = s.direction();
+        if knots[d] != level.knots[d] {
+            sides[s as usize] = project_curve(level.side(s), &knots[d])?;
+        }
+    }
+    Ok(Level { knots, sides })
+}
+
+/// Every level smoothed ([`smoothed_level`]); levels that end up with equal knot vectors
+/// are merged (the finer one's sides kept).
+pub fn smoothed_levels(levels: &[Level]) -> Result<Vec<Level>> {
+    let mut out: Vec<Level> = Vec::with_capacity(levels.len());
+    for l in levels {
+        let l = smoothed_level(l)?;
+        match out.last_mut() {
+            Some(prev) if prev.knots == l.knots => *prev = l,
+            _ => out.push(l),
+        }
+    }
+    Ok(out)
+}
+
+/// `Σ⁰` with the kinks and what they are: the level the map ends on.
+#[derive(Debug, Clone)]
+pub struct KinkedLevel {
+    /// The `C^0` basis (a knot of multiplicity `p` at each kink) with the sides, exact at
+    /// the kinks.
+    pub level: Level,
+    /// The kinks kept, with their [`Kink::map_parameter`] set.
+    pub kinks: Vec<Kink>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A polygon sampled densely with noise-free points: its vertices, and nothing else;
+    /// a densely sampled circle arc has none.
+    #[test]
+    fn cloud_corners_find_polygon_vertices() {
+        let verts: [Point; 4] = [[0.0, 0.0], [1.0, 0.0], [1.5, 0.8], [2.5, 0.9]];
+        let mut pts = Vec::new();
+        for w in verts.windows(2) {
+            for k in 0..40 {
+                let t = k as f64 / 40.0;
+                pts.push([w[0][0] + t * (w[1][0] - w[0][0]), w[0][1] + t * (w[1][1] - w[0][1])]);
+            }
+        }
+        pts.push(verts[3]);
+        let c = cloud_corners(&pts, 30.0);
+        assert_eq!(c.iter().map(|c| c.0).collect::<Vec<_>>(), vec![40, 80], "{c:?}");
+        let t1 = (0.8f64).atan2(0.5).to_degrees();
+        assert!((c[0].1 - t1).abs() < 1e-9, "{c:?}");
+        // sparse: the vertices alone
+        let c = cloud_corners(&verts, 30.0);
+        assert_eq!(c.iter().map(|c| c.0).collect::<Vec<_>>(), vec![1, 2]);
+        // an arc of 90 degrees in 200 points: no corner
+        let arc: Vec<Point> = (0..=200)
+            .map(|k| {
+                let t = std::f64::consts::FRAC_PI_2 * k as f64 / 200.0;
+                [t.cos(), t.sin()]
+            })
+            .collect();
+        assert!(cloud_corners(&arc, 30.0).is_empty());
+    }
+
+    #[test]
+    fn kinks_are_read_from_a_stored_report() {
+        let r = serde_json::json!({ "kinks": [
+            { "side": "north", "point": [-4.0, 4.0], "kept": true },
+            { "side": "east", "point": [1.0, 2.0], "kept": false },
+            { "side": "east", "point": "malformed" }
+        ] });
+        assert_eq!(kinks_in_report(&r), vec![([-4.0, 4.0], true), ([1.0, 2.0], false)]);
+        assert!(kinks_in_report(&serde_json::json!({ "verdict": "certified" })).is_empty());
+    }
+
+    /// `C^0` knots and zero-speed knots of spline sides, with their turning.
+    #[test]
+    fn spline_kinks_are_c0_and_zero_speed_knots() {
+        // quadratic with a double knot at 0.5: C0, turning 90 degrees
+        let kv = KnotVector::new(2, vec![0., 0., 0., 0.5, 0.5, 1., 1., 1.]).unwrap();
+        let c = Curve::polynomial(kv, vec![[0., 0.], [0.5, 0.], [1., 0.], [1., 0.5], [1., 1.]]);
+        let k = spline_kinks(&c);
+        assert_eq!(k.len(), 1);
+        assert!(k[0].c0_knot && !k[0].zero_speed && (k[0].turning_degrees - 90.0).abs() < 1e-6, "{k:?}");
+        // plate_with_hole's north side: a repeated control point, speed zero at 0.5
+        let kv = KnotVector::new(2, vec![0., 0., 0., 0.5, 1., 1., 1.]).unwrap();
+        let c = Curve::polynomial(kv, vec![[-4., 0.], [-4., 4.], [-4., 4.], [0., 4.]]);
+        let k = spline_kinks(&c);
+        assert_eq!(k.len(), 1);
+        assert!(!k[0].c0_knot && k[0].zero_speed && (k[0].turning_degrees - 90.0).abs() < 1e-6, "{k:?}");
+        assert_eq!(k[0].point, [-4., 4.]);
+        // a smooth cubic with simple knots: none
+        let kv = KnotVector::open_uniform(3, 4);
+        let c = Curve::polynomial(kv, (0..7).map(|i| [i as f64, (i as f64).sin()]).collect());
+        assert!(spline_kinks(&c).is_empty());
+    }
+
+    /// Lowering the multiplicity and projecting: a smooth curve refined onto `Σ⁰` is
+    /// reproduced on `Σ¹` (knot removal is exact in the space), a kinked one is rounded.
+    #[test]
+    fn smoothing_reproduces_smooth_sides_and_rounds_kinks() {
+        let kv0 = KnotVector::new(3, vec![0., 0., 0., 0., 0.4, 0.4, 0.4, 1., 1., 1., 1.]).unwrap();
+        let kv1 = lowered(&kv0);
+        assert_eq!(kv1.multiplicity(0.4), 2);
+        let smooth =
+            Curve::polynomial(KnotVector::open_uniform(3, 1), vec![[0., 0.], [0.3, 0.2], [0.7, -0.1], [1., 0.]]);
+        let on0 = smooth.refined(&kv0).unwrap();
+        let p = project_curve(&on0, &kv1).unwrap();
+        for k in 0..=20 {
+            let t = k as f64 / 20.0;
+            let (a, b) = (p.eval(t), smooth.eval(t));
+            assert!((a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13);
+        }
+        let kinked = Curve::polynomial(
+            kv0.clone(),
+            vec![[0., 0.], [0.1, 0.], [0.3, 0.], [0.4, 0.], [0.4, 0.2], [0.4, 0.4], [0.4, 0.6]],
+        );
+        let r = project_curve(&kinked, &kv1).unwrap();
+        let at = r.eval(0.4);
+        assert!((at[0] - 0.4).abs() + at[1].abs() > 1e-3, "the kink is rounded on Σ¹: {at:?}");
+        // a rational arc (quarter circle) on a refined basis is reproduced with its weights
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let arc = Curve::new(KnotVector::open_uniform(2, 1), vec![[1., 0.], [1., 1.], [0., 1.]], Some(vec![1., s, 1.]))
+            .unwrap();
+        let kv = KnotVector::new(2, vec![0., 0., 0., 0.5, 0.5, 1., 1., 1.]).unwrap();
+        let on0 = arc.refined(&kv).unwrap();
+        let r = project_curve(&on0, &lowered(&kv)).unwrap();
+        for k in 0..=20 {
+            let x = r.eval(k as f64 / 20.0);
+            assert!((x[0].hypot(x[1]) - 1.0).abs() < 1e-12, "{x:?}");
+        }
+    }
+}

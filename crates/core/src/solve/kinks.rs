@@ -1,0 +1,344 @@
+//! The `C^0` route of paper §9: a map whose sides keep their kinks exactly.
+//!
+//! The Galerkin form (8) needs a `C^1` basis, so the solver has solved it on the smoothed
+//! basis `Σ¹` (the kinks' knots at multiplicity `p - 1`, the contour projected there,
+//! [`crate::boundary::kinks`]). [`keep_kinks`] then
+//! 1. prolongs that map to the `C^0` basis `Σ⁰` (the kinks' knots at multiplicity `p`,
+//!    joined with the knots the solve added: balancing, refinement, repair), exactly;
+//! 2. imposes the difference of the boundary control points (the kinked sides against the
+//!    smoothed ones) by the linear-elasticity step, with the boundary displacement damped
+//!    by `α < 1` and the Winslow functional (16) minimised for each damped boundary while
+//!    the full step is not certified bijective, `α` raised towards 1 from each bijective
+//!    solution ([`continuation_with`], the same continuation as between levels, judged
+//!    by the certificate);
+//! 3. minimises the Winslow functional (16) on `Σ⁰` (it allows `C^0`, needs a bijective
+//!    start: [`WinslowMethod`]) from that start, with the kinked boundary fixed;
+//! 4. certifies the result. The map is replaced only by a certified one (the minimised
+//!    map, else the certified start of step 3); otherwise the `Σ¹` map stays, with its
+//!    rounded kinks, and the report says why.
+//!
+//! Where the full step of 2. is not certified (next to a reflex kink the harmonic map is
+//! singular, `x_ξ → 0`, and a coarse basis cannot follow), the offending elements and a
+//! halo are bisected as in the defect correction (§8.2), the last certified map of the
+//! continuation is prolonged onto the refined basis and the continuation goes on from
+//! there, at most `repair` rounds.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::improve::{bijective, from_bijective_start};
+use super::initial::{continuation_with, set_boundary, Continuation};
+use super::newton::{NonlinearSolver, Status};
+use super::options::SolveOptions;
+use super::repair::plan_repair;
+use crate::boundary::kinks::KinkedLevel;
+use crate::boundary::level::Level;
+use crate::discrete::assembly::Discretization;
+use crate::discrete::dofs::DofMap;
+use crate::error::Result;
+use crate::methods::egg::EggAssembler;
+use crate::methods::winslow::{winslow_objective, WinslowMethod};
+use crate::methods::Method;
+use crate::spline::curve::Point;
+use crate::spline::surface::{Side, Surface};
+use crate::verify::certificate::{certify, Certificate};
+
+/// What the `C^0` route did (stored in the report as `c0_route`).
+#[derive(Debug, Clone, Serialize)]
+pub struct KinkStage {
+    /// Kinks kept on the map's sides.
+    pub kinks: usize,
+    /// Functions of the smoothed basis `Σ¹` the EGG map was solved on.
+    pub smoothed_functions: usize,
+    /// Functions of the `C^0` basis `Σ⁰`.
+    pub functions: usize,
+    /// Largest distance between a boundary control point of the prolonged `Σ¹` map and
+    /// its `Σ⁰` target, relative to the diameter (what the elasticity step imposes).
+    pub boundary_shift: f64,
+    /// Damped-boundary Winslow solves (`α < 1`) before the full boundary.
+    pub continuation_steps: usize,
+    /// Newton iterations spent in them.
+    pub continuation_iterations: usize,
+    /// Rounds of local refinement (§8.2) around elements where the continuation's full
+    /// step was not certified (at most the solve's `repair`).
+    pub refinements: usize,
+    /// The largest fraction of the boundary displacement reached by a certified map (1
+    /// when the kinks were reached).
+    pub alpha: f64,
+    /// Newton iterations of the final Winslow minimisation.
+    pub iterations: usize,
+    /// Whether it met its stopping rule.
+    pub converged: bool,
+    /// Winslow value (eq. 16) of its start and of its result (`null` where undefined).
+    pub winslow: [Option<f64>; 2],
+    /// Whether the map with the kinks replaced the `Σ¹` map (certified).
+    pub kept: bool,
+    /// The certificate's sentence on the `Σ⁰` map.
+    pub certificate: String,
+    /// Why the kinks were not kept, when they were not.
+    pub failure: Option<String>,
+    /// Seconds for the stage.
+    pub seconds: f64,
+    /// Plain-language summary.
+    pub message: String,
+}
+
+impl KinkStage {
+    /// The record of a route that did not run (the `Σ¹` map is not a bijective start).
+    pub fn skipped(kinked: &KinkedLevel, smoothed_functions: usize, why: String) -> Self {
+        Self {
+            kinks: kinked.kinks.len(),
+            smoothed_functions,
+            functions: kinked.level.num_basis(),
+            boundary_shift: 0.0,
+            continuation_steps: 0,
+            continuation_iterations: 0,
+            refinements: 0,
+            alpha: 0.0,
+            iterations: 0,
+            converged: false,
+            winslow: [None, None],
+            kept: false,
+            certificate: String::new(),
+            failure: Some(why.clone()),
+            seconds: 0.0,
+            message: format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹"),
+        }
+    }
+}
+
+/// The outcome of [`keep_kinks`]: the map with the kinks and its certificate when kept.
+#[derive(Debug, Clone)]
+pub struct KinkOutcome {
+    /// The certified `Σ⁰` map (`None`: not kept).
+    pub map: Option<Surface>,
+    /// Its certificate.
+    pub certificate: Option<Certificate>,
+    /// Its level (basis and sides).
+    pub level: Option<Level>,
+    /// The stage report.
+    pub report: KinkStage,
+}
+
+/// The `Σ⁰` level `c0` joined with the knots of `map` (the `Σ¹` map, which may hold
+/// knots of repair rounds): the sides refined onto the union.
+fn joined_level(map: &Surface, c0: &Level) -> Result<Level> {
+    let knots = [map.knots[0].union(&c0.knots[0])?, map.knots[1].union(&c0.knots[1])?];
+    let mut sides = c0.sides.clone();
+    for s in Side::ALL {
+        sides[s as usize] = sides[s as usize].refined(&knots[s.direction()])?;
+    }
+    Ok(Level { knots, sides })
+}
+
+/// The `C^0` route (module documentation) from the `Σ¹` map `map`, certified bijective,
+/// to the `C^0` level `c0` (the kinks `kinked` at multiplicity `p`): the map on `Σ⁰` with
+/// the kinks kept exactly, certified, or why not.
+pub fn keep_kinks(
+    map: &Surface,
+    c0: &Level,
+    kinked: &KinkedLevel,
+    opts: &SolveOptions,
+    assembler: &dyn EggAssembler,
+    diameter: f64,
+) -> Result<KinkOutcome> {
+    let t0 = Instant::now();
+    let mut level = joined_level(map, c0)?;
+    let mut base = map.refined(&level.knots)?.control_points;
+    let [p, q] = map.degrees();
+    let method = WinslowMethod;
+    let mut cont = Continuation::default();
+    let mut report = KinkStage {
+        kinks: kinked.kinks.len(),
+        smoothed_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
+        functions: level.num_basis(),
+        boundary_shift: 0.0,
+        continuation_steps: 0,
+        continuation_iterations: 0,
+        refinements: 0,
+        alpha: 0.0,
+        iterations: 0,
+        converged: false,
+        winslow: [None, None],
+        kept: false,
+        certificate: String::new(),
+        failure: None,
+        seconds: 0.0,
+        message: String::new(),
+    };
+    // the damped elasticity continuation to the kinked boundary; where its full step is
+    // not certified, the offending elements are bisected (§8.2) and it goes on from the
+    // last certified map, prolonged
+    let (disc, weights, start, start_cert) = loop {
+        let weights = level.weights()?;
+        let dofs = DofMap::for_basis(&level.knots, &opts.topology)?;
+        let disc =
+            Arc::new(Discretization::with_dofs(level.knots.clone(), p.max(q) + 2, dofs).with_weights(weights.clone())?);
+        let mut target = base.clone();
+        set_boundary(disc.shape(), &level.sides, &mut target)?;
+        if report.refinements == 0 {
+            report.boundary_shift =
+                base.iter().zip(&target).fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1]))) / diameter;
+        }
+        let surface = |cps: &[Point]| Surface {
+            knots: level.knots.clone(),
+            control_points: cps.to_vec(),
+            weights: weights.clone(),
+        };
+        let certified = |cps: &[Point]| certify(&surface(cps), &opts.certify).is_ok_and(|c| bijective(&c));
+        let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
+        // the damped steps are counted per round (the cap of the continuation is per basis)
+        let mut round = Continuation::default();
+        let out = continuation_with(&method, assembler, &disc, base, &target, nl, diameter, &mut round, &certified)?;
+        cont.steps += round.steps;
+        cont.iterations += round.iterations;
+        report.alpha = report.alpha.max(out.alpha);
+        let cert = certify(&surface(&out.guess), &opts.certify)?;
+        if bijective(&cert) || report.refinements >= opts.repair {
+            break (disc, weights, out.guess, cert);
+        }
+        let Some(r) = plan_repair(&level, &cert, report.refinements + 1, opts.repair_halo, None)? else {
+            break (disc, weights, out.guess, cert);
+        };
+        let reached = surface(&out.base);
+        level = r.level;
+        base = reached.refined(&level.knots)?.control_points;
+        report.refinements += 1;
+    };
+    report.functions = level.num_basis();
+    report.continuation_steps = cont.steps;
+    report.continuation_iterations = cont.iterations;
+    let surface =
+        |cps: &[Point]| Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
+    let finite = |j: f64| j.is_finite().then_some(j);
+    report.winslow[0] = finite(winslow_objective(&disc, &start));
+    if !bijective(&start_cert) {
+        let why = format!(
+            "the elasticity step to the kinked boundary ({} damped Winslow solves, {} refinement round(s), {:.3} of the \
+             boundary displacement reached with a certified map) gave no bijective start: {}",
+            cont.steps,
+            report.refinements,
+            report.alpha,
+            start_cert.message()
+        );
+        report.certificate = start_cert.message();
+        report.message = format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹");
+        report.failure = Some(why);
+        report.seconds = t0.elapsed().as_secs_f64();
+        return Ok(KinkOutcome { map: None, certificate: None, level: None, report });
+    }
+    let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
+    let c0 = disc.dofs.gather(&start);
+    let mut solver = NonlinearSolver::new(method.problem(disc.clone(), start.clone()), c0, nl);
+    for it in solver.by_ref() {
+        report.iterations = it?.iteration;
+    }
+    report.converged = *solver.status() == Status::Converged;
+    if let Status::Failed(why) = solver.status() {
+        report.failure = Some(format!("Winslow minimisation: {why}"));
+    }
+    let (problem, c) = solver.into_parts();
+    let minimised = problem.control_points(&c);
+    report.winslow[1] = finite(winslow_objective(&disc, &minimised));
+    let cert = certify(&surface(&minimised), &opts.certify)?;
+    let (cps, cert, which) = if bijective(&cert) {
+        (minimised, cert, "the Winslow minimiser")
+    } else {
+        (start, start_cert, "the certified elasticity start (the Winslow minimiser is not certified)")
+    };
+    report.kept = true;
+    report.certificate = cert.message();
+    report.message = format!(
+        "{} kink(s) kept exactly: {which} on the C0 basis ({} functions, from the smoothed {}; boundary moved by \
+         {:.3e} of the diameter, {} damped step(s), {} refinement round(s))",
+        report.kinks,
+        report.functions,
+        report.smoothed_functions,
+        report.boundary_shift,
+        cont.steps,
+        report.refinements
+    );
+    report.seconds = t0.elapsed().as_secs_f64();
+    let map = surface(&cps);
+    Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
+}
+
+/// Distance from `x` to the curve `c`: the closest of 32 samples per element, refined by
+/// golden-section search around it.
+fn distance_to_curve(c: &crate::spline::curve::Curve, x: Point) -> f64 {
+    let d = |t: f64| {
+        let y = c.eval(t);
+        (y[0] - x[0]).hypot(y[1] - x[1])
+    };
+    let (lo, hi) = c.domain();
+    let mut best = (f64::INFINITY, lo, 0.0);
+    for (_, a, b) in c.knots.elements() {
+        let h = (b - a) / 32.0;
+        for k in 0..=32 {
+            let t = a + h * k as f64;
+            let v = d(t);
+            if v < best.0 {
+                best = (v, t, h);
+            }
+        }
+    }
+    let (mut a, mut b) = ((best.1 - best.2).max(lo), (best.1 + best.2).min(hi));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (u, v) = (b - g * (b - a), a + g * (b - a));
+        if d(u) < d(v) {
+            b = v;
+        } else {
+            a = u;
+        }
+    }
+    best.0.min(d(0.5 * (a + b)))
+}
+
+/// The kinks of the report: those the hierarchy keeps (`kept` says whether the `C^0`
+/// route kept them on `map`) and those [`detect`](crate::boundary::kinks::detect) finds
+/// with the thresholds of `--kinks auto` but nothing keeps (rounded), each with the
+/// distance of `map` (in the input's coordinates, like `boundary`) from the point.
+pub fn kink_reports(
+    boundary: &crate::boundary::Boundary,
+    h: &crate::boundary::hierarchy::Hierarchy,
+    map: &Surface,
+    kept: bool,
+) -> Vec<crate::boundary::corners::KinkReport> {
+    use crate::boundary::kinks::{detect, Kink, KinkMode};
+    use crate::boundary::BasisChoice;
+    let kept_list: &[Kink] = h.kinked.as_ref().map_or(&[], |k| &k.kinks);
+    let input = h.basis.used == BasisChoice::Input;
+    let entry = |k: &Kink, point: Point, kept: bool| {
+        let side = map.boundary(k.side);
+        let at = if kept { k.map_parameter } else { None };
+        let deviation = match at {
+            Some(t) => {
+                let y = side.eval(t);
+                (y[0] - point[0]).hypot(y[1] - point[1])
+            }
+            None => distance_to_curve(&side, point),
+        };
+        crate::boundary::corners::KinkReport {
+            side: k.side.name(),
+            parameter: k.parameter,
+            point,
+            turning_degrees: k.turning_degrees,
+            kind: k.kind,
+            kept,
+            map_parameter: at,
+            deviation,
+        }
+    };
+    let mut out: Vec<_> = kept_list.iter().map(|k| entry(k, h.similarity.to_physical(k.point), kept)).collect();
+    for k in detect(boundary, KinkMode::Auto, input) {
+        if !kept_list.iter().any(|x| x.side == k.side && (x.parameter - k.parameter).abs() <= 1e-12) {
+            out.push(entry(&k, k.point, false));
+        }
+    }
+    let side = |name: &str| Side::ALL.iter().position(|s| s.name() == name);
+    out.sort_by(|a, b| side(a.side).cmp(&side(b.side)).then(a.parameter.total_cmp(&b.parameter)));
+    out
+}
