@@ -6,6 +6,9 @@
 //! | [`egg`] | EGG, Galerkin form with the plain operator `L` or the scaled `L / (g11 + g22)`: [`EggMethod`](egg::EggMethod) | eq. (8), (12), (23) |
 //! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
 //! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
+//! | [`density`] | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
+//! | [`harmonic`] | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: [`VariationalHarmonicMethod`](harmonic::VariationalHarmonicMethod) | eq. (46) |
+//! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
@@ -38,9 +41,12 @@
 //! The quadrature back end (CPU here, WGSL in the GPU crate) sits behind the EGG method:
 //! [`EggAssembler`](egg::EggAssembler).
 
+pub mod density;
 pub mod egg;
 pub mod flux;
 pub mod galerkin;
+pub mod harmonic;
+pub mod quasi_conformal;
 pub mod weak_form;
 pub mod winslow;
 
@@ -96,6 +102,14 @@ pub trait DiscreteProblem {
     fn raise_shift(&mut self) -> bool {
         false
     }
+    /// A symmetric rank-one term of the Jacobian that the sparse matrix of the last
+    /// [`DiscreteProblem::jacobian`] call leaves out, `dF/dc = jac + σ u uᵀ`, as `(σ, u)`:
+    /// a dense coupling of all unknowns, e.g. through a global scalar eliminated from the
+    /// problem (the quasi-conformal method's `k`, eq. 47). The Newton solver applies it
+    /// by the Sherman-Morrison formula. `None` (the default) for a sparse Jacobian.
+    fn rank_one(&self) -> Option<(f64, &[f64])> {
+        None
+    }
     /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
     /// approximates the last Jacobian minus `shift` times the mass matrix (a
     /// preconditioner for Krylov solvers), or `None` when the problem has none.
@@ -132,6 +146,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn raise_shift(&mut self) -> bool {
         (**self).raise_shift()
+    }
+    fn rank_one(&self) -> Option<(f64, &[f64])> {
+        (**self).rank_one()
     }
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         (**self).preconditioner(shift)
@@ -178,7 +195,14 @@ pub(crate) fn jacobian_fd_mismatch(prob: &mut dyn DiscreteProblem, c: &[f64], h:
     let mut f = vec![0.0; n];
     let mut jac = Csr::default();
     prob.jacobian(c, &mut f, &mut jac);
-    let dense = jac.to_dense();
+    let mut dense = jac.to_dense();
+    if let Some((sigma, u)) = prob.rank_one() {
+        for (row, ui) in dense.iter_mut().zip(u) {
+            for (v, uj) in row.iter_mut().zip(u) {
+                *v += sigma * ui * uj;
+            }
+        }
+    }
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for j in 0..n {
         let (mut cp, mut cm) = (c.to_vec(), c.to_vec());
