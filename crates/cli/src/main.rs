@@ -30,6 +30,7 @@ use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
+mod compare_cmd;
 mod corpus;
 mod inspect_ring;
 mod mesh;
@@ -76,6 +77,11 @@ enum Command {
     /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
     /// angle per step, one certified map per frame from extrapolated initial guesses.
     Sweep(Box<sweep_cmd::SweepArgs>),
+    /// The methods of paper §10 on one basis: EGG, the variational harmonic method
+    /// (eq. 46) and the quasi-conformal functional (eq. 47-48); iterations, the
+    /// certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
+    /// Jacobian and time per method.
+    Compare(Box<compare_cmd::CompareArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -572,6 +578,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
+        Command::Compare(a) => compare_cmd::run(*a),
     }
 }
 

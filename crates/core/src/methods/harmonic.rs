@@ -328,6 +328,10 @@ impl DiscreteProblem for HarmonicProblem {
         self.hessian.raise()
     }
 
+    fn step_accepted(&mut self, delta: f64) {
+        self.hessian.accepted(delta);
+    }
+
     /// `K` of [`vhm_principal`] on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         let (w1, _) = self.method.weights();

@@ -102,6 +102,11 @@ pub trait DiscreteProblem {
     fn raise_shift(&mut self) -> bool {
         false
     }
+    /// For a minimization method: the line search accepted a step with damping `delta`
+    /// (1 for the full Newton step). A problem that modifies its Hessian (a
+    /// Levenberg-Marquardt shift) may adapt the modification for the next point: a
+    /// heavily damped step says the quadratic model was poor. The default ignores it.
+    fn step_accepted(&mut self, _delta: f64) {}
     /// A symmetric rank-one term of the Jacobian that the sparse matrix of the last
     /// [`DiscreteProblem::jacobian`] call leaves out, `dF/dc = jac + σ u uᵀ`, as `(σ, u)`:
     /// a dense coupling of all unknowns, e.g. through a global scalar eliminated from the
@@ -146,6 +151,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn raise_shift(&mut self) -> bool {
         (**self).raise_shift()
+    }
+    fn step_accepted(&mut self, delta: f64) {
+        (**self).step_accepted(delta)
     }
     fn rank_one(&self) -> Option<(f64, &[f64])> {
         (**self).rank_one()

@@ -12,8 +12,10 @@
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
 //! | [`sweep`] | [`Sweep`](sweep::Sweep): the sliding O-grid, inner contour turned per frame, extrapolated initial guesses | §11.1, Fig. 22 |
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified | §4.1, §9 |
+//! | [`compare`] | [`compare`](compare::compare): EGG, the variational harmonic and the quasi-conformal methods (and more through [`Contender`](compare::Contender)) on one basis, judged by the certificate, `Q(x) / Q(x_G)`, the Winslow, Liao and area-orthogonality values | §10, Tables 1-3 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
+pub mod compare;
 pub mod improve;
 pub mod initial;
 pub mod levels;

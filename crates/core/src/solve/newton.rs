@@ -426,6 +426,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
                 std::mem::swap(&mut self.f, &mut ft);
                 self.norm = nt;
                 self.objective = Some(jt);
+                self.problem.step_accepted(delta);
                 if self.converged(step) {
                     self.status = Status::Converged;
                 } else if self.newton_its >= self.opts.max_newton {
