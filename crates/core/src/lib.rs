@@ -47,6 +47,9 @@
 //! | §8.1, eq. (43) | bijectivity certificate | [`verify::certificate`]; corners that force `det J <= 0`: [`boundary::corners`] |
 //! | §8.2 | local defect correction | [`solve::repair`] |
 //! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
+//! | §10.1, eq. (46) | variational harmonic method | [`methods::harmonic`] (kernel of second-derivative functionals: [`methods::density`]) |
+//! | §10.2, eq. (47)-(48) | quasi-conformal functional, `k` eliminated | [`methods::quasi_conformal`] (rank-one term: [`methods::DiscreteProblem::rank_one`]) |
+//! | §10, Tables 1-3 | the comparison of methods on one basis | [`solve::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //!
 //! A geometry is a basis plus coefficients ([`Surface`], [`Curve`]); one DOF map

@@ -27,7 +27,9 @@ fn compare_button_runs_the_methods_and_the_selector_switches_maps() {
     h.run();
     assert!(h.state().state.comparison.is_none());
     h.get_by_label("Compare methods").click();
-    h.run();
+    // one frame starts the job (the spinner then repaints until it ends)
+    h.step();
+    assert!(h.state().state.solving());
     h.state_mut().state.wait_for_solve();
     h.run();
     let state = &h.state().state;
@@ -57,7 +59,7 @@ fn compare_button_runs_the_methods_and_the_selector_switches_maps() {
     assert_eq!(shown(&h), vhm_map);
     // a plain solve replaces the comparison
     h.get_by_role_and_label(egui::Role::Button, "Solve").click();
-    h.run();
+    h.step();
     h.state_mut().state.wait_for_solve();
     h.run();
     assert!(h.state().state.comparison.is_none());
