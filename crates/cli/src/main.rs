@@ -30,6 +30,7 @@ use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
+mod compare_cmd;
 mod corpus;
 mod inspect_ring;
 mod loft_cmd;
@@ -85,6 +86,11 @@ enum Command {
     /// Winslow or area-orthogonality functional subject to positive Bernstein coefficients
     /// of det J, from the EGG map or from the max-z point of eq. (49); or eq. (49) alone.
     Optimise(Box<optimise_cmd::OptimiseArgs>),
+    /// The methods of paper §10 on one basis: EGG, the variational harmonic method
+    /// (eq. 46) and the quasi-conformal functional (eq. 47-48); iterations, the
+    /// certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
+    /// Jacobian and time per method.
+    Compare(Box<compare_cmd::CompareArgs>),
 }
 
 #[derive(Args, Debug)]
@@ -597,6 +603,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Sweep(a) => sweep_cmd::run(*a),
         Command::Loft(a) => loft_cmd::run(*a),
         Command::Optimise(a) => optimise_cmd::run(*a),
+        Command::Compare(a) => compare_cmd::run(*a),
     }
 }
 

@@ -48,6 +48,9 @@
 //! | §8.2 | local defect correction | [`solve::repair`] |
 //! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
 //! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | [`verify::certificate::coefficients`], [`solve::constrained`], functionals in [`methods::metric_norms`] |
+//! | §10.1, eq. (46) | variational harmonic method | [`methods::harmonic`] (kernel of second-derivative functionals: [`methods::density`]) |
+//! | §10.2, eq. (47)-(48) | quasi-conformal functional, `k` eliminated | [`methods::quasi_conformal`] (rank-one term: [`methods::DiscreteProblem::rank_one`]) |
+//! | §10, Tables 1-3 | the comparison of methods on one basis | [`solve::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
 //!

@@ -326,6 +326,9 @@ impl ViewerApp {
             }
         }
         section(ui, "Solve", |ui| self.solve_section(ui));
+        if self.state.comparison.is_some() {
+            section(ui, "Methods", |ui| self.methods_section(ui));
+        }
         section(ui, "Display", |ui| self.display_section(ui));
         if let Some(mv) = self.state.scene.as_ref().and_then(|s| s.map.as_ref()) {
             section(ui, "Quality", |ui| quality_section(ui, mv));
@@ -413,6 +416,13 @@ impl ViewerApp {
                 ui.spinner();
             }
         });
+        let compare = ui
+            .add_enabled(self.state.can_solve(), egui::Button::new("Compare methods"))
+            .on_hover_text("EGG, the variational harmonic method (eq. 46) and the quasi-conformal functional (eq. 47-48) on one basis; switch between their maps below");
+        if compare.clicked() {
+            let ctx = ui.ctx().clone();
+            self.state.start_compare(move || ctx.request_repaint());
+        }
         let Some(job) = &self.state.job else { return };
         let state = match &job.state {
             JobState::Running => "running".to_string(),
@@ -424,6 +434,38 @@ impl ViewerApp {
         ui.label(format!("{}: {state}", job.name));
         ui.label(job.progress.text());
         residual_plot(ui, &job.progress.history);
+    }
+
+    /// The comparison's rows (paper §10's columns); clicking a method shows its map.
+    fn methods_section(&mut self, ui: &mut Ui) {
+        let Some(c) = &self.state.comparison else { return };
+        let mut clicked = None;
+        ui.label(format!("{} basis; Q(x_G) from the EGG map", c.basis));
+        egui::Grid::new("methods").striped(true).show(ui, |ui| {
+            for h in ["method", "IT", "BIJ", "Q/Q(x_G)", "W", "s"] {
+                ui.label(RichText::new(h).strong());
+            }
+            ui.end_row();
+            for (i, r) in c.rows.iter().enumerate() {
+                let selected = self.state.selected_method == Some(i);
+                if ui.add_enabled(r.map.is_some(), egui::Button::selectable(selected, &r.method)).clicked() {
+                    clicked = Some(i);
+                }
+                ui.label(format!("{}{}", r.iterations, if r.converged { "" } else { " (no)" }));
+                ui.label(r.bij());
+                ui.label(r.q_ratio.map_or("-".into(), |q| format!("{q:.3}")));
+                let w = r.measures.as_ref().and_then(|m| m.winslow);
+                ui.label(w.map_or("inf".into(), |w| format!("{w:.3}")));
+                ui.label(format!("{:.2}", r.seconds));
+                ui.end_row();
+            }
+        });
+        for r in c.rows.iter().filter(|r| !r.converged) {
+            ui.label(format!("{}: not converged: {}", r.method, r.failure.clone().unwrap_or_default()));
+        }
+        if let Some(i) = clicked {
+            self.state.select_method(i);
+        }
     }
 
     // ---------------------------------------------------------------- views

@@ -323,6 +323,13 @@ impl Scene {
         self.map = Some(mv);
     }
 
+    /// Put a map without a solver report into the scene (a method of a comparison): its
+    /// verdict is the core's exact certificate; the input boundary stays.
+    pub fn set_map(&mut self, map: Surface, sampler: &dyn DetJSampler, settings: SceneSettings) {
+        let res = settings.resolution.unwrap_or_else(|| default_resolution(&map));
+        self.map = Some(MapView::new(map, sampler, res, settings.density, None));
+    }
+
     /// Recompute what depends on the settings (after a change of resolution or density).
     pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
         if let Some(mv) = self.map.take() {

@@ -1,7 +1,9 @@
 //! A solve in a background thread: the core's [`EggSolver`] event stream is forwarded
 //! over a channel to the UI, which keeps the progress (level, iteration, residual) and
 //! the residual history for the live plot. A cancel flag is checked between events;
-//! dropping the solver cancels it.
+//! dropping the solver cancels it. The same job runs a comparison of methods (paper §10,
+//! [`compare`]): every method's solver events stream the same way, and the comparison,
+//! one map per method, arrives at the end.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
@@ -10,6 +12,7 @@ use std::thread::JoinHandle;
 
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::methods::egg::CpuAssembler;
+use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
@@ -28,8 +31,19 @@ pub enum Msg {
     },
     /// An event of the solver stream.
     Event(Event),
+    /// A method of a comparison starts (`index` of `count`).
+    Method {
+        /// Method name.
+        method: String,
+        /// Its position.
+        index: usize,
+        /// Number of methods.
+        count: usize,
+    },
     /// The solve finished.
     Finished(Box<Solution>),
+    /// The comparison finished.
+    Compared(Box<Comparison>),
     /// The solve failed.
     Failed(String),
     /// The cancel flag was seen; the solver was dropped.
@@ -48,6 +62,35 @@ pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: 
     let again = SolveOptions { fit: fitted, ..opts.clone() };
     if let Some(s) = attempt(boundary, &again, cancel, send) {
         send(Msg::Finished(Box::new(winslow::solve::solver::auto_choice(sol, s, why))));
+    }
+}
+
+/// Compare `methods` on `boundary` (EGG first, then each on EGG's basis), sending every
+/// solver event and each method's start to `send`; checks `cancel` between events.
+/// Always ends with `Compared`, `Failed` or `Cancelled`.
+pub fn run_compare(
+    boundary: &Boundary,
+    methods: &[MethodChoice],
+    opts: &CompareOptions,
+    cancel: &AtomicBool,
+    send: &mut dyn FnMut(Msg),
+) {
+    let mut progress = |e: CompareEvent| {
+        if cancel.load(Ordering::Relaxed) {
+            return false;
+        }
+        match e {
+            CompareEvent::Started { method, index, count } => send(Msg::Method { method, index, count }),
+            CompareEvent::Solver(e) => send(Msg::Event(e)),
+            CompareEvent::Finished(_) => {}
+        }
+        true
+    };
+    let out = compare(boundary, methods, opts, Arc::new(CpuAssembler), &mut progress);
+    match out {
+        Ok(Some(c)) => send(Msg::Compared(Box::new(c))),
+        Ok(None) => send(Msg::Cancelled),
+        Err(e) => send(Msg::Failed(format!("comparing methods: {e}"))),
     }
 }
 
@@ -133,6 +176,8 @@ pub struct Progress {
     pub history: Vec<ResidualPoint>,
     /// Levels finished (converged or not).
     pub levels_done: usize,
+    /// In a comparison: the method being solved, its position and the number of methods.
+    pub method: Option<(String, usize, usize)>,
 }
 
 impl Progress {
@@ -154,7 +199,11 @@ impl Progress {
                 scaled_residual: iterate.scaled_residual,
             }),
             Msg::Event(Event::LevelFinished(_)) => self.levels_done += 1,
-            Msg::Finished(_) | Msg::Failed(_) | Msg::Cancelled => {}
+            Msg::Method { method, index, count } => {
+                self.method = Some((method.clone(), *index, *count));
+                self.level = None;
+            }
+            Msg::Finished(_) | Msg::Compared(_) | Msg::Failed(_) | Msg::Cancelled => {}
         }
     }
 
@@ -163,8 +212,15 @@ impl Progress {
         self.history.last()
     }
 
-    /// One line of text: level, iteration, residual.
+    /// One line of text: the method of a comparison, level, iteration, residual.
     pub fn text(&self) -> String {
+        match &self.method {
+            Some((m, index, count)) => format!("method {m} ({}/{count}): {}", index + 1, self.level_text()),
+            None => self.level_text(),
+        }
+    }
+
+    fn level_text(&self) -> String {
         let Some((level, levels)) = self.level else {
             return match self.fit_levels {
                 Some(n) => format!("fitted {n} hierarchy levels; starting"),
@@ -215,20 +271,42 @@ pub struct SolveJob {
     rx: Receiver<Msg>,
     cancel: Arc<AtomicBool>,
     handle: Option<JoinHandle<()>>,
+    /// A finished comparison, until taken ([`SolveJob::take_comparison`]).
+    comparison: Option<Comparison>,
 }
 
 impl SolveJob {
     /// Start solving `boundary` in a new thread; `notify` is called after every message
     /// (the UI passes `request_repaint`).
     pub fn start(boundary: Boundary, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
+        let name = boundary.name.clone();
+        Self::spawn(name, notify, move |cancel, send| run(&boundary, &opts, cancel, send))
+    }
+
+    /// Start comparing `methods` on `boundary` in a new thread ([`run_compare`]); the
+    /// comparison is taken with [`SolveJob::take_comparison`] once finished.
+    pub fn start_compare(
+        boundary: Boundary,
+        methods: Vec<MethodChoice>,
+        opts: CompareOptions,
+        notify: impl Fn() + Send + 'static,
+    ) -> Self {
+        let name = boundary.name.clone();
+        Self::spawn(name, notify, move |cancel, send| run_compare(&boundary, &methods, &opts, cancel, send))
+    }
+
+    fn spawn(
+        name: String,
+        notify: impl Fn() + Send + 'static,
+        work: impl FnOnce(&AtomicBool, &mut dyn FnMut(Msg)) + Send + 'static,
+    ) -> Self {
         let (tx, rx) = channel();
         let cancel = Arc::new(AtomicBool::new(false));
         let flag = cancel.clone();
-        let name = boundary.name.clone();
         let handle = std::thread::Builder::new()
             .name("winslow-solve".into())
             .spawn(move || {
-                run(&boundary, &opts, &flag, &mut |m| {
+                work(&flag.clone(), &mut |m| {
                     // the UI may have gone away: then nobody listens and we stop at the next check
                     if tx.send(m).is_err() {
                         flag.store(true, Ordering::Relaxed);
@@ -239,7 +317,12 @@ impl SolveJob {
             .ok();
         let state =
             if handle.is_some() { JobState::Running } else { JobState::Failed("could not start a thread".into()) };
-        Self { name, state, progress: Progress::default(), rx, cancel, handle }
+        Self { name, state, progress: Progress::default(), rx, cancel, handle, comparison: None }
+    }
+
+    /// The comparison, once, after a comparison job finished.
+    pub fn take_comparison(&mut self) -> Option<Comparison> {
+        self.comparison.take()
     }
 
     /// Ask the thread to stop at the next event.
@@ -262,6 +345,10 @@ impl SolveJob {
             Msg::Finished(s) => {
                 self.state = JobState::Finished;
                 return Some(*s);
+            }
+            Msg::Compared(c) => {
+                self.state = JobState::Finished;
+                self.comparison = Some(*c);
             }
             Msg::Failed(e) => self.state = JobState::Failed(e),
             Msg::Cancelled => self.state = JobState::Cancelled,
@@ -383,6 +470,33 @@ mod tests {
         assert_eq!(iterates, 1);
         assert!(matches!(msgs.last(), Some(Msg::Cancelled)));
         assert!(!msgs.iter().any(|m| matches!(m, Msg::Finished(_))));
+    }
+
+    /// A comparison streams each method's start and solver events, and ends with one
+    /// row per method, EGG first; the progress line names the method.
+    #[test]
+    fn run_compare_streams_methods_and_the_comparison() {
+        let opts = CompareOptions { solve: quick(), ..Default::default() };
+        let mut msgs = Vec::new();
+        run_compare(&annulus(), &[MethodChoice::Vhm], &opts, &AtomicBool::new(false), &mut |m| msgs.push(m));
+        let started: Vec<String> = msgs
+            .iter()
+            .filter_map(|m| if let Msg::Method { method, .. } = m { Some(method.clone()) } else { None })
+            .collect();
+        assert_eq!(started, ["egg", "vhm"]);
+        let Some(Msg::Compared(c)) = msgs.last() else { panic!("{:?}", msgs.last()) };
+        let names: Vec<&str> = c.rows.iter().map(|r| r.method.as_str()).collect();
+        assert_eq!(names, ["egg", "vhm"]);
+        let mut p = Progress::default();
+        for m in &msgs {
+            p.apply(m);
+        }
+        assert!(p.text().starts_with("method vhm (2/2): level"), "{}", p.text());
+        // cancelled at the first event
+        let cancel = AtomicBool::new(true);
+        let mut msgs = Vec::new();
+        run_compare(&annulus(), &[MethodChoice::Vhm], &opts, &cancel, &mut |m| msgs.push(m));
+        assert!(matches!(msgs.last(), Some(Msg::Cancelled)), "{msgs:?}");
     }
 
     #[test]

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use egui::Vec2;
 use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
+use winslow::solve::compare::{CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::Point;
 
@@ -147,6 +148,11 @@ pub struct ViewerState {
     pub selected_fold: Option<usize>,
     /// The mesh overlay (winslow-mesh): settings and the last build.
     pub mesh: MeshOverlayState,
+    /// The last comparison of methods (paper §10) on the scene's boundary: one map per
+    /// method, shown one at a time ([`ViewerState::select_method`]).
+    pub comparison: Option<Comparison>,
+    /// The row of `comparison` whose map the scene shows.
+    pub selected_method: Option<usize>,
     sampler: Arc<dyn DetJSampler>,
 }
 
@@ -175,6 +181,8 @@ impl ViewerState {
             probe: None,
             selected_fold: None,
             mesh: MeshOverlayState::default(),
+            comparison: None,
+            selected_method: None,
             sampler,
         }
     }
@@ -210,6 +218,8 @@ impl ViewerState {
             job.cancel();
         }
         self.job = None;
+        self.comparison = None;
+        self.selected_method = None;
         self.scene = Some(scene);
         self.refit = true;
         self.probe = None;
@@ -246,8 +256,49 @@ impl ViewerState {
         }
         let scene = self.scene.as_ref().expect("can_solve");
         self.job = Some(SolveJob::start(scene.boundary.boundary.clone(), self.solve.options(), notify));
+        self.comparison = None;
+        self.selected_method = None;
         self.status = Some(format!("solving {}", scene.name));
         true
+    }
+
+    /// Start comparing the methods of paper §10 (EGG, the variational harmonic method,
+    /// the quasi-conformal functional) on the scene's boundary with the solver settings;
+    /// `notify` as for [`ViewerState::start_solve`].
+    pub fn start_compare(&mut self, notify: impl Fn() + Send + 'static) -> bool {
+        if !self.can_solve() {
+            return false;
+        }
+        let scene = self.scene.as_ref().expect("can_solve");
+        let mut opts = CompareOptions::default();
+        let base = self.solve.options();
+        opts.solve.fit = base.fit;
+        opts.solve.operator = base.operator;
+        opts.solve.min_elements = base.min_elements;
+        opts.solve.refine = base.refine;
+        let methods = MethodChoice::ALL.to_vec();
+        self.job = Some(SolveJob::start_compare(scene.boundary.boundary.clone(), methods, opts, notify));
+        self.status = Some(format!("comparing methods on {}", scene.name));
+        true
+    }
+
+    /// Show the map of row `index` of the comparison (the scene keeps its boundary);
+    /// `false` when there is no such row or it has no map.
+    pub fn select_method(&mut self, index: usize) -> bool {
+        let Some(row) = self.comparison.as_ref().and_then(|c| c.rows.get(index)) else { return false };
+        let (Some(map), Some(scene)) = (&row.map, self.scene.as_mut()) else { return false };
+        scene.set_map(map.clone(), self.sampler.as_ref(), self.settings);
+        self.status = Some(format!("showing the {} map: {}", row.method, row.bij()));
+        self.selected_method = Some(index);
+        self.selected_fold = None;
+        true
+    }
+
+    /// Keep a finished comparison and show its first (EGG) map.
+    fn set_comparison(&mut self, c: Comparison) {
+        self.comparison = Some(c);
+        self.select_method(0);
+        self.refit = true;
     }
 
     /// Ask the running solve to stop.
@@ -263,6 +314,11 @@ impl ViewerState {
         let Some(job) = self.job.as_mut() else { return false };
         let before = (job.state.clone(), job.progress.history.len());
         let solution = job.poll();
+        if let Some(c) = job.take_comparison() {
+            self.set_comparison(c);
+            return true;
+        }
+        let Some(job) = self.job.as_mut() else { return false };
         let changed = solution.is_some() || before != (job.state.clone(), job.progress.history.len());
         match (&job.state, solution) {
             (JobState::Finished, Some(sol)) => {
@@ -283,7 +339,11 @@ impl ViewerState {
     /// Block until a running solve ends and take its result (for `--screenshot`).
     pub fn wait_for_solve(&mut self) {
         if let Some(job) = self.job.as_mut() {
-            if let Some(sol) = job.wait() {
+            let solution = job.wait();
+            if let Some(c) = job.take_comparison() {
+                self.set_comparison(c);
+            }
+            if let Some(sol) = solution {
                 self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
                 if let Some(scene) = self.scene.as_mut() {
                     scene.set_solution(sol, self.sampler.as_ref(), self.settings);

@@ -7,6 +7,10 @@
 //! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
 //! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
 //! | [`metric_norms`] | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): [`MetricNormMethod`](metric_norms::MetricNormMethod) | eq. (3), §10.3 |
+    }
+//! | [`density`] | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
+//! | [`harmonic`] | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: [`VariationalHarmonicMethod`](harmonic::VariationalHarmonicMethod) | eq. (46) |
+//! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
@@ -39,10 +43,13 @@
 //! The quadrature back end (CPU here, WGSL in the GPU crate) sits behind the EGG method:
 //! [`EggAssembler`](egg::EggAssembler).
 
+pub mod density;
 pub mod egg;
 pub mod flux;
 pub mod galerkin;
 pub mod metric_norms;
+pub mod harmonic;
+pub mod quasi_conformal;
 pub mod weak_form;
 pub mod winslow;
 
@@ -104,6 +111,19 @@ pub trait DiscreteProblem {
     fn modified(&self) -> bool {
         false
     }
+    /// For a minimization method: the line search accepted a step with damping `delta`
+    /// (1 for the full Newton step). A problem that modifies its Hessian (a
+    /// Levenberg-Marquardt shift) may adapt the modification for the next point: a
+    /// heavily damped step says the quadratic model was poor. The default ignores it.
+    fn step_accepted(&mut self, _delta: f64) {}
+    /// A symmetric rank-one term of the Jacobian that the sparse matrix of the last
+    /// [`DiscreteProblem::jacobian`] call leaves out, `dF/dc = jac + σ u uᵀ`, as `(σ, u)`:
+    /// a dense coupling of all unknowns, e.g. through a global scalar eliminated from the
+    /// problem (the quasi-conformal method's `k`, eq. 47). The Newton solver applies it
+    /// by the Sherman-Morrison formula. `None` (the default) for a sparse Jacobian.
+    fn rank_one(&self) -> Option<(f64, &[f64])> {
+        None
+    }
     /// A symmetric positive definite scalar matrix `K` such that `-diag(K, K)`
     /// approximates the last Jacobian minus `shift` times the mass matrix (a
     /// preconditioner for Krylov solvers), or `None` when the problem has none.
@@ -143,6 +163,12 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn modified(&self) -> bool {
         (**self).modified()
+    }
+    fn step_accepted(&mut self, delta: f64) {
+        (**self).step_accepted(delta)
+    }
+    fn rank_one(&self) -> Option<(f64, &[f64])> {
+        (**self).rank_one()
     }
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         (**self).preconditioner(shift)
@@ -189,7 +215,14 @@ pub(crate) fn jacobian_fd_mismatch(prob: &mut dyn DiscreteProblem, c: &[f64], h:
     let mut f = vec![0.0; n];
     let mut jac = Csr::default();
     prob.jacobian(c, &mut f, &mut jac);
-    let dense = jac.to_dense();
+    let mut dense = jac.to_dense();
+    if let Some((sigma, u)) = prob.rank_one() {
+        for (row, ui) in dense.iter_mut().zip(u) {
+            for (v, uj) in row.iter_mut().zip(u) {
+                *v += sigma * ui * uj;
+            }
+        }
+    }
     let (mut err, mut scale) = (0.0f64, 0.0f64);
     for j in 0..n {
         let (mut cp, mut cm) = (c.to_vec(), c.to_vec());

@@ -327,7 +327,10 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         };
         self.lin.factor_stored(k)?;
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let dx = self.lin.solve(&rhs);
+        let dx = match (self.lin.solve(&rhs), self.problem.rank_one()) {
+            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
+            (dx, _) => dx,
+        };
         self.timings.linear += t.elapsed();
         dx
     }
@@ -469,6 +472,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
                 std::mem::swap(&mut self.f, &mut ft);
                 self.norm = nt;
                 self.objective = Some(jt);
+                self.problem.step_accepted(delta);
                 if self.converged(step) || (negligible && delta == 1.0) {
                     self.status = Status::Converged;
                 } else if self.newton_its >= self.opts.max_newton {
@@ -570,6 +574,22 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             }
         }
     }
+}
+
+/// `(A + σ u uᵀ)⁻¹ b` from `x = A⁻¹ b` and the factorization of `A` in `lin` (the
+/// rank-one term of [`DiscreteProblem::rank_one`]): `x − σ (uᵀx) / (1 + σ uᵀz) z` with
+/// `z = A⁻¹ u` (Sherman-Morrison); an error when `1 + σ uᵀz` vanishes (the updated
+/// matrix is singular).
+fn sherman_morrison(lin: &mut LinearSolver, x: Vec<f64>, sigma: f64, u: &[f64]) -> Result<Vec<f64>> {
+    let z = lin.solve(u)?;
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+    let (uz, ux) = (sigma * dot(u, &z), sigma * dot(u, &x));
+    let denom = 1.0 + uz;
+    if !denom.is_finite() || denom.abs() <= 1e-12 * (1.0 + uz.abs()) {
+        return Err(crate::error::Error::LinearSolver("singular rank-one update (Sherman-Morrison)".into()));
+    }
+    let t = ux / denom;
+    Ok(x.iter().zip(&z).map(|(xi, zi)| xi - t * zi).collect())
 }
 
 impl<P: DiscreteProblem> Iterator for NonlinearSolver<P> {
@@ -678,6 +698,61 @@ mod tests {
             let (problem, _) = solver.into_parts();
             assert!(problem.rejected > 0, "the test must exercise infeasible trial steps");
             assert!(!problem.evaluated_outside, "F evaluated outside the admissible set");
+        }
+    }
+
+    /// `J(c) = |c − a|² / 2 + (Σ c)² / 2`, presented as the sparse `−I` plus the rank-one
+    /// term `−1 1ᵀ`: quadratic, so one exact Newton step (Sherman-Morrison) lands on the
+    /// minimiser `c = a − (Σ a) / (n + 1)`.
+    struct RankOne {
+        a: Vec<f64>,
+        ones: Vec<f64>,
+        mass: Csr,
+    }
+
+    impl DiscreteProblem for RankOne {
+        fn size(&self) -> usize {
+            self.a.len()
+        }
+        fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+            let s: f64 = c.iter().sum();
+            for ((f, x), a) in f.iter_mut().zip(c).zip(&self.a) {
+                *f = -(x - a) - s;
+            }
+        }
+        fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
+            self.residual(c, f);
+            *jac = Csr::from_rows(c.len(), (0..c.len()).map(|i| vec![(i, -1.0)]).collect());
+        }
+        fn rank_one(&self) -> Option<(f64, &[f64])> {
+            Some((-1.0, &self.ones))
+        }
+        fn mass(&mut self) -> &Csr {
+            &self.mass
+        }
+        fn objective(&mut self, c: &[f64]) -> Option<f64> {
+            let s: f64 = c.iter().sum();
+            Some(c.iter().zip(&self.a).map(|(x, a)| 0.5 * (x - a) * (x - a)).sum::<f64>() + 0.5 * s * s)
+        }
+        fn control_points(&self, c: &[f64]) -> Vec<Point> {
+            c.iter().map(|&x| [x, 0.0]).collect()
+        }
+    }
+
+    #[test]
+    fn rank_one_term_gives_the_exact_newton_step() {
+        let a: Vec<f64> = (0..7).map(|i| 0.3 * i as f64 - 1.0).collect();
+        let n = a.len();
+        let p = RankOne { a: a.clone(), ones: vec![1.0; n], mass: Csr::identity(n) };
+        let mut solver =
+            NonlinearSolver::new(p, vec![0.0; n], NonlinearOptions { fallback: false, ..Default::default() });
+        let its: Vec<Iterate> = solver.by_ref().map(|i| i.unwrap()).collect();
+        assert_eq!(solver.status(), &Status::Converged);
+        assert_eq!(its.last().unwrap().iteration, 1, "one Newton step");
+        assert_eq!(its.last().unwrap().damping, 1.0);
+        let shift = a.iter().sum::<f64>() / (n as f64 + 1.0);
+        for (x, a) in solver.solution().iter().zip(&a) {
+            assert!((x - (a - shift)).abs() < 1e-13);
         }
     }
 

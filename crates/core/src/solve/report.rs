@@ -92,6 +92,16 @@ pub enum Verdict {
 }
 
 impl Verdict {
+    /// The verdict of a certificate (a converged map's).
+    pub fn of_certificate(c: &Certificate) -> Self {
+        match c.verdict {
+            crate::verify::certificate::Verdict::Certified { .. } => Verdict::Certified,
+            crate::verify::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+            crate::verify::certificate::Verdict::Folded { .. } => Verdict::Folded,
+            crate::verify::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
+        }
+    }
+
     /// The name in the JSON report (`"certified"`, `"degenerate-corner"`, `"folded"`,
     /// `"undecided"`, `"not-converged"`).
     pub fn name(self) -> &'static str {

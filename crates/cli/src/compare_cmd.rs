@@ -1,0 +1,255 @@
+//! `winslow compare BOUNDARY [--methods egg,vhm,qc] [--json] [--png-dir DIR]`: the
+//! methods of paper §10 on one basis, one table row each
+//! ([`winslow::solve::compare`]): iterations, the certificate's verdict, `Q(x) / Q(x_G)`,
+//! the Winslow, Liao and area-orthogonality values, the smallest scaled Jacobian, time.
+
+use super::*;
+use winslow::methods::quasi_conformal::QcHessian;
+use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
+
+#[derive(Args, Debug)]
+pub(super) struct CompareArgs {
+    /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
+    boundary: PathBuf,
+    /// Methods, comma-separated: egg (eq. 8, always run: its map is x_G), vhm (the
+    /// variational harmonic method, eq. 46), qc (the quasi-conformal functional, eq. 47-48).
+    #[arg(long, value_delimiter = ',', default_value = "egg,vhm,qc")]
+    methods: Vec<String>,
+    /// Weight of the uniformity term of the variational harmonic method (eq. 46),
+    /// dimensionless: applied as lambda1 * diameter^4.
+    #[arg(long, default_value_t = 0.0)]
+    lambda1: f64,
+    /// Weight of the area-orthogonality term of the variational harmonic method,
+    /// dimensionless: applied as lambda2 * diameter^2.
+    #[arg(long, default_value_t = 0.0)]
+    lambda2: f64,
+    /// Hessian of the quasi-conformal iteration: the Gauss-Newton matrix
+    /// (Levenberg-Marquardt, the default) or the exact Hessian (Newton's method).
+    #[arg(long, value_enum, default_value = "gauss-newton")]
+    qc_hessian: QcHessianArg,
+    #[command(flatten)]
+    fit: FitArgs,
+    /// Nonlinear tolerance on each method's scaled residual.
+    #[arg(long, default_value_t = 1e-9)]
+    tol: f64,
+    /// Newton iterations per level before the fall-back to pseudo time-stepping.
+    #[arg(long, default_value_t = CompareOptions::default().solve.nonlinear.max_newton)]
+    max_newton: usize,
+    /// Levels of the hierarchy each method solves (the finest always): 1 starts every
+    /// method from the Coons patch of the finest basis; more add the coarse-to-fine
+    /// prolongations and continuation (§6.3, §9).
+    #[arg(long, default_value_t = 1)]
+    levels: usize,
+    /// Minimum number of elements per direction on the finest level.
+    #[arg(long, default_value_t = 8)]
+    min_elements: usize,
+    /// Extra uniform halvings of the finest level.
+    #[arg(long, default_value_t = 0)]
+    refine: usize,
+    /// Basis growth factor between solved levels.
+    #[arg(long, default_value_t = SolveOptions::default().growth)]
+    growth: f64,
+    /// Operator of EGG: L of eq. (4) or L / (g11 + g22).
+    #[arg(long, value_enum, default_value = "scaled")]
+    operator: OperatorArg,
+    /// Linear solver: sparse LU, GMRES, or auto (LU up to 1000 unknowns).
+    #[arg(long, value_enum, default_value = "auto")]
+    linear: LinearArg,
+    /// Rounds of defect correction per method (default 0: every method on the same
+    /// basis; with rounds, each method may refine around its own folds).
+    #[arg(long, default_value_t = 0)]
+    repair: usize,
+    /// Length scales a1,a2 of the Poisson benchmark's u* (default: half the bounding box
+    /// extents of the EGG map), the same for every method.
+    #[arg(long, value_delimiter = ',', num_args = 2)]
+    poisson_scales: Option<Vec<f64>>,
+    /// Write one picture per method, DIR/NAME-METHOD.png (grid lines coloured by det J).
+    #[arg(long)]
+    png_dir: Option<PathBuf>,
+    /// Print the comparison as JSON on stdout (progress goes to stderr).
+    #[arg(long)]
+    json: bool,
+    /// No progress output.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Progress of every nonlinear iterate (residual, objective, damping).
+    #[arg(short, long)]
+    verbose: bool,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum QcHessianArg {
+    GaussNewton,
+    Exact,
+}
+
+impl CompareArgs {
+    fn options(&self) -> Result<(Vec<MethodChoice>, CompareOptions)> {
+        let methods = self.methods.iter().map(|m| MethodChoice::parse(m)).collect::<winslow::Result<Vec<_>>>()?;
+        let solver = SolverArgs {
+            fit: self.fit.clone(),
+            tol: self.tol,
+            levels: Some(self.levels.max(1)),
+            min_elements: self.min_elements,
+            refine: self.refine,
+            growth: self.growth,
+            iteration: IterationArg::Newton,
+            method: MethodArg::Egg,
+            operator: self.operator,
+            linear: self.linear,
+            repair: self.repair,
+            no_repair: false,
+            repair_freeze: None,
+            improve: None,
+        };
+        // the comparison's defaults (one level, no repair, its iteration limits), with the
+        // fit, operator, sizes and tolerances of the flags
+        let mut opts = CompareOptions::default();
+        let max_pseudo = opts.solve.nonlinear.max_pseudo;
+        opts.solve = solver.options()?;
+        opts.solve.nonlinear.max_newton = self.max_newton.max(1);
+        opts.solve.nonlinear.max_pseudo = max_pseudo;
+        for (name, v) in [("--lambda1", self.lambda1), ("--lambda2", self.lambda2)] {
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("{name} must be finite and not negative, got {v}");
+            }
+        }
+        (opts.lambda1, opts.lambda2) = (self.lambda1, self.lambda2);
+        opts.qc_hessian = match self.qc_hessian {
+            QcHessianArg::GaussNewton => QcHessian::GaussNewton,
+            QcHessianArg::Exact => QcHessian::Exact,
+        };
+        if let Some(s) = &self.poisson_scales {
+            if !s.iter().all(|v| v.is_finite() && *v > 0.0) {
+                bail!("--poisson-scales must be two positive numbers, got {s:?}");
+            }
+            opts.poisson_scales = Some([s[0], s[1]]);
+        }
+        Ok((methods, opts))
+    }
+}
+
+pub(super) fn run(a: CompareArgs) -> Result<i32> {
+    let (methods, opts) = a.options()?;
+    let boundary = load_boundary(&a.boundary, a.fit.reorient)?;
+    let quiet = a.quiet || a.json;
+    let stderr = std::io::stderr();
+    let mut progress = |e: CompareEvent| {
+        if quiet {
+            return true;
+        }
+        let mut err = stderr.lock();
+        let _ = match e {
+            CompareEvent::Started { method, index, count } => {
+                writeln!(err, "[{}/{count}] {method}", index + 1)
+            }
+            CompareEvent::Solver(Event::LevelFinished(r)) => writeln!(
+                err,
+                "  level {}: {}x{} basis, {} iterations, {}",
+                r.level + 1,
+                r.shape[0],
+                r.shape[1],
+                r.iterations + r.continuation_iterations,
+                if r.converged {
+                    "converged".into()
+                } else {
+                    format!("not converged ({})", r.failure.unwrap_or_default())
+                }
+            ),
+            CompareEvent::Solver(Event::Iterate { iterate: it, .. }) if a.verbose => writeln!(
+                err,
+                "    {:>3} {:<10} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}",
+                it.iteration,
+                format!("{:?}", it.method),
+                it.residual,
+                it.scaled_residual,
+                it.step,
+                it.damping,
+                it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
+            ),
+            CompareEvent::Solver(_) => Ok(()),
+            CompareEvent::Finished(row) => writeln!(err, "  {}: {}, {:.3} s", row.method, row.bij(), row.seconds),
+        };
+        true
+    };
+    let cmp = compare(&boundary, &methods, &opts, Arc::new(winslow::CpuAssembler), &mut progress)
+        .with_context(|| format!("comparing methods on {}", a.boundary.display()))?
+        .context("the comparison was cancelled")?;
+    if let Some(dir) = &a.png_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for row in &cmp.rows {
+            if let Some(map) = &row.map {
+                let path = dir.join(format!("{}-{}.png", cmp.name, row.method));
+                output::write_png(&path, &render(map, &PictureOptions::default()))?;
+                if !quiet {
+                    eprintln!("wrote {}", path.display());
+                }
+            }
+        }
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&cmp)?);
+    } else {
+        print!("{}", table(&cmp));
+    }
+    Ok(0)
+}
+
+/// `x` in a fixed width, `-` when absent.
+fn num(x: Option<f64>, prec: usize) -> String {
+    match x {
+        Some(v) if v.is_finite() && (v.abs() >= 1e4 || (v != 0.0 && v.abs() < 1e-2)) => format!("{v:.prec$e}"),
+        Some(v) if v.is_finite() => format!("{v:.prec$}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    }
+}
+
+/// The paper's columns (Tables 1-3) and ours, one row per method, notes below.
+pub(super) fn table(c: &Comparison) -> String {
+    let mut s = format!(
+        "{}: {} basis, degree {}x{}, Poisson scales a = ({:.4}, {:.4})\n",
+        c.name, c.basis, c.degree[0], c.degree[1], c.poisson_scales[0], c.poisson_scales[1]
+    );
+    if let Some(why) = &c.basis_fallback {
+        s.push_str(&format!("  basis: {why}\n"));
+    }
+    s.push_str(&format!(
+        "{:<8} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9}\n",
+        "method", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"
+    ));
+    let mut notes = Vec::new();
+    for r in &c.rows {
+        let m = r.measures.as_ref();
+        s.push_str(&format!(
+            "{:<8} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9.3}\n",
+            r.method,
+            r.iterations,
+            if r.converged { "yes" } else { "no" },
+            r.bij(),
+            num(r.q_ratio, 3),
+            num(m.and_then(|m| m.winslow).or(m.map(|_| f64::INFINITY)), 3),
+            num(m.map(|m| m.liao), 3),
+            num(m.map(|m| m.area_orthogonality), 3),
+            num(m.map(|m| m.scaled_jacobian_min), 3),
+            m.map_or("-".into(), |m| format!("{}x{}", m.shape[0], m.shape[1])),
+            r.seconds
+        ));
+        if let Some(why) = &r.failure {
+            notes.push(format!("  {}: not converged: {why}", r.method));
+        }
+        if let Some(m) = m.filter(|m| !matches!(m.verdict, Verdict::Certified | Verdict::DegenerateCorner)) {
+            notes.push(format!(
+                "  {}: the map is {} (its last iterate): {}",
+                r.method,
+                m.verdict.name(),
+                m.certificate
+            ));
+        }
+    }
+    for n in notes {
+        s.push_str(&n);
+        s.push('\n');
+    }
+    s
+}

@@ -1,0 +1,592 @@
+//! The comparison of paper §10 (Tables 1-3): several parameterization methods run on the
+//! same boundary, the same hierarchy of bases and the same starts, and every resulting
+//! map judged by the same measures: the nonlinear iterations (IT), bijectivity by the
+//! certificate (BIJ, §8.1), the Poisson benchmark `Q(x) / Q(x_G)` of eq. (44)-(45) with
+//! `x_G` the EGG map, the Winslow value `W` (eq. 16), the Liao and area-orthogonality
+//! functionals (eq. 3), the smallest scaled Jacobian and the time.
+//!
+//! # Methods and the extension point
+//!
+//! [`MethodChoice`] is the registry of the methods `compare` knows by name; each gives a
+//! [`Contender`], which runs on a [`CompareContext`] (boundary, hierarchy, options, the
+//! EGG reference run) and returns a [`MethodRun`]: its name, nonlinear iterations,
+//! whether it converged and why not, the map, the seconds. The measures are computed here,
+//! uniformly, from the map alone ([`Measures::of`]); a contender never reports its own
+//! verdict. A new method is a new [`MethodChoice`] variant and a [`Contender`]
+//! implementation (a minimization or root-finding [`Method`] can use [`HierarchyRun`]).
+//!
+//! EGG always runs first: its map is `x_G`, and with the basis `auto` its run decides
+//! the basis (the input's own basis when its map is certified, else the fitted one, as
+//! `winslow solve` does); every other method then runs on that basis, from the same
+//! start: by default the Coons patch of the finest basis ([`CompareOptions::default`]),
+//! with more levels the coarse-to-fine walk of §6.3 ([`HierarchyRun`]). Defect
+//! correction (§8.2) is off by default: it would refine each method's basis differently.
+//!
+//! Nothing ends silently folded: a method that does not converge, or whose map the
+//! certificate does not prove bijective, is reported as such with its last iterate; a
+//! method that fails outright is a row with the error and no measures.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::options::SolveOptions;
+use super::report::{Solution, Verdict};
+use super::solver::{auto_fallback, EggSolver, Event};
+use crate::boundary::hierarchy::{build_hierarchy, Hierarchy};
+use crate::boundary::{BasisChoice, Boundary};
+use crate::error::{Error, Result};
+use crate::methods::egg::{EggAssembler, EggMethod};
+use crate::methods::harmonic::VariationalHarmonicMethod;
+use crate::methods::quasi_conformal::{QcHessian, QuasiConformalMethod};
+use crate::methods::Method;
+use crate::spline::surface::Surface;
+use crate::verify::certificate::certify;
+use crate::verify::poisson::{default_scales, poisson_benchmark};
+use crate::verify::quality::quality;
+
+/// The methods `compare` knows by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodChoice {
+    /// Elliptic grid generation, eq. (8) (the reference `x_G`).
+    Egg,
+    /// The variational harmonic method, eq. (46).
+    Vhm,
+    /// The quasi-conformal functional, eq. (47)-(48).
+    Qc,
+}
+
+impl MethodChoice {
+    /// Every registered method, in table order.
+    pub const ALL: [MethodChoice; 3] = [MethodChoice::Egg, MethodChoice::Vhm, MethodChoice::Qc];
+
+    /// The name in tables, reports and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodChoice::Egg => "egg",
+            MethodChoice::Vhm => "vhm",
+            MethodChoice::Qc => "qc",
+        }
+    }
+
+    /// The method called `name`; [`Error::Invalid`] listing the known names otherwise.
+    pub fn parse(name: &str) -> Result<Self> {
+        let name = name.trim().to_ascii_lowercase();
+        Self::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
+            let known: Vec<&str> = Self::ALL.iter().map(|m| m.name()).collect();
+            Error::Invalid(format!("unknown method '{name}' (known: {})", known.join(", ")))
+        })
+    }
+
+    /// The contender that runs this method with `opts`.
+    pub fn contender(self, opts: &CompareOptions) -> Box<dyn Contender> {
+        match self {
+            MethodChoice::Egg => Box::new(HierarchyRun::new(self.name(), None)),
+            MethodChoice::Vhm => {
+                let vhm = VariationalHarmonicMethod { lambda1: opts.lambda1, lambda2: opts.lambda2, length: 1.0 };
+                Box::new(HierarchyRun::new(self.name(), Some(Arc::new(vhm))))
+            }
+            MethodChoice::Qc => Box::new(HierarchyRun::new(
+                self.name(),
+                Some(Arc::new(QuasiConformalMethod { hessian: opts.qc_hessian })),
+            )),
+        }
+    }
+}
+
+/// Options of a comparison.
+#[derive(Debug, Clone)]
+pub struct CompareOptions {
+    /// Fit, levels, nonlinear iteration, certificate (shared by every method); the EGG
+    /// operator.
+    pub solve: SolveOptions,
+    /// `λ₁` of the variational harmonic method (dimensionless, relative to the domain's
+    /// diameter; see [`crate::methods::harmonic`]).
+    pub lambda1: f64,
+    /// `λ₂` of the variational harmonic method.
+    pub lambda2: f64,
+    /// The Hessian of the quasi-conformal iteration (Gauss-Newton by default).
+    pub qc_hessian: QcHessian,
+    /// Length scales of the Poisson benchmark's `u*` (default: [`default_scales`] of the
+    /// EGG map), the same for every method.
+    pub poisson_scales: Option<[f64; 2]>,
+}
+
+impl Default for CompareOptions {
+    /// The solver's defaults, except: one level (every method starts from the Coons patch
+    /// of the finest basis: one start and one basis for all, as in the paper's Table 3;
+    /// more levels add the elasticity prolongations and the boundary continuation of
+    /// §6.3 and §9, whose damped solves a slowly converging method repeats), no defect
+    /// correction (it would refine each method's basis differently), room for 200
+    /// Newton iterations (the variational methods need tens to hundreds where EGG needs a
+    /// handful: the quasi-conformal functional converges linearly, its minimizers being
+    /// degenerate) and 100 pseudo-time steps after them.
+    fn default() -> Self {
+        let mut solve = SolveOptions { repair: 0, max_levels: Some(1), ..Default::default() };
+        solve.nonlinear.max_newton = 200;
+        solve.nonlinear.max_pseudo = 100;
+        Self { solve, lambda1: 0.0, lambda2: 0.0, qc_hessian: QcHessian::default(), poisson_scales: None }
+    }
+}
+
+/// What a contender sees.
+pub struct CompareContext<'a> {
+    /// The boundary.
+    pub boundary: &'a Boundary,
+    /// The hierarchy of bases every method uses (EGG's).
+    pub hierarchy: &'a Hierarchy,
+    /// Shared options.
+    pub options: &'a CompareOptions,
+    /// Quadrature back end of the hierarchy's operators.
+    pub assembler: Arc<dyn EggAssembler>,
+    /// The EGG run (`x_G`), for methods that start from it; `None` while EGG runs.
+    pub reference: Option<&'a MethodRun>,
+}
+
+impl std::fmt::Debug for CompareContext<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompareContext").field("boundary", &self.boundary.name).finish_non_exhaustive()
+    }
+}
+
+/// What a contender returns: the measures are computed from `map` by the comparison.
+#[derive(Debug, Clone)]
+pub struct MethodRun {
+    /// Method name.
+    pub method: String,
+    /// Nonlinear iterations in all, continuation solves included.
+    pub iterations: usize,
+    /// Whether the method met its stopping rule on the finest level.
+    pub converged: bool,
+    /// Why it did not, if it did not.
+    pub failure: Option<String>,
+    /// The map (the last iterate when not converged), in the input's coordinates.
+    pub map: Surface,
+    /// Wall-clock seconds of the run.
+    pub seconds: f64,
+}
+
+impl MethodRun {
+    /// The run of a coarse-to-fine solve.
+    pub fn of_solution(method: &str, sol: &Solution, seconds: f64) -> Self {
+        let levels = &sol.report.levels;
+        let last = levels.last();
+        Self {
+            method: method.to_string(),
+            iterations: levels.iter().map(|l| l.iterations + l.continuation_iterations).sum(),
+            converged: last.is_some_and(|l| l.converged),
+            failure: last.and_then(|l| l.failure.clone()),
+            map: sol.map.clone(),
+            seconds,
+        }
+    }
+}
+
+/// A method of the comparison (see the module documentation).
+pub trait Contender: Send + Sync + std::fmt::Debug {
+    /// Name in tables and reports.
+    fn name(&self) -> &str;
+    /// Run on the context's hierarchy; `progress` sees the solver's events and returns
+    /// `false` to cancel (then `Ok(None)`).
+    fn run(&self, ctx: &CompareContext<'_>, progress: &mut dyn FnMut(&Event) -> bool) -> Result<Option<MethodRun>>;
+}
+
+/// A [`Method`] solved coarse to fine over the hierarchy ([`EggSolver::with_method`]),
+/// from the Coons patch and the elasticity prolongations, as EGG is; `None` is EGG with
+/// the options' operator and the context's assembler.
+#[derive(Debug, Clone)]
+pub struct HierarchyRun {
+    name: String,
+    method: Option<Arc<dyn MethodFactory>>,
+}
+
+/// Makes the method of a [`HierarchyRun`] for one hierarchy.
+pub trait MethodFactory: Send + Sync + std::fmt::Debug {
+    /// The method for `hierarchy`.
+    fn method(&self, hierarchy: &Hierarchy) -> Arc<dyn Method>;
+}
+
+impl MethodFactory for QuasiConformalMethod {
+    fn method(&self, _: &Hierarchy) -> Arc<dyn Method> {
+        Arc::new(*self)
+    }
+}
+
+/// The reference length of the weights is the domain's diameter (dimensionless `λ`).
+impl MethodFactory for VariationalHarmonicMethod {
+    fn method(&self, h: &Hierarchy) -> Arc<dyn Method> {
+        Arc::new(VariationalHarmonicMethod { length: h.diameter, ..*self })
+    }
+}
+
+impl HierarchyRun {
+    /// A run called `name` of `method` (`None`: EGG).
+    pub fn new(name: &str, method: Option<Arc<dyn MethodFactory>>) -> Self {
+        Self { name: name.to_string(), method }
+    }
+
+    /// The coarse-to-fine solve on `h`, events to `progress`; `None` when cancelled.
+    fn solve(
+        &self,
+        ctx: &CompareContext<'_>,
+        h: &Hierarchy,
+        progress: &mut dyn FnMut(&Event) -> bool,
+    ) -> Result<Option<Solution>> {
+        let opts = ctx.options.solve.clone();
+        let assembler = ctx.assembler.clone();
+        let method: Arc<dyn Method> = match &self.method {
+            Some(f) => f.method(h),
+            None => Arc::new(EggMethod { operator: opts.operator, assembler: assembler.clone() }),
+        };
+        let mut solver = EggSolver::with_method(h, opts, assembler, method)?;
+        for e in solver.by_ref() {
+            if !progress(&e?) {
+                return Ok(None);
+            }
+        }
+        Ok(Some(solver.finish(ctx.boundary, h)?))
+    }
+}
+
+impl Contender for HierarchyRun {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn run(&self, ctx: &CompareContext<'_>, progress: &mut dyn FnMut(&Event) -> bool) -> Result<Option<MethodRun>> {
+        let t0 = Instant::now();
+        let sol = self.solve(ctx, ctx.hierarchy, progress)?;
+        Ok(sol.map(|s| MethodRun::of_solution(&self.name, &s, t0.elapsed().as_secs_f64())))
+    }
+}
+
+/// The measures of one map, computed the same way for every method.
+#[derive(Debug, Clone, Serialize)]
+pub struct Measures {
+    /// The certificate's verdict (BIJ).
+    pub verdict: Verdict,
+    /// The certificate's message.
+    pub certificate: String,
+    /// `Q(x)` of eq. (45); `None` when the benchmark could not be solved on the map.
+    pub q: Option<f64>,
+    /// Winslow functional (eq. 16); `None` when `det J <= 0` at a quadrature point.
+    pub winslow: Option<f64>,
+    /// Liao functional `∫ g₁₁² + g₂₂² + 2 g₁₂²` (eq. 3).
+    pub liao: f64,
+    /// Area orthogonality `∫ g₁₁² + g₂₂²` (eq. 3).
+    pub area_orthogonality: f64,
+    /// Smallest per-element minimum of the scaled Jacobian `det J / (|x_ξ| |x_η|)`.
+    pub scaled_jacobian_min: f64,
+    /// Basis functions per direction of the map.
+    pub shape: [usize; 2],
+}
+
+impl Measures {
+    /// Certificate, functionals and the Poisson benchmark with length scales `scales`.
+    pub fn of(map: &Surface, opts: &CompareOptions, scales: [f64; 2]) -> Result<Self> {
+        let cert = certify(map, &opts.solve.certify)?;
+        let q = quality(map);
+        let f = q.functionals;
+        Ok(Self {
+            verdict: Verdict::of_certificate(&cert),
+            certificate: cert.message(),
+            q: poisson_benchmark(map, Some(scales)).ok().map(|p| p.q).filter(|v| v.is_finite()),
+            winslow: f.winslow.is_finite().then_some(f.winslow),
+            liao: f.liao,
+            area_orthogonality: f.area_orthogonality,
+            scaled_jacobian_min: q.scaled_jacobian.min,
+            shape: map.shape(),
+        })
+    }
+}
+
+/// One row of the comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompareRow {
+    /// Method name.
+    pub method: String,
+    /// Nonlinear iterations (IT), continuation solves included.
+    pub iterations: usize,
+    /// Whether the method met its stopping rule.
+    pub converged: bool,
+    /// Why it did not converge, or the error that stopped it.
+    pub failure: Option<String>,
+    /// The measures of its map; `None` when the method failed without a map.
+    pub measures: Option<Measures>,
+    /// `Q(x) / Q(x_G)`.
+    pub q_ratio: Option<f64>,
+    /// Seconds of the run (measures not included).
+    pub seconds: f64,
+    /// The map, when there is one.
+    #[serde(skip)]
+    pub map: Option<Surface>,
+}
+
+impl CompareRow {
+    /// One word for the BIJ column: the certificate's verdict, `error` without a map.
+    pub fn bij(&self) -> &'static str {
+        self.measures.as_ref().map_or("error", |m| m.verdict.name())
+    }
+}
+
+/// The outcome of [`compare`].
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// Name of the geometry.
+    pub name: String,
+    /// The basis every method used: `input` or `fitted`.
+    pub basis: &'static str,
+    /// Why the input basis was left for the fitted one (basis `auto`), if it was.
+    pub basis_fallback: Option<String>,
+    /// Degrees of the maps.
+    pub degree: [usize; 2],
+    /// Length scales of the Poisson benchmark.
+    pub poisson_scales: [f64; 2],
+    /// One row per method, EGG first.
+    pub rows: Vec<CompareRow>,
+}
+
+impl Comparison {
+    /// The row of `method`.
+    pub fn row(&self, method: &str) -> Option<&CompareRow> {
+        self.rows.iter().find(|r| r.method == method)
+    }
+}
+
+/// What [`compare`] reports while it runs.
+#[derive(Debug, Clone)]
+pub enum CompareEvent {
+    /// A method starts (`index` of `count`).
+    Started {
+        /// Method name.
+        method: String,
+        /// Its position.
+        index: usize,
+        /// Number of methods.
+        count: usize,
+    },
+    /// An event of the method's solver.
+    Solver(Event),
+    /// A method's row is complete.
+    Finished(Box<CompareRow>),
+}
+
+/// Run EGG and then each of `methods` (EGG is always first, listed or not; repeats are
+/// dropped) on `boundary` with `opts` (module documentation). `progress` sees every
+/// event and returns `false` to cancel: then `Ok(None)`.
+pub fn compare(
+    boundary: &Boundary,
+    methods: &[MethodChoice],
+    opts: &CompareOptions,
+    assembler: Arc<dyn EggAssembler>,
+    progress: &mut dyn FnMut(CompareEvent) -> bool,
+) -> Result<Option<Comparison>> {
+    let mut order = vec![MethodChoice::Egg];
+    for &m in methods {
+        if !order.contains(&m) {
+            order.push(m);
+        }
+    }
+    let count = order.len();
+    if !progress(CompareEvent::Started { method: MethodChoice::Egg.name().into(), index: 0, count }) {
+        return Ok(None);
+    }
+    // EGG decides the basis, as `winslow solve` does
+    let t0 = Instant::now();
+    let egg = HierarchyRun::new(MethodChoice::Egg.name(), None);
+    let mut h = build_hierarchy(boundary, &opts.solve.fit)?;
+    let ctx = CompareContext { boundary, hierarchy: &h, options: opts, assembler: assembler.clone(), reference: None };
+    let Some(mut sol) = egg.solve(&ctx, &h, &mut |e| progress(CompareEvent::Solver(e.clone())))? else {
+        return Ok(None);
+    };
+    let mut fallback = None;
+    if let Some((fitted, why)) = auto_fallback(&sol, &opts.solve.fit) {
+        let mut o = opts.clone();
+        o.solve.fit = fitted;
+        h = build_hierarchy(boundary, &o.solve.fit)?;
+        let ctx =
+            CompareContext { boundary, hierarchy: &h, options: &o, assembler: assembler.clone(), reference: None };
+        let Some(again) = egg.solve(&ctx, &h, &mut |e| progress(CompareEvent::Solver(e.clone())))? else {
+            return Ok(None);
+        };
+        sol = again;
+        fallback = Some(why);
+    }
+    let reference = MethodRun::of_solution(egg.name(), &sol, t0.elapsed().as_secs_f64());
+    let scales = opts.poisson_scales.unwrap_or_else(|| default_scales(&reference.map));
+    let basis = match h.basis.used {
+        BasisChoice::Input => "input",
+        BasisChoice::Fitted | BasisChoice::Auto => "fitted",
+    };
+    let mut out = Comparison {
+        name: boundary.name.clone(),
+        basis,
+        basis_fallback: fallback,
+        degree: reference.map.degrees(),
+        poisson_scales: scales,
+        rows: Vec::new(),
+    };
+    for (index, choice) in order.into_iter().enumerate() {
+        let run = if choice == MethodChoice::Egg {
+            Ok(Some(reference.clone()))
+        } else {
+            if !progress(CompareEvent::Started { method: choice.name().into(), index, count }) {
+                return Ok(None);
+            }
+            let ctx = CompareContext {
+                boundary,
+                hierarchy: &h,
+                options: opts,
+                assembler: assembler.clone(),
+                reference: Some(&reference),
+            };
+            let t = Instant::now();
+            let run = choice.contender(opts).run(&ctx, &mut |e| progress(CompareEvent::Solver(e.clone())));
+            run.map(|r| r.map(|r| MethodRun { seconds: t.elapsed().as_secs_f64(), ..r }))
+        };
+        let row = match run {
+            Ok(None) => return Ok(None),
+            Ok(Some(r)) => row_of(r, opts, scales, out.rows.first())?,
+            Err(e) => CompareRow {
+                method: choice.name().into(),
+                iterations: 0,
+                converged: false,
+                failure: Some(e.to_string()),
+                measures: None,
+                q_ratio: None,
+                seconds: 0.0,
+                map: None,
+            },
+        };
+        if !progress(CompareEvent::Finished(Box::new(row.clone()))) {
+            return Ok(None);
+        }
+        out.rows.push(row);
+    }
+    Ok(Some(out))
+}
+
+/// The row of a run: its measures and `Q / Q(x_G)` against the reference row.
+fn row_of(r: MethodRun, opts: &CompareOptions, scales: [f64; 2], reference: Option<&CompareRow>) -> Result<CompareRow> {
+    let measures = Measures::of(&r.map, opts, scales)?;
+    let q_ref = match reference {
+        Some(row) => row.measures.as_ref().and_then(|m| m.q),
+        None => measures.q,
+    };
+    let q_ratio = match (measures.q, q_ref) {
+        (Some(q), Some(g)) if g > 0.0 => Some(q / g),
+        _ => None,
+    };
+    Ok(CompareRow {
+        method: r.method,
+        iterations: r.iterations,
+        converged: r.converged,
+        failure: r.failure,
+        measures: Some(measures),
+        q_ratio,
+        seconds: r.seconds,
+        map: Some(r.map),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::{Analytic, SideCurve};
+    use crate::methods::egg::CpuAssembler;
+
+    /// The image of the unit square under `x = A ξ + b`, four straight sides.
+    fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
+        let f = |u: f64, v: f64| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v];
+        let side = move |g: fn(f64) -> (f64, f64)| {
+            SideCurve::Analytic(Analytic::new(move |t| {
+                let (u, v) = g(t);
+                f(u, v)
+            }))
+        };
+        let sides = [side(|t| (t, 0.0)), side(|t| (1.0, t)), side(|t| (t, 1.0)), side(|t| (0.0, t))];
+        (Boundary { name: "parallelogram".into(), sides }, f)
+    }
+
+    /// On an affine boundary every method returns the affine map (EGG and VHM to
+    /// rounding; the quasi-conformal minimizer is degenerate, see
+    /// [`crate::methods::quasi_conformal`], and resolved to its stopping rule), each
+    /// certified, on one basis, with `Q / Q(x_G) = 1` for maps equal to EGG's.
+    #[test]
+    fn every_method_returns_the_affine_map_of_an_affine_boundary() {
+        let (b, f) = parallelogram();
+        let opts = CompareOptions {
+            solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
+            ..Default::default()
+        };
+        let mut events = Vec::new();
+        let cmp = compare(
+            &b,
+            &[MethodChoice::Qc, MethodChoice::Vhm, MethodChoice::Qc],
+            &opts,
+            Arc::new(CpuAssembler),
+            &mut |e| {
+                if let CompareEvent::Started { method, .. } = &e {
+                    events.push(method.clone());
+                }
+                true
+            },
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!(events, ["egg", "qc", "vhm"], "EGG first, repeats dropped");
+        let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
+        assert_eq!(names, ["egg", "qc", "vhm"]);
+        let shape = cmp.rows[0].measures.as_ref().unwrap().shape;
+        for r in &cmp.rows {
+            let m = r.measures.as_ref().unwrap();
+            assert!(r.converged, "{}: {:?}", r.method, r.failure);
+            assert_eq!(m.verdict, Verdict::Certified, "{}", r.method);
+            assert_eq!(m.shape, shape, "{}: one basis", r.method);
+            let tol = if r.method == "qc" { 1e-4 } else { 1e-9 };
+            let map = r.map.as_ref().unwrap();
+            for (u, v) in [(0.3, 0.7), (0.5, 0.5), (0.9, 0.2), (0.05, 0.95)] {
+                let (x, e) = (map.eval(u, v), f(u, v));
+                assert!(
+                    (x[0] - e[0]).abs() < tol && (x[1] - e[1]).abs() < tol,
+                    "{} at ({u}, {v}): {x:?} vs {e:?}",
+                    r.method
+                );
+            }
+            // the same map, the same Poisson error
+            let q = r.q_ratio.unwrap();
+            assert!((q - 1.0).abs() < if r.method == "qc" { 1e-3 } else { 1e-8 }, "{}: Q / Q(x_G) = {q}", r.method);
+        }
+        assert_eq!(cmp.rows[0].q_ratio, Some(1.0));
+    }
+
+    #[test]
+    fn names_parse_and_unknown_names_are_errors() {
+        for m in MethodChoice::ALL {
+            assert_eq!(MethodChoice::parse(m.name()).unwrap(), m);
+        }
+        assert_eq!(MethodChoice::parse(" VHM ").unwrap(), MethodChoice::Vhm);
+        let e = MethodChoice::parse("ipopt").unwrap_err().to_string();
+        assert!(e.contains("ipopt") && e.contains("egg, vhm, qc"), "{e}");
+    }
+
+    /// The progress callback cancels: `Ok(None)`, no comparison.
+    #[test]
+    fn progress_can_cancel() {
+        let (b, _) = parallelogram();
+        let opts = CompareOptions {
+            solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
+            ..Default::default()
+        };
+        let mut seen = 0;
+        let out = compare(&b, &[MethodChoice::Vhm], &opts, Arc::new(CpuAssembler), &mut |_| {
+            seen += 1;
+            seen < 3
+        })
+        .unwrap();
+        assert!(out.is_none());
+        assert_eq!(seen, 3);
+    }
+}
