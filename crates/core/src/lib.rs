@@ -62,6 +62,7 @@ pub mod error;
 pub mod io;
 pub mod linalg;
 pub mod methods;
+pub mod multipatch;
 pub mod solve;
 pub mod spline;
 #[doc(hidden)]
