@@ -5,12 +5,24 @@
 //! | [`layout`] | patches, interfaces, the boundary condition of every patch side |
 //! | [`classes`] | the direction classes of the knot vectors: one knot vector per interface, propagated through chains of patches |
 //! | [`gismo`] | G+Smo XML `<MultiPatch>` files, read and written with G+Smo's side numbering and orientation flags |
+//! | [`json`] | the JSON multipatch document of `formats.md`, with named curves shared by patches |
+//! | [`dofs`] | the global numbering of shared control points over all patches |
+//! | [`problem`] | one discrete problem over all patches (Winslow functional eq. 16, weak form eq. 14) on the shared numbering |
+//! | [`solve`](mod@solve) | the conforming solve with fixed interfaces, patch by patch, and the layout's refinement |
+//! | [`free`] | the free-interface stage: one global problem from the certified fixed solve |
 //! | [`check`] | validation of a layout: shared sides identical, orientations consistent, counter-clockwise patches, complete interfaces, no crossing boundaries |
 
 pub mod check;
 pub mod classes;
+pub mod dofs;
+pub mod free;
 pub mod gismo;
+pub mod json;
 pub mod layout;
+pub mod problem;
+pub mod solve;
 
 pub use check::{validate_layout, LayoutReport};
 pub use layout::{Interface, Layout, Patch, PatchSide};
+pub use problem::Functional;
+pub use solve::{solve_multipatch, Interfaces, MultipatchOptions, MultipatchSolution};
