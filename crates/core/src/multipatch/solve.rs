@@ -263,6 +263,9 @@ fn solve_patch(layout: &Layout, p: usize, sides: &[Curve; 4], opts: &SolveOption
     Ok((map, sol.report))
 }
 
+/// A patch's map, report and certificate, and the knot vectors it was solved on.
+type Solved = (Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2]);
+
 /// Solve `layout` (see the module documentation).
 pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<MultipatchSolution> {
     let t0 = Instant::now();
@@ -275,7 +278,7 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
         bases = bases.refined(None);
     }
     let n = unit.patches.len();
-    let mut solved: Vec<Option<(Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2])>> = vec![None; n];
+    let mut solved: Vec<Option<Solved>> = vec![None; n];
     let mut rounds = 0;
     loop {
         let sides = bases.conforming_sides(&unit)?;
