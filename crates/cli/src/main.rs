@@ -33,6 +33,7 @@ use winslow_gpu::{Backend, Precision, Selected};
 mod corpus;
 mod inspect_ring;
 mod mesh;
+mod multipatch_cmd;
 mod output;
 mod solve_cmd;
 mod sweep_cmd;
@@ -438,6 +439,8 @@ struct SolveArgs {
     start: Option<PathBuf>,
     /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
     /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
+    /// A multipatch input (G+Smo <MultiPatch> or a JSON document with "patches") is
+    /// written as a JSON multipatch document or G+Smo XML (.xml).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
@@ -479,6 +482,8 @@ struct SolveArgs {
     mesh: Option<PathBuf>,
     #[command(flatten)]
     mesh_spec: mesh::MeshSpec,
+    #[command(flatten)]
+    multipatch: multipatch_cmd::MultipatchArgs,
 }
 
 #[derive(Args, Debug)]

@@ -10,6 +10,7 @@
 //! | [`problem`] | one discrete problem over all patches (Winslow functional eq. 16, weak form eq. 14) on the shared numbering |
 //! | [`solve`](mod@solve) | the conforming solve with fixed interfaces, patch by patch, and the layout's refinement |
 //! | [`free`] | the free-interface stage: one global problem from the certified fixed solve |
+//! | [`output`] | writing a solved layout (JSON, per-patch map documents, G+Smo XML, VTK multiblock) and reading any multipatch file |
 //! | [`check`] | validation of a layout: shared sides identical, orientations consistent, counter-clockwise patches, complete interfaces, no crossing boundaries |
 
 pub mod check;
@@ -19,10 +20,12 @@ pub mod free;
 pub mod gismo;
 pub mod json;
 pub mod layout;
+pub mod output;
 pub mod problem;
 pub mod solve;
 
 pub use check::{validate_layout, LayoutReport};
 pub use layout::{Interface, Layout, Patch, PatchSide};
+pub use output::read_layout;
 pub use problem::Functional;
 pub use solve::{solve_multipatch, Interfaces, MultipatchOptions, MultipatchSolution};
