@@ -77,6 +77,12 @@ enum Command {
     /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
     /// angle per step, one certified map per frame from extrapolated initial guesses.
     Sweep(Box<sweep_cmd::SweepArgs>),
+    /// Split a certified map's domain into two four-sided patches sharing a curve between
+    /// points on opposite sides (paper §11.2, Fig. 25); `winslow solve` takes the result.
+    Split(multipatch_cmd::SplitArgs),
+    /// Join two maps sharing a whole side into one map with a C0 knot, smoothed by the
+    /// weak form (eq. 14) from that bijective start (paper §11.2, Fig. 27-28).
+    Join(multipatch_cmd::JoinArgs),
 }
 
 #[derive(Args, Debug)]
@@ -577,6 +583,8 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
+        Command::Split(a) => multipatch_cmd::split(a),
+        Command::Join(a) => multipatch_cmd::join(a),
     }
 }
 

@@ -11,6 +11,8 @@
 //! | [`solve`](mod@solve) | the conforming solve with fixed interfaces, patch by patch, and the layout's refinement |
 //! | [`free`] | the free-interface stage: one global problem from the certified fixed solve |
 //! | [`output`] | writing a solved layout (JSON, per-patch map documents, G+Smo XML, VTK multiblock) and reading any multipatch file |
+//! | [`join`] | two patches sharing a whole side joined into one map with a `C⁰` knot |
+//! | [`split`] | a domain split by the image of a parameter curve (straight or shortest in the map's metric) into two patches |
 //! | [`check`] | validation of a layout: shared sides identical, orientations consistent, counter-clockwise patches, complete interfaces, no crossing boundaries |
 
 pub mod check;
@@ -18,11 +20,13 @@ pub mod classes;
 pub mod dofs;
 pub mod free;
 pub mod gismo;
+pub mod join;
 pub mod json;
 pub mod layout;
 pub mod output;
 pub mod problem;
 pub mod solve;
+pub mod split;
 
 pub use check::{validate_layout, LayoutReport};
 pub use layout::{Interface, Layout, Patch, PatchSide};
