@@ -96,7 +96,7 @@ struct ConvertArgs {
 
 #[derive(Args, Debug)]
 struct CheckArgs {
-    /// Map file (JSON map document or G+Smo XML).
+    /// Map file (JSON map document or G+Smo XML; a multipatch file: every patch).
     map: PathBuf,
     /// The input boundary: report the largest deviation of the map's boundary from it.
     #[arg(long)]
@@ -652,14 +652,19 @@ fn convert(a: ConvertArgs) -> Result<i32> {
 }
 
 fn check(a: CheckArgs) -> Result<i32> {
-    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-    let Document::Map { name, map, .. } = doc else {
-        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
-    };
     let opts = CertifyOptions {
         max_depth: a.max_depth.clamp(1, 40),
         max_boxes: a.max_boxes.clamp(1, 1 << 24),
         excuse_corners: !a.strict_corners,
+    };
+    if let Some(layout) =
+        winslow::multipatch::read_layout(&a.map).with_context(|| format!("reading {}", a.map.display()))?
+    {
+        return multipatch_cmd::check(layout, &opts, a.json);
+    }
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
     };
     let certificate = certify(&map, &opts).context("certifying the map")?;
     let quality = quality(&map);

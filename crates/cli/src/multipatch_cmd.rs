@@ -344,3 +344,64 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
     }
     Ok(exit_code(verdict))
 }
+
+/// `winslow check LAYOUT`: certify every patch map of a multipatch file (a G+Smo
+/// `<MultiPatch>` or a solved JSON layout) and measure how far the two sides of every
+/// interface are apart; the exit code of the worst patch.
+pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result<i32> {
+    use winslow::multipatch::solve::{interface_mismatch, verdict_of};
+    let mut maps = Vec::with_capacity(layout.patches.len());
+    for p in &layout.patches {
+        let Some(m) = &p.map else {
+            bail!(
+                "patch {} of {} is a boundary, not a map: there is nothing to certify (solve the layout first)",
+                p.name,
+                layout.name
+            )
+        };
+        maps.push(m.clone());
+    }
+    let validation = winslow::multipatch::validate_layout(&layout);
+    let mut rows = Vec::with_capacity(maps.len());
+    let mut worst = Verdict::Certified;
+    for (p, m) in layout.patches.iter().zip(&maps) {
+        let c = certify(m, opts).with_context(|| format!("certifying patch {}", p.name))?;
+        let v = verdict_of(&c);
+        if exit_code(v) > exit_code(worst) {
+            worst = v;
+        }
+        let w = quality(m).functionals.winslow;
+        rows.push(serde_json::json!({
+            "name": p.name, "verdict": v, "message": c.message(), "certificate": c,
+            "winslow": w.is_finite().then_some(w), "shape": m.shape(),
+        }));
+    }
+    let mismatch = interface_mismatch(&layout, &maps);
+    let report = serde_json::json!({
+        "name": layout.name,
+        "verdict": worst,
+        "patches": rows,
+        "interfaces": layout.interfaces.len(),
+        "interface_mismatch": mismatch,
+        "layout": match &validation { Ok(r) => serde_json::to_value(r)?, Err(e) => serde_json::json!({ "error": e.to_string() }) },
+    });
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{}: {} ({} patches, {} interfaces)",
+            layout.name,
+            output::verdict_word(worst),
+            maps.len(),
+            layout.interfaces.len()
+        );
+        for r in &rows {
+            println!("  patch {:<10} {}", r["name"].as_str().unwrap_or(""), r["message"].as_str().unwrap_or(""));
+        }
+        println!("  interface control points differ by up to {mismatch:.3e}");
+        if let Err(e) = &validation {
+            println!("  layout: {e}");
+        }
+    }
+    Ok(exit_code(worst))
+}
