@@ -5,8 +5,9 @@
 //! patch is an ordinary single-patch EGG solve (the coarse-to-fine solver of
 //! [`crate::solve::solver`] on the input basis of its conforming sides), run in
 //! parallel, and certified on its own. A patch that is not certified refines the
-//! direction classes it belongs to (so its neighbours are refined with it and the
-//! layout stays conforming) and the layout is solved again, at most
+//! direction classes it belongs to (the direction of its longer elements, or both; its
+//! neighbours are refined with it, so the layout stays conforming) and the layout is
+//! solved again, at most
 //! [`MultipatchOptions::repair`] times. With [`Interfaces::Free`] the certified layout
 //! is then improved with its interfaces free ([`super::free`]).
 //!
@@ -275,6 +276,24 @@ fn solve_patch(
     Ok((map, sol.report, cert))
 }
 
+/// The directions of a patch to refine when it is not certified: the one whose elements
+/// are longer (mean length of its two sides per element), or both when they are within a
+/// factor 2 of each other (a thin C-grid refines across, not along).
+fn coarse_directions(sides: &[Curve; 4], knots: &[crate::spline::knots::KnotVector; 2]) -> Vec<usize> {
+    let length = |c: &Curve| c.sample(64).windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum::<f64>();
+    let per = |d: usize, a: Side, b: Side| {
+        0.5 * (length(&sides[a as usize]) + length(&sides[b as usize])) / knots[d].num_elements().max(1) as f64
+    };
+    let (hx, hy) = (per(0, Side::South, Side::North), per(1, Side::West, Side::East));
+    if hx > 2.0 * hy {
+        vec![0]
+    } else if hy > 2.0 * hx {
+        vec![1]
+    } else {
+        vec![0, 1]
+    }
+}
+
 /// A patch's map, report and certificate, and the knot vectors it was solved on.
 type Solved = (Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2]);
 
@@ -319,7 +338,12 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
         if failing.is_empty() || rounds >= opts.repair {
             break;
         }
-        let mut classes: Vec<usize> = failing.iter().flat_map(|&p| bases.classes.member[p].map(|m| m.0)).collect();
+        let mut classes = Vec::new();
+        for &p in &failing {
+            for d in coarse_directions(&sides[p], &bases.patch_knots(p)) {
+                classes.push(bases.classes.member[p][d].0);
+            }
+        }
         classes.sort_unstable();
         classes.dedup();
         bases = bases.refined(Some(&classes));
