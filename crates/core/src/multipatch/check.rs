@@ -269,53 +269,77 @@ fn check_complete(layout: &Layout, polys: &[[Vec<Point>; 4]], diameter: f64) -> 
 }
 
 /// No two patch boundaries cross (away from the corners they share) and no patch lies
-/// inside another.
+/// inside another. Candidate pairs of segments come from a uniform grid over all sides'
+/// segments (about as many cells as segments), so the cost is about linear.
 fn check_crossings(layout: &Layout, polys: &[[Vec<Point>; 4]], diameter: f64) -> Result<()> {
     let radius = CORNER_NEIGHBOURHOOD * diameter;
     let n = layout.patches.len();
     let corners: Vec<[Point; 4]> = layout.patches.iter().map(|p| p.corners()).collect();
-    let boxes: Vec<[(Point, Point); 4]> = polys.iter().map(|ps| ps.each_ref().map(|p| bbox(p))).collect();
-    let overlap = |a: &(Point, Point), b: &(Point, Point)| {
-        a.0[0] <= b.1[0] + radius && b.0[0] <= a.1[0] + radius && a.0[1] <= b.1[1] + radius && b.0[1] <= a.1[1] + radius
+    // every segment: (patch, side, start, end)
+    let segs: Vec<(usize, Side, Point, Point)> = (0..n)
+        .flat_map(|p| Side::ALL.into_iter().map(move |s| (p, s)))
+        .flat_map(|(p, s)| polys[p][s as usize].windows(2).map(move |w| (p, s, w[0], w[1])))
+        .collect();
+    let all: Vec<Point> = segs.iter().flat_map(|s| [s.2, s.3]).collect();
+    let (lo, hi) = bbox(&all);
+    let cells = segs.len().clamp(1, 1 << 22) as f64;
+    let (w, h) = ((hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE));
+    let gx = ((cells * w / h).sqrt().ceil()).clamp(1.0, cells) as usize;
+    let gy = ((cells / gx as f64).ceil()).clamp(1.0, cells) as usize;
+    let (cw, ch) = (w / gx as f64, h / gy as f64);
+    let cell = |x: f64, y: f64| {
+        let i = (((x - lo[0]) / cw).floor().max(0.0) as usize).min(gx - 1);
+        let j = (((y - lo[1]) / ch).floor().max(0.0) as usize).min(gy - 1);
+        (i, j)
     };
-    for p in 0..n {
-        for q in p + 1..n {
-            let near_corner = |x: Point| corners[p].iter().chain(&corners[q]).any(|&c| dist(x, c) <= radius);
-            for s in Side::ALL {
-                for t in Side::ALL {
-                    let (a, b) = (PatchSide { patch: p, side: s }, PatchSide { patch: q, side: t });
-                    if layout.across(a).is_some_and(|(_, o)| o == b) {
-                        continue;
-                    }
-                    if !overlap(&boxes[p][s as usize], &boxes[q][t as usize]) {
-                        continue;
-                    }
-                    let (pa, pb) = (&polys[p][s as usize], &polys[q][t as usize]);
-                    for u in pa.windows(2) {
-                        let bu = bbox(u);
-                        for v in pb.windows(2) {
-                            if !overlap(&bu, &bbox(v)) {
-                                continue;
-                            }
-                            if let Some(x) = segment_hit(u[0], u[1], v[0], v[1]) {
-                                if !near_corner(x) {
-                                    return Err(layout.error(
-                                        p,
-                                        Some(s),
-                                        format!(
-                                            "meets the {t} side of patch {} at ({:.6}, {:.6}), away from their corners: patches meet along whole sides (interfaces) or at corners, their boundaries do not cross",
-                                            layout.label(q),
-                                            x[0],
-                                            x[1]
-                                        ),
-                                    ));
-                                }
-                            }
-                        }
+    let mut entries: Vec<(usize, u32)> = Vec::with_capacity(2 * segs.len());
+    for (k, &(_, _, a, b)) in segs.iter().enumerate() {
+        let (i0, j0) = cell(a[0].min(b[0]) - radius, a[1].min(b[1]) - radius);
+        let (i1, j1) = cell(a[0].max(b[0]) + radius, a[1].max(b[1]) + radius);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                entries.push((j * gx + i, k as u32));
+            }
+        }
+    }
+    entries.sort_unstable();
+    let mut start = 0;
+    while start < entries.len() {
+        let mut end = start;
+        while end < entries.len() && entries[end].0 == entries[start].0 {
+            end += 1;
+        }
+        let group = &entries[start..end];
+        for (x, &(_, k)) in group.iter().enumerate() {
+            for &(_, l) in &group[x + 1..] {
+                let (u, v) = (segs[k as usize], segs[l as usize]);
+                if u.0 == v.0 {
+                    continue;
+                }
+                let (a, b) = (PatchSide { patch: u.0, side: u.1 }, PatchSide { patch: v.0, side: v.1 });
+                if layout.across(a).is_some_and(|(_, o)| o == b) {
+                    continue;
+                }
+                if let Some(x) = segment_hit(u.2, u.3, v.2, v.3) {
+                    let near = corners[u.0].iter().chain(&corners[v.0]).any(|&c| dist(x, c) <= radius);
+                    if !near {
+                        let (p, q) = if u.0 < v.0 { (u, v) } else { (v, u) };
+                        return Err(layout.error(
+                            p.0,
+                            Some(p.1),
+                            format!(
+                                "meets the {} side of patch {} at ({:.6}, {:.6}), away from their corners: patches meet along whole sides (interfaces) or at corners, their boundaries do not cross",
+                                q.1,
+                                layout.label(q.0),
+                                x[0],
+                                x[1]
+                            ),
+                        ));
                     }
                 }
             }
         }
+        start = end;
     }
     // one patch inside another: a corner strictly inside another patch
     let closed: Vec<Vec<Point>> = polys

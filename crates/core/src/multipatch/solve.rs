@@ -260,6 +260,10 @@ fn solve_patch(
     o.repair = 0;
     o.improve = None;
     o.fit.basis = BasisChoice::Input;
+    // the report's det J sample (information only: the verdict is the certificate's) at
+    // 8 points per element of the finer direction, not more than asked for
+    let finest = h.levels.last().map_or(1, |l| l.knots[0].num_elements().max(l.knots[1].num_elements()));
+    o.sample = o.sample.min(8 * finest.max(4));
     let sol = EggSolver::new(&h, o, std::sync::Arc::new(CpuAssembler))?.finish(&boundary, &h)?;
     let mut map = sol.map;
     // the boundary control points are the conforming sides' exactly
