@@ -5,7 +5,8 @@
 # by winslow's certificate. Prints a Markdown table; see scripts/bench_peers.py for how the
 # initial patch and the bases are built. A benchmark, run by hand: CI does not call it.
 #   scripts/bench-peers.sh [WINSLOW_BIN] [OUT_DIR]
-#   (REFINE=0,1 ONLY=duck,puzzle3 narrow the run; VENV= picks the environment)
+#   (REFINE=0,1 ONLY=duck,puzzle3 narrow the run; VENV= picks the environment;
+#    MULTIPATCH=1 races the multipatch files, fixed and free interfaces, instead)
 # Needs python3 with the venv module (Debian/Ubuntu: apt-get install python3-venv) and PyPI.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,4 +19,4 @@ if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV" || { echo "python3 -m venv failed: install the venv module (apt-get install python3-venv)" >&2; exit 1; }
 fi
 "$VENV/bin/python" -c "import pygismo" 2>/dev/null || "$VENV/bin/pip" install -q "pygismo==$PYGISMO_VERSION"
-"$VENV/bin/python" scripts/bench_peers.py "$(realpath "$W")" "$OUT" ${REFINE:+--refine "$REFINE"} ${ONLY:+--only "$ONLY"}
+"$VENV/bin/python" scripts/bench_peers.py "$(realpath "$W")" "$OUT" ${REFINE:+--refine "$REFINE"} ${ONLY:+--only "$ONLY"} ${MULTIPATCH:+--multipatch}

@@ -36,6 +36,7 @@ mod inspect_ring;
 mod loft_cmd;
 mod mesh;
 mod optimise_cmd;
+mod multipatch_cmd;
 mod output;
 mod solve_cmd;
 mod sweep_cmd;
@@ -91,6 +92,12 @@ enum Command {
     /// certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
     /// Jacobian and time per method.
     Compare(Box<compare_cmd::CompareArgs>),
+    /// Split a certified map's domain into two four-sided patches sharing a curve between
+    /// points on opposite sides (paper §11.2, Fig. 25); `winslow solve` takes the result.
+    Split(multipatch_cmd::SplitArgs),
+    /// Join two maps sharing a whole side into one map with a C0 knot, smoothed by the
+    /// weak form (eq. 14) from that bijective start (paper §11.2, Fig. 27-28).
+    Join(multipatch_cmd::JoinArgs),
 }
 
 #[derive(Args, Debug)]
@@ -104,7 +111,8 @@ struct ConvertArgs {
 
 #[derive(Args, Debug)]
 struct CheckArgs {
-    /// Map file (JSON map document or G+Smo XML; a volume: the trivariate certificate).
+    /// Map file (JSON map document or G+Smo XML; a volume: the trivariate certificate; a
+    /// multipatch file: every patch).
     map: PathBuf,
     /// The input boundary: report the largest deviation of the map's boundary from it.
     #[arg(long)]
@@ -466,6 +474,8 @@ struct SolveArgs {
     start: Option<PathBuf>,
     /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
     /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
+    /// A multipatch input (G+Smo <MultiPatch> or a JSON document with "patches") is
+    /// written as a JSON multipatch document or G+Smo XML (.xml).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
@@ -507,6 +517,8 @@ struct SolveArgs {
     mesh: Option<PathBuf>,
     #[command(flatten)]
     mesh_spec: mesh::MeshSpec,
+    #[command(flatten)]
+    multipatch: multipatch_cmd::MultipatchArgs,
 }
 
 #[derive(Args, Debug)]
@@ -604,6 +616,8 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Loft(a) => loft_cmd::run(*a),
         Command::Optimise(a) => optimise_cmd::run(*a),
         Command::Compare(a) => compare_cmd::run(*a),
+        Command::Split(a) => multipatch_cmd::split(a),
+        Command::Join(a) => multipatch_cmd::join(a),
     }
 }
 
@@ -685,6 +699,15 @@ fn check(a: CheckArgs) -> Result<i32> {
         max_depth: a.max_depth.clamp(1, 40),
         max_boxes: a.max_boxes.clamp(1, 1 << 24),
         excuse_corners: !a.strict_corners,
+    };
+    if let Some(layout) =
+        winslow::multipatch::read_layout(&a.map).with_context(|| format!("reading {}", a.map.display()))?
+    {
+        return multipatch_cmd::check(layout, &opts, a.json);
+    }
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
     };
     let certificate = certify(&map, &opts).context("certifying the map")?;
     let quality = quality(&map);

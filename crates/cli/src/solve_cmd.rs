@@ -179,6 +179,11 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
+    if let Some(layout) =
+        winslow::multipatch::read_layout(path).with_context(|| format!("reading {}", path.display()))?
+    {
+        return super::multipatch_cmd::solve(layout, &a);
+    }
     let ring = read_ring(path).with_context(|| format!("reading {}", path.display()))?;
     let sel = a.backend.select(a.quiet || a.json)?;
     let sol = match ring {

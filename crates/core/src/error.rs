@@ -94,6 +94,18 @@ pub enum Error {
     /// not certified.
     #[error("{method} needs a bijective start: {reason}")]
     InfeasibleStart { method: String, reason: String },
+    /// A multipatch layout (paper §11.2) is inconsistent: `patch` names the patch (index
+    /// and name), `side` its side (empty for the patch as a whole).
+    #[error("multipatch layout, patch {patch}{}: {reason}", side_of(.side))]
+    Layout { patch: String, side: String, reason: String },
+}
+
+fn side_of(side: &str) -> String {
+    if side.is_empty() {
+        String::new()
+    } else {
+        format!(", {side} side")
+    }
 }
 
 fn at(context: &str) -> String {

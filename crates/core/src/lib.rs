@@ -18,8 +18,10 @@
 //! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
 //! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
 //! | [`io`] | readers and writers: JSON exchange formats, G+Smo XML, pictures |
+//! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split, multipatch files |
 //!
-//! Dependencies point one way, down this table read from the bottom: `io` uses
+//! Dependencies point one way, down this table read from the bottom: `multipatch` uses
+//! every group above it (it solves patches with `solve`, reads and writes with `io`), `io` uses
 //! `verify`, `solve` uses `methods`, which use `verify`, `discrete`, `spline` and
 //! `linalg`; no module imports a module that imports it back. Two places differ from a
 //! plain "one folder per pipeline step": sparse storage sits in [`linalg`], *below*
@@ -53,6 +55,7 @@
 //! | §10, Tables 1-3 | the comparison of methods on one basis | [`solve::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
+//! | §11.2 | multipatch layouts, one knot vector per interface, fixed and free interfaces, joining and splitting | [`multipatch`] |
 //!
 //! A geometry is a basis plus coefficients ([`Surface`], [`Curve`]); one DOF map
 //! ([`discrete::dofs::DofMap`], built from the patch's [`Topology`]) of free versus fixed
@@ -67,6 +70,7 @@ pub mod error;
 pub mod io;
 pub mod linalg;
 pub mod methods;
+pub mod multipatch;
 pub mod solve;
 pub mod spline;
 #[doc(hidden)]

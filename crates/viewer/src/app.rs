@@ -557,7 +557,21 @@ impl ViewerApp {
         let scene = self.state.scene.as_ref().expect("scene");
         let d = self.state.display;
         if let Some(mv) = &scene.map {
-            let scale = ColourScale::for_values(&mv.sample.values, d.scale);
+            let scale =
+                self.state.colour_scale().unwrap_or_else(|| ColourScale::for_values(&mv.sample.values, d.scale));
+            // the other patches of a multipatch layout, under the first one's overlays
+            for other in &scene.patches {
+                if d.heat {
+                    painter.add(heat_mesh(other, &scale, |k| to(other.positions[k])));
+                }
+                let stroke = Stroke::new(0.8, Color32::from_black_alpha(150));
+                for line in other.iso.xi.iter().chain(&other.iso.eta).filter(|_| d.grid) {
+                    painter.add(Shape::line(line.iter().map(|&p| to(p)).collect(), stroke));
+                }
+                for side in &other.sides {
+                    painter.add(Shape::line(side.iter().map(|&p| to(p)).collect(), Stroke::new(1.6, Color32::BLACK)));
+                }
+            }
             if d.heat {
                 painter.add(heat_mesh(mv, &scale, |k| to(mv.positions[k])));
             }

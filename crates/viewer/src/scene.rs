@@ -7,6 +7,9 @@ use std::path::{Path, PathBuf};
 
 use winslow::boundary::validate::sample_side;
 use winslow::io::{checked_boundary, parse_document, read_text, Document, ReadOptions};
+use winslow::multipatch::gismo::is_gismo_multipatch;
+use winslow::multipatch::json::is_json_multipatch;
+use winslow::multipatch::read_layout;
 use winslow::solve::report::Solution;
 use winslow::verify::quality::DetJSample;
 use winslow::{Boundary, Point, Side, SideCurve, Surface};
@@ -234,12 +237,16 @@ pub struct Scene {
     pub name: String,
     /// File it came from.
     pub path: Option<PathBuf>,
-    /// What the file was ("boundary", "map").
+    /// What the file was ("boundary", "map", "multipatch").
     pub kind: &'static str,
     /// The boundary (of a boundary file, or the sides of a map): what `solve` uses.
     pub boundary: BoundaryView,
     /// The map, if any.
     pub map: Option<MapView>,
+    /// The other patches of a multipatch layout (paper §11.2): `map` is the first patch
+    /// (the one the side panel and the parameter view describe), these are drawn beside
+    /// it in the physical view, on one colour scale.
+    pub patches: Vec<MapView>,
 }
 
 /// Display settings that change what the scene computes.
@@ -262,6 +269,14 @@ impl Scene {
     pub fn open(path: &Path, sampler: &dyn DetJSampler, settings: SceneSettings) -> anyhow::Result<Self> {
         use anyhow::Context;
         let text = read_text(path).with_context(|| format!("reading {}", path.display()))?;
+        if is_gismo_multipatch(&text) || is_json_multipatch(&text) {
+            let layout = read_layout(path).with_context(|| format!("reading {}", path.display()))?;
+            let layout = layout.context("not a multipatch file")?;
+            return Self::from_layout(layout, sampler, settings).map(|mut s| {
+                s.path = Some(path.to_path_buf());
+                s
+            });
+        }
         let mut doc = parse_document(&text).with_context(|| format!("reading {}", path.display()))?;
         if doc.name().is_empty() {
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
@@ -295,9 +310,14 @@ impl Scene {
         certificate: Option<Certificate>,
     ) -> Self {
         match doc {
-            Document::Boundary(b) => {
-                Self { name: b.name.clone(), path: None, kind: "boundary", boundary: BoundaryView::new(b), map: None }
-            }
+            Document::Boundary(b) => Self {
+                name: b.name.clone(),
+                path: None,
+                kind: "boundary",
+                boundary: BoundaryView::new(b),
+                map: None,
+                patches: Vec::new(),
+            },
             Document::Map { name, map } => {
                 let doc = Document::Map { name: name.clone(), map: map.clone() };
                 let res = settings.resolution.unwrap_or_else(|| default_resolution(&map));
@@ -307,9 +327,48 @@ impl Scene {
                     kind: "map",
                     boundary: BoundaryView::new(doc.into_boundary()),
                     map: Some(MapView::new(map, sampler, res, settings.density, certificate)),
+                    patches: Vec::new(),
                 }
             }
         }
+    }
+
+    /// A scene of a multipatch layout whose patches are maps (a G+Smo multipatch file,
+    /// or the output of `winslow solve` on a layout): the first patch is `map`, the
+    /// others are `patches`; each is judged by the exact certificate. A layout of
+    /// boundaries (an input document) has nothing to draw yet: an error says to solve it.
+    pub fn from_layout(
+        layout: winslow::multipatch::Layout,
+        sampler: &dyn DetJSampler,
+        settings: SceneSettings,
+    ) -> anyhow::Result<Self> {
+        let mut views = Vec::with_capacity(layout.patches.len());
+        for p in &layout.patches {
+            let Some(map) = &p.map else {
+                anyhow::bail!(
+                    "patch {} of the multipatch layout {} is a boundary, not a map: solve the layout with `winslow solve` and open its output",
+                    p.name,
+                    layout.name
+                )
+            };
+            let res = settings.resolution.unwrap_or_else(|| default_resolution(map));
+            views.push(MapView::new(map.clone(), sampler, res, settings.density, None));
+        }
+        let first = views.remove(0);
+        let doc = Document::Map { name: layout.patches[0].name.clone(), map: first.map.clone() };
+        Ok(Self {
+            name: format!("{} ({} patches)", layout.name, layout.patches.len()),
+            path: None,
+            kind: "multipatch",
+            boundary: BoundaryView::new(doc.into_boundary()),
+            map: Some(first),
+            patches: views,
+        })
+    }
+
+    /// Every map of the scene: the map, then the other patches.
+    pub fn maps(&self) -> impl Iterator<Item = &MapView> {
+        self.map.iter().chain(&self.patches)
     }
 
     /// Put a solver's map into the scene (keeps the input boundary).
@@ -332,6 +391,10 @@ impl Scene {
 
     /// Recompute what depends on the settings (after a change of resolution or density).
     pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
+        for mv in &mut self.patches {
+            let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
+            *mv = MapView::new(mv.map.clone(), sampler, res, settings.density, None);
+        }
         if let Some(mv) = self.map.take() {
             let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
             let (report, matches, kinks) = (mv.report, mv.matches, mv.kinks);
@@ -349,6 +412,13 @@ impl Scene {
     /// Bounds of what is drawn in the physical view.
     pub fn bounds(&self) -> Bounds {
         let b = self.boundary.bounds();
+        let b = self.patches.iter().fold(b, |acc, m| match acc {
+            Some(a) => Some([
+                [a[0][0].min(m.bounds[0][0]), a[0][1].min(m.bounds[0][1])],
+                [a[1][0].max(m.bounds[1][0]), a[1][1].max(m.bounds[1][1])],
+            ]),
+            None => Some(m.bounds),
+        });
         match (&self.map, b) {
             (Some(m), Some(b)) => [
                 [m.bounds[0][0].min(b[0][0]), m.bounds[0][1].min(b[0][1])],

@@ -240,7 +240,8 @@ impl ViewerState {
 
     /// Whether a solve can start: a valid boundary and no solve running.
     pub fn can_solve(&self) -> bool {
-        self.scene.as_ref().is_some_and(|s| s.boundary.problem.is_none()) && !self.solving()
+        // a multipatch layout is solved by `winslow solve`, not patch by patch here
+        self.scene.as_ref().is_some_and(|s| s.boundary.problem.is_none() && s.patches.is_empty()) && !self.solving()
     }
 
     /// Whether a solve is running.
@@ -355,8 +356,14 @@ impl ViewerState {
 
     /// The colour scale of the current heat map.
     pub fn colour_scale(&self) -> Option<ColourScale> {
-        let mv = self.scene.as_ref()?.map.as_ref()?;
-        Some(ColourScale::for_values(&mv.sample.values, self.display.scale))
+        let scene = self.scene.as_ref()?;
+        let mv = scene.map.as_ref()?;
+        if scene.patches.is_empty() {
+            return Some(ColourScale::for_values(&mv.sample.values, self.display.scale));
+        }
+        // one scale over all patches of a layout
+        let all: Vec<f64> = scene.maps().flat_map(|m| m.sample.values.iter().copied()).collect();
+        Some(ColourScale::for_values(&all, self.display.scale))
     }
 
     /// Build the mesh overlay on the current map (the error goes to the overlay's panel
@@ -532,6 +539,37 @@ mod tests {
         assert_eq!(mv.quality.det_j_min, mv.sample.min);
         // the map's own boundary can be solved again
         assert_eq!(scene.boundary.problem.is_none(), s.can_solve());
+    }
+
+    #[test]
+    fn opens_a_multipatch_file_with_all_patches() {
+        let mut s = state();
+        s.open(&data("gismo/xml/multipatch/TUDflame.xml")).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "multipatch");
+        assert_eq!(scene.maps().count(), 5);
+        // the view spans every patch, the colour scale every patch's samples
+        let b = scene.bounds();
+        for mv in scene.maps() {
+            assert!(mv.bounds[0][0] >= b[0][0] && mv.bounds[1][1] <= b[1][1]);
+        }
+        let hi = scene.maps().map(|m| m.quality.det_j_max).fold(0.0, f64::max);
+        assert_eq!(s.colour_scale().unwrap().hi, hi);
+        for mv in scene.maps() {
+            assert!(mv.quality.det_j_max > 0.0 && mv.sample.values.len() == (mv.resolution() + 1).pow(2));
+        }
+        // a layout of boundaries has nothing to draw: a clear error, the scene stays
+        let dir = std::env::temp_dir().join(format!("winslow-viewer-mp-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let text = std::fs::read_to_string(data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap();
+        let layout = winslow::multipatch::gismo::parse_gismo_multipatch(&text).unwrap();
+        let doc = winslow::multipatch::json::layout_to_json(&layout);
+        winslow::io::write_json(&dir.join("input.json"), &doc).unwrap();
+        assert!(!s.can_solve(), "a layout is not solved patch by patch");
+        let e = s.open(&dir.join("input.json")).unwrap_err();
+        assert!(e.contains("winslow solve"), "{e}");
+        assert_eq!(s.scene.as_ref().unwrap().kind, "multipatch");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

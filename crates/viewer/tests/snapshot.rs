@@ -227,3 +227,16 @@ fn the_mesh_section_builds_the_overlay() {
     let map = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().map.clone();
     assert!(h.state().state.mesh.drawn(&map).is_some());
 }
+
+#[test]
+fn multipatch_view_snapshot() {
+    // G+Smo's TUDflame: five patches drawn in the physical view on one det J scale
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("gismo/xml/multipatch/TUDflame.xml")).unwrap();
+    let scene = app.state.scene.as_ref().unwrap();
+    assert_eq!(scene.kind, "multipatch");
+    assert_eq!(scene.patches.len(), 4);
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("multipatch_view");
+}

@@ -501,7 +501,7 @@ fn shoelace(pts: &[Point]) -> f64 {
 }
 
 /// Where segments `ab` and `cd` meet (touching counts), if they do.
-fn segment_hit(a: Point, b: Point, c: Point, d: Point) -> Option<Point> {
+pub(crate) fn segment_hit(a: Point, b: Point, c: Point, d: Point) -> Option<Point> {
     let d1 = cross(sub(b, a), sub(c, a));
     let d2 = cross(sub(b, a), sub(d, a));
     let d3 = cross(sub(d, c), sub(a, c));

@@ -12,8 +12,10 @@
 //! whose knot vector across is periodic ([`Topology::ring`]: the O-grid of §11.1, `eta`
 //! periodic, `xi = 0` inner and `xi = 1` outer contour), numbered with shared DOFs by
 //! [`DofMap::for_basis`](super::dofs::DofMap::for_basis). Interfaces are checked for
-//! consistency here and refused with a typed error by the DOF map until the multipatch
-//! numbering exists.
+//! consistency here and refused with a typed error by this single-patch DOF map; the
+//! multipatch layouts of `crate::multipatch` give every patch side its condition and
+//! number the shared control points of interfaces once over all patches
+//! (`crate::multipatch::dofs::GlobalDofs`).
 
 use serde::Serialize;
 

@@ -26,15 +26,15 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
 
 /// Largest number of XML nodes parsed (a guard against absurd inputs).
-pub(super) const MAX_NODES: u32 = 1 << 24;
+pub(crate) const MAX_NODES: u32 = 1 << 24;
 /// Deepest element nesting accepted (G+Smo files nest about six levels; the XML parser
 /// recurses per level, so absurd nesting must be refused before parsing).
-pub(super) const MAX_DEPTH: usize = 256;
+pub(crate) const MAX_DEPTH: usize = 256;
 /// Relative corner tolerance used to *choose* the side assignment of four curves; the
 /// stricter check of `formats.md` is done by validation afterwards.
 pub const ASSIGN_TOL: f64 = 1e-6;
 
-pub(super) fn xml_err(context: &str, message: impl Into<String>) -> Error {
+pub(crate) fn xml_err(context: &str, message: impl Into<String>) -> Error {
     Error::Xml { context: context.to_string(), message: message.into() }
 }
 
@@ -43,7 +43,7 @@ fn is(node: &Node, name: &str) -> bool {
 }
 
 /// Element children with the given tag name.
-pub(super) fn children<'a, 'i>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
+pub(crate) fn children<'a, 'i>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
     node.children().filter(move |c| is(c, name))
 }
 
@@ -171,7 +171,7 @@ fn tensor_basis(node: Node, ctx: &str) -> Result<[KnotVector; 2]> {
 }
 
 /// A `TensorBSpline2` or `TensorNurbs2` geometry, knot domains mapped to `[0, 1]`.
-fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
+pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
     let basis = only_child(geom, "Basis", ctx)?;
     let bctx = format!("{ctx}.Basis");
     let (kv, w) = if rational {
@@ -342,7 +342,7 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
 /// Whether elements nest deeper than `limit` (a conservative scan: comments, CDATA,
 /// processing instructions, declarations and quoted attribute values are skipped;
 /// self-closing tags do not count).
-pub(super) fn nesting_exceeds(text: &str, limit: usize) -> bool {
+pub(crate) fn nesting_exceeds(text: &str, limit: usize) -> bool {
     let b = text.as_bytes();
     let find =
         |from: usize, pat: &[u8]| b[from.min(b.len())..].windows(pat.len()).position(|w| w == pat).map(|k| from + k);

@@ -131,6 +131,12 @@ impl Canvas {
 /// largest sampled `det J` (at most four decades).
 pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
     let n = render_resolution(opts);
+    let (pts, det) = sample(map, n);
+    render_sampled(n, &pts, &det, opts)
+}
+
+/// Points and `det J` of `map` on the `(n+1)^2` grid of [`render`].
+fn sample(map: &Surface, n: usize) -> (Vec<Point>, Vec<f64>) {
     let mut pts = Vec::with_capacity((n + 1) * (n + 1));
     let mut det = Vec::with_capacity((n + 1) * (n + 1));
     let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
@@ -143,7 +149,17 @@ pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
             det.push(d.det_j());
         }
     }
-    render_sampled(n, &pts, &det, opts)
+    (pts, det)
+}
+
+/// Render the patches `maps` of a multipatch layout into one picture: each patch as
+/// [`render`] draws a map, one logarithmic `det J` colour scale over all of them, and
+/// every patch's boundary (so the interfaces) drawn in black.
+pub fn render_layout(maps: &[Surface], opts: &PictureOptions) -> Image {
+    let n = render_resolution(opts);
+    let samples: Vec<(Vec<Point>, Vec<f64>)> = maps.iter().map(|m| sample(m, n)).collect();
+    let refs: Vec<(&[Point], &[f64])> = samples.iter().map(|(p, d)| (p.as_slice(), d.as_slice())).collect();
+    render_patches_sampled(n, &refs, opts)
 }
 
 /// Grid cells per direction that [`render`] samples for `opts`.
@@ -155,10 +171,17 @@ pub fn render_resolution(opts: &PictureOptions) -> usize {
 /// [`render_resolution`]): points `pts` and `det J` values `det`, row-major with `eta`
 /// outer. Lets another back end (the GPU) do the sampling.
 pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOptions) -> Image {
-    assert_eq!(pts.len(), (n + 1) * (n + 1), "render_sampled: {} points for n = {n}", pts.len());
-    assert_eq!(det.len(), pts.len(), "render_sampled: det and points differ in length");
+    render_patches_sampled(n, &[(pts, det)], opts)
+}
+
+/// [`render_sampled`] of several patches in one picture (one colour scale).
+pub fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], opts: &PictureOptions) -> Image {
+    for (pts, det) in patches {
+        assert_eq!(pts.len(), (n + 1) * (n + 1), "render_sampled: {} points for n = {n}", pts.len());
+        assert_eq!(det.len(), pts.len(), "render_sampled: det and points differ in length");
+    }
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for p in pts {
+    for p in patches.iter().flat_map(|(pts, _)| pts.iter()) {
         xmin = xmin.min(p[0]);
         xmax = xmax.max(p[0]);
         ymin = ymin.min(p[1]);
@@ -174,50 +197,55 @@ pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOption
     let padv = (h as f64 - ht * s) / 2.0;
     let mut cv = Canvas { w, h, rgba: vec![255; 4 * w * h], x0: xmin - pad / s, y0: ymin - padv / s, s };
     // logarithmic colour scale over the positive values (at most 4 decades)
-    let dmax = det.iter().cloned().fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
-    let dmin = det.iter().cloned().filter(|&v| v > 0.0).fold(dmax, f64::min).max(dmax * 1e-4);
+    let all = || patches.iter().flat_map(|(_, det)| det.iter().copied());
+    let dmax = all().fold(0.0f64, f64::max).max(f64::MIN_POSITIVE);
+    let dmin = all().filter(|&v| v > 0.0).fold(dmax, f64::min).max(dmax * 1e-4);
     let span = (dmax / dmin).ln().max(1e-12);
     let shade = move |v: f64| if v <= 0.0 { FOLD_COLOUR } else { colormap((v / dmin).ln() / span) };
     let idx = |i: usize, j: usize| j * (n + 1) + i;
     // positive cells first, then cells with a non-positive corner on top
     for pass in 0..2 {
-        for j in 0..n {
-            for i in 0..n {
-                let ks = [idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)];
-                let folded = ks.iter().any(|&k| det[k] <= 0.0);
-                if folded != (pass == 1) {
-                    continue;
+        for (pts, det) in patches {
+            for j in 0..n {
+                for i in 0..n {
+                    let ks = [idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)];
+                    let folded = ks.iter().any(|&k| det[k] <= 0.0);
+                    if folded != (pass == 1) {
+                        continue;
+                    }
+                    let p: Vec<(f64, f64)> = ks.iter().map(|&k| cv.to_px(pts[k])).collect();
+                    let v: Vec<f64> = ks.iter().map(|&k| det[k]).collect();
+                    cv.triangle([p[0], p[1], p[2]], [v[0], v[1], v[2]], &shade);
+                    cv.triangle([p[0], p[2], p[3]], [v[0], v[2], v[3]], &shade);
                 }
-                let p: Vec<(f64, f64)> = ks.iter().map(|&k| cv.to_px(pts[k])).collect();
-                let v: Vec<f64> = ks.iter().map(|&k| det[k]).collect();
-                cv.triangle([p[0], p[1], p[2]], [v[0], v[1], v[2]], &shade);
-                cv.triangle([p[0], p[2], p[3]], [v[0], v[2], v[3]], &shade);
             }
         }
     }
-    // iso-lines
-    let gl = opts.grid_lines;
-    if gl > 0 {
-        for l in 1..gl {
-            let t = l as f64 / gl as f64;
-            let k = ((t * n as f64).round() as usize).min(n);
-            for m in 0..n {
-                let (a, b) = (cv.to_px(pts[idx(k, m)]), cv.to_px(pts[idx(k, m + 1)]));
-                cv.line(a, b, [30, 30, 30], 0.7);
-                let (a, b) = (cv.to_px(pts[idx(m, k)]), cv.to_px(pts[idx(m + 1, k)]));
-                cv.line(a, b, [30, 30, 30], 0.7);
+    for (pts, _) in patches {
+        // iso-lines
+        let gl = opts.grid_lines;
+        if gl > 0 {
+            for l in 1..gl {
+                let t = l as f64 / gl as f64;
+                let k = ((t * n as f64).round() as usize).min(n);
+                for m in 0..n {
+                    let (a, b) = (cv.to_px(pts[idx(k, m)]), cv.to_px(pts[idx(k, m + 1)]));
+                    cv.line(a, b, [30, 30, 30], 0.7);
+                    let (a, b) = (cv.to_px(pts[idx(m, k)]), cv.to_px(pts[idx(m + 1, k)]));
+                    cv.line(a, b, [30, 30, 30], 0.7);
+                }
             }
         }
-    }
-    for m in 0..n {
-        for (a, b) in [
-            (idx(m, 0), idx(m + 1, 0)),
-            (idx(m, n), idx(m + 1, n)),
-            (idx(0, m), idx(0, m + 1)),
-            (idx(n, m), idx(n, m + 1)),
-        ] {
-            let (pa, pb) = (cv.to_px(pts[a]), cv.to_px(pts[b]));
-            cv.line(pa, pb, [0, 0, 0], 1.0);
+        for m in 0..n {
+            for (a, b) in [
+                (idx(m, 0), idx(m + 1, 0)),
+                (idx(m, n), idx(m + 1, n)),
+                (idx(0, m), idx(0, m + 1)),
+                (idx(n, m), idx(n, m + 1)),
+            ] {
+                let (pa, pb) = (cv.to_px(pts[a]), cv.to_px(pts[b]));
+                cv.line(pa, pb, [0, 0, 0], 1.0);
+            }
         }
     }
     for &(a, b) in &opts.segments {

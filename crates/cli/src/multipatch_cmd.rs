@@ -1,0 +1,407 @@
+//! Multipatch layouts (paper §11.2) from the command line: `winslow solve` on a G+Smo
+//! `<MultiPatch>` file or a JSON multipatch document (`--interfaces fixed|free`), and
+//! the `split` and `join` commands.
+
+use super::*;
+use winslow::io::picture::render_layout;
+use winslow::multipatch::output::{solution_to_gismo_xml, solution_to_json, write_patch_maps, write_vtm};
+use winslow::multipatch::{solve_multipatch, Functional, Interfaces, Layout, MultipatchOptions, MultipatchSolution};
+
+/// The options of `winslow solve` that only a multipatch layout reads.
+#[derive(Args, Debug, Clone)]
+pub(super) struct MultipatchArgs {
+    /// Multipatch input: keep the interfaces where they are (each patch solved with its
+    /// four sides as Dirichlet data, conforming bases), or, after that, free the interior
+    /// control points of the interfaces and solve one problem over all patches.
+    #[arg(long, value_enum, default_value = "fixed")]
+    interfaces: InterfacesArg,
+    /// The problem over all patches with `--interfaces free`: the Winslow functional
+    /// (eq. 16) or the weak form (eq. 14).
+    #[arg(long, value_enum, default_value = "winslow")]
+    functional: FunctionalArg,
+    /// Multipatch input: also write one JSON map document per patch into this directory.
+    #[arg(long, value_name = "DIR")]
+    patch_maps: Option<PathBuf>,
+    /// Multipatch input: also write a VTK multiblock file (.vtm) with one exact Bézier
+    /// .vtu per patch (in a directory named after the file).
+    #[arg(long, value_name = "FILE.vtm")]
+    vtm: Option<PathBuf>,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum InterfacesArg {
+    Fixed,
+    Free,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum FunctionalArg {
+    Winslow,
+    Weak,
+}
+
+/// The options of a layout solve from the arguments of `winslow solve`.
+fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
+    let solve = a.solver.options()?;
+    if solve.improve.is_some() {
+        bail!(
+            "--improve and --method weak|winslow improve one patch; for a multipatch layout use --interfaces free (with --functional winslow|weak)"
+        );
+    }
+    Ok(MultipatchOptions {
+        interfaces: match a.multipatch.interfaces {
+            InterfacesArg::Fixed => Interfaces::Fixed,
+            InterfacesArg::Free => Interfaces::Free,
+        },
+        functional: match a.multipatch.functional {
+            FunctionalArg::Winslow => Functional::Winslow,
+            FunctionalArg::Weak => Functional::WeakForm,
+        },
+        refine: solve.refine,
+        // a layout refinement refines whole chains of patches: at most three rounds
+        repair: solve.repair.min(3),
+        solve,
+    })
+}
+
+/// `winslow solve LAYOUT`: solve, write, summarize; the exit code of the worst verdict.
+pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
+    let opts = options(a)?;
+    if !(a.quiet || a.json) {
+        eprintln!(
+            "{}: multipatch layout, {} patches, {} interfaces; interfaces {}",
+            layout.name,
+            layout.patches.len(),
+            layout.interfaces.len(),
+            opts.interfaces.name()
+        );
+    }
+    let sol = solve_multipatch(&layout, &opts).with_context(|| format!("solving the layout {}", layout.name))?;
+    write(&sol, a)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&sol.report)?);
+    } else {
+        print!("{}", summary(&sol));
+    }
+    Ok(exit_code(sol.report.verdict))
+}
+
+/// Write the solution where `a` asks: `-o` (.xml: G+Smo, else the JSON document),
+/// `--gismo`, `--png` (the whole layout), `--vtm`, `--patch-maps`.
+fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
+    let xml = |p: &Path| -> Result<()> {
+        output::ensure_parent(p)?;
+        std::fs::write(p, solution_to_gismo_xml(sol)?).with_context(|| format!("writing {}", p.display()))
+    };
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "xml" => xml(&a.output)?,
+        "json" | "" => {
+            output::ensure_parent(&a.output)?;
+            winslow::io::write_json(&a.output, &solution_to_json(sol)?)?;
+        }
+        other => bail!("a multipatch layout is written as .json or .xml (G+Smo), not .{other}; see --vtm and --png"),
+    }
+    if let Some(p) = &a.gismo {
+        xml(p)?;
+    }
+    if let Some(p) = &a.png {
+        output::write_png(p, &render_layout(&sol.maps(), &PictureOptions::default()))?;
+    }
+    if let Some(p) = &a.multipatch.vtm {
+        output::ensure_parent(p)?;
+        write_vtm(sol, p)?;
+    }
+    if let Some(d) = &a.multipatch.patch_maps {
+        write_patch_maps(sol, d)?;
+    }
+    for (flag, given) in [
+        ("--iges", a.iges.is_some()),
+        ("--vtu", a.vtu.is_some()),
+        ("--vtk", a.vtk.is_some()),
+        ("--mesh", a.mesh.is_some()),
+    ] {
+        if given {
+            eprintln!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps or --gismo");
+        }
+    }
+    Ok(())
+}
+
+/// The text summary of a layout solve.
+pub(super) fn summary(sol: &MultipatchSolution) -> String {
+    let r = &sol.report;
+    let mut s = format!("{}: {}\n  {}\n", r.name, output::verdict_word(r.verdict), r.message);
+    for (p, v) in sol.patches.iter().zip(&r.verdicts) {
+        let [nx, ny] = p.map.shape();
+        let last = p.solve.levels.last();
+        s.push_str(&format!(
+            "  patch {:<10} {:>3}x{:<3} functions, {} Newton iterations: {} ({})\n",
+            p.name,
+            nx,
+            ny,
+            last.map_or(0, |l| l.newton_iterations),
+            v.name(),
+            p.certificate.message()
+        ));
+    }
+    for c in &r.classes {
+        s.push_str(&format!("  knot class p={} {} elements: {}\n", c.degree, c.elements, c.members.join(" ")));
+    }
+    let w = r.winslow.map_or("undefined".into(), |w| format!("{w:.6}"));
+    s.push_str(&format!("  total Winslow value {w}; {:.3} s (fixed interfaces {:.3} s)\n", r.seconds, r.fixed_seconds));
+    s
+}
+
+/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
+fn exit_code(v: Verdict) -> i32 {
+    match v {
+        Verdict::Certified | Verdict::DegenerateCorner => 0,
+        Verdict::Folded => 3,
+        Verdict::NotConverged => 4,
+        Verdict::Undecided => 5,
+    }
+}
+
+/// `winslow split`: cut a certified map's domain in two (paper §11.2, Fig. 25).
+#[derive(Args, Debug)]
+pub(super) struct SplitArgs {
+    /// The map (JSON map document or G+Smo XML patch); it must be certified bijective.
+    map: PathBuf,
+    /// First end of the splitting curve: `SIDE:T` (south, east, north or west, and the
+    /// parameter along it in (0, 1)) or a point `X,Y` (the nearest boundary point).
+    #[arg(long, allow_hyphen_values = true)]
+    from: String,
+    /// Second end, on the opposite side, in the same form.
+    #[arg(long, allow_hyphen_values = true)]
+    to: String,
+    /// The curve in the parameter square: the straight segment, or the shortest path in
+    /// the metric of the map (through narrow gaps).
+    #[arg(long, value_enum, default_value = "straight")]
+    path: PathArg,
+    /// Degree of the splitting curve.
+    #[arg(long, default_value_t = 3)]
+    degree: usize,
+    /// Fit tolerance of the splitting curve, relative to the diameter.
+    #[arg(long, default_value_t = 1e-5)]
+    tol: f64,
+    /// Output: the multipatch document of the two parts (`winslow solve` takes it); the
+    /// two boundary documents go next to it as STEM-a.json and STEM-b.json.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also draw the map with the splitting curve.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy)]
+enum PathArg {
+    Straight,
+    Shortest,
+}
+
+/// `winslow join`: two maps sharing a whole side as one map (paper §11.2, Fig. 27-28).
+#[derive(Args, Debug)]
+pub(super) struct JoinArgs {
+    /// The first map.
+    a: PathBuf,
+    /// The second map.
+    b: PathBuf,
+    /// Smoothing of the joined map from its bijective start: the weak form (eq. 14, as in
+    /// the paper) or the Winslow functional (eq. 16).
+    #[arg(long, value_enum, default_value = "weak")]
+    functional: FunctionalArg,
+    /// Output map (.json with a report, or .xml, .igs, .vtu, .vtk by extension).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also draw the joined map.
+    #[arg(long)]
+    png: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+fn read_map(path: &Path) -> Result<(String, Surface)> {
+    match read_document(path).with_context(|| format!("reading {}", path.display()))? {
+        Document::Map { name, map } => Ok((name, map)),
+        Document::Boundary(_) => bail!("{} is a boundary, not a map: run `winslow solve` first", path.display()),
+    }
+}
+
+/// `SIDE:T` or `X,Y` as a side point of `map`.
+fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::SidePoint> {
+    use winslow::multipatch::split::{nearest_boundary_point, SidePoint};
+    if let Some((side, t)) = s.split_once(':') {
+        let side = Side::ALL
+            .into_iter()
+            .find(|x| x.name() == side.trim())
+            .with_context(|| format!("{side:?} is not south, east, north or west"))?;
+        let t: f64 = t.trim().parse().with_context(|| format!("{t:?} is not a number"))?;
+        return Ok(SidePoint { side, t });
+    }
+    let xy: Vec<f64> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .with_context(|| format!("{s:?} is neither SIDE:T nor X,Y"))?;
+    let [x, y] = xy[..] else { bail!("{s:?} is neither SIDE:T nor X,Y") };
+    let (p, d) = nearest_boundary_point(map, [x, y]);
+    eprintln!("({x}, {y}) -> {} side at t = {:.6} ({d:.3e} away)", p.side, p.t);
+    Ok(p)
+}
+
+pub(super) fn split(a: SplitArgs) -> Result<i32> {
+    use winslow::multipatch::json::layout_to_json;
+    use winslow::multipatch::split::{split_map, SplitOptions, SplitPath};
+    let (name, map) = read_map(&a.map)?;
+    let cert = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
+    let (from, to) = (side_point(&map, &a.from)?, side_point(&map, &a.to)?);
+    let path = match a.path {
+        PathArg::Straight => SplitPath::Straight,
+        PathArg::Shortest => SplitPath::Shortest,
+    };
+    let opts = SplitOptions { path, degree: a.degree, tol: a.tol, ..Default::default() };
+    let s = split_map(&name, &map, &cert, from, to, &opts).context("splitting the map")?;
+    output::ensure_parent(&a.output)?;
+    winslow::io::write_json(&a.output, &layout_to_json(&s.layout))?;
+    let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
+    let mut written = vec![a.output.clone()];
+    for (k, p) in s.layout.patches.iter().enumerate() {
+        let path = a.output.with_file_name(format!("{stem}-{}.json", ["a", "b"][k]));
+        let b = Boundary { name: p.name.clone(), sides: p.sides.clone().map(winslow::SideCurve::Spline) };
+        winslow::io::write_json(&path, &winslow::io::boundary_to_json(&b))?;
+        written.push(path);
+    }
+    if let Some(p) = &a.png {
+        let pts = s.curve.sample(256);
+        let segments = pts.windows(2).map(|w| (w[0], w[1])).collect();
+        output::write_png(p, &winslow::io::picture::render(&map, &PictureOptions { segments, ..Default::default() }))?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&s.report)?);
+    } else {
+        let r = &s.report;
+        println!(
+            "{name}: split from the {} side at {:.6} to the {} side at {:.6} ({:?} parameter path)",
+            r.from.side, r.from.t, r.to.side, r.to.t, r.path
+        );
+        println!(
+            "  splitting curve: p={}, {} elements, length {:.6}, fit error {:.3e}; areas {:.6} and {:.6}",
+            s.curve.degree(),
+            r.elements,
+            r.length,
+            r.fit_error,
+            r.areas[0],
+            r.areas[1]
+        );
+        let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+        println!("  wrote {}", names.join(", "));
+    }
+    Ok(0)
+}
+
+pub(super) fn join(a: JoinArgs) -> Result<i32> {
+    use winslow::multipatch::join::join_and_smooth;
+    let (na, ma) = read_map(&a.a)?;
+    let (nb, mb) = read_map(&a.b)?;
+    let functional = match a.functional {
+        FunctionalArg::Winslow => Functional::Winslow,
+        FunctionalArg::Weak => Functional::WeakForm,
+    };
+    let opts = CertifyOptions::default();
+    let j = join_and_smooth(&ma, &mb, functional, Default::default(), &opts).context("joining the maps")?;
+    let name = format!("{na}+{nb}");
+    let verdict = winslow::multipatch::solve::verdict_of(&j.certificate);
+    let report = serde_json::json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "verdict": verdict,
+        "message": j.certificate.message(),
+        "certificate": j.certificate,
+        "join": j.join,
+        "smoothing": j.smoothing,
+    });
+    let label = format!("verdict {verdict:?}: {}", j.certificate.message());
+    let json = || map_to_json(&name, &j.map, Some(serde_json::json!({ "report": report })));
+    output::write_map(&a.output, &name, &j.map, &label, json)?;
+    if let Some(p) = &a.png {
+        output::write_png(p, &winslow::io::picture::render(&j.map, &PictureOptions::default()))?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("{name}: {}", output::verdict_word(verdict));
+        println!(
+            "  joined along the {} side of {} and the {} side of {}: {}x{} functions, C0 knot at {:.4}, boundary turns by {:.1} and {:.1} degrees where they meet",
+            j.join.sides[0], a.a.display(), j.join.sides[1], a.b.display(), j.join.shape[0], j.join.shape[1], j.join.c0_knot,
+            j.join.turn_degrees[0], j.join.turn_degrees[1]
+        );
+        println!("  {}", j.smoothing.message);
+        println!("  wrote {}", a.output.display());
+    }
+    Ok(exit_code(verdict))
+}
+
+/// `winslow check LAYOUT`: certify every patch map of a multipatch file (a G+Smo
+/// `<MultiPatch>` or a solved JSON layout) and measure how far the two sides of every
+/// interface are apart; the exit code of the worst patch.
+pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result<i32> {
+    use winslow::multipatch::solve::{interface_mismatch, verdict_of};
+    let mut maps = Vec::with_capacity(layout.patches.len());
+    for p in &layout.patches {
+        let Some(m) = &p.map else {
+            bail!(
+                "patch {} of {} is a boundary, not a map: there is nothing to certify (solve the layout first)",
+                p.name,
+                layout.name
+            )
+        };
+        maps.push(m.clone());
+    }
+    let validation = winslow::multipatch::validate_layout(&layout);
+    let mut rows = Vec::with_capacity(maps.len());
+    let mut worst = Verdict::Certified;
+    for (p, m) in layout.patches.iter().zip(&maps) {
+        let c = certify(m, opts).with_context(|| format!("certifying patch {}", p.name))?;
+        let v = verdict_of(&c);
+        if exit_code(v) > exit_code(worst) {
+            worst = v;
+        }
+        let w = quality(m).functionals.winslow;
+        rows.push(serde_json::json!({
+            "name": p.name, "verdict": v, "message": c.message(), "certificate": c,
+            "winslow": w.is_finite().then_some(w), "shape": m.shape(),
+        }));
+    }
+    let mismatch = interface_mismatch(&layout, &maps);
+    let report = serde_json::json!({
+        "name": layout.name,
+        "verdict": worst,
+        "patches": rows,
+        "interfaces": layout.interfaces.len(),
+        "interface_mismatch": mismatch,
+        "layout": match &validation { Ok(r) => serde_json::to_value(r)?, Err(e) => serde_json::json!({ "error": e.to_string() }) },
+    });
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{}: {} ({} patches, {} interfaces)",
+            layout.name,
+            output::verdict_word(worst),
+            maps.len(),
+            layout.interfaces.len()
+        );
+        for r in &rows {
+            println!("  patch {:<10} {}", r["name"].as_str().unwrap_or(""), r["message"].as_str().unwrap_or(""));
+        }
+        println!("  interface control points differ by up to {mismatch:.3e}");
+        if let Err(e) = &validation {
+            println!("  layout: {e}");
+        }
+    }
+    Ok(exit_code(worst))
+}
