@@ -292,6 +292,75 @@ fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Cur
     fit_periodic(kv, &Samples { s: pairs.iter().map(|p| p.0).collect(), x: pairs.iter().map(|p| p.1).collect() })
 }
 
+/// The parameter `u` of the crossing of the closed curve `c` with the ray `origin + t dir`
+/// (`t > 0`) nearest to `near` (periodically): `g(u) = cross(dir, c(u) - origin) = 0`,
+/// by Newton's method from `near` when it lands on the ray within one mean element of
+/// `near`, else bracketed on `8` samples per element and refined by bisection to
+/// rounding. `None` when the ray misses the curve. Used to keep a seam on a ray while the
+/// curve turns (a sliding grid).
+pub fn ray_parameter(c: &Curve, origin: Point, dir: Point, near: f64) -> Option<f64> {
+    let (a, b) = c.domain();
+    let l = b - a;
+    let wrap = |u: f64| a + (u - a).rem_euclid(l);
+    let mut u = near;
+    for _ in 0..12 {
+        let d = c.derivs(wrap(u), 1);
+        let w = [d.x[0] - origin[0], d.x[1] - origin[1]];
+        let (g, dg) = (dir[0] * w[1] - dir[1] * w[0], dir[0] * d.d1[1] - dir[1] * d.d1[0]);
+        let du = g / dg;
+        if !du.is_finite() {
+            break;
+        }
+        u -= du;
+        if du.abs() <= 1e-15 * l {
+            let p = c.eval(wrap(u));
+            let along = dir[0] * (p[0] - origin[0]) + dir[1] * (p[1] - origin[1]);
+            if along > 0.0 && (u - near).abs() <= l / c.knots.num_elements().max(1) as f64 {
+                return Some(wrap(u));
+            }
+            break;
+        }
+    }
+    let g = |u: f64| {
+        let p = c.eval(u);
+        let w = [p[0] - origin[0], p[1] - origin[1]];
+        (dir[0] * w[1] - dir[1] * w[0], dir[0] * w[0] + dir[1] * w[1])
+    };
+    let m = 8 * c.knots.num_elements().max(8);
+    let us: Vec<f64> = (0..=m).map(|k| a + l * k as f64 / m as f64).collect();
+    let gs: Vec<(f64, f64)> = us.iter().map(|&u| g(u)).collect();
+    let near = a + (near - a).rem_euclid(l);
+    let gap = |u: f64| {
+        let d = (u - near).rem_euclid(l);
+        d.min(l - d)
+    };
+    let mut best: Option<f64> = None;
+    for k in 0..m {
+        let ((g0, d0), (g1, d1)) = (gs[k], gs[k + 1]);
+        if !(g0 <= 0.0 && g1 > 0.0 || g0 >= 0.0 && g1 < 0.0) || d0 + d1 <= 0.0 {
+            continue;
+        }
+        let (mut lo, mut hi) = (us[k], us[k + 1]);
+        let s0 = g0.signum();
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if g(mid).0.signum() == s0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let u = if g0 == 0.0 { us[k] } else { 0.5 * (lo + hi) };
+        if g(u).1 > 0.0 && best.is_none_or(|v| gap(u) < gap(v)) {
+            best = Some(u);
+        }
+    }
+    best
+}
+
 impl ClosedContour {
     /// The contour turned rigidly by `angle` (radians, counter-clockwise) about `center`.
     pub fn rotated(&self, center: Point, angle: f64) -> ClosedContour {
@@ -311,6 +380,26 @@ impl ClosedContour {
                 ClosedContour::Analytic(Analytic::new(move |t| rot(f.eval(t))))
             }
         }
+    }
+
+    /// The largest distance between this contour and `other` at their dense polygons'
+    /// vertices (point clouds: their points), relative to the diameter of `other`'s
+    /// bounding box; `None` when the two are sampled differently (different kinds or
+    /// numbers of points).
+    pub fn deviation_from(&self, other: &ClosedContour) -> Option<f64> {
+        let (a, b) = (self.polygon(), other.polygon());
+        if a.len() != b.len() || std::mem::discriminant(self) != std::mem::discriminant(other) {
+            return None;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &b {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+        Some(a.iter().zip(&b).map(|(p, q)| dist(*p, *q)).fold(0.0, f64::max) / diameter)
     }
 
     /// The mean of the contour's arc-length samples (its centroid, for point clouds the
