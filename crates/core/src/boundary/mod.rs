@@ -32,6 +32,7 @@ pub mod input_basis;
 pub mod normalise;
 pub mod reparam;
 pub mod ring;
+pub mod ring_fit;
 pub mod validate;
 
 use std::sync::Arc;
