@@ -225,6 +225,18 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             f0.report.seconds,
             f0.report.verdict,
         );
+        // the sliding seam moves the parameter by |Δθ| / 2π of a period per step; the
+        // prediction is good while that is a small part of the smallest element
+        let h = sol.map.knots[1].elements().iter().map(|e| e.2 - e.1).fold(f64::INFINITY, f64::min);
+        let slide = step.abs() / std::f64::consts::TAU * sol.map.knots[1].length() / h;
+        if seam != Seam::Material && a.rotate_inner.is_some() {
+            eprintln!("the inner parameter slides by {slide:.3} of the smallest eta element per step");
+            if slide > 0.25 {
+                eprintln!(
+                    "warning: more than a quarter of an element per step; the extrapolated predictions will be poor (a coarser --fit-tol or a smaller step keeps them within one Newton step)"
+                );
+            }
+        }
         eprintln!("{HEADER}");
     }
     let every = a.every as usize;
