@@ -488,7 +488,7 @@ fn improve_and_start_from_a_map() {
 fn solve_a_ring_end_to_end() {
     let dir = std::env::temp_dir().join(format!("winslow-ring-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for name in ["eccentric_annulus", "annulus_periodic"] {
+    for name in ["eccentric_annulus", "annulus_periodic", "rotor_lobes_in_circle"] {
         let (map, png) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.png")));
         let out = bin()
             .arg("solve")

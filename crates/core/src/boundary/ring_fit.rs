@@ -9,15 +9,17 @@
 //! `p + 1`), every element where either contour deviates by more than `tol * diameter`
 //! at a sample is bisected (knots stay dyadic, `k / (n_0 2^l)`), and both contours are
 //! refitted; each fit is one level of the hierarchy. An element is bisected only when
-//! each half keeps at least `p + 1` samples of both contours (the fit stays well posed);
-//! the loop ends when no element is marked or the next level would pass the element
-//! cap.
+//! each half keeps at least `p + 1` samples of every contour that misses the tolerance
+//! there (more elements cannot bring a sparse cloud closer); the other contour's fit
+//! stays well posed on elements without samples by the tiny smoothing term of the
+//! four-sided point fits ([`REGULARIZATION`], `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
+//! when no element is marked or the next level would pass the element cap.
 //!
 //! **Normalisation.** Like a four-sided boundary
 //! ([`crate::boundary::normalise::Similarity`]), a ring far from the origin or of extreme
 //! size is fitted and solved in the coordinates `(x - c) / s` of its outer contour's
 //! bounding box and mapped back; [`RingFit`] lives in those coordinates.
-use super::fit::{FitOptions, SideFit};
+use super::fit::{FitOptions, SideFit, REGULARIZATION};
 use super::hierarchy::{BasisReport, Hierarchy, Level};
 use super::normalise::Similarity;
 use super::reparam::{Reparam, ReparamReport};
@@ -29,6 +31,7 @@ use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
 use crate::spline::surface::Side;
 
 /// Arc-length fraction of the first crossing of the ray `o + t dir`, `t > 0`, with the
@@ -100,11 +103,35 @@ fn fit_periodic_elements(kv: &KnotVector, smp: &Samples) -> Result<(Curve, f64, 
             rhs[a][0] += va * x[0];
             rhs[a][1] += va * x[1];
             for (jb, &vb) in v.iter().enumerate() {
-                let c = (b.first() + jb) % d;
-                match rows[a].iter_mut().find(|e| e.0 == c) {
-                    Some(e) => e.1 += va * vb,
-                    None => rows[a].push((c, va * vb)),
+                add_entry(&mut rows[a], (b.first() + jb) % d, va * vb);
+            }
+        }
+    }
+    // the smoothing term of the four-sided point fits, `λ Σ_e h_e^3 ∫_e |f''|^2` with
+    // `λ = REGULARIZATION tr(B^T B) / tr(R)`: elements without samples stay well posed
+    let mut reg: Vec<Vec<(usize, f64)>> = vec![Vec::new(); d];
+    let gauss = GaussLegendre::new(kv.degree() + 1);
+    for (span, lo, hi) in kv.elements() {
+        let h3 = (hi - lo).powi(3);
+        for (u, w) in gauss.on(lo, hi) {
+            b.eval_in_span(kv, span, u, 2);
+            let v = b.ders(2);
+            for (ja, &va) in v.iter().enumerate() {
+                for (jb, &vb) in v.iter().enumerate() {
+                    add_entry(&mut reg[(b.first() + ja) % d], (b.first() + jb) % d, h3 * w * va * vb);
                 }
+            }
+        }
+    }
+    let trace = |m: &[Vec<(usize, f64)>]| {
+        m.iter().enumerate().flat_map(|(i, r)| r.iter().filter(move |e| e.0 == i)).map(|e| e.1).sum::<f64>()
+    };
+    let (data_tr, reg_tr) = (trace(&rows), trace(&reg));
+    if reg_tr > 0.0 {
+        let lambda = if data_tr > 0.0 { REGULARIZATION * data_tr / reg_tr } else { 1.0 };
+        for (r, g) in rows.iter_mut().zip(&reg) {
+            for &(c, v) in g {
+                add_entry(r, c, lambda * v);
             }
         }
     }
@@ -134,6 +161,14 @@ fn fit_periodic_elements(kv: &KnotVector, smp: &Samples) -> Result<(Curve, f64, 
         per[k] = per[k].max(e);
     }
     Ok((curve, err, per))
+}
+
+/// `row[c] += v` in a sparse row.
+fn add_entry(row: &mut Vec<(usize, f64)>, c: usize, v: f64) {
+    match row.iter_mut().find(|e| e.0 == c) {
+        Some(e) => e.1 += v,
+        None => row.push((c, v)),
+    }
 }
 
 /// [`fit_periodic_elements`] without the per-element errors.
@@ -290,7 +325,11 @@ pub fn fit_ring_with(
         let uniform = refinement == EtaRefinement::Uniform;
         let marked: Vec<usize> = (0..per_i.len())
             .filter(|&e| uniform || per_i[e].max(per_o[e]) > tol_abs)
-            .filter(|&e| (2 * e..2 * e + 2).all(|h| ni[h] > degree && no[h] > degree))
+            .filter(|&e| {
+                // a contour that misses the tolerance here needs samples in both halves
+                let enough = |per: &[f64], n: &[usize]| per[e] <= tol_abs || (2 * e..2 * e + 2).all(|h| n[h] > degree);
+                enough(&per_i, &ni) && enough(&per_o, &no)
+            })
             .collect();
         if marked.is_empty()
             || (uniform && marked.len() < per_i.len())
