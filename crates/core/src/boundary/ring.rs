@@ -74,7 +74,7 @@ impl ClosedContour {
 
     /// A closed polygon of at least `m` points of a parametric contour (64 per element
     /// of a spline), the points of a cloud.
-    pub(super) fn polygon_with(&self, m: usize) -> Vec<Point> {
+    pub fn polygon_with(&self, m: usize) -> Vec<Point> {
         match self {
             ClosedContour::Points(p) => p.clone(),
             ClosedContour::Spline(c) => {

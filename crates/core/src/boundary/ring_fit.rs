@@ -230,29 +230,10 @@ pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Re
     fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive)
 }
 
-/// Points of the polygons a ring is validated on (closed, oriented, nested).
-const CHECK: usize = 4096;
-
-/// How the ring fit refines its knot vector in `eta`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum EtaRefinement {
-    /// Bisect the elements that miss the tolerance (§5; the module documentation).
-    #[default]
-    Adaptive,
-    /// Halve every element while any misses it: uniform knots, whose space is invariant
-    /// under shifts by whole elements (a sliding grid moves the parameter along the
-    /// contour, where locally refined elements would not follow the features).
-    Uniform,
-}
-
-/// [`fit_ring`] with the refinement in `eta` chosen.
-pub fn fit_ring_with(
-    ring: &Ring,
-    degree: usize,
-    tol: f64,
-    max_elements: usize,
-    refinement: EtaRefinement,
-) -> Result<RingFit> {
+/// Check a ring: both contours closed and finite, counter-clockwise, the inner inside
+/// the outer (on polygons of about [`CHECK`] points). Returns the outer contour's
+/// bounding box `[lo, hi]`.
+pub fn check_ring(ring: &Ring) -> Result<[Point; 2]> {
     // validation on polygons of about 4096 points (the nesting test is quadratic)
     let outer_poly = ring.outer.polygon_with(CHECK);
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -284,6 +265,34 @@ pub fn fit_ring_with(
             p[0], p[1]
         )));
     }
+    Ok([lo, hi])
+}
+
+/// Points of the polygons a ring is validated on (closed, oriented, nested).
+const CHECK: usize = 4096;
+
+/// How the ring fit refines its knot vector in `eta`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EtaRefinement {
+    /// Bisect the elements that miss the tolerance (§5; the module documentation).
+    #[default]
+    Adaptive,
+    /// Halve every element while any misses it: uniform knots, whose space is invariant
+    /// under shifts by whole elements (a sliding grid moves the parameter along the
+    /// contour, where locally refined elements would not follow the features).
+    Uniform,
+}
+
+/// [`fit_ring`] with the refinement in `eta` chosen.
+pub fn fit_ring_with(
+    ring: &Ring,
+    degree: usize,
+    tol: f64,
+    max_elements: usize,
+    refinement: EtaRefinement,
+) -> Result<RingFit> {
+    let [lo, hi] = check_ring(ring)?;
+    let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
     let similarity = Similarity::for_box(lo, hi, &format!("ring '{}'", ring.name))?;
     let unit =
         |c: &ClosedContour| if similarity.is_identity() { c.clone() } else { c.mapped(move |p| similarity.to_unit(p)) };
