@@ -167,6 +167,81 @@ pub fn periodic_elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     Ok((fine.clone(), expand(rows, fine.num_basis(), kv.num_basis())))
 }
 
+/// The open (clamped) knot vector on the domain `[a, a + L]` of a periodic `kv` (its
+/// interior knots, both ends `p + 1` times) and the operator `C` (`n_open x n` stored
+/// functions) with `sum_i (C c)_i N^open_i = sum_k c_k N_k` on `[a, a + L]`: the same
+/// curve as an ordinary clamped spline whose first and last control points coincide (the
+/// seam's continuity is no longer built into the basis). Coefficients by blossoming, as
+/// in [`periodic_prolongation`].
+pub fn periodic_to_open(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
+    if !kv.is_periodic() {
+        return Err(Error::Invalid("periodic_to_open needs a periodic knot vector".into()));
+    }
+    let (p, d) = (kv.degree(), kv.dim());
+    let (a, b) = kv.domain();
+    let mut knots = vec![a; p + 1];
+    knots.extend(kv.knots().iter().copied().filter(|&t| t > a && t < b));
+    knots.extend(std::iter::repeat_n(b, p + 1));
+    let open = KnotVector::new(p, knots)?;
+    let t = open.knots();
+    let rows = (0..open.num_basis())
+        .map(|i| {
+            let k = (i..=i + p).max_by(|&x, &y| (t[x + 1] - t[x]).total_cmp(&(t[y + 1] - t[y]))).expect("p + 1");
+            let s = extended_span(kv, 0.5 * (t[k] + t[k + 1]));
+            let w = blossom_weights(|j| kv.extended(j), p, s, &t[i + 1..=i + p]);
+            let mut row = Vec::with_capacity(p + 1);
+            for (jj, &wj) in w.iter().enumerate() {
+                add_wrapped(&mut row, s - p as isize + jj as isize, d, wj);
+            }
+            row.sort_by_key(|e| e.0);
+            row
+        })
+        .collect();
+    Ok((open, Csr::from_rows(kv.num_basis(), rows)))
+}
+
+/// `map` with every periodic direction written on its open knot vector
+/// ([`periodic_to_open`]): the same map on its domain (weights kept, control points in
+/// homogeneous form), for formats without periodic bases. Maps without a periodic
+/// direction come back unchanged.
+pub fn open_equivalent(map: &crate::spline::surface::Surface) -> Result<crate::spline::surface::Surface> {
+    let mut out = map.clone();
+    for dir in 0..2 {
+        if !out.knots[dir].is_periodic() {
+            continue;
+        }
+        let (open, c) = periodic_to_open(&out.knots[dir])?;
+        let [nx, ny] = out.shape();
+        let (n_old, n_new) = ([nx, ny][dir], open.num_basis());
+        let idx = |i: usize, j: usize, n0: usize| if dir == 0 { j * n0 + i } else { i * nx + j };
+        let other = [ny, nx][dir];
+        let w = |k: usize| out.weights.as_ref().map_or(1.0, |w| w[k]);
+        let mut cps = vec![[0.0; 2]; n_new * other];
+        let mut ws = vec![0.0; n_new * other];
+        let n0 = if dir == 0 { n_new } else { nx };
+        for o in 0..other {
+            for r in 0..n_new {
+                let (mut x, mut y, mut wt) = (0.0, 0.0, 0.0);
+                for (col, v) in c.row(r) {
+                    let k = idx(col, o, nx);
+                    x += v * w(k) * out.control_points[k][0];
+                    y += v * w(k) * out.control_points[k][1];
+                    wt += v * w(k);
+                }
+                let k = idx(r, o, n0);
+                cps[k] = [x / wt, y / wt];
+                ws[k] = wt;
+            }
+        }
+        debug_assert_eq!(c.ncols, n_old);
+        let mut knots = out.knots.clone();
+        knots[dir] = open;
+        let weights = out.weights.is_some().then_some(ws);
+        out = crate::spline::surface::Surface::new(knots, cps, weights)?;
+    }
+    Ok(out)
+}
+
 /// An element `(span, a, b)`: `[t_span, t_span+1] = [a, b]`.
 pub type Element = (usize, f64, f64);
 
@@ -517,5 +592,32 @@ mod tests {
         };
         let (e1, e2) = (err(2e-2), err(1e-2));
         assert!(e2 < e1 / 30.0, "ratio {} ({e1:e} -> {e2:e})", e1 / e2);
+    }
+
+    /// The open equivalent of a periodic curve is the same curve on its domain, for every
+    /// degree, with a double knot, rational too.
+    #[test]
+    fn periodic_curves_open_exactly() {
+        let mut rng = Lcg::new(23);
+        for p in 1..=5 {
+            for rational in [false, true] {
+                let c = random_closed(&mut rng, p, 7, rational);
+                let (open, op) = periodic_to_open(&c.knots).unwrap();
+                assert!(open.is_open() && open.domain() == c.knots.domain());
+                let w = |k: usize| c.weights.as_ref().map_or(1.0, |w| w[k]);
+                let hom: Vec<[f64; 3]> = (0..op.nrows)
+                    .map(|r| {
+                        op.row(r).fold([0.0; 3], |a, (k, v)| {
+                            let q = c.control_points[k];
+                            [a[0] + v * w(k) * q[0], a[1] + v * w(k) * q[1], a[2] + v * w(k)]
+                        })
+                    })
+                    .collect();
+                let cps = hom.iter().map(|h| [h[0] / h[2], h[1] / h[2]]).collect();
+                let weights = rational.then(|| hom.iter().map(|h| h[2]).collect());
+                let o = Curve::new(open, cps, weights).unwrap();
+                assert_same(&c, &o, &format!("open p={p} rational={rational}"));
+            }
+        }
     }
 }
