@@ -6,7 +6,9 @@
 
 use super::*;
 use winslow::boundary::ring::{ClosedContour, Ring};
+use winslow::boundary::ring_fit::EtaRefinement;
 use winslow::io::picture::Image;
+use winslow::solve::solver::solve_ring_with;
 use winslow::solve::sweep::{Frame, FrameReport, Seam, Sweep, SweepOptions};
 
 #[derive(Args, Debug)]
@@ -57,6 +59,12 @@ pub(super) struct SweepArgs {
     /// Frames per second of the --apng.
     #[arg(long, default_value_t = 25)]
     apng_fps: u16,
+    /// Every N-th frame of a turning contour, also solve that frame cold (the ring with
+    /// the input inner contour turned, fitted and solved from scratch) and record its time
+    /// (`cold_checks` in sweep.json): the per-frame cost against a cold solve of the same
+    /// frame.
+    #[arg(long, default_value_t = 0)]
+    cold_every: usize,
     /// No per-frame lines on stderr.
     #[arg(long)]
     quiet: bool,
@@ -246,6 +254,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
     let mut pvd =
         String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
     let mut failures = 0;
+    let mut cold_checks = Vec::new();
     let mut frame: Frame = f0;
     loop {
         let r = &frame.report;
@@ -280,6 +289,22 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         if k > steps {
             break;
         }
+        if a.cold_every > 0 && contours.is_empty() && k % a.cold_every == 0 {
+            let angle = k as f64 * step;
+            let centre = a.center.unwrap_or_else(|| ring.inner.centroid());
+            let turned = Ring { inner: ring.inner.rotated(centre, angle), ..ring.clone() };
+            let refinement = if seam == Seam::Material { EtaRefinement::Adaptive } else { EtaRefinement::Uniform };
+            let t0 = std::time::Instant::now();
+            let cold =
+                solve_ring_with(&turned, &opts, refinement).with_context(|| format!("cold solve of frame {k}"))?;
+            let seconds = t0.elapsed().as_secs_f64();
+            cold_checks.push(serde_json::json!({
+                "frame": k,
+                "seconds": seconds,
+                "verdict": cold.report.verdict.name(),
+                "shape": cold.map.shape(),
+            }));
+        }
         frame = match contours.get(k - 1) {
             Some((path, inner)) => sweep
                 .next_frame_contour(inner, times[k - 1])
@@ -307,6 +332,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         "frames": rows,
         "cold_seconds": cold,
         "failures": failures,
+        "cold_checks": cold_checks,
         "from_frame_6": {
             "max_newton": max_newton,
             "max_linear_solves": max_solves,
@@ -326,5 +352,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         min_det,
         a.output.display()
     );
+    if !cold_checks.is_empty() {
+        let cold: Vec<f64> = cold_checks.iter().filter_map(|c| c["seconds"].as_f64()).collect();
+        let mean_cold = cold.iter().sum::<f64>() / cold.len() as f64;
+        println!(
+            "cold solves of {} frames: mean {mean_cold:.4} s; a predicted frame takes {:.3} of that",
+            cold.len(),
+            mean.unwrap_or(f64::NAN) / mean_cold
+        );
+    }
     Ok(if failures == 0 { 0 } else { 3 })
 }

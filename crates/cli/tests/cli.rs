@@ -570,7 +570,7 @@ fn sweep_writes_frames_series_and_table() {
     let out = bin()
         .arg("sweep")
         .arg(data().join("rings/eccentric_annulus.json"))
-        .args(["--rotate-inner", "0.5", "--steps", "8", "--every", "4", "--quiet", "--apng"])
+        .args(["--rotate-inner", "0.5", "--steps", "8", "--every", "4", "--cold-every", "4", "--quiet", "--apng"])
         .arg(sub.join("a.png"))
         .arg("-o")
         .arg(&sub)
@@ -579,6 +579,11 @@ fn sweep_writes_frames_series_and_table() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(files(&sub, "vtu").len(), 3);
     assert_eq!(std::fs::read_to_string(sub.join("sweep.csv")).unwrap().lines().count(), 10);
+    // frames 4 and 8 were also solved cold, and certified
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(sub.join("sweep.json")).unwrap()).unwrap();
+    let cold = v["cold_checks"].as_array().unwrap();
+    assert_eq!(cold.iter().map(|c| c["frame"].as_u64().unwrap()).collect::<Vec<_>>(), [4, 8]);
+    assert!(cold.iter().all(|c| c["verdict"] == "certified"));
     let reader = png::Decoder::new(std::fs::File::open(sub.join("a.png")).unwrap()).read_info().unwrap();
     assert_eq!(reader.info().animation_control.map(|a| a.num_frames), Some(3));
     let bad = bin()
