@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use winslow::boundary::fit::FitOptions;
-use winslow::boundary::ring::{fit_ring, ClosedContour, Ring};
+use winslow::boundary::ring::{ClosedContour, Ring};
+use winslow::boundary::ring_fit::fit_ring;
 
 fn describe(c: &ClosedContour) -> String {
     match c {
@@ -33,11 +34,12 @@ pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::R
                 "kind": "ring",
                 "inner": describe(&ring.inner),
                 "outer": describe(&ring.outer),
-                "diameter": f.diameter,
-                "tolerance": f.tol_abs,
+                "diameter": f.similarity.length(f.diameter),
+                "tolerance": f.similarity.length(f.tol_abs),
                 "levels": f.levels.len(),
                 "elements": f.levels.last().map_or(0, |l| l.knots.num_elements()),
-                "max_error": f.levels.last().map(|l| l.max_error),
+                "max_error": f.levels.last().map(|l| l.max_error.map(|e| f.similarity.length(e))),
+                "normalisation": (!f.similarity.is_identity()).then_some(f.similarity),
                 "converged": f.converged,
                 "outer_seam_shift": f.outer_shift.rem_euclid(1.0),
                 "problems": [],
@@ -59,18 +61,19 @@ pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::R
     let _ = writeln!(s, "  outer: {}", describe(&ring.outer));
     let code = match &fit {
         Ok(f) => {
-            let _ = writeln!(s, "  closed, counter-clockwise, inner inside outer; diameter {:.6}", f.diameter);
+            let len = |l: f64| f.similarity.length(l);
+            let _ = writeln!(s, "  closed, counter-clockwise, inner inside outer; diameter {:.6}", len(f.diameter));
             let last = f.levels.last();
             let _ = writeln!(
                 s,
                 "  contour fit: tolerance {:.3e} (relative {:.1e}), {} periodic levels, finest {} elements (p={}), max error inner {:.3e}, outer {:.3e}{}",
-                f.tol_abs,
+                len(f.tol_abs),
                 f.tol_abs / f.diameter,
                 f.levels.len(),
                 last.map_or(0, |l| l.knots.num_elements()),
                 opts.degree,
-                last.map_or(0.0, |l| l.max_error[0]),
-                last.map_or(0.0, |l| l.max_error[1]),
+                last.map_or(0.0, |l| len(l.max_error[0])),
+                last.map_or(0.0, |l| len(l.max_error[1])),
                 if f.converged { "" } else { "  (tolerance NOT met)" }
             );
             let _ = writeln!(

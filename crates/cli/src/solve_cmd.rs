@@ -3,7 +3,8 @@
 
 use super::*;
 use winslow::boundary::hierarchy::Hierarchy;
-use winslow::boundary::ring::{ring_hierarchy, Ring};
+use winslow::boundary::ring::Ring;
+use winslow::boundary::ring_fit::ring_hierarchy;
 use winslow::io::ring::read_ring;
 use winslow::solve::solver::ring_options;
 

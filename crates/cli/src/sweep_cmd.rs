@@ -1,36 +1,85 @@
-//! `winslow sweep RING --rotate-inner DEG --steps N [--center X,Y] -o DIR`: the sliding
-//! O-grid of paper §11.1 ([`winslow::solve::sweep`]): one map per frame (JSON with the
-//! frame's row, and VTK Bézier cells), a ParaView `.pvd` series, and the per-frame table
-//! (`sweep.csv`, `sweep.json`, and on stdout).
+//! `winslow sweep RING (--rotate-inner DEG --steps N [--center X,Y] | --inner-frames
+//! PATH...) -o DIR`: the sliding O-grid of paper §11.1 ([`winslow::solve::sweep`]): one
+//! map per frame (JSON with the frame's row, and VTK Bézier cells), a ParaView `.pvd`
+//! series, the per-frame table (`sweep.csv`, `sweep.json`, and on stdout), and with
+//! `--apng` an animated PNG of the frames.
 
 use super::*;
-use winslow::io::ring::read_ring;
-use winslow::solve::sweep::{FrameReport, Sweep, SweepOptions};
+use winslow::boundary::ring::{ClosedContour, Ring};
+use winslow::boundary::ring_fit::EtaRefinement;
+use winslow::io::picture::Image;
+use winslow::solve::solver::solve_ring_with;
+use winslow::solve::sweep::{Frame, FrameReport, Seam, Sweep, SweepOptions};
 
 #[derive(Args, Debug)]
 pub(super) struct SweepArgs {
-    /// Ring document (two closed contours, see formats.md).
+    /// Ring document (two closed contours, see formats.md): frame 0.
     ring: PathBuf,
     /// Rotation of the inner contour per step, degrees (counter-clockwise).
-    #[arg(long, allow_negative_numbers = true)]
-    rotate_inner: f64,
-    /// Number of steps after frame 0.
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "inner_frames")]
+    rotate_inner: Option<f64>,
+    /// Number of steps after frame 0 (a turning contour; with --inner-frames, at most
+    /// this many of the files).
     #[arg(long)]
-    steps: usize,
+    steps: Option<usize>,
     /// Centre of rotation `x,y` (default: the inner contour's centroid).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     center: Option<[f64; 2]>,
+    /// Non-rigid motion: the inner contours of frames 1, 2, ..., as ring documents
+    /// (their outer contour must be frame 0's) or directories of them (their *.json files
+    /// in name order).
+    #[arg(long, num_args = 1.., conflicts_with_all = ["rotate_inner", "center"])]
+    inner_frames: Vec<PathBuf>,
+    /// Times of the --inner-frames, increasing and positive (frame 0 is at time 0;
+    /// default 1, 2, 3, ...). Uneven steps are fine: the extrapolation uses the times.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, requires = "inner_frames")]
+    times: Vec<f64>,
+    /// Where eta = 0 sits on the turning inner contour: `slide` (the grid slides along
+    /// the contour at the mean angular rate), `ray` (on the ray from the inner centroid
+    /// through the frame-0 seam, the paper's choice) or `material` (turns with the
+    /// contour: the grid twists).
+    #[arg(long, value_enum, default_value_t = SeamArg::Slide)]
+    seam: SeamArg,
     /// Highest order of the time extrapolation of the control points (0 to 5).
     #[arg(long, default_value_t = 5)]
     order: usize,
     /// Output directory: frame_NNNN.json, frame_NNNN.vtu, sweep.pvd, sweep.csv, sweep.json.
     #[arg(short, long)]
     output: PathBuf,
+    /// Write the maps (and the .pvd and --apng frames) of every N-th frame only; the
+    /// table has every frame.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+    /// Also write an animated PNG (APNG) of the written frames: det J heat map and grid.
+    #[arg(long)]
+    apng: Option<PathBuf>,
+    /// Longer side of the --apng frames in pixels.
+    #[arg(long, default_value_t = 480)]
+    apng_size: usize,
+    /// Frames per second of the --apng.
+    #[arg(long, default_value_t = 25)]
+    apng_fps: u16,
+    /// Every N-th frame of a turning contour, also solve that frame cold (the ring with
+    /// the input inner contour turned, fitted and solved from scratch) and record its time
+    /// (`cold_checks` in sweep.json): the per-frame cost against a cold solve of the same
+    /// frame.
+    #[arg(long, default_value_t = 0)]
+    cold_every: usize,
     /// No per-frame lines on stderr.
     #[arg(long)]
     quiet: bool,
     #[command(flatten)]
     solver: SolverArgs,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum SeamArg {
+    /// The inner parameter slides by -θ/2π of a period (smooth in time).
+    Slide,
+    /// eta = 0 on the seam ray (the paper's c_r(eta)_y = 0).
+    Ray,
+    /// The frame-0 inner control points turned rigidly (the grid twists).
+    Material,
 }
 
 fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
@@ -44,11 +93,14 @@ fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
     }
 }
 
+const HEADER: &str = "frame,time,angle_deg,predictor,newton,linear_solves,residual_before,residual_after,converged,inner_fit_error,inner_shift,seam_offset_deg,seconds,verdict,det_j_lower_bound";
+
 fn row(r: &FrameReport) -> String {
     format!(
-        "{},{:.6},{},{},{},{:.3e},{:.3e},{},{:.3e},{:.4},{},{}",
+        "{},{:.9},{},{},{},{},{:.3e},{:.3e},{},{:.3e},{:.6e},{:.4},{:.4},{},{}",
         r.frame,
-        r.angle_degrees,
+        r.time,
+        r.angle_degrees.map_or(String::new(), |a| format!("{a:.6}")),
         r.predictor_order.map_or("cold".into(), |o| o.to_string()),
         r.newton_iterations,
         r.linear_solves,
@@ -56,55 +108,176 @@ fn row(r: &FrameReport) -> String {
         r.residual_after,
         r.converged,
         r.inner_fit_error,
+        r.inner_shift,
+        r.seam_offset_degrees,
         r.seconds,
         r.verdict,
         r.det_j_lower_bound.map_or(String::new(), |b| format!("{b:.6e}"))
     )
 }
 
+/// The ring documents of `paths` (directories give their `*.json` files in name order)
+/// with their inner contours; each outer contour must be `base`'s.
+fn inner_frames(paths: &[PathBuf], base: &Ring) -> Result<Vec<(PathBuf, ClosedContour)>> {
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let mut v: Vec<PathBuf> = std::fs::read_dir(p)
+                .with_context(|| format!("reading directory {}", p.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|f| f.extension().is_some_and(|x| x.eq_ignore_ascii_case("json")))
+                .collect();
+            v.sort();
+            if v.is_empty() {
+                bail!("--inner-frames: {} holds no .json files", p.display());
+            }
+            files.extend(v);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    files
+        .into_iter()
+        .map(|f| {
+            let ring = read_ring(&f).with_context(|| format!("reading {}", f.display()))?.with_context(|| {
+                format!("{} is not a ring document (--inner-frames takes ring documents)", f.display())
+            })?;
+            let dev = ring.outer.deviation_from(&base.outer);
+            if dev.is_none_or(|d| d > 1e-9) {
+                bail!(
+                    "{}: its outer contour is not frame 0's ({}); a sweep moves the inner contour only",
+                    f.display(),
+                    dev.map_or("sampled differently".into(), |d| format!("{d:.3e} apart"))
+                );
+            }
+            Ok((f, ring.inner))
+        })
+        .collect()
+}
+
+/// An animated PNG written frame by frame; every frame is cropped or padded (white) to
+/// the first frame's size.
+struct Apng {
+    writer: png::Writer<std::io::BufWriter<std::fs::File>>,
+    size: (usize, usize),
+}
+
+impl Apng {
+    fn create(path: &Path, first: &Image, frames: u32, fps: u16) -> Result<Self> {
+        output::ensure_parent(path)?;
+        let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), first.width as u32, first.height as u32);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_animated(frames, 0)?;
+        enc.set_frame_delay(1, fps.max(1))?;
+        Ok(Self { writer: enc.write_header()?, size: (first.width, first.height) })
+    }
+
+    fn push(&mut self, img: &Image) -> Result<()> {
+        let (w, h) = self.size;
+        let mut rgba = vec![255u8; 4 * w * h];
+        for y in 0..h.min(img.height) {
+            let n = 4 * w.min(img.width);
+            rgba[4 * y * w..4 * y * w + n].copy_from_slice(&img.rgba[4 * y * img.width..4 * y * img.width + n]);
+        }
+        self.writer.write_image_data(&rgba)?;
+        Ok(())
+    }
+}
+
 pub(super) fn run(a: SweepArgs) -> Result<i32> {
     if a.order > 5 {
         bail!("--order must be between 0 and 5, got {}", a.order);
     }
-    if !a.rotate_inner.is_finite() {
-        bail!("--rotate-inner must be a finite number of degrees, got {}", a.rotate_inner);
-    }
+    let step = match a.rotate_inner {
+        Some(d) if !d.is_finite() => bail!("--rotate-inner must be a finite number of degrees, got {d}"),
+        Some(d) => d.to_radians(),
+        None => 0.0,
+    };
     let opts = a.solver.options()?;
     let ring = read_ring(&a.ring).with_context(|| format!("reading {}", a.ring.display()))?.with_context(|| {
         format!("{} is not a ring document (a \"ring\" with inner and outer contours)", a.ring.display())
     })?;
+    let mut contours = inner_frames(&a.inner_frames, &ring)?;
+    if let Some(n) = a.steps.filter(|_| !contours.is_empty()) {
+        contours.truncate(n);
+    }
+    let steps = match (a.rotate_inner, a.steps) {
+        (Some(_), Some(n)) => n,
+        (Some(_), None) => bail!("--rotate-inner needs --steps"),
+        (None, _) => contours.len(),
+    };
+    let times: Vec<f64> = if a.times.is_empty() { (1..=steps).map(|k| k as f64).collect() } else { a.times.clone() };
+    if !contours.is_empty() && times.len() != contours.len() {
+        bail!("--times gives {} times for {} inner frames", times.len(), contours.len());
+    }
     std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
-    let so = SweepOptions { step: a.rotate_inner.to_radians(), steps: a.steps, center: a.center, max_order: a.order };
+    let seam = match a.seam {
+        SeamArg::Slide => Seam::Slide,
+        SeamArg::Ray => Seam::Ray,
+        SeamArg::Material => Seam::Material,
+    };
+    let so = SweepOptions { step, steps, center: a.center, max_order: a.order, seam };
     let (mut sweep, sol, f0) = Sweep::new(&ring, &opts, so).context("solving frame 0")?;
-    let header = "frame,angle_deg,predictor,newton,linear_solves,residual_before,residual_after,converged,inner_fit_error,seconds,verdict,det_j_lower_bound";
     if !a.quiet {
+        let what = match a.rotate_inner {
+            Some(d) => format!("{steps} frames at {d} degrees per step"),
+            None => format!("{steps} inner contours"),
+        };
         eprintln!(
-            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}); {} frames at {} degrees per step",
+            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}); {what}",
             ring.name,
             sol.map.shape()[0],
             sol.map.shape()[1],
             f0.report.seconds,
             f0.report.verdict,
-            a.steps,
-            a.rotate_inner
         );
-        eprintln!("{header}");
+        // the sliding seam moves the parameter by |Δθ| / 2π of a period per step; the
+        // prediction is good while that is a small part of the smallest element
+        let h = sol.map.knots[1].elements().iter().map(|e| e.2 - e.1).fold(f64::INFINITY, f64::min);
+        let slide = step.abs() / std::f64::consts::TAU * sol.map.knots[1].length() / h;
+        if seam != Seam::Material && a.rotate_inner.is_some() {
+            eprintln!("the inner parameter slides by {slide:.3} of the smallest eta element per step");
+            if slide > 0.25 {
+                eprintln!(
+                    "warning: more than a quarter of an element per step; the extrapolated predictions will be poor (a coarser --fit-tol or a smaller step keeps them within one Newton step)"
+                );
+            }
+        }
+        eprintln!("{HEADER}");
     }
+    let every = a.every as usize;
+    let picture = PictureOptions { size: a.apng_size.max(16), grid_lines: 16, resolution: 160, segments: Vec::new() };
+    let mut apng: Option<Apng> = None;
     let mut rows = Vec::new();
     let mut pvd =
         String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
     let mut failures = 0;
-    let mut frame = f0;
+    let mut cold_checks = Vec::new();
+    let mut frame: Frame = f0;
     loop {
         let r = &frame.report;
-        let stem = format!("frame_{:04}", r.frame);
-        let label = format!("frame {} at {:.6} degrees: {}", r.frame, r.angle_degrees, r.verdict);
-        let report = serde_json::to_value(r)?;
-        let json =
-            || map_to_json(&format!("{}-{stem}", ring.name), &frame.map, Some(serde_json::json!({ "frame": report })));
-        output::write_map_as(&a.output.join(format!("{stem}.json")), "json", &ring.name, &frame.map, &label, json)?;
-        output::write_map_as(&a.output.join(format!("{stem}.vtu")), "vtu", &ring.name, &frame.map, &label, json)?;
-        pvd.push_str(&format!("    <DataSet timestep=\"{}\" part=\"0\" file=\"{stem}.vtu\"/>\n", r.angle_degrees));
+        if r.frame.is_multiple_of(every) {
+            let stem = format!("frame_{:04}", r.frame);
+            let label = format!("frame {} at time {:.9}: {}", r.frame, r.time, r.verdict);
+            let report = serde_json::to_value(r)?;
+            let json = || {
+                map_to_json(&format!("{}-{stem}", ring.name), &frame.map, Some(serde_json::json!({ "frame": report })))
+            };
+            let path = a.output.join(format!("{stem}.json"));
+            output::write_map_as(&path, "json", &ring.name, &frame.map, &label, json)?;
+            output::write_map_as(&a.output.join(format!("{stem}.vtu")), "vtu", &ring.name, &frame.map, &label, json)?;
+            pvd.push_str(&format!("    <DataSet timestep=\"{}\" part=\"0\" file=\"{stem}.vtu\"/>\n", r.time));
+            if let Some(path) = &a.apng {
+                let img = render(&frame.map, &picture);
+                let w = match apng.as_mut() {
+                    Some(w) => w,
+                    None => apng.insert(Apng::create(path, &img, (steps / every + 1) as u32, a.apng_fps)?),
+                };
+                w.push(&img)?;
+            }
+        }
         if r.verdict != "certified" || !r.converged {
             failures += 1;
         }
@@ -112,40 +285,81 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             eprintln!("{}", row(r));
         }
         rows.push(frame.report.clone());
-        if rows.len() > a.steps {
+        let k = rows.len();
+        if k > steps {
             break;
         }
-        frame = sweep.next_frame().with_context(|| format!("solving frame {}", rows.len()))?;
+        if a.cold_every > 0 && contours.is_empty() && k % a.cold_every == 0 {
+            let angle = k as f64 * step;
+            let centre = a.center.unwrap_or_else(|| ring.inner.centroid());
+            let turned = Ring { inner: ring.inner.rotated(centre, angle), ..ring.clone() };
+            let refinement = if seam == Seam::Material { EtaRefinement::Adaptive } else { EtaRefinement::Uniform };
+            let t0 = std::time::Instant::now();
+            let cold =
+                solve_ring_with(&turned, &opts, refinement).with_context(|| format!("cold solve of frame {k}"))?;
+            let seconds = t0.elapsed().as_secs_f64();
+            cold_checks.push(serde_json::json!({
+                "frame": k,
+                "seconds": seconds,
+                "verdict": cold.report.verdict.name(),
+                "shape": cold.map.shape(),
+            }));
+        }
+        frame = match contours.get(k - 1) {
+            Some((path, inner)) => sweep
+                .next_frame_contour(inner, times[k - 1])
+                .with_context(|| format!("solving frame {k} ({})", path.display()))?,
+            None => sweep.next_frame().with_context(|| format!("solving frame {k}"))?,
+        };
+    }
+    if let Some(w) = apng {
+        w.writer.finish()?;
     }
     pvd.push_str("  </Collection>\n</VTKFile>\n");
     std::fs::write(a.output.join("sweep.pvd"), pvd)?;
-    let csv: String = std::iter::once(header.to_string()).chain(rows.iter().map(row)).collect::<Vec<_>>().join("\n");
+    let csv: String = std::iter::once(HEADER.to_string()).chain(rows.iter().map(row)).collect::<Vec<_>>().join("\n");
     std::fs::write(a.output.join("sweep.csv"), csv + "\n")?;
     let cold = rows[0].seconds;
     let later: Vec<&FrameReport> = rows.iter().skip(6).collect();
+    let max_newton = later.iter().map(|r| r.newton_iterations).max();
+    let max_solves = later.iter().map(|r| r.linear_solves).max();
+    let mean = (!later.is_empty()).then(|| later.iter().map(|r| r.seconds).sum::<f64>() / later.len() as f64);
+    let min_det = rows.iter().filter_map(|r| r.det_j_lower_bound).fold(f64::INFINITY, f64::min);
     let summary = serde_json::json!({
         "name": ring.name,
         "step_degrees": a.rotate_inner,
+        "seam": serde_json::to_value(seam)?,
         "frames": rows,
         "cold_seconds": cold,
         "failures": failures,
+        "cold_checks": cold_checks,
         "from_frame_6": {
-            "max_newton": later.iter().map(|r| r.newton_iterations).max(),
-            "max_linear_solves": later.iter().map(|r| r.linear_solves).max(),
-            "mean_seconds": (!later.is_empty()).then(|| later.iter().map(|r| r.seconds).sum::<f64>() / later.len() as f64),
+            "max_newton": max_newton,
+            "max_linear_solves": max_solves,
+            "mean_seconds": mean,
         },
     });
     winslow::io::write_json(&a.output.join("sweep.json"), &summary)?;
     println!(
-        "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; wrote {}",
+        "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; smallest certified det J {:.4e}; wrote {}",
         ring.name,
         rows.len(),
         failures,
         cold,
-        later.iter().map(|r| r.newton_iterations).max().unwrap_or(0),
-        later.iter().map(|r| r.linear_solves).max().unwrap_or(0),
-        if later.is_empty() { f64::NAN } else { later.iter().map(|r| r.seconds).sum::<f64>() / later.len() as f64 },
+        max_newton.unwrap_or(0),
+        max_solves.unwrap_or(0),
+        mean.unwrap_or(f64::NAN),
+        min_det,
         a.output.display()
     );
+    if !cold_checks.is_empty() {
+        let cold: Vec<f64> = cold_checks.iter().filter_map(|c| c["seconds"].as_f64()).collect();
+        let mean_cold = cold.iter().sum::<f64>() / cold.len() as f64;
+        println!(
+            "cold solves of {} frames: mean {mean_cold:.4} s; a predicted frame takes {:.3} of that",
+            cold.len(),
+            mean.unwrap_or(f64::NAN) / mean_cold
+        );
+    }
     Ok(if failures == 0 { 0 } else { 3 })
 }

@@ -488,7 +488,7 @@ fn improve_and_start_from_a_map() {
 fn solve_a_ring_end_to_end() {
     let dir = std::env::temp_dir().join(format!("winslow-ring-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    for name in ["eccentric_annulus", "annulus_periodic"] {
+    for name in ["eccentric_annulus", "annulus_periodic", "rotor_lobes_in_circle"] {
         let (map, png) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.png")));
         let out = bin()
             .arg("solve")
@@ -535,7 +535,9 @@ fn sweep_writes_frames_series_and_table() {
     let out = bin()
         .arg("sweep")
         .arg(data().join("rings/eccentric_annulus.json"))
-        .args(["--rotate-inner", "0.5", "--steps", "8", "--center", "0,0", "--quiet", "-o"])
+        .args(["--rotate-inner", "0.5", "--steps", "8", "--center", "0,0", "--quiet", "--apng"])
+        .arg(dir.join("sweep.png"))
+        .arg("-o")
         .arg(&dir)
         .output()
         .unwrap();
@@ -559,6 +561,31 @@ fn sweep_writes_frames_series_and_table() {
         _ => panic!("not a map"),
     };
     assert!(m.knots[1].is_periodic());
+    // the animated PNG has one frame per frame written
+    let dec = png::Decoder::new(std::fs::File::open(dir.join("sweep.png")).unwrap());
+    let reader = dec.read_info().unwrap();
+    assert_eq!(reader.info().animation_control.map(|a| a.num_frames), Some(9));
+    // --every 4: maps and animation frames 0, 4, 8; the table keeps all frames
+    let sub = dir.join("every");
+    let out = bin()
+        .arg("sweep")
+        .arg(data().join("rings/eccentric_annulus.json"))
+        .args(["--rotate-inner", "0.5", "--steps", "8", "--every", "4", "--cold-every", "4", "--quiet", "--apng"])
+        .arg(sub.join("a.png"))
+        .arg("-o")
+        .arg(&sub)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(files(&sub, "vtu").len(), 3);
+    assert_eq!(std::fs::read_to_string(sub.join("sweep.csv")).unwrap().lines().count(), 10);
+    // frames 4 and 8 were also solved cold, and certified
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(sub.join("sweep.json")).unwrap()).unwrap();
+    let cold = v["cold_checks"].as_array().unwrap();
+    assert_eq!(cold.iter().map(|c| c["frame"].as_u64().unwrap()).collect::<Vec<_>>(), [4, 8]);
+    assert!(cold.iter().all(|c| c["verdict"] == "certified"));
+    let reader = png::Decoder::new(std::fs::File::open(sub.join("a.png")).unwrap()).read_info().unwrap();
+    assert_eq!(reader.info().animation_control.map(|a| a.num_frames), Some(3));
     let bad = bin()
         .arg("sweep")
         .arg(data().join("wavy_lid.json"))
@@ -568,6 +595,69 @@ fn sweep_writes_frames_series_and_table() {
         .unwrap();
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(!bad.status.success() && err.contains("not a ring document"), "{err}");
+}
+
+/// `winslow sweep --inner-frames`: non-rigid motion from a directory of ring documents
+/// (the inner circle grows, uneven times): one certified map per file, whose inner
+/// boundary is that file's contour; a file with another outer contour is refused.
+#[test]
+fn sweep_follows_inner_contours_given_as_files() {
+    let dir = std::env::temp_dir().join(format!("winslow-sweep-nonrigid-{}", std::process::id()));
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let base = data().join("rings/eccentric_annulus.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&base).unwrap()).unwrap();
+    let radius = |k: usize| 0.4 * (1.0 + 0.02 * k as f64);
+    for k in 1..=7 {
+        let r = radius(k);
+        let pts: Vec<[f64; 2]> = (0..200)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / 200.0;
+                [0.25 + r * t.cos(), 0.1 + r * t.sin()]
+            })
+            .collect();
+        doc["ring"]["inner"] = serde_json::json!({ "points": pts });
+        std::fs::write(frames.join(format!("f{k:02}.json")), doc.to_string()).unwrap();
+    }
+    let out = bin()
+        .arg("sweep")
+        .arg(&base)
+        .arg("--inner-frames")
+        .arg(&frames)
+        .args(["--times", "1,2,2.5,3.5,4,5,5.5", "--quiet", "-o"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/sweep.json")).unwrap()).unwrap();
+    let rows = v["frames"].as_array().unwrap();
+    assert_eq!(rows.len(), 8);
+    assert_eq!(v["failures"], 0);
+    assert_eq!(rows[3]["time"], 2.5);
+    for k in [1, 7] {
+        let m = match winslow::read_document(&dir.join(format!("out/frame_{k:04}.json"))).unwrap() {
+            winslow::Document::Map { map, .. } => map,
+            _ => panic!("not a map"),
+        };
+        let p = m.eval(0.0, 0.37);
+        assert!(((p[0] - 0.25).hypot(p[1] - 0.1) - radius(k)).abs() < 1e-4, "frame {k}: {p:?}");
+    }
+    // another outer contour is refused, naming the file
+    doc["ring"]["outer"] = serde_json::json!({ "points": [[-2.0, -2.0], [2.0, -2.0], [2.0, 2.0], [-2.0, 2.0]] });
+    std::fs::write(frames.join("f99.json"), doc.to_string()).unwrap();
+    let out = bin()
+        .arg("sweep")
+        .arg(&base)
+        .arg("--inner-frames")
+        .arg(&frames)
+        .arg("-o")
+        .arg(dir.join("o2"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("f99.json") && err.contains("outer"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `winslow corpus` writes the seeded hard domains, which read back as boundaries, and

@@ -8,7 +8,8 @@
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-use winslow::boundary::ring::{fit_contour, ClosedContour};
+use winslow::boundary::ring::ClosedContour;
+use winslow::boundary::ring_fit::fit_contour;
 use winslow::boundary::Analytic;
 use winslow::discrete::assembly::{Discretization, Operator};
 use winslow::discrete::topology::Topology;

@@ -5,7 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
+use winslow::boundary::ring::{ClosedContour, Ring};
+use winslow::boundary::ring_fit::{check_ring, cut_open};
 use winslow::boundary::validate::sample_side;
+use winslow::io::ring::parse_ring_json;
 use winslow::io::{checked_boundary, parse_document, read_text, Document, ReadOptions};
 use winslow::multipatch::gismo::is_gismo_multipatch;
 use winslow::multipatch::json::is_json_multipatch;
@@ -63,6 +66,34 @@ impl BoundaryView {
     /// Bounds of the polylines.
     pub fn bounds(&self) -> Option<Bounds> {
         bounds_of(self.polylines.iter().flatten())
+    }
+}
+
+impl BoundaryView {
+    /// A ring's two closed contours (paper §11.1): west the inner and east the outer one,
+    /// south and north the seam segment between their starts; the problem is the ring's
+    /// check ([`check_ring`]: closed, counter-clockwise, nested).
+    pub fn ring(ring: &Ring) -> Self {
+        let problem = check_ring(ring).err().map(|e| e.to_string());
+        let closed = |c: &ClosedContour| {
+            let mut p = c.polygon_with(512);
+            if let Some(&q) = p.first() {
+                p.push(q);
+            }
+            p
+        };
+        let (inner, outer) = (closed(&ring.inner), closed(&ring.outer));
+        let seam: Vec<Point> = inner.first().into_iter().chain(outer.first()).copied().collect();
+        let control_polygons = [&ring.inner, &ring.outer]
+            .into_iter()
+            .filter_map(|c| match c {
+                ClosedContour::Spline(s) => Some(s.control_points.clone()),
+                _ => None,
+            })
+            .collect();
+        let boundary =
+            cut_open(ring, [seam.first().copied().unwrap_or_default(), seam.last().copied().unwrap_or_default()]);
+        Self { boundary, polylines: [seam.clone(), outer, seam, inner], control_polygons, problem, reoriented: false }
     }
 }
 
@@ -237,8 +268,11 @@ pub struct Scene {
     pub name: String,
     /// File it came from.
     pub path: Option<PathBuf>,
-    /// What the file was ("boundary", "map", "multipatch").
+    /// What the file was ("boundary", "map", "multipatch", "ring", "ring map").
     pub kind: &'static str,
+    /// The ring (O-grid, `eta` periodic) a solve fits: of a ring document, or the two
+    /// contours of a map with `eta` periodic.
+    pub ring: Option<Ring>,
     /// The boundary (of a boundary file, or the sides of a map): what `solve` uses.
     pub boundary: BoundaryView,
     /// The map, if any.
@@ -277,12 +311,20 @@ impl Scene {
                 s
             });
         }
+        let stem = || path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        if let Some(mut ring) = parse_ring_json(&text).with_context(|| format!("reading {}", path.display()))? {
+            if ring.name.is_empty() {
+                ring.name = stem();
+            }
+            let mut scene = Self::from_ring(ring);
+            scene.path = Some(path.to_path_buf());
+            return Ok(scene);
+        }
         let mut doc = parse_document(&text).with_context(|| format!("reading {}", path.display()))?;
         if doc.name().is_empty() {
-            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             match &mut doc {
-                Document::Boundary(b) => b.name = stem,
-                Document::Map { name, .. } => *name = stem,
+                Document::Boundary(b) => b.name = stem(),
+                Document::Map { name, .. } => *name = stem(),
             }
         }
         // a map file may carry the solver's report
@@ -302,6 +344,12 @@ impl Scene {
         Ok(scene)
     }
 
+    /// A scene of a ring document: its contours, solved as a ring.
+    pub fn from_ring(ring: Ring) -> Self {
+        let boundary = BoundaryView::ring(&ring);
+        Self { name: ring.name.clone(), path: None, kind: "ring", boundary, map: None, ring: Some(ring) }
+    }
+
     /// A scene of a document.
     pub fn from_document(
         doc: Document,
@@ -317,17 +365,31 @@ impl Scene {
                 boundary: BoundaryView::new(b),
                 map: None,
                 patches: Vec::new(),
+                ring: None,
             },
             Document::Map { name, map } => {
-                let doc = Document::Map { name: name.clone(), map: map.clone() };
                 let res = settings.resolution.unwrap_or_else(|| default_resolution(&map));
+                // a map with eta periodic (an O-grid) is bounded by two closed contours
+                let ring = map.knots[1].is_periodic().then(|| Ring {
+                    name: name.clone(),
+                    inner: ClosedContour::Spline(map.boundary(Side::West)),
+                    outer: ClosedContour::Spline(map.boundary(Side::East)),
+                });
+                let (kind, boundary) = match &ring {
+                    Some(r) => ("ring map", BoundaryView::ring(r)),
+                    None => (
+                        "map",
+                        BoundaryView::new(Document::Map { name: name.clone(), map: map.clone() }.into_boundary()),
+                    ),
+                };
                 Self {
                     name,
                     path: None,
-                    kind: "map",
-                    boundary: BoundaryView::new(doc.into_boundary()),
+                    kind,
+                    boundary,
                     map: Some(MapView::new(map, sampler, res, settings.density, certificate)),
                     patches: Vec::new(),
+                    ring,
                 }
             }
         }

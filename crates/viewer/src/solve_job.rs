@@ -10,13 +10,16 @@ use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use winslow::boundary::hierarchy::build_hierarchy;
+use winslow::boundary::hierarchy::{build_hierarchy, Hierarchy};
+use winslow::boundary::ring::Ring;
+use winslow::boundary::ring_fit::ring_hierarchy;
+use winslow::boundary::BasisChoice;
 use winslow::methods::egg::CpuAssembler;
 use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
-use winslow::solve::solver::{auto_fallback, EggSolver, Event};
+use winslow::solve::solver::{auto_fallback, ring_options, EggSolver, Event};
 use winslow::Boundary;
 
 /// A message from the solving thread.
@@ -113,8 +116,37 @@ fn attempt(
             return None;
         }
     };
+    drive(&h, boundary, opts.clone(), cancel, send)
+}
+
+/// Fit and solve a ring (O-grid, `eta` periodic: paper §11.1) as `winslow solve` does,
+/// sending every step to `send`.
+pub fn run_ring(ring: &Ring, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
+    if cancel.load(Ordering::Relaxed) {
+        return send(Msg::Cancelled);
+    }
+    match ring_hierarchy(ring, &opts.fit) {
+        Ok((h, cut)) => {
+            if let Some(sol) = drive(&h, &cut, ring_options(opts), cancel, send) {
+                send(Msg::Finished(Box::new(sol)));
+            }
+        }
+        Err(e) => send(Msg::Failed(format!("fitting the ring's contours: {e}"))),
+    }
+}
+
+/// Solve on the fitted hierarchy `h` of `boundary`; `None` once `Failed` or `Cancelled`
+/// was sent.
+fn drive(
+    h: &Hierarchy,
+    boundary: &Boundary,
+    opts: SolveOptions,
+    cancel: &AtomicBool,
+    send: &mut dyn FnMut(Msg),
+) -> Option<Solution> {
+    let cancelled = || cancel.load(Ordering::Relaxed);
     send(Msg::Fitted { levels: h.levels.len(), tolerance: h.physical_tol_abs() });
-    let mut solver = match EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler)) {
+    let mut solver = match EggSolver::new(h, opts, Arc::new(CpuAssembler)) {
         Ok(s) => s,
         Err(e) => {
             send(Msg::Failed(e.to_string()));
@@ -135,7 +167,7 @@ fn attempt(
             None => break,
         }
     }
-    match solver.finish(boundary, &h) {
+    match solver.finish(boundary, h) {
         Ok(s) => Some(s),
         Err(e) => {
             send(Msg::Failed(e.to_string()));
@@ -293,6 +325,12 @@ impl SolveJob {
     ) -> Self {
         let name = boundary.name.clone();
         Self::spawn(name, notify, move |cancel, send| run_compare(&boundary, &methods, &opts, cancel, send))
+    }
+
+    /// Start solving a ring ([`run_ring`]) in a new thread.
+    pub fn start_ring(ring: Ring, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
+        let name = ring.name.clone();
+        Self::spawn(name, notify, move |cancel, send| run_ring(&ring, &opts, cancel, send))
     }
 
     fn spawn(

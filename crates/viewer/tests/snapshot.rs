@@ -90,6 +90,25 @@ fn folded_map_snapshot() {
 }
 
 #[test]
+fn ring_view_snapshot() {
+    // the Fig. 16-like rotor in its casing (paper §11.1) solved as an O-grid: the
+    // periodic map's det J heat map and grid, seam included
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("rings/rotor_lobes_in_circle.json")).unwrap();
+    assert_eq!(app.state.scene.as_ref().unwrap().kind, "ring");
+    app.state.solve.fit_tol = 1e-3;
+    assert!(app.state.start_solve(|| {}));
+    app.state.wait_for_solve();
+    let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    assert!(mv.map.knots[1].is_periodic());
+    assert_eq!(mv.certificate.verdict, winslow::solve::report::Verdict::Certified, "{}", mv.certificate.message);
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label("ring");
+    h.snapshot("ring_view");
+}
+
+#[test]
 fn boundary_view_snapshot() {
     let mut app = ViewerApp::new(Arc::new(CpuSampler));
     app.state.open(&data("horseshoe.json")).unwrap();

@@ -36,6 +36,7 @@ pub mod level;
 pub mod normalise;
 pub mod reparam;
 pub mod ring;
+pub mod ring_fit;
 pub mod validate;
 
 use std::sync::Arc;

@@ -341,9 +341,14 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     /// `[KRYLOV_TOL, ETA_MAX]`, and never tighter than needed to reach the tolerance:
     /// the step leaves `|F_{k+1}| ~ eta_k |F_k|`, so `eta_k >= tol / (2 |F_k|)` (scaled)
     /// suffices. Keeps the quadratic convergence of Newton's method while the first
-    /// steps and the last one need few Krylov iterations.
+    /// steps and the last one need few Krylov iterations. A first step from a start
+    /// within `sqrt(tol)` (scaled; an extrapolated prediction, a prolonged solution) is
+    /// in the quadratic regime, where the step's own error `O(|F|^2)` is below the
+    /// tolerance: it is solved to `tol / (2 |F_0|)` so that one step suffices.
     fn forcing(&self) -> f64 {
+        let enough = 0.5 * self.opts.tol / self.scaled().max(f64::MIN_POSITIVE);
         let eta = match self.previous {
+            None if self.scaled() <= self.opts.tol.sqrt() => enough,
             None => ETA_MAX,
             Some((norm, eta)) => {
                 let ew = 0.9 * (self.norm / norm).powi(2);
@@ -355,7 +360,6 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
                 }
             }
         };
-        let enough = 0.5 * self.opts.tol / self.scaled().max(f64::MIN_POSITIVE);
         eta.min(ETA_MAX).max(enough).clamp(KRYLOV_TOL, ETA_MAX)
     }
 

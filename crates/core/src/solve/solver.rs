@@ -544,7 +544,16 @@ pub fn ring_options(opts: &SolveOptions) -> SolveOptions {
 /// fine with `eta` periodic, `xi = 0` on the inner and `xi = 1` on the outer contour, on
 /// the CPU ([`ring_options`]).
 pub fn solve_ring(ring: &crate::boundary::ring::Ring, opts: &SolveOptions) -> Result<Solution> {
-    let (h, cut) = crate::boundary::ring::ring_hierarchy(ring, &opts.fit)?;
+    solve_ring_with(ring, opts, crate::boundary::ring_fit::EtaRefinement::Adaptive)
+}
+
+/// [`solve_ring`] with the refinement of the contour fit in `eta` chosen.
+pub fn solve_ring_with(
+    ring: &crate::boundary::ring::Ring,
+    opts: &SolveOptions,
+    refinement: crate::boundary::ring_fit::EtaRefinement,
+) -> Result<Solution> {
+    let (h, cut) = crate::boundary::ring_fit::ring_hierarchy_with(ring, &opts.fit, refinement)?;
     EggSolver::new(&h, ring_options(opts), Arc::new(CpuAssembler))?.finish(&cut, &h)
 }
 

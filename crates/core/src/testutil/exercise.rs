@@ -94,7 +94,7 @@ pub fn exercise_ring_text(text: &str) -> Trace {
     let mut trace = Trace::default();
     if let Some(Some(ring)) = trace.record("read", crate::io::ring::parse_ring_json(text)) {
         trace.boundaries += 1;
-        if trace.record("fit", crate::boundary::ring::fit_ring(&ring, 3, 1e-2, 64)).is_some() {
+        if trace.record("fit", crate::boundary::ring_fit::fit_ring(&ring, 3, 1e-2, 64)).is_some() {
             trace.valid_boundaries += 1;
         }
     }
