@@ -35,8 +35,8 @@ mod corpus;
 mod inspect_ring;
 mod loft_cmd;
 mod mesh;
-mod optimise_cmd;
 mod multipatch_cmd;
+mod optimise_cmd;
 mod output;
 mod solve_cmd;
 mod sweep_cmd;
@@ -691,10 +691,6 @@ fn check(a: CheckArgs) -> Result<i32> {
     if let Some(v) = loft_cmd::volume_in(&a.map)? {
         return loft_cmd::check_volume(&v, a.max_depth, a.max_boxes, a.json);
     }
-    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-    let Document::Map { name, map, .. } = doc else {
-        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
-    };
     let opts = CertifyOptions {
         max_depth: a.max_depth.clamp(1, 40),
         max_boxes: a.max_boxes.clamp(1, 1 << 24),

@@ -248,7 +248,13 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         eprintln!("{HEADER}");
     }
     let every = a.every as usize;
-    let picture = PictureOptions { size: a.apng_size.max(16), grid_lines: 16, resolution: 160, segments: Vec::new() };
+    let picture = PictureOptions {
+        size: a.apng_size.max(16),
+        grid_lines: 16,
+        resolution: 160,
+        segments: Vec::new(),
+        kinks: Vec::new(),
+    };
     let mut apng: Option<Apng> = None;
     let mut rows = Vec::new();
     let mut pvd =

@@ -38,7 +38,8 @@ fn compare_prints_the_table_and_writes_pictures() {
 
 #[test]
 fn compare_json_has_one_row_per_method() {
-    let out = bin().arg("compare").arg(annulus()).args(["--methods", "vhm", "--lambda1", "0.01", "--json"]).output().unwrap();
+    let out =
+        bin().arg("compare").arg(annulus()).args(["--methods", "vhm", "--lambda1", "0.01", "--json"]).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = v["rows"].as_array().unwrap();

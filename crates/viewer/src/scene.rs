@@ -347,7 +347,15 @@ impl Scene {
     /// A scene of a ring document: its contours, solved as a ring.
     pub fn from_ring(ring: Ring) -> Self {
         let boundary = BoundaryView::ring(&ring);
-        Self { name: ring.name.clone(), path: None, kind: "ring", boundary, map: None, ring: Some(ring) }
+        Self {
+            name: ring.name.clone(),
+            path: None,
+            kind: "ring",
+            boundary,
+            map: None,
+            patches: Vec::new(),
+            ring: Some(ring),
+        }
     }
 
     /// A scene of a document.
@@ -425,6 +433,7 @@ impl Scene {
             boundary: BoundaryView::new(doc.into_boundary()),
             map: Some(first),
             patches: views,
+            ring: None,
         })
     }
 

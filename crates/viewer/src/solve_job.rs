@@ -13,7 +13,6 @@ use std::thread::JoinHandle;
 use winslow::boundary::hierarchy::{build_hierarchy, Hierarchy};
 use winslow::boundary::ring::Ring;
 use winslow::boundary::ring_fit::ring_hierarchy;
-use winslow::boundary::BasisChoice;
 use winslow::methods::egg::CpuAssembler;
 use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;

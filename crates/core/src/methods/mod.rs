@@ -7,7 +7,6 @@
 //! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
 //! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
 //! | [`metric_norms`] | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): [`MetricNormMethod`](metric_norms::MetricNormMethod) | eq. (3), §10.3 |
-    }
 //! | [`density`] | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
 //! | [`harmonic`] | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: [`VariationalHarmonicMethod`](harmonic::VariationalHarmonicMethod) | eq. (46) |
 //! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
@@ -47,8 +46,8 @@ pub mod density;
 pub mod egg;
 pub mod flux;
 pub mod galerkin;
-pub mod metric_norms;
 pub mod harmonic;
+pub mod metric_norms;
 pub mod quasi_conformal;
 pub mod weak_form;
 pub mod winslow;

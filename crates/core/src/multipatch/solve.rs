@@ -252,7 +252,8 @@ fn solve_patch(
         tol_abs: opts.fit.tol * diameter,
         diameter,
         reparam: ReparamReport::native(),
-        basis: BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None },
+        basis: BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None, kinks: None },
+        kinked: None,
         similarity: Similarity::IDENTITY,
     };
     let mut o = opts.clone();
