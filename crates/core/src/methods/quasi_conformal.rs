@@ -124,7 +124,7 @@ pub fn beltrami(e: &Jet, hessian: bool) -> (f64, Jet, JetMatrix) {
     let q = qp * qp + qm * qm;
     let mut grad = [0.0; JET];
     let mut hess = [[0.0; JET]; JET];
-    if !(q > 0.0) {
+    if q.is_nan() || q <= 0.0 {
         return (f64::INFINITY, grad, hess);
     }
     let f = p / q;
