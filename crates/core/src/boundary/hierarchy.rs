@@ -108,10 +108,10 @@ impl Hierarchy {
 }
 
 /// With `opts.basis` = [`BasisChoice::Input`] or [`BasisChoice::Auto`] (the default), the
-/// hierarchy on the input's own basis ([`input_levels`]) when the sides allow it;
+/// hierarchy on the input's own basis ([`input_levels`](crate::boundary::input_basis::input_levels)) when the sides allow it;
 /// otherwise, and with [`BasisChoice::Fitted`]:
 /// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
-/// §7), fit the four sides adaptively (see [`fit_side_with`]) with `tol_abs = tol *
+/// §7), fit the four sides adaptively (see [`fit_side_with`](crate::boundary::fit::fit_side_with)) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
 ///

@@ -149,7 +149,7 @@ pub const SPLINE_KINK_DEGREES: f64 = 1.0;
 
 /// A point cloud's turning of at least this (degrees), measured by [`kinks::cloud_corners`], is a
 /// corner (`--kinks auto` keeps it, the report names it otherwise). A sampled smooth
-/// curve turns less at the scale of [`CORNER_WINDOW`] unless its radius of curvature is
+/// curve turns less at the scale of [`CORNER_WINDOW`](kinks::CORNER_WINDOW) unless its radius of curvature is
 /// below about twice the window.
 pub const CLOUD_CORNER_DEGREES: f64 = 30.0;
 

@@ -231,7 +231,7 @@ pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Re
 }
 
 /// Check a ring: both contours closed and finite, counter-clockwise, the inner inside
-/// the outer (on polygons of about [`CHECK`] points). Returns the outer contour's
+/// the outer (on polygons of about 4096 points). Returns the outer contour's
 /// bounding box `[lo, hi]`.
 pub fn check_ring(ring: &Ring) -> Result<[Point; 2]> {
     // validation on polygons of about 4096 points (the nesting test is quadratic)

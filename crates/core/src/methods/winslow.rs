@@ -143,7 +143,7 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
 
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
-/// form of [`flux_form`] with `G = -∂W/∂e`.
+/// form of [`flux_form`](super::flux::flux_form) with `G = -∂W/∂e`.
 pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
     winslow_gradient_with(disc, cps, res, stencil, 0.0);
 }

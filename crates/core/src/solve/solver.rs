@@ -540,7 +540,7 @@ pub fn ring_options(opts: &SolveOptions) -> SolveOptions {
 }
 
 /// Fit a ring's contours on one periodic knot vector
-/// ([`ring_hierarchy`](crate::boundary::ring::ring_hierarchy)) and solve EGG coarse to
+/// ([`ring_hierarchy`](crate::boundary::ring_fit::ring_hierarchy)) and solve EGG coarse to
 /// fine with `eta` periodic, `xi = 0` on the inner and `xi = 1` on the outer contour, on
 /// the CPU ([`ring_options`]).
 pub fn solve_ring(ring: &crate::boundary::ring::Ring, opts: &SolveOptions) -> Result<Solution> {
