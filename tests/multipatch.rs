@@ -157,3 +157,27 @@ fn straight(free: &winslow::multipatch::MultipatchSolution, w_fixed: f64) {
     }
     assert!(f.max_interface_displacement > 0.1);
 }
+
+/// G+Smo wraps single domains in `<MultiPatch>` too: four boundary curves as
+/// `<MultiPatch parDim="1">`, one surface as a one-patch `<MultiPatch>`. Those are
+/// boundary and map documents for the ordinary readers and solve, not layouts; the
+/// shared multipatch files are layouts.
+#[test]
+fn single_domain_gismo_files_are_not_layouts() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/xml");
+    let mut single = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "xml") {
+            let layout = winslow::multipatch::read_layout(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(layout.is_none(), "{} read as a multipatch layout", path.display());
+            winslow::read_document(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            single += 1;
+        }
+    }
+    assert!(single >= 10, "{single} single-domain files");
+    for name in ["TUDflame.xml", "circleMP.xml", "plateWithHoleMP.xml"] {
+        let layout = winslow::multipatch::read_layout(&data(name)).unwrap();
+        assert!(layout.is_some_and(|l| l.patches.len() > 1), "{name}");
+    }
+}

@@ -474,7 +474,7 @@ struct SolveArgs {
     start: Option<PathBuf>,
     /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
     /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
-    /// A multipatch input (G+Smo <MultiPatch> or a JSON document with "patches") is
+    /// A multipatch input (G+Smo `<MultiPatch>` or a JSON document with "patches") is
     /// written as a JSON multipatch document or G+Smo XML (.xml).
     #[arg(short, long)]
     output: PathBuf,

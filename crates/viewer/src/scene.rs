@@ -305,11 +305,13 @@ impl Scene {
         let text = read_text(path).with_context(|| format!("reading {}", path.display()))?;
         if is_gismo_multipatch(&text) || is_json_multipatch(&text) {
             let layout = read_layout(path).with_context(|| format!("reading {}", path.display()))?;
-            let layout = layout.context("not a multipatch file")?;
-            return Self::from_layout(layout, sampler, settings).map(|mut s| {
-                s.path = Some(path.to_path_buf());
-                s
-            });
+            // a single G+Smo patch in <MultiPatch> is an ordinary map
+            if let Some(layout) = layout {
+                return Self::from_layout(layout, sampler, settings).map(|mut s| {
+                    s.path = Some(path.to_path_buf());
+                    s
+                });
+            }
         }
         let stem = || path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         if let Some(mut ring) = parse_ring_json(&text).with_context(|| format!("reading {}", path.display()))? {

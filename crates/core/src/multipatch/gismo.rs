@@ -34,10 +34,19 @@ use crate::io::gismo::{children, nesting_exceeds, patch, xml_err, MAX_DEPTH, MAX
 use crate::io::gismo_writer::surface_to_gismo_xml;
 use crate::spline::surface::{Side, Surface};
 
-/// Whether `text` is a G+Smo XML document with a `<MultiPatch>` element.
+/// Whether `text` is a G+Smo XML document with a `<MultiPatch>` element of surfaces: one
+/// whose `parDim` is not 1 (G+Smo stores the four boundary curves of a single domain as a
+/// `<MultiPatch parDim="1">`; that is a boundary document, read by
+/// [`crate::io::read_document`]).
 pub fn is_gismo_multipatch(text: &str) -> bool {
     let body = text.trim_start_matches('\u{feff}').trim_start();
-    body.starts_with('<') && body.contains("<MultiPatch")
+    body.starts_with('<')
+        && body.match_indices("<MultiPatch").any(|(k, _)| {
+            let tag = &body[k..];
+            let tag = &tag[..tag.find('>').unwrap_or(tag.len())];
+            let compact: String = tag.chars().filter(|c| !c.is_whitespace()).collect();
+            !(compact.contains("parDim=\"1\"") || compact.contains("parDim='1'"))
+        })
 }
 
 /// G+Smo's side number (1 west, 2 east, 3 south, 4 north) as a [`Side`].

@@ -18,11 +18,18 @@ use crate::io::{map_to_json, read_text};
 
 /// A layout from a multipatch file (G+Smo XML with a `<MultiPatch>`, or a JSON document
 /// with `patches`), named after the file stem when it has no name; `None` when the file
-/// is not a multipatch document.
+/// is not a multipatch document or is a G+Smo file of one patch without interfaces (G+Smo
+/// writes single maps that way; they are read as maps by [`crate::io::read_document`]).
 pub fn read_layout(path: &Path) -> Result<Option<Layout>> {
     let text = read_text(path)?;
     let mut layout = if is_gismo_multipatch(&text) {
-        parse_gismo_multipatch(&text)?
+        let layout = parse_gismo_multipatch(&text)?;
+        if layout.patches.len() == 1 && layout.interfaces.is_empty() {
+            // G+Smo wraps single patches in <MultiPatch> too: that is a map, read by
+            // `io::read_document` (and solved with its own options, e.g. `--basis auto`)
+            return Ok(None);
+        }
+        layout
     } else if is_json_multipatch(&text) {
         parse_json_multipatch(&text)?
     } else {
