@@ -1,0 +1,97 @@
+//! `winslow check MAP`: the bijectivity certificate of a map (a volume: the trivariate
+//! one; a multipatch file: every patch), its quality, and optionally its boundary
+//! deviation and the Poisson benchmark Q(x) (paper eq. 44-45).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use winslow::io::{read_document, Document};
+use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
+use winslow::verify::poisson::poisson_benchmark;
+use winslow::verify::quality::{boundary_deviation, quality};
+
+use crate::{load_boundary, loft_cmd, multipatch_cmd, output};
+
+#[derive(Args, Debug)]
+pub(crate) struct CheckArgs {
+    /// Map file (JSON map document or G+Smo XML; a volume: the trivariate certificate; a
+    /// multipatch file: every patch).
+    map: PathBuf,
+    /// The input boundary: report the largest deviation of the map's boundary from it.
+    #[arg(long)]
+    boundary: Option<PathBuf>,
+    /// Also solve the grid-quality benchmark -Δu = -Δu* (paper eq. 44-45) and report Q(x).
+    #[arg(long)]
+    poisson: bool,
+    /// Length scales a1,a2 of u* = sin(pi x / a1) sin(pi y / a2) (default: half the
+    /// bounding box extents).
+    #[arg(long, value_delimiter = ',', num_args = 2)]
+    poisson_scales: Option<Vec<f64>>,
+    /// Most bisections per element in the certificate (also the depth of the excused
+    /// neighbourhood of a forced corner: 2^-depth of the element).
+    #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
+    max_depth: usize,
+    /// Most Bernstein boxes examined per element.
+    #[arg(long, default_value_t = CertifyOptions::default().max_boxes)]
+    max_boxes: usize,
+    /// Excuse no corner: corners of 180 degrees or more leave the verdict undecided (or
+    /// folded) instead of degenerate-corner.
+    #[arg(long)]
+    strict_corners: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+pub(crate) fn check(a: CheckArgs) -> Result<i32> {
+    if let Some(v) = loft_cmd::volume_in(&a.map)? {
+        return loft_cmd::check_volume(&v, a.max_depth, a.max_boxes, a.json);
+    }
+    let opts = CertifyOptions {
+        max_depth: a.max_depth.clamp(1, 40),
+        max_boxes: a.max_boxes.clamp(1, 1 << 24),
+        excuse_corners: !a.strict_corners,
+    };
+    if let Some(layout) =
+        winslow::multipatch::read_layout(&a.map).with_context(|| format!("reading {}", a.map.display()))?
+    {
+        return multipatch_cmd::check(layout, &opts, a.json);
+    }
+    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
+    let Document::Map { name, map, .. } = doc else {
+        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+    };
+    let certificate = certify(&map, &opts).context("certifying the map")?;
+    let quality = quality(&map);
+    let deviation = match &a.boundary {
+        Some(p) => {
+            let b = load_boundary(p, false)?;
+            Some(boundary_deviation(&map, &b, 400))
+        }
+        None => None,
+    };
+    let poisson = if a.poisson {
+        let scales = a.poisson_scales.as_ref().map(|v| [v[0], v[1]]);
+        match poisson_benchmark(&map, scales) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                eprintln!("warning: the Poisson benchmark could not be solved on this map: {e}");
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let report = output::CheckReport { name, certificate, quality, boundary_deviation: deviation, poisson };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", output::check_text(&report));
+    }
+    Ok(match report.certificate.verdict {
+        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
+        CertVerdict::Folded { .. } => 3,
+        CertVerdict::Undecided { .. } => 5,
+    })
+}
