@@ -1,18 +1,25 @@
-//! `winslow compare BOUNDARY [--methods egg,vhm,qc] [--json] [--png-dir DIR]`: the
-//! methods of paper §10 on one basis, one table row each
+//! `winslow compare BOUNDARY [--methods egg,vhm,qc,maxz,liao,winslow-functional,ao]
+//! [--json] [--png-dir DIR]`: the methods of paper §10 on one basis, one table row each
 //! ([`winslow::solve::compare`]): iterations, the certificate's verdict, `Q(x) / Q(x_G)`,
 //! the Winslow, Liao and area-orthogonality values, the smallest scaled Jacobian, time.
 
 use super::*;
 use winslow::methods::quasi_conformal::QcHessian;
 use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
+use winslow::solve::constrained::ConstrainedOptions;
 
 #[derive(Args, Debug)]
 pub(super) struct CompareArgs {
     /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
     boundary: PathBuf,
     /// Methods, comma-separated: egg (eq. 8, always run: its map is x_G), vhm (the
-    /// variational harmonic method, eq. 46), qc (the quasi-conformal functional, eq. 47-48).
+    /// variational harmonic method, eq. 46), qc (the quasi-conformal functional, eq.
+    /// 47-48), and Gravesen's: maxz (eq. 49 from the Coons patch, stopped at z > 0), liao,
+    /// winslow-functional, ao (the Liao, Winslow eq. 16 or area-orthogonality functional
+    /// minimised subject to d(c) >= eps from x_G, as `winslow optimise --from egg`).
+    /// Gravesen's need a polynomial basis (--basis fitted where the input is NURBS) and
+    /// the constrained ones at most 3000 unknowns (a coarse --fit-tol); else their rows
+    /// are errors saying so.
     #[arg(long, value_delimiter = ',', default_value = "egg,vhm,qc")]
     methods: Vec<String>,
     /// Weight of the uniformity term of the variational harmonic method (eq. 46),
@@ -27,6 +34,13 @@ pub(super) struct CompareArgs {
     /// (Levenberg-Marquardt, the default) or the exact Hessian (Newton's method).
     #[arg(long, value_enum, default_value = "gauss-newton")]
     qc_hessian: QcHessianArg,
+    /// eps of the constraints d(c) >= eps of liao, winslow-functional and ao, relative to
+    /// the mean det J.
+    #[arg(long, default_value_t = ConstrainedOptions::default().eps)]
+    eps: f64,
+    /// Most SQP iterations of liao, winslow-functional and ao.
+    #[arg(long, default_value_t = ConstrainedOptions::default().max_iterations)]
+    max_sqp: usize,
     #[command(flatten)]
     fit: FitArgs,
     /// Nonlinear tolerance on each method's scaled residual.
@@ -119,6 +133,11 @@ impl CompareArgs {
             QcHessianArg::GaussNewton => QcHessian::GaussNewton,
             QcHessianArg::Exact => QcHessian::Exact,
         };
+        if !(self.eps > 0.0 && self.eps < 1.0) {
+            bail!("--eps must be in (0, 1) (a fraction of the mean det J), got {}", self.eps);
+        }
+        opts.constrained.eps = self.eps;
+        opts.constrained.max_iterations = self.max_sqp.max(1);
         if let Some(s) = &self.poisson_scales {
             if !s.iter().all(|v| v.is_finite() && *v > 0.0) {
                 bail!("--poisson-scales must be two positive numbers, got {s:?}");
@@ -214,16 +233,18 @@ pub(super) fn table(c: &Comparison) -> String {
     if let Some(why) = &c.basis_fallback {
         s.push_str(&format!("  basis: {why}\n"));
     }
+    let w = c.rows.iter().map(|r| r.method.len()).max().unwrap_or(0).max(6);
     s.push_str(&format!(
-        "{:<8} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9}\n",
-        "method", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"
+        "{:<w$} {:<9} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9}\n",
+        "method", "start", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"
     ));
     let mut notes = Vec::new();
     for r in &c.rows {
         let m = r.measures.as_ref();
         s.push_str(&format!(
-            "{:<8} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9.3}\n",
+            "{:<w$} {:<9} {:>5} {:>5} {:<17} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>9.3}\n",
             r.method,
+            r.start,
             r.iterations,
             if r.converged { "yes" } else { "no" },
             r.bij(),
@@ -235,8 +256,13 @@ pub(super) fn table(c: &Comparison) -> String {
             m.map_or("-".into(), |m| format!("{}x{}", m.shape[0], m.shape[1])),
             r.seconds
         ));
-        if let Some(why) = &r.failure {
-            notes.push(format!("  {}: not converged: {why}", r.method));
+        for n in &r.notes {
+            notes.push(format!("  {}: {n}", r.method));
+        }
+        match (&r.failure, m) {
+            (Some(why), None) => notes.push(format!("  {}: no map: {why}", r.method)),
+            (Some(why), Some(_)) => notes.push(format!("  {}: not converged: {why}", r.method)),
+            (None, _) => {}
         }
         if let Some(m) = m.filter(|m| !matches!(m.verdict, Verdict::Certified | Verdict::DegenerateCorner)) {
             notes.push(format!(
@@ -247,6 +273,10 @@ pub(super) fn table(c: &Comparison) -> String {
             ));
         }
     }
+    notes.push(
+        "  start: coons = the Coons patch of the finest basis, hierarchy = coarse to fine from the coarsest, egg = x_G"
+            .into(),
+    );
     for n in notes {
         s.push_str(&n);
         s.push('\n');

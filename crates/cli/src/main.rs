@@ -88,8 +88,9 @@ enum Command {
     /// of det J, from the EGG map or from the max-z point of eq. (49); or eq. (49) alone.
     Optimise(Box<optimise_cmd::OptimiseArgs>),
     /// The methods of paper §10 on one basis: EGG, the variational harmonic method
-    /// (eq. 46) and the quasi-conformal functional (eq. 47-48); iterations, the
-    /// certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
+    /// (eq. 46), the quasi-conformal functional (eq. 47-48) and, on request, Gravesen's
+    /// max-z (eq. 49) and constrained Liao, Winslow and area-orthogonality optimisations
+    /// from the EGG map; iterations, the certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
     /// Jacobian and time per method.
     Compare(Box<compare_cmd::CompareArgs>),
     /// Split a certified map's domain into two four-sided patches sharing a curve between

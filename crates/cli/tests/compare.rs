@@ -66,3 +66,89 @@ fn unknown_methods_and_bad_weights_are_errors() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--lambda2"));
 }
+
+/// The rows of `winslow compare ARGS --json` by method name.
+fn json_rows(args: &[&str]) -> Vec<serde_json::Value> {
+    let out = bin().arg("compare").args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    v["rows"].as_array().unwrap().clone()
+}
+
+/// Gravesen's methods on a small fitted basis: verdicts from the certificate, the
+/// constrained optimisations from x_G, each no worse than x_G for its own functional
+/// (x_G is feasible here, so the SQP's accepted steps only decrease the functional).
+#[test]
+fn compare_runs_gravesens_methods_from_the_egg_map() {
+    let path = annulus();
+    let args = [
+        path.to_str().unwrap(),
+        "--methods",
+        "maxz,liao,ao,winslow-functional",
+        "--basis",
+        "fitted",
+        "--fit-tol",
+        "1e-2",
+    ];
+    let rows = json_rows(&args);
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(names, ["egg", "maxz", "liao", "ao", "winslow-functional"]);
+    let shape = &rows[0]["measures"]["shape"];
+    for r in &rows {
+        assert_eq!(r["measures"]["verdict"], "certified", "{r}");
+        assert!(r["measures"]["certificate"].as_str().unwrap().starts_with("certified bijective"), "{r}");
+        assert_eq!(r["converged"], true, "{r}");
+        assert_eq!(&r["measures"]["shape"], shape, "one basis: {r}");
+    }
+    assert_eq!(rows[1]["start"], "coons");
+    // the Coons patch of the quarter annulus is already feasible (z > 0): no LP needed
+    assert!(rows[1]["notes"][0].as_str().unwrap().contains("0 LPs"), "{}", rows[1]);
+    let value = |r: &serde_json::Value, key: &str| r["measures"][key].as_f64().unwrap();
+    for (row, key) in [(&rows[2], "liao"), (&rows[3], "area_orthogonality"), (&rows[4], "winslow")] {
+        assert_eq!(row["start"], "egg", "{row}");
+        assert!(row["iterations"].as_u64().unwrap() >= 1, "{row}");
+        let (own, egg) = (value(row, key), value(&rows[0], key));
+        assert!(own <= egg * (1.0 + 1e-9), "{}: {key} {own} > {egg} of x_G", row["method"]);
+    }
+    // Liao and AO move well away from x_G (EGG does not minimise them)
+    assert!(value(&rows[2], "liao") < 0.95 * value(&rows[0], "liao"), "{}", rows[2]);
+    assert!(value(&rows[3], "area_orthogonality") < 0.95 * value(&rows[0], "area_orthogonality"));
+}
+
+/// Max-z climbs from a folded Coons patch (the star's) to a certified start.
+#[test]
+fn compare_maxz_certifies_a_folded_coons_patch() {
+    let star = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/contours/star8.json");
+    let args =
+        [star.to_str().unwrap(), "--methods", "maxz", "--basis", "fitted", "--fit-tol", "1e-2", "--min-elements", "4"];
+    let rows = json_rows(&args);
+    let maxz = &rows[1];
+    assert_eq!(maxz["method"], "maxz");
+    assert!(maxz["iterations"].as_u64().unwrap() >= 1, "{maxz}");
+    assert_eq!(maxz["converged"], true, "{maxz}");
+    assert_eq!(maxz["measures"]["verdict"], "certified", "{maxz}");
+}
+
+/// A rational basis (the input's NURBS) and a basis over the dense cap are error rows
+/// that say why, with no map and no measures.
+#[test]
+fn gravesens_methods_refuse_a_rational_or_large_basis_clearly() {
+    let nurbs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/maps/quarter_annulus_nurbs.json");
+    let rows = json_rows(&[nurbs.to_str().unwrap(), "--methods", "maxz,liao"]);
+    assert_eq!(rows[0]["measures"]["verdict"], "certified");
+    for r in &rows[1..] {
+        assert!(r["measures"].is_null(), "{r}");
+        let why = r["failure"].as_str().unwrap();
+        assert!(why.contains("not run") && why.contains("rational") && why.contains("--basis fitted"), "{why}");
+    }
+    // the star on at least 32 cubic elements per direction: over the dense SQP's 3000 unknowns
+    let star = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/contours/star8.json");
+    let args =
+        [star.to_str().unwrap(), "--methods", "ao", "--basis", "fitted", "--fit-tol", "1e-2", "--min-elements", "32"];
+    let rows = json_rows(&args);
+    assert!(rows[1]["measures"].is_null(), "{}", rows[1]);
+    let why = rows[1]["failure"].as_str().unwrap();
+    assert!(why.contains("not run") && why.contains("over the 3000"), "{why}");
+    let n: usize = why.split(" unknowns").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(n > 3000, "{why}");
+}

@@ -52,7 +52,7 @@
 //! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | [`verify::certificate::coefficients`], [`solve::constrained`], functionals in [`methods::metric_norms`] |
 //! | §10.1, eq. (46) | variational harmonic method | [`methods::harmonic`] (kernel of second-derivative functionals: [`methods::density`]) |
 //! | §10.2, eq. (47)-(48) | quasi-conformal functional, `k` eliminated | [`methods::quasi_conformal`] (rank-one term: [`methods::DiscreteProblem::rank_one`]) |
-//! | §10, Tables 1-3 | the comparison of methods on one basis | [`solve::compare`] |
+//! | §10, Tables 1-3 | the comparison of methods on one basis: EGG, VHM (eq. 46), quasi-conformal (eq. 47-48), max-z (eq. 49), constrained Liao / Winslow / area orthogonality from `x_G` | [`solve::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
 //! | §11.2 | multipatch layouts, one knot vector per interface, fixed and free interfaces, joining and splitting | [`multipatch`] |

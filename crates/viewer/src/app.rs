@@ -417,8 +417,16 @@ impl ViewerApp {
             }
         });
         let compare = ui
-            .add_enabled(self.state.can_solve(), egui::Button::new("Compare methods"))
-            .on_hover_text("EGG, the variational harmonic method (eq. 46) and the quasi-conformal functional (eq. 47-48) on one basis; switch between their maps below");
+            .horizontal(|ui| {
+                let b = ui
+                    .add_enabled(self.state.can_solve(), egui::Button::new("Compare methods"))
+                    .on_hover_text("EGG, the variational harmonic method (eq. 46) and the quasi-conformal functional (eq. 47-48) on one basis; switch between their maps below");
+                ui.checkbox(&mut self.state.compare_gravesen, "with Gravesen's").on_hover_text(
+                    "also max-z (eq. 49) from the Coons patch and the Liao, Winslow and area-orthogonality functionals subject to d(c) >= eps from the EGG map; they need the fitted (polynomial) basis with at most 3000 unknowns",
+                );
+                b
+            })
+            .inner;
         if compare.clicked() {
             let ctx = ui.ctx().clone();
             self.state.start_compare(move || ctx.request_repaint());

@@ -153,6 +153,10 @@ pub struct ViewerState {
     pub comparison: Option<Comparison>,
     /// The row of `comparison` whose map the scene shows.
     pub selected_method: Option<usize>,
+    /// Whether "Compare methods" adds Gravesen's methods (max-z, eq. 49, and the Liao,
+    /// Winslow and area-orthogonality functionals subject to `d(c) >= ε` from `x_G`) to
+    /// [`MethodChoice::DEFAULT`]; they need a polynomial basis of at most 3000 unknowns.
+    pub compare_gravesen: bool,
     sampler: Arc<dyn DetJSampler>,
 }
 
@@ -183,6 +187,7 @@ impl ViewerState {
             mesh: MeshOverlayState::default(),
             comparison: None,
             selected_method: None,
+            compare_gravesen: false,
             sampler,
         }
     }
@@ -267,8 +272,9 @@ impl ViewerState {
     }
 
     /// Start comparing the methods of paper §10 (EGG, the variational harmonic method,
-    /// the quasi-conformal functional) on the scene's boundary with the solver settings;
-    /// `notify` as for [`ViewerState::start_solve`].
+    /// the quasi-conformal functional, and Gravesen's with
+    /// [`ViewerState::compare_gravesen`]) on the scene's boundary with the solver
+    /// settings; `notify` as for [`ViewerState::start_solve`].
     pub fn start_compare(&mut self, notify: impl Fn() + Send + 'static) -> bool {
         if !self.can_solve() {
             return false;
@@ -280,7 +286,7 @@ impl ViewerState {
         opts.solve.operator = base.operator;
         opts.solve.min_elements = base.min_elements;
         opts.solve.refine = base.refine;
-        let methods = MethodChoice::ALL.to_vec();
+        let methods = if self.compare_gravesen { MethodChoice::ALL.to_vec() } else { MethodChoice::DEFAULT.to_vec() };
         self.job = Some(SolveJob::start_compare(scene.boundary.boundary.clone(), methods, opts, notify));
         self.status = Some(format!("comparing methods on {}", scene.name));
         true

@@ -65,3 +65,36 @@ fn compare_button_runs_the_methods_and_the_selector_switches_maps() {
     assert!(h.state().state.comparison.is_none());
     assert!(h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().report.is_some());
 }
+
+/// The "with Gravesen's" box adds max-z and the constrained optimisations from `x_G`
+/// (on the fitted B-spline basis), and the selector shows their maps like any other row.
+#[test]
+fn gravesens_methods_join_the_comparison_when_ticked() {
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("quarter_annulus.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    app.state.solve.fit_tol = 1e-2;
+    app.state.solve.basis = winslow::boundary::BasisChoice::Fitted;
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1180.0, 2400.0))
+        .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app);
+    h.run();
+    h.get_by_label("with Gravesen's").click();
+    h.run();
+    assert!(h.state().state.compare_gravesen);
+    h.get_by_label("Compare methods").click();
+    h.step();
+    h.state_mut().state.wait_for_solve();
+    h.run();
+    let cmp = h.state().state.comparison.clone().expect("a comparison");
+    let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
+    assert_eq!(names, ["egg", "vhm", "qc", "maxz", "liao", "winslow-functional", "ao"]);
+    for r in &cmp.rows {
+        assert_eq!(r.bij(), "certified", "{}: {:?}", r.method, r.failure);
+    }
+    h.get_by_label("liao").click();
+    h.run();
+    assert_eq!(h.state().state.selected_method, Some(4));
+    let shown = h.state().state.scene.as_ref().unwrap().map.as_ref().unwrap().map.clone();
+    assert_eq!(&shown, cmp.rows[4].map.as_ref().unwrap());
+}

@@ -22,6 +22,21 @@
 //! with more levels the coarse-to-fine walk of §6.3 ([`HierarchyRun`]). Defect
 //! correction (§8.2) is off by default: it would refine each method's basis differently.
 //!
+//! | name | method | start | IT counts |
+//! |------|--------|-------|-----------|
+//! | `egg` | EGG, eq. (8) (`x_G`) | Coons patch | Newton / pseudo-time iterations |
+//! | `vhm` | variational harmonic, eq. (46) | Coons patch | Newton iterations |
+//! | `qc` | quasi-conformal, eq. (47)-(48) | Coons patch | Levenberg-Marquardt / Newton iterations |
+//! | `maxz` | Gravesen's feasible start, eq. (49), stopped at `z > 0` | Coons patch | LPs |
+//! | `liao` | Liao functional (eq. 3) subject to `d(c) >= ε` | `x_G` | QPs of the SQP (+ restoration LPs) |
+//! | `winslow-functional` | Winslow functional (eq. 16) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
+//! | `ao` | area orthogonality (eq. 3) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
+//!
+//! Gravesen's methods (the last four, [`ConstrainedRun`], [`MaxZRun`]) need a polynomial
+//! basis, the constrained ones at most [`MAX_UNKNOWNS`](super::constrained::MAX_UNKNOWNS) unknowns: on
+//! another basis their rows are errors that say so. [`MethodChoice::DEFAULT`] leaves
+//! them out.
+//!
 //! Nothing ends silently folded: a method that does not converge, or whose map the
 //! certificate does not prove bijective, is reported as such with its last iterate; a
 //! method that fails outright is a row with the error and no measures.
@@ -31,6 +46,11 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+mod gravesen;
+
+pub use gravesen::{ConstrainedRun, MaxZRun};
+
+use super::constrained::{ConstrainedOptions, Functional};
 use super::options::SolveOptions;
 use super::report::{Solution, Verdict};
 use super::solver::{auto_fallback, EggSolver, Event};
@@ -56,11 +76,35 @@ pub enum MethodChoice {
     Vhm,
     /// The quasi-conformal functional, eq. (47)-(48).
     Qc,
+    /// Gravesen's feasible start, eq. (49), alone: `max z` subject to `d(c) >= z 1` from
+    /// the Coons patch of the EGG basis, stopped at `z > 0` ([`run_max_z`](super::constrained::run_max_z)).
+    #[serde(rename = "maxz")]
+    MaxZ,
+    /// The Liao functional (eq. 3) minimised subject to `d(c) >= ε` from `x_G`
+    /// ([`run`](super::constrained::run)).
+    Liao,
+    /// The Winslow functional (eq. 16) minimised subject to `d(c) >= ε` from `x_G`.
+    WinslowFunctional,
+    /// The area-orthogonality functional (eq. 3) minimised subject to `d(c) >= ε` from `x_G`.
+    Ao,
 }
 
 impl MethodChoice {
     /// Every registered method, in table order.
-    pub const ALL: [MethodChoice; 3] = [MethodChoice::Egg, MethodChoice::Vhm, MethodChoice::Qc];
+    pub const ALL: [MethodChoice; 7] = [
+        MethodChoice::Egg,
+        MethodChoice::Vhm,
+        MethodChoice::Qc,
+        MethodChoice::MaxZ,
+        MethodChoice::Liao,
+        MethodChoice::WinslowFunctional,
+        MethodChoice::Ao,
+    ];
+
+    /// The default selection (`winslow compare` without `--methods`, the viewer without
+    /// Gravesen's methods): the methods that run on any basis. Gravesen's need a
+    /// polynomial basis of at most [`MAX_UNKNOWNS`](super::constrained::MAX_UNKNOWNS) unknowns.
+    pub const DEFAULT: [MethodChoice; 3] = [MethodChoice::Egg, MethodChoice::Vhm, MethodChoice::Qc];
 
     /// The name in tables, reports and on the command line.
     pub fn name(self) -> &'static str {
@@ -68,6 +112,21 @@ impl MethodChoice {
             MethodChoice::Egg => "egg",
             MethodChoice::Vhm => "vhm",
             MethodChoice::Qc => "qc",
+            MethodChoice::MaxZ => "maxz",
+            MethodChoice::Liao => "liao",
+            MethodChoice::WinslowFunctional => "winslow-functional",
+            MethodChoice::Ao => "ao",
+        }
+    }
+
+    /// Where the method starts with `opts`: `coons` (the Coons patch of the finest
+    /// basis), `hierarchy` (coarse to fine from the Coons patch of the coarsest level,
+    /// more than one level) or `egg` (the EGG map `x_G`).
+    pub fn start(self, opts: &CompareOptions) -> &'static str {
+        match self {
+            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.max_levels != Some(1) => "hierarchy",
+            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc | MethodChoice::MaxZ => "coons",
+            MethodChoice::Liao | MethodChoice::WinslowFunctional | MethodChoice::Ao => "egg",
         }
     }
 
@@ -92,6 +151,10 @@ impl MethodChoice {
                 self.name(),
                 Some(Arc::new(QuasiConformalMethod { hessian: opts.qc_hessian })),
             )),
+            MethodChoice::MaxZ => Box::new(MaxZRun),
+            MethodChoice::Liao => Box::new(ConstrainedRun::new(self.name(), Functional::Liao)),
+            MethodChoice::WinslowFunctional => Box::new(ConstrainedRun::new(self.name(), Functional::Winslow)),
+            MethodChoice::Ao => Box::new(ConstrainedRun::new(self.name(), Functional::AreaOrthogonality)),
         }
     }
 }
@@ -112,6 +175,9 @@ pub struct CompareOptions {
     /// Length scales of the Poisson benchmark's `u*` (default: [`default_scales`] of the
     /// EGG map), the same for every method.
     pub poisson_scales: Option<[f64; 2]>,
+    /// `ε`, iteration limits and tolerances of Gravesen's methods (max-z and the
+    /// constrained optimisations); their certificate options are `solve.certify`.
+    pub constrained: ConstrainedOptions,
 }
 
 impl Default for CompareOptions {
@@ -127,7 +193,14 @@ impl Default for CompareOptions {
         let mut solve = SolveOptions { repair: 0, max_levels: Some(1), ..Default::default() };
         solve.nonlinear.max_newton = 200;
         solve.nonlinear.max_pseudo = 100;
-        Self { solve, lambda1: 0.0, lambda2: 0.0, qc_hessian: QcHessian::default(), poisson_scales: None }
+        Self {
+            solve,
+            lambda1: 0.0,
+            lambda2: 0.0,
+            qc_hessian: QcHessian::default(),
+            poisson_scales: None,
+            constrained: ConstrainedOptions::default(),
+        }
     }
 }
 
@@ -166,6 +239,8 @@ pub struct MethodRun {
     pub map: Surface,
     /// Wall-clock seconds of the run.
     pub seconds: f64,
+    /// What the run did beyond its iterations (stages, the start's and result's values).
+    pub notes: Vec<String>,
 }
 
 impl MethodRun {
@@ -180,6 +255,7 @@ impl MethodRun {
             failure: last.and_then(|l| l.failure.clone()),
             map: sol.map.clone(),
             seconds,
+            notes: Vec::new(),
         }
     }
 }
@@ -307,7 +383,10 @@ impl Measures {
 pub struct CompareRow {
     /// Method name.
     pub method: String,
-    /// Nonlinear iterations (IT), continuation solves included.
+    /// Where it started ([`MethodChoice::start`]): `coons`, `hierarchy` or `egg`.
+    pub start: &'static str,
+    /// Nonlinear iterations (IT), continuation solves included; for Gravesen's methods
+    /// the LP / QP subproblems solved.
     pub iterations: usize,
     /// Whether the method met its stopping rule.
     pub converged: bool,
@@ -319,6 +398,8 @@ pub struct CompareRow {
     pub q_ratio: Option<f64>,
     /// Seconds of the run (measures not included).
     pub seconds: f64,
+    /// What the run did beyond its iterations ([`MethodRun::notes`]).
+    pub notes: Vec<String>,
     /// The map, when there is one.
     #[serde(skip)]
     pub map: Option<Surface>,
@@ -448,15 +529,17 @@ pub fn compare(
         };
         let row = match run {
             Ok(None) => return Ok(None),
-            Ok(Some(r)) => row_of(r, opts, scales, out.rows.first())?,
+            Ok(Some(r)) => row_of(r, choice.start(opts), opts, scales, out.rows.first())?,
             Err(e) => CompareRow {
                 method: choice.name().into(),
+                start: choice.start(opts),
                 iterations: 0,
                 converged: false,
                 failure: Some(e.to_string()),
                 measures: None,
                 q_ratio: None,
                 seconds: 0.0,
+                notes: Vec::new(),
                 map: None,
             },
         };
@@ -469,7 +552,13 @@ pub fn compare(
 }
 
 /// The row of a run: its measures and `Q / Q(x_G)` against the reference row.
-fn row_of(r: MethodRun, opts: &CompareOptions, scales: [f64; 2], reference: Option<&CompareRow>) -> Result<CompareRow> {
+fn row_of(
+    r: MethodRun,
+    start: &'static str,
+    opts: &CompareOptions,
+    scales: [f64; 2],
+    reference: Option<&CompareRow>,
+) -> Result<CompareRow> {
     let measures = Measures::of(&r.map, opts, scales)?;
     let q_ref = match reference {
         Some(row) => row.measures.as_ref().and_then(|m| m.q),
@@ -481,112 +570,17 @@ fn row_of(r: MethodRun, opts: &CompareOptions, scales: [f64; 2], reference: Opti
     };
     Ok(CompareRow {
         method: r.method,
+        start,
         iterations: r.iterations,
         converged: r.converged,
         failure: r.failure,
         measures: Some(measures),
         q_ratio,
         seconds: r.seconds,
+        notes: r.notes,
         map: Some(r.map),
     })
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::boundary::{Analytic, SideCurve};
-    use crate::methods::egg::CpuAssembler;
-
-    /// The image of the unit square under `x = A ξ + b`, four straight sides.
-    fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
-        let f = |u: f64, v: f64| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v];
-        let side = move |g: fn(f64) -> (f64, f64)| {
-            SideCurve::Analytic(Analytic::new(move |t| {
-                let (u, v) = g(t);
-                f(u, v)
-            }))
-        };
-        let sides = [side(|t| (t, 0.0)), side(|t| (1.0, t)), side(|t| (t, 1.0)), side(|t| (0.0, t))];
-        (Boundary { name: "parallelogram".into(), sides }, f)
-    }
-
-    /// On an affine boundary every method returns the affine map (EGG and VHM to
-    /// rounding; the quasi-conformal minimizer is degenerate, see
-    /// [`crate::methods::quasi_conformal`], and resolved to its stopping rule), each
-    /// certified, on one basis, with `Q / Q(x_G) = 1` for maps equal to EGG's.
-    #[test]
-    fn every_method_returns_the_affine_map_of_an_affine_boundary() {
-        let (b, f) = parallelogram();
-        let opts = CompareOptions {
-            solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
-            ..Default::default()
-        };
-        let mut events = Vec::new();
-        let cmp = compare(
-            &b,
-            &[MethodChoice::Qc, MethodChoice::Vhm, MethodChoice::Qc],
-            &opts,
-            Arc::new(CpuAssembler),
-            &mut |e| {
-                if let CompareEvent::Started { method, .. } = &e {
-                    events.push(method.clone());
-                }
-                true
-            },
-        )
-        .unwrap()
-        .unwrap();
-        assert_eq!(events, ["egg", "qc", "vhm"], "EGG first, repeats dropped");
-        let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
-        assert_eq!(names, ["egg", "qc", "vhm"]);
-        let shape = cmp.rows[0].measures.as_ref().unwrap().shape;
-        for r in &cmp.rows {
-            let m = r.measures.as_ref().unwrap();
-            assert!(r.converged, "{}: {:?}", r.method, r.failure);
-            assert_eq!(m.verdict, Verdict::Certified, "{}", r.method);
-            assert_eq!(m.shape, shape, "{}: one basis", r.method);
-            let tol = if r.method == "qc" { 1e-4 } else { 1e-9 };
-            let map = r.map.as_ref().unwrap();
-            for (u, v) in [(0.3, 0.7), (0.5, 0.5), (0.9, 0.2), (0.05, 0.95)] {
-                let (x, e) = (map.eval(u, v), f(u, v));
-                assert!(
-                    (x[0] - e[0]).abs() < tol && (x[1] - e[1]).abs() < tol,
-                    "{} at ({u}, {v}): {x:?} vs {e:?}",
-                    r.method
-                );
-            }
-            // the same map, the same Poisson error
-            let q = r.q_ratio.unwrap();
-            assert!((q - 1.0).abs() < if r.method == "qc" { 1e-3 } else { 1e-8 }, "{}: Q / Q(x_G) = {q}", r.method);
-        }
-        assert_eq!(cmp.rows[0].q_ratio, Some(1.0));
-    }
-
-    #[test]
-    fn names_parse_and_unknown_names_are_errors() {
-        for m in MethodChoice::ALL {
-            assert_eq!(MethodChoice::parse(m.name()).unwrap(), m);
-        }
-        assert_eq!(MethodChoice::parse(" VHM ").unwrap(), MethodChoice::Vhm);
-        let e = MethodChoice::parse("ipopt").unwrap_err().to_string();
-        assert!(e.contains("ipopt") && e.contains("egg, vhm, qc"), "{e}");
-    }
-
-    /// The progress callback cancels: `Ok(None)`, no comparison.
-    #[test]
-    fn progress_can_cancel() {
-        let (b, _) = parallelogram();
-        let opts = CompareOptions {
-            solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
-            ..Default::default()
-        };
-        let mut seen = 0;
-        let out = compare(&b, &[MethodChoice::Vhm], &opts, Arc::new(CpuAssembler), &mut |_| {
-            seen += 1;
-            seen < 3
-        })
-        .unwrap();
-        assert!(out.is_none());
-        assert_eq!(seen, 3);
-    }
-}
+mod tests;

@@ -15,7 +15,7 @@
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified | §4.1, §9 |
 //! | [`constrained`] | Gravesen's feasible start [`max_z`](constrained::max_z) (`max z`, `d(c) >= z 1`) and the constrained optimisation [`optimise`](constrained::optimise) of the Liao, Winslow or area-orthogonality functional subject to `d(c) >= ε` (SQP, Clarabel subproblems), from the EGG map or the max-z point: [`run`](constrained::run) | §10.3, eq. (49), Table 3 |
 //! | [`kinks`] | [`keep_kinks`](kinks::keep_kinks): the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |
-//! | [`compare`] | [`compare`](compare::compare): EGG, the variational harmonic and the quasi-conformal methods (and more through [`Contender`](compare::Contender)) on one basis, judged by the certificate, `Q(x) / Q(x_G)`, the Winslow, Liao and area-orthogonality values | §10, Tables 1-3 |
+//! | [`compare`] | [`compare`](compare::compare): EGG, the variational harmonic and the quasi-conformal methods, Gravesen's max-z and constrained Liao / Winslow / area-orthogonality optimisations from `x_G` ([`MethodChoice`](compare::MethodChoice); more through [`Contender`](compare::Contender)) on one basis, judged by the certificate, `Q(x) / Q(x_G)`, the Winslow, Liao and area-orthogonality values | §10, Tables 1-3 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod compare;

@@ -34,7 +34,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 pub use feasible::max_z;
-pub use sqp::optimise;
+pub use sqp::{optimise, MAX_UNKNOWNS};
 
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::DofMap;
