@@ -298,8 +298,9 @@ impl ViewerApp {
                 ),
             };
             if let Some(s) = &self.state.status {
+                // elided to the width the hint leaves (the full text is on hover)
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                    ui.label(RichText::new(s).weak());
+                    ui.add(egui::Label::new(RichText::new(s).weak()).truncate());
                 });
             }
         });
