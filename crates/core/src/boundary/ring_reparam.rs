@@ -25,7 +25,7 @@
 //! one gets `eta^2_j = s^1_i` at every matched pair and, between consecutive matches
 //! (and the seam at both ends), cord length mapped onto the interval of the two matched
 //! values (eq. 41-42, [`fill_abscissae`]; or a Fritsch-Carlson monotone cubic with
-//! [`Fill::MonotoneCubic`]). The new outer parameter is strictly increasing from `s^2_0`
+//! [`Fill::MonotoneCubic`](super::reparam::Fill::MonotoneCubic)). The new outer parameter is strictly increasing from `s^2_0`
 //! to `s^2_0 + 1`: a monotone periodic map of the outer contour onto itself, equal to
 //! arc length when nothing is matched (then the samples are left untouched, bit for bit).
 //! The contours are then fitted on one periodic knot vector as before
