@@ -226,12 +226,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             None => format!("{steps} inner contours"),
         };
         eprintln!(
-            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}); {what}",
+            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}, reparameterization {} with {} matched pairs, kept by every frame); {what}",
             ring.name,
             sol.map.shape()[0],
             sol.map.shape()[1],
             f0.report.seconds,
             f0.report.verdict,
+            sol.report.reparam.used.name(),
+            sol.report.reparam.matches.len(),
         );
         // the sliding seam moves the parameter by |Δθ| / 2π of a period per step; the
         // prediction is good while that is a small part of the smallest element
@@ -335,6 +337,9 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         "name": ring.name,
         "step_degrees": a.rotate_inner,
         "seam": serde_json::to_value(seam)?,
+        // frame 0's parameterization, which every frame keeps (arc length unless
+        // `--reparam constrained`: see `winslow::solve::sweep`)
+        "reparam": serde_json::to_value(&sol.report.reparam)?,
         "frames": rows,
         "cold_seconds": cold,
         "failures": failures,

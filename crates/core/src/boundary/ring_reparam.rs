@@ -109,10 +109,16 @@ pub(super) fn ring_reparam(
 /// diameter) of the circle.
 #[cfg(test)]
 pub(crate) fn lobed_gap() -> super::ring::Ring {
+    lobed_gap_from(std::f64::consts::FRAC_PI_2)
+}
+
+/// [`lobed_gap`] with the inner contour starting at `θ = start`.
+#[cfg(test)]
+pub(crate) fn lobed_gap_from(start: f64) -> super::ring::Ring {
     use super::ring::ClosedContour;
-    use std::f64::consts::{FRAC_PI_2, TAU};
-    let inner = ClosedContour::Analytic(super::Analytic::new(|t| {
-        let th = FRAC_PI_2 + TAU * t;
+    use std::f64::consts::TAU;
+    let inner = ClosedContour::Analytic(super::Analytic::new(move |t| {
+        let th = start + TAU * t;
         let r = 0.35 * (1.0 + 0.2 * (3.0 * th).cos());
         [0.578 + r * th.cos(), r * th.sin()]
     }));
@@ -184,6 +190,27 @@ mod tests {
         let last = a.levels.last().unwrap();
         assert!(dist(last.curves[0].eval(m.parameter), m.points[0]) <= a.tol_abs);
         assert!(dist(last.curves[1].eval(m.parameter), m.points[1]) > 0.2);
+    }
+
+    /// The seam through the gap (the inner contour starts at the lobe tip): `eta = 0`
+    /// stays where arc length puts it, the matches keep the separation from it on both
+    /// sides of the period and are in cyclic order.
+    #[test]
+    fn seam_through_the_gap_stays_fixed() {
+        let ring = lobed_gap_from(0.0);
+        let (f, a) = (fit(&ring, Reparam::Auto, Fill::CordLength), fit(&ring, Reparam::ArcLength, Fill::CordLength));
+        assert!(f.converged && f.reparam.used == Reparam::Constrained && !f.reparam.matches.is_empty());
+        let (lf, la) = (f.levels.last().unwrap(), a.levels.last().unwrap());
+        for k in 0..2 {
+            assert!(dist(lf.curves[k].eval(0.0), la.curves[k].eval(0.0)) <= 2.0 * f.tol_abs);
+        }
+        let t: Vec<f64> = f.reparam.matches.iter().map(|m| m.parameter).collect();
+        assert!(t.windows(2).all(|w| w[1] > w[0]) && t[0] > 0.01 && *t.last().unwrap() < 0.99, "{t:?}");
+        // matched on both sides of the seam
+        assert!(t[0] < 0.1 && *t.last().unwrap() > 0.9, "{t:?}");
+        for m in &f.reparam.matches {
+            assert!(dist(lf.curves[1].eval(m.parameter), m.points[1]) <= f.tol_abs, "{m:?}");
+        }
     }
 
     /// Without a narrow gap `auto` is arc length, bit for bit; `constrained` on a ring

@@ -46,7 +46,9 @@
 //! explicitly ([`Reparam::Constrained`]): `auto` reads as arc length here
 //! ([`frame0_options`]). Matched pairs belong to one position of the inner contour; as it
 //! turns, the outer parameter stays bunched where frame 0's lobe tips were (the rotor
-//! rings have narrow tip gaps, so `auto` would match them). The matching is not redone
+//! rings have narrow tip gaps, so `auto` would match them; with `constrained` the male
+//! rotor's 1000 frames are certified too, smallest det J 4.49 against 4.69 by arc
+//! length, BENCHMARKS.md). The matching is not redone
 //! per frame either: it is a discrete choice of pairs (§7.2, last paragraph: not a
 //! continuous function of the shape), and redoing it would make the boundary control
 //! points jump in time and spoil the extrapolation.
