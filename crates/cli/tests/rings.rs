@@ -46,6 +46,8 @@ fn solve_ring_matches_a_narrow_gap() {
         if method == "auto" {
             assert_eq!(rp["used"], "constrained");
             assert!(err.contains("reparameterization: constrained (requested auto)"), "{err}");
+            let text = String::from_utf8_lossy(&out.stdout);
+            assert!(text.contains("gap/diameter inner-outer 7.20e-4") && text.contains("inner/outer at "), "{text}");
             assert!(matches.len() >= 3, "{matches:?}");
             assert_eq!(r["verdict"], "certified", "{}", r["message"]);
             for m in matches {
