@@ -7,7 +7,7 @@ use std::path::Path;
 
 use winslow::boundary::fit::FitOptions;
 use winslow::boundary::ring::{ClosedContour, Ring};
-use winslow::boundary::ring_fit::fit_ring;
+use winslow::boundary::ring_fit::{fit_ring_with, EtaRefinement};
 
 fn describe(c: &ClosedContour) -> String {
     match c {
@@ -26,7 +26,7 @@ fn describe(c: &ClosedContour) -> String {
 /// Print (or with `json`, write as JSON) the ring's contours and fit; exit code 0, or 2
 /// when the ring is invalid or its fit fails.
 pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::Result<i32> {
-    let fit = fit_ring(ring, opts.degree, opts.tol, opts.max_elements);
+    let fit = fit_ring_with(ring, opts.degree, opts.tol, opts.max_elements, EtaRefinement::Adaptive, &opts.reparam);
     if json {
         let v = match &fit {
             Ok(f) => serde_json::json!({
@@ -42,6 +42,11 @@ pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::R
                 "normalisation": (!f.similarity.is_identity()).then_some(f.similarity),
                 "converged": f.converged,
                 "outer_seam_shift": f.outer_shift.rem_euclid(1.0),
+                "reparam": {
+                    "used": f.reparam.used.name(),
+                    "gap_ratio": f.reparam.gap_ratio[1],
+                    "matches": f.reparam.matches.len(),
+                },
                 "problems": [],
             }),
             Err(e) => serde_json::json!({
@@ -80,6 +85,15 @@ pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::R
                 s,
                 "  eta = 0 on the outer contour at arc-length fraction {:.6}",
                 f.outer_shift.rem_euclid(1.0)
+            );
+            let _ = writeln!(
+                s,
+                "  reparameterization: {} (requested {}); gap/diameter {:.2e} (threshold {:.1e}); {} matched pairs",
+                f.reparam.used.name(),
+                f.reparam.requested.name(),
+                f.reparam.gap_ratio[1],
+                f.reparam.gap_threshold,
+                f.reparam.matches.len()
             );
             let _ = writeln!(s, "  no problems found");
             0

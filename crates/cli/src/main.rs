@@ -122,11 +122,13 @@ struct FitArgs {
     #[arg(long)]
     reorient: bool,
     /// Boundary reparameterization (paper §7): auto = constrained cord length on
-    /// opposite sides closer than --reparam-gap times their length, none elsewhere.
+    /// opposite sides closer than --reparam-gap times their length, none elsewhere; for a
+    /// ring: arc length, with facing points of a narrow gap (closer than --reparam-gap
+    /// times the diameter) matched at the same eta (arclength/none: never matched).
     #[arg(long, value_enum, default_value = "auto")]
     reparam: ReparamArg,
     /// Narrow-gap threshold (auto) and matching distance (constrained), relative to the
-    /// mean length of the two opposite sides.
+    /// mean length of the two opposite sides (for a ring: the outer contour's diameter).
     #[arg(long, default_value_t = ReparamOptions::default().gap)]
     reparam_gap: f64,
     /// Minimum separation of two matched pairs, in cord length of each side.

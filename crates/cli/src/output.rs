@@ -136,7 +136,19 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
     );
     let rp = &r.reparam;
     let gap = |g: f64| if g.is_finite() { format!("{g:.2e}") } else { "-".into() };
-    let _ = writeln!(
+    if sol.map.knots[1].is_periodic() {
+        // a ring: one pair of contours, the gap over the outer contour's diameter
+        let _ = writeln!(
+            s,
+            "  reparameterization: {} (requested {}); gap/diameter inner-outer {} (threshold {:.1e}); {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            gap(rp.gap_ratio[1]),
+            rp.gap_threshold,
+            rp.matches.len()
+        );
+    } else {
+        let _ = writeln!(
         s,
         "  reparameterization: {} (requested {}); gap/length south-north {} ({}), west-east {} ({}); {} matched pairs",
         rp.used.name(),
@@ -147,6 +159,7 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
         rp.pair_methods[1].name(),
         rp.matches.len()
     );
+    }
     for m in &rp.matches {
         let _ = writeln!(
             s,

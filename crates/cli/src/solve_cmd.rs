@@ -37,11 +37,21 @@ pub(super) fn run_ring_solver(
 ) -> Result<Solution> {
     let (h, cut) = ring_hierarchy(ring, &opts.fit).context("fitting the ring's contours")?;
     if !quiet {
+        let rp = &h.reparam;
         eprintln!(
-            "{}: ring (O-grid, eta periodic), contours fitted on {} periodic levels up to {} elements in eta, by arc length",
+            "{}: ring (O-grid, eta periodic), contours fitted on {} periodic levels up to {} elements in eta, {}",
             ring.name,
             h.levels.len(),
-            h.finest().knots[1].num_elements()
+            h.finest().knots[1].num_elements(),
+            if rp.matches.is_empty() { "by arc length" } else { "arc length with the narrow gap matched (§7.2)" }
+        );
+        eprintln!(
+            "  reparameterization: {} (requested {}); gap/diameter {:.2e} (threshold {:.1e}); {} matched pairs",
+            rp.used.name(),
+            rp.requested.name(),
+            rp.gap_ratio[1],
+            rp.gap_threshold,
+            rp.matches.len()
         );
         let (s, e) = (&cut.sides[Side::West as usize], &cut.sides[Side::East as usize]);
         eprintln!("  inner: {}; outer: {}", s.describe(), e.describe());

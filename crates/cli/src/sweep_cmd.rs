@@ -9,7 +9,7 @@ use winslow::boundary::ring::{ClosedContour, Ring};
 use winslow::boundary::ring_fit::EtaRefinement;
 use winslow::io::picture::Image;
 use winslow::solve::solver::solve_ring_with;
-use winslow::solve::sweep::{Frame, FrameReport, Seam, Sweep, SweepOptions};
+use winslow::solve::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, SweepOptions};
 
 #[derive(Args, Debug)]
 pub(super) struct SweepArgs {
@@ -226,12 +226,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             None => format!("{steps} inner contours"),
         };
         eprintln!(
-            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}); {what}",
+            "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}, reparameterization {} with {} matched pairs, kept by every frame); {what}",
             ring.name,
             sol.map.shape()[0],
             sol.map.shape()[1],
             f0.report.seconds,
             f0.report.verdict,
+            sol.report.reparam.used.name(),
+            sol.report.reparam.matches.len(),
         );
         // the sliding seam moves the parameter by |Δθ| / 2π of a period per step; the
         // prediction is good while that is a small part of the smallest element
@@ -301,8 +303,8 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             let turned = Ring { inner: ring.inner.rotated(centre, angle), ..ring.clone() };
             let refinement = if seam == Seam::Material { EtaRefinement::Adaptive } else { EtaRefinement::Uniform };
             let t0 = std::time::Instant::now();
-            let cold =
-                solve_ring_with(&turned, &opts, refinement).with_context(|| format!("cold solve of frame {k}"))?;
+            let cold = solve_ring_with(&turned, &frame0_options(&opts), refinement)
+                .with_context(|| format!("cold solve of frame {k}"))?;
             let seconds = t0.elapsed().as_secs_f64();
             cold_checks.push(serde_json::json!({
                 "frame": k,
@@ -335,6 +337,9 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         "name": ring.name,
         "step_degrees": a.rotate_inner,
         "seam": serde_json::to_value(seam)?,
+        // frame 0's parameterization, which every frame keeps (arc length unless
+        // `--reparam constrained`: see `winslow::solve::sweep`)
+        "reparam": serde_json::to_value(&sol.report.reparam)?,
         "frames": rows,
         "cold_seconds": cold,
         "failures": failures,

@@ -37,6 +37,7 @@ pub mod normalise;
 pub mod reparam;
 pub mod ring;
 pub mod ring_fit;
+pub mod ring_reparam;
 pub mod validate;
 
 use std::sync::Arc;

@@ -1,6 +1,7 @@
 //! The contour fit of a ring (paper §5 on closed contours, §11.1): both contours of a
 //! [`Ring`] on one periodic knot vector in `eta`, parameterized by arc length with the
-//! seam of [`crate::boundary::ring`], and the hierarchy of bases the solver walks.
+//! seam of [`crate::boundary::ring`] (narrow gaps matched by
+//! [`crate::boundary::ring_reparam`]), and the hierarchy of bases the solver walks.
 //!
 //! **Fit.** Least squares `min sum_k |C(eta_k) - x_k|^2` over the `d` distinct control
 //! points (wrapped collocation matrix) on one periodic knot vector for both contours, at
@@ -22,8 +23,9 @@
 use super::fit::{FitOptions, SideFit, REGULARIZATION};
 use super::hierarchy::{BasisReport, Hierarchy, Level};
 use super::normalise::Similarity;
-use super::reparam::{Reparam, ReparamReport};
+use super::reparam::{ReparamOptions, ReparamReport};
 use super::ring::{dist, inside, signed_area, ClosedContour, Ring, Samples};
+use super::ring_reparam::{ring_reparam, wrapped};
 use super::{Boundary, SideCurve};
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
@@ -84,6 +86,9 @@ pub struct RingFit {
     /// The input's coordinates from the fit's: `x = c + s x̂` (the identity for a
     /// well-placed ring); lengths above are in the fit's coordinates.
     pub similarity: Similarity,
+    /// The reparameterization: arc length, or the matching of narrow gaps
+    /// ([`crate::boundary::ring_reparam`]); matched points in the fit's coordinates.
+    pub reparam: ReparamReport,
 }
 
 /// Least-squares fit `min sum_k |C(s_k) - x_k|^2` of a periodic curve on `kv` (normal
@@ -215,19 +220,17 @@ pub fn fit_contour_seam(
 }
 
 fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Curve, f64)> {
-    let mut pairs: Vec<(f64, Point)> =
-        smp.s.iter().zip(&smp.x).map(|(&s, &x)| ((s - shift).rem_euclid(1.0), x)).collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    fit_periodic(kv, &Samples { s: pairs.iter().map(|p| p.0).collect(), x: pairs.iter().map(|p| p.1).collect() })
+    fit_periodic(kv, &wrapped(smp.s.iter().map(|s| s - shift), &smp.x))
 }
 
 /// Validate a ring (closed contours, counter-clockwise, the inner inside the outer),
 /// bring it to unit size ([`Similarity`]), reparameterize both contours by arc length
-/// with the seam of the module documentation, and fit them adaptively on dyadic periodic
-/// knot vectors of degree `degree` until `tol * diameter` is met (at most
-/// `max_elements` elements).
+/// with the seam of the module documentation (and match narrow gaps: the default
+/// [`ReparamOptions`], `auto`, see [`crate::boundary::ring_reparam`]), and fit them
+/// adaptively on dyadic periodic knot vectors of degree `degree` until `tol * diameter`
+/// is met (at most `max_elements` elements).
 pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
-    fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive)
+    fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive, &ReparamOptions::default())
 }
 
 /// Check a ring: both contours closed and finite, counter-clockwise, the inner inside
@@ -283,13 +286,14 @@ pub enum EtaRefinement {
     Uniform,
 }
 
-/// [`fit_ring`] with the refinement in `eta` chosen.
+/// [`fit_ring`] with the refinement in `eta` and the reparameterization chosen.
 pub fn fit_ring_with(
     ring: &Ring,
     degree: usize,
     tol: f64,
     max_elements: usize,
     refinement: EtaRefinement,
+    reparam: &ReparamOptions,
 ) -> Result<RingFit> {
     let [lo, hi] = check_ring(ring)?;
     let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
@@ -310,10 +314,12 @@ pub fn fit_ring_with(
         let k = (0..outer.x.len()).min_by(|&a, &b| dist(outer.x[a], start).total_cmp(&dist(outer.x[b], start)));
         outer.s[k.unwrap_or(0)]
     });
-    let mut pairs: Vec<(f64, Point)> =
-        outer.s.iter().zip(&outer.x).map(|(&s, &x)| ((s - shift).rem_euclid(1.0), x)).collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    outer = Samples { s: pairs.iter().map(|p| p.0).collect(), x: pairs.iter().map(|p| p.1).collect() };
+    outer = wrapped(outer.s.iter().map(|s| s - shift), &outer.x);
+    // narrow gaps: matched pairs at the same eta (the inner keeps arc length)
+    let (matched, report) = ring_reparam(&inner, &outer, diameter, reparam)?;
+    if let Some(m) = matched {
+        outer = m;
+    }
     let tol_abs = tol * diameter;
     let mut levels = Vec::new();
     let mut kv = KnotVector::periodic_uniform(degree, 4.max(degree + 1).next_power_of_two());
@@ -322,8 +328,10 @@ pub fn fit_ring_with(
         let (co, eo, per_o) = fit_periodic_elements(&kv, &outer)?;
         levels.push(RingLevel { knots: kv.clone(), curves: [ci, co], max_error: [ei, eo] });
         let done = ei <= tol_abs && eo <= tol_abs;
-        let finish =
-            |levels| Ok(RingFit { levels, converged: done, tol_abs, diameter, outer_shift: shift, similarity });
+        let finish = |levels| {
+            let reparam = report.clone();
+            Ok(RingFit { levels, converged: done, tol_abs, diameter, outer_shift: shift, similarity, reparam })
+        };
         if done {
             return finish(levels);
         }
@@ -371,7 +379,7 @@ pub fn ring_hierarchy(ring: &Ring, opts: &FitOptions) -> Result<(Hierarchy, Boun
 /// [`ring_hierarchy`] with the refinement in `eta` chosen.
 pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefinement) -> Result<(Hierarchy, Boundary)> {
     opts.validate()?;
-    let fit = fit_ring_with(ring, opts.degree, opts.tol, opts.max_elements, refinement)?;
+    let fit = fit_ring_with(ring, opts.degree, opts.tol, opts.max_elements, refinement, &opts.reparam)?;
     let p = opts.degree;
     let xi = KnotVector::open_uniform(p, 1);
     let finest = &fit.levels.last().expect("at least one fit").curves;
@@ -409,15 +417,12 @@ pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefine
         side_fit(Side::North, None),
         side_fit(Side::West, Some(0)),
     ];
-    let mut reparam = ReparamReport::native();
-    reparam.requested = Reparam::ArcLength;
-    reparam.used = Reparam::ArcLength;
     let h = Hierarchy {
         levels,
         fits,
         tol_abs: fit.tol_abs,
         diameter: fit.diameter,
-        reparam,
+        reparam: fit.reparam.clone(),
         basis: BasisReport::fitted(),
         kinked: None,
         similarity: fit.similarity,
@@ -483,8 +488,9 @@ mod tests {
             [r * (TAU * t).cos(), r * (TAU * t).sin()]
         }));
         let ring = Ring { name: "bump".into(), inner: bump, outer: circle(3.0, [0.0; 2], 0.0) };
-        let a = fit_ring_with(&ring, 3, 1e-4, 4096, EtaRefinement::Adaptive).unwrap();
-        let u = fit_ring_with(&ring, 3, 1e-4, 4096, EtaRefinement::Uniform).unwrap();
+        let o = ReparamOptions::default();
+        let a = fit_ring_with(&ring, 3, 1e-4, 4096, EtaRefinement::Adaptive, &o).unwrap();
+        let u = fit_ring_with(&ring, 3, 1e-4, 4096, EtaRefinement::Uniform, &o).unwrap();
         assert!(a.converged && u.converged);
         let (ka, ku) = (&a.levels.last().unwrap().knots, &u.levels.last().unwrap().knots);
         assert!(2 * ka.num_elements() < ku.num_elements(), "{} vs {}", ka.num_elements(), ku.num_elements());

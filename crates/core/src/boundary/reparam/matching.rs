@@ -144,27 +144,45 @@ pub fn constrained_params(
         .ok_or_else(|| Error::Invalid("constrained cord length: first side has zero length".into()))?;
     let c2 = cord_length_params(p2)
         .ok_or_else(|| Error::Invalid("constrained cord length: second side has zero length".into()))?;
+    let pairs = match_clouds(p1, &c1, p2, &c2, eps, sep, across);
+    let known: Vec<(usize, f64)> = pairs.iter().map(|&(i, j)| (j, c1[i])).collect();
+    let xi2 = fill_abscissae(&c2, &known, fill)?;
+    Ok((c1, xi2, pairs))
+}
+
+/// [`match_pairs`] on two whole clouds with parameters `c1`, `c2` (each increasing over
+/// `[0, 1]`): the quadratic search runs on at most [`MAX_SEARCH_POINTS`] points of each
+/// (every k-th point, ends kept), the pairs are returned as indices of the full clouds, and only
+/// pairs with `c1` strictly increasing inside `(0, 1)` and `c2` strictly increasing are
+/// kept (repeated points can give equal parameters). Shared by the four-sided
+/// [`constrained_params`] and the ring matching ([`crate::boundary::ring_reparam`]).
+pub fn match_clouds(
+    p1: &[Point],
+    c1: &[f64],
+    p2: &[Point],
+    c2: &[f64],
+    eps: f64,
+    sep: f64,
+    across: Across,
+) -> Vec<(usize, usize)> {
     // the closest-pair search is quadratic: on very dense clouds it runs on every k-th point
     let (i1, i2) = (thinned(p1.len()), thinned(p2.len()));
     let pick = |idx: &[usize], v: &[Point]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
     let pickc = |idx: &[usize], v: &[f64]| idx.iter().map(|&k| v[k]).collect::<Vec<_>>();
     let mut pairs: Vec<(usize, usize)> =
-        match_pairs(&pick(&i1, p1), &pickc(&i1, &c1), &pick(&i2, p2), &pickc(&i2, &c2), eps, sep, across)
+        match_pairs(&pick(&i1, p1), &pickc(&i1, c1), &pick(&i2, p2), &pickc(&i2, c2), eps, sep, across)
             .into_iter()
             .map(|(a, b)| (i1[a], i2[b]))
             .collect();
-    // repeated points on side 1 can give equal abscissae: keep strictly increasing ones
-    let mut last = 0.0;
-    pairs.retain(|&(i, _)| {
-        let ok = c1[i] > last && c1[i] < 1.0;
+    let (mut last1, mut last2) = (0.0, f64::NEG_INFINITY);
+    pairs.retain(|&(i, j)| {
+        let ok = c1[i] > last1 && c1[i] < 1.0 && c2[j] > last2;
         if ok {
-            last = c1[i];
+            (last1, last2) = (c1[i], c2[j]);
         }
         ok
     });
-    let known: Vec<(usize, f64)> = pairs.iter().map(|&(i, j)| (j, c1[i])).collect();
-    let xi2 = fill_abscissae(&c2, &known, fill)?;
-    Ok((c1, xi2, pairs))
+    pairs
 }
 
 /// Most points per side that the quadratic searches ([`match_pairs`], [`min_distance`])

@@ -18,6 +18,9 @@
 //!   by a Fritsch-Carlson monotone cubic through the matched values or by piecewise cord
 //!   length between consecutive matches (eq. 41-42). See [`constrained_params`].
 //!
+//! Rings (closed contours, `eta` periodic) use the same matching on the two contours
+//! cut open at the seam: [`crate::boundary::ring_reparam`].
+//!
 //! Parametric sides are turned into point clouds by dense sampling
 //! ([`sample_side`]); the resulting abscissae `ξ_k` of the samples `t_k` define
 //! `g` as the monotone cubic through `(ξ_k, t_k)`.
@@ -408,7 +411,7 @@ pub enum SideParam {
 /// A matched pair of points on two opposite sides, at the same parameter.
 #[derive(Debug, Clone, Serialize)]
 pub struct Match {
-    /// The two sides ("south", "north") or ("west", "east").
+    /// The two sides ("south", "north") or ("west", "east"); ("inner", "outer") on a ring.
     pub sides: [&'static str; 2],
     /// The common parameter (`xi` for south/north, `eta` for west/east).
     pub parameter: f64,
@@ -425,11 +428,12 @@ pub struct ReparamReport {
     /// (`none` for `auto` without narrow gaps).
     pub used: Reparam,
     /// Per pair (south/north, west/east): smallest distance between the two sides over
-    /// their mean length.
+    /// their mean length (a ring: `[null, inner/outer distance over the diameter]`).
     pub gap_ratio: [f64; 2],
     /// Per pair: the method applied to it.
     pub pair_methods: [Reparam; 2],
-    /// Threshold of `auto` and of the matching, relative to the mean length of a pair.
+    /// Threshold of `auto` and of the matching, relative to the mean length of a pair
+    /// (a ring: to the outer contour's diameter).
     pub gap_threshold: f64,
     /// Fill of the unmatched abscissae.
     pub fill: Fill,
