@@ -155,7 +155,8 @@ pub struct Improved {
 /// The nonlinear options of `method` run from a bijective start on `m` free functions:
 /// Newton with its line search only (pseudo time-stepping is for starts far from a
 /// solution, and 400 of its steps cost minutes on a fine basis), the residual scaled by
-/// [`Method::residual_scale`], the step tolerance in length units; a minimisation stops
+/// [`Method::residual_scale`], the step tolerance in length units, a failed line search
+/// on a GMRES direction retried with LU ([`NonlinearOptions::direct_retry`]); a minimisation stops
 /// when its decrement is negligible ([`crate::solve::newton::DECREMENT_TOL`]) or after
 /// [`MAX_MODIFIED_STEPS`] steps with a modified Hessian.
 pub fn from_bijective_start(
@@ -166,6 +167,7 @@ pub fn from_bijective_start(
 ) -> NonlinearOptions {
     let mut nl = nonlinear;
     nl.method = NonlinearMethod::Newton;
+    nl.direct_retry = true;
     nl.fallback = false;
     nl.scale = method.residual_scale(diameter, m);
     nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;

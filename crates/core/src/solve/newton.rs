@@ -77,6 +77,12 @@ pub struct NonlinearOptions {
     /// whose decrement (the decrease its quadratic model predicts) is at most this
     /// fraction of `|J|` (see [`DECREMENT_TOL`]); 0: off.
     pub decrement_tol: f64,
+    /// A root-finding Newton step whose line search fails on a GMRES direction is solved
+    /// again once with sparse direct LU (kept for the rest of the solve) before the solver
+    /// gives up: an inexact Krylov direction need not descend where GMRES's preconditioner
+    /// is poor (cells of aspect ratio ~100). Off by default (EGG falls back to pseudo time
+    /// instead); the improvement stage from a bijective start turns it on.
+    pub direct_retry: bool,
 }
 
 impl Default for NonlinearOptions {
@@ -93,6 +99,7 @@ impl Default for NonlinearOptions {
             linear: LinearMethod::Auto,
             max_modified: None,
             decrement_tol: 0.0,
+            direct_retry: false,
         }
     }
 }
@@ -436,6 +443,13 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             };
             delta = q.clamp(0.1 * delta, 0.5 * delta);
             if delta < 1e-4 {
+                if self.opts.direct_retry && self.lin.method() == LinearMethod::Gmres {
+                    // the GMRES direction does not descend: this step again, solved directly
+                    self.lin = LinearSolver::new(LinearMethod::Lu);
+                    self.iteration -= 1;
+                    self.newton_its -= 1;
+                    return self.newton_step();
+                }
                 return Ok(self.stall("line search failed (no descent along the Newton direction)".into()));
             }
         }
