@@ -82,6 +82,11 @@ pub(crate) fn jet_at(disc: &Discretization, ex: usize, ey: usize, cps: &[Point],
     e
 }
 
+/// The first derivatives `(x_ξ, x_η, y_ξ, y_η)` held in a jet (its slots 0, 1, 5, 6).
+pub fn first_derivatives(e: &Jet) -> [f64; 4] {
+    [e[0], e[1], e[5], e[6]]
+}
+
 /// `Σ_q w_q ψ(E_q)` over the quadrature points of `disc` for the map with control points
 /// `cps`; `+∞` when `ψ` is not finite at a point (outside the density's domain). Rows of
 /// elements in parallel, summed in order (deterministic).

@@ -28,13 +28,13 @@
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
-use super::flux::{flux_form, gradient_at};
+use super::density::{first_derivatives, integrate, Order};
+use super::flux::flux_form;
 use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
-use crate::discrete::assembly::{Discretization, Scratch};
+use crate::discrete::assembly::Discretization;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
@@ -95,28 +95,7 @@ pub fn metric_density(norm: MetricNorm, e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4
 /// `∫ W(∇x) dξ` of a density `W` of `e = (x_ξ, x_η, y_ξ, y_η)` by the quadrature of
 /// `disc`; rows of elements in parallel, summed in order (deterministic).
 pub fn density_integral(disc: &Discretization, cps: &[Point], density: impl Fn([f64; 4]) -> f64 + Sync) -> f64 {
-    let (p, q) = disc.degrees();
-    let nq = [disc.tables[0].nq, disc.tables[1].nq];
-    let (nex, ney) = (disc.tables[0].num_elements(), disc.tables[1].num_elements());
-    let rows: Vec<f64> = (0..ney)
-        .into_par_iter()
-        .map_init(
-            || Scratch::new(p, q, 1),
-            |s, ey| {
-                let mut sum = 0.0;
-                for ex in 0..nex {
-                    for kv in 0..nq[1] {
-                        for ku in 0..nq[0] {
-                            let wq = disc.tensor_basis(ex, ey, ku, kv, s);
-                            sum += wq * density(gradient_at(disc, ex, ey, cps, s));
-                        }
-                    }
-                }
-                sum
-            },
-        )
-        .collect();
-    rows.iter().sum()
+    integrate(disc, cps, Order::First, |e| density(first_derivatives(e)))
 }
 
 /// A metric norm (Liao or area orthogonality) minimized from any start.

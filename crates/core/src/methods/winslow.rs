@@ -44,12 +44,11 @@
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
-
+use super::density::{first_derivatives, integrate, Order};
 use super::flux::{flux_form_with, gradient_at};
 use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method, Start};
-use crate::discrete::assembly::{element_product, Discretization, Scratch};
+use crate::discrete::assembly::{element_product, Discretization};
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
@@ -112,33 +111,15 @@ pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
 /// `+∞` when `det J <= 0` at a quadrature point. Element rows in parallel, summed in
 /// order (deterministic).
 pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
-    let (p, q) = disc.degrees();
-    let nq = [disc.tables[0].nq, disc.tables[1].nq];
-    let (nex, ney) = (disc.tables[0].num_elements(), disc.tables[1].num_elements());
-    let rows: Vec<f64> = (0..ney)
-        .into_par_iter()
-        .map_init(
-            || Scratch::new(p, q, 1),
-            |s, ey| {
-                let mut sum = 0.0;
-                for ex in 0..nex {
-                    for kv in 0..nq[1] {
-                        for ku in 0..nq[0] {
-                            let wq = disc.tensor_basis(ex, ey, ku, kv, s);
-                            let [a, b, c, d] = gradient_at(disc, ex, ey, cps, s);
-                            let det = a * d - b * c;
-                            if det.is_nan() || det <= 0.0 {
-                                return f64::INFINITY;
-                            }
-                            sum += wq * (a * a + b * b + c * c + d * d) / det;
-                        }
-                    }
-                }
-                sum
-            },
-        )
-        .collect();
-    rows.iter().sum()
+    integrate(disc, cps, Order::First, |e| {
+        let [a, b, c, d] = first_derivatives(e);
+        let det = a * d - b * c;
+        if det.is_nan() || det <= 0.0 {
+            f64::INFINITY
+        } else {
+            (a * a + b * b + c * c + d * d) / det
+        }
+    })
 }
 
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
