@@ -86,12 +86,13 @@ pub struct KinkStage {
 }
 
 impl KinkStage {
-    /// The record of a route that did not run (the `Σ¹` map is not a bijective start).
-    pub fn skipped(kinked: &KinkedLevel, smoothed_functions: usize, why: String) -> Self {
+    /// The stage not yet run: `kinked` on `functions` functions (from `smoothed_functions`
+    /// of the smoothed basis), nothing done.
+    fn new(kinked: &KinkedLevel, smoothed_functions: usize, functions: usize) -> Self {
         Self {
             kinks: kinked.kinks.len(),
             smoothed_functions,
-            functions: kinked.level.num_basis(),
+            functions,
             boundary_shift: 0.0,
             continuation_steps: 0,
             continuation_iterations: 0,
@@ -102,10 +103,16 @@ impl KinkStage {
             winslow: [None, None],
             kept: false,
             certificate: String::new(),
-            failure: Some(why.clone()),
+            failure: None,
             seconds: 0.0,
-            message: format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹"),
+            message: String::new(),
         }
+    }
+
+    /// The record of a route that did not run (the `Σ¹` map is not a bijective start).
+    pub fn skipped(kinked: &KinkedLevel, smoothed_functions: usize, why: String) -> Self {
+        let message = format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹");
+        Self { failure: Some(why), message, ..Self::new(kinked, smoothed_functions, kinked.level.num_basis()) }
     }
 }
 
@@ -150,24 +157,7 @@ pub fn keep_kinks(
     let [p, q] = map.degrees();
     let method = WinslowMethod;
     let mut cont = Continuation::default();
-    let mut report = KinkStage {
-        kinks: kinked.kinks.len(),
-        smoothed_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
-        functions: level.num_basis(),
-        boundary_shift: 0.0,
-        continuation_steps: 0,
-        continuation_iterations: 0,
-        refinements: 0,
-        alpha: 0.0,
-        iterations: 0,
-        converged: false,
-        winslow: [None, None],
-        kept: false,
-        certificate: String::new(),
-        failure: None,
-        seconds: 0.0,
-        message: String::new(),
-    };
+    let mut report = KinkStage::new(kinked, map.knots[0].num_basis() * map.knots[1].num_basis(), level.num_basis());
     // the damped elasticity continuation to the kinked boundary; where its full step is
     // not certified, the offending elements are bisected (§8.2) and it goes on from the
     // last certified map, prolonged

@@ -1,29 +1,10 @@
 //! Tests of the Winslow functional: density, gradient and Hessian against finite
 //! differences, the projection onto semidefinite matrices, the problem's line search.
 use super::*;
+use crate::methods::density::tests::affine;
 use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
 use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
-
-/// The affine map `(ξ, η) -> (2ξ + 0.5η + 1, -0.3ξ + 1.5η)` on a `p`, `ne` basis
-/// (Greville interpolation reproduces it), interior control points moved by up to
-/// `noise / 2`.
-fn affine(p: usize, ne: usize, seed: u64, noise: f64) -> (Arc<Discretization>, Vec<Point>, Vec<Point>) {
-    let kx = KnotVector::open_uniform(p, ne);
-    let ky = KnotVector::open_uniform(p, ne).with_inserted(&[0.37]);
-    let (gx, gy) = (kx.greville(), ky.greville());
-    let exact: Vec<Point> =
-        gy.iter().flat_map(|&v| gx.iter().map(move |&u| [2.0 * u + 0.5 * v + 1.0, -0.3 * u + 1.5 * v])).collect();
-    let disc = Discretization::new([kx, ky]);
-    let mut rng = Lcg::new(seed);
-    let mut cps = exact.clone();
-    for &k in disc.dofs.free() {
-        for d in 0..2 {
-            cps[k][d] += noise * (rng.uniform() - 0.5);
-        }
-    }
-    (Arc::new(disc), cps, exact)
-}
 
 /// A curved map (a perturbed annulus sector).
 fn curved(seed: u64, noise: f64) -> (Arc<Discretization>, Vec<Point>) {
