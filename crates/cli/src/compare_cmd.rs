@@ -66,7 +66,7 @@ pub(super) struct CompareArgs {
     /// Operator of EGG: L of eq. (4) or L / (g11 + g22).
     #[arg(long, value_enum, default_value = "scaled")]
     operator: OperatorArg,
-    /// Linear solver: sparse LU, GMRES, or auto (LU up to 1000 unknowns).
+    /// Linear solver: sparse LU, GMRES, or auto (LU up to 64 unknowns, GMRES above).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
     /// Rounds of defect correction per method (default 0: every method on the same

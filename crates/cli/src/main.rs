@@ -321,7 +321,7 @@ struct SolverArgs {
     /// shared geometries, see BENCHMARKS.md).
     #[arg(long, value_enum, default_value = "scaled")]
     operator: OperatorArg,
-    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), or auto (LU up to 1000 unknowns).
+    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), or auto (LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations).
     #[arg(long, value_enum, default_value = "auto")]
     linear: LinearArg,
     /// Rounds of defect correction: while the certificate says folded or undecided,
@@ -551,6 +551,10 @@ enum KernelArg {
 
 fn main() {
     let cli = Cli::parse();
+    // the worker threads start with the process (as G+Smo's OpenMP threads persist
+    // between solves), not inside the first parallel loop of a solve's clock; an error
+    // (a pool already built) leaves the existing one
+    let _ = rayon::ThreadPoolBuilder::new().build_global();
     let code = match run(cli) {
         Ok(code) => code,
         Err(e) => {

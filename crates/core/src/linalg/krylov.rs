@@ -232,8 +232,10 @@ pub fn gmres(
             r[i] = b[i] - w[i];
         }
         if total >= max_iter {
+            // a tight tolerance missed by a little still gives a usable solution; a
+            // loose one (an inexact Newton forcing term) must be met within 10 %
             let rn = dot(&r, &r).sqrt();
-            if rn <= 1e3 * tol * bnorm {
+            if rn <= (1e3 * tol).min(0.1) * bnorm {
                 return Ok((x, total));
             }
             return Err(Error::LinearSolver(format!("GMRES: residual {:.3e} after {total} iterations", rn / bnorm)));

@@ -59,11 +59,25 @@ pub enum LinearMethod {
 /// Iterations after which [`LinearMethod::Pcg`] gives up for a direct factorization.
 pub const MAX_PCG: usize = 500;
 
-/// Largest system that [`LinearMethod::Auto`] factorizes directly.
-pub const AUTO_LU_LIMIT: usize = 1_000;
+/// Largest system that [`LinearMethod::Auto`] factorizes directly. Preconditioned GMRES
+/// overtakes faer's sparse LU on the EGG Jacobian at about 64 unknowns (measured on the
+/// shared G+Smo geometries on their input bases: 96 unknowns 1.9 against 2.1 ms per
+/// solve, 384: 5.1 against 12 ms, 988: 29 against 71 ms; 32-50 unknowns: LU faster by
+/// 0.1-0.6 ms).
+pub const AUTO_LU_LIMIT: usize = 64;
 
 /// Default relative residual at which GMRES stops.
 pub const KRYLOV_TOL: f64 = 1e-10;
+
+/// GMRES iterations per solve after which [`LinearMethod::Gmres`] gives up.
+pub const MAX_KRYLOV: usize = 2000;
+
+/// GMRES iterations per solve after which [`LinearMethod::Auto`] factorizes the system
+/// by LU instead (for the rest of the solve): with the problem's SPD preconditioner a
+/// solve takes at most 30 iterations on the shared geometries; one that takes 500 has a
+/// preconditioner that does not fit the operator (the weak form, eq. 14, on cells of
+/// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
+pub const AUTO_MAX_KRYLOV: usize = 500;
 
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
 pub const REFRESH_KRYLOV: usize = 30;
@@ -113,6 +127,14 @@ impl Scalar for f32 {
     }
 }
 
+/// The parallelism of the numeric Cholesky factorizations: sequential. faer's
+/// rayon-parallel supernodal factorization was 2-3x slower on 2 cores at every size
+/// measured (the Winslow Hessian of jigsaw01, 9984 unknowns: 0.24 s against 0.11 s of
+/// factorizations; the EGG preconditioner of the quarter annulus at 230 k unknowns:
+/// whole solve 3.8 s against 2.0 s), and its idle workers spinning slowed the parallel
+/// assembly around it. The parallelism of a solve is in its element loops.
+const CHOLESKY_PAR: Par = Par::Seq;
+
 /// Sparse Cholesky `A = L L^T` of an SPD matrix with a fixed sparsity pattern: symbolic
 /// analysis (ordering, elimination tree, supernodes) once, then numeric factorizations
 /// and solves into storage allocated up front.
@@ -155,7 +177,7 @@ impl<T: Scalar> Cholesky<T> {
         let symbolic =
             factorize_symbolic_cholesky(symmetric_pattern(a), Side::Lower, ord, CholeskySymbolicParams::default())
                 .map_err(|e| Error::LinearSolver(format!("symbolic Cholesky: {e:?}")))?;
-        let scratch = symbolic.factorize_numeric_llt_scratch::<T>(Par::rayon(0), Default::default());
+        let scratch = symbolic.factorize_numeric_llt_scratch::<T>(CHOLESKY_PAR, Default::default());
         let factor_scratch =
             MemBuffer::try_new(scratch).map_err(|_| Error::LinearSolver("Cholesky: out of memory".into()))?;
         let values = vec![T::zero_impl(); symbolic.len_val()];
@@ -171,7 +193,7 @@ impl<T: Scalar> Cholesky<T> {
                 SparseColMatRef::new(symmetric_pattern(a), entries),
                 Side::Lower,
                 Default::default(),
-                Par::rayon(0),
+                CHOLESKY_PAR,
                 MemStack::new(&mut self.factor_scratch),
                 Default::default(),
             )
@@ -485,7 +507,8 @@ impl LinearSolver {
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let pc = self.precond.as_mut().expect("set with matrix");
-                match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, 2000) {
+                let cap = if self.fallback { AUTO_MAX_KRYLOV } else { MAX_KRYLOV };
+                match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, cap) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
                         self.last_krylov = it;

@@ -228,12 +228,13 @@ pub struct Solution {
 /// Smallest sampled `det J` outside the neighbourhoods of the corners that the
 /// boundary forces to `det J <= 0`: the first two knot spans in each direction there.
 pub fn min_away_from_corners(map: &Surface, s: &crate::verify::quality::DetJSample, corners: &[CornerReport]) -> f64 {
-    let span = |d: usize, at_end: bool| {
+    // the widths of the first two and the last two knot spans, [direction][at end]
+    let spans: [[f64; 2]; 2] = std::array::from_fn(|d| {
         let b = map.knots[d].breaks();
         let k = b.len();
-        let w = if at_end { b[k - 1] - b[k.saturating_sub(3)] } else { b[2.min(k - 1)] - b[0] };
-        w.max(0.0)
-    };
+        [(b[2.min(k - 1)] - b[0]).max(0.0), (b[k - 1] - b[k.saturating_sub(3)]).max(0.0)]
+    });
+    let span = |d: usize, at_end: bool| spans[d][usize::from(at_end)];
     let centres = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
     let n = s.n;
     let mut min = f64::INFINITY;

@@ -130,7 +130,8 @@ pub fn solve_poisson(
     let k = disc.scalar.matrix(&stencil);
     let lift = disc.apply_to_fixed_scalar(&stencil, &u);
     let rhs: Vec<f64> = disc.restrict(&res, 1).iter().zip(&lift).map(|(r, l)| r - l).collect();
-    let mut ls = LinearSolver::new(LinearMethod::Auto);
+    // the stiffness matrix is symmetric positive definite: sparse Cholesky, exact to rounding
+    let mut ls = LinearSolver::new(LinearMethod::Cholesky);
     ls.factor(&k)?;
     let c = ls.solve(&rhs)?;
     for (fi, &kk) in disc.dofs.free().iter().enumerate() {

@@ -59,17 +59,53 @@ pub fn grid_abscissae(n: usize) -> impl Iterator<Item = f64> {
 }
 
 /// Sample `det J` on an `(n+1)^2` grid (boundary included). The `xi` basis is
-/// evaluated once per column, rows run in parallel.
+/// evaluated once per column; per row of the grid the homogeneous control net `(w x, w
+/// y, w)` is first contracted with the `eta` basis and its derivative (`H_b[i] = Σ_j
+/// N_j^(b)(η) (w x, w y, w)_{ij}`, `b = 0, 1`), so each point costs `p + 1` terms instead
+/// of `(p + 1)^2`; `det J = x_ξ × x_η` by the quotient rule `x_ξ = (X_ξ - x W_ξ) / W`.
+/// Rows run in parallel.
 pub fn sample_det_j(map: &Surface, n: usize) -> DetJSample {
     let n = n.max(1);
+    let nx = map.shape()[0];
     let bu: Vec<BasisDerivs> = grid_abscissae(n).map(|u| BasisDerivs::at(&map.knots[0], u, 1)).collect();
+    let weight = |k: usize| map.weights.as_ref().map_or(1.0, |w| w[k]);
     let mut values = vec![0.0; (n + 1) * (n + 1)];
-    values.par_chunks_mut(n + 1).zip(grid_abscissae(n).collect::<Vec<_>>()).for_each(|(row, v)| {
-        let bv = BasisDerivs::at(&map.knots[1], v, 1);
-        for (d, bu) in row.iter_mut().zip(&bu) {
-            *d = map.derivs_with(bu, &bv, 1).det_j();
-        }
-    });
+    values.par_chunks_mut(n + 1).zip(grid_abscissae(n).collect::<Vec<_>>()).for_each_init(
+        || vec![[[0.0f64; 3]; 2]; nx],
+        |h, (row, v)| {
+            let bv = BasisDerivs::at(&map.knots[1], v, 1);
+            for (i, hi) in h.iter_mut().enumerate() {
+                *hi = [[0.0; 3]; 2];
+                for jb in 0..=bv.degree {
+                    let k = (bv.first() + jb) * nx + i;
+                    let (w, c) = (weight(k), map.control_points[k]);
+                    let hom = [w * c[0], w * c[1], w];
+                    for (b, hb) in hi.iter_mut().enumerate() {
+                        for (t, x) in hb.iter_mut().zip(hom) {
+                            *t += bv.d[b][jb] * x;
+                        }
+                    }
+                }
+            }
+            for (d, bu) in row.iter_mut().zip(&bu) {
+                // (X, X_ξ, X_η) in homogeneous coordinates
+                let (mut x0, mut xu, mut xv) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
+                for ia in 0..=bu.degree {
+                    let hi = &h[bu.first() + ia];
+                    for c in 0..3 {
+                        x0[c] += bu.d[0][ia] * hi[0][c];
+                        xu[c] += bu.d[1][ia] * hi[0][c];
+                        xv[c] += bu.d[0][ia] * hi[1][c];
+                    }
+                }
+                let w = x0[2];
+                let p = [x0[0] / w, x0[1] / w];
+                let du = [(xu[0] - p[0] * xu[2]) / w, (xu[1] - p[1] * xu[2]) / w];
+                let dv = [(xv[0] - p[0] * xv[2]) / w, (xv[1] - p[1] * xv[2]) / w];
+                *d = du[0] * dv[1] - dv[0] * du[1];
+            }
+        },
+    );
     DetJSample::from_values(n, values)
 }
 
