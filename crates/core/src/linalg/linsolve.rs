@@ -37,7 +37,7 @@ pub enum LinearMethod {
     /// SPD approximation when it offers one, by ILU(0) otherwise.
     Gmres,
     /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
-    /// does not converge.
+    /// does not converge within [`AUTO_MAX_KRYLOV`] iterations.
     Auto,
     /// Sparse Cholesky `L L^T` (symmetric positive definite systems only).
     Cholesky,
@@ -73,8 +73,9 @@ pub const KRYLOV_TOL: f64 = 1e-10;
 pub const MAX_KRYLOV: usize = 2000;
 
 /// GMRES iterations per solve after which [`LinearMethod::Auto`] factorizes the system
-/// by LU instead (for the rest of the solve): with the problem's SPD preconditioner a
-/// solve takes at most 30 iterations on the shared geometries; one that takes 500 has a
+/// by LU instead (for the rest of the solve); `n / 8` (at least 100) for `n < 4000`
+/// unknowns, where LU is cheap: with the problem's SPD preconditioner an EGG solve takes
+/// at most 30 iterations on the shared geometries; one that takes this many has a
 /// preconditioner that does not fit the operator (the weak form, eq. 14, on cells of
 /// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
 pub const AUTO_MAX_KRYLOV: usize = 500;
@@ -507,7 +508,8 @@ impl LinearSolver {
             LinearMethod::Gmres => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let pc = self.precond.as_mut().expect("set with matrix");
-                let cap = if self.fallback { AUTO_MAX_KRYLOV } else { MAX_KRYLOV };
+                // a direct factorization of a small system costs few GMRES iterations
+                let cap = if self.fallback { (b.len() / 8).clamp(100, AUTO_MAX_KRYLOV) } else { MAX_KRYLOV };
                 match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, cap) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
