@@ -20,6 +20,7 @@ use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
 use crate::boundary::kinks::smoothed_levels;
+use crate::boundary::normalise::Similarity;
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
@@ -76,6 +77,9 @@ pub struct EggSolver {
     /// samples).
     assembler: Arc<dyn EggAssembler>,
     diameter: f64,
+    /// The input's coordinates from the normalised ones the solve runs in: the
+    /// certificates judge the map as it will be written.
+    sim: Similarity,
     next_level: usize,
     active: Option<Active>,
     previous: Option<Surface>,
@@ -141,6 +145,7 @@ impl EggSolver {
             method,
             assembler,
             diameter: hierarchy.diameter,
+            sim: hierarchy.similarity,
             next_level: 0,
             active: None,
             previous: None,
@@ -281,10 +286,15 @@ impl EggSolver {
             e?;
         }
         let mut map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
+        // the certificate of the map in the input's coordinates; the verdict is the same in
+        // the normalised ones (a similarity), which the stages below read
+        let sim = hierarchy.similarity;
         let mut certificate = match self.certificate.take() {
             Some(c) => c,
-            None => certify(&map, &self.opts.certify)?,
+            None => certify(&sim.physical_surface(&map)?, &self.opts.certify)?,
         };
+        // whether `certificate` is that of `map` brought back (else `map` changed since)
+        let mut physical = true;
         // the C0 route of §9: the kinks kept exactly on Σ⁰ from the Σ¹ map
         let mut c0_level = None;
         let c0_route = match (&hierarchy.kinked, &self.c0) {
@@ -305,6 +315,7 @@ impl EggSolver {
                         map = m;
                         certificate = c;
                         c0_level = Some(l);
+                        physical = false;
                     }
                     Some(out.report)
                 }
@@ -320,8 +331,11 @@ impl EggSolver {
                     let nl = self.opts.nonlinear;
                     match improve(&map, &certificate, &*method, topology, nl, certify_opts, self.diameter) {
                         Ok(out) => {
-                            map = out.map;
-                            certificate = out.certificate;
+                            if out.report.accepted {
+                                map = out.map;
+                                certificate = out.certificate;
+                                physical = false;
+                            }
                             Some(out.report)
                         }
                         Err(Error::InfeasibleStart { reason, .. }) => {
@@ -335,10 +349,11 @@ impl EggSolver {
             }
         };
         // back to the input's coordinates; the verdict is that of the map written
-        let sim = hierarchy.similarity;
         if !sim.is_identity() {
             map = sim.physical_surface(&map)?;
-            certificate = certify(&map, &self.opts.certify)?;
+            if !physical {
+                certificate = certify(&map, &self.opts.certify)?;
+            }
             for l in &mut self.reports {
                 l.initial_det_j_min = sim.area(l.initial_det_j_min);
             }
@@ -385,7 +400,9 @@ impl EggSolver {
     fn repair(&mut self) -> Result<bool> {
         let (Some(map), Some(last)) = (&self.previous, self.plan.last()) else { return Ok(false) };
         if self.certificate.is_none() {
-            self.certificate = Some(certify(map, &self.opts.certify)?);
+            // in the input's coordinates: the certificate of the map as it is written,
+            // reused by `finish` when no later stage changes the map
+            self.certificate = Some(certify(&self.sim.physical_surface(map)?, &self.opts.certify)?);
         }
         let cert = self.certificate.as_ref().expect("set above");
         if self.repairs >= self.opts.repair {
