@@ -8,6 +8,10 @@
 #   cargo build --release -p winslow-cli
 #   bash scripts/kinks-bench.sh target/release/winslow
 #   bash scripts/kinks-bench.sh target/release/winslow --basis fitted
+#   LOCAL="1 2 3" bash scripts/kinks-bench.sh target/release/winslow
+#     (instead: the C0 route's final Winslow minimisation on all control points against
+#     --kinks-local K, on the geometries with kinks: unknowns, Winslow value, min scaled
+#     Jacobian, C0 route and total time)
 #
 # Needs jq. A benchmark: CI does not run it.
 set -euo pipefail
@@ -16,6 +20,23 @@ shift
 cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+if [ -n "${LOCAL:-}" ]; then
+  echo "| geometry | spans | verdict | unknowns | Winslow start | Winslow after | min scaled J | C0 route s | total s |"
+  echo "|---|---|---|---:|---:|---:|---:|---:|---:|"
+  for f in tests/data/notched_square.json tests/data/gismo/plate_with_hole.json tests/data/gismo/rotor_sector.json tests/data/contours/star8.json tests/data/contours/l_shape.json; do
+    name=$(basename "$f" .json)
+    for k in all $LOCAL; do
+      local_arg=()
+      [ "$k" != all ] && local_arg=(--kinks-local "$k")
+      "$bin" solve "$f" -o "$tmp/$name.json" --json -q "${local_arg[@]}" "$@" >"$tmp/$name.report.json" 2>"$tmp/$name.log" || true
+      jq -r --arg name "$name" --arg k "$k" '
+        def f(n): if . == null then "-" else (. * pow(10; n) | round / pow(10; n) | tostring) end;
+        "| \($name) | \($k) | \(.verdict) | \(.c0_route.unknowns) | \(.c0_route.winslow[0] | f(6)) | \(.c0_route.winslow[1] | f(6)) | \(.quality.scaled_jacobian.min | f(4)) | \(.c0_route.seconds | f(3)) | \(.seconds | f(3)) |"
+      ' "$tmp/$name.report.json"
+    done
+  done
+  exit 0
+fi
 echo "| geometry | none: verdict | basis | functions | s | auto: verdict | basis | functions | s | kinks kept / found | max deviation at a kink / diam | C0 route s |"
 echo "|---|---|---|---:|---:|---|---|---:|---:|---|---:|---:|"
 for f in tests/data/*.json tests/data/gismo/*.json tests/data/contours/*.json; do

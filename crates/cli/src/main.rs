@@ -340,6 +340,11 @@ struct SolverArgs {
     /// (eq. 14); certify again and keep the improved map only when it is certified.
     #[arg(long, value_enum)]
     improve: Option<ImproveArg>,
+    /// With kinks kept (--kinks): the final Winslow minimisation of the C0 route moves only
+    /// the control points within this many knot spans of a kink (paper §9, last
+    /// paragraph); the rest keep the elasticity start. Default: all of them.
+    #[arg(long, value_name = "SPANS")]
+    kinks_local: Option<usize>,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
@@ -393,6 +398,7 @@ impl SolverArgs {
         o.min_elements = self.min_elements.max(1);
         o.refine = self.refine;
         o.growth = self.growth.max(1.0);
+        o.kinks_local = self.kinks_local;
         o.improve = self.improve.map(|i| match i {
             ImproveArg::Winslow => Improve::Winslow,
             ImproveArg::Weak => Improve::WeakForm,

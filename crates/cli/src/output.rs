@@ -230,12 +230,14 @@ fn kink_lines(s: &mut String, r: &winslow::Report) {
         let w = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.6}"));
         let _ = writeln!(
             s,
-            "  C0 route (§9): {}; {} -> {} functions, {} damped step(s), {} Winslow iterations (Winslow {} -> {}), {:.3} s",
+            "  C0 route (§9): {}; {} -> {} functions, {} damped step(s), {} Winslow iterations on {} unknowns{} (Winslow {} -> {}), {:.3} s",
             if c.kept { "kinks kept" } else { "kinks NOT kept" },
             c.smoothed_functions,
             c.functions,
             c.continuation_steps,
             c.iterations,
+            c.unknowns,
+            c.local_spans.map_or(String::new(), |k| format!(" within {k} span(s) of a kink")),
             w(c.winslow[0]),
             w(c.winslow[1]),
             c.seconds

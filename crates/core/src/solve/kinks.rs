@@ -32,8 +32,8 @@ use super::improve::{bijective, from_bijective_start};
 use super::initial::{continuation_with, set_boundary, Continuation};
 use super::newton::{NonlinearSolver, Status};
 use super::options::SolveOptions;
-use super::repair::plan_repair;
-use crate::boundary::kinks::KinkedLevel;
+use super::repair::{frozen_dofs, plan_repair};
+use crate::boundary::kinks::{Kink, KinkedLevel};
 use crate::boundary::level::Level;
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::DofMap;
@@ -42,6 +42,7 @@ use crate::methods::egg::EggAssembler;
 use crate::methods::winslow::{winslow_objective, WinslowMethod};
 use crate::methods::Method;
 use crate::spline::curve::Point;
+use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate};
 
@@ -69,6 +70,11 @@ pub struct KinkStage {
     pub alpha: f64,
     /// Newton iterations of the final Winslow minimisation.
     pub iterations: usize,
+    /// Its unknowns (`2 x` the control points it moves: all interior ones, or with
+    /// `kinks_local` those near the kinks).
+    pub unknowns: usize,
+    /// The `kinks_local` it ran with (knot spans around each kink), if any.
+    pub local_spans: Option<usize>,
     /// Whether it met its stopping rule.
     pub converged: bool,
     /// Winslow value (eq. 16) of its start and of its result (`null` where undefined).
@@ -99,6 +105,8 @@ impl KinkStage {
             refinements: 0,
             alpha: 0.0,
             iterations: 0,
+            unknowns: 0,
+            local_spans: None,
             converged: false,
             winslow: [None, None],
             kept: false,
@@ -219,9 +227,23 @@ pub fn keep_kinks(
         report.seconds = t0.elapsed().as_secs_f64();
         return Ok(KinkOutcome { map: None, certificate: None, level: None, report });
     }
-    let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
-    let c0 = disc.dofs.gather(&start);
-    let mut solver = NonlinearSolver::new(method.problem(disc.clone(), start.clone()), c0, nl);
+    // §9, last paragraph: only the control points near the kinks move (`kinks_local`)
+    let boxes = opts.kinks_local.map(|spans| kink_boxes(&level.knots, &kinked.kinks, spans));
+    let local = match &boxes {
+        Some(b) => frozen_dofs(&level.knots, b, &opts.topology)?,
+        None => None,
+    };
+    let moved = match local {
+        Some(dofs) => {
+            Arc::new(Discretization::with_dofs(level.knots.clone(), p.max(q) + 2, dofs).with_weights(weights.clone())?)
+        }
+        None => disc.clone(),
+    };
+    report.unknowns = 2 * moved.dofs.num_free();
+    report.local_spans = opts.kinks_local;
+    let nl = from_bijective_start(opts.nonlinear, &method, diameter, moved.dofs.num_free());
+    let c0 = moved.dofs.gather(&start);
+    let mut solver = NonlinearSolver::new(method.problem(moved, start.clone()), c0, nl);
     for it in solver.by_ref() {
         report.iterations = it?.iteration;
     }
@@ -253,6 +275,30 @@ pub fn keep_kinks(
     report.seconds = t0.elapsed().as_secs_f64();
     let map = surface(&cps);
     Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
+}
+
+/// The parameter boxes `[ξ0, ξ1, η0, η1]` reaching `spans` knot spans of `knots` along
+/// the side on either side of each kink and `spans` spans into the domain (the control
+/// points whose support meets one are those "in the vicinity of the boundary control
+/// points that correspond to the C0-continuities", §9).
+fn kink_boxes(knots: &[KnotVector; 2], kinks: &[Kink], spans: usize) -> Vec<[f64; 4]> {
+    let breaks = [knots[0].breaks(), knots[1].breaks()];
+    kinks
+        .iter()
+        .filter_map(|k| {
+            let t = k.map_parameter?;
+            let d = k.side.direction();
+            let (along, across) = (&breaks[d], &breaks[1 - d]);
+            let (n, m) = (along.len() - 1, across.len() - 1);
+            let i = along.partition_point(|&b| b < t).min(n);
+            let (lo, hi) = (along[i.saturating_sub(spans)], along[(i + spans).min(n)]);
+            let (c0, c1) = match k.side {
+                Side::South | Side::West => (across[0], across[spans.min(m)]),
+                Side::North | Side::East => (across[m.saturating_sub(spans)], across[m]),
+            };
+            Some(if d == 0 { [lo, hi, c0, c1] } else { [c0, c1, lo, hi] })
+        })
+        .collect()
 }
 
 /// Distance from `x` to the curve `c`: the closest of 32 samples per element, refined by

@@ -56,6 +56,11 @@ pub struct SolveOptions {
     /// minimize the Winslow functional, eq. 16) and certify again; the improved map is
     /// kept only when certified ([`crate::solve::improve`]).
     pub improve: Option<Improve>,
+    /// With kinks kept (§9): the final Winslow minimisation of the `C^0` route moves only
+    /// the control points whose support meets a square of this many knot spans of `Σ⁰`
+    /// around each kink (paper §9, last paragraph); the others keep the elasticity start.
+    /// `None`: all interior control points.
+    pub kinks_local: Option<usize>,
 }
 
 impl Default for SolveOptions {
@@ -77,6 +82,7 @@ impl Default for SolveOptions {
             poisson: false,
             topology: Topology::dirichlet(),
             improve: None,
+            kinks_local: None,
         }
     }
 }

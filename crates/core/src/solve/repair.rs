@@ -114,21 +114,28 @@ pub fn frozen_discretization(
     boxes: &[[f64; 4]],
     topology: &Topology,
 ) -> Result<Discretization> {
+    let (p, q) = (knots[0].degree(), knots[1].degree());
+    match frozen_dofs(knots, boxes, topology)? {
+        Some(dofs) => Ok(Discretization::with_dofs(knots.clone(), p.max(q) + 1, dofs)),
+        None => Discretization::for_topology(knots.clone(), topology),
+    }
+}
+
+/// The DOF map of [`frozen_discretization`]: free are the functions free under
+/// `topology` whose support meets one of `boxes`; `None` (all free ones) when that leaves
+/// none, and on a periodic basis (which shares DOFs across the seam).
+pub fn frozen_dofs(knots: &[KnotVector; 2], boxes: &[[f64; 4]], topology: &Topology) -> Result<Option<DofMap>> {
     let shape = [knots[0].num_basis(), knots[1].num_basis()];
     let (p, q) = (knots[0].degree(), knots[1].degree());
     let (tu, tv) = (knots[0].knots(), knots[1].knots());
     let all = DofMap::for_basis(knots, topology)?;
     if !all.replicas().is_empty() {
-        // a periodic basis shares DOFs across the seam: the repair round frees them all
-        return Discretization::for_topology(knots.clone(), topology);
+        return Ok(None);
     }
     let interior = |i: usize, j: usize| all.free_index(j * shape[0] + i) != FIXED;
     let near = |i: usize, j: usize| {
         boxes.iter().any(|b| tu[i] < b[1] && tu[i + p + 1] > b[0] && tv[j] < b[3] && tv[j + q + 1] > b[2])
     };
     let dofs = DofMap::from_predicate(shape, |i, j| interior(i, j) && near(i, j));
-    if dofs.num_free() == 0 {
-        return Discretization::for_topology(knots.clone(), topology);
-    }
-    Ok(Discretization::with_dofs(knots.clone(), p.max(q) + 1, dofs))
+    Ok((dofs.num_free() > 0).then_some(dofs))
 }
