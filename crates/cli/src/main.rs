@@ -557,11 +557,17 @@ enum KernelArg {
 
 fn main() {
     let cli = Cli::parse();
-    // the worker threads start with the process (as G+Smo's OpenMP threads persist
-    // between solves), not inside the first parallel loop of a solve's clock; an error
-    // (a pool already built) leaves the existing one
-    let _ = rayon::ThreadPoolBuilder::new().build_global();
-    let code = match run(cli) {
+    // the command runs on a worker of the thread pool, started with the process: a
+    // parallel loop then splits off work for the other workers instead of handing the
+    // whole loop to the pool and blocking until a sleeping worker has woken and run it
+    // (tens of microseconds per loop, most of the solve of a tiny map); the workers get
+    // the main thread's stack size
+    let pool = rayon::ThreadPoolBuilder::new().stack_size(16 << 20).build();
+    let result = match pool {
+        Ok(pool) => pool.install(|| run(cli)),
+        Err(_) => run(cli),
+    };
+    let code = match result {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
