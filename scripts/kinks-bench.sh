@@ -9,9 +9,9 @@
 #   bash scripts/kinks-bench.sh target/release/winslow
 #   bash scripts/kinks-bench.sh target/release/winslow --basis fitted
 #   LOCAL="1 2 3" bash scripts/kinks-bench.sh target/release/winslow
-#     (instead: the C0 route's final Winslow minimisation on all control points against
-#     --kinks-local K, on the geometries with kinks: unknowns, Winslow value, min scaled
-#     Jacobian, C0 route and total time)
+#     (instead: the C0 route's final Winslow minimisation on all control points
+#     (--kinks-local all) against --kinks-local K, on the geometries with kinks: unknowns,
+#     Winslow value, min scaled Jacobian, C0 route and total time)
 #
 # Needs jq. A benchmark: CI does not run it.
 set -euo pipefail
@@ -26,9 +26,7 @@ if [ -n "${LOCAL:-}" ]; then
   for f in tests/data/notched_square.json tests/data/gismo/plate_with_hole.json tests/data/gismo/rotor_sector.json tests/data/contours/star8.json tests/data/contours/l_shape.json; do
     name=$(basename "$f" .json)
     for k in all $LOCAL; do
-      local_arg=()
-      [ "$k" != all ] && local_arg=(--kinks-local "$k")
-      "$bin" solve "$f" -o "$tmp/$name.json" --json -q "${local_arg[@]}" "$@" >"$tmp/$name.report.json" 2>"$tmp/$name.log" || true
+      "$bin" solve "$f" -o "$tmp/$name.json" --json -q --kinks-local "$k" "$@" >"$tmp/$name.report.json" 2>"$tmp/$name.log" || true
       jq -r --arg name "$name" --arg k "$k" '
         def f(n): if . == null then "-" else (. * pow(10; n) | round / pow(10; n) | tostring) end;
         "| \($name) | \($k) | \(.verdict) | \(.c0_route.unknowns) | \(.c0_route.winslow[0] | f(6)) | \(.c0_route.winslow[1] | f(6)) | \(.quality.scaled_jacobian.min | f(4)) | \(.c0_route.seconds | f(3)) | \(.seconds | f(3)) |"

@@ -9,7 +9,7 @@ use std::path::Path;
 use winslow::boundary::kinks::{KinkKind, KinkMode};
 use winslow::boundary::BasisChoice;
 use winslow::io::{read_boundary, ReadOptions};
-use winslow::solve::options::SolveOptions;
+use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
 use winslow::solve::solver::solve;
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
@@ -156,7 +156,7 @@ fn star_polygon_certifies_with_its_kinks_kept() {
 #[test]
 fn the_local_winslow_stage_moves_only_the_control_points_near_the_kinks() {
     let global = opts(BasisChoice::Auto, KinkMode::Auto);
-    let local = SolveOptions { kinks_local: Some(1), ..global.clone() };
+    let local = SolveOptions { kinks_local: KinksLocal::Spans(1), ..global.clone() };
     let (_, g) = run("notched_square.json", &global);
     let (_, l) = run("notched_square.json", &local);
     for sol in [&g, &l] {

@@ -115,7 +115,7 @@ impl CompareArgs {
             no_repair: false,
             repair_freeze: None,
             improve: None,
-            kinks_local: None,
+            kinks_local: KinksLocal::All,
         };
         // the comparison's defaults (one level, no repair, its iteration limits), with the
         // fit, operator, sizes and tolerances of the flags

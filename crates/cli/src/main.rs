@@ -21,7 +21,7 @@ use winslow::methods::egg::{EggAssembler, EggMethod};
 use winslow::methods::Method;
 use winslow::solve::improve::{improve, Improve};
 use winslow::solve::newton::NonlinearMethod;
-use winslow::solve::options::SolveOptions;
+use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
 use winslow::solve::solver::{EggSolver, Event};
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
@@ -155,6 +155,10 @@ struct FitArgs {
     /// finished by the Winslow functional (16).
     #[arg(long, default_value_t = FitOptions::default().kinks, value_parser = parse_kinks)]
     kinks: KinkMode,
+}
+
+fn parse_kinks_local(s: &str) -> std::result::Result<KinksLocal, String> {
+    KinksLocal::parse(s).ok_or_else(|| format!("expected auto, all or a number of knot spans, got '{s}'"))
 }
 
 fn parse_kinks(s: &str) -> std::result::Result<KinkMode, String> {
@@ -340,11 +344,12 @@ struct SolverArgs {
     /// (eq. 14); certify again and keep the improved map only when it is certified.
     #[arg(long, value_enum)]
     improve: Option<ImproveArg>,
-    /// With kinks kept (--kinks): the final Winslow minimisation of the C0 route moves only
-    /// the control points within this many knot spans of a kink (paper §9, last
-    /// paragraph); the rest keep the elasticity start. Default: all of them.
-    #[arg(long, value_name = "SPANS")]
-    kinks_local: Option<usize>,
+    /// With kinks kept (--kinks): which control points the final Winslow minimisation of
+    /// the C0 route moves: `all`, a number of knot spans around each kink (paper §9, last
+    /// paragraph; the rest keep the elasticity start), or `auto` (all up to 50 000
+    /// unknowns, 3 spans above).
+    #[arg(long, default_value = "auto", value_parser = parse_kinks_local)]
+    kinks_local: KinksLocal,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]

@@ -73,7 +73,7 @@ pub struct KinkStage {
     /// Its unknowns (`2 x` the control points it moves: all interior ones, or with
     /// `kinks_local` those near the kinks).
     pub unknowns: usize,
-    /// The `kinks_local` it ran with (knot spans around each kink), if any.
+    /// The knot spans around each kink it moved (`kinks_local`), `None` when all.
     pub local_spans: Option<usize>,
     /// Whether it met its stopping rule.
     pub converged: bool,
@@ -228,7 +228,8 @@ pub fn keep_kinks(
         return Ok(KinkOutcome { map: None, certificate: None, level: None, report });
     }
     // §9, last paragraph: only the control points near the kinks move (`kinks_local`)
-    let boxes = opts.kinks_local.map(|spans| kink_boxes(&level.knots, &kinked.kinks, spans));
+    let spans = opts.kinks_local.spans(2 * disc.dofs.num_free());
+    let boxes = spans.map(|spans| kink_boxes(&level.knots, &kinked.kinks, spans));
     let local = match &boxes {
         Some(b) => frozen_dofs(&level.knots, b, &opts.topology)?,
         None => None,
@@ -240,7 +241,7 @@ pub fn keep_kinks(
         None => disc.clone(),
     };
     report.unknowns = 2 * moved.dofs.num_free();
-    report.local_spans = opts.kinks_local;
+    report.local_spans = spans;
     let nl = from_bijective_start(opts.nonlinear, &method, diameter, moved.dofs.num_free());
     let c0 = moved.dofs.gather(&start);
     let mut solver = NonlinearSolver::new(method.problem(moved, start.clone()), c0, nl);

@@ -56,11 +56,55 @@ pub struct SolveOptions {
     /// minimize the Winslow functional, eq. 16) and certify again; the improved map is
     /// kept only when certified ([`crate::solve::improve`]).
     pub improve: Option<Improve>,
-    /// With kinks kept (§9): the final Winslow minimisation of the `C^0` route moves only
-    /// the control points whose support meets a square of this many knot spans of `Σ⁰`
-    /// around each kink (paper §9, last paragraph); the others keep the elasticity start.
-    /// `None`: all interior control points.
-    pub kinks_local: Option<usize>,
+    /// With kinks kept (§9): which control points the final Winslow minimisation of the
+    /// `C^0` route moves ([`KinksLocal`]).
+    pub kinks_local: KinksLocal,
+}
+
+/// Which control points the `C^0` route's final Winslow minimisation moves (paper §9,
+/// last paragraph: "only recomputing a subset of DOFs in the vicinity of the boundary
+/// control points that correspond to the C0-continuities").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum KinksLocal {
+    /// All interior ones up to [`KINKS_LOCAL_ABOVE`] unknowns, those within
+    /// [`KINKS_LOCAL_SPANS`] knot spans of a kink above: the global minimisation improves
+    /// the whole map a little but costs a Cholesky factorization of the whole vector
+    /// Hessian per Newton step (puzzle-5 of the hard corpus, 224 k unknowns: 34 s of a
+    /// 51 s solve, against 3 s locally; BENCHMARKS.md).
+    #[default]
+    Auto,
+    /// All interior control points.
+    All,
+    /// Those whose support meets a square of this many knot spans of `Σ⁰` around each
+    /// kink (along the side and into the domain); the others keep the elasticity start.
+    Spans(usize),
+}
+
+/// Unknowns of the `C^0` basis above which [`KinksLocal::Auto`] minimises locally.
+pub const KINKS_LOCAL_ABOVE: usize = 50_000;
+
+/// Knot spans around each kink that [`KinksLocal::Auto`] moves above [`KINKS_LOCAL_ABOVE`].
+pub const KINKS_LOCAL_SPANS: usize = 3;
+
+impl KinksLocal {
+    /// The spans around each kink to move for a `C^0` basis with `unknowns` free
+    /// unknowns; `None`: all.
+    pub fn spans(self, unknowns: usize) -> Option<usize> {
+        match self {
+            KinksLocal::Auto => (unknowns > KINKS_LOCAL_ABOVE).then_some(KINKS_LOCAL_SPANS),
+            KinksLocal::All => None,
+            KinksLocal::Spans(k) => Some(k),
+        }
+    }
+
+    /// `auto`, `all` or a number of spans.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(KinksLocal::Auto),
+            "all" => Some(KinksLocal::All),
+            _ => s.parse().ok().map(KinksLocal::Spans),
+        }
+    }
 }
 
 impl Default for SolveOptions {
@@ -82,7 +126,27 @@ impl Default for SolveOptions {
             poisson: false,
             topology: Topology::dirichlet(),
             improve: None,
-            kinks_local: None,
+            kinks_local: KinksLocal::Auto,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `auto` moves all control points up to the threshold and a few spans around each
+    /// kink above it; the spelled-out choices are taken as given.
+    #[test]
+    fn kinks_local_choices() {
+        assert_eq!(KinksLocal::Auto.spans(KINKS_LOCAL_ABOVE), None);
+        assert_eq!(KinksLocal::Auto.spans(KINKS_LOCAL_ABOVE + 1), Some(KINKS_LOCAL_SPANS));
+        assert_eq!(KinksLocal::All.spans(10 * KINKS_LOCAL_ABOVE), None);
+        assert_eq!(KinksLocal::Spans(2).spans(10), Some(2));
+        assert_eq!(KinksLocal::parse("auto"), Some(KinksLocal::Auto));
+        assert_eq!(KinksLocal::parse("all"), Some(KinksLocal::All));
+        assert_eq!(KinksLocal::parse("4"), Some(KinksLocal::Spans(4)));
+        assert_eq!(KinksLocal::parse("-1"), None);
+        assert_eq!(KinksLocal::parse("some"), None);
     }
 }
