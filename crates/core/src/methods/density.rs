@@ -355,6 +355,14 @@ pub(crate) mod tests {
     pub(crate) fn curved(p: usize, q: usize, seed: u64, noise: f64) -> (Discretization, Vec<Point>) {
         let kx = KnotVector::open_uniform(p, 4);
         let ky = KnotVector::open_uniform(q, 3).with_inserted(&[0.3]);
+        let cps = annulus_points(&kx, &ky, seed, noise);
+        (Discretization::new([kx, ky]), cps)
+    }
+
+    /// The control points of a perturbed annulus sector on the basis `kx x ky`: the
+    /// Greville points `(u, v)` mapped to radius `1 + u`, angle `1.2 v`, each moved by
+    /// up to `noise / 2` per coordinate (positively oriented for small `noise`).
+    pub(crate) fn annulus_points(kx: &KnotVector, ky: &KnotVector, seed: u64, noise: f64) -> Vec<Point> {
         let (gx, gy) = (kx.greville(), ky.greville());
         let mut rng = Lcg::new(seed);
         let mut cps = Vec::new();
@@ -364,7 +372,7 @@ pub(crate) mod tests {
                 cps.push([r * t.cos() + noise * (rng.uniform() - 0.5), r * t.sin() + noise * (rng.uniform() - 0.5)]);
             }
         }
-        (Discretization::new([kx, ky]), cps)
+        cps
     }
 
     /// The affine map `(ξ, η) -> (2ξ + 0.5η + 1, -0.3ξ + 1.5η)` on a `p`, `ne` basis

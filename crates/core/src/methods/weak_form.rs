@@ -181,6 +181,7 @@ impl DiscreteProblem for WeakFormProblem {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::methods::density::tests::annulus_points;
     use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
     use crate::spline::knots::KnotVector;
     use crate::testutil::Lcg;
@@ -189,15 +190,7 @@ mod tests {
     fn curved(seed: u64, noise: f64) -> (Arc<Discretization>, Vec<Point>) {
         let kx = KnotVector::open_uniform(3, 4).with_inserted(&[0.5, 0.5]);
         let ky = KnotVector::open_uniform(2, 3).with_inserted(&[0.3]);
-        let (gx, gy) = (kx.greville(), ky.greville());
-        let mut rng = Lcg::new(seed);
-        let mut cps = Vec::new();
-        for &v in &gy {
-            for &u in &gx {
-                let (r, t) = (1.0 + u, 1.2 * v);
-                cps.push([r * t.cos() + noise * (rng.uniform() - 0.5), r * t.sin() + noise * (rng.uniform() - 0.5)]);
-            }
-        }
+        let cps = annulus_points(&kx, &ky, seed, noise);
         (Arc::new(Discretization::new([kx, ky])), cps)
     }
 
