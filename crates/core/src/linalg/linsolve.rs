@@ -1,5 +1,6 @@
 //! Linear solvers behind one interface: sparse LU (faer; the symbolic factorization is
-//! computed once per sparsity pattern and reused for every numeric factorization), sparse
+//! computed once per sparsity pattern and reused for every numeric factorization; dense
+//! LU for systems of at most [`DENSE_LIMIT`] unknowns, [`crate::linalg::dense`]), sparse
 //! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
@@ -23,6 +24,7 @@ use faer::{Conj, Par, Side};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
@@ -30,7 +32,7 @@ use crate::linalg::sparse::Csr;
 /// Which linear solver the nonlinear solvers use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LinearMethod {
-    /// Sparse direct LU.
+    /// Sparse direct LU; dense ([`DenseLu`]) up to [`DENSE_LIMIT`] unknowns.
     #[default]
     Lu,
     /// Restarted flexible GMRES(50), relative tolerance 1e-10, preconditioned by the problem's
@@ -273,6 +275,11 @@ pub struct LinearSolver {
     method: LinearMethod,
     symbolic: Option<SymbolicLu<usize>>,
     lu: Option<Lu<usize, f64>>,
+    /// LU of a system of at most [`DENSE_LIMIT`] unknowns (dense, no symbolic analysis).
+    dense: Option<DenseLu>,
+    /// Cholesky of a system of at most [`DENSE_LIMIT`] unknowns (of `-A` for
+    /// [`LinearMethod::NegCholesky`]).
+    dense_llt: Option<DenseCholesky>,
     llt: Option<Cholesky<f64>>,
     precond: Option<Preconditioner>,
     matrix: Option<Csr>,
@@ -300,6 +307,8 @@ impl LinearSolver {
             method,
             symbolic: None,
             lu: None,
+            dense: None,
+            dense_llt: None,
             llt: None,
             precond: None,
             matrix: None,
@@ -426,7 +435,13 @@ impl LinearSolver {
     fn factor_matrix(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
         self.resolve(a.nrows);
         match self.method {
+            LinearMethod::Lu if a.nrows <= DENSE_LIMIT => {
+                let mut lu = self.dense.take().unwrap_or_default();
+                lu.factor(a)?;
+                self.dense = Some(lu);
+            }
             LinearMethod::Lu => {
+                self.dense = None;
                 let sym = SymbolicSparseColMatRef::new_checked(a.ncols, a.nrows, &a.row_ptr, None, &a.col_idx);
                 if self.symbolic.is_none() {
                     self.symbolic =
@@ -438,6 +453,13 @@ impl LinearSolver {
                     Lu::try_new_with_symbolic(symbolic, mat)
                         .map_err(|e| Error::LinearSolver(format!("numeric LU: {e:?}")))?,
                 );
+            }
+            LinearMethod::Cholesky | LinearMethod::NegCholesky if a.nrows <= DENSE_LIMIT => {
+                let sign = if self.method == LinearMethod::NegCholesky { -1.0 } else { 1.0 };
+                // a failed factorization leaves no factor to solve with
+                let mut llt = self.dense_llt.take().unwrap_or_default();
+                llt.factor(a, sign)?;
+                self.dense_llt = Some(llt);
             }
             LinearMethod::Cholesky => {
                 let slot = self.llt.take();
@@ -486,11 +508,19 @@ impl LinearSolver {
     /// Solve `a x = b` with the last factorized `a`.
     pub fn solve(&mut self, b: &[f64]) -> Result<Vec<f64>> {
         let x = match self.method {
+            LinearMethod::Lu if self.dense.is_some() => self.dense.as_ref().expect("checked").solve(b),
             LinearMethod::Lu => {
                 let lu = self.lu.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let mut x = faer::Mat::<f64>::from_fn(b.len(), 1, |i, _| b[i]);
                 lu.solve_transpose_in_place(x.as_mut());
                 (0..b.len()).map(|i| x[(i, 0)]).collect::<Vec<_>>()
+            }
+            LinearMethod::Cholesky | LinearMethod::NegCholesky if self.dense_llt.is_some() => {
+                // (-A) x = -b for NegCholesky, whose factor is that of -A
+                let sign = if self.method == LinearMethod::NegCholesky { -1.0 } else { 1.0 };
+                let mut x: Vec<f64> = b.iter().map(|v| sign * v).collect();
+                self.dense_llt.as_ref().expect("checked").solve_columns(&mut x);
+                x
             }
             LinearMethod::Cholesky => {
                 let llt = self.llt.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;

@@ -5,6 +5,7 @@
 //! | module | holds |
 //! |---|---|
 //! | [`banded`] | [`Banded`](banded::Banded): symmetric banded matrices, banded Cholesky |
+//! | [`dense`] | [`DenseLu`](dense::DenseLu): LU with partial pivoting of the small systems of tiny bases |
 //! | [`sparse`] | [`Csr`](sparse::Csr): storage, products, pattern unions |
 //! | [`ordering`] | nested dissection of a grid of points, interleaving of component blocks |
 //! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver): LU, Cholesky preconditioners (f32/f64), the choice of method |
@@ -15,6 +16,7 @@
 //! sparse storage must sit below the splines; none of these modules knows what a spline is.
 
 pub mod banded;
+pub mod dense;
 pub mod krylov;
 pub mod linsolve;
 pub mod ordering;

@@ -439,8 +439,7 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let (ua, ub) = map.knots[0].domain();
     let (va, vb) = map.knots[1].domain();
     let par_area = (ub - ua) * (vb - va);
-    cert.mean_det_j =
-        if rational { crate::verify::quality::functionals(map).area / par_area } else { integral / par_area };
+    cert.mean_det_j = if rational { crate::verify::quality::area(map) / par_area } else { integral / par_area };
     let relative = cert.lower_bound / cert.mean_det_j;
     let degenerate: Vec<&'static str> =
         cert.corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();

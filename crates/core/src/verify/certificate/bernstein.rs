@@ -134,36 +134,48 @@ pub fn product_error(amax_a: f64, ea: f64, amax_b: f64, eb: f64, r: usize) -> f6
     (ea * amax_b + (amax_a + ea) * eb + gamma(r) * amax_a * amax_b) * (1.0 + 1e-6)
 }
 
-/// Split at `u = 1/2` (de Casteljau) into the left and right halves.
+/// Split at `u = 1/2` (de Casteljau) into the left and right halves. `tmp` holds at
+/// least `d.len()` values: the rows run side by side (the net transposed, so that each
+/// de Casteljau level is one pass over contiguous memory); every value is the same
+/// `(a + b) / 2` of the same operands as one row at a time.
 pub fn split_u(c: &[f64], d: Deg, left: &mut [f64], right: &mut [f64], tmp: &mut [f64]) {
     let [du, dv] = d.0;
-    let w = du + 1;
-    for l in 0..=dv {
-        let row = &c[l * w..(l + 1) * w];
-        tmp[..w].copy_from_slice(row);
-        for r in 0..=du {
-            left[l * w + r] = tmp[0];
-            right[l * w + du - r] = tmp[du - r];
-            for k in 0..du - r {
-                tmp[k] = 0.5 * (tmp[k] + tmp[k + 1]);
+    let (w, h) = (du + 1, dv + 1);
+    // t[k h + l] = c[l w + k]
+    let t = &mut tmp[..w * h];
+    for (l, row) in c[..w * h].chunks_exact(w).enumerate() {
+        for (k, &v) in row.iter().enumerate() {
+            t[k * h + l] = v;
+        }
+    }
+    for r in 0..=du {
+        for l in 0..h {
+            left[l * w + r] = t[l];
+            right[l * w + du - r] = t[(du - r) * h + l];
+        }
+        for k in 0..du - r {
+            let (a, b) = t[k * h..(k + 2) * h].split_at_mut(h);
+            for (x, y) in a.iter_mut().zip(b.iter()) {
+                *x = 0.5 * (*x + *y);
             }
         }
     }
 }
 
-/// Split at `v = 1/2`.
+/// Split at `v = 1/2`; `tmp` holds at least `d.len()` values (whole rows of the net
+/// are averaged at once).
 pub fn split_v(c: &[f64], d: Deg, left: &mut [f64], right: &mut [f64], tmp: &mut [f64]) {
     let [du, dv] = d.0;
-    let w = du + 1;
-    for k in 0..=du {
-        for l in 0..=dv {
-            tmp[l] = c[l * w + k];
-        }
-        for r in 0..=dv {
-            left[r * w + k] = tmp[0];
-            right[(dv - r) * w + k] = tmp[dv - r];
-            for l in 0..dv - r {
-                tmp[l] = 0.5 * (tmp[l] + tmp[l + 1]);
+    let (w, h) = (du + 1, dv + 1);
+    let t = &mut tmp[..w * h];
+    t.copy_from_slice(&c[..w * h]);
+    for r in 0..=dv {
+        left[r * w..(r + 1) * w].copy_from_slice(&t[..w]);
+        right[(dv - r) * w..(dv - r + 1) * w].copy_from_slice(&t[(dv - r) * w..(dv - r + 1) * w]);
+        for l in 0..dv - r {
+            let (a, b) = t[l * w..(l + 2) * w].split_at_mut(w);
+            for (x, y) in a.iter_mut().zip(b.iter()) {
+                *x = 0.5 * (*x + *y);
             }
         }
     }

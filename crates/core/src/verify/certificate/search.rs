@@ -164,14 +164,15 @@ impl Ctx<'_, '_> {
 fn split4(b: &SubBox, d: Deg, tmp: &mut [f64]) -> [SubBox; 4] {
     let n = d.len();
     let err = bz::split_error(&b.c, d, b.err);
-    let (mut l, mut r) = (vec![0.0; n], vec![0.0; n]);
-    bz::split_u(&b.c, d, &mut l, &mut r, tmp);
+    let mut halves = vec![0.0; 2 * n];
+    let (l, r) = halves.split_at_mut(n);
+    bz::split_u(&b.c, d, l, r, tmp);
     let mu = 0.5 * (b.su[0] + b.su[1]);
     let mv = 0.5 * (b.sv[0] + b.sv[1]);
     let (mut ll, mut lh) = (vec![0.0; n], vec![0.0; n]);
-    bz::split_v(&l, d, &mut ll, &mut lh, tmp);
+    bz::split_v(l, d, &mut ll, &mut lh, tmp);
     let (mut rl, mut rh) = (vec![0.0; n], vec![0.0; n]);
-    bz::split_v(&r, d, &mut rl, &mut rh, tmp);
+    bz::split_v(r, d, &mut rl, &mut rh, tmp);
     let depth = b.depth + 1;
     [
         SubBox { c: ll, su: [b.su[0], mu], sv: [b.sv[0], mv], depth, err },
