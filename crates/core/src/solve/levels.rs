@@ -36,6 +36,17 @@ pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) ->
     out
 }
 
+/// An input basis refined uniformly to at most this many functions is solved on its
+/// finest level only, from the Coons patch (an unrefined input basis of up to
+/// [`DIRECT_SOLVE_MAX_FUNCTIONS`](crate::boundary::input_basis::DIRECT_SOLVE_MAX_FUNCTIONS)
+/// functions is anyway): at most 64 unknowns, factorized densely, a level costs mostly
+/// its set-up (discretization, start, elasticity prolongation), and the coarse level
+/// saves no fine Newton step. Measured on the shared G+Smo geometries refined once and
+/// twice (9 to 60 functions; `bash scripts/bench-peers.sh`, BENCHMARKS.md): the same
+/// verdicts in 25-40 % less time; at 81 (lake) and 252 functions (duck) the coarse level
+/// saves one or two fine Newton steps and the hierarchy is faster.
+pub const DIRECT_REFINED_MAX_FUNCTIONS: usize = 64;
+
 /// Size ratio below which two levels count as one size in [`select_levels`].
 pub const SAME_SIZE: f64 = 1.5;
 

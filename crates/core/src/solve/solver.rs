@@ -13,7 +13,7 @@ use std::time::Instant;
 use super::improve::{bijective, improve, Improvement};
 use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
-use super::levels::{prepare_levels, select_levels};
+use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
@@ -137,7 +137,13 @@ impl EggSolver {
             None => (levels, None),
         };
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
-        let chosen = select_levels(&sizes, opts.growth, opts.max_levels);
+        let mut chosen = select_levels(&sizes, opts.growth, opts.max_levels);
+        // a tiny input basis refined (`refine`) is solved directly from the Coons patch
+        if hierarchy.basis.used == BasisChoice::Input
+            && sizes.last().is_some_and(|&n| n <= DIRECT_REFINED_MAX_FUNCTIONS)
+        {
+            chosen.drain(..chosen.len() - 1);
+        }
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
         Ok(Self {
             plan,
