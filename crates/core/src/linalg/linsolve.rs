@@ -455,19 +455,22 @@ impl LinearSolver {
                 }
                 // a failed numeric factorization (not positive definite: a minimisation
                 // then modifies its Hessian and factorizes again) keeps the analysis
-                let mut chol = match self.llt.take().or_else(|| self.analysed.take()) {
-                    Some(c) if c.dim() == neg.nrows => c,
-                    _ => Cholesky::analyze(&neg, self.order_for(neg.nrows).as_deref())?,
+                let chol = match self.llt.take().or_else(|| self.analysed.take()) {
+                    Some(c) if c.dim() == neg.nrows => Ok(c),
+                    _ => Cholesky::analyze(&neg, self.order_for(neg.nrows).as_deref()),
                 };
-                let r = chol.factor(&neg);
+                let r = match chol {
+                    Ok(mut c) => match c.factor(&neg) {
+                        Ok(()) => Ok(c),
+                        Err(e) => {
+                            self.analysed = Some(c);
+                            Err(e)
+                        }
+                    },
+                    Err(e) => Err(e),
+                };
                 self.negated = neg;
-                match r {
-                    Ok(()) => self.llt = Some(chol),
-                    Err(e) => {
-                        self.analysed = Some(chol);
-                        return Err(e);
-                    }
-                }
+                self.llt = Some(r?);
             }
             LinearMethod::Gmres => {
                 let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
