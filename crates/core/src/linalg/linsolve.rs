@@ -297,6 +297,9 @@ pub struct LinearSolver {
     pub krylov_tol: f64,
     /// `-A` for [`LinearMethod::NegCholesky`] (pattern copied once).
     negated: Csr,
+    /// The symbolic analysis of a [`LinearMethod::NegCholesky`] factorization that failed
+    /// (reused by the next one).
+    analysed: Option<Cholesky<f64>>,
 }
 
 impl LinearSolver {
@@ -320,6 +323,7 @@ impl LinearSolver {
             fallback,
             krylov_tol: KRYLOV_TOL,
             negated: Csr::default(),
+            analysed: None,
         }
     }
 
@@ -471,8 +475,22 @@ impl LinearSolver {
                 for v in neg.values.iter_mut() {
                     *v = -*v;
                 }
-                let slot = self.llt.take();
-                let r = self.cholesky(&neg, slot);
+                // a failed numeric factorization (not positive definite: a minimisation
+                // then modifies its Hessian and factorizes again) keeps the analysis
+                let chol = match self.llt.take().or_else(|| self.analysed.take()) {
+                    Some(c) if c.dim() == neg.nrows => Ok(c),
+                    _ => Cholesky::analyze(&neg, self.order_for(neg.nrows).as_deref()),
+                };
+                let r = match chol {
+                    Ok(mut c) => match c.factor(&neg) {
+                        Ok(()) => Ok(c),
+                        Err(e) => {
+                            self.analysed = Some(c);
+                            Err(e)
+                        }
+                    },
+                    Err(e) => Err(e),
+                };
                 self.negated = neg;
                 self.llt = Some(r?);
             }
@@ -634,6 +652,41 @@ mod tests {
             }
         }
         Csr::from_triplets(n, n, &t)
+    }
+
+    /// `A = -(T + s I)` with the symmetric `T = tridiag(-1, 2, -1)` (eigenvalues in
+    /// `(0, 4)`): negative definite for `s = 0.1`, indefinite for `s = -1`.
+    fn shifted_laplacian(n: usize, s: f64) -> Csr {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, -(2.0 + s)));
+            if i > 0 {
+                t.push((i, i - 1, 1.0));
+            }
+            if i + 1 < n {
+                t.push((i, i + 1, 1.0));
+            }
+        }
+        Csr::from_triplets(n, n, &t)
+    }
+
+    /// A negated Cholesky factorization fails exactly when `-A` is not positive definite
+    /// and keeps its symbolic analysis for the next one, which then solves `A x = b`.
+    #[test]
+    fn neg_cholesky_after_a_failure_solves() {
+        let n = 60;
+        let mut lin = LinearSolver::new(LinearMethod::NegCholesky);
+        assert!(lin.factor(&shifted_laplacian(n, -1.0)).is_err(), "-A is indefinite");
+        assert!(lin.analysed.is_some() && lin.llt.is_none(), "the analysis is kept, no factor");
+        assert!(lin.solve(&vec![1.0; n]).is_err(), "no solve after a failed factorization");
+        let a = shifted_laplacian(n, 0.1);
+        lin.factor(&a).unwrap();
+        assert!(lin.analysed.is_none() && lin.llt.is_some());
+        let b: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).cos()).collect();
+        let x = lin.solve(&b).unwrap();
+        for (r, b) in a.apply(&x).iter().zip(&b) {
+            assert!((r - b).abs() < 1e-12, "{r} vs {b}");
+        }
     }
 
     #[test]

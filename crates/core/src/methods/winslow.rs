@@ -40,7 +40,10 @@
 //! the modification steps back one stage (`m = 1` becomes `0.9`, then `0.3`, then the
 //! exact Hessian; diagonal shifts decay tenfold), so near the minimizer Newton converges
 //! quadratically, and where the exact Hessian is far from definite no assembly and
-//! factorization are spent on it at every step.
+//! factorization are spent on it at every step. A point where the modification had to be
+//! raised passes it on unchanged to the next one (which then steps back): the stages
+//! that failed at a point are not tried again at the next (on wavy_lid and jigsaw01
+//! this saves one failed assembly and factorization, with the same iterates).
 
 use std::sync::Arc;
 
@@ -126,6 +129,17 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
 /// form of [`flux_form`](super::flux::flux_form) with `G = -∂W/∂e`.
 pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
+    if stencil.is_empty() {
+        // the gradient only: `∂W/∂e = 2 e / D - W D' / D` without the Hessian
+        flux_form_with(disc, cps, res, stencil, true, |e| {
+            let [a, b, c, d] = e;
+            let inv = 1.0 / (a * d - b * c);
+            let w = (a * a + b * b + c * c + d * d) * inv;
+            let dd = [d, -c, -b, a];
+            (std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv), [[0.0; 4]; 4])
+        });
+        return;
+    }
     winslow_gradient_with(disc, cps, res, stencil, 0.0);
 }
 
@@ -163,54 +177,49 @@ pub fn winslow_gradient_with(
 /// `U diag(0,1) Vᵀ` from the `2 x 2` Hessian of `W(σ₁, σ₂)`, whose determinant is
 /// `-(1/σ₁² - 1/σ₂²)² <= 0`: one of each sign. Negative eigenvalues are dropped. The
 /// same as [`project_psd`] of [`winslow_density`]'s Hessian, about 20 times cheaper.
+///
+/// No angle is computed: `∇x = [[a, b], [c, d]] = q R(α₂) + r R(α₁) Z` (`R` a rotation,
+/// `Z = diag(1, -1)`; `q (cos α₂, sin α₂) = ((a + d)/2, (c - b)/2)`, `r (cos α₁, sin α₁) =
+/// ((a - d)/2, (c + b)/2)`, `σ₁,₂ = q ± r`), and with `U = R(φ)`, `Vᵀ = R(θ)`, `φ ± θ = α₂,
+/// α₁`: `U Vᵀ = R(α₂)`, `U Z Vᵀ = R(α₁) Z`, `U [[0,1],[1,0]] Vᵀ = R(α₁ + π/2) Z`; the
+/// eigenvector `(u₁, u₂)` of the `2 x 2` block is `∝ (λ - h₂₂, h₁₂)`.
 pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
     let [a, b, c, d] = e;
-    // F = [[a, b], [c, d]] = R(phi) diag(s1, s2) R(theta)
     let (ee, ff, gg, hh) = (0.5 * (a + d), 0.5 * (a - d), 0.5 * (c + b), 0.5 * (c - b));
     let (q, r) = (ee.hypot(hh), ff.hypot(gg));
     let (s1, s2) = (q + r, q - r);
-    let (a1, a2) = (gg.atan2(ff), hh.atan2(ee));
-    let (theta, phi) = (0.5 * (a2 - a1), 0.5 * (a2 + a1));
-    let (cu, su, cv, sv) = (phi.cos(), phi.sin(), theta.cos(), theta.sin());
-    let u = [[cu, -su], [su, cu]];
-    let vt = [[cv, -sv], [sv, cv]];
-    // vec(U M Vᵀ) row-major, the layout of e
-    let mode = |m: [[f64; 2]; 2]| -> [f64; 4] {
-        let mut um = [[0.0; 2]; 2];
-        for i in 0..2 {
-            for j in 0..2 {
-                um[i][j] = u[i][0] * m[0][j] + u[i][1] * m[1][j];
-            }
-        }
-        let mut out = [0.0; 4];
-        for i in 0..2 {
-            for j in 0..2 {
-                out[2 * i + j] = um[i][0] * vt[0][j] + um[i][1] * vt[1][j];
-            }
-        }
-        out
-    };
-    let p = s1 * s2;
+    // cos, sin of α₂ and α₁ (α₁ = 0 at a conformal point, where the result does not
+    // depend on it)
+    let (c2, n2) = (ee / q, hh / q);
+    let (c1, n1) = if r > 0.0 { (ff / r, gg / r) } else { (1.0, 0.0) };
+    // row-major vec of R(α₂) and of R(α₁) Z, R(α₁ + π/2) Z
+    let rot = [c2, -n2, n2, c2];
+    let refl = [c1, n1, n1, -c1];
     let r2 = std::f64::consts::FRAC_1_SQRT_2;
-    let mut modes: Vec<(f64, [f64; 4])> = vec![((s1 + s2) * (s1 + s2) / (p * p), mode([[0.0, r2], [r2, 0.0]]))];
+    let flip = [-r2 * n1, r2 * c1, r2 * c1, r2 * n1];
+    let p = s1 * s2;
+    let mut out = [[0.0; 4]; 4];
+    let mut add = |l: f64, v: [f64; 4]| {
+        for i in 0..4 {
+            for j in 0..4 {
+                out[i][j] += l * v[i] * v[j];
+            }
+        }
+    };
+    add((s1 + s2) * (s1 + s2) / (p * p), flip);
     // scaling block: [[2 s2 / s1³, -(1/s1² + 1/s2²)], [., 2 s1 / s2³]]
     let (h11, h22, h12) = (2.0 * s2 / (s1 * s1 * s1), 2.0 * s1 / (s2 * s2 * s2), -(1.0 / (s1 * s1) + 1.0 / (s2 * s2)));
     let (mean, half) = (0.5 * (h11 + h22), 0.5 * (h11 - h22));
     let rad = half.hypot(h12);
     let lambda = mean + rad;
     if lambda > 0.0 {
-        // eigenvector of the larger eigenvalue
-        let t = 0.5 * h12.atan2(half);
-        let (ct, st) = (t.cos(), t.sin());
-        modes.push((lambda, mode([[ct, 0.0], [0.0, st]])));
-    }
-    let mut out = [[0.0; 4]; 4];
-    for (l, v) in modes {
-        for i in 0..4 {
-            for j in 0..4 {
-                out[i][j] += l * v[i] * v[j];
-            }
-        }
+        // eigenvector (u1, u2) of the larger eigenvalue, ∝ (λ - h22, h12) (h12 < 0);
+        // U diag(u1, u2) Vᵀ = (u1 + u2)/2 R(α₂) + (u1 - u2)/2 R(α₁) Z
+        let (v1, v2) = (half + rad, h12);
+        let norm = v1.hypot(v2);
+        let (u1, u2) = (v1 / norm, v2 / norm);
+        let (sp, sm) = (0.5 * (u1 + u2), 0.5 * (u1 - u2));
+        add(lambda, std::array::from_fn(|i| sp * rot[i] + sm * refl[i]));
     }
     out
 }
@@ -347,6 +356,9 @@ pub struct WinslowProblem {
     /// without assembly).
     assembled: Option<(Vec<f64>, f64)>,
     raised: bool,
+    /// The modification was raised at the current point ([`DiscreteProblem::raise_shift`]):
+    /// the next point starts with it rather than one stage back.
+    raised_at_point: bool,
     /// The density Hessians are projected onto the semidefinite matrices
     /// ([`winslow_gradient_with`]) at this point.
     projected: f64,
@@ -363,7 +375,15 @@ impl WinslowProblem {
     pub fn new(disc: Arc<Discretization>, cps: Vec<Point>) -> Self {
         let pat = &disc.vector.csr;
         let diag = (0..pat.nrows).map(|r| pat.position(r, r).expect("the pattern holds the diagonal")).collect();
-        Self { state: GalerkinState::new(disc, cps), diag, shift: 0.0, assembled: None, raised: false, projected: 0.0 }
+        Self {
+            state: GalerkinState::new(disc, cps),
+            diag,
+            shift: 0.0,
+            assembled: None,
+            raised: false,
+            raised_at_point: false,
+            projected: 0.0,
+        }
     }
 
     /// The current unknown vector.
@@ -391,10 +411,12 @@ impl DiscreteProblem for WinslowProblem {
     }
 
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
-        if !std::mem::take(&mut self.raised) {
+        if !std::mem::take(&mut self.raised) && !std::mem::take(&mut self.raised_at_point) {
             // a new point: one step back towards the exact Hessian (after a fully
             // projected one the exact Hessian is rarely definite: trying it would cost
-            // an assembly and a failed factorization)
+            // an assembly and a failed factorization); where the last point needed a
+            // stronger modification than the one it started with, its modification
+            // is kept for this one (the stages it failed would fail here too)
             self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
             self.projected = match self.projected {
                 x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
@@ -437,6 +459,7 @@ impl DiscreteProblem for WinslowProblem {
 
     fn raise_shift(&mut self) -> bool {
         self.raised = true;
+        self.raised_at_point = true;
         if self.projected < 1.0 {
             self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
             return true;

@@ -92,8 +92,11 @@ pub struct Improvement {
     pub converged: bool,
     /// Why the solver stopped early, if it did.
     pub failure: Option<String>,
-    /// Nonlinear iterations.
+    /// Nonlinear iterations (Newton steps: one Jacobian or Hessian each).
     pub iterations: usize,
+    /// Chord steps taken after Newton steps ([`NonlinearOptions::chord`]): one residual
+    /// and one solve with the step's factorization each.
+    pub chord_steps: usize,
     /// Unknowns (`2 m`).
     pub unknowns: usize,
     /// `|∇J|` per iterate, start first.
@@ -127,6 +130,7 @@ impl Improvement {
             converged: false,
             failure: Some(why.clone()),
             iterations: 0,
+            chord_steps: 0,
             unknowns: 0,
             residuals: Vec::new(),
             objective: Vec::new(),
@@ -156,7 +160,10 @@ pub struct Improved {
 /// Newton with its line search only (pseudo time-stepping is for starts far from a
 /// solution, and 400 of its steps cost minutes on a fine basis), the residual scaled by
 /// [`Method::residual_scale`], the step tolerance in length units, a failed line search
-/// on a GMRES direction retried with LU ([`NonlinearOptions::direct_retry`]); a minimisation stops
+/// on a GMRES direction retried with LU ([`NonlinearOptions::direct_retry`]), a
+/// root-finding step followed by a chord step ([`NonlinearOptions::chord`]), a
+/// minimisation's full step by a longer one where `J` falls further
+/// ([`NonlinearOptions::extrapolate`]); a minimisation stops
 /// when its decrement is negligible ([`crate::solve::newton::DECREMENT_TOL`]) or after
 /// [`MAX_MODIFIED_STEPS`] steps with a modified Hessian.
 pub fn from_bijective_start(
@@ -168,6 +175,8 @@ pub fn from_bijective_start(
     let mut nl = nonlinear;
     nl.method = NonlinearMethod::Newton;
     nl.direct_retry = true;
+    nl.chord = true;
+    nl.extrapolate = true;
     nl.fallback = false;
     nl.scale = method.residual_scale(diameter, m);
     nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
@@ -233,7 +242,7 @@ pub fn improve(
         iterations = it.iteration;
     }
     let status = solver.status().clone();
-    let timings = solver.timings;
+    let (timings, chord_steps) = (solver.timings, solver.chord_steps);
     let (problem, c) = solver.into_parts();
     let candidate =
         Surface { knots: map.knots.clone(), control_points: problem.control_points(&c), weights: map.weights.clone() };
@@ -300,6 +309,7 @@ pub fn improve(
             _ => None,
         },
         iterations,
+        chord_steps,
         unknowns: 2 * m,
         residuals,
         objective,

@@ -195,7 +195,8 @@ fn preconditioner_block_is_the_definite_mean_block() {
 /// projected (in three steps, the last one fully) onto the semidefinite matrices (so
 /// `-dF/dc` is semidefinite), then adds
 /// `τ |H_ii|` to the diagonal of that (no other entry changes, no reassembly needed),
-/// `τ` growing tenfold per call; a new point starts from the exact Hessian again.
+/// `τ` growing tenfold per call; a new point keeps the modification of a point where it
+/// was raised, and steps back one stage towards the exact Hessian otherwise.
 #[test]
 fn raised_shift_projects_then_adds_to_the_diagonal() {
     let (disc, cps, _) = twisted(2, 4, 1.0);
@@ -230,9 +231,14 @@ fn raised_shift_projects_then_adds_to_the_diagonal() {
             assert!((d1[i][j] - expect).abs() <= 1e-14 * dp[i][i].abs(), "({i}, {j})");
         }
     }
-    // a new point: one step back towards the exact Hessian, which comes back after
-    // three new points
+    // a new point after one where the modification was raised: the same modification
+    // (the stages that failed are not tried again) ...
     let mut c2 = c.clone();
+    c2[0] += 1e-3;
+    prob.jacobian(&c2, &mut f, &mut jac1);
+    assert!(prob.shift() == tau && prob.projected == 1.0 && prob.modified());
+    // ... then one step back towards the exact Hessian per new point, which comes back
+    // after three
     c2[0] += 1e-3;
     prob.jacobian(&c2, &mut f, &mut jac1);
     assert!(prob.shift() < tau && prob.projected == 3.0 * PROJECTION_FIRST && prob.modified());
@@ -242,6 +248,15 @@ fn raised_shift_projects_then_adds_to_the_diagonal() {
         assert_eq!(prob.modified(), k == 0);
     }
     assert_eq!(prob.projected, 0.0);
+    // a point that needed no raise passes nothing on
+    assert!(prob.raise_shift());
+    prob.jacobian(&c2, &mut f, &mut jac1);
+    c2[0] += 1e-3;
+    prob.jacobian(&c2, &mut f, &mut jac1);
+    assert_eq!(prob.projected, PROJECTION_FIRST, "raised at the last point: kept");
+    c2[0] += 1e-3;
+    prob.jacobian(&c2, &mut f, &mut jac1);
+    assert_eq!(prob.projected, 0.0, "not raised at the last point: one stage back");
 }
 
 /// The closed-form projection of the density Hessian equals the projection by Jacobi
