@@ -674,7 +674,8 @@ mod tests {
     /// and keeps its symbolic analysis for the next one, which then solves `A x = b`.
     #[test]
     fn neg_cholesky_after_a_failure_solves() {
-        let n = 60;
+        // past the dense limit: the sparse factorization with its symbolic analysis
+        let n = 2 * DENSE_LIMIT;
         let mut lin = LinearSolver::new(LinearMethod::NegCholesky);
         assert!(lin.factor(&shifted_laplacian(n, -1.0)).is_err(), "-A is indefinite");
         assert!(lin.analysed.is_some() && lin.llt.is_none(), "the analysis is kept, no factor");
@@ -686,6 +687,51 @@ mod tests {
         let x = lin.solve(&b).unwrap();
         for (r, b) in a.apply(&x).iter().zip(&b) {
             assert!((r - b).abs() < 1e-12, "{r} vs {b}");
+        }
+        // within the dense limit likewise: no factor after a failure, a solve after success
+        let n = DENSE_LIMIT / 2;
+        let mut lin = LinearSolver::new(LinearMethod::NegCholesky);
+        assert!(lin.factor(&shifted_laplacian(n, -1.0)).is_err(), "-A is indefinite");
+        assert!(lin.solve(&vec![1.0; n]).is_err(), "no solve after a failed factorization");
+        let a = shifted_laplacian(n, 0.1);
+        lin.factor(&a).unwrap();
+        let x = lin.solve(&b[..n]).unwrap();
+        for (r, b) in a.apply(&x).iter().zip(&b) {
+            assert!((r - b).abs() < 1e-12, "{r} vs {b}");
+        }
+    }
+
+    /// Dense (up to `DENSE_LIMIT` unknowns) and sparse LU give the same solution of a
+    /// nonsymmetric system to rounding.
+    #[test]
+    fn dense_and_sparse_lu_agree() {
+        let n = DENSE_LIMIT;
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, 3.0 + (i as f64 * 0.7).sin()));
+            if i > 0 {
+                t.push((i, i - 1, -1.2));
+            }
+            if i + 2 < n {
+                t.push((i, i + 2, 0.5));
+            }
+        }
+        let a = Csr::from_triplets(n, n, &t);
+        let b: Vec<f64> = (0..n).map(|i| (0.2 * i as f64).cos()).collect();
+        let mut dense = LinearSolver::new(LinearMethod::Lu);
+        dense.factor(&a).unwrap();
+        let x = dense.solve(&b).unwrap();
+        assert!(dense.dense.is_some() && dense.lu.is_none(), "dense within the limit");
+        let mut big = t.clone();
+        big.push((n, n, 1.0));
+        let mut sparse = LinearSolver::new(LinearMethod::Lu);
+        sparse.factor(&Csr::from_triplets(n + 1, n + 1, &big)).unwrap();
+        assert!(sparse.dense.is_none() && sparse.lu.is_some(), "sparse past the limit");
+        let mut bb = b.clone();
+        bb.push(0.0);
+        let y = sparse.solve(&bb).unwrap();
+        for (u, v) in x.iter().zip(&y) {
+            assert!((u - v).abs() < 1e-13, "{u} vs {v}");
         }
     }
 
