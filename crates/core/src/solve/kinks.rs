@@ -23,6 +23,7 @@
 //! continuation is prolonged onto the refined basis and the continuation goes on from
 //! there, at most `repair` rounds.
 
+use std::cell::RefCell;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -185,7 +186,16 @@ pub fn keep_kinks(
             control_points: cps.to_vec(),
             weights: weights.clone(),
         };
-        let certified = |cps: &[Point]| certify(&surface(cps), &opts.certify).is_ok_and(|c| bijective(&c));
+        // the continuation's last certificate, reused for its guess below
+        let last: RefCell<Option<(Vec<Point>, Certificate)>> = RefCell::new(None);
+        let certified = |cps: &[Point]| match certify(&surface(cps), &opts.certify) {
+            Ok(c) => {
+                let ok = bijective(&c);
+                *last.borrow_mut() = Some((cps.to_vec(), c));
+                ok
+            }
+            Err(_) => false,
+        };
         let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
         // the damped steps are counted per round (the cap of the continuation is per basis)
         let mut round = Continuation::default();
@@ -193,7 +203,10 @@ pub fn keep_kinks(
         cont.steps += round.steps;
         cont.iterations += round.iterations;
         report.alpha = report.alpha.max(out.alpha);
-        let cert = certify(&surface(&out.guess), &opts.certify)?;
+        let cert = match last.take() {
+            Some((cps, c)) if cps == out.guess => c,
+            _ => certify(&surface(&out.guess), &opts.certify)?,
+        };
         if bijective(&cert) || report.refinements >= opts.repair {
             break (disc, weights, out.guess, cert);
         }
@@ -211,8 +224,8 @@ pub fn keep_kinks(
     let surface =
         |cps: &[Point]| Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
     let finite = |j: f64| j.is_finite().then_some(j);
-    report.winslow[0] = finite(winslow_objective(&disc, &start));
     if !bijective(&start_cert) {
+        report.winslow[0] = finite(winslow_objective(&disc, &start));
         let why = format!(
             "the elasticity step to the kinked boundary ({} damped Winslow solves, {} refinement round(s), {:.3} of the \
              boundary displacement reached with a certified map) gave no bijective start: {}",
@@ -245,6 +258,8 @@ pub fn keep_kinks(
     let nl = from_bijective_start(opts.nonlinear, &method, diameter, moved.dofs.num_free());
     let c0 = moved.dofs.gather(&start);
     let mut solver = NonlinearSolver::new(method.problem(moved, start.clone()), c0, nl);
+    // `J` on the same knots and quadrature as `disc` (the DOF map does not change it)
+    report.winslow[0] = solver.objective().and_then(finite);
     for it in solver.by_ref() {
         report.iterations = it?.iteration;
     }
@@ -252,9 +267,9 @@ pub fn keep_kinks(
     if let Status::Failed(why) = solver.status() {
         report.failure = Some(format!("Winslow minimisation: {why}"));
     }
+    report.winslow[1] = solver.objective().and_then(finite);
     let (problem, c) = solver.into_parts();
     let minimised = problem.control_points(&c);
-    report.winslow[1] = finite(winslow_objective(&disc, &minimised));
     let cert = certify(&surface(&minimised), &opts.certify)?;
     let (cps, cert, which) = if bijective(&cert) {
         (minimised, cert, "the Winslow minimiser")
