@@ -12,11 +12,13 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 
-/// Largest system that [`LinearSolver`](super::linsolve::LinearSolver)'s LU factorizes
-/// densely (`n x n` storage: 32 KiB at 64 unknowns). Measured on the 2- to 64-unknown EGG
-/// Jacobians of the shared G+Smo geometries: 1-6 µs per factorization and solve, against
-/// 8-40 µs for faer's sparse LU with its symbolic analysis reused (BENCHMARKS.md,
-/// "Same-basis race against G+Smo").
+/// Largest system that [`LinearSolver`](super::linsolve::LinearSolver) factorizes
+/// densely (`n x n` storage: 32 KiB at 64 unknowns), the limit up to which the automatic
+/// choice factorizes at all ([`AUTO_LU_LIMIT`](super::linsolve::AUTO_LU_LIMIT)). Measured
+/// on the EGG solves of the shared G+Smo geometries on their input bases (a Newton step:
+/// assembly, factorization, solve, line search): lake, 32 unknowns, 85 -> 58 µs per step
+/// and 334 -> 171 µs for the first (faer's symbolic analysis); cooks_membrane, 2
+/// unknowns, 8 -> 4.6 µs (BENCHMARKS.md, "Same-basis race against G+Smo").
 pub const DENSE_LIMIT: usize = 64;
 
 /// The factors `P A = L U` of a square matrix, row-major.

@@ -42,9 +42,10 @@ pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) ->
 /// functions is anyway): at most 64 unknowns, factorized densely, a level costs mostly
 /// its set-up (discretization, start, elasticity prolongation), and the coarse level
 /// saves no fine Newton step. Measured on the shared G+Smo geometries refined once and
-/// twice (9 to 60 functions; `bash scripts/bench-peers.sh`, BENCHMARKS.md): the same
-/// verdicts in 25-40 % less time; at 81 (lake) and 252 functions (duck) the coarse level
-/// saves one or two fine Newton steps and the hierarchy is faster.
+/// twice (16 to 60 functions: disk, cooks_membrane, flapping_beam, lake, plate_with_hole;
+/// `bash scripts/bench-peers.sh`, BENCHMARKS.md): the same verdicts in 10-40 % less time
+/// (cooks_membrane refined once 168 -> 97 µs); at 81 (lake) and 252 functions (duck) the
+/// coarse level saves one or two fine Newton steps and the hierarchy is faster.
 pub const DIRECT_REFINED_MAX_FUNCTIONS: usize = 64;
 
 /// Size ratio below which two levels count as one size in [`select_levels`].
