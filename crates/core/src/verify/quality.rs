@@ -142,6 +142,20 @@ pub fn functionals(map: &Surface) -> Functionals {
     integrate(map).functionals
 }
 
+/// The `xi` basis of `map` and its derivatives to `order` at the points of `g` on every
+/// element `(span, a, b)` of `ex`, with the quadrature weights, element by element.
+fn tabulate_xi(map: &Surface, g: &GaussLegendre, ex: &[(usize, f64, f64)], order: usize) -> Vec<(BasisDerivs, f64)> {
+    ex.iter()
+        .flat_map(|&(sx, xa, xb)| {
+            g.on(xa, xb).map(move |(u, wu)| {
+                let mut b = BasisDerivs::default();
+                b.eval_in_span(&map.knots[0], sx, u, order);
+                (b, wu)
+            })
+        })
+        .collect()
+}
+
 /// The area `∫ det J dξ dη` of `map` by the quadrature of [`functionals`] (`(p + 2) x
 /// (q + 2)` Gauss points per element, rows of elements summed in order), from first
 /// derivatives only: the certificate's mean `det J` of a rational map, where the
@@ -151,16 +165,7 @@ pub fn area(map: &Surface) -> f64 {
     let gx = GaussLegendre::new(p + 2);
     let gy = GaussLegendre::new(q + 2);
     let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
-    let bus: Vec<(BasisDerivs, f64)> = ex
-        .iter()
-        .flat_map(|&(sx, xa, xb)| {
-            gx.on(xa, xb).map(move |(u, wu)| {
-                let mut b = BasisDerivs::default();
-                b.eval_in_span(&map.knots[0], sx, u, 1);
-                (b, wu)
-            })
-        })
-        .collect();
+    let bus = tabulate_xi(map, &gx, &ex, 1);
     let row = |&(sy, ya, yb): &(usize, f64, f64)| {
         let mut acc = 0.0;
         let mut bv = BasisDerivs::default();
@@ -198,16 +203,7 @@ fn integrate(map: &Surface) -> Pass {
     let gy = GaussLegendre::new(q + 2);
     let (ex, ey) = (map.knots[0].elements(), map.knots[1].elements());
     let nu = p + 2;
-    let bus: Vec<(BasisDerivs, f64)> = ex
-        .iter()
-        .flat_map(|&(sx, xa, xb)| {
-            gx.on(xa, xb).map(move |(u, wu)| {
-                let mut b = BasisDerivs::default();
-                b.eval_in_span(&map.knots[0], sx, u, 2);
-                (b, wu)
-            })
-        })
-        .collect();
+    let bus = tabulate_xi(map, &gx, &ex, 2);
     // per row: area, winslow, harmonic, area orthogonality, liao, uniformity, min det J,
     // scaled-Jacobian integral, weight; and the row's cells
     type Row = ([f64; 9], Vec<[f64; 3]>);
