@@ -18,7 +18,8 @@ use crate::linalg::sparse::Csr;
 /// on the EGG solves of the shared G+Smo geometries on their input bases (a Newton step:
 /// assembly, factorization, solve, line search): lake, 32 unknowns, 85 -> 58 µs per step
 /// and 334 -> 171 µs for the first (faer's symbolic analysis); cooks_membrane, 2
-/// unknowns, 8 -> 4.6 µs (BENCHMARKS.md, "Same-basis race against G+Smo").
+/// unknowns, 8 -> 4.6 µs (time stamps around each step, a throwaway probe;
+/// BENCHMARKS.md, "Same-basis race against G+Smo").
 pub const DENSE_LIMIT: usize = 64;
 
 /// The factors `P A = L U` of a square matrix, row-major.
@@ -194,6 +195,7 @@ impl DenseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testutil::Lcg;
 
     fn csr(n: usize, dense: &[f64]) -> Csr {
         let mut row_ptr = vec![0];
@@ -226,11 +228,8 @@ mod tests {
         }
         // a 40 x 40 system with a pseudo-random nonsymmetric matrix
         let n = 40;
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = Lcg::new(12345);
+        let mut rnd = || rng.uniform() - 0.5;
         let a: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
         let b: Vec<f64> = (0..n).map(|_| rnd()).collect();
         lu.factor(&csr(n, &a)).unwrap();
@@ -246,11 +245,8 @@ mod tests {
     fn cholesky_solves_and_refuses_indefinite() {
         let n = 30;
         // A = B Bᵀ + n I with B pseudo-random
-        let mut s = 777u64;
-        let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = Lcg::new(777);
+        let mut rnd = || rng.uniform() - 0.5;
         let b: Vec<f64> = (0..n * n).map(|_| rnd()).collect();
         let a: Vec<f64> = (0..n * n)
             .map(|ij| {

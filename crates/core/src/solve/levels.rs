@@ -12,9 +12,14 @@ use crate::spline::surface::Side;
 /// Choose the levels to solve: from the coarsest, each next one at least `growth` times
 /// larger, always ending with the finest. A level of nearly the finest's size (less than
 /// [`SAME_SIZE`] times smaller) is replaced by the finest: solving twice at one size
-/// costs a full solve and gains nothing. The coarsest level always stays.
-pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>) -> Vec<usize> {
+/// costs a full solve and gains nothing. The coarsest level always stays, unless the
+/// finest has at most `direct_max` functions: then it is solved alone (see
+/// [`DIRECT_REFINED_MAX_FUNCTIONS`]; 0: never).
+pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>, direct_max: usize) -> Vec<usize> {
     let last = sizes.len() - 1;
+    if sizes[last] <= direct_max {
+        return vec![last];
+    }
     let mut out = vec![0];
     for (k, &s) in sizes.iter().enumerate().skip(1) {
         let previous = *out.last().expect("non-empty");
@@ -174,12 +179,15 @@ mod tests {
     #[test]
     fn level_selection_quadruples() {
         // 310 replaces 300: both would be solved at nearly one size
-        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None), vec![0, 2, 5]);
-        assert_eq!(select_levels(&[16, 20, 64, 70, 300], 4.0, None), vec![0, 2, 4]);
-        assert_eq!(select_levels(&[16, 20], 4.0, None), vec![0, 1]);
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300, 310], 4.0, None, 0), vec![0, 2, 5]);
+        assert_eq!(select_levels(&[16, 20, 64, 70, 300], 4.0, None, 0), vec![0, 2, 4]);
+        assert_eq!(select_levels(&[16, 20], 4.0, None, 0), vec![0, 1]);
         // a finest level well above the previous one (here 1.67 times) keeps it
-        assert_eq!(select_levels(&[162, 1122, 1870], 4.0, None), vec![0, 1, 2]);
-        assert_eq!(select_levels(&[16], 4.0, None), vec![0]);
-        assert_eq!(select_levels(&[16, 64, 256, 1024], 4.0, Some(2)), vec![0, 3]);
+        assert_eq!(select_levels(&[162, 1122, 1870], 4.0, None, 0), vec![0, 1, 2]);
+        assert_eq!(select_levels(&[16], 4.0, None, 0), vec![0]);
+        assert_eq!(select_levels(&[16, 64, 256, 1024], 4.0, Some(2), 0), vec![0, 3]);
+        // a finest level within `direct_max` alone; above it the hierarchy
+        assert_eq!(select_levels(&[9, 16], 4.0, None, DIRECT_REFINED_MAX_FUNCTIONS), vec![1]);
+        assert_eq!(select_levels(&[16, 36, 100], 4.0, None, DIRECT_REFINED_MAX_FUNCTIONS), vec![0, 2]);
     }
 }

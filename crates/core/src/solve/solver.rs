@@ -137,13 +137,12 @@ impl EggSolver {
             None => (levels, None),
         };
         let sizes: Vec<usize> = levels.iter().map(|l| l.num_basis()).collect();
-        let mut chosen = select_levels(&sizes, opts.growth, opts.max_levels);
         // a tiny input basis refined (`refine`) is solved directly from the Coons patch
-        if hierarchy.basis.used == BasisChoice::Input
-            && sizes.last().is_some_and(|&n| n <= DIRECT_REFINED_MAX_FUNCTIONS)
-        {
-            chosen.drain(..chosen.len() - 1);
-        }
+        let direct_max = match hierarchy.basis.used {
+            BasisChoice::Input => DIRECT_REFINED_MAX_FUNCTIONS,
+            BasisChoice::Fitted | BasisChoice::Auto => 0,
+        };
+        let chosen = select_levels(&sizes, opts.growth, opts.max_levels, direct_max);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
         Ok(Self {
             plan,
