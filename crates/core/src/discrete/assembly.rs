@@ -24,6 +24,13 @@ use crate::spline::quadrature::GaussLegendre;
 
 const W: usize = MAX_DEGREE + 1;
 
+/// One element row of [`Discretization::assemble`] with its chunks of the residual and
+/// of the stencil storage.
+type RowChunks<'a> = ((usize, Option<&'a mut [f64]>), Option<&'a mut [f64]>);
+
+/// Quadrature points below which [`Discretization::assemble`] runs on the calling thread.
+pub const SERIAL_ASSEMBLY_POINTS: usize = 4096;
+
 /// Univariate basis values at one quadrature point: weight (times element length),
 /// abscissa, and `n[k][j]` = `k`-th derivative of the `j`-th non-zero function.
 #[derive(Debug, Clone, Copy)]
@@ -328,6 +335,9 @@ impl Discretization {
         let want_mat = !stencil.is_empty();
         res.fill(0.0);
         stencil.fill(0.0);
+        // one thread for small bases, where waking the pool costs more than it saves
+        let serial = self.num_elements() * tx.nq * ty.nq < SERIAL_ASSEMBLY_POINTS;
+        let mut scratch = None;
         for color in 0..=q {
             let rows: Vec<usize> = (color..ty.num_elements()).step_by(q + 1).collect();
             let r_ranges: Vec<(usize, usize)> =
@@ -344,41 +354,46 @@ impl Discretization {
             } else {
                 rows.iter().map(|_| None).collect()
             };
-            rows.into_par_iter().zip(r_chunks).zip(m_chunks).for_each_init(
-                || Scratch::new(p, q, ncomp),
-                |s, ((ey, mut rc), mut mc)| {
-                    for ex in 0..tx.num_elements() {
-                        let fx = tx.first[ex];
-                        kernel(ex, ey, s);
-                        let nloc = s.nloc;
-                        for ja in 0..=q {
-                            for ia in 0..=p {
-                                let a = ja * (p + 1) + ia;
-                                let row = ja * nx + fx + ia; // row inside the chunk
-                                if let Some(rc) = rc.as_deref_mut() {
-                                    for z in 0..ncomp {
-                                        rc[row * ncomp + z] += s.re[z * nloc + a];
-                                    }
+            let body = |s: &mut Scratch, ((ey, mut rc), mut mc): RowChunks<'_>| {
+                for ex in 0..tx.num_elements() {
+                    let fx = tx.first[ex];
+                    kernel(ex, ey, s);
+                    let nloc = s.nloc;
+                    for ja in 0..=q {
+                        for ia in 0..=p {
+                            let a = ja * (p + 1) + ia;
+                            let row = ja * nx + fx + ia; // row inside the chunk
+                            if let Some(rc) = rc.as_deref_mut() {
+                                for z in 0..ncomp {
+                                    rc[row * ncomp + z] += s.re[z * nloc + a];
                                 }
-                                if let Some(mc) = mc.as_deref_mut() {
-                                    let base = row * row_len;
-                                    for zd in 0..ncomp * ncomp {
-                                        let blk = &s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
-                                        let out = &mut mc[base + zd * sw..base + (zd + 1) * sw];
-                                        for jb in 0..=q {
-                                            let off = (jb + q - ja) * (2 * p + 1) + p - ia;
-                                            let src = &blk[jb * (p + 1)..(jb + 1) * (p + 1)];
-                                            for (o, v) in out[off..off + p + 1].iter_mut().zip(src) {
-                                                *o += v;
-                                            }
+                            }
+                            if let Some(mc) = mc.as_deref_mut() {
+                                let base = row * row_len;
+                                for zd in 0..ncomp * ncomp {
+                                    let blk = &s.ke[(zd * nloc + a) * nloc..(zd * nloc + a + 1) * nloc];
+                                    let out = &mut mc[base + zd * sw..base + (zd + 1) * sw];
+                                    for jb in 0..=q {
+                                        let off = (jb + q - ja) * (2 * p + 1) + p - ia;
+                                        let src = &blk[jb * (p + 1)..(jb + 1) * (p + 1)];
+                                        for (o, v) in out[off..off + p + 1].iter_mut().zip(src) {
+                                            *o += v;
                                         }
                                     }
                                 }
                             }
                         }
                     }
-                },
-            );
+                }
+            };
+            if serial {
+                let s = scratch.get_or_insert_with(|| Scratch::new(p, q, ncomp));
+                for item in rows.into_iter().zip(r_chunks).zip(m_chunks) {
+                    body(s, item);
+                }
+            } else {
+                rows.into_par_iter().zip(r_chunks).zip(m_chunks).for_each_init(|| Scratch::new(p, q, ncomp), body);
+            }
         }
     }
 
@@ -421,6 +436,47 @@ impl Discretization {
                 let ruv = (wa * b[4] - ru * wv - rv * wu - r * wuv) / w0;
                 let rvv = (wa * b[5] - 2.0 * rv * wv - r * wvv) / w0;
                 *b = [r, ru, rv, ruu, ruv, rvv];
+            }
+        }
+        tu.w * tv.w
+    }
+
+    /// [`Discretization::tensor_basis`] up to first derivatives: `s.b[a][0..3] = (w,
+    /// w_u, w_v)`, the second-derivative slots left as they are, for the first-order
+    /// forms (eq. 14, 16), which read no others. The rational quotient rule takes one
+    /// division per point instead of six per function.
+    pub(crate) fn tensor_basis_first(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
+        let (p, q) = self.degrees();
+        let tu = self.tables[0].at(ex, ku);
+        let tv = self.tables[1].at(ey, kv);
+        for jb in 0..=q {
+            let (v0, v1) = (tv.n[0][jb], tv.n[1][jb]);
+            for ib in 0..=p {
+                let (u0, u1) = (tu.n[0][ib], tu.n[1][ib]);
+                let b = &mut s.b[jb * (p + 1) + ib];
+                b[0] = u0 * v0;
+                b[1] = u1 * v0;
+                b[2] = u0 * v1;
+            }
+        }
+        if let Some(w) = &self.weights {
+            let nx = self.shape()[0];
+            let (fx, fy) = (self.tables[0].first[ex], self.tables[1].first[ey]);
+            let weight = |a: usize| w[(fy + a / (p + 1)) * nx + fx + a % (p + 1)];
+            let (mut w0, mut wu, mut wv) = (0.0, 0.0, 0.0);
+            for (a, b) in s.b.iter().enumerate() {
+                let wa = weight(a);
+                w0 += wa * b[0];
+                wu += wa * b[1];
+                wv += wa * b[2];
+            }
+            let inv = 1.0 / w0;
+            for (a, b) in s.b.iter_mut().enumerate() {
+                let wa = weight(a) * inv;
+                let r = wa * b[0];
+                b[0] = r;
+                b[1] = wa * b[1] - r * wu * inv;
+                b[2] = wa * b[2] - r * wv * inv;
             }
         }
         tu.w * tv.w

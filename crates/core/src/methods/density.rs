@@ -105,16 +105,23 @@ where
             |s, ey| {
                 let mut sum = 0.0;
                 for ex in 0..nex {
+                    // per element, then the elements in order (as in
+                    // `winslow::winslow_value_and_gradient`, bit for bit)
+                    let mut cell = 0.0;
                     for kv in 0..nq[1] {
                         for ku in 0..nq[0] {
-                            let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                            let wq = match order {
+                                Order::First => disc.tensor_basis_first(ex, ey, ku, kv, s),
+                                Order::Second => disc.tensor_basis(ex, ey, ku, kv, s),
+                            };
                             let v = psi(&jet_at(disc, ex, ey, cps, s, nd));
                             if !v.is_finite() {
                                 return f64::INFINITY;
                             }
-                            sum += wq * v;
+                            cell += wq * v;
                         }
                     }
+                    sum += cell;
                 }
                 sum
             },
@@ -145,7 +152,10 @@ where
         for kv in 0..nq[1] {
             for ku in 0..nq[0] {
                 let k = kv * nq[0] + ku;
-                let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                let wq = match order {
+                    Order::First => disc.tensor_basis_first(ex, ey, ku, kv, s),
+                    Order::Second => disc.tensor_basis(ex, ey, ku, kv, s),
+                };
                 let e = jet_at(disc, ex, ey, cps, s, nd);
                 let (g, h) = dpsi(&e, want_mat);
                 for a in 0..nloc {

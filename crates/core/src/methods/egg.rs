@@ -287,6 +287,34 @@ mod tests {
         }
     }
 
+    /// [`Discretization::tensor_basis_first`] gives the values and first derivatives of
+    /// [`Discretization::tensor_basis`]: the same products on a polynomial basis (bit for
+    /// bit), the same quotient rule to rounding on a rational one.
+    #[test]
+    fn first_order_tensor_basis_matches_the_full_one() {
+        use crate::discrete::assembly::Scratch;
+        let (poly, _) = setup(2, [3, 4], 2, 0.1);
+        let n = poly.dofs.num_total();
+        let rational = setup(2, [3, 4], 2, 0.1).0.with_weights(Some(weights(n, 9))).unwrap();
+        for (disc, tol) in [(&poly, 0.0), (&rational, 4.0 * f64::EPSILON)] {
+            let (p, q) = disc.degrees();
+            let (mut full, mut first) = (Scratch::new(p, q, 1), Scratch::new(p, q, 1));
+            for ey in 0..disc.tables[1].num_elements() {
+                for ex in 0..disc.tables[0].num_elements() {
+                    for (ku, kv) in [(0, 0), (1, 2), (2, 1)] {
+                        let w = disc.tensor_basis(ex, ey, ku, kv, &mut full);
+                        assert_eq!(w, disc.tensor_basis_first(ex, ey, ku, kv, &mut first));
+                        for (a, b) in full.b.iter().zip(&first.b) {
+                            for k in 0..3 {
+                                assert!((a[k] - b[k]).abs() <= tol * (1.0 + a[k].abs()), "{k}: {} vs {}", a[k], b[k]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// `-diag(K, K)` of the metric Laplacian preconditions the Newton systems with
     /// GMRES iteration counts that do not grow under refinement, and GMRES reproduces
     /// the direct solution.

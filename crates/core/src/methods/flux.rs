@@ -71,7 +71,7 @@ pub fn flux_form_with<G>(
         for kv in 0..nq[1] {
             for ku in 0..nq[0] {
                 let k = kv * nq[0] + ku;
-                let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                let wq = disc.tensor_basis_first(ex, ey, ku, kv, s);
                 let e = gradient_at(disc, ex, ey, cps, s);
                 let (g, h) = flux(e);
                 for a in 0..nloc {
@@ -137,7 +137,7 @@ pub fn min_det_j(disc: &Discretization, cps: &[Point]) -> f64 {
                 for ex in 0..nex {
                     for kv in 0..nq[1] {
                         for ku in 0..nq[0] {
-                            disc.tensor_basis(ex, ey, ku, kv, s);
+                            disc.tensor_basis_first(ex, ey, ku, kv, s);
                             let [a, b, c, d] = gradient_at(disc, ex, ey, cps, s);
                             let det = a * d - b * c;
                             m = if det.is_nan() { f64::NEG_INFINITY } else { m.min(det) };

@@ -45,6 +45,7 @@
 //! that failed at a point are not tried again at the next (on wavy_lid and jigsaw01
 //! this saves one failed assembly and factorization, with the same iterates).
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use super::density::{first_derivatives, integrate, Order};
@@ -123,6 +124,50 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
             (a * a + b * b + c * c + d * d) / det
         }
     })
+}
+
+/// `J = ∫ W` (eq. 16, as [`winslow_objective`], bit for bit) and `F = -∇J` (full,
+/// component-interleaved, length `2 n`, into `res`) in one pass over the quadrature
+/// points: a line search that accepts a point needs both there, and the basis values and
+/// `∇x` at a point are the larger part of either pass. `+∞` (and `res` meaningless) when
+/// `det J <= 0` at a quadrature point.
+pub fn winslow_value_and_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64]) -> f64 {
+    let nq = [disc.tables[0].nq, disc.tables[1].nq];
+    let nex = disc.tables[0].num_elements();
+    // the value of each element (written once, by the thread that assembles it)
+    let cells: Vec<AtomicU64> = (0..disc.num_elements()).map(|_| AtomicU64::new(0)).collect();
+    disc.assemble(2, res, &mut [], |ex, ey, s| {
+        let nloc = s.nloc;
+        s.re.fill(0.0);
+        let mut cell = 0.0;
+        for kv in 0..nq[1] {
+            for ku in 0..nq[0] {
+                let wq = disc.tensor_basis_first(ex, ey, ku, kv, s);
+                let e = gradient_at(disc, ex, ey, cps, s);
+                let [a, b, c, d] = e;
+                let det = a * d - b * c;
+                if det.is_nan() || det <= 0.0 {
+                    cell = f64::INFINITY;
+                    continue;
+                }
+                let n = a * a + b * b + c * c + d * d;
+                let w = n / det;
+                cell += wq * w;
+                // -∂W/∂e = -(2 e - W D') / D
+                let inv = 1.0 / det;
+                let dd = [d, -c, -b, a];
+                let g: [f64; 4] = std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv);
+                for a in 0..nloc {
+                    let (bu, bv) = (s.b[a][1], s.b[a][2]);
+                    s.re[a] += wq * (g[0] * bu + g[1] * bv);
+                    s.re[nloc + a] += wq * (g[2] * bu + g[3] * bv);
+                }
+            }
+        }
+        cells[ey * nex + ex].store(cell.to_bits(), Ordering::Relaxed);
+    });
+    let values: Vec<f64> = cells.iter().map(|c| f64::from_bits(c.load(Ordering::Relaxed))).collect();
+    values.chunks_exact(nex).map(|row| row.iter().fold(0.0, |s, v| s + v)).sum()
 }
 
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
@@ -289,7 +334,7 @@ pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil
         for kv in 0..nq[1] {
             for ku in 0..nq[0] {
                 let k = kv * nq[0] + ku;
-                let wq = disc.tensor_basis(ex, ey, ku, kv, s);
+                let wq = disc.tensor_basis_first(ex, ey, ku, kv, s);
                 let e = gradient_at(disc, ex, ey, cps, s);
                 let [a11, a12, a22] = definite_mean_block(e);
                 let (a11, a12, a22) = (wq * a11, wq * a12, wq * a22);
@@ -362,6 +407,10 @@ pub struct WinslowProblem {
     /// The density Hessians are projected onto the semidefinite matrices
     /// ([`winslow_gradient_with`]) at this point.
     projected: f64,
+    /// The full `F = -∇J` at the point of the last [`DiscreteProblem::objective`]
+    /// ([`winslow_value_and_gradient`]), with that point: the residual there is read, not
+    /// assembled again.
+    gradient: (Vec<f64>, Option<Vec<f64>>),
 }
 
 impl std::fmt::Debug for WinslowProblem {
@@ -383,6 +432,7 @@ impl WinslowProblem {
             raised: false,
             raised_at_point: false,
             projected: 0.0,
+            gradient: (Vec::new(), None),
         }
     }
 
@@ -403,6 +453,10 @@ impl DiscreteProblem for WinslowProblem {
     }
 
     fn residual(&mut self, c: &[f64], f: &mut [f64]) {
+        if self.gradient.1.as_deref() == Some(c) {
+            f.copy_from_slice(&self.state.disc.restrict(&self.gradient.0, 2));
+            return;
+        }
         let s = &mut self.state;
         s.load(c);
         winslow_gradient(&s.disc, &s.cps, &mut s.res_full, &mut []);
@@ -445,8 +499,15 @@ impl DiscreteProblem for WinslowProblem {
         self.state.mass(|disc, st| disc.mass(st))
     }
 
+    /// With the gradient there ([`winslow_value_and_gradient`]), for the residual the
+    /// solver asks for at an accepted point.
     fn objective(&mut self, c: &[f64]) -> Option<f64> {
-        Some(winslow_objective(&self.state.disc, &self.state.control_points(c)))
+        let cps = self.state.control_points(c);
+        let (grad, at) = &mut self.gradient;
+        grad.resize(2 * cps.len(), 0.0);
+        let j = winslow_value_and_gradient(&self.state.disc, &cps, grad);
+        *at = j.is_finite().then(|| c.to_vec());
+        Some(j)
     }
 
     /// First the partly, then fully projected Hessian ([`winslow_gradient_with`] with

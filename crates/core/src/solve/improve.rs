@@ -235,12 +235,20 @@ pub fn improve(
     let mut solver = NonlinearSolver::new(problem, c0, nl);
     let minimizes = solver.objective().is_some();
     let (mut residuals, mut objective, mut iterations) = (Vec::new(), Vec::new(), 0);
-    for it in solver.by_ref() {
-        let it = it?;
-        residuals.push(it.residual);
-        objective.extend(it.objective);
-        iterations = it.iteration;
-    }
+    // the start's figures on the other core meanwhile (a small basis assembles on one)
+    let (before, run) = rayon::join(
+        || MapQuality::of(map),
+        || -> Result<()> {
+            for it in solver.by_ref() {
+                let it = it?;
+                residuals.push(it.residual);
+                objective.extend(it.objective);
+                iterations = it.iteration;
+            }
+            Ok(())
+        },
+    );
+    run?;
     let status = solver.status().clone();
     let (timings, chord_steps) = (solver.timings, solver.chord_steps);
     let (problem, c) = solver.into_parts();
@@ -252,9 +260,8 @@ pub fn improve(
         .zip(&map.control_points)
         .fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1])))
         / diameter;
-    let before = MapQuality::of(map);
-    let after = MapQuality::of(&candidate);
-    let cert = certify(&candidate, certify_opts)?;
+    let (after, cert) = rayon::join(|| MapQuality::of(&candidate), || certify(&candidate, certify_opts));
+    let cert = cert?;
     let as_good = match certificate.verdict {
         Verdict::Certified { .. } => matches!(cert.verdict, Verdict::Certified { .. }),
         _ => bijective(&cert),
