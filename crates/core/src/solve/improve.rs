@@ -161,7 +161,7 @@ pub struct Improved {
 /// solution, and 400 of its steps cost minutes on a fine basis), the residual scaled by
 /// [`Method::residual_scale`], the step tolerance in length units, a failed line search
 /// on a GMRES direction retried with LU ([`NonlinearOptions::direct_retry`]), a
-/// root-finding step followed by a chord step ([`NonlinearOptions::chord`]), a
+/// Newton step followed by chord steps ([`NonlinearOptions::chord`]), a
 /// minimisation's full step by a longer one where `J` falls further
 /// ([`NonlinearOptions::extrapolate`]); a minimisation stops
 /// when its decrement is negligible ([`crate::solve::newton::DECREMENT_TOL`]) or after

@@ -16,10 +16,10 @@
 //! `+∞`, or [`DiscreteProblem::admissible`] false) are never accepted.
 //!
 //! Two accelerations, off by default and on for a local improvement from a bijective
-//! start ([`crate::solve::improve`]): a root-finding Newton step may be followed by one
-//! chord step with the same factorization ([`NonlinearOptions::chord`], Shamanskii's
-//! method), and a minimisation's full step by a longer one along the same direction
-//! ([`NonlinearOptions::extrapolate`]).
+//! start ([`crate::solve::improve`]): a Newton step may be followed by chord steps with
+//! the same factorization ([`NonlinearOptions::chord`], Shamanskii's method: one for
+//! root finding, up to three for a minimisation), and a minimisation's full step by a
+//! longer one along the same direction ([`NonlinearOptions::extrapolate`]).
 
 use std::time::{Duration, Instant};
 
@@ -36,6 +36,18 @@ use crate::methods::DiscreteProblem;
 /// of the diameter), which saves one to three of the iterations the gradient test `|∇J|
 /// diam <= tol` takes.
 pub const DECREMENT_TOL: f64 = 1e-6;
+
+/// Chord steps of a minimisation after one exact Newton step at most
+/// ([`NonlinearOptions::chord`]).
+pub const MAX_DESCENT_CHORDS: usize = 3;
+
+/// A minimisation's chord step ends the iteration when its decrement is below this
+/// fraction of [`NonlinearOptions::decrement_tol`]` |J|`: its model has the Hessian of an
+/// earlier point, so the chord iteration contracts linearly (by `ρ ~ |c_{k+1} - c_k|`)
+/// where Newton's contracts quadratically, and leaves `ρ` times its decrement; the
+/// fraction keeps the control points as close to the minimiser as after a Newton step of
+/// negligible decrement (about `10⁻⁶` of the diameter).
+pub const CHORD_DECREMENT_FACTOR: f64 = 1e-3;
 
 /// Largest forcing term of the inexact Newton method (see `NonlinearSolver::forcing`).
 pub const ETA_MAX: f64 = 1e-2;
@@ -98,6 +110,14 @@ pub struct NonlinearOptions {
     /// form (eq. 14) needs fewer Jacobians (wavy_lid 6 -> 4), each step one more residual
     /// and solve ([`NonlinearSolver::chord_steps`] counts the chord steps taken). The
     /// stopping rule is unchanged: it is tested on the residual of the iterate kept.
+    ///
+    /// For a minimisation, a full exact Newton step is followed by up to
+    /// [`MAX_DESCENT_CHORDS`] chord steps with the step's Hessian, each kept on an Armijo
+    /// decrease of `J` at a feasible point (`NonlinearSolver::descent_chord`); one whose
+    /// decrement is below [`CHORD_DECREMENT_FACTOR`] times the decrement rule ends the
+    /// iteration. From the EGG map (Winslow, eq. 16) this takes one Newton step (one
+    /// Hessian assembly and factorization) fewer on 12 of the 19 shared geometries, with
+    /// the same minimum to about `10⁻¹⁰` relative.
     pub chord: bool,
     /// A full Newton step (accepted by the line search) is followed by a trial of a longer
     /// step along the same direction, kept when it is admissible and lower: for a
@@ -550,7 +570,19 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
                 self.norm = nt;
                 self.objective = Some(jt);
                 self.problem.step_accepted(delta);
-                if self.converged(step) || (negligible && delta == 1.0) {
+                let mut done = self.converged(step) || (negligible && delta == 1.0);
+                let mut step = step;
+                if exact && delta == 1.0 && self.opts.chord {
+                    for _ in 0..MAX_DESCENT_CHORDS {
+                        if done {
+                            break;
+                        }
+                        let Some((chord, negligible)) = self.descent_chord() else { break };
+                        step = chord;
+                        done = negligible || self.converged(step);
+                    }
+                }
+                if done {
                     self.status = Status::Converged;
                 } else if self.newton_its >= self.opts.max_newton {
                     return self.stall_with(format!("Newton reached {} iterations", self.opts.max_newton), step, delta);
@@ -576,6 +608,49 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
                     .stall("line search failed (no decrease of the objective along the Newton direction)".into());
             }
         }
+    }
+
+    /// One chord step of a minimisation from the point a full exact Newton step reached
+    /// ([`NonlinearOptions::chord`]): `z` from the Hessian of that step, still factorized,
+    /// and the new gradient, `-∇²J(c_k) z = ∇J(c_{k+1})`; `c_{k+1} + z` replaces
+    /// `c_{k+1}` when `z` descends, the point is feasible and `J` falls by the Armijo
+    /// fraction `J(c_{k+1} + z) <= J(c_{k+1}) + 10^-4 ∇J·z` (a full step only). Returns
+    /// the step length `max |z_i|` of a kept step and whether its decrement `-∇J·z / 2`
+    /// (the model's, with the Hessian of `c_k`) is negligible
+    /// ([`NonlinearOptions::decrement_tol`]): the minimisation has then converged, as after
+    /// a full Newton step of negligible decrement. `None` when the step is not kept.
+    fn descent_chord(&mut self) -> Option<(f64, bool)> {
+        let j0 = self.objective?;
+        let t = Instant::now();
+        let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
+        let dz = match (self.lin.solve(&rhs), self.problem.rank_one()) {
+            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
+            (dz, _) => dz,
+        };
+        self.timings.linear += t.elapsed();
+        let dz = dz.ok()?;
+        let slope = -self.f.iter().zip(&dz).map(|(f, d)| f * d).sum::<f64>();
+        if slope.is_nan() || slope >= 0.0 {
+            return None;
+        }
+        let z: Vec<f64> = self.c.iter().zip(&dz).map(|(c, d)| c + d).collect();
+        if !self.problem.admissible(&z) {
+            return None;
+        }
+        let t0 = Instant::now();
+        let jz = self.problem.objective(&z).unwrap_or(f64::NAN);
+        self.timings.assembly += t0.elapsed();
+        if !(jz.is_finite() && jz <= j0 + 1e-4 * slope) {
+            return None;
+        }
+        let mut fz = vec![0.0; self.c.len()];
+        self.norm = self.eval(&z, &mut fz);
+        self.c = z;
+        self.f = fz;
+        self.objective = Some(jz);
+        self.chord_steps += 1;
+        let negligible = -0.5 * slope <= CHORD_DECREMENT_FACTOR * self.opts.decrement_tol * j0.abs();
+        Some((dz.iter().fold(0.0f64, |m, d| m.max(d.abs())), negligible))
     }
 
     /// One chord step from the accepted iterate ([`NonlinearOptions::chord`]): `z` from
