@@ -28,7 +28,8 @@ const W: usize = MAX_DEGREE + 1;
 /// of the stencil storage.
 type RowChunks<'a> = ((usize, Option<&'a mut [f64]>), Option<&'a mut [f64]>);
 
-/// Quadrature points below which [`Discretization::assemble`] runs on the calling thread.
+/// Quadrature points below which the assembly of a basis runs on the calling thread: waking
+/// the rayon pool for each of its `q + 1` colours costs more than the work below it.
 pub const SERIAL_ASSEMBLY_POINTS: usize = 4096;
 
 /// Univariate basis values at one quadrature point: weight (times element length),

@@ -610,6 +610,19 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         }
     }
 
+    /// `z` of `F'(c_prev) z = -F(c)` with the factorization of the last Newton step (and
+    /// its rank-one term): the direction of a chord step; `None` when the solve fails.
+    fn chord_direction(&mut self) -> Option<Vec<f64>> {
+        let t = Instant::now();
+        let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
+        let dz = match (self.lin.solve(&rhs), self.problem.rank_one()) {
+            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
+            (dz, _) => dz,
+        };
+        self.timings.linear += t.elapsed();
+        dz.ok()
+    }
+
     /// One chord step of a minimisation from the point a full exact Newton step reached
     /// ([`NonlinearOptions::chord`]): `z` from the Hessian of that step, still factorized,
     /// and the new gradient, `-∇²J(c_k) z = ∇J(c_{k+1})`; `c_{k+1} + z` replaces
@@ -621,14 +634,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     /// a full Newton step of negligible decrement. `None` when the step is not kept.
     fn descent_chord(&mut self) -> Option<(f64, bool)> {
         let j0 = self.objective?;
-        let t = Instant::now();
-        let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let dz = match (self.lin.solve(&rhs), self.problem.rank_one()) {
-            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
-            (dz, _) => dz,
-        };
-        self.timings.linear += t.elapsed();
-        let dz = dz.ok()?;
+        let dz = self.chord_direction()?;
         let slope = -self.f.iter().zip(&dz).map(|(f, d)| f * d).sum::<f64>();
         if slope.is_nan() || slope >= 0.0 {
             return None;
@@ -658,14 +664,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     /// rank-one term), kept when `c + z` is admissible and `|F(c + z)| <= (1 - 10^-4)
     /// |F(c)|`; the length `max |z_i|` of a kept step, `None` otherwise.
     fn chord_step(&mut self) -> Option<f64> {
-        let t = Instant::now();
-        let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let dz = match (self.lin.solve(&rhs), self.problem.rank_one()) {
-            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
-            (dz, _) => dz,
-        };
-        self.timings.linear += t.elapsed();
-        let dz = dz.ok()?;
+        let dz = self.chord_direction()?;
         let z: Vec<f64> = self.c.iter().zip(&dz).map(|(c, d)| c + d).collect();
         if !self.problem.admissible(&z) {
             return None;
