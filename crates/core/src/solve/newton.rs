@@ -234,10 +234,12 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     pub fn new(mut problem: P, c0: Vec<f64>, opts: NonlinearOptions) -> Self {
         let mut f = vec![0.0; problem.size()];
         let t = Instant::now();
+        // the objective first: a problem may compute the gradient with it (the Winslow
+        // functional, in one pass) and read it for the residual
+        let objective = problem.objective(&c0);
         problem.residual(&c0, &mut f);
         let assembly = t.elapsed();
         let norm = norm2(&f);
-        let objective = problem.objective(&c0);
         // a minimisation's Newton matrix is -∇²J: Cholesky of ∇²J (which fails exactly
         // when the Hessian is not positive definite, see `newton_step`) unless the caller
         // chose a solver
