@@ -149,6 +149,21 @@ fn star_polygon_certifies_with_its_kinks_kept() {
     assert!(dev > 1e-2 * none.report.diameter, "without kinks the polygon is rounded: {dev}");
 }
 
+/// An L-shaped polygon: its reflex corner and the convex one opposite it are kinks inside
+/// sides; the C0 route's elasticity continuation has to refine around the reflex corner
+/// before its map on the kinked basis is certified. Both kinks kept exactly, certified.
+/// (With extrapolated steps in the continuation's damped Winslow solves the map folded
+/// between quadrature points near the corner and the kinks were dropped.)
+#[test]
+fn l_shape_certifies_with_its_reflex_corner_kept() {
+    let (_, sol) = run("contours/l_shape.json", &opts(BasisChoice::Auto, KinkMode::Auto));
+    let r = &sol.report;
+    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+    kinks_kept(&sol, 2);
+    let c0 = r.c0_route.as_ref().expect("the C0 route ran");
+    assert!(c0.failure.is_none(), "{}", c0.message);
+}
+
 /// `kinks_local` (§9, last paragraph): the final Winslow minimisation moves only the
 /// control points near the kink. It runs on fewer unknowns from the same elasticity start,
 /// over a subspace of the global one, so its Winslow value lies between the start's and

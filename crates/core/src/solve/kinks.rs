@@ -31,7 +31,7 @@ use serde::Serialize;
 
 use super::improve::{bijective, from_bijective_start};
 use super::initial::{continuation_with, set_boundary, Continuation};
-use super::newton::{NonlinearSolver, Status};
+use super::newton::{NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_dofs, plan_repair};
 use crate::boundary::kinks::{Kink, KinkedLevel};
@@ -196,7 +196,15 @@ pub fn keep_kinks(
             }
             Err(_) => false,
         };
-        let nl = from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free());
+        // no extrapolated steps in the continuation: a damped solve must stay well inside
+        // the bijective maps for the next boundary increment, and a step up to three times
+        // the Newton step's length, feasible at the quadrature points only, folded
+        // l_shape's map between them (the continuation then ran 35 damped solves and 6
+        // refinement rounds and gave up at 0.8 of the boundary displacement)
+        let nl = NonlinearOptions {
+            extrapolate: false,
+            ..from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free())
+        };
         // the damped steps are counted per round (the cap of the continuation is per basis)
         let mut round = Continuation::default();
         let out = continuation_with(&method, assembler, &disc, base, &target, nl, diameter, &mut round, &certified)?;
