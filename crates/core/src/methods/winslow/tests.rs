@@ -316,3 +316,40 @@ fn psd_projection_of_the_density_hessian() {
         }
     }
 }
+
+/// The one-pass value and gradient: the value is [`winslow_objective`]'s bit for bit (the
+/// same quadrature, summed per element and then in order), the gradient
+/// [`winslow_gradient`]'s to rounding, on a polynomial and a rational basis; a folded map
+/// has the value `+∞`; and the problem's residual at the point of its last objective is
+/// the gradient of that pass.
+#[test]
+fn value_and_gradient_in_one_pass() {
+    let (disc, cps) = curved(7, 0.05);
+    let n = disc.dofs.num_total();
+    let weights: Vec<f64> = (0..n).map(|i| 1.0 + 0.3 * ((i * 7 % 11) as f64 / 11.0)).collect();
+    let rational = Arc::new((*disc).clone().with_weights(Some(weights)).unwrap());
+    for d in [&disc, &rational] {
+        let (mut one, mut two) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+        let j = winslow_value_and_gradient(d, &cps, &mut one);
+        assert_eq!(j.to_bits(), winslow_objective(d, &cps).to_bits());
+        winslow_gradient(d, &cps, &mut two, &mut []);
+        let scale = max_abs(two.iter().copied());
+        assert!(max_abs(one.iter().zip(&two).map(|(a, b)| a - b)) <= 1e-13 * scale);
+    }
+    // a control point pulled across the map folds it
+    let mut folded = cps.clone();
+    let nx = disc.shape()[0];
+    folded[nx + 1] = [folded[nx + 1][0] + 10.0, folded[nx + 1][1] - 10.0];
+    assert_eq!(winslow_value_and_gradient(&disc, &folded, &mut vec![0.0; 2 * n]), f64::INFINITY);
+    assert_eq!(winslow_objective(&disc, &folded), f64::INFINITY);
+    // the residual after the objective is read from the pass
+    let mut problem = WinslowProblem::new(disc.clone(), cps.clone());
+    let c = problem.unknowns();
+    let (mut cached, mut fresh) = (vec![0.0; c.len()], vec![0.0; c.len()]);
+    problem.objective(&c);
+    problem.residual(&c, &mut cached);
+    let mut other = WinslowProblem::new(disc, cps);
+    other.residual(&c, &mut fresh);
+    let scale = max_abs(fresh.iter().copied());
+    assert!(max_abs(cached.iter().zip(&fresh).map(|(a, b)| a - b)) <= 1e-13 * scale);
+}
