@@ -278,12 +278,16 @@ pub fn improve(
     let fmt = |w: Option<f64>| w.map_or("undefined".to_string(), |w| format!("{w:.6}"));
     let message = if accepted {
         format!(
-            "{}: Winslow value {} -> {}, min scaled Jacobian {:.4} -> {:.4} in {iterations} iterations; {}",
+            "{}: Winslow value {} -> {}, min scaled Jacobian {:.4} -> {:.4} in {iterations} iterations{}; {}",
             method.name(),
             fmt(before.winslow),
             fmt(after.winslow),
             before.scaled_jacobian_min,
             after.scaled_jacobian_min,
+            match chord_steps {
+                0 => String::new(),
+                k => format!(" and {k} chord step(s)"),
+            },
             cert.message()
         )
     } else if !as_good {
