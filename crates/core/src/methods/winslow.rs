@@ -126,6 +126,14 @@ pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
     })
 }
 
+/// `-∂W/∂e = -(2 e - W D') / D` at `e`, with `W` and `1 / D` given (the gradient of
+/// [`winslow_density`] without its Hessian).
+fn neg_density_gradient(e: [f64; 4], w: f64, inv: f64) -> [f64; 4] {
+    let [a, b, c, d] = e;
+    let dd = [d, -c, -b, a];
+    std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv)
+}
+
 /// `J = ∫ W` (eq. 16, as [`winslow_objective`], bit for bit) and `F = -∇J` (full,
 /// component-interleaved, length `2 n`, into `res`) in one pass over the quadrature
 /// points: a line search that accepts a point needs both there, and the basis values and
@@ -153,10 +161,7 @@ pub fn winslow_value_and_gradient(disc: &Discretization, cps: &[Point], res: &mu
                 let n = a * a + b * b + c * c + d * d;
                 let w = n / det;
                 cell += wq * w;
-                // -∂W/∂e = -(2 e - W D') / D
-                let inv = 1.0 / det;
-                let dd = [d, -c, -b, a];
-                let g: [f64; 4] = std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv);
+                let g = neg_density_gradient(e, w, 1.0 / det);
                 for a in 0..nloc {
                     let (bu, bv) = (s.b[a][1], s.b[a][2]);
                     s.re[a] += wq * (g[0] * bu + g[1] * bv);
@@ -180,8 +185,7 @@ pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], s
             let [a, b, c, d] = e;
             let inv = 1.0 / (a * d - b * c);
             let w = (a * a + b * b + c * c + d * d) * inv;
-            let dd = [d, -c, -b, a];
-            (std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv), [[0.0; 4]; 4])
+            (neg_density_gradient(e, w, inv), [[0.0; 4]; 4])
         });
         return;
     }
