@@ -28,6 +28,7 @@ use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
+use crate::linalg::split_cholesky::{SplitCholesky, SPLIT_MIN};
 
 /// Which linear solver the nonlinear solvers use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -135,7 +136,8 @@ impl Scalar for f32 {
 /// measured (the Winslow Hessian of jigsaw01, 9984 unknowns: 0.24 s against 0.11 s of
 /// factorizations; the EGG preconditioner of the quarter annulus at 230 k unknowns:
 /// whole solve 3.8 s against 2.0 s), and its idle workers spinning slowed the parallel
-/// assembly around it. The parallelism of a solve is in its element loops.
+/// assembly around it. The parallelism of a solve is in its element loops, and in the
+/// two halves of a direct factorization split at its top separator ([`Direct`]).
 const CHOLESKY_PAR: Par = Par::Seq;
 
 /// Sparse Cholesky `A = L L^T` of an SPD matrix with a fixed sparsity pattern: symbolic
@@ -226,6 +228,49 @@ impl<T: Scalar> Cholesky<T> {
     }
 }
 
+/// The double-precision Cholesky factor of a direct solve: whole, or, from [`SPLIT_MIN`]
+/// unknowns in a nested-dissection order on two threads or more, split at the order's
+/// top separator with the halves factorized at once ([`SplitCholesky`]: on the Winslow
+/// Hessian of jigsaw01, 9984 unknowns, BENCHMARKS.md).
+#[derive(Debug)]
+enum Direct {
+    Whole(Box<Cholesky<f64>>),
+    Split(Box<SplitCholesky>),
+}
+
+impl Direct {
+    fn analyze(a: &Csr, order: Option<&[usize]>) -> Result<Self> {
+        let split = order
+            .filter(|_| a.nrows >= SPLIT_MIN && rayon::current_num_threads() >= 2)
+            .and_then(|o| SplitCholesky::analyze(a, o));
+        Ok(match split {
+            Some(s) => Self::Split(Box::new(s)),
+            None => Self::Whole(Box::new(Cholesky::analyze(a, order)?)),
+        })
+    }
+
+    fn factor(&mut self, a: &Csr) -> Result<()> {
+        match self {
+            Self::Whole(c) => c.factor(a),
+            Self::Split(c) => c.factor(a),
+        }
+    }
+
+    fn solve_columns(&mut self, x: &mut [f64]) {
+        match self {
+            Self::Whole(c) => c.solve_columns(x),
+            Self::Split(c) => c.solve_columns(x),
+        }
+    }
+
+    fn dim(&self) -> usize {
+        match self {
+            Self::Whole(c) => c.dim(),
+            Self::Split(c) => c.dim(),
+        }
+    }
+}
+
 /// A GMRES preconditioner.
 #[derive(Debug)]
 enum Preconditioner {
@@ -280,7 +325,7 @@ pub struct LinearSolver {
     /// Cholesky of a system of at most [`DENSE_LIMIT`] unknowns (of `-A` for
     /// [`LinearMethod::NegCholesky`]).
     dense_llt: Option<DenseCholesky>,
-    llt: Option<Cholesky<f64>>,
+    llt: Option<Direct>,
     precond: Option<Preconditioner>,
     matrix: Option<Csr>,
     /// Fill-reducing order of the `m` scalar unknowns (see [`LinearSolver::set_ordering`]).
@@ -299,7 +344,7 @@ pub struct LinearSolver {
     negated: Csr,
     /// The symbolic analysis of a [`LinearMethod::NegCholesky`] factorization that failed
     /// (reused by the next one).
-    analysed: Option<Cholesky<f64>>,
+    analysed: Option<Direct>,
 }
 
 impl LinearSolver {
@@ -466,8 +511,12 @@ impl LinearSolver {
                 self.dense_llt = Some(llt);
             }
             LinearMethod::Cholesky => {
-                let slot = self.llt.take();
-                self.llt = Some(self.cholesky(a, slot)?);
+                let mut chol = match self.llt.take() {
+                    Some(c) if c.dim() == a.nrows => c,
+                    _ => Direct::analyze(a, self.order_for(a.nrows).as_deref())?,
+                };
+                chol.factor(a)?;
+                self.llt = Some(chol);
             }
             LinearMethod::NegCholesky => {
                 let mut neg = std::mem::take(&mut self.negated);
@@ -479,7 +528,7 @@ impl LinearSolver {
                 // then modifies its Hessian and factorizes again) keeps the analysis
                 let chol = match self.llt.take().or_else(|| self.analysed.take()) {
                     Some(c) if c.dim() == neg.nrows => Ok(c),
-                    _ => Cholesky::analyze(&neg, self.order_for(neg.nrows).as_deref()),
+                    _ => Direct::analyze(&neg, self.order_for(neg.nrows).as_deref()),
                 };
                 let r = match chol {
                     Ok(mut c) => match c.factor(&neg) {

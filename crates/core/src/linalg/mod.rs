@@ -21,3 +21,4 @@ pub mod krylov;
 pub mod linsolve;
 pub mod ordering;
 pub mod sparse;
+pub mod split_cholesky;
