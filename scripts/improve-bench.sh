@@ -3,7 +3,10 @@
 # with the given `winslow` binary and prints a Markdown table of the Winslow value
 # (eq. 16), the smallest scaled Jacobian and the largest orthogonality deviation before
 # and after the improvement stage, its iterations and time, and the time of the EGG solve
-# before it (the report's total minus the stage). Extra arguments go to `winslow solve`.
+# before it (the report's total minus the stage: the report's `seconds` count the levels,
+# repair and certificate, not the boundary fit nor the report's own measurements; on solves
+# of 1-3 ms one run resolves the ratio to about 10 %, `cargo bench --bench improve` times
+# both warm). Extra arguments go to `winslow solve`.
 #
 #   cargo build --release -p winslow-cli
 #   bash scripts/improve-bench.sh target/release/winslow

@@ -110,6 +110,11 @@ pub struct Discretization {
     /// in control-net order, or `None` for the polynomial B-spline basis; see
     /// [`Discretization::with_weights`].
     pub weights: Option<Vec<f64>>,
+    /// `(w, w_u, w_v)` of every function at every quadrature point, element by element,
+    /// for [`Discretization::tensor_basis_first`] on a basis of fewer than
+    /// [`SERIAL_ASSEMBLY_POINTS`] points (computed on first use: the first-order forms
+    /// of eq. 14 and 16 then copy what they would recompute at every pass).
+    first_order: std::sync::OnceLock<Vec<[f64; 3]>>,
 }
 
 /// Which operator [`Discretization::egg`] discretizes.
@@ -242,7 +247,7 @@ impl Discretization {
         let nx = dofs.shape()[0];
         let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();
         let ordering = crate::linalg::ordering::nested_dissection(&nodes, [p, q]);
-        Self { knots, tables, dofs, vector, scalar, ordering, weights: None }
+        Self { knots, tables, dofs, vector, scalar, ordering, weights: None, first_order: Default::default() }
     }
 
     /// The rational basis `R_b = w_b N_b / W` with `W = sum_b w_b N_b` (NURBS, §5.2) on
@@ -267,6 +272,7 @@ impl Discretization {
             }
         }
         self.weights = weights;
+        self.first_order = Default::default();
         Ok(self)
     }
 
@@ -447,6 +453,36 @@ impl Discretization {
     /// forms (eq. 14, 16), which read no others. The rational quotient rule takes one
     /// division per point instead of six per function.
     pub(crate) fn tensor_basis_first(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
+        let (tx, ty) = (&self.tables[0], &self.tables[1]);
+        let nqp = tx.nq * ty.nq;
+        if self.num_elements() * nqp < SERIAL_ASSEMBLY_POINTS {
+            let cache = self.first_order.get_or_init(|| {
+                let mut s = Scratch::new(self.degrees().0, self.degrees().1, 1);
+                let mut out = Vec::with_capacity(self.num_elements() * nqp * s.nloc);
+                for ey in 0..ty.num_elements() {
+                    for ex in 0..tx.num_elements() {
+                        for kv in 0..ty.nq {
+                            for ku in 0..tx.nq {
+                                self.compute_first(ex, ey, ku, kv, &mut s);
+                                out.extend(s.b.iter().map(|b| [b[0], b[1], b[2]]));
+                            }
+                        }
+                    }
+                }
+                out
+            });
+            let nloc = s.nloc;
+            let k = ((ey * tx.num_elements() + ex) * nqp + kv * tx.nq + ku) * nloc;
+            for (b, c) in s.b.iter_mut().zip(&cache[k..k + nloc]) {
+                b[..3].copy_from_slice(c);
+            }
+            return tx.at(ex, ku).w * ty.at(ey, kv).w;
+        }
+        self.compute_first(ex, ey, ku, kv, s)
+    }
+
+    /// [`Discretization::tensor_basis_first`], computed.
+    fn compute_first(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
         let (p, q) = self.degrees();
         let tu = self.tables[0].at(ex, ku);
         let tv = self.tables[1].at(ey, kv);
