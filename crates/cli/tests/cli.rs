@@ -524,6 +524,7 @@ fn solve_a_ring_end_to_end() {
     let out = bin().arg("solve").arg(&bad).arg("-o").arg(dir.join("bad_map.json")).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("inner contour is not inside"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `winslow sweep`: frames, ParaView series and table are written, every frame is
@@ -595,6 +596,7 @@ fn sweep_writes_frames_series_and_table() {
         .unwrap();
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(!bad.status.success() && err.contains("not a ring document"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `winslow sweep --inner-frames`: non-rigid motion from a directory of ring documents

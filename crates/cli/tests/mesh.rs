@@ -90,4 +90,5 @@ fn solve_then_mesh_in_every_format() {
     let (ok, _, err) = run(&["mesh", &d("lid.json"), "-o", &d("x.stl"), "--structured", "5x5"]);
     assert!(!ok && err.contains("unknown mesh format"), "{err}");
     assert!(!dir.join("x.msh").exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -11,8 +11,34 @@ use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::{structured, unstructured, DVec2, Distribution, Mesh, Side, StructuredOptions, UnstructuredOptions};
 
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("winslow-mesh-{}-{name}", std::process::id()))
+/// A scratch path in the temporary folder, removed (file or folder) when the test that
+/// made it ends without a panic: kept for inspection after a failure.
+struct Tmp(PathBuf);
+
+impl std::ops::Deref for Tmp {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Tmp {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Tmp {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_file(&self.0);
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+fn tmp(name: &str) -> Tmp {
+    Tmp(std::env::temp_dir().join(format!("winslow-mesh-{}-{name}", std::process::id())))
 }
 
 fn meshes() -> Vec<Mesh> {
