@@ -11,7 +11,8 @@
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use winslow::discrete::assembly::{DirTable, Discretization, Operator};
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::discrete::tables::DirTable;
 use winslow::methods::egg::{CpuAssembler, EggAssembler};
 use winslow::spline::curve::Point;
 use winslow::spline::surface::Surface;

@@ -10,7 +10,7 @@
 //! the vectors and *stencil storage* of the CPU assembler ([`winslow::discrete::assembly`]), so
 //! the sparsity patterns, gathers and linear solvers are shared, and the two back ends
 //! are interchangeable. The univariate basis tables come from the core
-//! ([`winslow::discrete::assembly::DirTable`], [`winslow::spline::basis::BasisDerivs`]) and are uploaded
+//! ([`winslow::discrete::tables::DirTable`], [`winslow::spline::basis::BasisDerivs`]) and are uploaded
 //! once per basis; the GPU only runs the tensor-product sums.
 //!
 //! Precision: f64 where the adapter offers `SHADER_F64` (lavapipe does); otherwise (or

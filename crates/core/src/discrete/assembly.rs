@@ -17,12 +17,10 @@ use crate::discrete::dofs::{DofMap, FIXED};
 use crate::discrete::pattern::stencil_neighbours;
 pub use crate::discrete::pattern::SystemPattern;
 use crate::discrete::topology::Topology;
-use crate::error::{Result, MAX_DEGREE};
-use crate::spline::basis::BasisDerivs;
+use crate::error::Result;
 use crate::spline::knots::KnotVector;
-use crate::spline::quadrature::GaussLegendre;
 
-const W: usize = MAX_DEGREE + 1;
+use crate::discrete::tables::DirTable;
 
 /// One element row of [`Discretization::assemble`] with its chunks of the residual and
 /// of the stencil storage.
@@ -31,64 +29,6 @@ type RowChunks<'a> = ((usize, Option<&'a mut [f64]>), Option<&'a mut [f64]>);
 /// Quadrature points below which the assembly of a basis runs on the calling thread: waking
 /// the rayon pool for each of its `q + 1` colours costs more than the work below it.
 pub const SERIAL_ASSEMBLY_POINTS: usize = 4096;
-
-/// Univariate basis values at one quadrature point: weight (times element length),
-/// abscissa, and `n[k][j]` = `k`-th derivative of the `j`-th non-zero function.
-#[derive(Debug, Clone, Copy)]
-pub struct QpTab {
-    /// Quadrature weight scaled to the element.
-    pub w: f64,
-    /// Abscissa.
-    pub u: f64,
-    /// Values and derivatives.
-    pub n: [[f64; W]; 3],
-}
-
-/// Basis tables of one direction: per element its first non-zero function and its
-/// quadrature points.
-#[derive(Debug, Clone)]
-pub struct DirTable {
-    /// Degree.
-    pub p: usize,
-    /// Points per element.
-    pub nq: usize,
-    /// First non-zero basis function per element.
-    pub first: Vec<usize>,
-    /// Element bounds.
-    pub bounds: Vec<(f64, f64)>,
-    /// `qp[e * nq + k]`.
-    pub qp: Vec<QpTab>,
-}
-
-impl DirTable {
-    /// Tabulate `kv` at `nq` Gauss points per element.
-    pub fn new(kv: &KnotVector, nq: usize) -> Self {
-        let g = GaussLegendre::new(nq);
-        let mut first = Vec::new();
-        let mut bounds = Vec::new();
-        let mut qp = Vec::new();
-        let mut b = BasisDerivs::default();
-        for (span, a, bb) in kv.elements() {
-            first.push(span - kv.degree());
-            bounds.push((a, bb));
-            for (u, w) in g.on(a, bb) {
-                b.eval_in_span(kv, span, u, 2);
-                qp.push(QpTab { w, u, n: b.d });
-            }
-        }
-        Self { p: kv.degree(), nq, first, bounds, qp }
-    }
-
-    /// Number of elements.
-    pub fn num_elements(&self) -> usize {
-        self.first.len()
-    }
-
-    /// Table of point `k` of element `e`.
-    pub fn at(&self, e: usize, k: usize) -> &QpTab {
-        &self.qp[e * self.nq + k]
-    }
-}
 
 /// Everything computed once per basis: tables, DOF map, patterns.
 #[derive(Debug, Clone)]
@@ -114,7 +54,7 @@ pub struct Discretization {
     /// for [`Discretization::tensor_basis_first`] on a basis of fewer than
     /// [`SERIAL_ASSEMBLY_POINTS`] points (computed on first use: the first-order forms
     /// of eq. 14 and 16 then copy what they would recompute at every pass).
-    first_order: std::sync::OnceLock<Vec<[f64; 3]>>,
+    pub(crate) first_order: std::sync::OnceLock<Vec<[f64; 3]>>,
 }
 
 /// Which operator [`Discretization::egg`] discretizes.

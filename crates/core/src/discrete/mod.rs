@@ -7,6 +7,7 @@
 //! | [`topology`] | [`Topology`](topology::Topology): the boundary condition of each side of a patch (Dirichlet, periodic, interface) | §4, §11.1, §11.2 |
 //! | [`dofs`] | [`DofMap`](dofs::DofMap): free versus fixed DOFs, gather and scatter of the unknowns `c` | eq. (9)-(10) |
 //! | [`pattern`] | [`SystemPattern`](pattern::SystemPattern): sparsity of the free-free systems, gather from stencil storage (periodic replicas summed) | |
+//! | [`tables`] | [`DirTable`](tables::DirTable): the univariate basis at the Gauss points | §4 |
 //! | [`assembly`] | [`Discretization`](assembly::Discretization): basis tables, patterns, the EGG residual and Jacobian kernels (eq. 8, 12, 23), mass, elasticity, metric Laplacian | §4, §6 |
 //!
 //! Symbolic work (tables, patterns, orderings) is done once per basis when a
@@ -16,4 +17,5 @@
 pub mod assembly;
 pub mod dofs;
 pub mod pattern;
+pub mod tables;
 pub mod topology;
