@@ -16,11 +16,10 @@ use rayon::prelude::*;
 use crate::discrete::dofs::{DofMap, FIXED};
 use crate::discrete::pattern::stencil_neighbours;
 pub use crate::discrete::pattern::SystemPattern;
+use crate::discrete::tables::DirTable;
 use crate::discrete::topology::Topology;
 use crate::error::Result;
 use crate::spline::knots::KnotVector;
-
-use crate::discrete::tables::DirTable;
 
 /// One element row of [`Discretization::assemble`] with its chunks of the residual and
 /// of the stencil storage.
@@ -29,6 +28,13 @@ type RowChunks<'a> = ((usize, Option<&'a mut [f64]>), Option<&'a mut [f64]>);
 /// Quadrature points below which the assembly of a basis runs on the calling thread: waking
 /// the rayon pool for each of its `q + 1` colours costs more than the work below it.
 pub const SERIAL_ASSEMBLY_POINTS: usize = 4096;
+
+/// Quadrature points below which `Discretization::tensor_basis_first` reads the
+/// first-order basis values from a table made on first use (`24 nloc` bytes a point: at
+/// most 1.5 MB for p = 3) instead of forming them at every pass: on such bases the
+/// products and, on a NURBS basis, the quotient rule are a sizeable part of a pass (the
+/// Winslow stage on disk 1.44 -> 1.20 ms, BENCHMARKS.md).
+pub const FIRST_ORDER_TABLE_POINTS: usize = 4096;
 
 /// Everything computed once per basis: tables, DOF map, patterns.
 #[derive(Debug, Clone)]
@@ -52,7 +58,7 @@ pub struct Discretization {
     pub weights: Option<Vec<f64>>,
     /// `(w, w_u, w_v)` of every function at every quadrature point, element by element,
     /// for [`Discretization::tensor_basis_first`] on a basis of fewer than
-    /// [`SERIAL_ASSEMBLY_POINTS`] points (computed on first use: the first-order forms
+    /// [`FIRST_ORDER_TABLE_POINTS`] points (computed on first use: the first-order forms
     /// of eq. 14 and 16 then copy what they would recompute at every pass).
     pub(crate) first_order: std::sync::OnceLock<Vec<[f64; 3]>>,
 }
@@ -395,7 +401,7 @@ impl Discretization {
     pub(crate) fn tensor_basis_first(&self, ex: usize, ey: usize, ku: usize, kv: usize, s: &mut Scratch) -> f64 {
         let (tx, ty) = (&self.tables[0], &self.tables[1]);
         let nqp = tx.nq * ty.nq;
-        if self.num_elements() * nqp < SERIAL_ASSEMBLY_POINTS {
+        if self.num_elements() * nqp < FIRST_ORDER_TABLE_POINTS {
             let cache = self.first_order.get_or_init(|| {
                 let mut s = Scratch::new(self.degrees().0, self.degrees().1, 1);
                 let mut out = Vec::with_capacity(self.num_elements() * nqp * s.nloc);

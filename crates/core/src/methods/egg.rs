@@ -293,14 +293,14 @@ mod tests {
     /// small basis as computed on a large one (40 x 40 elements: 14 400 points).
     #[test]
     fn first_order_tensor_basis_matches_the_full_one() {
-        use crate::discrete::assembly::{Scratch, SERIAL_ASSEMBLY_POINTS};
+        use crate::discrete::assembly::{Scratch, FIRST_ORDER_TABLE_POINTS};
         let (poly, _) = setup(2, [3, 4], 2, 0.1);
         let n = poly.dofs.num_total();
         let rational = setup(2, [3, 4], 2, 0.1).0.with_weights(Some(weights(n, 9))).unwrap();
         let large = setup(2, [40, 40], 2, 0.1).0;
         let n = large.dofs.num_total();
         let large = large.with_weights(Some(weights(n, 5))).unwrap();
-        assert!(large.num_elements() * 9 >= SERIAL_ASSEMBLY_POINTS);
+        assert!(large.num_elements() * 9 >= FIRST_ORDER_TABLE_POINTS);
         for (disc, tol) in [(&poly, 0.0), (&rational, 4.0 * f64::EPSILON), (&large, 4.0 * f64::EPSILON)] {
             let (p, q) = disc.degrees();
             let (mut full, mut first) = (Scratch::new(p, q, 1), Scratch::new(p, q, 1));
