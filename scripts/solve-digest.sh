@@ -1,34 +1,94 @@
 #!/usr/bin/env bash
-# Solves every bundled geometry (tests/data, tests/data/gismo, tests/data/gismo/xml) with
-# the given `winslow` binary and writes each map with the time-dependent report fields
-# (every key ending in "seconds") removed and keys sorted, so that the outputs of two
-# builds can be compared byte for byte (a refactor must not change results); the
-# progress on stderr goes to NAME.log (timings differ from run to run):
+# Runs every bundled input through the given `winslow` binary and keeps what it wrote,
+# so that the outputs of two builds can be compared byte for byte (a refactor must not
+# change results):
+#   - every four-sided geometry (tests/data, tests/data/contours, tests/data/gismo,
+#     tests/data/gismo/xml), solved with the given extra flags;
+#   - every ring (tests/data/rings), solved;
+#   - every multipatch layout (tests/data/gismo/xml/multipatch), with fixed and with free
+#     interfaces;
+#   - a map improved on its own basis (`solve --start`, Winslow);
+#   - the comparison of methods on one basis (`compare --json`);
+#   - a short sliding-grid sweep of a ring and the volume lofted from its frames.
+# Each JSON output is written with the time-dependent fields (every key ending in
+# "seconds") removed and keys sorted (NAME.digest.json); the exit code goes to NAME.exit;
+# the progress on stderr goes to NAME.log (timings differ from run to run):
 #
-#   cargo build --release -p winslow-cli && cp target/release/winslow /tmp/winslow-before
+#   cargo build -p winslow-cli && cp target/debug/winslow /tmp/winslow-before
 #   bash scripts/solve-digest.sh /tmp/winslow-before /tmp/before
 #   ... change, rebuild ...
-#   bash scripts/solve-digest.sh target/release/winslow /tmp/after
+#   bash scripts/solve-digest.sh target/debug/winslow /tmp/after
 #   diff -r -x "*.log" /tmp/before /tmp/after && echo identical
 #
 # Needs jq. A development tool: CI does not run it.
 set -euo pipefail
 bin=$(realpath "$1")
-out=$2
+out=$(realpath -m "$2")
 shift 2
 cd "$(dirname "$0")/.."
 mkdir -p "$out"
-for f in tests/data/*.json tests/data/gismo/*.json tests/data/gismo/xml/*.xml; do
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+
+digest() { # JSON file -> NAME.digest.json
+  jq -S 'walk(if type == "object" then with_entries(select(.key | test("seconds$") | not)) else . end)' \
+    "$1" >"$out/$2.digest.json"
+}
+
+# run NAME ARGS...: the command's exit code to NAME.exit, stderr to NAME.log, stdout to
+# NAME.stdout (kept only for --json commands, whose stdout is the result)
+run() {
+  local name=$1
+  shift
+  local rc=0
+  "$bin" "$@" >"$scratch/$name.stdout" 2>"$out/$name.log" || rc=$?
+  echo "$rc" >"$out/$name.exit"
+  echo "$name: exit $rc"
+}
+
+solve_to_digest() { # NAME INPUT [FLAGS...]
+  local name=$1 input=$2
+  shift 2
+  run "$name" solve "$input" -o "$scratch/$name.json" "$@"
+  [ -f "$scratch/$name.json" ] && digest "$scratch/$name.json" "$name"
+  return 0
+}
+
+for f in tests/data/*.json tests/data/contours/*.json tests/data/gismo/*.json tests/data/gismo/xml/*.xml; do
   name=$(basename "$f")
   name=${name%.*}
-  case "$f" in *.xml) name="xml_$name" ;; esac
-  rc=0
-  "$bin" solve "$f" -o "$out/$name.map.json" "$@" >/dev/null 2>"$out/$name.log" || rc=$?
-  echo "$rc" >"$out/$name.exit"
-  if [ -f "$out/$name.map.json" ]; then
-    jq -S 'walk(if type == "object" then with_entries(select(.key | test("seconds$") | not)) else . end)' \
-      "$out/$name.map.json" >"$out/$name.digest.json"
-    rm "$out/$name.map.json"
-  fi
-  echo "$name: exit $rc"
+  case "$f" in
+    *.xml) name="xml_$name" ;;
+    */contours/*) name="contour_$name" ;;
+  esac
+  solve_to_digest "$name" "$f" "$@"
 done
+
+for f in tests/data/rings/*.json; do
+  name=$(basename "$f" .json)
+  solve_to_digest "ring_$name" "$f" "$@"
+done
+
+for f in tests/data/gismo/xml/multipatch/*.xml; do
+  name=$(basename "$f" .xml)
+  for interfaces in fixed free; do
+    solve_to_digest "mp_${name}_$interfaces" "$f" --interfaces "$interfaces" "$@"
+  done
+done
+
+# a map improved on its own basis from the certified EGG map of wavy_lid
+if [ -f "$scratch/wavy_lid.json" ]; then
+  solve_to_digest improve_wavy_lid "$scratch/wavy_lid.json" --start "$scratch/wavy_lid.json" --method winslow
+fi
+
+run compare_quarter_annulus compare tests/data/quarter_annulus.json --json
+digest "$scratch/compare_quarter_annulus.stdout" compare_quarter_annulus
+
+run sweep_annulus sweep tests/data/rings/eccentric_annulus.json --rotate-inner 3 --steps 6 --fit-tol 1e-3 \
+  -o "$scratch/sweep" --quiet
+for f in "$scratch"/sweep/*.json; do
+  [ -f "$f" ] && digest "$f" "sweep_$(basename "$f" .json)"
+done
+run loft_annulus loft "$scratch"/sweep/frame_*.json --dz 0.05 -o "$scratch/loft.json"
+[ -f "$scratch/loft.json" ] && digest "$scratch/loft.json" loft_annulus
+exit 0
