@@ -1,16 +1,15 @@
 //! Library use in a dozen lines: an annulus sector given by analytic sides (Rust
-//! closures), solved coarse to fine while printing the solver's stream of iterates.
+//! closures), run through the pipeline while printing its stages (the solver's stream of
+//! levels and iterates).
 //!
 //! `cargo run --example annulus`; `cargo test --workspace` runs it as a test too.
 
 use std::f64::consts::PI;
-use std::sync::Arc;
 
-use winslow::methods::egg::CpuAssembler;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
-use winslow::solve::solver::{EggSolver, Event};
-use winslow::{build_hierarchy, Analytic, Boundary, SideCurve};
+use winslow::solve::solver::Event;
+use winslow::{Analytic, Boundary, Pipeline, SideCurve, Stage};
 
 fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
     let arc = move |r: f64| SideCurve::Analytic(Analytic::new(move |t| [r * (angle * t).cos(), r * (angle * t).sin()]));
@@ -23,17 +22,20 @@ fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
 
 fn run() -> winslow::Result<(Verdict, f64)> {
     let boundary = annulus(1.0, 2.0, 1.5 * PI);
-    let opts = SolveOptions::default();
-    let hierarchy = build_hierarchy(&boundary, &opts.fit)?;
-    let mut solver = EggSolver::new(&hierarchy, opts, Arc::new(CpuAssembler))?;
-    for event in solver.by_ref() {
-        match event? {
-            Event::LevelStarted { level, shape, .. } => println!("level {level}: {}x{} basis", shape[0], shape[1]),
-            Event::Iterate { iterate, .. } => println!("  {:>2}  |F| = {:.3e}", iterate.iteration, iterate.residual),
-            Event::LevelFinished(r) => println!("  done in {} iterations", r.iterations),
+    let solution = Pipeline::new(boundary, SolveOptions::default()).run(&mut |stage| {
+        match stage {
+            Stage::Fitted { hierarchy, .. } => println!("fitted: {} levels", hierarchy.levels.len()),
+            Stage::Solver(Event::LevelStarted { level, shape, .. }) => {
+                println!("level {level}: {}x{} basis", shape[0], shape[1])
+            }
+            Stage::Solver(Event::Iterate { iterate, .. }) => {
+                println!("  {:>2}  |F| = {:.3e}", iterate.iteration, iterate.residual)
+            }
+            Stage::Solver(Event::LevelFinished(r)) => println!("  done in {} iterations", r.iterations),
+            _ => {}
         }
-    }
-    let solution = solver.finish(&boundary, &hierarchy)?;
+        true // go on
+    })?;
     let r = &solution.report;
     println!(
         "{}: {:?}, det J min {:.4}, area {:.6} (exact {:.6})",

@@ -6,9 +6,9 @@
 //! `winslow corpus --solve` (BENCHMARKS.md).
 
 use winslow::boundary::families::Family;
+use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
-use winslow::solve::solver::solve;
 
 fn certified(family: Family, seed: u64) {
     let b = family.generate(seed);

@@ -9,9 +9,9 @@ use std::path::Path;
 use winslow::boundary::validate::validate;
 use winslow::boundary::{Boundary, SideCurve};
 use winslow::io::{read_boundary, ReadOptions};
+use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Solution;
-use winslow::solve::solver::solve;
 use winslow::{Error, Point};
 
 fn load(file: &str) -> Boundary {

@@ -9,9 +9,9 @@ use std::path::Path;
 use winslow::boundary::kinks::{KinkKind, KinkMode};
 use winslow::boundary::BasisChoice;
 use winslow::io::{read_boundary, ReadOptions};
+use winslow::solve;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
-use winslow::solve::solver::solve;
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::Boundary;
 

@@ -7,9 +7,9 @@ use std::path::Path;
 
 use winslow::boundary::reparam::Reparam;
 use winslow::io::{read_boundary, ReadOptions};
+use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::{Solution, Verdict};
-use winslow::solve::solver::solve;
 use winslow::verify::quality::sample_det_j;
 use winslow::{build_hierarchy, Boundary, FitOptions, Side};
 

@@ -11,9 +11,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use winslow::boundary::families::{corpus, Family};
 use winslow::io::json::{boundary_to_json, write_json};
+use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
-use winslow::solve::solver::solve;
 
 #[derive(Args, Debug)]
 pub struct CorpusArgs {

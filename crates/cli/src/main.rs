@@ -23,7 +23,7 @@ use winslow::solve::improve::{improve, Improve};
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
-use winslow::solve::solver::{EggSolver, Event};
+use winslow::solve::solver::Event;
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
@@ -713,7 +713,7 @@ fn bench(a: BenchArgs) -> Result<i32> {
             let o = SolveOptions { refine: r, ..opts.clone() };
             output::reset_peak_memory();
             let t = Instant::now();
-            let sol = solve_cmd::run_solver(&boundary, &o, sel.as_assembler(), true)?;
+            let sol = solve_cmd::run_pipeline(boundary.clone(), &o, sel.as_assembler(), true)?;
             let total = t.elapsed().as_secs_f64();
             let row = output::BenchRow::new(&sol, r, total);
             if a.json {

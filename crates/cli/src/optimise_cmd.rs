@@ -116,7 +116,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     }
     let quiet = a.quiet || a.json;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
-    let sol = solve_cmd::run_solver(&boundary, &opts, Arc::new(CpuAssembler), quiet)?;
+    let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?;
     let egg = &sol.map;
     let copts = ConstrainedOptions {
         eps: a.eps,

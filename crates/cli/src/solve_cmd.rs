@@ -2,178 +2,157 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
-use winslow::boundary::hierarchy::Hierarchy;
-use winslow::boundary::ring::Ring;
-use winslow::boundary::ring_fit::ring_hierarchy;
 use winslow::io::ring::read_ring;
-use winslow::solve::solver::ring_options;
+use winslow::{Input, Pipeline, Stage};
 
-/// Run the solver stream, printing progress.
-pub(super) fn run_solver(
-    boundary: &Boundary,
+/// Run the pipeline on `input`, printing its stages on stderr unless `quiet`.
+pub(super) fn run_pipeline(
+    input: impl Into<Input>,
     opts: &SolveOptions,
     assembler: Arc<dyn EggAssembler>,
     quiet: bool,
 ) -> Result<Solution> {
-    let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
-    let sol = drive(boundary, &h, opts, assembler.clone(), quiet)?;
-    let Some((fitted, why)) = winslow::solve::solver::auto_fallback(&sol, &opts.fit) else { return Ok(sol) };
-    if !quiet {
-        eprintln!("basis auto: {why}");
-    }
-    let opts = SolveOptions { fit: fitted, ..opts.clone() };
-    let h = build_hierarchy(boundary, &opts.fit).context("fitting the boundary")?;
-    let again = drive(boundary, &h, &opts, assembler, quiet)?;
-    Ok(winslow::solve::solver::auto_choice(sol, again, why))
-}
-
-/// Fit a ring's contours on one periodic knot vector and solve with `eta` periodic
-/// (`winslow solve ring.json`, paper §11.1), printing progress.
-pub(super) fn run_ring_solver(
-    ring: &Ring,
-    opts: &SolveOptions,
-    assembler: Arc<dyn EggAssembler>,
-    quiet: bool,
-) -> Result<Solution> {
-    let (h, cut) = ring_hierarchy(ring, &opts.fit).context("fitting the ring's contours")?;
-    if !quiet {
-        let rp = &h.reparam;
-        eprintln!(
-            "{}: ring (O-grid, eta periodic), contours fitted on {} periodic levels up to {} elements in eta, {}",
-            ring.name,
-            h.levels.len(),
-            h.finest().knots[1].num_elements(),
-            if rp.matches.is_empty() { "by arc length" } else { "arc length with the narrow gap matched (§7.2)" }
-        );
-        eprintln!(
-            "  reparameterization: {} (requested {}); gap/diameter {:.2e} (threshold {:.1e}); {} matched pairs",
-            rp.used.name(),
-            rp.requested.name(),
-            rp.gap_ratio[1],
-            rp.gap_threshold,
-            rp.matches.len()
-        );
-        let (s, e) = (&cut.sides[Side::West as usize], &cut.sides[Side::East as usize]);
-        eprintln!("  inner: {}; outer: {}", s.describe(), e.describe());
-        let seam = cut.side(Side::South).endpoints();
-        eprintln!(
-            "  eta = 0 from ({:.6}, {:.6}) on the inner to ({:.6}, {:.6}) on the outer contour",
-            seam.0[0], seam.0[1], seam.1[0], seam.1[1]
-        );
-        for (s, what) in [(Side::West, "inner"), (Side::East, "outer")] {
-            let f = &h.fits[s as usize];
-            if !f.converged {
-                eprintln!(
-                    "  warning: the {what} contour's fit did not reach the tolerance {:.3e} (max error {:.3e} on {} elements)",
-                    h.physical_tol_abs(),
-                    f.final_max_error(),
-                    h.finest().knots[1].num_elements()
-                );
-            }
-        }
-    }
-    drive(&cut, &h, &ring_options(opts), assembler, quiet)
-}
-
-/// Run the solver stream over the hierarchy `h` of `boundary`, printing progress.
-fn drive(
-    boundary: &Boundary,
-    h: &Hierarchy,
-    opts: &SolveOptions,
-    assembler: Arc<dyn EggAssembler>,
-    quiet: bool,
-) -> Result<Solution> {
-    if !quiet && !opts.topology.eta_periodic() {
-        let tol = h.physical_tol_abs();
-        eprintln!(
-            "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
-            boundary.name,
-            h.levels.len(),
-            h.physical_diameter()
-        );
-        match (&h.basis.fallback, h.basis.used) {
-            (Some(why), _) => eprintln!("  basis: fitted (the input basis cannot be used: {why})"),
-            (None, BasisChoice::Auto) => {}
-            (None, BasisChoice::Input) => eprintln!(
-                "  basis: input, {}x{} functions, boundary kept exactly",
-                h.finest().knots[0].num_basis(),
-                h.finest().knots[1].num_basis()
-            ),
-            (None, BasisChoice::Fitted) => {}
-        }
-        if let Some(k) = &h.basis.kinks {
-            eprintln!("  kinks: {k}");
-        }
-        let rp = &h.reparam;
-        eprintln!(
-            "  reparameterization: {} (requested {}), {} matched pairs",
-            rp.used.name(),
-            rp.requested.name(),
-            rp.matches.len()
-        );
-        for s in Side::ALL {
-            let f = &h.fits[s as usize];
-            if !f.converged {
-                eprintln!(
-                    "  warning: {s} side fit did not reach the tolerance (max error {:.3e})",
-                    f.max_error.last().copied().unwrap_or(0.0)
-                );
-            }
-        }
-    }
-    let mut solver = EggSolver::new(h, opts.clone(), assembler)?;
-    if !quiet {
-        let m = solver.method();
-        eprintln!("  method: {} (start: {:?})", m.name(), m.start());
-    }
+    let pipeline = Pipeline::new(input, opts.clone()).backend(assembler);
     let stderr = std::io::stderr();
-    for event in solver.by_ref() {
-        let event = event?;
+    let mut failed = None;
+    let out = pipeline.run(&mut |stage| {
         if quiet {
-            continue;
+            return true;
         }
-        let mut e = stderr.lock();
-        match event {
-            Event::LevelStarted { level, levels, shape, unknowns, initial_guess } => {
-                writeln!(
-                    e,
-                    "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}",
-                    level + 1,
-                    shape[0],
-                    shape[1]
-                )?;
-            }
-            Event::Iterate { iterate: it, .. } => {
-                writeln!(
-                    e,
-                    "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
-                    it.iteration,
-                    format!("{:?}", it.method),
-                    it.residual,
-                    it.scaled_residual,
-                    it.step,
-                    it.damping,
-                    it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
-                    it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
-                )?;
-            }
-            Event::LevelFinished(r) => {
-                writeln!(
-                    e,
-                    "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
-                    r.iterations,
-                    if r.converged {
-                        "converged".to_string()
-                    } else {
-                        format!("NOT converged ({})", r.failure.unwrap_or_default())
-                    },
-                    r.initial_det_j_min,
-                    r.seconds
-                )?;
+        match print_stage(&mut stderr.lock(), stage) {
+            Ok(()) => true,
+            Err(e) => {
+                failed = Some(e);
+                false
             }
         }
+    });
+    if let Some(e) = failed {
+        return Err(e).context("writing the progress");
     }
-    Ok(solver.finish(boundary, h)?)
+    Ok(out?)
+}
+
+/// One stage of the pipeline as progress lines.
+fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
+    match stage {
+        Stage::Fitted { input: Input::Ring(ring), boundary: cut, hierarchy: h, method } => {
+            let rp = &h.reparam;
+            writeln!(
+                e,
+                "{}: ring (O-grid, eta periodic), contours fitted on {} periodic levels up to {} elements in eta, {}",
+                ring.name,
+                h.levels.len(),
+                h.finest().knots[1].num_elements(),
+                if rp.matches.is_empty() { "by arc length" } else { "arc length with the narrow gap matched (§7.2)" }
+            )?;
+            writeln!(
+                e,
+                "  reparameterization: {} (requested {}); gap/diameter {:.2e} (threshold {:.1e}); {} matched pairs",
+                rp.used.name(),
+                rp.requested.name(),
+                rp.gap_ratio[1],
+                rp.gap_threshold,
+                rp.matches.len()
+            )?;
+            let (s, w) = (&cut.sides[Side::West as usize], &cut.sides[Side::East as usize]);
+            writeln!(e, "  inner: {}; outer: {}", s.describe(), w.describe())?;
+            let seam = cut.side(Side::South).endpoints();
+            writeln!(
+                e,
+                "  eta = 0 from ({:.6}, {:.6}) on the inner to ({:.6}, {:.6}) on the outer contour",
+                seam.0[0], seam.0[1], seam.1[0], seam.1[1]
+            )?;
+            for (s, what) in [(Side::West, "inner"), (Side::East, "outer")] {
+                let f = &h.fits[s as usize];
+                if !f.converged {
+                    writeln!(
+                        e,
+                        "  warning: the {what} contour's fit did not reach the tolerance {:.3e} (max error {:.3e} on {} elements)",
+                        h.physical_tol_abs(),
+                        f.final_max_error(),
+                        h.finest().knots[1].num_elements()
+                    )?;
+                }
+            }
+            writeln!(e, "  method: {} (start: {:?})", method.name(), method.start())
+        }
+        Stage::Fitted { boundary, hierarchy: h, method, .. } => {
+            let tol = h.physical_tol_abs();
+            writeln!(
+                e,
+                "{}: {} hierarchy levels (fit tolerance {tol:.3e}, diameter {:.4})",
+                boundary.name,
+                h.levels.len(),
+                h.physical_diameter()
+            )?;
+            match (&h.basis.fallback, h.basis.used) {
+                (Some(why), _) => writeln!(e, "  basis: fitted (the input basis cannot be used: {why})")?,
+                (None, BasisChoice::Input) => writeln!(
+                    e,
+                    "  basis: input, {}x{} functions, boundary kept exactly",
+                    h.finest().knots[0].num_basis(),
+                    h.finest().knots[1].num_basis()
+                )?,
+                (None, BasisChoice::Auto | BasisChoice::Fitted) => {}
+            }
+            if let Some(k) = &h.basis.kinks {
+                writeln!(e, "  kinks: {k}")?;
+            }
+            let rp = &h.reparam;
+            writeln!(
+                e,
+                "  reparameterization: {} (requested {}), {} matched pairs",
+                rp.used.name(),
+                rp.requested.name(),
+                rp.matches.len()
+            )?;
+            for s in Side::ALL {
+                let f = &h.fits[s as usize];
+                if !f.converged {
+                    writeln!(
+                        e,
+                        "  warning: {s} side fit did not reach the tolerance (max error {:.3e})",
+                        f.max_error.last().copied().unwrap_or(0.0)
+                    )?;
+                }
+            }
+            writeln!(e, "  method: {} (start: {:?})", method.name(), method.start())
+        }
+        Stage::Fallback { reason } => writeln!(e, "basis auto: {reason}"),
+        Stage::Solver(Event::LevelStarted { level, levels, shape, unknowns, initial_guess }) => writeln!(
+            e,
+            "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}",
+            level + 1,
+            shape[0],
+            shape[1]
+        ),
+        Stage::Solver(Event::Iterate { iterate: it, .. }) => writeln!(
+            e,
+            "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
+            it.iteration,
+            format!("{:?}", it.method),
+            it.residual,
+            it.scaled_residual,
+            it.step,
+            it.damping,
+            it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
+            it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
+        ),
+        Stage::Solver(Event::LevelFinished(r)) => writeln!(
+            e,
+            "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
+            r.iterations,
+            if r.converged {
+                "converged".to_string()
+            } else {
+                format!("NOT converged ({})", r.failure.clone().unwrap_or_default())
+            },
+            r.initial_det_j_min,
+            r.seconds
+        ),
+        _ => Ok(()),
+    }
 }
 
 pub(super) fn solve(a: SolveArgs) -> Result<i32> {
@@ -197,13 +176,11 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     }
     let ring = read_ring(path).with_context(|| format!("reading {}", path.display()))?;
     let sel = a.backend.select(a.quiet || a.json)?;
-    let sol = match ring {
-        Some(ring) => run_ring_solver(&ring, &opts, sel.as_assembler(), a.quiet || a.json)?,
-        None => {
-            let boundary = load_boundary(path, a.solver.fit.reorient)?;
-            run_solver(&boundary, &opts, sel.as_assembler(), a.quiet || a.json)?
-        }
+    let input = match ring {
+        Some(ring) => Input::Ring(ring),
+        None => Input::Boundary(load_boundary(path, a.solver.fit.reorient)?),
     };
+    let sol = run_pipeline(input, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let json = || map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report })));

@@ -8,7 +8,6 @@ use super::*;
 use winslow::boundary::ring::{ClosedContour, Ring};
 use winslow::boundary::ring_fit::EtaRefinement;
 use winslow::io::picture::Image;
-use winslow::solve::solver::solve_ring_with;
 use winslow::solve::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, SweepOptions};
 
 #[derive(Args, Debug)]
@@ -303,7 +302,9 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             let turned = Ring { inner: ring.inner.rotated(centre, angle), ..ring.clone() };
             let refinement = if seam == Seam::Material { EtaRefinement::Adaptive } else { EtaRefinement::Uniform };
             let t0 = std::time::Instant::now();
-            let cold = solve_ring_with(&turned, &frame0_options(&opts), refinement)
+            let cold = winslow::Pipeline::new(turned, frame0_options(&opts))
+                .eta_refinement(refinement)
+                .solve()
                 .with_context(|| format!("cold solve of frame {k}"))?;
             let seconds = t0.elapsed().as_secs_f64();
             cold_checks.push(serde_json::json!({

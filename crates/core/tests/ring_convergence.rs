@@ -96,7 +96,7 @@ fn shared_rings_solve_and_certify() {
         let ring = winslow::io::ring::read_ring(&dir.join(format!("{name}.json"))).unwrap().expect("a ring document");
         let mut opts = SolveOptions::default();
         opts.fit.tol = fit_tol;
-        let sol = winslow::solve::solver::solve_ring(&ring, &opts).unwrap();
+        let sol = winslow::Pipeline::new(ring, opts.clone()).solve().unwrap();
         assert_eq!(sol.report.verdict, Verdict::Certified, "{name}: {}", sol.report.message);
         let dev = sol.report.boundary_deviation;
         assert!(

@@ -23,7 +23,7 @@
 //! let gpu = Arc::new(Gpu::new(&GpuOptions::default())?);
 //! println!("{}", gpu.describe());
 //! let assembler = Arc::new(GpuAssembler::new(gpu));
-//! // winslow::solve::solver::EggSolver::new(&hierarchy, opts, assembler) ...
+//! // winslow::Pipeline::new(boundary, opts).backend(assembler).solve()?
 //! # Ok::<(), winslow_gpu::GpuError>(())
 //! ```
 

@@ -9,13 +9,13 @@ use std::sync::{Arc, OnceLock};
 use winslow::boundary::fit::FitOptions;
 use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::discrete::assembly::{Discretization, Operator};
-use winslow::methods::egg::{CpuAssembler, EggAssembler};
+use winslow::methods::egg::EggAssembler;
 use winslow::solve::initial::coons;
 use winslow::solve::options::SolveOptions;
-use winslow::solve::solver::EggSolver;
 use winslow::spline::curve::Point;
 use winslow::spline::knots::KnotVector;
 use winslow::verify::quality::sample_det_j;
+use winslow::Pipeline;
 use winslow::{read_boundary, ReadOptions, Surface};
 use winslow_gpu::{gpu_required, Gpu, GpuAssembler, GpuOptions, Precision};
 
@@ -245,8 +245,8 @@ fn solve_on_the_gpu_gives_the_cpu_map() {
     let b = read_boundary(&data("quarter_annulus.json"), &ReadOptions::default()).expect("boundary");
     let opts = SolveOptions { min_elements: 6, ..Default::default() };
     let h = build_hierarchy(&b, &opts.fit).expect("fit");
-    let cpu = EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler)).unwrap().finish(&b, &h).unwrap();
-    let gpu = EggSolver::new(&h, opts, g.clone() as Arc<dyn EggAssembler>).unwrap().finish(&b, &h).unwrap();
+    let cpu = Pipeline::new(b.clone(), opts.clone()).solve().unwrap();
+    let gpu = Pipeline::new(b, opts).backend(g.clone() as Arc<dyn EggAssembler>).solve().unwrap();
     assert!(gpu.report.backend.starts_with("gpu: "), "{}", gpu.report.backend);
     assert!(!gpu.report.backend.contains("fell back"), "{}", gpu.report.backend);
     assert_eq!(cpu.map.knots, gpu.map.knots);

@@ -10,16 +10,14 @@ use std::sync::mpsc::{channel, Receiver, TryRecvError};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use winslow::boundary::hierarchy::{build_hierarchy, Hierarchy};
 use winslow::boundary::ring::Ring;
-use winslow::boundary::ring_fit::ring_hierarchy;
 use winslow::methods::egg::CpuAssembler;
 use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
-use winslow::solve::solver::{auto_fallback, ring_options, EggSolver, Event};
-use winslow::Boundary;
+use winslow::solve::solver::Event;
+use winslow::{Boundary, Input, Pipeline, Stage};
 
 /// A message from the solving thread.
 #[derive(Debug)]
@@ -52,18 +50,29 @@ pub enum Msg {
     Cancelled,
 }
 
-/// Fit and solve `boundary`, sending every step to `send`; checks `cancel` before the
-/// fit and between events. Always ends with `Finished`, `Failed` or `Cancelled`. With the
-/// default basis `auto`, a map on the input basis that is not certified is solved again on
-/// the fitted basis ([`auto_fallback`]), as the CLI does.
-pub fn run(boundary: &Boundary, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
-    let Some(sol) = attempt(boundary, opts, cancel, send) else { return };
-    let Some((fitted, why)) = auto_fallback(&sol, &opts.fit) else {
-        return send(Msg::Finished(Box::new(sol)));
-    };
-    let again = SolveOptions { fit: fitted, ..opts.clone() };
-    if let Some(s) = attempt(boundary, &again, cancel, send) {
-        send(Msg::Finished(Box::new(winslow::solve::solver::auto_choice(sol, s, why))));
+/// Run the pipeline on `input` (a boundary, or a ring: paper §11.1), sending every
+/// stage to `send`; checks `cancel` before the fit and at every stage. Always ends with
+/// `Finished`, `Failed` or `Cancelled`. With the default basis `auto`, a map on the input
+/// basis that is not certified is solved again on the fitted basis, as the CLI does.
+pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
+    let cancelled = || cancel.load(Ordering::Relaxed);
+    if cancelled() {
+        return send(Msg::Cancelled);
+    }
+    let out = Pipeline::new(input, opts.clone()).run(&mut |stage| {
+        match stage {
+            Stage::Fitted { hierarchy, .. } => {
+                send(Msg::Fitted { levels: hierarchy.levels.len(), tolerance: hierarchy.physical_tol_abs() })
+            }
+            Stage::Solver(e) => send(Msg::Event((*e).clone())),
+            _ => {}
+        }
+        !cancelled()
+    });
+    match out {
+        Ok(sol) => send(Msg::Finished(Box::new(sol))),
+        Err(winslow::Error::Cancelled) => send(Msg::Cancelled),
+        Err(e) => send(Msg::Failed(e.to_string())),
     }
 }
 
@@ -93,85 +102,6 @@ pub fn run_compare(
         Ok(Some(c)) => send(Msg::Compared(Box::new(c))),
         Ok(None) => send(Msg::Cancelled),
         Err(e) => send(Msg::Failed(format!("comparing methods: {e}"))),
-    }
-}
-
-/// One fit and solve; `None` once `Failed` or `Cancelled` was sent.
-fn attempt(
-    boundary: &Boundary,
-    opts: &SolveOptions,
-    cancel: &AtomicBool,
-    send: &mut dyn FnMut(Msg),
-) -> Option<Solution> {
-    let cancelled = || cancel.load(Ordering::Relaxed);
-    if cancelled() {
-        send(Msg::Cancelled);
-        return None;
-    }
-    let h = match build_hierarchy(boundary, &opts.fit) {
-        Ok(h) => h,
-        Err(e) => {
-            send(Msg::Failed(format!("fitting the boundary: {e}")));
-            return None;
-        }
-    };
-    drive(&h, boundary, opts.clone(), cancel, send)
-}
-
-/// Fit and solve a ring (O-grid, `eta` periodic: paper §11.1) as `winslow solve` does,
-/// sending every step to `send`.
-pub fn run_ring(ring: &Ring, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
-    if cancel.load(Ordering::Relaxed) {
-        return send(Msg::Cancelled);
-    }
-    match ring_hierarchy(ring, &opts.fit) {
-        Ok((h, cut)) => {
-            if let Some(sol) = drive(&h, &cut, ring_options(opts), cancel, send) {
-                send(Msg::Finished(Box::new(sol)));
-            }
-        }
-        Err(e) => send(Msg::Failed(format!("fitting the ring's contours: {e}"))),
-    }
-}
-
-/// Solve on the fitted hierarchy `h` of `boundary`; `None` once `Failed` or `Cancelled`
-/// was sent.
-fn drive(
-    h: &Hierarchy,
-    boundary: &Boundary,
-    opts: SolveOptions,
-    cancel: &AtomicBool,
-    send: &mut dyn FnMut(Msg),
-) -> Option<Solution> {
-    let cancelled = || cancel.load(Ordering::Relaxed);
-    send(Msg::Fitted { levels: h.levels.len(), tolerance: h.physical_tol_abs() });
-    let mut solver = match EggSolver::new(h, opts, Arc::new(CpuAssembler)) {
-        Ok(s) => s,
-        Err(e) => {
-            send(Msg::Failed(e.to_string()));
-            return None;
-        }
-    };
-    loop {
-        if cancelled() {
-            send(Msg::Cancelled);
-            return None;
-        }
-        match solver.next() {
-            Some(Ok(e)) => send(Msg::Event(e)),
-            Some(Err(e)) => {
-                send(Msg::Failed(e.to_string()));
-                return None;
-            }
-            None => break,
-        }
-    }
-    match solver.finish(boundary, h) {
-        Ok(s) => Some(s),
-        Err(e) => {
-            send(Msg::Failed(e.to_string()));
-            None
-        }
     }
 }
 
@@ -311,7 +241,7 @@ impl SolveJob {
     /// (the UI passes `request_repaint`).
     pub fn start(boundary: Boundary, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
         let name = boundary.name.clone();
-        Self::spawn(name, notify, move |cancel, send| run(&boundary, &opts, cancel, send))
+        Self::spawn(name, notify, move |cancel, send| run(Input::Boundary(boundary), &opts, cancel, send))
     }
 
     /// Start comparing `methods` on `boundary` in a new thread ([`run_compare`]); the
@@ -326,10 +256,10 @@ impl SolveJob {
         Self::spawn(name, notify, move |cancel, send| run_compare(&boundary, &methods, &opts, cancel, send))
     }
 
-    /// Start solving a ring ([`run_ring`]) in a new thread.
+    /// Start solving a ring ([`run`]) in a new thread.
     pub fn start_ring(ring: Ring, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
         let name = ring.name.clone();
-        Self::spawn(name, notify, move |cancel, send| run_ring(&ring, &opts, cancel, send))
+        Self::spawn(name, notify, move |cancel, send| run(Input::Ring(ring), &opts, cancel, send))
     }
 
     fn spawn(
@@ -472,7 +402,7 @@ mod tests {
     #[test]
     fn run_streams_levels_iterates_and_the_solution() {
         let mut msgs = Vec::new();
-        run(&annulus(), &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
+        run(annulus().into(), &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
         assert!(matches!(msgs.first(), Some(Msg::Fitted { levels, .. }) if *levels >= 1));
         assert!(matches!(msgs.get(1), Some(Msg::Event(Event::LevelStarted { level: 0, .. }))));
         let Some(Msg::Finished(sol)) = msgs.last() else { panic!("{:?}", msgs.last()) };
@@ -496,7 +426,7 @@ mod tests {
     fn cancel_flag_stops_between_events() {
         let cancel = AtomicBool::new(false);
         let mut msgs = Vec::new();
-        run(&annulus(), &quick(), &cancel, &mut |m| {
+        run(annulus().into(), &quick(), &cancel, &mut |m| {
             if matches!(m, Msg::Event(Event::Iterate { .. })) {
                 cancel.store(true, Ordering::Relaxed);
             }
@@ -542,7 +472,7 @@ mod tests {
         let dot = SideCurve::Analytic(Analytic::new(|_| [0.0, 0.0]));
         let b = Boundary { name: "dot".into(), sides: [dot.clone(), dot.clone(), dot.clone(), dot] };
         let mut msgs = Vec::new();
-        run(&b, &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
+        run(b.into(), &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
         assert!(matches!(msgs.last(), Some(Msg::Failed(_))), "{msgs:?}");
     }
 

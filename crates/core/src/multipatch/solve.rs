@@ -265,7 +265,7 @@ fn solve_patch(
     // 8 points per element of the finer direction, not more than asked for
     let finest = h.levels.last().map_or(1, |l| l.knots[0].num_elements().max(l.knots[1].num_elements()));
     o.sample = o.sample.min(8 * finest.max(4));
-    let sol = EggSolver::new(&h, o, std::sync::Arc::new(CpuAssembler))?.finish(&boundary, &h)?;
+    let sol = EggSolver::new(&boundary, std::sync::Arc::new(h), o, std::sync::Arc::new(CpuAssembler))?.finish()?;
     let mut map = sol.map;
     // the boundary control points are the conforming sides' exactly
     let shape = map.shape();

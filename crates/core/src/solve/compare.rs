@@ -53,14 +53,15 @@ pub use gravesen::{ConstrainedRun, MaxZRun};
 use super::constrained::{ConstrainedOptions, Functional};
 use super::options::SolveOptions;
 use super::report::{Solution, Verdict};
-use super::solver::{auto_fallback, EggSolver, Event};
-use crate::boundary::hierarchy::{build_hierarchy, Hierarchy};
+use super::solver::{EggSolver, Event};
+use crate::boundary::hierarchy::Hierarchy;
 use crate::boundary::{BasisChoice, Boundary};
 use crate::error::{Error, Result};
 use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::harmonic::VariationalHarmonicMethod;
 use crate::methods::quasi_conformal::{QcHessian, QuasiConformalMethod};
 use crate::methods::Method;
+use crate::pipeline::{Pipeline, Stage};
 use crate::spline::surface::Surface;
 use crate::verify::certificate::certify;
 use crate::verify::poisson::{default_scales, poisson_benchmark};
@@ -209,7 +210,7 @@ pub struct CompareContext<'a> {
     /// The boundary.
     pub boundary: &'a Boundary,
     /// The hierarchy of bases every method uses (EGG's).
-    pub hierarchy: &'a Hierarchy,
+    pub hierarchy: &'a Arc<Hierarchy>,
     /// Shared options.
     pub options: &'a CompareOptions,
     /// Quadrature back end of the hierarchy's operators.
@@ -307,7 +308,7 @@ impl HierarchyRun {
     fn solve(
         &self,
         ctx: &CompareContext<'_>,
-        h: &Hierarchy,
+        h: &Arc<Hierarchy>,
         progress: &mut dyn FnMut(&Event) -> bool,
     ) -> Result<Option<Solution>> {
         let opts = ctx.options.solve.clone();
@@ -316,13 +317,13 @@ impl HierarchyRun {
             Some(f) => f.method(h),
             None => Arc::new(EggMethod { operator: opts.operator, assembler: assembler.clone() }),
         };
-        let mut solver = EggSolver::with_method(h, opts, assembler, method)?;
+        let mut solver = EggSolver::with_method(ctx.boundary, h.clone(), opts, assembler, method)?;
         for e in solver.by_ref() {
             if !progress(&e?) {
                 return Ok(None);
             }
         }
-        Ok(Some(solver.finish(ctx.boundary, h)?))
+        Ok(Some(solver.finish()?))
     }
 }
 
@@ -474,28 +475,25 @@ pub fn compare(
     if !progress(CompareEvent::Started { method: MethodChoice::Egg.name().into(), index: 0, count }) {
         return Ok(None);
     }
-    // EGG decides the basis, as `winslow solve` does
+    // EGG decides the basis, as `winslow solve` does: the pipeline, with its fallback
     let t0 = Instant::now();
-    let egg = HierarchyRun::new(MethodChoice::Egg.name(), None);
-    let mut h = build_hierarchy(boundary, &opts.solve.fit)?;
-    let ctx = CompareContext { boundary, hierarchy: &h, options: opts, assembler: assembler.clone(), reference: None };
-    let Some(mut sol) = egg.solve(&ctx, &h, &mut |e| progress(CompareEvent::Solver(e.clone())))? else {
-        return Ok(None);
-    };
     let mut fallback = None;
-    if let Some((fitted, why)) = auto_fallback(&sol, &opts.solve.fit) {
-        let mut o = opts.clone();
-        o.solve.fit = fitted;
-        h = build_hierarchy(boundary, &o.solve.fit)?;
-        let ctx =
-            CompareContext { boundary, hierarchy: &h, options: &o, assembler: assembler.clone(), reference: None };
-        let Some(again) = egg.solve(&ctx, &h, &mut |e| progress(CompareEvent::Solver(e.clone())))? else {
-            return Ok(None);
-        };
-        sol = again;
-        fallback = Some(why);
-    }
-    let reference = MethodRun::of_solution(egg.name(), &sol, t0.elapsed().as_secs_f64());
+    let egg = Pipeline::new(boundary.clone(), opts.solve.clone()).backend(assembler.clone()).run_keeping_hierarchy(
+        &mut |stage| match stage {
+            Stage::Solver(e) => progress(CompareEvent::Solver((*e).clone())),
+            Stage::Fallback { reason } => {
+                fallback = Some(reason.to_string());
+                true
+            }
+            _ => true,
+        },
+    );
+    let (sol, h) = match egg {
+        Ok(out) => out,
+        Err(Error::Cancelled) => return Ok(None),
+        Err(e) => return Err(e),
+    };
+    let reference = MethodRun::of_solution(MethodChoice::Egg.name(), &sol, t0.elapsed().as_secs_f64());
     let scales = opts.poisson_scales.unwrap_or_else(|| default_scales(&reference.map));
     let basis = match h.basis.used {
         BasisChoice::Input => "input",

@@ -9,7 +9,7 @@
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
 //! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
-//! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s; [`solve`](solver::solve) | §6.3 |
+//! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s | §6.3 |
 //! | [`sweep`] | [`Sweep`](sweep::Sweep): the sliding O-grid, inner contour turned per frame, extrapolated initial guesses | §11.1, Fig. 22 |
 //! | [`loft`] | [`loft`](loft::loft): a volume from planar slices, certified, with slices inserted (solved from interpolated guesses) where it is not | §11.1, Fig. 23 |
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified | §4.1, §9 |

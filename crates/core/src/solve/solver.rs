@@ -17,15 +17,15 @@ use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS}
 use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
-use super::report::{InitialGuess, LevelReport, ReportContext, Solution, Verdict};
-use crate::boundary::hierarchy::{build_hierarchy, Hierarchy, Level};
+use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
+use crate::boundary::hierarchy::{Hierarchy, Level};
 use crate::boundary::kinks::smoothed_levels;
 use crate::boundary::normalise::Similarity;
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
-use crate::methods::egg::{CpuAssembler, EggAssembler, EggMethod};
+use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::{DiscreteProblem, Method, Start};
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
@@ -96,6 +96,11 @@ pub struct EggSolver {
     /// With kinks kept (§9): the finest `C^0` level `Σ⁰` (balanced and refined like the
     /// plan, whose levels are its smoothing `Σ¹`).
     c0: Option<Level>,
+    /// The boundary solved (a ring's cut at its seam), in the input's coordinates: the
+    /// report measures the map against it.
+    boundary: Boundary,
+    /// The hierarchy the plan was made from: its similarity, kinks and basis report.
+    hierarchy: Arc<Hierarchy>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -105,17 +110,23 @@ impl std::fmt::Debug for EggSolver {
 }
 
 impl EggSolver {
-    /// A solver of EGG (eq. 8, `opts.operator`) over the levels of `hierarchy` (extended
-    /// and selected by `opts`), assembled on `assembler`.
-    pub fn new(hierarchy: &Hierarchy, opts: SolveOptions, assembler: Arc<dyn EggAssembler>) -> Result<Self> {
+    /// A solver of EGG (eq. 8, `opts.operator`) over the levels of `hierarchy` (the fit of
+    /// `boundary`, extended and selected by `opts`), assembled on `assembler`.
+    pub fn new(
+        boundary: &Boundary,
+        hierarchy: Arc<Hierarchy>,
+        opts: SolveOptions,
+        assembler: Arc<dyn EggAssembler>,
+    ) -> Result<Self> {
         let method = Arc::new(EggMethod { operator: opts.operator, assembler: assembler.clone() });
-        Self::with_method(hierarchy, opts, assembler, method)
+        Self::with_method(boundary, hierarchy, opts, assembler, method)
     }
 
-    /// A solver of `method` over the levels of `hierarchy`; `assembler` assembles the
-    /// hierarchy's operators (elasticity, continuation samples).
+    /// A solver of `method` over the levels of `hierarchy` (the fit of `boundary`);
+    /// `assembler` assembles the hierarchy's operators (elasticity, continuation samples).
     pub fn with_method(
-        hierarchy: &Hierarchy,
+        boundary: &Boundary,
+        hierarchy: Arc<Hierarchy>,
         opts: SolveOptions,
         assembler: Arc<dyn EggAssembler>,
         method: Arc<dyn Method>,
@@ -162,6 +173,8 @@ impl EggSolver {
             certificate: None,
             free_boxes: Vec::new(),
             c0,
+            boundary: boundary.clone(),
+            hierarchy,
         })
     }
 
@@ -286,10 +299,12 @@ impl EggSolver {
     /// coordinates (the solve ran in the normalised ones of
     /// [`Hierarchy::similarity`]; a map brought back is certified again). Runs the
     /// remaining iterations first if the stream was not drained.
-    pub fn finish(mut self, boundary: &Boundary, hierarchy: &Hierarchy) -> Result<Solution> {
+    pub fn finish(mut self) -> Result<Solution> {
         for e in self.by_ref() {
             e?;
         }
+        let hierarchy = self.hierarchy.clone();
+        let (boundary, hierarchy) = (&self.boundary, &*hierarchy);
         let mut map = self.previous.clone().ok_or_else(|| Error::Invalid("no level was solved".into()))?;
         // the certificate of the map in the input's coordinates; the verdict is the same in
         // the normalised ones (a similarity), which the stages below read
@@ -399,6 +414,11 @@ impl EggSolver {
         Ok(Solution::new(&boundary.name, map, self.reports, ctx))
     }
 
+    /// The hierarchy the solver was made from.
+    pub fn hierarchy(&self) -> &Arc<Hierarchy> {
+        &self.hierarchy
+    }
+
     /// Certify the last solved map (once) and, when it folds or is undecided and rounds
     /// are left, append the defect-correction level of [`plan_repair`]. Returns
     /// `Ok(true)` when a level was added.
@@ -474,115 +494,11 @@ impl Iterator for EggSolver {
     }
 }
 
-/// Fit the boundary, then solve coarse to fine on the CPU; drains the event stream. With
-/// [`BasisChoice::Auto`] a map on the input basis that is not certified is solved again
-/// on the fitted basis ([`auto_fallback`]).
-pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
-    let h = build_hierarchy(boundary, &opts.fit)?;
-    let sol = EggSolver::new(&h, opts.clone(), Arc::new(CpuAssembler))?.finish(boundary, &h)?;
-    match auto_fallback(&sol, &opts.fit) {
-        None => Ok(sol),
-        Some((fitted, why)) => {
-            let mut o = opts.clone();
-            o.fit = fitted;
-            let h = build_hierarchy(boundary, &o.fit)?;
-            let again = EggSolver::new(&h, o, Arc::new(CpuAssembler))?.finish(boundary, &h)?;
-            Ok(auto_choice(sol, again, why))
-        }
-    }
-}
-
-/// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
-/// basis) again as `again` (fitted basis) for the reason `why`: `again`, with the reason
-/// in its report; but a `degenerate-corner` map on the input basis stands when the fitted
-/// one is not certified either (its boundary is the exact one). The time of both solves
-/// counts.
-pub fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
-    if first.report.verdict == Verdict::DegenerateCorner && again.report.verdict != Verdict::Certified {
-        let mut first = first;
-        first.report.seconds += again.report.seconds;
-        first.report.message.push_str(&format!(
-            "; solved again on the fitted basis too, where the map is {}: the input basis' map is kept",
-            again.report.verdict.name()
-        ));
-        return first;
-    }
-    again.report.basis.requested = BasisChoice::Auto;
-    again.report.basis.fallback = Some(why);
-    again.report.seconds += first.report.seconds;
-    again
-}
-
-/// With [`BasisChoice::Auto`]: when `sol` was solved on the input basis and its map is
-/// not certified (folded, undecided or not converged; `degenerate-corner` at corners of
-/// the domain is the best map such a boundary allows and is kept, but not when only
-/// zero-speed points of the input's parameterization are excused: the fitted basis
-/// reparameterizes them, see [`auto_choice`]), the fit options of the fitted basis and
-/// the reason to solve again with them. `None` when `sol` stands.
-pub fn auto_fallback(
-    sol: &Solution,
-    fit: &crate::boundary::fit::FitOptions,
-) -> Option<(crate::boundary::fit::FitOptions, String)> {
-    let r = &sol.report;
-    if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
-        return None;
-    }
-    let zero_speed_only = r.verdict == Verdict::DegenerateCorner
-        && !r.certificate.excused_points.is_empty()
-        && r.certificate.corners.iter().all(|c| c.excused_extent.is_none());
-    if r.verdict == Verdict::Certified || (r.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
-        return None;
-    }
-    let why = if zero_speed_only {
-        format!(
-            "on the input basis ({} functions) det J = 0 where the input's parameterization has zero speed; solved \
-             again on the fitted basis, which reparameterizes the side there",
-            r.basis_functions
-        )
-    } else {
-        format!(
-            "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
-            r.basis_functions,
-            r.repairs,
-            r.verdict.name()
-        )
-    };
-    let fit = crate::boundary::fit::FitOptions { basis: BasisChoice::Fitted, ..*fit };
-    Some((fit, why))
-}
-
-/// The options of a ring solve (§11.1) made from `opts`: `eta` periodic
-/// ([`Topology::ring`](crate::discrete::topology::Topology::ring)), and no corner of the
-/// parameter square excused by the certificate (a ring has no corners).
-pub fn ring_options(opts: &SolveOptions) -> SolveOptions {
-    let mut o = opts.clone();
-    o.topology = crate::discrete::topology::Topology::ring();
-    o.certify.excuse_corners = false;
-    o
-}
-
-/// Fit a ring's contours on one periodic knot vector
-/// ([`ring_hierarchy`](crate::boundary::ring_fit::ring_hierarchy)) and solve EGG coarse to
-/// fine with `eta` periodic, `xi = 0` on the inner and `xi = 1` on the outer contour, on
-/// the CPU ([`ring_options`]).
-pub fn solve_ring(ring: &crate::boundary::ring::Ring, opts: &SolveOptions) -> Result<Solution> {
-    solve_ring_with(ring, opts, crate::boundary::ring_fit::EtaRefinement::Adaptive)
-}
-
-/// [`solve_ring`] with the refinement of the contour fit in `eta` chosen.
-pub fn solve_ring_with(
-    ring: &crate::boundary::ring::Ring,
-    opts: &SolveOptions,
-    refinement: crate::boundary::ring_fit::EtaRefinement,
-) -> Result<Solution> {
-    let (h, cut) = crate::boundary::ring_fit::ring_hierarchy_with(ring, &opts.fit, refinement)?;
-    EggSolver::new(&h, ring_options(opts), Arc::new(CpuAssembler))?.finish(&cut, &h)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::boundary::{Analytic, SideCurve};
+    use crate::pipeline::{solve, Pipeline};
     use crate::solve::report::Verdict;
 
     fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
@@ -623,7 +539,7 @@ mod tests {
             inner: circle(0.4, [0.25, 0.1]),
             outer: circle(1.0, [0.0; 2]),
         };
-        let sol = solve_ring(&ring, &SolveOptions::default()).unwrap();
+        let sol = Pipeline::new(ring, SolveOptions::default()).solve().unwrap();
         let r = &sol.report;
         assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
         assert!(sol.map.knots[1].is_periodic() && !sol.map.knots[0].is_periodic());
@@ -645,7 +561,7 @@ mod tests {
         for method in [Reparam::Auto, Reparam::ArcLength] {
             let mut opts = SolveOptions::default();
             opts.fit.reparam.method = method;
-            let sol = solve_ring(&ring, &opts).unwrap();
+            let sol = Pipeline::new(ring.clone(), opts).solve().unwrap();
             let r = &sol.report;
             assert_eq!(r.reparam.used == Reparam::Constrained, method == Reparam::Auto);
             assert_eq!(r.reparam.matches.is_empty(), method == Reparam::ArcLength);

@@ -2,7 +2,7 @@
 //! rigidly by a fixed angle per time step, or follows a given list of contours), the outer
 //! contour fixed, solved frame after frame on one basis from extrapolated initial guesses.
 //!
-//! **Basis.** Frame 0 is a cold coarse-to-fine solve ([`solve_ring_with`]); its finest
+//! **Basis.** Frame 0 is a cold coarse-to-fine solve ([`Pipeline`]); its finest
 //! basis `Ξ × H` (`H` periodic) serves every frame. `H` is uniform for a sliding seam
 //! ([`EtaRefinement::Uniform`]: the parameter slides along the contour, and locally
 //! refined elements would not follow the features they were refined for), adaptive for
@@ -75,7 +75,6 @@ use serde::Serialize;
 use super::newton::{NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
 use super::options::SolveOptions;
 use super::report::Solution;
-use super::solver::{ring_options, solve_ring_with};
 use crate::boundary::normalise::Similarity;
 use crate::boundary::reparam::Reparam;
 use crate::boundary::ring::{ray_parameter, ClosedContour, Ring};
@@ -84,6 +83,7 @@ use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::EggMethod;
 use crate::methods::Method;
+use crate::pipeline::{ring_options, Pipeline};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::periodic::PeriodicTranslate;
@@ -254,7 +254,7 @@ pub fn frame0_options(opts: &SolveOptions) -> SolveOptions {
 }
 
 impl Sweep {
-    /// Solve frame 0 cold ([`solve_ring_with`]) and set up the sweep on its basis. The frames
+    /// Solve frame 0 cold ([`Pipeline`]) and set up the sweep on its basis. The frames
     /// are solved in the coordinates the cold solve ran in (`report.normalisation`, the
     /// identity for a well-placed ring) and mapped back; the certificate is that of the
     /// map written.
@@ -270,7 +270,7 @@ impl Sweep {
             Seam::Material => EtaRefinement::Adaptive,
             Seam::Slide | Seam::Ray => EtaRefinement::Uniform,
         };
-        let sol = solve_ring_with(ring, &frame0_options(opts), refinement)?;
+        let sol = Pipeline::new(ring.clone(), frame0_options(opts)).eta_refinement(refinement).solve()?;
         let opts = ring_options(opts);
         // the sweep runs in the coordinates the cold solve ran in (normalised rings)
         let sim = sol.report.normalisation.unwrap_or(Similarity::IDENTITY);

@@ -1,0 +1,274 @@
+//! The one observable entry of a solve: an [`Input`], the grouped [`SolveOptions`] and a
+//! quadrature back end, run with an observer that sees every stage and may stop it.
+//!
+//! ```text
+//! fit (§5, §7) → hierarchy (§5.4) → coarse-to-fine solve (§6.3) → defect correction (§8.2)
+//!   → kinks kept (§9) → improvement (§4.1) → certificate (§8.1) → report
+//!   → with `--basis auto`: solved again on the fitted basis when the input basis' map is
+//!     not certified
+//! ```
+//!
+//! ```no_run
+//! use winslow::pipeline::{Pipeline, Stage};
+//! # fn main() -> winslow::Result<()> {
+//! let boundary = winslow::io::read_boundary("tests/data/wavy_lid.json".as_ref(), &Default::default())?;
+//! let solution = Pipeline::new(boundary, Default::default()).run(&mut |stage: &Stage<'_>| {
+//!     if let Stage::Solver(e) = stage {
+//!         eprintln!("{e:?}");
+//!     }
+//!     true // go on; `false` stops the solve (`Error::Cancelled`)
+//! })?;
+//! println!("{}", solution.report.verdict.name());
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The CLI's `solve`, the viewer's solve job, `compare` and the core's [`solve`] all run
+//! this; they only render its stages.
+
+use std::sync::Arc;
+
+use crate::boundary::fit::FitOptions;
+use crate::boundary::hierarchy::{build_hierarchy, Hierarchy};
+use crate::boundary::ring::Ring;
+use crate::boundary::ring_fit::{ring_hierarchy_with, EtaRefinement};
+use crate::boundary::{BasisChoice, Boundary};
+use crate::discrete::topology::Topology;
+use crate::error::{Error, Result};
+use crate::methods::egg::{CpuAssembler, EggAssembler};
+use crate::methods::Method;
+use crate::solve::options::SolveOptions;
+use crate::solve::report::{Solution, Verdict};
+use crate::solve::solver::{EggSolver, Event};
+
+/// What the pipeline solves.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Input {
+    /// A four-sided boundary: the map of the unit square onto the domain it bounds.
+    Boundary(Boundary),
+    /// A ring (paper §11.1): an O-grid between two closed contours, `eta` periodic.
+    Ring(Ring),
+}
+
+impl Input {
+    /// Name of the geometry.
+    pub fn name(&self) -> &str {
+        match self {
+            Input::Boundary(b) => &b.name,
+            Input::Ring(r) => &r.name,
+        }
+    }
+}
+
+impl From<Boundary> for Input {
+    fn from(b: Boundary) -> Self {
+        Input::Boundary(b)
+    }
+}
+
+impl From<Ring> for Input {
+    fn from(r: Ring) -> Self {
+        Input::Ring(r)
+    }
+}
+
+/// A stage of the pipeline, as the observer sees it.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Stage<'a> {
+    /// The input was fitted: the hierarchy of nested bases (§5.4) that the solve walks,
+    /// and the four-sided boundary it solves (a ring's is cut at its seam, `eta = 0`).
+    Fitted {
+        /// The input.
+        input: &'a Input,
+        /// The four-sided boundary solved, in the input's coordinates.
+        boundary: &'a Boundary,
+        /// The hierarchy (in normalised coordinates, see [`Hierarchy::similarity`]).
+        hierarchy: &'a Hierarchy,
+        /// The method solved on every level.
+        method: &'a dyn Method,
+    },
+    /// An event of the coarse-to-fine solver: a level starts, an iterate, a level ends.
+    Solver(&'a Event),
+    /// With [`BasisChoice::Auto`]: the map on the input basis is not certified, the input
+    /// is solved again on the fitted basis; the stages of that solve follow.
+    Fallback {
+        /// Why.
+        reason: &'a str,
+    },
+}
+
+/// The observer of a run: sees every [`Stage`]; returns `false` to stop the solve.
+pub type Observer<'o> = dyn FnMut(&Stage<'_>) -> bool + 'o;
+
+/// The pipeline of one input (see the module documentation).
+pub struct Pipeline {
+    input: Input,
+    opts: SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    method: Option<Arc<dyn Method>>,
+    eta_refinement: EtaRefinement,
+}
+
+impl std::fmt::Debug for Pipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pipeline")
+            .field("input", &self.input.name())
+            .field("backend", &self.assembler.name())
+            .field("method", &self.method.as_ref().map(|m| m.name()))
+            .finish_non_exhaustive()
+    }
+}
+
+impl Pipeline {
+    /// The pipeline of `input` with `opts`, on the CPU back end.
+    pub fn new(input: impl Into<Input>, opts: SolveOptions) -> Self {
+        Self {
+            input: input.into(),
+            opts,
+            assembler: Arc::new(CpuAssembler),
+            method: None,
+            eta_refinement: EtaRefinement::Adaptive,
+        }
+    }
+
+    /// Assemble on `assembler` (the GPU crate's, or the CPU's, the default).
+    pub fn backend(mut self, assembler: Arc<dyn EggAssembler>) -> Self {
+        self.assembler = assembler;
+        self
+    }
+
+    /// Solve `method` on every level instead of EGG (eq. 8) with the options' operator.
+    pub fn method(mut self, method: Arc<dyn Method>) -> Self {
+        self.method = Some(method);
+        self
+    }
+
+    /// A ring's contour fit refines `eta` as `refinement` says (the sliding grid's frames
+    /// keep frame 0's uniform knots).
+    pub fn eta_refinement(mut self, refinement: EtaRefinement) -> Self {
+        self.eta_refinement = refinement;
+        self
+    }
+
+    /// Solve without watching.
+    pub fn solve(self) -> Result<Solution> {
+        self.run(&mut |_| true)
+    }
+
+    /// Solve, every stage to `observer`; [`Error::Cancelled`] when it returned `false`.
+    pub fn run(self, observer: &mut Observer<'_>) -> Result<Solution> {
+        self.run_keeping_hierarchy(observer).map(|(sol, _)| sol)
+    }
+
+    /// [`Pipeline::run`], with the hierarchy the solution was solved on (the fitted one
+    /// after a fallback): the comparison of methods solves the others on it.
+    pub(crate) fn run_keeping_hierarchy(self, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+        let first = self.attempt(&self.opts, observer)?;
+        let Some((fitted, why)) = auto_fallback(&first.0, &self.opts.fit) else { return Ok(first) };
+        if !observer(&Stage::Fallback { reason: &why }) {
+            return Err(Error::Cancelled);
+        }
+        let opts = SolveOptions { fit: fitted, ..self.opts.clone() };
+        let (again, h) = self.attempt(&opts, observer)?;
+        Ok((auto_choice(first.0, again, why), h))
+    }
+
+    /// One fit and coarse-to-fine solve with `opts`.
+    fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+        let (boundary, hierarchy, opts) = match &self.input {
+            Input::Boundary(b) => (b.clone(), build_hierarchy(b, &opts.fit)?, opts.clone()),
+            Input::Ring(r) => {
+                let (h, cut) = ring_hierarchy_with(r, &opts.fit, self.eta_refinement)?;
+                (cut, h, ring_options(opts))
+            }
+        };
+        let hierarchy = Arc::new(hierarchy);
+        let mut solver = match &self.method {
+            Some(m) => EggSolver::with_method(&boundary, hierarchy.clone(), opts, self.assembler.clone(), m.clone())?,
+            None => EggSolver::new(&boundary, hierarchy.clone(), opts, self.assembler.clone())?,
+        };
+        let fitted =
+            Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };
+        if !observer(&fitted) {
+            return Err(Error::Cancelled);
+        }
+        for event in solver.by_ref() {
+            if !observer(&Stage::Solver(&event?)) {
+                return Err(Error::Cancelled);
+            }
+        }
+        Ok((solver.finish()?, hierarchy))
+    }
+}
+
+/// Fit `boundary`, then solve coarse to fine on the CPU ([`Pipeline::solve`]).
+pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
+    Pipeline::new(boundary.clone(), opts.clone()).solve()
+}
+
+/// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
+/// basis) again as `again` (fitted basis) for the reason `why`: `again`, with the reason
+/// in its report; but a `degenerate-corner` map on the input basis stands when the fitted
+/// one is not certified either (its boundary is the exact one). The time of both solves
+/// counts.
+fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
+    if first.report.verdict == Verdict::DegenerateCorner && again.report.verdict != Verdict::Certified {
+        let mut first = first;
+        first.report.seconds += again.report.seconds;
+        first.report.message.push_str(&format!(
+            "; solved again on the fitted basis too, where the map is {}: the input basis' map is kept",
+            again.report.verdict.name()
+        ));
+        return first;
+    }
+    again.report.basis.requested = BasisChoice::Auto;
+    again.report.basis.fallback = Some(why);
+    again.report.seconds += first.report.seconds;
+    again
+}
+
+/// With [`BasisChoice::Auto`]: when `sol` was solved on the input basis and its map is
+/// not certified (folded, undecided or not converged; `degenerate-corner` at corners of
+/// the domain is the best map such a boundary allows and is kept, but not when only
+/// zero-speed points of the input's parameterization are excused: the fitted basis
+/// reparameterizes them, see [`auto_choice`]), the fit options of the fitted basis and
+/// the reason to solve again with them. `None` when `sol` stands.
+fn auto_fallback(sol: &Solution, fit: &FitOptions) -> Option<(FitOptions, String)> {
+    let r = &sol.report;
+    if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
+        return None;
+    }
+    let zero_speed_only = r.verdict == Verdict::DegenerateCorner
+        && !r.certificate.excused_points.is_empty()
+        && r.certificate.corners.iter().all(|c| c.excused_extent.is_none());
+    if r.verdict == Verdict::Certified || (r.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
+        return None;
+    }
+    let why = if zero_speed_only {
+        format!(
+            "on the input basis ({} functions) det J = 0 where the input's parameterization has zero speed; solved \
+             again on the fitted basis, which reparameterizes the side there",
+            r.basis_functions
+        )
+    } else {
+        format!(
+            "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
+            r.basis_functions,
+            r.repairs,
+            r.verdict.name()
+        )
+    };
+    Some((FitOptions { basis: BasisChoice::Fitted, ..*fit }, why))
+}
+
+/// The options of a ring solve (§11.1) made from `opts`: `eta` periodic
+/// ([`Topology::ring`]), and no corner of the parameter square excused by the certificate
+/// (a ring has no corners).
+pub(crate) fn ring_options(opts: &SolveOptions) -> SolveOptions {
+    let mut o = opts.clone();
+    o.topology = Topology::ring();
+    o.certify.excuse_corners = false;
+    o
+}
