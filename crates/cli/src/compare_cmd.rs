@@ -33,7 +33,7 @@ pub(super) struct CompareArgs {
     /// Hessian of the quasi-conformal iteration: the Gauss-Newton matrix
     /// (Levenberg-Marquardt, the default) or the exact Hessian (Newton's method).
     #[arg(long, value_enum, default_value = "gauss-newton")]
-    qc_hessian: QcHessianArg,
+    qc_hessian: QcHessian,
     /// eps of the constraints d(c) >= eps of liao, winslow-functional and ao, relative to
     /// the mean det J.
     #[arg(long, default_value_t = ConstrainedOptions::default().eps)]
@@ -65,10 +65,10 @@ pub(super) struct CompareArgs {
     growth: f64,
     /// Operator of EGG: L of eq. (4) or L / (g11 + g22).
     #[arg(long, value_enum, default_value = "scaled")]
-    operator: OperatorArg,
+    operator: Operator,
     /// Linear solver: sparse LU, GMRES, or auto (LU up to 64 unknowns, GMRES above).
     #[arg(long, value_enum, default_value = "auto")]
-    linear: LinearArg,
+    linear: LinearMethod,
     /// Rounds of defect correction per method (default 0: every method on the same
     /// basis; with rounds, each method may refine around its own folds).
     #[arg(long, default_value_t = 0)]
@@ -91,12 +91,6 @@ pub(super) struct CompareArgs {
     verbose: bool,
 }
 
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum QcHessianArg {
-    GaussNewton,
-    Exact,
-}
-
 impl CompareArgs {
     fn options(&self) -> Result<(Vec<MethodChoice>, CompareOptions)> {
         let methods = self.methods.iter().map(|m| MethodChoice::parse(m)).collect::<winslow::Result<Vec<_>>>()?;
@@ -107,7 +101,7 @@ impl CompareArgs {
             min_elements: self.min_elements,
             refine: self.refine,
             growth: self.growth,
-            iteration: IterationArg::Newton,
+            iteration: NonlinearMethod::Newton,
             method: MethodArg::Egg,
             operator: self.operator,
             linear: self.linear,
@@ -130,10 +124,7 @@ impl CompareArgs {
             }
         }
         (opts.lambda1, opts.lambda2) = (self.lambda1, self.lambda2);
-        opts.qc_hessian = match self.qc_hessian {
-            QcHessianArg::GaussNewton => QcHessian::GaussNewton,
-            QcHessianArg::Exact => QcHessian::Exact,
-        };
+        opts.qc_hessian = self.qc_hessian;
         if !(self.eps > 0.0 && self.eps < 1.0) {
             bail!("--eps must be in (0, 1) (a fraction of the mean det J), got {}", self.eps);
         }

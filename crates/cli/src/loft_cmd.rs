@@ -11,14 +11,6 @@ use winslow::spline::loft::Interpolation;
 use winslow::spline::volume::Volume;
 use winslow::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeVerdict};
 
-#[derive(ValueEnum, Debug, Clone, Copy)]
-pub(super) enum InterpolationArg {
-    /// First order (the paper's): piecewise linear in z, C0 across the slices.
-    Linear,
-    /// The C2 cubic spline through the slices (not-a-knot ends).
-    Cubic,
-}
-
 #[derive(Args, Debug)]
 pub(super) struct LoftArgs {
     /// Planar maps (JSON map documents or G+Smo XML), in the order of their heights.
@@ -37,13 +29,13 @@ pub(super) struct LoftArgs {
     /// slices (the paper's choice), so an inserted slice changes nothing beyond its two
     /// intervals; cubic is smooth (C2) but couples all slices.
     #[arg(long, value_enum, default_value = "linear")]
-    interpolation: InterpolationArg,
+    interpolation: Interpolation,
     /// Most slices inserted where the volume is not certified.
     #[arg(long, default_value_t = LoftOptions::default().max_inserted)]
     max_inserted: usize,
     /// Operator of inserted slices' EGG solves (as in `solve`).
     #[arg(long, value_enum, default_value = "scaled")]
-    operator: OperatorArg,
+    operator: Operator,
     /// Most bisections per element in the certificates.
     #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
     max_depth: usize,
@@ -111,14 +103,7 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
         }
         slices.push(map);
     }
-    let interpolation = match a.interpolation {
-        InterpolationArg::Linear => Interpolation::Linear,
-        InterpolationArg::Cubic => Interpolation::Cubic,
-    };
-    let operator = match a.operator {
-        OperatorArg::Plain => Operator::Plain,
-        OperatorArg::Scaled => Operator::Scaled,
-    };
+    let (interpolation, operator) = (a.interpolation, a.operator);
     let opts = LoftOptions {
         interpolation,
         max_inserted: a.max_inserted,

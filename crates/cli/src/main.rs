@@ -126,7 +126,7 @@ struct FitArgs {
     /// ring: arc length, with facing points of a narrow gap (closer than --reparam-gap
     /// times the diameter) matched at the same eta (arclength/none: never matched).
     #[arg(long, value_enum, default_value = "auto")]
-    reparam: ReparamArg,
+    reparam: Reparam,
     /// Narrow-gap threshold (auto) and matching distance (constrained), relative to the
     /// mean length of the two opposite sides (for a ring: the outer contour's diameter).
     #[arg(long, default_value_t = ReparamOptions::default().gap)]
@@ -137,7 +137,7 @@ struct FitArgs {
     /// How unmatched parameters are filled: cord length between matches (eq. 41-42) or a
     /// Fritsch-Carlson monotone cubic.
     #[arg(long, value_enum, default_value = "cord-length")]
-    reparam_fill: FillArg,
+    reparam_fill: Fill,
     /// Basis of the map: `auto` (the default: the input's own basis, boundary kept
     /// exactly, when its map is certified; else solved again on the fitted basis, with the
     /// reason in the report), `fitted` (dyadic C^{p-1} fits of the sides within --fit-tol,
@@ -145,7 +145,7 @@ struct FitArgs {
     /// sides' own basis whatever the verdict; falls back to `fitted` with a message for
     /// point clouds, analytic sides and C0 knots).
     #[arg(long, value_enum, default_value = "auto")]
-    basis: BasisArg,
+    basis: BasisChoice,
     /// Kinks inside the sides kept exactly (paper §9): `auto` (spline sides' C0 knots and
     /// zero-speed knots turning more than 1 degree, point clouds' corners turning 30 degrees
     /// or more), `none` (rounded by the C^{p-1} fit and reported; on the input basis a C0
@@ -165,32 +165,6 @@ fn parse_kinks(s: &str) -> std::result::Result<KinkMode, String> {
     KinkMode::parse(s).ok_or_else(|| format!("expected auto, none or an angle in (0, 180] degrees, got '{s}'"))
 }
 
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum BasisArg {
-    /// The input's own basis when the sides allow it and its map is certified, else the
-    /// fitted basis
-    Auto,
-    /// Dyadic bases fitted to the boundary within --fit-tol (§5)
-    Fitted,
-    /// The input's own basis, boundary kept exactly (§5.2), falling back to fitted only
-    /// when the sides have no usable basis
-    Input,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum ReparamArg {
-    Auto,
-    None,
-    Arclength,
-    Constrained,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum FillArg {
-    CordLength,
-    MonotoneCubic,
-}
-
 #[derive(Args, Debug)]
 struct InspectArgs {
     /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
@@ -200,12 +174,6 @@ struct InspectArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum IterationArg {
-    Newton,
-    PseudoTime,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -226,26 +194,6 @@ enum MethodArg {
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
-enum OperatorArg {
-    Plain,
-    Scaled,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum LinearArg {
-    Lu,
-    Gmres,
-    Auto,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum BackendArg {
-    Cpu,
-    Gpu,
-    Auto,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
 enum PrecisionArg {
     Auto,
     F64,
@@ -258,7 +206,7 @@ struct BackendArgs {
     /// Quadrature back end: the CPU; a GPU through wgpu (any adapter, lavapipe included;
     /// none is an error); or auto (a hardware GPU with f64 shaders, else the CPU).
     #[arg(long, value_enum, default_value = "cpu")]
-    backend: BackendArg,
+    backend: Backend,
     /// GPU precision: f64 where the adapter offers it, else f32 matrices with the
     /// residual in f64 on the CPU; or forced.
     #[arg(long, value_enum, default_value = "auto")]
@@ -268,17 +216,12 @@ struct BackendArgs {
 impl BackendArgs {
     /// Open the back end and say which one runs (stderr unless `quiet`).
     fn select(&self, quiet: bool) -> Result<Selected> {
-        let backend = match self.backend {
-            BackendArg::Cpu => Backend::Cpu,
-            BackendArg::Gpu => Backend::Gpu,
-            BackendArg::Auto => Backend::Auto,
-        };
         let precision = match self.precision {
             PrecisionArg::Auto => None,
             PrecisionArg::F64 => Some(Precision::F64),
             PrecisionArg::F32 => Some(Precision::F32),
         };
-        let sel = winslow_gpu::assembler(backend, precision).context("opening the GPU")?;
+        let sel = winslow_gpu::assembler(self.backend, precision).context("opening the GPU")?;
         if !quiet {
             eprintln!("backend: {}", sel.describe());
         }
@@ -315,7 +258,7 @@ struct SolverArgs {
     growth: f64,
     /// Nonlinear iteration (Newton falls back to pseudo time-stepping when it stalls).
     #[arg(long, value_enum, default_value = "newton")]
-    iteration: IterationArg,
+    iteration: NonlinearMethod,
     /// Method: egg (eq. 8) from the boundary; weak (eq. 14) or winslow (eq. 16) from a
     /// certified map: the EGG map of the boundary (same as `--improve`), or the map of
     /// `--start`. (`--method newton|pseudo-time` is the old spelling of `--iteration`.)
@@ -324,10 +267,10 @@ struct SolverArgs {
     /// Operator: L of eq. (4), or L / (g11 + g22) as in G+Smo (converges better on the
     /// shared geometries, see BENCHMARKS.md).
     #[arg(long, value_enum, default_value = "scaled")]
-    operator: OperatorArg,
+    operator: Operator,
     /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), or auto (LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations).
     #[arg(long, value_enum, default_value = "auto")]
-    linear: LinearArg,
+    linear: LinearMethod,
     /// Rounds of defect correction: while the certificate says folded or undecided,
     /// refine around the offending elements and solve again, at most this often.
     #[arg(long, default_value_t = SolveOptions::default().repair)]
@@ -343,21 +286,13 @@ struct SolverArgs {
     /// certified map: minimize the Winslow functional (eq. 16) or solve the weak form
     /// (eq. 14); certify again and keep the improved map only when it is certified.
     #[arg(long, value_enum)]
-    improve: Option<ImproveArg>,
+    improve: Option<Improve>,
     /// With kinks kept (--kinks): which control points the final Winslow minimisation of
     /// the C0 route moves: `all`, a number of knot spans around each kink (paper §9, last
     /// paragraph; the rest keep the elasticity start), or `auto` (all up to 50 000
     /// unknowns, 3 spans above).
     #[arg(long, default_value = "auto", value_parser = parse_kinks_local)]
     kinks_local: KinksLocal,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum ImproveArg {
-    /// Minimize the Winslow functional (eq. 16).
-    Winslow,
-    /// Solve the weak form (eq. 14) from the certified map.
-    Weak,
 }
 
 impl SolverArgs {
@@ -382,32 +317,21 @@ impl SolverArgs {
         }
         let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
         o.nonlinear.tol = self.tol;
-        o.nonlinear.method = match (self.method, self.iteration) {
-            (MethodArg::Newton, _) => NonlinearMethod::Newton,
-            (MethodArg::PseudoTime, _) => NonlinearMethod::PseudoTime,
-            (_, IterationArg::Newton) => NonlinearMethod::Newton,
-            (_, IterationArg::PseudoTime) => NonlinearMethod::PseudoTime,
+        o.nonlinear.method = match self.method {
+            MethodArg::Newton => NonlinearMethod::Newton,
+            MethodArg::PseudoTime => NonlinearMethod::PseudoTime,
+            MethodArg::Egg | MethodArg::Weak | MethodArg::Winslow => self.iteration,
         };
-        o.nonlinear.linear = match self.linear {
-            LinearArg::Lu => LinearMethod::Lu,
-            LinearArg::Gmres => LinearMethod::Gmres,
-            LinearArg::Auto => LinearMethod::Auto,
-        };
+        o.nonlinear.linear = self.linear;
         o.repair = if self.no_repair { 0 } else { self.repair };
         o.repair_freeze = self.repair_freeze;
-        o.operator = match self.operator {
-            OperatorArg::Plain => Operator::Plain,
-            OperatorArg::Scaled => Operator::Scaled,
-        };
+        o.operator = self.operator;
         o.max_levels = self.levels;
         o.min_elements = self.min_elements.max(1);
         o.refine = self.refine;
         o.growth = self.growth.max(1.0);
         o.kinks_local = self.kinks_local;
-        o.improve = self.improve.map(|i| match i {
-            ImproveArg::Winslow => Improve::Winslow,
-            ImproveArg::Weak => Improve::WeakForm,
-        });
+        o.improve = self.improve;
         // a method that needs a bijective start runs after the EGG solve
         if let Some(m) = self.improvement_method() {
             if o.improve.is_some_and(|i| i != m) {
@@ -421,26 +345,13 @@ impl SolverArgs {
 
 fn fit_options(f: &FitArgs) -> FitOptions {
     let reparam = ReparamOptions {
-        method: match f.reparam {
-            ReparamArg::Auto => Reparam::Auto,
-            ReparamArg::None => Reparam::None,
-            ReparamArg::Arclength => Reparam::ArcLength,
-            ReparamArg::Constrained => Reparam::Constrained,
-        },
+        method: f.reparam,
         gap: f.reparam_gap,
         separation: f.reparam_separation,
-        fill: match f.reparam_fill {
-            FillArg::CordLength => Fill::CordLength,
-            FillArg::MonotoneCubic => Fill::MonotoneCubic,
-        },
+        fill: f.reparam_fill,
         ..Default::default()
     };
-    let basis = match f.basis {
-        BasisArg::Auto => BasisChoice::Auto,
-        BasisArg::Fitted => BasisChoice::Fitted,
-        BasisArg::Input => BasisChoice::Input,
-    };
-    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis, kinks: f.kinks, ..Default::default() }
+    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis: f.basis, kinks: f.kinks, ..Default::default() }
 }
 
 #[derive(Args, Debug)]

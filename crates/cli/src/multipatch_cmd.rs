@@ -5,6 +5,7 @@
 use super::*;
 use winslow::io::picture::render_layout;
 use winslow::multipatch::output::{solution_to_gismo_xml, solution_to_json, write_patch_maps, write_vtm};
+use winslow::multipatch::split::SplitPath;
 use winslow::multipatch::{solve_multipatch, Functional, Interfaces, Layout, MultipatchOptions, MultipatchSolution};
 
 /// The options of `winslow solve` that only a multipatch layout reads.
@@ -14,7 +15,7 @@ pub(super) struct MultipatchArgs {
     /// four sides as Dirichlet data, conforming bases), or, after that, free the interior
     /// control points of the interfaces and solve one problem over all patches.
     #[arg(long, value_enum, default_value = "fixed")]
-    interfaces: InterfacesArg,
+    interfaces: Interfaces,
     /// The problem over all patches with `--interfaces free`: the Winslow functional
     /// (eq. 16) or the weak form (eq. 14).
     #[arg(long, value_enum, default_value = "winslow")]
@@ -26,12 +27,6 @@ pub(super) struct MultipatchArgs {
     /// .vtu per patch (in a directory named after the file).
     #[arg(long, value_name = "FILE.vtm")]
     vtm: Option<PathBuf>,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum InterfacesArg {
-    Fixed,
-    Free,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy)]
@@ -49,10 +44,7 @@ fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
         );
     }
     Ok(MultipatchOptions {
-        interfaces: match a.multipatch.interfaces {
-            InterfacesArg::Fixed => Interfaces::Fixed,
-            InterfacesArg::Free => Interfaces::Free,
-        },
+        interfaces: a.multipatch.interfaces,
         functional: match a.multipatch.functional {
             FunctionalArg::Winslow => Functional::Winslow,
             FunctionalArg::Weak => Functional::WeakForm,
@@ -178,7 +170,7 @@ pub(super) struct SplitArgs {
     /// The curve in the parameter square: the straight segment, or the shortest path in
     /// the metric of the map (through narrow gaps).
     #[arg(long, value_enum, default_value = "straight")]
-    path: PathArg,
+    path: SplitPath,
     /// Degree of the splitting curve.
     #[arg(long, default_value_t = 3)]
     degree: usize,
@@ -195,12 +187,6 @@ pub(super) struct SplitArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum PathArg {
-    Straight,
-    Shortest,
 }
 
 /// `winslow join`: two maps sharing a whole side as one map (paper §11.2, Fig. 27-28).
@@ -256,14 +242,11 @@ fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::Side
 
 pub(super) fn split(a: SplitArgs) -> Result<i32> {
     use winslow::multipatch::json::layout_to_json;
-    use winslow::multipatch::split::{split_map, SplitOptions, SplitPath};
+    use winslow::multipatch::split::{split_map, SplitOptions};
     let (name, map) = read_map(&a.map)?;
     let cert = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
     let (from, to) = (side_point(&map, &a.from)?, side_point(&map, &a.to)?);
-    let path = match a.path {
-        PathArg::Straight => SplitPath::Straight,
-        PathArg::Shortest => SplitPath::Shortest,
-    };
+    let path = a.path;
     let opts = SplitOptions { path, degree: a.degree, tol: a.tol, ..Default::default() };
     let s = split_map(&name, &map, &cert, from, to, &opts).context("splitting the map")?;
     output::ensure_parent(&a.output)?;

@@ -20,7 +20,7 @@ pub(super) struct OptimiseArgs {
     /// The functional minimised subject to d(c) >= eps: Liao (int g11^2 + g22^2 + 2 g12^2),
     /// Winslow (eq. 16) or area orthogonality (int g11^2 + g22^2).
     #[arg(long, value_enum, default_value = "liao")]
-    functional: FunctionalArg,
+    functional: Functional,
     /// Start: the EGG map (G), the max-z point of eq. (49) reached from the Coons patch
     /// (Z), or both (one row of the paper's Table 3; -o then writes the result from G).
     #[arg(long, value_enum, default_value = "egg")]
@@ -59,13 +59,6 @@ pub(super) struct OptimiseArgs {
     /// constraint count small).
     #[command(flatten)]
     solver: SolverArgs,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum FunctionalArg {
-    Liao,
-    Winslow,
-    Ao,
 }
 
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,11 +119,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         certify: opts.certify,
         ..Default::default()
     };
-    let functional = match a.functional {
-        FunctionalArg::Liao => Functional::Liao,
-        FunctionalArg::Winslow => Functional::Winslow,
-        FunctionalArg::Ao => Functional::AreaOrthogonality,
-    };
+    let functional = a.functional;
     let starts = match a.from {
         FromArg::Egg => vec![StartFrom::Egg],
         FromArg::Maxz => vec![StartFrom::MaxZ],

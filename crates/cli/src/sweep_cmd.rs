@@ -37,8 +37,8 @@ pub(super) struct SweepArgs {
     /// the contour at the mean angular rate), `ray` (on the ray from the inner centroid
     /// through the frame-0 seam, the paper's choice) or `material` (turns with the
     /// contour: the grid twists).
-    #[arg(long, value_enum, default_value_t = SeamArg::Slide)]
-    seam: SeamArg,
+    #[arg(long, value_enum, default_value_t = Seam::Slide)]
+    seam: Seam,
     /// Highest order of the time extrapolation of the control points (0 to 5).
     #[arg(long, default_value_t = 5)]
     order: usize,
@@ -69,16 +69,6 @@ pub(super) struct SweepArgs {
     quiet: bool,
     #[command(flatten)]
     solver: SolverArgs,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum SeamArg {
-    /// The inner parameter slides by -θ/2π of a period (smooth in time).
-    Slide,
-    /// eta = 0 on the seam ray (the paper's c_r(eta)_y = 0).
-    Ray,
-    /// The frame-0 inner control points turned rigidly (the grid twists).
-    Material,
 }
 
 fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
@@ -212,11 +202,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         bail!("--times gives {} times for {} inner frames", times.len(), contours.len());
     }
     std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
-    let seam = match a.seam {
-        SeamArg::Slide => Seam::Slide,
-        SeamArg::Ray => Seam::Ray,
-        SeamArg::Material => Seam::Material,
-    };
+    let seam = a.seam;
     let so = SweepOptions { step, steps, center: a.center, max_order: a.order, seam };
     let (mut sweep, sol, f0) = Sweep::new(&ring, &opts, so).context("solving frame 0")?;
     if !a.quiet {

@@ -87,6 +87,7 @@ pub fn shader_source(f64_source: &str, precision: Precision) -> String {
 
 /// Which quadrature back end a command uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Backend {
     /// The multi-threaded CPU assembler of the core.
     #[default]

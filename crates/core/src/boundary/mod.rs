@@ -48,16 +48,28 @@ use crate::spline::surface::Side;
 
 /// The basis a map is solved in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum BasisChoice {
     /// The input basis when the sides allow it and its map is certified, else the fitted
     /// basis ([`crate::pipeline::Pipeline`] solves again): the boundary is kept exactly
     /// wherever that gives a certified map (BASIS.md table in BENCHMARKS.md).
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "The input's own basis when the sides allow it and its map is certified, else the fitted basis")
+    )]
     Auto,
     /// Dyadic `C^{p-1}` bases fitted to the boundary within a tolerance (§5).
+    #[cfg_attr(feature = "clap", value(help = "Dyadic bases fitted to the boundary within --fit-tol (§5)"))]
     Fitted,
     /// The basis of the input's spline sides, boundary kept exactly (§5.2).
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "The input's own basis, boundary kept exactly (§5.2), falling back to fitted only when the sides have no usable basis"
+        )
+    )]
     Input,
 }
 

@@ -65,6 +65,7 @@ pub struct Discretization {
 
 /// Which operator [`Discretization::egg`] discretizes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Operator {
     /// `L(x, y, .)` of eq. (4), as in eq. (8).
     #[default]

@@ -32,22 +32,31 @@ use crate::linalg::split_cholesky::{SplitCholesky, SPLIT_MIN};
 
 /// Which linear solver the nonlinear solvers use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LinearMethod {
     /// Sparse direct LU; dense ([`DenseLu`]) up to [`DENSE_LIMIT`] unknowns.
     #[default]
+    #[cfg_attr(feature = "clap", value(help = "Sparse direct LU"))]
     Lu,
     /// Restarted flexible GMRES(50), relative tolerance 1e-10, preconditioned by the problem's
     /// SPD approximation when it offers one, by ILU(0) otherwise.
+    #[cfg_attr(feature = "clap", value(help = "GMRES, preconditioned by the metric Laplacian"))]
     Gmres,
     /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
     /// does not converge within [`AUTO_MAX_KRYLOV`] iterations.
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations")
+    )]
     Auto,
     /// Sparse Cholesky `L L^T` (symmetric positive definite systems only).
+    #[cfg_attr(feature = "clap", value(skip))]
     Cholesky,
     /// Sparse Cholesky of `-A` (symmetric negative definite systems: `A = -∇²J` of a
     /// minimisation near its minimiser). Factorizing fails, with a typed error, exactly
     /// when `-A` is not positive definite: the caller then modifies `A` (a larger
     /// diagonal shift) and factorizes again.
+    #[cfg_attr(feature = "clap", value(skip))]
     NegCholesky,
     /// Conjugate gradients for symmetric positive definite systems of `c` components
     /// (`c m` unknowns in component blocks, `m` the length of the ordering given with
@@ -56,6 +65,7 @@ pub enum LinearMethod {
     /// iteration count is bounded by Korn's inequality, not by the mesh size). Falls
     /// back to [`LinearMethod::Cholesky`] when CG does not converge in [`MAX_PCG`]
     /// iterations.
+    #[cfg_attr(feature = "clap", value(skip))]
     Pcg,
 }
 

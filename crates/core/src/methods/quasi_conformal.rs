@@ -82,6 +82,7 @@ pub struct QuasiConformalMethod {
 
 /// The Hessian of `T*` presented to the nonlinear solver.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum QcHessian {
     /// The Gauss-Newton matrix `2 ∫ (∇f − ḡ)(∇f − ḡ)ᵀ` (Levenberg-Marquardt).

@@ -41,6 +41,7 @@ use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
 
 /// How the interfaces between patches are treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Interfaces {
     /// The interfaces are Dirichlet data of both patches (their curves as given).

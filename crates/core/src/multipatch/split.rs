@@ -20,6 +20,7 @@ use crate::verify::certificate::{Certificate, Verdict};
 
 /// The curve in the parameter square that is mapped to the splitting curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum SplitPath {
     /// The straight segment between the two parameter points.

@@ -28,11 +28,14 @@ use crate::verify::quality::quality;
 
 /// Which improvement runs after the solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Improve {
     /// Minimize the Winslow functional (eq. 16): [`WinslowMethod`].
+    #[cfg_attr(feature = "clap", value(help = "Minimize the Winslow functional (eq. 16)"))]
     Winslow,
     /// Solve the weak form (eq. 14) from the map: [`WeakFormMethod`].
+    #[cfg_attr(feature = "clap", value(name = "weak", help = "Solve the weak form (eq. 14) from the certified map"))]
     WeakForm,
 }
 

@@ -45,6 +45,7 @@ pub const ETA_MAX: f64 = 1e-2;
 
 /// Nonlinear iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum NonlinearMethod {
     /// Damped Newton with line search (§6.1), falling back to pseudo time on a stall.

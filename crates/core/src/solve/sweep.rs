@@ -92,6 +92,7 @@ use crate::verify::certificate::{certify, Verdict as CertVerdict};
 
 /// Where `eta = 0` sits on a turning inner contour (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Seam {
     /// The grid slides along the inner contour at the mean angular rate:

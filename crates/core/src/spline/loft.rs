@@ -33,6 +33,7 @@ use crate::spline::volume::Volume;
 
 /// How the slices are joined in `z`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Interpolation {
     /// Piecewise linear in `ζ` (the paper's first-order interpolation): the default,

@@ -45,17 +45,25 @@ use crate::spline::surface::Side;
 
 /// Which reparameterization the contour fit applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Reparam {
     /// The input's own parameterization (cord length for point clouds).
     None,
     /// Arc length: cord length for point clouds, eq. 38-39 for parametric sides.
+    #[cfg_attr(feature = "clap", value(name = "arclength"))]
     ArcLength,
     /// Constrained cord length on both pairs of opposite sides (eq. 40-42).
     Constrained,
     /// Constrained cord length on every pair of opposite sides that come closer than
     /// [`ReparamOptions::gap`] times their mean length; `None` elsewhere.
     #[default]
+    #[cfg_attr(
+        feature = "clap",
+        value(
+            help = "Constrained cord length on opposite sides closer than --reparam-gap times their mean length, none elsewhere"
+        )
+    )]
     Auto,
 }
 
@@ -73,6 +81,7 @@ impl Reparam {
 
 /// How the unmatched abscissae of the second side are filled (§7.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Fill {
     /// Cord length between consecutive matches (eq. 41-42).

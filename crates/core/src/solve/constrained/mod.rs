@@ -51,6 +51,7 @@ use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict};
 
 /// The quality functional minimised subject to `d(c) >= ε`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Functional {
     /// `∫ g11² + g22² + 2 g12²` (eq. 3).
@@ -58,6 +59,7 @@ pub enum Functional {
     /// `∫ (g11 + g22) / det J` (eq. 16).
     Winslow,
     /// `∫ g11² + g22²` (eq. 3).
+    #[cfg_attr(feature = "clap", value(name = "ao"))]
     AreaOrthogonality,
 }
 
