@@ -2,8 +2,6 @@
 //! plain statements about boundaries that forbid a positive det J, and convergence under
 //! refinement.
 
-use std::path::Path;
-
 use winslow::io::{read_boundary, ReadOptions};
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::{Solution, Verdict};
@@ -11,7 +9,7 @@ use winslow::solve::solver::solve;
 use winslow::verify::quality::sample_det_j;
 
 fn run(file: &str, opts: &SolveOptions) -> Solution {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
+    let path = winslow::testutil::data(file);
     let b = read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"));
     solve(&b, opts).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
@@ -246,7 +244,7 @@ fn input_basis_keeps_the_boundary_exactly() {
     use winslow::{Side, SideCurve};
     let mut opts = SolveOptions::default();
     opts.fit.basis = BasisChoice::Input;
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/duck.json");
+    let path = winslow::testutil::data("gismo/duck.json");
     let b = read_boundary(&path, &ReadOptions::default()).unwrap();
     let sol = solve(&b, &opts).unwrap();
     let r = &sol.report;
@@ -268,7 +266,7 @@ fn input_basis_keeps_the_boundary_exactly() {
     }
     // a C0 knot inside a side is not rounded silently: kept by the C0 route of §9 (the
     // default, tests/kinks.rs), or, with kinks not kept, the fitted basis with the reason
-    let rotor = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/rotor_sector.json");
+    let rotor = winslow::testutil::data("gismo/rotor_sector.json");
     let b = read_boundary(&rotor, &ReadOptions::default()).unwrap();
     let h = winslow::build_hierarchy(&b, &opts.fit).unwrap();
     assert_eq!(h.basis.used, BasisChoice::Input);

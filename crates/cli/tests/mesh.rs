@@ -1,15 +1,8 @@
 //! `winslow mesh` and `winslow solve --mesh` end to end.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_winslow"))
-}
-
-fn data() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data")
-}
+use common::{bin, data};
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = bin().args(args).output().unwrap();
@@ -18,7 +11,8 @@ fn run(args: &[&str]) -> (bool, String, String) {
 
 #[test]
 fn solve_then_mesh_in_every_format() {
-    let dir = std::env::temp_dir().join(format!("winslow-cli-mesh-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path().join("cli-mesh");
     let d = |f: &str| dir.join(f).to_string_lossy().into_owned();
     let lid = data().join("wavy_lid.json").to_string_lossy().into_owned();
     // solve and mesh in one command: boundary layers at the south side
@@ -90,5 +84,4 @@ fn solve_then_mesh_in_every_format() {
     let (ok, _, err) = run(&["mesh", &d("lid.json"), "-o", &d("x.stl"), "--structured", "5x5"]);
     assert!(!ok && err.contains("unknown mesh format"), "{err}");
     assert!(!dir.join("x.msh").exists());
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -73,6 +73,7 @@ pub mod methods;
 pub mod multipatch;
 pub mod solve;
 pub mod spline;
+#[cfg(any(test, feature = "testutil"))]
 #[doc(hidden)]
 pub mod testutil;
 pub mod verify;
