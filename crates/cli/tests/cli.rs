@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{bin, data};
+use common::{bin, data, read_json, stdout_json};
 
 fn files(dir: &Path, ext: &str) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
@@ -25,22 +25,17 @@ fn inspect_every_shared_geometry() {
     all.extend(files(&data().join("gismo/xml"), "xml"));
     assert!(all.len() >= 32, "{} files", all.len());
     for f in all {
-        let out = bin().arg("inspect").arg(&f).output().unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        assert!(out.status.success(), "{}: {text}{}", f.display(), String::from_utf8_lossy(&out.stderr));
-        for needle in [
-            "south",
-            "east",
-            "north",
-            "west",
-            "knots",
-            "corner",
-            "orientation CounterClockwise",
-            "contour fit: tolerance",
-            "no problems found",
-        ] {
-            assert!(text.contains(needle), "{}: missing {needle:?} in\n{text}", f.display());
-        }
+        let out = bin().args(["inspect", "--json"]).arg(&f).output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}: {}", f.display(), String::from_utf8_lossy(&out.stderr));
+        let v = stdout_json(&out);
+        let sides: Vec<&str> = v["sides"].as_array().unwrap().iter().map(|s| s["side"].as_str().unwrap()).collect();
+        assert_eq!(sides, ["south", "east", "north", "west"], "{}", f.display());
+        assert_eq!(v["corner_angles"].as_array().map(Vec::len), Some(4), "{}: {v}", f.display());
+        assert_eq!(v["orientation"], "CounterClockwise", "{}", f.display());
+        // the contour fit ran on every side, and found no problem
+        assert!(v["fit_tolerance"].as_f64().unwrap() > 0.0, "{}: {v}", f.display());
+        assert_eq!(v["fit"].as_array().map(Vec::len), Some(4), "{}: {v}", f.display());
+        assert_eq!(v["problems"], serde_json::json!([]), "{}", f.display());
     }
 }
 
@@ -668,12 +663,20 @@ fn corpus_writes_and_solves_the_hard_families() {
         .arg(&dir)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("| sharp-corner | 2 | 2 |") && stdout.contains("| sparse-cloud | 2 | 2 |"), "{stdout}");
-    assert!(stdout.contains("certified 4 of 4"), "{stdout}");
+    // exit 0: every domain certified (1 when any is not)
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     let written = files(&dir, "json");
     assert_eq!(written.len(), 4, "{written:?}");
+    for family in ["sharp-corner", "sparse-cloud"] {
+        let n = written.iter().filter(|f| f.file_name().unwrap().to_string_lossy().starts_with(family)).count();
+        assert_eq!(n, 2, "{family}: {written:?}");
+    }
     for f in &written {
         let o = bin().arg("inspect").arg(f).output().unwrap();
         assert!(o.status.success(), "{}: {}", f.display(), String::from_utf8_lossy(&o.stderr));
@@ -773,8 +776,11 @@ fn kinks_are_kept_reported_and_marked() {
     let out = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "none"]).output().unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success() && text.contains("rounded") && !text.contains("C0 route"), "{text}");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = &read_json(&map)["report"];
+    let kinks = report["kinks"].as_array().unwrap();
+    assert!(kinks.len() == 12 && kinks.iter().all(|k| k["kept"] == false), "{}", report["kinks"]);
+    assert!(report["c0_route"].is_null(), "{}", report["c0_route"]);
     let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "200"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("angle in (0, 180]"));

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use common::{bin, data};
+use common::{bin, data, stdout_json};
 
 fn annulus() -> PathBuf {
     data().join("quarter_annulus.json")
@@ -15,19 +15,28 @@ fn annulus() -> PathBuf {
 fn compare_prints_the_table_and_writes_pictures() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().join("compare");
-    let out = bin().arg("compare").arg(annulus()).arg("--png-dir").arg(&dir).arg("-q").output().unwrap();
+    // the human table: its columns and one row per method
+    let out = bin().arg("compare").arg(annulus()).arg("-q").output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     for col in ["method", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"] {
         assert!(text.contains(col), "missing column {col:?} in\n{text}");
     }
-    let rows: Vec<&str> = text.lines().filter(|l| ["egg ", "vhm ", "qc "].iter().any(|m| l.starts_with(m))).collect();
-    assert_eq!(rows.len(), 3, "{text}");
-    for r in &rows {
-        assert!(r.contains("certified") && r.contains(" yes "), "{r}");
+    let rows = text.lines().filter(|l| ["egg ", "vhm ", "qc "].iter().any(|m| l.starts_with(m))).count();
+    assert_eq!(rows, 3, "{text}");
+    // the same run as JSON, with the pictures: every method converged and certified
+    let out = bin().arg("compare").arg(annulus()).arg("--png-dir").arg(&dir).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = stdout_json(&out);
+    let rows = v["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(names, ["egg", "vhm", "qc"]);
+    for r in rows {
+        assert_eq!(r["measures"]["verdict"], "certified", "{r}");
+        assert_eq!(r["converged"], true, "{r}");
     }
     // EGG is the reference of Q(x)/Q(x_G)
-    assert!(rows[0].contains("1.000"), "{}", rows[0]);
+    assert_eq!(rows[0]["q_ratio"].as_f64(), Some(1.0), "{}", rows[0]);
     for m in ["egg", "vhm", "qc"] {
         let png = dir.join(format!("quarter_annulus-{m}.png"));
         let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
