@@ -653,7 +653,7 @@ fn sweep_follows_inner_contours_given_as_files() {
 }
 
 /// `winslow corpus` writes the seeded hard domains, which read back as boundaries, and
-/// with `--solve` prints the per-family table and exits 0 only when all are certified.
+/// with `--solve` solves them and exits 0 only when all are certified.
 #[test]
 fn corpus_writes_and_solves_the_hard_families() {
     let scratch = tempfile::tempdir().unwrap();
