@@ -2,16 +2,12 @@
 //! geometries (copies under `tests/data/`).
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use winslow::boundary::cord_length::cord_length_params;
 use winslow::boundary::fit::project_side;
+use winslow::testutil::data_dir;
 use winslow::{build_hierarchy, Analytic, Boundary, Curve, FitOptions, Hierarchy, KnotVector, Point, Side, SideCurve};
-
-fn data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
-}
 
 fn point(v: &Value) -> Point {
     let a = v.as_array().expect("point is an array");

@@ -4,8 +4,6 @@
 //! input's own coordinates; sizes whose `det J` leaves `f64`'s range get a typed error,
 //! not a wrong diagnosis.
 
-use std::path::Path;
-
 use winslow::boundary::validate::validate;
 use winslow::boundary::{Boundary, SideCurve};
 use winslow::io::{read_boundary, ReadOptions};
@@ -15,7 +13,7 @@ use winslow::solve::report::Solution;
 use winslow::{Error, Point};
 
 fn load(file: &str) -> Boundary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
+    let path = winslow::testutil::data(file);
     read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 

@@ -1,7 +1,7 @@
 //! Input/output and validation of the shared geometries (copied to `tests/data/`) and of
 //! malformed inputs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde_json::{json, Value};
 use winslow::boundary::validate::{inspect, Orientation};
@@ -10,33 +10,14 @@ use winslow::io::{
     boundary_to_contour_json, boundary_to_json, checked_boundary, map_to_json, parse_document, parse_gismo_xml,
     parse_json, write_json, MAX_FILE_BYTES,
 };
-use winslow::testutil::Lcg;
+use winslow::testutil::{data, data_files, Lcg};
 use winslow::{read_boundary, read_document, validate, Boundary, Document, Error, Point, ReadOptions, Side, SideCurve};
 
-fn data(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(rel)
-}
-
-fn files_in(dir: &str, ext: &str) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(data(dir))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == ext))
-        .collect();
-    v.sort();
-    v
-}
-
 fn all_shared_files() -> Vec<PathBuf> {
-    let mut v = files_in("", "json");
-    v.extend(files_in("gismo", "json"));
-    v.extend(files_in("gismo/xml", "xml"));
+    let mut v = data_files("", "json");
+    v.extend(data_files("gismo", "json"));
+    v.extend(data_files("gismo/xml", "xml"));
     v
-}
-
-/// A unique scratch path in the system temp directory.
-fn scratch(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("winslow-io-test-{}-{name}", std::process::id()))
 }
 
 #[test]
@@ -109,7 +90,7 @@ fn sides_agree(a: &Boundary, b: &Boundary, what: &str) {
 
 #[test]
 fn gismo_xml_equals_json() {
-    let xmls = files_in("gismo/xml", "xml");
+    let xmls = data_files("gismo/xml", "xml");
     assert_eq!(xmls.len(), 13);
     for x in xmls {
         let stem = x.file_stem().unwrap().to_string_lossy().into_owned();
@@ -126,7 +107,7 @@ fn gismo_xml_equals_json() {
 fn gismo_orientation_field_matches_the_assignment() {
     // The JSON files say whether xi and eta were swapped for counter-clockwise order; the
     // XML reader must reach the same conclusion (it does for male_casing_ring by transposing).
-    for j in files_in("gismo", "json") {
+    for j in data_files("gismo", "json") {
         let v: Value = serde_json::from_str(&std::fs::read_to_string(&j).unwrap()).unwrap();
         let transposed = v["orientation"]["transposed_for_ccw"].as_bool().unwrap();
         let stem = j.file_stem().unwrap().to_string_lossy().into_owned();
@@ -164,10 +145,10 @@ fn map_round_trip_is_bit_exact() {
         let text2 = serde_json::to_string_pretty(&map_to_json(&name2, &map2, Some(extra))).unwrap();
         assert_eq!(text, text2, "{stem}");
         // The map document is also accepted as a boundary.
-        let path = scratch(&format!("{stem}-map.json"));
+        let scratch = tempfile::tempdir().unwrap();
+        let path = scratch.path().join(format!("{stem}-map.json"));
         write_json(&path, &v).unwrap();
         let b = read_boundary(&path, &ReadOptions::default()).unwrap();
-        std::fs::remove_file(&path).unwrap();
         for s in Side::ALL {
             let SideCurve::Spline(c) = b.side(s) else { panic!() };
             let m = map.boundary(s);
@@ -249,10 +230,10 @@ fn contour_document_round_trip() {
         assert_eq!(p, r, "{s}");
     }
     // Same polygon without the repeated point, through a file.
-    let path = scratch("star-contour.json");
+    let scratch = tempfile::tempdir().unwrap();
+    let path = scratch.path().join("star-contour.json");
     write_json(&path, &json!({"name": "star", "contour": {"points": &pts[..64], "corners": corners}})).unwrap();
     let b4 = read_boundary(&path, &ReadOptions::default()).unwrap();
-    std::fs::remove_file(&path).unwrap();
     for s in Side::ALL {
         let (SideCurve::Points(p), SideCurve::Points(q)) = (b.side(s), b4.side(s)) else { panic!() };
         assert_eq!(p, q, "{s}");
@@ -265,13 +246,13 @@ fn clockwise_contour_is_rejected_or_reoriented() {
     pts.reverse();
     // corners in the order of the (clockwise) polygon
     let doc = json!({"name": "cw", "contour": {"points": pts, "corners": [0, 10, 20, 30]}});
-    let path = scratch("cw.json");
+    let scratch = tempfile::tempdir().unwrap();
+    let path = scratch.path().join("cw.json");
     write_json(&path, &doc).unwrap();
     let e = read_boundary(&path, &ReadOptions::default()).unwrap_err();
     assert!(matches!(e, Error::Clockwise { area } if area < 0.0), "{e}");
     assert!(e.to_string().contains("reorient"));
     let b = read_boundary(&path, &ReadOptions { reorient: true }).unwrap();
-    std::fs::remove_file(&path).unwrap();
     let r = validate(&b).unwrap();
     assert_eq!(r.orientation, Orientation::CounterClockwise);
     assert!(r.signed_area > 0.0);
@@ -526,12 +507,12 @@ fn absurd_sizes() {
     let e = winslow::io::split_contour(&pts, [0, 1, 2, 3]).unwrap_err();
     assert!(matches!(e, Error::TooLarge { .. }), "{e}");
     // a file larger than 256 MiB (sparse, so it costs no disk space)
-    let path = scratch("huge.json");
+    let scratch = tempfile::tempdir().unwrap();
+    let path = scratch.path().join("huge.json");
     let f = std::fs::File::create(&path).unwrap();
     f.set_len(MAX_FILE_BYTES + 1).unwrap();
     drop(f);
     let e = read_document(&path).unwrap_err();
-    std::fs::remove_file(&path).unwrap();
     assert!(matches!(e, Error::TooLarge { .. }), "{e}");
 }
 
@@ -571,10 +552,10 @@ fn truncated_and_mutated_inputs_never_panic() {
 fn unnamed_documents_take_the_file_stem() {
     let mut d = square_doc();
     d.as_object_mut().unwrap().remove("name");
-    let path = scratch("stemmed.json");
+    let scratch = tempfile::tempdir().unwrap();
+    let path = scratch.path().join("stemmed.json");
     write_json(&path, &d).unwrap();
     let b = read_boundary(&path, &ReadOptions::default()).unwrap();
-    std::fs::remove_file(&path).unwrap();
     assert!(b.name.ends_with("stemmed"), "{}", b.name);
 }
 

@@ -4,8 +4,6 @@
 //! and the fitted basis: the map passes through every kink (deviation at rounding level),
 //! has a knot line of multiplicity `p` there, and is certified.
 
-use std::path::Path;
-
 use winslow::boundary::kinks::{KinkKind, KinkMode};
 use winslow::boundary::BasisChoice;
 use winslow::io::{read_boundary, ReadOptions};
@@ -16,7 +14,7 @@ use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdi
 use winslow::Boundary;
 
 fn boundary(file: &str) -> Boundary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
+    let path = winslow::testutil::data(file);
     read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 

@@ -2,7 +2,7 @@
 //! (`tests/data/gismo/xml/multipatch/`): reading, validation, conforming bases, solves
 //! with fixed and free interfaces, and the round trip of the G+Smo multipatch writer.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use winslow::multipatch::classes::LayoutBases;
 use winslow::multipatch::gismo::{multipatch_to_gismo_xml, parse_gismo_multipatch};
@@ -12,7 +12,7 @@ use winslow::solve::report::Verdict;
 use winslow::{Curve, KnotVector, Point, Side};
 
 fn data(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/xml/multipatch").join(rel)
+    winslow::testutil::data("gismo/xml/multipatch").join(rel)
 }
 
 fn read(name: &str) -> Layout {
@@ -164,7 +164,7 @@ fn straight(free: &winslow::multipatch::MultipatchSolution, w_fixed: f64) {
 /// shared multipatch files are layouts.
 #[test]
 fn single_domain_gismo_files_are_not_layouts() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/xml");
+    let dir = winslow::testutil::data("gismo/xml");
     let mut single = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();

@@ -38,7 +38,7 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// The valid files: `(path relative to tests/data, text)`.
 fn valid_files() -> Vec<(String, String)> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let root = winslow::testutil::data_dir();
     let mut paths = Vec::new();
     collect(&root, &mut paths);
     paths

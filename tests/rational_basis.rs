@@ -4,7 +4,6 @@
 //! where it should be, and it commutes with knot insertion.
 
 use std::f64::consts::FRAC_1_SQRT_2;
-use std::path::Path;
 
 use winslow::boundary::hierarchy::Level;
 use winslow::boundary::BasisChoice;
@@ -100,7 +99,7 @@ fn exact_arcs_stay_circles() {
 /// the four corners, where the circle's straight angle forces `det J = 0`.
 #[test]
 fn disk_keeps_its_arcs() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gismo/xml/disk.xml");
+    let path = winslow::testutil::data("gismo/xml/disk.xml");
     let b = read_boundary(&path, &ReadOptions::default()).unwrap();
     let sol = solve(&b, &input_basis()).unwrap();
     let r = &sol.report;

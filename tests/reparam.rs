@@ -3,8 +3,6 @@
 //! pairs lie at the same parameter on both fitted sides, and the maps are certified
 //! bijective (exact Bernstein bounds of det J), which a dense sample confirms.
 
-use std::path::Path;
-
 use winslow::boundary::reparam::Reparam;
 use winslow::io::{read_boundary, ReadOptions};
 use winslow::solve;
@@ -14,7 +12,7 @@ use winslow::verify::quality::sample_det_j;
 use winslow::{build_hierarchy, Boundary, FitOptions, Side};
 
 fn boundary(file: &str) -> Boundary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file);
+    let path = winslow::testutil::data(file);
     read_boundary(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"))
 }
 

@@ -1,39 +1,47 @@
 //! `winslow compare` end to end on a small geometry: the paper's columns per method, the
 //! JSON form, one picture per method, and clear errors.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_winslow"))
-}
+use std::path::PathBuf;
+
+use common::{bin, data, stdout_json};
 
 fn annulus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/quarter_annulus.json")
+    data().join("quarter_annulus.json")
 }
 
 #[test]
 fn compare_prints_the_table_and_writes_pictures() {
-    let dir = std::env::temp_dir().join(format!("winslow-compare-{}", std::process::id()));
-    let out = bin().arg("compare").arg(annulus()).arg("--png-dir").arg(&dir).arg("-q").output().unwrap();
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path().join("compare");
+    // the human table: its columns and one row per method
+    let out = bin().arg("compare").arg(annulus()).arg("-q").output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     for col in ["method", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"] {
         assert!(text.contains(col), "missing column {col:?} in\n{text}");
     }
-    let rows: Vec<&str> = text.lines().filter(|l| ["egg ", "vhm ", "qc "].iter().any(|m| l.starts_with(m))).collect();
-    assert_eq!(rows.len(), 3, "{text}");
-    for r in &rows {
-        assert!(r.contains("certified") && r.contains(" yes "), "{r}");
+    let rows = text.lines().filter(|l| ["egg ", "vhm ", "qc "].iter().any(|m| l.starts_with(m))).count();
+    assert_eq!(rows, 3, "{text}");
+    // the same run as JSON, with the pictures: every method converged and certified
+    let out = bin().arg("compare").arg(annulus()).arg("--png-dir").arg(&dir).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = stdout_json(&out);
+    let rows = v["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(names, ["egg", "vhm", "qc"]);
+    for r in rows {
+        assert_eq!(r["measures"]["verdict"], "certified", "{r}");
+        assert_eq!(r["converged"], true, "{r}");
     }
     // EGG is the reference of Q(x)/Q(x_G)
-    assert!(rows[0].contains("1.000"), "{}", rows[0]);
+    assert_eq!(rows[0]["q_ratio"].as_f64(), Some(1.0), "{}", rows[0]);
     for m in ["egg", "vhm", "qc"] {
         let png = dir.join(format!("quarter_annulus-{m}.png"));
         let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -118,7 +126,7 @@ fn compare_runs_gravesens_methods_from_the_egg_map() {
 /// Max-z climbs from a folded Coons patch (the star's) to a certified start.
 #[test]
 fn compare_maxz_certifies_a_folded_coons_patch() {
-    let star = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/contours/star8.json");
+    let star = data().join("contours/star8.json");
     let args =
         [star.to_str().unwrap(), "--methods", "maxz", "--basis", "fitted", "--fit-tol", "1e-2", "--min-elements", "4"];
     let rows = json_rows(&args);
@@ -133,7 +141,7 @@ fn compare_maxz_certifies_a_folded_coons_patch() {
 /// that say why, with no map and no measures.
 #[test]
 fn gravesens_methods_refuse_a_rational_or_large_basis_clearly() {
-    let nurbs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/maps/quarter_annulus_nurbs.json");
+    let nurbs = data().join("maps/quarter_annulus_nurbs.json");
     let rows = json_rows(&[nurbs.to_str().unwrap(), "--methods", "maxz,liao"]);
     assert_eq!(rows[0]["measures"]["verdict"], "certified");
     for r in &rows[1..] {
@@ -142,7 +150,7 @@ fn gravesens_methods_refuse_a_rational_or_large_basis_clearly() {
         assert!(why.contains("not run") && why.contains("rational") && why.contains("--basis fitted"), "{why}");
     }
     // the star on at least 32 cubic elements per direction: over the dense SQP's 3000 unknowns
-    let star = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/contours/star8.json");
+    let star = data().join("contours/star8.json");
     let args =
         [star.to_str().unwrap(), "--methods", "ao", "--basis", "fitted", "--fit-tol", "1e-2", "--min-elements", "32"];
     let rows = json_rows(&args);

@@ -2,21 +2,15 @@
 //! certified volume, written as JSON / G+Smo XML / VTK and read back by `check` and
 //! `convert`; a planted fold in a volume found by `check`; typed errors for bad slices.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_winslow"))
-}
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use common::{bin, data};
 
 fn maps() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/maps")
-}
-
-fn tmp(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("winslow-loft-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    data().join("maps")
 }
 
 fn text(o: &Output) -> String {
@@ -27,7 +21,8 @@ fn text(o: &Output) -> String {
 /// to one basis; linear and cubic lofts certify; the outputs read back.
 #[test]
 fn loft_writes_a_certified_volume_that_reads_back() {
-    let dir = tmp("ok");
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let sq = maps().join("skewed_square.json");
     for interp in ["linear", "cubic"] {
         let out_json = dir.join(format!("{interp}.json"));
@@ -71,12 +66,12 @@ fn loft_writes_a_certified_volume_that_reads_back() {
     let qa = maps().join("quarter_annulus_nurbs.json");
     let o = bin().arg("loft").args([&qa, &qa]).args(["--dz", "1", "-o"]).arg(dir.join("qa.json")).output().unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn bad_slices_are_clear_errors() {
-    let dir = tmp("bad");
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let sq = maps().join("skewed_square.json");
     let run = |args: &[&str], files: &[&Path]| {
         let o = bin().arg("loft").args(files).args(args).arg("-o").arg(dir.join("v.json")).output().unwrap();
@@ -95,14 +90,14 @@ fn bad_slices_are_clear_errors() {
     std::fs::write(&folded, doc.to_string()).unwrap();
     let e = run(&["--dz", "1"], &[&sq, &folded]);
     assert!(e.contains("slice 1") && e.contains("not certified"), "{e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A trilinear volume document with its middle control point pushed across its neighbour: `check` says
 /// folded (exit 3) with a point inside the moved function's support.
 #[test]
 fn check_finds_a_fold_in_a_volume() {
-    let dir = tmp("fold");
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let g = [0.0, 0.5, 1.0];
     let mut cps = Vec::new();
     for (k, &z) in g.iter().enumerate() {
@@ -124,5 +119,4 @@ fn check_finds_a_fold_in_a_volume() {
     assert_eq!(v["kind"], "folded");
     assert!(v["value"].as_f64().unwrap() < 0.0, "{v}");
     assert!(v["param"].as_array().unwrap().iter().all(|x| (0.0..=1.0).contains(&x.as_f64().unwrap())), "{v}");
-    std::fs::remove_dir_all(&dir).ok();
 }

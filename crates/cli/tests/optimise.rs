@@ -1,20 +1,14 @@
 //! `winslow optimise` end to end (paper §10.3): both starts on a coarse basis, the JSON
 //! report, the written map certified again by `winslow check`, and eq. (49) alone.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_winslow"))
-}
-
-fn data() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data")
-}
+use common::{bin, data};
 
 #[test]
 fn optimise_from_both_starts_writes_a_certified_map() {
-    let dir = std::env::temp_dir().join(format!("winslow-optimise-{}", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path().join("optimise");
     let map = dir.join("annulus.json");
     let out = bin()
         .arg("optimise")
@@ -43,7 +37,6 @@ fn optimise_from_both_starts_writes_a_certified_map() {
     // the written map (the run from G) is certified by `winslow check`
     let check = bin().arg("check").arg(&map).output().unwrap();
     assert!(check.status.success(), "{}", String::from_utf8_lossy(&check.stdout));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -6,7 +6,6 @@
 //! and jigsaw01: numeric factorization, and one solve. Run with `cargo bench --workspace
 //! --bench cholesky`.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -29,7 +28,7 @@ const GEOMETRIES: [&str; 2] = ["gismo/puzzle4", "gismo/jigsaw01"];
 
 /// `∇²J` at the EGG map (fully projected, definite) and its order.
 fn hessian(name: &str) -> (Csr, Vec<usize>, Vec<f64>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(format!("{name}.json"));
+    let path = winslow::testutil::data(&format!("{name}.json"));
     let boundary = read_boundary(&path, &ReadOptions::default()).expect("a shared geometry");
     let map = solve(&boundary, &SolveOptions::default()).expect("the EGG solve").map;
     let [p, q] = map.degrees();

@@ -7,7 +7,6 @@
 //! and solve to about 10 %; warm and repeated, their ratio is resolved. Run with `cargo
 //! bench --workspace --bench improve`.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -27,7 +26,7 @@ fn bench(c: &mut Criterion) {
     g.sample_size(20);
     let opts = SolveOptions::default();
     for name in GEOMETRIES {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(format!("{name}.json"));
+        let path = winslow::testutil::data(&format!("{name}.json"));
         let boundary = read_boundary(&path, &ReadOptions::default()).expect("a shared geometry");
         let label = name.rsplit('/').next().unwrap_or(name);
         g.bench_with_input(BenchmarkId::new("egg-solve", label), &(), |b, _| {

@@ -74,6 +74,7 @@ pub mod multipatch;
 pub mod pipeline;
 pub mod solve;
 pub mod spline;
+#[cfg(any(test, feature = "testutil"))]
 #[doc(hidden)]
 pub mod testutil;
 pub mod verify;

@@ -91,7 +91,7 @@ fn concentric_annulus_converges_at_the_spline_order() {
 fn shared_rings_solve_and_certify() {
     use winslow::solve::options::SolveOptions;
     use winslow::solve::report::Verdict;
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/rings");
+    let dir = winslow::testutil::data("rings");
     for (name, fit_tol) in [("male_rotor_in_casing", 1e-3), ("eccentric_annulus", 1e-4)] {
         let ring = winslow::io::ring::read_ring(&dir.join(format!("{name}.json"))).unwrap().expect("a ring document");
         let mut opts = SolveOptions::default();

@@ -3,7 +3,6 @@
 //! full solve. With `WINSLOW_REQUIRE_GPU=1` (CI) a missing adapter fails the tests;
 //! otherwise they print a note and return.
 
-use std::path::Path;
 use std::sync::{Arc, OnceLock};
 
 use winslow::boundary::fit::FitOptions;
@@ -14,6 +13,7 @@ use winslow::solve::initial::coons;
 use winslow::solve::options::SolveOptions;
 use winslow::spline::curve::Point;
 use winslow::spline::knots::KnotVector;
+use winslow::testutil::data;
 use winslow::verify::quality::sample_det_j;
 use winslow::Pipeline;
 use winslow::{read_boundary, ReadOptions, Surface};
@@ -42,10 +42,6 @@ fn gpu(precision: Precision) -> Option<Arc<GpuAssembler>> {
         Precision::F64 => F64.get_or_init(|| open(Precision::F64)).clone(),
         Precision::F32 => F32.get_or_init(|| open(Precision::F32)).clone(),
     }
-}
-
-fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
 }
 
 /// A basis and control points: the Coons patch of a level of a shared geometry's fit

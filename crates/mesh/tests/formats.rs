@@ -4,42 +4,12 @@
 mod common;
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use common::{annulus, signed_area};
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::{structured, unstructured, DVec2, Distribution, Mesh, Side, StructuredOptions, UnstructuredOptions};
-
-/// A scratch path in the temporary folder, removed (file or folder) when the test that
-/// made it ends without a panic: kept for inspection after a failure.
-struct Tmp(PathBuf);
-
-impl std::ops::Deref for Tmp {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Tmp {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Tmp {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_file(&self.0);
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-fn tmp(name: &str) -> Tmp {
-    Tmp(std::env::temp_dir().join(format!("winslow-mesh-{}-{name}", std::process::id())))
-}
 
 fn meshes() -> Vec<Mesh> {
     let map = annulus();
@@ -135,11 +105,12 @@ fn read_msh(text: &str, mesh: &Mesh) {
 
 #[test]
 fn gmsh_round_trip() {
+    let scratch = tempfile::tempdir().unwrap();
     let map = annulus();
     for mesh in meshes() {
         for p in 1..=3 {
             let m = elevate(&mesh, &map, p).unwrap();
-            let path = tmp(&format!("m{p}.msh"));
+            let path = scratch.path().join(format!("m{p}.msh"));
             write(&m, &path, Format::Gmsh).unwrap();
             read_msh(&std::fs::read_to_string(&path).unwrap(), &m);
         }
@@ -157,11 +128,12 @@ fn xml_array<'a>(text: &'a str, name: &str) -> Vec<&'a str> {
 
 #[test]
 fn vtu_round_trip() {
+    let scratch = tempfile::tempdir().unwrap();
     let map = annulus();
     for mesh in meshes() {
         for p in 1..=3 {
             let m = elevate(&mesh, &map, p).unwrap();
-            let path = tmp(&format!("m{p}.vtu"));
+            let path = scratch.path().join(format!("m{p}.vtu"));
             write(&m, &path, Format::Vtu).unwrap();
             let text = std::fs::read_to_string(&path).unwrap();
             let n = m.points.len();
@@ -219,8 +191,9 @@ fn vtu_round_trip() {
 
 #[test]
 fn su2_round_trip() {
+    let scratch = tempfile::tempdir().unwrap();
     for mesh in meshes() {
-        let path = tmp("m.su2");
+        let path = scratch.path().join("m.su2");
         write(&mesh, &path, Format::Su2).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('%')).collect();
@@ -269,8 +242,9 @@ fn su2_round_trip() {
 
 #[test]
 fn plot3d_round_trip_and_refusals() {
+    let scratch = tempfile::tempdir().unwrap();
     let [s, u] = &meshes()[..] else { unreachable!() };
-    let path = tmp("m.xyz");
+    let path = scratch.path().join("m.xyz");
     write(s, &path, Format::Plot3d).unwrap();
     let v: Vec<f64> = std::fs::read_to_string(&path).unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
     assert_eq!(v[..3], [1.0, 13.0, 7.0]);
@@ -279,9 +253,9 @@ fn plot3d_round_trip_and_refusals() {
     for (k, p) in s.points.iter().enumerate() {
         assert_eq!((v[3 + k], v[3 + n + k]), (p.x, p.y));
     }
-    let bad = tmp("u.xyz");
+    let bad = scratch.path().join("u.xyz");
     assert!(write(u, &bad, Format::Plot3d).is_err());
-    assert!(write(&elevate(s, &annulus(), 2).unwrap(), &tmp("e.su2"), Format::Su2).is_err());
+    assert!(write(&elevate(s, &annulus(), 2).unwrap(), &scratch.path().join("e.su2"), Format::Su2).is_err());
     assert_eq!(Format::from_path(Path::new("a/b.msh")).unwrap(), Format::Gmsh);
     assert_eq!(Format::from_path(Path::new("case/")).unwrap(), Format::OpenFoam);
     assert!(Format::from_path(Path::new("a.stl")).is_err());
@@ -301,8 +275,9 @@ fn foam_list(dir: &Path, name: &str) -> Vec<String> {
 
 #[test]
 fn openfoam_polymesh_follows_the_rules() {
+    let scratch = tempfile::tempdir().unwrap();
     for mesh in meshes() {
-        let case = tmp(&format!("case-{}", mesh.kind.name()));
+        let case = scratch.path().join(format!("case-{}", mesh.kind.name()));
         write(&mesh, &case, Format::OpenFoam).unwrap();
         let dir = case.join("constant/polyMesh");
         let pts: Vec<[f64; 3]> = foam_list(&dir, "points")

@@ -120,8 +120,8 @@ fn a_folded_map_gives_a_mesh_that_is_refused() {
     let err = mesh.check().unwrap_err();
     assert!(matches!(err, MeshError::Inverted { count, .. } if count > 0), "{err}");
     assert!(quality(&mesh).unwrap().inverted > 0);
-    let dir = std::env::temp_dir().join(format!("winslow-mesh-folded-{}", std::process::id()));
-    let path = dir.join("folded.msh");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("folded.msh");
     let r = winslow_mesh::formats::write(&mesh, &path, winslow_mesh::formats::Format::Gmsh);
     assert!(matches!(r, Err(MeshError::Inverted { .. })));
     assert!(!path.exists());

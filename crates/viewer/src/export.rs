@@ -55,7 +55,8 @@ mod tests {
     fn png_round_trip() {
         let mut img = ColorImage::filled([4, 3], Color32::from_rgb(10, 20, 30));
         img.pixels[4 + 2] = fold_colour();
-        let path = std::env::temp_dir().join(format!("winslow-viewer-png-{}.png", std::process::id()));
+        let scratch = tempfile::tempdir().unwrap();
+        let path = scratch.path().join("crop.png");
         let crop = Rect::from_min_max(Pos2::new(1.0, 1.0), Pos2::new(3.0, 3.0));
         write_png(&path, &img, Some(crop)).unwrap();
         let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
@@ -66,6 +67,5 @@ mod tests {
         // pixel (2, 1) of the image is (1, 0) of the crop
         assert_eq!(&buf[4..8], &[255, 0, 255, 255]);
         assert_eq!(&buf[0..4], &[10, 20, 30, 255]);
-        std::fs::remove_file(&path).ok();
     }
 }

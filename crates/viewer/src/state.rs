@@ -430,9 +430,7 @@ mod tests {
     use crate::sampler::CpuSampler;
     use winslow::solve::report::Verdict;
 
-    fn data(name: &str) -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
-    }
+    use winslow::testutil::data;
 
     fn state() -> ViewerState {
         ViewerState::new(Arc::new(CpuSampler))
@@ -486,8 +484,8 @@ mod tests {
         // write the map as the CLI does and open it: same map, the stored verdict
         let report = serde_json::to_value(mv.report.as_ref().unwrap()).unwrap();
         let doc = winslow::io::map_to_json("qa", &mv.map, Some(serde_json::json!({ "report": report })));
-        let dir = std::env::temp_dir().join(format!("winslow-viewer-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         let path = dir.join("qa.json");
         winslow::io::write_json(&path, &doc).unwrap();
         let mut t = state();
@@ -499,7 +497,6 @@ mod tests {
         assert_eq!(mv2.certificate.source, crate::certificate::CertificateSource::File);
         assert_eq!(mv2.certificate.verdict, Verdict::Certified);
         assert_eq!(mv2.exact_certificate.verdict, Verdict::Certified);
-        std::fs::remove_dir_all(&dir).ok();
 
         // probes: parameter -> physical -> parameter
         for q in [[0.25, 0.75], [0.5, 0.5], [0.9, 0.1]] {
@@ -568,8 +565,8 @@ mod tests {
             assert!(mv.quality.det_j_max > 0.0 && mv.sample.values.len() == (mv.resolution() + 1).pow(2));
         }
         // a layout of boundaries has nothing to draw: a clear error, the scene stays
-        let dir = std::env::temp_dir().join(format!("winslow-viewer-mp-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         let text = std::fs::read_to_string(data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap();
         let layout = winslow::multipatch::gismo::parse_gismo_multipatch(&text).unwrap();
         let doc = winslow::multipatch::json::layout_to_json(&layout);
@@ -578,7 +575,6 @@ mod tests {
         let e = s.open(&dir.join("input.json")).unwrap_err();
         assert!(e.contains("winslow solve"), "{e}");
         assert_eq!(s.scene.as_ref().unwrap().kind, "multipatch");
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
@@ -617,8 +613,8 @@ mod tests {
         assert!(mv.quality.det_j_min > 0.0);
 
         let doc = winslow::io::map_to_json("ecc", &mv.map, None);
-        let dir = std::env::temp_dir().join(format!("winslow-viewer-ring-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
         winslow::io::write_json(&dir.join("ecc.json"), &doc).unwrap();
         let mut t = state();
         t.open(&dir.join("ecc.json")).unwrap();
@@ -642,6 +638,5 @@ mod tests {
         t.open(&bad).unwrap();
         let p = t.scene.as_ref().unwrap().boundary.problem.clone().unwrap();
         assert!(p.contains("not inside") && !t.can_solve(), "{p}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -3,17 +3,13 @@
 //! in the background job, and the "Methods" section switches the views between their
 //! maps, as a user clicks them (egui_kittest, no GPU needed).
 
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use egui::Vec2;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
+use winslow::testutil::data;
 use winslow_viewer::{CpuSampler, ViewerApp};
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
-}
 
 #[test]
 fn compare_button_runs_the_methods_and_the_selector_switches_maps() {

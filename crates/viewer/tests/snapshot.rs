@@ -9,15 +9,12 @@ use egui::Vec2;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use winslow::io::Document;
+use winslow::testutil::data;
 use winslow_viewer::scene::Scene;
 use winslow_viewer::state::ViewKind;
 use winslow_viewer::{CpuSampler, ViewerApp};
 
 const SIZE: Vec2 = Vec2::new(1180.0, 720.0);
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(name)
-}
 
 fn harness(app: ViewerApp) -> Harness<'static, ViewerApp> {
     Harness::builder().with_size(SIZE).wgpu().build_ui_state(|ui, app: &mut ViewerApp| app.show(ui), app)
@@ -155,14 +152,14 @@ fn hover_zoom_and_export() {
     assert!((w0[0] - w1[0]).abs() < 1e-3 && (w0[1] - w1[1]).abs() < 1e-3);
 
     // export the views to a PNG through the integration's screenshot
-    let path = std::env::temp_dir().join(format!("winslow-viewer-export-{}.png", std::process::id()));
+    let scratch = tempfile::tempdir().unwrap();
+    let path = scratch.path().join("export.png");
     h.state_mut().export_views(path.clone());
     h.run_steps(8);
     let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).expect("exported")));
     let info = dec.read_info().unwrap().info().clone();
     // the views are narrower than the window (side panel) and not taller
     assert!(info.width > 300 && (info.width as f32) < SIZE.x && (info.height as f32) < SIZE.y, "{info:?}");
-    std::fs::remove_file(&path).ok();
 }
 
 /// A file dropped on the window, as an integration would hand it over.

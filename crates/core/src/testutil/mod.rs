@@ -1,4 +1,34 @@
-//! Deterministic pseudo-random numbers for tests (no external crate).
+//! Helpers of the workspace's tests (behind the `testutil` feature): the bundled test
+//! data, deterministic pseudo-random numbers (no external crate), and the readers'
+//! exercisers and mutators of the fuzz targets.
+
+use std::path::{Path, PathBuf};
+
+/// The bundled test data folder, `tests/data` at the workspace root (the shared
+/// geometries, contours, rings, maps and G+Smo files).
+pub fn data_dir() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).expect("crates/core sits two levels down");
+    root.join("tests").join("data")
+}
+
+/// A bundled test file or folder: `data("gismo/duck.json")` is
+/// `tests/data/gismo/duck.json` at the workspace root.
+pub fn data(rel: &str) -> PathBuf {
+    data_dir().join(rel)
+}
+
+/// The bundled files directly in the test data folder `rel` (`""`: `tests/data` itself)
+/// whose extension is `ext`, sorted by name.
+pub fn data_files(rel: &str, ext: &str) -> Vec<PathBuf> {
+    let dir = data(rel);
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("a readable folder entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    v.sort();
+    v
+}
 
 /// A 64-bit linear congruential generator (Knuth's MMIX constants).
 #[derive(Debug, Clone)]
