@@ -38,6 +38,7 @@ mod mesh;
 mod multipatch_cmd;
 mod optimise_cmd;
 mod output;
+mod reference;
 mod solve_cmd;
 mod sweep_cmd;
 
@@ -55,50 +56,89 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Print sides, degrees, knots, corner angles, orientation and fit tolerance per side.
+    #[command(after_help = "Example:\n  winslow inspect tests/data/wavy_lid.json")]
     Inspect(InspectArgs),
     /// Solve the EGG equations for a boundary and write the map (with a report).
+    #[command(
+        after_help = "Example:\n  winslow solve tests/data/wavy_lid.json -o out/wavy_lid.json --png out/wavy_lid.png"
+    )]
     Solve(Box<SolveArgs>),
     /// Draw an existing map file as a PNG (grid lines coloured by det J).
+    #[command(
+        after_help = "Example (a map written by `winslow solve`):\n  winslow render out/wavy_lid.json --png out/wavy_lid-render.png"
+    )]
     Render(RenderArgs),
     /// Run the solver on a list of geometries and sizes and print a table.
+    #[command(
+        after_help = "Example:\n  winslow bench tests/data/wavy_lid.json tests/data/quarter_annulus.json --refinements 0,1"
+    )]
     Bench(BenchArgs),
     /// Classical meshes from a map (paper §11.3): structured with clustering and
     /// boundary layers, or unstructured triangulations; linear or curved; written as
     /// Gmsh, VTU, SU2, PLOT3D or OpenFOAM, with a quality table.
+    #[command(
+        after_help = "Example (a map written by `winslow solve`):\n  winslow mesh out/wavy_lid.json -o out/wavy_lid.msh --structured 65x33 --cluster eta:arctan:6"
+    )]
     Mesh(mesh::MeshArgs),
     /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
     /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
+    #[command(
+        after_help = "Example (a map written by `winslow solve`):\n  winslow check out/wavy_lid.json --boundary tests/data/wavy_lid.json --poisson"
+    )]
     Check(check_cmd::CheckArgs),
     /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
     /// Bézier cells), .vtk (sampled structured grid).
+    #[command(
+        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml"
+    )]
     Convert(ConvertArgs),
     /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,
     /// sharp corners, puzzle tabs, thin strips, CAD sides, noisy and sparse clouds);
     /// write them, and with --solve solve each and print a table per family.
+    #[command(after_help = "Example:\n  winslow corpus -o out/corpus --per-family 1 --families spiral,strip --solve")]
     Corpus(corpus::CorpusArgs),
     /// The sliding O-grid (paper §11.1): a ring whose inner contour turns by a fixed
     /// angle per step, one certified map per frame from extrapolated initial guesses.
+    #[command(
+        after_help = "Example:\n  winslow sweep tests/data/rings/eccentric_annulus.json --rotate-inner 5 --steps 8 -o out/sweep"
+    )]
     Sweep(Box<sweep_cmd::SweepArgs>),
     /// Volumes from planar slices (paper §11.1, Fig. 23): one basis, linear or C2 cubic
     /// in z, certified (trivariate det J), slices inserted where it is not.
+    #[command(
+        after_help = "Example (the frames of the `winslow sweep` example):\n  winslow loft out/sweep/frame_0000.json out/sweep/frame_0004.json out/sweep/frame_0008.json --dz 0.1 -o out/volume.json"
+    )]
     Loft(Box<loft_cmd::LoftArgs>),
     /// Constrained quality optimisation (paper §10.3, Gravesen et al.): minimise the Liao,
     /// Winslow or area-orthogonality functional subject to positive Bernstein coefficients
     /// of det J, from the EGG map or from the max-z point of eq. (49); or eq. (49) alone.
+    #[command(
+        after_help = "Example:\n  winslow optimise tests/data/quarter_annulus.json --functional liao --from egg --fit-tol 1e-2 -o out/qa-liao.json"
+    )]
     Optimise(Box<optimise_cmd::OptimiseArgs>),
     /// The methods of paper §10 on one basis: EGG, the variational harmonic method
     /// (eq. 46), the quasi-conformal functional (eq. 47-48) and, on request, Gravesen's
     /// max-z (eq. 49) and constrained Liao, Winslow and area-orthogonality optimisations
     /// from the EGG map; iterations, the certificate's verdict, Q(x)/Q(x_G), Winslow, Liao, area orthogonality, min scaled
     /// Jacobian and time per method.
+    #[command(after_help = "Example:\n  winslow compare tests/data/quarter_annulus.json --methods egg,vhm,qc")]
     Compare(Box<compare_cmd::CompareArgs>),
     /// Split a certified map's domain into two four-sided patches sharing a curve between
     /// points on opposite sides (paper §11.2, Fig. 25); `winslow solve` takes the result.
+    #[command(
+        after_help = "Example (a map written by `winslow solve`):\n  winslow split out/wavy_lid.json --from south:0.45 --to north:0.55 -o out/parts.json"
+    )]
     Split(multipatch_cmd::SplitArgs),
     /// Join two maps sharing a whole side into one map with a C0 knot, smoothed by the
     /// weak form (eq. 14) from that bijective start (paper §11.2, Fig. 27-28).
+    #[command(
+        after_help = "Example (the two halves of the `winslow split` example, solved):\n  winslow solve out/parts-a.json -o out/a.json -q\n  winslow solve out/parts-b.json -o out/b.json -q\n  winslow join out/a.json out/b.json -o out/joined.json"
+    )]
     Join(multipatch_cmd::JoinArgs),
+    /// Print the command-line reference (docs/cli.md) generated from these definitions.
+    #[command(hide = true)]
+    Reference,
 }
 
 #[derive(Args, Debug)]
@@ -522,6 +562,10 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Compare(a) => compare_cmd::run(*a),
         Command::Split(a) => multipatch_cmd::split(a),
         Command::Join(a) => multipatch_cmd::join(a),
+        Command::Reference => {
+            print!("{}", reference::markdown(<Cli as clap::CommandFactory>::command()));
+            Ok(0)
+        }
     }
 }
 
