@@ -26,8 +26,8 @@ pub(crate) struct CheckArgs {
     poisson: bool,
     /// Length scales a1,a2 of u* = sin(pi x / a1) sin(pi y / a2) (default: half the
     /// bounding box extents).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
-    poisson_scales: Option<Vec<f64>>,
+    #[arg(long, value_name = "A1,A2", value_parser = super::parse_scales)]
+    poisson_scales: Option<[f64; 2]>,
     /// Most bisections per element in the certificate (also the depth of the excused
     /// neighbourhood of a forced corner: 2^-depth of the element).
     #[arg(long, default_value_t = CertifyOptions::default().max_depth)]
@@ -72,8 +72,7 @@ pub(crate) fn check(a: CheckArgs) -> Result<i32> {
         None => None,
     };
     let poisson = if a.poisson {
-        let scales = a.poisson_scales.as_ref().map(|v| [v[0], v[1]]);
-        match poisson_benchmark(&map, scales) {
+        match poisson_benchmark(&map, a.poisson_scales) {
             Ok(r) => Some(r),
             Err(e) => {
                 eprintln!("warning: the Poisson benchmark could not be solved on this map: {e}");

@@ -75,8 +75,8 @@ pub(super) struct CompareArgs {
     repair: usize,
     /// Length scales a1,a2 of the Poisson benchmark's u* (default: half the bounding box
     /// extents of the EGG map), the same for every method.
-    #[arg(long, value_delimiter = ',', num_args = 2)]
-    poisson_scales: Option<Vec<f64>>,
+    #[arg(long, value_name = "A1,A2", value_parser = super::parse_scales)]
+    poisson_scales: Option<[f64; 2]>,
     /// Write one picture per method, DIR/NAME-METHOD.png (grid lines coloured by det J).
     #[arg(long)]
     png_dir: Option<PathBuf>,
@@ -130,12 +130,7 @@ impl CompareArgs {
         }
         opts.constrained.eps = self.eps;
         opts.constrained.max_iterations = self.max_sqp.max(1);
-        if let Some(s) = &self.poisson_scales {
-            if !s.iter().all(|v| v.is_finite() && *v > 0.0) {
-                bail!("--poisson-scales must be two positive numbers, got {s:?}");
-            }
-            opts.poisson_scales = Some([s[0], s[1]]);
-        }
+        opts.poisson_scales = self.poisson_scales;
         Ok((methods, opts))
     }
 }

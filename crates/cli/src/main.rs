@@ -201,6 +201,19 @@ fn parse_kinks_local(s: &str) -> std::result::Result<KinksLocal, String> {
     KinksLocal::parse(s).ok_or_else(|| format!("expected auto, all or a number of knot spans, got '{s}'"))
 }
 
+/// `A1,A2`: the two positive length scales of the Poisson benchmark's `u*` (§10).
+fn parse_scales(s: &str) -> std::result::Result<[f64; 2], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("expected A1,A2 (two numbers), got '{s}': {e}"))?;
+    match v[..] {
+        [a, b] if a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0 => Ok([a, b]),
+        _ => Err(format!("expected A1,A2 (two positive numbers), got '{s}'")),
+    }
+}
+
 fn parse_kinks(s: &str) -> std::result::Result<KinkMode, String> {
     KinkMode::parse(s).ok_or_else(|| format!("expected auto, none or an angle in (0, 180] degrees, got '{s}'"))
 }
