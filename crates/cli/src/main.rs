@@ -359,15 +359,6 @@ impl SolverArgs {
     }
 
     fn options(&self) -> Result<SolveOptions> {
-        if self.fit.degree < 2 {
-            bail!("--degree must be at least 2 (the EGG equations need C1 maps), got {}", self.fit.degree);
-        }
-        if !(self.fit.fit_tol > 0.0 && self.fit.fit_tol < 1.0) {
-            bail!("--fit-tol must be in (0, 1), got {}", self.fit.fit_tol);
-        }
-        if self.tol.is_nan() || self.tol <= 0.0 {
-            bail!("--tol must be positive, got {}", self.tol);
-        }
         let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
         o.nonlinear.tol = self.tol;
         o.nonlinear.method = match self.method {
@@ -392,6 +383,7 @@ impl SolverArgs {
             }
             o.improve = Some(m);
         }
+        o.validate()?;
         Ok(o)
     }
 }

@@ -165,6 +165,7 @@ impl Pipeline {
     /// [`Pipeline::run`], with the hierarchy the solution was solved on (the fitted one
     /// after a fallback): the comparison of methods solves the others on it.
     pub(crate) fn run_keeping_hierarchy(self, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+        self.opts.validate()?;
         let first = self.attempt(&self.opts, observer)?;
         let Some((fitted, why)) = auto_fallback(&first.0, &self.opts.fit) else { return Ok(first) };
         if !observer(&Stage::Fallback { reason: &why }) {
@@ -271,4 +272,94 @@ pub(crate) fn ring_options(opts: &SolveOptions) -> SolveOptions {
     o.topology = Topology::ring();
     o.certify.excuse_corners = false;
     o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{read_boundary, ReadOptions};
+    use crate::testutil::data;
+
+    fn puzzle4() -> Boundary {
+        read_boundary(&data("gismo/puzzle4.json"), &ReadOptions::default()).expect("puzzle4")
+    }
+
+    /// The stages in order: fitted, the solver's stream, the fallback with the reason the
+    /// report gives, the fitted basis' stages; the result is `solve`'s bit for bit, and the
+    /// observer saw every iterate the report records.
+    #[test]
+    fn the_observer_sees_every_stage_of_a_fallback() {
+        let mut opts = SolveOptions::default();
+        opts.repair = 1; // puzzle4's input basis folds after one round: solved again on the fitted basis
+        let mut seen = Vec::new();
+        let mut residuals = Vec::new();
+        let sol = Pipeline::new(puzzle4(), opts.clone())
+            .run(&mut |stage| {
+                seen.push(match stage {
+                    Stage::Fitted { hierarchy, .. } => format!("fitted {:?}", hierarchy.basis.used),
+                    Stage::Fallback { reason } => format!("fallback {reason}"),
+                    Stage::Solver(Event::Iterate { iterate, .. }) => {
+                        residuals.push(iterate.residual);
+                        "iterate".into()
+                    }
+                    Stage::Solver(_) => "level".into(),
+                });
+                true
+            })
+            .unwrap();
+        let r = &sol.report;
+        assert_eq!((r.basis.requested, r.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
+        let fallback = seen.iter().position(|s| s.starts_with("fallback")).expect("a fallback stage");
+        assert_eq!(seen[0], "fitted Input");
+        assert_eq!(seen[fallback + 1], "fitted Fitted");
+        assert_eq!(seen[fallback], format!("fallback {}", r.basis.fallback.as_deref().unwrap()));
+        assert_eq!(seen.iter().filter(|s| s.starts_with("fitted")).count(), 2);
+        // the fitted basis' iterates are the report's, in order
+        let recorded: Vec<f64> = r.levels.iter().flat_map(|l| l.residuals.clone()).collect();
+        assert_eq!(residuals[residuals.len() - recorded.len()..], recorded[..]);
+        let again = solve(&puzzle4(), &opts).unwrap();
+        assert_eq!(again.map.control_points, sol.map.control_points);
+        assert_eq!(again.report.verdict, r.verdict);
+    }
+
+    /// The observer stops the solve at its first iterate: `Error::Cancelled`, and nothing
+    /// after the stage that said stop.
+    #[test]
+    fn the_observer_stops_the_solve() {
+        let mut stages = 0;
+        let out = Pipeline::new(puzzle4(), SolveOptions::default()).run(&mut |stage| {
+            stages += 1;
+            !matches!(stage, Stage::Solver(Event::Iterate { .. }))
+        });
+        assert!(matches!(out, Err(Error::Cancelled)), "{out:?}");
+        // fitted, the first level's start, its first iterate
+        assert_eq!(stages, 3);
+    }
+
+    /// Options are checked before anything runs, with a message naming the option.
+    #[test]
+    fn invalid_options_are_refused_before_the_fit() {
+        for (what, opts) in [
+            ("nonlinear tolerance", {
+                let mut o = SolveOptions::default();
+                o.nonlinear.tol = 0.0;
+                o
+            }),
+            ("growth", SolveOptions { growth: f64::NAN, ..Default::default() }),
+            ("fit tolerance", {
+                let mut o = SolveOptions::default();
+                o.fit.tol = 1.5;
+                o
+            }),
+        ] {
+            let mut stages = 0;
+            let out = Pipeline::new(puzzle4(), opts).run(&mut |_| {
+                stages += 1;
+                true
+            });
+            let Err(e) = out else { panic!("{what}: accepted") };
+            assert!(e.to_string().contains(what), "{what}: {e}");
+            assert_eq!(stages, 0, "{what}");
+        }
+    }
 }

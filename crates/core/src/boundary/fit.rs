@@ -129,8 +129,11 @@ impl FitOptions {
                 reason: format!("the contour fit needs 2 <= p <= {MAX_DEGREE}"),
             });
         }
-        if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(Error::Invalid(format!("fit tolerance must be positive and finite, got {}", self.tol)));
+        if !(self.tol > 0.0 && self.tol < 1.0) {
+            return Err(Error::Invalid(format!(
+                "the fit tolerance (fit-tol, relative to the diameter) must be in (0, 1), got {}",
+                self.tol
+            )));
         }
         if self.initial_elements == 0 || self.max_levels == 0 {
             return Err(Error::Invalid(format!(

@@ -4,6 +4,7 @@
 use crate::boundary::fit::FitOptions;
 use crate::discrete::assembly::Operator;
 use crate::discrete::topology::Topology;
+use crate::error::{Error, Result};
 use crate::verify::certificate::CertifyOptions;
 
 use super::improve::Improve;
@@ -104,6 +105,38 @@ impl KinksLocal {
             "all" => Some(KinksLocal::All),
             _ => s.parse().ok().map(KinksLocal::Spans),
         }
+    }
+}
+
+impl SolveOptions {
+    /// Check every option before a solve: the fit's ([`FitOptions::validate`]), a positive
+    /// finite nonlinear tolerance, a growth factor and an aspect bound of at least 1, at
+    /// least one element per direction, a sample count of at least 2, and the topology's
+    /// boundary conditions. The error names the option.
+    pub fn validate(&self) -> Result<()> {
+        self.fit.validate()?;
+        let tol = self.nonlinear.tol;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(Error::Invalid(format!(
+                "the nonlinear tolerance (tol) must be positive and finite, got {tol}"
+            )));
+        }
+        if !(self.growth >= 1.0 && self.growth.is_finite()) {
+            return Err(Error::Invalid(format!(
+                "the growth factor must be finite and at least 1, got {}",
+                self.growth
+            )));
+        }
+        if !(self.aspect >= 1.0) {
+            return Err(Error::Invalid(format!("the aspect bound must be at least 1, got {}", self.aspect)));
+        }
+        if self.min_elements == 0 || self.sample < 2 {
+            return Err(Error::Invalid(format!(
+                "min_elements must be at least 1 and sample at least 2, got {} and {}",
+                self.min_elements, self.sample
+            )));
+        }
+        self.topology.validate(None)
     }
 }
 
