@@ -36,8 +36,12 @@
 //! is excused the same way when it is a corner of elements ([`ExcusedPoint`]); there no
 //! negative value is forced, so a fold next to it is a fold.
 //!
-//! **Volumes.** Trivariate maps have their own certificate, with the same arithmetic:
-//! [`volume::certify_volume`].
+//! **Volumes.** Trivariate maps have their own entry and report,
+//! [`volume::certify_volume`], on the same machinery: the modules `bernstein` (tensor
+//! Bernstein polynomials and their rounding bounds), `element` (extraction, local net,
+//! `det J` per element) and `search` (proof, fold witnesses, corner neighbourhoods) are
+//! generic over the number of parameters `D` (2 or 3), and so are the per-element
+//! reports [`Fold`] and [`Undecided`].
 
 mod bernstein;
 pub mod coefficients;
@@ -52,8 +56,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::spline::surface::{Side, Surface};
-use bernstein::{split_u, split_v};
-use element::DetJElements;
+use element::Elements;
 
 /// Options of [`certify`].
 #[derive(Debug, Clone, Copy)]
@@ -169,26 +172,33 @@ pub struct ExcusedPoint {
     pub extent: [f64; 2],
 }
 
-/// An element where `det J < 0` was proven at a point.
-#[derive(Debug, Clone, Serialize)]
-pub struct FoldInfo {
-    /// Element `(i, j)`.
-    pub element: [usize; 2],
+/// An element where `det J < 0` was proven at a point (`D = 2`: of a map of the plane,
+/// [`FoldInfo`]; `D = 3`: of a volume, [`volume::VolumeFold`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(bound(serialize = "[usize; D]: Serialize, [f64; D]: Serialize"))]
+pub struct Fold<const D: usize> {
+    /// Element (`(i, j)`, `(i, j, k)`: its indices per direction).
+    pub element: [usize; D],
     /// Parameter point.
-    pub param: [f64; 2],
-    /// `det J` there, evaluated on this element (one-sided on a `C^0` knot line).
+    pub param: [f64; D],
+    /// `det J` there, evaluated on this element (one-sided on a `C^0` knot line or plane).
     pub value: f64,
     /// Rounding bound of `value` (`value < -error_bound`).
     pub error_bound: f64,
-    /// On a knot line where the map is only `C^0`: which one-sided limit `value` is.
+    /// On a knot line (plane) where the map is only `C^0`: which one-sided limit `value` is.
     pub one_sided: Option<String>,
 }
 
-/// An element neither proven positive nor shown to fold.
+/// A fold of a map of the plane.
+pub type FoldInfo = Fold<2>;
+
+/// An element neither proven positive nor shown to fold (`D = 2`: of a map of the plane,
+/// [`UndecidedInfo`]; `D = 3`: of a volume, [`volume::VolumeUndecided`]).
 #[derive(Debug, Clone, Serialize)]
-pub struct UndecidedInfo {
-    /// Element `(i, j)`.
-    pub element: [usize; 2],
+#[serde(bound(serialize = "[usize; D]: Serialize"))]
+pub struct Undecided<const D: usize> {
+    /// Element (its indices per direction).
+    pub element: [usize; D],
     /// Why the search stopped: `max-depth` or `box-budget`.
     pub reason: &'static str,
     /// Deepest bisection level reached on the element.
@@ -201,6 +211,9 @@ pub struct UndecidedInfo {
     /// within rounding there.
     pub error_bound: f64,
 }
+
+/// An undecided element of a map of the plane.
+pub type UndecidedInfo = Undecided<2>;
 
 /// The bijectivity certificate of a map.
 #[derive(Debug, Clone, Serialize)]
@@ -329,12 +342,12 @@ impl Certificate {
 fn excuse_point(
     out: &mut Vec<ExcusedPoint>,
     map: &Surface,
-    dj: &DetJElements<'_>,
+    dj: &Elements<'_, 2>,
     e: [usize; 2],
     k: usize,
     ext: [f64; 2],
 ) {
-    let (bu, bv) = dj.bounds(e);
+    let [bu, bv] = dj.bounds(e);
     let local = [(0, 0), (1, 0), (1, 1), (0, 1)][k];
     let param = [bu[local.0], bv[local.1]];
     if let Some(p) = out.iter_mut().find(|p| p.param == param) {
@@ -381,12 +394,14 @@ pub fn corner_info(map: &Surface) -> Vec<CornerInfo> {
 /// error ([`crate::error::Error::KnotMultiplicity`]).
 pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let t0 = Instant::now();
-    let dj = DetJElements::new(map)?;
+    let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let mut corners = corner_info(map);
     let all: Vec<[usize; 2]> = (0..shape[1]).flat_map(|j| (0..shape[0]).map(move |i| [i, j])).collect();
-    let results: Vec<search::ElementResult> =
-        all.par_iter().map_init(|| dj.work(), |w, &e| search::examine(&dj, e, opts, w)).collect();
+    let results: Vec<search::SurfaceElement> = all
+        .par_iter()
+        .map_init(|| vec![0.0; dj.deg.len()], |tmp, &e| search::examine_surface(&dj, e, opts, tmp))
+        .collect();
     let rational = map.weights.is_some();
     let mut cert = Certificate {
         verdict: Verdict::Undecided { elements: Vec::new() },
@@ -407,14 +422,14 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         seconds: 0.0,
     };
     let mut integral = 0.0;
-    for (e, r) in all.iter().zip(results) {
+    for (e, search::SurfaceElement { result: r, forced, integral: element_integral }) in all.iter().zip(results) {
         cert.boxes += r.boxes;
         cert.max_depth = cert.max_depth.max(r.depth);
-        integral += r.integral;
+        integral += element_integral;
         cert.min_value_found = cert.min_value_found.min(r.min_value);
         cert.lower_bound = cert.lower_bound.min(r.lower);
         for k in 0..4 {
-            if r.forced & (1 << k) != 0 {
+            if forced & (1 << k) != 0 {
                 corners[k].forbids_positivity = true;
             }
             if let Some(x) = r.excused[k] {
@@ -469,18 +484,18 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
 /// `max_boxes` is reached; `upper` is a value at a sub-box corner. Polynomial maps only
 /// (for rational maps the numerator is minimised, scaled per element).
 pub fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f64, f64)> {
-    let dj = DetJElements::new(map)?;
+    let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let d = dj.deg;
     let n = d.len();
     let [du, dv] = d.0;
-    let mut w = dj.work();
+    let mut tmp = vec![0.0; n];
     let mut upper = f64::INFINITY;
     let mut heap: Vec<(f64, Vec<f64>, usize)> = Vec::new();
     for j in 0..shape[1] {
         for i in 0..shape[0] {
             let mut c = vec![0.0; n];
-            let sc = dj.coefficients([i, j], &mut w, &mut c);
+            let (sc, _) = dj.coefficients([i, j], &mut c);
             for x in c.iter_mut() {
                 *x *= sc.factor;
             }
@@ -504,10 +519,10 @@ pub fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f6
         }
         boxes += 1;
         let (mut l, mut r) = (vec![0.0; n], vec![0.0; n]);
-        split_u(&c, d, &mut l, &mut r, &mut w.tmp);
+        bernstein::split(&c, d, 0, &mut l, &mut r, &mut tmp);
         for half in [l, r] {
             let (mut lo2, mut hi2) = (vec![0.0; n], vec![0.0; n]);
-            split_v(&half, d, &mut lo2, &mut hi2, &mut w.tmp);
+            bernstein::split(&half, d, 1, &mut lo2, &mut hi2, &mut tmp);
             for ch in [lo2, hi2] {
                 let m = ch.iter().copied().fold(f64::INFINITY, f64::min);
                 if m < upper {

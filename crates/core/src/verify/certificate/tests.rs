@@ -29,22 +29,21 @@ fn bernstein_det_j_equals_det_j() {
     for (p, q) in [(2, 2), (3, 2), (2, 4), (3, 3)] {
         for rational in [false, true] {
             let map = perturbed(&mut rng, p, q, [3, 2], 0.8, rational);
-            let dj = DetJElements::new(&map).unwrap();
-            let mut w = dj.work();
+            let dj = Elements::surface(&map).unwrap();
+            let mut tmp = vec![0.0; dj.deg.len()];
             let mut c = vec![0.0; dj.deg.len()];
             for j in 0..2 {
                 for i in 0..3 {
-                    let sc = dj.coefficients([i, j], &mut w, &mut c);
-                    let wnet = w.net[2].clone();
-                    let (bu, bv) = dj.bounds([i, j]);
+                    let (sc, nets) = dj.coefficients([i, j], &mut c);
+                    let [bu, bv] = dj.bounds([i, j]);
                     for _ in 0..10 {
                         let (s, t) = (rng.uniform(), rng.uniform());
                         let (u, v) = (bu[0] + s * (bu[1] - bu[0]), bv[0] + t * (bv[1] - bv[0]));
                         let exact = map.derivs(u, v, 1).det_j();
-                        let mut val = sc.factor * bernstein::eval(&c, dj.deg, [1.0 - s, s], [1.0 - t, t], &mut w.tmp);
+                        let st = [[1.0 - s, s], [1.0 - t, t]];
+                        let mut val = sc.factor * bernstein::eval(&c, dj.deg, st, &mut tmp);
                         if rational {
-                            let wt =
-                                bernstein::eval(&wnet, bernstein::Deg([p, q]), [1.0 - s, s], [1.0 - t, t], &mut w.tmp);
+                            let wt = bernstein::eval(&nets.h[2].c, bernstein::Deg([p, q]), st, &mut tmp);
                             val /= wt.powi(3);
                         }
                         assert!(

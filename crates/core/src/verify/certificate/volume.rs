@@ -2,12 +2,13 @@
 //! tensor-product map of degree `(p, q, r)` is, on every element, a polynomial of degree
 //! `(3p - 1, 3q - 1, 3r - 1)` (`det J = x_ξ · (x_η × x_ζ)`, each factor one degree lower
 //! in its own direction); for a NURBS map `det J = N / W⁴` with a numerator `N` of degree
-//! `(4p - 1, 4q - 1, 4r - 1)` (module `element`). As in the plane ([`super`]): the
-//! coefficients come in Bernstein form from the Bézier extraction, carry a rigorous
-//! bound of their rounding error (module `tensor`: `γ_n` bounds, the net taken relative
-//! to the element's first control point and scaled by a power of two), the smallest
-//! coefficient minus its bound is a proven lower bound, and boxes that are neither
-//! proven positive nor shown to fold are bisected (de Casteljau, all three directions).
+//! `(4p - 1, 4q - 1, 4r - 1)`. The machinery is the plane's ([`super`]), in three
+//! variables: the coefficients come in Bernstein form from the Bézier extraction
+//! (module `element`), carry a rigorous bound of their rounding error (module
+//! `bernstein`: `γ_n` bounds, the net taken relative to the element's first control
+//! point and scaled by a power of two), the smallest coefficient minus its bound is a
+//! proven lower bound, and boxes that are neither proven positive nor shown to fold are
+//! bisected (de Casteljau, all three directions; module `search`).
 //!
 //! **Verdicts.** [`VolumeVerdict::Certified`] when every element is proven
 //! (`min ĉ - e > 0` on every box), with the proven lower bound of `det J`;
@@ -16,21 +17,17 @@
 //! point); [`VolumeVerdict::Undecided`] when the budget is spent, with the reason per
 //! element. Unlike maps of the plane there is no excused corner: every point counts.
 
-mod element;
-mod search;
-mod tensor;
-
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::CertifyOptions;
+use super::element::Elements;
+use super::{search, CertifyOptions, Fold, Undecided};
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::quadrature::GaussLegendre;
 use crate::spline::volume::Volume;
-use element::DetJ3;
 
 /// The outcome of [`certify_volume`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -74,37 +71,11 @@ impl VolumeVerdict {
     }
 }
 
-/// An element where `det J < 0` was proven at a point.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct VolumeFold {
-    /// Element `(i, j, k)`.
-    pub element: [usize; 3],
-    /// Parameter point.
-    pub param: [f64; 3],
-    /// `det J` there (one-sided on a `C^0` knot plane).
-    pub value: f64,
-    /// Rounding bound of `value` (`value < -error_bound`).
-    pub error_bound: f64,
-    /// On a knot plane where the map is only `C^0`: which one-sided limit `value` is.
-    pub one_sided: Option<String>,
-}
+/// A fold of a volume.
+pub type VolumeFold = Fold<3>;
 
-/// An element neither proven positive nor shown to fold.
-#[derive(Debug, Clone, Serialize)]
-pub struct VolumeUndecided {
-    /// Element `(i, j, k)`.
-    pub element: [usize; 3],
-    /// Why the search stopped: `max-depth` or `box-budget`.
-    pub reason: &'static str,
-    /// Deepest bisection level reached on the element.
-    pub depth: usize,
-    /// Boxes examined on the element.
-    pub boxes: usize,
-    /// Smallest `det J` coefficient of the first box left open (scaled like `det J`).
-    pub smallest_coefficient: f64,
-    /// Its rounding bound.
-    pub error_bound: f64,
-}
+/// An undecided element of a volume.
+pub type VolumeUndecided = Undecided<3>;
 
 /// The bijectivity certificate of a volume.
 #[derive(Debug, Clone, Serialize)]
@@ -222,11 +193,12 @@ pub fn volume_integral(vol: &Volume) -> f64 {
 /// domain is a typed error ([`crate::error::Error::KnotMultiplicity`]).
 pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCertificate> {
     let t0 = Instant::now();
-    let dj = DetJ3::new(vol)?;
+    let dj = Elements::volume(vol)?;
     let shape = dj.shape();
     let all: Vec<[usize; 3]> =
         (0..shape[2]).flat_map(|k| (0..shape[1]).flat_map(move |j| (0..shape[0]).map(move |i| [i, j, k]))).collect();
-    let results: Vec<search::ElementResult3> = all.par_iter().map(|&e| search::examine(&dj, e, opts)).collect();
+    let results: Vec<(search::ElementResult<3>, f64)> =
+        all.par_iter().map(|&e| search::examine_volume(&dj, e, opts)).collect();
     let mut cert = VolumeCertificate {
         verdict: VolumeVerdict::Undecided { elements: Vec::new() },
         lower_bound: f64::INFINITY,
@@ -242,10 +214,10 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
         seconds: 0.0,
     };
     let mut integral = 0.0;
-    for r in results {
+    for (r, element_integral) in results {
         cert.boxes += r.boxes;
         cert.max_depth = cert.max_depth.max(r.depth);
-        integral += r.integral;
+        integral += element_integral;
         cert.min_value_found = cert.min_value_found.min(r.min_value);
         cert.lower_bound = cert.lower_bound.min(r.lower);
         if let Some(f) = r.fold {
