@@ -266,11 +266,9 @@ impl Certificate {
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            Verdict::Certified { lower_bound, relative } => format!(
-                "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {} elements \
-                 ({} Bernstein boxes, rounding bounded)",
-                self.elements, self.boxes
-            ),
+            Verdict::Certified { lower_bound, relative } => {
+                certified_message(*lower_bound, *relative, self.elements, self.boxes)
+            }
             Verdict::DegenerateCorner { corners, lower_bound, relative, .. } => {
                 let why: Vec<String> = self
                     .corners
@@ -311,30 +309,59 @@ impl Certificate {
                     what.join(" and ")
                 )
             }
-            Verdict::Folded { param, point, value, error_bound, one_sided } => format!(
-                "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at (xi, eta) = ({:.6}, {:.6}), \
-                 x = ({:.6}, {:.6}){}; {} element(s) fold",
-                param[0],
-                param[1],
-                point[0],
-                point[1],
-                one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
-                self.folds.len()
-            ),
+            Verdict::Folded { param, point, value, error_bound, one_sided } => {
+                folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
+            }
             Verdict::Undecided { elements } => {
-                let rounding = self.undecided_info.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
-                let budget = self.undecided_info.iter().filter(|u| u.reason == "box-budget").count();
-                format!(
-                    "undecided: {} element(s) neither proven positive nor shown to fold within {} bisections \
-                     ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; \
-                     smallest value found {:.4e})",
-                    elements.len(),
-                    self.max_depth,
-                    self.min_value_found
-                )
+                undecided_message(elements.len(), &self.undecided_info, self.max_depth, self.min_value_found)
             }
         }
     }
+}
+
+/// The sentence of a certified verdict.
+fn certified_message(lower_bound: f64, relative: f64, elements: usize, boxes: usize) -> String {
+    format!(
+        "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {elements} elements \
+         ({boxes} Bernstein boxes, rounding bounded)"
+    )
+}
+
+/// The sentence of a folded verdict: `det J = value` at the parameter point `param`
+/// (`(xi, eta)` or `(xi, eta, zeta)`), the physical point `point`.
+fn folded_message<const D: usize>(
+    param: &[f64; D],
+    point: &[f64; D],
+    value: f64,
+    error_bound: f64,
+    one_sided: &Option<String>,
+    folds: usize,
+) -> String {
+    let names = ["xi", "eta", "zeta"][..D].join(", ");
+    let list = |v: &[f64; D]| v.iter().map(|x| format!("{x:.6}")).collect::<Vec<_>>().join(", ");
+    format!(
+        "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at ({names}) = ({}), x = ({}){}; {folds} \
+         element(s) fold",
+        list(param),
+        list(point),
+        one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
+    )
+}
+
+/// The sentence of an undecided verdict: `open` elements left open, why each.
+fn undecided_message<const D: usize>(
+    open: usize,
+    undecided: &[Undecided<D>],
+    max_depth: usize,
+    min_value_found: f64,
+) -> String {
+    let rounding = undecided.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
+    let budget = undecided.iter().filter(|u| u.reason == "box-budget").count();
+    format!(
+        "undecided: {open} element(s) neither proven positive nor shown to fold within {max_depth} bisections \
+         ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; smallest value \
+         found {min_value_found:.4e})"
+    )
 }
 
 /// Record the excused neighbourhood of extent `ext` around local corner `k` of element
@@ -397,37 +424,14 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let mut corners = corner_info(map);
-    let all: Vec<[usize; 2]> = (0..shape[1]).flat_map(|j| (0..shape[0]).map(move |i| [i, j])).collect();
+    let all = search::all_elements(shape);
     let results: Vec<search::SurfaceElement> = all
         .par_iter()
         .map_init(|| vec![0.0; dj.deg.len()], |tmp, &e| search::examine_surface(&dj, e, opts, tmp))
         .collect();
-    let rational = map.weights.is_some();
-    let mut cert = Certificate {
-        verdict: Verdict::Undecided { elements: Vec::new() },
-        lower_bound: f64::INFINITY,
-        mean_det_j: 0.0,
-        min_value_found: f64::INFINITY,
-        det_degree: dj.deg.0,
-        corners: Vec::new(),
-        elements: all.len(),
-        element_shape: shape,
-        boxes: 0,
-        max_depth: 0,
-        excused: Vec::new(),
-        excused_points: Vec::new(),
-        folds: Vec::new(),
-        undecided: Vec::new(),
-        undecided_info: Vec::new(),
-        seconds: 0.0,
-    };
-    let mut integral = 0.0;
-    for (e, search::SurfaceElement { result: r, forced, integral: element_integral }) in all.iter().zip(results) {
-        cert.boxes += r.boxes;
-        cert.max_depth = cert.max_depth.max(r.depth);
-        integral += element_integral;
-        cert.min_value_found = cert.min_value_found.min(r.min_value);
-        cert.lower_bound = cert.lower_bound.min(r.lower);
+    let mut totals = search::Totals::new();
+    let (mut excused, mut excused_points) = (Vec::new(), Vec::new());
+    for (e, search::SurfaceElement { result: r, forced, integral }) in all.iter().zip(results) {
         for k in 0..4 {
             if forced & (1 << k) != 0 {
                 corners[k].forbids_positivity = true;
@@ -436,30 +440,24 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
                 corners[k].excused_extent = Some(x);
             }
             if let Some(x) = r.excused[4 + k] {
-                excuse_point(&mut cert.excused_points, map, &dj, *e, k, x);
+                excuse_point(&mut excused_points, map, &dj, *e, k, x);
             }
         }
         if r.excused.iter().any(Option::is_some) {
-            cert.excused.push(*e);
+            excused.push(*e);
         }
-        if let Some(f) = r.fold {
-            cert.min_value_found = cert.min_value_found.min(f.value);
-            cert.folds.push(f);
-        } else if let Some(u) = r.undecided {
-            cert.undecided.push(*e);
-            cert.undecided_info.push(u);
-        }
+        totals.add(r, integral);
     }
-    cert.corners = corners;
     let (ua, ub) = map.knots[0].domain();
     let (va, vb) = map.knots[1].domain();
     let par_area = (ub - ua) * (vb - va);
-    cert.mean_det_j = if rational { crate::verify::quality::area(map) / par_area } else { integral / par_area };
-    let relative = cert.lower_bound / cert.mean_det_j;
+    let mean_det_j =
+        if map.weights.is_some() { crate::verify::quality::area(map) / par_area } else { totals.integral / par_area };
+    let relative = totals.lower_bound / mean_det_j;
     let degenerate: Vec<&'static str> =
-        cert.corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
-    let points: Vec<[f64; 2]> = cert.excused_points.iter().map(|p| p.param).collect();
-    cert.verdict = if let Some(f) = cert.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)) {
+        corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
+    let points: Vec<[f64; 2]> = excused_points.iter().map(|p: &ExcusedPoint| p.param).collect();
+    let verdict = if let Some(f) = totals.worst_fold() {
         Verdict::Folded {
             param: f.param,
             point: map.eval(f.param[0], f.param[1]),
@@ -467,15 +465,31 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
             error_bound: f.error_bound,
             one_sided: f.one_sided.clone(),
         }
-    } else if !cert.undecided.is_empty() {
-        Verdict::Undecided { elements: cert.undecided.clone() }
+    } else if !totals.undecided.is_empty() {
+        Verdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else if !degenerate.is_empty() || !points.is_empty() {
-        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: cert.lower_bound, relative }
+        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: totals.lower_bound, relative }
     } else {
-        Verdict::Certified { lower_bound: cert.lower_bound, relative }
+        Verdict::Certified { lower_bound: totals.lower_bound, relative }
     };
-    cert.seconds = t0.elapsed().as_secs_f64();
-    Ok(cert)
+    Ok(Certificate {
+        verdict,
+        lower_bound: totals.lower_bound,
+        mean_det_j,
+        min_value_found: totals.min_value_found,
+        det_degree: dj.deg.0,
+        corners,
+        elements: all.len(),
+        element_shape: shape,
+        boxes: totals.boxes,
+        max_depth: totals.max_depth,
+        excused,
+        excused_points,
+        folds: totals.folds,
+        undecided: totals.undecided.iter().map(|u| u.element).collect(),
+        undecided_info: totals.undecided,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
 /// The global minimum of `det J` by branch and bound on the Bernstein form, in floating

@@ -416,3 +416,64 @@ fn zero_speed_point(el: &Elements<'_, 2>, nets: &super::element::Nets<2>, e: [us
     let on_xi_side = (s == 0 && e[0] == 0) || (s == 1 && e[0] + 1 == shape[0]);
     (on_eta_side && el.zero_tangent(nets, 0, s, t)) || (on_xi_side && el.zero_tangent(nets, 1, s, t))
 }
+
+/// Every element of a map with `shape` elements per direction, direction 0 fastest.
+pub(super) fn all_elements<const D: usize>(shape: [usize; D]) -> Vec<[usize; D]> {
+    (0..shape.iter().product())
+        .map(|mut i| {
+            std::array::from_fn(|d| {
+                let k = i % shape[d];
+                i /= shape[d];
+                k
+            })
+        })
+        .collect()
+}
+
+/// The elements' outcomes summed up, in the order of the elements.
+pub(super) struct Totals<const D: usize> {
+    /// Proven lower bound of `det J` over the proven boxes.
+    pub lower_bound: f64,
+    /// Smallest value of `det J` met (box corners of polynomial maps, fold witnesses).
+    pub min_value_found: f64,
+    pub boxes: usize,
+    pub max_depth: usize,
+    /// `∫ det J` (polynomial maps).
+    pub integral: f64,
+    pub folds: Vec<Fold<D>>,
+    pub undecided: Vec<Undecided<D>>,
+}
+
+impl<const D: usize> Totals<D> {
+    pub fn new() -> Self {
+        Self {
+            lower_bound: f64::INFINITY,
+            min_value_found: f64::INFINITY,
+            boxes: 0,
+            max_depth: 0,
+            integral: 0.0,
+            folds: Vec::new(),
+            undecided: Vec::new(),
+        }
+    }
+
+    /// Add one element's outcome and its `∫ det J`.
+    pub fn add(&mut self, r: ElementResult<D>, integral: f64) {
+        self.boxes += r.boxes;
+        self.max_depth = self.max_depth.max(r.depth);
+        self.integral += integral;
+        self.min_value_found = self.min_value_found.min(r.min_value);
+        self.lower_bound = self.lower_bound.min(r.lower);
+        if let Some(f) = r.fold {
+            self.min_value_found = self.min_value_found.min(f.value);
+            self.folds.push(f);
+        } else if let Some(u) = r.undecided {
+            self.undecided.push(u);
+        }
+    }
+
+    /// The most negative fold found.
+    pub fn worst_fold(&self) -> Option<&Fold<D>> {
+        self.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value))
+    }
+}

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::element::Elements;
-use super::{search, CertifyOptions, Fold, Undecided};
+use super::{certified_message, folded_message, search, undecided_message, CertifyOptions, Fold, Undecided};
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::quadrature::GaussLegendre;
@@ -120,34 +120,14 @@ impl VolumeCertificate {
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            VolumeVerdict::Certified { lower_bound, relative } => format!(
-                "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {} elements \
-                 ({} Bernstein boxes, rounding bounded)",
-                self.elements, self.boxes
-            ),
-            VolumeVerdict::Folded { param, point, value, error_bound, one_sided } => format!(
-                "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at (xi, eta, zeta) = ({:.6}, {:.6}, \
-                 {:.6}), x = ({:.6}, {:.6}, {:.6}){}; {} element(s) fold",
-                param[0],
-                param[1],
-                param[2],
-                point[0],
-                point[1],
-                point[2],
-                one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
-                self.folds.len()
-            ),
+            VolumeVerdict::Certified { lower_bound, relative } => {
+                certified_message(*lower_bound, *relative, self.elements, self.boxes)
+            }
+            VolumeVerdict::Folded { param, point, value, error_bound, one_sided } => {
+                folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
+            }
             VolumeVerdict::Undecided { elements } => {
-                let rounding = self.undecided.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
-                let budget = self.undecided.iter().filter(|u| u.reason == "box-budget").count();
-                format!(
-                    "undecided: {} element(s) neither proven positive nor shown to fold within {} bisections \
-                     ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; \
-                     smallest value found {:.4e})",
-                    elements.len(),
-                    self.max_depth,
-                    self.min_value_found
-                )
+                undecided_message(elements.len(), &self.undecided, self.max_depth, self.min_value_found)
             }
         }
     }
@@ -195,45 +175,18 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
     let t0 = Instant::now();
     let dj = Elements::volume(vol)?;
     let shape = dj.shape();
-    let all: Vec<[usize; 3]> =
-        (0..shape[2]).flat_map(|k| (0..shape[1]).flat_map(move |j| (0..shape[0]).map(move |i| [i, j, k]))).collect();
+    let all = search::all_elements(shape);
     let results: Vec<(search::ElementResult<3>, f64)> =
         all.par_iter().map(|&e| search::examine_volume(&dj, e, opts)).collect();
-    let mut cert = VolumeCertificate {
-        verdict: VolumeVerdict::Undecided { elements: Vec::new() },
-        lower_bound: f64::INFINITY,
-        mean_det_j: 0.0,
-        min_value_found: f64::INFINITY,
-        det_degree: dj.deg.0,
-        elements: all.len(),
-        element_shape: shape,
-        boxes: 0,
-        max_depth: 0,
-        folds: Vec::new(),
-        undecided: Vec::new(),
-        seconds: 0.0,
-    };
-    let mut integral = 0.0;
-    for (r, element_integral) in results {
-        cert.boxes += r.boxes;
-        cert.max_depth = cert.max_depth.max(r.depth);
-        integral += element_integral;
-        cert.min_value_found = cert.min_value_found.min(r.min_value);
-        cert.lower_bound = cert.lower_bound.min(r.lower);
-        if let Some(f) = r.fold {
-            cert.min_value_found = cert.min_value_found.min(f.value);
-            cert.folds.push(f);
-        } else if let Some(u) = r.undecided {
-            cert.undecided.push(u);
-        }
+    let mut totals = search::Totals::new();
+    for (r, integral) in results {
+        totals.add(r, integral);
     }
     let par_volume: f64 = vol.knots.iter().map(|k| k.domain().1 - k.domain().0).product();
-    if vol.weights.is_some() {
-        integral = volume_integral(vol);
-    }
-    cert.mean_det_j = integral / par_volume;
-    let relative = cert.lower_bound / cert.mean_det_j;
-    cert.verdict = if let Some(f) = cert.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)) {
+    let integral = if vol.weights.is_some() { volume_integral(vol) } else { totals.integral };
+    let mean_det_j = integral / par_volume;
+    let relative = totals.lower_bound / mean_det_j;
+    let verdict = if let Some(f) = totals.worst_fold() {
         VolumeVerdict::Folded {
             param: f.param,
             point: vol.eval(f.param),
@@ -241,16 +194,26 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
             error_bound: f.error_bound,
             one_sided: f.one_sided.clone(),
         }
-    } else if !cert.undecided.is_empty() {
-        VolumeVerdict::Undecided { elements: cert.undecided.iter().map(|u| u.element).collect() }
+    } else if !totals.undecided.is_empty() {
+        VolumeVerdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else {
-        VolumeVerdict::Certified { lower_bound: cert.lower_bound, relative }
+        VolumeVerdict::Certified { lower_bound: totals.lower_bound, relative }
     };
-    cert.seconds = t0.elapsed().as_secs_f64();
-    Ok(cert)
+    Ok(VolumeCertificate {
+        verdict,
+        lower_bound: totals.lower_bound,
+        mean_det_j,
+        min_value_found: totals.min_value_found,
+        det_degree: dj.deg.0,
+        elements: all.len(),
+        element_shape: shape,
+        boxes: totals.boxes,
+        max_depth: totals.max_depth,
+        folds: totals.folds,
+        undecided: totals.undecided,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
-#[cfg(test)]
-mod judge;
 #[cfg(test)]
 mod tests;

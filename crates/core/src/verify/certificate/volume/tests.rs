@@ -1,10 +1,10 @@
-use super::judge::{Exact3, Sign3};
 use super::*;
 use crate::error::Error;
 use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
 use crate::verify::certificate::bernstein::{eval, Deg};
 use crate::verify::certificate::element::Elements;
+use crate::verify::certificate::judge::{Exact3, Sign3};
 
 /// The identity of the unit cube on open uniform bases (control points at the Greville
 /// abscissae), every control point moved at random by `amp` times the element size.
@@ -131,7 +131,7 @@ fn certificate_agrees_with_the_exact_judge() {
         for amp in [0.2, 0.9, 1.4, 2.0] {
             let vol = perturbed(&mut rng, deg, ne, amp, rational);
             let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
-            let exact = Exact3::new(&vol).sign(5, 200);
+            let (exact, _) = Exact3::volume(&vol).sign(1, 5, 200);
             match (&exact, &c.verdict) {
                 (Sign3::Positive, VolumeVerdict::Folded { .. }) => panic!("judge positive, certificate folded"),
                 (Sign3::Negative { .. }, VolumeVerdict::Certified { .. }) => panic!("judge negative, certified"),
