@@ -256,11 +256,7 @@ pub struct Certificate {
 impl Certificate {
     /// The elements a defect correction should refine: folded and undecided ones.
     pub fn offending_elements(&self) -> Vec<[usize; 2]> {
-        let mut v: Vec<[usize; 2]> =
-            self.folds.iter().map(|f| f.element).chain(self.undecided.iter().copied()).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        offending(&self.folds, self.undecided.iter().copied())
     }
 
     /// A sentence describing the verdict.
@@ -317,6 +313,14 @@ impl Certificate {
             }
         }
     }
+}
+
+/// The elements of `folds` and `undecided`, sorted, each once.
+fn offending<const D: usize>(folds: &[Fold<D>], undecided: impl Iterator<Item = [usize; D]>) -> Vec<[usize; D]> {
+    let mut v: Vec<[usize; D]> = folds.iter().map(|f| f.element).chain(undecided).collect();
+    v.sort_unstable();
+    v.dedup();
+    v
 }
 
 /// The sentence of a certified verdict.

@@ -1,23 +1,7 @@
+use super::rounding_tests::perturbed;
 use super::*;
 use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
-
-/// The identity map of the unit square on an open uniform basis, control points at the
-/// Greville abscissae, plus a random perturbation of relative size `amp` (of the
-/// element size) on every control point.
-fn perturbed(rng: &mut Lcg, p: usize, q: usize, ne: [usize; 2], amp: f64, rational: bool) -> Surface {
-    let kx = KnotVector::open_uniform(p, ne[0]);
-    let ky = KnotVector::open_uniform(q, ne[1]);
-    let (gx, gy) = (kx.greville(), ky.greville());
-    let mut cps = Vec::new();
-    for &y in &gy {
-        for &x in &gx {
-            cps.push([x + amp * (rng.uniform() - 0.5) / ne[0] as f64, y + amp * (rng.uniform() - 0.5) / ne[1] as f64]);
-        }
-    }
-    let w = rational.then(|| (0..cps.len()).map(|_| 0.6 + 0.8 * rng.uniform()).collect());
-    Surface::new([kx, ky], cps, w).unwrap()
-}
 
 fn dense_min(map: &Surface, n: usize) -> f64 {
     crate::verify::quality::sample_det_j(map, n).min

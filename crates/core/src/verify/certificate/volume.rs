@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::element::Elements;
-use super::{certified_message, folded_message, search, undecided_message, CertifyOptions, Fold, Undecided};
+use super::{certified_message, folded_message, offending, search, undecided_message, CertifyOptions, Fold, Undecided};
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::quadrature::GaussLegendre;
@@ -110,11 +110,7 @@ pub struct VolumeCertificate {
 impl VolumeCertificate {
     /// Elements that are folded or undecided.
     pub fn offending_elements(&self) -> Vec<[usize; 3]> {
-        let mut v: Vec<[usize; 3]> =
-            self.folds.iter().map(|f| f.element).chain(self.undecided.iter().map(|u| u.element)).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        offending(&self.folds, self.undecided.iter().map(|u| u.element))
     }
 
     /// A sentence describing the verdict.
