@@ -75,6 +75,18 @@ impl<const D: usize> Deg<D> {
             k
         })
     }
+    /// Step the multi-index `k` to the next one in the order of the coefficients, over
+    /// the directions `from..D` (the others held; after the last one `k` is all zeros
+    /// there).
+    pub fn advance(self, k: &mut [usize; D], from: usize) {
+        for dir in from..D {
+            k[dir] += 1;
+            if k[dir] <= self.0[dir] {
+                return;
+            }
+            k[dir] = 0;
+        }
+    }
     /// Sum of the degrees of two polynomials (of their product).
     pub fn plus(self, o: Self) -> Self {
         Self(std::array::from_fn(|dir| self.0[dir] + o.0[dir]))
@@ -116,6 +128,10 @@ impl Binom {
     pub fn get(&self, n: usize, k: usize) -> f64 {
         self.rows[n][k]
     }
+    /// `binom(n, k)` for `k = 0..=n`.
+    fn row(&self, n: usize) -> &[f64] {
+        &self.rows[n]
+    }
     /// `Π_dir binom(d_dir, k_dir)`, multiplied in the order of the directions.
     fn product<const D: usize>(&self, d: Deg<D>, k: [usize; D]) -> f64 {
         (1..D).fold(self.get(d.0[0], k[0]), |r, dir| r * self.get(d.0[dir], k[dir]))
@@ -153,45 +169,45 @@ pub fn mul_add<const D: usize>(bn: &Binom, a: &[f64], da: Deg<D>, b: &[f64], db:
     let wb = db.0[0] + 1;
     let lines = db.len() / wb;
     // b with its binomials (space)
-    let bs: Vec<f64> = if D == 2 {
-        Vec::new()
-    } else {
-        b.iter()
-            .enumerate()
-            .map(|(j, &v)| {
-                let kb = db.index(j);
-                (0..D).fold(v, |r, dir| r * bn.get(db.0[dir], kb[dir]))
-            })
-            .collect()
-    };
-    for (i, &av) in a.iter().enumerate() {
-        let ka = da.index(i);
-        let x = (0..D).fold(av, |r, dir| r * bn.get(da.0[dir], ka[dir])) * s;
-        if x == 0.0 {
-            continue;
+    let mut bs = Vec::new();
+    if D != 2 {
+        let mut kb = [0; D];
+        for &v in b {
+            bs.push((0..D).fold(v, |r, dir| r * bn.get(db.0[dir], kb[dir])));
+            db.advance(&mut kb, 0);
         }
-        for line in 0..lines {
-            let kb = db.index(line * wb);
-            let row = dn.at(std::array::from_fn(|dir| ka[dir] + kb[dir]));
-            let (bl, out) = (&b[line * wb..(line + 1) * wb], &mut out[row..row + wb]);
-            if D == 2 {
-                let y = (1..D).fold(x, |r, dir| r * bn.get(db.0[dir], kb[dir]));
-                for (k, (o, &v)) in out.iter_mut().zip(bl).enumerate() {
-                    *o += y * v * bn.get(db.0[0], k);
+    }
+    let mut ka = [0; D];
+    for &av in a {
+        let x = (0..D).fold(av, |r, dir| r * bn.get(da.0[dir], ka[dir])) * s;
+        if x != 0.0 {
+            let mut kb = [0; D];
+            for line in 0..lines {
+                let row = dn.at(std::array::from_fn(|dir| ka[dir] + kb[dir]));
+                let (bl, out) = (&b[line * wb..(line + 1) * wb], &mut out[row..row + wb]);
+                if D == 2 {
+                    let y = (1..D).fold(x, |r, dir| r * bn.get(db.0[dir], kb[dir]));
+                    for ((o, &v), &bk) in out.iter_mut().zip(bl).zip(bn.row(db.0[0])) {
+                        *o += y * v * bk;
+                    }
+                } else {
+                    for (o, &v) in out.iter_mut().zip(&bs[line * wb..(line + 1) * wb]) {
+                        *o += x * v;
+                    }
                 }
-            } else {
-                for (o, &v) in out.iter_mut().zip(&bs[line * wb..(line + 1) * wb]) {
-                    *o += x * v;
-                }
+                db.advance(&mut kb, 1);
             }
         }
+        da.advance(&mut ka, 0);
     }
 }
 
 /// Divide the accumulated products by `Π_dir binom(n_dir, k_dir)`.
 pub fn normalize<const D: usize>(bn: &Binom, d: Deg<D>, out: &mut [f64]) {
-    for (i, o) in out[..d.len()].iter_mut().enumerate() {
-        *o /= bn.product(d, d.index(i));
+    let mut k = [0; D];
+    for o in out[..d.len()].iter_mut() {
+        *o /= bn.product(d, k);
+        d.advance(&mut k, 0);
     }
 }
 
@@ -218,13 +234,14 @@ impl<const D: usize> Poly<D> {
     /// the absolute slack [`TINY`], which the caller adds where it is used).
     pub fn diff(&self, dir: usize) -> (Vec<f64>, f64) {
         let d = self.d.minus_one(dir);
-        let step = self.d.stride(dir);
-        let c: Vec<f64> = (0..d.len())
-            .map(|i| {
-                let k = self.d.at(d.index(i));
-                self.c[k + step] - self.c[k]
-            })
-            .collect();
+        // slabs of n + 1 blocks of `step` values (a block: one index in `dir`)
+        let (step, n) = (self.d.stride(dir), self.d.0[dir]);
+        let mut c = vec![0.0; d.len()];
+        for (slab, out) in self.c.chunks_exact(step * (n + 1)).zip(c.chunks_exact_mut(step * n)) {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = slab[k + step] - slab[k];
+            }
+        }
         let e = (2.0 * self.e + U * amax(&c)) * (1.0 + 1e-6);
         (c, e)
     }

@@ -198,17 +198,15 @@ impl<'a, const D: usize> Elements<'a, D> {
         let spans: [(usize, f64, f64); D] = std::array::from_fn(|d| self.ex[d].elements[e[d]]);
         let first: [usize; D] = std::array::from_fn(|d| spans[d].0 - degrees[d]);
         let net_deg = Deg(self.net_shape.map(|s| s - 1));
-        let global = |i: usize| {
-            let k = dn.index(i);
-            net_deg.at(std::array::from_fn(|d| first[d] + k[d]))
-        };
         let rational = self.rational();
-        let o = self.points[global(0)];
+        let o = self.points[net_deg.at(first)];
         // local coordinates relative to o, then the weight: loc[i * (D + 1) + z]
         let mut loc = Vec::with_capacity(n * (D + 1));
         let (mut dmax, mut wmax_in) = (0.0f64, 0.0f64);
-        for i in 0..n {
-            let k = global(i);
+        let mut ki = [0; D];
+        for _ in 0..n {
+            let k = net_deg.at(std::array::from_fn(|d| first[d] + ki[d]));
+            dn.advance(&mut ki, 0);
             let x = self.points[k];
             let wt = self.weights.map_or(1.0, |w| w[k]);
             for z in 0..D {
@@ -236,23 +234,24 @@ impl<'a, const D: usize> Elements<'a, D> {
             .map(|z| {
                 // net[m] = Σ_i loc[i][z] Π_dir op_dir[i_dir][m_dir]
                 let mut net = vec![0.0; n];
+                let mut ki = [0; D];
                 for i in 0..n {
                     let v = loc[i * (D + 1) + z];
-                    if v == 0.0 {
-                        continue;
-                    }
-                    let ki = dn.index(i);
-                    for line in 0..lines {
-                        let km = dn.index(line * w0);
-                        let y = (1..D).rev().fold(v, |y, d| y * ops[d][ki[d] * (degrees[d] + 1) + km[d]]);
-                        if y == 0.0 {
-                            continue;
+                    if v != 0.0 {
+                        let mut km = [0; D];
+                        for line in 0..lines {
+                            let y = (1..D).rev().fold(v, |y, d| y * ops[d][ki[d] * (degrees[d] + 1) + km[d]]);
+                            dn.advance(&mut km, 1);
+                            if y == 0.0 {
+                                continue;
+                            }
+                            let row = &mut net[line * w0..(line + 1) * w0];
+                            for (x, &b) in row.iter_mut().zip(&ops[0][ki[0] * w0..(ki[0] + 1) * w0]) {
+                                *x += y * b;
+                            }
                         }
-                        let row = &mut net[line * w0..(line + 1) * w0];
-                        for (x, &b) in row.iter_mut().zip(&ops[0][ki[0] * w0..(ki[0] + 1) * w0]) {
-                            *x += y * b;
-                        }
                     }
+                    dn.advance(&mut ki, 0);
                 }
                 let hmax = (0..n).fold(0.0f64, |m, i| m.max(loc[i * (D + 1) + z].abs()));
                 Poly { c: net, d: dn, e: gamma(n1) * hmax + TINY }

@@ -92,10 +92,11 @@ pub(super) struct ElementDet<'a> {
     pub sc: ElementScale,
     /// Weight net (rational maps).
     pub wnet: Option<&'a [f64]>,
-    /// Per local corner: the domain corner (0..4) or zero-speed point (4..8) forced there.
-    pub forced: Vec<Option<usize>>,
+    /// Per local corner (`2^D` of them): the domain corner (0..4) or zero-speed point
+    /// (4..8) forced there.
+    pub forced: [Option<usize>; 8],
     /// Per local corner: whether `det J < 0` is proven there.
-    pub negative: Vec<bool>,
+    pub negative: [bool; 8],
 }
 
 struct Ctx<'a, 'b, const D: usize> {
@@ -116,7 +117,7 @@ impl<const D: usize> Ctx<'_, '_, D> {
 
     /// Which forced corner a box touches, if any.
     fn touches(&self, b: &SubBox<D>) -> Option<usize> {
-        (0..self.det.forced.len()).find(|&k| {
+        (0..1 << D).find(|&k| {
             let bits = corner_bits(D, k);
             self.det.forced[k].is_some()
                 && (0..D).all(|dir| if (bits >> dir) & 1 == 0 { b.s[dir][0] == 0.0 } else { b.s[dir][1] == 1.0 })
@@ -192,12 +193,6 @@ fn split<const D: usize>(b: &SubBox<D>, d: Deg<D>, tmp: &mut [f64]) -> Vec<SubBo
 fn run<const D: usize>(ctx: &Ctx<'_, '_, D>, tmp: &mut [f64], mut stack: Vec<SubBox<D>>, st: &mut Search<D>) {
     let d = ctx.el.deg;
     let nc = 1 << D;
-    let corners: Vec<([f64; D], usize)> = (0..nc)
-        .map(|bits: usize| {
-            let bit = |dir: usize| (bits >> dir) & 1;
-            (std::array::from_fn(|dir| bit(dir) as f64), d.at(std::array::from_fn(|dir| bit(dir) * d.0[dir])))
-        })
-        .collect();
     while let Some(b) = stack.pop() {
         if let Some(k) = ctx.touches(&b) {
             corner(ctx, tmp, b, k, st);
@@ -226,7 +221,13 @@ fn run<const D: usize>(ctx: &Ctx<'_, '_, D>, tmp: &mut [f64], mut stack: Vec<Sub
         let g: [f64; D] = std::array::from_fn(|dir| dyadic(idx[dir], d.0[dir]));
         let gval = bz::eval(&b.c, d, g.map(|x| [1.0 - x, x]), tmp);
         let gerr = bz::eval_error(&b.c, d, b.err, 0);
-        let mut cands: Vec<([f64; D], f64, f64)> = corners.iter().map(|&(s, k)| (s, b.c[k], b.err)).collect();
+        let mut cands: Vec<([f64; D], f64, f64)> = (0..nc)
+            .map(|bits: usize| {
+                let bit = |dir: usize| (bits >> dir) & 1;
+                let k = d.at(std::array::from_fn(|dir| bit(dir) * d.0[dir]));
+                (std::array::from_fn(|dir| bit(dir) as f64), b.c[k], b.err)
+            })
+            .collect();
         for c in &cands {
             st.min_value = st.min_value.min(c.1);
         }
@@ -371,8 +372,8 @@ pub(super) fn examine_surface(
     let (y0, y1) = (e[1] == 0, e[1] + 1 == shape[1]);
     let at = [x0 && y0, x1 && y0, x1 && y1, x0 && y1];
     let corner_coef = [c0[0], c0[du], c0[n - 1], c0[dv * (du + 1)]];
-    let mut forced = vec![None; 4];
-    let mut negative = vec![false; 4];
+    let mut forced = [None; 8];
+    let mut negative = [false; 8];
     let mut forced_bits = 0u8;
     for k in 0..4 {
         if at[k] && corner_coef[k] <= sc.err {
@@ -401,7 +402,7 @@ pub(super) fn examine_volume(el: &Elements<'_, 3>, e: [usize; 3], opts: &Certify
     let (c0, sc, wnet) = el.volume_coefficients(e);
     let mut tmp = vec![0.0; el.deg.len()];
     let integral = if el.rational() { 0.0 } else { integral(&c0, sc.factor, el.bounds(e)) };
-    let det = ElementDet { c0: &c0, sc, wnet: wnet.as_deref(), forced: vec![None; 8], negative: vec![false; 8] };
+    let det = ElementDet { c0: &c0, sc, wnet: wnet.as_deref(), forced: [None; 8], negative: [false; 8] };
     (examine(el, e, det, opts, &mut tmp), integral)
 }
 
