@@ -36,8 +36,12 @@
 //! is excused the same way when it is a corner of elements ([`ExcusedPoint`]); there no
 //! negative value is forced, so a fold next to it is a fold.
 //!
-//! **Volumes.** Trivariate maps have their own certificate, with the same arithmetic:
-//! [`volume::certify_volume`].
+//! **Volumes.** Trivariate maps have their own entry and report,
+//! [`volume::certify_volume`], on the same machinery: the modules `bernstein` (tensor
+//! Bernstein polynomials and their rounding bounds), `element` (extraction, local net,
+//! `det J` per element) and `search` (proof, fold witnesses, corner neighbourhoods) are
+//! generic over the number of parameters `D` (2 or 3), and so are the per-element
+//! reports [`Fold`] and [`Undecided`].
 
 mod bernstein;
 pub mod coefficients;
@@ -52,8 +56,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::spline::surface::{Side, Surface};
-use bernstein::{split_u, split_v};
-use element::DetJElements;
+use element::Elements;
 
 /// Options of [`certify`].
 #[derive(Debug, Clone, Copy)]
@@ -169,26 +172,33 @@ pub struct ExcusedPoint {
     pub extent: [f64; 2],
 }
 
-/// An element where `det J < 0` was proven at a point.
-#[derive(Debug, Clone, Serialize)]
-pub struct FoldInfo {
-    /// Element `(i, j)`.
-    pub element: [usize; 2],
+/// An element where `det J < 0` was proven at a point (`D = 2`: of a map of the plane,
+/// [`FoldInfo`]; `D = 3`: of a volume, [`volume::VolumeFold`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(bound(serialize = "[usize; D]: Serialize, [f64; D]: Serialize"))]
+pub struct Fold<const D: usize> {
+    /// Element (`(i, j)`, `(i, j, k)`: its indices per direction).
+    pub element: [usize; D],
     /// Parameter point.
-    pub param: [f64; 2],
-    /// `det J` there, evaluated on this element (one-sided on a `C^0` knot line).
+    pub param: [f64; D],
+    /// `det J` there, evaluated on this element (one-sided on a `C^0` knot line or plane).
     pub value: f64,
     /// Rounding bound of `value` (`value < -error_bound`).
     pub error_bound: f64,
-    /// On a knot line where the map is only `C^0`: which one-sided limit `value` is.
+    /// On a knot line (plane) where the map is only `C^0`: which one-sided limit `value` is.
     pub one_sided: Option<String>,
 }
 
-/// An element neither proven positive nor shown to fold.
+/// A fold of a map of the plane.
+pub type FoldInfo = Fold<2>;
+
+/// An element neither proven positive nor shown to fold (`D = 2`: of a map of the plane,
+/// [`UndecidedInfo`]; `D = 3`: of a volume, [`volume::VolumeUndecided`]).
 #[derive(Debug, Clone, Serialize)]
-pub struct UndecidedInfo {
-    /// Element `(i, j)`.
-    pub element: [usize; 2],
+#[serde(bound(serialize = "[usize; D]: Serialize"))]
+pub struct Undecided<const D: usize> {
+    /// Element (its indices per direction).
+    pub element: [usize; D],
     /// Why the search stopped: `max-depth` or `box-budget`.
     pub reason: &'static str,
     /// Deepest bisection level reached on the element.
@@ -201,6 +211,9 @@ pub struct UndecidedInfo {
     /// within rounding there.
     pub error_bound: f64,
 }
+
+/// An undecided element of a map of the plane.
+pub type UndecidedInfo = Undecided<2>;
 
 /// The bijectivity certificate of a map.
 #[derive(Debug, Clone, Serialize)]
@@ -243,21 +256,15 @@ pub struct Certificate {
 impl Certificate {
     /// The elements a defect correction should refine: folded and undecided ones.
     pub fn offending_elements(&self) -> Vec<[usize; 2]> {
-        let mut v: Vec<[usize; 2]> =
-            self.folds.iter().map(|f| f.element).chain(self.undecided.iter().copied()).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        offending(&self.folds, self.undecided.iter().copied())
     }
 
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            Verdict::Certified { lower_bound, relative } => format!(
-                "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {} elements \
-                 ({} Bernstein boxes, rounding bounded)",
-                self.elements, self.boxes
-            ),
+            Verdict::Certified { lower_bound, relative } => {
+                certified_message(*lower_bound, *relative, self.elements, self.boxes)
+            }
             Verdict::DegenerateCorner { corners, lower_bound, relative, .. } => {
                 let why: Vec<String> = self
                     .corners
@@ -298,30 +305,67 @@ impl Certificate {
                     what.join(" and ")
                 )
             }
-            Verdict::Folded { param, point, value, error_bound, one_sided } => format!(
-                "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at (xi, eta) = ({:.6}, {:.6}), \
-                 x = ({:.6}, {:.6}){}; {} element(s) fold",
-                param[0],
-                param[1],
-                point[0],
-                point[1],
-                one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
-                self.folds.len()
-            ),
+            Verdict::Folded { param, point, value, error_bound, one_sided } => {
+                folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
+            }
             Verdict::Undecided { elements } => {
-                let rounding = self.undecided_info.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
-                let budget = self.undecided_info.iter().filter(|u| u.reason == "box-budget").count();
-                format!(
-                    "undecided: {} element(s) neither proven positive nor shown to fold within {} bisections \
-                     ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; \
-                     smallest value found {:.4e})",
-                    elements.len(),
-                    self.max_depth,
-                    self.min_value_found
-                )
+                undecided_message(elements.len(), &self.undecided_info, self.max_depth, self.min_value_found)
             }
         }
     }
+}
+
+/// The elements of `folds` and `undecided`, sorted, each once.
+fn offending<const D: usize>(folds: &[Fold<D>], undecided: impl Iterator<Item = [usize; D]>) -> Vec<[usize; D]> {
+    let mut v: Vec<[usize; D]> = folds.iter().map(|f| f.element).chain(undecided).collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// The sentence of a certified verdict.
+fn certified_message(lower_bound: f64, relative: f64, elements: usize, boxes: usize) -> String {
+    format!(
+        "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {elements} elements \
+         ({boxes} Bernstein boxes, rounding bounded)"
+    )
+}
+
+/// The sentence of a folded verdict: `det J = value` at the parameter point `param`
+/// (`(xi, eta)` or `(xi, eta, zeta)`), the physical point `point`.
+fn folded_message<const D: usize>(
+    param: &[f64; D],
+    point: &[f64; D],
+    value: f64,
+    error_bound: f64,
+    one_sided: &Option<String>,
+    folds: usize,
+) -> String {
+    let names = ["xi", "eta", "zeta"][..D].join(", ");
+    let list = |v: &[f64; D]| v.iter().map(|x| format!("{x:.6}")).collect::<Vec<_>>().join(", ");
+    format!(
+        "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at ({names}) = ({}), x = ({}){}; {folds} \
+         element(s) fold",
+        list(param),
+        list(point),
+        one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
+    )
+}
+
+/// The sentence of an undecided verdict: `open` elements left open, why each.
+fn undecided_message<const D: usize>(
+    open: usize,
+    undecided: &[Undecided<D>],
+    max_depth: usize,
+    min_value_found: f64,
+) -> String {
+    let rounding = undecided.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
+    let budget = undecided.iter().filter(|u| u.reason == "box-budget").count();
+    format!(
+        "undecided: {open} element(s) neither proven positive nor shown to fold within {max_depth} bisections \
+         ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; smallest value \
+         found {min_value_found:.4e})"
+    )
 }
 
 /// Record the excused neighbourhood of extent `ext` around local corner `k` of element
@@ -329,12 +373,12 @@ impl Certificate {
 fn excuse_point(
     out: &mut Vec<ExcusedPoint>,
     map: &Surface,
-    dj: &DetJElements<'_>,
+    dj: &Elements<'_, 2>,
     e: [usize; 2],
     k: usize,
     ext: [f64; 2],
 ) {
-    let (bu, bv) = dj.bounds(e);
+    let [bu, bv] = dj.bounds(e);
     let local = [(0, 0), (1, 0), (1, 1), (0, 1)][k];
     let param = [bu[local.0], bv[local.1]];
     if let Some(p) = out.iter_mut().find(|p| p.param == param) {
@@ -381,70 +425,43 @@ pub fn corner_info(map: &Surface) -> Vec<CornerInfo> {
 /// error ([`crate::error::Error::KnotMultiplicity`]).
 pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let t0 = Instant::now();
-    let dj = DetJElements::new(map)?;
+    let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let mut corners = corner_info(map);
-    let all: Vec<[usize; 2]> = (0..shape[1]).flat_map(|j| (0..shape[0]).map(move |i| [i, j])).collect();
-    let results: Vec<search::ElementResult> =
-        all.par_iter().map_init(|| dj.work(), |w, &e| search::examine(&dj, e, opts, w)).collect();
-    let rational = map.weights.is_some();
-    let mut cert = Certificate {
-        verdict: Verdict::Undecided { elements: Vec::new() },
-        lower_bound: f64::INFINITY,
-        mean_det_j: 0.0,
-        min_value_found: f64::INFINITY,
-        det_degree: dj.deg.0,
-        corners: Vec::new(),
-        elements: all.len(),
-        element_shape: shape,
-        boxes: 0,
-        max_depth: 0,
-        excused: Vec::new(),
-        excused_points: Vec::new(),
-        folds: Vec::new(),
-        undecided: Vec::new(),
-        undecided_info: Vec::new(),
-        seconds: 0.0,
-    };
-    let mut integral = 0.0;
-    for (e, r) in all.iter().zip(results) {
-        cert.boxes += r.boxes;
-        cert.max_depth = cert.max_depth.max(r.depth);
-        integral += r.integral;
-        cert.min_value_found = cert.min_value_found.min(r.min_value);
-        cert.lower_bound = cert.lower_bound.min(r.lower);
+    let all = search::all_elements(shape);
+    let results: Vec<search::SurfaceElement> = all
+        .par_iter()
+        .map_init(|| vec![0.0; dj.deg.len()], |tmp, &e| search::examine_surface(&dj, e, opts, tmp))
+        .collect();
+    let mut totals = search::Totals::new();
+    let (mut excused, mut excused_points) = (Vec::new(), Vec::new());
+    for (e, search::SurfaceElement { result: r, forced, integral }) in all.iter().zip(results) {
         for k in 0..4 {
-            if r.forced & (1 << k) != 0 {
+            if forced & (1 << k) != 0 {
                 corners[k].forbids_positivity = true;
             }
             if let Some(x) = r.excused[k] {
                 corners[k].excused_extent = Some(x);
             }
             if let Some(x) = r.excused[4 + k] {
-                excuse_point(&mut cert.excused_points, map, &dj, *e, k, x);
+                excuse_point(&mut excused_points, map, &dj, *e, k, x);
             }
         }
         if r.excused.iter().any(Option::is_some) {
-            cert.excused.push(*e);
+            excused.push(*e);
         }
-        if let Some(f) = r.fold {
-            cert.min_value_found = cert.min_value_found.min(f.value);
-            cert.folds.push(f);
-        } else if let Some(u) = r.undecided {
-            cert.undecided.push(*e);
-            cert.undecided_info.push(u);
-        }
+        totals.add(r, integral);
     }
-    cert.corners = corners;
     let (ua, ub) = map.knots[0].domain();
     let (va, vb) = map.knots[1].domain();
     let par_area = (ub - ua) * (vb - va);
-    cert.mean_det_j = if rational { crate::verify::quality::area(map) / par_area } else { integral / par_area };
-    let relative = cert.lower_bound / cert.mean_det_j;
+    let mean_det_j =
+        if map.weights.is_some() { crate::verify::quality::area(map) / par_area } else { totals.integral / par_area };
+    let relative = totals.lower_bound / mean_det_j;
     let degenerate: Vec<&'static str> =
-        cert.corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
-    let points: Vec<[f64; 2]> = cert.excused_points.iter().map(|p| p.param).collect();
-    cert.verdict = if let Some(f) = cert.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)) {
+        corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
+    let points: Vec<[f64; 2]> = excused_points.iter().map(|p: &ExcusedPoint| p.param).collect();
+    let verdict = if let Some(f) = totals.worst_fold() {
         Verdict::Folded {
             param: f.param,
             point: map.eval(f.param[0], f.param[1]),
@@ -452,15 +469,31 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
             error_bound: f.error_bound,
             one_sided: f.one_sided.clone(),
         }
-    } else if !cert.undecided.is_empty() {
-        Verdict::Undecided { elements: cert.undecided.clone() }
+    } else if !totals.undecided.is_empty() {
+        Verdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else if !degenerate.is_empty() || !points.is_empty() {
-        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: cert.lower_bound, relative }
+        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: totals.lower_bound, relative }
     } else {
-        Verdict::Certified { lower_bound: cert.lower_bound, relative }
+        Verdict::Certified { lower_bound: totals.lower_bound, relative }
     };
-    cert.seconds = t0.elapsed().as_secs_f64();
-    Ok(cert)
+    Ok(Certificate {
+        verdict,
+        lower_bound: totals.lower_bound,
+        mean_det_j,
+        min_value_found: totals.min_value_found,
+        det_degree: dj.deg.0,
+        corners,
+        elements: all.len(),
+        element_shape: shape,
+        boxes: totals.boxes,
+        max_depth: totals.max_depth,
+        excused,
+        excused_points,
+        folds: totals.folds,
+        undecided: totals.undecided.iter().map(|u| u.element).collect(),
+        undecided_info: totals.undecided,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
 /// The global minimum of `det J` by branch and bound on the Bernstein form, in floating
@@ -469,18 +502,18 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
 /// `max_boxes` is reached; `upper` is a value at a sub-box corner. Polynomial maps only
 /// (for rational maps the numerator is minimised, scaled per element).
 pub fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f64, f64)> {
-    let dj = DetJElements::new(map)?;
+    let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let d = dj.deg;
     let n = d.len();
     let [du, dv] = d.0;
-    let mut w = dj.work();
+    let mut tmp = vec![0.0; n];
     let mut upper = f64::INFINITY;
     let mut heap: Vec<(f64, Vec<f64>, usize)> = Vec::new();
     for j in 0..shape[1] {
         for i in 0..shape[0] {
             let mut c = vec![0.0; n];
-            let sc = dj.coefficients([i, j], &mut w, &mut c);
+            let (sc, _) = dj.coefficients([i, j], &mut c);
             for x in c.iter_mut() {
                 *x *= sc.factor;
             }
@@ -504,10 +537,10 @@ pub fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f6
         }
         boxes += 1;
         let (mut l, mut r) = (vec![0.0; n], vec![0.0; n]);
-        split_u(&c, d, &mut l, &mut r, &mut w.tmp);
+        bernstein::split(&c, d, 0, &mut l, &mut r, &mut tmp);
         for half in [l, r] {
             let (mut lo2, mut hi2) = (vec![0.0; n], vec![0.0; n]);
-            split_v(&half, d, &mut lo2, &mut hi2, &mut w.tmp);
+            bernstein::split(&half, d, 1, &mut lo2, &mut hi2, &mut tmp);
             for ch in [lo2, hi2] {
                 let m = ch.iter().copied().fold(f64::INFINITY, f64::min);
                 if m < upper {

@@ -111,15 +111,15 @@ impl DetCoefficients {
         (b - a) * (d - c)
     }
 
-    fn deg_u(&self) -> Deg {
+    fn deg_u(&self) -> Deg<2> {
         Deg([self.p - 1, self.q])
     }
 
-    fn deg_v(&self) -> Deg {
+    fn deg_v(&self) -> Deg<2> {
         Deg([self.p, self.q - 1])
     }
 
-    fn deg_d(&self) -> Deg {
+    fn deg_d(&self) -> Deg<2> {
         Deg(self.degree())
     }
 

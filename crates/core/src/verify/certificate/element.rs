@@ -1,4 +1,5 @@
-//! `det J` of a map on one element in Bernstein form, with a rigorous bound of the
+//! `det J` of a tensor-product map in `D` variables (`D = 2`: a map of the plane, `D = 3`:
+//! a volume) on one Bézier element in Bernstein form, with a rigorous bound of the
 //! rounding error of every coefficient (see [`super::bernstein`] for the arithmetic).
 //!
 //! **Local origin and scale.** On element `e` the control points are taken relative to
@@ -15,19 +16,33 @@
 //! `1 - α = (t_{i+p+1-r} - x_r) / (t_{i+p+1-r} - t_i)` (both evaluated directly, both
 //! `>= 0`): five roundings per level, so every entry has relative error at most `γ_{5p}`.
 //!
-//! **Coefficients.** With `n₁ = h + 5p + 5q + 2 + (p+1)(q+1)` roundings per term of the
+//! **Nets.** With `n₁ = h + 5 Σ p_dir + D + Π (p_dir + 1) + 3` roundings per term of the
 //! net (`h = 1` for a polynomial map, `2` for a rational one), the Bernstein net of each
-//! homogeneous coordinate is known to `e_net = γ_{n₁+3} max|H|` (the extraction
-//! operators are a partition of unity), its differences to `2 e_net + u max|Δ|`, and the
-//! products of [`super::bernstein::product_error`] give the bound `e` of the `det J`
-//! coefficients (of the numerator `N` of `det J = N / W³` for a rational map). The
-//! factor `p q / (h_ξ h_η)` of the derivatives is left out (positive) and applied when
-//! values are reported.
+//! homogeneous coordinate `H = (w x, w)` is known to `e_net = γ_{n₁} max|H|` (the
+//! extraction operators are a partition of unity), its differences to
+//! `2 e_net + u max|Δ|`.
+//!
+//! **Plane** (degree `(p, q)`, paper §8.1, eq. 43): `det J = x_ξ × x_η`, of degree
+//! `(2p - 1, 2q - 1)`; for a rational map `x = X / W`, `det J = N / W³` with
+//! `N = W (X_ξ Y_η - X_η Y_ξ) + X (Y_ξ W_η - Y_η W_ξ) + Y (X_η W_ξ - X_ξ W_η)`, of degree
+//! `(3p - 1, 3q - 1)`. The products of [`super::bernstein::product_error`] give the bound
+//! `e` of the coefficients.
+//!
+//! **Space** (degree `(p, q, r)`, paper §11.1): `det J = X_ξ · (X_η × X_ζ)`, of degree
+//! `(3p - 1, 3q - 1, 3r - 1)`; for a rational map, with `x_a = (W X_a - W_a X) / W²` and
+//! multilinearity of the determinant, `det J = N / W⁴`,
+//! `N = W det[X_ξ, X_η, X_ζ] - W_ξ det[X, X_η, X_ζ] - W_η det[X_ξ, X, X_ζ] - W_ζ det[X_ξ, X_η, X]`
+//! (`det[H, H_ξ, H_η, H_ζ]` of the homogeneous `H`), of degree `(4p - 1, 4q - 1, 4r - 1)`.
+//!
+//! Since `W > 0` the numerator is certified. The positive factor
+//! `Π p_dir / Π h_dir` of the derivatives and the power `D` of the spatial scale are left
+//! out and applied when values are reported.
 
-use super::bernstein::{self as bz, amax, gamma, product_error, Binom, Deg, TINY, U};
+use super::bernstein::{self as bz, amax, gamma, product_error, sum_of_products, Binom, Deg, Poly, TINY};
 use crate::error::{Error, Result};
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
+use crate::spline::volume::Volume;
 
 /// Per-direction extraction operators computed by blossoming, entrywise relative error
 /// `<= γ_{5p}`.
@@ -86,27 +101,21 @@ impl Extraction {
     }
 }
 
-/// `det J` (numerator for rational maps) of a map per element in Bernstein form.
-pub(super) struct DetJElements<'a> {
-    pub map: &'a Surface,
-    pub ex: [Extraction; 2],
+/// `det J` (numerator for rational maps) of a map in `D` variables per element in
+/// Bernstein form.
+pub(super) struct Elements<'a, const D: usize> {
+    /// Extraction per direction.
+    pub ex: [Extraction; D],
+    /// Degrees of the map.
+    pub degrees: [usize; D],
+    /// Control points (direction 0 fastest) and their number per direction.
+    points: &'a [[f64; D]],
+    net_shape: [usize; D],
+    /// Weights of a rational map.
+    weights: Option<&'a [f64]>,
     pub binom: Binom,
     /// Degree of the `det J` polynomial (of its numerator).
-    pub deg: Deg,
-}
-
-/// Per-thread scratch.
-pub(super) struct Work {
-    loc: Vec<[f64; 3]>,
-    pub net: [Vec<f64>; 3],
-    du: [Vec<f64>; 3],
-    dv: [Vec<f64>; 3],
-    /// Rounding bounds of `net`, `du` and `dv` per homogeneous component.
-    e_net: [f64; 3],
-    e_du: [f64; 3],
-    e_dv: [f64; 3],
-    pub tmp: Vec<f64>,
-    prod: Vec<f64>,
+    pub deg: Deg<D>,
 }
 
 /// The coefficients' companions: error bound and the factors that turn them into `det J`.
@@ -114,146 +123,187 @@ pub(super) struct Work {
 pub(super) struct ElementScale {
     /// `|ĉ_k - c_k| <= err` for every coefficient.
     pub err: f64,
-    /// `det J = factor * N / W³` (`W = 1` for polynomial maps).
+    /// `det J = factor * N / W^(D+1)` (`W = 1` for polynomial maps).
     pub factor: f64,
     /// Upper bound of the (scaled) weight function `W` on the element (1 if polynomial).
     pub wmax: f64,
 }
 
-impl<'a> DetJElements<'a> {
-    pub fn new(map: &'a Surface) -> Result<Self> {
-        let ex = [Extraction::new(&map.knots[0], "xi")?, Extraction::new(&map.knots[1], "eta")?];
-        let [p, q] = map.degrees();
-        let deg = if map.weights.is_some() { Deg([3 * p - 1, 3 * q - 1]) } else { Deg([2 * p - 1, 2 * q - 1]) };
-        Ok(Self { map, ex, binom: Binom::new(3 * p.max(q) + 2), deg })
-    }
+/// The Bernstein nets of an element's homogeneous coordinates and their differences.
+pub(super) struct Nets<const D: usize> {
+    /// `h[z]`: `w (x_z - o_z)` (scaled) for `z < D`, then `w` (rational maps only).
+    pub h: Vec<Poly<D>>,
+    /// `dh[dir][z]`: the differences of `h[z]` in direction `dir` (bound without [`TINY`]).
+    pub dh: Vec<Vec<Poly<D>>>,
+    /// `Π p_dir / Π h_dir / scale^D`: `det J = factor N / W^(D+1)`.
+    pub factor: f64,
+}
 
-    pub fn shape(&self) -> [usize; 2] {
-        [self.ex[0].elements.len(), self.ex[1].elements.len()]
-    }
-
-    pub fn work(&self) -> Work {
-        let [p, q] = self.map.degrees();
-        let n = (p + 1) * (q + 1);
-        let big = self.deg.len();
-        Work {
-            loc: vec![[0.0; 3]; n],
-            net: std::array::from_fn(|_| vec![0.0; n]),
-            du: std::array::from_fn(|_| vec![0.0; p * (q + 1)]),
-            dv: std::array::from_fn(|_| vec![0.0; (p + 1) * q]),
-            e_net: [0.0; 3],
-            e_du: [0.0; 3],
-            e_dv: [0.0; 3],
-            tmp: vec![0.0; 2 * (self.deg.0[0].max(self.deg.0[1]) + 2) + big],
-            prod: vec![0.0; big],
+impl<'a, const D: usize> Elements<'a, D> {
+    /// The elements of the map with these knot vectors, control points (direction 0
+    /// fastest) and weights; a typed error for an interior knot of multiplicity above the
+    /// degree.
+    pub fn new(knots: &[KnotVector; D], points: &'a [[f64; D]], weights: Option<&'a [f64]>) -> Result<Self> {
+        let names = ["xi", "eta", "zeta"];
+        let mut ex = Vec::with_capacity(D);
+        for (kv, name) in knots.iter().zip(names) {
+            ex.push(Extraction::new(kv, name)?);
         }
+        let ex: [Extraction; D] = ex.try_into().unwrap_or_else(|_| unreachable!("one per direction"));
+        let degrees = knots.each_ref().map(KnotVector::degree);
+        let k = if weights.is_some() { D + 1 } else { D };
+        let deg = Deg(degrees.map(|p| k * p - 1));
+        let pmax = degrees.into_iter().max().unwrap_or(1);
+        let net_shape = knots.each_ref().map(KnotVector::num_basis);
+        Ok(Self { ex, degrees, points, net_shape, weights, binom: Binom::new((D + 1) * pmax + 2), deg })
     }
 
-    /// Element bounds `([u0, u1], [v0, v1])`.
-    pub fn bounds(&self, e: [usize; 2]) -> ([f64; 2], [f64; 2]) {
-        let (_, a, b) = self.ex[0].elements[e[0]];
-        let (_, c, d) = self.ex[1].elements[e[1]];
-        ([a, b], [c, d])
+    /// Whether the map is rational.
+    pub fn rational(&self) -> bool {
+        self.weights.is_some()
     }
 
-    /// Whether the map is only `C^0` (multiplicity `>= p`) across the knot line at the
-    /// `end` (0: start, 1: end) of element `e` in direction `dir`, the line being interior.
-    pub fn c0_line(&self, dir: usize, e: usize, end: usize) -> bool {
+    /// Degree of the weight function.
+    pub fn weight_deg(&self) -> Deg<D> {
+        Deg(self.degrees)
+    }
+
+    /// Elements per direction.
+    pub fn shape(&self) -> [usize; D] {
+        self.ex.each_ref().map(|x| x.elements.len())
+    }
+
+    /// Element bounds per direction.
+    pub fn bounds(&self, e: [usize; D]) -> [[f64; 2]; D] {
+        std::array::from_fn(|d| {
+            let (_, a, b) = self.ex[d].elements[e[d]];
+            [a, b]
+        })
+    }
+
+    /// Whether the map is only `C^0` (multiplicity `>= p`) across the knot line (plane) at
+    /// the `end` (0: start, 1: end) of element `e` in direction `dir`, the line being
+    /// interior.
+    pub fn c0_knot(&self, dir: usize, e: usize, end: usize) -> bool {
         let i = e + end;
         let n = self.ex[dir].elements.len();
-        i > 0 && i < n && self.ex[dir].break_mult[i] >= self.map.degrees()[dir]
+        i > 0 && i < n && self.ex[dir].break_mult[i] >= self.degrees[dir]
     }
 
-    /// Coefficients of `det J` (numerator for rational maps, see the module doc) on
-    /// element `e` into `out`, with their error bound and scale.
-    pub fn coefficients(&self, e: [usize; 2], w: &mut Work, out: &mut [f64]) -> ElementScale {
-        let [p, q] = self.map.degrees();
-        let nx = self.map.shape()[0];
-        let (su, a, b) = self.ex[0].elements[e[0]];
-        let (sv, c, d) = self.ex[1].elements[e[1]];
-        let (hu, hv) = (b - a, d - c);
-        let (fu, fv) = (su - p, sv - q);
-        let rational = self.map.weights.is_some();
-        let o = self.map.control_points[fv * nx + fu];
-        // local coordinates relative to o; weights
-        let mut dmax = 0.0f64;
-        let mut wmax_in = 0.0f64;
-        for j in 0..=q {
-            for i in 0..=p {
-                let k = (fv + j) * nx + fu + i;
-                let x = self.map.control_points[k];
-                let wt = self.map.weights.as_ref().map_or(1.0, |w| w[k]);
-                let dd = [x[0] - o[0], x[1] - o[1]];
-                dmax = dmax.max(dd[0].abs()).max(dd[1].abs());
-                wmax_in = wmax_in.max(wt);
-                w.loc[j * (p + 1) + i] = [dd[0], dd[1], wt];
+    /// The nets of element `e` (see the module doc).
+    pub fn nets(&self, e: [usize; D]) -> Nets<D> {
+        let degrees = self.degrees;
+        let dn = Deg(degrees);
+        let n = dn.len();
+        let spans: [(usize, f64, f64); D] = std::array::from_fn(|d| self.ex[d].elements[e[d]]);
+        let first: [usize; D] = std::array::from_fn(|d| spans[d].0 - degrees[d]);
+        let net_deg = Deg(self.net_shape.map(|s| s - 1));
+        let rational = self.rational();
+        let o = self.points[net_deg.at(first)];
+        // local coordinates relative to o, then the weight: loc[i * (D + 1) + z]
+        let mut loc = Vec::with_capacity(n * (D + 1));
+        let (mut dmax, mut wmax_in) = (0.0f64, 0.0f64);
+        let mut ki = [0; D];
+        for _ in 0..n {
+            let k = net_deg.at(std::array::from_fn(|d| first[d] + ki[d]));
+            dn.advance(&mut ki, 0);
+            let x = self.points[k];
+            let wt = self.weights.map_or(1.0, |w| w[k]);
+            for z in 0..D {
+                let d = x[z] - o[z];
+                dmax = dmax.max(d.abs());
+                loc.push(d);
             }
+            wmax_in = wmax_in.max(wt);
+            loc.push(wt);
         }
         let sc = pow2_unit(dmax);
         let ws = if rational { pow2_unit(wmax_in) } else { 1.0 };
-        for l in w.loc.iter_mut() {
-            let wt = l[2] * ws;
-            *l = [wt * (l[0] * sc), wt * (l[1] * sc), wt];
+        for l in loc.chunks_exact_mut(D + 1) {
+            let wt = l[D] * ws;
+            for x in &mut l[..D] {
+                *x = wt * (*x * sc);
+            }
+            l[D] = wt;
         }
         let h_round = if rational { 2 } else { 1 };
-        let n1 = h_round + 5 * p + 5 * q + 2 + (p + 1) * (q + 1) + 3;
-        // Bernstein net: net[k][l] = sum_ij loc[i][j] opx[i][k] opy[j][l]
-        let (ox, oy) = (&self.ex[0].ops[e[0]], &self.ex[1].ops[e[1]]);
-        let ncomp = if rational { 3 } else { 2 };
-        let mut e_net = [0.0; 3];
-        let mut e_du = [0.0; 3];
-        let mut e_dv = [0.0; 3];
-        for z in 0..ncomp {
-            let hmax = w.loc.iter().fold(0.0f64, |m, h| m.max(h[z].abs()));
-            e_net[z] = gamma(n1) * hmax + TINY;
-            let net = &mut w.net[z];
-            net.fill(0.0);
-            for j in 0..=q {
-                for i in 0..=p {
-                    let v = w.loc[j * (p + 1) + i][z];
-                    if v == 0.0 {
-                        continue;
-                    }
-                    for l in 0..=q {
-                        let y = v * oy[j * (q + 1) + l];
-                        if y == 0.0 {
-                            continue;
-                        }
-                        for k in 0..=p {
-                            net[l * (p + 1) + k] += y * ox[i * (p + 1) + k];
+        let n1 = h_round + 5 * degrees.iter().sum::<usize>() + D + n + 3;
+        let ops: [&Vec<f64>; D] = std::array::from_fn(|d| &self.ex[d].ops[e[d]]);
+        let (w0, lines) = (degrees[0] + 1, n / (degrees[0] + 1));
+        let h: Vec<Poly<D>> = (0..if rational { D + 1 } else { D })
+            .map(|z| {
+                // net[m] = Σ_i loc[i][z] Π_dir op_dir[i_dir][m_dir]
+                let mut net = vec![0.0; n];
+                let mut ki = [0; D];
+                for i in 0..n {
+                    let v = loc[i * (D + 1) + z];
+                    if v != 0.0 {
+                        let mut km = [0; D];
+                        for line in 0..lines {
+                            let y = (1..D).rev().fold(v, |y, d| y * ops[d][ki[d] * (degrees[d] + 1) + km[d]]);
+                            dn.advance(&mut km, 1);
+                            if y == 0.0 {
+                                continue;
+                            }
+                            let row = &mut net[line * w0..(line + 1) * w0];
+                            for (x, &b) in row.iter_mut().zip(&ops[0][ki[0] * w0..(ki[0] + 1) * w0]) {
+                                *x += y * b;
+                            }
                         }
                     }
+                    dn.advance(&mut ki, 0);
                 }
-            }
-            // differences: degree (p - 1, q) and (p, q - 1); the factors p / h_u, q / h_v
-            // are left out
-            for l in 0..=q {
-                for k in 0..p {
-                    w.du[z][l * p + k] = net[l * (p + 1) + k + 1] - net[l * (p + 1) + k];
-                }
-            }
-            for l in 0..q {
-                for k in 0..=p {
-                    w.dv[z][l * (p + 1) + k] = net[(l + 1) * (p + 1) + k] - net[l * (p + 1) + k];
-                }
-            }
-            e_du[z] = (2.0 * e_net[z] + U * amax(&w.du[z])) * (1.0 + 1e-6);
-            e_dv[z] = (2.0 * e_net[z] + U * amax(&w.dv[z])) * (1.0 + 1e-6);
-        }
-        (w.e_net, w.e_du, w.e_dv) = (e_net, e_du, e_dv);
+                let hmax = (0..n).fold(0.0f64, |m, i| m.max(loc[i * (D + 1) + z].abs()));
+                Poly { c: net, d: dn, e: gamma(n1) * hmax + TINY }
+            })
+            .collect();
+        let dh = (0..D)
+            .map(|dir| {
+                h.iter()
+                    .map(|x| {
+                        let (c, e) = x.diff(dir);
+                        Poly { c, d: dn.minus_one(dir), e }
+                    })
+                    .collect()
+            })
+            .collect();
+        let hprod: f64 = spans.iter().map(|&(_, a, b)| b - a).product();
+        let scale = (0..D).fold(1.0, |r, _| r * sc);
+        let factor = degrees.iter().product::<usize>() as f64 / hprod / scale;
+        Nets { h, dh, factor }
+    }
+
+    /// Upper bound of the weight function on an element from its net (each coefficient
+    /// known to `e`); 1 for polynomial maps.
+    fn wmax(&self, nets: &Nets<D>) -> f64 {
+        nets.h.get(D).map_or(1.0, |w| (amax(&w.c) + w.e) * (1.0 + 1e-6))
+    }
+}
+
+impl<'a> Elements<'a, 2> {
+    /// The elements of a map of the plane.
+    pub fn surface(map: &'a Surface) -> Result<Self> {
+        Self::new(&map.knots, &map.control_points, map.weights.as_deref())
+    }
+
+    /// Coefficients of `det J` (numerator for rational maps, see the module doc) on
+    /// element `e` into `out`, with their error bound and scale, and the nets.
+    pub fn coefficients(&self, e: [usize; 2], out: &mut [f64]) -> (ElementScale, Nets<2>) {
+        let [p, q] = self.degrees;
+        let nets = self.nets(e);
+        let (du, dv) = (&nets.dh[0], &nets.dh[1]);
         let (du_deg, dv_deg, n_deg) = (Deg([p - 1, q]), Deg([p, q - 1]), Deg([p, q]));
         let bn = &self.binom;
-        let factor = (p * q) as f64 / (hu * hv) / (sc * sc);
+        let factor = nets.factor;
         out.fill(0.0);
-        let r2 = bz::MUL_ROUNDINGS + bz::terms_per_coefficient(du_deg) + bz::terms_per_coefficient(dv_deg);
-        let pair_err =
-            |w: &Work, zu: usize, zv: usize| product_error(amax(&w.du[zu]), e_du[zu], amax(&w.dv[zv]), e_dv[zv], r2);
-        if !rational {
-            bz::mul_add(bn, &w.du[0], du_deg, &w.dv[1], dv_deg, 1.0, out);
-            bz::mul_add(bn, &w.dv[0], dv_deg, &w.du[1], du_deg, -1.0, out);
+        let r2 = bz::mul_roundings(2) + bz::terms_per_coefficient(du_deg) + bz::terms_per_coefficient(dv_deg);
+        let pair_err = |zu: usize, zv: usize| product_error(amax(&du[zu].c), du[zu].e, amax(&dv[zv].c), dv[zv].e, r2);
+        if !self.rational() {
+            bz::mul_add(bn, &du[0].c, du_deg, &dv[1].c, dv_deg, 1.0, out);
+            bz::mul_add(bn, &dv[0].c, dv_deg, &du[1].c, du_deg, -1.0, out);
             bz::normalize(bn, self.deg, out);
-            let err = pair_err(w, 0, 1) + pair_err(w, 1, 0) + TINY;
-            return ElementScale { err, factor, wmax: 1.0 };
+            let err = pair_err(0, 1) + pair_err(1, 0) + TINY;
+            return (ElementScale { err, factor, wmax: 1.0 }, nets);
         }
         // N = W (X_u Y_v - X_v Y_u) + X (Y_u W_v - Y_v W_u) + Y (X_v W_u - X_u W_v)
         let d2 = Deg([2 * p - 1, 2 * q - 1]);
@@ -261,56 +311,100 @@ impl<'a> DetJElements<'a> {
         type Term = (usize, [(usize, usize, f64); 2]);
         let terms: [Term; 3] =
             [(2, [(0, 1, 1.0), (1, 0, -1.0)]), (0, [(1, 2, 1.0), (2, 1, -1.0)]), (1, [(2, 0, 1.0), (0, 2, -1.0)])];
-        let r3 = bz::MUL_ROUNDINGS + 3 * bz::terms_per_coefficient(n_deg);
+        let r3 = bz::mul_roundings(2) + 3 * bz::terms_per_coefficient(n_deg);
         let mut err = TINY;
+        let mut tmp = vec![0.0; d2.len()];
         for (outer, pair) in terms {
             let mut e_tmp = TINY;
-            {
-                let tmp = &mut w.prod[..d2.len()];
-                tmp.fill(0.0);
-                for (zu, zv, sign) in pair {
-                    bz::mul_add(bn, &w.du[zu], du_deg, &w.dv[zv], dv_deg, sign, tmp);
-                }
-                bz::normalize(bn, d2, tmp);
+            tmp.fill(0.0);
+            for (zu, zv, sign) in pair {
+                bz::mul_add(bn, &du[zu].c, du_deg, &dv[zv].c, dv_deg, sign, &mut tmp);
             }
+            bz::normalize(bn, d2, &mut tmp);
             for (zu, zv, _) in pair {
-                e_tmp += pair_err(w, zu, zv);
+                e_tmp += pair_err(zu, zv);
             }
-            let tmp = &w.prod[..d2.len()];
-            bz::mul_add(bn, &w.net[outer], n_deg, tmp, d2, 1.0, out);
-            err += product_error(amax(&w.net[outer]), e_net[outer], amax(tmp), e_tmp, r3);
+            let h = &nets.h[outer];
+            bz::mul_add(bn, &h.c, n_deg, &tmp, d2, 1.0, out);
+            err += product_error(amax(&h.c), h.e, amax(&tmp), e_tmp, r3);
         }
         bz::normalize(bn, self.deg, out);
-        // W <= max of its Bernstein coefficients (each known to e_net[2])
-        let wmax = (amax(&w.net[2]) + e_net[2]) * (1.0 + 1e-6);
-        ElementScale { err, factor, wmax }
+        // W <= max of its Bernstein coefficients (each known to e_net)
+        let wmax = self.wmax(&nets);
+        (ElementScale { err, factor, wmax }, nets)
     }
-}
 
-impl DetJElements<'_> {
     /// Whether the tangent of the domain boundary along side `dir` (0: a side `eta =
     /// const`, whose tangent is `x_ξ`; 1: `xi = const`, tangent `x_η`) vanishes within its
-    /// rounding bound at local corner `(s, t)` (`0` or `1` each) of the element whose net
-    /// [`DetJElements::coefficients`] left in `w`: one-sided from this element, from the
-    /// differences of the Bernstein net (for a rational map, of `X' W - X W'`, whose bound
-    /// is taken to first order).
-    pub fn zero_tangent(&self, w: &Work, dir: usize, s: usize, t: usize) -> bool {
-        let [p, q] = self.map.degrees();
-        let (d, e_d) = if dir == 0 { (&w.du, &w.e_du) } else { (&w.dv, &w.e_dv) };
+    /// rounding bound at local corner `(s, t)` (`0` or `1` each) of the element with these
+    /// nets: one-sided from this element, from the differences of the Bernstein net (for a
+    /// rational map, of `X' W - X W'`, whose bound is taken to first order).
+    pub fn zero_tangent(&self, nets: &Nets<2>, dir: usize, s: usize, t: usize) -> bool {
+        let [p, q] = self.degrees;
+        let d = &nets.dh[dir];
         // index of the difference at the corner, and of the net value there
         let k = if dir == 0 { t * q * p + s * (p - 1) } else { t * (q - 1) * (p + 1) + s * p };
         let at = t * q * (p + 1) + s * p;
-        if self.map.weights.is_none() {
-            return (0..2).all(|z| d[z][k].abs() <= e_d[z]);
+        if !self.rational() {
+            return (0..2).all(|z| d[z].c[k].abs() <= d[z].e);
         }
-        let (wv, wd) = (w.net[2][at], d[2][k]);
+        let h = &nets.h;
+        let (wv, wd) = (h[2].c[at], d[2].c[k]);
         (0..2).all(|z| {
-            let v = d[z][k] * wv - w.net[z][at] * wd;
-            let bound =
-                e_d[z] * wv.abs() + d[z][k].abs() * w.e_net[2] + w.net[z][at].abs() * e_d[2] + wd.abs() * w.e_net[z];
+            let v = d[z].c[k] * wv - h[z].c[at] * wd;
+            let bound = d[z].e * wv.abs() + d[z].c[k].abs() * h[2].e + h[z].c[at].abs() * d[2].e + wd.abs() * h[z].e;
             v.abs() <= 2.0 * bound
         })
     }
+}
+
+impl<'a> Elements<'a, 3> {
+    /// The elements of a volume.
+    pub fn volume(vol: &'a Volume) -> Result<Self> {
+        Self::new(&vol.knots, &vol.control_points, vol.weights.as_deref())
+    }
+
+    /// `det J` (its numerator for rational maps) on element `e`: coefficients, their
+    /// bound and scale, and the weight function's net (rational maps).
+    pub fn volume_coefficients(&self, e: [usize; 3]) -> (Vec<f64>, ElementScale, Option<Vec<f64>>) {
+        let nets = self.nets(e);
+        // the differences with the absolute slack
+        let d: Vec<Vec<Poly<3>>> = nets
+            .dh
+            .iter()
+            .map(|dir| dir.iter().map(|x| Poly { c: x.c.clone(), d: x.d, e: x.e + TINY }).collect())
+            .collect();
+        let (du, dv, dw) = (&d[0], &d[1], &d[2]);
+        let bn = &self.binom;
+        let factor = nets.factor;
+        let c_vw = cross(bn, &dv[..3], &dw[..3]);
+        let d1 = dot(bn, &du[..3], &c_vw);
+        if !self.rational() {
+            return (d1.c, ElementScale { err: d1.e, factor, wmax: 1.0 }, None);
+        }
+        let (x, w) = (&nets.h[..3], &nets.h[3]);
+        let t_u = dot(bn, x, &c_vw);
+        let t_v = dot(bn, x, &cross(bn, &dw[..3], &du[..3]));
+        let t_w = dot(bn, x, &cross(bn, &du[..3], &dv[..3]));
+        let num =
+            sum_of_products(bn, &[(w, &d1, 1.0), (&du[3], &t_u, -1.0), (&dv[3], &t_v, -1.0), (&dw[3], &t_w, -1.0)]);
+        let wmax = self.wmax(&nets);
+        (num.c, ElementScale { err: num.e, factor, wmax }, Some(w.c.clone()))
+    }
+}
+
+/// `a × b` of vectors of Bernstein polynomials.
+fn cross(bn: &Binom, a: &[Poly<3>], b: &[Poly<3>]) -> [Poly<3>; 3] {
+    [
+        sum_of_products(bn, &[(&a[1], &b[2], 1.0), (&a[2], &b[1], -1.0)]),
+        sum_of_products(bn, &[(&a[2], &b[0], 1.0), (&a[0], &b[2], -1.0)]),
+        sum_of_products(bn, &[(&a[0], &b[1], 1.0), (&a[1], &b[0], -1.0)]),
+    ]
+}
+
+/// `a · b` of vectors of Bernstein polynomials.
+fn dot(bn: &Binom, a: &[Poly<3>], b: &[Poly<3>]) -> Poly<3> {
+    sum_of_products(bn, &[(&a[0], &b[0], 1.0), (&a[1], &b[1], 1.0), (&a[2], &b[2], 1.0)])
 }
 
 /// The power of two `2^k` with `x 2^k` in `[0.5, 1)` (1 for `x = 0`; `k` clamped to

@@ -1,72 +1,77 @@
-//! The search on one element: prove `det J > 0` box by box, find a fold witness, or
-//! shrink the neighbourhood of a forced corner.
+//! The search on one element of a map in `D` variables (a map of the plane, a volume):
+//! prove `det J > 0` box by box, find a fold witness, or (in the plane) shrink the
+//! neighbourhood of a forced corner.
 //!
 //! A box with coefficients `ĉ` known to `e` is *proven* when `min ĉ - e > 0`. A fold
 //! needs a witness: a box corner (its coefficient is the value there) or a dyadic point
 //! near the smallest coefficient whose value is `< -e'`; the witness is then re-evaluated
 //! from the element's coefficients at the reported (rounded) parameter point, with the
 //! error of the local coordinates `(u - a) / (b - a)` bounded, and only reported when it
-//! is still `< -(its bound)`. Otherwise the box is bisected (de Casteljau), and when the
-//! budget is spent the element is undecided.
+//! is still `< -(its bound)`. Otherwise the box is bisected in every direction (de
+//! Casteljau), and when the budget is spent the element is undecided.
 //!
 //! At a *forced* corner (its `det J` coefficient, exact up to `e`, is not provably
 //! positive: an angle of 180 degrees or more, or a vanishing tangent) the box touching
-//! the corner is bisected; its three other children must be proven positive, and the
-//! search descends into the corner child, until the depth limit: the corner box left is
-//! the excused neighbourhood, whose size is reported. When a sibling cannot be proven,
-//! the current corner box is the neighbourhood, unless the sibling holds a fold witness
-//! and the corner's `det J` is not provably negative (a straight corner, where no
-//! negative value is forced): then it is a fold.
+//! the corner is bisected; its other children must be proven positive, and the search
+//! descends into the corner child, until the depth limit: the corner box left is the
+//! excused neighbourhood, whose size is reported. When a sibling cannot be proven, the
+//! current corner box is the neighbourhood, unless the sibling holds a fold witness and
+//! the corner's `det J` is not provably negative (a straight corner, where no negative
+//! value is forced): then it is a fold. Volumes have no forced corners (a lofted volume
+//! has no forced corner edges when its slices are certified).
 
-use super::bernstein::{self as bz, amax, Deg};
-use super::element::{DetJElements, ElementScale, Work};
-use super::{CertifyOptions, FoldInfo, UndecidedInfo};
+use super::bernstein::{self as bz, Deg};
+use super::element::{ElementScale, Elements};
+use super::{CertifyOptions, Fold, Undecided};
 
-/// A sub-box of an element: coefficients, local ranges, depth, error bound.
-pub(super) struct SubBox {
+/// A sub-box of an element: coefficients, local ranges per direction, depth, error bound.
+struct SubBox<const D: usize> {
     c: Vec<f64>,
-    su: [f64; 2],
-    sv: [f64; 2],
+    s: [[f64; 2]; D],
     depth: usize,
     err: f64,
 }
 
-/// Local corners `(s, t)` of an element, numbered like the domain corners.
-const LOCAL: [(f64, f64); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+/// Local corner `k` of a box as bits (bit `dir` set: the upper end in direction `dir`):
+/// in the plane numbered like the domain's corners (south-west, south-east, north-east,
+/// north-west), in space by the bits themselves.
+fn corner_bits(d: usize, k: usize) -> usize {
+    if d == 2 {
+        [0, 1, 3, 2][k]
+    } else {
+        k
+    }
+}
 
 /// Outcome of one element.
 #[derive(Debug, Clone)]
-pub(super) struct ElementResult {
-    pub fold: Option<FoldInfo>,
-    pub undecided: Option<UndecidedInfo>,
+pub(super) struct ElementResult<const D: usize> {
+    pub fold: Option<Fold<D>>,
+    pub undecided: Option<Undecided<D>>,
     /// Lower bound of `det J` over the proven boxes (`+inf` if none).
     pub lower: f64,
     /// Smallest value of `det J` met at box corners (polynomial maps; `+inf` otherwise).
     pub min_value: f64,
-    /// Integral of `det J` over the element (polynomial maps).
-    pub integral: f64,
     pub boxes: usize,
     pub depth: usize,
-    /// Domain corners (bits) at this element where `det J > 0` is not provable.
-    pub forced: u8,
     /// Parameter extent of the excused neighbourhood per domain corner (0..4) and per
-    /// zero-speed boundary point at local corner `k - 4` of the element (4..8).
-    pub excused: [Option<[f64; 2]>; 8],
+    /// zero-speed boundary point at local corner `k - 4` of the element (4..8; the plane).
+    pub excused: [Option<[f64; D]>; 8],
 }
 
 /// State of a search (a tentative one for the siblings of a corner box).
-struct Search {
-    fold: Option<FoldInfo>,
+struct Search<const D: usize> {
+    fold: Option<Fold<D>>,
     /// (reason, box error, smallest corner value) of the first box left open.
     open: Option<(&'static str, f64, f64)>,
     lower: f64,
     min_value: f64,
     boxes: usize,
     depth: usize,
-    excused: [Option<[f64; 2]>; 8],
+    excused: [Option<[f64; D]>; 8],
 }
 
-impl Search {
+impl<const D: usize> Search<D> {
     fn new(boxes: usize) -> Self {
         Self {
             fold: None,
@@ -80,116 +85,117 @@ impl Search {
     }
 }
 
-struct Ctx<'a, 'b> {
-    dj: &'a DetJElements<'b>,
-    opts: &'a CertifyOptions,
-    e: [usize; 2],
-    bu: [f64; 2],
-    bv: [f64; 2],
-    c0: &'a [f64],
-    sc: ElementScale,
+/// One element's `det J` as the search sees it.
+pub(super) struct ElementDet<'a> {
+    /// Coefficients of `det J` (its numerator).
+    pub c0: &'a [f64],
+    pub sc: ElementScale,
     /// Weight net (rational maps).
-    wnet: Option<Vec<f64>>,
-    /// Domain corner forced at each local corner.
-    forced: [Option<usize>; 4],
-    /// Whether `det J < 0` is proven at that local corner.
-    negative: [bool; 4],
+    pub wnet: Option<&'a [f64]>,
+    /// Per local corner (`2^D` of them): the domain corner (0..4) or zero-speed point
+    /// (4..8) forced there.
+    pub forced: [Option<usize>; 8],
+    /// Per local corner: whether `det J < 0` is proven there.
+    pub negative: [bool; 8],
 }
 
-impl Ctx<'_, '_> {
-    fn deg(&self) -> Deg {
-        self.dj.deg
-    }
+struct Ctx<'a, 'b, const D: usize> {
+    el: &'a Elements<'b, D>,
+    opts: &'a CertifyOptions,
+    e: [usize; D],
+    bounds: [[f64; 2]; D],
+    det: ElementDet<'a>,
+}
 
-    /// `det J` from a numerator value at local `(s, t)` (weights' value there).
-    fn to_det(&self, v: f64, s: [f64; 2], t: [f64; 2], tmp: &mut [f64]) -> f64 {
-        let [p, q] = self.dj.map.degrees();
-        let wv = self.wnet.as_ref().map_or(1.0, |wn| bz::eval(wn, Deg([p, q]), s, t, tmp));
-        self.sc.factor * v / (wv * wv * wv)
+impl<const D: usize> Ctx<'_, '_, D> {
+    /// `det J` from a numerator value at local coordinates `s` (weights' value there;
+    /// `W^(D+1)` multiplied out factor by factor).
+    fn to_det(&self, v: f64, s: [[f64; 2]; D], tmp: &mut [f64]) -> f64 {
+        let wv = self.det.wnet.map_or(1.0, |wn| bz::eval(wn, self.el.weight_deg(), s, tmp));
+        self.det.sc.factor * v / (0..=D).fold(1.0, |r, _| r * wv)
     }
 
     /// Which forced corner a box touches, if any.
-    fn touches(&self, b: &SubBox) -> Option<usize> {
-        (0..4).find(|&k| {
-            let (s, t) = LOCAL[k];
-            self.forced[k].is_some()
-                && (if s == 0.0 { b.su[0] == 0.0 } else { b.su[1] == 1.0 })
-                && (if t == 0.0 { b.sv[0] == 0.0 } else { b.sv[1] == 1.0 })
+    fn touches(&self, b: &SubBox<D>) -> Option<usize> {
+        (0..1 << D).find(|&k| {
+            let bits = corner_bits(D, k);
+            self.det.forced[k].is_some()
+                && (0..D).all(|dir| if (bits >> dir) & 1 == 0 { b.s[dir][0] == 0.0 } else { b.s[dir][1] == 1.0 })
         })
     }
 
-    /// Re-evaluate a witness at local dyadic `(ls, lt)` from the element's coefficients
-    /// at the rounded parameter point; `Some` when `det J < 0` there is proven.
-    fn confirm(&self, ls: f64, lt: f64, tmp: &mut [f64]) -> Option<FoldInfo> {
-        let at = |x: f64, r: [f64; 2]| -> (f64, [f64; 2]) {
-            if x == 0.0 {
-                (r[0], [1.0, 0.0])
-            } else if x == 1.0 {
-                (r[1], [0.0, 1.0])
+    /// Re-evaluate a witness at the local dyadic point `ls` from the element's
+    /// coefficients at the rounded parameter point; `Some` when `det J < 0` there is proven.
+    fn confirm(&self, ls: [f64; D], tmp: &mut [f64]) -> Option<Fold<D>> {
+        let mut param = [0.0; D];
+        let mut s = [[0.0; 2]; D];
+        for d in 0..D {
+            let [a, b] = self.bounds[d];
+            (param[d], s[d]) = if ls[d] == 0.0 {
+                (a, [1.0, 0.0])
+            } else if ls[d] == 1.0 {
+                (b, [0.0, 1.0])
             } else {
-                let u = r[0] + x * (r[1] - r[0]);
-                let u = u.clamp(r[0], r[1]);
-                let h = r[1] - r[0];
-                (u, [(r[1] - u) / h, (u - r[0]) / h])
-            }
-        };
-        let (u, s) = at(ls, self.bu);
-        let (v, t) = at(lt, self.bv);
-        let val = bz::eval(self.c0, self.deg(), s, t, tmp);
-        let bound = bz::eval_error(self.c0, self.deg(), self.sc.err, 3);
+                let u = (a + ls[d] * (b - a)).clamp(a, b);
+                let h = b - a;
+                (u, [(b - u) / h, (u - a) / h])
+            };
+        }
+        let deg = self.el.deg;
+        let val = bz::eval(self.det.c0, deg, s, tmp);
+        let bound = bz::eval_error(self.det.c0, deg, self.det.sc.err, 3);
         if val >= -bound {
             return None;
         }
         let mut sides = Vec::new();
-        for (dir, x, r, name) in [(0, ls, self.bu, "xi"), (1, lt, self.bv, "eta")] {
-            for (end, at_end) in [(0, x == 0.0), (1, x == 1.0)] {
-                if at_end && self.dj.c0_line(dir, self.e[dir], end) {
-                    let (knot, rel) = if end == 0 { (r[0], ">") } else { (r[1], "<") };
+        for (dir, name) in ["xi", "eta", "zeta"].into_iter().take(D).enumerate() {
+            for (end, at_end) in [(0, ls[dir] == 0.0), (1, ls[dir] == 1.0)] {
+                if at_end && self.el.c0_knot(dir, self.e[dir], end) {
+                    let (knot, rel) = if end == 0 { (self.bounds[dir][0], ">") } else { (self.bounds[dir][1], "<") };
                     sides.push(format!(
                         "one-sided limit from {name} {rel} {knot} (the map is only C0 across {name} = {knot})"
                     ));
                 }
             }
         }
-        Some(FoldInfo {
+        Some(Fold {
             element: self.e,
-            param: [u, v],
-            value: self.to_det(val, s, t, tmp),
-            error_bound: self.to_det(bound, s, t, tmp),
+            param,
+            value: self.to_det(val, s, tmp),
+            error_bound: self.to_det(bound, s, tmp),
             one_sided: (!sides.is_empty()).then(|| sides.join("; ")),
         })
     }
 }
 
-fn split4(b: &SubBox, d: Deg, tmp: &mut [f64]) -> [SubBox; 4] {
-    let n = d.len();
+/// The `2^D` children of a box, in the order of the local corners.
+fn split<const D: usize>(b: &SubBox<D>, d: Deg<D>, tmp: &mut [f64]) -> Vec<SubBox<D>> {
     let err = bz::split_error(&b.c, d, b.err);
-    let mut halves = vec![0.0; 2 * n];
-    let (l, r) = halves.split_at_mut(n);
-    bz::split_u(&b.c, d, l, r, tmp);
-    let mu = 0.5 * (b.su[0] + b.su[1]);
-    let mv = 0.5 * (b.sv[0] + b.sv[1]);
-    let (mut ll, mut lh) = (vec![0.0; n], vec![0.0; n]);
-    bz::split_v(l, d, &mut ll, &mut lh, tmp);
-    let (mut rl, mut rh) = (vec![0.0; n], vec![0.0; n]);
-    bz::split_v(r, d, &mut rl, &mut rh, tmp);
-    let depth = b.depth + 1;
-    [
-        SubBox { c: ll, su: [b.su[0], mu], sv: [b.sv[0], mv], depth, err },
-        SubBox { c: rl, su: [mu, b.su[1]], sv: [b.sv[0], mv], depth, err },
-        SubBox { c: rh, su: [mu, b.su[1]], sv: [mv, b.sv[1]], depth, err },
-        SubBox { c: lh, su: [b.su[0], mu], sv: [mv, b.sv[1]], depth, err },
-    ]
+    let mut kids: Vec<Option<Vec<f64>>> = bz::children(&b.c, d, tmp).into_iter().map(Some).collect();
+    (0..kids.len())
+        .map(|k| {
+            let bits = corner_bits(D, k);
+            let s = std::array::from_fn(|dir| {
+                let [lo, hi] = b.s[dir];
+                let mid = 0.5 * (lo + hi);
+                if (bits >> dir) & 1 == 0 {
+                    [lo, mid]
+                } else {
+                    [mid, hi]
+                }
+            });
+            SubBox { c: kids[bits].take().expect("each child once"), s, depth: b.depth + 1, err }
+        })
+        .collect()
 }
 
 /// Prove, refute or leave open the boxes of `stack`.
-fn run(ctx: &Ctx<'_, '_>, w: &mut Work, mut stack: Vec<SubBox>, st: &mut Search) {
-    let d = ctx.deg();
-    let [du, dv] = d.0;
-    let wd = du + 1;
+fn run<const D: usize>(ctx: &Ctx<'_, '_, D>, tmp: &mut [f64], mut stack: Vec<SubBox<D>>, st: &mut Search<D>) {
+    let d = ctx.el.deg;
+    let nc = 1 << D;
     while let Some(b) = stack.pop() {
         if let Some(k) = ctx.touches(&b) {
-            corner(ctx, w, b, k, st);
+            corner(ctx, tmp, b, k, st);
             if st.fold.is_some() {
                 return;
             }
@@ -210,28 +216,27 @@ fn run(ctx: &Ctx<'_, '_>, w: &mut Work, mut stack: Vec<SubBox>, st: &mut Search)
         }
         // witnesses: the box corners (values known to b.err) and a dyadic point near the
         // smallest coefficient's Greville point
-        let (kk, ll) = (kmin % wd, kmin / wd);
+        let idx = d.index(kmin);
         let dyadic = |k: usize, n: usize| if n > 0 { (16.0 * k as f64 / n as f64).round() / 16.0 } else { 0.5 };
-        let (gs, gt) = (dyadic(kk, du), dyadic(ll, dv));
-        let gval = bz::eval(&b.c, d, [1.0 - gs, gs], [1.0 - gt, gt], &mut w.tmp);
+        let g: [f64; D] = std::array::from_fn(|dir| dyadic(idx[dir], d.0[dir]));
+        let gval = bz::eval(&b.c, d, g.map(|x| [1.0 - x, x]), tmp);
         let gerr = bz::eval_error(&b.c, d, b.err, 0);
-        let cands = [
-            (0.0, 0.0, b.c[0], b.err),
-            (1.0, 0.0, b.c[du], b.err),
-            (0.0, 1.0, b.c[dv * wd], b.err),
-            (1.0, 1.0, b.c[dv * wd + du], b.err),
-            (gs, gt, gval, gerr),
-        ];
-        for &(s, t, v, _) in &cands[..4] {
-            st.min_value = st.min_value.min(v);
-            let _ = (s, t);
+        let mut cands: Vec<([f64; D], f64, f64)> = (0..nc)
+            .map(|bits: usize| {
+                let bit = |dir: usize| (bits >> dir) & 1;
+                let k = d.at(std::array::from_fn(|dir| bit(dir) * d.0[dir]));
+                (std::array::from_fn(|dir| bit(dir) as f64), b.c[k], b.err)
+            })
+            .collect();
+        for c in &cands {
+            st.min_value = st.min_value.min(c.1);
         }
-        let mut best: Option<FoldInfo> = None;
-        for (s, t, v, e) in cands {
+        cands.push((g, gval, gerr));
+        let mut best: Option<Fold<D>> = None;
+        for (s, v, e) in cands {
             if v < -e {
-                let ls = b.su[0] + s * (b.su[1] - b.su[0]);
-                let lt = b.sv[0] + t * (b.sv[1] - b.sv[0]);
-                if let Some(f) = ctx.confirm(ls, lt, &mut w.tmp) {
+                let ls = std::array::from_fn(|k| b.s[k][0] + s[k] * (b.s[k][1] - b.s[k][0]));
+                if let Some(f) = ctx.confirm(ls, tmp) {
                     if best.as_ref().is_none_or(|x| f.value < x.value) {
                         best = Some(f);
                     }
@@ -242,7 +247,7 @@ fn run(ctx: &Ctx<'_, '_>, w: &mut Work, mut stack: Vec<SubBox>, st: &mut Search)
             st.fold = best;
             return;
         }
-        let spent = st.boxes + stack.len() + 4 > ctx.opts.max_boxes;
+        let spent = st.boxes + stack.len() + nc > ctx.opts.max_boxes;
         if b.depth >= ctx.opts.max_depth || spent {
             if st.open.is_none() {
                 let reason = if spent { "box-budget" } else { "max-depth" };
@@ -250,33 +255,25 @@ fn run(ctx: &Ctx<'_, '_>, w: &mut Work, mut stack: Vec<SubBox>, st: &mut Search)
             }
             continue;
         }
-        stack.extend(split4(&b, d, &mut w.tmp));
+        stack.extend(split(&b, d, tmp));
     }
 }
 
 /// Shrink the neighbourhood of forced corner `k` (local corner `k` of the element).
-fn corner(ctx: &Ctx<'_, '_>, w: &mut Work, mut b: SubBox, k: usize, st: &mut Search) {
-    let d = ctx.deg();
-    let dom = ctx.forced[k].unwrap_or(k);
+fn corner<const D: usize>(ctx: &Ctx<'_, '_, D>, tmp: &mut [f64], mut b: SubBox<D>, k: usize, st: &mut Search<D>) {
+    let d = ctx.el.deg;
+    let dom = ctx.det.forced[k].unwrap_or(k);
     loop {
         st.boxes += 1;
         st.depth = st.depth.max(b.depth);
-        let spent = st.boxes + 4 > ctx.opts.max_boxes;
+        let spent = st.boxes + (1 << D) > ctx.opts.max_boxes;
         if b.depth >= ctx.opts.max_depth || spent {
             break;
         }
-        let children = split4(&b, d, &mut w.tmp);
-        let mut others = Vec::with_capacity(3);
-        let mut cc = None;
-        for (i, c) in children.into_iter().enumerate() {
-            if i == k {
-                cc = Some(c);
-            } else {
-                others.push(c);
-            }
-        }
+        let mut others = split(&b, d, tmp);
+        let cc = others.remove(k);
         let mut sub = Search::new(st.boxes);
-        run(ctx, w, others, &mut sub);
+        run(ctx, tmp, others, &mut sub);
         st.boxes = sub.boxes;
         st.depth = st.depth.max(sub.depth);
         if sub.fold.is_none() && sub.open.is_none() {
@@ -285,76 +282,35 @@ fn corner(ctx: &Ctx<'_, '_>, w: &mut Work, mut b: SubBox, k: usize, st: &mut Sea
             for (a, x) in st.excused.iter_mut().zip(sub.excused) {
                 *a = a.or(x);
             }
-            b = cc.expect("four children");
+            b = cc;
             continue;
         }
-        if sub.fold.is_some() && !ctx.negative[k] {
+        if sub.fold.is_some() && !ctx.det.negative[k] {
             st.fold = sub.fold;
             return;
         }
         break;
     }
-    let ext = [(b.su[1] - b.su[0]) * (ctx.bu[1] - ctx.bu[0]), (b.sv[1] - b.sv[0]) * (ctx.bv[1] - ctx.bv[0])];
+    let ext = std::array::from_fn(|dir| (b.s[dir][1] - b.s[dir][0]) * (ctx.bounds[dir][1] - ctx.bounds[dir][0]));
     st.excused[dom] = Some(ext);
 }
 
-/// Whether local corner `k` of element `e` lies on a side of the domain (not at one of
-/// its corners) where that side's tangent vanishes within rounding, one-sided from `e`.
-fn zero_speed_point(dj: &DetJElements<'_>, w: &Work, e: [usize; 2], k: usize) -> bool {
-    let shape = dj.shape();
-    let (s, t) = LOCAL[k];
-    let (s, t) = (s as usize, t as usize);
-    // on a side eta = const (south or north): the tangent is x_ξ; xi = const: x_η
-    let on_eta_side = (t == 0 && e[1] == 0) || (t == 1 && e[1] + 1 == shape[1]);
-    let on_xi_side = (s == 0 && e[0] == 0) || (s == 1 && e[0] + 1 == shape[0]);
-    (on_eta_side && dj.zero_tangent(w, 0, s, t)) || (on_xi_side && dj.zero_tangent(w, 1, s, t))
-}
-
-/// Examine element `e`.
-pub(super) fn examine(dj: &DetJElements<'_>, e: [usize; 2], opts: &CertifyOptions, w: &mut Work) -> ElementResult {
-    let d = dj.deg;
-    let [du, dv] = d.0;
-    let n = d.len();
-    let (bu, bv) = dj.bounds(e);
-    let mut c0 = vec![0.0; n];
-    let sc = dj.coefficients(e, w, &mut c0);
-    let wnet = dj.map.weights.is_some().then(|| w.net[2].clone());
-    let shape = dj.shape();
-    // domain corners at this element's local corners
-    let (x0, x1) = (e[0] == 0, e[0] + 1 == shape[0]);
-    let (y0, y1) = (e[1] == 0, e[1] + 1 == shape[1]);
-    let at = [x0 && y0, x1 && y0, x1 && y1, x0 && y1];
-    let corner_coef = [c0[0], c0[du], c0[n - 1], c0[dv * (du + 1)]];
-    let mut forced = [None; 4];
-    let mut negative = [false; 4];
-    let mut forced_bits = 0u8;
-    for k in 0..4 {
-        if at[k] && corner_coef[k] <= sc.err {
-            forced_bits |= 1 << k;
-            if opts.excuse_corners {
-                forced[k] = Some(k);
-                negative[k] = corner_coef[k] < -sc.err;
-            }
-        } else if !at[k] && opts.excuse_corners && corner_coef[k] <= sc.err && zero_speed_point(dj, w, e, k) {
-            // a point of a side where the side's own speed vanishes: det J = x_ξ × x_η = 0
-            // there for every map of that boundary (not a negative value: a fold nearby
-            // is still a fold)
-            forced[k] = Some(4 + k);
-        }
-    }
-    let integral = if dj.map.weights.is_none() {
-        c0.iter().sum::<f64>() / n as f64 * sc.factor * (bu[1] - bu[0]) * (bv[1] - bv[0])
-    } else {
-        0.0
-    };
-    let ctx = Ctx { dj, opts, e, bu, bv, c0: &c0, sc, wnet, forced, negative };
+/// Examine element `e` whose `det J` is `det`; `tmp` holds at least `el.deg.len()` values.
+pub(super) fn examine<const D: usize>(
+    el: &Elements<'_, D>,
+    e: [usize; D],
+    det: ElementDet<'_>,
+    opts: &CertifyOptions,
+    tmp: &mut [f64],
+) -> ElementResult<D> {
+    let sc = det.sc;
+    let root = SubBox { c: det.c0.to_vec(), s: [[0.0, 1.0]; D], depth: 0, err: sc.err };
+    let ctx = Ctx { el, opts, e, bounds: el.bounds(e), det };
     let mut st = Search::new(0);
-    let root = SubBox { c: c0.clone(), su: [0.0, 1.0], sv: [0.0, 1.0], depth: 0, err: sc.err };
-    run(&ctx, w, vec![root], &mut st);
-    let to_det_bound = |v: f64| sc.factor * v / (sc.wmax * sc.wmax * sc.wmax);
-    let rational = dj.map.weights.is_some();
+    run(&ctx, tmp, vec![root], &mut st);
+    let to_det_bound = |v: f64| sc.factor * v / sc.wmax.powi(D as i32 + 1);
     let undecided = if st.fold.is_none() {
-        st.open.map(|(reason, err, cmin)| UndecidedInfo {
+        st.open.map(|(reason, err, cmin)| Undecided {
             element: e,
             reason,
             depth: st.depth,
@@ -365,16 +321,160 @@ pub(super) fn examine(dj: &DetJElements<'_>, e: [usize; 2], opts: &CertifyOption
     } else {
         None
     };
-    let _ = amax;
     ElementResult {
         fold: st.fold,
         undecided,
         lower: if st.lower.is_finite() { to_det_bound(st.lower) * (1.0 - 1e-12) } else { f64::INFINITY },
-        min_value: if rational { f64::INFINITY } else { sc.factor * st.min_value },
-        integral,
+        min_value: if el.rational() { f64::INFINITY } else { sc.factor * st.min_value },
         boxes: st.boxes,
         depth: st.depth,
-        forced: forced_bits,
         excused: st.excused,
+    }
+}
+
+/// `∫ det J` over an element of a polynomial map: the mean of the Bernstein coefficients
+/// times the factor and the element's parameter measure (multiplied as each certificate
+/// always has).
+fn integral<const D: usize>(c0: &[f64], factor: f64, bounds: [[f64; 2]; D]) -> f64 {
+    let mean = c0.iter().sum::<f64>() / c0.len() as f64 * factor;
+    if D == 2 {
+        bounds.iter().fold(mean, |r, b| r * (b[1] - b[0]))
+    } else {
+        mean * bounds.iter().map(|b| b[1] - b[0]).product::<f64>()
+    }
+}
+
+/// A planar element's outcome with the corners forced there.
+pub(super) struct SurfaceElement {
+    pub result: ElementResult<2>,
+    /// Domain corners (bits) at this element where `det J > 0` is not provable.
+    pub forced: u8,
+    /// Integral of `det J` over the element (polynomial maps).
+    pub integral: f64,
+}
+
+/// Examine element `e` of a map of the plane: its forced corners and zero-speed points,
+/// then the search.
+pub(super) fn examine_surface(
+    el: &Elements<'_, 2>,
+    e: [usize; 2],
+    opts: &CertifyOptions,
+    tmp: &mut [f64],
+) -> SurfaceElement {
+    let d = el.deg;
+    let [du, dv] = d.0;
+    let n = d.len();
+    let mut c0 = vec![0.0; n];
+    let (sc, nets) = el.coefficients(e, &mut c0);
+    let shape = el.shape();
+    // domain corners at this element's local corners
+    let (x0, x1) = (e[0] == 0, e[0] + 1 == shape[0]);
+    let (y0, y1) = (e[1] == 0, e[1] + 1 == shape[1]);
+    let at = [x0 && y0, x1 && y0, x1 && y1, x0 && y1];
+    let corner_coef = [c0[0], c0[du], c0[n - 1], c0[dv * (du + 1)]];
+    let mut forced = [None; 8];
+    let mut negative = [false; 8];
+    let mut forced_bits = 0u8;
+    for k in 0..4 {
+        if at[k] && corner_coef[k] <= sc.err {
+            forced_bits |= 1 << k;
+            if opts.excuse_corners {
+                forced[k] = Some(k);
+                negative[k] = corner_coef[k] < -sc.err;
+            }
+        } else if !at[k] && opts.excuse_corners && corner_coef[k] <= sc.err && zero_speed_point(el, &nets, e, k) {
+            // a point of a side where the side's own speed vanishes: det J = x_ξ × x_η = 0
+            // there for every map of that boundary (not a negative value: a fold nearby
+            // is still a fold)
+            forced[k] = Some(4 + k);
+        }
+    }
+    let bounds = el.bounds(e);
+    let integral = if el.rational() { 0.0 } else { integral(&c0, sc.factor, bounds) };
+    let wnet = nets.h.get(2).map(|w| w.c.as_slice());
+    let result = examine(el, e, ElementDet { c0: &c0, sc, wnet, forced, negative }, opts, tmp);
+    SurfaceElement { result, forced: forced_bits, integral }
+}
+
+/// Examine element `e` of a volume (no forced corners); also `∫ det J` over it
+/// (polynomial maps).
+pub(super) fn examine_volume(el: &Elements<'_, 3>, e: [usize; 3], opts: &CertifyOptions) -> (ElementResult<3>, f64) {
+    let (c0, sc, wnet) = el.volume_coefficients(e);
+    let mut tmp = vec![0.0; el.deg.len()];
+    let integral = if el.rational() { 0.0 } else { integral(&c0, sc.factor, el.bounds(e)) };
+    let det = ElementDet { c0: &c0, sc, wnet: wnet.as_deref(), forced: [None; 8], negative: [false; 8] };
+    (examine(el, e, det, opts, &mut tmp), integral)
+}
+
+/// Whether local corner `k` of element `e` lies on a side of the domain (not at one of
+/// its corners) where that side's tangent vanishes within rounding, one-sided from `e`.
+fn zero_speed_point(el: &Elements<'_, 2>, nets: &super::element::Nets<2>, e: [usize; 2], k: usize) -> bool {
+    let shape = el.shape();
+    let bits = corner_bits(2, k);
+    let (s, t) = (bits & 1, bits >> 1);
+    // on a side eta = const (south or north): the tangent is x_ξ; xi = const: x_η
+    let on_eta_side = (t == 0 && e[1] == 0) || (t == 1 && e[1] + 1 == shape[1]);
+    let on_xi_side = (s == 0 && e[0] == 0) || (s == 1 && e[0] + 1 == shape[0]);
+    (on_eta_side && el.zero_tangent(nets, 0, s, t)) || (on_xi_side && el.zero_tangent(nets, 1, s, t))
+}
+
+/// Every element of a map with `shape` elements per direction, direction 0 fastest.
+pub(super) fn all_elements<const D: usize>(shape: [usize; D]) -> Vec<[usize; D]> {
+    (0..shape.iter().product())
+        .map(|mut i| {
+            std::array::from_fn(|d| {
+                let k = i % shape[d];
+                i /= shape[d];
+                k
+            })
+        })
+        .collect()
+}
+
+/// The elements' outcomes summed up, in the order of the elements.
+pub(super) struct Totals<const D: usize> {
+    /// Proven lower bound of `det J` over the proven boxes.
+    pub lower_bound: f64,
+    /// Smallest value of `det J` met (box corners of polynomial maps, fold witnesses).
+    pub min_value_found: f64,
+    pub boxes: usize,
+    pub max_depth: usize,
+    /// `∫ det J` (polynomial maps).
+    pub integral: f64,
+    pub folds: Vec<Fold<D>>,
+    pub undecided: Vec<Undecided<D>>,
+}
+
+impl<const D: usize> Totals<D> {
+    pub fn new() -> Self {
+        Self {
+            lower_bound: f64::INFINITY,
+            min_value_found: f64::INFINITY,
+            boxes: 0,
+            max_depth: 0,
+            integral: 0.0,
+            folds: Vec::new(),
+            undecided: Vec::new(),
+        }
+    }
+
+    /// Add one element's outcome and its `∫ det J`.
+    pub fn add(&mut self, r: ElementResult<D>, integral: f64) {
+        self.boxes += r.boxes;
+        self.max_depth = self.max_depth.max(r.depth);
+        self.integral += integral;
+        self.min_value_found = self.min_value_found.min(r.min_value);
+        self.lower_bound = self.lower_bound.min(r.lower);
+        if let Some(f) = r.fold {
+            self.min_value_found = self.min_value_found.min(f.value);
+            self.folds.push(f);
+        } else if let Some(u) = r.undecided {
+            self.undecided.push(u);
+        }
+    }
+
+    /// The most negative fold found.
+    pub fn worst_fold(&self) -> Option<&Fold<D>> {
+        self.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value))
     }
 }

@@ -1,23 +1,7 @@
+use super::rounding_tests::perturbed;
 use super::*;
 use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
-
-/// The identity map of the unit square on an open uniform basis, control points at the
-/// Greville abscissae, plus a random perturbation of relative size `amp` (of the
-/// element size) on every control point.
-fn perturbed(rng: &mut Lcg, p: usize, q: usize, ne: [usize; 2], amp: f64, rational: bool) -> Surface {
-    let kx = KnotVector::open_uniform(p, ne[0]);
-    let ky = KnotVector::open_uniform(q, ne[1]);
-    let (gx, gy) = (kx.greville(), ky.greville());
-    let mut cps = Vec::new();
-    for &y in &gy {
-        for &x in &gx {
-            cps.push([x + amp * (rng.uniform() - 0.5) / ne[0] as f64, y + amp * (rng.uniform() - 0.5) / ne[1] as f64]);
-        }
-    }
-    let w = rational.then(|| (0..cps.len()).map(|_| 0.6 + 0.8 * rng.uniform()).collect());
-    Surface::new([kx, ky], cps, w).unwrap()
-}
 
 fn dense_min(map: &Surface, n: usize) -> f64 {
     crate::verify::quality::sample_det_j(map, n).min
@@ -29,22 +13,21 @@ fn bernstein_det_j_equals_det_j() {
     for (p, q) in [(2, 2), (3, 2), (2, 4), (3, 3)] {
         for rational in [false, true] {
             let map = perturbed(&mut rng, p, q, [3, 2], 0.8, rational);
-            let dj = DetJElements::new(&map).unwrap();
-            let mut w = dj.work();
+            let dj = Elements::surface(&map).unwrap();
+            let mut tmp = vec![0.0; dj.deg.len()];
             let mut c = vec![0.0; dj.deg.len()];
             for j in 0..2 {
                 for i in 0..3 {
-                    let sc = dj.coefficients([i, j], &mut w, &mut c);
-                    let wnet = w.net[2].clone();
-                    let (bu, bv) = dj.bounds([i, j]);
+                    let (sc, nets) = dj.coefficients([i, j], &mut c);
+                    let [bu, bv] = dj.bounds([i, j]);
                     for _ in 0..10 {
                         let (s, t) = (rng.uniform(), rng.uniform());
                         let (u, v) = (bu[0] + s * (bu[1] - bu[0]), bv[0] + t * (bv[1] - bv[0]));
                         let exact = map.derivs(u, v, 1).det_j();
-                        let mut val = sc.factor * bernstein::eval(&c, dj.deg, [1.0 - s, s], [1.0 - t, t], &mut w.tmp);
+                        let st = [[1.0 - s, s], [1.0 - t, t]];
+                        let mut val = sc.factor * bernstein::eval(&c, dj.deg, st, &mut tmp);
                         if rational {
-                            let wt =
-                                bernstein::eval(&wnet, bernstein::Deg([p, q]), [1.0 - s, s], [1.0 - t, t], &mut w.tmp);
+                            let wt = bernstein::eval(&nets.h[2].c, bernstein::Deg([p, q]), st, &mut tmp);
                             val /= wt.powi(3);
                         }
                         assert!(

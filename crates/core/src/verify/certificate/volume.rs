@@ -2,12 +2,13 @@
 //! tensor-product map of degree `(p, q, r)` is, on every element, a polynomial of degree
 //! `(3p - 1, 3q - 1, 3r - 1)` (`det J = x_ξ · (x_η × x_ζ)`, each factor one degree lower
 //! in its own direction); for a NURBS map `det J = N / W⁴` with a numerator `N` of degree
-//! `(4p - 1, 4q - 1, 4r - 1)` (module `element`). As in the plane ([`super`]): the
-//! coefficients come in Bernstein form from the Bézier extraction, carry a rigorous
-//! bound of their rounding error (module `tensor`: `γ_n` bounds, the net taken relative
-//! to the element's first control point and scaled by a power of two), the smallest
-//! coefficient minus its bound is a proven lower bound, and boxes that are neither
-//! proven positive nor shown to fold are bisected (de Casteljau, all three directions).
+//! `(4p - 1, 4q - 1, 4r - 1)`. The machinery is the plane's ([`super`]), in three
+//! variables: the coefficients come in Bernstein form from the Bézier extraction
+//! (module `element`), carry a rigorous bound of their rounding error (module
+//! `bernstein`: `γ_n` bounds, the net taken relative to the element's first control
+//! point and scaled by a power of two), the smallest coefficient minus its bound is a
+//! proven lower bound, and boxes that are neither proven positive nor shown to fold are
+//! bisected (de Casteljau, all three directions; module `search`).
 //!
 //! **Verdicts.** [`VolumeVerdict::Certified`] when every element is proven
 //! (`min ĉ - e > 0` on every box), with the proven lower bound of `det J`;
@@ -16,21 +17,17 @@
 //! point); [`VolumeVerdict::Undecided`] when the budget is spent, with the reason per
 //! element. Unlike maps of the plane there is no excused corner: every point counts.
 
-mod element;
-mod search;
-mod tensor;
-
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::CertifyOptions;
+use super::element::Elements;
+use super::{certified_message, folded_message, offending, search, undecided_message, CertifyOptions, Fold, Undecided};
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::quadrature::GaussLegendre;
 use crate::spline::volume::Volume;
-use element::DetJ3;
 
 /// The outcome of [`certify_volume`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -74,37 +71,11 @@ impl VolumeVerdict {
     }
 }
 
-/// An element where `det J < 0` was proven at a point.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct VolumeFold {
-    /// Element `(i, j, k)`.
-    pub element: [usize; 3],
-    /// Parameter point.
-    pub param: [f64; 3],
-    /// `det J` there (one-sided on a `C^0` knot plane).
-    pub value: f64,
-    /// Rounding bound of `value` (`value < -error_bound`).
-    pub error_bound: f64,
-    /// On a knot plane where the map is only `C^0`: which one-sided limit `value` is.
-    pub one_sided: Option<String>,
-}
+/// A fold of a volume.
+pub type VolumeFold = Fold<3>;
 
-/// An element neither proven positive nor shown to fold.
-#[derive(Debug, Clone, Serialize)]
-pub struct VolumeUndecided {
-    /// Element `(i, j, k)`.
-    pub element: [usize; 3],
-    /// Why the search stopped: `max-depth` or `box-budget`.
-    pub reason: &'static str,
-    /// Deepest bisection level reached on the element.
-    pub depth: usize,
-    /// Boxes examined on the element.
-    pub boxes: usize,
-    /// Smallest `det J` coefficient of the first box left open (scaled like `det J`).
-    pub smallest_coefficient: f64,
-    /// Its rounding bound.
-    pub error_bound: f64,
-}
+/// An undecided element of a volume.
+pub type VolumeUndecided = Undecided<3>;
 
 /// The bijectivity certificate of a volume.
 #[derive(Debug, Clone, Serialize)]
@@ -139,44 +110,20 @@ pub struct VolumeCertificate {
 impl VolumeCertificate {
     /// Elements that are folded or undecided.
     pub fn offending_elements(&self) -> Vec<[usize; 3]> {
-        let mut v: Vec<[usize; 3]> =
-            self.folds.iter().map(|f| f.element).chain(self.undecided.iter().map(|u| u.element)).collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        offending(&self.folds, self.undecided.iter().map(|u| u.element))
     }
 
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            VolumeVerdict::Certified { lower_bound, relative } => format!(
-                "certified bijective: det J >= {lower_bound:.4e} ({relative:.3e} of its mean) proven on all {} elements \
-                 ({} Bernstein boxes, rounding bounded)",
-                self.elements, self.boxes
-            ),
-            VolumeVerdict::Folded { param, point, value, error_bound, one_sided } => format!(
-                "FOLDED: det J = {value:.4e} < 0 (rounding bound {error_bound:.1e}) at (xi, eta, zeta) = ({:.6}, {:.6}, \
-                 {:.6}), x = ({:.6}, {:.6}, {:.6}){}; {} element(s) fold",
-                param[0],
-                param[1],
-                param[2],
-                point[0],
-                point[1],
-                point[2],
-                one_sided.as_ref().map(|s| format!(", {s}")).unwrap_or_default(),
-                self.folds.len()
-            ),
+            VolumeVerdict::Certified { lower_bound, relative } => {
+                certified_message(*lower_bound, *relative, self.elements, self.boxes)
+            }
+            VolumeVerdict::Folded { param, point, value, error_bound, one_sided } => {
+                folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
+            }
             VolumeVerdict::Undecided { elements } => {
-                let rounding = self.undecided.iter().filter(|u| u.smallest_coefficient.abs() <= u.error_bound).count();
-                let budget = self.undecided.iter().filter(|u| u.reason == "box-budget").count();
-                format!(
-                    "undecided: {} element(s) neither proven positive nor shown to fold within {} bisections \
-                     ({rounding} with det J zero within its rounding bound, {budget} stopped by the box budget; \
-                     smallest value found {:.4e})",
-                    elements.len(),
-                    self.max_depth,
-                    self.min_value_found
-                )
+                undecided_message(elements.len(), &self.undecided, self.max_depth, self.min_value_found)
             }
         }
     }
@@ -222,46 +169,20 @@ pub fn volume_integral(vol: &Volume) -> f64 {
 /// domain is a typed error ([`crate::error::Error::KnotMultiplicity`]).
 pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCertificate> {
     let t0 = Instant::now();
-    let dj = DetJ3::new(vol)?;
+    let dj = Elements::volume(vol)?;
     let shape = dj.shape();
-    let all: Vec<[usize; 3]> =
-        (0..shape[2]).flat_map(|k| (0..shape[1]).flat_map(move |j| (0..shape[0]).map(move |i| [i, j, k]))).collect();
-    let results: Vec<search::ElementResult3> = all.par_iter().map(|&e| search::examine(&dj, e, opts)).collect();
-    let mut cert = VolumeCertificate {
-        verdict: VolumeVerdict::Undecided { elements: Vec::new() },
-        lower_bound: f64::INFINITY,
-        mean_det_j: 0.0,
-        min_value_found: f64::INFINITY,
-        det_degree: dj.deg.0,
-        elements: all.len(),
-        element_shape: shape,
-        boxes: 0,
-        max_depth: 0,
-        folds: Vec::new(),
-        undecided: Vec::new(),
-        seconds: 0.0,
-    };
-    let mut integral = 0.0;
-    for r in results {
-        cert.boxes += r.boxes;
-        cert.max_depth = cert.max_depth.max(r.depth);
-        integral += r.integral;
-        cert.min_value_found = cert.min_value_found.min(r.min_value);
-        cert.lower_bound = cert.lower_bound.min(r.lower);
-        if let Some(f) = r.fold {
-            cert.min_value_found = cert.min_value_found.min(f.value);
-            cert.folds.push(f);
-        } else if let Some(u) = r.undecided {
-            cert.undecided.push(u);
-        }
+    let all = search::all_elements(shape);
+    let results: Vec<(search::ElementResult<3>, f64)> =
+        all.par_iter().map(|&e| search::examine_volume(&dj, e, opts)).collect();
+    let mut totals = search::Totals::new();
+    for (r, integral) in results {
+        totals.add(r, integral);
     }
     let par_volume: f64 = vol.knots.iter().map(|k| k.domain().1 - k.domain().0).product();
-    if vol.weights.is_some() {
-        integral = volume_integral(vol);
-    }
-    cert.mean_det_j = integral / par_volume;
-    let relative = cert.lower_bound / cert.mean_det_j;
-    cert.verdict = if let Some(f) = cert.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)) {
+    let integral = if vol.weights.is_some() { volume_integral(vol) } else { totals.integral };
+    let mean_det_j = integral / par_volume;
+    let relative = totals.lower_bound / mean_det_j;
+    let verdict = if let Some(f) = totals.worst_fold() {
         VolumeVerdict::Folded {
             param: f.param,
             point: vol.eval(f.param),
@@ -269,16 +190,26 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
             error_bound: f.error_bound,
             one_sided: f.one_sided.clone(),
         }
-    } else if !cert.undecided.is_empty() {
-        VolumeVerdict::Undecided { elements: cert.undecided.iter().map(|u| u.element).collect() }
+    } else if !totals.undecided.is_empty() {
+        VolumeVerdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else {
-        VolumeVerdict::Certified { lower_bound: cert.lower_bound, relative }
+        VolumeVerdict::Certified { lower_bound: totals.lower_bound, relative }
     };
-    cert.seconds = t0.elapsed().as_secs_f64();
-    Ok(cert)
+    Ok(VolumeCertificate {
+        verdict,
+        lower_bound: totals.lower_bound,
+        mean_det_j,
+        min_value_found: totals.min_value_found,
+        det_degree: dj.deg.0,
+        elements: all.len(),
+        element_shape: shape,
+        boxes: totals.boxes,
+        max_depth: totals.max_depth,
+        folds: totals.folds,
+        undecided: totals.undecided,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
-#[cfg(test)]
-mod judge;
 #[cfg(test)]
 mod tests;

@@ -2,7 +2,7 @@ use super::*;
 use crate::spline::surface::Surface;
 use crate::testutil::Lcg;
 use crate::verify::certificate::bernstein::eval;
-use crate::verify::certificate::element::DetJElements;
+use crate::verify::certificate::element::Elements;
 
 /// A perturbed identity on an open basis with one inner knot of multiplicity two.
 fn map(rng: &mut Lcg, p: usize, q: usize, amp: f64) -> Surface {
@@ -26,25 +26,25 @@ fn coefficients_are_the_certificates_and_interpolate_det_j() {
         let dc = DetCoefficients::new(&s.knots).unwrap();
         let d = dc.values(&s.control_points);
         assert_eq!(d.len(), dc.len());
-        let dj = DetJElements::new(&s).unwrap();
+        let dj = Elements::surface(&s).unwrap();
         assert_eq!(dj.deg.0, dc.degree());
-        let mut w = dj.work();
+        let mut tmp = vec![0.0; dj.deg.len()];
         let mut c = vec![0.0; dj.deg.len()];
         let [n, m] = dc.shape();
         let per = dc.per_element();
         for j in 0..m {
             for i in 0..n {
-                let sc = dj.coefficients([i, j], &mut w, &mut c);
+                let (sc, _) = dj.coefficients([i, j], &mut c);
                 let mine = &d[(j * n + i) * per..(j * n + i + 1) * per];
                 let scale = mine.iter().fold(0.0f64, |a, x| a.max(x.abs()));
                 for (a, b) in mine.iter().zip(&c) {
                     assert!((a - sc.factor * b).abs() < 1e-12 * scale, "p={p} q={q}: {a} vs {}", sc.factor * b);
                 }
-                let (bu, bv) = dj.bounds([i, j]);
+                let [bu, bv] = dj.bounds([i, j]);
                 for _ in 0..5 {
                     let (x, y) = (rng.uniform(), rng.uniform());
                     let exact = s.derivs(bu[0] + x * (bu[1] - bu[0]), bv[0] + y * (bv[1] - bv[0]), 1).det_j();
-                    let val = eval(mine, Deg(dc.degree()), [1.0 - x, x], [1.0 - y, y], &mut w.tmp);
+                    let val = eval(mine, Deg(dc.degree()), [[1.0 - x, x], [1.0 - y, y]], &mut tmp);
                     assert!((val - exact).abs() < 1e-12 * scale, "{val} vs {exact}");
                 }
             }

@@ -1,10 +1,10 @@
-use super::element::DetJ3;
-use super::judge::{Exact3, Sign3};
-use super::tensor::{eval, scratch_len, Deg3};
 use super::*;
 use crate::error::Error;
 use crate::spline::knots::KnotVector;
 use crate::testutil::Lcg;
+use crate::verify::certificate::bernstein::{eval, Deg};
+use crate::verify::certificate::element::Elements;
+use crate::verify::certificate::judge::{Exact3, Sign3};
 
 /// The identity of the unit cube on open uniform bases (control points at the Greville
 /// abscissae), every control point moved at random by `amp` times the element size.
@@ -54,19 +54,19 @@ fn bernstein_det_j_equals_det_j() {
     for deg in [[1, 1, 1], [2, 2, 1], [2, 3, 2], [3, 3, 3]] {
         for rational in [false, true] {
             let vol = perturbed(&mut rng, deg, [2, 2, 2], 0.8, rational);
-            let dj = DetJ3::new(&vol).unwrap();
-            let mut tmp = vec![0.0; scratch_len(dj.deg)];
+            let dj = Elements::volume(&vol).unwrap();
+            let mut tmp = vec![0.0; dj.deg.len()];
             for e in [[0, 0, 0], [1, 0, 1], [1, 1, 1]] {
-                let el = dj.coefficients(e);
+                let (c, sc, wnet) = dj.volume_coefficients(e);
                 let b = dj.bounds(e);
                 for _ in 0..10 {
                     let s = [rng.uniform(), rng.uniform(), rng.uniform()];
                     let u = std::array::from_fn(|d| b[d][0] + s[d] * (b[d][1] - b[d][0]));
                     let exact = vol.derivs(u).det_j();
                     let pairs = s.map(|x| [1.0 - x, x]);
-                    let mut val = el.factor * eval(&el.c, dj.deg, pairs, &mut tmp);
-                    if let Some(wn) = &el.wnet {
-                        val /= eval(wn, Deg3(deg), pairs, &mut tmp).powi(4);
+                    let mut val = sc.factor * eval(&c, dj.deg, pairs, &mut tmp);
+                    if let Some(wn) = &wnet {
+                        val /= eval(wn, Deg(deg), pairs, &mut tmp).powi(4);
                     }
                     assert!((val - exact).abs() < 1e-11 * (1.0 + exact.abs()), "{deg:?} {rational}: {val} vs {exact}");
                 }
@@ -131,7 +131,7 @@ fn certificate_agrees_with_the_exact_judge() {
         for amp in [0.2, 0.9, 1.4, 2.0] {
             let vol = perturbed(&mut rng, deg, ne, amp, rational);
             let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
-            let exact = Exact3::new(&vol).sign(5, 200);
+            let (exact, _) = Exact3::volume(&vol).sign(1, 5, 200);
             match (&exact, &c.verdict) {
                 (Sign3::Positive, VolumeVerdict::Folded { .. }) => panic!("judge positive, certificate folded"),
                 (Sign3::Negative { .. }, VolumeVerdict::Certified { .. }) => panic!("judge negative, certified"),
