@@ -14,8 +14,6 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use serde::Serialize;
-
 use super::dofs::GlobalDofs;
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::{DofMap, FIXED};
@@ -29,26 +27,10 @@ use crate::methods::DiscreteProblem;
 use crate::spline::curve::Point;
 use crate::spline::surface::Surface;
 
-/// What the global problem over all patches is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum Functional {
-    /// Minimize the Winslow functional (eq. 16) over all patches.
-    #[default]
-    Winslow,
-    /// Solve the weak form (eq. 14) over all patches.
-    WeakForm,
-}
-
-impl Functional {
-    /// `"winslow"` or `"weak-form"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Functional::Winslow => "winslow",
-            Functional::WeakForm => "weak-form",
-        }
-    }
-}
+/// What the global problem over all patches is: the improvement's functional
+/// ([`Improve`](crate::solve::improve::Improve)), the Winslow functional (eq. 16) or the
+/// weak form (eq. 14), summed over the patches.
+pub use crate::solve::improve::Improve as Functional;
 
 /// Smallest and largest relative diagonal shift of the presented Hessian.
 const SHIFT_MIN: f64 = 1e-4;

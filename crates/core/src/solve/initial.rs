@@ -5,7 +5,8 @@
 
 use std::sync::Arc;
 
-use super::newton::{NonlinearOptions, NonlinearSolver, Status};
+use super::fixed_basis::FixedBasisSolve;
+use super::newton::NonlinearOptions;
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
@@ -268,20 +269,13 @@ pub fn continuation_with(
             continue;
         }
         // solve with the damped boundary
-        let c0 = disc.dofs.gather(&guess);
-        let problem = method.problem(disc.clone(), guess.clone());
-        let mut solver = NonlinearSolver::new(problem, c0, nl);
-        let mut iterations = 0;
-        for it in solver.by_ref() {
-            iterations = it?.iteration;
-        }
+        let solved = FixedBasisSolve::new(method, disc.clone(), guess.clone(), nl).finish()?;
         cont.steps += 1;
         // a minimisation only lowers its objective from a feasible start: a positive
         // result is a better base even before its stopping rule is met
-        let converged = *solver.status() == Status::Converged || solver.objective().is_some_and(f64::is_finite);
-        let (problem, c) = solver.into_parts();
-        let sol = problem.control_points(&c);
-        cont.iterations += iterations;
+        let converged = solved.converged() || solved.objective.is_some_and(f64::is_finite);
+        let sol = solved.control_points;
+        cont.iterations += solved.history.iterations;
         if converged && positive(&sol) {
             base = sol;
             done = a;

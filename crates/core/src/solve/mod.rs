@@ -5,6 +5,7 @@
 //! | module | holds | paper |
 //! |---|---|---|
 //! | [`newton`] | [`NonlinearSolver`](newton::NonlinearSolver): damped Newton with line search, pseudo time-stepping with the SER rule; an `Iterator` of iterates | §6.1, §6.2, eq. (24)-(33) |
+//! | [`fixed_basis`] | [`FixedBasisSolve`](fixed_basis::FixedBasisSolve): one solve on a fixed basis (scaled options, iterates recorded while they stream, the result taken back, "keep only if certified"), run by every stage below | §4.1, §6, §9, §11 |
 //! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
@@ -20,6 +21,7 @@
 
 pub mod compare;
 pub mod constrained;
+pub mod fixed_basis;
 pub mod improve;
 pub mod initial;
 pub mod kinks;
