@@ -48,7 +48,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::density::{first_derivatives, integrate, Order};
+use super::density::{first_derivatives, integrate, lowered, raised, shift_diagonal, Order};
 use super::flux::{flux_form_with, gradient_at};
 use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method, Start};
@@ -388,47 +388,6 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
 /// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
 pub const PROJECTION_FIRST: f64 = 0.3;
 
-/// Smallest and largest relative diagonal shift `τ` of the Hessian.
-const SHIFT_MIN: f64 = 1e-4;
-const SHIFT_MAX: f64 = 1e8;
-
-/// The relative diagonal shift `τ` of a Hessian presented as the Newton matrix `-H` of
-/// `F = -∇J`: `H_ii + τ max(|H_ii|, 10⁻⁸ mean_j |H_jj|)`, raised `0, 10⁻⁴, 10⁻³, …,
-/// 10⁸` while the Hessian is not positive definite along the Newton direction, and one
-/// stage back (tenfold down, to 0 below `10⁻³`) at a new point. Shared by every
-/// Winslow problem, on one patch ([`WinslowProblem`]) or over a layout
-/// ([`crate::multipatch::problem::MultipatchProblem`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct DiagonalShift(pub(crate) f64);
-
-impl DiagonalShift {
-    /// One stage back, at a new point.
-    pub(crate) fn decay(&mut self) {
-        self.0 = if self.0 > 10.0 * SHIFT_MIN { 0.1 * self.0 } else { 0.0 };
-    }
-
-    /// One stage up; `false` (unchanged) past the largest.
-    pub(crate) fn raise(&mut self) -> bool {
-        let next = if self.0 == 0.0 { SHIFT_MIN } else { 10.0 * self.0 };
-        if next > SHIFT_MAX {
-            return false;
-        }
-        self.0 = next;
-        true
-    }
-
-    /// Shift the diagonal entries at positions `diag` of the Newton matrix `values`.
-    pub(crate) fn apply(self, diag: &[usize], values: &mut [f64]) {
-        if self.0 > 0.0 {
-            let mean = diag.iter().map(|&k| values[k].abs()).sum::<f64>() / diag.len().max(1) as f64;
-            for &k in diag {
-                // values = -H: H_ii + τ max(|H_ii|, 1e-8 mean)
-                values[k] -= self.0 * values[k].abs().max(1e-8 * mean);
-            }
-        }
-    }
-}
-
 /// The Winslow functional on one level: discretization, control points (fixed ones hold
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
@@ -437,7 +396,7 @@ pub struct WinslowProblem {
     /// Positions of the diagonal entries in the vector pattern's values.
     diag: Vec<usize>,
     /// Relative diagonal shift `τ` of the presented Hessian.
-    shift: DiagonalShift,
+    shift: f64,
     /// The stencil holds the Hessian at `assembled`, projected or not (for a re-shift
     /// without assembly).
     assembled: Option<(Vec<f64>, f64)>,
@@ -456,7 +415,7 @@ pub struct WinslowProblem {
 
 impl std::fmt::Debug for WinslowProblem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("WinslowProblem").field("unknowns", &self.size()).field("shift", &self.shift.0).finish()
+        f.debug_struct("WinslowProblem").field("unknowns", &self.size()).field("shift", &self.shift).finish()
     }
 }
 
@@ -468,7 +427,7 @@ impl WinslowProblem {
         Self {
             state: GalerkinState::new(disc, cps),
             diag,
-            shift: DiagonalShift::default(),
+            shift: 0.0,
             assembled: None,
             raised: false,
             raised_at_point: false,
@@ -484,7 +443,7 @@ impl WinslowProblem {
 
     /// The relative diagonal shift `τ` the last Jacobian carried.
     pub fn shift(&self) -> f64 {
-        self.shift.0
+        self.shift
     }
 }
 
@@ -512,7 +471,7 @@ impl DiscreteProblem for WinslowProblem {
             // an assembly and a failed factorization); where the last point needed a
             // stronger modification than the one it started with, its modification
             // is kept for this one (the stages it failed would fail here too)
-            self.shift.decay();
+            self.shift = lowered(self.shift);
             self.projected = match self.projected {
                 x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
                 x if x > PROJECTION_FIRST => PROJECTION_FIRST,
@@ -527,7 +486,7 @@ impl DiscreteProblem for WinslowProblem {
         }
         s.restrict_residual(f);
         s.gather_jacobian(jac);
-        self.shift.apply(&self.diag, &mut jac.values);
+        shift_diagonal(self.shift, &self.diag, &mut jac.values);
     }
 
     fn mass(&mut self) -> &Csr {
@@ -550,7 +509,7 @@ impl DiscreteProblem for WinslowProblem {
     /// point, a descent direction of moderate length where the exact one is indefinite),
     /// then diagonal shifts on top of it.
     fn modified(&self) -> bool {
-        self.projected > 0.0 || self.shift.0 > 0.0
+        self.projected > 0.0 || self.shift > 0.0
     }
 
     fn raise_shift(&mut self) -> bool {
@@ -560,7 +519,9 @@ impl DiscreteProblem for WinslowProblem {
             self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
             return true;
         }
-        self.shift.raise()
+        let Some(next) = raised(self.shift) else { return false };
+        self.shift = next;
+        true
     }
 
     /// `K` of [`winslow_laplace`] on the current control points.

@@ -19,9 +19,11 @@ use crate::discrete::dofs::DofMap;
 use crate::discrete::pattern::{summed_pattern, StencilBasis, SystemPattern};
 use crate::error::Result;
 use crate::linalg::sparse::Csr;
+use crate::methods::density::{lowered, raised, shift_diagonal};
 use crate::methods::flux::{flux_form, min_det_j};
+use crate::methods::galerkin::block_mass;
 use crate::methods::weak_form::{weak_flux, weak_laplace};
-use crate::methods::winslow::{winslow_gradient, winslow_laplace, winslow_objective, DiagonalShift};
+use crate::methods::winslow::{winslow_gradient, winslow_laplace, winslow_objective};
 use crate::methods::DiscreteProblem;
 use crate::spline::curve::Point;
 use crate::spline::surface::Surface;
@@ -48,7 +50,7 @@ pub struct MultipatchProblem {
     mass: Option<Csr>,
     prec: Csr,
     diag: Vec<usize>,
-    shift: DiagonalShift,
+    shift: f64,
     raised: bool,
     assembled: Option<Vec<f64>>,
 }
@@ -116,7 +118,7 @@ impl MultipatchProblem {
             scalar,
             mass: None,
             diag,
-            shift: DiagonalShift::default(),
+            shift: 0.0,
             raised: false,
             assembled: None,
             scratch: cps.clone(),
@@ -196,7 +198,7 @@ impl DiscreteProblem for MultipatchProblem {
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
         let winslow = self.functional == Functional::Winslow;
         if winslow && !std::mem::take(&mut self.raised) {
-            self.shift.decay();
+            self.shift = lowered(self.shift);
         }
         if self.assembled.as_deref() != Some(c) {
             self.dofs.scatter(c, &mut self.cps);
@@ -209,7 +211,7 @@ impl DiscreteProblem for MultipatchProblem {
         }
         self.vector.gather_into(&self.stencil, &mut jac.values);
         if winslow {
-            self.shift.apply(&self.diag, &mut jac.values);
+            shift_diagonal(self.shift, &self.diag, &mut jac.values);
         }
     }
 
@@ -219,18 +221,7 @@ impl DiscreteProblem for MultipatchProblem {
             for (p, disc) in self.discs.iter().enumerate() {
                 disc.mass(&mut st[self.soffsets[p]..self.soffsets[p] + disc.stencil_len(1)]);
             }
-            let m = self.scalar.matrix(&st);
-            let ms = self.dofs.num_free();
-            let mut out = self.vector.csr.clone();
-            for r in 0..out.nrows {
-                let (z, f) = (r / ms, r % ms);
-                for k in out.row_ptr[r]..out.row_ptr[r + 1] {
-                    let cidx = out.col_idx[k];
-                    let (d, g) = (cidx / ms, cidx % ms);
-                    out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
-                }
-            }
-            self.mass = Some(out);
+            self.mass = Some(block_mass(&self.vector.csr, &self.scalar.matrix(&st)));
         }
         self.mass.as_ref().expect("set above")
     }
@@ -256,9 +247,8 @@ impl DiscreteProblem for MultipatchProblem {
         if self.functional != Functional::Winslow {
             return false;
         }
-        if !self.shift.raise() {
-            return false;
-        }
+        let Some(next) = raised(self.shift) else { return false };
+        self.shift = next;
         self.raised = true;
         true
     }

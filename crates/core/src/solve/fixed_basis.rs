@@ -1,19 +1,10 @@
-//! One solve on a fixed basis: a [`DiscreteProblem`] (a [`Method`] on a
-//! [`Discretization`], or a problem already built) run by the [`NonlinearSolver`] from a
-//! start, its iterates recorded while they stream ([`History`]), its unknowns taken back
-//! as control points ([`Solved`]) and, where a stage asks for it, certified and kept only
-//! if the certificate allows ([`Solved::keep_if`]: "keep only if certified", paper §4.1,
-//! §9).
-//!
-//! Every stage that solves on one basis runs through it: the levels of the
-//! coarse-to-fine solve (§6.3) and the damped solves of their boundary continuation, the
-//! improvement of a certified map (§4.1), the `C⁰` route of the kinks (§9), the frames of
-//! a sliding grid and the inserted slices of a loft (§11.1), the free interfaces of a
-//! layout (§11.2).
-//!
-//! The options are made dimensionless the same way everywhere ([`scaled_options`]): the
-//! stopping rule reads `|F|` times [`Method::residual_scale`] of the geometry's diameter
-//! and the free functions, and the step tolerance is in length units.
+//! One solve on a fixed basis, run by every stage that solves on one basis (the levels
+//! of §6.3 and their continuation, the improvement of §4.1, the `C⁰` route of §9, sweep
+//! frames and loft slices of §11.1, the free interfaces of §11.2): a [`DiscreteProblem`]
+//! run by the [`NonlinearSolver`] from a start with options scaled by the geometry
+//! ([`scaled_options`]), its iterates recorded while they stream ([`History`]), the
+//! unknowns taken back as control points ([`Solved`]) and, where asked, certified and
+//! kept only if the certificate allows ([`Solved::keep_if`]).
 
 use std::sync::Arc;
 
@@ -82,14 +73,10 @@ impl History {
         }
     }
 
-    /// `|F|` at the start (NaN before the first iterate).
-    pub fn residual_before(&self) -> f64 {
-        self.residuals.first().copied().unwrap_or(f64::NAN)
-    }
-
-    /// `|F|` at the last iterate (NaN before the first).
-    pub fn residual_after(&self) -> f64 {
-        self.residuals.last().copied().unwrap_or(f64::NAN)
+    /// `|F|` at the start and at the last iterate (NaN before the first iterate).
+    pub fn residuals_before_after(&self) -> (f64, f64) {
+        let at = |r: Option<&f64>| r.copied().unwrap_or(f64::NAN);
+        (at(self.residuals.first()), at(self.residuals.last()))
     }
 }
 
@@ -128,11 +115,6 @@ impl<P: DiscreteProblem> FixedBasisSolve<P> {
     /// The objective `J` at the start (`None` for a root-finding method).
     pub fn start_objective(&self) -> Option<f64> {
         self.start_objective
-    }
-
-    /// The iterates so far.
-    pub fn history(&self) -> &History {
-        &self.history
     }
 
     /// The next iterate, recorded; `Ok(None)` once converged or failed.
@@ -224,13 +206,13 @@ impl Solved {
     }
 }
 
-/// A [`Solved`] result with its certificate and whether it is kept.
+/// A [`Solved`] result, what certifying it gave and whether the rule keeps it.
 #[derive(Debug, Clone)]
 pub struct Certified<C> {
     /// The result.
     pub solved: Solved,
     /// What certifying it gave.
     pub certificate: C,
-    /// Whether the certification rule keeps it.
+    /// Whether the rule keeps it.
     pub kept: bool,
 }

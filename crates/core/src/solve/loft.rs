@@ -199,7 +199,7 @@ fn solve_slice(guess: &Surface, opts: &LoftOptions) -> Result<(Surface, usize, f
         return Err(Error::NoConvergence(format!("inserted slice: {why}")));
     }
     let h = &solved.history;
-    let (iterations, before, after) = (h.iterations, h.residual_before(), h.residual_after());
+    let (iterations, (before, after)) = (h.iterations, h.residuals_before_after());
     let map =
         Surface { knots: guess.knots.clone(), control_points: solved.control_points, weights: guess.weights.clone() };
     Ok((map, iterations, before, after))

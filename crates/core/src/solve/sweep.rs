@@ -420,7 +420,7 @@ impl Sweep {
         let solved = FixedBasisSolve::new(&method, self.disc.clone(), cps, nl).finish()?;
         let h = &solved.history;
         let (newton, solves) = (h.newton_iterations, h.newton_iterations + h.pseudo_time_iterations);
-        let (before, after, converged) = (h.residual_before(), h.residual_after(), solved.converged());
+        let ((before, after), converged) = (h.residuals_before_after(), solved.converged());
         let unit = Surface { knots: self.knots.clone(), control_points: solved.control_points, weights: None };
         let map = self.sim.physical_surface(&unit)?;
         let cert = certify(&map, &self.opts.certify)?;
