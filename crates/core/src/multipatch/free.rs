@@ -17,11 +17,11 @@ use super::dofs::GlobalDofs;
 use super::layout::Layout;
 use super::problem::{Functional, MultipatchProblem};
 use crate::error::{Error, Result};
-use crate::solve::fixed_basis::{as_well_certified, bijective, scaled_options, FixedBasisSolve};
-use crate::solve::improve::{kept, winslow_text, Kept};
+use crate::solve::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
+use crate::solve::improve::{improve_layout, winslow_text, Kept, LayoutImprovement};
 use crate::solve::newton::{NonlinearMethod, NonlinearOptions};
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict};
+use crate::verify::certificate::{Certificate, CertifyOptions, Verdict};
 use crate::verify::quality::quality;
 
 /// What the free-interface stage did.
@@ -111,28 +111,16 @@ pub fn free_interfaces(
     nl.method = NonlinearMethod::Newton;
     nl.fallback = false;
     let nl = scaled_options(nl, &*functional.method(), diameter, m);
-    let solved = FixedBasisSolve::with_problem(problem, c0, nl).finish()?;
-    let mut rest = solved.control_points.as_slice();
-    let candidate: Vec<Surface> = maps
-        .iter()
-        .map(|m| {
-            let (cp, tail) = rest.split_at(m.control_points.len());
-            rest = tail;
-            Surface { control_points: cp.to_vec(), ..m.clone() }
-        })
-        .collect();
+    let solve = FixedBasisSolve::with_problem(problem, c0, nl);
+    let out = improve_layout(maps, certificates, solve, total_winslow, |w| *w, certify_opts)?;
+    let LayoutImprovement { candidate, certificates: certs, solved, before, after, outcome } = out;
     let mut max_disp = 0.0f64;
     for copies in dofs.copies.iter().filter(|c| c.len() > 1) {
         let (p, k) = copies[0];
         let (a, b) = (maps[p].control_points[k], candidate[p].control_points[k]);
         max_disp = max_disp.max((a[0] - b[0]).hypot(a[1] - b[1]) / diameter);
     }
-    let certs: Vec<Certificate> = candidate.iter().map(|m| certify(m, certify_opts)).collect::<Result<_>>()?;
-    let as_good = certificates.iter().zip(&certs).all(|(before, after)| as_well_certified(before, after));
-    let (before, after) = (total_winslow(maps), total_winslow(&candidate));
     let converged = solved.converged();
-    let minimizes = functional == Functional::Winslow;
-    let outcome = kept(as_good, minimizes, converged, before, after);
     let accepted = outcome == Kept::Accepted;
     let iterations = solved.history.iterations;
     let message = match outcome {

@@ -3,8 +3,9 @@
 //! frames and loft slices of §11.1, the free interfaces of §11.2): a [`DiscreteProblem`]
 //! run by the [`NonlinearSolver`] from a start with options scaled by the geometry
 //! ([`scaled_options`]), its iterates recorded while they stream ([`History`]), the
-//! unknowns taken back as control points ([`Solved`]) and, where asked, certified and
-//! kept only if the certificate allows ([`Solved::keep_if`]).
+//! unknowns taken back as control points ([`Solved`]); the certificate rules of "keep
+//! only if certified" are [`bijective`] and [`as_well_certified`] (an improvement on a
+//! layout applies them to every patch, [`crate::solve::improve`]).
 
 use std::sync::Arc;
 
@@ -192,27 +193,4 @@ impl Solved {
             _ => None,
         }
     }
-
-    /// "Keep only if certified": `certify` the result's control points, then `keep` the
-    /// result or not by its certificate (and the solve's outcome).
-    pub fn keep_if<C>(
-        self,
-        certify: impl FnOnce(&[Point]) -> Result<C>,
-        keep: impl FnOnce(&C, &Solved) -> bool,
-    ) -> Result<Certified<C>> {
-        let certificate = certify(&self.control_points)?;
-        let kept = keep(&certificate, &self);
-        Ok(Certified { solved: self, certificate, kept })
-    }
-}
-
-/// A [`Solved`] result, what certifying it gave and whether the rule keeps it.
-#[derive(Debug, Clone)]
-pub struct Certified<C> {
-    /// The result.
-    pub solved: Solved,
-    /// What certifying it gave.
-    pub certificate: C,
-    /// Whether the rule keeps it.
-    pub kept: bool,
 }

@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::fixed_basis::{as_well_certified, bijective, scaled_options, FixedBasisSolve};
+use super::fixed_basis::{as_well_certified, bijective, scaled_options, FixedBasisSolve, Solved};
 use super::newton::{NonlinearMethod, NonlinearOptions};
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::DofMap;
@@ -22,7 +22,7 @@ use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
 use crate::methods::weak_form::WeakFormMethod;
 use crate::methods::winslow::WinslowMethod;
-use crate::methods::Method;
+use crate::methods::{DiscreteProblem, Method};
 use crate::spline::surface::Surface;
 use crate::verify::certificate::{certify, Certificate, CertifyOptions};
 use crate::verify::quality::quality;
@@ -220,22 +220,67 @@ pub(crate) fn kept(as_good: bool, minimizes: bool, converged: bool, before: Opti
     }
 }
 
-/// The outcome of [`kept`].
+/// The outcome of [`kept`]: the result replaces the start, or is not as well certified,
+/// or (a minimisation) has a larger Winslow value, or (root finding) did not converge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Kept {
-    /// The result replaces the start.
     Accepted,
-    /// The result is not as well certified as the start.
     NotCertified,
-    /// A minimisation's result has a larger Winslow value.
     NotLower,
-    /// A root-finding method did not converge.
     NotConverged,
 }
 
 /// A Winslow value for a message (`undefined` when the map folds at a quadrature point).
 pub(crate) fn winslow_text(w: Option<f64>) -> String {
     w.map_or("undefined".to_string(), |w| format!("{w:.6}"))
+}
+
+/// What [`improve_layout`] gives: the candidate maps (one per patch), their certificates,
+/// the solve, the `quality` figures of the start and of the candidate, and the verdict of
+/// [`kept`].
+pub(crate) struct LayoutImprovement<Q> {
+    pub(crate) candidate: Vec<Surface>,
+    pub(crate) certificates: Vec<Certificate>,
+    pub(crate) solved: Solved,
+    pub(crate) before: Q,
+    pub(crate) after: Q,
+    pub(crate) outcome: Kept,
+}
+
+/// Improvement on a layout (one patch: a one-patch layout, §4.1; several: the free
+/// interfaces of §11.2): run `solve` (a method that needs a bijective start, from the
+/// patch maps `maps` certified by `certificates`) while `quality` measures the start, cut
+/// its control points into the patches' maps, certify each while `quality` measures them,
+/// and judge the candidate by [`kept`] (every patch [`as_well_certified`] as before, the
+/// Winslow value `winslow` of the figures not larger, or the solve converged).
+pub(crate) fn improve_layout<P: DiscreteProblem + Send, Q: Send>(
+    maps: &[Surface],
+    certificates: &[Certificate],
+    mut solve: FixedBasisSolve<P>,
+    quality: impl Fn(&[Surface]) -> Q + Sync,
+    winslow: impl Fn(&Q) -> Option<f64>,
+    certify_opts: &CertifyOptions,
+) -> Result<LayoutImprovement<Q>> {
+    let minimizes = solve.start_objective().is_some();
+    // the start's figures on the other core meanwhile (a small basis assembles on one)
+    let (before, run) = rayon::join(|| quality(maps), || solve.drain());
+    run?;
+    let solved = solve.finish()?;
+    let mut rest = solved.control_points.as_slice();
+    let candidate: Vec<Surface> = maps
+        .iter()
+        .map(|m| {
+            let (cp, tail) = rest.split_at(m.control_points.len());
+            rest = tail;
+            Surface { control_points: cp.to_vec(), ..m.clone() }
+        })
+        .collect();
+    let certify_all = || candidate.iter().map(|m| certify(m, certify_opts)).collect::<Result<Vec<_>>>();
+    let (after, certs) = rayon::join(|| quality(&candidate), certify_all);
+    let certs = certs?;
+    let as_good = certificates.iter().zip(&certs).all(|(before, after)| as_well_certified(before, after));
+    let outcome = kept(as_good, minimizes, solved.converged(), winslow(&before), winslow(&after));
+    Ok(LayoutImprovement { candidate, certificates: certs, solved, before, after, outcome })
 }
 
 /// Run `method` from the certified map `map` (certificate `certificate`) on the same
@@ -267,27 +312,18 @@ pub fn improve(
         Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs).with_weights(map.weights.clone())?);
     let m = disc.dofs.num_free();
     let nl = from_bijective_start(nonlinear, method, diameter, m);
-    let mut solve = FixedBasisSolve::new(method, disc, map.control_points.clone(), nl);
-    let minimizes = solve.start_objective().is_some();
-    // the start's figures on the other core meanwhile (a small basis assembles on one)
-    let (before, run) = rayon::join(|| MapQuality::of(map), || solve.drain());
-    run?;
-    let solved = solve.finish()?;
-    let candidate = Surface {
-        knots: map.knots.clone(),
-        control_points: solved.control_points.clone(),
-        weights: map.weights.clone(),
-    };
+    let solve = FixedBasisSolve::new(method, disc, map.control_points.clone(), nl);
+    let (maps, certificates) = (std::slice::from_ref(map), std::slice::from_ref(certificate));
+    let out = improve_layout(maps, certificates, solve, |m| MapQuality::of(&m[0]), |q| q.winslow, certify_opts)?;
+    let LayoutImprovement { mut candidate, certificates: mut certs, solved, before, after, outcome } = out;
+    let (candidate, cert) = (candidate.swap_remove(0), certs.swap_remove(0));
     let max_displacement = candidate
         .control_points
         .iter()
         .zip(&map.control_points)
         .fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1])))
         / diameter;
-    let (after, cert) = rayon::join(|| MapQuality::of(&candidate), || certify(&candidate, certify_opts));
-    let cert = cert?;
     let converged = solved.converged();
-    let outcome = kept(as_well_certified(certificate, &cert), minimizes, converged, before.winslow, after.winslow);
     let accepted = outcome == Kept::Accepted;
     let (iterations, chord_steps) = (solved.history.iterations, solved.chord_steps);
     let message = match outcome {

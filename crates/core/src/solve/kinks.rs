@@ -270,9 +270,9 @@ pub fn keep_kinks(
     report.failure = solved.failure().map(|why| format!("Winslow minimisation: {why}"));
     // `J` on the same knots and quadrature as `disc` (the DOF map does not change it)
     report.winslow = [solved.start_objective.and_then(finite), solved.objective.and_then(finite)];
-    let kept = solved.keep_if(|cps| certify(&surface(cps), &opts.certify), |cert, _| bijective(cert))?;
-    let (minimised, cert) = (kept.solved.control_points, kept.certificate);
-    let (cps, cert, which) = if kept.kept {
+    let cert = certify(&surface(&solved.control_points), &opts.certify)?;
+    let minimised = solved.control_points;
+    let (cps, cert, which) = if bijective(&cert) {
         (minimised, cert, "the Winslow minimiser")
     } else {
         (start, start_cert, "the certified elasticity start (the Winslow minimiser is not certified)")
