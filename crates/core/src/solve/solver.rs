@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use super::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
 use super::improve::{improve, Improvement};
-use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
+use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
 use super::newton::{Iterate, NonlinearOptions};
@@ -224,7 +224,10 @@ impl EggSolver {
                 set_boundary(disc.shape(), &level.sides, &mut target)?;
                 let nl = self.level_options(disc.dofs.num_free());
                 let (method, assembler) = (&*self.method, &*self.assembler);
-                let cps = continuation(method, assembler, &disc, fine, &target, nl, self.diameter, &mut cont)?;
+                let positive = |c: &[crate::spline::curve::Point]| det_j_min(assembler, &disc, c) > 0.0;
+                let out =
+                    continuation_with(method, assembler, &disc, fine, &target, nl, self.diameter, &mut cont, &positive);
+                let cps = out?.guess;
                 (cps, InitialGuess::Elasticity)
             }
         };
