@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 use crate::methods::{Method, Start};
 use crate::spline::surface::{Side, Surface};
-use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
+use crate::verify::certificate::{certify, Certificate};
 use crate::verify::quality::{boundary_deviation, parametric_boundary_deviation};
 
 /// One item of the solver's stream.
@@ -197,10 +197,10 @@ impl EggSolver {
         }
         let map = Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
         let cert = certify(&map, &self.opts.certify)?;
-        match cert.verdict {
-            CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => Ok(()),
-            _ => Err(Error::InfeasibleStart { method: self.method.name().into(), reason: cert.message() }),
+        if !bijective(&cert) {
+            return Err(Error::InfeasibleStart { method: self.method.name().into(), reason: cert.message() });
         }
+        Ok(())
     }
 
     fn start_level(&mut self, k: usize) -> Result<Event> {
