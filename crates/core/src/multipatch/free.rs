@@ -3,10 +3,11 @@
 //! interfaces become unknowns of one problem over all patches ([`MultipatchProblem`]:
 //! the Winslow functional eq. 16, or the weak form eq. 14, both defined for `C⁰` joins
 //! and both needing `det J > 0`), solved by Newton with the line search that never
-//! leaves the bijective maps. Every patch is certified again; the result replaces the
-//! start only when every patch is at least as well certified as before and, for the
-//! Winslow functional, the total value is not larger (for the weak form: the solve
-//! converged).
+//! leaves the bijective maps: the improvement of a certified map on a layout
+//! (`improve_layout` of [`crate::solve::improve`]). Every patch is certified again; the
+//! result replaces the start only when every patch is at least as well certified as
+//! before and, for the Winslow functional, the total value is not larger (for the weak
+//! form: the solve converged).
 
 use std::sync::Arc;
 use std::time::Instant;
