@@ -72,45 +72,17 @@ impl SystemPattern {
     }
 
     /// The pattern with periodic replicas: row `f` sums the stencil rows of every stored
-    /// function with free index `f`, and each column collects every neighbour with the
-    /// same free index (sorted columns; first source in `src`, the others in `extra`).
+    /// function with free index `f` ([`summed_pattern`] on one basis).
     fn shared(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
-        let m = dofs.num_free();
-        let sw = (2 * p + 1) * (2 * q + 1);
-        let row_len = ncomp * ncomp * sw;
-        let mut stored: Vec<Vec<usize>> = dofs.free().iter().map(|&k| vec![k]).collect();
+        let mut stored: Vec<Vec<(usize, usize)>> = dofs.free().iter().map(|&k| vec![(0, k)]).collect();
         for &(k, _) in dofs.replicas() {
             let f = dofs.free_index(k);
             if f != FIXED {
-                stored[f].push(k);
+                stored[f].push((0, k));
             }
         }
-        let mut row_ptr = vec![0];
-        let (mut col_idx, mut src, mut extra) = (Vec::new(), Vec::new(), Vec::new());
-        for z in 0..ncomp {
-            for ks in &stored {
-                let mut row: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-                for &k in ks {
-                    for d in 0..ncomp {
-                        for (s, kk) in stencil_neighbours(dofs.shape(), p, q, k) {
-                            let fc = dofs.free_index(kk);
-                            if fc != FIXED {
-                                row.entry(d * m + fc).or_default().push(k * row_len + (z * ncomp + d) * sw + s);
-                            }
-                        }
-                    }
-                }
-                for (col, sources) in row {
-                    extra.extend(sources[1..].iter().map(|&st| (col_idx.len(), st)));
-                    col_idx.push(col);
-                    src.push(sources[0]);
-                }
-                row_ptr.push(col_idx.len());
-            }
-        }
-        let nnz = col_idx.len();
-        let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
-        Self { ncomp, csr, src, extra }
+        let basis = StencilBasis { shape: dofs.shape(), degrees: [p, q], offset: 0 };
+        summed_pattern(ncomp, &stored, |_| basis, |_, kk| dofs.free_index(kk))
     }
 
     /// Copy the stencil storage into the CSR values.
@@ -144,4 +116,61 @@ impl SystemPattern {
         }
         m
     }
+}
+
+/// Where one tensor basis's stencil storage lies in the storage a [`summed_pattern`]
+/// reads: its basis shape, degrees and first position.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StencilBasis {
+    /// Basis functions per direction.
+    pub shape: [usize; 2],
+    /// Degrees `[p, q]`.
+    pub degrees: [usize; 2],
+    /// Position of the basis's first stencil entry in the concatenated storage.
+    pub offset: usize,
+}
+
+/// The pattern of the `ncomp`-component system whose row `z m + f` sums the stencil rows
+/// of every stored copy `(b, k)` (function `k` of basis `b`) in `rows[f]`, `m =
+/// rows.len()`: a periodic replica on one basis ([`SystemPattern`] with replicas), or a
+/// control point shared by the patches of a layout. `free_index(b, kk)` is the free index
+/// of function `kk` of basis `b` ([`FIXED`] when fixed); each column collects every
+/// neighbour with the same free index (sorted columns; first source in `src`, the others
+/// in `extra`), sources are positions in the bases' concatenated stencil storage.
+pub(crate) fn summed_pattern(
+    ncomp: usize,
+    rows: &[Vec<(usize, usize)>],
+    basis: impl Fn(usize) -> StencilBasis,
+    free_index: impl Fn(usize, usize) -> usize,
+) -> SystemPattern {
+    let m = rows.len();
+    let mut row_ptr = vec![0];
+    let (mut col_idx, mut src, mut extra) = (Vec::new(), Vec::new(), Vec::new());
+    for z in 0..ncomp {
+        for copies in rows {
+            let mut row: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+            for &(b, k) in copies {
+                let StencilBasis { shape, degrees: [p, q], offset } = basis(b);
+                let sw = (2 * p + 1) * (2 * q + 1);
+                let row_len = ncomp * ncomp * sw;
+                for d in 0..ncomp {
+                    for (s, kk) in stencil_neighbours(shape, p, q, k) {
+                        let fc = free_index(b, kk);
+                        if fc != FIXED {
+                            row.entry(d * m + fc).or_default().push(offset + k * row_len + (z * ncomp + d) * sw + s);
+                        }
+                    }
+                }
+            }
+            for (col, sources) in row {
+                extra.extend(sources[1..].iter().map(|&st| (col_idx.len(), st)));
+                col_idx.push(col);
+                src.push(sources[0]);
+            }
+            row_ptr.push(col_idx.len());
+        }
+    }
+    let nnz = col_idx.len();
+    let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
+    SystemPattern { ncomp, csr, src, extra }
 }

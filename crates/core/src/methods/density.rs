@@ -287,21 +287,12 @@ impl ShiftedHessian {
 
     /// Add the shift to the diagonal of the presented Jacobian `jac = -∇²J`.
     pub fn apply(&self, jac: &mut Csr) {
-        if self.shift == 0.0 {
-            return;
-        }
-        let mean = self.diag.iter().map(|&k| jac.values[k].abs()).sum::<f64>() / self.diag.len().max(1) as f64;
-        for &k in &self.diag {
-            jac.values[k] -= self.shift * jac.values[k].abs().max(1e-8 * mean);
-        }
+        shift_diagonal(self.shift, &self.diag, &mut jac.values);
     }
 
     /// Raise `τ` tenfold (to [`SHIFT_MIN`] from zero); `false` past [`SHIFT_MAX`].
     pub fn raise(&mut self) -> bool {
-        let next = if self.shift == 0.0 { SHIFT_MIN } else { 10.0 * self.shift };
-        if next > SHIFT_MAX {
-            return false;
-        }
+        let Some(next) = raised(self.shift) else { return false };
         self.shift = next;
         self.next = lowered(next);
         self.raised = true;
@@ -309,12 +300,32 @@ impl ShiftedHessian {
     }
 }
 
-/// `τ / 10`, zero below [`SHIFT_MIN`].
-fn lowered(shift: f64) -> f64 {
+/// `τ / 10`, zero below [`SHIFT_MIN`]: the shift one stage back.
+pub(crate) fn lowered(shift: f64) -> f64 {
     if shift > 10.0 * SHIFT_MIN {
         0.1 * shift
     } else {
         0.0
+    }
+}
+
+/// `10 τ` ([`SHIFT_MIN`] from zero): the shift one stage up; `None` past [`SHIFT_MAX`].
+pub(crate) fn raised(shift: f64) -> Option<f64> {
+    let next = if shift == 0.0 { SHIFT_MIN } else { 10.0 * shift };
+    (next <= SHIFT_MAX).then_some(next)
+}
+
+/// The relative diagonal shift `τ` of a Hessian presented as the Newton matrix `-H` (the
+/// positions `diag` of its diagonal in `values`): `H_ii + τ max(|H_ii|, 10⁻⁸ mean_j
+/// |H_jj|)`; the one rule of every minimisation problem (on one patch, or over a layout,
+/// [`crate::multipatch::problem::MultipatchProblem`]).
+pub(crate) fn shift_diagonal(shift: f64, diag: &[usize], values: &mut [f64]) {
+    if shift == 0.0 {
+        return;
+    }
+    let mean = diag.iter().map(|&k| values[k].abs()).sum::<f64>() / diag.len().max(1) as f64;
+    for &k in diag {
+        values[k] -= shift * values[k].abs().max(1e-8 * mean);
     }
 }
 

@@ -93,7 +93,7 @@ impl GalerkinState {
         if self.mass.is_none() {
             let mut st = vec![0.0; self.disc.stencil_len(1)];
             fill(&self.disc, &mut st);
-            self.mass = Some(block_mass(&self.disc, &self.disc.scalar.matrix(&st)));
+            self.mass = Some(block_mass(&self.disc.vector.csr, &self.disc.scalar.matrix(&st)));
         }
         self.mass.as_ref().expect("set above")
     }
@@ -110,11 +110,11 @@ impl GalerkinState {
     }
 }
 
-/// The block mass matrix `diag(M, M)` of eq. (30) in the vector pattern of `disc`, from
-/// the scalar mass matrix `m` (in the scalar pattern).
-fn block_mass(disc: &Discretization, m: &Csr) -> Csr {
-    let ms = disc.dofs.num_free();
-    let mut out = disc.vector.csr.clone();
+/// The block mass matrix `diag(M, M)` of eq. (30) in the two-component pattern `vector`,
+/// from the scalar mass matrix `m` (in the scalar pattern of the same unknowns).
+pub(crate) fn block_mass(vector: &Csr, m: &Csr) -> Csr {
+    let ms = m.nrows;
+    let mut out = vector.clone();
     for r in 0..out.nrows {
         let (z, f) = (r / ms, r % ms);
         for k in out.row_ptr[r]..out.row_ptr[r + 1] {

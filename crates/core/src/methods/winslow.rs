@@ -48,7 +48,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::density::{first_derivatives, integrate, Order};
+use super::density::{first_derivatives, integrate, lowered, raised, shift_diagonal, Order};
 use super::flux::{flux_form_with, gradient_at};
 use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method, Start};
@@ -388,10 +388,6 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
 /// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
 pub const PROJECTION_FIRST: f64 = 0.3;
 
-/// Smallest and largest relative diagonal shift `τ` of the Hessian.
-const SHIFT_MIN: f64 = 1e-4;
-const SHIFT_MAX: f64 = 1e8;
-
 /// The Winslow functional on one level: discretization, control points (fixed ones hold
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
@@ -475,7 +471,7 @@ impl DiscreteProblem for WinslowProblem {
             // an assembly and a failed factorization); where the last point needed a
             // stronger modification than the one it started with, its modification
             // is kept for this one (the stages it failed would fail here too)
-            self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
+            self.shift = lowered(self.shift);
             self.projected = match self.projected {
                 x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
                 x if x > PROJECTION_FIRST => PROJECTION_FIRST,
@@ -490,13 +486,7 @@ impl DiscreteProblem for WinslowProblem {
         }
         s.restrict_residual(f);
         s.gather_jacobian(jac);
-        if self.shift > 0.0 {
-            let mean = self.diag.iter().map(|&k| jac.values[k].abs()).sum::<f64>() / self.diag.len().max(1) as f64;
-            for &k in &self.diag {
-                // jac = -H: H_ii + τ max(|H_ii|, 1e-8 mean)
-                jac.values[k] -= self.shift * jac.values[k].abs().max(1e-8 * mean);
-            }
-        }
+        shift_diagonal(self.shift, &self.diag, &mut jac.values);
     }
 
     fn mass(&mut self) -> &Csr {
@@ -529,13 +519,8 @@ impl DiscreteProblem for WinslowProblem {
             self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
             return true;
         }
-        let next = if self.shift == 0.0 { SHIFT_MIN } else { 10.0 * self.shift };
-        if next > SHIFT_MAX {
-            return false;
-        }
+        let Some(next) = raised(self.shift) else { return false };
         self.shift = next;
-        self.raised = true;
-
         true
     }
 

@@ -15,6 +15,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
+use super::dofs::find;
 use super::layout::{reversed_on, Layout, PatchSide};
 use crate::error::Result;
 use crate::spline::curve::{Curve, Point};
@@ -296,19 +297,6 @@ pub fn vertex_points(layout: &Layout) -> Vec<[Point; 4]> {
 pub fn vertex_groups(layout: &Layout) -> Vec<usize> {
     let n = 4 * layout.patches.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], x: usize) -> usize {
-        let mut r = x;
-        while parent[r] != r {
-            r = parent[r];
-        }
-        let mut y = x;
-        while parent[y] != r {
-            let next = parent[y];
-            parent[y] = r;
-            y = next;
-        }
-        r
-    }
     // the corners at the start and end of a side
     let ends = |ps: PatchSide| -> (usize, usize) {
         let b = 4 * ps.patch;

@@ -49,19 +49,6 @@ impl GlobalDofs {
             .collect();
         let total: usize = shapes.iter().map(|s| s[0] * s[1]).sum();
         let mut parent: Vec<usize> = (0..total).collect();
-        fn find(parent: &mut [usize], x: usize) -> usize {
-            let mut r = x;
-            while parent[r] != r {
-                r = parent[r];
-            }
-            let mut y = x;
-            while parent[y] != r {
-                let next = parent[y];
-                parent[y] = r;
-                y = next;
-            }
-            r
-        }
         let mut outer = vec![false; total];
         for (p, t) in topologies.iter().enumerate() {
             for s in Side::ALL {
@@ -164,6 +151,22 @@ impl GlobalDofs {
             }
         }
     }
+}
+
+/// The root of `x` in the union-find forest `parent` (`parent[r] == r` at a root), with
+/// the path from `x` compressed onto it.
+pub(crate) fn find(parent: &mut [usize], x: usize) -> usize {
+    let mut r = x;
+    while parent[r] != r {
+        r = parent[r];
+    }
+    let mut y = x;
+    while parent[y] != r {
+        let next = parent[y];
+        parent[y] = r;
+        y = next;
+    }
+    r
 }
 
 #[cfg(test)]

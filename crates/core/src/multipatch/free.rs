@@ -3,10 +3,11 @@
 //! interfaces become unknowns of one problem over all patches ([`MultipatchProblem`]:
 //! the Winslow functional eq. 16, or the weak form eq. 14, both defined for `C⁰` joins
 //! and both needing `det J > 0`), solved by Newton with the line search that never
-//! leaves the bijective maps. Every patch is certified again; the result replaces the
-//! start only when every patch is at least as well certified as before and, for the
-//! Winslow functional, the total value is not larger (for the weak form: the solve
-//! converged).
+//! leaves the bijective maps: the improvement of a certified map on a layout
+//! (`improve_layout` of [`crate::solve::improve`]). Every patch is certified again; the
+//! result replaces the start only when every patch is at least as well certified as
+//! before and, for the Winslow functional, the total value is not larger (for the weak
+//! form: the solve converged).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,9 +18,11 @@ use super::dofs::GlobalDofs;
 use super::layout::Layout;
 use super::problem::{Functional, MultipatchProblem};
 use crate::error::{Error, Result};
-use crate::solve::newton::{NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use crate::solve::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
+use crate::solve::improve::{improve_layout, winslow_text, Kept, LayoutImprovement};
+use crate::solve::newton::{NonlinearMethod, NonlinearOptions};
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict};
+use crate::verify::certificate::{Certificate, CertifyOptions, Verdict};
 use crate::verify::quality::quality;
 
 /// What the free-interface stage did.
@@ -71,10 +74,6 @@ pub struct Freed {
     pub report: FreeReport,
 }
 
-fn bijective(c: &Certificate) -> bool {
-    matches!(c.verdict, Verdict::Certified { .. } | Verdict::DegenerateCorner { .. })
-}
-
 /// Total Winslow value of `maps` (`None` when one folds at a quadrature point).
 pub fn total_winslow(maps: &[Surface]) -> Option<f64> {
     let w: f64 = maps.iter().map(|m| quality(m).functionals.winslow).sum();
@@ -112,89 +111,60 @@ pub fn free_interfaces(
     let mut nl = nonlinear;
     nl.method = NonlinearMethod::Newton;
     nl.fallback = false;
-    nl.scale = match functional {
-        // |∇J| ~ 1 / diam whatever m (as for one patch)
-        Functional::Winslow => diameter,
-        Functional::WeakForm => 1.0,
-    };
-    nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
-    let mut solver = NonlinearSolver::new(problem, c0, nl);
-    let (mut residuals, mut objective, mut iterations) = (Vec::new(), Vec::new(), 0);
-    for it in solver.by_ref() {
-        let it = it?;
-        residuals.push(it.residual);
-        objective.extend(it.objective);
-        iterations = it.iteration;
-    }
-    let status = solver.status().clone();
-    let (problem, c) = solver.into_parts();
-    let cps = problem.patch_control_points(&c);
-    let candidate: Vec<Surface> =
-        maps.iter().zip(cps).map(|(m, cp)| Surface { control_points: cp, ..m.clone() }).collect();
+    let nl = scaled_options(nl, &*functional.method(), diameter, m);
+    let solve = FixedBasisSolve::with_problem(problem, c0, nl);
+    let out = improve_layout(maps, certificates, solve, total_winslow, |w| *w, certify_opts)?;
+    let LayoutImprovement { candidate, certificates: certs, solved, before, after, outcome } = out;
     let mut max_disp = 0.0f64;
     for copies in dofs.copies.iter().filter(|c| c.len() > 1) {
         let (p, k) = copies[0];
         let (a, b) = (maps[p].control_points[k], candidate[p].control_points[k]);
         max_disp = max_disp.max((a[0] - b[0]).hypot(a[1] - b[1]) / diameter);
     }
-    let certs: Vec<Certificate> = candidate.iter().map(|m| certify(m, certify_opts)).collect::<Result<_>>()?;
-    let as_good = certificates.iter().zip(&certs).all(|(before, after)| match before.verdict {
-        Verdict::Certified { .. } => matches!(after.verdict, Verdict::Certified { .. }),
-        _ => bijective(after),
-    });
-    let (before, after) = (total_winslow(maps), total_winslow(&candidate));
-    let converged = status == Status::Converged;
-    let lower = match (after, before) {
-        (Some(a), Some(b)) => a <= b,
-        (Some(_), None) => true,
-        (None, _) => false,
-    };
-    let accepted = as_good && if functional == Functional::Winslow { lower } else { converged };
-    let fmt = |w: Option<f64>| w.map_or("undefined".to_string(), |w| format!("{w:.6}"));
-    let message = if accepted {
-        format!(
+    let converged = solved.converged();
+    let accepted = outcome == Kept::Accepted;
+    let iterations = solved.history.iterations;
+    let message = match outcome {
+        Kept::Accepted => format!(
             "free interfaces ({}): total Winslow value {} -> {} in {iterations} iterations, {m} free control points ({interface_unknowns} on interfaces), interface points moved by up to {max_disp:.3e} of the diameter; every patch certified again",
             functional.name(),
-            fmt(before),
-            fmt(after)
-        )
-    } else if !as_good {
-        let bad: Vec<String> = certs
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| !matches!(c.verdict, Verdict::Certified { .. }))
-            .map(|(p, c)| format!("patch {}: {}", layout.label(p), c.message()))
-            .collect();
-        format!(
-            "free interfaces ({}): the result is not certified ({}); the fixed-interface maps are kept",
-            functional.name(),
-            bad.join("; ")
-        )
-    } else if functional == Functional::Winslow {
-        format!(
+            winslow_text(before),
+            winslow_text(after)
+        ),
+        Kept::NotCertified => {
+            let bad: Vec<String> = certs
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| !matches!(c.verdict, Verdict::Certified { .. }))
+                .map(|(p, c)| format!("patch {}: {}", layout.label(p), c.message()))
+                .collect();
+            format!(
+                "free interfaces ({}): the result is not certified ({}); the fixed-interface maps are kept",
+                functional.name(),
+                bad.join("; ")
+            )
+        }
+        Kept::NotLower => format!(
             "free interfaces (winslow): the result's total Winslow value {} is not below the start's {}; the fixed-interface maps are kept",
-            fmt(after),
-            fmt(before)
-        )
-    } else {
-        format!(
-            "free interfaces (weak-form): the solver did not converge ({status:?}); the fixed-interface maps are kept"
-        )
+            winslow_text(after),
+            winslow_text(before)
+        ),
+        Kept::NotConverged => format!(
+            "free interfaces (weak-form): the solver did not converge ({:?}); the fixed-interface maps are kept",
+            solved.status
+        ),
     };
     let report = FreeReport {
         functional: functional.name(),
         accepted,
         converged,
-        failure: match status {
-            Status::Failed(why) => Some(why),
-            _ => None,
-        },
+        failure: solved.failure().map(str::to_string),
         iterations,
         unknowns: 2 * m,
         interface_unknowns,
         fixed_vertices: dofs.fixed_vertices,
-        residuals,
-        objective,
+        residuals: solved.history.residuals,
+        objective: solved.history.objectives,
         winslow_before: before,
         winslow_after: after,
         max_interface_displacement: max_disp,

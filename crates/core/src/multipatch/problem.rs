@@ -11,48 +11,27 @@
 //! summed on one patch, [`crate::discrete::pattern`]). Signs and the diagonal shift of
 //! the Winslow Hessian follow [`crate::methods::winslow::WinslowProblem`].
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
-
-use serde::Serialize;
 
 use super::dofs::GlobalDofs;
 use crate::discrete::assembly::Discretization;
-use crate::discrete::dofs::{DofMap, FIXED};
-use crate::discrete::pattern::{stencil_neighbours, SystemPattern};
+use crate::discrete::dofs::DofMap;
+use crate::discrete::pattern::{summed_pattern, StencilBasis, SystemPattern};
 use crate::error::Result;
 use crate::linalg::sparse::Csr;
+use crate::methods::density::{lowered, raised, shift_diagonal};
 use crate::methods::flux::{flux_form, min_det_j};
+use crate::methods::galerkin::block_mass;
 use crate::methods::weak_form::{weak_flux, weak_laplace};
 use crate::methods::winslow::{winslow_gradient, winslow_laplace, winslow_objective};
 use crate::methods::DiscreteProblem;
 use crate::spline::curve::Point;
 use crate::spline::surface::Surface;
 
-/// What the global problem over all patches is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum Functional {
-    /// Minimize the Winslow functional (eq. 16) over all patches.
-    #[default]
-    Winslow,
-    /// Solve the weak form (eq. 14) over all patches.
-    WeakForm,
-}
-
-impl Functional {
-    /// `"winslow"` or `"weak-form"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Functional::Winslow => "winslow",
-            Functional::WeakForm => "weak-form",
-        }
-    }
-}
-
-/// Smallest and largest relative diagonal shift of the presented Hessian.
-const SHIFT_MIN: f64 = 1e-4;
-const SHIFT_MAX: f64 = 1e8;
+/// What the global problem over all patches is: the improvement's functional
+/// ([`Improve`](crate::solve::improve::Improve)), the Winslow functional (eq. 16) or the
+/// weak form (eq. 14), summed over the patches.
+pub use crate::solve::improve::Improve as Functional;
 
 /// The global problem (see the module documentation).
 pub struct MultipatchProblem {
@@ -86,43 +65,16 @@ impl std::fmt::Debug for MultipatchProblem {
     }
 }
 
-/// The pattern of the `ncomp`-component global system: row `z m + f` sums the stencil
-/// rows of every copy `(p, k)` of free point `f`; sources are positions in the
-/// concatenation of the patches' stencils (`offsets[p]` where patch `p`'s begins).
+/// The pattern of the `ncomp`-component global system ([`summed_pattern`]): row `z m +
+/// f` sums the stencil rows of every copy `(p, k)` of free point `f`; sources are
+/// positions in the concatenation of the patches' stencils (`offsets[p]` where patch
+/// `p`'s begins).
 fn global_pattern(discs: &[Arc<Discretization>], dofs: &GlobalDofs, ncomp: usize, offsets: &[usize]) -> SystemPattern {
-    let m = dofs.num_free();
-    let mut row_ptr = vec![0];
-    let (mut col_idx, mut src, mut extra) = (Vec::new(), Vec::new(), Vec::new());
-    for z in 0..ncomp {
-        for copies in &dofs.copies {
-            let mut row: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-            for &(p, k) in copies {
-                let disc = &discs[p];
-                let (pd, qd) = disc.degrees();
-                let sw = (2 * pd + 1) * (2 * qd + 1);
-                let row_len = ncomp * ncomp * sw;
-                for d in 0..ncomp {
-                    for (s, kk) in stencil_neighbours(disc.shape(), pd, qd, k) {
-                        let fc = dofs.free_of[p][kk];
-                        if fc != FIXED {
-                            row.entry(d * m + fc)
-                                .or_default()
-                                .push(offsets[p] + k * row_len + (z * ncomp + d) * sw + s);
-                        }
-                    }
-                }
-            }
-            for (col, sources) in row {
-                extra.extend(sources[1..].iter().map(|&st| (col_idx.len(), st)));
-                col_idx.push(col);
-                src.push(sources[0]);
-            }
-            row_ptr.push(col_idx.len());
-        }
-    }
-    let nnz = col_idx.len();
-    let csr = Csr { nrows: ncomp * m, ncols: ncomp * m, row_ptr, col_idx, values: vec![0.0; nnz] };
-    SystemPattern { ncomp, csr, src, extra }
+    let basis = |p: usize| {
+        let (pd, qd) = discs[p].degrees();
+        StencilBasis { shape: discs[p].shape(), degrees: [pd, qd], offset: offsets[p] }
+    };
+    summed_pattern(ncomp, &dofs.copies, basis, |p, kk| dofs.free_of[p][kk])
 }
 
 impl MultipatchProblem {
@@ -246,7 +198,7 @@ impl DiscreteProblem for MultipatchProblem {
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
         let winslow = self.functional == Functional::Winslow;
         if winslow && !std::mem::take(&mut self.raised) {
-            self.shift = if self.shift > 10.0 * SHIFT_MIN { 0.1 * self.shift } else { 0.0 };
+            self.shift = lowered(self.shift);
         }
         if self.assembled.as_deref() != Some(c) {
             self.dofs.scatter(c, &mut self.cps);
@@ -258,11 +210,8 @@ impl DiscreteProblem for MultipatchProblem {
             jac.assign(&self.vector.csr);
         }
         self.vector.gather_into(&self.stencil, &mut jac.values);
-        if winslow && self.shift > 0.0 {
-            let mean = self.diag.iter().map(|&k| jac.values[k].abs()).sum::<f64>() / self.diag.len().max(1) as f64;
-            for &k in &self.diag {
-                jac.values[k] -= self.shift * jac.values[k].abs().max(1e-8 * mean);
-            }
+        if winslow {
+            shift_diagonal(self.shift, &self.diag, &mut jac.values);
         }
     }
 
@@ -272,18 +221,7 @@ impl DiscreteProblem for MultipatchProblem {
             for (p, disc) in self.discs.iter().enumerate() {
                 disc.mass(&mut st[self.soffsets[p]..self.soffsets[p] + disc.stencil_len(1)]);
             }
-            let m = self.scalar.matrix(&st);
-            let ms = self.dofs.num_free();
-            let mut out = self.vector.csr.clone();
-            for r in 0..out.nrows {
-                let (z, f) = (r / ms, r % ms);
-                for k in out.row_ptr[r]..out.row_ptr[r + 1] {
-                    let cidx = out.col_idx[k];
-                    let (d, g) = (cidx / ms, cidx % ms);
-                    out.values[k] = if z == d { m.get(f, g) } else { 0.0 };
-                }
-            }
-            self.mass = Some(out);
+            self.mass = Some(block_mass(&self.vector.csr, &self.scalar.matrix(&st)));
         }
         self.mass.as_ref().expect("set above")
     }
@@ -309,10 +247,7 @@ impl DiscreteProblem for MultipatchProblem {
         if self.functional != Functional::Winslow {
             return false;
         }
-        let next = if self.shift == 0.0 { SHIFT_MIN } else { 10.0 * self.shift };
-        if next > SHIFT_MAX {
-            return false;
-        }
+        let Some(next) = raised(self.shift) else { return false };
         self.shift = next;
         self.raised = true;
         true

@@ -14,24 +14,26 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::newton::{NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use super::fixed_basis::{as_well_certified, bijective, scaled_options, FixedBasisSolve, Solved};
+use super::newton::{NonlinearMethod, NonlinearOptions};
 use crate::discrete::assembly::Discretization;
 use crate::discrete::dofs::DofMap;
 use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
 use crate::methods::weak_form::WeakFormMethod;
 use crate::methods::winslow::WinslowMethod;
-use crate::methods::Method;
+use crate::methods::{DiscreteProblem, Method};
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict};
+use crate::verify::certificate::{certify, Certificate, CertifyOptions};
 use crate::verify::quality::quality;
 
 /// Which improvement runs after the solve.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Improve {
     /// Minimize the Winslow functional (eq. 16): [`WinslowMethod`].
+    #[default]
     #[cfg_attr(feature = "clap", value(help = "Minimize the Winslow functional (eq. 16)"))]
     Winslow,
     /// Solve the weak form (eq. 14) from the map: [`WeakFormMethod`].
@@ -46,6 +48,11 @@ impl Improve {
             Improve::Winslow => Arc::new(WinslowMethod),
             Improve::WeakForm => Arc::new(WeakFormMethod),
         }
+    }
+
+    /// The method's name: `"winslow"` or `"weak-form"`.
+    pub fn name(self) -> &'static str {
+        self.method().name()
     }
 }
 
@@ -181,8 +188,7 @@ pub fn from_bijective_start(
     nl.chord = true;
     nl.extrapolate = true;
     nl.fallback = false;
-    nl.scale = method.residual_scale(diameter, m);
-    nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
+    let mut nl = scaled_options(nl, method, diameter, m);
     nl.max_modified = nl.max_modified.or(Some(MAX_MODIFIED_STEPS));
     if nl.decrement_tol == 0.0 {
         nl.decrement_tol = crate::solve::newton::DECREMENT_TOL;
@@ -199,9 +205,85 @@ pub fn from_bijective_start(
 /// "Improving the EGG map".
 pub const MAX_MODIFIED_STEPS: usize = 4;
 
-/// Whether a certificate allows a method that needs `det J > 0` to start.
-pub fn bijective(c: &Certificate) -> bool {
-    matches!(c.verdict, Verdict::Certified { .. } | Verdict::DegenerateCorner { .. })
+/// Whether an improvement is kept: its certificate is at least as good as the start's
+/// ([`as_well_certified`], `as_good`) and, for a minimisation, its Winslow value `after`
+/// is not larger than `before` (a minimisation only lowers its objective, the line search
+/// sees to it), for a root-finding method, the solver converged.
+pub(crate) fn kept(as_good: bool, minimizes: bool, converged: bool, before: Option<f64>, after: Option<f64>) -> Kept {
+    let lower = match (after, before) {
+        (Some(a), Some(b)) => a <= b,
+        (Some(_), None) => true,
+        (None, _) => false,
+    };
+    match (as_good, minimizes) {
+        (false, _) => Kept::NotCertified,
+        (true, true) if !lower => Kept::NotLower,
+        (true, false) if !converged => Kept::NotConverged,
+        _ => Kept::Accepted,
+    }
+}
+
+/// The outcome of [`kept`]: the result replaces the start, or is not as well certified,
+/// or (a minimisation) has a larger Winslow value, or (root finding) did not converge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kept {
+    Accepted,
+    NotCertified,
+    NotLower,
+    NotConverged,
+}
+
+/// A Winslow value for a message (`undefined` when the map folds at a quadrature point).
+pub(crate) fn winslow_text(w: Option<f64>) -> String {
+    w.map_or("undefined".to_string(), |w| format!("{w:.6}"))
+}
+
+/// What [`improve_layout`] gives: the candidate maps (one per patch), their certificates,
+/// the solve, the `quality` figures of the start and of the candidate, and the verdict of
+/// [`kept`].
+pub(crate) struct LayoutImprovement<Q> {
+    pub(crate) candidate: Vec<Surface>,
+    pub(crate) certificates: Vec<Certificate>,
+    pub(crate) solved: Solved,
+    pub(crate) before: Q,
+    pub(crate) after: Q,
+    pub(crate) outcome: Kept,
+}
+
+/// Improvement on a layout (one patch: a one-patch layout, §4.1; several: the free
+/// interfaces of §11.2): run `solve` (a method that needs a bijective start, from the
+/// patch maps `maps` certified by `certificates`) while `quality` measures the start, cut
+/// its control points into the patches' maps, certify each while `quality` measures them,
+/// and judge the candidate by [`kept`] (every patch [`as_well_certified`] as before, the
+/// Winslow value `winslow` of the figures not larger, or the solve converged).
+pub(crate) fn improve_layout<P: DiscreteProblem + Send, Q: Send>(
+    maps: &[Surface],
+    certificates: &[Certificate],
+    mut solve: FixedBasisSolve<P>,
+    quality: impl Fn(&[Surface]) -> Q + Sync,
+    winslow: impl Fn(&Q) -> Option<f64>,
+    certify_opts: &CertifyOptions,
+) -> Result<LayoutImprovement<Q>> {
+    let minimizes = solve.start_objective().is_some();
+    // the start's figures on the other core meanwhile (a small basis assembles on one)
+    let (before, run) = rayon::join(|| quality(maps), || solve.drain());
+    run?;
+    let solved = solve.finish()?;
+    let mut rest = solved.control_points.as_slice();
+    let candidate: Vec<Surface> = maps
+        .iter()
+        .map(|m| {
+            let (cp, tail) = rest.split_at(m.control_points.len());
+            rest = tail;
+            Surface { control_points: cp.to_vec(), ..m.clone() }
+        })
+        .collect();
+    let certify_all = || candidate.iter().map(|m| certify(m, certify_opts)).collect::<Result<Vec<_>>>();
+    let (after, certs) = rayon::join(|| quality(&candidate), certify_all);
+    let certs = certs?;
+    let as_good = certificates.iter().zip(&certs).all(|(before, after)| as_well_certified(before, after));
+    let outcome = kept(as_good, minimizes, solved.converged(), winslow(&before), winslow(&after));
+    Ok(LayoutImprovement { candidate, certificates: certs, solved, before, after, outcome })
 }
 
 /// Run `method` from the certified map `map` (certificate `certificate`) on the same
@@ -233,58 +315,26 @@ pub fn improve(
         Arc::new(Discretization::with_dofs(map.knots.clone(), p.max(q) + 2, dofs).with_weights(map.weights.clone())?);
     let m = disc.dofs.num_free();
     let nl = from_bijective_start(nonlinear, method, diameter, m);
-    let c0 = disc.dofs.gather(&map.control_points);
-    let problem = method.problem(disc, map.control_points.clone());
-    let mut solver = NonlinearSolver::new(problem, c0, nl);
-    let minimizes = solver.objective().is_some();
-    let (mut residuals, mut objective, mut iterations) = (Vec::new(), Vec::new(), 0);
-    // the start's figures on the other core meanwhile (a small basis assembles on one)
-    let (before, run) = rayon::join(
-        || MapQuality::of(map),
-        || -> Result<()> {
-            for it in solver.by_ref() {
-                let it = it?;
-                residuals.push(it.residual);
-                objective.extend(it.objective);
-                iterations = it.iteration;
-            }
-            Ok(())
-        },
-    );
-    run?;
-    let status = solver.status().clone();
-    let (timings, chord_steps) = (solver.timings, solver.chord_steps);
-    let (problem, c) = solver.into_parts();
-    let candidate =
-        Surface { knots: map.knots.clone(), control_points: problem.control_points(&c), weights: map.weights.clone() };
+    let solve = FixedBasisSolve::new(method, disc, map.control_points.clone(), nl);
+    let (maps, certificates) = (std::slice::from_ref(map), std::slice::from_ref(certificate));
+    let out = improve_layout(maps, certificates, solve, |m| MapQuality::of(&m[0]), |q| q.winslow, certify_opts)?;
+    let LayoutImprovement { mut candidate, certificates: mut certs, solved, before, after, outcome } = out;
+    let (candidate, cert) = (candidate.swap_remove(0), certs.swap_remove(0));
     let max_displacement = candidate
         .control_points
         .iter()
         .zip(&map.control_points)
         .fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1])))
         / diameter;
-    let (after, cert) = rayon::join(|| MapQuality::of(&candidate), || certify(&candidate, certify_opts));
-    let cert = cert?;
-    let as_good = match certificate.verdict {
-        Verdict::Certified { .. } => matches!(cert.verdict, Verdict::Certified { .. }),
-        _ => bijective(&cert),
-    };
-    let lower = match (after.winslow, before.winslow) {
-        (Some(a), Some(b)) => a <= b,
-        (Some(_), None) => true,
-        (None, _) => false,
-    };
-    let converged = status == Status::Converged;
-    // a minimization only lowers its objective (the line search sees to it): keep any
-    // certified result with a lower Winslow value; a root-finding method must converge
-    let accepted = as_good && if minimizes { lower } else { converged };
-    let fmt = |w: Option<f64>| w.map_or("undefined".to_string(), |w| format!("{w:.6}"));
-    let message = if accepted {
-        format!(
+    let converged = solved.converged();
+    let accepted = outcome == Kept::Accepted;
+    let (iterations, chord_steps) = (solved.history.iterations, solved.chord_steps);
+    let message = match outcome {
+        Kept::Accepted => format!(
             "{}: Winslow value {} -> {}, min scaled Jacobian {:.4} -> {:.4} in {iterations} iterations{}; {}",
             method.name(),
-            fmt(before.winslow),
-            fmt(after.winslow),
+            winslow_text(before.winslow),
+            winslow_text(after.winslow),
             before.scaled_jacobian_min,
             after.scaled_jacobian_min,
             match chord_steps {
@@ -292,25 +342,21 @@ pub fn improve(
                 k => format!(" and {k} chord step(s)"),
             },
             cert.message()
-        )
-    } else if !as_good {
-        format!("{}: the minimized map is not certified ({}); the start is kept", method.name(), cert.message())
-    } else if !minimizes {
-        format!(
+        ),
+        Kept::NotCertified => {
+            format!("{}: the minimized map is not certified ({}); the start is kept", method.name(), cert.message())
+        }
+        Kept::NotConverged => format!(
             "{}: the solver did not converge ({}); the start is kept",
             method.name(),
-            match &status {
-                Status::Failed(why) => why.as_str(),
-                _ => "stopped",
-            }
-        )
-    } else {
-        format!(
+            solved.failure().unwrap_or("stopped")
+        ),
+        Kept::NotLower => format!(
             "{}: the minimized map's Winslow value {} is not below the start's {}; the start is kept",
             method.name(),
-            fmt(after.winslow),
-            fmt(before.winslow)
-        )
+            winslow_text(after.winslow),
+            winslow_text(before.winslow)
+        ),
     };
     let report = Improvement {
         method: method.name(),
@@ -318,20 +364,17 @@ pub fn improve(
         after,
         accepted,
         converged,
-        failure: match status {
-            Status::Failed(why) => Some(why),
-            _ => None,
-        },
+        failure: solved.failure().map(str::to_string),
         iterations,
         chord_steps,
         unknowns: 2 * m,
-        residuals,
-        objective,
+        residuals: solved.history.residuals,
+        objective: solved.history.objectives,
         max_displacement,
         certificate: cert.message(),
         seconds: 0.0,
-        assembly_seconds: timings.assembly.as_secs_f64(),
-        linear_seconds: timings.linear.as_secs_f64(),
+        assembly_seconds: solved.timings.assembly.as_secs_f64(),
+        linear_seconds: solved.timings.linear.as_secs_f64(),
         message,
     };
     let (map, certificate) = if accepted { (candidate, cert) } else { (map.clone(), certificate.clone()) };
@@ -344,6 +387,7 @@ pub fn improve(
 mod tests {
     use super::*;
     use crate::spline::knots::KnotVector;
+    use crate::verify::certificate::Verdict;
 
     /// A quarter annulus interpolated at the Greville points with a sheared interior:
     /// bijective, not the Winslow minimizer.

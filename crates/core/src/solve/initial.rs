@@ -5,7 +5,8 @@
 
 use std::sync::Arc;
 
-use super::newton::{NonlinearOptions, NonlinearSolver, Status};
+use super::fixed_basis::FixedBasisSolve;
+use super::newton::NonlinearOptions;
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
@@ -186,31 +187,6 @@ pub const MIN_CONTINUATION_STEP: f64 = 1.0 / 64.0;
 /// Most damped boundary solves per level.
 pub const MAX_CONTINUATION_STEPS: usize = 24;
 
-/// Initial guess of a finer level (§6.3, §9): the elasticity correction of the
-/// prolonged map `base` towards the fitted boundary `target`. When that guess is not
-/// positive on a sample, the boundary displacement is damped by `alpha < 1`, the EGG
-/// equations are solved with the damped boundary from the (positive) elasticity
-/// guess, and the remaining displacement is applied from that solution, until the
-/// target contour is reached (at most [`MAX_CONTINUATION_STEPS`] damped solves, steps
-/// no shorter than [`MIN_CONTINUATION_STEP`]).
-///
-/// `method` poses the damped solves, `assembler` samples `det J` and assembles the
-/// elasticity operator; `nl` are the level's nonlinear options (scaled as the level's
-/// final solve), `diameter` the domain's.
-pub fn continuation(
-    method: &dyn Method,
-    assembler: &dyn EggAssembler,
-    disc: &Arc<Discretization>,
-    base: Vec<Point>,
-    target: &[Point],
-    nl: NonlinearOptions,
-    diameter: f64,
-    cont: &mut Continuation,
-) -> Result<Vec<Point>> {
-    let positive = |c: &[Point]| det_j_min(assembler, disc, c) > 0.0;
-    Ok(continuation_with(method, assembler, disc, base, target, nl, diameter, cont, &positive)?.guess)
-}
-
 /// The outcome of [`continuation_with`].
 #[derive(Debug, Clone)]
 pub struct Continued {
@@ -223,10 +199,20 @@ pub struct Continued {
     pub alpha: f64,
 }
 
-/// [`continuation`] with the test of a guess given: `positive(control points)` (the
-/// sampled `det J` for [`continuation`]; the certificate for the `C^0` route of §9,
-/// whose Winslow solves need a bijective start); also returns the last positive map
-/// reached, from which a caller may go on on a refined basis.
+/// Initial guess of a finer level (§6.3, §9): the elasticity correction of the
+/// prolonged map `base` towards the fitted boundary `target`. When that guess is not
+/// `positive` (the sampled `det J` of a level, [`det_j_min`]; the certificate for the
+/// `C^0` route of §9, whose Winslow solves need a bijective start), the boundary
+/// displacement is damped by `alpha < 1`, the equations are solved with the damped
+/// boundary from the (positive) elasticity guess, and the remaining displacement is
+/// applied from that solution, until the target contour is reached (at most
+/// [`MAX_CONTINUATION_STEPS`] damped solves, steps no shorter than
+/// [`MIN_CONTINUATION_STEP`]). Also returns the last positive map reached, from which a
+/// caller may go on on a refined basis.
+///
+/// `method` poses the damped solves, `assembler` assembles the elasticity operator; `nl`
+/// are the level's nonlinear options (scaled as the level's final solve), `diameter` the
+/// domain's.
 pub fn continuation_with(
     method: &dyn Method,
     assembler: &dyn EggAssembler,
@@ -268,20 +254,13 @@ pub fn continuation_with(
             continue;
         }
         // solve with the damped boundary
-        let c0 = disc.dofs.gather(&guess);
-        let problem = method.problem(disc.clone(), guess.clone());
-        let mut solver = NonlinearSolver::new(problem, c0, nl);
-        let mut iterations = 0;
-        for it in solver.by_ref() {
-            iterations = it?.iteration;
-        }
+        let solved = FixedBasisSolve::new(method, disc.clone(), guess.clone(), nl).finish()?;
         cont.steps += 1;
         // a minimisation only lowers its objective from a feasible start: a positive
         // result is a better base even before its stopping rule is met
-        let converged = *solver.status() == Status::Converged || solver.objective().is_some_and(f64::is_finite);
-        let (problem, c) = solver.into_parts();
-        let sol = problem.control_points(&c);
-        cont.iterations += iterations;
+        let converged = solved.converged() || solved.objective.is_some_and(f64::is_finite);
+        let sol = solved.control_points;
+        cont.iterations += solved.history.iterations;
         if converged && positive(&sol) {
             base = sol;
             done = a;

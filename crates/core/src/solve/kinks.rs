@@ -29,9 +29,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::improve::{bijective, from_bijective_start};
+use super::fixed_basis::{bijective, FixedBasisSolve};
+use super::improve::from_bijective_start;
 use super::initial::{continuation_with, set_boundary, Continuation};
-use super::newton::{NonlinearOptions, NonlinearSolver, Status};
+use super::newton::NonlinearOptions;
 use super::options::SolveOptions;
 use super::repair::{frozen_dofs, plan_repair};
 use crate::boundary::kinks::{Kink, KinkedLevel};
@@ -41,7 +42,6 @@ use crate::discrete::dofs::DofMap;
 use crate::error::Result;
 use crate::methods::egg::EggAssembler;
 use crate::methods::winslow::{winslow_objective, WinslowMethod};
-use crate::methods::Method;
 use crate::spline::curve::Point;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
@@ -264,21 +264,14 @@ pub fn keep_kinks(
     report.unknowns = 2 * moved.dofs.num_free();
     report.local_spans = spans;
     let nl = from_bijective_start(opts.nonlinear, &method, diameter, moved.dofs.num_free());
-    let c0 = moved.dofs.gather(&start);
-    let mut solver = NonlinearSolver::new(method.problem(moved, start.clone()), c0, nl);
+    let solved = FixedBasisSolve::new(&method, moved, start.clone(), nl).finish()?;
+    report.iterations = solved.history.iterations;
+    report.converged = solved.converged();
+    report.failure = solved.failure().map(|why| format!("Winslow minimisation: {why}"));
     // `J` on the same knots and quadrature as `disc` (the DOF map does not change it)
-    report.winslow[0] = solver.objective().and_then(finite);
-    for it in solver.by_ref() {
-        report.iterations = it?.iteration;
-    }
-    report.converged = *solver.status() == Status::Converged;
-    if let Status::Failed(why) = solver.status() {
-        report.failure = Some(format!("Winslow minimisation: {why}"));
-    }
-    report.winslow[1] = solver.objective().and_then(finite);
-    let (problem, c) = solver.into_parts();
-    let minimised = problem.control_points(&c);
-    let cert = certify(&surface(&minimised), &opts.certify)?;
+    report.winslow = [solved.start_objective.and_then(finite), solved.objective.and_then(finite)];
+    let cert = certify(&surface(&solved.control_points), &opts.certify)?;
+    let minimised = solved.control_points;
     let (cps, cert, which) = if bijective(&cert) {
         (minimised, cert, "the Winslow minimiser")
     } else {

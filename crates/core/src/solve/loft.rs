@@ -20,12 +20,12 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::newton::{NonlinearOptions, NonlinearSolver, Status};
+use super::fixed_basis::{scaled_options, FixedBasisSolve};
+use super::newton::NonlinearOptions;
 use crate::discrete::assembly::{Discretization, Operator};
 use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
 use crate::methods::egg::EggMethod;
-use crate::methods::Method;
 use crate::spline::loft::{check_heights, common_basis, interpolate, planar_section, zeta_of, Interpolation};
 use crate::spline::surface::Surface;
 use crate::spline::volume::Volume;
@@ -191,31 +191,17 @@ fn solve_slice(guess: &Surface, opts: &LoftOptions) -> Result<(Surface, usize, f
     }
     let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
     let method = EggMethod::cpu(opts.operator);
-    let mut nl = opts.nonlinear;
-    nl.scale = method.residual_scale(diameter, disc.dofs.num_free());
-    nl.step_tol = nl.step_tol.max(1e-13) * diameter;
+    let nl = scaled_options(opts.nonlinear, &method, diameter, disc.dofs.num_free());
     let mut cps = guess.control_points.clone();
     disc.dofs.wrap(&mut cps);
-    let c0 = disc.dofs.gather(&cps);
-    let mut solver = NonlinearSolver::new(method.problem(disc.clone(), cps), c0, nl);
-    let (mut before, mut after, mut iterations) = (f64::NAN, f64::NAN, 0);
-    for it in solver.by_ref() {
-        let it = it?;
-        if it.iteration == 0 {
-            before = it.residual;
-        }
-        iterations = it.iteration;
-        after = it.residual;
-    }
-    if let Status::Failed(why) = solver.status() {
+    let solved = FixedBasisSolve::new(&method, disc, cps, nl).finish()?;
+    if let Some(why) = solved.failure() {
         return Err(Error::NoConvergence(format!("inserted slice: {why}")));
     }
-    let (problem, c) = solver.into_parts();
-    let map = Surface {
-        knots: guess.knots.clone(),
-        control_points: problem.control_points(&c),
-        weights: guess.weights.clone(),
-    };
+    let h = &solved.history;
+    let (iterations, (before, after)) = (h.iterations, h.residuals_before_after());
+    let map =
+        Surface { knots: guess.knots.clone(), control_points: solved.control_points, weights: guess.weights.clone() };
     Ok((map, iterations, before, after))
 }
 

@@ -3,18 +3,19 @@
 //! progress, the viewer's live plot and the tests all read.
 //!
 //! The solver talks to the discrete problem only through [`Method`] and
-//! [`DiscreteProblem`]: EGG (eq. 8) by default, any
+//! [`DiscreteProblem`](crate::methods::DiscreteProblem): EGG (eq. 8) by default, any
 //! other method through [`EggSolver::with_method`]. The patch's boundary conditions are
 //! data ([`SolveOptions::topology`]), read by the DOF map of every level.
 
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::improve::{bijective, improve, Improvement};
-use super::initial::{continuation, coons, det_j_min, set_boundary, Continuation};
+use super::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
+use super::improve::{improve, Improvement};
+use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
-use super::newton::{Iterate, NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use super::newton::{Iterate, NonlinearOptions};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
@@ -26,9 +27,9 @@ use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::{EggAssembler, EggMethod};
-use crate::methods::{DiscreteProblem, Method, Start};
+use crate::methods::{Method, Start};
 use crate::spline::surface::{Side, Surface};
-use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
+use crate::verify::certificate::{certify, Certificate};
 use crate::verify::quality::{boundary_deviation, parametric_boundary_deviation};
 
 /// One item of the solver's stream.
@@ -60,7 +61,7 @@ pub enum Event {
 
 struct Active {
     level: usize,
-    solver: NonlinearSolver<Box<dyn DiscreteProblem + Send>>,
+    solver: FixedBasisSolve,
     report: LevelReport,
     started: Instant,
     /// The level's rational weights ([`Level::weights`]), `None` when polynomial.
@@ -193,10 +194,7 @@ impl EggSolver {
     /// [`Method::residual_size`] is the relative residual) and the step tolerance in
     /// length units.
     fn level_options(&self, m: usize) -> NonlinearOptions {
-        let mut nl = self.opts.nonlinear;
-        nl.scale = self.method.residual_scale(self.diameter, m);
-        nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
-        nl
+        scaled_options(self.opts.nonlinear, &*self.method, self.diameter, m)
     }
 
     /// A method that needs a bijective start gets one the certificate proves (or one
@@ -212,10 +210,10 @@ impl EggSolver {
         }
         let map = Surface { knots: level.knots.clone(), control_points: cps.to_vec(), weights: weights.clone() };
         let cert = certify(&map, &self.opts.certify)?;
-        match cert.verdict {
-            CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => Ok(()),
-            _ => Err(Error::InfeasibleStart { method: self.method.name().into(), reason: cert.message() }),
+        if !bijective(&cert) {
+            return Err(Error::InfeasibleStart { method: self.method.name().into(), reason: cert.message() });
         }
+        Ok(())
     }
 
     fn start_level(&mut self, k: usize) -> Result<Event> {
@@ -239,7 +237,10 @@ impl EggSolver {
                 set_boundary(disc.shape(), &level.sides, &mut target)?;
                 let nl = self.level_options(disc.dofs.num_free());
                 let (method, assembler) = (&*self.method, &*self.assembler);
-                let cps = continuation(method, assembler, &disc, fine, &target, nl, self.diameter, &mut cont)?;
+                let positive = |c: &[crate::spline::curve::Point]| det_j_min(assembler, &disc, c) > 0.0;
+                let out =
+                    continuation_with(method, assembler, &disc, fine, &target, nl, self.diameter, &mut cont, &positive);
+                let cps = out?.guess;
                 (cps, InitialGuess::Elasticity)
             }
         };
@@ -247,10 +248,7 @@ impl EggSolver {
         let initial_det_j_min = det_j_min(&*self.assembler, &disc, &cps);
         self.check_start(level, &weights, &cps)?;
         let m = disc.dofs.num_free();
-        let nl = self.level_options(m);
-        let c0 = disc.dofs.gather(&cps);
-        let problem = self.method.problem(disc, cps);
-        let solver = NonlinearSolver::new(problem, c0, nl);
+        let solver = FixedBasisSolve::new(&*self.method, disc, cps, self.level_options(m));
         let report = LevelReport {
             level: k,
             shape,
@@ -276,23 +274,22 @@ impl EggSolver {
         Ok(Event::LevelStarted { level: k, levels: self.plan.len(), shape, unknowns: 2 * m, initial_guess: guess })
     }
 
-    fn finish_level(&mut self) -> Event {
+    fn finish_level(&mut self) -> Result<Event> {
         let mut a = self.active.take().expect("active level");
-        let status = a.solver.status().clone();
-        a.report.converged = status == Status::Converged;
-        if let Status::Failed(why) = status {
-            a.report.failure = Some(why);
-        }
-        let timings = a.solver.timings;
-        a.report.assembly_seconds = timings.assembly.as_secs_f64();
-        a.report.linear_seconds = timings.linear.as_secs_f64();
-        a.report.krylov_iterations = a.solver.krylov_iterations();
+        let solved = a.solver.finish()?;
+        (a.report.converged, a.report.failure) = (solved.converged(), solved.failure().map(str::to_string));
+        let h = solved.history;
+        (a.report.iterations, a.report.newton_iterations) = (h.iterations, h.newton_iterations);
+        a.report.pseudo_time_iterations = h.pseudo_time_iterations;
+        (a.report.residuals, a.report.scaled_residuals) = (h.residuals, h.scaled_residuals);
+        a.report.assembly_seconds = solved.timings.assembly.as_secs_f64();
+        a.report.linear_seconds = solved.timings.linear.as_secs_f64();
+        a.report.krylov_iterations = solved.krylov_iterations;
         a.report.seconds = a.started.elapsed().as_secs_f64();
-        let (problem, c) = a.solver.into_parts();
         let knots = self.plan[a.level].knots.clone();
-        self.previous = Some(Surface { knots, control_points: problem.control_points(&c), weights: a.weights });
+        self.previous = Some(Surface { knots, control_points: solved.control_points, weights: a.weights });
         self.reports.push(a.report.clone());
-        Event::LevelFinished(a.report)
+        Ok(Event::LevelFinished(a.report))
     }
 
     /// Finish: the map of the finest level and the full report, in the input's
@@ -455,19 +452,12 @@ impl Iterator for EggSolver {
         }
         if let Some(a) = self.active.as_mut() {
             match a.solver.step() {
-                Ok(Some(it)) => {
-                    a.report.residuals.push(it.residual);
-                    a.report.scaled_residuals.push(it.scaled_residual);
-                    if it.iteration > 0 {
-                        a.report.iterations = it.iteration;
-                        match it.method {
-                            NonlinearMethod::Newton => a.report.newton_iterations += 1,
-                            NonlinearMethod::PseudoTime => a.report.pseudo_time_iterations += 1,
-                        }
-                    }
-                    return Some(Ok(Event::Iterate { level: a.level, iterate: it }));
+                Ok(Some(it)) => return Some(Ok(Event::Iterate { level: a.level, iterate: it })),
+                Ok(None) => {
+                    let r = self.finish_level();
+                    self.failed = r.is_err();
+                    return Some(r);
                 }
-                Ok(None) => return Some(Ok(self.finish_level())),
                 Err(e) => {
                     self.failed = true;
                     return Some(Err(e));

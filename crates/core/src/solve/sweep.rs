@@ -63,7 +63,7 @@
 //! `1e-9`: `|F| sqrt(m) / diam`, absolute in that scaled sense), the same test as a cold
 //! solve; a prediction already within it takes no Newton step. A prediction within
 //! `sqrt(tol)` is in Newton's quadratic regime, and its one linear solve is carried to
-//! `tol / (2 |F_0|)` ([`NonlinearSolver`]'s forcing term), so one step meets the
+//! `tol / (2 |F_0|)` ([`NonlinearSolver`](crate::solve::newton::NonlinearSolver)'s forcing term), so one step meets the
 //! tolerance; the default first forcing term `1e-2` of a cold start had left `|F|`
 //! about `1e-2 |F_0|` and cost a second iteration on every frame.
 
@@ -72,7 +72,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::newton::{NonlinearMethod, NonlinearOptions, NonlinearSolver, Status};
+use super::fixed_basis::{scaled_options, FixedBasisSolve};
 use super::options::SolveOptions;
 use super::report::Solution;
 use crate::boundary::normalise::Similarity;
@@ -82,7 +82,6 @@ use crate::boundary::ring_fit::{fit_contour_seam, EtaRefinement};
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::EggMethod;
-use crate::methods::Method;
 use crate::pipeline::{ring_options, Pipeline};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
@@ -417,30 +416,13 @@ impl Sweep {
             cps[j * nx + nx - 1] = last[j * nx + nx - 1];
         }
         let method = EggMethod::cpu(self.opts.operator);
-        let m = self.disc.dofs.num_free();
-        let mut nl: NonlinearOptions = self.opts.nonlinear;
-        nl.scale = method.residual_scale(self.diameter, m);
-        nl.step_tol = self.opts.nonlinear.step_tol.max(1e-13) * self.diameter;
+        let nl = scaled_options(self.opts.nonlinear, &method, self.diameter, self.disc.dofs.num_free());
         self.disc.dofs.wrap(&mut cps);
-        let c0 = self.disc.dofs.gather(&cps);
-        let problem = method.problem(self.disc.clone(), cps);
-        let mut solver = NonlinearSolver::new(problem, c0, nl);
-        let (mut before, mut after, mut newton, mut solves) = (f64::NAN, f64::NAN, 0, 0);
-        for it in solver.by_ref() {
-            let it = it?;
-            if it.iteration == 0 {
-                before = it.residual;
-            } else {
-                solves += 1;
-                if it.method == NonlinearMethod::Newton {
-                    newton += 1;
-                }
-            }
-            after = it.residual;
-        }
-        let converged = solver.status() == &Status::Converged;
-        let (problem, c) = solver.into_parts();
-        let unit = Surface { knots: self.knots.clone(), control_points: problem.control_points(&c), weights: None };
+        let solved = FixedBasisSolve::new(&method, self.disc.clone(), cps, nl).finish()?;
+        let h = &solved.history;
+        let (newton, solves) = (h.newton_iterations, h.newton_iterations + h.pseudo_time_iterations);
+        let ((before, after), converged) = (h.residuals_before_after(), solved.converged());
+        let unit = Surface { knots: self.knots.clone(), control_points: solved.control_points, weights: None };
         let map = self.sim.physical_surface(&unit)?;
         let cert = certify(&map, &self.opts.certify)?;
         let (v, lb) = verdict(&cert.verdict);

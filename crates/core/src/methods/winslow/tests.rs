@@ -2,6 +2,7 @@
 //! differences, the projection onto semidefinite matrices, the problem's line search.
 use super::*;
 use crate::methods::density::tests::{affine, problem_fd};
+use crate::methods::density::SHIFT_MIN;
 use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
 use crate::spline::knots::KnotVector;
 
