@@ -19,7 +19,7 @@ pub(super) struct MultipatchArgs {
     /// The problem over all patches with `--interfaces free`: the Winslow functional
     /// (eq. 16) or the weak form (eq. 14).
     #[arg(long, value_enum, default_value = "winslow")]
-    functional: FunctionalArg,
+    functional: Functional,
     /// Multipatch input: also write one JSON map document per patch into this directory.
     #[arg(long, value_name = "DIR")]
     patch_maps: Option<PathBuf>,
@@ -27,12 +27,6 @@ pub(super) struct MultipatchArgs {
     /// .vtu per patch (in a directory named after the file).
     #[arg(long, value_name = "FILE.vtm")]
     vtm: Option<PathBuf>,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum FunctionalArg {
-    Winslow,
-    Weak,
 }
 
 /// The options of a layout solve from the arguments of `winslow solve`.
@@ -45,10 +39,7 @@ fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
     }
     Ok(MultipatchOptions {
         interfaces: a.multipatch.interfaces,
-        functional: match a.multipatch.functional {
-            FunctionalArg::Winslow => Functional::Winslow,
-            FunctionalArg::Weak => Functional::WeakForm,
-        },
+        functional: a.multipatch.functional,
         refine: solve.refine,
         // a layout refinement refines whole chains of patches: at most three rounds
         repair: solve.repair.min(3),
@@ -199,7 +190,7 @@ pub(super) struct JoinArgs {
     /// Smoothing of the joined map from its bijective start: the weak form (eq. 14, as in
     /// the paper) or the Winslow functional (eq. 16).
     #[arg(long, value_enum, default_value = "weak")]
-    functional: FunctionalArg,
+    functional: Functional,
     /// Output map (.json with a report, or .xml, .igs, .vtu, .vtk by extension).
     #[arg(short, long)]
     output: PathBuf,
@@ -291,10 +282,7 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
     use winslow::multipatch::join::join_and_smooth;
     let (na, ma) = read_map(&a.a)?;
     let (nb, mb) = read_map(&a.b)?;
-    let functional = match a.functional {
-        FunctionalArg::Winslow => Functional::Winslow,
-        FunctionalArg::Weak => Functional::WeakForm,
-    };
+    let functional = a.functional;
     let opts = CertifyOptions::default();
     let j = join_and_smooth(&ma, &mb, functional, Default::default(), &opts).context("joining the maps")?;
     let name = format!("{na}+{nb}");
