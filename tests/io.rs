@@ -300,7 +300,7 @@ fn square_doc() -> Value {
 /// Parse a document and validate it as `read_boundary` does.
 fn load(v: &Value) -> Result<Boundary, Error> {
     let doc = parse_json(&v.to_string())?;
-    checked_boundary(doc.into_boundary(), &ReadOptions::default()).map(|(b, _)| b)
+    checked_boundary(doc.into_boundary()?, &ReadOptions::default()).map(|(b, _)| b)
 }
 
 #[test]
@@ -359,7 +359,7 @@ fn non_finite_numbers() {
     // JSON cannot carry NaN; an overflowing literal is a parse error (or infinity).
     let text = square_doc().to_string().replacen("0.5", "1e999", 1);
     assert!(text.contains("1e999"));
-    let e = parse_json(&text).and_then(|d| checked_boundary(d.into_boundary(), &ReadOptions::default()).map(|_| ()));
+    let e = parse_json(&text).and_then(|d| checked_boundary(d.into_boundary()?, &ReadOptions::default()).map(|_| ()));
     assert!(matches!(e, Err(Error::Json { .. } | Error::NonFinite { .. })), "{e:?}");
     let text = square_doc().to_string().replacen("[0.0,0.0],[1.0,0.0]", "[0.0,0.0],[-1e400,0.0]", 1);
     assert!(matches!(parse_json(&text), Err(Error::Json { .. } | Error::NonFinite { .. })));
@@ -547,7 +547,7 @@ fn truncated_and_mutated_inputs_never_panic() {
         let bytes = t.as_bytes();
         // every truncation point (on char boundaries)
         for cut in (0..bytes.len()).filter(|&c| t.is_char_boundary(c)) {
-            if parse_document(&t[..cut]).and_then(|d| inspect(&d.into_boundary())).is_err() {
+            if parse_document(&t[..cut]).and_then(|d| inspect(&d.into_boundary()?)).is_err() {
                 errors += 1;
             }
         }
@@ -560,7 +560,7 @@ fn truncated_and_mutated_inputs_never_panic() {
                 b[i] = alphabet[rng.below(alphabet.len())];
             }
             if let Ok(s) = String::from_utf8(b) {
-                let _ = parse_document(&s).and_then(|d| inspect(&d.into_boundary()));
+                let _ = parse_document(&s).and_then(|d| inspect(&d.into_boundary()?));
             }
         }
     }

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use winslow::multipatch::gismo::parse_gismo_multipatch;
-use winslow::multipatch::json::parse_json_multipatch;
+use winslow::io::multipatch::gismo::parse_gismo_multipatch;
+use winslow::io::multipatch::json::parse_json_multipatch;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_winslow"))

@@ -24,9 +24,9 @@ use std::collections::HashMap;
 
 use serde_json::{json, Map, Value};
 
-use super::layout::{Interface, Layout, Patch, PatchSide};
 use crate::error::{Error, Result};
 use crate::io::json::{CurveJson, MapJson};
+use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
 use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
 
@@ -54,7 +54,7 @@ fn curve_of(v: Value, ctx: &str) -> Result<Curve> {
 }
 
 /// Parse a multipatch document (see the module documentation); the layout is not
-/// validated here ([`super::check::validate_layout`]).
+/// validated here ([`crate::multipatch::check::validate_layout`]).
 pub fn parse_json_multipatch(text: &str) -> Result<Layout> {
     let v: Value = serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| jerr("", e.to_string()))?;
     let Value::Object(mut obj) = v else { return Err(jerr("", "the document must be an object")) };
