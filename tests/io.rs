@@ -589,3 +589,63 @@ fn analytic_sides_are_written_as_point_clouds() {
     let SideCurve::Points(p) = b2.side(Side::North) else { panic!() };
     assert_eq!(p[512], [0.5, 1.1]);
 }
+
+/// `winslow::read` tells every kind of document apart: one bundled file of each kind,
+/// and a solved multipatch result and a volume written by `winslow::write`.
+#[test]
+fn read_returns_the_kind_of_every_bundled_document() {
+    for (rel, kind) in [
+        ("wavy_lid.json", "boundary"),
+        ("contours/star8.json", "boundary"),
+        ("gismo/xml/duck.xml", "boundary"),
+        ("maps/skewed_square.json", "map"),
+        ("maps/quarter_annulus_nurbs.xml", "map"),
+        ("gismo/xml/disk.xml", "map"),
+        ("maps/skewed_square.igs", "map"),
+        ("rings/eccentric_annulus.json", "ring"),
+        ("gismo/xml/multipatch/plateWithHoleMP.xml", "multipatch layout"),
+    ] {
+        let doc = winslow::read(&data(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert_eq!(doc.kind(), kind, "{rel}");
+        assert!(!doc.name().is_empty(), "{rel}: named after the file at least");
+    }
+    let dir = scratch("kinds");
+    std::fs::create_dir_all(&dir).unwrap();
+    // a solved result: the G+Smo layout's patch maps as a JSON multipatch document
+    let Document::Layout(layout) = winslow::read(&data("gismo/xml/multipatch/circleMP.xml")).unwrap() else {
+        panic!("not a layout")
+    };
+    let n = layout.patches.len();
+    let patches = winslow::io::Patches {
+        layout: &layout,
+        maps: layout.patches.iter().map(|p| p.map.clone().expect("G+Smo patches are maps")).collect(),
+        reports: vec![Value::Null; n],
+        messages: vec![String::new(); n],
+        report: json!({}),
+        message: String::new(),
+    };
+    let result = dir.join("result.json");
+    winslow::write(&result, &winslow::Output::Multipatch(patches)).unwrap();
+    assert_eq!(winslow::read(&result).unwrap().kind(), "multipatch result");
+    // a volume, in JSON and G+Smo XML
+    let k = winslow::KnotVector::open_uniform(1, 1);
+    let cps = (0..8).map(|i| [(i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64]).collect();
+    let volume = winslow::spline::volume::Volume::new([k.clone(), k.clone(), k], cps, None).unwrap();
+    for file in ["cube.json", "cube.xml"] {
+        let path = dir.join(file);
+        winslow::write(&path, &winslow::Output::Volume { name: "cube", volume: &volume, label: "", extra: None })
+            .unwrap();
+        assert_eq!(winslow::read(&path).unwrap().kind(), "volume", "{file}");
+    }
+    // general domains and graphs are named, not half read
+    let domain = dir.join("domain.json");
+    write_json(&domain, &json!({ "name": "d", "domain": { "outer": { "points": [[0, 0], [1, 0], [1, 1]] } } }))
+        .unwrap();
+    let e = winslow::read(&domain).unwrap_err();
+    assert!(matches!(&e, Error::DocumentKind { path: Some(p), .. } if p == &domain), "{e}");
+    assert!(e.to_string().contains("general planar domain"), "{e}");
+    // a ring is not a boundary: the error names both
+    let e = read_boundary(&data("rings/eccentric_annulus.json"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("a ring document, where a four-sided boundary"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
