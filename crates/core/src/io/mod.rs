@@ -1,13 +1,13 @@
 //! Reading and writing every format, like meshio's `read` and `write`: [`read`] decides
 //! the kind of a file by its content and returns a [`Document`] (boundary, map, ring,
-//! multipatch layout or result, volume); [`write`] writes an [`Output`] in the format of
+//! multipatch layout or result, volume); [`write()`] writes an [`Output`] in the format of
 //! the file's extension, every file through one atomic writer ([`file::write_with`]).
 //!
 //! | module | holds |
 //! |---|---|
 //! | [`document`] | the kinds of document and the reader that tells them apart |
 //! | [`output`] | what can be written, and the dispatch by extension |
-//! | [`file`] | reading text with a size limit; the atomic writer |
+//! | [`mod@file`] | reading text with a size limit; the atomic writer |
 //! | [`json`] | the JSON exchange formats of `formats.md`: boundary, contour, map |
 //! | [`ring`] | ring (O-type) documents |
 //! | [`multipatch`] | multipatch layouts and results: JSON, G+Smo `<MultiPatch>`, VTK multiblock |

@@ -1,5 +1,5 @@
 //! What can be written ([`Output`]) and the one writer that picks the format by the
-//! file's extension ([`write`]), like meshio's `write`. Every file goes through the
+//! file's extension ([`write()`]), like meshio's `write`. Every file goes through the
 //! atomic writer ([`super::file::write_with`]).
 //!
 //! | output | extensions |

@@ -1,6 +1,6 @@
 //! Multipatch files (paper §11.2): the JSON multipatch document of `formats.md` with
-//! named curves ([`json`]), G+Smo XML `<MultiPatch>` files with G+Smo's side numbering
-//! and orientation flags ([`gismo`]), and the output of a set of patch maps
+//! named curves ([`mod@json`]), G+Smo XML `<MultiPatch>` files with G+Smo's side numbering
+//! and orientation flags ([`mod@gismo`]), and the output of a set of patch maps
 //! ([`Patches`]: the JSON document, G+Smo XML, a VTK multiblock file `.vtm` referencing
 //! one exact Bézier `.vtu` per patch, one JSON map document per patch).
 //!
