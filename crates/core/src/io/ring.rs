@@ -49,7 +49,7 @@ fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
 
 /// The ring of a JSON document with a top-level `"ring"` field, `None` for any other
 /// document. Errors name the place (`ring.inner.knots`, ...).
-pub fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
+pub(crate) fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
     let text = text.trim_start_matches('\u{feff}').trim_start();
     if !text.starts_with('{') {
         return Ok(None);
