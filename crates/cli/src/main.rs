@@ -59,7 +59,7 @@ enum Command {
     Inspect(InspectArgs),
     /// Solve the EGG equations for a boundary and write the map (with a report).
     Solve(Box<SolveArgs>),
-    /// Draw an existing map file as a PNG (grid lines coloured by det J).
+    /// Draw a map, a ring map or a multipatch result as a PNG (grid lines coloured by det J).
     Render(RenderArgs),
     /// Run the solver on a list of geometries and sizes and print a table.
     Bench(BenchArgs),
@@ -72,7 +72,8 @@ enum Command {
     Check(check_cmd::CheckArgs),
     /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
-    /// Bézier cells), .vtk (sampled structured grid).
+    /// Bézier cells), .vtk (sampled structured grid); a multipatch result as .json, .xml
+    /// or .vtm; a volume as .json, .xml, .vtu or .vtk. The map is certified again.
     Convert(ConvertArgs),
     /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,
     /// sharp corners, puzzle tabs, thin strips, CAD sides, noisy and sparse clouds);
@@ -104,7 +105,7 @@ enum Command {
 
 #[derive(Args, Debug)]
 struct ConvertArgs {
-    /// Map file (JSON map document, G+Smo XML or IGES).
+    /// Map file (JSON map document, G+Smo XML or IGES), multipatch result or volume.
     map: PathBuf,
     /// Output file; the format follows its extension.
     #[arg(short, long)]
@@ -507,7 +508,7 @@ struct SolveArgs {
 
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// Map file.
+    /// Map file (a ring map or a multipatch result too).
     map: PathBuf,
     /// Output PNG.
     #[arg(long)]
