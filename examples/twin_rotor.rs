@@ -30,8 +30,7 @@ use std::time::Instant;
 
 use winslow::boundary::fit::{fit_side, FitOptions};
 use winslow::boundary::ring::ClosedContour;
-use winslow::io::ring::read_ring;
-use winslow::multipatch::json::layout_to_json;
+use winslow::io::Output;
 use winslow::multipatch::split::{nearest_boundary_point, split_map, SplitOptions, SplitPath};
 use winslow::multipatch::{solve_multipatch, Interface, Interfaces, Layout, MultipatchOptions, Patch, PatchSide};
 use winslow::solve::options::SolveOptions;
@@ -122,7 +121,7 @@ fn main() -> Res<()> {
     std::fs::create_dir_all(&out)?;
     let t0 = Instant::now();
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/rings/male_rotor_in_casing.json");
-    let ring = read_ring(&data)?.ok_or("not a ring")?;
+    let winslow::Document::Ring(ring) = winslow::read(&data)? else { return Err("not a ring".into()) };
     let ClosedContour::Spline(rotor) = ring.inner else { return Err("the rotor is not a spline".into()) };
     let h = (R * R - C * C).sqrt();
     let (top, bot) = ([0.0, h], [0.0, -h]);
@@ -170,7 +169,8 @@ fn main() -> Res<()> {
         sep.report.basis_functions,
         sep.report.basis.used.name()
     );
-    winslow::io::write_json(&out.join("separator.json"), &winslow::io::map_to_json("separator", &sep.map, None))?;
+    let separator_map = Output::Map { name: "separator", map: &sep.map, label: &sep.report.message, extra: None };
+    winslow::write(&out.join("separator.json"), &separator_map)?;
     // split it from the top cusp to the bottom cusp through the map
     let (from, _) = nearest_boundary_point(&sep.map, top);
     let (to, _) = nearest_boundary_point(&sep.map, bot);
@@ -217,7 +217,7 @@ fn main() -> Res<()> {
             iface(ps(3, Side::North), ps(2, Side::North), true),
         ],
     };
-    winslow::io::write_json(&out.join("layout.json"), &layout_to_json(&layout))?;
+    winslow::write(&out.join("layout.json"), &Output::Layout(&layout))?;
     println!("layout written: {}", out.join("layout.json").display());
     for interfaces in [Interfaces::Fixed, Interfaces::Free] {
         let opts = MultipatchOptions { interfaces, ..Default::default() };
@@ -229,19 +229,8 @@ fn main() -> Res<()> {
             println!("  {:<13} {nx:>3}x{ny:<4} {}", p.name, p.certificate.message());
         }
         let img = winslow::io::picture::render_layout(&sol.maps(), &Default::default());
-        write_ppm(&out.join(format!("twin_rotor_{}.ppm", interfaces.name())), &img)?;
+        winslow::write(&out.join(format!("twin_rotor_{}.png", interfaces.name())), &Output::Picture(&img))?;
     }
     println!("total {:.3} s", t0.elapsed().as_secs_f64());
-    Ok(())
-}
-
-/// A binary PPM of the picture (the example has no PNG encoder; `winslow render` draws
-/// single maps, `winslow solve --png` layouts).
-fn write_ppm(path: &Path, img: &winslow::io::picture::Image) -> Res<()> {
-    let mut bytes = format!("P6\n{} {}\n255\n", img.width, img.height).into_bytes();
-    for px in img.rgba.chunks_exact(4) {
-        bytes.extend_from_slice(&px[..3]);
-    }
-    std::fs::write(path, bytes)?;
     Ok(())
 }

@@ -281,7 +281,7 @@ fn square_doc() -> Value {
 /// Parse a document and validate it as `read_boundary` does.
 fn load(v: &Value) -> Result<Boundary, Error> {
     let doc = parse_json(&v.to_string())?;
-    checked_boundary(doc.into_boundary(), &ReadOptions::default()).map(|(b, _)| b)
+    checked_boundary(doc.into_boundary()?, &ReadOptions::default()).map(|(b, _)| b)
 }
 
 #[test]
@@ -340,7 +340,7 @@ fn non_finite_numbers() {
     // JSON cannot carry NaN; an overflowing literal is a parse error (or infinity).
     let text = square_doc().to_string().replacen("0.5", "1e999", 1);
     assert!(text.contains("1e999"));
-    let e = parse_json(&text).and_then(|d| checked_boundary(d.into_boundary(), &ReadOptions::default()).map(|_| ()));
+    let e = parse_json(&text).and_then(|d| checked_boundary(d.into_boundary()?, &ReadOptions::default()).map(|_| ()));
     assert!(matches!(e, Err(Error::Json { .. } | Error::NonFinite { .. })), "{e:?}");
     let text = square_doc().to_string().replacen("[0.0,0.0],[1.0,0.0]", "[0.0,0.0],[-1e400,0.0]", 1);
     assert!(matches!(parse_json(&text), Err(Error::Json { .. } | Error::NonFinite { .. })));
@@ -528,7 +528,7 @@ fn truncated_and_mutated_inputs_never_panic() {
         let bytes = t.as_bytes();
         // every truncation point (on char boundaries)
         for cut in (0..bytes.len()).filter(|&c| t.is_char_boundary(c)) {
-            if parse_document(&t[..cut]).and_then(|d| inspect(&d.into_boundary())).is_err() {
+            if parse_document(&t[..cut]).and_then(|d| inspect(&d.into_boundary()?)).is_err() {
                 errors += 1;
             }
         }
@@ -541,7 +541,7 @@ fn truncated_and_mutated_inputs_never_panic() {
                 b[i] = alphabet[rng.below(alphabet.len())];
             }
             if let Ok(s) = String::from_utf8(b) {
-                let _ = parse_document(&s).and_then(|d| inspect(&d.into_boundary()));
+                let _ = parse_document(&s).and_then(|d| inspect(&d.into_boundary()?));
             }
         }
     }
@@ -569,4 +569,63 @@ fn analytic_sides_are_written_as_point_clouds() {
     let b2 = load(&v).unwrap();
     let SideCurve::Points(p) = b2.side(Side::North) else { panic!() };
     assert_eq!(p[512], [0.5, 1.1]);
+}
+
+/// `winslow::read` tells every kind of document apart: one bundled file of each kind,
+/// and a solved multipatch result and a volume written by `winslow::write`.
+#[test]
+fn read_returns_the_kind_of_every_bundled_document() {
+    for (rel, kind) in [
+        ("wavy_lid.json", "boundary"),
+        ("contours/star8.json", "boundary"),
+        ("gismo/xml/duck.xml", "boundary"),
+        ("maps/skewed_square.json", "map"),
+        ("maps/quarter_annulus_nurbs.xml", "map"),
+        ("gismo/xml/disk.xml", "map"),
+        ("maps/skewed_square.igs", "map"),
+        ("rings/eccentric_annulus.json", "ring"),
+        ("gismo/xml/multipatch/plateWithHoleMP.xml", "multipatch layout"),
+    ] {
+        let doc = winslow::read(&data(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert_eq!(doc.kind(), kind, "{rel}");
+        assert!(!doc.name().is_empty(), "{rel}: named after the file at least");
+    }
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    // a solved result: the G+Smo layout's patch maps as a JSON multipatch document
+    let Document::Layout(layout) = winslow::read(&data("gismo/xml/multipatch/circleMP.xml")).unwrap() else {
+        panic!("not a layout")
+    };
+    let n = layout.patches.len();
+    let patches = winslow::io::Patches {
+        layout: &layout,
+        maps: layout.patches.iter().map(|p| p.map.clone().expect("G+Smo patches are maps")).collect(),
+        reports: vec![Value::Null; n],
+        messages: vec![String::new(); n],
+        report: json!({}),
+        message: String::new(),
+    };
+    let result = dir.join("result.json");
+    winslow::write(&result, &winslow::Output::Multipatch(patches)).unwrap();
+    assert_eq!(winslow::read(&result).unwrap().kind(), "multipatch result");
+    // a volume, in JSON and G+Smo XML
+    let k = winslow::KnotVector::open_uniform(1, 1);
+    let cps = (0..8).map(|i| [(i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64]).collect();
+    let volume = winslow::spline::volume::Volume::new([k.clone(), k.clone(), k], cps, None).unwrap();
+    for file in ["cube.json", "cube.xml"] {
+        let path = dir.join(file);
+        winslow::write(&path, &winslow::Output::Volume { name: "cube", volume: &volume, label: "", extra: None })
+            .unwrap();
+        assert_eq!(winslow::read(&path).unwrap().kind(), "volume", "{file}");
+    }
+    // general domains and graphs are named, not half read
+    let domain = dir.join("domain.json");
+    write_json(&domain, &json!({ "name": "d", "domain": { "outer": { "points": [[0, 0], [1, 0], [1, 1]] } } }))
+        .unwrap();
+    let e = winslow::read(&domain).unwrap_err();
+    assert!(matches!(&e, Error::DocumentKind { path: Some(p), .. } if p == &domain), "{e}");
+    assert!(e.to_string().contains("general planar domain"), "{e}");
+    // a ring is not a boundary: the error names both
+    let e = read_boundary(&data("rings/eccentric_annulus.json"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("a ring document, where a four-sided boundary"), "{e}");
 }

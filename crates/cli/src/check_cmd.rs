@@ -4,14 +4,14 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
-use winslow::io::{read_document, Document};
+use winslow::io::Document;
 use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
 use winslow::verify::poisson::poisson_benchmark;
 use winslow::verify::quality::{boundary_deviation, quality};
 
-use crate::{load_boundary, loft_cmd, multipatch_cmd, output};
+use crate::{files, load_boundary, loft_cmd, multipatch_cmd, output};
 
 #[derive(Args, Debug)]
 pub(crate) struct CheckArgs {
@@ -45,22 +45,19 @@ pub(crate) struct CheckArgs {
 }
 
 pub(crate) fn check(a: CheckArgs) -> Result<i32> {
-    if let Some(v) = loft_cmd::volume_in(&a.map)? {
-        return loft_cmd::check_volume(&v, a.max_depth, a.max_boxes, a.json);
-    }
     let opts = CertifyOptions {
         max_depth: a.max_depth.clamp(1, 40),
         max_boxes: a.max_boxes.clamp(1, 1 << 24),
         excuse_corners: !a.strict_corners,
     };
-    if let Some(layout) =
-        winslow::multipatch::read_layout(&a.map).with_context(|| format!("reading {}", a.map.display()))?
-    {
-        return multipatch_cmd::check(layout, &opts, a.json);
-    }
-    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-    let Document::Map { name, map, .. } = doc else {
-        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
+    let (name, map) = match files::read(&a.map)? {
+        Document::Volume { name, volume } => {
+            return loft_cmd::check_volume(&name, &volume, a.max_depth, a.max_boxes, a.json)
+        }
+        Document::Layout(layout) | Document::Multipatch(layout) => return multipatch_cmd::check(layout, &opts, a.json),
+        doc => {
+            files::map_of(doc, &a.map, "check needs a map, a multipatch file or a volume (run `winslow solve` first)")?
+        }
     };
     let certificate = certify(&map, &opts).context("certifying the map")?;
     let quality = quality(&map);

@@ -182,11 +182,11 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
         .with_context(|| format!("comparing methods on {}", a.boundary.display()))?
         .context("the comparison was cancelled")?;
     if let Some(dir) = &a.png_dir {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for row in &cmp.rows {
             if let Some(map) = &row.map {
                 let path = dir.join(format!("{}-{}.png", cmp.name, row.method));
-                output::write_png(&path, &render(map, &PictureOptions::default()))?;
+                let image = render(map, &PictureOptions::default());
+                crate::files::write(&path, &winslow::io::Output::Picture(&image))?;
                 if !quiet {
                     eprintln!("wrote {}", path.display());
                 }

@@ -10,7 +10,6 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use winslow::boundary::families::{corpus, Family};
-use winslow::io::json::{boundary_to_json, write_json};
 use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
@@ -59,10 +58,8 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
     let domains: Vec<_> =
         corpus(a.per_family, a.seed).into_iter().filter(|(f, _)| families.is_empty() || families.contains(f)).collect();
     if let Some(dir) = &a.output {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (_, b) in &domains {
-            let path = dir.join(format!("{}.json", b.name));
-            write_json(&path, &boundary_to_json(b)).with_context(|| format!("writing {}", path.display()))?;
+            crate::files::write(&dir.join(format!("{}.json", b.name)), &winslow::io::Output::Boundary(b))?;
         }
         println!("wrote {} boundaries to {}", domains.len(), dir.display());
     }

@@ -4,8 +4,7 @@
 //! `convert` (JSON, G+Smo XML `TensorBSpline3`, VTK).
 
 use super::*;
-use winslow::io::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
-use winslow::io::volume::{read_volume, volume_to_json, VolumeDocument};
+use crate::files;
 use winslow::solve::loft::{loft, LoftOptions, SliceBoundary};
 use winslow::spline::loft::Interpolation;
 use winslow::spline::volume::Volume;
@@ -59,25 +58,6 @@ fn exit_code(v: &VolumeVerdict) -> i32 {
     }
 }
 
-/// Write a volume in the format of the output's extension.
-fn write_volume(path: &Path, vol: &Volume, label: &str, json: impl Fn() -> serde_json::Value) -> Result<()> {
-    output::ensure_parent(path)?;
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    let text = match ext.as_str() {
-        "xml" => winslow::io::gismo_writer::volume_to_gismo_xml(vol, label),
-        "vtu" => volume_bezier_vtu(vol, label)?,
-        "vtk" => {
-            let elems = vol.knots.each_ref().map(|k| (4 * k.num_elements()).clamp(8, 256));
-            volume_structured_vtk(vol, elems)
-        }
-        _ => {
-            winslow::io::write_json(path, &json()).with_context(|| format!("writing {}", path.display()))?;
-            return Ok(());
-        }
-    };
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
-}
-
 fn certify_options(max_depth: usize, max_boxes: usize) -> CertifyOptions {
     CertifyOptions { max_depth: max_depth.clamp(1, 40), max_boxes: max_boxes.clamp(1, 1 << 24), excuse_corners: true }
 }
@@ -94,10 +74,8 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
     let mut slices = Vec::with_capacity(a.slices.len());
     let mut name = String::new();
     for (i, p) in a.slices.iter().enumerate() {
-        let doc = read_document(p).with_context(|| format!("reading slice {i} ({})", p.display()))?;
-        let Document::Map { name: n, map } = doc else {
-            bail!("slice {i} ({}) is a boundary, not a map: solve it first", p.display())
-        };
+        let doc = files::read(p).with_context(|| format!("slice {i}"))?;
+        let (n, map) = files::map_of(doc, p, &format!("slice {i} must be a map (solve it first)"))?;
         if i == 0 {
             name = format!("{n}-loft");
         }
@@ -115,9 +93,8 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
     let out = loft(&slices, &z, &opts, SliceBoundary::Interpolated).context("lofting the slices")?;
     let cert = &out.certificate;
     let label = format!("volume certificate: {}", cert.message());
-    let json =
-        || volume_to_json(&name, &out.volume, Some(serde_json::json!({ "report": &out.report, "certificate": cert })));
-    write_volume(&a.output, &out.volume, &label, json)?;
+    let extra = Some(serde_json::json!({ "report": &out.report, "certificate": cert }));
+    files::write(&a.output, &Output::Volume { name: &name, volume: &out.volume, label: &label, extra })?;
     let inserted = out.report.slices.iter().filter(|s| s.given.is_none()).count();
     if a.json {
         let v = serde_json::json!({ "report": &out.report, "certificate": cert, "seconds": t0.elapsed().as_secs_f64(),
@@ -165,11 +142,10 @@ struct VolumeCheck<'a> {
 }
 
 /// `winslow check` on a volume document (JSON or G+Smo XML): the trivariate certificate.
-pub(super) fn check_volume(doc: &VolumeDocument, max_depth: usize, max_boxes: usize, json: bool) -> Result<i32> {
-    let vol = &doc.volume;
+pub(super) fn check_volume(name: &str, vol: &Volume, max_depth: usize, max_boxes: usize, json: bool) -> Result<i32> {
     let cert = certify_volume(vol, &certify_options(max_depth, max_boxes)).context("certifying the volume")?;
     let report = VolumeCheck {
-        name: &doc.name,
+        name,
         kind: "volume",
         degrees: vol.degrees(),
         shape: vol.shape(),
@@ -184,7 +160,7 @@ pub(super) fn check_volume(doc: &VolumeDocument, max_depth: usize, max_boxes: us
         let (d, s) = (report.degrees, report.shape);
         println!(
             "{}: volume of degrees ({}, {}, {}), {} x {} x {} control points, {} elements, det J of degree ({}, {}, {})",
-            doc.name, d[0], d[1], d[2], s[0], s[1], s[2], cert.elements, cert.det_degree[0], cert.det_degree[1], cert.det_degree[2]
+            name, d[0], d[1], d[2], s[0], s[1], s[2], cert.elements, cert.det_degree[0], cert.det_degree[1], cert.det_degree[2]
         );
         println!("{}", cert.message());
         println!("volume (integral of det J) {:.6e}; certificate {:.3} s", report.volume, cert.seconds);
@@ -193,16 +169,11 @@ pub(super) fn check_volume(doc: &VolumeDocument, max_depth: usize, max_boxes: us
 }
 
 /// `winslow convert` of a volume: certified again, written by the output's extension.
-pub(super) fn convert_volume(doc: &VolumeDocument, output: &Path) -> Result<i32> {
-    let cert = certify_volume(&doc.volume, &CertifyOptions::default()).context("certifying the volume")?;
+pub(super) fn convert_volume(name: &str, volume: &Volume, output: &Path) -> Result<i32> {
+    let cert = certify_volume(volume, &CertifyOptions::default()).context("certifying the volume")?;
     let label = format!("volume certificate: {}", cert.message());
-    let json = || volume_to_json(&doc.name, &doc.volume, Some(serde_json::json!({ "certificate": &cert })));
-    write_volume(output, &doc.volume, &label, json)?;
+    let extra = Some(serde_json::json!({ "certificate": &cert }));
+    files::write(output, &Output::Volume { name, volume, label: &label, extra })?;
     println!("wrote {} ({label})", output.display());
     Ok(exit_code(&cert.verdict))
-}
-
-/// A volume in `path`, if it holds one (JSON or G+Smo XML).
-pub(super) fn volume_in(path: &Path) -> Result<Option<VolumeDocument>> {
-    read_volume(path).with_context(|| format!("reading {}", path.display()))
 }

@@ -13,9 +13,8 @@ use winslow::boundary::hierarchy::build_hierarchy;
 use winslow::boundary::reparam::{Fill, Reparam, ReparamOptions};
 use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
-use winslow::io::picture::{render, PictureOptions};
-use winslow::io::ring::read_ring;
-use winslow::io::{checked_boundary, map_to_json, read_document, Document, ReadOptions};
+use winslow::io::picture::{render, render_layout, PictureOptions};
+use winslow::io::{checked_boundary, Document, Output, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::{EggAssembler, EggMethod};
 use winslow::methods::Method;
@@ -31,7 +30,9 @@ use winslow_gpu::{Backend, Precision, Selected};
 
 mod check_cmd;
 mod compare_cmd;
+mod convert_cmd;
 mod corpus;
+mod files;
 mod inspect_ring;
 mod loft_cmd;
 mod mesh;
@@ -63,7 +64,7 @@ enum Command {
         after_help = "Example:\n  winslow solve tests/data/wavy_lid.json -o out/wavy_lid.json --png out/wavy_lid.png"
     )]
     Solve(Box<SolveArgs>),
-    /// Draw an existing map file as a PNG (grid lines coloured by det J).
+    /// Draw a map, a ring map or a multipatch result as a PNG (grid lines coloured by det J).
     #[command(
         after_help = "Example (a map written by `winslow solve`):\n  winslow render out/wavy_lid.json --png out/wavy_lid-render.png"
     )]
@@ -88,7 +89,8 @@ enum Command {
     Check(check_cmd::CheckArgs),
     /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
-    /// Bézier cells), .vtk (sampled structured grid).
+    /// Bézier cells), .vtk (sampled structured grid); a multipatch result as .json, .xml
+    /// or .vtm; a volume as .json, .xml, .vtu or .vtk. The map is certified again.
     #[command(
         after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml"
     )]
@@ -143,7 +145,7 @@ enum Command {
 
 #[derive(Args, Debug)]
 struct ConvertArgs {
-    /// Map file (JSON map document, G+Smo XML or IGES).
+    /// Map file (JSON map document, G+Smo XML or IGES), multipatch result or volume.
     map: PathBuf,
     /// Output file; the format follows its extension.
     #[arg(short, long)]
@@ -462,7 +464,7 @@ struct SolveArgs {
 
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// Map file.
+    /// Map file (a ring map or a multipatch result too).
     map: PathBuf,
     /// Output PNG.
     #[arg(long)]
@@ -542,23 +544,10 @@ fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Inspect(a) => inspect(a),
         Command::Solve(a) => solve_cmd::solve(*a),
-        Command::Render(a) => {
-            let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-            let Document::Map { map, .. } = doc else {
-                bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
-            };
-            let segments = if a.no_matches { Vec::new() } else { output::report_matches(&a.map) };
-            let kinks = output::report_kinks(&a.map);
-            let (size, grid_lines) = (a.size.clamp(64, 8192), a.lines);
-            let opts = PictureOptions { size, grid_lines, segments, kinks, ..Default::default() };
-            let sel = a.backend.select(false)?;
-            output::write_png(&a.png, &picture(&sel, &map, &opts)?)?;
-            println!("wrote {}", a.png.display());
-            Ok(0)
-        }
+        Command::Render(a) => convert_cmd::render(a),
         Command::Bench(a) => bench(a),
         Command::Check(a) => check_cmd::check(a),
-        Command::Convert(a) => convert(a),
+        Command::Convert(a) => convert_cmd::convert(a),
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
@@ -575,22 +564,20 @@ fn run(cli: Cli) -> Result<i32> {
 }
 
 fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
-    let doc = read_document(path).with_context(|| format!("reading {}", path.display()))?;
-    let (b, _) = checked_boundary(doc.into_boundary(), &ReadOptions { reorient })
-        .with_context(|| format!("validating {}", path.display()))?;
+    let b = files::boundary_of(files::read(path)?, path)?;
+    let (b, _) =
+        checked_boundary(b, &ReadOptions { reorient }).with_context(|| format!("validating {}", path.display()))?;
     Ok(b)
 }
 
 fn inspect(a: InspectArgs) -> Result<i32> {
-    if let Some(ring) = read_ring(&a.file).with_context(|| format!("reading {}", a.file.display()))? {
-        return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
-    }
-    let doc = read_document(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
+    let doc = files::read(&a.file)?;
     let kind = match &doc {
+        Document::Ring(ring) => return inspect_ring::run(&a.file, ring, &fit_options(&a.fit), a.json),
         Document::Boundary(_) => "boundary",
-        Document::Map { .. } => "map (its four boundary curves are inspected)",
+        _ => "map (its four boundary curves are inspected)",
     };
-    let boundary = doc.into_boundary();
+    let boundary = files::boundary_of(doc, &a.file)?;
     let mut problems = Vec::new();
     let checked = checked_boundary(boundary.clone(), &ReadOptions { reorient: a.fit.reorient });
     let (boundary, report) = match checked {
@@ -617,27 +604,6 @@ fn inspect(a: InspectArgs) -> Result<i32> {
         print!("{text}");
     }
     Ok(if problems.is_empty() { 0 } else { 2 })
-}
-
-fn convert(a: ConvertArgs) -> Result<i32> {
-    if let Some(v) = loft_cmd::volume_in(&a.map)? {
-        return loft_cmd::convert_volume(&v, &a.output);
-    }
-    let doc = read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-    let Document::Map { name, map, .. } = doc else {
-        bail!("{} is a boundary, not a map: run `winslow solve` first", a.map.display())
-    };
-    // the verdict travels with the map: certify it again (the input may carry none)
-    let certificate = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
-    let label = format!("certificate: {}", certificate.message());
-    let json = || map_to_json(&name, &map, Some(serde_json::json!({ "certificate": &certificate })));
-    output::write_map(&a.output, &name, &map, &label, json)?;
-    println!("wrote {} ({label})", a.output.display());
-    Ok(match certificate.verdict {
-        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
-        CertVerdict::Folded { .. } => 3,
-        CertVerdict::Undecided { .. } => 5,
-    })
 }
 
 fn bench(a: BenchArgs) -> Result<i32> {

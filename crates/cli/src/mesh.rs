@@ -228,10 +228,8 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
 
 /// `winslow mesh`.
 pub fn run(a: MeshArgs) -> Result<i32> {
-    let doc = winslow::read_document(&a.map).with_context(|| format!("reading {}", a.map.display()))?;
-    let winslow::Document::Map { map, .. } = doc else {
-        bail!("{} is a boundary, not a map: run `winslow solve` first (or `solve --mesh`)", a.map.display())
-    };
+    let needed = "mesh needs a map (run `winslow solve` first, or `solve --mesh`)";
+    let (_, map) = crate::files::map_of(crate::files::read(&a.map)?, &a.map, needed)?;
     make_and_write(&map, &a.spec, &a.output, false)?;
     Ok(0)
 }

@@ -3,9 +3,11 @@
 //! the `split` and `join` commands.
 
 use super::*;
-use winslow::io::picture::render_layout;
-use winslow::multipatch::output::{solution_to_gismo_xml, solution_to_json, write_patch_maps, write_vtm};
+use winslow::io::multipatch::write_patch_maps;
+use winslow::io::Patches;
 use winslow::multipatch::split::SplitPath;
+
+use crate::files;
 use winslow::multipatch::{solve_multipatch, Functional, Interfaces, Layout, MultipatchOptions, MultipatchSolution};
 
 /// The options of `winslow solve` that only a multipatch layout reads.
@@ -69,31 +71,19 @@ pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
     Ok(exit_code(sol.report.verdict))
 }
 
-/// Write the solution where `a` asks: `-o` (.xml: G+Smo, else the JSON document),
-/// `--gismo`, `--png` (the whole layout), `--vtm`, `--patch-maps`.
+/// Write the solution where `a` asks: `-o` by its extension (.json, .xml for G+Smo,
+/// .vtm), `--gismo`, `--png` (the whole layout), `--vtm`, `--patch-maps`.
 fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
-    let xml = |p: &Path| -> Result<()> {
-        output::ensure_parent(p)?;
-        std::fs::write(p, solution_to_gismo_xml(sol)?).with_context(|| format!("writing {}", p.display()))
-    };
-    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    match ext.as_str() {
-        "xml" => xml(&a.output)?,
-        "json" | "" => {
-            output::ensure_parent(&a.output)?;
-            winslow::io::write_json(&a.output, &solution_to_json(sol)?)?;
-        }
-        other => bail!("a multipatch layout is written as .json or .xml (G+Smo), not .{other}; see --vtm and --png"),
-    }
+    let patches = Output::Multipatch(Patches::of_solution(sol)?);
+    files::write(&a.output, &patches)?;
     if let Some(p) = &a.gismo {
-        xml(p)?;
+        files::write_as(p, "xml", &patches)?;
     }
     if let Some(p) = &a.png {
-        output::write_png(p, &render_layout(&sol.maps(), &PictureOptions::default()))?;
+        files::write(p, &Output::Picture(&render_layout(&sol.maps(), &PictureOptions::default())))?;
     }
     if let Some(p) = &a.multipatch.vtm {
-        output::ensure_parent(p)?;
-        write_vtm(sol, p)?;
+        files::write_as(p, "vtm", &patches)?;
     }
     if let Some(d) = &a.multipatch.patch_maps {
         write_patch_maps(sol, d)?;
@@ -203,10 +193,7 @@ pub(super) struct JoinArgs {
 }
 
 fn read_map(path: &Path) -> Result<(String, Surface)> {
-    match read_document(path).with_context(|| format!("reading {}", path.display()))? {
-        Document::Map { name, map } => Ok((name, map)),
-        Document::Boundary(_) => bail!("{} is a boundary, not a map: run `winslow solve` first", path.display()),
-    }
+    files::map_of(files::read(path)?, path, files::SOLVE_FIRST)
 }
 
 /// `SIDE:T` or `X,Y` as a side point of `map`.
@@ -232,7 +219,6 @@ fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::Side
 }
 
 pub(super) fn split(a: SplitArgs) -> Result<i32> {
-    use winslow::multipatch::json::layout_to_json;
     use winslow::multipatch::split::{split_map, SplitOptions};
     let (name, map) = read_map(&a.map)?;
     let cert = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
@@ -240,20 +226,20 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
     let path = a.path;
     let opts = SplitOptions { path, degree: a.degree, tol: a.tol, ..Default::default() };
     let s = split_map(&name, &map, &cert, from, to, &opts).context("splitting the map")?;
-    output::ensure_parent(&a.output)?;
-    winslow::io::write_json(&a.output, &layout_to_json(&s.layout))?;
+    files::write(&a.output, &Output::Layout(&s.layout))?;
     let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
     let mut written = vec![a.output.clone()];
     for (k, p) in s.layout.patches.iter().enumerate() {
         let path = a.output.with_file_name(format!("{stem}-{}.json", ["a", "b"][k]));
         let b = Boundary { name: p.name.clone(), sides: p.sides.clone().map(winslow::SideCurve::Spline) };
-        winslow::io::write_json(&path, &winslow::io::boundary_to_json(&b))?;
+        files::write(&path, &Output::Boundary(&b))?;
         written.push(path);
     }
     if let Some(p) = &a.png {
         let pts = s.curve.sample(256);
         let segments = pts.windows(2).map(|w| (w[0], w[1])).collect();
-        output::write_png(p, &winslow::io::picture::render(&map, &PictureOptions { segments, ..Default::default() }))?;
+        let image = render(&map, &PictureOptions { segments, ..Default::default() });
+        files::write(p, &Output::Picture(&image))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&s.report)?);
@@ -296,10 +282,10 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
         "smoothing": j.smoothing,
     });
     let label = format!("verdict {verdict:?}: {}", j.certificate.message());
-    let json = || map_to_json(&name, &j.map, Some(serde_json::json!({ "report": report })));
-    output::write_map(&a.output, &name, &j.map, &label, json)?;
+    let extra = Some(serde_json::json!({ "report": report }));
+    files::write(&a.output, &Output::Map { name: &name, map: &j.map, label: &label, extra })?;
     if let Some(p) = &a.png {
-        output::write_png(p, &winslow::io::picture::render(&j.map, &PictureOptions::default()))?;
+        files::write(p, &Output::Picture(&render(&j.map, &PictureOptions::default())))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

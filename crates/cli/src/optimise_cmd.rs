@@ -156,11 +156,11 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     });
     if let Some(out) = &a.output {
         let label = format!("{}: {}", first.name, first.certificate.message());
-        let json = || map_to_json(&sol.name, &first.map, Some(serde_json::json!({ "report": report })));
-        output::write_map(out, &sol.name, &first.map, &label, json)?;
+        let extra = Some(serde_json::json!({ "report": report }));
+        crate::files::write(out, &Output::Map { name: &sol.name, map: &first.map, label: &label, extra })?;
     }
     if let Some(p) = &a.png {
-        output::write_png(p, &render(&first.map, &PictureOptions::default()))?;
+        crate::files::write(p, &Output::Picture(&render(&first.map, &PictureOptions::default())))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

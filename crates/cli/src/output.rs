@@ -1,78 +1,19 @@
-//! Text, table, PNG and VTK output of the CLI.
+//! Text and table output of the CLI: summaries, reports and tables (files are written
+//! by `winslow::io::write`, see `files`).
 
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
 use winslow::boundary::hierarchy::Hierarchy;
 use winslow::boundary::validate::ValidationReport;
-use winslow::io::{self, picture::Image};
 use winslow::solve::report::{Solution, Verdict};
 use winslow::verify::certificate::Certificate;
 use winslow::verify::poisson::PoissonReport;
 use winslow::verify::quality::Quality;
-use winslow::{Boundary, Side, SideCurve, Surface};
-
-/// Encode an RGBA image as PNG.
-pub fn write_png(path: &Path, img: &Image) -> Result<()> {
-    ensure_parent(path)?;
-    let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), img.width as u32, img.height as u32);
-    enc.set_color(png::ColorType::Rgba);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut w = enc.write_header()?;
-    w.write_image_data(&img.rgba)?;
-    Ok(())
-}
-
-pub fn ensure_parent(path: &Path) -> Result<()> {
-    if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-    }
-    Ok(())
-}
-
-/// Write `map` to `path` in the format of its extension (see [`write_map_as`]); JSON
-/// when the extension is none of those.
-pub fn write_map(
-    path: &Path,
-    name: &str,
-    map: &Surface,
-    label: &str,
-    json: impl Fn() -> serde_json::Value,
-) -> Result<()> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    write_map_as(path, &ext, name, map, label, json)
-}
-
-/// Write `map` as `ext`: `xml` (G+Smo), `igs`/`iges` (IGES 5.3), `vtu` (VTK Bézier cells),
-/// `vtk` (sampled structured grid), anything else the JSON document `json()`. `label`
-/// (the verdict) goes into the file's comment where the format has one.
-pub fn write_map_as(
-    path: &Path,
-    ext: &str,
-    name: &str,
-    map: &Surface,
-    label: &str,
-    json: impl Fn() -> serde_json::Value,
-) -> Result<()> {
-    ensure_parent(path)?;
-    let file_name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_else(|| name.to_string());
-    let text = match ext {
-        "xml" => io::gismo_writer::surface_to_gismo_xml(map, label),
-        "igs" | "iges" => io::iges::surface_to_iges(map, &file_name, label),
-        "vtu" => io::vtk::bezier_vtu(map, label)?,
-        "vtk" => io::vtk::structured_grid_vtk(map, 128),
-        _ => {
-            io::write_json(path, &json()).with_context(|| format!("writing {}", path.display()))?;
-            return Ok(());
-        }
-    };
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
-}
+use winslow::{Boundary, Side, SideCurve};
 
 /// The short human summary after a solve.
 pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
@@ -449,21 +390,6 @@ pub fn inspect_text(
         }
     }
     s
-}
-
-/// The matched pairs (`report.reparam.matches[].points`) of a map file written by
-/// `winslow solve`, as segments; empty when the file has none or cannot be read.
-pub fn report_matches(path: &Path) -> Vec<(winslow::Point, winslow::Point)> {
-    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
-    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
-    winslow::boundary::reparam::matches_in_report(&doc["report"])
-}
-
-/// The kinks stored in a map file's report (points, kept or not), for `render`.
-pub fn report_kinks(path: &Path) -> Vec<(winslow::Point, bool)> {
-    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
-    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
-    winslow::boundary::kinks::kinks_in_report(&doc["report"])
 }
 
 /// `winslow inspect --json`.

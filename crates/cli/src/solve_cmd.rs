@@ -2,7 +2,7 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
-use winslow::io::ring::read_ring;
+use crate::files;
 use winslow::{Input, Pipeline, Stage};
 
 /// Run the pipeline on `input`, printing its stages on stderr unless `quiet`.
@@ -169,34 +169,37 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let mut opts = a.solver.options()?;
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
-    if let Some(layout) =
-        winslow::multipatch::read_layout(path).with_context(|| format!("reading {}", path.display()))?
-    {
-        return super::multipatch_cmd::solve(layout, &a);
-    }
-    let ring = read_ring(path).with_context(|| format!("reading {}", path.display()))?;
+    let doc = files::read(path)?;
     let sel = a.backend.select(a.quiet || a.json)?;
-    let input = match ring {
-        Some(ring) => Input::Ring(ring),
-        None => Input::Boundary(load_boundary(path, a.solver.fit.reorient)?),
+    let input = match doc {
+        Document::Layout(layout) | Document::Multipatch(layout) => return super::multipatch_cmd::solve(layout, &a),
+        Document::Ring(ring) => Input::Ring(ring),
+        doc => {
+            let boundary = files::boundary_of(doc, path)?;
+            let (boundary, _) = checked_boundary(boundary, &ReadOptions { reorient: a.solver.fit.reorient })
+                .with_context(|| format!("validating {}", path.display()))?;
+            Input::Boundary(boundary)
+        }
     };
     let sol = run_pipeline(input, &opts, sel.as_assembler(), a.quiet || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
-    let json = || map_to_json(&sol.name, &sol.map, Some(serde_json::json!({ "report": report })));
-    output::write_map(&a.output, &sol.name, &sol.map, &label, json)?;
+    let extra = Some(serde_json::json!({ "report": report }));
+    let map = Output::Map { name: &sol.name, map: &sol.map, label: &label, extra };
+    files::write(&a.output, &map)?;
     for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu")] {
         if let Some(p) = path {
-            output::write_map_as(p, ext, &sol.name, &sol.map, &label, json)?;
+            files::write_as(p, ext, &map)?;
         }
     }
     if let Some(p) = &a.png {
         let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
         let kinks = sol.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
-        output::write_png(p, &picture(&sel, &sol.map, &PictureOptions { segments, kinks, ..Default::default() })?)?;
+        let image = picture(&sel, &sol.map, &PictureOptions { segments, kinks, ..Default::default() })?;
+        files::write(p, &Output::Picture(&image))?;
     }
     if let Some(p) = &a.vtk {
-        output::write_map_as(p, "vtk", &sol.name, &sol.map, &label, json)?;
+        files::write_as(p, "vtk", &map)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -215,10 +218,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
 /// only when certified.
 pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
     let opts = a.solver.options()?;
-    let doc = read_document(start).with_context(|| format!("reading {}", start.display()))?;
-    let Document::Map { name, map, .. } = doc else {
-        bail!("{} is a boundary, not a map: --start needs a map document", start.display())
-    };
+    let (name, map) = files::map_of(files::read(start)?, start, "--start needs a map")?;
     let method: Arc<dyn Method> = match a.solver.method {
         MethodArg::Winslow => Improve::Winslow.method(),
         MethodArg::Weak => Improve::WeakForm.method(),
@@ -268,16 +268,17 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         "seconds": t0.elapsed().as_secs_f64(),
     });
     let label = format!("verdict {verdict:?}: {}", out.certificate.message());
-    let json = || map_to_json(&name, &out.map, Some(serde_json::json!({ "report": report })));
-    output::write_map(&a.output, &name, &out.map, &label, json)?;
+    let extra = Some(serde_json::json!({ "report": report }));
+    let map = Output::Map { name: &name, map: &out.map, label: &label, extra };
+    files::write(&a.output, &map)?;
     for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu"), (&a.vtk, "vtk")] {
         if let Some(p) = path {
-            output::write_map_as(p, ext, &name, &out.map, &label, json)?;
+            files::write_as(p, ext, &map)?;
         }
     }
     if let Some(p) = &a.png {
         let sel = a.backend.select(a.quiet || a.json)?;
-        output::write_png(p, &picture(&sel, &out.map, &PictureOptions::default())?)?;
+        files::write(p, &Output::Picture(&picture(&sel, &out.map, &PictureOptions::default())?))?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -128,9 +128,7 @@ fn inner_frames(paths: &[PathBuf], base: &Ring) -> Result<Vec<(PathBuf, ClosedCo
     files
         .into_iter()
         .map(|f| {
-            let ring = read_ring(&f).with_context(|| format!("reading {}", f.display()))?.with_context(|| {
-                format!("{} is not a ring document (--inner-frames takes ring documents)", f.display())
-            })?;
+            let ring = ring_in(&f, "--inner-frames takes ring documents")?;
             let dev = ring.outer.deviation_from(&base.outer);
             if dev.is_none_or(|d| d > 1e-9) {
                 bail!(
@@ -144,23 +142,46 @@ fn inner_frames(paths: &[PathBuf], base: &Ring) -> Result<Vec<(PathBuf, ClosedCo
         .collect()
 }
 
-/// An animated PNG written frame by frame; every frame is cropped or padded (white) to
-/// the first frame's size.
+/// The ring of a ring document; any other kind is the error naming it.
+fn ring_in(path: &Path, needed: &str) -> Result<Ring> {
+    match crate::files::read(path)? {
+        Document::Ring(ring) => Ok(ring),
+        doc => Err(crate::files::wrong_kind(&doc, path, needed)),
+    }
+}
+
+/// An animated PNG encoded frame by frame in memory (written at the end through the
+/// atomic writer); every frame is cropped or padded (white) to the first frame's size.
 struct Apng {
-    writer: png::Writer<std::io::BufWriter<std::fs::File>>,
+    writer: png::Writer<Bytes>,
+    bytes: Bytes,
     size: (usize, usize),
 }
 
+/// The encoded bytes, shared between the encoder and [`Apng`].
+#[derive(Clone, Default)]
+struct Bytes(std::rc::Rc<std::cell::RefCell<Vec<u8>>>);
+
+impl std::io::Write for Bytes {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 impl Apng {
-    fn create(path: &Path, first: &Image, frames: u32, fps: u16) -> Result<Self> {
-        output::ensure_parent(path)?;
-        let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), first.width as u32, first.height as u32);
+    fn create(first: &Image, frames: u32, fps: u16) -> Result<Self> {
+        let bytes = Bytes::default();
+        let mut enc = png::Encoder::new(bytes.clone(), first.width as u32, first.height as u32);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_animated(frames, 0)?;
         enc.set_frame_delay(1, fps.max(1))?;
-        Ok(Self { writer: enc.write_header()?, size: (first.width, first.height) })
+        Ok(Self { writer: enc.write_header()?, bytes, size: (first.width, first.height) })
     }
 
     fn push(&mut self, img: &Image) -> Result<()> {
@@ -185,9 +206,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         None => 0.0,
     };
     let opts = a.solver.options()?;
-    let ring = read_ring(&a.ring).with_context(|| format!("reading {}", a.ring.display()))?.with_context(|| {
-        format!("{} is not a ring document (a \"ring\" with inner and outer contours)", a.ring.display())
-    })?;
+    let ring = ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours)")?;
     let mut contours = inner_frames(&a.inner_frames, &ring)?;
     if let Some(n) = a.steps.filter(|_| !contours.is_empty()) {
         contours.truncate(n);
@@ -255,18 +274,17 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             let stem = format!("frame_{:04}", r.frame);
             let label = format!("frame {} at time {:.9}: {}", r.frame, r.time, r.verdict);
             let report = serde_json::to_value(r)?;
-            let json = || {
-                map_to_json(&format!("{}-{stem}", ring.name), &frame.map, Some(serde_json::json!({ "frame": report })))
-            };
-            let path = a.output.join(format!("{stem}.json"));
-            output::write_map_as(&path, "json", &ring.name, &frame.map, &label, json)?;
-            output::write_map_as(&a.output.join(format!("{stem}.vtu")), "vtu", &ring.name, &frame.map, &label, json)?;
+            let name = format!("{}-{stem}", ring.name);
+            let extra = Some(serde_json::json!({ "frame": report }));
+            let map = Output::Map { name: &name, map: &frame.map, label: &label, extra };
+            crate::files::write(&a.output.join(format!("{stem}.json")), &map)?;
+            crate::files::write(&a.output.join(format!("{stem}.vtu")), &map)?;
             pvd.push_str(&format!("    <DataSet timestep=\"{}\" part=\"0\" file=\"{stem}.vtu\"/>\n", r.time));
-            if let Some(path) = &a.apng {
+            if a.apng.is_some() {
                 let img = render(&frame.map, &picture);
                 let w = match apng.as_mut() {
                     Some(w) => w,
-                    None => apng.insert(Apng::create(path, &img, (steps / every + 1) as u32, a.apng_fps)?),
+                    None => apng.insert(Apng::create(&img, (steps / every + 1) as u32, a.apng_fps)?),
                 };
                 w.push(&img)?;
             }
@@ -307,13 +325,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             None => sweep.next_frame().with_context(|| format!("solving frame {k}"))?,
         };
     }
-    if let Some(w) = apng {
+    if let (Some(w), Some(path)) = (apng, &a.apng) {
         w.writer.finish()?;
+        winslow::io::write_bytes(path, &w.bytes.0.borrow())?;
     }
     pvd.push_str("  </Collection>\n</VTKFile>\n");
-    std::fs::write(a.output.join("sweep.pvd"), pvd)?;
+    winslow::io::write_bytes(&a.output.join("sweep.pvd"), pvd.as_bytes())?;
     let csv: String = std::iter::once(HEADER.to_string()).chain(rows.iter().map(row)).collect::<Vec<_>>().join("\n");
-    std::fs::write(a.output.join("sweep.csv"), csv + "\n")?;
+    winslow::io::write_bytes(&a.output.join("sweep.csv"), (csv + "\n").as_bytes())?;
     let cold = rows[0].seconds;
     let later: Vec<&FrameReport> = rows.iter().skip(6).collect();
     let max_newton = later.iter().map(|r| r.newton_iterations).max();
@@ -337,7 +356,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             "mean_seconds": mean,
         },
     });
-    winslow::io::write_json(&a.output.join("sweep.json"), &summary)?;
+    winslow::io::write_json(&a.output.join("sweep.json"), &summary)?; // atomic, as every file
     println!(
         "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; smallest certified det J {:.4e}; wrote {}",
         ring.name,

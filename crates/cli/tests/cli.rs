@@ -398,7 +398,8 @@ fn map_writers_round_trip_through_the_readers() {
     assert!(std::fs::read_to_string(&again).unwrap().contains("<!-- certificate: certified"));
     // a boundary is not a map
     let c = bin().arg("convert").arg(data().join("quarter_annulus.json")).arg("-o").arg(&again).output().unwrap();
-    assert!(!c.status.success() && String::from_utf8_lossy(&c.stderr).contains("not a map"));
+    let err = String::from_utf8_lossy(&c.stderr);
+    assert!(!c.status.success() && err.contains("a boundary document, where convert writes a map"), "{err}");
 }
 
 /// `--improve winslow` lowers the Winslow value of a certified map and reports both;
@@ -457,7 +458,8 @@ fn improve_and_start_from_a_map() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not a map"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("a boundary document, where --start needs a map"), "{err}");
     // the old spelling of --iteration
     let out = bin()
         .args(["solve"])
@@ -586,7 +588,7 @@ fn sweep_writes_frames_series_and_table() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&bad.stderr);
-    assert!(!bad.status.success() && err.contains("not a ring document"), "{err}");
+    assert!(!bad.status.success() && err.contains("a boundary document, where sweep needs a ring document"), "{err}");
 }
 
 /// `winslow sweep --inner-frames`: non-rigid motion from a directory of ring documents
@@ -784,4 +786,99 @@ fn kinks_are_kept_reported_and_marked() {
     let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "200"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("angle in (0, 180]"));
+}
+
+/// `convert` and `render` act on a ring map and on a multipatch result (every patch
+/// certified again; .json, .xml, .vtm), and name the kind they got otherwise; a missing
+/// file's cause is printed once.
+#[test]
+fn convert_and_render_take_ring_maps_and_multipatch_results() {
+    use winslow::io::{Output, Patches};
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let ok = |args: &[&std::ffi::OsStr]| {
+        let out = bin().args(args).output().unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success(), "{args:?}: {text}");
+        text
+    };
+    let refused = |args: &[&std::ffi::OsStr]| {
+        let out = bin().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let os = |p: &Path| p.as_os_str().to_owned();
+    // a ring map: an annulus between radii 1 and 2, eta periodic
+    let kv = winslow::KnotVector::periodic_uniform(2, 8);
+    let d = kv.dim();
+    let angle = |k: usize| std::f64::consts::TAU * (k % d) as f64 / d as f64;
+    let cps = (0..kv.num_basis()).flat_map(|k| [1.0, 2.0].map(|r| [r * angle(k).cos(), r * angle(k).sin()])).collect();
+    let annulus = winslow::Surface::new([winslow::KnotVector::open_uniform(1, 1), kv], cps, None).unwrap();
+    let ring_map = dir.join("annulus.json");
+    winslow::write(&ring_map, &Output::Map { name: "annulus", map: &annulus, label: "", extra: None }).unwrap();
+    let xml = dir.join("annulus.xml");
+    let text = ok(&["convert".as_ref(), &os(&ring_map), "-o".as_ref(), &os(&xml)]);
+    assert!(text.contains("certified"), "{text}");
+    // G+Smo has no periodic basis: the same map on a clamped one
+    match winslow::read(&xml).unwrap() {
+        winslow::Document::Map { map, .. } => {
+            for k in 0..=20 {
+                let (u, v) = ((k % 3) as f64 / 2.0, k as f64 / 20.0);
+                let (a, b) = (map.eval(u, v), annulus.eval(u, v));
+                assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "({u}, {v}): {a:?} {b:?}");
+            }
+        }
+        other => panic!("{}", other.kind()),
+    }
+    let again = dir.join("annulus-again.json");
+    ok(&["convert".as_ref(), &os(&ring_map), "-o".as_ref(), &os(&again)]);
+    match winslow::read(&again).unwrap() {
+        winslow::Document::Map { map, .. } => assert_eq!(map, annulus),
+        other => panic!("{}", other.kind()),
+    }
+    ok(&["render".as_ref(), &os(&ring_map), "--png".as_ref(), &os(&dir.join("annulus.png"))]);
+    assert!(std::fs::metadata(dir.join("annulus.png")).unwrap().len() > 1000);
+    // a multipatch result: the patch maps of a G+Smo layout as a JSON result
+    let winslow::Document::Layout(layout) =
+        winslow::read(&data().join("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap()
+    else {
+        panic!("not a layout")
+    };
+    let n = layout.patches.len();
+    let patches = Patches {
+        layout: &layout,
+        maps: layout.patches.iter().map(|p| p.map.clone().unwrap()).collect(),
+        reports: vec![serde_json::Value::Null; n],
+        messages: vec![String::new(); n],
+        report: serde_json::json!({}),
+        message: String::new(),
+    };
+    let result = dir.join("plate.json");
+    winslow::write(&result, &Output::Multipatch(patches)).unwrap();
+    for out in ["plate-again.json", "plate.xml", "plate.vtm"] {
+        let text = ok(&["convert".as_ref(), &os(&result), "-o".as_ref(), &os(&dir.join(out))]);
+        assert!(text.contains(&format!("{n} of {n} patches certified")), "{text}");
+    }
+    assert_eq!(winslow::read(&dir.join("plate-again.json")).unwrap().kind(), "multipatch result");
+    assert_eq!(winslow::read(&dir.join("plate.xml")).unwrap().kind(), "multipatch layout");
+    assert!(dir.join("plate").join(format!("{}.vtu", layout.patches[0].name)).is_file());
+    ok(&["render".as_ref(), &os(&result), "--png".as_ref(), &os(&dir.join("plate.png"))]);
+    assert!(std::fs::metadata(dir.join("plate.png")).unwrap().len() > 1000);
+    // kinds they cannot act on, and extensions that do not fit, are named
+    let ring = data().join("rings/eccentric_annulus.json");
+    let err = refused(&["convert".as_ref(), &os(&ring), "-o".as_ref(), &os(&dir.join("x.json"))]);
+    assert!(err.contains("a ring document, where convert writes a map"), "{err}");
+    let err = refused(&["render".as_ref(), &os(&ring), "--png".as_ref(), &os(&dir.join("x.png"))]);
+    assert!(err.contains("a ring document, where render draws"), "{err}");
+    let input = dir.join("input.json");
+    winslow::write(&input, &Output::Layout(&layout)).unwrap();
+    let err = refused(&["convert".as_ref(), &os(&input), "-o".as_ref(), &os(&dir.join("x.json"))]);
+    assert!(err.contains("a multipatch layout document, where convert writes"), "{err}");
+    let err = refused(&["convert".as_ref(), &os(&result), "-o".as_ref(), &os(&dir.join("x.igs"))]);
+    assert!(err.contains("a multipatch result cannot be written as .igs"), "{err}");
+    assert!(!dir.join("x.igs").exists() && !dir.join("x.json").exists() && !dir.join("x.png").exists());
+    // an I/O error names the file and its cause once
+    let err = refused(&["convert".as_ref(), &os(&dir.join("missing.json")), "-o".as_ref(), &os(&dir.join("x.json"))]);
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+    assert_eq!(err.matches("missing.json").count(), 1, "{err}");
 }

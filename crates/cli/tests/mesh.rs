@@ -108,7 +108,7 @@ fn solve_then_mesh_in_every_format() {
     assert!(dir.join("lid-case/constant/polyMesh/owner").exists());
     // refusals: a boundary is not a map; PLOT3D holds no triangles; bad specs
     let (ok, _, err) = run(&["mesh", &lid, "-o", &d("x.msh"), "--structured", "5x5"]);
-    assert!(!ok && err.contains("not a map"), "{err}");
+    assert!(!ok && err.contains("a boundary document, where mesh needs a map"), "{err}");
     let (ok, _, err) = run(&["mesh", &d("lid.json"), "-o", &d("x.xyz"), "--unstructured", "--size", "0.2"]);
     assert!(!ok && err.contains("PLOT3D"), "{err}");
     let (ok, _, err) =

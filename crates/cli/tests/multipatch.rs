@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use common::{bin, data};
-use winslow::multipatch::gismo::parse_gismo_multipatch;
-use winslow::multipatch::json::parse_json_multipatch;
+use winslow::io::multipatch::gismo::parse_gismo_multipatch;
+use winslow::io::multipatch::json::parse_json_multipatch;
 
 fn run(cmd: &mut Command) -> (String, String) {
     let out = cmd.output().unwrap();

@@ -29,13 +29,10 @@ pub enum Error {
     /// A G+Smo XML document could not be parsed or has the wrong shape.
     #[error("malformed G+Smo XML{}: {message}", at(.context))]
     Xml { context: String, message: String },
-    /// Reading or writing a file failed.
-    #[error("I/O error on {path}: {source}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    /// Reading or writing a file failed. The cause is part of the message and not
+    /// also a `source()`, so that a chain of errors prints it once.
+    #[error("I/O error on {path}: {cause}")]
+    Io { path: PathBuf, cause: std::io::Error },
     /// Adjacent sides do not meet at their common corner.
     #[error("corner gap between {side_a} and {side_b}: the ends are {gap:.3e} apart (tolerance {tol:.3e}) at ({x:.6}, {y:.6})")]
     CornerGap { side_a: String, side_b: String, gap: f64, tol: f64, x: f64, y: f64 },
@@ -101,6 +98,21 @@ pub enum Error {
     /// The observer of a [`Pipeline`](crate::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
     Cancelled,
+    /// A document of one kind (`crate::io::Document::kind`) where another is needed, or
+    /// a kind of `formats.md` that this version does not read (`needed` then says so).
+    #[error("{}a {found} document, where {needed}", .path.as_ref().map(|p| format!("{}: ", p.display())).unwrap_or_default())]
+    DocumentKind { path: Option<PathBuf>, found: String, needed: String },
+    /// An output file whose extension does not fit the kind of what is written.
+    #[error("{path}: a {kind} cannot be written as {}; it is written as {accepted}", extension_name(.extension))]
+    Extension { path: PathBuf, kind: String, extension: String, accepted: String },
+}
+
+fn extension_name(ext: &str) -> String {
+    if ext.is_empty() {
+        "a file without an extension".into()
+    } else {
+        format!(".{ext}")
+    }
 }
 
 fn side_of(side: &str) -> String {

@@ -17,13 +17,13 @@
 //! | [`methods`] | the parameterization methods behind one interface ([`Method`], [`DiscreteProblem`]): EGG (eq. 8) |
 //! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
 //! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
-//! | [`io`] | readers and writers: JSON exchange formats, G+Smo XML, pictures |
-//! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split, multipatch files |
+//! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split |
+//! | [`io`] | [`read()`] and [`write()`]: every document kind (boundary, map, ring, multipatch layout and result, volume) in JSON, G+Smo XML, IGES, VTK and PNG |
 //!
-//! Dependencies point one way, down this table read from the bottom: `multipatch` uses
-//! every group above it (it solves patches with `solve`, reads and writes with `io`), `io` uses
-//! `verify`, `solve` uses `methods`, which use `verify`, `discrete`, `spline` and
-//! `linalg`; no module imports a module that imports it back. Two places differ from a
+//! Dependencies point one way, down this table read from the bottom: `io` uses every
+//! group above it (it reads and writes boundaries, maps, layouts and their solutions),
+//! `multipatch` uses `solve` and what `solve` uses, `solve` uses `methods`, which use
+//! `verify`, `discrete`, `spline` and `linalg`; no module imports a module that imports it back. Two places differ from a
 //! plain "one folder per pipeline step": sparse storage sits in [`linalg`], *below*
 //! [`spline`], because the refinement operators of the splines (knot insertion,
 //! degree elevation) are sparse matrices; and the quadrature back end of EGG
@@ -85,7 +85,7 @@ pub use boundary::validate::{validate, ValidationReport};
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use discrete::topology::{SideCondition, Topology};
 pub use error::{Error, Result};
-pub use io::{read_boundary, read_document, Document, ReadOptions};
+pub use io::{read, read_boundary, read_document, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
 pub use pipeline::{solve, Input, Pipeline, Stage};

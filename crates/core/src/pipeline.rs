@@ -289,8 +289,8 @@ mod tests {
     /// observer saw every iterate the report records.
     #[test]
     fn the_observer_sees_every_stage_of_a_fallback() {
-        let mut opts = SolveOptions::default();
-        opts.repair = 1; // puzzle4's input basis folds after one round: solved again on the fitted basis
+        // puzzle4's input basis folds after one repair round: solved again on the fitted basis
+        let opts = SolveOptions { repair: 1, ..Default::default() };
         let mut seen = Vec::new();
         let mut residuals = Vec::new();
         let sol = Pipeline::new(puzzle4(), opts.clone())

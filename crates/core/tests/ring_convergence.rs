@@ -93,7 +93,9 @@ fn shared_rings_solve_and_certify() {
     use winslow::solve::report::Verdict;
     let dir = winslow::testutil::data("rings");
     for (name, fit_tol) in [("male_rotor_in_casing", 1e-3), ("eccentric_annulus", 1e-4)] {
-        let ring = winslow::io::ring::read_ring(&dir.join(format!("{name}.json"))).unwrap().expect("a ring document");
+        let winslow::Document::Ring(ring) = winslow::read(&dir.join(format!("{name}.json"))).unwrap() else {
+            panic!("{name} is not a ring document")
+        };
         let mut opts = SolveOptions::default();
         opts.fit.tol = fit_tol;
         let sol = winslow::Pipeline::new(ring, opts.clone()).solve().unwrap();

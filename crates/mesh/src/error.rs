@@ -1,7 +1,5 @@
 //! The crate's error type: every refusal names what and where.
 
-use std::path::PathBuf;
-
 /// Errors of mesh generation, checking and writing.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
@@ -46,15 +44,10 @@ pub enum MeshError {
     /// The triangulation failed.
     #[error("triangulation: {0}")]
     Triangulation(String),
-    /// Reading or writing a file.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// Writing a file (through `winslow::io`'s atomic writer, whose error names the
+    /// file and its cause).
+    #[error(transparent)]
+    File(winslow::Error),
 }
 
 impl MeshError {

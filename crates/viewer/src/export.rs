@@ -11,14 +11,8 @@ pub fn write_png(path: &std::path::Path, image: &ColorImage, crop: Option<Rect>)
             rgba.extend_from_slice(&image.pixels[y * image.size[0] + x].to_srgba_unmultiplied());
         }
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
-    let mut enc = png::Encoder::new(file, w as u32, h as u32);
-    enc.set_color(png::ColorType::Rgba);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.write_header()?.write_image_data(&rgba)?;
+    let image = winslow::io::picture::Image { width: w, height: h, rgba };
+    winslow::io::write(path, &winslow::io::Output::Picture(&image))?;
     Ok(())
 }
 

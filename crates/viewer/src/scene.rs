@@ -8,11 +8,7 @@ use std::path::{Path, PathBuf};
 use winslow::boundary::ring::{ClosedContour, Ring};
 use winslow::boundary::ring_fit::{check_ring, cut_open};
 use winslow::boundary::validate::sample_side;
-use winslow::io::ring::parse_ring_json;
-use winslow::io::{checked_boundary, parse_document, read_text, Document, ReadOptions};
-use winslow::multipatch::gismo::is_gismo_multipatch;
-use winslow::multipatch::json::is_json_multipatch;
-use winslow::multipatch::read_layout;
+use winslow::io::{checked_boundary, read_with_report, Document, ReadOptions};
 use winslow::solve::report::Solution;
 use winslow::verify::quality::DetJSample;
 use winslow::{Boundary, Point, Side, SideCurve, Surface};
@@ -299,45 +295,16 @@ impl Default for SceneSettings {
 }
 
 impl Scene {
-    /// Read a boundary or map file (JSON or G+Smo XML, detected by content).
+    /// Read any document [`winslow::io::read`] reads that has something to draw: a
+    /// boundary, a map (with the report a solve stored beside it), a ring, a multipatch
+    /// layout or result.
     pub fn open(path: &Path, sampler: &dyn DetJSampler, settings: SceneSettings) -> anyhow::Result<Self> {
         use anyhow::Context;
-        let text = read_text(path).with_context(|| format!("reading {}", path.display()))?;
-        if is_gismo_multipatch(&text) || is_json_multipatch(&text) {
-            let layout = read_layout(path).with_context(|| format!("reading {}", path.display()))?;
-            // a single G+Smo patch in <MultiPatch> is an ordinary map
-            if let Some(layout) = layout {
-                return Self::from_layout(layout, sampler, settings).map(|mut s| {
-                    s.path = Some(path.to_path_buf());
-                    s
-                });
-            }
-        }
-        let stem = || path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        if let Some(mut ring) = parse_ring_json(&text).with_context(|| format!("reading {}", path.display()))? {
-            if ring.name.is_empty() {
-                ring.name = stem();
-            }
-            let mut scene = Self::from_ring(ring);
-            scene.path = Some(path.to_path_buf());
-            return Ok(scene);
-        }
-        let mut doc = parse_document(&text).with_context(|| format!("reading {}", path.display()))?;
-        if doc.name().is_empty() {
-            match &mut doc {
-                Document::Boundary(b) => b.name = stem(),
-                Document::Map { name, .. } => *name = stem(),
-            }
-        }
+        let (doc, report) = read_with_report(path).with_context(|| format!("reading {}", path.display()))?;
         // a map file may carry the solver's report
-        let report = match &doc {
-            Document::Map { .. } => {
-                serde_json::from_str::<serde_json::Value>(&text).ok().and_then(|v| v.get("report").cloned())
-            }
-            Document::Boundary(_) => None,
-        };
+        let report = report.filter(|_| matches!(doc, Document::Map { .. }));
         let stored = report.as_ref().and_then(Certificate::from_stored);
-        let mut scene = Self::from_document(doc, sampler, settings, stored);
+        let mut scene = Self::from_document(doc, sampler, settings, stored)?;
         if let (Some(mv), Some(r)) = (scene.map.as_mut(), &report) {
             mv.matches = stored_matches(r);
             mv.kinks = winslow::boundary::kinks::kinks_in_report(r);
@@ -360,14 +327,14 @@ impl Scene {
         }
     }
 
-    /// A scene of a document.
+    /// A scene of a document; a volume is an error (the viewer draws planar documents).
     pub fn from_document(
         doc: Document,
         sampler: &dyn DetJSampler,
         settings: SceneSettings,
         certificate: Option<Certificate>,
-    ) -> Self {
-        match doc {
+    ) -> anyhow::Result<Self> {
+        Ok(match doc {
             Document::Boundary(b) => Self {
                 name: b.name.clone(),
                 path: None,
@@ -387,10 +354,7 @@ impl Scene {
                 });
                 let (kind, boundary) = match &ring {
                     Some(r) => ("ring map", BoundaryView::ring(r)),
-                    None => (
-                        "map",
-                        BoundaryView::new(Document::Map { name: name.clone(), map: map.clone() }.into_boundary()),
-                    ),
+                    None => ("map", BoundaryView::new(Document::Map { name: name.clone(), map: map.clone() }.into_boundary()?)),
                 };
                 Self {
                     name,
@@ -402,7 +366,14 @@ impl Scene {
                     ring,
                 }
             }
-        }
+            Document::Ring(ring) => Self::from_ring(ring),
+            Document::Layout(layout) | Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
+            doc @ Document::Volume { .. } => {
+                return Err(doc
+                    .wrong_kind(None, "the viewer draws planar documents (`winslow convert` writes a volume as .vtu or .vtk for ParaView)")
+                    .into())
+            }
+        })
     }
 
     /// A scene of a multipatch layout whose patches are maps (a G+Smo multipatch file,
@@ -432,7 +403,7 @@ impl Scene {
             name: format!("{} ({} patches)", layout.name, layout.patches.len()),
             path: None,
             kind: "multipatch",
-            boundary: BoundaryView::new(doc.into_boundary()),
+            boundary: BoundaryView::new(doc.into_boundary()?),
             map: Some(first),
             patches: views,
             ring: None,

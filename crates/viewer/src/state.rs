@@ -567,10 +567,12 @@ mod tests {
         // a layout of boundaries has nothing to draw: a clear error, the scene stays
         let scratch = tempfile::tempdir().unwrap();
         let dir = scratch.path();
-        let text = std::fs::read_to_string(data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap();
-        let layout = winslow::multipatch::gismo::parse_gismo_multipatch(&text).unwrap();
-        let doc = winslow::multipatch::json::layout_to_json(&layout);
-        winslow::io::write_json(&dir.join("input.json"), &doc).unwrap();
+        let winslow::Document::Layout(layout) =
+            winslow::read(&data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap()
+        else {
+            panic!("not a layout")
+        };
+        winslow::write(&dir.join("input.json"), &winslow::Output::Layout(&layout)).unwrap();
         assert!(!s.can_solve(), "a layout is not solved patch by patch");
         let e = s.open(&dir.join("input.json")).unwrap_err();
         assert!(e.contains("winslow solve"), "{e}");

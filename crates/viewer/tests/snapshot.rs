@@ -74,7 +74,8 @@ fn folded_map_snapshot() {
     let [x, y] = map.control_points[k];
     map.control_points[k] = [x + 0.9, y + 0.9];
     let folded =
-        Scene::from_document(Document::Map { name: "folded".into(), map }, &CpuSampler, app.state.settings, None);
+        Scene::from_document(Document::Map { name: "folded".into(), map }, &CpuSampler, app.state.settings, None)
+            .unwrap();
     app.state.set_scene(folded);
     app.state.display.net = true;
     app.state.selected_fold = Some(0);

@@ -325,7 +325,11 @@ pub fn parse_json(text: &str) -> Result<Document> {
         let contour: ContourJson = serde_json::from_value(c).map_err(json_err("contour"))?;
         return ContourDoc { name, contour }.to_boundary().map(Document::Boundary);
     }
-    Err(Error::Json { context: String::new(), message: "expected a \"boundary\", \"contour\" or \"map\" field (a \"ring\" document is read by io::ring and solved by `winslow solve`)".into() })
+    Err(Error::Json {
+        context: String::new(),
+        message: "no document field: expected \"boundary\", \"contour\", \"map\", \"ring\" or \"patches\" (formats.md)"
+            .into(),
+    })
 }
 
 /// Split a closed polygon at its corners `[i_sw, i_se, i_ne, i_nw]` into the sides of
@@ -454,11 +458,13 @@ pub fn map_to_json(name: &str, map: &Surface, extra: Option<Value>) -> Value {
     Value::Object(doc)
 }
 
-/// Write a JSON value to a file (pretty-printed, numbers round-trip exactly).
+/// Write a JSON value to a file (pretty-printed, numbers round-trip exactly) through the
+/// atomic writer ([`super::file::write_with`]).
 pub fn write_json(path: &Path, value: &Value) -> Result<()> {
-    let io = |source: std::io::Error| Error::Io { path: path.to_path_buf(), source };
-    let text = serde_json::to_string_pretty(value).map_err(|e| io(std::io::Error::other(e)))?;
-    std::fs::write(path, text + "\n").map_err(io)
+    super::file::write_with(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, value)?;
+        w.write_all(b"\n")
+    })
 }
 
 #[cfg(test)]

@@ -1,25 +1,39 @@
-//! Reading and writing: the JSON exchange formats of `formats.md` ([`json`]), G+Smo
-//! XML files ([`gismo`] reads, [`gismo_writer`] writes), IGES 5.3 rational B-spline
-//! surfaces ([`iges`], both ways), VTK files ([`vtk`]: a sampled structured grid, and the
-//! exact map as Bézier cells) and pictures of a map, grid lines coloured by `det J`
-//! ([`picture`], PNG through the CLI); ring (O-type) documents ([`ring`]); trivariate
-//! maps (volumes) in JSON, G+Smo XML and VTK ([`volume`]).
+//! Reading and writing every format, like meshio's `read` and `write`: [`read`] decides
+//! the kind of a file by its content and returns a [`Document`] (boundary, map, ring,
+//! multipatch layout or result, volume); [`write()`] writes an [`Output`] in the format of
+//! the file's extension, every file through one atomic writer ([`file::write_with`]).
 //!
-//! [`read_document`] detects the kind of file by its content (a JSON object or an XML
-//! document); [`read_boundary`] turns any accepted document into a validated,
+//! | module | holds |
+//! |---|---|
+//! | [`document`] | the kinds of document and the reader that tells them apart |
+//! | [`output`] | what can be written, and the dispatch by extension |
+//! | [`mod@file`] | reading text with a size limit; the atomic writer |
+//! | [`json`] | the JSON exchange formats of `formats.md`: boundary, contour, map |
+//! | [`ring`] | ring (O-type) documents |
+//! | [`multipatch`] | multipatch layouts and results: JSON, G+Smo `<MultiPatch>`, VTK multiblock |
+//! | [`volume`] | trivariate maps: JSON, G+Smo `TensorBSpline3`, VTK |
+//! | [`gismo`] / [`gismo_writer`] | G+Smo XML, read and written |
+//! | [`iges`] | IGES 5.3 rational B-spline surfaces (entity 128), both ways |
+//! | [`vtk`] | a sampled structured grid, and the exact map as Bézier cells |
+//! | [`picture`] | pictures of a map, grid lines coloured by `det J`, encoded as PNG |
+//!
+//! [`read_boundary`] turns any document with a four-sided boundary into a validated,
 //! counter-clockwise [`Boundary`]. All inputs are untrusted: every malformed file gives
 //! an [`Error`] naming what is wrong and where, never a panic.
 
+pub mod document;
+pub mod file;
 pub mod gismo;
 pub mod gismo_writer;
 pub mod iges;
 pub mod json;
+pub mod multipatch;
+pub mod output;
 pub mod picture;
 pub mod ring;
 pub mod volume;
 pub mod vtk;
 
-use std::io::Read;
 use std::path::Path;
 
 use crate::boundary::validate::{inspect, validate, Orientation, ValidationReport};
@@ -29,68 +43,15 @@ use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
 
+pub use document::{parse_document, read, read_with_report, Document};
+pub use file::{read_text, write_bytes, write_with, MAX_FILE_BYTES};
 pub use gismo::parse_gismo_xml;
 pub use json::{
     boundary_to_contour_json, boundary_to_json, curve_to_json, map_to_json, parse_json, split_contour, write_json,
     BoundaryDoc, ContourDoc, ContourJson, CurveJson, MapDoc, MapJson, PointsJson, SideJson, SidesJson,
 };
-
-/// Largest file [`read_document`] accepts: 256 MiB.
-pub const MAX_FILE_BYTES: u64 = 256 << 20;
-
-/// A document read from a file.
-// A boundary is not much larger than a map and documents are few: no boxing.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone)]
-pub enum Document {
-    /// A boundary: a boundary or contour JSON document, or four G+Smo curves.
-    Boundary(Boundary),
-    /// A tensor-product map: a map JSON document or one G+Smo tensor patch.
-    Map {
-        /// Name of the geometry.
-        name: String,
-        /// The map, knot domains mapped to `[0, 1]`.
-        map: Surface,
-    },
-}
-
-impl Document {
-    /// Name of the geometry (empty when the file gave none).
-    pub fn name(&self) -> &str {
-        match self {
-            Document::Boundary(b) => &b.name,
-            Document::Map { name, .. } => name,
-        }
-    }
-
-    fn set_name_if_empty(&mut self, fallback: &str) {
-        let name = match self {
-            Document::Boundary(b) => &mut b.name,
-            Document::Map { name, .. } => name,
-        };
-        if name.is_empty() {
-            *name = fallback.to_string();
-        }
-    }
-
-    /// The boundary: itself, or the four boundary curves of a map (`Surface::boundary`;
-    /// a side whose weights are all 1 becomes a polynomial curve, as in `Curve::new`).
-    pub fn into_boundary(self) -> Boundary {
-        match self {
-            Document::Boundary(b) => b,
-            Document::Map { name, map } => {
-                let side = |s: Side| {
-                    let mut c = map.boundary(s);
-                    if c.weights.as_ref().is_some_and(|w| w.iter().all(|&x| x == 1.0)) {
-                        c.weights = None;
-                    }
-                    SideCurve::Spline(c)
-                };
-                Boundary { name, sides: Side::ALL.map(side) }
-            }
-        }
-    }
-}
+pub use multipatch::Patches;
+pub use output::{write, Output};
 
 /// Options of [`read_boundary`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -100,60 +61,10 @@ pub struct ReadOptions {
     pub reorient: bool,
 }
 
-/// Read a whole file as UTF-8 text, refusing files above [`MAX_FILE_BYTES`].
-pub fn read_text(path: &Path) -> Result<String> {
-    let io = |source: std::io::Error| Error::Io { path: path.to_path_buf(), source };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let too_large = |found: u64| Error::TooLarge {
-        context: path.display().to_string(),
-        what: "file size in bytes".into(),
-        found: usize::try_from(found).unwrap_or(usize::MAX),
-        limit: MAX_FILE_BYTES as usize,
-    };
-    if let Ok(meta) = file.metadata() {
-        if meta.len() > MAX_FILE_BYTES {
-            return Err(too_large(meta.len()));
-        }
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(io)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
-    String::from_utf8(bytes).map_err(|e| Error::Invalid(format!("{} is not UTF-8 text: {e}", path.display())))
-}
-
-/// Parse a document from text: JSON when it starts with `{`, G+Smo XML when it starts
-/// with `<` (after a byte-order mark and white space), IGES when its first record has the
-/// Start-section letter in column 73 (a map, transposed when its boundary runs
-/// clockwise, as for G+Smo patches).
-pub fn parse_document(text: &str) -> Result<Document> {
-    if iges::is_iges(text) {
-        let mut map = iges::parse_iges(text)?;
-        if surface_boundary_area(&map) < 0.0 {
-            map = map.transposed();
-        }
-        return Ok(Document::Map { name: String::new(), map });
-    }
-    let body = text.trim_start_matches('\u{feff}').trim_start();
-    match body.chars().next() {
-        Some('{') => parse_json(body),
-        Some('<') => parse_gismo_xml(body),
-        Some(c) => Err(Error::Invalid(format!(
-            "the input is neither a JSON object nor an XML document (it starts with {c:?})"
-        ))),
-        None => Err(Error::Invalid("the input is empty".into())),
-    }
-}
-
-/// Read a boundary, contour or map JSON document or a G+Smo XML file, detected by
-/// content. A document without a name is named after the file stem.
+/// Read a document ([`read`]); kept for callers of the time when only boundaries and
+/// maps were documents.
 pub fn read_document(path: &Path) -> Result<Document> {
-    let text = read_text(path)?;
-    let mut doc = parse_document(&text)?;
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    doc.set_name_if_empty(&stem);
-    Ok(doc)
+    read(path)
 }
 
 /// Validate a boundary read from somewhere and orient it: a clockwise contour is an
@@ -176,8 +87,9 @@ pub fn checked_boundary(boundary: Boundary, opts: &ReadOptions) -> Result<(Bound
 /// XML with four curves or one patch), validate it ([`crate::boundary::validate::validate`]) and
 /// return it counter-clockwise (see [`ReadOptions::reorient`]).
 pub fn read_boundary(path: &Path, opts: &ReadOptions) -> Result<Boundary> {
-    let doc = read_document(path)?;
-    checked_boundary(doc.into_boundary(), opts).map(|(b, _)| b)
+    let doc = read(path)?;
+    let boundary = doc.into_boundary().map_err(|e| document::at_path(e, path))?;
+    checked_boundary(boundary, opts).map(|(b, _)| b)
 }
 
 /// Re-validate a knot vector after mapping its domain to `[0, 1]` (the affine map can
@@ -232,27 +144,6 @@ pub(crate) fn surface_boundary_area(s: &Surface) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn detects_kind_by_content() {
-        assert!(matches!(parse_document(""), Err(Error::Invalid(_))));
-        assert!(matches!(parse_document("hello"), Err(Error::Invalid(_))));
-        assert!(matches!(parse_document("\u{feff} {"), Err(Error::Json { .. })));
-        assert!(matches!(parse_document("  <xml"), Err(Error::Xml { .. })));
-    }
-
-    #[test]
-    fn deep_json_nesting_is_an_error() {
-        let text = format!("{{\"boundary\": {}", "[".repeat(100_000));
-        assert!(matches!(parse_document(&text), Err(Error::Json { .. })));
-    }
-
-    #[test]
-    fn missing_file_is_io_error() {
-        let e = read_document(Path::new("/nonexistent/winslow/nothing.json")).unwrap_err();
-        assert!(matches!(e, Error::Io { .. }));
-        assert!(e.to_string().contains("nothing.json"));
-    }
 
     #[test]
     fn reversal_matches_curve_reversed() {

@@ -8,8 +8,6 @@
 //! the cloud's extent) is dropped. Closedness, orientation and nesting are checked by
 //! [`crate::boundary::ring_fit::fit_ring`].
 
-use std::path::Path;
-
 use serde_json::{json, Value};
 
 use super::json::{CurveJson, PointsJson};
@@ -51,15 +49,25 @@ fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
 
 /// The ring of a JSON document with a top-level `"ring"` field, `None` for any other
 /// document. Errors name the place (`ring.inner.knots`, ...).
-pub fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
+pub(crate) fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
     let text = text.trim_start_matches('\u{feff}').trim_start();
     if !text.starts_with('{') {
         return Ok(None);
     }
     let v: Value =
         serde_json::from_str(text).map_err(|e| Error::Json { context: String::new(), message: e.to_string() })?;
-    let Value::Object(mut obj) = v else { return Ok(None) };
-    let Some(r) = obj.remove("ring") else { return Ok(None) };
+    if v.get("ring").is_none() {
+        return Ok(None);
+    }
+    ring_of_json(v).map(Some)
+}
+
+/// The ring of a JSON document known to have a top-level `"ring"` field.
+pub(crate) fn ring_of_json(v: Value) -> Result<Ring> {
+    let Value::Object(mut obj) = v else {
+        return Err(Error::Json { context: String::new(), message: "the document must be an object".into() });
+    };
+    let r = obj.remove("ring").unwrap_or(Value::Null);
     let name = match obj.remove("name") {
         Some(Value::String(s)) => s,
         _ => String::new(),
@@ -71,18 +79,7 @@ pub fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
         r.remove(k).ok_or_else(|| Error::Json { context: "ring".into(), message: format!("missing contour \"{k}\"") })
     };
     let (inner, outer) = (take("inner")?, take("outer")?);
-    Ok(Some(Ring { name, inner: closed(inner, "ring.inner")?, outer: closed(outer, "ring.outer")? }))
-}
-
-/// Read a ring document; `None` when the file is another kind of document. A ring
-/// without a name is named after the file stem.
-pub fn read_ring(path: &Path) -> Result<Option<Ring>> {
-    let text = super::read_text(path)?;
-    let mut ring = parse_ring_json(&text)?;
-    if let Some(r) = ring.as_mut().filter(|r| r.name.is_empty()) {
-        r.name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    }
-    Ok(ring)
+    Ok(Ring { name, inner: closed(inner, "ring.inner")?, outer: closed(outer, "ring.outer")? })
 }
 
 /// The JSON form of a ring; analytic contours become point clouds of 1024 points.

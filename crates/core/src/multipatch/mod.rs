@@ -1,16 +1,14 @@
-//! Multipatch domains (paper §11.2).
+//! Multipatch domains (paper §11.2): the mathematics. Multipatch files (JSON, G+Smo
+//! `<MultiPatch>`, VTK multiblock) are read and written in [`crate::io::multipatch`].
 //!
 //! | module | holds |
 //! |---|---|
 //! | [`layout`] | patches, interfaces, the boundary condition of every patch side |
 //! | [`classes`] | the direction classes of the knot vectors: one knot vector per interface, propagated through chains of patches |
-//! | [`gismo`] | G+Smo XML `<MultiPatch>` files, read and written with G+Smo's side numbering and orientation flags |
-//! | [`json`] | the JSON multipatch document of `formats.md`, with named curves shared by patches |
 //! | [`dofs`] | the global numbering of shared control points over all patches |
 //! | [`problem`] | one discrete problem over all patches (Winslow functional eq. 16, weak form eq. 14) on the shared numbering |
 //! | [`solve`](mod@solve) | the conforming solve with fixed interfaces, patch by patch, and the layout's refinement |
 //! | [`free`] | the free-interface stage: one global problem from the certified fixed solve |
-//! | [`output`] | writing a solved layout (JSON, per-patch map documents, G+Smo XML, VTK multiblock) and reading any multipatch file |
 //! | [`join`] | two patches sharing a whole side joined into one map with a `C⁰` knot |
 //! | [`split`] | a domain split by the image of a parameter curve (straight or shortest in the map's metric) into two patches |
 //! | [`check`] | validation of a layout: shared sides identical, orientations consistent, counter-clockwise patches, complete interfaces, no crossing boundaries |
@@ -19,17 +17,13 @@ pub mod check;
 pub mod classes;
 pub mod dofs;
 pub mod free;
-pub mod gismo;
 pub mod join;
-pub mod json;
 pub mod layout;
-pub mod output;
 pub mod problem;
 pub mod solve;
 pub mod split;
 
 pub use check::{validate_layout, LayoutReport};
 pub use layout::{Interface, Layout, Patch, PatchSide};
-pub use output::read_layout;
 pub use problem::Functional;
 pub use solve::{solve_multipatch, Interfaces, MultipatchOptions, MultipatchSolution};

@@ -127,7 +127,7 @@ impl SolveOptions {
                 self.growth
             )));
         }
-        if !(self.aspect >= 1.0) {
+        if self.aspect.is_nan() || self.aspect < 1.0 {
             return Err(Error::Invalid(format!("the aspect bound must be at least 1, got {}", self.aspect)));
         }
         if self.min_elements == 0 || self.sample < 2 {

@@ -75,15 +75,10 @@ impl Format {
 /// first: an inverted or degenerate cell is an error and nothing is written.
 pub fn write(mesh: &Mesh, path: &Path, format: Format) -> Result<Vec<PathBuf>> {
     mesh.check()?;
-    let io = |p: &Path| {
-        let p = p.to_path_buf();
-        move |source| MeshError::Io { path: p, source }
-    };
+    // every file through the atomic writer: never a half-written mesh under its name
+    let file = |p: &Path, text: String| winslow::io::write_bytes(p, text.as_bytes()).map_err(MeshError::File);
     let single = |text: String| -> Result<Vec<PathBuf>> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(io(dir))?;
-        }
-        std::fs::write(path, text).map_err(io(path))?;
+        file(path, text)?;
         Ok(vec![path.to_path_buf()])
     };
     match format {
@@ -93,11 +88,10 @@ pub fn write(mesh: &Mesh, path: &Path, format: Format) -> Result<Vec<PathBuf>> {
         Format::Plot3d => single(plot3d::to_string(mesh)?),
         Format::OpenFoam => {
             let dir = path.join("constant").join("polyMesh");
-            std::fs::create_dir_all(&dir).map_err(io(&dir))?;
             let mut out = Vec::new();
             for (name, text) in openfoam::files(mesh, &openfoam::OpenFoamOptions::default())? {
                 let p = dir.join(name);
-                std::fs::write(&p, text).map_err(io(&p))?;
+                file(&p, text)?;
                 out.push(p);
             }
             Ok(out)

@@ -112,7 +112,7 @@ pub fn parse_gismo_volume(text: &str) -> Result<Volume> {
 mod tests {
     use super::*;
     use crate::io::gismo_writer::volume_to_gismo_xml;
-    use crate::io::volume::parse_volume_document;
+    use crate::io::{parse_document, Document};
     use crate::testutil::Lcg;
 
     fn random(rational: bool, seed: u64) -> Volume {
@@ -135,10 +135,10 @@ mod tests {
             let v = random(rational, 3 + rational as u64);
             let xml = volume_to_gismo_xml(&v, "certified -- yes");
             assert!(xml.contains(if rational { "TensorNurbs3" } else { "TensorBSpline3" }));
-            let back = parse_volume_document(&xml).unwrap().expect("a volume");
-            assert_eq!(back.volume, v);
+            let Document::Volume { volume, .. } = parse_document(&xml).unwrap() else { panic!("not a volume") };
+            assert_eq!(volume, v);
             let bits = |v: &Volume| v.control_points.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&back.volume), bits(&v));
+            assert_eq!(bits(&volume), bits(&v));
         }
     }
 
@@ -153,6 +153,6 @@ mod tests {
         let basis = xml.replace("TensorBSplineBasis3", "TensorBSplineBasis2");
         assert!(matches!(parse_gismo_volume(&basis), Err(Error::Xml { .. })));
         let planar = "<xml><Geometry type=\"TensorBSpline2\"/></xml>";
-        assert!(parse_volume_document(planar).unwrap().is_none());
+        assert!(!matches!(parse_document(planar), Ok(Document::Volume { .. })));
     }
 }

@@ -17,7 +17,6 @@
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-use super::VolumeDocument;
 use crate::error::{Error, Result, MAX_CONTROL_POINTS};
 use crate::io::normalized_knots;
 use crate::spline::knots::KnotVector;
@@ -81,8 +80,9 @@ impl VolumeJson {
     }
 }
 
-/// Parse a trivariate map document (already known to be one).
-pub(super) fn parse_volume_json(mut v: Value) -> Result<VolumeDocument> {
+/// Parse a trivariate map document (already known to be one): its name (empty when it
+/// has none) and its volume.
+pub(crate) fn parse_volume_json(mut v: Value) -> Result<(String, Volume)> {
     let name = match v.get("name") {
         None | Some(Value::Null) => String::new(),
         Some(Value::String(s)) => s.clone(),
@@ -91,7 +91,7 @@ pub(super) fn parse_volume_json(mut v: Value) -> Result<VolumeDocument> {
     let map = v.get_mut("map").map(Value::take).unwrap_or(Value::Null);
     let vj: VolumeJson =
         serde_json::from_value(map).map_err(|e| Error::Json { context: "map".into(), message: e.to_string() })?;
-    Ok(VolumeDocument { name, volume: vj.to_volume().map_err(|e| e.within("map"))? })
+    Ok((name, vj.to_volume().map_err(|e| e.within("map"))?))
 }
 
 /// A trivariate map document `{"name", "map": {...}}`; the fields of `extra` (an object,
@@ -113,8 +113,8 @@ pub fn volume_to_json(name: &str, v: &Volume, extra: Option<Value>) -> Value {
 
 #[cfg(test)]
 mod tests {
-    use super::super::parse_volume_document;
     use super::*;
+    use crate::io::{parse_document, Document};
 
     fn sample(rational: bool) -> Volume {
         let k = [KnotVector::open_uniform(2, 2), KnotVector::open_uniform(1, 3), KnotVector::open_uniform(3, 1)];
@@ -131,9 +131,9 @@ mod tests {
             let v = sample(rational);
             let doc = volume_to_json("vol", &v, Some(json!({"certificate": {"kind": "certified"}, "map": 1})));
             let text = serde_json::to_string(&doc).unwrap();
-            let back = parse_volume_document(&text).unwrap().expect("a volume");
-            assert_eq!(back.name, "vol");
-            assert_eq!(back.volume, v);
+            let Document::Volume { name, volume } = parse_document(&text).unwrap() else { panic!("not a volume") };
+            assert_eq!(name, "vol");
+            assert_eq!(volume, v);
         }
     }
 
@@ -141,13 +141,13 @@ mod tests {
     fn planar_maps_are_not_volumes_and_errors_name_the_field() {
         let planar =
             r#"{"map":{"degree":[1,1],"knots":[[0,0,1,1],[0,0,1,1]],"control_points":[[0,0],[1,0],[0,1],[1,1]]}}"#;
-        assert!(parse_volume_document(planar).unwrap().is_none());
+        assert!(matches!(parse_document(planar), Ok(Document::Map { .. })));
         let bad = r#"{"map":{"degree":[1,1,1],"knots":[[0,0,1,1],[0,0,1,1],[0,1,0,1]],"control_points":[]}}"#;
-        let e = parse_volume_document(bad).unwrap_err();
+        let e = parse_document(bad).unwrap_err();
         assert!(e.to_string().contains("map.knots[2]"), "{e}");
         let short = r#"{"map":{"degree":[1,1,1],"knots":[[0,0,1,1],[0,0,1,1],[0,0,1,1]],"control_points":[[0,0,0]]}}"#;
-        assert!(matches!(parse_volume_document(short), Err(Error::Length { .. })));
+        assert!(matches!(parse_document(short), Err(Error::Length { .. })));
         let wrong = r#"{"map":{"degree":[1,1,1],"knots":[[0,0,1,1],[0,0,1,1],[0,0,1,1]],"control_points":[[0,0]]}}"#;
-        assert!(matches!(parse_volume_document(wrong), Err(Error::Json { .. })));
+        assert!(matches!(parse_document(wrong), Err(Error::Json { .. })));
     }
 }

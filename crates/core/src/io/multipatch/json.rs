@@ -24,9 +24,9 @@ use std::collections::HashMap;
 
 use serde_json::{json, Map, Value};
 
-use super::layout::{Interface, Layout, Patch, PatchSide};
 use crate::error::{Error, Result};
 use crate::io::json::{CurveJson, MapJson};
+use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
 use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
 
@@ -38,13 +38,6 @@ fn side_named(name: &str) -> Option<Side> {
     Side::ALL.into_iter().find(|s| s.name() == name)
 }
 
-/// Whether `text` is a JSON object with a `patches` field.
-pub fn is_json_multipatch(text: &str) -> bool {
-    let body = text.trim_start_matches('\u{feff}').trim_start();
-    body.starts_with('{')
-        && serde_json::from_str::<Value>(body).is_ok_and(|v| v.as_object().is_some_and(|o| o.contains_key("patches")))
-}
-
 fn curve_of(v: Value, ctx: &str) -> Result<Curve> {
     let c: CurveJson = serde_json::from_value(v).map_err(|e| jerr(ctx, e.to_string()))?;
     if c.periodic {
@@ -54,7 +47,7 @@ fn curve_of(v: Value, ctx: &str) -> Result<Curve> {
 }
 
 /// Parse a multipatch document (see the module documentation); the layout is not
-/// validated here ([`super::check::validate_layout`]).
+/// validated here ([`crate::multipatch::check::validate_layout`]).
 pub fn parse_json_multipatch(text: &str) -> Result<Layout> {
     let v: Value = serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| jerr("", e.to_string()))?;
     let Value::Object(mut obj) = v else { return Err(jerr("", "the document must be an object")) };
@@ -300,7 +293,6 @@ mod tests {
 
     #[test]
     fn named_curves_and_listed_interfaces() {
-        assert!(is_json_multipatch(DOC) && !is_json_multipatch("{\"map\": 1}"));
         let l = parse_json_multipatch(DOC).unwrap();
         assert_eq!(l.patches.len(), 2);
         assert_eq!(l.interfaces.len(), 1);

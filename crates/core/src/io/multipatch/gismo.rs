@@ -28,16 +28,16 @@
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
-use super::layout::{Interface, Layout, Patch, PatchSide};
 use crate::error::{Error, Result};
 use crate::io::gismo::{children, nesting_exceeds, patch, xml_err, MAX_DEPTH, MAX_NODES};
 use crate::io::gismo_writer::surface_to_gismo_xml;
+use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
 use crate::spline::surface::{Side, Surface};
 
 /// Whether `text` is a G+Smo XML document with a `<MultiPatch>` element of surfaces: one
 /// whose `parDim` is not 1 (G+Smo stores the four boundary curves of a single domain as a
 /// `<MultiPatch parDim="1">`; that is a boundary document, read by
-/// [`crate::io::read_document`]).
+/// [`crate::io::read`]).
 pub fn is_gismo_multipatch(text: &str) -> bool {
     let body = text.trim_start_matches('\u{feff}').trim_start();
     body.starts_with('<')
@@ -99,7 +99,7 @@ fn integers(node: roxmltree::Node, ctx: &str) -> Result<Vec<i64>> {
 }
 
 /// Parse a G+Smo multipatch file into a layout (see the module documentation); the
-/// layout is not validated here ([`super::check::validate_layout`]), its name is empty.
+/// layout is not validated here ([`crate::multipatch::check::validate_layout`]), its name is empty.
 pub fn parse_gismo_multipatch(text: &str) -> Result<Layout> {
     if nesting_exceeds(text, MAX_DEPTH) {
         return Err(xml_err("", format!("elements are nested more than {MAX_DEPTH} levels deep")));

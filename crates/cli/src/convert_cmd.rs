@@ -1,0 +1,98 @@
+//! `winslow render` and `winslow convert`: a solved document drawn as a PNG, or written
+//! in another format (by the output's extension). Both take every document they can
+//! act on — a map (a ring map included), a multipatch result (or a G+Smo multipatch
+//! file, whose patches are maps), and for `convert` a volume — and name the kind they
+//! got otherwise.
+
+use super::*;
+use winslow::io::{Output, Patches};
+use winslow::multipatch::Layout;
+
+use crate::files;
+
+/// The patch maps of a layout whose every patch is a map, `None` otherwise.
+fn patch_maps(layout: &Layout) -> Option<Vec<Surface>> {
+    layout.patches.iter().map(|p| p.map.clone()).collect()
+}
+
+const RENDER_NEEDS: &str = "render draws a map, a ring map or a multipatch result (run `winslow solve` first)";
+
+/// `winslow render MAP --png OUT`.
+pub(super) fn render(a: RenderArgs) -> Result<i32> {
+    let (doc, report) = files::read_with_report(&a.map)?;
+    let report = report.unwrap_or_default();
+    let segments = if a.no_matches { Vec::new() } else { winslow::boundary::reparam::matches_in_report(&report) };
+    let kinks = winslow::boundary::kinks::kinks_in_report(&report);
+    let (size, grid_lines) = (a.size.clamp(64, 8192), a.lines);
+    let opts = PictureOptions { size, grid_lines, segments, kinks, ..Default::default() };
+    let image = match &doc {
+        Document::Map { map, .. } => {
+            let sel = a.backend.select(false)?;
+            picture(&sel, map, &opts)?
+        }
+        Document::Layout(l) | Document::Multipatch(l) => match patch_maps(l) {
+            Some(maps) => render_layout(&maps, &opts),
+            None => return Err(files::wrong_kind(&doc, &a.map, RENDER_NEEDS)),
+        },
+        _ => return Err(files::wrong_kind(&doc, &a.map, RENDER_NEEDS)),
+    };
+    files::write(&a.png, &Output::Picture(&image))?;
+    println!("wrote {}", a.png.display());
+    Ok(0)
+}
+
+/// The exit code of a planar certificate: 0 certified or degenerate corner, 3 folded,
+/// 5 undecided.
+fn planar_exit(v: &CertVerdict) -> i32 {
+    match v {
+        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
+        CertVerdict::Folded { .. } => 3,
+        CertVerdict::Undecided { .. } => 5,
+    }
+}
+
+const CONVERT_NEEDS: &str =
+    "convert writes a map, a ring map, a multipatch result or a volume (run `winslow solve` first)";
+
+/// `winslow convert IN -o OUT`: certified again (the verdict travels with the file),
+/// written by the output's extension.
+pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
+    let doc = files::read(&a.map)?;
+    match doc {
+        Document::Map { name, map } => {
+            let certificate = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
+            let label = format!("certificate: {}", certificate.message());
+            let extra = Some(serde_json::json!({ "certificate": &certificate }));
+            files::write(&a.output, &Output::Map { name: &name, map: &map, label: &label, extra })?;
+            println!("wrote {} ({label})", a.output.display());
+            Ok(planar_exit(&certificate.verdict))
+        }
+        Document::Volume { name, volume } => loft_cmd::convert_volume(&name, &volume, &a.output),
+        Document::Layout(ref layout) | Document::Multipatch(ref layout) => {
+            let Some(maps) = patch_maps(layout) else { return Err(files::wrong_kind(&doc, &a.map, CONVERT_NEEDS)) };
+            convert_patches(layout, maps, &a.output)
+        }
+        other => Err(files::wrong_kind(&other, &a.map, CONVERT_NEEDS)),
+    }
+}
+
+/// A multipatch document of maps, every patch certified again, written by extension
+/// (.json, .xml, .vtm); the exit code of the worst patch.
+fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result<i32> {
+    let mut reports = Vec::with_capacity(maps.len());
+    let mut messages = Vec::with_capacity(maps.len());
+    let mut codes = Vec::with_capacity(maps.len());
+    for (p, map) in layout.patches.iter().zip(&maps) {
+        let c = certify(map, &CertifyOptions::default()).with_context(|| format!("certifying patch {}", p.name))?;
+        codes.push(planar_exit(&c.verdict));
+        messages.push(c.message());
+        reports.push(serde_json::json!({ "certificate": c }));
+    }
+    let bijective = codes.iter().filter(|&&c| c == 0).count();
+    let message = format!("{bijective} of {} patches certified bijective (or best possible at a corner)", maps.len());
+    let report = serde_json::json!({ "message": message });
+    let patches = Patches { layout, maps, reports, messages, report, message: message.clone() };
+    files::write(output, &Output::Multipatch(patches))?;
+    println!("wrote {} ({message})", output.display());
+    Ok(codes.into_iter().max().unwrap_or(0))
+}
