@@ -10,7 +10,7 @@ use winslow::io::{read_boundary, ReadOptions};
 use winslow::solve;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
-use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
+use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 use winslow::Boundary;
 
 fn boundary(file: &str) -> Boundary {
@@ -127,7 +127,7 @@ fn a_fold_next_to_a_zero_speed_point_is_a_fold() {
     assert!(d(i) < 1e-12, "the kink's control point");
     map.control_points[(ny - 2) * nx + i] = [-6.0, 6.0];
     let c = certify(&map, &CertifyOptions::default()).unwrap();
-    assert!(matches!(c.verdict, CertVerdict::Folded { .. }), "{}", c.message());
+    assert!(matches!(c.verdict, Finding::Folded { .. }), "{}", c.message());
 }
 
 /// An eight-pointed star given as a 16-vertex polygon (three interior kinks per side, six

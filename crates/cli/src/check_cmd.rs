@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use winslow::io::Document;
-use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
+use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 use winslow::verify::poisson::poisson_benchmark;
 use winslow::verify::quality::{boundary_deviation, quality};
 
@@ -72,7 +72,7 @@ pub(crate) fn check(a: CheckArgs) -> Result<i32> {
         match poisson_benchmark(&map, a.poisson_scales) {
             Ok(r) => Some(r),
             Err(e) => {
-                eprintln!("warning: the Poisson benchmark could not be solved on this map: {e}");
+                note!("warning: the Poisson benchmark could not be solved on this map: {e}");
                 None
             }
         }
@@ -83,11 +83,11 @@ pub(crate) fn check(a: CheckArgs) -> Result<i32> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", output::check_text(&report));
+        say_raw!("{}", output::check_text(&report));
     }
     Ok(match report.certificate.verdict {
-        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
-        CertVerdict::Folded { .. } => 3,
-        CertVerdict::Undecided { .. } => 5,
+        Finding::Certified { .. } | Finding::DegenerateCorner { .. } => 0,
+        Finding::Folded { .. } => 3,
+        Finding::Undecided { .. } => 5,
     })
 }

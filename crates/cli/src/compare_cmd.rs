@@ -83,9 +83,6 @@ pub(super) struct CompareArgs {
     /// Print the comparison as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
-    /// No progress output.
-    #[arg(short, long)]
-    quiet: bool,
     /// Progress of every nonlinear iterate (residual, objective, damping).
     #[arg(short, long)]
     verbose: bool,
@@ -138,7 +135,7 @@ impl CompareArgs {
 pub(super) fn run(a: CompareArgs) -> Result<i32> {
     let (methods, opts) = a.options()?;
     let boundary = load_boundary(&a.boundary, a.fit.reorient)?;
-    let quiet = a.quiet || a.json;
+    let quiet = output::quiet() || a.json;
     let stderr = std::io::stderr();
     let mut progress = |e: CompareEvent| {
         if quiet {
@@ -188,7 +185,7 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
                 let image = render(map, &PictureOptions::default());
                 crate::files::write(&path, &winslow::io::Output::Picture(&image))?;
                 if !quiet {
-                    eprintln!("wrote {}", path.display());
+                    note!("wrote {}", path.display());
                 }
             }
         }
@@ -196,7 +193,7 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&cmp)?);
     } else {
-        print!("{}", table(&cmp));
+        say_raw!("{}", table(&cmp));
     }
     Ok(0)
 }

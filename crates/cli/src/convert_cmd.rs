@@ -37,17 +37,17 @@ pub(super) fn render(a: RenderArgs) -> Result<i32> {
         _ => return Err(files::wrong_kind(&doc, &a.map, RENDER_NEEDS)),
     };
     files::write(&a.png, &Output::Picture(&image))?;
-    println!("wrote {}", a.png.display());
+    say!("wrote {}", a.png.display());
     Ok(0)
 }
 
 /// The exit code of a planar certificate: 0 certified or degenerate corner, 3 folded,
 /// 5 undecided.
-fn planar_exit(v: &CertVerdict) -> i32 {
+fn planar_exit(v: &Finding) -> i32 {
     match v {
-        CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. } => 0,
-        CertVerdict::Folded { .. } => 3,
-        CertVerdict::Undecided { .. } => 5,
+        Finding::Certified { .. } | Finding::DegenerateCorner { .. } => 0,
+        Finding::Folded { .. } => 3,
+        Finding::Undecided { .. } => 5,
     }
 }
 
@@ -64,7 +64,7 @@ pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
             let label = format!("certificate: {}", certificate.message());
             let extra = Some(serde_json::json!({ "certificate": &certificate }));
             files::write(&a.output, &Output::Map { name: &name, map: &map, label: &label, extra })?;
-            println!("wrote {} ({label})", a.output.display());
+            say!("wrote {} ({label})", a.output.display());
             Ok(planar_exit(&certificate.verdict))
         }
         Document::Volume { name, volume } => loft_cmd::convert_volume(&name, &volume, &a.output),
@@ -93,6 +93,35 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
     let report = serde_json::json!({ "message": message });
     let patches = Patches { layout, maps, reports, messages, report, message: message.clone() };
     files::write(output, &Output::Multipatch(patches))?;
-    println!("wrote {} ({message})", output.display());
+    say!("wrote {} ({message})", output.display());
     Ok(codes.into_iter().max().unwrap_or(0))
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct ConvertArgs {
+    /// Map file (JSON map document, G+Smo XML or IGES), multipatch result or volume.
+    pub(crate) map: PathBuf,
+    /// Output file; the format follows its extension.
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct RenderArgs {
+    /// Map file (a ring map or a multipatch result too).
+    pub(crate) map: PathBuf,
+    /// Output PNG.
+    #[arg(long)]
+    pub(crate) png: PathBuf,
+    /// Iso-lines per direction.
+    #[arg(long, default_value_t = 24)]
+    pub(crate) lines: usize,
+    /// Longer image side in pixels.
+    #[arg(long, default_value_t = 900)]
+    pub(crate) size: usize,
+    #[command(flatten)]
+    pub(crate) backend: BackendArgs,
+    /// Do not draw the matched pairs of the reparameterization stored in the report.
+    #[arg(long)]
+    pub(crate) no_matches: bool,
 }

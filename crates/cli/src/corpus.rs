@@ -61,7 +61,7 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         for (_, b) in &domains {
             crate::files::write(&dir.join(format!("{}.json", b.name)), &winslow::io::Output::Boundary(b))?;
         }
-        println!("wrote {} boundaries to {}", domains.len(), dir.display());
+        say!("wrote {} boundaries to {}", domains.len(), dir.display());
     }
     if !a.solve {
         return Ok(0);
@@ -79,7 +79,7 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
             Err(e) => ("error".to_string(), e.to_string()),
         };
         let secs = t0.elapsed().as_secs_f64();
-        println!("{:<18} {:<18} {secs:7.2} s  {detail}", b.name, verdict);
+        say!("{:<18} {:<18} {secs:7.2} s  {detail}", b.name, verdict);
         let t = tally.entry(family.name()).or_default();
         t.domains += 1;
         t.seconds += secs;
@@ -88,15 +88,13 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         }
         *t.by_verdict.entry(verdict).or_default() += 1;
     }
-    println!();
-    println!(
-        "| family | domains | certified | degenerate corner | folded | undecided | not converged | error | time s |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    say!();
+    say!("| family | domains | certified | degenerate corner | folded | undecided | not converged | error | time s |");
+    say!("|---|---|---|---|---|---|---|---|---|");
     let (mut all, mut ok) = (0, 0);
     for (name, t) in &tally {
         let n = |v: &str| t.by_verdict.get(v).copied().unwrap_or(0);
-        println!(
+        say!(
             "| {name} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
             t.domains,
             n("certified"),
@@ -110,10 +108,10 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         all += t.domains;
         ok += n("certified");
     }
-    println!("\ncertified {ok} of {all} ({:.1} %)", 100.0 * ok as f64 / all.max(1) as f64);
+    say!("\ncertified {ok} of {all} ({:.1} %)", 100.0 * ok as f64 / all.max(1) as f64);
     for t in tally.values() {
         for f in &t.failures {
-            println!("  not certified: {f}");
+            say!("  not certified: {f}");
         }
     }
     Ok(if ok == all { 0 } else { 1 })

@@ -103,6 +103,6 @@ pub fn run(file: &Path, ring: &Ring, opts: &FitOptions, json: bool) -> anyhow::R
             2
         }
     };
-    print!("{s}");
+    say_raw!("{s}");
     Ok(code)
 }

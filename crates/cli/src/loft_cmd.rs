@@ -8,7 +8,7 @@ use crate::files;
 use winslow::solve::loft::{loft, LoftOptions, SliceBoundary};
 use winslow::spline::loft::Interpolation;
 use winslow::spline::volume::Volume;
-use winslow::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeVerdict};
+use winslow::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeFinding};
 
 #[derive(Args, Debug)]
 pub(super) struct LoftArgs {
@@ -50,11 +50,11 @@ pub(super) struct LoftArgs {
     json: bool,
 }
 
-fn exit_code(v: &VolumeVerdict) -> i32 {
+fn exit_code(v: &VolumeFinding) -> i32 {
     match v {
-        VolumeVerdict::Certified { .. } => 0,
-        VolumeVerdict::Folded { .. } => 3,
-        VolumeVerdict::Undecided { .. } => 5,
+        VolumeFinding::Certified { .. } => 0,
+        VolumeFinding::Folded { .. } => 3,
+        VolumeFinding::Undecided { .. } => 5,
     }
 }
 
@@ -103,7 +103,7 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
     } else {
         let d = out.volume.degrees();
         let s = out.volume.shape();
-        println!(
+        say!(
             "{name}: {} slices ({} given, {inserted} inserted, boundary of inserted slices interpolated), {} interpolation, \
              degrees ({}, {}, {}), {} x {} x {} control points, {} elements",
             out.slices.len(),
@@ -117,8 +117,8 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
             s[2],
             cert.elements
         );
-        println!("{}", cert.message());
-        println!(
+        say!("{}", cert.message());
+        say!(
             "{} round(s); volume certificate {:.3} s; total {:.3} s; peak memory {:.1} MiB; wrote {}",
             out.report.rounds.len(),
             cert.seconds,
@@ -158,12 +158,12 @@ pub(super) fn check_volume(name: &str, vol: &Volume, max_depth: usize, max_boxes
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         let (d, s) = (report.degrees, report.shape);
-        println!(
+        say!(
             "{}: volume of degrees ({}, {}, {}), {} x {} x {} control points, {} elements, det J of degree ({}, {}, {})",
             name, d[0], d[1], d[2], s[0], s[1], s[2], cert.elements, cert.det_degree[0], cert.det_degree[1], cert.det_degree[2]
         );
-        println!("{}", cert.message());
-        println!("volume (integral of det J) {:.6e}; certificate {:.3} s", report.volume, cert.seconds);
+        say!("{}", cert.message());
+        say!("volume (integral of det J) {:.6e}; certificate {:.3} s", report.volume, cert.seconds);
     }
     Ok(exit_code(&cert.verdict))
 }
@@ -174,6 +174,6 @@ pub(super) fn convert_volume(name: &str, volume: &Volume, output: &Path) -> Resu
     let label = format!("volume certificate: {}", cert.message());
     let extra = Some(serde_json::json!({ "certificate": &cert }));
     files::write(output, &Output::Volume { name, volume, label: &label, extra })?;
-    println!("wrote {} ({label})", output.display());
+    say!("wrote {} ({label})", output.display());
     Ok(exit_code(&cert.verdict))
 }

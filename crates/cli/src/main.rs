@@ -23,16 +23,46 @@ use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::{Solution, Verdict};
 use winslow::solve::solver::Event;
-use winslow::verify::certificate::{certify, CertifyOptions, Verdict as CertVerdict};
+use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 use winslow::verify::quality::{boundary_deviation, quality};
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 
+/// `println!` unless `-q`: a command's human-readable output.
+macro_rules! say {
+    ($($t:tt)*) => {
+        if !$crate::output::quiet() {
+            println!($($t)*)
+        }
+    };
+}
+
+/// `print!` unless `-q`.
+macro_rules! say_raw {
+    ($($t:tt)*) => {
+        if !$crate::output::quiet() {
+            print!($($t)*)
+        }
+    };
+}
+
+/// `eprintln!` unless `-q`: progress, notes and warnings (errors are always printed).
+macro_rules! note {
+    ($($t:tt)*) => {
+        if !$crate::output::quiet() {
+            eprintln!($($t)*)
+        }
+    };
+}
+
+mod args;
+mod bench_cmd;
 mod check_cmd;
 mod compare_cmd;
 mod convert_cmd;
 mod corpus;
 mod files;
+mod inspect_cmd;
 mod inspect_ring;
 mod loft_cmd;
 mod mesh;
@@ -43,6 +73,12 @@ mod reference;
 mod solve_cmd;
 mod sweep_cmd;
 
+use args::*;
+use bench_cmd::*;
+use convert_cmd::{ConvertArgs, RenderArgs};
+use inspect_cmd::*;
+use solve_cmd::SolveArgs;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "winslow",
@@ -50,6 +86,10 @@ mod sweep_cmd;
     about = "Bijective spline maps of the unit square from a planar boundary (elliptic grid generation in IGA)"
 )]
 struct Cli {
+    /// Print nothing but errors: the exit code and the files written say the rest
+    /// (`--json` output is still printed).
+    #[arg(short, long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -143,381 +183,6 @@ enum Command {
     Reference,
 }
 
-#[derive(Args, Debug)]
-struct ConvertArgs {
-    /// Map file (JSON map document, G+Smo XML or IGES), multipatch result or volume.
-    map: PathBuf,
-    /// Output file; the format follows its extension.
-    #[arg(short, long)]
-    output: PathBuf,
-}
-
-#[derive(Args, Debug, Clone)]
-struct FitArgs {
-    /// Spline degree of the map (p >= 2).
-    #[arg(long, default_value_t = 3)]
-    degree: usize,
-    /// Contour fit tolerance, relative to the bounding-box diameter.
-    #[arg(long, default_value_t = 1e-4)]
-    fit_tol: f64,
-    /// Turn a clockwise boundary counter-clockwise (swaps xi and eta) instead of failing.
-    #[arg(long)]
-    reorient: bool,
-    /// Boundary reparameterization (paper §7): auto = constrained cord length on
-    /// opposite sides closer than --reparam-gap times their length, none elsewhere; for a
-    /// ring: arc length, with facing points of a narrow gap (closer than --reparam-gap
-    /// times the diameter) matched at the same eta (arclength/none: never matched).
-    #[arg(long, value_enum, default_value = "auto")]
-    reparam: Reparam,
-    /// Narrow-gap threshold (auto) and matching distance (constrained), relative to the
-    /// mean length of the two opposite sides (for a ring: the outer contour's diameter).
-    #[arg(long, default_value_t = ReparamOptions::default().gap)]
-    reparam_gap: f64,
-    /// Minimum separation of two matched pairs, in cord length of each side.
-    #[arg(long, default_value_t = ReparamOptions::default().separation)]
-    reparam_separation: f64,
-    /// How unmatched parameters are filled: cord length between matches (eq. 41-42) or a
-    /// Fritsch-Carlson monotone cubic.
-    #[arg(long, value_enum, default_value = "cord-length")]
-    reparam_fill: Fill,
-    /// Basis of the map: `auto` (the default: the input's own basis, boundary kept
-    /// exactly, when its map is certified; else solved again on the fitted basis, with the
-    /// reason in the report), `fitted` (dyadic C^{p-1} fits of the sides within --fit-tol,
-    /// which with --degree applies to fitted bases only) or `input` (the B-spline or NURBS
-    /// sides' own basis whatever the verdict; falls back to `fitted` with a message for
-    /// point clouds, analytic sides and C0 knots).
-    #[arg(long, value_enum, default_value = "auto")]
-    basis: BasisChoice,
-    /// Kinks inside the sides kept exactly (paper §9): `auto` (spline sides' C0 knots and
-    /// zero-speed knots turning more than 1 degree, point clouds' corners turning 30 degrees
-    /// or more), `none` (rounded by the C^{p-1} fit and reported; on the input basis a C0
-    /// knot then falls back to fitted) or an angle in degrees (every kink turning at least
-    /// that much). A kept kink gets a knot line of multiplicity p; EGG is solved on the
-    /// smoothed basis, the map moved to the kinked boundary by damped elasticity and
-    /// finished by the Winslow functional (16).
-    #[arg(long, default_value_t = FitOptions::default().kinks, value_parser = parse_kinks)]
-    kinks: KinkMode,
-}
-
-fn parse_kinks_local(s: &str) -> std::result::Result<KinksLocal, String> {
-    KinksLocal::parse(s).ok_or_else(|| format!("expected auto, all or a number of knot spans, got '{s}'"))
-}
-
-/// `A1,A2`: the two positive length scales of the Poisson benchmark's `u*` (§10).
-fn parse_scales(s: &str) -> std::result::Result<[f64; 2], String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|t| t.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|e| format!("expected A1,A2 (two numbers), got '{s}': {e}"))?;
-    match v[..] {
-        [a, b] if a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0 => Ok([a, b]),
-        _ => Err(format!("expected A1,A2 (two positive numbers), got '{s}'")),
-    }
-}
-
-fn parse_kinks(s: &str) -> std::result::Result<KinkMode, String> {
-    KinkMode::parse(s).ok_or_else(|| format!("expected auto, none or an angle in (0, 180] degrees, got '{s}'"))
-}
-
-#[derive(Args, Debug)]
-struct InspectArgs {
-    /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
-    file: PathBuf,
-    #[command(flatten)]
-    fit: FitArgs,
-    /// Print the report as JSON.
-    #[arg(long)]
-    json: bool,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-enum MethodArg {
-    /// Elliptic grid generation, eq. (8): from the boundary (or from --start).
-    Egg,
-    /// The weak form, eq. (14), from a certified map (the EGG map, or --start).
-    Weak,
-    /// Minimize the Winslow functional, eq. (16), from a certified map (the EGG map, or
-    /// --start).
-    Winslow,
-    /// Old spelling of `--iteration newton`.
-    #[value(hide = true)]
-    Newton,
-    /// Old spelling of `--iteration pseudo-time`.
-    #[value(hide = true)]
-    PseudoTime,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy)]
-enum PrecisionArg {
-    Auto,
-    F64,
-    F32,
-}
-
-/// Where the quadrature runs.
-#[derive(Args, Debug, Clone)]
-struct BackendArgs {
-    /// Quadrature back end: the CPU; a GPU through wgpu (any adapter, lavapipe included;
-    /// none is an error); or auto (a hardware GPU with f64 shaders, else the CPU).
-    #[arg(long, value_enum, default_value = "cpu")]
-    backend: Backend,
-    /// GPU precision: f64 where the adapter offers it, else f32 matrices with the
-    /// residual in f64 on the CPU; or forced.
-    #[arg(long, value_enum, default_value = "auto")]
-    precision: PrecisionArg,
-}
-
-impl BackendArgs {
-    /// Open the back end and say which one runs (stderr unless `quiet`).
-    fn select(&self, quiet: bool) -> Result<Selected> {
-        let precision = match self.precision {
-            PrecisionArg::Auto => None,
-            PrecisionArg::F64 => Some(Precision::F64),
-            PrecisionArg::F32 => Some(Precision::F32),
-        };
-        let sel = winslow_gpu::assembler(self.backend, precision).context("opening the GPU")?;
-        if !quiet {
-            eprintln!("backend: {}", sel.describe());
-        }
-        Ok(sel)
-    }
-}
-
-/// The picture of `map`, sampled on the GPU when one is selected.
-fn picture(sel: &Selected, map: &Surface, opts: &PictureOptions) -> Result<winslow::io::picture::Image> {
-    Ok(match sel.gpu() {
-        Some(g) => g.render(map, opts).context("sampling det J on the GPU")?,
-        None => render(map, opts),
-    })
-}
-
-#[derive(Args, Debug, Clone)]
-struct SolverArgs {
-    #[command(flatten)]
-    fit: FitArgs,
-    /// Nonlinear tolerance on the scaled residual ||F|| sqrt(m) / diam^3.
-    #[arg(long, default_value_t = 1e-9)]
-    tol: f64,
-    /// Solve at most this many levels of the hierarchy (the finest is always solved).
-    #[arg(long)]
-    levels: Option<usize>,
-    /// Minimum number of elements per direction on the finest level.
-    #[arg(long, default_value_t = 8)]
-    min_elements: usize,
-    /// Extra uniform halvings of the finest level.
-    #[arg(long, default_value_t = 0)]
-    refine: usize,
-    /// Basis growth factor between solved levels (1 solves every level of the hierarchy).
-    #[arg(long, default_value_t = SolveOptions::default().growth)]
-    growth: f64,
-    /// Nonlinear iteration (Newton falls back to pseudo time-stepping when it stalls).
-    #[arg(long, value_enum, default_value = "newton")]
-    iteration: NonlinearMethod,
-    /// Method: egg (eq. 8) from the boundary; weak (eq. 14) or winslow (eq. 16) from a
-    /// certified map: the EGG map of the boundary (same as `--improve`), or the map of
-    /// `--start`. (`--method newton|pseudo-time` is the old spelling of `--iteration`.)
-    #[arg(long, value_enum, default_value = "egg")]
-    method: MethodArg,
-    /// Operator: L of eq. (4), or L / (g11 + g22) as in G+Smo (converges better on the
-    /// shared geometries, see BENCHMARKS.md).
-    #[arg(long, value_enum, default_value = "scaled")]
-    operator: Operator,
-    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), or auto (LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations).
-    #[arg(long, value_enum, default_value = "auto")]
-    linear: LinearMethod,
-    /// Rounds of defect correction: while the certificate says folded or undecided,
-    /// refine around the offending elements and solve again, at most this often.
-    #[arg(long, default_value_t = SolveOptions::default().repair)]
-    repair: usize,
-    /// Do not repair a folded map (same as --repair 0).
-    #[arg(long)]
-    no_repair: bool,
-    /// In repair rounds, solve only for the control points within this many spans of
-    /// the offending elements (the rest stay frozen at the prolonged map).
-    #[arg(long)]
-    repair_freeze: Option<usize>,
-    /// After the solve and its certificate, improve the map on the same basis, from the
-    /// certified map: minimize the Winslow functional (eq. 16) or solve the weak form
-    /// (eq. 14); certify again and keep the improved map only when it is certified.
-    #[arg(long, value_enum)]
-    improve: Option<Improve>,
-    /// With kinks kept (--kinks): which control points the final Winslow minimisation of
-    /// the C0 route moves: `all`, a number of knot spans around each kink (paper §9, last
-    /// paragraph; the rest keep the elasticity start), or `auto` (all up to 50 000
-    /// unknowns, 3 spans above).
-    #[arg(long, default_value = "auto", value_parser = parse_kinks_local)]
-    kinks_local: KinksLocal,
-}
-
-impl SolverArgs {
-    /// The method of `--method` when it needs a bijective start.
-    fn improvement_method(&self) -> Option<Improve> {
-        match self.method {
-            MethodArg::Weak => Some(Improve::WeakForm),
-            MethodArg::Winslow => Some(Improve::Winslow),
-            _ => None,
-        }
-    }
-
-    fn options(&self) -> Result<SolveOptions> {
-        let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
-        o.nonlinear.tol = self.tol;
-        o.nonlinear.method = match self.method {
-            MethodArg::Newton => NonlinearMethod::Newton,
-            MethodArg::PseudoTime => NonlinearMethod::PseudoTime,
-            MethodArg::Egg | MethodArg::Weak | MethodArg::Winslow => self.iteration,
-        };
-        o.nonlinear.linear = self.linear;
-        o.repair = if self.no_repair { 0 } else { self.repair };
-        o.repair_freeze = self.repair_freeze;
-        o.operator = self.operator;
-        o.max_levels = self.levels;
-        o.min_elements = self.min_elements.max(1);
-        o.refine = self.refine;
-        o.growth = self.growth.max(1.0);
-        o.kinks_local = self.kinks_local;
-        o.improve = self.improve;
-        // a method that needs a bijective start runs after the EGG solve
-        if let Some(m) = self.improvement_method() {
-            if o.improve.is_some_and(|i| i != m) {
-                bail!("--method {:?} and --improve {:?} ask for two different improvements", self.method, o.improve);
-            }
-            o.improve = Some(m);
-        }
-        o.validate()?;
-        Ok(o)
-    }
-}
-
-fn fit_options(f: &FitArgs) -> FitOptions {
-    let reparam = ReparamOptions {
-        method: f.reparam,
-        gap: f.reparam_gap,
-        separation: f.reparam_separation,
-        fill: f.reparam_fill,
-        ..Default::default()
-    };
-    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis: f.basis, kinks: f.kinks, ..Default::default() }
-}
-
-#[derive(Args, Debug)]
-struct SolveArgs {
-    /// Boundary file (with `--start`: optional, the map's boundary deviation from it is
-    /// reported).
-    #[arg(required_unless_present = "start")]
-    boundary: Option<PathBuf>,
-    /// Start from this map document (made by `winslow solve` or another tool) instead of
-    /// solving from the boundary: the certificate must prove it bijective, its boundary
-    /// control points stay fixed, `--method` (winslow, weak or egg) runs on its basis,
-    /// and the result is kept only when certified.
-    #[arg(long)]
-    start: Option<PathBuf>,
-    /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
-    /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
-    /// A multipatch input (G+Smo `<MultiPatch>` or a JSON document with "patches") is
-    /// written as a JSON multipatch document or G+Smo XML (.xml).
-    #[arg(short, long)]
-    output: PathBuf,
-    #[command(flatten)]
-    solver: SolverArgs,
-    /// Write a picture of the map (grid lines coloured by det J; the matched pairs of
-    /// the constrained reparameterization drawn as segments).
-    #[arg(long)]
-    png: Option<PathBuf>,
-    /// Do not draw the matched pairs into the PNG.
-    #[arg(long)]
-    no_png_matches: bool,
-    /// Write a VTK structured grid with det J.
-    #[arg(long)]
-    vtk: Option<PathBuf>,
-    /// Also write the map as G+Smo XML (TensorBSpline2 / TensorNurbs2).
-    #[arg(long)]
-    gismo: Option<PathBuf>,
-    /// Also write the map as IGES 5.3 (rational B-spline surface, entity 128).
-    #[arg(long)]
-    iges: Option<PathBuf>,
-    /// Also write the exact map as VTK Bézier quadrilaterals (.vtu, det J as point data).
-    #[arg(long)]
-    vtu: Option<PathBuf>,
-    /// Print the report as JSON on stdout (progress goes to stderr).
-    #[arg(long)]
-    json: bool,
-    /// Also solve the grid-quality benchmark (paper eq. 44-45) on the map; Q(x) goes
-    /// into the report.
-    #[arg(long)]
-    poisson: bool,
-    /// No progress output.
-    #[arg(short, long)]
-    quiet: bool,
-    #[command(flatten)]
-    backend: BackendArgs,
-    /// Also write a mesh of the solved map (same options as `winslow mesh`): .msh,
-    /// .su2, .xyz, .vtu or a directory (OpenFOAM).
-    #[arg(long, value_name = "OUT")]
-    mesh: Option<PathBuf>,
-    #[command(flatten)]
-    mesh_spec: mesh::MeshSpec,
-    #[command(flatten)]
-    multipatch: multipatch_cmd::MultipatchArgs,
-}
-
-#[derive(Args, Debug)]
-struct RenderArgs {
-    /// Map file (a ring map or a multipatch result too).
-    map: PathBuf,
-    /// Output PNG.
-    #[arg(long)]
-    png: PathBuf,
-    /// Iso-lines per direction.
-    #[arg(long, default_value_t = 24)]
-    lines: usize,
-    /// Longer image side in pixels.
-    #[arg(long, default_value_t = 900)]
-    size: usize,
-    #[command(flatten)]
-    backend: BackendArgs,
-    /// Do not draw the matched pairs of the reparameterization stored in the report.
-    #[arg(long)]
-    no_matches: bool,
-}
-
-#[derive(Args, Debug)]
-struct BenchArgs {
-    /// Boundary files (default: every JSON geometry in tests/data and tests/data/gismo).
-    files: Vec<PathBuf>,
-    /// Extra uniform halvings of the finest level to run, comma-separated (one table row
-    /// per geometry and value).
-    #[arg(long, value_delimiter = ',', default_value = "0")]
-    refinements: Vec<usize>,
-    #[command(flatten)]
-    solver: SolverArgs,
-    /// Print the rows as JSON lines instead of a table.
-    #[arg(long)]
-    json: bool,
-    #[command(flatten)]
-    backend: BackendArgs,
-    /// Quadrature throughput (residual and Jacobian, CPU versus the selected back end)
-    /// at these sizes in scalar DOFs, comma-separated. With a GPU and no FILES this
-    /// table alone is printed, by default at 1e3, 1e4, 1e5 and 1e6 DOFs (1e6 left out on
-    /// a software adapter such as lavapipe).
-    #[arg(long, value_delimiter = ',')]
-    sizes: Vec<usize>,
-    /// Degree of the quadrature benchmark's basis.
-    #[arg(long, default_value_t = 3)]
-    bench_degree: usize,
-    /// GPU Jacobian kernel of the quadrature benchmark: element matrices (one workgroup
-    /// per element, then a gather; the solver's) or one invocation per stencil entry.
-    #[arg(long, value_enum, default_value = "element")]
-    gpu_kernel: KernelArg,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-enum KernelArg {
-    Element,
-    Entry,
-}
-
 fn main() {
     let cli = Cli::parse();
     // the command runs on a worker of the thread pool, started with the process: a
@@ -541,11 +206,12 @@ fn main() {
 }
 
 fn run(cli: Cli) -> Result<i32> {
+    output::set_quiet(cli.quiet);
     match cli.command {
-        Command::Inspect(a) => inspect(a),
+        Command::Inspect(a) => inspect_cmd::inspect(a),
         Command::Solve(a) => solve_cmd::solve(*a),
         Command::Render(a) => convert_cmd::render(a),
-        Command::Bench(a) => bench(a),
+        Command::Bench(a) => bench_cmd::bench(a),
         Command::Check(a) => check_cmd::check(a),
         Command::Convert(a) => convert_cmd::convert(a),
         Command::Mesh(a) => mesh::run(a),
@@ -561,128 +227,6 @@ fn run(cli: Cli) -> Result<i32> {
             Ok(0)
         }
     }
-}
-
-fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
-    let b = files::boundary_of(files::read(path)?, path)?;
-    let (b, _) =
-        checked_boundary(b, &ReadOptions { reorient }).with_context(|| format!("validating {}", path.display()))?;
-    Ok(b)
-}
-
-fn inspect(a: InspectArgs) -> Result<i32> {
-    let doc = files::read(&a.file)?;
-    let kind = match &doc {
-        Document::Ring(ring) => return inspect_ring::run(&a.file, ring, &fit_options(&a.fit), a.json),
-        Document::Boundary(_) => "boundary",
-        _ => "map (its four boundary curves are inspected)",
-    };
-    let boundary = files::boundary_of(doc, &a.file)?;
-    let mut problems = Vec::new();
-    let checked = checked_boundary(boundary.clone(), &ReadOptions { reorient: a.fit.reorient });
-    let (boundary, report) = match checked {
-        Ok((b, r)) => (b, Some(r)),
-        Err(e) => {
-            problems.push(e.to_string());
-            (boundary, None)
-        }
-    };
-    let fit = if problems.is_empty() { Some(build_hierarchy(&boundary, &fit_options(&a.fit))) } else { None };
-    let fit = match fit {
-        Some(Ok(h)) => Some(h),
-        Some(Err(e)) => {
-            problems.push(format!("contour fit failed: {e}"));
-            None
-        }
-        None => None,
-    };
-    let text = output::inspect_text(&a.file, kind, &boundary, report.as_ref(), fit.as_ref(), &problems);
-    if a.json {
-        let v = output::inspect_json(&boundary, report.as_ref(), fit.as_ref(), &problems);
-        println!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        print!("{text}");
-    }
-    Ok(if problems.is_empty() { 0 } else { 2 })
-}
-
-fn bench(a: BenchArgs) -> Result<i32> {
-    let opts = a.solver.options()?;
-    let sel = a.backend.select(a.json)?;
-    let sizes = match sel.gpu() {
-        _ if !a.sizes.is_empty() || !a.files.is_empty() => a.sizes.clone(),
-        // 10^6 takes many minutes on a software adapter (lavapipe): ask for it explicitly
-        Some(g) if g.is_software() => {
-            eprintln!("note: software adapter, sizes 1e3..1e5 (pass --sizes 1000000 for 1e6)");
-            vec![1_000, 10_000, 100_000]
-        }
-        Some(_) => vec![1_000, 10_000, 100_000, 1_000_000],
-        None => Vec::new(),
-    };
-    if !sizes.is_empty() {
-        quadrature_bench(&sel, &sizes, a.bench_degree, opts.operator, a.gpu_kernel == KernelArg::Entry, a.json)?;
-        if a.files.is_empty() {
-            return Ok(0);
-        }
-    }
-    let files = if a.files.is_empty() { output::default_bench_files()? } else { a.files.clone() };
-    let mut rows = Vec::new();
-    for f in &files {
-        let boundary = match load_boundary(f, a.solver.fit.reorient) {
-            Ok(b) => b,
-            Err(e) => {
-                eprintln!("skipping {}: {e:#}", f.display());
-                continue;
-            }
-        };
-        for &r in &a.refinements {
-            let o = SolveOptions { refine: r, ..opts.clone() };
-            output::reset_peak_memory();
-            let t = Instant::now();
-            let sol = solve_cmd::run_pipeline(boundary.clone(), &o, sel.as_assembler(), true)?;
-            let total = t.elapsed().as_secs_f64();
-            let row = output::BenchRow::new(&sol, r, total);
-            if a.json {
-                println!("{}", serde_json::to_string(&row)?);
-            }
-            rows.push(row);
-        }
-    }
-    if !a.json {
-        print!("{}", output::bench_table(&rows));
-    }
-    Ok(0)
-}
-
-/// Quadrature throughput at the given sizes, CPU versus the selected GPU.
-fn quadrature_bench(
-    sel: &Selected,
-    sizes: &[usize],
-    degree: usize,
-    op: Operator,
-    per_entry: bool,
-    json: bool,
-) -> Result<()> {
-    if !(2..=8).contains(&degree) {
-        bail!("--bench-degree must be in 2..=8, got {degree}");
-    }
-    let gpu = sel.gpu().map(|g| winslow_gpu::GpuAssembler::new(g.clone()).with_per_entry_jacobian(per_entry));
-    let gpu = gpu.as_ref();
-    let mut rows = Vec::new();
-    for &dofs in sizes {
-        let (disc, cps) = winslow_gpu::bench::quadrature_case(dofs, degree);
-        let row = winslow_gpu::bench::measure(&disc, &cps, op, gpu, 1.0).context("GPU quadrature")?;
-        if json {
-            println!("{}", serde_json::to_string(&row)?);
-        } else {
-            eprintln!("  {} DOFs done", row.dofs);
-        }
-        rows.push(row);
-    }
-    if !json {
-        print!("{}", output::quadrature_table(&sel.describe(), &rows));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

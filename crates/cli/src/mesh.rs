@@ -203,7 +203,7 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     let files = write(&mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
     let written = t.elapsed().as_secs_f64();
     if !quiet {
-        println!(
+        say!(
             "{} mesh, {} {}s of order {} ({}):",
             if mesh.structured.is_some() { "structured" } else { "unstructured" },
             mesh.num_cells(),
@@ -211,16 +211,16 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             mesh.order,
             format.name()
         );
-        print!("{}", q.table());
-        println!("  built in {built:.3} s, quality in {measured:.3} s, checked and written in {written:.3} s");
+        say_raw!("{}", q.table());
+        say!("  built in {built:.3} s, quality in {measured:.3} s, checked and written in {written:.3} s");
         if let Some(st) = stats {
-            println!(
+            say!(
                 "  meshing: boundary {:.3} s, spade refinement {:.3} s ({} of {} rounds), mapping {:.3} s, criteria {:.3} s, insertion {:.3} s, mesh {:.3} s",
                 st.boundary, st.refine, st.spade_refinements, st.rounds, st.map, st.criteria, st.insert, st.build
             );
         }
         for f in files {
-            println!("wrote {}", f.display());
+            say!("wrote {}", f.display());
         }
     }
     Ok(())

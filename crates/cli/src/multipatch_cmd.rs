@@ -52,8 +52,8 @@ fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
 /// `winslow solve LAYOUT`: solve, write, summarize; the exit code of the worst verdict.
 pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
     let opts = options(a)?;
-    if !(a.quiet || a.json) {
-        eprintln!(
+    if !(output::quiet() || a.json) {
+        note!(
             "{}: multipatch layout, {} patches, {} interfaces; interfaces {}",
             layout.name,
             layout.patches.len(),
@@ -66,9 +66,9 @@ pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&sol.report)?);
     } else {
-        print!("{}", summary(&sol));
+        say_raw!("{}", summary(&sol));
     }
-    Ok(exit_code(sol.report.verdict))
+    Ok(output::exit_code(sol.report.verdict))
 }
 
 /// Write the solution where `a` asks: `-o` by its extension (.json, .xml for G+Smo,
@@ -95,7 +95,7 @@ fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
         ("--mesh", a.mesh.is_some()),
     ] {
         if given {
-            eprintln!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps or --gismo");
+            note!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps or --gismo");
         }
     }
     Ok(())
@@ -126,16 +126,6 @@ pub(super) fn summary(sol: &MultipatchSolution) -> String {
     s
 }
 
-/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
-fn exit_code(v: Verdict) -> i32 {
-    match v {
-        Verdict::Certified | Verdict::DegenerateCorner => 0,
-        Verdict::Folded => 3,
-        Verdict::NotConverged => 4,
-        Verdict::Undecided => 5,
-    }
-}
-
 /// `winslow split`: cut a certified map's domain in two (paper §11.2, Fig. 25).
 #[derive(Args, Debug)]
 pub(super) struct SplitArgs {
@@ -152,12 +142,13 @@ pub(super) struct SplitArgs {
     /// the metric of the map (through narrow gaps).
     #[arg(long, value_enum, default_value = "straight")]
     path: SplitPath,
-    /// Degree of the splitting curve.
+    /// Spline degree of the splitting curve.
     #[arg(long, default_value_t = 3)]
     degree: usize,
-    /// Fit tolerance of the splitting curve, relative to the diameter.
+    /// Fit tolerance of the splitting curve, relative to the diameter (as `--fit-tol` of
+    /// `solve` for the sides).
     #[arg(long, default_value_t = 1e-5)]
-    tol: f64,
+    fit_tol: f64,
     /// Output: the multipatch document of the two parts (`winslow solve` takes it); the
     /// two boundary documents go next to it as STEM-a.json and STEM-b.json.
     #[arg(short, long)]
@@ -214,7 +205,7 @@ fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::Side
         .with_context(|| format!("{s:?} is neither SIDE:T nor X,Y"))?;
     let [x, y] = xy[..] else { bail!("{s:?} is neither SIDE:T nor X,Y") };
     let (p, d) = nearest_boundary_point(map, [x, y]);
-    eprintln!("({x}, {y}) -> {} side at t = {:.6} ({d:.3e} away)", p.side, p.t);
+    note!("({x}, {y}) -> {} side at t = {:.6} ({d:.3e} away)", p.side, p.t);
     Ok(p)
 }
 
@@ -224,7 +215,7 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
     let cert = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
     let (from, to) = (side_point(&map, &a.from)?, side_point(&map, &a.to)?);
     let path = a.path;
-    let opts = SplitOptions { path, degree: a.degree, tol: a.tol, ..Default::default() };
+    let opts = SplitOptions { path, degree: a.degree, tol: a.fit_tol, ..Default::default() };
     let s = split_map(&name, &map, &cert, from, to, &opts).context("splitting the map")?;
     files::write(&a.output, &Output::Layout(&s.layout))?;
     let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
@@ -245,11 +236,15 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
         println!("{}", serde_json::to_string_pretty(&s.report)?);
     } else {
         let r = &s.report;
-        println!(
+        say!(
             "{name}: split from the {} side at {:.6} to the {} side at {:.6} ({:?} parameter path)",
-            r.from.side, r.from.t, r.to.side, r.to.t, r.path
+            r.from.side,
+            r.from.t,
+            r.to.side,
+            r.to.t,
+            r.path
         );
-        println!(
+        say!(
             "  splitting curve: p={}, {} elements, length {:.6}, fit error {:.3e}; areas {:.6} and {:.6}",
             s.curve.degree(),
             r.elements,
@@ -259,7 +254,7 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
             r.areas[1]
         );
         let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-        println!("  wrote {}", names.join(", "));
+        say!("  wrote {}", names.join(", "));
     }
     Ok(0)
 }
@@ -272,7 +267,7 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
     let opts = CertifyOptions::default();
     let j = join_and_smooth(&ma, &mb, functional, Default::default(), &opts).context("joining the maps")?;
     let name = format!("{na}+{nb}");
-    let verdict = winslow::multipatch::solve::verdict_of(&j.certificate);
+    let verdict = Verdict::of_certificate(&j.certificate);
     let report = serde_json::json!({
         "version": env!("CARGO_PKG_VERSION"),
         "verdict": verdict,
@@ -290,23 +285,23 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!("{name}: {}", output::verdict_word(verdict));
-        println!(
+        say!("{name}: {}", output::verdict_word(verdict));
+        say!(
             "  joined along the {} side of {} and the {} side of {}: {}x{} functions, C0 knot at {:.4}, boundary turns by {:.1} and {:.1} degrees where they meet",
             j.join.sides[0], a.a.display(), j.join.sides[1], a.b.display(), j.join.shape[0], j.join.shape[1], j.join.c0_knot,
             j.join.turn_degrees[0], j.join.turn_degrees[1]
         );
-        println!("  {}", j.smoothing.message);
-        println!("  wrote {}", a.output.display());
+        say!("  {}", j.smoothing.message);
+        say!("  wrote {}", a.output.display());
     }
-    Ok(exit_code(verdict))
+    Ok(output::exit_code(verdict))
 }
 
 /// `winslow check LAYOUT`: certify every patch map of a multipatch file (a G+Smo
 /// `<MultiPatch>` or a solved JSON layout) and measure how far the two sides of every
 /// interface are apart; the exit code of the worst patch.
 pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result<i32> {
-    use winslow::multipatch::solve::{interface_mismatch, verdict_of};
+    use winslow::multipatch::solve::interface_mismatch;
     let mut maps = Vec::with_capacity(layout.patches.len());
     for p in &layout.patches {
         let Some(m) = &p.map else {
@@ -323,8 +318,8 @@ pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result
     let mut worst = Verdict::Certified;
     for (p, m) in layout.patches.iter().zip(&maps) {
         let c = certify(m, opts).with_context(|| format!("certifying patch {}", p.name))?;
-        let v = verdict_of(&c);
-        if exit_code(v) > exit_code(worst) {
+        let v = Verdict::of_certificate(&c);
+        if output::exit_code(v) > output::exit_code(worst) {
             worst = v;
         }
         let w = quality(m).functionals.winslow;
@@ -345,7 +340,7 @@ pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!(
+        say!(
             "{}: {} ({} patches, {} interfaces)",
             layout.name,
             output::verdict_word(worst),
@@ -353,12 +348,12 @@ pub(super) fn check(layout: Layout, opts: &CertifyOptions, json: bool) -> Result
             layout.interfaces.len()
         );
         for r in &rows {
-            println!("  patch {:<10} {}", r["name"].as_str().unwrap_or(""), r["message"].as_str().unwrap_or(""));
+            say!("  patch {:<10} {}", r["name"].as_str().unwrap_or(""), r["message"].as_str().unwrap_or(""));
         }
-        println!("  interface control points differ by up to {mismatch:.3e}");
+        say!("  interface control points differ by up to {mismatch:.3e}");
         if let Err(e) = &validation {
-            println!("  layout: {e}");
+            say!("  layout: {e}");
         }
     }
-    Ok(exit_code(worst))
+    Ok(output::exit_code(worst))
 }

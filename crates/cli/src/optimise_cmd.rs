@@ -51,9 +51,6 @@ pub(super) struct OptimiseArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
-    /// No progress output.
-    #[arg(short, long)]
-    quiet: bool,
     /// The EGG solve that gives the basis and start G (`--basis auto` means `fitted`
     /// here: the constraints need a polynomial basis; a coarse --fit-tol keeps the
     /// constraint count small).
@@ -107,7 +104,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     if opts.fit.basis == BasisChoice::Input {
         bail!("--basis input may be rational: the det J coefficient constraints need --basis fitted");
     }
-    let quiet = a.quiet || a.json;
+    let quiet = output::quiet() || a.json;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
     let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?;
     let egg = &sol.map;
@@ -179,7 +176,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         for p in a.output.iter().chain(&a.png) {
             let _ = writeln!(s, "  wrote {}", p.display());
         }
-        print!("{s}");
+        say_raw!("{s}");
     }
     Ok(if rows.iter().all(|r| r.outcome.certified) { 0 } else { 3 })
 }

@@ -654,3 +654,27 @@ pub fn peak_memory_mib() -> f64 {
         })
         .map_or(0.0, |kb| kb / 1024.0)
 }
+
+/// `-q`: the process prints nothing but errors (set once, by `main`).
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Set `-q` for the process.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether `-q` was given.
+pub fn quiet() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// The exit code of a verdict: 0 certified or degenerate corner (the best map the
+/// boundary allows), 3 folded, 4 not converged, 5 undecided.
+pub fn exit_code(v: Verdict) -> i32 {
+    match v {
+        Verdict::Certified | Verdict::DegenerateCorner => 0,
+        Verdict::Folded => 3,
+        Verdict::NotConverged => 4,
+        Verdict::Undecided => 5,
+    }
+}

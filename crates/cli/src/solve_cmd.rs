@@ -170,7 +170,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let doc = files::read(path)?;
-    let sel = a.backend.select(a.quiet || a.json)?;
+    let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => return super::multipatch_cmd::solve(layout, &a),
         Document::Ring(ring) => Input::Ring(ring),
@@ -181,7 +181,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
             Input::Boundary(boundary)
         }
     };
-    let sol = run_pipeline(input, &opts, sel.as_assembler(), a.quiet || a.json)?;
+    let sol = run_pipeline(input, &opts, sel.as_assembler(), output::quiet() || a.json)?;
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let extra = Some(serde_json::json!({ "report": report }));
@@ -204,13 +204,13 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
+        say_raw!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
     }
     if let Some(out) = &a.mesh {
         // a folded map gives inverted cells, which the writers refuse
         mesh::make_and_write(&sol.map, &a.mesh_spec, out, a.json)?;
     }
-    Ok(exit_code(sol.report.verdict))
+    Ok(output::exit_code(sol.report.verdict))
 }
 
 /// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: improve a
@@ -246,12 +246,7 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
     let out = improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)
         .with_context(|| format!("improving {}", start.display()))?;
     let deviation = boundary.as_ref().map(|b| boundary_deviation(&out.map, b, 400));
-    let verdict = match out.certificate.verdict {
-        CertVerdict::Certified { .. } => Verdict::Certified,
-        CertVerdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
-        CertVerdict::Folded { .. } => Verdict::Folded,
-        CertVerdict::Undecided { .. } => Verdict::Undecided,
-    };
+    let verdict = Verdict::of_certificate(&out.certificate);
     let q = quality(&out.map);
     let w = q.functionals.winslow;
     let report = serde_json::json!({
@@ -277,7 +272,7 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         }
     }
     if let Some(p) = &a.png {
-        let sel = a.backend.select(a.quiet || a.json)?;
+        let sel = a.backend.select(output::quiet() || a.json)?;
         files::write(p, &Output::Picture(&picture(&sel, &out.map, &PictureOptions::default())?))?;
     }
     if a.json {
@@ -301,17 +296,65 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
             ));
         }
         s.push_str(&format!("  wrote {}\n", a.output.display()));
-        print!("{s}");
+        say_raw!("{s}");
     }
-    Ok(exit_code(verdict))
+    Ok(output::exit_code(verdict))
 }
 
-/// 0 certified or degenerate corner, 3 folded, 4 not converged, 5 undecided.
-fn exit_code(v: Verdict) -> i32 {
-    match v {
-        Verdict::Certified | Verdict::DegenerateCorner => 0,
-        Verdict::Folded => 3,
-        Verdict::NotConverged => 4,
-        Verdict::Undecided => 5,
-    }
+#[derive(Args, Debug)]
+pub(crate) struct SolveArgs {
+    /// Boundary file (with `--start`: optional, the map's boundary deviation from it is
+    /// reported).
+    #[arg(required_unless_present = "start")]
+    pub(crate) boundary: Option<PathBuf>,
+    /// Start from this map document (made by `winslow solve` or another tool) instead of
+    /// solving from the boundary: the certificate must prove it bijective, its boundary
+    /// control points stay fixed, `--method` (winslow, weak or egg) runs on its basis,
+    /// and the result is kept only when certified.
+    #[arg(long)]
+    pub(crate) start: Option<PathBuf>,
+    /// Output map file: JSON with a "report" (default), or by extension G+Smo XML
+    /// (.xml), IGES (.igs, .iges), VTK Bézier cells (.vtu) or a sampled VTK grid (.vtk).
+    /// A multipatch input (G+Smo `<MultiPatch>` or a JSON document with "patches") is
+    /// written as a JSON multipatch document or G+Smo XML (.xml).
+    #[arg(short, long)]
+    pub(crate) output: PathBuf,
+    #[command(flatten)]
+    pub(crate) solver: SolverArgs,
+    /// Write a picture of the map (grid lines coloured by det J; the matched pairs of
+    /// the constrained reparameterization drawn as segments).
+    #[arg(long)]
+    pub(crate) png: Option<PathBuf>,
+    /// Do not draw the matched pairs into the PNG.
+    #[arg(long)]
+    pub(crate) no_png_matches: bool,
+    /// Write a VTK structured grid with det J.
+    #[arg(long)]
+    pub(crate) vtk: Option<PathBuf>,
+    /// Also write the map as G+Smo XML (TensorBSpline2 / TensorNurbs2).
+    #[arg(long)]
+    pub(crate) gismo: Option<PathBuf>,
+    /// Also write the map as IGES 5.3 (rational B-spline surface, entity 128).
+    #[arg(long)]
+    pub(crate) iges: Option<PathBuf>,
+    /// Also write the exact map as VTK Bézier quadrilaterals (.vtu, det J as point data).
+    #[arg(long)]
+    pub(crate) vtu: Option<PathBuf>,
+    /// Print the report as JSON on stdout (progress goes to stderr).
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Also solve the grid-quality benchmark (paper eq. 44-45) on the map; Q(x) goes
+    /// into the report.
+    #[arg(long)]
+    pub(crate) poisson: bool,
+    #[command(flatten)]
+    pub(crate) backend: BackendArgs,
+    /// Also write a mesh of the solved map (same options as `winslow mesh`): .msh,
+    /// .su2, .xyz, .vtu or a directory (OpenFOAM).
+    #[arg(long, value_name = "OUT")]
+    pub(crate) mesh: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) mesh_spec: mesh::MeshSpec,
+    #[command(flatten)]
+    pub(crate) multipatch: multipatch_cmd::MultipatchArgs,
 }

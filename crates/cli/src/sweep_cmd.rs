@@ -39,9 +39,10 @@ pub(super) struct SweepArgs {
     /// contour: the grid twists).
     #[arg(long, value_enum, default_value_t = Seam::Slide)]
     seam: Seam,
-    /// Highest order of the time extrapolation of the control points (0 to 5).
+    /// Highest order of the predictor: the time extrapolation of the control points (0 to
+    /// 5). (`--order` elsewhere is a mesh's element order.)
     #[arg(long, default_value_t = 5)]
-    order: usize,
+    predictor_order: usize,
     /// Output directory: frame_NNNN.json, frame_NNNN.vtu, sweep.pvd, sweep.csv, sweep.json.
     #[arg(short, long)]
     output: PathBuf,
@@ -64,9 +65,6 @@ pub(super) struct SweepArgs {
     /// frame.
     #[arg(long, default_value_t = 0)]
     cold_every: usize,
-    /// No per-frame lines on stderr.
-    #[arg(long)]
-    quiet: bool,
     #[command(flatten)]
     solver: SolverArgs,
 }
@@ -197,8 +195,8 @@ impl Apng {
 }
 
 pub(super) fn run(a: SweepArgs) -> Result<i32> {
-    if a.order > 5 {
-        bail!("--order must be between 0 and 5, got {}", a.order);
+    if a.predictor_order > 5 {
+        bail!("--predictor-order must be between 0 and 5, got {}", a.predictor_order);
     }
     let step = match a.rotate_inner {
         Some(d) if !d.is_finite() => bail!("--rotate-inner must be a finite number of degrees, got {d}"),
@@ -222,14 +220,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
     }
     std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
     let seam = a.seam;
-    let so = SweepOptions { step, steps, center: a.center, max_order: a.order, seam };
+    let so = SweepOptions { step, steps, center: a.center, max_order: a.predictor_order, seam };
     let (mut sweep, sol, f0) = Sweep::new(&ring, &opts, so).context("solving frame 0")?;
-    if !a.quiet {
+    if !output::quiet() {
         let what = match a.rotate_inner {
             Some(d) => format!("{steps} frames at {d} degrees per step"),
             None => format!("{steps} inner contours"),
         };
-        eprintln!(
+        note!(
             "{}: frame 0 solved cold ({}x{} basis, {:.3} s, {}, reparameterization {} with {} matched pairs, kept by every frame); {what}",
             ring.name,
             sol.map.shape()[0],
@@ -244,14 +242,14 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         let h = sol.map.knots[1].elements().iter().map(|e| e.2 - e.1).fold(f64::INFINITY, f64::min);
         let slide = step.abs() / std::f64::consts::TAU * sol.map.knots[1].length() / h;
         if seam != Seam::Material && a.rotate_inner.is_some() {
-            eprintln!("the inner parameter slides by {slide:.3} of the smallest eta element per step");
+            note!("the inner parameter slides by {slide:.3} of the smallest eta element per step");
             if slide > 0.25 {
-                eprintln!(
+                note!(
                     "warning: more than a quarter of an element per step; the extrapolated predictions will be poor (a coarser --fit-tol or a smaller step keeps them within one Newton step)"
                 );
             }
         }
-        eprintln!("{HEADER}");
+        note!("{HEADER}");
     }
     let every = a.every as usize;
     let picture = PictureOptions {
@@ -292,8 +290,8 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         if r.verdict != "certified" || !r.converged {
             failures += 1;
         }
-        if !a.quiet {
-            eprintln!("{}", row(r));
+        if !output::quiet() {
+            note!("{}", row(r));
         }
         rows.push(frame.report.clone());
         let k = rows.len();
@@ -357,7 +355,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         },
     });
     winslow::io::write_json(&a.output.join("sweep.json"), &summary)?; // atomic, as every file
-    println!(
+    say!(
         "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; smallest certified det J {:.4e}; wrote {}",
         ring.name,
         rows.len(),
@@ -372,7 +370,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
     if !cold_checks.is_empty() {
         let cold: Vec<f64> = cold_checks.iter().filter_map(|c| c["seconds"].as_f64()).collect();
         let mean_cold = cold.iter().sum::<f64>() / cold.len() as f64;
-        println!(
+        say!(
             "cold solves of {} frames: mean {mean_cold:.4} s; a predicted frame takes {:.3} of that",
             cold.len(),
             mean.unwrap_or(f64::NAN) / mean_cold

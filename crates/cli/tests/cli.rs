@@ -882,3 +882,50 @@ fn convert_and_render_take_ring_maps_and_multipatch_results() {
     assert_eq!(err.matches("os error").count(), 1, "{err}");
     assert_eq!(err.matches("missing.json").count(), 1, "{err}");
 }
+
+/// `-q` on every command leaves only errors: nothing on stdout or stderr when a command
+/// succeeds (the files are written all the same), the error alone when it fails.
+#[test]
+fn quiet_leaves_only_errors() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let map = dir.join("map.json");
+    let lid = data().join("wavy_lid.json");
+    let runs: Vec<Vec<std::ffi::OsString>> = vec![
+        vec![
+            "solve".into(),
+            lid.clone().into(),
+            "-o".into(),
+            map.clone().into(),
+            "--png".into(),
+            dir.join("map.png").into(),
+        ],
+        vec!["inspect".into(), lid.clone().into()],
+        vec!["check".into(), map.clone().into()],
+        vec!["convert".into(), map.clone().into(), "-o".into(), dir.join("map.xml").into()],
+        vec!["render".into(), map.clone().into(), "--png".into(), dir.join("render.png").into()],
+        vec![
+            "mesh".into(),
+            map.clone().into(),
+            "--structured".into(),
+            "11x11".into(),
+            "-o".into(),
+            dir.join("m.msh").into(),
+        ],
+    ];
+    for args in runs {
+        let out = bin().args(&args).arg("-q").output().unwrap();
+        let what = format!("{args:?}");
+        assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(out.stdout.is_empty(), "{what} printed {}", String::from_utf8_lossy(&out.stdout));
+        assert!(out.stderr.is_empty(), "{what} printed {}", String::from_utf8_lossy(&out.stderr));
+    }
+    for f in ["map.json", "map.png", "map.xml", "render.png", "m.msh"] {
+        assert!(dir.join(f).is_file(), "{f} not written");
+    }
+    // an error is still printed, and the exit code says so
+    let out = bin().arg("check").arg(dir.join("missing.json")).arg("-q").output().unwrap();
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with("error: "), "{}", String::from_utf8_lossy(&out.stderr));
+}

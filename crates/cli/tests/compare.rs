@@ -16,7 +16,7 @@ fn compare_prints_the_table_and_writes_pictures() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path().join("compare");
     // the human table: its columns and one row per method
-    let out = bin().arg("compare").arg(annulus()).arg("-q").output().unwrap();
+    let out = bin().arg("compare").arg(annulus()).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     for col in ["method", "IT", "conv", "BIJ", "Q/Q(x_G)", "W", "Liao", "AO", "min SJ", "basis", "time [s]"] {

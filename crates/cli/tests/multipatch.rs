@@ -48,7 +48,7 @@ fn solve_a_gismo_multipatch_with_free_interfaces() {
     assert_eq!(winslow::multipatch::solve::interface_mismatch(&layout, &maps_back), 0.0);
     for m in &maps_back {
         let c = winslow::certify(m, &Default::default()).unwrap();
-        assert!(matches!(c.verdict, winslow::verify::certificate::Verdict::Certified { .. }), "{}", c.message());
+        assert!(matches!(c.verdict, winslow::verify::certificate::Finding::Certified { .. }), "{}", c.message());
     }
     assert!(std::fs::read_to_string(&vtm).unwrap().contains("vtkMultiBlockDataSet"));
     assert_eq!(std::fs::read_dir(dir.join("flame")).unwrap().count(), 5);

@@ -152,14 +152,9 @@ impl Certificate {
     /// The core's exact certificate of `map`; the sample rules ([`Certificate::from_sample`])
     /// when it cannot be computed (e.g. a degree past the certificate's limit).
     pub fn exact(map: &Surface, q: &Quality) -> Self {
-        use winslow::verify::certificate::{certify, CertifyOptions, Verdict as Exact};
+        use winslow::verify::certificate::{certify, CertifyOptions};
         let Ok(c) = certify(map, &CertifyOptions::default()) else { return Self::from_sample(q) };
-        let verdict = match c.verdict {
-            Exact::Certified { .. } => Verdict::Certified,
-            Exact::DegenerateCorner { .. } => Verdict::DegenerateCorner,
-            Exact::Folded { .. } => Verdict::Folded,
-            Exact::Undecided { .. } => Verdict::Undecided,
-        };
+        let verdict = Verdict::of_certificate(&c);
         let mut details = Vec::new();
         if verdict_is_good(verdict) {
             details.push(("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)));

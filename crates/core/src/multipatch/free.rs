@@ -22,7 +22,7 @@ use crate::solve::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
 use crate::solve::improve::{improve_layout, winslow_text, Kept, LayoutImprovement};
 use crate::solve::newton::{NonlinearMethod, NonlinearOptions};
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{Certificate, CertifyOptions, Verdict};
+use crate::verify::certificate::{Certificate, CertifyOptions, Finding};
 use crate::verify::quality::quality;
 
 /// What the free-interface stage did.
@@ -135,7 +135,7 @@ pub fn free_interfaces(
             let bad: Vec<String> = certs
                 .iter()
                 .enumerate()
-                .filter(|(_, c)| !matches!(c.verdict, Verdict::Certified { .. }))
+                .filter(|(_, c)| !matches!(c.verdict, Finding::Certified { .. }))
                 .map(|(p, c)| format!("patch {}: {}", layout.label(p), c.message()))
                 .collect();
             format!(

@@ -355,7 +355,7 @@ mod tests {
             let r = &j.smoothing;
             assert!(r.accepted, "{functional:?}: {}", r.message);
             assert!(r.after.winslow.unwrap() < r.before.winslow.unwrap(), "{}", r.message);
-            assert!(matches!(j.certificate.verdict, crate::verify::certificate::Verdict::Certified { .. }));
+            assert!(matches!(j.certificate.verdict, crate::verify::certificate::Finding::Certified { .. }));
             assert_eq!(j.map.knots[0].multiplicity(j.join.c0_knot), 2);
         }
     }

@@ -37,7 +37,7 @@ use crate::solve::report::{Report, Verdict};
 use crate::solve::solver::EggSolver;
 use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
-use crate::verify::certificate::{certify, Certificate, Verdict as CertVerdict};
+use crate::verify::certificate::{certify, Certificate, Finding};
 
 /// How the interfaces between patches are treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
@@ -172,16 +172,6 @@ impl MultipatchSolution {
     /// The patch maps.
     pub fn maps(&self) -> Vec<Surface> {
         self.patches.iter().map(|p| p.map.clone()).collect()
-    }
-}
-
-/// The verdict of a certificate (of a converged solve).
-pub fn verdict_of(c: &Certificate) -> Verdict {
-    match c.verdict {
-        CertVerdict::Certified { .. } => Verdict::Certified,
-        CertVerdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
-        CertVerdict::Folded { .. } => Verdict::Folded,
-        CertVerdict::Undecided { .. } => Verdict::Undecided,
     }
 }
 
@@ -337,8 +327,7 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
             .filter(|&p| {
                 let s = solved[p].as_ref().expect("every patch solved");
                 let converged = s.1.levels.last().is_some_and(|l| l.converged);
-                !converged
-                    || !matches!(s.2.verdict, CertVerdict::Certified { .. } | CertVerdict::DegenerateCorner { .. })
+                !converged || !matches!(s.2.verdict, Finding::Certified { .. } | Finding::DegenerateCorner { .. })
             })
             .collect();
         if failing.is_empty() || rounds >= opts.repair {
@@ -396,8 +385,11 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
             free = Some(skipped(opts.functional, &maps, "not run: a patch's solve did not converge".into()));
         }
     }
-    let verdicts: Vec<Verdict> =
-        certs.iter().zip(&converged).map(|(c, &ok)| if ok { verdict_of(c) } else { Verdict::NotConverged }).collect();
+    let verdicts: Vec<Verdict> = certs
+        .iter()
+        .zip(&converged)
+        .map(|(c, &ok)| if ok { Verdict::of_certificate(c) } else { Verdict::NotConverged })
+        .collect();
     let verdict = verdicts.iter().copied().max_by_key(|&v| rank(v)).unwrap_or(Verdict::Certified);
     let classes = (0..bases.classes.len())
         .map(|c| ClassReport {

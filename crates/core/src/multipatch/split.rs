@@ -16,7 +16,7 @@ use crate::boundary::{Analytic, SideCurve};
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::{Side, Surface};
-use crate::verify::certificate::{Certificate, Verdict};
+use crate::verify::certificate::{Certificate, Finding};
 
 /// The curve in the parameter square that is mapped to the splitting curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
@@ -303,7 +303,7 @@ pub fn split_map(
     to: SidePoint,
     opts: &SplitOptions,
 ) -> Result<Split> {
-    if !matches!(certificate.verdict, Verdict::Certified { .. } | Verdict::DegenerateCorner { .. }) {
+    if !matches!(certificate.verdict, Finding::Certified { .. } | Finding::DegenerateCorner { .. }) {
         return Err(Error::InfeasibleStart { method: "split".into(), reason: certificate.message() });
     }
     if from.side.opposite() != to.side {

@@ -14,7 +14,7 @@ use crate::discrete::assembly::Discretization;
 use crate::error::Result;
 use crate::methods::{DiscreteProblem, Method};
 use crate::spline::curve::Point;
-use crate::verify::certificate::{Certificate, Verdict};
+use crate::verify::certificate::{Certificate, Finding};
 
 /// `nonlinear` for `method` on a basis with `m` free functions of a geometry of diameter
 /// `diameter`: the residual made dimensionless by [`Method::residual_scale`] (for EGG
@@ -31,14 +31,14 @@ pub fn scaled_options(nonlinear: NonlinearOptions, method: &dyn Method, diameter
 /// may start from it: certified, or positive away from corners the boundary forces to
 /// `det J = 0` (degenerate corner).
 pub fn bijective(c: &Certificate) -> bool {
-    matches!(c.verdict, Verdict::Certified { .. } | Verdict::DegenerateCorner { .. })
+    matches!(c.verdict, Finding::Certified { .. } | Finding::DegenerateCorner { .. })
 }
 
 /// Whether `after` is at least as well certified as `before`: a certified start needs a
 /// certified result, a degenerate-corner start a [`bijective`] one.
 pub fn as_well_certified(before: &Certificate, after: &Certificate) -> bool {
     match before.verdict {
-        Verdict::Certified { .. } => matches!(after.verdict, Verdict::Certified { .. }),
+        Finding::Certified { .. } => matches!(after.verdict, Finding::Certified { .. }),
         _ => bijective(after),
     }
 }

@@ -387,7 +387,7 @@ pub fn improve(
 mod tests {
     use super::*;
     use crate::spline::knots::KnotVector;
-    use crate::verify::certificate::Verdict;
+    use crate::verify::certificate::Finding;
 
     /// A quarter annulus interpolated at the Greville points with a sheared interior:
     /// bijective, not the Winslow minimizer.
@@ -420,7 +420,7 @@ mod tests {
         assert!(r.accepted && r.converged, "{}", r.message);
         assert!(r.after.winslow.unwrap() < 0.99 * r.before.winslow.unwrap(), "{}", r.message);
         assert!(r.after.scaled_jacobian_min > r.before.scaled_jacobian_min, "{}", r.message);
-        assert!(matches!(out.certificate.verdict, Verdict::Certified { .. }));
+        assert!(matches!(out.certificate.verdict, Finding::Certified { .. }));
         // the boundary is kept exactly
         for s in crate::spline::surface::Side::ALL {
             let (a, b) = (map.boundary(s), out.map.boundary(s));

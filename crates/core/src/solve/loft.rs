@@ -29,8 +29,8 @@ use crate::methods::egg::EggMethod;
 use crate::spline::loft::{check_heights, common_basis, interpolate, planar_section, zeta_of, Interpolation};
 use crate::spline::surface::Surface;
 use crate::spline::volume::Volume;
-use crate::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeVerdict};
-use crate::verify::certificate::{certify, CertifyOptions, Verdict};
+use crate::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeFinding};
+use crate::verify::certificate::{certify, CertifyOptions, Finding};
 
 /// Options of [`loft`].
 #[derive(Debug, Clone)]
@@ -171,7 +171,7 @@ fn topology_of(s: &Surface) -> Topology {
 fn require_certified(s: &Surface, slice: usize, z: f64, opts: &CertifyOptions) -> Result<f64> {
     let c = certify(s, opts)?;
     match &c.verdict {
-        Verdict::Certified { lower_bound, .. } => Ok(*lower_bound),
+        Finding::Certified { lower_bound, .. } => Ok(*lower_bound),
         v => Err(Error::SliceNotCertified { slice, z, verdict: v.name().into(), message: c.message() }),
     }
 }
@@ -281,7 +281,7 @@ pub fn loft(slices: &[Surface], z: &[f64], opts: &LoftOptions, boundary: SliceBo
             inserted_z: Vec::new(),
             certificate_seconds: cert.seconds,
         };
-        let heights = if matches!(cert.verdict, VolumeVerdict::Certified { .. }) {
+        let heights = if matches!(cert.verdict, VolumeFinding::Certified { .. }) {
             Vec::new()
         } else {
             insertion_heights(&vol, &cert, &zs)

@@ -95,10 +95,10 @@ impl Verdict {
     /// The verdict of a certificate (a converged map's).
     pub fn of_certificate(c: &Certificate) -> Self {
         match c.verdict {
-            crate::verify::certificate::Verdict::Certified { .. } => Verdict::Certified,
-            crate::verify::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
-            crate::verify::certificate::Verdict::Folded { .. } => Verdict::Folded,
-            crate::verify::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
+            crate::verify::certificate::Finding::Certified { .. } => Verdict::Certified,
+            crate::verify::certificate::Finding::DegenerateCorner { .. } => Verdict::DegenerateCorner,
+            crate::verify::certificate::Finding::Folded { .. } => Verdict::Folded,
+            crate::verify::certificate::Finding::Undecided { .. } => Verdict::Undecided,
         }
     }
 
@@ -289,12 +289,7 @@ impl Solution {
                 ),
             )
         } else {
-            let v = match certificate.verdict {
-                crate::verify::certificate::Verdict::Certified { .. } => Verdict::Certified,
-                crate::verify::certificate::Verdict::DegenerateCorner { .. } => Verdict::DegenerateCorner,
-                crate::verify::certificate::Verdict::Folded { .. } => Verdict::Folded,
-                crate::verify::certificate::Verdict::Undecided { .. } => Verdict::Undecided,
-            };
+            let v = Verdict::of_certificate(&certificate);
             let mut m = certificate.message();
             if v == Verdict::Certified {
                 for c in corners.iter().filter(|c| c.forces_nonpositive_det_j) {

@@ -87,7 +87,7 @@ use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::periodic::PeriodicTranslate;
 use crate::spline::surface::Surface;
-use crate::verify::certificate::{certify, Verdict as CertVerdict};
+use crate::verify::certificate::{certify, Finding};
 
 /// Where `eta = 0` sits on a turning inner contour (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -228,12 +228,12 @@ impl std::fmt::Debug for Sweep {
     }
 }
 
-fn verdict(v: &CertVerdict) -> (&'static str, Option<f64>) {
+fn verdict(v: &Finding) -> (&'static str, Option<f64>) {
     match v {
-        CertVerdict::Certified { lower_bound, .. } => ("certified", Some(*lower_bound)),
-        CertVerdict::DegenerateCorner { .. } => ("degenerate-corner", None),
-        CertVerdict::Folded { .. } => ("folded", None),
-        CertVerdict::Undecided { .. } => ("undecided", None),
+        Finding::Certified { lower_bound, .. } => ("certified", Some(*lower_bound)),
+        Finding::DegenerateCorner { .. } => ("degenerate-corner", None),
+        Finding::Folded { .. } => ("folded", None),
+        Finding::Undecided { .. } => ("undecided", None),
     }
 }
 

@@ -30,7 +30,7 @@
 //! `det J <= 0` there for every map: positivity is proven on everything except a
 //! neighbourhood of that corner found by bisection, whose parameter extent is reported
 //! ([`CornerInfo::excused_extent`]); the verdict is then
-//! [`Verdict::DegenerateCorner`]. Nothing is excused at any other corner. A point of a
+//! [`Finding::DegenerateCorner`]. Nothing is excused at any other corner. A point of a
 //! side where the side's own tangent vanishes within rounding (a zero-speed knot, e.g.
 //! repeated control points, where `det J = x_ξ × x_η = 0` for every map of the boundary)
 //! is excused the same way when it is a corner of elements ([`ExcusedPoint`]); there no
@@ -79,10 +79,13 @@ impl Default for CertifyOptions {
     }
 }
 
-/// The outcome of [`certify`].
+/// What [`certify`] found, with its evidence: a proven lower bound of `det J`, a point
+/// where it is proven negative, or the elements left undecided. The one verdict of a
+/// solve, which adds "not converged", is [`crate::Verdict`]
+/// ([`Verdict::of_certificate`](crate::Verdict::of_certificate)).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum Verdict {
+pub enum Finding {
     /// `det J > 0` on the whole parameter domain, proven.
     Certified {
         /// Proven lower bound of `det J`.
@@ -125,14 +128,14 @@ pub enum Verdict {
     },
 }
 
-impl Verdict {
+impl Finding {
     /// Short name (`certified`, `degenerate-corner`, `folded`, `undecided`).
     pub fn name(&self) -> &'static str {
         match self {
-            Verdict::Certified { .. } => "certified",
-            Verdict::DegenerateCorner { .. } => "degenerate-corner",
-            Verdict::Folded { .. } => "folded",
-            Verdict::Undecided { .. } => "undecided",
+            Finding::Certified { .. } => "certified",
+            Finding::DegenerateCorner { .. } => "degenerate-corner",
+            Finding::Folded { .. } => "folded",
+            Finding::Undecided { .. } => "undecided",
         }
     }
 }
@@ -219,7 +222,7 @@ pub type UndecidedInfo = Undecided<2>;
 #[derive(Debug, Clone, Serialize)]
 pub struct Certificate {
     /// The verdict.
-    pub verdict: Verdict,
+    pub verdict: Finding,
     /// Proven lower bound of `det J` over the proven elements (excused ones excluded).
     pub lower_bound: f64,
     /// Mean of `det J` over the parameter domain (area / parameter area; exact for
@@ -262,10 +265,10 @@ impl Certificate {
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            Verdict::Certified { lower_bound, relative } => {
+            Finding::Certified { lower_bound, relative } => {
                 certified_message(*lower_bound, *relative, self.elements, self.boxes)
             }
-            Verdict::DegenerateCorner { corners, lower_bound, relative, .. } => {
+            Finding::DegenerateCorner { corners, lower_bound, relative, .. } => {
                 let why: Vec<String> = self
                     .corners
                     .iter()
@@ -305,10 +308,10 @@ impl Certificate {
                     what.join(" and ")
                 )
             }
-            Verdict::Folded { param, point, value, error_bound, one_sided } => {
+            Finding::Folded { param, point, value, error_bound, one_sided } => {
                 folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
             }
-            Verdict::Undecided { elements } => {
+            Finding::Undecided { elements } => {
                 undecided_message(elements.len(), &self.undecided_info, self.max_depth, self.min_value_found)
             }
         }
@@ -462,7 +465,7 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
         corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
     let points: Vec<[f64; 2]> = excused_points.iter().map(|p: &ExcusedPoint| p.param).collect();
     let verdict = if let Some(f) = totals.worst_fold() {
-        Verdict::Folded {
+        Finding::Folded {
             param: f.param,
             point: map.eval(f.param[0], f.param[1]),
             value: f.value,
@@ -470,11 +473,11 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
             one_sided: f.one_sided.clone(),
         }
     } else if !totals.undecided.is_empty() {
-        Verdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
+        Finding::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else if !degenerate.is_empty() || !points.is_empty() {
-        Verdict::DegenerateCorner { corners: degenerate, points, lower_bound: totals.lower_bound, relative }
+        Finding::DegenerateCorner { corners: degenerate, points, lower_bound: totals.lower_bound, relative }
     } else {
-        Verdict::Certified { lower_bound: totals.lower_bound, relative }
+        Finding::Certified { lower_bound: totals.lower_bound, relative }
     };
     Ok(Certificate {
         verdict,

@@ -47,7 +47,7 @@ use crate::methods::Method;
 use crate::spline::curve::Point;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::coefficients::DetCoefficients;
-use crate::verify::certificate::{certify, Certificate, CertifyOptions, Verdict};
+use crate::verify::certificate::{certify, Certificate, CertifyOptions, Finding};
 
 /// The quality functional minimised subject to `d(c) >= ε`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -359,7 +359,7 @@ pub fn coons_start(map: &Surface) -> Result<Vec<Point>> {
 
 fn outcome_certificate(map: &Surface, opts: &ConstrainedOptions) -> Result<(Certificate, bool)> {
     let c = certify(map, &opts.certify)?;
-    let ok = matches!(c.verdict, Verdict::Certified { .. });
+    let ok = matches!(c.verdict, Finding::Certified { .. });
     Ok((c, ok))
 }
 

@@ -36,14 +36,14 @@ fn distance(a: &[Point], b: &[Point]) -> f64 {
 fn max_z_unfolds_a_folded_start_of_a_convex_domain() {
     let (disc, cps, _) = affine(4, 7, 3.0);
     let folded = certify(&surface(&disc, &cps), &CertifyOptions::default()).unwrap();
-    assert!(matches!(folded.verdict, Verdict::Folded { .. }), "{}", folded.message());
+    assert!(matches!(folded.verdict, Finding::Folded { .. }), "{}", folded.message());
     let z = max_z(&disc, &cps, 0.0, &ConstrainedOptions::default()).unwrap();
     let r = &z.report;
     assert!(r.converged, "{}", r.why);
     assert!(r.z_history[0] < 0.0 && *r.z_history.last().unwrap() > 0.0, "{:?}", r.z_history);
     assert!(r.z_history.windows(2).all(|w| w[1] > w[0]), "z increases: {:?}", r.z_history);
     let cert = certify(&surface(&disc, &z.control_points), &CertifyOptions::default()).unwrap();
-    assert!(matches!(cert.verdict, Verdict::Certified { .. }), "{}", cert.message());
+    assert!(matches!(cert.verdict, Finding::Certified { .. }), "{}", cert.message());
     // the boundary stays
     for &k in disc.dofs.free() {
         assert_eq!(disc.dofs.free_index(k), disc.dofs.free().iter().position(|&x| x == k).unwrap());
@@ -139,7 +139,7 @@ fn both_qp_hessians_reach_the_same_constrained_minimiser() {
         assert!(r.converged, "lagrangian {lagrangian_hessian}: {}", r.why);
         assert!((r.min_coefficient - opts.eps).abs() < 1e-6, "active: {}", r.min_coefficient);
         let cert = certify(&surface(&disc, &o.control_points), &CertifyOptions::default()).unwrap();
-        assert!(matches!(cert.verdict, Verdict::Certified { .. }), "{}", cert.message());
+        assert!(matches!(cert.verdict, Finding::Certified { .. }), "{}", cert.message());
         values.push(*r.objective_history.last().unwrap());
     }
     assert!((values[0] - values[1]).abs() < 1e-7 * values[0], "{values:?}");

@@ -41,7 +41,7 @@ fn a_slice_is_inserted_where_the_twist_collapses_the_volume() {
     assert_ne!(out.report.rounds[0].verdict, "certified");
     assert_eq!(out.report.rounds[0].inserted_z, vec![0.5]);
     assert_eq!(out.report.verdict, "certified");
-    assert!(matches!(out.certificate.verdict, VolumeVerdict::Certified { .. }));
+    assert!(matches!(out.certificate.verdict, VolumeFinding::Certified { .. }));
     assert_eq!(out.z, vec![0.0, 0.5, 1.0]);
     let r = &out.report.slices[1];
     assert_eq!((r.given, r.boundary), (None, Some("family")));
@@ -75,7 +75,7 @@ fn identical_slices_loft_to_a_certified_cylinder() {
         SliceBoundary::Interpolated,
     )
     .unwrap();
-    let VolumeVerdict::Certified { lower_bound, .. } = out.certificate.verdict else {
+    let VolumeFinding::Certified { lower_bound, .. } = out.certificate.verdict else {
         panic!("{:?}", out.certificate.verdict)
     };
     let m = crate::verify::quality::sample_det_j(&s, 64).min * 2.0;

@@ -80,7 +80,7 @@ pub(super) fn judge_one(map: &Surface, t: &mut Tally) {
     let [p, q] = map.degrees();
     t.maps += 1;
     match &cert.verdict {
-        Verdict::Certified { lower_bound, .. } => {
+        Finding::Certified { lower_bound, .. } => {
             t.certified += 1;
             let (sign, min_value) = ex.sign(p * q, 24, 400);
             match sign {
@@ -93,19 +93,19 @@ pub(super) fn judge_one(map: &Surface, t: &mut Tally) {
                 t.false_certificates += 1;
             }
         }
-        Verdict::Folded { .. } => {
+        Finding::Folded { .. } => {
             t.folded += 1;
             if cert.folds.iter().any(|f| ex.sign_at(f.element, f.param[0], f.param[1]) != std::cmp::Ordering::Less) {
                 t.false_folds += 1;
             }
         }
-        Verdict::Undecided { .. } => {
+        Finding::Undecided { .. } => {
             t.undecided += 1;
             if matches!(ex.sign(p * q, 16, 200).0, Sign::Negative { .. }) {
                 t.judge_negative += 1;
             }
         }
-        Verdict::DegenerateCorner { .. } => unreachable!("no corner is excused"),
+        Finding::DegenerateCorner { .. } => unreachable!("no corner is excused"),
     }
 }
 
@@ -218,13 +218,13 @@ fn translated_fold_is_not_certified() {
         for shift in [0.0, 1e10] {
             let m = moved(&map, 1.0, shift);
             let c = certify(&m, &CertifyOptions::default()).unwrap();
-            assert!(!matches!(c.verdict, Verdict::Certified { .. }), "shift {shift}: {:?}", c.verdict);
+            assert!(!matches!(c.verdict, Finding::Certified { .. }), "shift {shift}: {:?}", c.verdict);
             let ex = Exact::new(&m);
             for f in &c.folds {
                 assert_eq!(ex.sign_at(f.element, f.param[0], f.param[1]), std::cmp::Ordering::Less);
             }
             if shift == 0.0 {
-                assert!(matches!(c.verdict, Verdict::Folded { .. }), "{:?}", c.verdict);
+                assert!(matches!(c.verdict, Finding::Folded { .. }), "{:?}", c.verdict);
             }
         }
     }
@@ -255,11 +255,11 @@ fn quarter_annulus() -> Surface {
 fn translated_rational_map_keeps_a_true_bound() {
     let base = quarter_annulus();
     let c0 = certify(&base, &CertifyOptions::default()).unwrap();
-    assert!(matches!(c0.verdict, Verdict::Certified { .. }), "{:?}", c0.verdict);
+    assert!(matches!(c0.verdict, Finding::Certified { .. }), "{:?}", c0.verdict);
     for shift in [1e6, 1e7, 1e8, 1e9, 1e10, 1e12] {
         let m = moved(&base, 1.0, shift);
         let c = certify(&m, &CertifyOptions::default()).unwrap();
-        assert!(!matches!(c.verdict, Verdict::Folded { .. }), "shift {shift}: {}", c.message());
+        assert!(!matches!(c.verdict, Finding::Folded { .. }), "shift {shift}: {}", c.message());
         let ex = Exact::new(&m);
         let mut exact_min = f64::INFINITY;
         let [ne0, ne1] = c.element_shape;
@@ -273,9 +273,9 @@ fn translated_rational_map_keeps_a_true_bound() {
             }
         }
         if shift <= 1e9 {
-            assert!(matches!(c.verdict, Verdict::Certified { .. }), "shift {shift}: {}", c.message());
+            assert!(matches!(c.verdict, Finding::Certified { .. }), "shift {shift}: {}", c.message());
         }
-        if let Verdict::Certified { lower_bound, .. } = c.verdict {
+        if let Finding::Certified { lower_bound, .. } = c.verdict {
             assert!(lower_bound > 0.0 && lower_bound <= exact_min, "shift {shift}: {lower_bound} > {exact_min}");
         }
     }
@@ -296,7 +296,7 @@ fn maps_touching_zero_are_not_called_folded() {
         }
         if eps >= 1e-13 {
             assert!(
-                matches!(c.verdict, Verdict::Certified { .. } | Verdict::Undecided { .. }),
+                matches!(c.verdict, Finding::Certified { .. } | Finding::Undecided { .. }),
                 "map {k}: {}",
                 c.message()
             );
@@ -316,7 +316,7 @@ fn c0_knot_line_reports_the_folding_side() {
     let cps: Vec<[f64; 2]> = gy.iter().flat_map(|&y| xs.iter().map(move |&x| [x, y])).collect();
     let map = Surface::new([kx, ky], cps, None).unwrap();
     let c = certify(&map, &CertifyOptions::default()).unwrap();
-    let Verdict::Folded { param, value, one_sided, .. } = &c.verdict else { panic!("{}", c.message()) };
+    let Finding::Folded { param, value, one_sided, .. } = &c.verdict else { panic!("{}", c.message()) };
     // det J from the right: 2 (0.4 - 0.5) / 0.5 * 1 = -0.4; from the left: +1
     assert_eq!(param[0], 0.5, "{}", c.message());
     assert!((value + 0.4).abs() < 1e-12, "{value}");
@@ -350,11 +350,11 @@ fn nearly_straight_positive_corner_is_certified() {
         let map = coarse.refined(&[KnotVector::open_uniform(2, 4), KnotVector::open_uniform(2, 4)]).unwrap();
         let c = certify(&map, &CertifyOptions::default()).unwrap();
         if degenerate {
-            assert!(matches!(c.verdict, Verdict::DegenerateCorner { .. }), "{}", c.message());
+            assert!(matches!(c.verdict, Finding::DegenerateCorner { .. }), "{}", c.message());
             assert!(c.corners[0].excused_extent.is_some());
         } else {
             assert!(c.corners[0].angle_degrees > 179.9999999 && c.corners[0].angle_degrees < 180.0);
-            let Verdict::Certified { lower_bound, .. } = c.verdict else { panic!("{}", c.message()) };
+            let Finding::Certified { lower_bound, .. } = c.verdict else { panic!("{}", c.message()) };
             assert!(lower_bound > 0.0 && lower_bound <= b * (1.0 + 1e-6), "{lower_bound}");
             assert!(c.corners.iter().all(|k| k.excused_extent.is_none() && !k.forbids_positivity));
         }
@@ -381,7 +381,7 @@ fn fold_next_to_a_straight_corner_is_a_fold() {
     let nb = map.control_points[k + 1];
     map.control_points[k] = [nb[0] + 0.3, nb[1]];
     let c = certify(&map, &CertifyOptions::default()).unwrap();
-    let Verdict::Folded { param, .. } = c.verdict else { panic!("{}", c.message()) };
+    let Finding::Folded { param, .. } = c.verdict else { panic!("{}", c.message()) };
     assert!(param[0] > 0.0 || param[1] > 0.0);
     let ex = Exact::new(&map);
     for f in &c.folds {
@@ -420,9 +420,9 @@ fn extreme_scales_keep_clear_verdicts() {
         fold.control_points[i][0] = fold.control_points[i + 1][0] + 0.3;
         for (scale, shift) in [(1e150, 0.0), (1e-150, 0.0), (1e150, 1e9), (1e-150, 1e9), (1.0, 1e10)] {
             let c = certify(&moved(&pos, scale, shift), &CertifyOptions::default()).unwrap();
-            assert!(matches!(c.verdict, Verdict::Certified { .. }), "{scale} {shift}: {}", c.message());
+            assert!(matches!(c.verdict, Finding::Certified { .. }), "{scale} {shift}: {}", c.message());
             let c = certify(&moved(&fold, scale, shift), &CertifyOptions::default()).unwrap();
-            assert!(matches!(c.verdict, Verdict::Folded { .. }), "{scale} {shift}: {}", c.message());
+            assert!(matches!(c.verdict, Finding::Folded { .. }), "{scale} {shift}: {}", c.message());
         }
     }
 }

@@ -53,7 +53,7 @@ fn certificate_agrees_with_dense_sampling_on_smooth_maps() {
                 let m = dense_min(&map, 200);
                 assert!(m > 0.0);
                 match c.verdict {
-                    Verdict::Certified { lower_bound, relative } => {
+                    Finding::Certified { lower_bound, relative } => {
                         assert!(lower_bound > 0.0 && lower_bound <= m * (1.0 + 1e-12), "{lower_bound} vs {m}");
                         assert!((relative - lower_bound / c.mean_det_j).abs() < 1e-12);
                     }
@@ -83,7 +83,7 @@ fn planted_folds_are_found_and_located() {
                 let dx = next[0] - prev[0];
                 map.control_points[k][0] = next[0] + (3.0 + rng.uniform()) * dx;
                 let c = certify(&map, &CertifyOptions::default()).unwrap();
-                let Verdict::Folded { param, value, point, .. } = c.verdict.clone() else {
+                let Finding::Folded { param, value, point, .. } = c.verdict.clone() else {
                     panic!("planted fold missed: {:?}", c.verdict)
                 };
                 assert!(value < 0.0);
@@ -116,7 +116,7 @@ fn certified_is_never_wrong_on_random_maps() {
         let map = perturbed(&mut rng, p, q, [3, 3], amp, false);
         let c = certify(&map, &opts).unwrap();
         match c.verdict {
-            Verdict::Certified { lower_bound, .. } => {
+            Finding::Certified { lower_bound, .. } => {
                 certified += 1;
                 let (lo, hi) = det_j_min_bounds(&map, 1e-9, 20_000).unwrap();
                 assert!(hi > 0.0, "map {k}: certified but det J = {hi} somewhere");
@@ -124,13 +124,13 @@ fn certified_is_never_wrong_on_random_maps() {
                 assert!(lo > -1e-9);
                 assert!(dense_min(&map, 24) > 0.0, "map {k}");
             }
-            Verdict::Folded { param, .. } => {
+            Finding::Folded { param, .. } => {
                 folded += 1;
                 let v = map.derivs(param[0], param[1], 1).det_j();
                 assert!(v <= 1e-13, "map {k}: folded at a positive value {v}");
             }
-            Verdict::Undecided { .. } => undecided += 1,
-            Verdict::DegenerateCorner { .. } => unreachable!("no forced corners in this test"),
+            Finding::Undecided { .. } => undecided += 1,
+            Finding::DegenerateCorner { .. } => unreachable!("no forced corners in this test"),
         }
     }
     assert!(certified > 2000 && folded > 2000, "certified {certified} folded {folded} undecided {undecided}");
@@ -151,14 +151,14 @@ fn certified_is_never_wrong_on_random_rational_maps() {
         let map = perturbed(&mut rng, p, q, [3, 3], amp, true);
         let c = certify(&map, &opts).unwrap();
         match c.verdict {
-            Verdict::Certified { lower_bound, .. } => {
+            Finding::Certified { lower_bound, .. } => {
                 certified += 1;
                 let (_, hi) = det_j_min_bounds(&map, 1e-9, 20_000).unwrap();
                 assert!(hi > 0.0, "map {k}: certified but the numerator is {hi} somewhere");
                 let m = dense_min(&map, 24);
                 assert!(m > 0.0 && lower_bound <= m * (1.0 + 1e-12), "map {k}: bound {lower_bound}, sample {m}");
             }
-            Verdict::Folded { param, .. } => {
+            Finding::Folded { param, .. } => {
                 folded += 1;
                 assert!(map.derivs(param[0], param[1], 1).det_j() <= 1e-13, "map {k}");
             }
@@ -202,7 +202,7 @@ fn straight_corner_is_degenerate_not_folded() {
     }
     // w = z^2 + 2 z: w' = 2 z + 2 vanishes at z = -1, outside; corner angles 90 degrees
     let c = certify(&fine, &CertifyOptions::default()).unwrap();
-    assert!(matches!(c.verdict, Verdict::Certified { .. }), "{:?}", c.verdict);
+    assert!(matches!(c.verdict, Finding::Certified { .. }), "{:?}", c.verdict);
     // (u, v) -> (u - v, u^2 + v^2): injective, det J = 2 (u + v), zero at the
     // south-west corner, where the sides' tangents (1, 0) and (-1, 0) make 180 degrees
     let mut cps = Vec::new();
@@ -218,7 +218,7 @@ fn straight_corner_is_degenerate_not_folded() {
     assert!((c.corners[0].angle_degrees - 180.0).abs() < 1e-9, "{:?}", c.corners[0]);
     assert!(c.corners[0].forbids_positivity && c.corners[0].det_j.abs() < 1e-12);
     match &c.verdict {
-        Verdict::DegenerateCorner { corners, lower_bound, .. } => {
+        Finding::DegenerateCorner { corners, lower_bound, .. } => {
             assert_eq!(corners, &vec!["south-west"]);
             assert!(*lower_bound > 0.0);
         }
@@ -234,7 +234,7 @@ fn straight_corner_is_degenerate_not_folded() {
     let strict = CertifyOptions { excuse_corners: false, ..Default::default() };
     let c = certify(&fine, &strict).unwrap();
     match &c.verdict {
-        Verdict::Undecided { elements } => assert_eq!(elements, &vec![[0, 0]]),
+        Finding::Undecided { elements } => assert_eq!(elements, &vec![[0, 0]]),
         v => panic!("{v:?}"),
     }
 }
@@ -248,16 +248,16 @@ fn spent_budget_is_undecided() {
         let amp = 0.4 + 0.8 * rng.uniform();
         let map = perturbed(&mut rng, 3, 3, [3, 3], amp, false);
         let c = certify(&map, &CertifyOptions { excuse_corners: false, ..Default::default() }).unwrap();
-        (matches!(c.verdict, Verdict::Certified { .. }) && c.max_depth >= 2).then_some((map, c))
+        (matches!(c.verdict, Finding::Certified { .. }) && c.max_depth >= 2).then_some((map, c))
     });
     let (map, full) = found.expect("a map that needs two bisections");
     let c = certify(&map, &CertifyOptions { excuse_corners: false, max_depth: 1, ..Default::default() }).unwrap();
-    let Verdict::Undecided { elements } = &c.verdict else { panic!("{:?}", c.verdict) };
+    let Finding::Undecided { elements } = &c.verdict else { panic!("{:?}", c.verdict) };
     assert!(!elements.is_empty() && elements.len() < c.elements);
     assert_eq!(&c.offending_elements(), elements);
     assert!(c.folds.is_empty());
     // the full certificate's bound is below every exact value the truncated one met
-    let Verdict::Certified { lower_bound, .. } = full.verdict else { unreachable!() };
+    let Finding::Certified { lower_bound, .. } = full.verdict else { unreachable!() };
     assert!(lower_bound <= c.min_value_found);
 }
 
@@ -297,7 +297,7 @@ fn periodic_rings_certify_and_folds_are_found() {
         let cert = certify(&map, &CertifyOptions { excuse_corners: false, ..Default::default() }).unwrap();
         let dense = dense_min(&map, 200);
         match cert.verdict {
-            Verdict::Certified { lower_bound, .. } => {
+            Finding::Certified { lower_bound, .. } => {
                 assert!(lower_bound > 0.0 && lower_bound <= dense, "{lower_bound} vs {dense}")
             }
             v => panic!("p={p}: ring not certified: {v:?}"),
@@ -305,7 +305,7 @@ fn periodic_rings_certify_and_folds_are_found() {
         let folded = ring_map(&mut rng, p, [4, 9], 0.0, true);
         let cert = certify(&folded, &CertifyOptions { excuse_corners: false, ..Default::default() }).unwrap();
         match cert.verdict {
-            Verdict::Folded { param, value, .. } => {
+            Finding::Folded { param, value, .. } => {
                 assert!(value < 0.0);
                 assert!(folded.derivs(param[0], param[1], 1).det_j() < 0.0);
                 assert!(dense_min(&folded, 200) < 0.0);

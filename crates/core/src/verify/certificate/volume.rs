@@ -10,11 +10,11 @@
 //! proven lower bound, and boxes that are neither proven positive nor shown to fold are
 //! bisected (de Casteljau, all three directions; module `search`).
 //!
-//! **Verdicts.** [`VolumeVerdict::Certified`] when every element is proven
+//! **Verdicts.** [`VolumeFinding::Certified`] when every element is proven
 //! (`min ĉ - e > 0` on every box), with the proven lower bound of `det J`;
-//! [`VolumeVerdict::Folded`] when a point with `det J < -(its rounding bound)` is found,
+//! [`VolumeFinding::Folded`] when a point with `det J < -(its rounding bound)` is found,
 //! re-evaluated at the reported parameter point (with the parameter and the physical
-//! point); [`VolumeVerdict::Undecided`] when the budget is spent, with the reason per
+//! point); [`VolumeFinding::Undecided`] when the budget is spent, with the reason per
 //! element. Unlike maps of the plane there is no excused corner: every point counts.
 
 use std::time::Instant;
@@ -32,7 +32,7 @@ use crate::spline::volume::Volume;
 /// The outcome of [`certify_volume`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum VolumeVerdict {
+pub enum VolumeFinding {
     /// `det J > 0` on the whole parameter domain, proven.
     Certified {
         /// Proven lower bound of `det J`.
@@ -60,13 +60,13 @@ pub enum VolumeVerdict {
     },
 }
 
-impl VolumeVerdict {
+impl VolumeFinding {
     /// Short name (`certified`, `folded`, `undecided`).
     pub fn name(&self) -> &'static str {
         match self {
-            VolumeVerdict::Certified { .. } => "certified",
-            VolumeVerdict::Folded { .. } => "folded",
-            VolumeVerdict::Undecided { .. } => "undecided",
+            VolumeFinding::Certified { .. } => "certified",
+            VolumeFinding::Folded { .. } => "folded",
+            VolumeFinding::Undecided { .. } => "undecided",
         }
     }
 }
@@ -81,7 +81,7 @@ pub type VolumeUndecided = Undecided<3>;
 #[derive(Debug, Clone, Serialize)]
 pub struct VolumeCertificate {
     /// The verdict.
-    pub verdict: VolumeVerdict,
+    pub verdict: VolumeFinding,
     /// Proven lower bound of `det J` over the proven elements.
     pub lower_bound: f64,
     /// Mean of `det J` over the parameter domain (volume / parameter volume; exact for
@@ -116,13 +116,13 @@ impl VolumeCertificate {
     /// A sentence describing the verdict.
     pub fn message(&self) -> String {
         match &self.verdict {
-            VolumeVerdict::Certified { lower_bound, relative } => {
+            VolumeFinding::Certified { lower_bound, relative } => {
                 certified_message(*lower_bound, *relative, self.elements, self.boxes)
             }
-            VolumeVerdict::Folded { param, point, value, error_bound, one_sided } => {
+            VolumeFinding::Folded { param, point, value, error_bound, one_sided } => {
                 folded_message(param, point, *value, *error_bound, one_sided, self.folds.len())
             }
-            VolumeVerdict::Undecided { elements } => {
+            VolumeFinding::Undecided { elements } => {
                 undecided_message(elements.len(), &self.undecided, self.max_depth, self.min_value_found)
             }
         }
@@ -183,7 +183,7 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
     let mean_det_j = integral / par_volume;
     let relative = totals.lower_bound / mean_det_j;
     let verdict = if let Some(f) = totals.worst_fold() {
-        VolumeVerdict::Folded {
+        VolumeFinding::Folded {
             param: f.param,
             point: vol.eval(f.param),
             value: f.value,
@@ -191,9 +191,9 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
             one_sided: f.one_sided.clone(),
         }
     } else if !totals.undecided.is_empty() {
-        VolumeVerdict::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
+        VolumeFinding::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
     } else {
-        VolumeVerdict::Certified { lower_bound: totals.lower_bound, relative }
+        VolumeFinding::Certified { lower_bound: totals.lower_bound, relative }
     };
     Ok(VolumeCertificate {
         verdict,

@@ -88,7 +88,7 @@ fn certificate_agrees_with_dense_sampling() {
                 let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
                 let m = dense_min(&vol, 16);
                 match &c.verdict {
-                    VolumeVerdict::Certified { lower_bound, .. } => {
+                    VolumeFinding::Certified { lower_bound, .. } => {
                         certified += 1;
                         assert!(
                             m > 0.0 && *lower_bound > 0.0 && *lower_bound <= m * (1.0 + 1e-12),
@@ -97,7 +97,7 @@ fn certificate_agrees_with_dense_sampling() {
                         let vi = volume_integral(&vol);
                         assert!((c.mean_det_j - vi).abs() < 1e-9 * vi.abs(), "{} vs {vi}", c.mean_det_j);
                     }
-                    VolumeVerdict::Folded { param, point, value, .. } => {
+                    VolumeFinding::Folded { param, point, value, .. } => {
                         folded += 1;
                         let worst = c.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value)).unwrap();
                         let d = det_in_element(&vol, worst.element, *param);
@@ -109,10 +109,10 @@ fn certificate_agrees_with_dense_sampling() {
                             .iter()
                             .all(|f| det_in_element(&vol, f.element, f.param) < 1e-9 * f.value.abs()));
                     }
-                    VolumeVerdict::Undecided { .. } => assert!(m <= 0.0 || c.undecided.iter().all(|u| u.depth > 0)),
+                    VolumeFinding::Undecided { .. } => assert!(m <= 0.0 || c.undecided.iter().all(|u| u.depth > 0)),
                 }
                 if m < 0.0 {
-                    assert!(!matches!(c.verdict, VolumeVerdict::Certified { .. }), "sampled {m} < 0 yet certified");
+                    assert!(!matches!(c.verdict, VolumeFinding::Certified { .. }), "sampled {m} < 0 yet certified");
                 }
             }
         }
@@ -133,8 +133,8 @@ fn certificate_agrees_with_the_exact_judge() {
             let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
             let (exact, _) = Exact3::volume(&vol).sign(1, 5, 200);
             match (&exact, &c.verdict) {
-                (Sign3::Positive, VolumeVerdict::Folded { .. }) => panic!("judge positive, certificate folded"),
-                (Sign3::Negative { .. }, VolumeVerdict::Certified { .. }) => panic!("judge negative, certified"),
+                (Sign3::Positive, VolumeFinding::Folded { .. }) => panic!("judge positive, certificate folded"),
+                (Sign3::Negative { .. }, VolumeFinding::Certified { .. }) => panic!("judge negative, certified"),
                 _ => {}
             }
             pos += matches!(exact, Sign3::Positive) as usize;
@@ -158,7 +158,7 @@ fn planted_folds_are_found_and_located() {
                 let (next, prev) = (vol.control_points[k + 1], vol.control_points[k - 1]);
                 vol.control_points[k][0] = next[0] + (3.0 + rng.uniform()) * (next[0] - prev[0]);
                 let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
-                let VolumeVerdict::Folded { param, .. } = c.verdict else {
+                let VolumeFinding::Folded { param, .. } = c.verdict else {
                     panic!("planted fold missed: {:?}", c.verdict)
                 };
                 for d in 0..3 {
@@ -184,7 +184,7 @@ fn translation_keeps_the_verdict() {
         p[2] -= 3e8;
     }
     let b = certify_volume(&far, &CertifyOptions::default()).unwrap();
-    let (VolumeVerdict::Certified { lower_bound: la, .. }, VolumeVerdict::Certified { lower_bound: lb, .. }) =
+    let (VolumeFinding::Certified { lower_bound: la, .. }, VolumeFinding::Certified { lower_bound: lb, .. }) =
         (&a.verdict, &b.verdict)
     else {
         panic!("{:?} {:?}", a.verdict, b.verdict)
@@ -224,7 +224,7 @@ fn affine_maps_are_certified_with_a_tight_bound() {
         *p = std::array::from_fn(|r| 5.0 + a[r][0] * x[0] + a[r][1] * x[1] + a[r][2] * x[2]);
     }
     let c = certify_volume(&vol, &CertifyOptions::default()).unwrap();
-    let VolumeVerdict::Certified { lower_bound, relative } = c.verdict else { panic!("{:?}", c.verdict) };
+    let VolumeFinding::Certified { lower_bound, relative } = c.verdict else { panic!("{:?}", c.verdict) };
     assert!(det > 0.0 && lower_bound <= det && lower_bound > det * (1.0 - 1e-11), "{lower_bound} vs {det}");
     assert!((c.mean_det_j - det).abs() < 1e-12 * det && (relative - lower_bound / det).abs() < 1e-12);
     assert_eq!(c.boxes, c.elements);
