@@ -71,7 +71,6 @@ pub mod io;
 pub mod linalg;
 pub mod methods;
 pub mod multipatch;
-pub mod pipeline;
 pub mod solve;
 pub mod spline;
 #[cfg(any(test, feature = "testutil"))]
@@ -88,8 +87,9 @@ pub use error::{Error, Result};
 pub use io::{read, read_boundary, read_document, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
-pub use pipeline::{solve, Input, Pipeline, Stage};
 pub use solve::options::SolveOptions;
+pub use solve::pipeline;
+pub use solve::pipeline::{solve, Input, Pipeline, Stage};
 pub use solve::report::{Report, Solution, Verdict};
 pub use solve::solver::{EggSolver, Event};
 pub use spline::curve::{Curve, Point};

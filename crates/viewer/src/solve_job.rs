@@ -1,7 +1,7 @@
-//! A solve in a background thread: the core's [`EggSolver`] event stream is forwarded
-//! over a channel to the UI, which keeps the progress (level, iteration, residual) and
-//! the residual history for the live plot. A cancel flag is checked between events;
-//! dropping the solver cancels it. The same job runs a comparison of methods (paper §10,
+//! A solve in a background thread: the stages of the core's [`Pipeline`] (the fit, the
+//! solver's event stream) are forwarded over a channel to the UI, which keeps the
+//! progress (level, iteration, residual) and the residual history for the live plot. A
+//! cancel flag is checked at every stage; the observer then stops the pipeline. The same job runs a comparison of methods (paper §10,
 //! [`compare`]): every method's solver events stream the same way, and the comparison,
 //! one map per method, arrives at the end.
 

@@ -48,7 +48,9 @@ fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
 }
 
 /// The ring of a JSON document with a top-level `"ring"` field, `None` for any other
-/// document. Errors name the place (`ring.inner.knots`, ...).
+/// document. Errors name the place (`ring.inner.knots`, ...). (Files are read by
+/// [`crate::io::read`]; the tests and the fuzz exercisers parse text with this.)
+#[cfg(any(test, feature = "testutil"))]
 pub(crate) fn parse_ring_json(text: &str) -> Result<Option<Ring>> {
     let text = text.trim_start_matches('\u{feff}').trim_start();
     if !text.starts_with('{') {

@@ -61,7 +61,7 @@ use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::harmonic::VariationalHarmonicMethod;
 use crate::methods::quasi_conformal::{QcHessian, QuasiConformalMethod};
 use crate::methods::Method;
-use crate::pipeline::{Pipeline, Stage};
+use crate::solve::pipeline::{Pipeline, Stage};
 use crate::spline::surface::Surface;
 use crate::verify::certificate::certify;
 use crate::verify::poisson::{default_scales, poisson_benchmark};

@@ -488,7 +488,7 @@ impl Iterator for EggSolver {
 mod tests {
     use super::*;
     use crate::boundary::{Analytic, SideCurve};
-    use crate::pipeline::{solve, Pipeline};
+    use crate::solve::pipeline::{solve, Pipeline};
     use crate::solve::report::Verdict;
 
     fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {

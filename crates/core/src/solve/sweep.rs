@@ -82,7 +82,7 @@ use crate::boundary::ring_fit::{fit_contour_seam, EtaRefinement};
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::EggMethod;
-use crate::pipeline::{ring_options, Pipeline};
+use crate::solve::pipeline::{ring_options, Pipeline};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::periodic::PeriodicTranslate;
