@@ -231,16 +231,7 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         Some(p) => Some(load_boundary(p, a.solver.fit.reorient)?),
         None => None,
     };
-    let diameter = {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in &map.control_points {
-            for d in 0..2 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
-    };
+    let diameter = map.control_diameter();
     let t0 = std::time::Instant::now();
     let cert = certify(&map, &opts.certify).context("certifying the start")?;
     let out = improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)

@@ -337,16 +337,7 @@ pub fn split_map(
         m2.eval(u, v)
     }));
     let (xa, xb) = (map.eval(pa[0], pa[1]), map.eval(pb[0], pb[1]));
-    let diameter = {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in &map.control_points {
-            for d in 0..2 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
-    };
+    let diameter = map.control_diameter();
     let fo = FitOptions { degree: opts.degree, tol: opts.tol, ..Default::default() };
     let fit = fit_side(Side::East, &image, (xa, xb), &fo, opts.tol * diameter)?;
     let mut curve = fit.finest().clone();

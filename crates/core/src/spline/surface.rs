@@ -126,6 +126,19 @@ impl Surface {
         Ok(Self { knots, control_points, weights })
     }
 
+    /// The diameter of the control points' bounding box, which contains the map (convex
+    /// hull property of the B-spline and NURBS basis): the length scale of a map.
+    pub fn control_diameter(&self) -> f64 {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &self.control_points {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+    }
+
     /// Number of basis functions per direction.
     pub fn shape(&self) -> [usize; 2] {
         [self.knots[0].num_basis(), self.knots[1].num_basis()]
