@@ -159,17 +159,9 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
                     format!("not converged ({})", r.failure.unwrap_or_default())
                 }
             ),
-            CompareEvent::Solver(Event::Iterate { iterate: it, .. }) if a.verbose => writeln!(
-                err,
-                "    {:>3} {:<10} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}",
-                it.iteration,
-                format!("{:?}", it.method),
-                it.residual,
-                it.scaled_residual,
-                it.step,
-                it.damping,
-                it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
-            ),
+            CompareEvent::Solver(Event::Iterate { iterate, .. }) if a.verbose => {
+                writeln!(err, "    {}", output::iterate_line(&iterate))
+            }
             CompareEvent::Solver(_) => Ok(()),
             CompareEvent::Finished(row) => writeln!(err, "  {}: {}, {:.3} s", row.method, row.bij(), row.seconds),
         };

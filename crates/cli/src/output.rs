@@ -678,3 +678,19 @@ pub fn exit_code(v: Verdict) -> i32 {
         Verdict::Undecided => 5,
     }
 }
+
+/// One nonlinear iterate as a progress line: iteration, method, `||F||`, the scaled
+/// residual, step, damping, and the time step or objective when there is one.
+pub fn iterate_line(it: &winslow::solve::newton::Iterate) -> String {
+    format!(
+        "{:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
+        it.iteration,
+        format!("{:?}", it.method),
+        it.residual,
+        it.scaled_residual,
+        it.step,
+        it.damping,
+        it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
+        it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
+    )
+}

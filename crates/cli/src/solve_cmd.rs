@@ -127,18 +127,7 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
             shape[0],
             shape[1]
         ),
-        Stage::Solver(Event::Iterate { iterate: it, .. }) => writeln!(
-            e,
-            "  {:>3} {:<11} |F| = {:.3e}  scaled {:.3e}  step {:.2e}  damping {:.3}{}{}",
-            it.iteration,
-            format!("{:?}", it.method),
-            it.residual,
-            it.scaled_residual,
-            it.step,
-            it.damping,
-            it.dt.map(|d| format!("  dt {d:.2e}")).unwrap_or_default(),
-            it.objective.map(|j| format!("  J {j:.6e}")).unwrap_or_default()
-        ),
+        Stage::Solver(Event::Iterate { iterate, .. }) => writeln!(e, "  {}", output::iterate_line(iterate)),
         Stage::Solver(Event::LevelFinished(r)) => writeln!(
             e,
             "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",

@@ -14,7 +14,7 @@ fn committed_reference_is_current() {
     let generated = String::from_utf8(out.stdout).expect("UTF-8 reference");
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/cli.md");
     if std::env::var_os("WINSLOW_BLESS").is_some() {
-        std::fs::write(&path, &generated).expect("write docs/cli.md");
+        winslow::io::write_bytes(&path, generated.as_bytes()).expect("write docs/cli.md");
         return;
     }
     let committed = std::fs::read_to_string(&path).unwrap_or_default();
