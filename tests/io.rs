@@ -11,7 +11,7 @@ use winslow::io::{
     parse_json, write_json, MAX_FILE_BYTES,
 };
 use winslow::testutil::{data, data_files, Lcg};
-use winslow::{read_boundary, read_document, validate, Boundary, Document, Error, Point, ReadOptions, Side, SideCurve};
+use winslow::{read, read_boundary, validate, Boundary, Document, Error, Point, ReadOptions, Side, SideCurve};
 
 fn all_shared_files() -> Vec<PathBuf> {
     let mut v = data_files("", "json");
@@ -125,7 +125,7 @@ fn gismo_orientation_field_matches_the_assignment() {
 #[test]
 fn map_round_trip_is_bit_exact() {
     for stem in ["rotor_sector", "plate_with_hole", "disk", "flapping_beam", "lake", "cooks_membrane"] {
-        let Document::Map { name, map } = read_document(&data(&format!("gismo/xml/{stem}.xml"))).unwrap() else {
+        let Document::Map { name, map } = read(&data(&format!("gismo/xml/{stem}.xml"))).unwrap() else {
             panic!("{stem} is not a map");
         };
         assert_eq!(name, stem);
@@ -512,7 +512,7 @@ fn absurd_sizes() {
     let f = std::fs::File::create(&path).unwrap();
     f.set_len(MAX_FILE_BYTES + 1).unwrap();
     drop(f);
-    let e = read_document(&path).unwrap_err();
+    let e = read(&path).unwrap_err();
     assert!(matches!(e, Error::TooLarge { .. }), "{e}");
 }
 

@@ -368,7 +368,7 @@ fn map_writers_round_trip_through_the_readers() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let read = |p: &Path| match winslow::read_document(p).unwrap() {
+    let read = |p: &Path| match winslow::read(p).unwrap() {
         winslow::Document::Map { map, .. } => map,
         _ => panic!("{} is not a map", p.display()),
     };
@@ -499,7 +499,7 @@ fn solve_a_ring_end_to_end() {
         assert_eq!(v["map"]["periodic"], serde_json::json!([false, true]));
         assert_eq!(v["report"]["verdict"], "certified");
         assert_eq!(v["report"]["corners"], serde_json::json!([]));
-        let m = match winslow::read_document(&map).unwrap() {
+        let m = match winslow::read(&map).unwrap() {
             winslow::Document::Map { map, .. } => map,
             _ => panic!("not a map"),
         };
@@ -550,7 +550,7 @@ fn sweep_writes_frames_series_and_table() {
     let frames = v["frames"].as_array().unwrap();
     assert!(frames.iter().all(|f| f["verdict"] == "certified"));
     // a frame map reads back as a periodic map
-    let m = match winslow::read_document(&dir.join("frame_0005.json")).unwrap() {
+    let m = match winslow::read(&dir.join("frame_0005.json")).unwrap() {
         winslow::Document::Map { map, .. } => map,
         _ => panic!("not a map"),
     };
@@ -631,7 +631,7 @@ fn sweep_follows_inner_contours_given_as_files() {
     assert_eq!(v["failures"], 0);
     assert_eq!(rows[3]["time"], 2.5);
     for k in [1, 7] {
-        let m = match winslow::read_document(&dir.join(format!("out/frame_{k:04}.json"))).unwrap() {
+        let m = match winslow::read(&dir.join(format!("out/frame_{k:04}.json"))).unwrap() {
             winslow::Document::Map { map, .. } => map,
             _ => panic!("not a map"),
         };

@@ -94,7 +94,7 @@ fn split_solve_join() {
     assert_eq!(patches.len(), 2);
     let (out, _) = run(bin().arg("join").arg(&patches[0]).arg(&patches[1]).arg("-o").arg(&joined));
     assert!(out.contains("certified bijective") && out.contains("C0 knot"), "{out}");
-    let m = match winslow::read_document(&joined).unwrap() {
+    let m = match winslow::read(&joined).unwrap() {
         winslow::Document::Map { map, .. } => map,
         _ => panic!("a map"),
     };

@@ -84,7 +84,7 @@ pub use boundary::validate::{validate, ValidationReport};
 pub use boundary::{Analytic, Boundary, SideCurve};
 pub use discrete::topology::{SideCondition, Topology};
 pub use error::{Error, Result};
-pub use io::{read, read_boundary, read_document, write, Document, Output, ReadOptions};
+pub use io::{read, read_boundary, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
 pub use solve::options::SolveOptions;

@@ -61,12 +61,6 @@ pub struct ReadOptions {
     pub reorient: bool,
 }
 
-/// Read a document ([`read`]); kept for callers of the time when only boundaries and
-/// maps were documents.
-pub fn read_document(path: &Path) -> Result<Document> {
-    read(path)
-}
-
 /// Validate a boundary read from somewhere and orient it: a clockwise contour is an
 /// [`Error::Clockwise`] unless `opts.reorient`, which transposes it. Returns the
 /// (possibly transposed) boundary and its validation report.
