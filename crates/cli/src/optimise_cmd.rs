@@ -106,7 +106,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     }
     let quiet = output::quiet() || a.json;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
-    let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?;
+    let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?.into_map()?;
     let egg = &sol.map;
     let copts = ConstrainedOptions {
         eps: a.eps,
