@@ -174,8 +174,16 @@ fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
     let lid = data().join("wavy_lid.json").to_string_lossy().into_owned();
     let (ok, _, _) = run(&["solve", &lid, "-o", &d("lid.json"), "-q"]);
     assert!(ok);
-    let (ok, _, _) =
-        run(&["mesh", &d("lid.json"), "-o", &d("seam.msh"), "--structured", "9x9", "--cluster", "inner:first-height:1e-3"]);
+    let (ok, _, _) = run(&[
+        "mesh",
+        &d("lid.json"),
+        "-o",
+        &d("seam.msh"),
+        "--structured",
+        "9x9",
+        "--cluster",
+        "inner:first-height:1e-3",
+    ]);
     assert!(!ok);
     // a ring cut into a four-sided map has coinciding nodes at the cut: refused, unwritten
     let cut = data().join("gismo/male_casing_ring.json").to_string_lossy().into_owned();

@@ -77,7 +77,9 @@ fn parameter_height(map: &Surface, dir: usize, at_start: bool, h: f64, g: f64, o
             side: side.name().into(),
             height: h,
             growth: g,
-            why: format!("the height exceeds the whole extent {full:.4e} across the domain on the grid line {other} = {o}"),
+            why: format!(
+                "the height exceeds the whole extent {full:.4e} across the domain on the grid line {other} = {o}"
+            ),
         });
     }
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
@@ -144,10 +146,9 @@ fn layer_lines(
         })
         .collect::<Result<_>>()?;
     let heights = if shared {
-        let least = |f: fn(&(Option<f64>, Option<f64>)) -> Option<f64>| {
-            heights.iter().filter_map(f).reduce(f64::min)
-        };
-        vec![(least(|h| h.0), least(|h| h.1)); heights.len()]
+        let least0 = heights.iter().filter_map(|h| h.0).reduce(f64::min);
+        let least1 = heights.iter().filter_map(|h| h.1).reduce(f64::min);
+        vec![(least0, least1); heights.len()]
     } else {
         heights
     };
@@ -252,7 +253,10 @@ pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<Grid> {
         Some(l) => l[line][along],
         None => base[dir][along],
     };
-    let params = (0..n[1]).flat_map(|j| (0..n[0]).map(move |i| (i, j))).map(|(i, j)| DVec2::new(coord(0, i, j), coord(1, j, i))).collect();
+    let params = (0..n[1])
+        .flat_map(|j| (0..n[0]).map(move |i| (i, j)))
+        .map(|(i, j)| DVec2::new(coord(0, i, j), coord(1, j, i)))
+        .collect();
     Ok(Grid { n, periodic, params })
 }
 
@@ -297,9 +301,8 @@ pub fn grid_mesh(map: &Surface, grid: &Grid) -> Mesh {
         if grid.periodic[dir] {
             // the walls are the ends of the other direction: inner encloses less area
             let wall = |k: usize| -> f64 {
-                let ring: Vec<DVec2> = (0..grid.n[dir])
-                    .map(|s| if dir == 1 { points[id(k, s)] } else { points[id(s, k)] })
-                    .collect();
+                let ring: Vec<DVec2> =
+                    (0..grid.n[dir]).map(|s| if dir == 1 { points[id(k, s)] } else { points[id(s, k)] }).collect();
                 let o = ring[0];
                 let twice: f64 = (0..ring.len()).map(|s| (ring[s] - o).perp_dot(ring[(s + 1) % ring.len()] - o)).sum();
                 twice.abs()

@@ -170,7 +170,9 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         // duplicated nodes, which no solver accepts
         return Err(MeshError::Unsupported {
             format: "an unstructured mesh",
-            why: "the map is periodic (a ring): its seam would be a crack; use --structured NXxNY, whose seam is merged".into(),
+            why:
+                "the map is periodic (a ring): its seam would be a crack; use --structured NXxNY, whose seam is merged"
+                    .into(),
         });
     }
     if !(opts.size.is_finite() && opts.size > 0.0) {

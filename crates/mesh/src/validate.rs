@@ -312,7 +312,8 @@ mod tests {
         // parallelograms sheared by s: the face x = 1 + s y between the two cells has
         // non-orthogonality atan(s) exactly
         let s: f64 = 3.0;
-        let m = quads(&[[0., 0.], [1., 0.], [2., 0.], [s, 1.], [1. + s, 1.], [2. + s, 1.]], &[[0, 1, 4, 3], [1, 2, 5, 4]]);
+        let m =
+            quads(&[[0., 0.], [1., 0.], [2., 0.], [s, 1.], [1. + s, 1.], [2. + s, 1.]], &[[0, 1, 4, 3], [1, 2, 5, 4]]);
         let f = faces(&m).unwrap();
         let cen = centroids(&m);
         let ang = face_non_orthogonality(m.points[1], m.points[4], cen[0], cen[1]);

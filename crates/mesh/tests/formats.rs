@@ -53,8 +53,7 @@ fn read_msh(text: &str, mesh: &Mesh) {
     assert_eq!(section(text, "MeshFormat"), ["4.1 0 8"]);
     let names = section(text, "PhysicalNames");
     let sides = mesh.boundary_sides();
-    let mut expect: Vec<String> =
-        sides.iter().map(|&s| format!("1 {} \"{}\"", s as usize + 1, mesh.name(s))).collect();
+    let mut expect: Vec<String> = sides.iter().map(|&s| format!("1 {} \"{}\"", s as usize + 1, mesh.name(s))).collect();
     expect.push("2 5 \"domain\"".into());
     assert_eq!(names[1..], expect);
     let ent = section(text, "Entities");
@@ -81,7 +80,11 @@ fn read_msh(text: &str, mesh: &Mesh) {
         for (k, &t) in tags.iter().enumerate() {
             let x = nums(lines[at + 1 + count + k]);
             coords.insert(t, DVec2::new(x[0], x[1]));
-            assert_eq!(winslow_mesh::formats::gmsh::entity(mesh.params[t - 1], mesh.periodic), (dim, tag), "node {t} classification");
+            assert_eq!(
+                winslow_mesh::formats::gmsh::entity(mesh.params[t - 1], mesh.periodic),
+                (dim, tag),
+                "node {t} classification"
+            );
         }
         at += 1 + 2 * count;
     }

@@ -4,9 +4,9 @@ mod common;
 
 use common::{affine, annulus, folded, ring, signed_area};
 use winslow_mesh::distribution::End;
+use winslow_mesh::formats::Format;
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::quality::quality;
-use winslow_mesh::formats::Format;
 use winslow_mesh::topology::faces;
 use winslow_mesh::validate::validate;
 use winslow_mesh::{
@@ -86,8 +86,9 @@ fn first_cell_height_on_a_curved_map() {
     let h = 2e-3;
     let layers = |start| Distribution::Layers { start: Some(start), end: None, growth: 1.3 };
     // layers in eta only: the chord of the first eta step is h on every radius 1 + u
-    let mesh = structured(&map, &StructuredOptions { points: [31, 25], distribution: [Distribution::Uniform, layers(h)] })
-        .unwrap();
+    let mesh =
+        structured(&map, &StructuredOptions { points: [31, 25], distribution: [Distribution::Uniform, layers(h)] })
+            .unwrap();
     let [nx, ny] = mesh.structured.unwrap();
     let p = |i: usize, j: usize| mesh.points[j * nx + i];
     for i in 0..nx {
@@ -97,8 +98,8 @@ fn first_cell_height_on_a_curved_map() {
     // layers in both directions: a tensor grid, h the largest first chord (the outer
     // radius 2 against the inner 1: the smallest is h / 2); xi-lines are radial and the
     // xi height is the radius step on all of them
-    let mesh = structured(&map, &StructuredOptions { points: [31, 25], distribution: [layers(5e-3), layers(h)] })
-        .unwrap();
+    let mesh =
+        structured(&map, &StructuredOptions { points: [31, 25], distribution: [layers(5e-3), layers(h)] }).unwrap();
     let p = |i: usize, j: usize| mesh.points[j * nx + i];
     let first: Vec<f64> = (0..nx).map(|i| p(i, 1).distance(p(i, 0))).collect();
     let hi = first.iter().copied().fold(0.0, f64::max);
