@@ -210,9 +210,6 @@ impl Quality {
         if self.faces_over_90 > 0 {
             rows.push(("faces at 90 deg or more", format!("{}", self.faces_over_90)));
         }
-        for (name, [lo, hi]) in &self.first_heights {
-            rows.push(("first cell height min / max", format!("{lo:.4e} / {hi:.4e} ({name})")));
-        }
         if let Some(r) = self.min_jacobian_ratio {
             rows.push(("min det J ratio (curved)", format!("{r:.4}")));
         }
@@ -220,8 +217,18 @@ impl Quality {
         rows
     }
 
-    /// The quality table as text.
+    /// The smallest and largest first cell of each wall, as rows `(name, value)`.
+    pub fn first_height_rows(&self) -> Vec<(String, String)> {
+        self.first_heights
+            .iter()
+            .map(|(name, [lo, hi])| (format!("first cell {name} min / max"), format!("{lo:.4e} / {hi:.4e}")))
+            .collect()
+    }
+
+    /// The quality table as text, the first cells of the walls last.
     pub fn table(&self) -> String {
-        self.rows().iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
+        let mut rows: Vec<(String, String)> = self.rows().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        rows.extend(self.first_height_rows());
+        rows.iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
     }
 }
