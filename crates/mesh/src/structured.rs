@@ -69,12 +69,12 @@ fn first_edge(map: &Surface, dir: usize, at_start: bool, t: f64, o: f64) -> f64 
 /// The parameter spacing whose first edge on the line at `o` has physical length `h`,
 /// from below (bisection to round-off; the edge length grows with the spacing on a
 /// bijective map): the first cell never exceeds `h`.
-fn parameter_height(map: &Surface, dir: usize, at_start: bool, h: f64, g: f64, o: f64, side: Side) -> Result<f64> {
+fn parameter_height(map: &Surface, dir: usize, at_start: bool, h: f64, g: f64, o: f64, side: &str) -> Result<f64> {
     let full = first_edge(map, dir, at_start, 1.0, o);
     if h.is_nan() || h >= full {
         let other = ["eta", "xi"][dir];
         return Err(MeshError::Layer {
-            side: side.name().into(),
+            side: side.into(),
             height: h,
             growth: g,
             why: format!(
@@ -136,7 +136,8 @@ fn layer_lines(
     let Distribution::Layers { start, end, growth } = *d else {
         return Err(MeshError::param(["xi", "eta"][dir], "layers expected"));
     };
-    let [s0, s1] = sides(dir);
+    // the walls of a ring (the other direction periodic) are named inner and outer
+    let [s0, s1] = if periodic_directions(map)[1 - dir] { ["inner", "outer"] } else { sides(dir).map(Side::name) };
     let heights: Vec<(Option<f64>, Option<f64>)> = others
         .par_iter()
         .map(|&o| {
@@ -152,13 +153,13 @@ fn layer_lines(
     } else {
         heights
     };
-    let names = [s0.name(), s1.name()];
+    let names = [s0, s1];
     let all = |m: usize| heights.iter().all(|&(h0, h1)| layer_sizes(m, h0, h1, growth, names).is_ok());
     let mut out = Vec::with_capacity(others.len());
     for (&o, &(h0, h1)) in others.iter().zip(&heights) {
         let sizes = layer_sizes(n - 1, h0, h1, growth, names).map_err(|e| match e {
             MeshError::Layer { side, why, growth, .. } => {
-                let height = if side == s0.name() { start.unwrap_or(0.0) } else { end.unwrap_or(0.0) };
+                let height = if side == s0 { start.unwrap_or(0.0) } else { end.unwrap_or(0.0) };
                 // the fewest points that would do on every line, when more points help
                 let mut hint = String::new();
                 if let Some(hi) = (0..24).map(|k| (n - 1) << k).find(|&m| all(m)) {
