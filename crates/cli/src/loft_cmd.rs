@@ -51,11 +51,7 @@ pub(super) struct LoftArgs {
 }
 
 fn exit_code(v: &VolumeFinding) -> i32 {
-    match v {
-        VolumeFinding::Certified { .. } => 0,
-        VolumeFinding::Folded { .. } => 3,
-        VolumeFinding::Undecided { .. } => 5,
-    }
+    output::exit_code(Verdict::of_finding(v))
 }
 
 fn certify_options(max_depth: usize, max_boxes: usize) -> CertifyOptions {

@@ -94,7 +94,12 @@ pub enum Verdict {
 impl Verdict {
     /// The verdict of a certificate (a converged map's).
     pub fn of_certificate(c: &Certificate) -> Self {
-        match c.verdict {
+        Self::of_finding(&c.verdict)
+    }
+
+    /// The verdict of what a certificate found, of a map of the plane or of a volume.
+    pub fn of_finding<const D: usize>(f: &crate::verify::certificate::Finding<D>) -> Self {
+        match f {
             crate::verify::certificate::Finding::Certified { .. } => Verdict::Certified,
             crate::verify::certificate::Finding::DegenerateCorner { .. } => Verdict::DegenerateCorner,
             crate::verify::certificate::Finding::Folded { .. } => Verdict::Folded,

@@ -80,12 +80,14 @@ impl Default for CertifyOptions {
 }
 
 /// What [`certify`] found, with its evidence: a proven lower bound of `det J`, a point
-/// where it is proven negative, or the elements left undecided. The one verdict of a
-/// solve, which adds "not converged", is [`crate::Verdict`]
+/// where it is proven negative, or the elements left undecided; `D` parameters (2: a map
+/// of the plane; 3: a volume, [`volume::VolumeFinding`], which has no excused corner). The
+/// one verdict of a solve, which adds "not converged", is [`crate::Verdict`]
 /// ([`Verdict::of_certificate`](crate::Verdict::of_certificate)).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum Finding {
+#[serde(bound(serialize = "[usize; D]: Serialize, [f64; D]: Serialize"))]
+pub enum Finding<const D: usize = 2> {
     /// `det J > 0` on the whole parameter domain, proven.
     Certified {
         /// Proven lower bound of `det J`.
@@ -101,7 +103,7 @@ pub enum Finding {
         corners: Vec<&'static str>,
         /// The zero-speed points of the sides, in the parameter domain (`(xi, eta)`).
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        points: Vec<[f64; 2]>,
+        points: Vec<[f64; D]>,
         /// Proven lower bound of `det J` away from those corners.
         lower_bound: f64,
         /// `lower_bound / mean det J`.
@@ -110,11 +112,11 @@ pub enum Finding {
     /// A point with `det J < 0` proven (value below minus its rounding bound) away from
     /// forced corners (the most negative found).
     Folded {
-        /// Parameter point `(xi, eta)`.
-        param: [f64; 2],
+        /// Parameter point `(xi, eta)` (`(xi, eta, zeta)`).
+        param: [f64; D],
         /// Physical point `x(xi, eta)`.
-        point: [f64; 2],
-        /// `det J` there (on a `C^0` knot line: the one-sided value of the folding side).
+        point: [f64; D],
+        /// `det J` there (on a `C^0` knot line or plane: the one-sided value of the folding side).
         value: f64,
         /// Rounding bound of `value`.
         error_bound: f64,
@@ -123,12 +125,12 @@ pub enum Finding {
     },
     /// The subdivision budget was spent before every element was decided.
     Undecided {
-        /// Elements `(i, j)` (indices of the element in `xi` and `eta`) left open.
-        elements: Vec<[usize; 2]>,
+        /// Elements `(i, j)` (`(i, j, k)`: indices of the element per direction) left open.
+        elements: Vec<[usize; D]>,
     },
 }
 
-impl Finding {
+impl<const D: usize> Finding<D> {
     /// Short name (`certified`, `degenerate-corner`, `folded`, `undecided`).
     pub fn name(&self) -> &'static str {
         match self {

@@ -10,11 +10,11 @@
 //! proven lower bound, and boxes that are neither proven positive nor shown to fold are
 //! bisected (de Casteljau, all three directions; module `search`).
 //!
-//! **Verdicts.** [`VolumeFinding::Certified`] when every element is proven
+//! **Verdicts.** [`Finding::Certified`] when every element is proven
 //! (`min ĉ - e > 0` on every box), with the proven lower bound of `det J`;
-//! [`VolumeFinding::Folded`] when a point with `det J < -(its rounding bound)` is found,
+//! [`Finding::Folded`] when a point with `det J < -(its rounding bound)` is found,
 //! re-evaluated at the reported parameter point (with the parameter and the physical
-//! point); [`VolumeFinding::Undecided`] when the budget is spent, with the reason per
+//! point); [`Finding::Undecided`] when the budget is spent, with the reason per
 //! element. Unlike maps of the plane there is no excused corner: every point counts.
 
 use std::time::Instant;
@@ -23,53 +23,17 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::element::Elements;
-use super::{certified_message, folded_message, offending, search, undecided_message, CertifyOptions, Fold, Undecided};
+use super::{
+    certified_message, folded_message, offending, search, undecided_message, CertifyOptions, Finding, Fold, Undecided,
+};
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::quadrature::GaussLegendre;
 use crate::spline::volume::Volume;
 
-/// The outcome of [`certify_volume`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum VolumeFinding {
-    /// `det J > 0` on the whole parameter domain, proven.
-    Certified {
-        /// Proven lower bound of `det J`.
-        lower_bound: f64,
-        /// `lower_bound / mean det J`.
-        relative: f64,
-    },
-    /// A point with `det J < 0` proven (the most negative found).
-    Folded {
-        /// Parameter point `(ξ, η, ζ)`.
-        param: [f64; 3],
-        /// Physical point `x(ξ, η, ζ)`.
-        point: [f64; 3],
-        /// `det J` there (on a `C^0` knot plane: the one-sided value of the folding side).
-        value: f64,
-        /// Rounding bound of `value`.
-        error_bound: f64,
-        /// On a knot plane where the map is only `C^0`: which one-sided limit `value` is.
-        one_sided: Option<String>,
-    },
-    /// The subdivision budget was spent before every element was decided.
-    Undecided {
-        /// Elements `(i, j, k)` left open.
-        elements: Vec<[usize; 3]>,
-    },
-}
-
-impl VolumeFinding {
-    /// Short name (`certified`, `folded`, `undecided`).
-    pub fn name(&self) -> &'static str {
-        match self {
-            VolumeFinding::Certified { .. } => "certified",
-            VolumeFinding::Folded { .. } => "folded",
-            VolumeFinding::Undecided { .. } => "undecided",
-        }
-    }
-}
+/// The outcome of [`certify_volume`] (never [`Finding::DegenerateCorner`]: every point
+/// of a volume counts).
+pub type VolumeFinding = Finding<3>;
 
 /// A fold of a volume.
 pub type VolumeFold = Fold<3>;
@@ -124,6 +88,9 @@ impl VolumeCertificate {
             }
             VolumeFinding::Undecided { elements } => {
                 undecided_message(elements.len(), &self.undecided, self.max_depth, self.min_value_found)
+            }
+            VolumeFinding::DegenerateCorner { lower_bound, relative, .. } => {
+                certified_message(*lower_bound, *relative, self.elements, self.boxes)
             }
         }
     }
