@@ -466,20 +466,11 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     let degenerate: Vec<&'static str> =
         corners.iter().filter(|c| c.excused_extent.is_some()).map(|c| c.corner).collect();
     let points: Vec<[f64; 2]> = excused_points.iter().map(|p: &ExcusedPoint| p.param).collect();
-    let verdict = if let Some(f) = totals.worst_fold() {
-        Finding::Folded {
-            param: f.param,
-            point: map.eval(f.param[0], f.param[1]),
-            value: f.value,
-            error_bound: f.error_bound,
-            one_sided: f.one_sided.clone(),
+    let verdict = match totals.finding(|u| map.eval(u[0], u[1]), relative) {
+        Finding::Certified { lower_bound, relative } if !degenerate.is_empty() || !points.is_empty() => {
+            Finding::DegenerateCorner { corners: degenerate, points, lower_bound, relative }
         }
-    } else if !totals.undecided.is_empty() {
-        Finding::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
-    } else if !degenerate.is_empty() || !points.is_empty() {
-        Finding::DegenerateCorner { corners: degenerate, points, lower_bound: totals.lower_bound, relative }
-    } else {
-        Finding::Certified { lower_bound: totals.lower_bound, relative }
+        found => found,
     };
     Ok(Certificate {
         verdict,

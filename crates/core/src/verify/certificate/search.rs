@@ -477,4 +477,24 @@ impl<const D: usize> Totals<D> {
     pub fn worst_fold(&self) -> Option<&Fold<D>> {
         self.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value))
     }
+
+    /// The finding of these totals: the worst fold (its physical point by `eval`), else
+    /// the undecided elements, else certified with `relative = lower bound / mean det J`
+    /// (a map of the plane turns the last into `DegenerateCorner` where it excused some).
+    pub fn finding(&self, eval: impl Fn([f64; D]) -> [f64; D], relative: f64) -> super::Finding<D> {
+        use super::Finding;
+        if let Some(f) = self.worst_fold() {
+            Finding::Folded {
+                param: f.param,
+                point: eval(f.param),
+                value: f.value,
+                error_bound: f.error_bound,
+                one_sided: f.one_sided.clone(),
+            }
+        } else if !self.undecided.is_empty() {
+            Finding::Undecided { elements: self.undecided.iter().map(|u| u.element).collect() }
+        } else {
+            Finding::Certified { lower_bound: self.lower_bound, relative }
+        }
+    }
 }

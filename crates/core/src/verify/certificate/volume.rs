@@ -149,19 +149,7 @@ pub fn certify_volume(vol: &Volume, opts: &CertifyOptions) -> Result<VolumeCerti
     let integral = if vol.weights.is_some() { volume_integral(vol) } else { totals.integral };
     let mean_det_j = integral / par_volume;
     let relative = totals.lower_bound / mean_det_j;
-    let verdict = if let Some(f) = totals.worst_fold() {
-        VolumeFinding::Folded {
-            param: f.param,
-            point: vol.eval(f.param),
-            value: f.value,
-            error_bound: f.error_bound,
-            one_sided: f.one_sided.clone(),
-        }
-    } else if !totals.undecided.is_empty() {
-        VolumeFinding::Undecided { elements: totals.undecided.iter().map(|u| u.element).collect() }
-    } else {
-        VolumeFinding::Certified { lower_bound: totals.lower_bound, relative }
-    };
+    let verdict = totals.finding(|u| vol.eval(u), relative);
     Ok(VolumeCertificate {
         verdict,
         lower_bound: totals.lower_bound,
