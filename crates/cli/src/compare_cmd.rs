@@ -134,6 +134,7 @@ impl CompareArgs {
 
 pub(super) fn run(a: CompareArgs) -> Result<i32> {
     let (methods, opts) = a.options()?;
+    crate::files::OutputPlan::new().input(&a.boundary).folder_maybe("--png-dir", a.png_dir.as_deref()).check()?;
     let boundary = load_boundary(&a.boundary, a.fit.reorient)?;
     let quiet = output::quiet() || a.json;
     let stderr = std::io::stderr();
@@ -176,14 +177,11 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
                 let path = dir.join(format!("{}-{}.png", cmp.name, row.method));
                 let image = render(map, &PictureOptions::default());
                 crate::files::write(&path, &winslow::io::Output::Picture(&image))?;
-                if !quiet {
-                    note!("wrote {}", path.display());
-                }
             }
         }
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&cmp)?);
+        crate::files::print_json(serde_json::to_value(&cmp)?)?;
     } else {
         say_raw!("{}", table(&cmp));
     }
