@@ -85,6 +85,17 @@ pub(crate) fn boundary_of(doc: Document, path: &Path) -> Result<winslow::Boundar
     })
 }
 
+/// The ring of a ring document or a ring map ([`Document::into_ring`]); any other kind is
+/// the error naming it.
+pub(crate) fn ring_of(doc: Document, path: &Path) -> Result<winslow::boundary::ring::Ring> {
+    doc.into_ring().map_err(|e| match e {
+        Error::DocumentKind { found, needed, .. } => {
+            Error::DocumentKind { path: Some(path.to_path_buf()), found, needed }.into()
+        }
+        e => e.into(),
+    })
+}
+
 /// The error for a boundary or a layout given where a solved map is needed.
 pub(crate) const SOLVE_FIRST: &str = "a map is needed (run `winslow solve` first)";
 

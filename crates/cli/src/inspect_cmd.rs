@@ -5,7 +5,8 @@ use super::*;
 
 #[derive(Args, Debug)]
 pub(crate) struct InspectArgs {
-    /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
+    /// Boundary file (JSON boundary, contour or map document; G+Smo XML), or a ring
+    /// document or ring map (its two contours).
     pub(crate) file: PathBuf,
     #[command(flatten)]
     pub(crate) fit: FitArgs,
@@ -25,6 +26,10 @@ pub(crate) fn inspect(a: InspectArgs) -> Result<i32> {
     let doc = files::read(&a.file)?;
     let kind = match &doc {
         Document::Ring(ring) => return inspect_ring::run(&a.file, ring, &fit_options(&a.fit), a.json),
+        doc if doc.is_ring_map() => {
+            let ring = files::ring_of(doc, &a.file)?;
+            return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
+        }
         Document::Boundary(_) => "boundary",
         _ => "map (its four boundary curves are inspected)",
     };

@@ -185,8 +185,13 @@ pub(super) struct JoinArgs {
     json: bool,
 }
 
-fn read_map(path: &Path) -> Result<(String, Surface)> {
-    files::map_of(files::read(path)?, path, files::SOLVE_FIRST)
+/// A four-sided map (a ring map has no four sides to split or join along).
+fn read_map(path: &Path, command: &str) -> Result<(String, Surface)> {
+    let doc = files::read(path)?;
+    if doc.is_ring_map() {
+        return Err(files::wrong_kind(&doc, path, &format!("{command} needs a four-sided map")));
+    }
+    files::map_of(doc, path, files::SOLVE_FIRST)
 }
 
 /// `SIDE:T` or `X,Y` as a side point of `map`.
@@ -213,7 +218,7 @@ fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::Side
 
 pub(super) fn split(a: SplitArgs) -> Result<i32> {
     use winslow::multipatch::split::{split_map, SplitOptions};
-    let (name, map) = read_map(&a.map)?;
+    let (name, map) = read_map(&a.map, "split")?;
     let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
     let parts = ["a", "b"].map(|k| a.output.with_file_name(format!("{stem}-{k}.json")));
     files::OutputPlan::new()
@@ -266,8 +271,8 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
 
 pub(super) fn join(a: JoinArgs) -> Result<i32> {
     use winslow::multipatch::join::join_and_smooth;
-    let (na, ma) = read_map(&a.a)?;
-    let (nb, mb) = read_map(&a.b)?;
+    let (na, ma) = read_map(&a.a, "join")?;
+    let (nb, mb) = read_map(&a.b, "join")?;
     files::OutputPlan::new()
         .input(&a.a)
         .input(&a.b)

@@ -165,6 +165,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => return super::multipatch_cmd::solve(layout, &a),
         Document::Ring(ring) => Input::Ring(ring),
+        // a ring map (a sweep's frame): the ring between its two contours
+        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),
         doc => {
             let boundary = files::boundary_of(doc, path)?;
             let (boundary, _) = checked_boundary(boundary, &ReadOptions { reorient: a.solver.fit.reorient })

@@ -12,7 +12,8 @@ use winslow::solve::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, Swe
 
 #[derive(Args, Debug)]
 pub(super) struct SweepArgs {
-    /// Ring document (two closed contours, see formats.md): frame 0.
+    /// Ring document (two closed contours, see formats.md) or a ring map (its two
+    /// contours): frame 0.
     ring: PathBuf,
     /// Rotation of the inner contour per step, degrees (counter-clockwise).
     #[arg(long, allow_negative_numbers = true, required_unless_present = "inner_frames")]
@@ -155,10 +156,12 @@ fn inner_frames(paths: &[PathBuf], base: &Ring) -> Result<Vec<(PathBuf, ClosedCo
         .collect()
 }
 
-/// The ring of a ring document; any other kind is the error naming it.
+/// The ring of a ring document or a ring map (e.g. a frame of another sweep); any other
+/// kind is the error naming it.
 fn ring_in(path: &Path, needed: &str) -> Result<Ring> {
     match crate::files::read(path)? {
         Document::Ring(ring) => Ok(ring),
+        doc if doc.is_ring_map() => crate::files::ring_of(doc, path),
         doc => Err(crate::files::wrong_kind(&doc, path, needed)),
     }
 }
@@ -219,7 +222,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         None => 0.0,
     };
     let opts = a.solver.options()?;
-    let ring = ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours)")?;
+    let ring = ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours) or a ring map")?;
     let mut contours = inner_frames(&a.inner_frames, &ring)?;
     if let Some(n) = a.steps.filter(|_| !contours.is_empty()) {
         contours.truncate(n);

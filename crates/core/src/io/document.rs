@@ -29,7 +29,7 @@ use super::ring::ring_of_json;
 use super::volume::gismo::parse_gismo_volume;
 use super::volume::json::parse_volume_json;
 use super::{iges, read_text, surface_boundary_area};
-use crate::boundary::ring::Ring;
+use crate::boundary::ring::{signed_area, ClosedContour, Ring};
 use crate::boundary::{Boundary, SideCurve};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
@@ -126,6 +126,36 @@ impl Document {
                 Ok(Boundary { name, sides: Side::ALL.map(side) })
             }
             other => Err(other.wrong_kind(None, "a four-sided boundary or map is needed")),
+        }
+    }
+
+    /// Whether this is a ring map: a map periodic in `eta`.
+    pub fn is_ring_map(&self) -> bool {
+        matches!(self, Document::Map { map, .. } if map.knots[1].is_periodic())
+    }
+
+    /// The ring: itself, or the two contours of a ring map (a map periodic in `eta`):
+    /// its `xi = 0` side as the inner contour and its `xi = 1` side as the outer, each
+    /// turned counter-clockwise. Any other kind is an [`Error::DocumentKind`].
+    pub fn into_ring(self) -> Result<Ring> {
+        match self {
+            Document::Ring(r) => Ok(r),
+            Document::Map { name, map } if map.knots[1].is_periodic() => {
+                let contour = |s: Side| {
+                    let mut c = map.boundary(s);
+                    if c.weights.as_ref().is_some_and(|w| w.iter().all(|&x| x == 1.0)) {
+                        c.weights = None;
+                    }
+                    let closed = ClosedContour::Spline(c.clone());
+                    if signed_area(&closed.polygon_with(256)) < 0.0 {
+                        ClosedContour::Spline(c.reversed())
+                    } else {
+                        closed
+                    }
+                };
+                Ok(Ring { name, inner: contour(Side::West), outer: contour(Side::East) })
+            }
+            other => Err(other.wrong_kind(None, "a ring or a ring map is needed")),
         }
     }
 }

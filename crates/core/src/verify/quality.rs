@@ -519,4 +519,50 @@ mod tests {
         assert!((a - f).abs() < 1e-14 * f.abs(), "{a} vs {f}");
         assert!((a + 0.75 * std::f64::consts::PI).abs() < 1e-6, "{a}");
     }
+
+    /// The boundary deviation is geometric: a side that is the input curve with another
+    /// parameterization (a quarter circle with Möbius-reweighted NURBS weights) deviates by
+    /// rounding only, a concentric arc of radius 1.1 by exactly 0.1, and a point cloud by
+    /// the distance to its polyline.
+    #[test]
+    fn boundary_deviation_is_the_distance_to_the_input_curve() {
+        use crate::boundary::{Boundary, SideCurve};
+        use crate::spline::curve::Curve;
+        use crate::spline::surface::Side;
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let arc = |r: f64, c: f64| {
+            Curve::new(KnotVector::open_uniform(2, 1), vec![[r, 0.0], [r, r], [0.0, r]], Some(vec![1.0, c * h, c * c]))
+                .unwrap()
+        };
+        // the quarter annulus between radii 1 and 2, its inner arc reparameterized (c = 3)
+        let (inner, outer) = (arc(1.0, 3.0), arc(2.0, 1.0));
+        let cps = inner.control_points.iter().chain(&outer.control_points).copied().collect();
+        let weights = inner.weights.clone().unwrap().into_iter().chain(outer.weights.clone().unwrap()).collect();
+        let map = Surface::new([KnotVector::open_uniform(2, 1), KnotVector::open_uniform(1, 1)], cps, Some(weights))
+            .unwrap();
+        let south = map.boundary(Side::South);
+        let t = 0.3;
+        let (p, q) = (south.eval(t), arc(1.0, 1.0).eval(t));
+        assert!((p[0] - q[0]).hypot(p[1] - q[1]) > 0.1, "the parameterizations differ");
+        let with_south = |c: SideCurve| Boundary {
+            name: "annulus".into(),
+            sides: Side::ALL.map(|s| if s == Side::South { c.clone() } else { SideCurve::Spline(map.boundary(s)) }),
+        };
+        let d = boundary_deviation(&map, &with_south(SideCurve::Spline(arc(1.0, 1.0))), 400);
+        assert!(d.iter().all(|&x| x < 1e-14), "{d:?}");
+        let d = boundary_deviation(&map, &with_south(SideCurve::Spline(arc(1.1, 1.0))), 400);
+        assert!((d[0] - 0.1).abs() < 1e-14, "{d:?}");
+        assert!(d[1..].iter().all(|&x| x < 1e-14), "{d:?}");
+        // a point cloud on the unit circle: the polyline's chords are within 1 - cos(π/4n)
+        let n = 64;
+        let cloud: Vec<[f64; 2]> = (0..=n)
+            .map(|k| {
+                let a = std::f64::consts::FRAC_PI_2 * k as f64 / n as f64;
+                [a.cos(), a.sin()]
+            })
+            .collect();
+        let d = boundary_deviation(&map, &with_south(SideCurve::Points(cloud)), 400);
+        let sagitta = 1.0 - (std::f64::consts::FRAC_PI_4 / n as f64).cos();
+        assert!(d[0] <= sagitta * (1.0 + 1e-9) && d[0] > 0.5 * sagitta, "{} {sagitta}", d[0]);
+    }
 }
