@@ -24,12 +24,12 @@ pub(crate) fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
 
 pub(crate) fn inspect(a: InspectArgs) -> Result<i32> {
     let doc = files::read(&a.file)?;
+    if doc.is_ring_map() {
+        let ring = files::ring_of(doc, &a.file)?;
+        return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
+    }
     let kind = match &doc {
         Document::Ring(ring) => return inspect_ring::run(&a.file, ring, &fit_options(&a.fit), a.json),
-        doc if doc.is_ring_map() => {
-            let ring = files::ring_of(doc, &a.file)?;
-            return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
-        }
         Document::Boundary(_) => "boundary",
         _ => "map (its four boundary curves are inspected)",
     };

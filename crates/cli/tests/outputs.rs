@@ -94,7 +94,7 @@ fn convert_and_render_take_ring_maps_and_multipatch_results() {
     let err = refused(&["convert".as_ref(), &os(&input), "-o".as_ref(), &os(&dir.join("x.json"))]);
     assert!(err.contains("a multipatch layout document, where convert writes"), "{err}");
     let err = refused(&["convert".as_ref(), &os(&result), "-o".as_ref(), &os(&dir.join("x.igs"))]);
-    assert!(err.contains("a multipatch result cannot be written as .igs"), "{err}");
+    assert!(err.contains("a multipatch result is written as") && err.contains("not .igs"), "{err}");
     assert!(!dir.join("x.igs").exists() && !dir.join("x.json").exists() && !dir.join("x.png").exists());
     // an I/O error names the file and its cause once
     let err = refused(&["convert".as_ref(), &os(&dir.join("missing.json")), "-o".as_ref(), &os(&dir.join("x.json"))]);
@@ -340,4 +340,55 @@ fn a_sweep_never_mixes_with_an_earlier_one() {
     let table = common::read_json(&folder.join("sweep.json"));
     assert_eq!(table["frames"].as_array().unwrap().len(), 2);
     assert_eq!(table["step_degrees"], 0.17);
+}
+
+/// A ring map (what `solve` and `sweep` write for a ring) is taken as its ring by
+/// `solve`, `inspect` and `sweep`, and by `split` and `join` named as a ring map where a
+/// four-sided map is needed (not a corner gap of its seam).
+#[test]
+fn a_ring_map_is_taken_as_its_ring() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let os = |p: &Path| p.as_os_str().to_owned();
+    let ring_map = dir.join("ring-map.json");
+    let ring = data().join("rings/eccentric_annulus.json");
+    let (code, err) = run(&["solve".as_ref(), &os(&ring), "-o".as_ref(), &os(&ring_map)]);
+    assert_eq!(code, Some(0), "{err}");
+    let again = dir.join("again.json");
+    let (code, err) = run(&["solve".as_ref(), &os(&ring_map), "-o".as_ref(), &os(&again)]);
+    assert_eq!(code, Some(0), "{err}");
+    let report = common::read_json(&again)["report"].clone();
+    assert_eq!(report["verdict"], "certified");
+    // the contours are the first map's sides: the boundary deviation is the fit's
+    let first = common::read_json(&ring_map)["report"]["boundary_deviation"].clone();
+    let dev = |v: &serde_json::Value, k: usize| v[k].as_f64().unwrap();
+    assert!(dev(&report["boundary_deviation"], 1) < 1e-3 && dev(&first, 1) < 1e-3, "{report}");
+    assert_eq!(run(&["inspect".as_ref(), &os(&ring_map)]).0, Some(0));
+    let frames = dir.join("frames");
+    let (code, err) = run(&[
+        "sweep".as_ref(),
+        &os(&ring_map),
+        "--rotate-inner".as_ref(),
+        "2".as_ref(),
+        "--steps".as_ref(),
+        "1".as_ref(),
+        "-o".as_ref(),
+        &os(&frames),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(frames.join("frame_0001.json").is_file());
+    let parts = dir.join("parts.json");
+    let (code, err) = run(&[
+        "split".as_ref(),
+        &os(&ring_map),
+        "--from".as_ref(),
+        "south:0.5".as_ref(),
+        "--to".as_ref(),
+        "north:0.5".as_ref(),
+        "-o".as_ref(),
+        &os(&parts),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("a ring map document, where split needs a four-sided map"), "{err}");
+    assert!(!parts.exists());
 }
