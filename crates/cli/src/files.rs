@@ -35,6 +35,10 @@ pub(crate) fn read_with_report(path: &Path) -> Result<(Document, Option<serde_js
 pub(crate) fn write(path: &Path, out: &Output) -> Result<()> {
     io::write(path, out).map_err(|e| named(e, "writing", path))?;
     record(path);
+    if extension_of(path) == "vtm" {
+        // the blocks go into a folder named after the file
+        record(&path.with_extension(""));
+    }
     Ok(())
 }
 
@@ -43,6 +47,9 @@ pub(crate) fn write(path: &Path, out: &Output) -> Result<()> {
 pub(crate) fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
     io::output::write_as(path, extension, out).map_err(|e| named(e, "writing", path))?;
     record(path);
+    if extension == "vtm" {
+        record(&path.with_extension(""));
+    }
     Ok(())
 }
 
