@@ -177,7 +177,13 @@ impl OutputPlan {
     }
 
     /// An output file of `what` given by `flag`, written as one of `extensions`.
-    pub(crate) fn file(mut self, flag: &str, path: &Path, what: &'static str, extensions: &'static [&'static str]) -> Self {
+    pub(crate) fn file(
+        mut self,
+        flag: &str,
+        path: &Path,
+        what: &'static str,
+        extensions: &'static [&'static str],
+    ) -> Self {
         self.outputs.push(Planned {
             flag: flag.to_string(),
             path: path.to_path_buf(),
@@ -187,7 +193,13 @@ impl OutputPlan {
     }
 
     /// [`Self::file`] when the flag was given.
-    pub(crate) fn maybe(self, flag: &str, path: Option<&Path>, what: &'static str, extensions: &'static [&'static str]) -> Self {
+    pub(crate) fn maybe(
+        self,
+        flag: &str,
+        path: Option<&Path>,
+        what: &'static str,
+        extensions: &'static [&'static str],
+    ) -> Self {
         match path {
             Some(p) => self.file(flag, p, what, extensions),
             None => self,
@@ -314,8 +326,7 @@ fn writable(flag: &str, path: &Path, dir: &Path) -> Result<()> {
         bail!("{flag} {}: {} is a file, not a folder", path.display(), at.display());
     }
     static PROBE: AtomicU64 = AtomicU64::new(0);
-    let probe =
-        at.join(format!(".winslow-probe.{}.{}", std::process::id(), PROBE.fetch_add(1, Ordering::Relaxed)));
+    let probe = at.join(format!(".winslow-probe.{}.{}", std::process::id(), PROBE.fetch_add(1, Ordering::Relaxed)));
     match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
         Ok(_) => {
             let _ = std::fs::remove_file(&probe);

@@ -222,7 +222,8 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         None => 0.0,
     };
     let opts = a.solver.options()?;
-    let ring = ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours) or a ring map")?;
+    let ring =
+        ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours) or a ring map")?;
     let mut contours = inner_frames(&a.inner_frames, &ring)?;
     if let Some(n) = a.steps.filter(|_| !contours.is_empty()) {
         contours.truncate(n);

@@ -187,7 +187,16 @@ fn outputs_that_would_replace_an_input_or_each_other_are_refused_first() {
         #[cfg(unix)]
         vec!["solve".into(), os(&link), "-o".into(), os(&lid)],
         vec!["solve".into(), "--start".into(), os(&map), "-o".into(), os(&map)],
-        vec!["solve".into(), os(&lid), "--start".into(), os(&map), "-o".into(), os(&dir.join("x.json")), "--png".into(), os(&lid)],
+        vec![
+            "solve".into(),
+            os(&lid),
+            "--start".into(),
+            os(&map),
+            "-o".into(),
+            os(&dir.join("x.json")),
+            "--png".into(),
+            os(&lid),
+        ],
         // the map replaced by a picture, a conversion, a mesh
         vec!["render".into(), os(&map), "--png".into(), os(&map)],
         vec!["convert".into(), os(&map), "-o".into(), os(&map)],
@@ -201,7 +210,14 @@ fn outputs_that_would_replace_an_input_or_each_other_are_refused_first() {
         vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m3.json")), "--iges".into(), os(&dir.join("m3.xml"))],
         vec!["render".into(), os(&map), "--png".into(), os(&dir.join("m3.jpg"))],
         // a folder that is a file
-        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m4.json")), "--png".into(), os(&a_file.join("x.png"))],
+        vec![
+            "solve".into(),
+            os(&lid),
+            "-o".into(),
+            os(&dir.join("m4.json")),
+            "--png".into(),
+            os(&a_file.join("x.png")),
+        ],
         vec!["solve".into(), os(&lid), "-o".into(), os(&a_file.join("m4.json"))],
         // a split's parts next to its output, a loft's output on a slice
         vec![

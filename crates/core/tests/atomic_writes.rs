@@ -4,7 +4,6 @@
 //! both, the file under the final name is the old one, byte for byte; a failed write
 //! leaves no temporary file either.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -393,7 +393,8 @@ impl<'a> SideSamples<'a> {
                 for (k, &(_, a, b)) in c.knots.elements().iter().enumerate() {
                     let first = if k == 0 { 0 } else { 1 };
                     for j in first..=SAMPLES_PER_SPAN {
-                        let t = if j == SAMPLES_PER_SPAN { b } else { a + (b - a) * j as f64 / SAMPLES_PER_SPAN as f64 };
+                        let t =
+                            if j == SAMPLES_PER_SPAN { b } else { a + (b - a) * j as f64 / SAMPLES_PER_SPAN as f64 };
                         out.push((t, c.eval(t)));
                     }
                 }
@@ -538,8 +539,8 @@ mod tests {
         let (inner, outer) = (arc(1.0, 3.0), arc(2.0, 1.0));
         let cps = inner.control_points.iter().chain(&outer.control_points).copied().collect();
         let weights = inner.weights.clone().unwrap().into_iter().chain(outer.weights.clone().unwrap()).collect();
-        let map = Surface::new([KnotVector::open_uniform(2, 1), KnotVector::open_uniform(1, 1)], cps, Some(weights))
-            .unwrap();
+        let map =
+            Surface::new([KnotVector::open_uniform(2, 1), KnotVector::open_uniform(1, 1)], cps, Some(weights)).unwrap();
         let south = map.boundary(Side::South);
         let t = 0.3;
         let (p, q) = (south.eval(t), arc(1.0, 1.0).eval(t));
