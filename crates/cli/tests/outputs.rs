@@ -356,6 +356,27 @@ fn a_sweep_never_mixes_with_an_earlier_one() {
     let table = common::read_json(&folder.join("sweep.json"));
     assert_eq!(table["frames"].as_array().unwrap().len(), 2);
     assert_eq!(table["step_degrees"], 0.17);
+    // the pictures of `compare --png-dir` likewise
+    let pictures = dir.join("pictures");
+    let compare = |extra: &[&str]| {
+        let out = bin()
+            .arg("compare")
+            .arg(data().join("quarter_annulus.json"))
+            .args(["--methods", "egg", "--png-dir"])
+            .arg(&pictures)
+            .args(extra)
+            .arg("-q")
+            .output()
+            .unwrap();
+        out.status.code()
+    };
+    assert_eq!(compare(&[]), Some(0));
+    let stale = pictures.join("quarter_annulus-vhm.png");
+    std::fs::write(&stale, b"an earlier run's picture").unwrap();
+    assert_eq!(compare(&[]), Some(1));
+    assert!(stale.is_file());
+    assert_eq!(compare(&["--overwrite"]), Some(0));
+    assert!(!stale.exists() && pictures.join("quarter_annulus-egg.png").is_file());
 }
 
 /// A ring map (what `solve` and `sweep` write for a ring) is taken as its ring by

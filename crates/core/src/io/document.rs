@@ -271,6 +271,39 @@ pub fn read_with_report(path: &Path) -> Result<(Document, Option<Value>)> {
 mod tests {
     use super::*;
 
+    /// A ring map's ring is its two contours, turned counter-clockwise: the annulus
+    /// between radii 1 and 2 whose `eta` runs clockwise gives its contours of radius 1
+    /// (inner) and 2 (outer), counter-clockwise; a four-sided map is not a ring map.
+    #[test]
+    fn a_ring_map_gives_its_ring() {
+        use crate::spline::knots::KnotVector;
+        let kv = KnotVector::periodic_uniform(2, 8);
+        let d = kv.dim();
+        let angle = |k: usize| -std::f64::consts::TAU * (k % d) as f64 / d as f64;
+        let cps =
+            (0..kv.num_basis()).flat_map(|k| [1.0, 2.0].map(|r| [r * angle(k).cos(), r * angle(k).sin()])).collect();
+        let map = Surface::new([KnotVector::open_uniform(1, 1), kv], cps, None).unwrap();
+        let doc = Document::Map { name: "annulus".into(), map };
+        assert!(doc.is_ring_map());
+        let ring = doc.into_ring().unwrap();
+        let area = |c: &ClosedContour| signed_area(&c.polygon_with(64));
+        let (inner, outer) = (area(&ring.inner), area(&ring.outer));
+        // a quadratic periodic spline inside the circle's octagon (area 2 sqrt(2) r^2),
+        // the outer one the inner scaled by 2
+        assert!(inner > 0.8 * std::f64::consts::PI && inner < 2.0 * 2f64.sqrt(), "{inner}");
+        assert!((outer / inner - 4.0).abs() < 1e-12, "{inner} {outer}");
+        let square = Surface::new(
+            [KnotVector::open_uniform(1, 1), KnotVector::open_uniform(1, 1)],
+            vec![[0., 0.], [1., 0.], [0., 1.], [1., 1.]],
+            None,
+        )
+        .unwrap();
+        let doc = Document::Map { name: "square".into(), map: square };
+        assert!(!doc.is_ring_map());
+        let e = doc.into_ring().unwrap_err();
+        assert!(matches!(&e, Error::DocumentKind { found, .. } if found == "map"), "{e}");
+    }
+
     #[test]
     fn detects_kind_by_content() {
         assert!(matches!(parse_document(""), Err(Error::Invalid(_))));
