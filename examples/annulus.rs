@@ -22,20 +22,22 @@ fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
 
 fn run() -> winslow::Result<(Verdict, f64)> {
     let boundary = annulus(1.0, 2.0, 1.5 * PI);
-    let solution = Pipeline::new(boundary, SolveOptions::default()).run(&mut |stage| {
-        match stage {
-            Stage::Fitted { hierarchy, .. } => println!("fitted: {} levels", hierarchy.levels.len()),
-            Stage::Solver(Event::LevelStarted { level, shape, .. }) => {
-                println!("level {level}: {}x{} basis", shape[0], shape[1])
+    let solution = Pipeline::new(boundary, SolveOptions::default())
+        .run(&mut |stage| {
+            match stage {
+                Stage::Fitted { hierarchy, .. } => println!("fitted: {} levels", hierarchy.levels.len()),
+                Stage::Solver(Event::LevelStarted { level, shape, .. }) => {
+                    println!("level {level}: {}x{} basis", shape[0], shape[1])
+                }
+                Stage::Solver(Event::Iterate { iterate, .. }) => {
+                    println!("  {:>2}  |F| = {:.3e}", iterate.iteration, iterate.residual)
+                }
+                Stage::Solver(Event::LevelFinished(r)) => println!("  done in {} iterations", r.iterations),
+                _ => {}
             }
-            Stage::Solver(Event::Iterate { iterate, .. }) => {
-                println!("  {:>2}  |F| = {:.3e}", iterate.iteration, iterate.residual)
-            }
-            Stage::Solver(Event::LevelFinished(r)) => println!("  done in {} iterations", r.iterations),
-            _ => {}
-        }
-        true // go on
-    })?;
+            true // go on
+        })?
+        .into_map()?;
     let r = &solution.report;
     println!(
         "{}: {:?}, det J min {:.4}, area {:.6} (exact {:.6})",

@@ -32,9 +32,10 @@ use winslow::boundary::fit::{fit_side, FitOptions};
 use winslow::boundary::ring::ClosedContour;
 use winslow::io::Output;
 use winslow::multipatch::split::{nearest_boundary_point, split_map, SplitOptions, SplitPath};
-use winslow::multipatch::{solve_multipatch, Interface, Interfaces, Layout, MultipatchOptions, Patch, PatchSide};
+use winslow::multipatch::{Interface, Interfaces, Layout, Patch, PatchSide};
+use winslow::solve::improve::Improve;
 use winslow::solve::options::SolveOptions;
-use winslow::{Analytic, Boundary, Curve, Point, Side, SideCurve};
+use winslow::{Analytic, Boundary, Curve, Pipeline, Point, Side, SideCurve, Solved};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
@@ -220,8 +221,12 @@ fn main() -> Res<()> {
     winslow::write(&out.join("layout.json"), &Output::Layout(&layout))?;
     println!("layout written: {}", out.join("layout.json").display());
     for interfaces in [Interfaces::Fixed, Interfaces::Free] {
-        let opts = MultipatchOptions { interfaces, ..Default::default() };
-        let sol = solve_multipatch(&layout, &opts)?;
+        // free interfaces: the layout improved by the Winslow functional
+        let improve = (interfaces == Interfaces::Free).then_some(Improve::Winslow);
+        let opts = SolveOptions { improve, ..Default::default() };
+        let Solved::Layout(sol) = Pipeline::new(layout.clone(), opts).solve()? else {
+            unreachable!("a layout's solve")
+        };
         let r = &sol.report;
         println!("{} interfaces: {} ({:.3} s)", interfaces.name(), r.message, r.seconds);
         for p in &sol.patches {

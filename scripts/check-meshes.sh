@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Open winslow's mesh files in a reference reader (meshio, from PyPI, in a venv): solve
 # the shared geometries, write .msh/.vtu/.su2 (structured, unstructured, curved) and
-# load each with meshio, printing its point and cell counts. Run by hand, not by CI.
+# load each with meshio, printing its point and cell counts and distinct points (a ring's
+# seam is merged: as many distinct points as points; the cut ring male_casing_ring is
+# refused for its coinciding nodes). Run by hand, not by CI.
 #   scripts/check-meshes.sh [WINSLOW_BINARY]
 set -euo pipefail
 W=${1:-./target/release/winslow}
@@ -10,7 +12,8 @@ VENV=${VENV:-/tmp/winslow-meshio-venv}
 mkdir -p "$OUT"
 [ -x "$VENV/bin/python" ] || { python3 -m venv "$VENV" && "$VENV/bin/pip" install -q meshio; }
 for g in tests/data/spiral_channel.json tests/data/wavy_lid.json tests/data/quarter_annulus.json \
-         tests/data/gismo/male_casing_ring.json tests/data/gismo/puzzle3.json; do
+         tests/data/gismo/male_casing_ring.json tests/data/gismo/puzzle3.json \
+         tests/data/rings/male_rotor_in_casing.json; do
   n=$(basename "$g" .json)
   "$W" solve "$g" -o "$OUT/$n.json" -q > /dev/null || { echo "$n: solve failed, skipped"; continue; }
   "$W" mesh "$OUT/$n.json" -o "$OUT/$n-s.msh" --structured 101x33 --cluster eta:arctan:6 > /dev/null || echo "  (refused, see the error above)"
@@ -29,5 +32,6 @@ for f in sorted(glob.glob(sys.argv[1] + "/*.msh") + glob.glob(sys.argv[1] + "/*.
     m = meshio.read(f)
     cells = ", ".join(f"{b.type} {len(b.data)}" for b in m.cells)
     tags = sorted(m.field_data) if m.field_data else []
-    print(f"{f}: {len(m.points)} points; {cells}" + (f"; groups {tags}" if tags else ""))
+    distinct = len({tuple(p) for p in m.points.tolist()})
+    print(f"{f}: {len(m.points)} points ({distinct} distinct); {cells}" + (f"; groups {tags}" if tags else ""))
 PY

@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 OUT=${OUT:-out/mesh-bench}
 mkdir -p "$OUT"
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)"
-"$W" solve tests/data/gismo/male_casing_ring.json -o "$OUT/ring.json" -q > /dev/null
+"$W" solve tests/data/rings/male_rotor_in_casing.json -o "$OUT/ring.json" -q > /dev/null
 "$W" solve tests/data/spiral_channel.json -o "$OUT/spiral.json" -q > /dev/null
 "$W" solve tests/data/wavy_lid.json -o "$OUT/lid.json" -q > /dev/null
 run() {
@@ -25,7 +25,7 @@ run() {
     cat "$OUT/$name.time"
   done
 }
-run ring-fig31 "$OUT/ring.json" -o "$OUT/ring-fig31.msh" --structured 401x35 --cluster eta:arctan:6
+run ring-fig31 "$OUT/ring.json" -o "$OUT/ring-fig31.msh" --structured 35x400 --cluster xi:arctan:6
 run spiral-fig31 "$OUT/spiral.json" -o "$OUT/spiral-fig31.msh" --structured 401x35 --cluster eta:arctan:6
 run spiral-1e6 "$OUT/spiral.json" -o "$OUT/spiral-1e6.msh" --unstructured --size 0.004
 run lid-1e6 "$OUT/lid.json" -o "$OUT/lid-1e6.msh" --unstructured --size 0.004

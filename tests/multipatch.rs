@@ -6,10 +6,11 @@ use std::path::PathBuf;
 
 use winslow::io::multipatch::gismo::{multipatch_to_gismo_xml, parse_gismo_multipatch};
 use winslow::multipatch::classes::LayoutBases;
-use winslow::multipatch::{solve_multipatch, validate_layout, Interfaces, Layout, MultipatchOptions};
-use winslow::multipatch::{Functional, Interface, Patch, PatchSide};
+use winslow::multipatch::{validate_layout, Functional, Interfaces, Layout, MultipatchSolution};
+use winslow::multipatch::{Interface, Patch, PatchSide};
 use winslow::solve::report::Verdict;
 use winslow::{Curve, KnotVector, Point, Side};
+use winslow::{Pipeline, SolveOptions, Solved};
 
 fn data(rel: &str) -> PathBuf {
     winslow::testutil::data("gismo/xml/multipatch").join(rel)
@@ -56,10 +57,17 @@ fn gismo_multipatch_round_trip_is_exact() {
     }
 }
 
-fn solve(name: &str, interfaces: Interfaces) -> winslow::multipatch::MultipatchSolution {
-    let l = read(name);
-    let opts = MultipatchOptions { interfaces, ..Default::default() };
-    solve_multipatch(&l, &opts).unwrap_or_else(|e| panic!("{name}: {e}"))
+/// The pipeline's solve of `layout`, improved (free interfaces) by `functional`.
+fn solve_layout(layout: &Layout, functional: Option<Functional>) -> MultipatchSolution {
+    let opts = SolveOptions { improve: functional, ..Default::default() };
+    match Pipeline::new(layout.clone(), opts).solve() {
+        Ok(Solved::Layout(sol)) => *sol,
+        other => panic!("{}: {other:?}", layout.name),
+    }
+}
+
+fn solve(name: &str, interfaces: Interfaces) -> MultipatchSolution {
+    solve_layout(&read(name), (interfaces == Interfaces::Free).then_some(Functional::Winslow))
 }
 
 #[test]
@@ -130,13 +138,12 @@ fn bent_pair(bend: f64) -> Layout {
 #[test]
 fn free_interfaces_straighten_a_bent_interface() {
     let l = bent_pair(0.3);
-    let fixed = solve_multipatch(&l, &MultipatchOptions::default()).unwrap();
+    let fixed = solve_layout(&l, None);
     assert_eq!(fixed.report.verdict, Verdict::Certified, "{}", fixed.report.message);
     let w_fixed = fixed.report.winslow.unwrap();
     assert!(w_fixed > 4.1, "{w_fixed}");
     for functional in [Functional::Winslow, Functional::WeakForm] {
-        let opts = MultipatchOptions { interfaces: Interfaces::Free, functional, ..Default::default() };
-        let free = solve_multipatch(&l, &opts).unwrap();
+        let free = solve_layout(&l, Some(functional));
         straight(&free, w_fixed);
     }
 }

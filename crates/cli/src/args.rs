@@ -178,7 +178,8 @@ pub(crate) struct SolverArgs {
     pub(crate) repair_freeze: Option<usize>,
     /// After the solve and its certificate, improve the map on the same basis, from the
     /// certified map: minimize the Winslow functional (eq. 16) or solve the weak form
-    /// (eq. 14); certify again and keep the improved map only when it is certified.
+    /// (eq. 14); certify again and keep the improved map only when it is certified. On a
+    /// multipatch layout: free interfaces with this functional (`--interfaces free`).
     #[arg(long, value_enum)]
     pub(crate) improve: Option<Improve>,
     /// With kinks kept (--kinks): which control points the final Winslow minimisation of

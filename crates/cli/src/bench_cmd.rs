@@ -72,7 +72,7 @@ pub(crate) fn bench(a: BenchArgs) -> Result<i32> {
             let o = SolveOptions { refine: r, ..opts.clone() };
             output::reset_peak_memory();
             let t = Instant::now();
-            let sol = solve_cmd::run_pipeline(boundary.clone(), &o, sel.as_assembler(), true)?;
+            let sol = solve_cmd::run_pipeline(boundary.clone(), &o, sel.as_assembler(), true)?.into_map()?;
             let total = t.elapsed().as_secs_f64();
             let row = output::BenchRow::new(&sol, r, total);
             if a.json {

@@ -1,11 +1,11 @@
 //! `winslow compare BOUNDARY [--methods egg,vhm,qc,maxz,liao,winslow-functional,ao]
 //! [--json] [--png-dir DIR]`: the methods of paper §10 on one basis, one table row each
-//! ([`winslow::solve::compare`]): iterations, the certificate's verdict, `Q(x) / Q(x_G)`,
+//! ([`winslow::pipeline::compare`]): iterations, the certificate's verdict, `Q(x) / Q(x_G)`,
 //! the Winslow, Liao and area-orthogonality values, the smallest scaled Jacobian, time.
 
 use super::*;
 use winslow::methods::quasi_conformal::QcHessian;
-use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
+use winslow::pipeline::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::constrained::ConstrainedOptions;
 
 #[derive(Args, Debug)]

@@ -21,7 +21,7 @@ use winslow::methods::Method;
 use winslow::solve::improve::{improve, Improve};
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::{KinksLocal, SolveOptions};
-use winslow::solve::report::{Solution, Verdict};
+use winslow::solve::report::Verdict;
 use winslow::solve::solver::Event;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 use winslow::verify::quality::{boundary_deviation, quality};

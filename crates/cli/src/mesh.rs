@@ -24,8 +24,9 @@ pub struct MeshSpec {
     /// Point distribution of a structured mesh, repeatable: DIR:uniform, DIR:arctan:A
     /// (eq. 50, A = 6 in the paper), DIR:tanh:D (two-sided), SIDE:tanh:D (one-sided,
     /// clustered at SIDE), `SIDE:first-height:H[:GROWTH]` (geometric layers whose first
-    /// cell is H long in physical units, growth ratio limit GROWTH, default 1.2).
-    /// DIR is xi or eta; SIDE is south, east, north or west.
+    /// cell is H long in physical units on every grid line, growth ratio limit GROWTH,
+    /// default 1.2). DIR is xi or eta; SIDE is south, east, north or west, or on a ring
+    /// inner (= west) or outer (= east); a ring's south and north are its periodic seam.
     #[arg(long, value_name = "SPEC")]
     pub cluster: Vec<String>,
     /// Equidistribute a structured mesh's points along the boundary, repeatable:
@@ -83,11 +84,11 @@ pub fn distributions(specs: &[String], equi: &[String]) -> Result<[Distribution;
         let (dir, end) = match parts[0] {
             "xi" => (0, None),
             "eta" => (1, None),
-            "west" => (0, Some(End::Start)),
-            "east" => (0, Some(End::End)),
+            "west" | "inner" => (0, Some(End::Start)),
+            "east" | "outer" => (0, Some(End::End)),
             "south" => (1, Some(End::Start)),
             "north" => (1, Some(End::End)),
-            o => bail!("--cluster {spec}: '{o}' is not xi, eta, south, east, north or west"),
+            o => bail!("--cluster {spec}: '{o}' is not xi, eta, south, east, north, west, inner or outer"),
         };
         let arg = |k: usize, what: &str| -> Result<f64> {
             let s = parts.get(k).with_context(|| format!("--cluster {spec}: missing {what}"))?;
@@ -169,6 +170,12 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     let format = Format::from_path(output)?;
     let t = Instant::now();
     let mut stats: Option<MeshingStats> = None;
+    let ring = winslow_mesh::periodic_directions(map)[1];
+    if let Some(c) = spec.cluster.iter().find(|c| c.starts_with("inner:") || c.starts_with("outer:")) {
+        if !ring {
+            bail!("--cluster {c}: inner and outer name the walls of a ring (a periodic map); this map has south, east, north and west");
+        }
+    }
     let linear = if let Some(s) = &spec.structured {
         let opts = StructuredOptions {
             points: parse_points(s)?,
@@ -262,6 +269,8 @@ mod tests {
         let d =
             distributions_of(&["south:first-height:1e-4:1.1".into(), "north:first-height:2e-4:1.1".into()]).unwrap();
         assert_eq!(d[1], Distribution::Layers { start: Some(1e-4), end: Some(2e-4), growth: 1.1 });
+        let d = distributions_of(&["inner:first-height:1e-4".into(), "outer:first-height:2e-4".into()]).unwrap();
+        assert_eq!(d[0], Distribution::Layers { start: Some(1e-4), end: Some(2e-4), growth: 1.2 });
         let d = distributions_of(&["west:tanh:2".into()]).unwrap();
         assert_eq!(d[0], Distribution::TanhOneSided { strength: 2.0, at: End::Start });
         assert!(distributions_of(&["eta:arctan:x".into()]).is_err());

@@ -8,7 +8,7 @@ use winslow::io::Patches;
 use winslow::multipatch::split::SplitPath;
 
 use crate::files;
-use winslow::multipatch::{solve_multipatch, Functional, Interfaces, Layout, MultipatchOptions, MultipatchSolution};
+use winslow::multipatch::{interfaces_of, Functional, Interfaces, Layout, MultipatchSolution};
 
 /// The options of `winslow solve` that only a multipatch layout reads.
 #[derive(Args, Debug, Clone)]
@@ -31,37 +31,31 @@ pub(super) struct MultipatchArgs {
     pub(super) vtm: Option<PathBuf>,
 }
 
-/// The options of a layout solve from the arguments of `winslow solve`.
-fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
-    let solve = a.solver.options()?;
-    if solve.improve.is_some() {
-        bail!(
-            "--improve and --method weak|winslow improve one patch; for a multipatch layout use --interfaces free (with --functional winslow|weak)"
-        );
+/// The options of a layout solve from the arguments of `winslow solve`: `--interfaces
+/// free` is the layout's improvement by `--functional` (or by `--improve`'s method when
+/// given), the pipeline's free-interface stage.
+pub(super) fn options(a: &SolveArgs) -> Result<SolveOptions> {
+    let mut solve = a.solver.options()?;
+    if a.multipatch.interfaces == Interfaces::Free && solve.improve.is_none() {
+        solve.improve = Some(a.multipatch.functional);
     }
-    Ok(MultipatchOptions {
-        interfaces: a.multipatch.interfaces,
-        functional: a.multipatch.functional,
-        refine: solve.refine,
-        // a layout refinement refines whole chains of patches: at most three rounds
-        repair: solve.repair.min(3),
-        solve,
-    })
+    Ok(solve)
 }
 
-/// `winslow solve LAYOUT`: solve, write, summarize; the exit code of the worst verdict.
-pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
-    let opts = options(a)?;
-    if !(output::quiet() || a.json) {
-        note!(
-            "{}: multipatch layout, {} patches, {} interfaces; interfaces {}",
-            layout.name,
-            layout.patches.len(),
-            layout.interfaces.len(),
-            opts.interfaces.name()
-        );
-    }
-    let sol = solve_multipatch(&layout, &opts).with_context(|| format!("solving the layout {}", layout.name))?;
+/// The first line of a layout solve's progress.
+pub(super) fn announce(layout: &Layout, opts: &SolveOptions) {
+    note!(
+        "{}: multipatch layout, {} patches, {} interfaces; interfaces {}",
+        layout.name,
+        layout.patches.len(),
+        layout.interfaces.len(),
+        interfaces_of(opts).name()
+    );
+}
+
+/// `winslow solve LAYOUT` after the pipeline: write, summarize; the exit code of the
+/// worst verdict.
+pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
     write(&sol, a)?;
     if a.json {
         files::print_json(serde_json::to_value(&sol.report)?)?;

@@ -111,7 +111,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         .maybe("--png", a.png.as_deref(), "picture", crate::files::ext::PNG)
         .check()?;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
-    let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?;
+    let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?.into_map()?;
     let egg = &sol.map;
     let copts = ConstrainedOptions {
         eps: a.eps,

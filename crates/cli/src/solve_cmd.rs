@@ -3,7 +3,8 @@
 
 use super::*;
 use crate::files;
-use winslow::{Input, Pipeline, Stage};
+use winslow::multipatch::LayoutEvent;
+use winslow::{Input, Pipeline, Solved, Stage};
 
 /// Run the pipeline on `input`, printing its stages on stderr unless `quiet`.
 pub(super) fn run_pipeline(
@@ -11,7 +12,7 @@ pub(super) fn run_pipeline(
     opts: &SolveOptions,
     assembler: Arc<dyn EggAssembler>,
     quiet: bool,
-) -> Result<Solution> {
+) -> Result<Solved> {
     let pipeline = Pipeline::new(input, opts.clone()).backend(assembler);
     let stderr = std::io::stderr();
     let mut failed = None;
@@ -120,6 +121,23 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
             writeln!(e, "  method: {} (start: {:?})", method.name(), method.start())
         }
         Stage::Fallback { reason } => writeln!(e, "basis auto: {reason}"),
+        Stage::Layout(LayoutEvent::Bases { patches, classes, basis_functions }) => {
+            writeln!(
+                e,
+                "  conforming bases: {classes} knot classes, {basis_functions} functions over {patches} patches"
+            )
+        }
+        Stage::Layout(LayoutEvent::Round { round, solved, failing }) => writeln!(
+            e,
+            "  {}: {solved} patches solved; {}",
+            if *round == 0 { "fixed interfaces".to_string() } else { format!("layout refinement {round}") },
+            if failing.is_empty() {
+                "all certified".to_string()
+            } else {
+                format!("not certified: {}", failing.join(", "))
+            }
+        ),
+        Stage::Layout(LayoutEvent::Free { functional }) => writeln!(e, "  free interfaces: {functional}"),
         Stage::Solver(Event::LevelStarted { level, levels, shape, unknowns, initial_guess }) => writeln!(
             e,
             "level {}/{levels}: {}x{} basis, {unknowns} unknowns, initial guess {initial_guess:?}",
@@ -163,7 +181,22 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
-        Document::Layout(layout) | Document::Multipatch(layout) => return super::multipatch_cmd::solve(layout, &a),
+        Document::Layout(layout) | Document::Multipatch(layout) => {
+            let opts = super::multipatch_cmd::options(&a)?;
+            if !(output::quiet() || a.json) {
+                super::multipatch_cmd::announce(&layout, &opts);
+            }
+            let name = layout.name.clone();
+            let solved = run_pipeline(layout, &opts, sel.as_assembler(), output::quiet() || a.json)
+                .with_context(|| format!("solving the layout {name}"))?;
+            return match solved {
+                Solved::Layout(sol) => super::multipatch_cmd::finish(*sol, &a),
+                _ => bail!(
+                    "the solve of the layout {} gave no multipatch result",
+                    a.boundary.as_deref().unwrap_or(path).display()
+                ),
+            };
+        }
         Document::Ring(ring) => Input::Ring(ring),
         // a ring map (a sweep's frame): the ring between its two contours
         doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),
@@ -174,7 +207,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
             Input::Boundary(boundary)
         }
     };
-    let sol = run_pipeline(input, &opts, sel.as_assembler(), output::quiet() || a.json)?;
+    let sol = run_pipeline(input, &opts, sel.as_assembler(), output::quiet() || a.json)?.into_map()?;
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let extra = Some(serde_json::json!({ "report": report }));

@@ -1,5 +1,5 @@
 //! `winslow sweep RING (--rotate-inner DEG --steps N [--center X,Y] | --inner-frames
-//! PATH...) -o DIR`: the sliding O-grid of paper §11.1 ([`winslow::solve::sweep`]): one
+//! PATH...) -o DIR`: the sliding O-grid of paper §11.1 ([`winslow::pipeline::sweep`]): one
 //! map per frame (JSON with the frame's row, and VTK Bézier cells), a ParaView `.pvd`
 //! series, the per-frame table (`sweep.csv`, `sweep.json`, and on stdout), and with
 //! `--apng` an animated PNG of the frames.
@@ -8,7 +8,7 @@ use super::*;
 use winslow::boundary::ring::{ClosedContour, Ring};
 use winslow::boundary::ring_fit::EtaRefinement;
 use winslow::io::picture::Image;
-use winslow::solve::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, SweepOptions};
+use winslow::pipeline::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, SweepOptions};
 
 #[derive(Args, Debug)]
 pub(super) struct SweepArgs {
@@ -329,6 +329,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             let cold = winslow::Pipeline::new(turned, frame0_options(&opts))
                 .eta_refinement(refinement)
                 .solve()
+                .and_then(|s| s.into_map())
                 .with_context(|| format!("cold solve of frame {k}"))?;
             let seconds = t0.elapsed().as_secs_f64();
             cold_checks.push(serde_json::json!({
@@ -364,7 +365,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         "step_degrees": a.rotate_inner,
         "seam": serde_json::to_value(seam)?,
         // frame 0's parameterization, which every frame keeps (arc length unless
-        // `--reparam constrained`: see `winslow::solve::sweep`)
+        // `--reparam constrained`: see `winslow::pipeline::sweep`)
         "reparam": serde_json::to_value(&sol.report.reparam)?,
         "frames": rows,
         "cold_seconds": cold,

@@ -130,3 +130,66 @@ fn solve_then_mesh_in_every_format() {
     assert!(!ok && err.contains("unknown mesh format"), "{err}");
     assert!(!dir.join("x.msh").exists());
 }
+
+#[test]
+fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let d = |f: &str| dir.join(f).to_string_lossy().into_owned();
+    let ring = data().join("rings/annulus_periodic.json").to_string_lossy().into_owned();
+    let (ok, _, err) = run(&["solve", &ring, "-o", &d("ring.json"), "-q"]);
+    assert!(ok, "{err}");
+    // 9 x 40 points: the seam is not repeated, so 40 points around make 40 cells
+    let (ok, _, err) = run(&["mesh", &d("ring.json"), "-o", &d("ring.msh"), "--structured", "9x40"]);
+    assert!(ok, "{err}");
+    let (nodes, cells, clockwise) = msh_cells(&d("ring.msh"));
+    assert_eq!((nodes, cells, clockwise), (9 * 40, 8 * 40, 0));
+    let layers = ["--cluster", "inner:first-height:1e-3:1.2", "--cluster", "outer:first-height:1e-3:1.2"];
+    let map = d("ring.json");
+    for out in ["ring.su2", "ring-case/", "ring.xyz", "ring.vtu"] {
+        let mut args = vec!["mesh", &map[..], "-o"];
+        let o = d(out);
+        args.extend([&o[..], "--structured", "61x64"]);
+        args.extend(layers);
+        let (ok, _, err) = run(&args);
+        assert!(ok, "{out}: {err}");
+    }
+    assert!(dir.join("ring-case/constant/polyMesh/boundary").exists());
+    let boundary = std::fs::read_to_string(dir.join("ring-case/constant/polyMesh/boundary")).unwrap();
+    assert!(boundary.contains("    inner\n") && boundary.contains("    outer\n") && !boundary.contains("south"));
+    // layers on the seam, inner/outer on a four-sided map, an unstructured ring: refused
+    let (ok, _, _) = run(&[
+        "mesh",
+        &d("ring.json"),
+        "-o",
+        &d("seam.su2"),
+        "--structured",
+        "41x64",
+        "--cluster",
+        "south:first-height:1e-3",
+    ]);
+    assert!(!ok);
+    let (ok, _, _) = run(&["mesh", &d("ring.json"), "-o", &d("seam.msh"), "--unstructured", "--size", "0.3"]);
+    assert!(!ok);
+    let lid = data().join("wavy_lid.json").to_string_lossy().into_owned();
+    let (ok, _, _) = run(&["solve", &lid, "-o", &d("lid.json"), "-q"]);
+    assert!(ok);
+    let (ok, _, _) = run(&[
+        "mesh",
+        &d("lid.json"),
+        "-o",
+        &d("seam.msh"),
+        "--structured",
+        "9x9",
+        "--cluster",
+        "inner:first-height:1e-3",
+    ]);
+    assert!(!ok);
+    // a ring cut into a four-sided map has coinciding nodes at the cut: refused, unwritten
+    let cut = data().join("gismo/male_casing_ring.json").to_string_lossy().into_owned();
+    let (ok, _, err) = run(&["solve", &cut, "-o", &d("cut.json"), "-q"]);
+    assert!(ok, "{err}");
+    let (ok, _, _) = run(&["mesh", &d("cut.json"), "-o", &d("seam.su2"), "--structured", "101x33"]);
+    assert!(!ok);
+    assert!(!dir.join("seam.su2").exists() && !dir.join("seam.msh").exists());
+}

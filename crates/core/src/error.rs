@@ -95,7 +95,7 @@ pub enum Error {
     /// and name), `side` its side (empty for the patch as a whole).
     #[error("multipatch layout, patch {patch}{}: {reason}", side_of(.side))]
     Layout { patch: String, side: String, reason: String },
-    /// The observer of a [`Pipeline`](crate::solve::pipeline::Pipeline) run stopped it.
+    /// The observer of a [`Pipeline`](crate::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
     Cancelled,
     /// A document of one kind (`crate::io::Document::kind`) where another is needed, or

@@ -18,11 +18,12 @@
 //! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
 //! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
 //! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split |
+//! | [`pipeline`] | the one observable entry ([`Pipeline`]) of every input (boundary, ring, layout); the runs built on it: the comparison of methods ([`pipeline::compare`]), the sliding grid ([`pipeline::sweep`]) |
 //! | [`io`] | [`read()`] and [`write()`]: every document kind (boundary, map, ring, multipatch layout and result, volume) in JSON, G+Smo XML, IGES, VTK and PNG |
 //!
 //! Dependencies point one way, down this table read from the bottom: `io` uses every
 //! group above it (it reads and writes boundaries, maps, layouts and their solutions),
-//! `multipatch` uses `solve` and what `solve` uses, `solve` uses `methods`, which use
+//! `pipeline` uses `multipatch` and what it uses, `multipatch` uses `solve` and what `solve` uses, `solve` uses `methods`, which use
 //! `verify`, `discrete`, `spline` and `linalg`; no module imports a module that imports it back. Two places differ from a
 //! plain "one folder per pipeline step": sparse storage sits in [`linalg`], *below*
 //! [`spline`], because the refinement operators of the splines (knot insertion,
@@ -52,7 +53,7 @@
 //! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | [`verify::certificate::coefficients`], [`solve::constrained`], functionals in [`methods::metric_norms`] |
 //! | §10.1, eq. (46) | variational harmonic method | [`methods::harmonic`] (kernel of second-derivative functionals: [`methods::density`]) |
 //! | §10.2, eq. (47)-(48) | quasi-conformal functional, `k` eliminated | [`methods::quasi_conformal`] (rank-one term: [`methods::DiscreteProblem::rank_one`]) |
-//! | §10, Tables 1-3 | the comparison of methods on one basis: EGG, VHM (eq. 46), quasi-conformal (eq. 47-48), max-z (eq. 49), constrained Liao / Winslow / area orthogonality from `x_G` | [`solve::compare`] |
+//! | §10, Tables 1-3 | the comparison of methods on one basis: EGG, VHM (eq. 46), quasi-conformal (eq. 47-48), max-z (eq. 49), constrained Liao / Winslow / area orthogonality from `x_G` | [`pipeline::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
 //! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
 //! | §11.2 | multipatch layouts, one knot vector per interface, fixed and free interfaces, joining and splitting | [`multipatch`] |
@@ -71,6 +72,7 @@ pub mod io;
 pub mod linalg;
 pub mod methods;
 pub mod multipatch;
+pub mod pipeline;
 pub mod solve;
 pub mod spline;
 #[cfg(any(test, feature = "testutil"))]
@@ -87,9 +89,8 @@ pub use error::{Error, Result};
 pub use io::{read, read_boundary, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
+pub use pipeline::{solve, Input, Pipeline, Solved, Stage};
 pub use solve::options::SolveOptions;
-pub use solve::pipeline;
-pub use solve::pipeline::{solve, Input, Pipeline, Stage};
 pub use solve::report::{Report, Solution, Verdict};
 pub use solve::solver::{EggSolver, Event};
 pub use spline::curve::{Curve, Point};

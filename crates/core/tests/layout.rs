@@ -199,7 +199,19 @@ fn dependencies_point_one_way() {
         panic!("module groups import each other: {}", c.join(" -> "));
     }
     // the pipeline order of the crate docs: nothing below imports anything above
-    let order = ["error", "linalg", "spline", "boundary", "discrete", "verify", "methods", "solve", "multipatch", "io"];
+    let order = [
+        "error",
+        "linalg",
+        "spline",
+        "boundary",
+        "discrete",
+        "verify",
+        "methods",
+        "solve",
+        "multipatch",
+        "pipeline",
+        "io",
+    ];
     for (g, refs) in &groups {
         let Some(i) = order.iter().position(|o| o == g) else { continue };
         for r in refs {

@@ -98,7 +98,7 @@ fn shared_rings_solve_and_certify() {
         };
         let mut opts = SolveOptions::default();
         opts.fit.tol = fit_tol;
-        let sol = winslow::Pipeline::new(ring, opts.clone()).solve().unwrap();
+        let sol = winslow::Pipeline::new(ring, opts.clone()).solve().and_then(|s| s.into_map()).unwrap();
         assert_eq!(sol.report.verdict, Verdict::Certified, "{name}: {}", sol.report.message);
         let dev = sol.report.boundary_deviation;
         assert!(

@@ -241,8 +241,9 @@ fn solve_on_the_gpu_gives_the_cpu_map() {
     let b = read_boundary(&data("quarter_annulus.json"), &ReadOptions::default()).expect("boundary");
     let opts = SolveOptions { min_elements: 6, ..Default::default() };
     let h = build_hierarchy(&b, &opts.fit).expect("fit");
-    let cpu = Pipeline::new(b.clone(), opts.clone()).solve().unwrap();
-    let gpu = Pipeline::new(b, opts).backend(g.clone() as Arc<dyn EggAssembler>).solve().unwrap();
+    let cpu = Pipeline::new(b.clone(), opts.clone()).solve().and_then(|s| s.into_map()).unwrap();
+    let gpu =
+        Pipeline::new(b, opts).backend(g.clone() as Arc<dyn EggAssembler>).solve().and_then(|s| s.into_map()).unwrap();
     assert!(gpu.report.backend.starts_with("gpu: "), "{}", gpu.report.backend);
     assert!(!gpu.report.backend.contains("fell back"), "{}", gpu.report.backend);
     assert_eq!(cpu.map.knots, gpu.map.knots);

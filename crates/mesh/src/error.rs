@@ -33,6 +33,21 @@ pub enum MeshError {
         /// Number of offending cells.
         count: usize,
     },
+    /// A mesh that breaks a rule of the format it is written in ([`crate::validate`]);
+    /// nothing is written.
+    #[error("{format} would reject this mesh: rule \"{rule}\" fails at {count} place(s), the first: {first}; {hint}")]
+    Invalid {
+        /// The file format.
+        format: &'static str,
+        /// The rule broken.
+        rule: String,
+        /// How many places break it.
+        count: usize,
+        /// The first (or worst) place.
+        first: String,
+        /// What to change.
+        hint: String,
+    },
     /// A format that cannot hold this mesh (element kind or structure).
     #[error("{format} cannot hold this mesh: {why}")]
     Unsupported {

@@ -256,6 +256,30 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
     }
     let lat = lattice(mesh.kind, p);
     let k = mesh.kind.corners();
+    let periodic = mesh.periodic;
+    // across a periodic seam a cell's corner parameters are unwrapped next to `o`, and
+    // the new nodes' parameters wrapped back into [0, 1)
+    let unwrap = move |o: DVec2, q: DVec2| {
+        let mut q = q;
+        for d in 0..2 {
+            if periodic[d] {
+                q[d] -= (q[d] - o[d]).round();
+            }
+        }
+        q
+    };
+    let wrap = move |q: DVec2| {
+        let mut q = q;
+        for d in 0..2 {
+            if periodic[d] {
+                q[d] = q[d].rem_euclid(1.0);
+                if q[d] >= 1.0 {
+                    q[d] = 0.0;
+                }
+            }
+        }
+        q
+    };
     let mut params = mesh.params.clone();
     let mut edge_nodes: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
     let mut cells = Vec::with_capacity(mesh.num_cells() * lat.len());
@@ -268,7 +292,8 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
                 (1..p)
                     .map(|m| {
                         let t = m as f64 / p as f64;
-                        params.push(params[lo] * (1.0 - t) + params[hi] * t);
+                        let (a, b) = (params[lo], unwrap(params[lo], params[hi]));
+                        params.push(wrap(a * (1.0 - t) + b * t));
                         params.len() - 1
                     })
                     .collect()
@@ -282,14 +307,14 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
     };
     for c in 0..mesh.num_cells() {
         let v = mesh.corners(c).to_vec();
-        let q: Vec<DVec2> = v.iter().map(|&n| mesh.params[n]).collect();
+        let q: Vec<DVec2> = v.iter().map(|&n| unwrap(mesh.params[v[0]], mesh.params[n])).collect();
         cells.extend(&v);
         for e in 0..k {
             let ids = edge(v[e], v[(e + 1) % k], &mut params);
             cells.extend(ids);
         }
         for &[i, j] in &lat[k + k * (p - 1)..] {
-            params.push(reference_to_parameter(mesh.kind, &q, i as f64 / p as f64, j as f64 / p as f64));
+            params.push(wrap(reference_to_parameter(mesh.kind, &q, i as f64 / p as f64, j as f64 / p as f64)));
             cells.push(params.len() - 1);
         }
     }
@@ -305,7 +330,17 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
         .collect();
     let mut points = mesh.points.clone();
     points.extend(crate::map_points(map, &params[mesh.points.len()..]));
-    Ok(Mesh { points, params, kind: mesh.kind, order: p, cells, boundary, structured: None })
+    Ok(Mesh {
+        points,
+        params,
+        kind: mesh.kind,
+        order: p,
+        cells,
+        boundary,
+        structured: None,
+        periodic: mesh.periodic,
+        names: mesh.names.clone(),
+    })
 }
 
 #[cfg(test)]

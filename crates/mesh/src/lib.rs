@@ -12,11 +12,15 @@
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
+//! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
 //! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
 //!
 //! Every mesh is a [`Mesh`]: nodes (physical and parameter coordinates), cells of one
 //! [`ElementKind`] and order with nodes in Gmsh's ordering, and boundary edges labelled
-//! by [`Side`]. Writers refuse a mesh with an inverted cell ([`Mesh::check`]).
+//! by [`Side`] and named by [`Mesh::names`] (`inner`/`outer` on a ring). A periodic
+//! direction of the map (a ring's `eta`) has one node per seam point and no boundary on
+//! its seam. Writers refuse a mesh that breaks a rule of the format
+//! ([`validate::validate`]).
 
 pub mod distribution;
 pub mod equidistribution;
@@ -27,6 +31,7 @@ pub mod quality;
 pub mod structured;
 pub mod topology;
 pub mod unstructured;
+pub mod validate;
 
 pub use distribution::{Distribution, End};
 pub use equidistribution::Equidistribution;
@@ -102,8 +107,25 @@ pub struct Mesh {
     /// Boundary edges, counter-clockwise around the domain.
     pub boundary: Vec<BoundaryEdge>,
     /// Points per direction `[nx, ny]` when the nodes are a structured grid stored
-    /// `xi` fastest (linear structured meshes only).
+    /// `xi` fastest (linear structured meshes only); a periodic direction has as many
+    /// points as cells (its seam is not repeated).
     pub structured: Option<[usize; 2]>,
+    /// Periodic parameter directions (`[false, true]` for a ring): parameters in `[0, 1)`,
+    /// cells wrap around the seam, no boundary edges on it.
+    pub periodic: [bool; 2],
+    /// Name of the boundary group of each side (indexed by `Side as usize`): the side
+    /// names for a four-sided map, `inner`/`outer` for the walls of a ring.
+    pub names: [String; 4],
+}
+
+/// The side names `south`, `east`, `north`, `west`.
+pub fn side_names() -> [String; 4] {
+    Side::ALL.map(|s| s.name().to_string())
+}
+
+/// The periodic directions of a map (those whose knot vector is periodic).
+pub fn periodic_directions(map: &winslow::Surface) -> [bool; 2] {
+    [map.knots[0].is_periodic(), map.knots[1].is_periodic()]
 }
 
 impl Mesh {
@@ -121,6 +143,16 @@ impl Mesh {
     pub fn cell(&self, c: usize) -> &[usize] {
         let n = self.nodes_per_cell();
         &self.cells[c * n..(c + 1) * n]
+    }
+
+    /// The name of the boundary group of `side`.
+    pub fn name(&self, side: Side) -> &str {
+        &self.names[side as usize]
+    }
+
+    /// The sides that carry boundary edges, in the order south, east, north, west.
+    pub fn boundary_sides(&self) -> Vec<Side> {
+        Side::ALL.into_iter().filter(|&s| self.boundary.iter().any(|e| e.side == s)).collect()
     }
 
     /// The corner nodes of cell `c`, counter-clockwise.

@@ -51,6 +51,11 @@ pub struct Quality {
     pub max_growth: f64,
     /// Largest and mean non-orthogonality over internal edges, degrees.
     pub non_orthogonality: [f64; 2],
+    /// Internal faces at 90° or more (OpenFOAM refuses them; see [`crate::validate`]).
+    pub faces_over_90: usize,
+    /// Smallest and largest first-cell height at each wall of a structured mesh, by
+    /// boundary group name ([`crate::structured::first_heights`]).
+    pub first_heights: Vec<(String, [f64; 2])>,
     /// Cells that are inverted or degenerate (see [`Mesh::check`]).
     pub inverted: usize,
     /// Smallest ratio `min det J / max det J` of a curved element's own Jacobian over
@@ -64,20 +69,10 @@ fn cross(a: DVec2, b: DVec2) -> f64 {
     a.perp_dot(b)
 }
 
-/// Signed area and centroid of a polygon.
+/// Signed area and centroid of a polygon, about its first corner
+/// ([`crate::validate::area_centroid`]).
 fn area_centroid(p: &[DVec2]) -> (f64, DVec2) {
-    let (mut a, mut c) = (0.0, DVec2::ZERO);
-    for k in 0..p.len() {
-        let (u, v) = (p[k], p[(k + 1) % p.len()]);
-        let w = cross(u, v);
-        a += w;
-        c += (u + v) * w;
-    }
-    if a == 0.0 {
-        (0.0, p.iter().copied().sum::<DVec2>() / p.len() as f64)
-    } else {
-        (0.5 * a, c / (3.0 * a))
-    }
+    crate::validate::area_centroid(p)
 }
 
 /// Why cell `c` is inverted or degenerate, if it is: a corner that does not turn left.
@@ -149,18 +144,16 @@ pub fn quality_with(mesh: &Mesh, faces: &Faces) -> Quality {
         .map(|f| {
             let (o, nb) = (f.owner, f.neighbour);
             let (a, b) = (mesh.points[f.nodes[0]], mesh.points[f.nodes[1]]);
-            let normal = DVec2::new((b - a).y, -(b - a).x);
-            let d = centroid[nb] - centroid[o];
-            let cosang = (normal.dot(d) / (normal.length() * d.length())).clamp(-1.0, 1.0);
-            let ang = if cosang.is_nan() { 90.0 } else { cosang.acos().to_degrees() };
+            let ang = crate::validate::face_non_orthogonality(a, b, centroid[o], centroid[nb]);
             let (ao, an) = (per[o].area.abs(), per[nb].area.abs());
             let g = ao.max(an) / ao.min(an);
             (ang, if g.is_nan() { f64::INFINITY } else { g })
         })
         .collect();
-    let (mut no_max, mut no_sum) = (0.0f64, 0.0);
+    let (mut no_max, mut no_sum, mut over) = (0.0f64, 0.0, 0);
     for (f, &(ang, g)) in faces.internal.iter().zip(&edge) {
         no_max = no_max.max(ang);
+        over += usize::from(ang >= 90.0);
         no_sum += ang;
         for c in [f.owner, f.neighbour] {
             per[c].growth = per[c].growth.max(g);
@@ -177,6 +170,11 @@ pub fn quality_with(mesh: &Mesh, faces: &Faces) -> Quality {
         max_skewness: fold(|q| q.skewness, 0.0, f64::max),
         max_growth: fold(|q| q.growth, 1.0, f64::max),
         non_orthogonality: [no_max, if faces.internal.is_empty() { 0.0 } else { no_sum / faces.internal.len() as f64 }],
+        faces_over_90: over,
+        first_heights: crate::structured::first_heights(mesh)
+            .into_iter()
+            .map(|(side, h)| (mesh.name(side).to_string(), h))
+            .collect(),
         inverted,
         min_jacobian_ratio: None,
         per_cell: per,
@@ -209,6 +207,9 @@ impl Quality {
                 format!("{:.2} / {:.2} deg", self.non_orthogonality[0], self.non_orthogonality[1]),
             ),
         ];
+        if self.faces_over_90 > 0 {
+            rows.push(("faces at 90 deg or more", format!("{}", self.faces_over_90)));
+        }
         if let Some(r) = self.min_jacobian_ratio {
             rows.push(("min det J ratio (curved)", format!("{r:.4}")));
         }
@@ -216,8 +217,18 @@ impl Quality {
         rows
     }
 
-    /// The quality table as text.
+    /// The smallest and largest first cell of each wall, as rows `(name, value)`.
+    pub fn first_height_rows(&self) -> Vec<(String, String)> {
+        self.first_heights
+            .iter()
+            .map(|(name, [lo, hi])| (format!("first cell {name} min / max"), format!("{lo:.4e} / {hi:.4e}")))
+            .collect()
+    }
+
+    /// The quality table as text, the first cells of the walls last.
     pub fn table(&self) -> String {
-        self.rows().iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
+        let mut rows: Vec<(String, String)> = self.rows().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        rows.extend(self.first_height_rows());
+        rows.iter().map(|(k, v)| format!("  {k:<28} {v}\n")).collect()
     }
 }

@@ -165,6 +165,16 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         clock = Instant::now();
         t
     };
+    if crate::periodic_directions(map).contains(&true) {
+        // the triangulation of the parameter square would leave the seam a crack of
+        // duplicated nodes, which no solver accepts
+        return Err(MeshError::Unsupported {
+            format: "an unstructured mesh",
+            why:
+                "the map is periodic (a ring): its seam would be a crack; use --structured NXxNY, whose seam is merged"
+                    .into(),
+        });
+    }
     if !(opts.size.is_finite() && opts.size > 0.0) {
         return Err(MeshError::param("size", format!("must be positive, got {}", opts.size)));
     }
@@ -423,5 +433,15 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
         }
     };
     boundary.sort_by(|a, b| (a.side as usize).cmp(&(b.side as usize)).then(along(a).total_cmp(&along(b))));
-    Ok(Mesh { points, params, kind: ElementKind::Triangle, order: 1, cells, boundary, structured: None })
+    Ok(Mesh {
+        points,
+        params,
+        kind: ElementKind::Triangle,
+        order: 1,
+        cells,
+        boundary,
+        structured: None,
+        periodic: [false, false],
+        names: crate::side_names(),
+    })
 }

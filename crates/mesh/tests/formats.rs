@@ -6,7 +6,7 @@ mod common;
 use std::collections::HashMap;
 use std::path::Path;
 
-use common::{annulus, signed_area};
+use common::{annulus, ring, signed_area};
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::{structured, unstructured, DVec2, Distribution, Mesh, Side, StructuredOptions, UnstructuredOptions};
@@ -20,7 +20,17 @@ fn meshes() -> Vec<Mesh> {
     vec![
         structured(&map, &opts).unwrap(),
         unstructured(&map, &UnstructuredOptions { size: 0.25, ..Default::default() }).unwrap(),
+        structured(&ring(), &StructuredOptions { points: [5, 24], distribution: opts.distribution.clone() }).unwrap(),
     ]
+}
+
+/// The map a mesh of [`meshes`] was made on.
+fn map_of(mesh: &Mesh) -> winslow::Surface {
+    if mesh.periodic[1] {
+        ring()
+    } else {
+        annulus()
+    }
 }
 
 fn side_counts(mesh: &Mesh) -> [usize; 4] {
@@ -42,14 +52,21 @@ fn nums(line: &str) -> Vec<f64> {
 fn read_msh(text: &str, mesh: &Mesh) {
     assert_eq!(section(text, "MeshFormat"), ["4.1 0 8"]);
     let names = section(text, "PhysicalNames");
-    assert_eq!(names[1..], ["1 1 \"south\"", "1 2 \"east\"", "1 3 \"north\"", "1 4 \"west\"", "2 5 \"domain\""]);
+    let sides = mesh.boundary_sides();
+    let mut expect: Vec<String> = sides.iter().map(|&s| format!("1 {} \"{}\"", s as usize + 1, mesh.name(s))).collect();
+    expect.push("2 5 \"domain\"".into());
+    assert_eq!(names[1..], expect);
     let ent = section(text, "Entities");
-    assert_eq!(ent[0], "4 4 1 0");
-    for t in 0..4 {
-        let v = nums(ent[5 + t]);
-        assert_eq!((v[7], v[8]), (1.0, (t + 1) as f64), "curve {} physical group", t + 1);
+    let points = if mesh.periodic.contains(&true) { 0 } else { 4 };
+    assert_eq!(ent[0], format!("{points} {} 1 0", sides.len()));
+    for (k, &side) in sides.iter().enumerate() {
+        let v = nums(ent[1 + points + k]);
+        let t = side as usize + 1;
+        assert_eq!((v[0], v[7], v[8]), (t as f64, 1.0, t as f64), "curve {t} physical group");
     }
-    assert_eq!(nums(ent[9])[7..], [1.0, 5.0, 4.0, 1.0, 2.0, 3.0, 4.0]);
+    let mut surface = vec![1.0, 5.0, sides.len() as f64];
+    surface.extend(sides.iter().map(|&s| (s as usize + 1) as f64));
+    assert_eq!(nums(ent[1 + points + sides.len()])[7..], surface);
     let lines = section(text, "Nodes");
     let head = nums(lines[0]);
     let n = mesh.points.len();
@@ -63,7 +80,11 @@ fn read_msh(text: &str, mesh: &Mesh) {
         for (k, &t) in tags.iter().enumerate() {
             let x = nums(lines[at + 1 + count + k]);
             coords.insert(t, DVec2::new(x[0], x[1]));
-            assert_eq!(winslow_mesh::formats::gmsh::entity(mesh.params[t - 1]), (dim, tag), "node {t} classification");
+            assert_eq!(
+                winslow_mesh::formats::gmsh::entity(mesh.params[t - 1], mesh.periodic),
+                (dim, tag),
+                "node {t} classification"
+            );
         }
         at += 1 + 2 * count;
     }
@@ -86,7 +107,7 @@ fn read_msh(text: &str, mesh: &Mesh) {
                 assert_eq!(v.len(), mesh.order + 1);
                 per_curve[tag - 1] += 1;
                 for t in &v {
-                    let e = winslow_mesh::formats::gmsh::entity(mesh.params[t - 1]);
+                    let e = winslow_mesh::formats::gmsh::entity(mesh.params[t - 1], mesh.periodic);
                     assert!(e == (1, tag) || e.0 == 0, "line node {t} off curve {tag}");
                 }
             } else {
@@ -106,10 +127,9 @@ fn read_msh(text: &str, mesh: &Mesh) {
 #[test]
 fn gmsh_round_trip() {
     let scratch = tempfile::tempdir().unwrap();
-    let map = annulus();
     for mesh in meshes() {
         for p in 1..=3 {
-            let m = elevate(&mesh, &map, p).unwrap();
+            let m = elevate(&mesh, &map_of(&mesh), p).unwrap();
             let path = scratch.path().join(format!("m{p}.msh"));
             write(&m, &path, Format::Gmsh).unwrap();
             read_msh(&std::fs::read_to_string(&path).unwrap(), &m);
@@ -129,10 +149,9 @@ fn xml_array<'a>(text: &'a str, name: &str) -> Vec<&'a str> {
 #[test]
 fn vtu_round_trip() {
     let scratch = tempfile::tempdir().unwrap();
-    let map = annulus();
     for mesh in meshes() {
         for p in 1..=3 {
-            let m = elevate(&mesh, &map, p).unwrap();
+            let m = elevate(&mesh, &map_of(&mesh), p).unwrap();
             let path = scratch.path().join(format!("m{p}.vtu"));
             write(&m, &path, Format::Vtu).unwrap();
             let text = std::fs::read_to_string(&path).unwrap();
@@ -218,15 +237,31 @@ fn su2_round_trip() {
             assert!(signed_area(&c) > 0.0);
         }
         let mut at = 3 + ne + np;
-        assert_eq!(lines[at], "NMARK= 4");
+        let sides = mesh.boundary_sides();
+        assert_eq!(lines[at], format!("NMARK= {}", sides.len()));
         at += 1;
-        for (s, side) in Side::ALL.iter().enumerate() {
-            assert_eq!(lines[at], format!("MARKER_TAG= {}", side.name()));
+        // every edge used by one cell only is on a marker: the seam of a ring is interior
+        let mut once: HashMap<(usize, usize), usize> = HashMap::new();
+        for l in &lines[2..2 + ne] {
+            let v: Vec<usize> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            let c = &v[1..v.len() - 1];
+            for e in 0..c.len() {
+                let (a, b) = (c[e], c[(e + 1) % c.len()]);
+                *once.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        once.retain(|_, n| *n == 1);
+        let mut marked = 0;
+        for side in &sides {
+            let s = *side as usize;
+            assert_eq!(lines[at], format!("MARKER_TAG= {}", mesh.name(*side)));
             let k: usize = lines[at + 1].strip_prefix("MARKER_ELEMS= ").unwrap().parse().unwrap();
             assert_eq!(k, side_counts(&mesh)[s]);
+            marked += k;
             for l in &lines[at + 2..at + 2 + k] {
                 let v: Vec<usize> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
                 assert_eq!(v[0], 3);
+                assert!(once.contains_key(&(v[1].min(v[2]), v[1].max(v[2]))), "marker edge inside the mesh");
                 assert!(v[1..].iter().all(|&i| match side {
                     Side::South => mesh.params[i].y == 0.0,
                     Side::East => mesh.params[i].x == 1.0,
@@ -237,13 +272,30 @@ fn su2_round_trip() {
             at += 2 + k;
         }
         assert_eq!(at, lines.len());
+        assert_eq!(marked, once.len(), "boundary edges without a marker");
+        // no two points coincide
+        let mut sorted: Vec<(u64, u64)> = pts.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), np);
     }
 }
 
 #[test]
 fn plot3d_round_trip_and_refusals() {
     let scratch = tempfile::tempdir().unwrap();
-    let [s, u] = &meshes()[..] else { unreachable!() };
+    let [s, u, r] = &meshes()[..] else { unreachable!() };
+    // a ring is an O-grid closed by repeating its seam line (JMAX = 24 + 1)
+    let path = scratch.path().join("r.xyz");
+    write(r, &path, Format::Plot3d).unwrap();
+    let v: Vec<f64> = std::fs::read_to_string(&path).unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(v[..3], [1.0, 5.0, 25.0]);
+    let n = 5 * 25;
+    assert_eq!(v.len(), 3 + 2 * n);
+    for i in 0..5 {
+        assert_eq!((v[3 + i], v[3 + n + i]), (v[3 + 24 * 5 + i], v[3 + n + 24 * 5 + i]));
+        assert_eq!((v[3 + i], v[3 + n + i]), (r.points[i].x, r.points[i].y));
+    }
     let path = scratch.path().join("m.xyz");
     write(s, &path, Format::Plot3d).unwrap();
     let v: Vec<f64> = std::fs::read_to_string(&path).unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
@@ -360,16 +412,20 @@ fn openfoam_polymesh_follows_the_rules() {
         let b = std::fs::read_to_string(dir.join("boundary")).unwrap();
         let mut start = ni;
         let counts = side_counts(&mesh);
-        for (k, name) in ["south", "east", "north", "west", "frontAndBack"].iter().enumerate() {
+        let sides = mesh.boundary_sides();
+        let mut names: Vec<&str> = sides.iter().map(|&s| mesh.name(s)).collect();
+        names.push("frontAndBack");
+        for (k, name) in names.iter().enumerate() {
             let at = b.find(&format!("    {name}\n")).unwrap_or_else(|| panic!("no patch {name}"));
             let block = &b[at..at + b[at..].find('}').unwrap()];
             let get = |key: &str| -> usize {
                 let l = block.lines().find(|l| l.trim_start().starts_with(key)).unwrap();
                 l.split_whitespace().nth(1).unwrap().trim_end_matches(';').parse().unwrap()
             };
-            let n = if k < 4 { counts[k] } else { 2 * cells };
+            let wall = k < sides.len();
+            let n = if wall { counts[sides[k] as usize] } else { 2 * cells };
             assert_eq!((get("nFaces"), get("startFace")), (n, start), "{name}");
-            assert!(block.contains(if k < 4 { "type            patch;" } else { "type            empty;" }));
+            assert!(block.contains(if wall { "type            patch;" } else { "type            empty;" }));
             start += n;
         }
         assert_eq!(start, faces.len());

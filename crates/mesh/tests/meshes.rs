@@ -2,11 +2,13 @@
 
 mod common;
 
-use common::{affine, annulus, folded, signed_area};
+use common::{affine, annulus, folded, ring, signed_area};
 use winslow_mesh::distribution::End;
+use winslow_mesh::formats::Format;
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::quality::quality;
-use winslow_mesh::structured::parameters;
+use winslow_mesh::topology::faces;
+use winslow_mesh::validate::validate;
 use winslow_mesh::{
     structured, unstructured, DVec2, Distribution, MeshError, Side, StructuredOptions, UnstructuredOptions,
 };
@@ -79,24 +81,112 @@ fn first_cell_height_and_growth_are_met_on_an_affine_map() {
 }
 
 #[test]
-fn first_cell_height_on_a_curved_map_is_the_largest_over_the_grid_lines() {
+fn first_cell_height_on_a_curved_map() {
     let map = annulus();
     let h = 2e-3;
+    let layers = |start| Distribution::Layers { start: Some(start), end: None, growth: 1.3 };
+    // layers in eta only: the chord of the first eta step is h on every radius 1 + u
+    let mesh =
+        structured(&map, &StructuredOptions { points: [31, 25], distribution: [Distribution::Uniform, layers(h)] })
+            .unwrap();
+    let [nx, ny] = mesh.structured.unwrap();
+    let p = |i: usize, j: usize| mesh.points[j * nx + i];
+    for i in 0..nx {
+        let e = p(i, 1).distance(p(i, 0));
+        assert!(e <= h * (1.0 + 1e-14) && e >= h * (1.0 - 1e-12), "line {i}: {e}");
+    }
+    // layers in both directions: a tensor grid, h the largest first chord (the outer
+    // radius 2 against the inner 1: the smallest is h / 2); xi-lines are radial and the
+    // xi height is the radius step on all of them
+    let mesh =
+        structured(&map, &StructuredOptions { points: [31, 25], distribution: [layers(5e-3), layers(h)] }).unwrap();
+    let p = |i: usize, j: usize| mesh.points[j * nx + i];
+    let first: Vec<f64> = (0..nx).map(|i| p(i, 1).distance(p(i, 0))).collect();
+    let hi = first.iter().copied().fold(0.0, f64::max);
+    assert!((hi - h).abs() < 1e-12 * h, "{hi}");
+    assert!((first[0] - h / 2.0).abs() < 1e-9 * h, "{}", first[0]);
+    for j in 0..ny {
+        let e = p(1, j).distance(p(0, j));
+        assert!((e - 5e-3).abs() < 1e-12 * 5e-3, "line {j}: {e}");
+    }
+    let q = quality(&mesh).unwrap();
+    let south = q.first_heights.iter().find(|(n, _)| n == "south").unwrap().1;
+    assert!((south[0] - first[0]).abs() < 1e-15 && south[1] == hi, "{south:?}");
+    assert_eq!(q.first_heights.len(), 4);
+}
+
+#[test]
+fn a_ring_has_one_node_per_seam_point_and_walls_named_inner_and_outer() {
+    let map = ring();
+    let mesh = structured(&map, &StructuredOptions::uniform(9, 40)).unwrap();
+    assert_eq!(mesh.points.len(), 9 * 40);
+    assert_eq!(mesh.num_cells(), 8 * 40);
+    assert!(winslow_mesh::validate::duplicate_nodes(&mesh).is_empty());
+    assert_eq!(mesh.boundary_sides(), [Side::East, Side::West]);
+    assert_eq!((mesh.name(Side::West), mesh.name(Side::East)), ("inner", "outer"));
+    // the seam is interior: 8 x 40 radial edges and 9 x 40 ring edges, 2 x 40 on walls
+    let f = faces(&mesh).unwrap();
+    assert_eq!((f.internal.len(), f.boundary.len()), (8 * 40 + 9 * 40 - 80, 80));
+    // the seam nodes are those of eta = 0; the cells of the last row use them
+    assert!(mesh.params.iter().all(|q| (0.0..1.0).contains(&q.y)));
+    let last = mesh.cell(mesh.num_cells() - 1);
+    assert_eq!((last[2], last[3]), (8, 7));
+    for format in [Format::Gmsh, Format::Su2, Format::OpenFoam, Format::Vtu, Format::Plot3d] {
+        validate(&mesh, format).unwrap();
+    }
+    // the walls are closed curves: every wall node on one wall edge start and one end
+    for side in [Side::East, Side::West] {
+        let mut starts: Vec<usize> = mesh.boundary.iter().filter(|e| e.side == side).map(|e| e.nodes[0]).collect();
+        let mut ends: Vec<usize> = mesh.boundary.iter().filter(|e| e.side == side).map(|e| e.nodes[1]).collect();
+        starts.sort_unstable();
+        ends.sort_unstable();
+        assert_eq!(starts, ends);
+        assert_eq!(starts.len(), 40);
+    }
+}
+
+#[test]
+fn first_cell_heights_on_a_ring_lie_within_h_over_g_and_h() {
+    // the gap between the walls varies from 1.2 to 1.8: one spacing for all lines
+    // would leave some first cells below h / 1.2
+    let map = ring();
+    let (h, g) = (1e-3, 1.2);
     let opts = StructuredOptions {
-        points: [31, 25],
-        distribution: [
-            Distribution::Layers { start: Some(5e-3), end: None, growth: 1.3 },
-            Distribution::Layers { start: Some(h), end: None, growth: 1.3 },
-        ],
+        points: [60, 64],
+        distribution: [Distribution::Layers { start: Some(h), end: Some(h), growth: g }, Distribution::Uniform],
     };
-    let [xi, eta] = parameters(&map, &opts).unwrap();
-    let x = |u: f64, v: f64| DVec2::from(map.eval(u, v));
-    let first = xi.iter().map(|&u| x(u, eta[1]).distance(x(u, 0.0))).fold(0.0, f64::max);
-    assert!((first - h).abs() < 1e-12 * h, "{first}");
-    // on the annulus the xi-lines are radial: the height is the radius step, 1 + u
-    assert!((xi[1] - 5e-3).abs() < 1e-12);
-    let west = eta.iter().map(|&v| x(xi[1], v).distance(x(0.0, v))).fold(0.0, f64::max);
-    assert!((west - 5e-3).abs() < 1e-12 * 5e-3, "{west}");
+    let mesh = structured(&map, &opts).unwrap();
+    let heights = winslow_mesh::structured::first_heights(&mesh);
+    assert_eq!(heights.len(), 2);
+    for (side, [lo, hi]) in heights {
+        assert!(lo >= h / g && hi <= h * (1.0 + 1e-14), "{side}: {lo} {hi}");
+        assert!(lo >= h * (1.0 - 1e-12), "{side}: {lo}");
+    }
+    // the radial lines are straight and evenly parametrized: the growth is exact
+    let [nx, ny] = mesh.structured.unwrap();
+    for j in 0..ny {
+        let e: Vec<f64> = (0..nx - 1).map(|i| mesh.points[j * nx + i + 1].distance(mesh.points[j * nx + i])).collect();
+        for w in e.windows(2) {
+            assert!((w[1] / w[0]).max(w[0] / w[1]) <= g * (1.0 + 1e-9), "line {j}");
+        }
+    }
+    for format in [Format::Gmsh, Format::Su2, Format::OpenFoam] {
+        validate(&mesh, format).unwrap();
+    }
+    // layers on the seam are refused, naming the walls
+    let seam = StructuredOptions {
+        points: [60, 64],
+        distribution: [Distribution::Uniform, Distribution::Layers { start: Some(h), end: None, growth: g }],
+    };
+    match structured(&map, &seam) {
+        Err(MeshError::Layer { side, why, .. }) => assert!(side == "south" && why.contains("seam"), "{why}"),
+        other => panic!("{other:?}"),
+    }
+    // an unstructured mesh would leave the seam a crack: refused
+    assert!(matches!(
+        unstructured(&map, &UnstructuredOptions { size: 0.3, ..Default::default() }),
+        Err(MeshError::Unsupported { .. })
+    ));
 }
 
 #[test]

@@ -104,7 +104,8 @@ fn diameter(map: &Surface) -> f64 {
 }
 
 impl MeshSettings {
-    /// The structured mesh's options (the `eta` distribution from the clustering).
+    /// The structured mesh's options (the `eta` distribution from the clustering; `xi`
+    /// on a ring, whose `eta` is periodic).
     pub fn structured_options(&self, map: &Surface) -> StructuredOptions {
         let eta = match self.clustering {
             Clustering::Uniform => Distribution::Uniform,
@@ -119,6 +120,11 @@ impl MeshSettings {
                 Distribution::Equidistributed(Equidistribution::Curvature { tol: self.strength * diameter(map) })
             }
         };
+        // a ring's eta runs around it (periodic, its ends are the seam): the clustering
+        // goes across the gap, in xi, between the inner and outer walls
+        if winslow_mesh::periodic_directions(map)[1] {
+            return StructuredOptions { points: self.points, distribution: [eta, Distribution::Uniform] };
+        }
         StructuredOptions { points: self.points, distribution: [Distribution::Uniform, eta] }
     }
 

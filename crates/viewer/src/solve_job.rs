@@ -12,7 +12,7 @@ use std::thread::JoinHandle;
 
 use winslow::boundary::ring::Ring;
 use winslow::methods::egg::CpuAssembler;
-use winslow::solve::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
+use winslow::pipeline::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
@@ -69,7 +69,7 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
         }
         !cancelled()
     });
-    match out {
+    match out.and_then(|solved| solved.into_map()) {
         Ok(sol) => send(Msg::Finished(Box::new(sol))),
         Err(winslow::Error::Cancelled) => send(Msg::Cancelled),
         Err(e) => send(Msg::Failed(e.to_string())),

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use egui::Vec2;
 use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
-use winslow::solve::compare::{CompareOptions, Comparison, MethodChoice};
+use winslow::pipeline::compare::{CompareOptions, Comparison, MethodChoice};
 use winslow::solve::options::SolveOptions;
 use winslow::Point;
 

@@ -52,7 +52,7 @@ use crate::spline::surface::Side;
 #[serde(rename_all = "kebab-case")]
 pub enum BasisChoice {
     /// The input basis when the sides allow it and its map is certified, else the fitted
-    /// basis ([`crate::solve::pipeline::Pipeline`] solves again): the boundary is kept exactly
+    /// basis ([`crate::pipeline::Pipeline`] solves again): the boundary is kept exactly
     /// wherever that gives a certified map (BASIS.md table in BENCHMARKS.md).
     #[default]
     #[cfg_attr(

@@ -26,4 +26,5 @@ pub mod split;
 pub use check::{validate_layout, LayoutReport};
 pub use layout::{Interface, Layout, Patch, PatchSide};
 pub use problem::Functional;
-pub use solve::{solve_multipatch, Interfaces, MultipatchOptions, MultipatchSolution};
+pub(crate) use solve::solve_multipatch;
+pub use solve::{interfaces_of, Interfaces, LayoutEvent, MultipatchSolution, LAYOUT_REPAIR};

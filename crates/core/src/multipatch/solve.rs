@@ -8,13 +8,14 @@
 //! direction classes it belongs to (the direction of its longer elements, or both; its
 //! neighbours are refined with it, so the layout stays conforming) and the layout is
 //! solved again, at most
-//! [`MultipatchOptions::repair`] times. With [`Interfaces::Free`] the certified layout
+//! [`LAYOUT_REPAIR`] times. With [`Interfaces::Free`] the certified layout
 //! is then improved with its interfaces free ([`super::free`]).
 //!
 //! The layout is solved in the normalised coordinates of one [`Similarity`] for all
 //! patches (the identity for a well-placed domain), so that the maps brought back are
 //! still conforming bit for bit.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -30,8 +31,8 @@ use crate::boundary::input_basis::input_levels;
 use crate::boundary::normalise::Similarity;
 use crate::boundary::reparam::ReparamReport;
 use crate::boundary::{diameter, BasisChoice, Boundary, SideCurve};
-use crate::error::Result;
-use crate::methods::egg::CpuAssembler;
+use crate::error::{Error, Result};
+use crate::methods::egg::EggAssembler;
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Report, Verdict};
 use crate::solve::solver::EggSolver;
@@ -63,32 +64,50 @@ impl Interfaces {
     }
 }
 
-/// Options of a multipatch solve.
-#[derive(Debug, Clone)]
-pub struct MultipatchOptions {
-    /// Options of every patch's solve (method, nonlinear iteration, certificate); its
-    /// `refine`, `repair` and `improve` are replaced by the layout's own.
-    pub solve: SolveOptions,
-    /// Fixed or free interfaces.
-    pub interfaces: Interfaces,
-    /// The problem of the free-interface stage.
-    pub functional: Functional,
-    /// Uniform halvings of every knot span of the layout's bases.
-    pub refine: usize,
-    /// Layout refinement rounds while a patch is not certified.
-    pub repair: usize,
+/// Layout refinement rounds at most while a patch is not certified ([`SolveOptions::repair`]
+/// when lower): a layout refinement refines whole chains of patches.
+pub const LAYOUT_REPAIR: usize = 3;
+
+/// How the options of one solve apply to a layout: every patch is solved with `opts`
+/// (method, nonlinear iteration, certificate), but `refine` refines the layout's bases,
+/// `repair` counts layout refinement rounds (at most [`LAYOUT_REPAIR`]), and `improve`
+/// is the free-interface stage (paper §11.2: improving a layout, one patch being a
+/// one-patch layout): [`Interfaces::Free`] with that functional.
+pub fn interfaces_of(opts: &SolveOptions) -> Interfaces {
+    if opts.improve.is_some() {
+        Interfaces::Free
+    } else {
+        Interfaces::Fixed
+    }
 }
 
-impl Default for MultipatchOptions {
-    fn default() -> Self {
-        Self {
-            solve: SolveOptions::default(),
-            interfaces: Interfaces::Fixed,
-            functional: Functional::Winslow,
-            refine: 0,
-            repair: 3,
-        }
-    }
+/// What a layout solve reports while it runs (the module documentation).
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum LayoutEvent {
+    /// The layout was validated and its conforming bases built.
+    Bases {
+        /// Patches.
+        patches: usize,
+        /// Direction classes (one knot vector each).
+        classes: usize,
+        /// Basis functions summed over the patches.
+        basis_functions: usize,
+    },
+    /// A round of fixed-interface solves ended.
+    Round {
+        /// The round (0: the first solve; then one per layout refinement).
+        round: usize,
+        /// Patches solved in this round (those whose bases changed).
+        solved: usize,
+        /// The patches not certified after it (the next round, if any, refines them).
+        failing: Vec<String>,
+    },
+    /// The free-interface stage starts.
+    Free {
+        /// Its functional: `"winslow"` or `"weak-form"`.
+        functional: &'static str,
+    },
 }
 
 /// One solved patch.
@@ -232,6 +251,7 @@ fn solve_patch(
     p: usize,
     sides: &[Curve; 4],
     opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
 ) -> Result<(Surface, Report, Certificate)> {
     let boundary = Boundary { name: layout.patches[p].name.clone(), sides: sides.clone().map(SideCurve::Spline) };
     let input = input_levels(&boundary)?
@@ -256,7 +276,7 @@ fn solve_patch(
     // 8 points per element of the finer direction, not more than asked for
     let finest = h.levels.last().map_or(1, |l| l.knots[0].num_elements().max(l.knots[1].num_elements()));
     o.sample = o.sample.min(8 * finest.max(4));
-    let sol = EggSolver::new(&boundary, std::sync::Arc::new(h), o, std::sync::Arc::new(CpuAssembler))?.finish()?;
+    let sol = EggSolver::new(&boundary, Arc::new(h), o, assembler)?.finish()?;
     let mut map = sol.map;
     // the boundary control points are the conforming sides' exactly
     let shape = map.shape();
@@ -291,11 +311,23 @@ fn coarse_directions(sides: &[Curve; 4], knots: &[crate::spline::knots::KnotVect
 }
 
 /// A patch's map, report and certificate, and the knot vectors it was solved on.
-type Solved = (Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2]);
+type PatchSolved = (Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2]);
 
-/// Solve `layout` (see the module documentation).
-pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<MultipatchSolution> {
+/// Solve `layout` (see the module documentation) with `opts` as [`interfaces_of`] says,
+/// every patch assembled on `assembler`; `observer` sees the [`LayoutEvent`]s and stops
+/// the solve ([`Error::Cancelled`]) when it returns `false`. The entry is
+/// [`Pipeline`](crate::pipeline::Pipeline) with a layout input.
+pub(crate) fn solve_multipatch(
+    layout: &Layout,
+    opts: &SolveOptions,
+    assembler: Arc<dyn EggAssembler>,
+    observer: &mut dyn FnMut(&LayoutEvent) -> bool,
+) -> Result<MultipatchSolution> {
     let t0 = Instant::now();
+    let interfaces = interfaces_of(opts);
+    let functional = opts.improve.unwrap_or_default();
+    let repair = opts.repair.min(LAYOUT_REPAIR);
+    let mut tell = |e: LayoutEvent| if observer(&e) { Ok(()) } else { Err(Error::Cancelled) };
     let checked = validate_layout(layout)?;
     let validation_seconds = t0.elapsed().as_secs_f64();
     let (lo, hi) = layout.bounding_box();
@@ -306,7 +338,8 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
         bases = bases.refined(None);
     }
     let n = unit.patches.len();
-    let mut solved: Vec<Option<Solved>> = vec![None; n];
+    tell(LayoutEvent::Bases { patches: n, classes: bases.classes.len(), basis_functions: bases.num_basis() })?;
+    let mut solved: Vec<Option<PatchSolved>> = vec![None; n];
     let mut rounds = 0;
     loop {
         let sides = bases.conforming_sides(&unit)?;
@@ -315,7 +348,7 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
         let results: Vec<Result<(usize, Surface, Report, Certificate)>> = todo
             .par_iter()
             .map(|&p| {
-                let (map, report, cert) = solve_patch(&unit, p, &sides[p], &opts.solve)?;
+                let (map, report, cert) = solve_patch(&unit, p, &sides[p], opts, assembler.clone())?;
                 Ok((p, map, report, cert))
             })
             .collect();
@@ -330,7 +363,9 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
                 !converged || !matches!(s.2.verdict, Finding::Certified { .. } | Finding::DegenerateCorner { .. })
             })
             .collect();
-        if failing.is_empty() || rounds >= opts.repair {
+        let failing_names = failing.iter().map(|&p| layout.label(p)).collect();
+        tell(LayoutEvent::Round { round: rounds, solved: todo.len(), failing: failing_names })?;
+        if failing.is_empty() || rounds >= repair {
             break;
         }
         let mut classes = Vec::new();
@@ -353,23 +388,17 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
         let (map, report, cert, _) = s.expect("every patch solved");
         converged.push(report.levels.last().is_some_and(|l| l.converged));
         let map = sim.physical_surface(&map)?;
-        let cert = if sim.is_identity() { cert } else { certify(&map, &opts.solve.certify)? };
+        let cert = if sim.is_identity() { cert } else { certify(&map, &opts.certify)? };
         maps.push(map);
         certs.push(cert);
         reports.push(report);
     }
     let mut free = None;
-    if opts.interfaces == Interfaces::Free {
+    if interfaces == Interfaces::Free {
         if converged.iter().all(|&c| c) {
-            let out = free_interfaces(
-                layout,
-                &maps,
-                &certs,
-                opts.functional,
-                opts.solve.nonlinear,
-                &opts.solve.certify,
-                checked.diameter,
-            );
+            tell(LayoutEvent::Free { functional: functional.name() })?;
+            let out =
+                free_interfaces(layout, &maps, &certs, functional, opts.nonlinear, &opts.certify, checked.diameter);
             match out {
                 Ok(f) => {
                     maps = f.maps;
@@ -377,12 +406,12 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
                     free = Some(f.report);
                 }
                 Err(crate::error::Error::InfeasibleStart { reason, .. }) => {
-                    free = Some(skipped(opts.functional, &maps, format!("not run: {reason}")));
+                    free = Some(skipped(functional, &maps, format!("not run: {reason}")));
                 }
                 Err(e) => return Err(e),
             }
         } else {
-            free = Some(skipped(opts.functional, &maps, "not run: a patch's solve did not converge".into()));
+            free = Some(skipped(functional, &maps, "not run: a patch's solve did not converge".into()));
         }
     }
     let verdicts: Vec<Verdict> = certs
@@ -409,7 +438,7 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
     let message = format!(
         "{good} of {n} patches certified ({}), interfaces {} ({} rounds of layout refinement); interface control points {}{}",
         verdict.name(),
-        opts.interfaces.name(),
+        interfaces.name(),
         rounds,
         if mismatch == 0.0 { "identical bit for bit".to_string() } else { format!("differ by up to {mismatch:.3e}") },
         free.as_ref().map(|f| format!("; {}", f.message)).unwrap_or_default()
@@ -432,7 +461,7 @@ pub fn solve_multipatch(layout: &Layout, opts: &MultipatchOptions) -> Result<Mul
     let report = MultipatchReport {
         version: env!("CARGO_PKG_VERSION"),
         name: layout.name.clone(),
-        interfaces: opts.interfaces.name(),
+        interfaces: interfaces.name(),
         layout: checked,
         classes,
         basis_functions: patches.iter().map(|p| p.map.control_points.len()).sum(),

@@ -9,18 +9,14 @@
 //! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
-//! | [`pipeline`] | [`Pipeline`](pipeline::Pipeline): the one observable entry (fit, hierarchy, solve, finish, fallback) of a boundary or a ring, run with an observer of its [`Stage`](pipeline::Stage)s; also `winslow::pipeline` | §5-§9 |
 //! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s | §6.3 |
-//! | [`sweep`] | [`Sweep`](sweep::Sweep): the sliding O-grid, inner contour turned per frame, extrapolated initial guesses | §11.1, Fig. 22 |
 //! | [`loft`] | [`loft`](loft::loft): a volume from planar slices, certified, with slices inserted (solved from interpolated guesses) where it is not | §11.1, Fig. 23 |
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified; the same stage on a layout (one patch: a one-patch layout) serves the free interfaces of [`multipatch`](crate::multipatch) | §4.1, §9, §11.2 |
 //! | [`constrained`] | Gravesen's feasible start [`max_z`](constrained::max_z) (`max z`, `d(c) >= z 1`) and the constrained optimisation [`optimise`](constrained::optimise) of the Liao, Winslow or area-orthogonality functional subject to `d(c) >= ε` (SQP, Clarabel subproblems), from the EGG map or the max-z point: [`run`](constrained::run) | §10.3, eq. (49), Table 3 |
 //! | [`kinks`] | [`keep_kinks`](kinks::keep_kinks): the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |
-//! | [`compare`] | [`compare`](compare::compare): EGG, the variational harmonic and the quasi-conformal methods, Gravesen's max-z and constrained Liao / Winslow / area-orthogonality optimisations from `x_G` ([`MethodChoice`](compare::MethodChoice); more through [`Contender`](compare::Contender)) on one basis, judged by the certificate, `Q(x) / Q(x_G)`, the Winslow, Liao and area-orthogonality values | §10, Tables 1-3 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
-pub mod compare;
 pub mod constrained;
 pub mod fixed_basis;
 pub mod improve;
@@ -30,8 +26,6 @@ pub mod levels;
 pub mod loft;
 pub mod newton;
 pub mod options;
-pub mod pipeline;
 pub mod repair;
 pub mod report;
 pub mod solver;
-pub mod sweep;

@@ -484,7 +484,7 @@ impl Iterator for EggSolver {
 mod tests {
     use super::*;
     use crate::boundary::{Analytic, SideCurve};
-    use crate::solve::pipeline::{solve, Pipeline};
+    use crate::pipeline::{solve, Pipeline};
     use crate::solve::report::Verdict;
 
     fn annulus(r0: f64, r1: f64, angle: f64) -> Boundary {
@@ -525,7 +525,7 @@ mod tests {
             inner: circle(0.4, [0.25, 0.1]),
             outer: circle(1.0, [0.0; 2]),
         };
-        let sol = Pipeline::new(ring, SolveOptions::default()).solve().unwrap();
+        let sol = Pipeline::new(ring, SolveOptions::default()).solve().and_then(|s| s.into_map()).unwrap();
         let r = &sol.report;
         assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
         assert!(sol.map.knots[1].is_periodic() && !sol.map.knots[0].is_periodic());
@@ -547,7 +547,7 @@ mod tests {
         for method in [Reparam::Auto, Reparam::ArcLength] {
             let mut opts = SolveOptions::default();
             opts.fit.reparam.method = method;
-            let sol = Pipeline::new(ring.clone(), opts).solve().unwrap();
+            let sol = Pipeline::new(ring.clone(), opts).solve().and_then(|s| s.into_map()).unwrap();
             let r = &sol.report;
             assert_eq!(r.reparam.used == Reparam::Constrained, method == Reparam::Auto);
             assert_eq!(r.reparam.matches.is_empty(), method == Reparam::ArcLength);

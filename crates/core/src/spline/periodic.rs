@@ -284,7 +284,7 @@ pub fn periodic_extraction(kv: &KnotVector) -> (Vec<Element>, Vec<Vec<f64>>) {
 /// cross-correlation of two degree-`p` B-splines: piecewise polynomial of degree `2p + 1`
 /// and `C^{2p}` in `sigma` (the `(p+1)`-th derivatives are sums of Dirac masses). A
 /// parameter that slides along a curve (the sliding grid of §11.1) then moves the control
-/// points smoothly in time, and the time extrapolation of `solve::sweep` keeps its
+/// points smoothly in time, and the time extrapolation of `pipeline::sweep` keeps its
 /// order; a refit to shifted samples would only be `C^{p-1}`.
 #[derive(Debug)]
 pub struct PeriodicTranslate {

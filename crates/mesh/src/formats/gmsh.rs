@@ -1,8 +1,10 @@
 //! Gmsh MSH 4.1 ASCII.
 //!
 //! Entities: points 1-4 at the parameter corners `(0,0), (1,0), (1,1), (0,1)`, curves 1-4
-//! = south, east, north, west (counter-clockwise, physical groups 1-4 of those names),
-//! surface 1 bounded by them (physical group 5 "domain"). Every node is classified on
+//! = south, east, north, west (counter-clockwise, physical groups 1-4 named by
+//! [`Mesh::names`]), surface 1 bounded by them (physical group 5 "domain"). A ring
+//! (periodic `eta`) has no corners and two closed curves, 4 (`inner`, `xi = 0`) and 2
+//! (`outer`, `xi = 1`); its seam nodes are surface nodes. Every node is classified on
 //! the entity its parameters lie on (corner, side or interior), one node block per
 //! entity; elements: lines on the curves (types 1, 8, 26 for order 1, 2, 3), the cells
 //! on the surface (triangles 2, 9, 21; quadrilaterals 3, 10, 36). Node tag = index + 1.
@@ -14,9 +16,11 @@ use winslow::Side;
 use crate::error::Result;
 use crate::{ElementKind, Mesh};
 
-/// Entity `(dim, tag)` of a node from its parameters.
-pub fn entity(q: glam::DVec2) -> (usize, usize) {
-    let (u0, u1, v0, v1) = (q.x == 0.0, q.x == 1.0, q.y == 0.0, q.y == 1.0);
+/// Entity `(dim, tag)` of a node from its parameters (a periodic direction has no
+/// sides: its seam is interior).
+pub fn entity(q: glam::DVec2, periodic: [bool; 2]) -> (usize, usize) {
+    let (u0, u1) = (!periodic[0] && q.x == 0.0, !periodic[0] && q.x == 1.0);
+    let (v0, v1) = (!periodic[1] && q.y == 0.0, !periodic[1] && q.y == 1.0);
     match (u0, u1, v0, v1) {
         (true, _, true, _) => (0, 1),
         (_, true, true, _) => (0, 2),
@@ -57,9 +61,11 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
     let w = |s: &mut String, a: std::fmt::Arguments| {
         let _ = s.write_fmt(a);
     };
-    w(&mut s, format_args!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n5\n"));
-    for side in Side::ALL {
-        w(&mut s, format_args!("1 {} \"{}\"\n", side as usize + 1, side.name()));
+    let sides = mesh.boundary_sides();
+    let corners = !mesh.periodic.contains(&true);
+    w(&mut s, format_args!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n{}\n", sides.len() + 1));
+    for &side in &sides {
+        w(&mut s, format_args!("1 {} \"{}\"\n", side as usize + 1, mesh.name(side)));
     }
     w(&mut s, format_args!("2 5 \"domain\"\n$EndPhysicalNames\n"));
     // corner positions and bounding boxes from the nodes classified on each entity
@@ -70,7 +76,7 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         _ => 8,
     };
     for (n, q) in mesh.params.iter().enumerate() {
-        buckets[slot(entity(*q))].push(n);
+        buckets[slot(entity(*q, mesh.periodic))].push(n);
     }
     let bbox = |nodes: &[usize]| {
         let mut lo = glam::DVec2::splat(f64::INFINITY);
@@ -81,22 +87,28 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         }
         (lo, hi)
     };
-    w(&mut s, format_args!("$Entities\n4 4 1 0\n"));
-    for t in 0..4 {
+    let points = if corners { 4 } else { 0 };
+    w(&mut s, format_args!("$Entities\n{points} {} 1 0\n", sides.len()));
+    for t in 0..points {
         let p = buckets[t].first().map_or(glam::DVec2::ZERO, |&n| mesh.points[n]);
         w(&mut s, format_args!("{} {} {} 0 0\n", t + 1, p.x, p.y));
     }
     let curve_points = [[1, 2], [2, 3], [3, 4], [4, 1]];
-    for t in 0..4 {
+    for t in sides.iter().map(|&side| side as usize) {
         let mut nodes = buckets[4 + t].clone();
         nodes.extend(curve_points[t].iter().flat_map(|&c| buckets[c - 1].iter().copied()));
         let (lo, hi) = bbox(&nodes);
         let [a, b] = curve_points[t];
-        w(&mut s, format_args!("{} {} {} 0 {} {} 0 1 {} 2 {a} -{b}\n", t + 1, lo.x, lo.y, hi.x, hi.y, t + 1));
+        let ends = if corners { format!("2 {a} -{b}") } else { "0".into() };
+        w(&mut s, format_args!("{} {} {} 0 {} {} 0 1 {} {ends}\n", t + 1, lo.x, lo.y, hi.x, hi.y, t + 1));
     }
     let all: Vec<usize> = (0..mesh.points.len()).collect();
     let (lo, hi) = bbox(&all);
-    w(&mut s, format_args!("1 {} {} 0 {} {} 0 1 5 4 1 2 3 4\n$EndEntities\n", lo.x, lo.y, hi.x, hi.y));
+    w(&mut s, format_args!("1 {} {} 0 {} {} 0 1 5 {}", lo.x, lo.y, hi.x, hi.y, sides.len()));
+    for &side in &sides {
+        w(&mut s, format_args!(" {}", side as usize + 1));
+    }
+    w(&mut s, format_args!("\n$EndEntities\n"));
     let entities = |k: usize| match k {
         0..=3 => (0, k + 1),
         4..=7 => (1, k - 3),

@@ -1,5 +1,6 @@
-//! Mesh files: each writer refuses an inverted mesh ([`crate::Mesh::check`]) and a mesh
-//! its format cannot hold.
+//! Mesh files: each writer refuses a mesh that breaks a rule of its format
+//! ([`crate::validate::validate`]: positive volumes, one orientation, no duplicate nodes,
+//! and for OpenFOAM non-orthogonality below 90°) and a mesh its format cannot hold.
 //!
 //! | format | module | holds |
 //! |---|---|---|
@@ -71,10 +72,11 @@ impl Format {
     }
 }
 
-/// Write `mesh` to `path` in `format`; returns the files written. The mesh is checked
-/// first: an inverted or degenerate cell is an error and nothing is written.
+/// Write `mesh` to `path` in `format`; returns the files written. The mesh is validated
+/// first against the format's rules ([`crate::validate::validate`]): a mesh that breaks
+/// one is an error naming the rule and the place, and nothing is written.
 pub fn write(mesh: &Mesh, path: &Path, format: Format) -> Result<Vec<PathBuf>> {
-    mesh.check()?;
+    crate::validate::validate(mesh, format)?;
     // every file through the atomic writer: never a half-written mesh under its name
     let file = |p: &Path, text: String| winslow::io::write_bytes(p, text.as_bytes()).map_err(MeshError::File);
     let single = |text: String| -> Result<Vec<PathBuf>> {

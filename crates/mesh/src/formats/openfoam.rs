@@ -1,6 +1,6 @@
 //! OpenFOAM `constant/polyMesh` for a 2D case: the mesh extruded one cell thick in `z`
-//! (`0` to the thickness), the four sides as `patch`es named `south`, `east`, `north`,
-//! `west`, and the front and back faces as the `empty` patch `frontAndBack`.
+//! (`0` to the thickness), the sides as `patch`es named by [`crate::Mesh::names`]
+//! (`south`, `east`, `north`, `west`; `inner` and `outer` on a ring), and the front and back faces as the `empty` patch `frontAndBack`.
 //!
 //! What OpenFOAM requires and this writer does: internal faces first, in upper-triangular
 //! order (sorted by owner, then neighbour, with owner < neighbour), each face's normal
@@ -9,8 +9,6 @@
 //! Linear cells only (quads become hexahedra, triangles prisms).
 
 use std::fmt::Write;
-
-use winslow::Side;
 
 use crate::error::Result;
 use crate::topology::faces;
@@ -69,14 +67,14 @@ pub fn files(mesh: &Mesh, opts: &OpenFoamOptions) -> Result<Vec<(&'static str, S
     }
     let mut patches = Vec::new();
     let mut start = n_int;
-    for side in Side::ALL {
+    for side in mesh.boundary_sides() {
         let mut count = 0;
         for face in f.boundary.iter().filter(|b| b.side == side) {
             quad(&mut face_text, face.nodes);
             let _ = writeln!(owner_text, "{}", face.owner);
             count += 1;
         }
-        patches.push((side.name(), "patch", count, start));
+        patches.push((mesh.name(side), "patch", count, start));
         start += count;
     }
     for c in 0..cells {

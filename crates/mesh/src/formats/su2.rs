@@ -1,10 +1,9 @@
 //! SU2 native mesh (`.su2`, ASCII): `NDIME= 2`, the cells as VTK types (5 triangle,
 //! 9 quad) with their index, the points with their index, and one marker per side
-//! (`MARKER_TAG= south`, ...) of line elements (VTK type 3). Linear cells only.
+//! named by [`Mesh::names`] (`MARKER_TAG= south`, ..., `inner`/`outer` on a ring) of line
+//! elements (VTK type 3). Linear cells only.
 
 use std::fmt::Write;
-
-use winslow::Side;
 
 use crate::error::Result;
 use crate::{ElementKind, Mesh};
@@ -31,10 +30,11 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         let p = mesh.points[i];
         let _ = writeln!(s, "{} {} {i}", p.x, p.y);
     }));
-    let _ = writeln!(s, "NMARK= 4");
-    for side in Side::ALL {
+    let sides = mesh.boundary_sides();
+    let _ = writeln!(s, "NMARK= {}", sides.len());
+    for side in sides {
         let edges: Vec<_> = mesh.boundary.iter().filter(|e| e.side == side).collect();
-        let _ = writeln!(s, "MARKER_TAG= {}\nMARKER_ELEMS= {}", side.name(), edges.len());
+        let _ = writeln!(s, "MARKER_TAG= {}\nMARKER_ELEMS= {}", mesh.name(side), edges.len());
         for e in edges {
             let _ = writeln!(s, "3 {} {}", e.nodes[0], e.nodes[1]);
         }

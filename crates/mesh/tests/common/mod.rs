@@ -46,3 +46,21 @@ pub fn folded() -> Surface {
 pub fn signed_area(p: &[DVec2]) -> f64 {
     (0..p.len()).map(|k| p[k].perp_dot(p[(k + 1) % p.len()])).sum()
 }
+
+/// A full ring: `u` from an inner circle of radius 0.5 about `(0.3, 0)` (`u = 0`) to the
+/// circle of radius 2 about the origin (`u = 1`), `v` periodic counter-clockwise (a
+/// periodic cubic B-spline of 16 elements through control points on the circles), so
+/// the gap between the walls varies from 1.2 to 1.8.
+pub fn ring() -> Surface {
+    let ku = KnotVector::open_uniform(1, 1);
+    let kv = KnotVector::periodic_uniform(3, 16);
+    let n = kv.num_basis();
+    let mut cps = Vec::new();
+    for j in 0..n {
+        let t = 2.0 * std::f64::consts::PI * ((j % 16) as f64) / 16.0;
+        for (c, r) in [(0.3, 0.5), (0.0, 2.0)] {
+            cps.push([c + r * t.cos(), r * t.sin()]);
+        }
+    }
+    Surface::new([ku, kv], cps, None).unwrap()
+}

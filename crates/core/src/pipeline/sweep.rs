@@ -72,9 +72,6 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::fixed_basis::{scaled_options, FixedBasisSolve};
-use super::options::SolveOptions;
-use super::report::Solution;
 use crate::boundary::normalise::Similarity;
 use crate::boundary::reparam::Reparam;
 use crate::boundary::ring::{ray_parameter, ClosedContour, Ring};
@@ -82,7 +79,10 @@ use crate::boundary::ring_fit::{fit_contour_seam, EtaRefinement};
 use crate::discrete::assembly::Discretization;
 use crate::error::{Error, Result};
 use crate::methods::egg::EggMethod;
-use crate::solve::pipeline::{ring_options, Pipeline};
+use crate::pipeline::{ring_options, Pipeline};
+use crate::solve::fixed_basis::{scaled_options, FixedBasisSolve};
+use crate::solve::options::SolveOptions;
+use crate::solve::report::Solution;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::periodic::PeriodicTranslate;
@@ -270,7 +270,7 @@ impl Sweep {
             Seam::Material => EtaRefinement::Adaptive,
             Seam::Slide | Seam::Ray => EtaRefinement::Uniform,
         };
-        let sol = Pipeline::new(ring.clone(), frame0_options(opts)).eta_refinement(refinement).solve()?;
+        let sol = Pipeline::new(ring.clone(), frame0_options(opts)).eta_refinement(refinement).solve()?.into_map()?;
         let opts = ring_options(opts);
         // the sweep runs in the coordinates the cold solve ran in (normalised rings)
         let sim = sol.report.normalisation.unwrap_or(Similarity::IDENTITY);

@@ -2,10 +2,13 @@
 //! quadrature back end, run with an observer that sees every stage and may stop it.
 //!
 //! ```text
-//! fit (§5, §7) → hierarchy (§5.4) → coarse-to-fine solve (§6.3) → defect correction (§8.2)
-//!   → kinks kept (§9) → improvement (§4.1) → certificate (§8.1) → report
+//! boundary, ring: fit (§5, §7) → hierarchy (§5.4) → coarse-to-fine solve (§6.3)
+//!   → defect correction (§8.2) → kinks kept (§9) → improvement (§4.1)
+//!   → certificate (§8.1) → report
 //!   → with `--basis auto`: solved again on the fitted basis when the input basis' map is
 //!     not certified
+//! layout (§11.2): conforming bases → every patch solved as above on them, in parallel
+//!   → layout refinement around the patches not certified → free interfaces (improvement)
 //! ```
 //!
 //! ```no_run
@@ -18,13 +21,18 @@
 //!     }
 //!     true // go on; `false` stops the solve (`Error::Cancelled`)
 //! })?;
-//! println!("{}", solution.report.verdict.name());
+//! println!("{}", solution.verdict().name());
 //! # Ok(())
 //! # }
 //! ```
 //!
-//! The CLI's `solve`, the viewer's solve job, `compare` and the core's [`solve`] all run
-//! this; they only render its stages.
+//! The CLI's `solve`, the viewer's solve job, [`compare`], [`sweep`] and the core's
+//! [`solve`] all run this; they only render its stages. The runs built on it live beside
+//! it: the comparison of methods on one basis ([`compare`], paper §10) and the sliding
+//! O-grid ([`sweep`], §11.1).
+
+pub mod compare;
+pub mod sweep;
 
 use std::sync::Arc;
 
@@ -37,6 +45,7 @@ use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
+use crate::multipatch::{solve_multipatch, Layout, LayoutEvent, MultipatchSolution};
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
@@ -49,6 +58,10 @@ pub enum Input {
     Boundary(Boundary),
     /// A ring (paper §11.1): an O-grid between two closed contours, `eta` periodic.
     Ring(Ring),
+    /// A multipatch layout (§11.2): four-sided patches and the interfaces between them,
+    /// solved conforming ([`multipatch::solve`](mod@crate::multipatch::solve); free interfaces when the options ask for
+    /// an improvement).
+    Layout(Layout),
 }
 
 impl Input {
@@ -57,6 +70,7 @@ impl Input {
         match self {
             Input::Boundary(b) => &b.name,
             Input::Ring(r) => &r.name,
+            Input::Layout(l) => &l.name,
         }
     }
 }
@@ -70,6 +84,45 @@ impl From<Boundary> for Input {
 impl From<Ring> for Input {
     fn from(r: Ring) -> Self {
         Input::Ring(r)
+    }
+}
+
+impl From<Layout> for Input {
+    fn from(l: Layout) -> Self {
+        Input::Layout(l)
+    }
+}
+
+/// What the pipeline gives back: one map, or a conforming map per patch.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Solved {
+    /// The map of a boundary or a ring.
+    Map(Box<Solution>),
+    /// The maps of a layout.
+    Layout(Box<MultipatchSolution>),
+}
+
+impl Solved {
+    /// The verdict (for a layout the worst over its patches).
+    pub fn verdict(&self) -> Verdict {
+        match self {
+            Solved::Map(s) => s.report.verdict,
+            Solved::Layout(s) => s.report.verdict,
+        }
+    }
+
+    /// The one map of a boundary or a ring; a layout's maps are the error
+    /// [`Error::DocumentKind`].
+    pub fn into_map(self) -> Result<Solution> {
+        match self {
+            Solved::Map(s) => Ok(*s),
+            Solved::Layout(_) => Err(Error::DocumentKind {
+                path: None,
+                found: "multipatch result".into(),
+                needed: "one map is needed".into(),
+            }),
+        }
     }
 }
 
@@ -97,6 +150,9 @@ pub enum Stage<'a> {
         /// Why.
         reason: &'a str,
     },
+    /// An event of a layout's solve: its bases, a round of patch solves, the
+    /// free-interface stage.
+    Layout(&'a LayoutEvent),
 }
 
 /// The observer of a run: sees every [`Stage`]; returns `false` to stop the solve.
@@ -139,7 +195,8 @@ impl Pipeline {
         self
     }
 
-    /// Solve `method` on every level instead of EGG (eq. 8) with the options' operator.
+    /// Solve `method` on every level instead of EGG (eq. 8) with the options' operator
+    /// (a boundary or a ring; a layout solves EGG on every patch).
     pub fn method(mut self, method: Arc<dyn Method>) -> Self {
         self.method = Some(method);
         self
@@ -153,17 +210,29 @@ impl Pipeline {
     }
 
     /// Solve without watching.
-    pub fn solve(self) -> Result<Solution> {
+    pub fn solve(self) -> Result<Solved> {
         self.run(&mut |_| true)
     }
 
     /// Solve, every stage to `observer`; [`Error::Cancelled`] when it returned `false`.
-    pub fn run(self, observer: &mut Observer<'_>) -> Result<Solution> {
-        self.run_keeping_hierarchy(observer).map(|(sol, _)| sol)
+    pub fn run(self, observer: &mut Observer<'_>) -> Result<Solved> {
+        if let Input::Layout(layout) = &self.input {
+            self.opts.validate()?;
+            if self.method.is_some() {
+                return Err(Error::Invalid(
+                    "a layout solves EGG on every patch; its free-interface stage is the options' improvement".into(),
+                ));
+            }
+            let assembler = self.assembler.clone();
+            return solve_multipatch(layout, &self.opts, assembler, &mut |e| observer(&Stage::Layout(e)))
+                .map(|s| Solved::Layout(Box::new(s)));
+        }
+        self.run_keeping_hierarchy(observer).map(|(sol, _)| Solved::Map(Box::new(sol)))
     }
 
-    /// [`Pipeline::run`], with the hierarchy the solution was solved on (the fitted one
-    /// after a fallback): the comparison of methods solves the others on it.
+    /// [`Pipeline::run`] of a boundary or a ring, with the hierarchy the solution was
+    /// solved on (the fitted one after a fallback): the comparison of methods solves the
+    /// others on it.
     pub(crate) fn run_keeping_hierarchy(self, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
         self.opts.validate()?;
         let first = self.attempt(&self.opts, observer)?;
@@ -184,6 +253,7 @@ impl Pipeline {
                 let (h, cut) = ring_hierarchy_with(r, &opts.fit, self.eta_refinement)?;
                 (cut, h, ring_options(opts))
             }
+            Input::Layout(_) => return Err(Error::Invalid("a layout has one map per patch, not one hierarchy".into())),
         };
         let hierarchy = Arc::new(hierarchy);
         let mut solver = match &self.method {
@@ -206,7 +276,7 @@ impl Pipeline {
 
 /// Fit `boundary`, then solve coarse to fine on the CPU ([`Pipeline::solve`]).
 pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
-    Pipeline::new(boundary.clone(), opts.clone()).solve()
+    Pipeline::new(boundary.clone(), opts.clone()).solve()?.into_map()
 }
 
 /// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
@@ -303,9 +373,11 @@ mod tests {
                         "iterate".into()
                     }
                     Stage::Solver(_) => "level".into(),
+                    other => panic!("a boundary's run saw {other:?}"),
                 });
                 true
             })
+            .and_then(Solved::into_map)
             .unwrap();
         let r = &sol.report;
         assert_eq!((r.basis.requested, r.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
@@ -361,5 +433,45 @@ mod tests {
             assert!(e.to_string().contains(what), "{what}: {e}");
             assert_eq!(stages, 0, "{what}");
         }
+    }
+
+    /// A layout runs through the same entry: its events in order (the conforming bases,
+    /// one round per layout refinement, then the free-interface stage of its
+    /// improvement), a multipatch result, and the observer's stop.
+    #[test]
+    fn a_layout_runs_through_the_pipeline() {
+        let layout = match crate::io::read(&data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap() {
+            crate::io::Document::Layout(l) => l,
+            other => panic!("plateWithHoleMP is a {}", other.kind()),
+        };
+        let opts = SolveOptions { improve: Some(crate::solve::improve::Improve::Winslow), ..Default::default() };
+        let mut events = Vec::new();
+        let solved = Pipeline::new(layout.clone(), opts.clone())
+            .run(&mut |stage| {
+                match stage {
+                    Stage::Layout(e) => events.push((*e).clone()),
+                    other => panic!("a layout's run saw {other:?}"),
+                }
+                true
+            })
+            .unwrap();
+        let verdict = solved.verdict();
+        let Solved::Layout(sol) = solved else { panic!("a layout gave one map") };
+        assert_eq!((sol.report.interfaces, verdict), ("free", Verdict::Certified), "{}", sol.report.message);
+        assert!(matches!(events[0], LayoutEvent::Bases { patches, .. } if patches == layout.patches.len()));
+        let rounds = events.iter().filter(|e| matches!(e, LayoutEvent::Round { .. })).count();
+        assert_eq!(rounds, sol.report.layout_refinements + 1);
+        assert!(matches!(events.last(), Some(LayoutEvent::Free { functional: "winslow" })), "{events:?}");
+        assert!(matches!(events[rounds], LayoutEvent::Round { ref failing, .. } if failing.is_empty()));
+        // one map is not what a layout gives
+        assert!(matches!(Solved::Layout(sol).into_map(), Err(Error::DocumentKind { .. })));
+        // stopped at its first event
+        let out = Pipeline::new(layout.clone(), opts).run(&mut |_| false);
+        assert!(matches!(out, Err(Error::Cancelled)), "{out:?}");
+        // a method replaces EGG on a boundary's levels, not on a layout's patches
+        let out = Pipeline::new(layout, SolveOptions::default())
+            .method(Arc::new(crate::methods::egg::EggMethod::cpu(Default::default())))
+            .solve();
+        assert!(matches!(out, Err(Error::Invalid(_))), "{out:?}");
     }
 }

@@ -33,7 +33,7 @@
 //! | `ao` | area orthogonality (eq. 3) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
 //!
 //! Gravesen's methods (the last four, [`ConstrainedRun`], [`MaxZRun`]) need a polynomial
-//! basis, the constrained ones at most [`MAX_UNKNOWNS`](super::constrained::MAX_UNKNOWNS) unknowns: on
+//! basis, the constrained ones at most [`MAX_UNKNOWNS`](crate::solve::constrained::MAX_UNKNOWNS) unknowns: on
 //! another basis their rows are errors that say so. [`MethodChoice::DEFAULT`] leaves
 //! them out.
 //!
@@ -50,10 +50,6 @@ mod gravesen;
 
 pub use gravesen::{ConstrainedRun, MaxZRun};
 
-use super::constrained::{ConstrainedOptions, Functional};
-use super::options::SolveOptions;
-use super::report::{Solution, Verdict};
-use super::solver::{EggSolver, Event};
 use crate::boundary::hierarchy::Hierarchy;
 use crate::boundary::{BasisChoice, Boundary};
 use crate::error::{Error, Result};
@@ -61,7 +57,11 @@ use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::harmonic::VariationalHarmonicMethod;
 use crate::methods::quasi_conformal::{QcHessian, QuasiConformalMethod};
 use crate::methods::Method;
-use crate::solve::pipeline::{Pipeline, Stage};
+use crate::pipeline::{Pipeline, Stage};
+use crate::solve::constrained::{ConstrainedOptions, Functional};
+use crate::solve::options::SolveOptions;
+use crate::solve::report::{Solution, Verdict};
+use crate::solve::solver::{EggSolver, Event};
 use crate::spline::surface::Surface;
 use crate::verify::certificate::certify;
 use crate::verify::poisson::{default_scales, poisson_benchmark};
@@ -78,11 +78,11 @@ pub enum MethodChoice {
     /// The quasi-conformal functional, eq. (47)-(48).
     Qc,
     /// Gravesen's feasible start, eq. (49), alone: `max z` subject to `d(c) >= z 1` from
-    /// the Coons patch of the EGG basis, stopped at `z > 0` ([`run_max_z`](super::constrained::run_max_z)).
+    /// the Coons patch of the EGG basis, stopped at `z > 0` ([`run_max_z`](crate::solve::constrained::run_max_z)).
     #[serde(rename = "maxz")]
     MaxZ,
     /// The Liao functional (eq. 3) minimised subject to `d(c) >= ε` from `x_G`
-    /// ([`run`](super::constrained::run)).
+    /// ([`run`](crate::solve::constrained::run)).
     Liao,
     /// The Winslow functional (eq. 16) minimised subject to `d(c) >= ε` from `x_G`.
     WinslowFunctional,
@@ -104,7 +104,7 @@ impl MethodChoice {
 
     /// The default selection (`winslow compare` without `--methods`, the viewer without
     /// Gravesen's methods): the methods that run on any basis. Gravesen's need a
-    /// polynomial basis of at most [`MAX_UNKNOWNS`](super::constrained::MAX_UNKNOWNS) unknowns.
+    /// polynomial basis of at most [`MAX_UNKNOWNS`](crate::solve::constrained::MAX_UNKNOWNS) unknowns.
     pub const DEFAULT: [MethodChoice; 3] = [MethodChoice::Egg, MethodChoice::Vhm, MethodChoice::Qc];
 
     /// The name in tables, reports and on the command line.
