@@ -80,6 +80,11 @@ pub(super) struct CompareArgs {
     /// Write one picture per method, DIR/NAME-METHOD.png (grid lines coloured by det J).
     #[arg(long)]
     png_dir: Option<PathBuf>,
+    /// Remove the pictures of an earlier comparison of this geometry (DIR/NAME-*.png)
+    /// from --png-dir first; without it, such files are an error (pictures of two runs
+    /// never mix).
+    #[arg(long, requires = "png_dir")]
+    overwrite: bool,
     /// Print the comparison as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
@@ -134,7 +139,13 @@ impl CompareArgs {
 
 pub(super) fn run(a: CompareArgs) -> Result<i32> {
     let (methods, opts) = a.options()?;
+    crate::files::OutputPlan::new().input(&a.boundary).folder_maybe("--png-dir", a.png_dir.as_deref()).check()?;
     let boundary = load_boundary(&a.boundary, a.fit.reorient)?;
+    if let Some(dir) = &a.png_dir {
+        let ours =
+            |f: &str| f.strip_prefix(boundary.name.as_str()).is_some_and(|r| r.starts_with('-') && r.ends_with(".png"));
+        crate::files::claim_folder("--png-dir", dir, ours, a.overwrite)?;
+    }
     let quiet = output::quiet() || a.json;
     let stderr = std::io::stderr();
     let mut progress = |e: CompareEvent| {
@@ -176,14 +187,11 @@ pub(super) fn run(a: CompareArgs) -> Result<i32> {
                 let path = dir.join(format!("{}-{}.png", cmp.name, row.method));
                 let image = render(map, &PictureOptions::default());
                 crate::files::write(&path, &winslow::io::Output::Picture(&image))?;
-                if !quiet {
-                    note!("wrote {}", path.display());
-                }
             }
         }
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&cmp)?);
+        crate::files::print_json(serde_json::to_value(&cmp)?)?;
     } else {
         say_raw!("{}", table(&cmp));
     }

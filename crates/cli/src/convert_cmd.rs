@@ -19,6 +19,7 @@ const RENDER_NEEDS: &str = "render draws a map, a ring map or a multipatch resul
 
 /// `winslow render MAP --png OUT`.
 pub(super) fn render(a: RenderArgs) -> Result<i32> {
+    files::OutputPlan::new().input(&a.map).file("--png", &a.png, "picture", files::ext::PNG).check()?;
     let (doc, report) = files::read_with_report(&a.map)?;
     let report = report.unwrap_or_default();
     let segments = if a.no_matches { Vec::new() } else { winslow::boundary::reparam::matches_in_report(&report) };
@@ -37,7 +38,6 @@ pub(super) fn render(a: RenderArgs) -> Result<i32> {
         _ => return Err(files::wrong_kind(&doc, &a.map, RENDER_NEEDS)),
     };
     files::write(&a.png, &Output::Picture(&image))?;
-    say!("wrote {}", a.png.display());
     Ok(0)
 }
 
@@ -58,13 +58,19 @@ const CONVERT_NEEDS: &str =
 /// written by the output's extension.
 pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
     let doc = files::read(&a.map)?;
+    let (what, extensions) = match doc {
+        Document::Volume { .. } => ("volume", files::ext::VOLUME),
+        Document::Layout(_) | Document::Multipatch(_) => ("multipatch result", files::ext::MULTIPATCH),
+        _ => ("map", files::ext::MAP),
+    };
+    files::OutputPlan::new().input(&a.map).file("-o", &a.output, what, extensions).check()?;
     match doc {
         Document::Map { name, map } => {
             let certificate = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
             let label = format!("certificate: {}", certificate.message());
             let extra = Some(serde_json::json!({ "certificate": &certificate }));
             files::write(&a.output, &Output::Map { name: &name, map: &map, label: &label, extra })?;
-            say!("wrote {} ({label})", a.output.display());
+            say!("{label}");
             Ok(planar_exit(&certificate.verdict))
         }
         Document::Volume { name, volume } => loft_cmd::convert_volume(&name, &volume, &a.output),
@@ -93,7 +99,7 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
     let report = serde_json::json!({ "message": message });
     let patches = Patches { layout, maps, reports, messages, report, message: message.clone() };
     files::write(output, &Output::Multipatch(patches))?;
-    say!("wrote {} ({message})", output.display());
+    say!("{message}");
     Ok(codes.into_iter().max().unwrap_or(0))
 }
 

@@ -29,6 +29,10 @@ pub struct CorpusArgs {
     /// strip, cad, noisy-cloud, sparse-cloud.
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
+    /// Remove the boundary documents of an earlier run from the -o folder first (without
+    /// it, such files are an error).
+    #[arg(long)]
+    overwrite: bool,
     /// Solve every domain (default settings) and print the verdicts and a table per
     /// family; exits 1 when any domain is not certified.
     #[arg(long)]
@@ -55,13 +59,22 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
     if a.output.is_none() && !a.solve {
         bail!("nothing to do: give -o DIR to write the domains, --solve to solve them, or both");
     }
+    if let Some(dir) = &a.output {
+        crate::files::OutputPlan::new().folder("-o", dir).check()?;
+        // FAMILY-SEED.json
+        let ours = |f: &str| {
+            f.strip_suffix(".json").and_then(|s| s.rsplit_once('-')).is_some_and(|(family, seed)| {
+                Family::parse(family).is_some() && seed.bytes().all(|b| b.is_ascii_digit())
+            })
+        };
+        crate::files::claim_folder("-o", dir, ours, a.overwrite)?;
+    }
     let domains: Vec<_> =
         corpus(a.per_family, a.seed).into_iter().filter(|(f, _)| families.is_empty() || families.contains(f)).collect();
     if let Some(dir) = &a.output {
         for (_, b) in &domains {
             crate::files::write(&dir.join(format!("{}.json", b.name)), &winslow::io::Output::Boundary(b))?;
         }
-        say!("wrote {} boundaries to {}", domains.len(), dir.display());
     }
     if !a.solve {
         return Ok(0);

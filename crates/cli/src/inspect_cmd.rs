@@ -5,7 +5,8 @@ use super::*;
 
 #[derive(Args, Debug)]
 pub(crate) struct InspectArgs {
-    /// Boundary file (JSON boundary, contour or map document; G+Smo XML).
+    /// Boundary file (JSON boundary, contour or map document; G+Smo XML), or a ring
+    /// document or ring map (its two contours).
     pub(crate) file: PathBuf,
     #[command(flatten)]
     pub(crate) fit: FitArgs,
@@ -23,6 +24,10 @@ pub(crate) fn load_boundary(path: &Path, reorient: bool) -> Result<Boundary> {
 
 pub(crate) fn inspect(a: InspectArgs) -> Result<i32> {
     let doc = files::read(&a.file)?;
+    if doc.is_ring_map() {
+        let ring = files::ring_of(doc, &a.file)?;
+        return inspect_ring::run(&a.file, &ring, &fit_options(&a.fit), a.json);
+    }
     let kind = match &doc {
         Document::Ring(ring) => return inspect_ring::run(&a.file, ring, &fit_options(&a.fit), a.json),
         Document::Boundary(_) => "boundary",

@@ -67,6 +67,11 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
         None if a.z.is_empty() => bail!("give the heights with --z z0,z1,... or --dz"),
         None => a.z.clone(),
     };
+    a.slices
+        .iter()
+        .fold(files::OutputPlan::new(), |p, s| p.input(s))
+        .file("-o", &a.output, "volume", files::ext::VOLUME)
+        .check()?;
     let mut slices = Vec::with_capacity(a.slices.len());
     let mut name = String::new();
     for (i, p) in a.slices.iter().enumerate() {
@@ -95,7 +100,7 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
     if a.json {
         let v = serde_json::json!({ "report": &out.report, "certificate": cert, "seconds": t0.elapsed().as_secs_f64(),
             "peak_memory_mib": output::peak_memory_mib() });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        files::print_json(v)?;
     } else {
         let d = out.volume.degrees();
         let s = out.volume.shape();
@@ -115,12 +120,11 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
         );
         say!("{}", cert.message());
         say!(
-            "{} round(s); volume certificate {:.3} s; total {:.3} s; peak memory {:.1} MiB; wrote {}",
+            "{} round(s); volume certificate {:.3} s; total {:.3} s; peak memory {:.1} MiB",
             out.report.rounds.len(),
             cert.seconds,
             t0.elapsed().as_secs_f64(),
             output::peak_memory_mib(),
-            a.output.display()
         );
     }
     Ok(exit_code(&cert.verdict))
@@ -170,6 +174,6 @@ pub(super) fn convert_volume(name: &str, volume: &Volume, output: &Path) -> Resu
     let label = format!("volume certificate: {}", cert.message());
     let extra = Some(serde_json::json!({ "certificate": &cert }));
     files::write(output, &Output::Volume { name, volume, label: &label, extra })?;
-    say!("wrote {} ({label})", output.display());
+    say!("{label}");
     Ok(exit_code(&cert.verdict))
 }

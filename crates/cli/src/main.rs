@@ -195,10 +195,21 @@ fn main() {
         Ok(pool) => pool.install(|| run(cli)),
         Err(_) => run(cli),
     };
+    // the files written: one line after the command's own output (in `--json` output
+    // the field "files"), and after an error what was written before it
+    let written = files::written_list();
     let code = match result {
-        Ok(code) => code,
+        Ok(code) => {
+            if !written.is_empty() && !files::json_printed() {
+                say!("wrote: {written}");
+            }
+            code
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
+            if !written.is_empty() {
+                eprintln!("written before the error: {written}");
+            }
             1
         }
     };

@@ -226,9 +226,9 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
                 st.boundary, st.refine, st.spade_refinements, st.rounds, st.map, st.criteria, st.insert, st.build
             );
         }
-        for f in files {
-            say!("wrote {}", f.display());
-        }
+    }
+    for f in files {
+        crate::files::record(&f);
     }
     Ok(())
 }
@@ -236,6 +236,7 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
 /// `winslow mesh`.
 pub fn run(a: MeshArgs) -> Result<i32> {
     let needed = "mesh needs a map (run `winslow solve` first, or `solve --mesh`)";
+    crate::files::OutputPlan::new().input(&a.map).mesh_maybe("-o", Some(&a.output))?.check()?;
     let (_, map) = crate::files::map_of(crate::files::read(&a.map)?, &a.map, needed)?;
     make_and_write(&map, &a.spec, &a.output, false)?;
     Ok(0)

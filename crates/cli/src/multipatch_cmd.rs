@@ -24,11 +24,11 @@ pub(super) struct MultipatchArgs {
     functional: Functional,
     /// Multipatch input: also write one JSON map document per patch into this directory.
     #[arg(long, value_name = "DIR")]
-    patch_maps: Option<PathBuf>,
+    pub(super) patch_maps: Option<PathBuf>,
     /// Multipatch input: also write a VTK multiblock file (.vtm) with one exact Bézier
     /// .vtu per patch (in a directory named after the file).
     #[arg(long, value_name = "FILE.vtm")]
-    vtm: Option<PathBuf>,
+    pub(super) vtm: Option<PathBuf>,
 }
 
 /// The options of a layout solve from the arguments of `winslow solve`: `--interfaces
@@ -58,7 +58,7 @@ pub(super) fn announce(layout: &Layout, opts: &SolveOptions) {
 pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
     write(&sol, a)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&sol.report)?);
+        files::print_json(serde_json::to_value(&sol.report)?)?;
     } else {
         say_raw!("{}", summary(&sol));
     }
@@ -80,7 +80,9 @@ fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
         files::write_as(p, "vtm", &patches)?;
     }
     if let Some(d) = &a.multipatch.patch_maps {
-        write_patch_maps(sol, d)?;
+        for p in write_patch_maps(sol, d)? {
+            files::record(&p);
+        }
     }
     for (flag, given) in [
         ("--iges", a.iges.is_some()),
@@ -177,8 +179,13 @@ pub(super) struct JoinArgs {
     json: bool,
 }
 
-fn read_map(path: &Path) -> Result<(String, Surface)> {
-    files::map_of(files::read(path)?, path, files::SOLVE_FIRST)
+/// A four-sided map (a ring map has no four sides to split or join along).
+fn read_map(path: &Path, command: &str) -> Result<(String, Surface)> {
+    let doc = files::read(path)?;
+    if doc.is_ring_map() {
+        return Err(files::wrong_kind(&doc, path, &format!("{command} needs a four-sided map")));
+    }
+    files::map_of(doc, path, files::SOLVE_FIRST)
 }
 
 /// `SIDE:T` or `X,Y` as a side point of `map`.
@@ -205,20 +212,25 @@ fn side_point(map: &Surface, s: &str) -> Result<winslow::multipatch::split::Side
 
 pub(super) fn split(a: SplitArgs) -> Result<i32> {
     use winslow::multipatch::split::{split_map, SplitOptions};
-    let (name, map) = read_map(&a.map)?;
+    let (name, map) = read_map(&a.map, "split")?;
+    let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
+    let parts = ["a", "b"].map(|k| a.output.with_file_name(format!("{stem}-{k}.json")));
+    files::OutputPlan::new()
+        .input(&a.map)
+        .file("-o", &a.output, "multipatch layout", files::ext::JSON)
+        .file("-o (part a)", &parts[0], "boundary", files::ext::JSON)
+        .file("-o (part b)", &parts[1], "boundary", files::ext::JSON)
+        .maybe("--png", a.png.as_deref(), "picture", files::ext::PNG)
+        .check()?;
     let cert = certify(&map, &CertifyOptions::default()).context("certifying the map")?;
     let (from, to) = (side_point(&map, &a.from)?, side_point(&map, &a.to)?);
     let path = a.path;
     let opts = SplitOptions { path, degree: a.degree, tol: a.fit_tol, ..Default::default() };
     let s = split_map(&name, &map, &cert, from, to, &opts).context("splitting the map")?;
     files::write(&a.output, &Output::Layout(&s.layout))?;
-    let stem = a.output.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_else(|| "split".into());
-    let mut written = vec![a.output.clone()];
-    for (k, p) in s.layout.patches.iter().enumerate() {
-        let path = a.output.with_file_name(format!("{stem}-{}.json", ["a", "b"][k]));
+    for (p, path) in s.layout.patches.iter().zip(&parts) {
         let b = Boundary { name: p.name.clone(), sides: p.sides.clone().map(winslow::SideCurve::Spline) };
-        files::write(&path, &Output::Boundary(&b))?;
-        written.push(path);
+        files::write(path, &Output::Boundary(&b))?;
     }
     if let Some(p) = &a.png {
         let pts = s.curve.sample(256);
@@ -227,7 +239,7 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
         files::write(p, &Output::Picture(&image))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&s.report)?);
+        files::print_json(serde_json::to_value(&s.report)?)?;
     } else {
         let r = &s.report;
         say!(
@@ -247,16 +259,20 @@ pub(super) fn split(a: SplitArgs) -> Result<i32> {
             r.areas[0],
             r.areas[1]
         );
-        let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-        say!("  wrote {}", names.join(", "));
     }
     Ok(0)
 }
 
 pub(super) fn join(a: JoinArgs) -> Result<i32> {
     use winslow::multipatch::join::join_and_smooth;
-    let (na, ma) = read_map(&a.a)?;
-    let (nb, mb) = read_map(&a.b)?;
+    let (na, ma) = read_map(&a.a, "join")?;
+    let (nb, mb) = read_map(&a.b, "join")?;
+    files::OutputPlan::new()
+        .input(&a.a)
+        .input(&a.b)
+        .file("-o", &a.output, "map", files::ext::MAP)
+        .maybe("--png", a.png.as_deref(), "picture", files::ext::PNG)
+        .check()?;
     let functional = a.functional;
     let opts = CertifyOptions::default();
     let j = join_and_smooth(&ma, &mb, functional, Default::default(), &opts).context("joining the maps")?;
@@ -277,7 +293,7 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
         files::write(p, &Output::Picture(&render(&j.map, &PictureOptions::default())))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        files::print_json(report)?;
     } else {
         say!("{name}: {}", output::verdict_word(verdict));
         say!(
@@ -286,7 +302,6 @@ pub(super) fn join(a: JoinArgs) -> Result<i32> {
             j.join.turn_degrees[0], j.join.turn_degrees[1]
         );
         say!("  {}", j.smoothing.message);
-        say!("  wrote {}", a.output.display());
     }
     Ok(output::exit_code(verdict))
 }

@@ -105,6 +105,11 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         bail!("--basis input may be rational: the det J coefficient constraints need --basis fitted");
     }
     let quiet = output::quiet() || a.json;
+    crate::files::OutputPlan::new()
+        .input(&a.boundary)
+        .maybe("-o", a.output.as_deref(), "map", crate::files::ext::MAP)
+        .maybe("--png", a.png.as_deref(), "picture", crate::files::ext::PNG)
+        .check()?;
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
     let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?.into_map()?;
     let egg = &sol.map;
@@ -160,7 +165,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         crate::files::write(p, &Output::Picture(&render(&first.map, &PictureOptions::default())))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        crate::files::print_json(report)?;
     } else {
         let mut s = format!(
             "{}: {nx}x{ny} basis of degree {:?}, {unknowns} unknowns, eps {:.1e} of the mean det J\n  EGG: {egg_iterations} \
@@ -172,9 +177,6 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         );
         for r in &rows {
             row_text(&mut s, r);
-        }
-        for p in a.output.iter().chain(&a.png) {
-            let _ = writeln!(s, "  wrote {}", p.display());
         }
         say_raw!("{s}");
     }

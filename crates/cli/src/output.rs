@@ -16,7 +16,7 @@ use winslow::verify::quality::Quality;
 use winslow::{Boundary, Side, SideCurve};
 
 /// The short human summary after a solve.
-pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
+pub fn summary(sol: &Solution) -> String {
     let r = &sol.report;
     let mut s = String::new();
     let last = r.levels.last();
@@ -107,10 +107,6 @@ pub fn summary(sol: &Solution, out: &Path, png: Option<&Path>) -> String {
             "    {}/{} at {:.6}: ({:.6}, {:.6}) - ({:.6}, {:.6})",
             m.sides[0], m.sides[1], m.parameter, m.points[0][0], m.points[0][1], m.points[1][0], m.points[1][1]
         );
-    }
-    let _ = writeln!(s, "  wrote {}", out.display());
-    if let Some(p) = png {
-        let _ = writeln!(s, "  wrote {}", p.display());
     }
     s
 }

@@ -177,6 +177,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let doc = files::read(path)?;
+    let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_));
+    output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => {
@@ -196,6 +198,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
             };
         }
         Document::Ring(ring) => Input::Ring(ring),
+        // a ring map (a sweep's frame): the ring between its two contours
+        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),
         doc => {
             let boundary = files::boundary_of(doc, path)?;
             let (boundary, _) = checked_boundary(boundary, &ReadOptions { reorient: a.solver.fit.reorient })
@@ -223,14 +227,15 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if let Some(p) = &a.vtk {
         files::write_as(p, "vtk", &map)?;
     }
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        say_raw!("{}", output::summary(&sol, &a.output, a.png.as_deref()));
+    if !a.json {
+        say_raw!("{}", output::summary(&sol));
     }
     if let Some(out) = &a.mesh {
         // a folded map gives inverted cells, which the writers refuse
         mesh::make_and_write(&sol.map, &a.mesh_spec, out, a.json)?;
+    }
+    if a.json {
+        files::print_json(report)?;
     }
     Ok(output::exit_code(sol.report.verdict))
 }
@@ -241,6 +246,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
 pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
     let opts = a.solver.options()?;
     let (name, map) = files::map_of(files::read(start)?, start, "--start needs a map")?;
+    let inputs: Vec<&Path> = std::iter::once(start).chain(a.boundary.as_deref()).collect();
+    output_plan(a, &inputs, false)?;
     let method: Arc<dyn Method> = match a.solver.method {
         MethodArg::Winslow => Improve::Winslow.method(),
         MethodArg::Weak => Improve::WeakForm.method(),
@@ -289,7 +296,7 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         files::write(p, &Output::Picture(&picture(&sel, &out.map, &PictureOptions::default())?))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        files::print_json(report)?;
     } else {
         let mut s = format!(
             "{name}: {} from {}\n  {}\n",
@@ -308,10 +315,30 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
                 d[3]
             ));
         }
-        s.push_str(&format!("  wrote {}\n", a.output.display()));
         say_raw!("{s}");
     }
     Ok(output::exit_code(verdict))
+}
+
+/// Check every output of `solve` before the work ([`files::OutputPlan`]): a single map's
+/// files, or a layout's (`multipatch`), none of them an input.
+fn output_plan(a: &SolveArgs, inputs: &[&Path], multipatch: bool) -> Result<()> {
+    use files::ext;
+    let mut plan = inputs.iter().fold(files::OutputPlan::new(), |p, i| p.input(i));
+    plan = if multipatch {
+        plan.file("-o", &a.output, "multipatch result", ext::MULTIPATCH)
+            .maybe("--vtm", a.multipatch.vtm.as_deref(), "VTK multiblock file", ext::VTM)
+            .folder_maybe("--patch-maps", a.multipatch.patch_maps.as_deref())
+    } else {
+        plan.file("-o", &a.output, "map", ext::MAP)
+            .maybe("--vtk", a.vtk.as_deref(), "VTK grid", ext::VTK)
+            .maybe("--iges", a.iges.as_deref(), "IGES file", ext::IGES)
+            .maybe("--vtu", a.vtu.as_deref(), "VTK Bézier file", ext::VTU)
+            .mesh_maybe("--mesh", a.mesh.as_deref())?
+    };
+    plan.maybe("--gismo", a.gismo.as_deref(), "G+Smo XML file", ext::XML)
+        .maybe("--png", a.png.as_deref(), "picture", ext::PNG)
+        .check()
 }
 
 #[derive(Args, Debug)]

@@ -12,7 +12,8 @@ use winslow::pipeline::sweep::{frame0_options, Frame, FrameReport, Seam, Sweep, 
 
 #[derive(Args, Debug)]
 pub(super) struct SweepArgs {
-    /// Ring document (two closed contours, see formats.md): frame 0.
+    /// Ring document (two closed contours, see formats.md) or a ring map (its two
+    /// contours): frame 0.
     ring: PathBuf,
     /// Rotation of the inner contour per step, degrees (counter-clockwise).
     #[arg(long, allow_negative_numbers = true, required_unless_present = "inner_frames")]
@@ -50,6 +51,11 @@ pub(super) struct SweepArgs {
     /// table has every frame.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     every: u64,
+    /// Remove the files of an earlier sweep (frame_NNNN.json/.vtu, sweep.pvd/.csv/.json)
+    /// from the output directory first; without it, such files are an error (frames of
+    /// two sweeps never mix).
+    #[arg(long)]
+    overwrite: bool,
     /// Also write an animated PNG (APNG) of the written frames: det J heat map and grid.
     #[arg(long)]
     apng: Option<PathBuf>,
@@ -78,6 +84,16 @@ fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
         [x, y] if x.is_finite() && y.is_finite() => Ok([x, y]),
         _ => Err(format!("expected two finite numbers x,y, got {s:?}")),
     }
+}
+
+/// Whether a file name is one a sweep writes: `frame_NNNN.json`, `frame_NNNN.vtu`,
+/// `sweep.pvd`, `sweep.csv`, `sweep.json`.
+fn of_a_sweep(name: &str) -> bool {
+    let frame = name
+        .strip_prefix("frame_")
+        .and_then(|r| r.strip_suffix(".json").or_else(|| r.strip_suffix(".vtu")))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+    frame || matches!(name, "sweep.pvd" | "sweep.csv" | "sweep.json")
 }
 
 const HEADER: &str = "frame,time,angle_deg,predictor,newton,linear_solves,residual_before,residual_after,converged,inner_fit_error,inner_shift,seam_offset_deg,seconds,verdict,det_j_lower_bound";
@@ -140,10 +156,12 @@ fn inner_frames(paths: &[PathBuf], base: &Ring) -> Result<Vec<(PathBuf, ClosedCo
         .collect()
 }
 
-/// The ring of a ring document; any other kind is the error naming it.
+/// The ring of a ring document or a ring map (e.g. a frame of another sweep); any other
+/// kind is the error naming it.
 fn ring_in(path: &Path, needed: &str) -> Result<Ring> {
     match crate::files::read(path)? {
         Document::Ring(ring) => Ok(ring),
+        doc if doc.is_ring_map() => crate::files::ring_of(doc, path),
         doc => Err(crate::files::wrong_kind(&doc, path, needed)),
     }
 }
@@ -204,7 +222,8 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         None => 0.0,
     };
     let opts = a.solver.options()?;
-    let ring = ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours)")?;
+    let ring =
+        ring_in(&a.ring, "sweep needs a ring document (a \"ring\" with inner and outer contours) or a ring map")?;
     let mut contours = inner_frames(&a.inner_frames, &ring)?;
     if let Some(n) = a.steps.filter(|_| !contours.is_empty()) {
         contours.truncate(n);
@@ -218,6 +237,9 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
     if !contours.is_empty() && times.len() != contours.len() {
         bail!("--times gives {} times for {} inner frames", times.len(), contours.len());
     }
+    let plan = std::iter::once(&a.ring).chain(&a.inner_frames).fold(crate::files::OutputPlan::new(), |p, i| p.input(i));
+    plan.folder("-o", &a.output).maybe("--apng", a.apng.as_deref(), "animated PNG", crate::files::ext::APNG).check()?;
+    crate::files::claim_folder("-o", &a.output, of_a_sweep, a.overwrite)?;
     std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
     let seam = a.seam;
     let so = SweepOptions { step, steps, center: a.center, max_order: a.predictor_order, seam };
@@ -326,12 +348,12 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
     }
     if let (Some(w), Some(path)) = (apng, &a.apng) {
         w.writer.finish()?;
-        winslow::io::write_bytes(path, &w.bytes.0.borrow())?;
+        crate::files::write_bytes(path, &w.bytes.0.borrow())?;
     }
     pvd.push_str("  </Collection>\n</VTKFile>\n");
-    winslow::io::write_bytes(&a.output.join("sweep.pvd"), pvd.as_bytes())?;
+    crate::files::write_bytes(&a.output.join("sweep.pvd"), pvd.as_bytes())?;
     let csv: String = std::iter::once(HEADER.to_string()).chain(rows.iter().map(row)).collect::<Vec<_>>().join("\n");
-    winslow::io::write_bytes(&a.output.join("sweep.csv"), (csv + "\n").as_bytes())?;
+    crate::files::write_bytes(&a.output.join("sweep.csv"), (csv + "\n").as_bytes())?;
     let cold = rows[0].seconds;
     let later: Vec<&FrameReport> = rows.iter().skip(6).collect();
     let max_newton = later.iter().map(|r| r.newton_iterations).max();
@@ -355,9 +377,9 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             "mean_seconds": mean,
         },
     });
-    winslow::io::write_json(&a.output.join("sweep.json"), &summary)?; // atomic, as every file
+    crate::files::write_json(&a.output.join("sweep.json"), &summary)?; // atomic, as every file
     say!(
-        "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; smallest certified det J {:.4e}; wrote {}",
+        "{}: {} frames, {} not certified or not converged; cold solve {:.3} s; from frame 6: at most {} Newton iterations and {} linear solves per frame, mean {:.4} s; smallest certified det J {:.4e}",
         ring.name,
         rows.len(),
         failures,
@@ -366,7 +388,6 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         max_solves.unwrap_or(0),
         mean.unwrap_or(f64::NAN),
         min_det,
-        a.output.display()
     );
     if !cold_checks.is_empty() {
         let cold: Vec<f64> = cold_checks.iter().filter_map(|c| c["seconds"].as_f64()).collect();

@@ -94,7 +94,7 @@ fn convert_and_render_take_ring_maps_and_multipatch_results() {
     let err = refused(&["convert".as_ref(), &os(&input), "-o".as_ref(), &os(&dir.join("x.json"))]);
     assert!(err.contains("a multipatch layout document, where convert writes"), "{err}");
     let err = refused(&["convert".as_ref(), &os(&result), "-o".as_ref(), &os(&dir.join("x.igs"))]);
-    assert!(err.contains("a multipatch result cannot be written as .igs"), "{err}");
+    assert!(err.contains("a multipatch result is written as") && err.contains("not .igs"), "{err}");
     assert!(!dir.join("x.igs").exists() && !dir.join("x.json").exists() && !dir.join("x.png").exists());
     // an I/O error names the file and its cause once
     let err = refused(&["convert".as_ref(), &os(&dir.join("missing.json")), "-o".as_ref(), &os(&dir.join("x.json"))]);
@@ -147,4 +147,285 @@ fn quiet_leaves_only_errors() {
     assert!(!out.status.success());
     assert!(out.stdout.is_empty());
     assert!(String::from_utf8_lossy(&out.stderr).starts_with("error: "), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// Run `winslow ARGS`; its exit code and standard error.
+fn run(args: &[&std::ffi::OsStr]) -> (Option<i32>, String) {
+    let out = bin().args(args).arg("-q").output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Every overwrite case of issue 30 is refused before any work, with exit code 1,
+/// leaving the inputs as they were and writing nothing: an output naming an input (by
+/// the same name, another spelling, or a link), two outputs naming one file, an
+/// extension that is not the format's, an output whose folder is a file.
+#[test]
+fn outputs_that_would_replace_an_input_or_each_other_are_refused_first() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let os = |p: &Path| p.as_os_str().to_owned();
+    let lid = dir.join("lid.json");
+    std::fs::copy(data().join("wavy_lid.json"), &lid).unwrap();
+    let original = std::fs::read(&lid).unwrap();
+    let map = dir.join("m.json");
+    let (code, err) = run(&["solve".as_ref(), &os(&lid), "-o".as_ref(), &os(&map)]);
+    assert_eq!(code, Some(0), "{err}");
+    let solved = std::fs::read(&map).unwrap();
+    let a_file = dir.join("a-file");
+    std::fs::write(&a_file, b"not a folder").unwrap();
+    let before: Vec<String> = listing(dir);
+    let dot = dir.join(".").join("lid.json");
+    let link = dir.join("link.json");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&lid, &link).unwrap();
+    #[cfg(not(unix))]
+    std::fs::copy(&lid, &link).unwrap();
+    let cases: Vec<Vec<std::ffi::OsString>> = vec![
+        // the input replaced by the map
+        vec!["solve".into(), os(&lid), "-o".into(), os(&lid)],
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dot)],
+        #[cfg(unix)]
+        vec!["solve".into(), os(&link), "-o".into(), os(&lid)],
+        vec!["solve".into(), "--start".into(), os(&map), "-o".into(), os(&map)],
+        vec![
+            "solve".into(),
+            os(&lid),
+            "--start".into(),
+            os(&map),
+            "-o".into(),
+            os(&dir.join("x.json")),
+            "--png".into(),
+            os(&lid),
+        ],
+        // the map replaced by a picture, a conversion, a mesh
+        vec!["render".into(), os(&map), "--png".into(), os(&map)],
+        vec!["convert".into(), os(&map), "-o".into(), os(&map)],
+        vec!["mesh".into(), os(&map), "-o".into(), os(&map), "--structured".into(), "5x5".into()],
+        // two outputs on one file
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m2.json")), "--png".into(), os(&dir.join("m2.json"))],
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m2.xml")), "--gismo".into(), os(&dir.join("m2.xml"))],
+        // extensions that are not the format's
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m3.json")), "--png".into(), os(&dir.join("m3.txt"))],
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m3.png"))],
+        vec!["solve".into(), os(&lid), "-o".into(), os(&dir.join("m3.json")), "--iges".into(), os(&dir.join("m3.xml"))],
+        vec!["render".into(), os(&map), "--png".into(), os(&dir.join("m3.jpg"))],
+        // a folder that is a file
+        vec![
+            "solve".into(),
+            os(&lid),
+            "-o".into(),
+            os(&dir.join("m4.json")),
+            "--png".into(),
+            os(&a_file.join("x.png")),
+        ],
+        vec!["solve".into(), os(&lid), "-o".into(), os(&a_file.join("m4.json"))],
+        // a split's parts next to its output, a loft's output on a slice
+        vec![
+            "split".into(),
+            os(&map),
+            "--from".into(),
+            "south:0.5".into(),
+            "--to".into(),
+            "north:0.5".into(),
+            "-o".into(),
+            os(&dir.join("m.json")),
+        ],
+        vec!["loft".into(), os(&map), os(&solved_copy(dir, &solved)), "--dz".into(), "1".into(), "-o".into(), os(&map)],
+    ];
+    for args in &cases {
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let (code, err) = run(&args);
+        assert_eq!(code, Some(1), "{args:?}: {err}");
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(!err.contains("written before the error"), "{args:?}: {err}");
+        assert_eq!(std::fs::read(&lid).unwrap(), original, "{args:?} changed the boundary");
+        assert_eq!(std::fs::read(&map).unwrap(), solved, "{args:?} changed the map");
+        let mut now = listing(dir);
+        now.retain(|n| n != "link.json" && n != "copy.json");
+        assert_eq!(now, before, "{args:?} wrote something");
+    }
+}
+
+/// A copy of the solved map (a second slice).
+fn solved_copy(dir: &Path, bytes: &[u8]) -> std::path::PathBuf {
+    let p = dir.join("copy.json");
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// The names in a folder (recursively, relative), sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() && !p.is_symlink() {
+                stack.push(p.clone());
+            }
+            out.push(p.strip_prefix(dir).unwrap().to_string_lossy().into_owned());
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Every file written is listed in the `--json` output's `"files"`, and exists; a
+/// command that fails after writing some names them on standard error.
+#[test]
+fn the_files_written_are_reported() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let lid = data().join("wavy_lid.json");
+    let out = bin()
+        .arg("solve")
+        .arg(&lid)
+        .arg("-o")
+        .arg(dir.join("map.json"))
+        .arg("--png")
+        .arg(dir.join("map.png"))
+        .arg("--gismo")
+        .arg(dir.join("map.xml"))
+        .arg("--mesh")
+        .arg(dir.join("map.msh"))
+        .args(["--structured", "9x9", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v = common::stdout_json(&out);
+    let files: Vec<&str> = v["files"].as_array().unwrap().iter().map(|f| f.as_str().unwrap()).collect();
+    let expected: Vec<String> =
+        ["map.json", "map.xml", "map.png", "map.msh"].iter().map(|f| dir.join(f).display().to_string()).collect();
+    assert_eq!(files, expected);
+    assert!(files.iter().all(|f| Path::new(f).is_file()));
+    assert_eq!(v["verdict"], "certified");
+    // the mesh fails after the map is written (a mesh of 1 point per direction): the
+    // error is followed by the list of what was written
+    let out = bin()
+        .arg("solve")
+        .arg(&lid)
+        .arg("-o")
+        .arg(dir.join("second.json"))
+        .arg("--mesh")
+        .arg(dir.join("second.msh"))
+        .args(["--structured", "1x1", "-q"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let last = err.lines().last().unwrap_or_default();
+    assert!(last.starts_with("written before the error: ") && last.contains("second.json"), "{err}");
+    assert!(dir.join("second.json").is_file() && !dir.join("second.msh").exists());
+}
+
+/// `sweep` into a folder that holds an earlier sweep's files is refused (nothing
+/// changes there); with `--overwrite` those files are removed first, so that no frame of
+/// the earlier sweep is left beside the new ones (and `loft` of `frame_*.json` lofts one
+/// sweep); other files in the folder are left alone.
+#[test]
+fn a_sweep_never_mixes_with_an_earlier_one() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let folder = dir.join("sweep");
+    let ring = data().join("rings/eccentric_annulus.json");
+    let sweep = |steps: &str, degrees: &str, extra: &[&str]| {
+        let out = bin()
+            .arg("sweep")
+            .arg(&ring)
+            .args(["--rotate-inner", degrees, "--steps", steps, "-q", "-o"])
+            .arg(&folder)
+            .args(extra)
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    assert_eq!(sweep("2", "1", &[]).0, Some(0));
+    std::fs::write(folder.join("notes.txt"), b"mine").unwrap();
+    let first = std::fs::read(folder.join("sweep.json")).unwrap();
+    let before = listing(&folder);
+    assert_eq!(before.iter().filter(|n| n.starts_with("frame_") && n.ends_with(".json")).count(), 3);
+    let (code, err) = sweep("1", "0.17", &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(listing(&folder), before);
+    assert_eq!(std::fs::read(folder.join("sweep.json")).unwrap(), first);
+    let (code, err) = sweep("1", "0.17", &["--overwrite"]);
+    assert_eq!(code, Some(0), "{err}");
+    let after = listing(&folder);
+    assert!(!after.contains(&"frame_0002.json".to_string()) && !after.contains(&"frame_0002.vtu".to_string()));
+    assert!(after.contains(&"frame_0001.json".to_string()) && after.contains(&"notes.txt".to_string()));
+    let table = common::read_json(&folder.join("sweep.json"));
+    assert_eq!(table["frames"].as_array().unwrap().len(), 2);
+    assert_eq!(table["step_degrees"], 0.17);
+    // the pictures of `compare --png-dir` likewise
+    let pictures = dir.join("pictures");
+    let compare = |extra: &[&str]| {
+        let out = bin()
+            .arg("compare")
+            .arg(data().join("quarter_annulus.json"))
+            .args(["--methods", "egg", "--png-dir"])
+            .arg(&pictures)
+            .args(extra)
+            .arg("-q")
+            .output()
+            .unwrap();
+        out.status.code()
+    };
+    assert_eq!(compare(&[]), Some(0));
+    let stale = pictures.join("quarter_annulus-vhm.png");
+    std::fs::write(&stale, b"an earlier run's picture").unwrap();
+    assert_eq!(compare(&[]), Some(1));
+    assert!(stale.is_file());
+    assert_eq!(compare(&["--overwrite"]), Some(0));
+    assert!(!stale.exists() && pictures.join("quarter_annulus-egg.png").is_file());
+}
+
+/// A ring map (what `solve` and `sweep` write for a ring) is taken as its ring by
+/// `solve`, `inspect` and `sweep`, and by `split` and `join` named as a ring map where a
+/// four-sided map is needed (not a corner gap of its seam).
+#[test]
+fn a_ring_map_is_taken_as_its_ring() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let os = |p: &Path| p.as_os_str().to_owned();
+    let ring_map = dir.join("ring-map.json");
+    let ring = data().join("rings/eccentric_annulus.json");
+    let (code, err) = run(&["solve".as_ref(), &os(&ring), "-o".as_ref(), &os(&ring_map)]);
+    assert_eq!(code, Some(0), "{err}");
+    let again = dir.join("again.json");
+    let (code, err) = run(&["solve".as_ref(), &os(&ring_map), "-o".as_ref(), &os(&again)]);
+    assert_eq!(code, Some(0), "{err}");
+    let report = common::read_json(&again)["report"].clone();
+    assert_eq!(report["verdict"], "certified");
+    // the contours are the first map's sides: the boundary deviation is the fit's
+    let first = common::read_json(&ring_map)["report"]["boundary_deviation"].clone();
+    let dev = |v: &serde_json::Value, k: usize| v[k].as_f64().unwrap();
+    assert!(dev(&report["boundary_deviation"], 1) < 1e-3 && dev(&first, 1) < 1e-3, "{report}");
+    assert_eq!(run(&["inspect".as_ref(), &os(&ring_map)]).0, Some(0));
+    let frames = dir.join("frames");
+    let (code, err) = run(&[
+        "sweep".as_ref(),
+        &os(&ring_map),
+        "--rotate-inner".as_ref(),
+        "2".as_ref(),
+        "--steps".as_ref(),
+        "1".as_ref(),
+        "-o".as_ref(),
+        &os(&frames),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(frames.join("frame_0001.json").is_file());
+    let parts = dir.join("parts.json");
+    let (code, err) = run(&[
+        "split".as_ref(),
+        &os(&ring_map),
+        "--from".as_ref(),
+        "south:0.5".as_ref(),
+        "--to".as_ref(),
+        "north:0.5".as_ref(),
+        "-o".as_ref(),
+        &os(&parts),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("a ring map document, where split needs a four-sided map"), "{err}");
+    assert!(!parts.exists());
 }

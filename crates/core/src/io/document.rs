@@ -29,7 +29,7 @@ use super::ring::ring_of_json;
 use super::volume::gismo::parse_gismo_volume;
 use super::volume::json::parse_volume_json;
 use super::{iges, read_text, surface_boundary_area};
-use crate::boundary::ring::Ring;
+use crate::boundary::ring::{signed_area, ClosedContour, Ring};
 use crate::boundary::{Boundary, SideCurve};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
@@ -126,6 +126,36 @@ impl Document {
                 Ok(Boundary { name, sides: Side::ALL.map(side) })
             }
             other => Err(other.wrong_kind(None, "a four-sided boundary or map is needed")),
+        }
+    }
+
+    /// Whether this is a ring map: a map periodic in `eta`.
+    pub fn is_ring_map(&self) -> bool {
+        matches!(self, Document::Map { map, .. } if map.knots[1].is_periodic())
+    }
+
+    /// The ring: itself, or the two contours of a ring map (a map periodic in `eta`):
+    /// its `xi = 0` side as the inner contour and its `xi = 1` side as the outer, each
+    /// turned counter-clockwise. Any other kind is an [`Error::DocumentKind`].
+    pub fn into_ring(self) -> Result<Ring> {
+        match self {
+            Document::Ring(r) => Ok(r),
+            Document::Map { name, map } if map.knots[1].is_periodic() => {
+                let contour = |s: Side| {
+                    let mut c = map.boundary(s);
+                    if c.weights.as_ref().is_some_and(|w| w.iter().all(|&x| x == 1.0)) {
+                        c.weights = None;
+                    }
+                    let closed = ClosedContour::Spline(c.clone());
+                    if signed_area(&closed.polygon_with(256)) < 0.0 {
+                        ClosedContour::Spline(c.reversed())
+                    } else {
+                        closed
+                    }
+                };
+                Ok(Ring { name, inner: contour(Side::West), outer: contour(Side::East) })
+            }
+            other => Err(other.wrong_kind(None, "a ring or a ring map is needed")),
         }
     }
 }
@@ -240,6 +270,39 @@ pub fn read_with_report(path: &Path) -> Result<(Document, Option<Value>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A ring map's ring is its two contours, turned counter-clockwise: the annulus
+    /// between radii 1 and 2 whose `eta` runs clockwise gives its contours of radius 1
+    /// (inner) and 2 (outer), counter-clockwise; a four-sided map is not a ring map.
+    #[test]
+    fn a_ring_map_gives_its_ring() {
+        use crate::spline::knots::KnotVector;
+        let kv = KnotVector::periodic_uniform(2, 8);
+        let d = kv.dim();
+        let angle = |k: usize| -std::f64::consts::TAU * (k % d) as f64 / d as f64;
+        let cps =
+            (0..kv.num_basis()).flat_map(|k| [1.0, 2.0].map(|r| [r * angle(k).cos(), r * angle(k).sin()])).collect();
+        let map = Surface::new([KnotVector::open_uniform(1, 1), kv], cps, None).unwrap();
+        let doc = Document::Map { name: "annulus".into(), map };
+        assert!(doc.is_ring_map());
+        let ring = doc.into_ring().unwrap();
+        let area = |c: &ClosedContour| signed_area(&c.polygon_with(64));
+        let (inner, outer) = (area(&ring.inner), area(&ring.outer));
+        // a quadratic periodic spline inside the circle's octagon (area 2 sqrt(2) r^2),
+        // the outer one the inner scaled by 2
+        assert!(inner > 0.8 * std::f64::consts::PI && inner < 2.0 * 2f64.sqrt(), "{inner}");
+        assert!((outer / inner - 4.0).abs() < 1e-12, "{inner} {outer}");
+        let square = Surface::new(
+            [KnotVector::open_uniform(1, 1), KnotVector::open_uniform(1, 1)],
+            vec![[0., 0.], [1., 0.], [0., 1.], [1., 1.]],
+            None,
+        )
+        .unwrap();
+        let doc = Document::Map { name: "square".into(), map: square };
+        assert!(!doc.is_ring_map());
+        let e = doc.into_ring().unwrap_err();
+        assert!(matches!(&e, Error::DocumentKind { found, .. } if found == "map"), "{e}");
+    }
 
     #[test]
     fn detects_kind_by_content() {

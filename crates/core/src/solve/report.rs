@@ -192,8 +192,8 @@ pub struct Report {
     /// kinked boundary, Winslow on the `C^0` basis; `null` when no kink is kept.
     pub c0_route: Option<KinkStage>,
     /// Largest distance of the map's boundary from the input boundary, per side
-    /// (south, east, north, west): from the input's polyline (resolution `1e-6` of the
-    /// diameter) on the fitted basis, at equal parameters on the input basis.
+    /// (south, east, north, west): [`crate::verify::quality::boundary_deviation`], the
+    /// measure `winslow check --boundary` reports too.
     pub boundary_deviation: [f64; 4],
     /// The outcome.
     pub verdict: Verdict,

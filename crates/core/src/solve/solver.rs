@@ -30,7 +30,7 @@ use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::{Method, Start};
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate};
-use crate::verify::quality::{boundary_deviation, parametric_boundary_deviation};
+use crate::verify::quality::boundary_deviation;
 
 /// One item of the solver's stream.
 #[derive(Debug, Clone)]
@@ -387,12 +387,8 @@ impl EggSolver {
             kinks: kink_reports(boundary, hierarchy, &map, kept),
             c0_route,
             boundary_deviation: {
-                let mut dev = match hierarchy.basis.used {
-                    // the same curve at equal parameters: measured exactly, not by a polyline
-                    BasisChoice::Input => parametric_boundary_deviation(&map, boundary, 400),
-                    BasisChoice::Fitted | BasisChoice::Auto => None,
-                }
-                .unwrap_or_else(|| boundary_deviation(&map, boundary, 400));
+                // the one measure (`verify::quality::boundary_deviation`), as `check --boundary`
+                let mut dev = boundary_deviation(&map, boundary, 400);
                 if self.opts.topology.eta_periodic() {
                     // south and north are the seam of a ring, not boundary
                     dev[Side::South as usize] = 0.0;
