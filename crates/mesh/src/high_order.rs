@@ -340,6 +340,7 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
         structured: None,
         periodic: mesh.periodic,
         names: mesh.names.clone(),
+        groups: mesh.groups.clone(),
     })
 }
 
