@@ -14,6 +14,7 @@
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
 //! | [`multipatch`] | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
 //! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
+//! | [`volume`] | structured hexahedral meshes of a trivariate map (a loft), corner Jacobians checked, the six sides named; `.vtu` and `.msh` |
 //! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
 //!
 //! Every mesh is a [`Mesh`]: nodes (physical and parameter coordinates), cells of one
@@ -34,6 +35,7 @@ pub mod structured;
 pub mod topology;
 pub mod unstructured;
 pub mod validate;
+pub mod volume;
 
 pub use distribution::{Distribution, End};
 pub use equidistribution::Equidistribution;
