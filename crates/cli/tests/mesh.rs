@@ -298,3 +298,41 @@ fn solve_a_layout_with_mesh_writes_one_mesh() {
     assert_eq!(msh_physical_names(&msh).iter().filter(|n| n.0 == 2).count(), patches);
     assert!(cells >= patches * 16);
 }
+
+#[test]
+fn a_volume_is_meshed_with_hexahedra() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let qa = data().join("maps/quarter_annulus_nurbs.json");
+    let volume = dir.join("v.json");
+    let o = bin().arg("loft").args([&qa, &qa]).args(["--dz", "1", "-q", "-o"]).arg(&volume).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = volume.to_str().unwrap();
+    for out in ["v.vtu", "v.msh"] {
+        let path = dir.join(out);
+        let (ok, _, err) = run(&["mesh", v, "-o", path.to_str().unwrap(), "--structured", "5x4x3"]);
+        assert!(ok, "{out}: {err}");
+        let text = std::fs::read_to_string(&path).unwrap();
+        if out.ends_with("vtu") {
+            // 4 x 3 x 2 hexahedra (VTK type 12)
+            assert!(text.contains("NumberOfPoints=\"60\" NumberOfCells=\"24\""), "{out}");
+        } else {
+            let names = msh_physical_names(&path);
+            let sides: Vec<&str> = names.iter().filter(|n| n.0 == 2).map(|n| n.1.as_str()).collect();
+            assert_eq!(sides, ["west", "east", "south", "north", "front", "back"]);
+        }
+    }
+    // refused, nothing written: a planar format, two counts, an unstructured mesh
+    let refused: [(&str, &[&str]); 3] = [
+        ("v.su2", &["--structured", "5x4x3"]),
+        ("w.vtu", &["--structured", "5x4"]),
+        ("u.vtu", &["--unstructured", "--size", "0.5"]),
+    ];
+    for (out, flags) in refused {
+        let path = dir.join(out);
+        let mut args = vec!["mesh", v, "-o", path.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let (ok, _, _) = run(&args);
+        assert!(!ok && !path.exists(), "{out}");
+    }
+}
