@@ -251,7 +251,9 @@ pub fn make_and_write_multipatch(layout: &Layout, spec: &MeshSpec, output: &Path
         );
     };
     if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {
-        bail!("--cluster and --equidistribute apply to a single map; a multipatch result is meshed with uniform points");
+        bail!(
+            "--cluster and --equidistribute apply to a single map; a multipatch result is meshed with uniform points"
+        );
     }
     if spec.order != 1 {
         bail!("--order {}: a multipatch result is meshed with linear cells only", spec.order);

@@ -91,11 +91,7 @@ fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
     if let Some(d) = &a.multipatch.patch_maps {
         write_patch_maps(sol, d)?;
     }
-    for (flag, given) in [
-        ("--iges", a.iges.is_some()),
-        ("--vtu", a.vtu.is_some()),
-        ("--vtk", a.vtk.is_some()),
-    ] {
+    for (flag, given) in [("--iges", a.iges.is_some()), ("--vtu", a.vtu.is_some()), ("--vtk", a.vtk.is_some())] {
         if given {
             note!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps, --gismo or --mesh");
         }

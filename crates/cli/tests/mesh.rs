@@ -241,7 +241,8 @@ fn a_multipatch_result_is_one_conforming_mesh() {
     // SU2 markers, VTU, an OpenFOAM case with cellZones
     for out in ["plate.su2", "plate.vtu", "case/"] {
         let path = dir.join(out);
-        let (ok, _, err) = run(&["mesh", result.to_str().unwrap(), "-o", path.to_str().unwrap(), "--structured", "9x7"]);
+        let (ok, _, err) =
+            run(&["mesh", result.to_str().unwrap(), "-o", path.to_str().unwrap(), "--structured", "9x7"]);
         assert!(ok, "{out}: {err}");
     }
     let su2 = std::fs::read_to_string(dir.join("plate.su2")).unwrap();

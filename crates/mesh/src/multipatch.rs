@@ -75,7 +75,10 @@ fn patch_name(layout: &Layout, p: usize) -> String {
 /// agree across interfaces). Not checked for inverted cells: the writers validate.
 pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh> {
     if points[0] < 2 || points[1] < 2 {
-        return Err(MeshError::param("points", format!("need at least 2 per direction, got {}x{}", points[0], points[1])));
+        return Err(MeshError::param(
+            "points",
+            format!("need at least 2 per direction, got {}x{}", points[0], points[1]),
+        ));
     }
     if layout.patches.is_empty() {
         return Err(MeshError::param("layout", "no patches"));

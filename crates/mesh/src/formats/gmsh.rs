@@ -243,7 +243,10 @@ pub fn grouped(mesh: &Mesh) -> Result<String> {
     }
     for (k, (_, cells)) in cgroups.iter().enumerate() {
         let (lo, hi) = bbox(&mut cells.iter().flat_map(|&c| mesh.cell(c).iter().copied()));
-        w(&mut s, format_args!("{} {} {} 0 {} {} 0 1 {} {}", k + 1, lo.x, lo.y, hi.x, hi.y, nb + k + 1, bounding[k].len()));
+        w(
+            &mut s,
+            format_args!("{} {} {} 0 {} {} 0 1 {} {}", k + 1, lo.x, lo.y, hi.x, hi.y, nb + k + 1, bounding[k].len()),
+        );
         for t in &bounding[k] {
             w(&mut s, format_args!(" {t}"));
         }
