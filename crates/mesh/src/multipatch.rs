@@ -211,7 +211,7 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
                 e.nodes.reverse();
             }
         }
-        edge_group.extend(std::iter::repeat(boundary_names.len()).take(edges.len()));
+        edge_group.extend(std::iter::repeat_n(boundary_names.len(), edges.len()));
         boundary.extend(edges);
         boundary_names.push(format!("{}.{}", patch_name(layout, ps.patch), ps.side.name()));
     }
