@@ -12,7 +12,7 @@
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
-//! | [`multipatch`] | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
+//! | [`multipatch`](mod@multipatch) | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
 //! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
 //! | [`volume`] | structured hexahedral meshes of a trivariate map (a loft), corner Jacobians checked, the six sides named; `.vtu` and `.msh` |
 //! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
@@ -121,7 +121,7 @@ pub struct Mesh {
     /// Name of the boundary group of each side (indexed by `Side as usize`): the side
     /// names for a four-sided map, `inner`/`outer` for the walls of a ring.
     pub names: [String; 4],
-    /// Named boundary and cell groups of a mesh of several patches ([`multipatch`]);
+    /// Named boundary and cell groups of a mesh of several patches ([`multipatch`](mod@multipatch));
     /// `None` for a mesh of one map, whose boundary groups are its sides ([`Mesh::names`])
     /// and whose cells are one group `domain`.
     pub groups: Option<Groups>,
