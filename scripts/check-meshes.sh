@@ -3,7 +3,8 @@
 # the shared geometries, write .msh/.vtu/.su2 (structured, unstructured, curved) and
 # load each with meshio, printing its point and cell counts and distinct points (a ring's
 # seam is merged: as many distinct points as points; the cut ring male_casing_ring is
-# refused for its coinciding nodes). Run by hand, not by CI.
+# refused for its coinciding nodes); multipatch results as one mesh (distinct points =
+# points: the interfaces are merged) and a lofted volume's hexahedra. Run by hand, not by CI.
 #   scripts/check-meshes.sh [WINSLOW_BINARY]
 set -euo pipefail
 W=${1:-./target/release/winslow}
@@ -26,6 +27,17 @@ for g in tests/data/spiral_channel.json tests/data/wavy_lid.json tests/data/quar
   "$W" mesh "$OUT/$n.json" -o "$OUT/$n-u.su2" --unstructured --size "$size" > /dev/null || echo "  (refused, see the error above)"
   "$W" mesh "$OUT/$n.json" -o "$OUT/$n-t3.msh" --unstructured --size "$size" --order 3 > /dev/null || echo "  (refused, see the error above)"
 done
+# multipatch results (one conforming mesh, groups per patch and outer side) and a volume
+for g in tests/data/gismo/xml/multipatch/plateWithHoleMP.xml tests/data/gismo/xml/multipatch/TUDflame.xml; do
+  n=$(basename "$g" .xml)
+  "$W" solve "$g" -o "$OUT/$n.json" -q > /dev/null || { echo "$n: solve failed, skipped"; continue; }
+  for f in msh su2 vtu; do
+    "$W" mesh "$OUT/$n.json" -o "$OUT/$n-mp.$f" --structured 33x33 > /dev/null || echo "  (refused, see the error above)"
+  done
+done
+qa=tests/data/maps/quarter_annulus_nurbs.json
+"$W" loft "$qa" "$qa" --dz 1 -o "$OUT/qa-volume.json" -q
+for f in msh vtu; do "$W" mesh "$OUT/qa-volume.json" -o "$OUT/qa-volume.$f" --structured 9x17x5 > /dev/null; done
 "$VENV/bin/python" - "$OUT" <<'PY'
 import sys, glob, meshio
 for f in sorted(glob.glob(sys.argv[1] + "/*.msh") + glob.glob(sys.argv[1] + "/*.vtu") + glob.glob(sys.argv[1] + "/*.su2")):

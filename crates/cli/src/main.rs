@@ -118,7 +118,7 @@ enum Command {
     /// boundary layers, or unstructured triangulations; linear or curved; written as
     /// Gmsh, VTU, SU2, PLOT3D or OpenFOAM, with a quality table.
     #[command(
-        after_help = "Example (a map written by `winslow solve`):\n  winslow mesh out/wavy_lid.json -o out/wavy_lid.msh --structured 65x33 --cluster eta:arctan:6"
+        after_help = "Example (a map written by `winslow solve`):\n  winslow mesh out/wavy_lid.json -o out/wavy_lid.msh --structured 65x33 --cluster eta:arctan:6\nExample (a multipatch result: one conforming mesh, a group per patch):\n  winslow mesh tests/data/gismo/xml/multipatch/plateWithHoleMP.xml -o out/plate.su2 --structured 17x17"
     )]
     Mesh(mesh::MeshArgs),
     /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its

@@ -6,6 +6,9 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use winslow::io::Document;
+use winslow::multipatch::Layout;
+use winslow::spline::volume::Volume;
 use winslow::Surface;
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
@@ -18,7 +21,8 @@ use winslow_mesh::{
 /// What mesh to make (shared by `mesh` and `solve --mesh`).
 #[derive(Args, Debug, Clone)]
 pub struct MeshSpec {
-    /// A structured mesh of NXxNY points (e.g. 401x35), sampled at xi_i x eta_j.
+    /// A structured mesh of NXxNY points (e.g. 401x35), sampled at xi_i x eta_j
+    /// (NXxNYxNZ for a volume).
     #[arg(long, value_name = "NXxNY", conflicts_with = "unstructured")]
     pub structured: Option<String>,
     /// Point distribution of a structured mesh, repeatable: DIR:uniform, DIR:arctan:A
@@ -61,7 +65,10 @@ pub struct MeshSpec {
 /// `winslow mesh` arguments.
 #[derive(Args, Debug)]
 pub struct MeshArgs {
-    /// Map file (JSON map document or G+Smo XML).
+    /// Map file (JSON map document or G+Smo XML), or a multipatch result (JSON with
+    /// "patches", or a G+Smo multipatch whose patches are maps): one conforming mesh,
+    /// --structured only, a cell group per patch; or a trivariate map (`winslow loft`):
+    /// hexahedra, --structured NXxNYxNZ, .vtu or .msh.
     pub map: PathBuf,
     /// Output: .msh (Gmsh 4.1), .su2, .xyz (PLOT3D), .vtu, or a directory (OpenFOAM
     /// case; polyMesh goes to DIR/constant/polyMesh).
@@ -233,12 +240,110 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     Ok(())
 }
 
-/// `winslow mesh`.
+/// Mesh a multipatch result (every patch a map): one conforming structured mesh, a
+/// cell group per patch and a boundary group per outer side; prints the resolution of
+/// each direction class and the quality table.
+pub fn make_and_write_multipatch(layout: &Layout, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
+    let format = Format::from_path(output)?;
+    let Some(s) = &spec.structured else {
+        bail!(
+            "a multipatch result is meshed with --structured NXxNY (points per patch, made equal across interfaces); --unstructured meshes of several patches are not supported"
+        );
+    };
+    if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {
+        bail!(
+            "--cluster and --equidistribute apply to a single map; a multipatch result is meshed with uniform points"
+        );
+    }
+    if spec.order != 1 {
+        bail!("--order {}: a multipatch result is meshed with linear cells only", spec.order);
+    }
+    let t = Instant::now();
+    let mp = winslow_mesh::multipatch(layout, parse_points(s)?)?;
+    let mesh = &mp.mesh;
+    let built = t.elapsed().as_secs_f64();
+    let q = quality(mesh)?;
+    let t = Instant::now();
+    let files = write(mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
+    let written = t.elapsed().as_secs_f64();
+    if !quiet {
+        say!(
+            "multipatch mesh, {} patches, {} {}s, {} nodes ({}):",
+            layout.patches.len(),
+            mesh.num_cells(),
+            mesh.kind.name(),
+            mesh.points.len(),
+            format.name()
+        );
+        let classes: Vec<String> = mp.class_points.iter().enumerate().map(|(c, n)| format!("{c}: {n}")).collect();
+        say!("  points per direction class (equal across interfaces): {}", classes.join(", "));
+        for (p, n) in mp.patch_points.iter().enumerate() {
+            say!("  {}: {}x{} points", layout.label(p), n[0], n[1]);
+        }
+        let groups: Vec<&str> = mesh.boundary_groups().into_iter().map(|g| g.0).collect();
+        say!("  boundary groups: {}", groups.join(", "));
+        say!("  largest interface gap {:.3e}", mp.interface_gap);
+        say_raw!("{}", q.table());
+        say!("  built in {built:.3} s, checked and written in {written:.3} s");
+    }
+    for f in files {
+        crate::files::record(&f);
+    }
+    Ok(())
+}
+
+/// Mesh a trivariate map (a loft): a structured hexahedral mesh, `--structured
+/// NXxNYxNZ`, written as .vtu or .msh after its corner Jacobians are checked.
+pub fn make_and_write_volume(volume: &Volume, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
+    let format = Format::from_path(output)?;
+    let Some(s) = &spec.structured else {
+        bail!("a volume is meshed with --structured NXxNYxNZ (hexahedra); --unstructured is for planar maps");
+    };
+    if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() || spec.order != 1 {
+        bail!("--cluster, --equidistribute and --order apply to planar maps; a volume is meshed with uniform linear hexahedra");
+    }
+    let parts: Vec<&str> = s.split(['x', 'X']).collect();
+    let n = |t: &str| t.trim().parse::<usize>().with_context(|| format!("--structured {s}: '{t}' is not a count"));
+    let points = match parts.as_slice() {
+        [a, b, c] => [n(a)?, n(b)?, n(c)?],
+        _ => bail!("--structured {s}: a volume needs NXxNYxNZ, e.g. 17x17x9"),
+    };
+    let mesh = winslow_mesh::volume::hexahedra(volume, points)?;
+    let files = winslow_mesh::volume::write_hex(&mesh, output, format)
+        .with_context(|| format!("writing {}", output.display()))?;
+    if !quiet {
+        let vols: Vec<f64> =
+            (0..mesh.cells.len()).map(|c| winslow_mesh::volume::hex_volume(&mesh.corners(c))).collect();
+        let (lo, hi) = vols.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+        say!(
+            "structured hexahedral mesh, {} hexahedra, {} nodes ({}): volume {:.6e}, cell volumes {lo:.3e} .. {hi:.3e}",
+            mesh.cells.len(),
+            mesh.points.len(),
+            format.name(),
+            vols.iter().sum::<f64>()
+        );
+    }
+    for f in files {
+        crate::files::record(&f);
+    }
+    Ok(())
+}
+
+/// `winslow mesh`: a map, or a multipatch result (a JSON result or a G+Smo multipatch
+/// whose patches are maps).
 pub fn run(a: MeshArgs) -> Result<i32> {
-    let needed = "mesh needs a map (run `winslow solve` first, or `solve --mesh`)";
+    let needed =
+        "mesh needs a map, a multipatch result or a volume (run `winslow solve` or `winslow loft` first, or `solve --mesh`)";
     crate::files::OutputPlan::new().input(&a.map).mesh_maybe("-o", Some(&a.output))?.check()?;
-    let (_, map) = crate::files::map_of(crate::files::read(&a.map)?, &a.map, needed)?;
-    make_and_write(&map, &a.spec, &a.output, false)?;
+    match crate::files::read(&a.map)? {
+        Document::Map { map, .. } => make_and_write(&map, &a.spec, &a.output, false)?,
+        Document::Multipatch(layout) => make_and_write_multipatch(&layout, &a.spec, &a.output, false)?,
+        Document::Layout(layout) if layout.patches.iter().all(|p| p.map.is_some()) => {
+            make_and_write_multipatch(&layout, &a.spec, &a.output, false)?
+        }
+        Document::Volume { volume, .. } => make_and_write_volume(&volume, &a.spec, &a.output, false)?,
+        other => return Err(crate::files::wrong_kind(&other, &a.map, needed)),
+    }
     Ok(0)
 }
 

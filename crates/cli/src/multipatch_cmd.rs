@@ -57,6 +57,15 @@ pub(super) fn announce(layout: &Layout, opts: &SolveOptions) {
 /// worst verdict.
 pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
     write(&sol, a)?;
+    if let Some(out) = &a.mesh {
+        // one conforming mesh of the solved patches (a folded patch gives inverted
+        // cells, which the writers refuse)
+        let mut layout = sol.layout.clone();
+        for (patch, map) in layout.patches.iter_mut().zip(sol.maps()) {
+            patch.map = Some(map);
+        }
+        super::mesh::make_and_write_multipatch(&layout, &a.mesh_spec, out, a.json || output::quiet())?;
+    }
     if a.json {
         files::print_json(serde_json::to_value(&sol.report)?)?;
     } else {
@@ -84,14 +93,9 @@ fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
             files::record(&p);
         }
     }
-    for (flag, given) in [
-        ("--iges", a.iges.is_some()),
-        ("--vtu", a.vtu.is_some()),
-        ("--vtk", a.vtk.is_some()),
-        ("--mesh", a.mesh.is_some()),
-    ] {
+    for (flag, given) in [("--iges", a.iges.is_some()), ("--vtu", a.vtu.is_some()), ("--vtk", a.vtk.is_some())] {
         if given {
-            note!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps or --gismo");
+            note!("note: {flag} writes one map; for a multipatch layout use --vtm, --patch-maps, --gismo or --mesh");
         }
     }
     Ok(())

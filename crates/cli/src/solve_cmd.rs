@@ -390,7 +390,8 @@ pub(crate) struct SolveArgs {
     #[command(flatten)]
     pub(crate) backend: BackendArgs,
     /// Also write a mesh of the solved map (same options as `winslow mesh`): .msh,
-    /// .su2, .xyz, .vtu or a directory (OpenFOAM).
+    /// .su2, .xyz, .vtu or a directory (OpenFOAM); of a layout, one conforming mesh of
+    /// all patches (--structured only).
     #[arg(long, value_name = "OUT")]
     pub(crate) mesh: Option<PathBuf>,
     #[command(flatten)]

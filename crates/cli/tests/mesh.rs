@@ -193,3 +193,147 @@ fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
     assert!(!ok);
     assert!(!dir.join("seam.su2").exists() && !dir.join("seam.msh").exists());
 }
+
+/// The physical names of a Gmsh file: `(dimension, name)`.
+fn msh_physical_names(path: &Path) -> Vec<(usize, String)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let body = text.split("$PhysicalNames\n").nth(1).unwrap().split("$EndPhysicalNames").next().unwrap();
+    body.lines()
+        .skip(1)
+        .map(|l| {
+            let t: Vec<&str> = l.splitn(3, ' ').collect();
+            (t[0].parse().unwrap(), t[2].trim_matches('"').to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn a_multipatch_result_is_one_conforming_mesh() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let xml = data().join("gismo/xml/multipatch/plateWithHoleMP.xml");
+    let result = dir.join("plate.json");
+    let out = bin().arg("solve").arg(&xml).arg("-q").arg("-o").arg(&result).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc = common::read_json(&result);
+    let patches: Vec<String> =
+        doc["patches"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap().to_string()).collect();
+    // the solved result and the G+Smo multipatch itself (its patches are maps)
+    for (input, tag) in [(result.clone(), "json"), (xml.clone(), "xml")] {
+        let msh = dir.join(format!("{tag}.msh"));
+        let (ok, _, err) = run(&["mesh", input.to_str().unwrap(), "-o", msh.to_str().unwrap(), "--structured", "9x7"]);
+        assert!(ok, "{tag}: {err}");
+        let (nodes, cells, clockwise) = msh_cells(msh.to_str().unwrap());
+        assert_eq!(clockwise, 0, "{tag}");
+        // two patches of 9x9 points (the interface links xi of one to eta of the other
+        // or the same directions: every class gets the larger count) share one side
+        assert!(cells >= 2 * 8 * 6 && nodes < 2 * cells, "{tag}: {nodes} nodes, {cells} cells");
+        let names = msh_physical_names(&msh);
+        let surfaces: Vec<&str> = names.iter().filter(|n| n.0 == 2).map(|n| n.1.as_str()).collect();
+        if tag == "json" {
+            assert_eq!(surfaces, patches.iter().map(String::as_str).collect::<Vec<_>>());
+        }
+        assert_eq!(surfaces.len(), 2, "{tag}");
+        let curves = names.iter().filter(|n| n.0 == 1).count();
+        assert_eq!(curves, 6, "{tag}: two patches with one shared side have 6 outer sides");
+        assert!(names.iter().filter(|n| n.0 == 1).all(|n| n.1.contains('.')), "{tag}: PATCH.SIDE");
+    }
+    // SU2 markers, VTU, an OpenFOAM case with cellZones
+    for out in ["plate.su2", "plate.vtu", "case/"] {
+        let path = dir.join(out);
+        let (ok, _, err) =
+            run(&["mesh", result.to_str().unwrap(), "-o", path.to_str().unwrap(), "--structured", "9x7"]);
+        assert!(ok, "{out}: {err}");
+    }
+    let su2 = std::fs::read_to_string(dir.join("plate.su2")).unwrap();
+    assert!(su2.contains("NMARK= 6\n"));
+    assert!(std::fs::read_to_string(dir.join("plate.vtu")).unwrap().contains("Name=\"patch\""));
+    assert!(dir.join("case/constant/polyMesh/cellZones").exists());
+    // refused, nothing written: PLOT3D (one block), unstructured, curved, clustered
+    let refused: [(&str, &[&str]); 4] = [
+        ("plate.xyz", &["--structured", "9x7"]),
+        ("u.msh", &["--unstructured", "--size", "0.5"]),
+        ("o2.msh", &["--structured", "9x7", "--order", "2"]),
+        ("c.msh", &["--structured", "9x7", "--cluster", "eta:arctan:3"]),
+    ];
+    for (out, flags) in refused {
+        let path = dir.join(out);
+        let mut args = vec!["mesh", result.to_str().unwrap(), "-o", path.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let (ok, _, err) = run(&args);
+        assert!(!ok && !err.is_empty(), "{out}");
+        assert!(!path.exists(), "{out}");
+    }
+}
+
+#[test]
+fn mesh_names_a_document_it_cannot_mesh() {
+    let scratch = tempfile::tempdir().unwrap();
+    let out = scratch.path().join("b.msh");
+    for input in [data().join("wavy_lid.json"), data().join("rings/male_rotor_in_casing.json")] {
+        let o = bin().arg("mesh").arg(&input).arg("-o").arg(&out).args(["--structured", "9x9"]).output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", input.display());
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn solve_a_layout_with_mesh_writes_one_mesh() {
+    let scratch = tempfile::tempdir().unwrap();
+    let (json, msh) = (scratch.path().join("c.json"), scratch.path().join("c.msh"));
+    let out = bin()
+        .arg("solve")
+        .arg(data().join("gismo/xml/multipatch/circleMP.xml"))
+        .arg("-q")
+        .arg("-o")
+        .arg(&json)
+        .arg("--mesh")
+        .arg(&msh)
+        .args(["--structured", "5x5"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (_, cells, clockwise) = msh_cells(msh.to_str().unwrap());
+    assert_eq!(clockwise, 0);
+    let patches = common::read_json(&json)["patches"].as_array().unwrap().len();
+    assert_eq!(msh_physical_names(&msh).iter().filter(|n| n.0 == 2).count(), patches);
+    assert!(cells >= patches * 16);
+}
+
+#[test]
+fn a_volume_is_meshed_with_hexahedra() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let qa = data().join("maps/quarter_annulus_nurbs.json");
+    let volume = dir.join("v.json");
+    let o = bin().arg("loft").args([&qa, &qa]).args(["--dz", "1", "-q", "-o"]).arg(&volume).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = volume.to_str().unwrap();
+    for out in ["v.vtu", "v.msh"] {
+        let path = dir.join(out);
+        let (ok, _, err) = run(&["mesh", v, "-o", path.to_str().unwrap(), "--structured", "5x4x3"]);
+        assert!(ok, "{out}: {err}");
+        let text = std::fs::read_to_string(&path).unwrap();
+        if out.ends_with("vtu") {
+            // 4 x 3 x 2 hexahedra (VTK type 12)
+            assert!(text.contains("NumberOfPoints=\"60\" NumberOfCells=\"24\""), "{out}");
+        } else {
+            let names = msh_physical_names(&path);
+            let sides: Vec<&str> = names.iter().filter(|n| n.0 == 2).map(|n| n.1.as_str()).collect();
+            assert_eq!(sides, ["west", "east", "south", "north", "front", "back"]);
+        }
+    }
+    // refused, nothing written: a planar format, two counts, an unstructured mesh
+    let refused: [(&str, &[&str]); 3] = [
+        ("v.su2", &["--structured", "5x4x3"]),
+        ("w.vtu", &["--structured", "5x4"]),
+        ("u.vtu", &["--unstructured", "--size", "0.5"]),
+    ];
+    for (out, flags) in refused {
+        let path = dir.join(out);
+        let mut args = vec!["mesh", v, "-o", path.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let (ok, _, _) = run(&args);
+        assert!(!ok && !path.exists(), "{out}");
+    }
+}

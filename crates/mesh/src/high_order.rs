@@ -254,6 +254,10 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
     if p == 1 {
         return Ok(mesh.clone());
     }
+    if mesh.groups.is_some() {
+        // its parameters are patch-local: one map cannot place the new nodes
+        return Err(MeshError::param("order", format!("{p} on a mesh of several patches: only linear cells so far")));
+    }
     let lat = lattice(mesh.kind, p);
     let k = mesh.kind.corners();
     let periodic = mesh.periodic;
@@ -340,6 +344,7 @@ pub fn elevate(mesh: &Mesh, map: &Surface, p: usize) -> Result<Mesh> {
         structured: None,
         periodic: mesh.periodic,
         names: mesh.names.clone(),
+        groups: mesh.groups.clone(),
     })
 }
 

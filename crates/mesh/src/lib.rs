@@ -12,7 +12,9 @@
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
+//! | [`multipatch`](mod@multipatch) | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
 //! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
+//! | [`volume`] | structured hexahedral meshes of a trivariate map (a loft), corner Jacobians checked, the six sides named; `.vtu` and `.msh` |
 //! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
 //!
 //! Every mesh is a [`Mesh`]: nodes (physical and parameter coordinates), cells of one
@@ -27,16 +29,19 @@ pub mod equidistribution;
 pub mod error;
 pub mod formats;
 pub mod high_order;
+pub mod multipatch;
 pub mod quality;
 pub mod structured;
 pub mod topology;
 pub mod unstructured;
 pub mod validate;
+pub mod volume;
 
 pub use distribution::{Distribution, End};
 pub use equidistribution::Equidistribution;
 pub use error::{MeshError, Result};
 pub use glam::DVec2;
+pub use multipatch::{multipatch, MultipatchMesh};
 pub use quality::{CellQuality, Quality};
 use rayon::prelude::*;
 pub use structured::{structured, StructuredOptions};
@@ -116,6 +121,23 @@ pub struct Mesh {
     /// Name of the boundary group of each side (indexed by `Side as usize`): the side
     /// names for a four-sided map, `inner`/`outer` for the walls of a ring.
     pub names: [String; 4],
+    /// Named boundary and cell groups of a mesh of several patches ([`multipatch`](mod@multipatch));
+    /// `None` for a mesh of one map, whose boundary groups are its sides ([`Mesh::names`])
+    /// and whose cells are one group `domain`.
+    pub groups: Option<Groups>,
+}
+
+/// Named groups of a mesh of several patches: boundary edges and cells by group index.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Groups {
+    /// Name of each boundary group (`PATCH.SIDE` for an outer side of a patch).
+    pub boundary: Vec<String>,
+    /// Boundary group of each edge of [`Mesh::boundary`].
+    pub edge_group: Vec<usize>,
+    /// Name of each cell group (a patch's name).
+    pub cells: Vec<String>,
+    /// Cell group of each cell.
+    pub cell_group: Vec<usize>,
 }
 
 /// The side names `south`, `east`, `north`, `west`.
@@ -148,6 +170,37 @@ impl Mesh {
     /// The name of the boundary group of `side`.
     pub fn name(&self, side: Side) -> &str {
         &self.names[side as usize]
+    }
+
+    /// The boundary groups that hold edges: name and the indices into [`Mesh::boundary`]
+    /// of its edges, in order (the sides south, east, north, west of a single map; the
+    /// [`Groups`] of a multipatch mesh).
+    pub fn boundary_groups(&self) -> Vec<(&str, Vec<usize>)> {
+        match &self.groups {
+            Some(g) => (0..g.boundary.len())
+                .map(|k| {
+                    let edges = (0..self.boundary.len()).filter(|&e| g.edge_group.get(e) == Some(&k)).collect();
+                    (g.boundary[k].as_str(), edges)
+                })
+                .filter(|(_, e): &(&str, Vec<usize>)| !e.is_empty())
+                .collect(),
+            None => self
+                .boundary_sides()
+                .into_iter()
+                .map(|s| (self.name(s), (0..self.boundary.len()).filter(|&e| self.boundary[e].side == s).collect()))
+                .collect(),
+        }
+    }
+
+    /// The cell groups: name and cell indices (one group `domain` of every cell for a
+    /// single map; a group per patch of a multipatch mesh).
+    pub fn cell_groups(&self) -> Vec<(&str, Vec<usize>)> {
+        match &self.groups {
+            Some(g) => (0..g.cells.len())
+                .map(|k| (g.cells[k].as_str(), (0..self.num_cells()).filter(|&c| g.cell_group[c] == k).collect()))
+                .collect(),
+            None => vec![("domain", (0..self.num_cells()).collect())],
+        }
     }
 
     /// The sides that carry boundary edges, in the order south, east, north, west.

@@ -326,6 +326,7 @@ pub fn grid_mesh(map: &Surface, grid: &Grid) -> Mesh {
         structured: Some([nx, ny]),
         periodic: grid.periodic,
         names,
+        groups: None,
     }
 }
 

@@ -443,5 +443,6 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
         structured: None,
         periodic: [false, false],
         names: crate::side_names(),
+        groups: None,
     })
 }

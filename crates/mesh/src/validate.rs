@@ -241,6 +241,7 @@ mod tests {
             structured: None,
             periodic: [false, false],
             names: side_names(),
+            groups: None,
         }
     }
 

@@ -1,6 +1,8 @@
 //! OpenFOAM `constant/polyMesh` for a 2D case: the mesh extruded one cell thick in `z`
 //! (`0` to the thickness), the sides as `patch`es named by [`crate::Mesh::names`]
-//! (`south`, `east`, `north`, `west`; `inner` and `outer` on a ring), and the front and back faces as the `empty` patch `frontAndBack`.
+//! (`south`, `east`, `north`, `west`; `inner` and `outer` on a ring; the boundary groups
+//! `PATCH.SIDE` of a multipatch mesh, whose patches are also the `cellZones`), and the
+//! front and back faces as the `empty` patch `frontAndBack`.
 //!
 //! What OpenFOAM requires and this writer does: internal faces first, in upper-triangular
 //! order (sorted by owner, then neighbour, with owner < neighbour), each face's normal
@@ -67,15 +69,15 @@ pub fn files(mesh: &Mesh, opts: &OpenFoamOptions) -> Result<Vec<(&'static str, S
     }
     let mut patches = Vec::new();
     let mut start = n_int;
-    for side in mesh.boundary_sides() {
-        let mut count = 0;
-        for face in f.boundary.iter().filter(|b| b.side == side) {
+    // topology::faces keeps the boundary faces in the order of mesh.boundary
+    for (name, edges) in mesh.boundary_groups() {
+        for &e in &edges {
+            let face = f.boundary[e];
             quad(&mut face_text, face.nodes);
             let _ = writeln!(owner_text, "{}", face.owner);
-            count += 1;
         }
-        patches.push((mesh.name(side), "patch", count, start));
-        start += count;
+        patches.push((name, "patch", edges.len(), start));
+        start += edges.len();
     }
     for c in 0..cells {
         let v = mesh.corners(c);
@@ -108,11 +110,31 @@ pub fn files(mesh: &Mesh, opts: &OpenFoamOptions) -> Result<Vec<(&'static str, S
         );
     }
     boundary.push_str(")\n");
-    Ok(vec![
+    let mut out = vec![
         ("points", points),
         ("faces", wrap("faceList", "faces", n_faces, face_text)),
         ("owner", wrap("labelList", "owner", n_faces, owner_text)),
         ("neighbour", wrap("labelList", "neighbour", n_int, neighbour_text)),
         ("boundary", boundary),
-    ])
+    ];
+    if mesh.groups.is_some() {
+        out.push(("cellZones", cell_zones(mesh)));
+    }
+    Ok(out)
+}
+
+/// The `cellZones` file: one zone per cell group of a multipatch mesh (its patch).
+pub fn cell_zones(mesh: &Mesh) -> String {
+    let mut s = header("regIOobject", "cellZones", "");
+    let groups = mesh.cell_groups();
+    let _ = writeln!(s, "{}\n(", groups.len());
+    for (name, cells) in groups {
+        let _ = writeln!(s, "{name}\n{{\n    type cellZone;\ncellLabels      List<label>\n{}\n(", cells.len());
+        for c in cells {
+            let _ = writeln!(s, "{c}");
+        }
+        s.push_str(")\n;\n}\n");
+    }
+    s.push_str(")\n");
+    s
 }

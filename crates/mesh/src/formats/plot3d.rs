@@ -12,6 +12,12 @@ use crate::Mesh;
 /// The file's text.
 pub fn to_string(mesh: &Mesh) -> Result<String> {
     super::linear_only(mesh, "PLOT3D")?;
+    if mesh.groups.is_some() {
+        return Err(MeshError::Unsupported {
+            format: "PLOT3D",
+            why: "a mesh of several patches joined at their interfaces; this writer holds one structured block (use .msh, .vtu, .su2 or an OpenFOAM directory)".into(),
+        });
+    }
     let Some([nx, ny]) = mesh.structured else {
         return Err(MeshError::Unsupported {
             format: "PLOT3D",

@@ -1,7 +1,9 @@
 //! SU2 native mesh (`.su2`, ASCII): `NDIME= 2`, the cells as VTK types (5 triangle,
 //! 9 quad) with their index, the points with their index, and one marker per side
 //! named by [`Mesh::names`] (`MARKER_TAG= south`, ..., `inner`/`outer` on a ring) of line
-//! elements (VTK type 3). Linear cells only.
+//! elements (VTK type 3); a multipatch mesh has one marker per boundary group
+//! ([`Mesh::boundary_groups`], `PATCH.SIDE`) and one zone (SU2 has no cell groups in a
+//! single-zone file: the patches are not told apart). Linear cells only.
 
 use std::fmt::Write;
 
@@ -30,12 +32,12 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         let p = mesh.points[i];
         let _ = writeln!(s, "{} {} {i}", p.x, p.y);
     }));
-    let sides = mesh.boundary_sides();
-    let _ = writeln!(s, "NMARK= {}", sides.len());
-    for side in sides {
-        let edges: Vec<_> = mesh.boundary.iter().filter(|e| e.side == side).collect();
-        let _ = writeln!(s, "MARKER_TAG= {}\nMARKER_ELEMS= {}", mesh.name(side), edges.len());
+    let groups = mesh.boundary_groups();
+    let _ = writeln!(s, "NMARK= {}", groups.len());
+    for (name, edges) in groups {
+        let _ = writeln!(s, "MARKER_TAG= {name}\nMARKER_ELEMS= {}", edges.len());
         for e in edges {
+            let e = &mesh.boundary[e];
             let _ = writeln!(s, "3 {} {}", e.nodes[0], e.nodes[1]);
         }
     }

@@ -1,5 +1,6 @@
 //! VTK XML unstructured grid (`.vtu`, ASCII), with the quality fields as cell data and
-//! the parameters `(xi, eta)` as point data.
+//! the parameters `(xi, eta)` as point data (patch-local on a multipatch mesh, which
+//! also has the cell data `patch`: the index of each cell's patch, [`Mesh::cell_groups`]).
 //!
 //! Cell types: triangle 5, quad 9; quadratic triangle 22 and biquadratic quad 28 (node
 //! order equal to Gmsh's 9 and 10); cubic Lagrange triangle 69 (Gmsh 21's order) and
@@ -76,6 +77,14 @@ pub fn to_string(mesh: &Mesh) -> Result<String> {
         let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">");
         s.push_str(&super::par_text(cells, |s, c| {
             let _ = writeln!(s, "{}", f(&q.per_cell[c]));
+        }));
+        s.push_str("</DataArray>\n");
+    }
+    if let Some(g) = &mesh.groups {
+        // the cell group (patch) of each cell, numbered as in Mesh::cell_groups
+        s.push_str("<DataArray type=\"Int32\" Name=\"patch\" format=\"ascii\">\n");
+        s.push_str(&super::par_text(cells, |s, c| {
+            let _ = writeln!(s, "{}", g.cell_group[c]);
         }));
         s.push_str("</DataArray>\n");
     }
