@@ -10,6 +10,7 @@
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
 //! | [`pipeline`] | [`Pipeline`](pipeline::Pipeline): the one observable entry (fit, hierarchy, solve, finish, fallback) of a boundary or a ring, run with an observer of its [`Stage`](pipeline::Stage)s; also `winslow::pipeline` | §5-§9 |
+//! | [`memory`] | the peak memory of a solve estimated from its basis sizes, checked against [`MemoryLimit`](memory::MemoryLimit) (`--max-memory`) before it allocates | |
 //! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s | §6.3 |
 //! | [`sweep`] | [`Sweep`](sweep::Sweep): the sliding O-grid, inner contour turned per frame, extrapolated initial guesses | §11.1, Fig. 22 |
@@ -28,6 +29,7 @@ pub mod initial;
 pub mod kinks;
 pub mod levels;
 pub mod loft;
+pub mod memory;
 pub mod newton;
 pub mod options;
 pub mod pipeline;

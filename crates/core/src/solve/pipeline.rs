@@ -37,6 +37,7 @@ use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
+use crate::solve::memory::MemoryEstimate;
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
@@ -176,8 +177,17 @@ impl Pipeline {
         Ok((auto_choice(first.0, again, why), h))
     }
 
-    /// One fit and coarse-to-fine solve with `opts`.
-    fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+    /// The estimated peak memory of the solve ([`MemoryEstimate`]): the input fitted and
+    /// its levels planned as [`Pipeline::run`] does (with `--basis auto`, those of the
+    /// first attempt), nothing solved. `winslow bench` prints it next to the measured peak.
+    pub fn estimate(&self) -> Result<MemoryEstimate> {
+        self.opts.validate()?;
+        let (_, _, solver) = self.plan(&self.opts)?;
+        Ok(MemoryEstimate::for_levels(solver.plan()))
+    }
+
+    /// The fit of the input and the solver of its levels (nothing large allocated yet).
+    fn plan(&self, opts: &SolveOptions) -> Result<(Boundary, Arc<Hierarchy>, EggSolver)> {
         let (boundary, hierarchy, opts) = match &self.input {
             Input::Boundary(b) => (b.clone(), build_hierarchy(b, &opts.fit)?, opts.clone()),
             Input::Ring(r) => {
@@ -186,10 +196,19 @@ impl Pipeline {
             }
         };
         let hierarchy = Arc::new(hierarchy);
-        let mut solver = match &self.method {
+        let solver = match &self.method {
             Some(m) => EggSolver::with_method(&boundary, hierarchy.clone(), opts, self.assembler.clone(), m.clone())?,
             None => EggSolver::new(&boundary, hierarchy.clone(), opts, self.assembler.clone())?,
         };
+        Ok((boundary, hierarchy, solver))
+    }
+
+    /// One fit and coarse-to-fine solve with `opts`; refused with [`Error::Memory`] when
+    /// its estimated peak exceeds `opts.max_memory`.
+    fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+        let (boundary, hierarchy, mut solver) = self.plan(opts)?;
+        let estimate = MemoryEstimate::for_levels(solver.plan());
+        opts.max_memory.check(&estimate, opts.refine, &format!("solving '{}'", self.input.name()))?;
         let fitted =
             Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };
         if !observer(&fitted) {
