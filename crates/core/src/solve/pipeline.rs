@@ -355,6 +355,32 @@ mod tests {
         assert_eq!(stages, 3);
     }
 
+    /// A memory limit below the estimated peak: [`Error::Memory`] with the estimate and
+    /// the limit, before any stage; [`Pipeline::estimate`] gives the same estimate.
+    #[test]
+    fn a_solve_above_the_memory_limit_is_refused_before_it_starts() {
+        let opts = SolveOptions { refine: 2, ..Default::default() };
+        let estimate = Pipeline::new(puzzle4(), opts.clone()).estimate().unwrap();
+        assert!(estimate.bytes > crate::solve::memory::BASE && estimate.unknowns > 0);
+        let limit = estimate.bytes - 1;
+        let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(limit), ..opts };
+        let mut stages = 0;
+        let out = Pipeline::new(puzzle4(), opts.clone()).run(&mut |_| {
+            stages += 1;
+            true
+        });
+        match out {
+            Err(Error::Memory { needed, available, ref advice, .. }) => {
+                assert_eq!((needed, available), (estimate.bytes, limit));
+                assert!(advice.contains("--refine 1"), "{advice}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(stages, 0);
+        let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(estimate.bytes), ..opts };
+        assert!(Pipeline::new(puzzle4(), opts).solve().is_ok());
+    }
+
     /// Options are checked before anything runs, with a message naming the option.
     #[test]
     fn invalid_options_are_refused_before_the_fit() {
