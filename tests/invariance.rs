@@ -213,7 +213,8 @@ fn layouts_translated_and_scaled_solve_alike() {
             let orig = solve_multipatch(&parse_gismo_multipatch(&text).unwrap(), &opts).unwrap();
             for (a, s) in similarities(orig.report.layout.diameter) {
                 let what = format!("{file} {interfaces:?} moved by {a:?}, scaled by {s:e}");
-                let layout = parse_gismo_multipatch(&similar_xml(&text, a, s)).unwrap_or_else(|e| panic!("{what}: {e}"));
+                let layout =
+                    parse_gismo_multipatch(&similar_xml(&text, a, s)).unwrap_or_else(|e| panic!("{what}: {e}"));
                 let moved = solve_multipatch(&layout, &opts).unwrap_or_else(|e| panic!("{what}: {e}"));
                 assert_eq!(layout_summary(&moved), layout_summary(&orig), "{what}");
                 let area = moved.report.layout.area / (s * s * orig.report.layout.area);
@@ -248,7 +249,8 @@ fn sweeps_and_lofts_translated_and_scaled_alike() {
         let maps: Vec<Surface> = frames.into_iter().map(|f| f.map).collect();
         let z: Vec<f64> = (0..maps.len()).map(|k| 1e9 * s + 0.05 * s * k as f64).collect();
         let l = loft(&maps, &z, &LoftOptions::default(), SliceBoundary::Interpolated).unwrap();
-        let rounds: Vec<_> = l.report.rounds.iter().map(|r| (r.verdict, r.offending_elements, r.inserted_z.len())).collect();
+        let rounds: Vec<_> =
+            l.report.rounds.iter().map(|r| (r.verdict, r.offending_elements, r.inserted_z.len())).collect();
         (rows, l.report.verdict, l.report.shape, rounds)
     };
     let orig = run([0.0, 0.0], 1.0);

@@ -63,9 +63,8 @@ fn an_address_space_limit_is_a_typed_error_not_an_abort() {
     let dir = tempfile::tempdir().unwrap();
     let map = dir.path().join("map.json");
     for limit in ["available", "none"] {
-        let script = format!(
-            "ulimit -v 1048576 && exec \"$0\" solve -q --refine 6 --max-memory {limit} \"$1\" -o \"$2\""
-        );
+        let script =
+            format!("ulimit -v 1048576 && exec \"$0\" solve -q --refine 6 --max-memory {limit} \"$1\" -o \"$2\"");
         let out = std::process::Command::new("sh")
             .args(["-c", &script, env!("CARGO_BIN_EXE_winslow")])
             .arg(data().join("wavy_lid.json"))
