@@ -135,7 +135,7 @@ impl MemoryLimit {
         };
         let v: f64 = num.trim().parse().ok()?;
         let bytes = v * (1u64 << shift) as f64;
-        (bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64).then(|| MemoryLimit::Bytes(bytes as u64))
+        (bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64).then_some(MemoryLimit::Bytes(bytes as u64))
     }
 
     /// The limit in bytes and where it comes from; `None`: no limit.
