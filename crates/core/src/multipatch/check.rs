@@ -3,7 +3,7 @@
 //! the same parameters, up to the interface's reversal) with the two patches on
 //! opposite sides of it, no two sides coinciding without an interface, and no two patch
 //! boundaries crossing or one patch inside another. Every failure is an
-//! [`Error::Layout`](crate::error::Error::Layout) naming the patch and side.
+//! [`Error::Layout`] naming the patch and side.
 
 use std::collections::HashSet;
 
