@@ -10,7 +10,7 @@ use winslow::io::{read_boundary, ReadOptions};
 use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Solution;
-use winslow::{Error, Point};
+use winslow::{Error, Point, Surface, Verdict};
 
 fn load(file: &str) -> Boundary {
     let path = winslow::testutil::data(file);
@@ -117,5 +117,155 @@ fn validation_reports_in_the_input_coordinates() {
             r1.corner_angles,
             r0.corner_angles
         );
+    }
+}
+
+// ---- every document kind (issue 30): rings, layouts, sweeps and lofted volumes ----
+
+use winslow::boundary::ring::Ring;
+use winslow::io::multipatch::gismo::parse_gismo_multipatch;
+use winslow::multipatch::{Functional, Interfaces, Layout, MultipatchSolution};
+use winslow::pipeline::sweep::{Sweep, SweepOptions};
+use winslow::solve::loft::{loft, LoftOptions, SliceBoundary};
+use winslow::{Document, Pipeline, Solved};
+
+/// The three similarities of `scripts/invariance.sh` for a domain of diameter `d`.
+fn similarities(d: f64) -> [(Point, f64); 3] {
+    [([1e9 * d, -2e9 * d], 1.0), ([0.0, 0.0], 1e150), ([0.0, 0.0], 1e-150)]
+}
+
+fn ring(file: &str) -> Ring {
+    match winslow::read(&winslow::testutil::data(file)).unwrap_or_else(|e| panic!("{file}: {e}")) {
+        Document::Ring(r) => r,
+        other => panic!("{file}: {}", other.kind()),
+    }
+}
+
+fn similar_ring(r: &Ring, a: Point, s: f64) -> Ring {
+    let f = move |p: Point| [p[0] * s + a[0], p[1] * s + a[1]];
+    Ring { name: r.name.clone(), inner: r.inner.mapped(f), outer: r.outer.mapped(f) }
+}
+
+/// Verdict and Newton iterations per level.
+fn summary(sol: &Solution) -> (Verdict, Vec<usize>) {
+    (sol.report.verdict, sol.report.levels.iter().map(|l| l.newton_iterations).collect())
+}
+
+/// A ring translated by 1e9 times its size was refused as running clockwise (its signed
+/// area computed from raw coordinates); now every similarity gives the same verdict and
+/// iterations, and the map transformed within the input's own rounding.
+#[test]
+fn rings_translated_and_scaled_solve_alike() {
+    for file in ["rings/eccentric_annulus.json", "rings/annulus_periodic.json"] {
+        let r = ring(file);
+        let orig = Pipeline::new(r.clone(), SolveOptions::default()).solve().and_then(Solved::into_map).unwrap();
+        let d = orig.report.diameter;
+        for (a, s) in similarities(d) {
+            let moved = Pipeline::new(similar_ring(&r, a, s), SolveOptions::default())
+                .solve()
+                .and_then(Solved::into_map)
+                .unwrap_or_else(|e| panic!("{file} moved by {a:?}, scaled by {s:e}: {e}"));
+            assert_eq!(summary(&moved), summary(&orig), "{file} moved by {a:?}, scaled by {s:e}");
+            let worst = orig
+                .map
+                .control_points
+                .iter()
+                .zip(&moved.map.control_points)
+                .map(|(p, q)| ((q[0] - a[0] - s * p[0]).abs()).max((q[1] - a[1] - s * p[1]).abs()) / (s * d))
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-5, "{file} moved by {a:?}: control points differ by {worst:.3e} of the diameter");
+        }
+    }
+}
+
+/// The control points of a G+Smo XML text mapped by `x ↦ a + s x` (what
+/// `scripts/similar_xml.py` does), so that the reader's orientation test sees them.
+fn similar_xml(text: &str, a: Point, s: f64) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("<coefs geoDim=\"2\">") {
+        let open = i + "<coefs geoDim=\"2\">".len();
+        let close = open + rest[open..].find("</coefs>").expect("closed coefs");
+        out.push_str(&rest[..open]);
+        let v: Vec<f64> = rest[open..close].split_whitespace().map(|t| t.parse().unwrap()).collect();
+        for p in v.chunks(2) {
+            out.push_str(&format!("{:?} {:?}\n", p[0] * s + a[0], p[1] * s + a[1]));
+        }
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The pipeline's solve of a layout with `opts`.
+fn solve_layout(layout: &Layout, opts: &SolveOptions) -> winslow::Result<MultipatchSolution> {
+    match Pipeline::new(layout.clone(), opts.clone()).solve()? {
+        Solved::Layout(sol) => Ok(*sol),
+        other => panic!("a layout gave {:?}", other.verdict()),
+    }
+}
+
+fn layout_summary(m: &MultipatchSolution) -> (Vec<Verdict>, Vec<Vec<usize>>, Option<usize>) {
+    let its = m.patches.iter().map(|p| p.solve.levels.iter().map(|l| l.newton_iterations).collect()).collect();
+    (m.report.verdicts.clone(), its, m.report.free.as_ref().map(|f| f.iterations))
+}
+
+/// Layouts translated far away failed their interface check (NURBS sides evaluated at
+/// 1e9 are rounded to 1e-7 of their size) and had their patches transposed by the
+/// reader; the free interfaces took a number of iterations that depended on the scale.
+#[test]
+fn layouts_translated_and_scaled_solve_alike() {
+    for file in ["gismo/xml/multipatch/plateWithHoleMP.xml", "gismo/xml/multipatch/circleMP.xml"] {
+        let text = std::fs::read_to_string(winslow::testutil::data(file)).unwrap();
+        for interfaces in [Interfaces::Fixed, Interfaces::Free] {
+            let improve = (interfaces == Interfaces::Free).then_some(Functional::Winslow);
+            let opts = SolveOptions { improve, ..Default::default() };
+            let orig = solve_layout(&parse_gismo_multipatch(&text).unwrap(), &opts).unwrap();
+            for (a, s) in similarities(orig.report.layout.diameter) {
+                let what = format!("{file} {interfaces:?} moved by {a:?}, scaled by {s:e}");
+                let layout =
+                    parse_gismo_multipatch(&similar_xml(&text, a, s)).unwrap_or_else(|e| panic!("{what}: {e}"));
+                let moved = solve_layout(&layout, &opts).unwrap_or_else(|e| panic!("{what}: {e}"));
+                assert_eq!(layout_summary(&moved), layout_summary(&orig), "{what}");
+                let area = moved.report.layout.area / (s * s * orig.report.layout.area);
+                assert!((area - 1.0).abs() < 1e-6, "{what}: area ratio {area}");
+            }
+        }
+    }
+}
+
+/// A sliding grid (three steps of 3 degrees about the inner circle's centre, mapped too)
+/// and the volume lofted from its frames (heights mapped too): the same verdicts,
+/// iterations and linear solves per frame, and the same loft.
+#[test]
+fn sweeps_and_lofts_translated_and_scaled_alike() {
+    let r = ring("rings/eccentric_annulus.json");
+    let mut opts = SolveOptions::default();
+    opts.fit.tol = 1e-3;
+    let run = |a: Point, s: f64| {
+        let sweep = SweepOptions {
+            step: 3f64.to_radians(),
+            steps: 3,
+            center: Some([0.25 * s + a[0], 0.1 * s + a[1]]),
+            ..Default::default()
+        };
+        let (mut sw, _, first) = Sweep::new(&similar_ring(&r, a, s), &opts, sweep).unwrap();
+        let mut frames = vec![first];
+        for _ in 0..3 {
+            frames.push(sw.next_frame().unwrap());
+        }
+        let rows: Vec<_> =
+            frames.iter().map(|f| (f.report.verdict, f.report.newton_iterations, f.report.linear_solves)).collect();
+        let maps: Vec<Surface> = frames.into_iter().map(|f| f.map).collect();
+        let z: Vec<f64> = (0..maps.len()).map(|k| 1e9 * s + 0.05 * s * k as f64).collect();
+        let l = loft(&maps, &z, &LoftOptions::default(), SliceBoundary::Interpolated).unwrap();
+        let rounds: Vec<_> =
+            l.report.rounds.iter().map(|r| (r.verdict, r.offending_elements, r.inserted_z.len())).collect();
+        (rows, l.report.verdict, l.report.shape, rounds)
+    };
+    let orig = run([0.0, 0.0], 1.0);
+    assert!(orig.0.iter().all(|f| f.0 == "certified"), "{orig:?}");
+    for (a, s) in similarities(2.0) {
+        assert_eq!(run(a, s), orig, "moved by {a:?}, scaled by {s:e}");
     }
 }

@@ -188,6 +188,24 @@ pub(crate) struct SolverArgs {
     /// unknowns, 3 spans above).
     #[arg(long, default_value = "auto", value_parser = parse_kinks_local)]
     pub(crate) kinks_local: KinksLocal,
+    #[command(flatten)]
+    pub(crate) memory: MemoryArgs,
+}
+
+/// The memory bound of a solve (every command that solves).
+#[derive(Args, Debug, Clone)]
+pub(crate) struct MemoryArgs {
+    /// The most memory a solve may take: bytes with an optional K, M, G or T suffix
+    /// (powers of 1024, e.g. 4G, 512M), `available` (the memory available when the solve
+    /// starts: MemAvailable, the cgroup's limit or `ulimit -v`, whichever is least; no
+    /// limit on systems other than Linux) or `none`. A solve whose estimated peak is above
+    /// it is refused before it allocates, with what lowers it (docs/solve.md, "Memory").
+    #[arg(long, default_value = "available", value_parser = parse_max_memory)]
+    pub(crate) max_memory: MemoryLimit,
+}
+
+pub(crate) fn parse_max_memory(s: &str) -> std::result::Result<MemoryLimit, String> {
+    MemoryLimit::parse(s).ok_or_else(|| format!("expected a size such as 4G or 512M, `available` or `none`, got '{s}'"))
 }
 
 impl SolverArgs {
@@ -218,6 +236,7 @@ impl SolverArgs {
         o.growth = self.growth.max(1.0);
         o.kinks_local = self.kinks_local;
         o.improve = self.improve;
+        o.max_memory = self.memory.max_memory;
         // a method that needs a bijective start runs after the EGG solve
         if let Some(m) = self.improvement_method() {
             if o.improve.is_some_and(|i| i != m) {

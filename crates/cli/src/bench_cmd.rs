@@ -70,11 +70,12 @@ pub(crate) fn bench(a: BenchArgs) -> Result<i32> {
         };
         for &r in &a.refinements {
             let o = SolveOptions { refine: r, ..opts.clone() };
+            let estimate = winslow::Pipeline::new(boundary.clone(), o.clone()).estimate()?;
             output::reset_peak_memory();
             let t = Instant::now();
             let sol = solve_cmd::run_pipeline(boundary.clone(), &o, sel.as_assembler(), true)?.into_map()?;
             let total = t.elapsed().as_secs_f64();
-            let row = output::BenchRow::new(&sol, r, total);
+            let row = output::BenchRow::new(&sol, r, total, estimate.bytes);
             if a.json {
                 println!("{}", serde_json::to_string(&row)?);
             }

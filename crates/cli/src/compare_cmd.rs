@@ -88,6 +88,8 @@ pub(super) struct CompareArgs {
     /// Print the comparison as JSON on stdout (progress goes to stderr).
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    memory: MemoryArgs,
     /// Progress of every nonlinear iterate (residual, objective, damping).
     #[arg(short, long)]
     verbose: bool,
@@ -112,6 +114,7 @@ impl CompareArgs {
             repair_freeze: None,
             improve: None,
             kinks_local: KinksLocal::All,
+            memory: self.memory.clone(),
         };
         // the comparison's defaults (one level, no repair, its iteration limits), with the
         // fit, operator, sizes and tolerances of the flags

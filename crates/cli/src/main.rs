@@ -19,6 +19,7 @@ use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::{EggAssembler, EggMethod};
 use winslow::methods::Method;
 use winslow::solve::improve::{improve, Improve};
+use winslow::solve::memory::MemoryLimit;
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::Verdict;

@@ -449,6 +449,9 @@ pub struct BenchRow {
     pub total_s: f64,
     /// Peak resident memory in MiB.
     pub peak_mib: f64,
+    /// The solve's estimated peak in MiB (`winslow::solve::memory`), the figure
+    /// `--max-memory` is checked against.
+    pub estimated_mib: f64,
     /// Elements of the final map.
     pub elements: usize,
     /// Seconds to certify the final map.
@@ -472,7 +475,7 @@ pub struct BenchRow {
 
 impl BenchRow {
     /// Row from a solution.
-    pub fn new(sol: &Solution, refine: usize, total_s: f64) -> Self {
+    pub fn new(sol: &Solution, refine: usize, total_s: f64, estimated_bytes: u64) -> Self {
         let r = &sol.report;
         let last = r.levels.last();
         Self {
@@ -486,6 +489,7 @@ impl BenchRow {
             solve_s: r.levels.iter().map(|l| l.linear_seconds).sum(),
             total_s,
             peak_mib: peak_memory_mib(),
+            estimated_mib: estimated_bytes as f64 / (1u64 << 20) as f64,
             elements: r.certificate.elements,
             certify_s: r.certificate.seconds,
             newton_iteration_s: last
@@ -537,14 +541,14 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | elements | certify s | Newton it s | verdict | reparam (matches) | basis | Winslow | min scaled J |"
+        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | estimated MiB | elements | certify s | Newton it s | verdict | reparam (matches) | basis | Winslow | min scaled J |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|");
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {} | {:.4} | {:.4} | {:?} | {} ({}) | {} | {} | {:.4} |",
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:.0} | {} | {:.4} | {:.4} | {:?} | {} ({}) | {} | {} | {:.4} |",
             r.geometry,
             r.refine,
             r.dofs,
@@ -554,6 +558,7 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
             r.solve_s,
             r.total_s,
             r.peak_mib,
+            r.estimated_mib,
             r.elements,
             r.certify_s,
             r.newton_iteration_s,

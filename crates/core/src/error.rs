@@ -95,6 +95,11 @@ pub enum Error {
     /// and name), `side` its side (empty for the patch as a whole).
     #[error("multipatch layout, patch {patch}{}: {reason}", side_of(.side))]
     Layout { patch: String, side: String, reason: String },
+    /// A solve whose estimated peak memory exceeds the limit (`--max-memory`, by default
+    /// the memory available), or an allocation the allocator refused
+    /// (`crate::solve::memory`): refused before it starts, never an abort.
+    #[error("not enough memory for {what}: about {} needed, {} available ({limit}); {advice}", crate::solve::memory::human(*.needed), crate::solve::memory::human(*.available))]
+    Memory { what: String, needed: u64, available: u64, limit: String, advice: String },
     /// The observer of a [`Pipeline`](crate::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
     Cancelled,

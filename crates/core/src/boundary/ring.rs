@@ -17,6 +17,7 @@
 //!
 //! **Fit**, **normalisation** and the **hierarchy** of bases: [`crate::boundary::ring_fit`]
 //! (adaptive and dyadic in `eta`, in unit coordinates).
+use super::normalise::Similarity;
 use super::{Analytic, SideCurve};
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
@@ -88,8 +89,10 @@ impl ClosedContour {
         }
     }
 
-    /// Check closedness, size and finiteness; `what` names the contour.
-    pub(super) fn validate(&self, what: &str, diameter: f64) -> Result<()> {
+    /// Check closedness, size and finiteness; `what` names the contour, `sim` maps the
+    /// coordinates it is given in (normalised, [`Similarity`]) to the input's for the
+    /// messages.
+    pub(super) fn validate(&self, what: &str, diameter: f64, sim: &Similarity) -> Result<()> {
         let (a, b) = match self {
             ClosedContour::Points(p) => {
                 if p.len() < 4 {
@@ -104,13 +107,15 @@ impl ClosedContour {
         };
         let gap = dist(a, b);
         if gap.is_nan() || gap > 1e-9 * diameter {
+            let (a, b) = (sim.to_physical(a), sim.to_physical(b));
             return Err(Error::Invalid(format!(
-                "the {what} contour is not closed: its ends ({}, {}) and ({}, {}) are {gap:.3e} apart (tolerance {:.3e})",
+                "the {what} contour is not closed: its ends ({}, {}) and ({}, {}) are {:.3e} apart (tolerance {:.3e})",
                 a[0],
                 a[1],
                 b[0],
                 b[1],
-                1e-9 * diameter
+                sim.length(gap),
+                sim.length(1e-9 * diameter)
             )));
         }
         Ok(())

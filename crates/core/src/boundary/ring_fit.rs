@@ -236,11 +236,18 @@ pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Re
 /// Check a ring: both contours closed and finite, counter-clockwise, the inner inside
 /// the outer (on polygons of about 4096 points). Returns the outer contour's
 /// bounding box `[lo, hi]`.
+///
+/// Like a four-sided boundary's validation, the checks run in the normalised
+/// coordinates of the outer contour's box ([`Similarity`]) and report in the input's:
+/// far from the origin, `Σ x_k y_{k+1} − x_{k+1} y_k` of the raw coordinates cancels
+/// every digit of the area (a ring of size 1 at `1e9` got a signed area of `−4e3`), and
+/// the closure gap of a spline evaluated there is rounding of the position, not of the
+/// curve. A well-placed ring (the identity) is checked on its own coordinates as before.
 pub fn check_ring(ring: &Ring) -> Result<[Point; 2]> {
     // validation on polygons of about 4096 points (the nesting test is quadratic)
-    let outer_poly = ring.outer.polygon_with(CHECK);
+    let raw_outer = ring.outer.polygon_with(CHECK);
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &outer_poly {
+    for p in &raw_outer {
         for d in 0..2 {
             lo[d] = lo[d].min(p[d]);
             hi[d] = hi[d].max(p[d]);
@@ -250,19 +257,26 @@ pub fn check_ring(ring: &Ring) -> Result<[Point; 2]> {
     if !(diameter.is_finite() && diameter > 0.0) {
         return Err(Error::Invalid(format!("ring '{}': the outer contour has diameter {diameter}", ring.name)));
     }
-    ring.inner.validate("inner", diameter)?;
-    ring.outer.validate("outer", diameter)?;
-    let inner_poly = ring.inner.polygon_with(CHECK);
+    let sim = Similarity::for_box(lo, hi, &format!("ring '{}'", ring.name))?;
+    let unit = |c: &ClosedContour| if sim.is_identity() { c.clone() } else { c.mapped(move |p| sim.to_unit(p)) };
+    let (inner, outer) = (unit(&ring.inner), unit(&ring.outer));
+    let unit_diameter = diameter / sim.scale;
+    inner.validate("inner", unit_diameter, &sim)?;
+    outer.validate("outer", unit_diameter, &sim)?;
+    let outer_poly = if sim.is_identity() { raw_outer } else { outer.polygon_with(CHECK) };
+    let inner_poly = inner.polygon_with(CHECK);
     for (what, poly) in [("inner", &inner_poly), ("outer", &outer_poly)] {
         let area = signed_area(poly);
         if area <= 0.0 {
             return Err(Error::Invalid(format!(
-                "the {what} contour runs clockwise (signed area {area:.6e}); both contours of a ring must run counter-clockwise"
+                "the {what} contour runs clockwise (signed area {:.6e}); both contours of a ring must run counter-clockwise",
+                sim.area(area)
             )));
         }
     }
     let stride = inner_poly.len().div_ceil(CHECK);
     if let Some(p) = inner_poly.iter().step_by(stride).find(|&&p| !inside(&outer_poly, p)) {
+        let p = sim.to_physical(*p);
         return Err(Error::Invalid(format!(
             "the inner contour is not inside the outer one: its point ({}, {}) lies outside",
             p[0], p[1]

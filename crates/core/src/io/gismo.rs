@@ -265,14 +265,12 @@ pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
     }
     let tol = ASSIGN_TOL * (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
     let ends: Vec<(Point, Point)> = curves.iter().map(Curve::endpoints).collect();
-    // Twice the signed area swept by each curve as stored (shoelace terms of its polyline).
-    let sweep: Vec<f64> = curves
-        .iter()
-        .map(|c| {
-            let poly = sample_side(&SideCurve::Spline(c.clone()), f64::INFINITY);
-            poly.windows(2).map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0]).sum()
-        })
-        .collect();
+    // Twice the signed area swept by each curve as stored about the box's centre
+    // (shoelace terms of its polyline; about the origin, products of coordinates far from
+    // it cancel every digit of the area).
+    let o = [0.5 * lo[0] + 0.5 * hi[0], 0.5 * lo[1] + 0.5 * hi[1]];
+    let sweep: Vec<f64> =
+        curves.iter().map(|c| super::shoelace(&sample_side(&SideCurve::Spline(c.clone()), f64::INFINITY), o)).collect();
     let d = |a: Point, b: Point| (a[0] - b[0]).hypot(a[1] - b[1]);
     // sides[k] = (curve index, reversed) for south, east, north, west
     let gap_of = |sides: Assignment| {

@@ -39,7 +39,7 @@ use std::path::Path;
 use crate::boundary::validate::{inspect, validate, Orientation, ValidationReport};
 use crate::boundary::{Boundary, SideCurve};
 use crate::error::{Error, Result};
-use crate::spline::curve::Curve;
+use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
 
@@ -126,13 +126,22 @@ pub(crate) fn reversed_curve(c: &Curve) -> Result<Curve> {
 /// (shoelace on a coarse sampling); positive when the map preserves orientation.
 pub(crate) fn surface_boundary_area(s: &Surface) -> f64 {
     let sides = Side::ALL.map(|side| SideCurve::Spline(s.boundary(side)));
+    // relative to a point of the patch: far from the origin the products of raw
+    // coordinates cancel every digit of the area (translation invariance)
+    let o = s.control_points.first().copied().unwrap_or([0.0; 2]);
     let mut area = 0.0;
     for (k, side) in sides.iter().enumerate() {
         let poly = crate::boundary::validate::sample_side(side, f64::INFINITY);
         let sign = if k < 2 { 1.0 } else { -1.0 };
-        area += sign * poly.windows(2).map(|w| w[0][0] * w[1][1] - w[0][1] * w[1][0]).sum::<f64>();
+        area += sign * shoelace(&poly, o);
     }
     0.5 * area
+}
+
+/// `Σ (x_k − o) × (x_{k+1} − o)` over the polyline `poly`: twice the signed area it
+/// sweeps about `o`.
+pub(crate) fn shoelace(poly: &[Point], o: Point) -> f64 {
+    poly.windows(2).map(|w| (w[0][0] - o[0]) * (w[1][1] - o[1]) - (w[0][1] - o[1]) * (w[1][0] - o[0])).sum()
 }
 
 #[cfg(test)]

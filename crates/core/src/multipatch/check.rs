@@ -3,16 +3,17 @@
 //! the same parameters, up to the interface's reversal) with the two patches on
 //! opposite sides of it, no two sides coinciding without an interface, and no two patch
 //! boundaries crossing or one patch inside another. Every failure is an
-//! [`Error::Layout`](crate::error::Error::Layout) naming the patch and side.
+//! [`Error::Layout`] naming the patch and side.
 
 use std::collections::HashSet;
 
 use serde::Serialize;
 
 use super::layout::{Layout, PatchSide};
+use crate::boundary::normalise::Similarity;
 use crate::boundary::validate::{inspect, sample_side, segment_hit, Orientation, CORNER_NEIGHBOURHOOD, FLATNESS};
 use crate::boundary::{Boundary, SideCurve};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
 
@@ -103,7 +104,42 @@ fn bbox(poly: &[Point]) -> (Point, Point) {
 }
 
 /// Validate `layout` (see the module documentation).
+///
+/// The checks run in the normalised coordinates of the layout's bounding box
+/// ([`Similarity`], as a four-sided boundary's and a ring's), so that a layout translated
+/// far from the origin or scaled to an extreme size gets the verdicts it gets where it
+/// is: far out, a NURBS side evaluated in raw coordinates is rounded to the position's
+/// precision and two sides of one interface seem to differ. The report is in the
+/// input's coordinates; the lengths of an error message in the normalised ones, which
+/// it then says.
 pub fn validate_layout(layout: &Layout) -> Result<LayoutReport> {
+    let (lo, hi) = layout.bounding_box();
+    let sim = Similarity::for_box(lo, hi, &format!("layout '{}'", layout.name))?;
+    if sim.is_identity() {
+        return validate_normalised(layout);
+    }
+    let mut r = validate_normalised(&layout.similar(&sim)).map_err(|e| match e {
+        Error::Layout { patch, side, reason } => Error::Layout {
+            patch,
+            side,
+            reason: format!(
+                "{reason} (lengths in the normalised coordinates (x - c) / s, c = ({:e}, {:e}), s = {:e})",
+                sim.centre[0], sim.centre[1], sim.scale
+            ),
+        },
+        e => e,
+    })?;
+    r.diameter = layout.diameter();
+    r.interface_gap = sim.length(r.interface_gap);
+    for a in r.areas.iter_mut() {
+        *a = sim.area(*a);
+    }
+    r.area = sim.area(r.area);
+    Ok(r)
+}
+
+/// [`validate_layout`] in the coordinates given.
+fn validate_normalised(layout: &Layout) -> Result<LayoutReport> {
     let n = layout.patches.len();
     if n == 0 {
         return Err(crate::error::Error::Layout {

@@ -9,6 +9,7 @@
 
 use serde::Serialize;
 
+use crate::boundary::normalise::Similarity;
 use crate::discrete::topology::{SideCondition, Topology};
 use crate::error::Error;
 use crate::spline::curve::{Curve, Point};
@@ -105,6 +106,27 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The layout with every control point in the normalised coordinates `sim.to_unit`
+    /// (weights, knots and interfaces unchanged; a clone for the identity).
+    pub fn similar(&self, sim: &Similarity) -> Layout {
+        if sim.is_identity() {
+            return self.clone();
+        }
+        let unit = |c: &Curve| Curve {
+            control_points: c.control_points.iter().map(|&p| sim.to_unit(p)).collect(),
+            ..c.clone()
+        };
+        Layout {
+            name: self.name.clone(),
+            patches: self
+                .patches
+                .iter()
+                .map(|p| Patch { name: p.name.clone(), sides: p.sides.each_ref().map(unit), map: None })
+                .collect(),
+            interfaces: self.interfaces.clone(),
+        }
+    }
+
     /// `"2 (p2)"`: a patch's index and name, for errors.
     pub fn label(&self, patch: usize) -> String {
         match self.patches.get(patch) {

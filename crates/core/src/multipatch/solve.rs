@@ -24,7 +24,7 @@ use serde::Serialize;
 use super::check::{validate_layout, LayoutReport};
 use super::classes::LayoutBases;
 use super::free::{free_interfaces, total_winslow, FreeReport};
-use super::layout::{Layout, Patch};
+use super::layout::Layout;
 use super::problem::Functional;
 use crate::boundary::hierarchy::{BasisReport, Hierarchy, Level};
 use crate::boundary::input_basis::input_levels;
@@ -225,24 +225,6 @@ pub fn interface_mismatch(layout: &Layout, maps: &[Surface]) -> f64 {
     worst
 }
 
-/// `layout` with every control point in the coordinates `sim.to_unit`.
-fn unit_layout(layout: &Layout, sim: &Similarity) -> Layout {
-    if sim.is_identity() {
-        return layout.clone();
-    }
-    let unit =
-        |c: &Curve| Curve { control_points: c.control_points.iter().map(|&p| sim.to_unit(p)).collect(), ..c.clone() };
-    Layout {
-        name: layout.name.clone(),
-        patches: layout
-            .patches
-            .iter()
-            .map(|p| Patch { name: p.name.clone(), sides: p.sides.each_ref().map(unit), map: None })
-            .collect(),
-        interfaces: layout.interfaces.clone(),
-    }
-}
-
 /// Solve one patch with its conforming `sides` as Dirichlet data on their own basis;
 /// its certificate is the solve's when the solved boundary is the conforming sides' bit
 /// for bit, else that of the map with them.
@@ -332,7 +314,7 @@ pub(crate) fn solve_multipatch(
     let validation_seconds = t0.elapsed().as_secs_f64();
     let (lo, hi) = layout.bounding_box();
     let sim = Similarity::for_box(lo, hi, &format!("layout '{}'", layout.name))?;
-    let unit = unit_layout(layout, &sim);
+    let unit = layout.similar(&sim);
     let mut bases = LayoutBases::new(&unit)?;
     for _ in 0..opts.refine {
         bases = bases.refined(None);
@@ -387,18 +369,18 @@ pub(crate) fn solve_multipatch(
     for s in solved {
         let (map, report, cert, _) = s.expect("every patch solved");
         converged.push(report.levels.last().is_some_and(|l| l.converged));
-        let map = sim.physical_surface(&map)?;
-        let cert = if sim.is_identity() { cert } else { certify(&map, &opts.certify)? };
         maps.push(map);
         certs.push(cert);
         reports.push(report);
     }
+    // the free interfaces move in the normalised coordinates the patches were solved in
+    // (their stopping rule and line search see lengths), then everything goes back
     let mut free = None;
     if interfaces == Interfaces::Free {
         if converged.iter().all(|&c| c) {
             tell(LayoutEvent::Free { functional: functional.name() })?;
             let out =
-                free_interfaces(layout, &maps, &certs, functional, opts.nonlinear, &opts.certify, checked.diameter);
+                free_interfaces(&unit, &maps, &certs, functional, opts.nonlinear, &opts.certify, checked.diameter / sim.scale);
             match out {
                 Ok(f) => {
                     maps = f.maps;
@@ -412,6 +394,13 @@ pub(crate) fn solve_multipatch(
             }
         } else {
             free = Some(skipped(functional, &maps, "not run: a patch's solve did not converge".into()));
+        }
+    }
+    if !sim.is_identity() {
+        maps = maps.iter().map(|m| sim.physical_surface(m)).collect::<Result<_>>()?;
+        certs = maps.iter().map(|m| certify(m, &opts.certify)).collect::<Result<_>>()?;
+        if let Some(f) = free.as_mut().filter(|f| f.accepted) {
+            f.certificates = certs.iter().map(Certificate::message).collect();
         }
     }
     let verdicts: Vec<Verdict> = certs

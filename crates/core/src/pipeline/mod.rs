@@ -46,6 +46,7 @@ use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
 use crate::multipatch::{solve_multipatch, Layout, LayoutEvent, MultipatchSolution};
+use crate::solve::memory::MemoryEstimate;
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
@@ -245,8 +246,17 @@ impl Pipeline {
         Ok((auto_choice(first.0, again, why), h))
     }
 
-    /// One fit and coarse-to-fine solve with `opts`.
-    fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+    /// The estimated peak memory of the solve ([`MemoryEstimate`]): the input fitted and
+    /// its levels planned as [`Pipeline::run`] does (with `--basis auto`, those of the
+    /// first attempt), nothing solved. `winslow bench` prints it next to the measured peak.
+    pub fn estimate(&self) -> Result<MemoryEstimate> {
+        self.opts.validate()?;
+        let (_, _, solver) = self.plan(&self.opts)?;
+        Ok(MemoryEstimate::for_levels(solver.plan()))
+    }
+
+    /// The fit of the input and the solver of its levels (nothing large allocated yet).
+    fn plan(&self, opts: &SolveOptions) -> Result<(Boundary, Arc<Hierarchy>, EggSolver)> {
         let (boundary, hierarchy, opts) = match &self.input {
             Input::Boundary(b) => (b.clone(), build_hierarchy(b, &opts.fit)?, opts.clone()),
             Input::Ring(r) => {
@@ -256,10 +266,19 @@ impl Pipeline {
             Input::Layout(_) => return Err(Error::Invalid("a layout has one map per patch, not one hierarchy".into())),
         };
         let hierarchy = Arc::new(hierarchy);
-        let mut solver = match &self.method {
+        let solver = match &self.method {
             Some(m) => EggSolver::with_method(&boundary, hierarchy.clone(), opts, self.assembler.clone(), m.clone())?,
             None => EggSolver::new(&boundary, hierarchy.clone(), opts, self.assembler.clone())?,
         };
+        Ok((boundary, hierarchy, solver))
+    }
+
+    /// One fit and coarse-to-fine solve with `opts`; refused with [`Error::Memory`] when
+    /// its estimated peak exceeds `opts.max_memory`.
+    fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
+        let (boundary, hierarchy, mut solver) = self.plan(opts)?;
+        let estimate = MemoryEstimate::for_levels(solver.plan());
+        opts.max_memory.check(&estimate, opts.refine, &format!("solving '{}'", self.input.name()))?;
         let fitted =
             Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };
         if !observer(&fitted) {
@@ -406,6 +425,32 @@ mod tests {
         assert!(matches!(out, Err(Error::Cancelled)), "{out:?}");
         // fitted, the first level's start, its first iterate
         assert_eq!(stages, 3);
+    }
+
+    /// A memory limit below the estimated peak: [`Error::Memory`] with the estimate and
+    /// the limit, before any stage; [`Pipeline::estimate`] gives the same estimate.
+    #[test]
+    fn a_solve_above_the_memory_limit_is_refused_before_it_starts() {
+        let opts = SolveOptions { refine: 2, ..Default::default() };
+        let estimate = Pipeline::new(puzzle4(), opts.clone()).estimate().unwrap();
+        assert!(estimate.bytes > crate::solve::memory::BASE && estimate.unknowns > 0);
+        let limit = estimate.bytes - 1;
+        let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(limit), ..opts };
+        let mut stages = 0;
+        let out = Pipeline::new(puzzle4(), opts.clone()).run(&mut |_| {
+            stages += 1;
+            true
+        });
+        match out {
+            Err(Error::Memory { needed, available, ref advice, .. }) => {
+                assert_eq!((needed, available), (estimate.bytes, limit));
+                assert!(advice.contains("--refine 1"), "{advice}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(stages, 0);
+        let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(estimate.bytes), ..opts };
+        assert!(Pipeline::new(puzzle4(), opts).solve().is_ok());
     }
 
     /// Options are checked before anything runs, with a message naming the option.

@@ -22,6 +22,7 @@ use serde::Serialize;
 
 use super::fixed_basis::{scaled_options, FixedBasisSolve};
 use super::newton::NonlinearOptions;
+use crate::boundary::normalise::Similarity;
 use crate::discrete::assembly::{Discretization, Operator};
 use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
@@ -177,8 +178,30 @@ fn require_certified(s: &Surface, slice: usize, z: f64, opts: &CertifyOptions) -
 }
 
 /// Solve EGG for the interior of `guess` (boundary control points fixed) by Newton on
-/// its basis; returns the map, the Newton iterations and the residuals before and after.
+/// its basis; returns the map, the Newton iterations and the residuals before and after
+/// (of the normalised problem). Solved in the normalised coordinates of the guess' box
+/// ([`Similarity`]) like every planar solve, so that a loft far from the origin or of
+/// extreme size inserts the slices it inserts at unit size.
 fn solve_slice(guess: &Surface, opts: &LoftOptions) -> Result<(Surface, usize, f64, f64)> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &guess.control_points {
+        for c in 0..2 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let sim = Similarity::for_box(lo, hi, "an inserted slice")?;
+    if sim.is_identity() {
+        return solve_unit_slice(guess, opts);
+    }
+    let unit =
+        Surface { control_points: guess.control_points.iter().map(|&p| sim.to_unit(p)).collect(), ..guess.clone() };
+    let (map, iterations, before, after) = solve_unit_slice(&unit, opts)?;
+    Ok((sim.physical_surface(&map)?, iterations, before, after))
+}
+
+/// [`solve_slice`] in the coordinates given.
+fn solve_unit_slice(guess: &Surface, opts: &LoftOptions) -> Result<(Surface, usize, f64, f64)> {
     let topology = topology_of(guess);
     let disc = Discretization::for_topology(guess.knots.clone(), &topology)?.with_weights(guess.weights.clone())?;
     let disc = Arc::new(disc);

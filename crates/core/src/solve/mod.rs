@@ -9,6 +9,7 @@
 //! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
 //! | [`levels`] | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
 //! | [`repair`] | local defect correction around folded or undecided elements | §8.2 |
+//! | [`memory`] | the peak memory of a solve estimated from its basis sizes, checked against [`MemoryLimit`](memory::MemoryLimit) (`--max-memory`) before it allocates | |
 //! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s | §6.3 |
 //! | [`loft`] | [`loft`](loft::loft): a volume from planar slices, certified, with slices inserted (solved from interpolated guesses) where it is not | §11.1, Fig. 23 |
@@ -24,6 +25,7 @@ pub mod initial;
 pub mod kinks;
 pub mod levels;
 pub mod loft;
+pub mod memory;
 pub mod newton;
 pub mod options;
 pub mod repair;

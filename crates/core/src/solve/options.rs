@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::verify::certificate::CertifyOptions;
 
 use super::improve::Improve;
+use super::memory::MemoryLimit;
 use super::newton::NonlinearOptions;
 
 /// Options of a complete solve.
@@ -60,6 +61,11 @@ pub struct SolveOptions {
     /// With kinks kept (§9): which control points the final Winslow minimisation of the
     /// `C^0` route moves ([`KinksLocal`]).
     pub kinks_local: KinksLocal,
+    /// The most memory the solve may take: its estimated peak
+    /// ([`MemoryEstimate`](super::memory::MemoryEstimate)) above it is refused with
+    /// [`Error::Memory`] before anything large is allocated (default: the memory
+    /// available when the solve starts).
+    pub max_memory: MemoryLimit,
 }
 
 /// Which control points the `C^0` route's final Winslow minimisation moves (paper §9,
@@ -136,6 +142,9 @@ impl SolveOptions {
                 self.min_elements, self.sample
             )));
         }
+        if self.max_memory == MemoryLimit::Bytes(0) {
+            return Err(Error::Invalid("the memory limit (max_memory) must be positive".into()));
+        }
         self.topology.validate(None)
     }
 }
@@ -160,6 +169,7 @@ impl Default for SolveOptions {
             topology: Topology::dirichlet(),
             improve: None,
             kinks_local: KinksLocal::Auto,
+            max_memory: MemoryLimit::Available,
         }
     }
 }

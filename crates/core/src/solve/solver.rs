@@ -15,6 +15,7 @@ use super::improve::{improve, Improvement};
 use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
+use super::memory::MemoryEstimate;
 use super::newton::{Iterate, NonlinearOptions};
 use super::options::SolveOptions;
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
@@ -219,6 +220,12 @@ impl EggSolver {
     fn start_level(&mut self, k: usize) -> Result<Event> {
         let t0 = Instant::now();
         let level = &self.plan[k];
+        // the level's estimated peak reserved and released: a limit the pipeline's check
+        // did not see (an address-space limit) is a typed error here, not an abort later
+        crate::solve::memory::reserve(
+            MemoryEstimate::for_knots(&level.knots).bytes,
+            &format!("level {k} ({} x {} functions)", level.knots[0].dim(), level.knots[1].dim()),
+        )?;
         let topology = &self.opts.topology;
         let weights = level.weights()?;
         let disc = Arc::new(

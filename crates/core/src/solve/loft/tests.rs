@@ -161,3 +161,29 @@ fn an_inserted_slice_with_the_interpolated_boundary_unfolds_opposite_swirls() {
     let c = mid.eval(0.5, 0.5);
     assert!((c[0] - 0.5).abs() < 1e-6 && (c[1] - 0.5).abs() < 1e-6, "{c:?}");
 }
+
+/// The opposite swirls translated by 1e9 times their size or scaled by 1e±150 (heights
+/// too): the same rounds, inserted heights (mapped), Newton iterations of the inserted
+/// slices and verdict; the inserted slice is solved in normalised coordinates.
+#[test]
+fn inserted_slices_are_solved_alike_far_away_and_at_extreme_sizes() {
+    let a = 2.8;
+    let run = |t: crate::spline::curve::Point, s: f64| {
+        let moved = |m: Surface| Surface {
+            control_points: m.control_points.iter().map(|p| [t[0] + s * p[0], t[1] + s * p[1]]).collect(),
+            ..m
+        };
+        let slices = [moved(swirl(a)), moved(swirl(-a))];
+        let z0 = 3e9 * s;
+        let out = loft(&slices, &[z0, z0 + s], &LoftOptions::default(), SliceBoundary::Interpolated).unwrap();
+        let rounds: Vec<_> =
+            out.report.rounds.iter().map(|r| (r.verdict, r.offending_elements, r.inserted_z.len())).collect();
+        let its: Vec<_> = out.report.slices.iter().map(|r| r.newton_iterations).collect();
+        (rounds, its, out.report.verdict)
+    };
+    let orig = run([0.0, 0.0], 1.0);
+    assert!(orig.1.iter().any(|i| i.is_some()), "{orig:?}");
+    for (t, s) in [([1.4e9, -2.8e9], 1.0), ([0.0, 0.0], 1e150), ([0.0, 0.0], 1e-150)] {
+        assert_eq!(run(t, s), orig, "moved by {t:?}, scaled by {s:e}");
+    }
+}
