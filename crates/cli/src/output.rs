@@ -20,7 +20,20 @@ pub fn summary(sol: &Solution) -> String {
     let r = &sol.report;
     let mut s = String::new();
     let last = r.levels.last();
-    let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
+    if r.boundary_kept {
+        let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
+    } else {
+        let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+        let rounded = r.kinks.iter().filter(|k| !k.kept).count();
+        let _ = writeln!(
+            s,
+            "{}: {}, but its boundary is NOT the input's: deviation {dev:.3e} above the fit tolerance {:.3e}{}",
+            sol.name,
+            verdict_word(r.verdict),
+            r.fit_tolerance,
+            if rounded > 0 { format!(" ({rounded} kinks not kept)") } else { String::new() }
+        );
+    }
     let _ = writeln!(s, "  {}", r.message);
     let _ = writeln!(s, "  backend: {}", r.backend);
     if let Some(l) = last {
@@ -671,6 +684,17 @@ pub fn quiet() -> bool {
 
 /// The exit code of a verdict: 0 certified or degenerate corner (the best map the
 /// boundary allows), 3 folded, 4 not converged, 5 undecided.
+/// The exit code of a solve: its verdict's ([`exit_code`]), but 6 for a bijective map
+/// whose boundary is not the input's within the fit tolerance ([`Report::boundary_kept`]).
+pub fn solve_exit_code(r: &winslow::Report) -> i32 {
+    match exit_code(r.verdict) {
+        0 if !r.boundary_kept => 6,
+        code => code,
+    }
+}
+
+/// The exit code of a verdict: 0 certified or degenerate corner, 3 folded, 4 not
+/// converged, 5 undecided.
 pub fn exit_code(v: Verdict) -> i32 {
     match v {
         Verdict::Certified | Verdict::DegenerateCorner => 0,

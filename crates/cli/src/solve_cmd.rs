@@ -237,7 +237,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if a.json {
         files::print_json(report)?;
     }
-    Ok(output::exit_code(sol.report.verdict))
+    Ok(output::solve_exit_code(&sol.report))
 }
 
 /// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: improve a

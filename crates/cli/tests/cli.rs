@@ -754,8 +754,8 @@ fn default_basis_keeps_spline_boundaries() {
 
 /// `--kinks`: the star polygon keeps its twelve vertices exactly (the report lists them as
 /// kept, the summary says so, the PNG is written with their marks and `render` reads them
-/// back from the report); `--kinks none` rounds them and says so; a bad angle is a clear
-/// error.
+/// back from the report); `--kinks none` rounds them and says so (exit 6: the boundary is
+/// not the input's); a bad angle is a clear error.
 #[test]
 fn kinks_are_kept_reported_and_marked() {
     let scratch = tempfile::tempdir().unwrap();
@@ -777,13 +777,40 @@ fn kinks_are_kept_reported_and_marked() {
     assert!(std::fs::metadata(&png).unwrap().len() > 1000);
     let out = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // rounded, the vertices are not the input's boundary any more: bijective, but exit 6
     let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "none"]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(6), "{}", String::from_utf8_lossy(&out.stderr));
     let report = &read_json(&map)["report"];
+    assert_eq!(report["boundary_kept"], false);
     let kinks = report["kinks"].as_array().unwrap();
     assert!(kinks.len() == 12 && kinks.iter().all(|k| k["kept"] == false), "{}", report["kinks"]);
     assert!(report["c0_route"].is_null(), "{}", report["c0_route"]);
     let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "200"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("angle in (0, 180]"));
+}
+
+/// A bijective map whose boundary is not the input's within the fit tolerance (the
+/// V-notch of `cad_kinks/vnotch.json`, which the `C^0` route does not keep) is not a
+/// success: exit 6, `boundary_kept: false` in the report, the summary's first line says
+/// so; the map is still written (it is bijective), labelled by its report.
+#[test]
+fn a_boundary_off_the_input_exits_6() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = data().join("cad_kinks/vnotch.json");
+    let map = dir.path().join("v.json");
+    let out = bin().arg("solve").arg(&input).arg("-o").arg(&map).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(6), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.contains("NOT the input's") && first.contains("kinks not kept"), "{first}");
+    let r = &read_json(&map)["report"];
+    assert_eq!(r["boundary_kept"], false);
+    let deviation = r["boundary_deviation"].as_array().unwrap().iter().map(|d| d.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(deviation > r["fit_tolerance"].as_f64().unwrap(), "{r}");
+    // the square with a rectangular step keeps its four kinks: a success
+    let out =
+        bin().arg("solve").arg(data().join("cad_kinks/step.json")).arg("-o").arg(&map).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(stdout_json(&out)["boundary_kept"], true);
 }

@@ -98,7 +98,7 @@ pub enum Error {
     /// A solve whose estimated peak memory exceeds the limit (`--max-memory`, by default
     /// the memory available), or an allocation the allocator refused
     /// (`crate::solve::memory`): refused before it starts, never an abort.
-    #[error("not enough memory for {what}: about {} needed, {} available ({limit}); {advice}", crate::solve::memory::human(*.needed), crate::solve::memory::human(*.available))]
+    #[error("not enough memory for {what}: about {} needed, {} available ({limit}); {advice}", human(*.needed), human(*.available))]
     Memory { what: String, needed: u64, available: u64, limit: String, advice: String },
     /// The observer of a [`Pipeline`](crate::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
@@ -161,3 +161,19 @@ impl Error {
 pub const MAX_DEGREE: usize = 12;
 /// Largest number of control points per direction accepted from a file.
 pub const MAX_CONTROL_POINTS: usize = 1 << 20;
+
+/// `n` bytes as `1.23 GiB`, `512 MiB`, ...
+pub fn human(n: u64) -> String {
+    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut k = 0;
+    while v >= 1024.0 && k + 1 < units.len() {
+        v /= 1024.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{n} B")
+    } else {
+        format!("{v:.3} {}", units[k])
+    }
+}

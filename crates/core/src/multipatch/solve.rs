@@ -379,8 +379,15 @@ pub(crate) fn solve_multipatch(
     if interfaces == Interfaces::Free {
         if converged.iter().all(|&c| c) {
             tell(LayoutEvent::Free { functional: functional.name() })?;
-            let out =
-                free_interfaces(&unit, &maps, &certs, functional, opts.nonlinear, &opts.certify, checked.diameter / sim.scale);
+            let out = free_interfaces(
+                &unit,
+                &maps,
+                &certs,
+                functional,
+                opts.nonlinear,
+                &opts.certify,
+                checked.diameter / sim.scale,
+            );
             match out {
                 Ok(f) => {
                     maps = f.maps;

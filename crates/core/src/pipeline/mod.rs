@@ -519,4 +519,24 @@ mod tests {
             .solve();
         assert!(matches!(out, Err(Error::Invalid(_))), "{out:?}");
     }
+
+    /// A fit stopped short of its tolerance (one level of a few elements for a wavy side):
+    /// the map may be bijective, but its boundary is not the input's within the tolerance,
+    /// so the report says so and it is not a success; with the fit's own levels it is.
+    #[test]
+    fn a_boundary_off_by_more_than_its_tolerance_is_not_a_success() {
+        let b = read_boundary(&data("wavy_lid.json"), &ReadOptions::default()).unwrap();
+        let mut opts = SolveOptions::default();
+        opts.fit.basis = BasisChoice::Fitted;
+        opts.fit.tol = 1e-6;
+        let good = solve(&b, &opts).unwrap();
+        assert!(good.report.boundary_kept && good.report.success(), "{}", good.report.message);
+        opts.fit.max_levels = 1;
+        let short = solve(&b, &opts).unwrap();
+        let r = &short.report;
+        let deviation = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+        assert!(deviation > r.fit_tolerance, "{deviation:e} <= {:e}", r.fit_tolerance);
+        assert!(!r.boundary_kept && !r.success(), "{}", r.message);
+        assert!(r.message.contains("NOT the input's"), "{}", r.message);
+    }
 }

@@ -32,6 +32,7 @@
 //! see is a typed error too, not the allocator's abort.
 
 use crate::boundary::hierarchy::Level;
+pub use crate::error::human;
 use crate::error::{Error, Result};
 use crate::spline::knots::KnotVector;
 
@@ -174,22 +175,6 @@ fn advice(estimate: &MemoryEstimate, refine: usize) -> String {
         format!("--refine {} needs about {} (each halving takes about 4x the memory)", refine - 1, human(quarter))
     } else {
         "a coarser basis needs less: a larger --fit-tol, a smaller --min-elements, or --basis input".into()
-    }
-}
-
-/// `n` bytes as `1.23 GiB`, `512 MiB`, ...
-pub fn human(n: u64) -> String {
-    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut v = n as f64;
-    let mut k = 0;
-    while v >= 1024.0 && k + 1 < units.len() {
-        v /= 1024.0;
-        k += 1;
-    }
-    if k == 0 {
-        format!("{n} B")
-    } else {
-        format!("{v:.3} {}", units[k])
     }
 }
 

@@ -195,6 +195,12 @@ pub struct Report {
     /// (south, east, north, west): [`crate::verify::quality::boundary_deviation`], the
     /// measure `winslow check --boundary` reports too.
     pub boundary_deviation: [f64; 4],
+    /// Whether the map's boundary is the input's within the stated tolerance: the largest
+    /// [`boundary_deviation`](Self::boundary_deviation) at most
+    /// [`fit_tolerance`](Self::fit_tolerance). A bijective map whose boundary is not (kinks
+    /// the `C^0` route of §9 could not keep, a fit short of its tolerance) is not a
+    /// success ([`Report::success`]).
+    pub boundary_kept: bool,
     /// The outcome.
     pub verdict: Verdict,
     /// Plain-language summary of the verdict.
@@ -217,6 +223,14 @@ pub struct Report {
     /// The similarity `x = centre + scale x̂` from the normalised coordinates the solve ran
     /// in (`boundary::normalise`); `null` when the input was solved as given.
     pub normalisation: Option<crate::boundary::normalise::Similarity>,
+}
+
+impl Report {
+    /// A success: certified (or the best map a forced degenerate corner admits) and its
+    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]).
+    pub fn success(&self) -> bool {
+        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner) && self.boundary_kept
+    }
 }
 
 /// A solved map and its report.
@@ -307,7 +321,16 @@ impl Solution {
             }
             (v, m)
         };
+        let fit_tolerance = h.physical_tol_abs();
+        let deviation = ctx.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+        let boundary_kept = deviation <= fit_tolerance;
         let mut message = message;
+        if !boundary_kept {
+            message.push_str(&format!(
+                "; the map's boundary is NOT the input's: it deviates by {deviation:.3e}, above the fit tolerance \
+                 {fit_tolerance:.3e}"
+            ));
+        }
         if let Some(r) = &ctx.c0_route {
             message.push_str(&format!("; {}", r.message));
         }
@@ -356,7 +379,7 @@ impl Solution {
                 Operator::Plain => "plain",
                 Operator::Scaled => "scaled",
             },
-            fit_tolerance: h.physical_tol_abs(),
+            fit_tolerance,
             diameter: h.physical_diameter(),
             fit,
             levels,
@@ -377,6 +400,7 @@ impl Solution {
             kinks,
             c0_route: ctx.c0_route,
             boundary_deviation: ctx.boundary_deviation,
+            boundary_kept,
             verdict,
             message,
             seconds: ctx.elapsed.as_secs_f64(),
