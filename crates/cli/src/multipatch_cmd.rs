@@ -50,7 +50,9 @@ fn options(a: &SolveArgs) -> Result<MultipatchOptions> {
 }
 
 /// `winslow solve LAYOUT`: solve, write, summarize; the exit code of the worst verdict.
-pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
+/// `made` is the report of the automatic layout when the layout was made from a general
+/// domain (`winslow solve DOMAIN`): it goes into the top-level report as `auto_layout`.
+pub(super) fn solve(layout: Layout, a: &SolveArgs, made: Option<serde_json::Value>) -> Result<i32> {
     let opts = options(a)?;
     if !(output::quiet() || a.json) {
         note!(
@@ -62,9 +64,13 @@ pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
         );
     }
     let sol = solve_multipatch(&layout, &opts).with_context(|| format!("solving the layout {}", layout.name))?;
-    write(&sol, a)?;
+    let mut report = serde_json::to_value(&sol.report)?;
+    if let Some(m) = made {
+        report["auto_layout"] = m;
+    }
+    write(&sol, report.clone(), a)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&sol.report)?);
+        println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         say_raw!("{}", summary(&sol));
     }
@@ -73,8 +79,10 @@ pub(super) fn solve(layout: Layout, a: &SolveArgs) -> Result<i32> {
 
 /// Write the solution where `a` asks: `-o` by its extension (.json, .xml for G+Smo,
 /// .vtm), `--gismo`, `--png` (the whole layout), `--vtm`, `--patch-maps`.
-fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
-    let patches = Output::Multipatch(Patches::of_solution(sol)?);
+fn write(sol: &MultipatchSolution, report: serde_json::Value, a: &SolveArgs) -> Result<()> {
+    let mut patches = Patches::of_solution(sol)?;
+    patches.report = report;
+    let patches = Output::Multipatch(patches);
     files::write(&a.output, &patches)?;
     if let Some(p) = &a.gismo {
         files::write_as(p, "xml", &patches)?;

@@ -95,6 +95,10 @@ pub enum Error {
     /// and name), `side` its side (empty for the patch as a whole).
     #[error("multipatch layout, patch {patch}{}: {reason}", side_of(.side))]
     Layout { patch: String, side: String, reason: String },
+    /// A general planar domain or plane graph (`formats.md`) is invalid: `at` names the
+    /// loop and curve (`"outer loop, curve 3"`, `"hole 1"`) or the edge.
+    #[error("domain, {at}: {reason}")]
+    Domain { at: String, reason: String },
     /// The observer of a [`Pipeline`](crate::solve::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
     Cancelled,
