@@ -26,9 +26,15 @@ pub struct CorpusArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
-    /// strip, cad, noisy-cloud, sparse-cloud.
+    /// strip, cad, noisy-cloud, sparse-cloud; with --general: ngon, l, t, u, e, plus.
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
+    /// The corpus of general domains instead (issue 31): N-gons with curved sides
+    /// (N = 3 ... 12), L, T, U, E and plus shapes with sharp or filleted reflex corners;
+    /// written as domain documents, and with --solve laid out automatically and solved
+    /// (a domain counts as certified when every patch is).
+    #[arg(long)]
+    general: bool,
     /// Solve every domain (default settings) and print the verdicts and a table per
     /// family; exits 1 when any domain is not certified.
     #[arg(long)]
@@ -44,6 +50,9 @@ struct Tally {
 }
 
 pub fn run(a: CorpusArgs) -> Result<i32> {
+    if a.general {
+        return crate::corpus_domains::run(&a.output, a.per_family, a.seed, &a.families, a.solve);
+    }
     let families: Vec<Family> = a
         .families
         .iter()

@@ -61,6 +61,7 @@ mod check_cmd;
 mod compare_cmd;
 mod convert_cmd;
 mod corpus;
+mod corpus_domains;
 mod domain_cmd;
 mod files;
 mod inspect_cmd;

@@ -50,7 +50,13 @@ pub struct Graph {
 /// the control point at `u`), each normalised to `[0, 1]`.
 pub fn split_curve(c: &Curve, u: f64) -> Result<(Curve, Curve)> {
     let p = c.degree();
-    let have = c.knots.multiplicity(u);
+    // a knot within the knot tolerance of u is where the curve is split
+    let u = if c.knots.multiplicity(u) > 0 {
+        c.knots.knots().iter().copied().min_by(|a, b| (a - u).abs().total_cmp(&(b - u).abs())).unwrap_or(u)
+    } else {
+        u
+    };
+    let have = c.knots.knots().iter().filter(|&&t| t == u).count();
     let fine = if have < p { c.knots.with_inserted(&vec![u; p - have]) } else { c.knots.clone() };
     let r = c.refined(&fine)?;
     let k = r.knots.knots();
@@ -235,7 +241,7 @@ mod tests {
         let kv = KnotVector::new(3, vec![0., 0., 0., 0., 0.4, 1., 1., 1., 1.]).unwrap();
         let c = Curve::new(kv, vec![[0., 0.], [1., 2.], [2., -1.], [3., 1.], [4., 0.]], Some(vec![1., 2., 1., 0.5, 1.]))
             .unwrap();
-        for u in [0.25, 0.4, 0.7] {
+        for u in [0.25, 0.4, 0.4 + 1e-15, 0.7] {
             let (a, b) = split_curve(&c, u).unwrap();
             assert_eq!(a.endpoints().1, b.endpoints().0);
             assert_eq!(a.endpoints().0, c.endpoints().0);

@@ -6,6 +6,7 @@
 //!
 //! | module | holds |
 //! |---|---|
+//! | [`corpus`] | a seeded corpus: `N`-gons with curved sides, L, T, U, E and plus shapes with sharp or filleted reflex corners |
 //! | [`validate`](mod@validate) | closed loops, no self-intersections, holes inside the outer loop and apart, orientation, area: typed errors naming the loop and curve |
 //! | [`harmonic`] | the discrete harmonic map of a regular `N`-gon onto a face (P1 finite elements), which places the template's vertices and cuts |
 //! | [`graph`] | the faces, edges and vertices of a layout under construction: edges split at a point, faces split by a new edge |
@@ -14,6 +15,7 @@
 //!
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
 
+pub mod corpus;
 pub mod graph;
 pub mod harmonic;
 pub mod reflex;

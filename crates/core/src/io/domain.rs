@@ -11,7 +11,7 @@
 
 use serde_json::Value;
 
-use super::json::SideJson;
+use super::json::{side_to_json, SideJson};
 use crate::boundary::kinks::cloud_corners;
 use crate::boundary::{KinkMode, SideCurve};
 use crate::domain::{Domain, Loop};
@@ -138,6 +138,16 @@ fn loop_of(v: Value, ctx: &str) -> Result<Loop> {
     Err(jerr(ctx, "a loop is {\"curves\": [...]}, {\"points\": [...], \"corners\": [...]} or a periodic Curve"))
 }
 
+/// The domain document of `d` (every loop as `"curves"`): what [`domain_of_json`]
+/// reads back as the same domain.
+pub fn domain_to_json(d: &Domain) -> Value {
+    let lp = |l: &Loop| serde_json::json!({ "curves": l.sides.iter().map(side_to_json).collect::<Vec<_>>() });
+    serde_json::json!({
+        "name": d.name,
+        "domain": { "outer": lp(&d.outer), "holes": d.holes.iter().map(lp).collect::<Vec<_>>() },
+    })
+}
+
 /// The domain of a JSON document with a top-level `"domain"` field (see the module
 /// documentation). Errors name the place (`domain.outer.curves[2].knots`, ...).
 pub fn domain_of_json(v: Value) -> Result<Domain> {
@@ -188,6 +198,15 @@ mod tests {
         assert!(matches!(&listed.outer.sides[0], SideCurve::Points(p) if p == &vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]));
         let found = parse(&sq.replace("CORNERS", "")).unwrap();
         assert_eq!(found.outer.detected_corners, vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
+    }
+
+    #[test]
+    fn written_domains_read_back() {
+        for (_, d) in crate::domain::corpus::domain_corpus(&[], 2, 3) {
+            let back = domain_of_json(domain_to_json(&d)).unwrap();
+            assert_eq!(back.name, d.name);
+            assert_eq!(format!("{:?}", back.outer.sides), format!("{:?}", d.outer.sides));
+        }
     }
 
     #[test]
