@@ -184,10 +184,8 @@ enum Command {
     /// automatically: cuts from reflex corners, a template per face placed by a harmonic
     /// map; write the layout (which `winslow solve` takes) and draw it. `winslow solve`
     /// on the domain lays it out and solves it in one go.
-    #[command(
-        after_help = "Example:
-  winslow layout tests/data/domains/pentagon.json -o out/pentagon-layout.json --png out/pentagon-layout.png"
-    )]
+    #[command(after_help = "Example:
+  winslow layout tests/data/domains/pentagon.json -o out/pentagon-layout.json --png out/pentagon-layout.png")]
     Layout(domain_cmd::LayoutArgs),
     /// Print the command-line reference (docs/cli.md) generated from these definitions.
     #[command(hide = true)]

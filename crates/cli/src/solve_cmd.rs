@@ -161,7 +161,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let doc = files::read(path)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
-        Document::Layout(layout) | Document::Multipatch(layout) => return super::multipatch_cmd::solve(layout, &a, None),
+        Document::Layout(layout) | Document::Multipatch(layout) => {
+            return super::multipatch_cmd::solve(layout, &a, None)
+        }
         Document::Domain(domain) => return super::domain_cmd::solve(domain, &a),
         Document::Ring(ring) => Input::Ring(ring),
         doc => {

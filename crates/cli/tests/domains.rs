@@ -13,7 +13,8 @@ fn solve_a_curved_pentagon_and_an_l_bracket() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     for (name, patches) in [("pentagon", 5), ("l_bracket", 3), ("hexagon_cloud", 6)] {
-        let (json, xml, png) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.xml")), dir.join(format!("{name}.png")));
+        let (json, xml, png) =
+            (dir.join(format!("{name}.json")), dir.join(format!("{name}.xml")), dir.join(format!("{name}.png")));
         let out = bin()
             .arg("solve")
             .arg(data().join(format!("domains/{name}.json")))

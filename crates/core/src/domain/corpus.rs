@@ -111,7 +111,16 @@ fn letter_polygon(f: DomainFamily, rng: &mut Rng) -> Vec<Point> {
         }
         DomainFamily::T => {
             let (s, h, bw, t) = (r(0.4, 1.0), r(1.0, 2.5), r(2.0, 3.5), r(0.4, 1.0));
-            vec![[-s / 2.0, 0.0], [s / 2.0, 0.0], [s / 2.0, h], [bw / 2.0, h], [bw / 2.0, h + t], [-bw / 2.0, h + t], [-bw / 2.0, h], [-s / 2.0, h]]
+            vec![
+                [-s / 2.0, 0.0],
+                [s / 2.0, 0.0],
+                [s / 2.0, h],
+                [bw / 2.0, h],
+                [bw / 2.0, h + t],
+                [-bw / 2.0, h + t],
+                [-bw / 2.0, h],
+                [-s / 2.0, h],
+            ]
         }
         DomainFamily::U => {
             let (w, h, a, b) = (r(2.0, 3.0), r(1.5, 3.0), r(0.3, 0.8), r(0.3, 0.8));

@@ -58,7 +58,15 @@ pub fn split_curve(c: &Curve, u: f64) -> Result<(Curve, Curve)> {
     };
     let have = c.knots.knots().iter().filter(|&&t| t == u).count();
     let fine = if have < p { c.knots.with_inserted(&vec![u; p - have]) } else { c.knots.clone() };
-    let r = c.refined(&fine)?;
+    let mut r = c.refined(&fine)?;
+    // the clamped ends are interpolated: keep them bit for bit (the refinement rounds)
+    let last = r.control_points.len() - 1;
+    r.control_points[0] = c.control_points[0];
+    r.control_points[last] = c.control_points[c.control_points.len() - 1];
+    if let (Some(rw), Some(cw)) = (r.weights.as_mut(), c.weights.as_ref()) {
+        rw[0] = cw[0];
+        rw[last] = cw[cw.len() - 1];
+    }
     let k = r.knots.knots();
     let i0 = k.partition_point(|&x| x < u);
     let mult = k[i0..].iter().take_while(|&&x| x == u).count();
@@ -72,7 +80,27 @@ pub fn split_curve(c: &Curve, u: f64) -> Result<(Curve, Curve)> {
         Ok(Curve::new(kv, r.control_points[range].to_vec(), w)?.normalized())
     };
     let n = r.control_points.len();
-    Ok((piece(left_knots, 0..i0)?, piece(right_knots, i0 - 1..n)?))
+    Ok((standard_weights(piece(left_knots, 0..i0)?), standard_weights(piece(right_knots, i0 - 1..n)?)))
+}
+
+/// A rational Bézier curve (one segment) in standard form: the same curve with both end
+/// weights 1, by the Möbius reparameterization `w_i -> w_i r^i / w_0`, `r = (w_0 /
+/// w_p)^(1/p)` (Farin, *NURBS*, §13.4), so that the corners of the patches it bounds
+/// carry one weight. Other curves are returned as they are.
+fn standard_weights(mut c: Curve) -> Curve {
+    let p = c.degree();
+    let Some(w) = c.weights.as_mut() else { return c };
+    if c.control_points.len() != p + 1 {
+        return c;
+    }
+    let (w0, wp) = (w[0], w[p]);
+    let r = (w0 / wp).powf(1.0 / p as f64);
+    for (i, x) in w.iter_mut().enumerate() {
+        *x *= r.powi(i as i32) / w0;
+    }
+    w[0] = 1.0;
+    w[p] = 1.0;
+    c
 }
 
 /// The angle in `[0, 2π)` by which the direction `a` turns counter-clockwise to `b`.
@@ -239,8 +267,7 @@ mod tests {
     #[test]
     fn split_curve_is_exact_and_shares_the_point() {
         let kv = KnotVector::new(3, vec![0., 0., 0., 0., 0.4, 1., 1., 1., 1.]).unwrap();
-        let c = Curve::new(kv, vec![[0., 0.], [1., 2.], [2., -1.], [3., 1.], [4., 0.]], Some(vec![1., 2., 1., 0.5, 1.]))
-            .unwrap();
+        let c = Curve::new(kv, vec![[0., 0.], [1., 2.], [2., -1.], [3., 1.], [4., 0.]], None).unwrap();
         for u in [0.25, 0.4, 0.4 + 1e-15, 0.7] {
             let (a, b) = split_curve(&c, u).unwrap();
             assert_eq!(a.endpoints().1, b.endpoints().0);
@@ -254,6 +281,25 @@ mod tests {
                 assert!((pb[0] - qb[0]).abs() + (pb[1] - qb[1]).abs() < 1e-13);
             }
         }
+    }
+
+    #[test]
+    fn halves_of_a_rational_arc_have_end_weights_one() {
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let kv = KnotVector::open_uniform(2, 1);
+        let arc = Curve::new(kv, vec![[1., 0.], [1., 1.], [0., 1.]], Some(vec![1., w, 1.])).unwrap();
+        let (a, b) = split_curve(&arc, 0.3).unwrap();
+        for h in [&a, &b] {
+            let ws = h.weights.as_ref().unwrap();
+            assert_eq!((ws[0], ws[2]), (1.0, 1.0));
+            // still on the unit circle
+            for k in 0..=20 {
+                let p = h.eval(k as f64 / 20.0);
+                assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-14, "{p:?}");
+            }
+        }
+        assert_eq!(a.endpoints().1, b.endpoints().0);
+        assert_eq!(a.endpoints().0, [1.0, 0.0]);
     }
 
     #[test]

@@ -167,7 +167,7 @@ impl HarmonicMap {
         for r in 0..m {
             for k in 0..(r * n).max(1) {
                 let f = r as f64 / m as f64;
-                let (s, j) = if r == 0 { (0, 0) } else { (k / r, k % r) };
+                let (s, j) = k.checked_div(r).map_or((0, 0), |s| (s, k % r));
                 let kb = s * m + (j * m) / r.max(1);
                 let q = x[boundary + kb % (m * n)];
                 x[node(n, r, k)] = [mean[0] + f * (q[0] - mean[0]), mean[1] + f * (q[1] - mean[1])];
@@ -293,7 +293,10 @@ mod tests {
                 for k in 0..(r * n).max(1) {
                     let want = f(position(n, m, r, k));
                     let got = h.values[node(n, r, k)];
-                    assert!((got[0] - want[0]).abs() < 1e-11 && (got[1] - want[1]).abs() < 1e-11, "{n}: {got:?} {want:?}");
+                    assert!(
+                        (got[0] - want[0]).abs() < 1e-11 && (got[1] - want[1]).abs() < 1e-11,
+                        "{n}: {got:?} {want:?}"
+                    );
                 }
             }
             assert!(h.min_area_ratio > 0.0);

@@ -54,7 +54,8 @@ fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) -> bool {
     let n = poly.len();
     // the segment without its ends, which lie on the boundary
     let e = 1e-6;
-    let (a1, b1) = ([a[0] + e * (b[0] - a[0]), a[1] + e * (b[1] - a[1])], [b[0] + e * (a[0] - b[0]), b[1] + e * (a[1] - b[1])]);
+    let (a1, b1) =
+        ([a[0] + e * (b[0] - a[0]), a[1] + e * (b[1] - a[1])], [b[0] + e * (a[0] - b[0]), b[1] + e * (a[1] - b[1])]);
     for i in 0..n {
         let (p, q) = (poly[i].0, poly[(i + 1) % n].0);
         if segment_distance(a1, b1, p, q).0 <= tol {
@@ -101,6 +102,10 @@ struct Candidate {
     angles: [f64; 4],
 }
 
+/// Where a cut may end: a corner of the face or a point on its side `k` at the edge
+/// parameter `u`; the point; the directions there (outgoing side, reversed incoming).
+type Target = (Option<usize>, Option<(usize, f64)>, Point, Point, Point);
+
 /// Angles within this of 180° (radians) are flat: such a corner is cut as well.
 const FLAT: f64 = 1e-6;
 
@@ -123,7 +128,8 @@ pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Re
         let o = g.vertices[o_vertex];
         let (t_out, back) = g.corner_directions(f, i);
         let label = g.faces[f].label.clone();
-        let reflex_error = || Error::Domain {
+        let reflex_error = || {
+            Error::Domain {
             at: format!("face {f} (label {label})"),
             reason: format!(
                 "the corner at ({:.6}, {:.6}) ({:.1} degrees) cannot be cut: no straight cut from it stays inside the face",
@@ -131,6 +137,7 @@ pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Re
                 o[1],
                 alpha.to_degrees()
             ),
+        }
         };
         let n = g.faces[f].sides.len();
         let corners = g.corners(f);
@@ -144,7 +151,7 @@ pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Re
             let Some((k, u, _)) = ray_hit(g, f, o, dir, 1e3 * tol) else { continue };
             let (e, fwd) = g.faces[f].sides[k];
             // the hit point on the side, and the two corners of that side
-            let mut targets: Vec<(Option<usize>, Option<(usize, f64)>, Point, Point, Point)> = Vec::new();
+            let mut targets: Vec<Target> = Vec::new();
             if u > 1e-6 && u < 1.0 - 1e-6 {
                 let c = &g.edges[e].curve;
                 let d1 = c.derivs(u, 1).d1;
@@ -173,8 +180,8 @@ pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Re
                 let angles = [a1, a2, b1, b2];
                 // no new reflex angle and no sliver; a flat part only where the corner
                 // was reflex (it is cut next)
-                let ok = angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT)
-                    && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
+                let ok =
+                    angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
                 if ok {
                     let score = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).fold(pi, f64::min);
                     cands.push(Candidate { corner, on_side, point: p, score, angles });
@@ -182,9 +189,10 @@ pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Re
             }
         }
         // the largest smallest angle; a corner before a new vertex when they tie
-        let Some(best) = cands.iter().max_by(|a, b| {
-            a.score.total_cmp(&b.score).then_with(|| a.corner.is_some().cmp(&b.corner.is_some()))
-        }) else {
+        let Some(best) = cands
+            .iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score).then_with(|| a.corner.is_some().cmp(&b.corner.is_some())))
+        else {
             return Err(reflex_error());
         };
         let j_vertex = match (best.corner, best.on_side) {

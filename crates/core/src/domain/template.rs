@@ -117,7 +117,8 @@ fn dist(a: Point, b: Point) -> f64 {
 fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
     let (a, b) = (pts[0], pts[pts.len() - 1]);
     let l = dist(a, b);
-    let off = |p: &Point| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / l.max(f64::MIN_POSITIVE);
+    let off =
+        |p: &Point| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / l.max(f64::MIN_POSITIVE);
     if pts.iter().all(|p| off(p) <= 1e-9 * diameter) {
         return Ok(line(a, b));
     }
@@ -146,7 +147,6 @@ fn loop_curves(domain: &Domain, diameter: f64, fit: &FitOptions) -> Result<Vec<C
         })
         .collect()
 }
-
 
 /// How a face is quadrangulated.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -85,7 +85,8 @@ fn midpoint_template_reproduces_affine_maps() {
             assert!(mid < 1e-9, "{n}: a cut does not end at a side's midpoint ({mid:.3e})");
         }
         // the patch areas sum to the polygon's
-        let exact = (0..n).map(|k| 0.5 * (pts[k][0] * pts[(k + 1) % n][1] - pts[(k + 1) % n][0] * pts[k][1])).sum::<f64>();
+        let exact =
+            (0..n).map(|k| 0.5 * (pts[k][0] * pts[(k + 1) % n][1] - pts[(k + 1) % n][0] * pts[k][1])).sum::<f64>();
         assert!((total_area(l) - exact).abs() < 1e-12 * exact, "{n}: {} vs {exact}", total_area(l));
     }
 }
@@ -141,7 +142,9 @@ fn domains_the_layout_refuses_are_typed_errors() {
     let two = Domain {
         name: "lens".into(),
         outer: Loop::new(vec![
-            SideCurve::Spline(Curve::new(KnotVector::open_uniform(2, 1), vec![[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]], None).unwrap()),
+            SideCurve::Spline(
+                Curve::new(KnotVector::open_uniform(2, 1), vec![[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]], None).unwrap(),
+            ),
             SideCurve::Spline(
                 Curve::new(KnotVector::open_uniform(2, 1), vec![[2.0, 0.0], [1.0, -1.0], [0.0, 0.0]], None).unwrap(),
             ),

@@ -77,9 +77,13 @@ pub(crate) fn segment_distance(a: Point, b: Point, c: Point, d: Point) -> (f64, 
         let q = [s[0] + t * vx, s[1] + t * vy];
         (dist(p, q), p)
     };
-    [to_seg(a, c, d), to_seg(b, c, d), to_seg(c, a, b), to_seg(d, a, b)]
-        .into_iter()
-        .fold((f64::INFINITY, a), |m, x| if x.0 < m.0 { x } else { m })
+    [to_seg(a, c, d), to_seg(b, c, d), to_seg(c, a, b), to_seg(d, a, b)].into_iter().fold((f64::INFINITY, a), |m, x| {
+        if x.0 < m.0 {
+            x
+        } else {
+            m
+        }
+    })
 }
 
 /// A segment of some loop: (loop index, segment index).
@@ -143,7 +147,11 @@ fn check_loop_sides(id: LoopId, l: &Loop, tol: f64) -> Result<()> {
     for (k, s) in l.sides.iter().enumerate() {
         match s {
             SideCurve::Points(p) if p.len() < 2 => {
-                return Err(domain_error(id, Some(k), format!("is a point cloud of {} points, at least 2 needed", p.len())))
+                return Err(domain_error(
+                    id,
+                    Some(k),
+                    format!("is a point cloud of {} points, at least 2 needed", p.len()),
+                ))
             }
             SideCurve::Points(p) if p.iter().any(|q| !q[0].is_finite() || !q[1].is_finite()) => {
                 return Err(domain_error(id, Some(k), "has a non-finite point"))
@@ -230,10 +238,7 @@ pub fn validate_domain(domain: &mut Domain) -> Result<DomainReport> {
                 LoopId::Hole(h) => domain.holes[h] = l,
             }
             lines[k] = polyline(domain.loop_of(id), FLATNESS * diameter);
-            reoriented.push(format!(
-                "{id} ran {}: reversed",
-                if want_ccw { "clockwise" } else { "counter-clockwise" }
-            ));
+            reoriented.push(format!("{id} ran {}: reversed", if want_ccw { "clockwise" } else { "counter-clockwise" }));
         }
         area += a.abs() * if want_ccw { 1.0 } else { -1.0 };
     }

@@ -69,7 +69,12 @@ fn closed_cloud(o: &serde_json::Map<String, Value>, ctx: &str) -> Result<Loop> {
         serde_json::from_value(o["points"].clone()).map_err(|e| jerr(format!("{ctx}.points"), e.to_string()))?;
     let n = points.len();
     if n > MAX_CONTROL_POINTS {
-        return Err(Error::TooLarge { context: ctx.into(), what: "number of points".into(), found: n, limit: MAX_CONTROL_POINTS });
+        return Err(Error::TooLarge {
+            context: ctx.into(),
+            what: "number of points".into(),
+            found: n,
+            limit: MAX_CONTROL_POINTS,
+        });
     }
     if n < 3 {
         return Err(Error::TooFewPoints { side: ctx.into(), found: n, needed: 3 });
@@ -83,7 +88,9 @@ fn closed_cloud(o: &serde_json::Map<String, Value>, ctx: &str) -> Result<Loop> {
             let mut c: Vec<usize> =
                 serde_json::from_value(v.clone()).map_err(|e| jerr(format!("{ctx}.corners"), e.to_string()))?;
             if let Some(&bad) = c.iter().find(|&&i| i >= n) {
-                return Err(Error::Corners { reason: format!("{ctx}: corner index {bad} is not below the {n} points") });
+                return Err(Error::Corners {
+                    reason: format!("{ctx}: corner index {bad} is not below the {n} points"),
+                });
             }
             c.sort_unstable();
             if c.windows(2).any(|w| w[0] == w[1]) {
@@ -195,7 +202,9 @@ mod tests {
         let sq = r#"{"domain": {"outer": {"points": [[0,0],[1,0],[2,0],[2,1],[2,2],[1,2],[0,2],[0,1]] CORNERS}}}"#;
         let listed = parse(&sq.replace("CORNERS", r#", "corners": [6, 0, 2, 4]"#)).unwrap();
         assert_eq!(listed.outer.corners(), 4);
-        assert!(matches!(&listed.outer.sides[0], SideCurve::Points(p) if p == &vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]));
+        assert!(
+            matches!(&listed.outer.sides[0], SideCurve::Points(p) if p == &vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+        );
         let found = parse(&sq.replace("CORNERS", "")).unwrap();
         assert_eq!(found.outer.detected_corners, vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
     }

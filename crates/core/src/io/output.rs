@@ -30,10 +30,10 @@ use super::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
 use super::vtk::{bezier_vtu, structured_grid_vtk};
 use crate::boundary::ring::Ring;
 use crate::boundary::Boundary;
+use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::Surface;
-use crate::domain::Domain;
 use crate::spline::volume::Volume;
 
 /// Samples per direction of a map's `.vtk` grid.

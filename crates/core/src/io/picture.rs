@@ -175,7 +175,10 @@ pub fn render_curves(curves: &[Vec<Point>], marks: &[Point], size: usize) -> Ima
     let (wd, ht) = ((hi[0] - lo[0]).max(1e-300), (hi[1] - lo[1]).max(1e-300));
     let margin = 0.04;
     let s = size as f64 * (1.0 - 2.0 * margin) / wd.max(ht);
-    let (w, h) = ((((wd * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16), (((ht * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16));
+    let (w, h) = (
+        (((wd * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16),
+        (((ht * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16),
+    );
     let (pad, padv) = ((w as f64 - wd * s) / 2.0, (h as f64 - ht * s) / 2.0);
     let mut cv = Canvas { w, h, rgba: vec![255; 4 * w * h], x0: lo[0] - pad / s, y0: lo[1] - padv / s, s };
     for c in curves {

@@ -218,7 +218,12 @@ fn unit_layout(layout: &Layout, sim: &Similarity) -> Layout {
         patches: layout
             .patches
             .iter()
-            .map(|p| Patch { name: p.name.clone(), sides: p.sides.each_ref().map(unit), map: None, face: p.face.clone() })
+            .map(|p| Patch {
+                name: p.name.clone(),
+                sides: p.sides.each_ref().map(unit),
+                map: None,
+                face: p.face.clone(),
+            })
             .collect(),
         interfaces: layout.interfaces.clone(),
     }
