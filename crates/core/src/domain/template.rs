@@ -244,7 +244,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
     let curves = loop_curves(&d, diameter, &opts.fit)?;
     let mut g = Graph::default();
     for c in &curves {
-        g.add_vertex(c.endpoints().0);
+        g.add_vertex(c.control_points[0]);
     }
     let sides: Vec<FaceSide> =
         curves.into_iter().enumerate().map(|(k, c)| (g.add_edge(c, k, (k + 1) % n, true), true)).collect();
