@@ -36,7 +36,7 @@ impl ArcLength {
         Self { s }
     }
 
-    /// Length of the curve (of its polyline of [`ARC_SAMPLES`] chords).
+    /// Length of the curve (of its polyline of 512 chords).
     pub fn length(&self) -> f64 {
         self.s[self.s.len() - 1]
     }

@@ -181,7 +181,7 @@ fn check_loop_sides(id: LoopId, l: &Loop, tol: f64) -> Result<()> {
 }
 
 /// Check `domain` (see the module documentation), orient its loops and report what was
-/// measured. Errors are [`Error::Domain`] naming the loop and curve.
+/// measured. Errors are [`crate::Error::Domain`] naming the loop and curve.
 pub fn validate_domain(domain: &mut Domain) -> Result<DomainReport> {
     let ids: Vec<LoopId> = domain.loops().map(|(id, _)| id).collect();
     // the tolerance is relative to the outer loop's extent
