@@ -26,13 +26,19 @@ pub struct CorpusArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
-    /// strip, cad, noisy-cloud, sparse-cloud.
+    /// strip, cad, noisy-cloud, sparse-cloud; with --general: ngon, l, t, u, e, plus.
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
     /// Remove the boundary documents of an earlier run from the -o folder first (without
     /// it, such files are an error).
     #[arg(long)]
     overwrite: bool,
+    /// The corpus of general domains instead (issue 31): N-gons with curved sides
+    /// (N = 3 ... 12), L, T, U, E and plus shapes with sharp or filleted reflex corners;
+    /// written as domain documents, and with --solve laid out automatically and solved
+    /// (a domain counts as certified when every patch is).
+    #[arg(long)]
+    general: bool,
     /// Solve every domain (default settings) and print the verdicts and a table per
     /// family; exits 1 when any domain is not certified.
     #[arg(long)]
@@ -48,6 +54,9 @@ struct Tally {
 }
 
 pub fn run(a: CorpusArgs) -> Result<i32> {
+    if a.general {
+        return crate::corpus_domains::run(&a.output, a.per_family, a.seed, &a.families, a.solve);
+    }
     let families: Vec<Family> = a
         .families
         .iter()

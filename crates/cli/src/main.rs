@@ -62,6 +62,8 @@ mod check_cmd;
 mod compare_cmd;
 mod convert_cmd;
 mod corpus;
+mod corpus_domains;
+mod domain_cmd;
 mod files;
 mod inspect_cmd;
 mod inspect_ring;
@@ -179,6 +181,13 @@ enum Command {
         after_help = "Example (the two halves of the `winslow split` example, solved):\n  winslow solve out/parts-a.json -o out/a.json -q\n  winslow solve out/parts-b.json -o out/b.json -q\n  winslow join out/a.json out/b.json -o out/joined.json"
     )]
     Join(multipatch_cmd::JoinArgs),
+    /// Lay a general planar domain (any number of corners) out into four-sided patches
+    /// automatically: cuts from reflex corners, a template per face placed by a harmonic
+    /// map; write the layout (which `winslow solve` takes) and draw it. `winslow solve`
+    /// on the domain lays it out and solves it in one go.
+    #[command(after_help = "Example:
+  winslow layout tests/data/domains/pentagon.json -o out/pentagon-layout.json --png out/pentagon-layout.png")]
+    Layout(domain_cmd::LayoutArgs),
     /// Print the command-line reference (docs/cli.md) generated from these definitions.
     #[command(hide = true)]
     Reference,
@@ -234,6 +243,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Compare(a) => compare_cmd::run(*a),
         Command::Split(a) => multipatch_cmd::split(a),
         Command::Join(a) => multipatch_cmd::join(a),
+        Command::Layout(a) => domain_cmd::layout(a),
         Command::Reference => {
             print!("{}", reference::markdown(<Cli as clap::CommandFactory>::command()));
             Ok(0)

@@ -54,9 +54,15 @@ pub(super) fn announce(layout: &Layout, opts: &SolveOptions) {
 }
 
 /// `winslow solve LAYOUT` after the pipeline: write, summarize; the exit code of the
-/// worst verdict.
-pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
-    write(&sol, a)?;
+/// worst verdict. `made` is the report of the automatic layout when the layout was made
+/// from a general domain (`winslow solve DOMAIN`): it goes into the top-level report as
+/// `auto_layout`.
+pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs, made: Option<serde_json::Value>) -> Result<i32> {
+    let mut report = serde_json::to_value(&sol.report)?;
+    if let Some(m) = made {
+        report["auto_layout"] = m;
+    }
+    write(&sol, report.clone(), a)?;
     if let Some(out) = &a.mesh {
         // one conforming mesh of the solved patches (a folded patch gives inverted
         // cells, which the writers refuse)
@@ -67,7 +73,7 @@ pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
         super::mesh::make_and_write_multipatch(&layout, &a.mesh_spec, out, a.json || output::quiet())?;
     }
     if a.json {
-        files::print_json(serde_json::to_value(&sol.report)?)?;
+        files::print_json(report)?;
     } else {
         say_raw!("{}", summary(&sol));
     }
@@ -76,8 +82,10 @@ pub(super) fn finish(sol: MultipatchSolution, a: &SolveArgs) -> Result<i32> {
 
 /// Write the solution where `a` asks: `-o` by its extension (.json, .xml for G+Smo,
 /// .vtm), `--gismo`, `--png` (the whole layout), `--vtm`, `--patch-maps`.
-fn write(sol: &MultipatchSolution, a: &SolveArgs) -> Result<()> {
-    let patches = Output::Multipatch(Patches::of_solution(sol)?);
+fn write(sol: &MultipatchSolution, report: serde_json::Value, a: &SolveArgs) -> Result<()> {
+    let mut patches = Patches::of_solution(sol)?;
+    patches.report = report;
+    let patches = Output::Multipatch(patches);
     files::write(&a.output, &patches)?;
     if let Some(p) = &a.gismo {
         files::write_as(p, "xml", &patches)?;

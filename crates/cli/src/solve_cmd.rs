@@ -162,6 +162,28 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
     }
 }
 
+/// `winslow solve` of a layout, or of the layout made from a general domain (whose
+/// report `made` joins the result as `auto_layout`): the pipeline, then the files and
+/// the summary of [`multipatch_cmd::finish`](super::multipatch_cmd::finish).
+pub(super) fn solve_layout(
+    layout: winslow::multipatch::Layout,
+    a: &SolveArgs,
+    made: Option<serde_json::Value>,
+    sel: &Selected,
+) -> Result<i32> {
+    let opts = super::multipatch_cmd::options(a)?;
+    if !(output::quiet() || a.json) {
+        super::multipatch_cmd::announce(&layout, &opts);
+    }
+    let name = layout.name.clone();
+    let solved = run_pipeline(layout, &opts, sel.as_assembler(), output::quiet() || a.json)
+        .with_context(|| format!("solving the layout {name}"))?;
+    match solved {
+        Solved::Layout(sol) => super::multipatch_cmd::finish(*sol, a, made),
+        _ => bail!("the solve of the layout {name} gave no multipatch result"),
+    }
+}
+
 pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let wants_mesh = a.mesh_spec.structured.is_some() || a.mesh_spec.unstructured;
     if wants_mesh != a.mesh.is_some() {
@@ -177,26 +199,14 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let doc = files::read(path)?;
-    let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_));
+    let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_));
     output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => {
-            let opts = super::multipatch_cmd::options(&a)?;
-            if !(output::quiet() || a.json) {
-                super::multipatch_cmd::announce(&layout, &opts);
-            }
-            let name = layout.name.clone();
-            let solved = run_pipeline(layout, &opts, sel.as_assembler(), output::quiet() || a.json)
-                .with_context(|| format!("solving the layout {name}"))?;
-            return match solved {
-                Solved::Layout(sol) => super::multipatch_cmd::finish(*sol, &a),
-                _ => bail!(
-                    "the solve of the layout {} gave no multipatch result",
-                    a.boundary.as_deref().unwrap_or(path).display()
-                ),
-            };
+            return solve_layout(layout, &a, None, &sel);
         }
+        Document::Domain(domain) => return super::domain_cmd::solve(domain, &a, &sel),
         Document::Ring(ring) => Input::Ring(ring),
         // a ring map (a sweep's frame): the ring between its two contours
         doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),

@@ -100,6 +100,10 @@ pub enum Error {
     /// (`crate::solve::memory`): refused before it starts, never an abort.
     #[error("not enough memory for {what}: about {} needed, {} available ({limit}); {advice}", human(*.needed), human(*.available))]
     Memory { what: String, needed: u64, available: u64, limit: String, advice: String },
+    /// A general planar domain or plane graph (`formats.md`) is invalid: `at` names the
+    /// loop and curve (`"outer loop, curve 3"`, `"hole 1"`) or the edge.
+    #[error("domain, {at}: {reason}")]
+    Domain { at: String, reason: String },
     /// The observer of a [`Pipeline`](crate::pipeline::Pipeline) run stopped it.
     #[error("stopped before the solve finished")]
     Cancelled,

@@ -18,6 +18,7 @@
 //! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
 //! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
 //! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split |
+//! | [`domain`] | general planar domains (any number of corners): validation and the automatic quad layout into a multipatch layout |
 //! | [`pipeline`] | the one observable entry ([`Pipeline`]) of every input (boundary, ring, layout); the runs built on it: the comparison of methods ([`pipeline::compare`]), the sliding grid ([`pipeline::sweep`]) |
 //! | [`io`] | [`read()`] and [`write()`]: every document kind (boundary, map, ring, multipatch layout and result, volume) in JSON, G+Smo XML, IGES, VTK and PNG |
 //!
@@ -67,6 +68,7 @@
 
 pub mod boundary;
 pub mod discrete;
+pub mod domain;
 pub mod error;
 pub mod io;
 pub mod linalg;

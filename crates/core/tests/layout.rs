@@ -209,6 +209,7 @@ fn dependencies_point_one_way() {
         "methods",
         "solve",
         "multipatch",
+        "domain",
         "pipeline",
         "io",
     ];

@@ -368,6 +368,11 @@ impl Scene {
             }
             Document::Ring(ring) => Self::from_ring(ring),
             Document::Layout(layout) | Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
+            doc @ Document::Domain(_) => {
+                return Err(doc
+                    .wrong_kind(None, "the viewer draws maps and solved layouts: `winslow solve` lays a domain out and solves it; open its output")
+                    .into())
+            }
             doc @ Document::Volume { .. } => {
                 return Err(doc
                     .wrong_kind(None, "the viewer draws planar documents (`winslow convert` writes a volume as .vtu or .vtk for ParaView)")

@@ -104,14 +104,14 @@ pub fn corpus(per_family: usize, seed: u64) -> Vec<(Family, Boundary)> {
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a tiny seeded generator, enough for shapes.
 #[derive(Debug, Clone)]
-struct Rng(u64);
+pub(crate) struct Rng(u64);
 
 impl Rng {
-    fn new(seed: u64) -> Self {
+    pub(crate) fn new(seed: u64) -> Self {
         Self(seed)
     }
     /// Uniform in `[0, 1)`.
-    fn uniform(&mut self) -> f64 {
+    pub(crate) fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -120,7 +120,7 @@ impl Rng {
     }
 }
 
-fn between(rng: &mut Rng, lo: f64, hi: f64) -> f64 {
+pub(crate) fn between(rng: &mut Rng, lo: f64, hi: f64) -> f64 {
     lo + (hi - lo) * rng.uniform()
 }
 

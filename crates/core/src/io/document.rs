@@ -9,7 +9,8 @@
 //! | JSON with `map` of three degrees | [`Document::Volume`] |
 //! | JSON with `map` | [`Document::Map`] |
 //! | JSON with `boundary` or `contour` | [`Document::Boundary`] |
-//! | JSON with `domain` or `graph` | not read yet: [`Error::DocumentKind`] naming the kind |
+//! | JSON with `domain` | [`Document::Domain`] (not validated: [`crate::domain::validate_domain`]) |
+//! | JSON with `graph` | not read yet: [`Error::DocumentKind`] naming the kind |
 //! | XML with `TensorBSpline3` / `TensorNurbs3` | [`Document::Volume`] |
 //! | XML with a `<MultiPatch>` of surfaces (two patches or more, or interfaces) | [`Document::Layout`] |
 //! | XML with four curves / one tensor patch | [`Document::Boundary`] / [`Document::Map`] |
@@ -21,6 +22,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use super::domain::domain_of_json;
 use super::gismo::parse_gismo_xml;
 use super::json::parse_json;
 use super::multipatch::gismo::{is_gismo_multipatch, parse_gismo_multipatch};
@@ -31,6 +33,7 @@ use super::volume::json::parse_volume_json;
 use super::{iges, read_text, surface_boundary_area};
 use crate::boundary::ring::{signed_area, ClosedContour, Ring};
 use crate::boundary::{Boundary, SideCurve};
+use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::{Side, Surface};
@@ -60,6 +63,9 @@ pub enum Document {
     /// A solved multipatch result: a JSON document with `patches`, every patch a `map`
     /// (each in [`crate::multipatch::Patch::map`]).
     Multipatch(Layout),
+    /// A general planar domain: an outer loop with any number of corners and holes
+    /// (`formats.md`, "General planar domain").
+    Domain(Domain),
     /// A trivariate map: a JSON map with three degrees, or G+Smo
     /// `TensorBSpline3` / `TensorNurbs3`.
     Volume {
@@ -72,7 +78,8 @@ pub enum Document {
 
 impl Document {
     /// The kind, for messages: `"boundary"`, `"map"`, `"ring map"` (a map with `eta`
-    /// periodic), `"ring"`, `"multipatch layout"`, `"multipatch result"`, `"volume"`.
+    /// periodic), `"ring"`, `"multipatch layout"`, `"multipatch result"`, `"domain"`,
+    /// `"volume"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Document::Boundary(_) => "boundary",
@@ -81,6 +88,7 @@ impl Document {
             Document::Ring(_) => "ring",
             Document::Layout(_) => "multipatch layout",
             Document::Multipatch(_) => "multipatch result",
+            Document::Domain(_) => "domain",
             Document::Volume { .. } => "volume",
         }
     }
@@ -91,6 +99,7 @@ impl Document {
             Document::Boundary(b) => &b.name,
             Document::Ring(r) => &r.name,
             Document::Layout(l) | Document::Multipatch(l) => &l.name,
+            Document::Domain(d) => &d.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -100,6 +109,7 @@ impl Document {
             Document::Boundary(b) => &mut b.name,
             Document::Ring(r) => &mut r.name,
             Document::Layout(l) | Document::Multipatch(l) => &mut l.name,
+            Document::Domain(d) => &mut d.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -161,7 +171,7 @@ impl Document {
 }
 
 /// The kinds of `formats.md` that are recognised but not read by this version.
-const NOT_READ: [(&str, &str); 2] = [("domain", "general planar domain"), ("graph", "plane graph")];
+const NOT_READ: [(&str, &str); 1] = [("graph", "plane graph")];
 
 fn json_document(body: &str) -> Result<Document> {
     let v: Value =
@@ -175,6 +185,9 @@ fn json_document(body: &str) -> Result<Document> {
     if obj.contains_key("ring") {
         return ring_of_json(v).map(Document::Ring);
     }
+    if obj.contains_key("domain") && !["map", "boundary", "contour"].iter().any(|k| obj.contains_key(*k)) {
+        return domain_of_json(v).map(Document::Domain);
+    }
     let volume = obj.get("map").and_then(|m| m.get("degree")).and_then(Value::as_array).is_some_and(|d| d.len() == 3);
     if volume {
         let (name, volume) = parse_volume_json(v)?;
@@ -185,8 +198,8 @@ fn json_document(body: &str) -> Result<Document> {
             return Err(Error::DocumentKind {
                 path: None,
                 found: format!("{kind} (\"{key}\")"),
-                needed: "this version reads boundaries, contours, maps, rings, multipatch layouts and results, \
-                         and volumes"
+                needed: "this version reads boundaries, contours, maps, rings, general domains, multipatch \
+                         layouts and results, and volumes"
                     .into(),
             });
         }
@@ -326,10 +339,11 @@ mod tests {
     }
 
     #[test]
-    fn domains_and_graphs_are_named_not_half_read() {
-        let domain = r#"{"name": "bracket", "domain": {"outer": {"points": [[0,0],[1,0],[1,1]]}, "holes": []}}"#;
-        let e = parse_document(domain).unwrap_err();
-        assert!(matches!(&e, Error::DocumentKind { found, .. } if found.contains("general planar domain")), "{e}");
+    fn domains_are_read_and_graphs_named_not_half_read() {
+        let domain = r#"{"name": "bracket", "domain": {"outer": {"points": [[0,0],[1,0],[1,1]], "corners": [0, 1, 2]}, "holes": []}}"#;
+        let doc = parse_document(domain).unwrap();
+        assert_eq!((doc.kind(), doc.name()), ("domain", "bracket"));
+        assert!(matches!(&doc, Document::Domain(d) if d.outer.corners() == 3));
         let graph = r#"{"graph": {"vertices": [[0,0],[1,0]], "edges": [{"from": 0, "to": 1}]}}"#;
         let e = parse_document(graph).unwrap_err();
         assert!(matches!(&e, Error::DocumentKind { found, .. } if found.contains("plane graph")), "{e}");

@@ -390,7 +390,7 @@ pub fn curve_to_json(c: &Curve) -> Value {
     json!(CurveJson::from_curve(c))
 }
 
-fn side_to_json(s: &SideCurve) -> Value {
+pub(crate) fn side_to_json(s: &SideCurve) -> Value {
     json!(SideJson::from_side(s))
 }
 

@@ -22,6 +22,7 @@
 //! an [`Error`] naming what is wrong and where, never a panic.
 
 pub mod document;
+pub mod domain;
 pub mod file;
 pub mod gismo;
 pub mod gismo_writer;

@@ -30,6 +30,7 @@ use super::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
 use super::vtk::{bezier_vtu, structured_grid_vtk};
 use crate::boundary::ring::Ring;
 use crate::boundary::Boundary;
+use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::Surface;
@@ -71,6 +72,8 @@ pub enum Output<'a> {
     Boundary(&'a Boundary),
     /// A ring (analytic contours become point clouds).
     Ring(&'a Ring),
+    /// A general planar domain.
+    Domain(&'a Domain),
     /// A picture ([`super::picture::render`]).
     Picture(&'a Image),
 }
@@ -85,6 +88,7 @@ impl Output<'_> {
             Output::Layout(_) => "multipatch layout",
             Output::Boundary(_) => "boundary",
             Output::Ring(_) => "ring",
+            Output::Domain(_) => "domain",
             Output::Picture(_) => "picture",
         }
     }
@@ -95,7 +99,7 @@ impl Output<'_> {
             Output::Map { .. } => ".json, .xml, .igs, .iges, .vtu or .vtk",
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
-            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) => ".json",
+            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) => ".json",
             Output::Picture(_) => ".png",
         }
     }
@@ -147,6 +151,7 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Layout(l), "json" | "") => write_json(path, &layout_to_json(l)),
         (Output::Boundary(b), "json" | "") => write_json(path, &boundary_to_json(b)),
         (Output::Ring(r), "json" | "") => write_json(path, &ring_to_json(r)),
+        (Output::Domain(d), "json" | "") => write_json(path, &super::domain::domain_to_json(d)),
         (Output::Picture(img), "png") => write_png(path, img),
         _ => Err(refused()),
     }

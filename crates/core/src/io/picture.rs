@@ -162,6 +162,43 @@ pub fn render_layout(maps: &[Surface], opts: &PictureOptions) -> Image {
     render_patches_sampled(n, &refs, opts)
 }
 
+/// Draw a layout without maps: the polylines `curves` (patch borders) in black and the
+/// points `marks` (irregular vertices) as red crosses, on white, fitted to the image.
+pub fn render_curves(curves: &[Vec<Point>], marks: &[Point], size: usize) -> Image {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in curves.iter().flatten() {
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    let (wd, ht) = ((hi[0] - lo[0]).max(1e-300), (hi[1] - lo[1]).max(1e-300));
+    let margin = 0.04;
+    let s = size as f64 * (1.0 - 2.0 * margin) / wd.max(ht);
+    let (w, h) = (
+        (((wd * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16),
+        (((ht * s) / (1.0 - 2.0 * margin)).ceil() as usize).max(16),
+    );
+    let (pad, padv) = ((w as f64 - wd * s) / 2.0, (h as f64 - ht * s) / 2.0);
+    let mut cv = Canvas { w, h, rgba: vec![255; 4 * w * h], x0: lo[0] - pad / s, y0: lo[1] - padv / s, s };
+    for c in curves {
+        for q in c.windows(2) {
+            let (a, b) = (cv.to_px(q[0]), cv.to_px(q[1]));
+            cv.line(a, b, [0, 0, 0], 1.0);
+        }
+    }
+    let r = 0.006 * w.max(h) as f64 + 2.0;
+    for &x in marks {
+        let (cx, cy) = cv.to_px(x);
+        for (dx, dy) in [(r, r), (r, -r)] {
+            for o in [0.0, 0.7] {
+                cv.line((cx - dx + o, cy - dy), (cx + dx + o, cy + dy), KEPT_KINK_COLOUR, 1.0);
+            }
+        }
+    }
+    Image { width: w, height: h, rgba: cv.rgba }
+}
+
 /// Grid cells per direction that [`render`] samples for `opts`.
 pub fn render_resolution(opts: &PictureOptions) -> usize {
     opts.resolution.max(8)

@@ -66,18 +66,21 @@ pub struct Patch {
     pub sides: [Curve; 4],
     /// The map the patch was given as, if any.
     pub map: Option<Surface>,
+    /// The region it covers (`"face"` of `formats.md`): the label of a graph face or
+    /// `"domain"`, for layouts made from a general domain or plane graph.
+    pub face: Option<String>,
 }
 
 impl Patch {
     /// A patch from its four sides.
     pub fn from_sides(name: impl Into<String>, sides: [Curve; 4]) -> Self {
-        Self { name: name.into(), sides: sides.map(|c| c.normalized()), map: None }
+        Self { name: name.into(), sides: sides.map(|c| c.normalized()), map: None, face: None }
     }
 
     /// A patch from a tensor map: its boundary curves are the sides.
     pub fn from_map(name: impl Into<String>, map: Surface) -> Self {
         let sides = Side::ALL.map(|s| map.boundary(s).normalized());
-        Self { name: name.into(), sides, map: Some(map) }
+        Self { name: name.into(), sides, map: Some(map), face: None }
     }
 
     /// The side `s`.
@@ -121,7 +124,12 @@ impl Layout {
             patches: self
                 .patches
                 .iter()
-                .map(|p| Patch { name: p.name.clone(), sides: p.sides.each_ref().map(unit), map: None })
+                .map(|p| Patch {
+                    name: p.name.clone(),
+                    sides: p.sides.each_ref().map(unit),
+                    map: None,
+                    face: p.face.clone(),
+                })
                 .collect(),
             interfaces: self.interfaces.clone(),
         }

@@ -112,6 +112,15 @@ pub fn exercise_document(doc: Document, trace: &mut Trace) {
                 exercise_boundary(&b, trace);
             }
         }
+        // a domain: validated and laid out (never a panic)
+        Document::Domain(mut d) => {
+            trace.boundaries += 1;
+            if trace.record("validate domain", crate::domain::validate_domain(&mut d)).is_some() {
+                trace.valid_boundaries += 1;
+                let opts = crate::domain::LayoutOptions { rings: 6, ..Default::default() };
+                trace.record("layout", crate::domain::auto_layout(&d, &opts));
+            }
+        }
         // rings have their own exerciser (`exercise_ring_text`); layouts and volumes none
         Document::Ring(_) | Document::Layout(_) | Document::Multipatch(_) | Document::Volume { .. } => {}
     }

@@ -135,6 +135,13 @@ pub fn parse_json_multipatch(text: &str) -> Result<Layout> {
         } else {
             return Err(jerr(ctx, "a patch needs a \"boundary\", a \"map\" or \"sides\""));
         };
+        let mut patch = patch;
+        patch.face = match o.remove("face") {
+            None | Some(Value::Null) => None,
+            Some(Value::String(s)) => Some(s),
+            Some(Value::Number(x)) => Some(x.to_string()),
+            Some(_) => return Err(jerr(format!("{ctx}.face"), "must be a string or a number")),
+        };
         patches.push(patch);
     }
     let mut layout = Layout { name, patches, interfaces: Vec::new() };
@@ -243,6 +250,9 @@ pub fn multipatch_to_json(layout: &Layout, maps: &[Surface], reports: Vec<Value>
         .map(|((p, m), r)| {
             let mut o = Map::new();
             o.insert("name".into(), json!(p.name));
+            if let Some(f) = &p.face {
+                o.insert("face".into(), json!(f));
+            }
             o.insert("map".into(), json!(MapJson::from_surface(m)));
             if !r.is_null() {
                 o.insert("report".into(), r);
@@ -263,8 +273,12 @@ pub fn layout_to_json(layout: &Layout) -> Value {
         .iter()
         .map(|p| {
             let s = |side: Side| json!(CurveJson::from_curve(p.side(side)));
-            json!({ "name": p.name, "boundary": {
-                "south": s(Side::South), "east": s(Side::East), "north": s(Side::North), "west": s(Side::West) } })
+            let mut o = json!({ "name": p.name, "boundary": {
+                "south": s(Side::South), "east": s(Side::East), "north": s(Side::North), "west": s(Side::West) } });
+            if let Some(f) = &p.face {
+                o["face"] = json!(f);
+            }
+            o
         })
         .collect();
     let interfaces: Vec<Value> = layout.interfaces.iter().map(|i| interface_json(layout, i)).collect();

@@ -1,0 +1,104 @@
+//! General planar domains through the `winslow` binary: `solve DOMAIN.json` (automatic
+//! layout, then the multipatch solve) writing the JSON document whose patches name their
+//! face and the layout's report, G+Smo XML and a PNG; `layout DOMAIN.json` writing the
+//! layout (which `solve` takes) and its picture; typed errors with exit code 1.
+
+mod common;
+
+use common::{bin, data, read_json, stdout_json};
+use winslow::io::multipatch::json::parse_json_multipatch;
+
+#[test]
+fn solve_a_curved_pentagon_and_an_l_bracket() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    for (name, patches) in [("pentagon", 5), ("l_bracket", 3), ("hexagon_cloud", 6)] {
+        let (json, xml, png) =
+            (dir.join(format!("{name}.json")), dir.join(format!("{name}.xml")), dir.join(format!("{name}.png")));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join(format!("domains/{name}.json")))
+            .arg("-o")
+            .arg(&json)
+            .arg("--gismo")
+            .arg(&xml)
+            .arg("--png")
+            .arg(&png)
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let report = stdout_json(&out);
+        assert_eq!(report["verdicts"], serde_json::json!(vec!["certified"; patches]), "{name}: {}", report["message"]);
+        assert_eq!(report["interface_mismatch"], 0.0);
+        assert_eq!(report["auto_layout"]["patches"], patches);
+        // the written document: every patch a map naming its face, read back as a layout
+        let doc = read_json(&json);
+        for p in doc["patches"].as_array().unwrap() {
+            assert_eq!(p["face"], "domain", "{name}");
+        }
+        assert!(!doc["report"]["auto_layout"]["faces"].as_array().unwrap().is_empty());
+        let back = parse_json_multipatch(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(back.patches.len(), patches);
+        assert!(back.patches.iter().all(|p| p.face.as_deref() == Some("domain")));
+        assert!(std::fs::read_to_string(&xml).unwrap().contains("<MultiPatch"));
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    }
+}
+
+#[test]
+fn layout_writes_a_layout_that_solve_takes() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let (layout, png, solved) = (dir.join("l.json"), dir.join("l.png"), dir.join("l-map.json"));
+    let out = bin()
+        .arg("layout")
+        .arg(data().join("domains/l_bracket.json"))
+        .arg("-o")
+        .arg(&layout)
+        .arg("--png")
+        .arg(&png)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    assert_eq!(report["patches"], 3);
+    assert_eq!(report["cuts"].as_array().unwrap().len(), 2);
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    let doc = read_json(&layout);
+    assert_eq!(doc["patches"].as_array().unwrap().len(), 3);
+    assert_eq!(doc["patches"][0]["face"], "domain");
+    let out = bin().arg("solve").arg(&layout).arg("-o").arg(&solved).arg("-q").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(read_json(&solved)["patches"][2]["face"], "domain");
+}
+
+#[test]
+fn bad_domains_are_typed_errors() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    for (doc, want) in [
+        // not closed
+        (
+            r#"{"domain": {"outer": {"curves": [{"points": [[0,0],[1,0]]}, {"points": [[1,0],[1,1]]}, {"points": [[1,1],[0,0.5]]}]}}}"#,
+            "outer loop, curve 2",
+        ),
+        // a hole crossing the outer loop
+        (
+            r#"{"domain": {"outer": {"points": [[0,0],[4,0],[4,4],[0,4]], "corners": [0,1,2,3]},
+                           "holes": [{"points": [[3,1],[5,1],[5,2],[3,2]], "corners": [0,1,2,3]}]}}"#,
+            "hole 0",
+        ),
+    ] {
+        let input = dir.join("bad.json");
+        std::fs::write(&input, doc).unwrap();
+        for cmd in ["solve", "layout"] {
+            let out = bin().arg(cmd).arg(&input).arg("-o").arg(dir.join("never.json")).output().unwrap();
+            assert_eq!(out.status.code(), Some(1), "{cmd}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains(want), "{cmd}: {want}: {err}");
+            assert!(!dir.join("never.json").exists());
+        }
+    }
+}

@@ -1,0 +1,402 @@
+//! The automatic quad layout of a general planar domain (issue 31), with no interaction:
+//!
+//! 1. **Sides**: point clouds are fitted by the contour fit of §5 (`FitOptions`); the
+//!    outer loop becomes one face of a [`Graph`], its sides boundary edges.
+//! 2. **Reflex corners** are cut by straight edges into the face ([`super::reflex`]).
+//! 3. **Templates**: a face with four corners stays one patch. Every other face with `N`
+//!    corners is cut into `N` quads around one interior vertex (valence `N`), the
+//!    midpoint template: the harmonic map of the regular `N`-gon onto the face
+//!    ([`HarmonicMap`], Hinz & Buffa) places the interior vertex (the image of the
+//!    polygon's centre) and the cuts (the images of the segments from the centre to the
+//!    midpoints of the sides, fitted by splines); the sides are split at their arc-length
+//!    midpoints, the images of the polygon's side midpoints. A four-sided face beside a
+//!    split edge is split too, by the image of the segment between the midpoints of that
+//!    edge and the opposite one (so the splits run through chains of four-sided faces and
+//!    the layout stays conforming), or into four when both pairs are split.
+//! 4. **Layout**: every face is now a patch (south, east, reversed north and reversed west
+//!    are its four sides; an edge shared by two patches is an interface), named `p0`,
+//!    `p1`, ..., each with the label of its face (`"domain"`).
+//!
+//! The report lists every cut, every face's template and the interior vertices whose
+//! valence is not 4.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::graph::{Face, FaceSide, Graph};
+use super::harmonic::{ArcLength, HarmonicMap};
+use super::reflex::{cut_reflex, line, CutReport};
+use super::validate::{validate_domain, DomainReport};
+use super::{domain_error, Domain, LoopId};
+use crate::boundary::fit::{fit_side, FitOptions};
+use crate::boundary::SideCurve;
+use crate::error::{Error, Result};
+use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
+use crate::spline::curve::{Curve, Point};
+use crate::spline::surface::Side;
+
+/// Options of the automatic layout.
+#[derive(Debug, Clone)]
+pub struct LayoutOptions {
+    /// The fit of point-cloud sides and of the template's cuts (degree, tolerance
+    /// relative to the diameter).
+    pub fit: FitOptions,
+    /// Rings of the discrete harmonic map of every face.
+    pub rings: usize,
+}
+
+impl Default for LayoutOptions {
+    fn default() -> Self {
+        Self { fit: FitOptions::default(), rings: 24 }
+    }
+}
+
+/// The template of one face.
+#[derive(Debug, Clone, Serialize)]
+pub struct FaceReport {
+    /// The face's label.
+    pub label: String,
+    /// Its corners.
+    pub corners: usize,
+    /// `"one patch"`, `"split in two"` or `"midpoint"` (`N` quads around a vertex).
+    pub template: &'static str,
+    /// Patches it became.
+    pub patches: usize,
+    /// The image of the polygon's centre (the interior vertex), for the midpoint template.
+    pub centre: Option<Point>,
+    /// Smallest ratio of image to parameter area over the harmonic map's triangles
+    /// (negative: the discrete map folds and the cuts may leave the face).
+    pub harmonic_min_area_ratio: Option<f64>,
+}
+
+/// An interior vertex whose valence is not 4.
+#[derive(Debug, Clone, Serialize)]
+pub struct IrregularVertex {
+    /// Where.
+    pub point: Point,
+    /// Number of patches (edges) meeting there.
+    pub valence: usize,
+}
+
+/// What the automatic layout did.
+#[derive(Debug, Clone, Serialize)]
+pub struct LayoutReport {
+    /// The validation of the domain.
+    pub domain: DomainReport,
+    /// Cuts from reflex corners.
+    pub cuts: Vec<CutReport>,
+    /// The template of every face.
+    pub faces: Vec<FaceReport>,
+    /// Interior vertices of valence other than 4.
+    pub irregular_vertices: Vec<IrregularVertex>,
+    /// Patches.
+    pub patches: usize,
+    /// Smallest and largest corner angle of a patch, degrees.
+    pub corner_angles: [f64; 2],
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// A laid-out domain: the multipatch layout (every patch naming its face) and the report.
+#[derive(Debug, Clone)]
+pub struct AutoLayout {
+    /// The layout, ready for [`crate::multipatch::solve_multipatch`].
+    pub layout: Layout,
+    /// What was done.
+    pub report: LayoutReport,
+}
+
+fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// A spline curve through `pts` from its first to its last point (both kept exactly):
+/// the straight segment when the points are on it (to `1e-9` of the diameter), else the
+/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand.
+fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
+    let (a, b) = (pts[0], pts[pts.len() - 1]);
+    let l = dist(a, b);
+    let off =
+        |p: &Point| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / l.max(f64::MIN_POSITIVE);
+    if pts.iter().all(|p| off(p) <= 1e-9 * diameter) {
+        return Ok(line(a, b));
+    }
+    let opts = FitOptions { max_elements: 16, max_levels: 6, ..*fit };
+    let tol = (10.0 * fit.tol).min(1e-2) * diameter;
+    Ok(fit_side(Side::South, &SideCurve::Points(pts.to_vec()), (a, b), &opts, tol)?.finest().clone())
+}
+
+/// The sides of `domain`'s outer loop as spline curves on `[0, 1]`.
+fn loop_curves(domain: &Domain, diameter: f64, fit: &FitOptions) -> Result<Vec<Curve>> {
+    let n = domain.outer.sides.len();
+    let corners: Vec<Point> = domain.outer.sides.iter().map(|s| s.endpoints().0).collect();
+    domain
+        .outer
+        .sides
+        .iter()
+        .enumerate()
+        .map(|(k, s)| match s {
+            SideCurve::Spline(c) => Ok(c.normalized()),
+            other => {
+                let ends = (corners[k], corners[(k + 1) % n]);
+                let f = fit_side(Side::South, other, ends, fit, fit.tol * diameter)
+                    .map_err(|e| domain_error(LoopId::Outer, Some(k), format!("its fit failed: {e}")))?;
+                Ok(f.finest().clone())
+            }
+        })
+        .collect()
+}
+
+/// How a face is quadrangulated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Template {
+    /// Four corners, no side split: one patch.
+    One,
+    /// Four corners, sides `r` and `r + 2` split: two patches.
+    Two(usize),
+    /// `N` quads around the image of the polygon's centre.
+    Midpoint,
+}
+
+/// The edges to split at their midpoints: every edge of a face that is not four-sided,
+/// and, through every four-sided face, the edge opposite a split one.
+fn edges_to_split(g: &Graph) -> Vec<bool> {
+    let mut split = vec![false; g.edges.len()];
+    for f in &g.faces {
+        if f.sides.len() != 4 {
+            for &(e, _) in &f.sides {
+                split[e] = true;
+            }
+        }
+    }
+    loop {
+        let mut changed = false;
+        for f in g.faces.iter().filter(|f| f.sides.len() == 4) {
+            for k in 0..4 {
+                let (a, b) = (f.sides[k].0, f.sides[(k + 2) % 4].0);
+                if split[a] && !split[b] {
+                    split[b] = true;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            return split;
+        }
+    }
+}
+
+/// The halves of every side of a face after its edges were split: per original side,
+/// the first and second half (in the face's direction) and the vertex between them, or
+/// the side itself when it was not split.
+type Halves = Vec<Result<(FaceSide, FaceSide, usize), FaceSide>>;
+
+fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
+    let cur = &g.faces[f].sides;
+    let mut out = Vec::with_capacity(n);
+    let mut k = 0;
+    for _ in 0..n {
+        let first = cur[k];
+        let end = g.start(cur[(k + 1) % cur.len()]);
+        if mids.get(end).copied().flatten().is_some() {
+            out.push(Ok((first, cur[k + 1], end)));
+            k += 2;
+        } else {
+            out.push(Err(first));
+            k += 1;
+        }
+    }
+    out
+}
+
+/// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
+fn spoke_curve(mut pts: Vec<Point>, from: Point, to: Point, diameter: f64, fit: &FitOptions) -> Result<Curve> {
+    let last = pts.len() - 1;
+    pts[0] = from;
+    pts[last] = to;
+    fit_points(&pts, diameter, fit)
+}
+
+/// Lay out `domain` (see the module documentation).
+pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> {
+    let t0 = Instant::now();
+    opts.fit.validate()?;
+    let mut d = domain.clone();
+    let checked = validate_domain(&mut d)?;
+    let diameter = checked.diameter;
+    if !d.holes.is_empty() {
+        return Err(domain_error(
+            LoopId::Hole(0),
+            None,
+            "holes are not laid out automatically by this version: cut the domain into hole-free parts, or give a multipatch layout",
+        ));
+    }
+    let n = d.outer.sides.len();
+    if n < 3 {
+        return Err(domain_error(
+            LoopId::Outer,
+            None,
+            format!("has {n} corner(s): the automatic layout needs at least 3 (list the corners, or give more curves)"),
+        ));
+    }
+    // 1. the outer loop as one face
+    let curves = loop_curves(&d, diameter, &opts.fit)?;
+    let mut g = Graph::default();
+    for c in &curves {
+        g.add_vertex(c.control_points[0]);
+    }
+    let sides: Vec<FaceSide> =
+        curves.into_iter().enumerate().map(|(k, c)| (g.add_edge(c, k, (k + 1) % n, true), true)).collect();
+    g.faces.push(Face { sides, label: "domain".into() });
+    // 2. reflex corners
+    let mut cuts = Vec::new();
+    cut_reflex(&mut g, diameter, &mut cuts)?;
+    // 3. templates: harmonic maps on the faces as they are, then the splits
+    let split = edges_to_split(&g);
+    let nf = g.faces.len();
+    let mut plans: Vec<(Template, usize, Option<HarmonicMap>)> = Vec::with_capacity(nf);
+    for f in 0..nf {
+        let sides = &g.faces[f].sides;
+        let k = sides.len();
+        let template = if k != 4 || sides.iter().all(|s| split[s.0]) {
+            Template::Midpoint
+        } else if split[sides[0].0] {
+            Template::Two(0)
+        } else if split[sides[1].0] {
+            Template::Two(1)
+        } else {
+            Template::One
+        };
+        let h = (template != Template::One).then(|| {
+            let curves: Vec<Curve> = sides.iter().map(|&s| g.side_curve(s)).collect();
+            HarmonicMap::new(&curves, opts.rings)
+        });
+        plans.push((template, k, h));
+    }
+    let mut mids: Vec<Option<usize>> = Vec::new();
+    for e in 0..split.len() {
+        if split[e] {
+            let u = ArcLength::new(&g.edges[e].curve).param(0.5);
+            let (v, _) = g.split_edge(e, u)?;
+            mids.resize(g.vertices.len(), None);
+            mids[v] = Some(e);
+        }
+    }
+    mids.resize(g.vertices.len(), None);
+    let mut faces = Vec::with_capacity(nf);
+    for (f, (template, k, h)) in plans.into_iter().enumerate() {
+        let label = g.faces[f].label.clone();
+        let hv = halves(&g, f, &mids, k);
+        let mut report = FaceReport {
+            label: label.clone(),
+            corners: k,
+            template: "one patch",
+            patches: 1,
+            centre: None,
+            harmonic_min_area_ratio: h.as_ref().map(|h| h.min_area_ratio),
+        };
+        match (template, h) {
+            (Template::One, _) | (_, None) => {}
+            (Template::Two(r), Some(h)) => {
+                let (Ok((a0, b0, m0)), Err(s1), Ok((a2, b2, m2)), Err(s3)) =
+                    (hv[r], hv[(r + 1) % 4], hv[(r + 2) % 4], hv[(r + 3) % 4])
+                else {
+                    return Err(Error::Invalid(format!("layout: face {f} is not split in two as planned")));
+                };
+                let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
+                pts.extend(h.spoke(r + 2).into_iter().skip(1));
+                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, &opts.fit)?;
+                let cut = g.add_edge(c, m0, m2, false);
+                g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
+                g.faces.push(Face { sides: vec![b2, s3, a0, (cut, true)], label: label.clone() });
+                report.template = "split in two";
+                report.patches = 2;
+            }
+            (Template::Midpoint, Some(h)) => {
+                let centre = g.add_vertex(h.centre());
+                let mut spokes = Vec::with_capacity(k);
+                let mut parts = Vec::with_capacity(k);
+                for (s, side) in hv.iter().enumerate() {
+                    let &Ok((a, b, m)) = side else {
+                        return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
+                    };
+                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, &opts.fit)?;
+                    spokes.push(g.add_edge(c, centre, m, false));
+                    parts.push((a, b));
+                }
+                for s in 0..k {
+                    let prev = (s + k - 1) % k;
+                    let sides = vec![parts[s].0, (spokes[s], false), (spokes[prev], true), parts[prev].1];
+                    if s == 0 {
+                        g.faces[f].sides = sides;
+                    } else {
+                        g.faces.push(Face { sides, label: label.clone() });
+                    }
+                }
+                report.template = "midpoint";
+                report.patches = k;
+                report.centre = Some(h.centre());
+            }
+        }
+        faces.push(report);
+    }
+    // 4. the layout
+    let layout = layout_of(&g, &d.name)?;
+    let valence = g.valences();
+    let boundary = g.on_boundary();
+    let irregular_vertices = (0..g.vertices.len())
+        .filter(|&v| !boundary[v] && valence[v] != 4)
+        .map(|v| IrregularVertex { point: g.vertices[v], valence: valence[v] })
+        .collect();
+    let mut corner_angles = [f64::INFINITY, f64::NEG_INFINITY];
+    for f in 0..g.faces.len() {
+        for i in 0..4 {
+            let a = g.corner_angle(f, i).to_degrees();
+            corner_angles = [corner_angles[0].min(a), corner_angles[1].max(a)];
+        }
+    }
+    let report = LayoutReport {
+        domain: checked,
+        cuts,
+        faces,
+        irregular_vertices,
+        patches: layout.patches.len(),
+        corner_angles,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    Ok(AutoLayout { layout, report })
+}
+
+/// The multipatch layout of a graph whose faces are all four-sided.
+fn layout_of(g: &Graph, name: &str) -> Result<Layout> {
+    let mut patches = Vec::with_capacity(g.faces.len());
+    // per edge: the patch sides along it and whether each runs with the edge
+    let mut users: Vec<Vec<(PatchSide, bool)>> = vec![Vec::new(); g.edges.len()];
+    for (p, f) in g.faces.iter().enumerate() {
+        if f.sides.len() != 4 {
+            return Err(Error::Invalid(format!("layout: face {p} has {} sides, not 4", f.sides.len())));
+        }
+        let mut sides = Vec::with_capacity(4);
+        for (k, side) in Side::ALL.into_iter().enumerate() {
+            let (e, fwd) = f.sides[k];
+            // south and east run with the face, north and west against it
+            let along = fwd != matches!(side, Side::North | Side::West);
+            let c = &g.edges[e].curve;
+            sides.push(if along { c.clone() } else { c.reversed().normalized() });
+            users[e].push((PatchSide { patch: p, side }, along));
+        }
+        let mut patch = Patch::from_sides(format!("p{p}"), sides.try_into().expect("four sides"));
+        patch.face = Some(f.label.clone());
+        patches.push(patch);
+    }
+    let mut interfaces = Vec::new();
+    for (e, u) in users.iter().enumerate() {
+        match u.as_slice() {
+            [_] => {}
+            [(a, ra), (b, rb)] => interfaces.push(Interface { first: *a, second: *b, reversed: ra != rb }),
+            _ => return Err(Error::Invalid(format!("layout: edge {e} is a side of {} patches", u.len()))),
+        }
+    }
+    Ok(Layout { name: name.to_string(), patches, interfaces })
+}
