@@ -685,7 +685,7 @@ pub fn quiet() -> bool {
 /// The exit code of a verdict: 0 certified or degenerate corner (the best map the
 /// boundary allows), 3 folded, 4 not converged, 5 undecided.
 /// The exit code of a solve: its verdict's ([`exit_code`]), but 6 for a bijective map
-/// whose boundary is not the input's within the fit tolerance ([`Report::boundary_kept`]).
+/// whose boundary is not the input's within the fit tolerance ([`winslow::Report::boundary_kept`]).
 pub fn solve_exit_code(r: &winslow::Report) -> i32 {
     match exit_code(r.verdict) {
         0 if !r.boundary_kept => 6,

@@ -164,7 +164,7 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
 
 /// `winslow solve` of a layout, or of the layout made from a general domain (whose
 /// report `made` joins the result as `auto_layout`): the pipeline, then the files and
-/// the summary of [`multipatch_cmd::finish`](super::multipatch_cmd::finish).
+/// the summary of `multipatch_cmd::finish`.
 pub(super) fn solve_layout(
     layout: winslow::multipatch::Layout,
     a: &SolveArgs,

@@ -101,7 +101,7 @@ pub struct LayoutReport {
 /// A laid-out domain: the multipatch layout (every patch naming its face) and the report.
 #[derive(Debug, Clone)]
 pub struct AutoLayout {
-    /// The layout, ready for [`crate::multipatch::solve_multipatch`].
+    /// The layout, ready for [`Pipeline`](crate::pipeline::Pipeline) ([`Input::Layout`](crate::pipeline::Input::Layout)).
     pub layout: Layout,
     /// What was done.
     pub report: LayoutReport,
