@@ -29,7 +29,7 @@ pub struct CorpusArgs {
     /// strip, cad, noisy-cloud, sparse-cloud; with --general: ngon, l, t, u, e, plus.
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
-    /// Remove the boundary documents of an earlier run from the -o folder first (without
+    /// Remove the documents (boundaries, or domains with --general) of an earlier run from the -o folder first (without
     /// it, such files are an error).
     #[arg(long)]
     overwrite: bool,
@@ -55,7 +55,7 @@ struct Tally {
 
 pub fn run(a: CorpusArgs) -> Result<i32> {
     if a.general {
-        return crate::corpus_domains::run(&a.output, a.per_family, a.seed, &a.families, a.solve);
+        return crate::corpus_domains::run(&a.output, a.per_family, a.seed, &a.families, a.solve, a.overwrite);
     }
     let families: Vec<Family> = a
         .families

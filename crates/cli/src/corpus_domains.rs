@@ -21,7 +21,14 @@ struct Tally {
     failures: Vec<String>,
 }
 
-pub fn run(output: &Option<PathBuf>, per_family: usize, seed: u64, names: &[String], solve: bool) -> Result<i32> {
+pub fn run(
+    output: &Option<PathBuf>,
+    per_family: usize,
+    seed: u64,
+    names: &[String],
+    solve: bool,
+    overwrite: bool,
+) -> Result<i32> {
     let families: Vec<DomainFamily> = names
         .iter()
         .map(|n| DomainFamily::parse(n).with_context(|| format!("unknown family '{n}' (ngon, l, t, u, e, plus)")))
@@ -32,12 +39,21 @@ pub fn run(output: &Option<PathBuf>, per_family: usize, seed: u64, names: &[Stri
     if output.is_none() && !solve {
         bail!("nothing to do: give -o DIR to write the domains, --solve to solve them, or both");
     }
+    if let Some(dir) = output {
+        crate::files::OutputPlan::new().folder("-o", dir).check()?;
+        // FAMILY-N.json of an earlier run
+        let ours = |f: &str| {
+            f.strip_suffix(".json").and_then(|s| s.rsplit_once('-')).is_some_and(|(family, n)| {
+                DomainFamily::parse(family).is_some() && n.bytes().all(|b| b.is_ascii_digit())
+            })
+        };
+        crate::files::claim_folder("-o", dir, ours, overwrite)?;
+    }
     let domains = domain_corpus(&families, per_family, seed);
     if let Some(dir) = output {
         for (_, d) in &domains {
             crate::files::write(&dir.join(format!("{}.json", d.name)), &winslow::io::Output::Domain(d))?;
         }
-        say!("wrote {} domains to {}", domains.len(), dir.display());
     }
     if !solve {
         return Ok(0);

@@ -78,6 +78,11 @@ pub(super) struct LayoutArgs {
 }
 
 pub(super) fn layout(a: LayoutArgs) -> Result<i32> {
+    files::OutputPlan::new()
+        .input(&a.domain)
+        .maybe("-o", a.output.as_deref(), "layout", files::ext::JSON)
+        .maybe("--png", a.png.as_deref(), "picture", files::ext::PNG)
+        .check()?;
     let doc = files::read(&a.domain)?;
     let Document::Domain(domain) = doc else {
         return Err(files::wrong_kind(&doc, &a.domain, "a general planar domain (\"domain\") is needed"));
@@ -93,7 +98,7 @@ pub(super) fn layout(a: LayoutArgs) -> Result<i32> {
         files::write(p, &Output::Picture(&render_curves(&curves, &marks, 900)))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&auto.report)?);
+        files::print_json(serde_json::to_value(&auto.report)?)?;
     } else {
         say_raw!("{}", summary(&auto));
     }
