@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use winslow::boundary::families::{corpus, Family};
+use winslow::boundary::families::{corpus, corpus_of, Family};
 use winslow::solve;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::Verdict;
@@ -26,7 +26,9 @@ pub struct CorpusArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
-    /// strip, cad, noisy-cloud, sparse-cloud; with --general: ngon, l, t, u, e, plus.
+    /// strip, cad, noisy-cloud, sparse-cloud; and cad-kinks (steps and V-notches at C0
+    /// knots of spline sides), which the default corpus leaves out; with --general: ngon,
+    /// l, t, u, e, plus.
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
     /// Remove the documents (boundaries, or domains with --general) of an earlier run from the -o folder first (without
@@ -78,8 +80,14 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         };
         crate::files::claim_folder("-o", dir, ours, a.overwrite)?;
     }
-    let domains: Vec<_> =
-        corpus(a.per_family, a.seed).into_iter().filter(|(f, _)| families.is_empty() || families.contains(f)).collect();
+    let domains: Vec<_> = if families.is_empty() {
+        corpus(a.per_family, a.seed)
+    } else {
+        // in the order of the families' list, the extra ones (not in the default corpus) last
+        let order: Vec<Family> =
+            Family::ALL.into_iter().chain(Family::EXTRA).filter(|f| families.contains(f)).collect();
+        corpus_of(&order, a.per_family, a.seed)
+    };
     if let Some(dir) = &a.output {
         for (_, b) in &domains {
             crate::files::write(&dir.join(format!("{}.json", b.name)), &winslow::io::Output::Boundary(b))?;

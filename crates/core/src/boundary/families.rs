@@ -10,6 +10,7 @@
 //! | `puzzle` | one or two rounded jigsaw tabs per side, in or out |
 //! | `strip` | a wavy strip of aspect ratio 20 to 200 |
 //! | `cad` | B-spline/NURBS sides: non-uniform non-dyadic knots, an exact circular arc, an interior `C0` kink, different degrees on opposite sides |
+//! | `cad-kinks` | degree-2 B-spline sides with `C0` knots: rectangular steps (reflex kinks turning back by 90°) and V-notches turning 30° to 130° at the tip, one to three per side, into the domain or out of it (not in the default corpus: `winslow corpus --families cad-kinks`) |
 //! | `noisy-cloud` | 1000 to 3000 points per side with noise `1e-4` |
 //! | `sparse-cloud` | 8 to 15 points per side |
 //!
@@ -38,6 +39,8 @@ pub enum Family {
     Cad,
     /// Dense noisy point clouds.
     NoisyCloud,
+    /// Degree-2 spline sides with steps and V-notches at `C0` knots.
+    CadKinks,
     /// Very sparse point clouds.
     SparseCloud,
 }
@@ -55,6 +58,10 @@ impl Family {
         Family::SparseCloud,
     ];
 
+    /// Families generated only on request (`winslow corpus --families`), not part of the
+    /// default corpus of [`Family::ALL`].
+    pub const EXTRA: [Family; 1] = [Family::CadKinks];
+
     /// Kebab-case name.
     pub fn name(self) -> &'static str {
         match self {
@@ -65,13 +72,14 @@ impl Family {
             Family::Strip => "strip",
             Family::Cad => "cad",
             Family::NoisyCloud => "noisy-cloud",
+            Family::CadKinks => "cad-kinks",
             Family::SparseCloud => "sparse-cloud",
         }
     }
 
     /// The family called `name`.
     pub fn parse(name: &str) -> Option<Family> {
-        Self::ALL.into_iter().find(|f| f.name() == name)
+        Self::ALL.into_iter().chain(Self::EXTRA).find(|f| f.name() == name)
     }
 
     /// The domain of this family for `seed`, named `"{family}-{seed}"`.
@@ -84,6 +92,7 @@ impl Family {
             Family::Puzzle => puzzle(&mut rng),
             Family::Strip => strip(&mut rng),
             Family::Cad => cad(&mut rng),
+            Family::CadKinks => cad_kinks(&mut rng),
             Family::NoisyCloud => {
                 let n = 1000 + (rng.uniform() * 2000.0) as usize;
                 deformed_square(&mut rng, n, 1e-4)
@@ -97,9 +106,14 @@ impl Family {
     }
 }
 
-/// `per_family` domains of every family, seeds `seed, seed + 1, ...`.
+/// `per_family` domains of every family of [`Family::ALL`], seeds `seed, seed + 1, ...`.
 pub fn corpus(per_family: usize, seed: u64) -> Vec<(Family, Boundary)> {
-    Family::ALL.into_iter().flat_map(|f| (0..per_family as u64).map(move |k| (f, f.generate(seed + k)))).collect()
+    corpus_of(&Family::ALL, per_family, seed)
+}
+
+/// `per_family` domains of each of `families`, seeds `seed, seed + 1, ...`.
+pub fn corpus_of(families: &[Family], per_family: usize, seed: u64) -> Vec<(Family, Boundary)> {
+    families.iter().flat_map(|&f| (0..per_family as u64).map(move |k| (f, f.generate(seed + k)))).collect()
 }
 
 /// SplitMix64 (Steele, Lea, Flood 2014): a tiny seeded generator, enough for shapes.
@@ -324,6 +338,71 @@ fn cad(rng: &mut Rng) -> [SideCurve; 4] {
     [south, east, north, west]
 }
 
+/// The degree-2 B-spline through the polyline `vertices`: one quadratic piece per segment
+/// (its middle control point at the segment's midpoint), a knot of multiplicity 2 (`C0`)
+/// at every inner vertex, uniform in the segment index.
+fn kinked_polyline(vertices: &[Point]) -> SideCurve {
+    let n = vertices.len() - 1;
+    let mut knots = vec![0.0; 3];
+    let mut cps = vec![vertices[0]];
+    for (k, w) in vertices.windows(2).enumerate() {
+        cps.push([0.5 * (w[0][0] + w[1][0]), 0.5 * (w[0][1] + w[1][1])]);
+        cps.push(w[1]);
+        let t = (k + 1) as f64 / n as f64;
+        if k + 1 == n {
+            knots.extend_from_slice(&[1.0; 3]);
+        } else {
+            knots.extend_from_slice(&[t, t]);
+        }
+    }
+    spline(2, knots, cps, None)
+}
+
+/// The vertices of a side from `(0, 0)` to `(1, 0)` with one to three features at least
+/// 0.05 apart: a rectangular step (width 0.08 to 0.2, height 0.05 to 0.2) or a V-notch
+/// (width 0.06 to 0.2, the tangent turning 30 to 130 degrees at the tip, height 0.2 at most), into the domain
+/// (`+y`) or out of it.
+fn kinked_side(rng: &mut Rng) -> Vec<Point> {
+    let count = 1 + (rng.uniform() * 3.0) as usize;
+    let slot = 0.8 / count as f64;
+    let mut v = vec![[0.0, 0.0]];
+    for k in 0..count {
+        let sign = if rng.uniform() < 0.6 { 1.0 } else { -1.0 };
+        let a = 0.1 + slot * k as f64;
+        if rng.uniform() < 0.4 {
+            let w = between(rng, 0.08, 0.2f64.min(slot - 0.05));
+            let x = a + between(rng, 0.0, slot - 0.05 - w);
+            let h = sign * between(rng, 0.05, 0.2);
+            v.extend([[x, 0.0], [x, h], [x + w, h], [x + w, 0.0]]);
+        } else {
+            // the tangent turns by `turn` at the tip (each flank rises at `turn / 2`, so it
+            // turns by half that at the base), the height 0.2 at most (narrower where needed)
+            let turn = between(rng, 30.0, 130.0).to_radians();
+            let slope = (0.5 * turn).tan();
+            let w = between(rng, 0.06, 0.2f64.min(slot - 0.05)).min(0.4 / slope);
+            let x = a + between(rng, 0.0, slot - 0.05 - w);
+            let h = 0.5 * w * slope;
+            v.extend([[x, 0.0], [x + 0.5 * w, sign * h], [x + w, 0.0]]);
+        }
+    }
+    v.push([1.0, 0.0]);
+    v
+}
+
+/// The unit square with kinked degree-2 spline sides ([`kinked_side`]): the south side
+/// always, the north side (mirrored, features from `y = 1`) in half the domains.
+fn cad_kinks(rng: &mut Rng) -> [SideCurve; 4] {
+    let south = kinked_polyline(&kinked_side(rng));
+    let north = if rng.uniform() < 0.5 {
+        kinked_polyline(&kinked_side(rng).iter().map(|p| [p[0], 1.0 - p[1]]).collect::<Vec<_>>())
+    } else {
+        spline(1, vec![0.0, 0.0, 1.0, 1.0], vec![[0.0, 1.0], [1.0, 1.0]], None)
+    };
+    let east = spline(1, vec![0.0, 0.0, 1.0, 1.0], vec![[1.0, 0.0], [1.0, 1.0]], None);
+    let west = spline(1, vec![0.0, 0.0, 1.0, 1.0], vec![[0.0, 0.0], [0.0, 1.0]], None);
+    [south, east, north, west]
+}
+
 /// The image of the unit square's sides under `x = u + e1 sin(2π v + φ1)`, `y = v + e2
 /// sin(2π u + φ2)` (bijective: `|e1 e2| 4π² < 1`), `n` points per side, each moved by
 /// Gaussian noise of standard deviation `noise` along the normal, except the corners.
@@ -366,7 +445,7 @@ mod tests {
 
     #[test]
     fn every_generated_domain_is_a_valid_counter_clockwise_boundary() {
-        for (family, b) in corpus(12, 0) {
+        for (family, b) in corpus(12, 0).into_iter().chain(corpus_of(&Family::EXTRA, 24, 0)) {
             let r = validate(&b).unwrap_or_else(|e| panic!("{}: {e}", b.name));
             assert!(r.signed_area > 0.0, "{family:?}");
         }
@@ -374,7 +453,7 @@ mod tests {
 
     #[test]
     fn generation_is_deterministic_and_seeds_differ() {
-        for f in Family::ALL {
+        for f in Family::ALL.into_iter().chain(Family::EXTRA) {
             let (a, b, c) = (f.generate(7), f.generate(7), f.generate(8));
             let pts = |b: &Boundary| format!("{:?}", b.sides[0]);
             assert_eq!(pts(&a), pts(&b), "{f:?}");
@@ -396,6 +475,22 @@ mod tests {
             assert!((8..=15).contains(&p.len()));
             let SideCurve::Points(p) = &Family::NoisyCloud.generate(seed).sides[0] else { panic!() };
             assert!((1000..=3000).contains(&p.len()));
+        }
+        // cad-kinks: every vertex of the south side a C0 knot, the tangent turning 30 to
+        // 130 degrees at V-tips, half that at their bases, 90 at steps
+        for seed in 0..24 {
+            let b = Family::CadKinks.generate(seed);
+            let SideCurve::Spline(c) = &b.sides[0] else { panic!() };
+            assert_eq!(c.knots.degree(), 2);
+            let inner = &c.knots.breaks_with_multiplicity()[1..];
+            let inner = &inner[..inner.len() - 1];
+            assert!(inner.len() >= 2 && inner.iter().all(|&(_, m)| m == 2));
+            let v: Vec<Point> = c.control_points.iter().step_by(2).copied().collect();
+            for w in v.windows(3) {
+                let (d0, d1) = ([w[1][0] - w[0][0], w[1][1] - w[0][1]], [w[2][0] - w[1][0], w[2][1] - w[1][1]]);
+                let turn = (d0[0] * d1[1] - d0[1] * d1[0]).atan2(d0[0] * d1[0] + d0[1] * d1[1]).abs().to_degrees();
+                assert!((14.9..=130.1).contains(&turn) || turn < 1e-9, "turn {turn}");
+            }
         }
         // the clearance gaps: the narrowest vertical extent is between 3e-3 and 1e-2
         for seed in 0..12 {

@@ -439,28 +439,49 @@ impl<'a> SideSamples<'a> {
             let q = self.eval(t);
             (p[0] - q[0]).hypot(p[1] - q[1])
         };
-        // golden section on the chord's parameters and its neighbours'
-        let (mut lo, mut hi) = (pts[at.saturating_sub(1)].0, pts[(at + 2).min(pts.len() - 1)].0);
-        let mut found = dist(lo).min(dist(hi));
-        let r = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut a, mut b) = (hi - r * (hi - lo), lo + r * (hi - lo));
-        let (mut fa, mut fb) = (dist(a), dist(b));
-        for _ in 0..80 {
-            if fa <= fb {
-                (hi, b, fb) = (b, a, fa);
-                a = hi - r * (hi - lo);
-                fa = dist(a);
-            } else {
-                (lo, a, fa) = (a, b, fb);
-                b = lo + r * (hi - lo);
-                fb = dist(b);
+        // golden section on the chord's parameters and its neighbours', on each piece
+        // between the side's C0 knots there (across a kink the distance need not be
+        // unimodal: on a narrow V-notch the search slid from a point of one flank to the
+        // other flank)
+        let golden = |mut lo: f64, mut hi: f64| {
+            let found = dist(lo).min(dist(hi));
+            let r = 0.5 * (5f64.sqrt() - 1.0);
+            let (mut a, mut b) = (hi - r * (hi - lo), lo + r * (hi - lo));
+            let (mut fa, mut fb) = (dist(a), dist(b));
+            for _ in 0..80 {
+                if fa <= fb {
+                    (hi, b, fb) = (b, a, fa);
+                    a = hi - r * (hi - lo);
+                    fa = dist(a);
+                } else {
+                    (lo, a, fa) = (a, b, fb);
+                    b = lo + r * (hi - lo);
+                    fb = dist(b);
+                }
+                if hi - lo <= f64::EPSILON * lo.abs().max(hi.abs()) {
+                    break;
+                }
             }
-            if hi - lo <= f64::EPSILON * lo.abs().max(hi.abs()) {
-                break;
-            }
+            found.min(fa).min(fb)
+        };
+        let (lo, hi) = (pts[at.saturating_sub(1)].0, pts[(at + 2).min(pts.len() - 1)].0);
+        let kinks: Vec<f64> = match self.side {
+            crate::boundary::SideCurve::Spline(c) => c
+                .knots
+                .breaks_with_multiplicity()
+                .into_iter()
+                .filter(|&(u, m)| m >= c.knots.degree() && u > lo && u < hi)
+                .map(|(u, _)| u)
+                .collect(),
+            _ => Vec::new(),
+        };
+        if kinks.is_empty() {
+            return golden(lo, hi);
         }
-        found = found.min(fa).min(fb);
-        found
+        let mut ends = vec![lo];
+        ends.extend(kinks);
+        ends.push(hi);
+        ends.windows(2).map(|w| golden(w[0], w[1])).fold(f64::INFINITY, f64::min)
     }
 }
 
