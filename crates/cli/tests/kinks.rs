@@ -1,0 +1,70 @@
+//! Kinks from the command line: kept exactly and marked (`--kinks`), rounded on purpose
+//! (`--kinks none`), and the exit code of a map whose boundary is not the input's (6).
+
+mod common;
+
+use common::{bin, data, read_json, stdout_json};
+
+/// `--kinks`: the star polygon keeps its twelve vertices exactly (the report lists them as
+/// kept, the summary says so, the PNG is written with their marks and `render` reads them
+/// back from the report); `--kinks none` rounds them and says so (exit 6: the boundary is
+/// not the input's); a bad angle is a clear error.
+#[test]
+fn kinks_are_kept_reported_and_marked() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path().join("cli-kinks");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (map, png) = (dir.join("star.json"), dir.join("star.png"));
+    let star = data().join("contours/star8.json");
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).arg("--png").arg(&png).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains("C0 route (§9): kinks kept") && text.contains("kept exactly"), "{text}");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+    let kinks = doc["report"]["kinks"].as_array().unwrap();
+    assert_eq!(kinks.len(), 12);
+    let d = doc["report"]["diameter"].as_f64().unwrap();
+    assert!(kinks.iter().all(|k| k["kept"] == true && k["deviation"].as_f64().unwrap() <= 1e-12 * d));
+    assert_eq!(doc["report"]["verdict"], "certified");
+    assert!(doc["report"]["c0_route"]["kept"] == true);
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    let out = bin().arg("render").arg(&map).arg("--png").arg(dir.join("again.png")).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // rounded, the vertices are not the input's boundary any more: bijective, but exit 6
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "none"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(6), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = &read_json(&map)["report"];
+    assert_eq!(report["boundary_kept"], false);
+    let kinks = report["kinks"].as_array().unwrap();
+    assert!(kinks.len() == 12 && kinks.iter().all(|k| k["kept"] == false), "{}", report["kinks"]);
+    assert!(report["c0_route"].is_null(), "{}", report["c0_route"]);
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "200"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("angle in (0, 180]"));
+}
+
+/// A bijective map whose boundary is not the input's within the fit tolerance (the star's
+/// twelve kinks rounded with `--kinks none`) is not a success: exit 6, `boundary_kept:
+/// false`, the summary's first line says so; the V-notch whose three kinks the `C^0` route
+/// keeps is a success.
+#[test]
+fn a_boundary_off_the_input_exits_6() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("star.json");
+    let star = data().join("contours/star8.json");
+    let out = bin().arg("solve").arg(&star).arg("-o").arg(&map).args(["--kinks", "none"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(6), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.contains("NOT the input's") && first.contains("12 kinks not kept"), "{first}");
+    let r = &read_json(&map)["report"];
+    assert_eq!(r["boundary_kept"], false);
+    let deviation = r["boundary_deviation"].as_array().unwrap().iter().map(|d| d.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(deviation > r["fit_tolerance"].as_f64().unwrap(), "{r}");
+    // the V-notch keeps its three kinks: a success, its boundary the input's
+    let v = dir.path().join("v.json");
+    let out =
+        bin().arg("solve").arg(data().join("cad_kinks/vnotch.json")).arg("-o").arg(&v).arg("--json").output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(stdout_json(&out)["boundary_kept"], true);
+}
