@@ -70,8 +70,38 @@ pub fn write_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Res
     if written.is_err() {
         // the temporary file may not exist (creating it failed): nothing to report
         let _ = std::fs::remove_file(&tmp);
+    } else {
+        remove_stale_temporaries(path);
     }
     written.map_err(io)
+}
+
+/// The temporaries of `path` left by writers that were killed mid-file
+/// (`.NAME.PID.N.tmp` whose process no longer runs, [`temporary_name`]) are removed
+/// after a successful write of `path`: a kill leaves a hidden file only until the next
+/// write of the same file. Where `/proc` is missing (not Linux) nothing is removed.
+fn remove_stale_temporaries(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else { return };
+    let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let file = file.to_string_lossy();
+        let Some((pid, n)) =
+            file.strip_prefix(&prefix).and_then(|r| r.strip_suffix(".tmp")).and_then(|r| r.split_once('.'))
+        else {
+            continue;
+        };
+        let (Ok(pid), Ok(_)) = (pid.parse::<u32>(), n.parse::<u64>()) else { continue };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            // another writer may have removed it first: nothing to report
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// Write bytes to a file atomically ([`write_with`]).
@@ -108,6 +138,26 @@ mod tests {
         write_bytes(&path, b"new").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
         assert_eq!(entries(dir), ["out.json"]);
+    }
+
+    /// A temporary of a writer that was killed (its process gone) is removed by the next
+    /// write of the same file; those of running writers (this process) and of other files
+    /// stay.
+    #[test]
+    fn a_killed_writers_temporary_goes_with_the_next_write() {
+        let scratch = tempfile::tempdir().unwrap();
+        let dir = scratch.path();
+        let path = dir.join("out.v1.json");
+        // no process has a PID above the kernel's pid_max (at most 2^22)
+        let dead = ".out.v1.json.999999999.0.tmp";
+        let running = format!(".out.v1.json.{}.77.tmp", std::process::id());
+        for f in [dead, running.as_str(), ".other.json.999999999.0.tmp", ".out.v1.json.x.tmp"] {
+            std::fs::write(dir.join(f), b"half").unwrap();
+        }
+        write_bytes(&path, b"new").unwrap();
+        let mut expect = vec![".other.json.999999999.0.tmp", ".out.v1.json.x.tmp", running.as_str(), "out.v1.json"];
+        expect.sort();
+        assert_eq!(entries(dir), expect);
     }
 
     #[test]
