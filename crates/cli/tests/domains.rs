@@ -92,7 +92,7 @@ fn bad_domains_are_typed_errors() {
         ),
     ] {
         let input = dir.join("bad.json");
-        std::fs::write(&input, doc).unwrap();
+        winslow::io::file::write_bytes(&input, doc.as_bytes()).unwrap();
         for cmd in ["solve", "layout"] {
             let out = bin().arg(cmd).arg(&input).arg("-o").arg(dir.join("never.json")).output().unwrap();
             assert_eq!(out.status.code(), Some(1), "{cmd}");

@@ -172,7 +172,7 @@ fn outputs_that_would_replace_an_input_or_each_other_are_refused_first() {
     assert_eq!(code, Some(0), "{err}");
     let solved = std::fs::read(&map).unwrap();
     let a_file = dir.join("a-file");
-    std::fs::write(&a_file, b"not a folder").unwrap();
+    winslow::io::file::write_bytes(&a_file, b"not a folder").unwrap();
     let before: Vec<String> = listing(dir);
     let dot = dir.join(".").join("lid.json");
     let link = dir.join("link.json");
@@ -249,7 +249,7 @@ fn outputs_that_would_replace_an_input_or_each_other_are_refused_first() {
 /// A copy of the solved map (a second slice).
 fn solved_copy(dir: &Path, bytes: &[u8]) -> std::path::PathBuf {
     let p = dir.join("copy.json");
-    std::fs::write(&p, bytes).unwrap();
+    winslow::io::file::write_bytes(&p, bytes).unwrap();
     p
 }
 

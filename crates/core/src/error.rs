@@ -181,3 +181,17 @@ pub fn human(n: u64) -> String {
         format!("{v:.3} {}", units[k])
     }
 }
+
+/// A point cloud of `n` points read at `context` within [`MAX_CONTROL_POINTS`], or the
+/// error [`Error::TooLarge`] naming it.
+pub(crate) fn check_point_count(n: usize, context: &str) -> Result<()> {
+    if n > MAX_CONTROL_POINTS {
+        return Err(Error::TooLarge {
+            context: context.into(),
+            what: "number of points".into(),
+            found: n,
+            limit: MAX_CONTROL_POINTS,
+        });
+    }
+    Ok(())
+}

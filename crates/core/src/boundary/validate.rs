@@ -14,7 +14,7 @@
 
 use crate::boundary::normalise::Similarity;
 use crate::boundary::{Boundary, SideCurve};
-use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::error::{check_point_count, Error, Result};
 use crate::spline::curve::{check_points, check_weights, Curve, Point};
 use crate::spline::surface::Side;
 
@@ -105,14 +105,7 @@ fn finite(p: Point) -> bool {
 fn check_side(side: &SideCurve) -> Result<()> {
     match side {
         SideCurve::Points(p) => {
-            if p.len() > MAX_CONTROL_POINTS {
-                return Err(Error::TooLarge {
-                    context: String::new(),
-                    what: "number of points".into(),
-                    found: p.len(),
-                    limit: MAX_CONTROL_POINTS,
-                });
-            }
+            check_point_count(p.len(), "")?;
             check_points(p, "point")
         }
         SideCurve::Spline(c) => check_curve(c),

@@ -15,7 +15,7 @@ use super::json::{side_to_json, SideJson};
 use crate::boundary::kinks::cloud_corners;
 use crate::boundary::{KinkMode, SideCurve};
 use crate::domain::{Domain, Loop};
-use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::error::{check_point_count, Error, Result};
 use crate::spline::curve::Point;
 
 fn jerr(context: impl Into<String>, message: impl Into<String>) -> Error {
@@ -25,14 +25,7 @@ fn jerr(context: impl Into<String>, message: impl Into<String>) -> Error {
 fn side(v: Value, ctx: &str) -> Result<SideCurve> {
     match SideJson::from_value(v).map_err(|e| jerr(ctx, e.to_string()))? {
         SideJson::Points(p) => {
-            if p.points.len() > MAX_CONTROL_POINTS {
-                return Err(Error::TooLarge {
-                    context: ctx.into(),
-                    what: "number of points".into(),
-                    found: p.points.len(),
-                    limit: MAX_CONTROL_POINTS,
-                });
-            }
+            check_point_count(p.points.len(), ctx)?;
             Ok(SideCurve::Points(p.points))
         }
         SideJson::Curve(c) => {
@@ -68,14 +61,7 @@ fn closed_cloud(o: &serde_json::Map<String, Value>, ctx: &str) -> Result<Loop> {
     let points: Vec<Point> =
         serde_json::from_value(o["points"].clone()).map_err(|e| jerr(format!("{ctx}.points"), e.to_string()))?;
     let n = points.len();
-    if n > MAX_CONTROL_POINTS {
-        return Err(Error::TooLarge {
-            context: ctx.into(),
-            what: "number of points".into(),
-            found: n,
-            limit: MAX_CONTROL_POINTS,
-        });
-    }
+    check_point_count(n, ctx)?;
     if n < 3 {
         return Err(Error::TooFewPoints { side: ctx.into(), found: n, needed: 3 });
     }

@@ -196,9 +196,7 @@ impl SideJson {
         match self {
             SideJson::Curve(c) => c.to_curve().map(SideCurve::Spline),
             SideJson::Points(p) => {
-                if p.points.len() > MAX_CONTROL_POINTS {
-                    return Err(too_large("number of points", p.points.len()));
-                }
+                crate::error::check_point_count(p.points.len(), "")?;
                 Ok(SideCurve::Points(p.points))
             }
         }

@@ -12,21 +12,14 @@ use serde_json::{json, Value};
 
 use super::json::{CurveJson, PointsJson};
 use crate::boundary::ring::{ClosedContour, Ring};
-use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::error::{check_point_count, Error, Result};
 
 fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
     let jerr = |e: serde_json::Error| Error::Json { context: ctx.into(), message: e.to_string() };
     match &v {
         Value::Object(o) if o.contains_key("points") => {
             let mut p: PointsJson = serde_json::from_value(v).map_err(jerr)?;
-            if p.points.len() > MAX_CONTROL_POINTS {
-                return Err(Error::TooLarge {
-                    context: ctx.into(),
-                    what: "number of points".into(),
-                    found: p.points.len(),
-                    limit: MAX_CONTROL_POINTS,
-                });
-            }
+            check_point_count(p.points.len(), ctx)?;
             let extent = p.points.iter().fold(0.0f64, |m, q| m.max(q[0].abs()).max(q[1].abs()));
             if p.points.len() > 1 {
                 let (a, b) = (p.points[0], p.points[p.points.len() - 1]);
