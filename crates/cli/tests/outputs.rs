@@ -340,7 +340,7 @@ fn a_sweep_never_mixes_with_an_earlier_one() {
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
     assert_eq!(sweep("2", "1", &[]).0, Some(0));
-    std::fs::write(folder.join("notes.txt"), b"mine").unwrap();
+    winslow::io::file::write_bytes(&folder.join("notes.txt"), b"mine").unwrap();
     let first = std::fs::read(folder.join("sweep.json")).unwrap();
     let before = listing(&folder);
     assert_eq!(before.iter().filter(|n| n.starts_with("frame_") && n.ends_with(".json")).count(), 3);
@@ -372,7 +372,7 @@ fn a_sweep_never_mixes_with_an_earlier_one() {
     };
     assert_eq!(compare(&[]), Some(0));
     let stale = pictures.join("quarter_annulus-vhm.png");
-    std::fs::write(&stale, b"an earlier run's picture").unwrap();
+    winslow::io::file::write_bytes(&stale, b"an earlier run's picture").unwrap();
     assert_eq!(compare(&[]), Some(1));
     assert!(stale.is_file());
     assert_eq!(compare(&["--overwrite"]), Some(0));

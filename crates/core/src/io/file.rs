@@ -152,7 +152,7 @@ mod tests {
         let dead = ".out.v1.json.999999999.0.tmp";
         let running = format!(".out.v1.json.{}.77.tmp", std::process::id());
         for f in [dead, running.as_str(), ".other.json.999999999.0.tmp", ".out.v1.json.x.tmp"] {
-            std::fs::write(dir.join(f), b"half").unwrap();
+            write_bytes(&dir.join(f), b"half").unwrap();
         }
         write_bytes(&path, b"new").unwrap();
         let mut expect = vec![".other.json.999999999.0.tmp", ".out.v1.json.x.tmp", running.as_str(), "out.v1.json"];
