@@ -25,6 +25,10 @@ pub(super) struct MultipatchArgs {
     /// Multipatch input: also write one JSON map document per patch into this directory.
     #[arg(long, value_name = "DIR")]
     pub(super) patch_maps: Option<PathBuf>,
+    /// With `--patch-maps`: remove the JSON documents an earlier run left in the folder
+    /// first (without it such a folder is refused, so that no stale patch is mixed in).
+    #[arg(long)]
+    pub(super) overwrite: bool,
     /// Multipatch input: also write a VTK multiblock file (.vtm) with one exact Bézier
     /// .vtu per patch (in a directory named after the file).
     #[arg(long, value_name = "FILE.vtm")]

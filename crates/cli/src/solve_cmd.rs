@@ -348,7 +348,14 @@ fn output_plan(a: &SolveArgs, inputs: &[&Path], multipatch: bool) -> Result<()> 
     };
     plan.maybe("--gismo", a.gismo.as_deref(), "G+Smo XML file", ext::XML)
         .maybe("--png", a.png.as_deref(), "picture", ext::PNG)
-        .check()
+        .check()?;
+    match &a.multipatch.patch_maps {
+        // the patch maps of an earlier run (another layout) are not mixed with this one's
+        Some(dir) if multipatch => {
+            files::claim_folder("--patch-maps", dir, |n| n.ends_with(".json"), a.multipatch.overwrite)
+        }
+        _ => Ok(()),
+    }
 }
 
 #[derive(Args, Debug)]

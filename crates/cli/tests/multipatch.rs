@@ -92,6 +92,31 @@ fn split_solve_join() {
         std::fs::read_dir(dir.join("patches")).unwrap().map(|e| e.unwrap().path()).collect();
     patches.sort();
     assert_eq!(patches.len(), 2);
+    // a second run into the same folder would mix its patches with these: refused before
+    // the solve (the old files intact), accepted with --overwrite (the old files removed)
+    let before = std::fs::read(&patches[0]).unwrap();
+    winslow::io::file::write_bytes(&dir.join("patches/stale.json"), b"{}").unwrap();
+    let again = |overwrite: bool| {
+        let mut c = bin();
+        c.arg("solve").arg(&split).args(["-q", "-o"]).arg(dir.join("again.json")).arg("--patch-maps");
+        c.arg(dir.join("patches"));
+        if overwrite {
+            c.arg("--overwrite");
+        }
+        c.output().unwrap()
+    };
+    let refused = again(false);
+    let e = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("--patch-maps") && e.contains("3 file(s) of an earlier run") && e.contains("--overwrite"),
+        "{e}"
+    );
+    assert!(!dir.join("again.json").exists());
+    assert_eq!(std::fs::read(&patches[0]).unwrap(), before);
+    assert!(again(true).status.success());
+    assert!(!dir.join("patches/stale.json").exists());
+    assert_eq!(std::fs::read_dir(dir.join("patches")).unwrap().count(), 2);
     let (out, _) = run(bin().arg("join").arg(&patches[0]).arg(&patches[1]).arg("-o").arg(&joined));
     assert!(out.contains("certified bijective") && out.contains("C0 knot"), "{out}");
     let m = match winslow::read(&joined).unwrap() {
@@ -111,7 +136,7 @@ fn an_inconsistent_layout_is_a_typed_error() {
     // flip the orientation flag of the one interface
     let bad = text.replace("1 1 0 2 0 1 1 1", "1 1 0 2 0 1 1 0");
     let f = dir.join("bad.xml");
-    std::fs::write(&f, bad).unwrap();
+    winslow::io::file::write_bytes(&f, bad.as_bytes()).unwrap();
     let out = bin().arg("solve").arg(&f).arg("-o").arg(dir.join("o.json")).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);

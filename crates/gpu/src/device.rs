@@ -245,14 +245,17 @@ impl Gpu {
             let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             let data = &view[..bytes as usize];
             match self.precision {
-                Precision::F64 => {
-                    let v: Vec<f64> = bytemuck::pod_collect_to_vec(data);
-                    out[..len].copy_from_slice(&v);
-                }
+                // A mapped range is aligned to `wgpu::MAP_ALIGNMENT` (8 bytes), so the reals are
+                // read in place; the copying fallback only serves an unaligned mapping.
+                Precision::F64 => match bytemuck::try_cast_slice::<u8, f64>(data) {
+                    Ok(v) => out[..len].copy_from_slice(v),
+                    Err(_) => out[..len].copy_from_slice(&bytemuck::pod_collect_to_vec::<u8, f64>(data)),
+                },
                 Precision::F32 => {
-                    let v: Vec<f32> = bytemuck::pod_collect_to_vec(data);
-                    for (o, x) in out[..len].iter_mut().zip(v) {
-                        *o = x as f64;
+                    let widen = |o: &mut [f64], v: &[f32]| o.iter_mut().zip(v).for_each(|(o, &x)| *o = x as f64);
+                    match bytemuck::try_cast_slice::<u8, f32>(data) {
+                        Ok(v) => widen(&mut out[..len], v),
+                        Err(_) => widen(&mut out[..len], &bytemuck::pod_collect_to_vec::<u8, f32>(data)),
                     }
                 }
             }

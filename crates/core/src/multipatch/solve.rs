@@ -33,6 +33,7 @@ use crate::boundary::reparam::ReparamReport;
 use crate::boundary::{diameter, BasisChoice, Boundary, SideCurve};
 use crate::error::{Error, Result};
 use crate::methods::egg::EggAssembler;
+use crate::solve::memory::MemoryEstimate;
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Report, Verdict};
 use crate::solve::solver::EggSolver;
@@ -293,6 +294,20 @@ fn coarse_directions(sides: &[Curve; 4], knots: &[crate::spline::knots::KnotVect
 }
 
 /// A patch's map, report and certificate, and the knot vectors it was solved on.
+/// The estimated peak memory of solving `layout` with `opts` ([`MemoryEstimate::for_patches`]
+/// of the conforming bases of the first round, after `opts.refine` halvings).
+pub(crate) fn layout_estimate(layout: &Layout, opts: &SolveOptions) -> Result<MemoryEstimate> {
+    validate_layout(layout)?;
+    let (lo, hi) = layout.bounding_box();
+    let sim = Similarity::for_box(lo, hi, &format!("layout '{}'", layout.name))?;
+    let mut bases = LayoutBases::new(&layout.similar(&sim))?;
+    for _ in 0..opts.refine {
+        bases = bases.refined(None);
+    }
+    let knots: Vec<_> = (0..layout.patches.len()).map(|p| bases.patch_knots(p)).collect();
+    Ok(MemoryEstimate::for_patches(&knots, interfaces_of(opts) == Interfaces::Free))
+}
+
 type PatchSolved = (Surface, Report, Certificate, [crate::spline::knots::KnotVector; 2]);
 
 /// Solve `layout` (see the module documentation) with `opts` as [`interfaces_of`] says,
@@ -320,6 +335,12 @@ pub(crate) fn solve_multipatch(
         bases = bases.refined(None);
     }
     let n = unit.patches.len();
+    let fits = |bases: &LayoutBases| {
+        let knots: Vec<_> = (0..n).map(|p| bases.patch_knots(p)).collect();
+        let estimate = MemoryEstimate::for_patches(&knots, interfaces == Interfaces::Free);
+        opts.max_memory.check(&estimate, opts.refine, &format!("solving layout '{}' ({n} patches)", layout.name))
+    };
+    fits(&bases)?;
     tell(LayoutEvent::Bases { patches: n, classes: bases.classes.len(), basis_functions: bases.num_basis() })?;
     let mut solved: Vec<Option<PatchSolved>> = vec![None; n];
     let mut rounds = 0;
@@ -359,6 +380,8 @@ pub(crate) fn solve_multipatch(
         classes.sort_unstable();
         classes.dedup();
         bases = bases.refined(Some(&classes));
+        // a repair round's finer bases are refused like the first ones, before any solve
+        fits(&bases)?;
         rounds += 1;
     }
     let fixed_seconds = t0.elapsed().as_secs_f64();

@@ -248,9 +248,12 @@ impl Pipeline {
 
     /// The estimated peak memory of the solve ([`MemoryEstimate`]): the input fitted and
     /// its levels planned as [`Pipeline::run`] does (with `--basis auto`, those of the
-    /// first attempt), nothing solved. `winslow bench` prints it next to the measured peak.
+    /// first attempt; of a layout, the conforming bases of all patches), nothing solved. `winslow bench` prints it next to the measured peak.
     pub fn estimate(&self) -> Result<MemoryEstimate> {
         self.opts.validate()?;
+        if let Input::Layout(layout) = &self.input {
+            return crate::multipatch::solve::layout_estimate(layout, &self.opts);
+        }
         let (_, _, solver) = self.plan(&self.opts)?;
         Ok(MemoryEstimate::for_levels(solver.plan()))
     }
@@ -478,6 +481,40 @@ mod tests {
             assert!(e.to_string().contains(what), "{what}: {e}");
             assert_eq!(stages, 0, "{what}");
         }
+    }
+
+    /// A layout's peak is estimated over all its patches (their conforming bases) and a
+    /// limit below it is refused before the first event; the estimate grows about 4x per
+    /// uniform halving, like a single map's.
+    #[test]
+    fn a_layout_above_the_memory_limit_is_refused_before_it_starts() {
+        use crate::solve::memory::{MemoryLimit, BASE};
+        let layout = match crate::io::read(&data("gismo/xml/multipatch/TUDflame.xml")).unwrap() {
+            crate::io::Document::Layout(l) => l,
+            other => panic!("TUDflame is a {}", other.kind()),
+        };
+        let at = |refine| Pipeline::new(layout.clone(), SolveOptions { refine, ..Default::default() }).estimate();
+        let (e1, e2) = (at(1).unwrap(), at(2).unwrap());
+        let ratio = (e2.bytes - BASE) as f64 / (e1.bytes - BASE) as f64;
+        assert!((3.0..5.0).contains(&ratio) && e2.unknowns > 3 * e1.unknowns, "{e1:?} {e2:?}");
+        // the free-interface stage factors all patches at once: twice the fixed stage's terms
+        let free =
+            SolveOptions { refine: 2, improve: Some(crate::solve::improve::Improve::Winslow), ..Default::default() };
+        let e2_free = Pipeline::new(layout.clone(), free).estimate().unwrap();
+        assert_eq!(e2_free.bytes - BASE, 2 * (e2.bytes - BASE));
+        let opts = SolveOptions { refine: 2, max_memory: MemoryLimit::Bytes(e2.bytes - 1), ..Default::default() };
+        let mut events = 0;
+        match Pipeline::new(layout.clone(), opts).run(&mut |_| {
+            events += 1;
+            true
+        }) {
+            Err(Error::Memory { needed, ref what, .. }) => {
+                assert_eq!(needed, e2.bytes);
+                assert!(what.contains("TUDflame") && what.contains("5 patches"), "{what}");
+            }
+            other => panic!("{:?}", other.map(|s| s.verdict())),
+        }
+        assert_eq!(events, 0);
     }
 
     /// A layout runs through the same entry: its events in order (the conforming bases,

@@ -125,6 +125,19 @@ pub fn patch_report(p: &PatchSolution) -> Value {
 /// One JSON map document per patch, `DIR/NAME.json` for each patch `NAME`, with the
 /// patch's report; returns the paths written.
 pub fn write_patch_maps(sol: &MultipatchSolution, dir: &Path) -> Result<Vec<PathBuf>> {
+    // two patch names that differ only in characters a file name cannot hold would
+    // write one file twice: refused before anything is written
+    let mut taken: std::collections::HashMap<String, &str> = std::collections::HashMap::new();
+    for p in &sol.patches {
+        if let Some(other) = taken.insert(file_safe(&p.name), &p.name) {
+            return Err(crate::error::Error::Invalid(format!(
+                "patches '{other}' and '{}' would both be written to {}.json in {}",
+                p.name,
+                file_safe(&p.name),
+                dir.display()
+            )));
+        }
+    }
     let mut out = Vec::new();
     for p in &sol.patches {
         let path = dir.join(format!("{}.json", file_safe(&p.name)));
