@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The Python package's tests: a virtual environment from the Python registry (maturin,
-# numpy, pytest, meshio), the extension built into it by `maturin develop` (the dev
+# numpy, pytest, meshio, dask[distributed]), the extension built into it by `maturin develop` (the dev
 # profile, in cargo's target folder), then pytest on crates/python/tests.
 # Installs python3 and its venv module when they are missing and we are root.
 set -euo pipefail
@@ -24,6 +24,6 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 # shellcheck disable=SC1091
 source "$venv/bin/activate"
-python -m pip install -q --disable-pip-version-check "maturin>=1.9,<2" numpy pytest meshio
+python -m pip install -q --disable-pip-version-check "maturin>=1.9,<2" numpy pytest meshio "dask[distributed]"
 maturin develop -q -m crates/python/Cargo.toml
 python -m pytest -q crates/python/tests "$@"

@@ -146,6 +146,17 @@ impl PyMap {
         py.detach(|| winslow::write(&path, &out)).py_err()
     }
 
+    /// The map document as JSON text (`docs/formats.md`; `winslow.parse` reads it back
+    /// bit for bit).
+    fn to_json(&self) -> String {
+        winslow::io::json::map_to_json(&self.name, &self.map, None).to_string()
+    }
+
+    /// Pickled as its JSON text (for `multiprocessing`, Dask, Ray).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((py.import("winslow")?.getattr("parse")?, (self.to_json(),)))
+    }
+
     fn __repr__(&self) -> String {
         let (s, d) = (self.map.shape(), self.map.degrees());
         format!(
@@ -289,6 +300,16 @@ impl PyBoundary {
     /// Write the boundary document (`.json`).
     fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
         py.detach(|| winslow::write(&path, &Output::Boundary(&self.boundary))).py_err()
+    }
+
+    /// The boundary document as JSON text (`winslow.parse` reads it back).
+    fn to_json(&self) -> String {
+        winslow::io::json::boundary_to_json(&self.boundary).to_string()
+    }
+
+    /// Pickled as its JSON text.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((py.import("winslow")?.getattr("parse")?, (self.to_json(),)))
     }
 
     fn __repr__(&self) -> String {

@@ -122,6 +122,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::solve, m)?)?;
     m.add_function(wrap_pyfunction!(solve::solve_many, m)?)?;
     m.add_function(wrap_pyfunction!(solve::check, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::solution_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_arrays, m)?)?;
     Ok(())
 }

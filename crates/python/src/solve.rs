@@ -84,6 +84,17 @@ impl PySolution {
         py.detach(|| self.write_to(&path)).py_err()
     }
 
+    /// The map document with its report as JSON text (what `write` puts in a `.json`).
+    fn to_json(&self) -> String {
+        let extra = Some(json!({ "report": self.report }));
+        winslow::io::json::map_to_json(&self.name, &self.map.map, extra).to_string()
+    }
+
+    /// Pickled as its JSON text (for `multiprocessing`, Dask, Ray).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((py.import("winslow._native")?.getattr("solution_from_json")?, (self.to_json(),)))
+    }
+
     fn __repr__(&self) -> String {
         format!("Solution(name={:?}, verdict={:?}, seconds={})", self.name, self.verdict, self.report["seconds"])
     }
@@ -294,4 +305,17 @@ pub fn check<'py>(py: Python<'py>, map: Bound<'py, PyAny>) -> PyResult<Bound<'py
     let cert = py.detach(|| winslow::certify(&map, &Default::default())).py_err()?;
     let verdict = winslow::Verdict::of_certificate(&cert);
     to_py(py, &json!({ "verdict": verdict, "certificate": cert }))
+}
+
+/// A `Solution` from the JSON text of a map document with its report (`Solution.to_json`).
+#[pyfunction]
+pub fn solution_from_json(text: &str) -> PyResult<PySolution> {
+    let doc = winslow::io::parse_document(text).py_err()?;
+    let value: Value = serde_json::from_str(text).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+    let Document::Map { name, map } = doc else {
+        return Err(errors::to_py(&doc.wrong_kind(None, "a solution is a map with its report")));
+    };
+    let report = value.get("report").cloned().unwrap_or(Value::Null);
+    let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
+    Ok(PySolution { name: name.clone(), map: PyMap { name, map }, report, verdict })
 }

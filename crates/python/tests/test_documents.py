@@ -187,3 +187,16 @@ def test_check_certifies_and_finds_folds(data):
     c = winslow.check(folded)
     assert c["verdict"] == "folded"
     assert c["certificate"]["min_value_found"] < 0
+
+
+def test_pickle_round_trip_bit_for_bit(data):
+    import pickle
+
+    m = random_map()
+    same_map(m, pickle.loads(pickle.dumps(m)))
+    s = winslow.solve(data / "quarter_annulus.json")
+    back = pickle.loads(pickle.dumps(s))
+    assert back.verdict == s.verdict and back.report == s.report
+    same_map(s.map, back.map)
+    b = winslow.read(data / "quarter_annulus.json")
+    assert pickle.loads(pickle.dumps(b)).to_json() == b.to_json()
