@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -28,13 +28,21 @@ pub struct PySolution {
     pub map: PyMap,
     pub report: Value,
     pub verdict: String,
+    /// Wall seconds of the pipeline's run inside Rust (fit to certificate).
+    pub pipeline_seconds: f64,
 }
 
 impl PySolution {
-    fn of(sol: Solution) -> PyResult<Self> {
+    fn of((sol, pipeline_seconds): (Solution, f64)) -> PyResult<Self> {
         let report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
         let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
-        Ok(Self { name: sol.name.clone(), map: PyMap { name: sol.name, map: sol.map }, report, verdict })
+        Ok(Self {
+            name: sol.name.clone(),
+            map: PyMap { name: sol.name, map: sol.map },
+            report,
+            verdict,
+            pipeline_seconds,
+        })
     }
 
     /// Write the map with its report (`.json`), or in another map format by extension.
@@ -71,6 +79,14 @@ impl PySolution {
     #[getter]
     fn certified(&self) -> bool {
         matches!(self.verdict.as_str(), "certified" | "degenerate-corner")
+    }
+
+    /// Wall seconds of the pipeline inside Rust (fit, solve, certificate; the progress
+    /// callback included, the Python call around it not): the call's overhead is the
+    /// rest of its time.
+    #[getter]
+    fn pipeline_seconds(&self) -> f64 {
+        self.pipeline_seconds
     }
 
     /// The report (as `winslow solve` writes it) as a dict.
@@ -150,8 +166,9 @@ pub fn event(stage: &Stage<'_>) -> Value {
 /// Run the pipeline without the GIL; every stage goes to `progress` (with the GIL, a
 /// return value of `False` stops the run) and pending signals are checked (Ctrl-C stops
 /// the run). A Python exception raised there is the result.
-fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>>) -> PyResult<Solution> {
+fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>>) -> PyResult<(Solution, f64)> {
     let mut raised: Option<PyErr> = None;
+    let t0 = Instant::now();
     let result = py.detach(|| {
         let pipeline = Pipeline::new(input, opts.solve.clone());
         pipeline.run(&mut |stage| {
@@ -178,10 +195,11 @@ fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>
             })
         })
     });
+    let seconds = t0.elapsed().as_secs_f64();
     if let Some(e) = raised {
         return Err(e);
     }
-    result.and_then(winslow::Solved::into_map).py_err()
+    Ok((result.and_then(winslow::Solved::into_map).py_err()?, seconds))
 }
 
 /// Solve the map of a boundary, map (its boundary) or ring: fit, coarse-to-fine EGG
@@ -229,7 +247,7 @@ pub fn solve_many<'py>(
     let mut results: Vec<Option<PyResult<PySolution>>> = prepared.into_iter().map(|p| p.err().map(Err)).collect();
     let mut interrupted = None;
     py.detach(|| {
-        let (tx, rx) = mpsc::channel::<(usize, winslow::Result<Solution>)>();
+        let (tx, rx) = mpsc::channel::<(usize, winslow::Result<(Solution, f64)>)>();
         std::thread::scope(|s| {
             let (stop, opts) = (&stop, &opts.solve);
             s.spawn(move || {
@@ -239,9 +257,11 @@ pub fn solve_many<'py>(
                             let _ = tx.send((i, Err(Error::Cancelled)));
                             return;
                         }
+                        let t0 = Instant::now();
                         let r = Pipeline::new(input, opts.clone())
                             .run(&mut |_| !stop.load(Ordering::Relaxed))
-                            .and_then(winslow::Solved::into_map);
+                            .and_then(winslow::Solved::into_map)
+                            .map(|s| (s, t0.elapsed().as_secs_f64()));
                         // the receiver lives until every sender is dropped
                         let _ = tx.send((i, r));
                     });
@@ -317,5 +337,5 @@ pub fn solution_from_json(text: &str) -> PyResult<PySolution> {
     };
     let report = value.get("report").cloned().unwrap_or(Value::Null);
     let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
-    Ok(PySolution { name: name.clone(), map: PyMap { name, map }, report, verdict })
+    Ok(PySolution { name: name.clone(), map: PyMap { name, map }, report, verdict, pipeline_seconds: f64::NAN })
 }

@@ -20,6 +20,8 @@ def test_solve_matches_the_report(data):
     assert stages[0] == "fitted" and "level_started" in stages and stages[-1] == "level_finished"
     r = s.report
     assert r["verdict"] == "certified"
+    # the pipeline's own time is within the call's, and holds the solver's
+    assert r["seconds"] <= s.pipeline_seconds
     # the last level's unknowns: two per free control point
     nu, nv = s.map.shape
     assert r["levels"][-1]["shape"] == [nu, nv]
