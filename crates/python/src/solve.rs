@@ -224,16 +224,29 @@ pub fn solve(
 /// list in the order of `inputs`, each a `Solution` or the `WinslowError` of that shape
 /// (not raised). `on_result(index, result)` is called (with the GIL) as each finishes.
 /// Ctrl-C stops the shapes not yet started and raises `KeyboardInterrupt`.
+///
+/// `same_basis=True` (a family of shapes whose sides share their bases): every shape is
+/// solved on its input's basis (`basis="input"`, the boundary kept exactly), and a
+/// solved map whose knot vectors differ from the first solved map's is replaced by a
+/// `WinslowError` of kind `"invalid"`: the solutions returned are comparable coefficient
+/// by coefficient.
 #[pyfunction]
-#[pyo3(signature = (inputs, *, workers=None, on_result=None, **options))]
+#[pyo3(signature = (inputs, *, workers=None, on_result=None, same_basis=false, **options))]
 pub fn solve_many<'py>(
     py: Python<'py>,
     inputs: Vec<Bound<'py, PyAny>>,
     workers: Option<usize>,
     on_result: Option<Py<PyAny>>,
+    same_basis: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let opts = options::parse(options)?;
+    let mut opts = options::parse(options)?;
+    if same_basis {
+        if options.is_some_and(|o| o.contains("basis").unwrap_or(false)) {
+            return Err(errors::invalid("same_basis=True solves on the input basis: leave out basis="));
+        }
+        opts.solve.fit.basis = winslow::boundary::BasisChoice::Input;
+    }
     // inputs that cannot be read are failures of their shape, like a failed solve
     let prepared: Vec<Result<Input, PyErr>> = inputs.iter().map(|i| input_of(py, i, opts.reorient)).collect();
     let n = prepared.len();
@@ -301,6 +314,9 @@ pub fn solve_many<'py>(
     if let Some(e) = interrupted {
         return Err(e);
     }
+    if same_basis {
+        one_basis(&mut results);
+    }
     let items = results
         .into_iter()
         .take(n)
@@ -313,6 +329,30 @@ pub fn solve_many<'py>(
         })
         .collect::<PyResult<Vec<_>>>()?;
     PyList::new(py, items)
+}
+
+/// Replace every solution whose knot vectors differ from the first solution's by an
+/// error naming the difference.
+fn one_basis(results: &mut [Option<PyResult<PySolution>>]) {
+    let first = results.iter().find_map(|r| match r {
+        Some(Ok(s)) => Some((s.name.clone(), s.map.map.knots.clone())),
+        _ => None,
+    });
+    let Some((name, knots)) = first else { return };
+    for r in results.iter_mut() {
+        if let Some(Ok(s)) = r {
+            if s.map.map.knots != knots {
+                let [a, b] = s.map.map.shape();
+                let message = format!(
+                    "same_basis: the map of {} ({a}x{b} functions) is not on the basis of {name}'s map ({}x{} functions)",
+                    s.name,
+                    knots[0].num_basis(),
+                    knots[1].num_basis()
+                );
+                *r = Some(Err(errors::invalid(message)));
+            }
+        }
+    }
 }
 
 /// The certificate of a map (`winslow check`): `{"verdict": ..., "certificate": {...}}`.

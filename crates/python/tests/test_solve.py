@@ -114,3 +114,40 @@ def test_ctrl_c_stops_a_solve(data, many):
     timer.join()
     # stopped at the next event, well before the solve's end
     assert time.perf_counter() - t0 < 3.0
+
+
+def perturbed_ducks(data, n, eps=0.02, seed=5):
+    """n ducks whose side control points are moved by a smooth random field: the sides
+    keep their knot vectors."""
+    duck = winslow.read(data / "gismo" / "duck.json")
+    rng = np.random.default_rng(seed)
+    allp = np.concatenate([s.control_points for s in duck.sides])
+    lo, L = allp.min(0), np.ptp(allp, 0).max()
+    out = []
+    for i in range(n):
+        c = rng.uniform(-1, 1, (2, 2))
+        sides = []
+        for s in duck.sides:
+            q = (s.control_points - lo) / L
+            field = np.stack([np.sin(np.pi * q[:, 0]), np.sin(np.pi * q[:, 1])], 1) @ c
+            sides.append(winslow.Curve(s.knots, s.degree, s.control_points + eps * L * field, s.weights))
+        out.append(winslow.Boundary(sides, name=f"duck{i}"))
+    return out
+
+
+def test_same_basis_family(data):
+    family = perturbed_ducks(data, 4)
+    res = winslow.solve_many(family, workers=2, same_basis=True)
+    assert all(isinstance(r, winslow.Solution) and r.certified for r in res)
+    k0 = res[0].map.knots
+    for r in res:
+        assert r.report["basis"]["used"] == "input"
+        assert all(np.array_equal(a, b) for a, b in zip(r.map.knots, k0))
+    # the coefficients differ by the shape: a family of maps on one basis
+    assert np.abs(res[1].map.control_points - res[0].map.control_points).max() > 0
+    # a shape on another basis (a quarter annulus of other sides) is refused, the rest kept
+    mixed = winslow.solve_many(family[:2] + [winslow.read(data / "quarter_annulus.json")], same_basis=True)
+    assert isinstance(mixed[0], winslow.Solution) and isinstance(mixed[1], winslow.Solution)
+    assert isinstance(mixed[2], winslow.WinslowError) and mixed[2].kind == "invalid"
+    with pytest.raises(winslow.WinslowError):
+        winslow.solve_many(family, same_basis=True, basis="fitted")

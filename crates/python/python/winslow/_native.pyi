@@ -121,6 +121,7 @@ def solve_many(
     *,
     workers: Optional[int] = None,
     on_result: Optional[Callable[[int, Union[Solution, WinslowError]], None]] = None,
+    same_basis: bool = False,
     **options: Any,
 ) -> list[Union[Solution, WinslowError]]: ...
 def solution_from_json(text: str) -> Solution: ...
