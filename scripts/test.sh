@@ -2,7 +2,8 @@
 # Runs every test of the workspace on a fresh Debian machine with only Rust installed.
 # Installs what the suite needs when it is missing and we are root (Mesa's lavapipe
 # Vulkan driver for the GPU tests), then: format check, clippy, the docs (no broken
-# intra-doc links), the whole test suite.
+# intra-doc links), the whole test suite, then the Python package's tests in a virtual
+# environment (scripts/python-tests.sh; installs python3-venv when missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,3 +31,5 @@ echo "== cargo doc (no broken intra-doc links) =="
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 echo "== cargo test =="
 cargo test --workspace
+echo "== Python package (pytest) =="
+bash scripts/python-tests.sh

@@ -57,6 +57,7 @@ macro_rules! note {
 }
 
 mod args;
+mod batch_cmd;
 mod bench_cmd;
 mod check_cmd;
 mod compare_cmd;
@@ -149,6 +150,14 @@ enum Command {
         after_help = "Example:\n  winslow sweep tests/data/rings/eccentric_annulus.json --rotate-inner 5 --steps 8 -o out/sweep"
     )]
     Sweep(Box<sweep_cmd::SweepArgs>),
+    /// Solve many shapes in parallel into a folder: one map per shape as it finishes, a
+    /// failure record per failing shape, a summary (batch.jsonl, batch.csv); a re-run
+    /// skips the shapes already solved. Exit code: 1 when a shape failed, else the worst
+    /// verdict's (0 when every map is bijective).
+    #[command(
+        after_help = "Example:\n  winslow batch tests/data/gismo/duck.json tests/data/quarter_annulus.json -o out/batch --jobs 2"
+    )]
+    Batch(Box<batch_cmd::BatchArgs>),
     /// Volumes from planar slices (paper §11.1, Fig. 23): one basis, linear or C2 cubic
     /// in z, certified (trivariate det J), slices inserted where it is not.
     #[command(
@@ -238,6 +247,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Mesh(a) => mesh::run(a),
         Command::Corpus(a) => corpus::run(a),
         Command::Sweep(a) => sweep_cmd::run(*a),
+        Command::Batch(a) => batch_cmd::run(*a),
         Command::Loft(a) => loft_cmd::run(*a),
         Command::Optimise(a) => optimise_cmd::run(*a),
         Command::Compare(a) => compare_cmd::run(*a),

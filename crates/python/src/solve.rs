@@ -1,0 +1,381 @@
+//! `solve` and `solve_many`: the pipeline ([`Pipeline::run`]) with the GIL released, its
+//! stages to an optional Python callback, Ctrl-C stopping the run through the observer;
+//! many shapes on a pool of `workers` threads.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use winslow::io::{checked_boundary, ReadOptions};
+use winslow::solve::report::Solution;
+use winslow::{Document, Error, Input, Output, Pipeline, Stage};
+
+use crate::convert::{json_to_py, to_py};
+use crate::errors::{self, IntoPy};
+use crate::geometry::{document_of, PyMap};
+use crate::options::{self, Options};
+
+/// A solved map with its report.
+#[pyclass(name = "Solution", module = "winslow", frozen)]
+#[derive(Debug, Clone)]
+pub struct PySolution {
+    pub name: String,
+    pub map: PyMap,
+    pub report: Value,
+    pub verdict: String,
+    /// Wall seconds of the pipeline's run inside Rust (fit to certificate).
+    pub pipeline_seconds: f64,
+}
+
+impl PySolution {
+    fn of((sol, pipeline_seconds): (Solution, f64)) -> PyResult<Self> {
+        let report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+        let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
+        Ok(Self {
+            name: sol.name.clone(),
+            map: PyMap { name: sol.name, map: sol.map },
+            report,
+            verdict,
+            pipeline_seconds,
+        })
+    }
+
+    /// Write the map with its report (`.json`), or in another map format by extension.
+    pub fn write_to(&self, path: &std::path::Path) -> winslow::Result<()> {
+        let label = format!("verdict {}: {}", self.verdict, self.report["message"].as_str().unwrap_or_default());
+        let extra = Some(json!({ "report": self.report }));
+        winslow::write(path, &Output::Map { name: &self.name, map: &self.map.map, label: &label, extra })
+    }
+}
+
+#[pymethods]
+impl PySolution {
+    /// Name of the geometry.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The map of the finest level.
+    #[getter]
+    fn map(&self) -> PyMap {
+        self.map.clone()
+    }
+
+    /// The verdict of the certificate: `"certified"`, `"degenerate-corner"`, `"folded"`,
+    /// `"undecided"` or `"not-converged"`.
+    #[getter]
+    fn verdict(&self) -> &str {
+        &self.verdict
+    }
+
+    /// Whether the map is proven bijective (certified, or degenerate only at corners the
+    /// boundary forces).
+    #[getter]
+    fn certified(&self) -> bool {
+        matches!(self.verdict.as_str(), "certified" | "degenerate-corner")
+    }
+
+    /// Wall seconds of the pipeline inside Rust (fit, solve, certificate; the progress
+    /// callback included, the Python call around it not): the call's overhead is the
+    /// rest of its time.
+    #[getter]
+    fn pipeline_seconds(&self) -> f64 {
+        self.pipeline_seconds
+    }
+
+    /// The report (as `winslow solve` writes it) as a dict.
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.report)
+    }
+
+    /// Write the map with its report; the format by the extension.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| self.write_to(&path)).py_err()
+    }
+
+    /// The map document with its report as JSON text (what `write` puts in a `.json`).
+    fn to_json(&self) -> String {
+        let extra = Some(json!({ "report": self.report }));
+        winslow::io::json::map_to_json(&self.name, &self.map.map, extra).to_string()
+    }
+
+    /// Pickled as its JSON text (for `multiprocessing`, Dask, Ray).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((py.import("winslow._native")?.getattr("solution_from_json")?, (self.to_json(),)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Solution(name={:?}, verdict={:?}, seconds={})", self.name, self.verdict, self.report["seconds"])
+    }
+}
+
+/// The pipeline's input of a Python object: a `Boundary`, a `Map` (its boundary), a
+/// ring `Document`, or a path to any of those.
+pub fn input_of(py: Python<'_>, obj: &Bound<'_, PyAny>, reorient: bool) -> PyResult<Input> {
+    let doc = match obj.extract::<PathBuf>() {
+        Ok(path) if !obj.is_instance_of::<pyo3::types::PyBytes>() => py.detach(|| winslow::read(&path)).py_err()?,
+        _ => document_of(obj)?,
+    };
+    input_of_document(doc, reorient).py_err()
+}
+
+/// The pipeline's input of a document (a boundary checked as the CLI does).
+pub fn input_of_document(doc: Document, reorient: bool) -> winslow::Result<Input> {
+    Ok(match doc {
+        Document::Ring(ring) => Input::Ring(ring),
+        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(doc.into_ring()?),
+        Document::Layout(l) => {
+            return Err(
+                Document::Layout(l).wrong_kind(None, "solve takes a boundary, map or ring (use the CLI for layouts)")
+            )
+        }
+        doc => {
+            let (b, _) = checked_boundary(doc.into_boundary()?, &ReadOptions { reorient })?;
+            Input::Boundary(b)
+        }
+    })
+}
+
+/// One stage as a JSON event for the progress callback.
+pub fn event(stage: &Stage<'_>) -> Value {
+    use winslow::Event;
+    match stage {
+        Stage::Fitted { input, hierarchy, method, .. } => json!({
+            "stage": "fitted", "name": input.name(), "levels": hierarchy.levels.len(), "method": method.name(),
+        }),
+        Stage::Solver(Event::LevelStarted { level, levels, shape, unknowns, .. }) => json!({
+            "stage": "level_started", "level": level, "levels": levels, "shape": shape, "unknowns": unknowns,
+        }),
+        Stage::Solver(Event::Iterate { level, iterate }) => {
+            json!({ "stage": "iterate", "level": level, "iterate": iterate })
+        }
+        Stage::Solver(Event::LevelFinished(r)) => json!({ "stage": "level_finished", "report": r }),
+        Stage::Fallback { reason } => json!({ "stage": "fallback", "reason": reason }),
+        Stage::Layout(e) => json!({ "stage": "layout", "event": format!("{e:?}") }),
+        _ => json!({ "stage": "other" }),
+    }
+}
+
+/// Run the pipeline without the GIL; every stage goes to `progress` (with the GIL, a
+/// return value of `False` stops the run) and pending signals are checked (Ctrl-C stops
+/// the run). A Python exception raised there is the result.
+fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>>) -> PyResult<(Solution, f64)> {
+    let mut raised: Option<PyErr> = None;
+    let t0 = Instant::now();
+    let result = py.detach(|| {
+        let pipeline = Pipeline::new(input, opts.solve.clone());
+        pipeline.run(&mut |stage| {
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    raised = Some(e);
+                    return false;
+                }
+                let Some(cb) = progress else { return true };
+                let ev = match json_to_py(py, &event(stage)) {
+                    Ok(ev) => ev,
+                    Err(e) => {
+                        raised = Some(e);
+                        return false;
+                    }
+                };
+                match cb.call1(py, (ev,)) {
+                    Ok(r) => !r.bind(py).is(pyo3::types::PyBool::new(py, false).to_owned()),
+                    Err(e) => {
+                        raised = Some(e);
+                        false
+                    }
+                }
+            })
+        })
+    });
+    let seconds = t0.elapsed().as_secs_f64();
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    Ok((result.and_then(winslow::Solved::into_map).py_err()?, seconds))
+}
+
+/// Solve the map of a boundary, map (its boundary) or ring: fit, coarse-to-fine EGG
+/// solve, certificate, fallback (`winslow solve`). The GIL is released during the
+/// solve; `progress(event: dict)` is called for every stage (returning `False` stops the
+/// solve with a `WinslowError` of kind `"cancelled"`); Ctrl-C stops it with
+/// `KeyboardInterrupt`. Options as keywords (see `winslow.SOLVE_OPTIONS`).
+#[pyfunction]
+#[pyo3(signature = (input, *, progress=None, **options))]
+pub fn solve(
+    py: Python<'_>,
+    input: Bound<'_, PyAny>,
+    progress: Option<Py<PyAny>>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PySolution> {
+    let opts = options::parse(options)?;
+    let input = input_of(py, &input, opts.reorient)?;
+    PySolution::of(run(py, input, &opts, progress.as_ref())?)
+}
+
+/// Solve many shapes on `workers` threads (default: all cores), the GIL released: a
+/// list in the order of `inputs`, each a `Solution` or the `WinslowError` of that shape
+/// (not raised). `on_result(index, result)` is called (with the GIL) as each finishes.
+/// Ctrl-C stops the shapes not yet started and raises `KeyboardInterrupt`.
+///
+/// `same_basis=True` (a family of shapes whose sides share their bases): every shape is
+/// solved on its input's basis (`basis="input"`, the boundary kept exactly), and a
+/// solved map whose knot vectors differ from the first solved map's is replaced by a
+/// `WinslowError` of kind `"invalid"`: the solutions returned are comparable coefficient
+/// by coefficient.
+#[pyfunction]
+#[pyo3(signature = (inputs, *, workers=None, on_result=None, same_basis=false, **options))]
+pub fn solve_many<'py>(
+    py: Python<'py>,
+    inputs: Vec<Bound<'py, PyAny>>,
+    workers: Option<usize>,
+    on_result: Option<Py<PyAny>>,
+    same_basis: bool,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut opts = options::parse(options)?;
+    if same_basis {
+        if options.is_some_and(|o| o.contains("basis").unwrap_or(false)) {
+            return Err(errors::invalid("same_basis=True solves on the input basis: leave out basis="));
+        }
+        opts.solve.fit.basis = winslow::boundary::BasisChoice::Input;
+    }
+    // inputs that cannot be read are failures of their shape, like a failed solve
+    let prepared: Vec<Result<Input, PyErr>> = inputs.iter().map(|i| input_of(py, i, opts.reorient)).collect();
+    let n = prepared.len();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(workers.unwrap_or(0))
+        .build()
+        .map_err(|e| errors::invalid(format!("cannot start {workers:?} workers: {e}")))?;
+    let stop = AtomicBool::new(false);
+    let jobs: Vec<(usize, Input)> =
+        prepared.iter().enumerate().filter_map(|(i, p)| p.as_ref().ok().map(|x| (i, x.clone()))).collect();
+    let mut results: Vec<Option<PyResult<PySolution>>> = prepared.into_iter().map(|p| p.err().map(Err)).collect();
+    let mut interrupted = None;
+    py.detach(|| {
+        let (tx, rx) = mpsc::channel::<(usize, winslow::Result<(Solution, f64)>)>();
+        std::thread::scope(|s| {
+            let (stop, opts) = (&stop, &opts.solve);
+            s.spawn(move || {
+                pool.install(|| {
+                    jobs.into_par_iter().for_each_with(tx, |tx, (i, input)| {
+                        if stop.load(Ordering::Relaxed) {
+                            let _ = tx.send((i, Err(Error::Cancelled)));
+                            return;
+                        }
+                        let t0 = Instant::now();
+                        let r = Pipeline::new(input, opts.clone())
+                            .run(&mut |_| !stop.load(Ordering::Relaxed))
+                            .and_then(winslow::Solved::into_map)
+                            .map(|s| (s, t0.elapsed().as_secs_f64()));
+                        // the receiver lives until every sender is dropped
+                        let _ = tx.send((i, r));
+                    });
+                });
+            });
+            loop {
+                match rx.recv_timeout(Duration::from_millis(50)) {
+                    Ok((i, r)) => {
+                        let r = r.map_err(|e| errors::to_py(&e)).and_then(PySolution::of);
+                        if let Some(cb) = &on_result {
+                            Python::attach(|py| -> PyResult<()> {
+                                let arg = match &r {
+                                    Ok(s) => Bound::new(py, s.clone())?.into_any(),
+                                    Err(e) => e.value(py).clone().into_any(),
+                                };
+                                cb.call1(py, (i, arg))?;
+                                Ok(())
+                            })
+                            .unwrap_or_else(|e| {
+                                stop.store(true, Ordering::Relaxed);
+                                interrupted.get_or_insert(e);
+                            });
+                        }
+                        results[i] = Some(r);
+                    }
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            stop.store(true, Ordering::Relaxed);
+                            interrupted.get_or_insert(e);
+                        }
+                    }
+                    Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                }
+            }
+        });
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    if same_basis {
+        one_basis(&mut results);
+    }
+    let items = results
+        .into_iter()
+        .take(n)
+        .map(|r| -> PyResult<Bound<'py, PyAny>> {
+            match r {
+                Some(Ok(s)) => Ok(Bound::new(py, s)?.into_any()),
+                Some(Err(e)) => Ok(e.value(py).clone().into_any()),
+                None => Ok(errors::to_py(&Error::Cancelled).value(py).clone().into_any()),
+            }
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    PyList::new(py, items)
+}
+
+/// Replace every solution whose knot vectors differ from the first solution's by an
+/// error naming the difference.
+fn one_basis(results: &mut [Option<PyResult<PySolution>>]) {
+    let first = results.iter().find_map(|r| match r {
+        Some(Ok(s)) => Some((s.name.clone(), s.map.map.knots.clone())),
+        _ => None,
+    });
+    let Some((name, knots)) = first else { return };
+    for r in results.iter_mut() {
+        if let Some(Ok(s)) = r {
+            if s.map.map.knots != knots {
+                let [a, b] = s.map.map.shape();
+                let message = format!(
+                    "same_basis: the map of {} ({a}x{b} functions) is not on the basis of {name}'s map ({}x{} functions)",
+                    s.name,
+                    knots[0].num_basis(),
+                    knots[1].num_basis()
+                );
+                *r = Some(Err(errors::invalid(message)));
+            }
+        }
+    }
+}
+
+/// The certificate of a map (`winslow check`): `{"verdict": ..., "certificate": {...}}`.
+#[pyfunction]
+pub fn check<'py>(py: Python<'py>, map: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let doc = document_of(&map)?;
+    let Document::Map { map, .. } = doc else {
+        return Err(errors::to_py(&doc.wrong_kind(None, "check certifies a map")));
+    };
+    let cert = py.detach(|| winslow::certify(&map, &Default::default())).py_err()?;
+    let verdict = winslow::Verdict::of_certificate(&cert);
+    to_py(py, &json!({ "verdict": verdict, "certificate": cert }))
+}
+
+/// A `Solution` from the JSON text of a map document with its report (`Solution.to_json`).
+#[pyfunction]
+pub fn solution_from_json(text: &str) -> PyResult<PySolution> {
+    let doc = winslow::io::parse_document(text).py_err()?;
+    let value: Value = serde_json::from_str(text).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+    let Document::Map { name, map } = doc else {
+        return Err(errors::to_py(&doc.wrong_kind(None, "a solution is a map with its report")));
+    };
+    let report = value.get("report").cloned().unwrap_or(Value::Null);
+    let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
+    Ok(PySolution { name: name.clone(), map: PyMap { name, map }, report, verdict, pipeline_seconds: f64::NAN })
+}
