@@ -160,7 +160,13 @@ impl HierarchicalMap {
 
     /// The blossom of this map's piece at the point `at` (inside an active cell) at the
     /// interior knots of function `f` of the tensor space `kv`.
-    fn piece_blossom(&self, lc: &mut LevelCoefficients<'_, Point>, at: [f64; 2], kv: &[KnotVector; 2], f: Index2) -> Point {
+    fn piece_blossom(
+        &self,
+        lc: &mut LevelCoefficients<'_, Point>,
+        at: [f64; 2],
+        kv: &[KnotVector; 2],
+        f: Index2,
+    ) -> Point {
         let (lo, co) = self.basis.cell_at(at[0], at[1]);
         let net = lc.cell_net(lo, co);
         let spans = self.basis.cell_spans(lo, co);
@@ -189,7 +195,8 @@ impl HierarchicalMap {
         let out: Vec<KnotVector> = (0..2)
             .map(|d| {
                 let old = &k0[d];
-                let new: Vec<f64> = edges[d].iter().map(|&b| f64::from_bits(b)).filter(|&x| old.multiplicity(x) == 0).collect();
+                let new: Vec<f64> =
+                    edges[d].iter().map(|&b| f64::from_bits(b)).filter(|&x| old.multiplicity(x) == 0).collect();
                 old.with_inserted(&new)
             })
             .collect();

@@ -33,9 +33,9 @@
 //! evaluation, per-cell Bézier nets, refinement and conversion to a tensor map).
 
 pub mod map;
-pub mod truncation;
 #[cfg(test)]
 mod tests;
+pub mod truncation;
 
 use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;
@@ -116,8 +116,12 @@ impl HierarchicalBasis {
                 });
             }
         }
-        let mut out =
-            Self { levels: vec![Level::new(knots)], refined: vec![BTreeSet::new()], active: vec![], lookup: HashMap::new() };
+        let mut out = Self {
+            levels: vec![Level::new(knots)],
+            refined: vec![BTreeSet::new()],
+            active: vec![],
+            lookup: HashMap::new(),
+        };
         out.update_active();
         Ok(out)
     }
@@ -232,7 +236,9 @@ impl HierarchicalBasis {
 
     /// Cells of level `l >= 1` in `Ω^l` (the children of the refined cells of level `l - 1`).
     fn domain_cells(&self, l: usize) -> impl Iterator<Item = Index2> + '_ {
-        self.refined[l - 1].iter().flat_map(|&[i, j]| [[2 * i, 2 * j], [2 * i + 1, 2 * j], [2 * i, 2 * j + 1], [2 * i + 1, 2 * j + 1]])
+        self.refined[l - 1]
+            .iter()
+            .flat_map(|&[i, j]| [[2 * i, 2 * j], [2 * i + 1, 2 * j], [2 * i, 2 * j + 1], [2 * i + 1, 2 * j + 1]])
     }
 
     /// Cells of the support of function `f` of level `l`, per direction.

@@ -15,7 +15,8 @@ fn kv(p: usize, breaks: &[f64]) -> KnotVector {
 
 /// A hierarchy refined towards the south-west corner and around an interior cell.
 fn sample_basis(p: usize, q: usize, m: usize) -> HierarchicalBasis {
-    let mut b = HierarchicalBasis::new([kv(p, &[0.0, 0.2, 0.45, 0.6, 0.8, 1.0]), kv(q, &[0.0, 0.3, 0.5, 0.75, 1.0])]).unwrap();
+    let mut b =
+        HierarchicalBasis::new([kv(p, &[0.0, 0.2, 0.45, 0.6, 0.8, 1.0]), kv(q, &[0.0, 0.3, 0.5, 0.75, 1.0])]).unwrap();
     b.refine(&[(0, [0, 0]), (0, [2, 1])], m).unwrap();
     b.refine(&[(1, [0, 0]), (1, [5, 3])], m).unwrap();
     b.refine(&[(2, [1, 0])], m).unwrap();
@@ -129,7 +130,8 @@ fn one_level_is_the_tensor_basis() {
 #[test]
 fn admissibility_bounds_the_levels_on_every_cell() {
     for m in [2, 3] {
-        let mut b = HierarchicalBasis::new([kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0]), kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0])]).unwrap();
+        let mut b =
+            HierarchicalBasis::new([kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0]), kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0])]).unwrap();
         // refine towards an interior point, five times
         for _ in 0..5 {
             let (l, c) = b.cell_at(0.51, 0.49);

@@ -155,6 +155,12 @@ pub struct LevelCoefficients<'a, V: Coefficient> {
     memo: HashMap<(usize, Index2), V>,
 }
 
+impl<V: Coefficient> std::fmt::Debug for LevelCoefficients<'_, V> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LevelCoefficients").field("memoised", &self.memo.len()).finish()
+    }
+}
+
 impl<'a, V: Coefficient> LevelCoefficients<'a, V> {
     /// The combination with coefficient `leaf(k)` on the `k`-th active function.
     pub fn new(basis: &'a HierarchicalBasis, leaf: impl Fn(usize) -> V + 'a) -> Self {
