@@ -138,15 +138,21 @@ impl HierarchicalMap {
     }
 
     /// The map after refining the active cells `marked` with admissibility class `m`
-    /// ([`HierarchicalBasis::refine`]): the same function in the finer THB space, every
-    /// coefficient the blossom of the old map's piece on an active cell of the new
-    /// function's level inside its support.
+    /// ([`HierarchicalBasis::refine`]): the same function in the finer THB space, every new
+    /// function's coefficient the blossom of the old map's piece on an active cell of its
+    /// level inside its support (the functions active before keep theirs).
     pub fn refined(&self, marked: &[(usize, Index2)], m: usize) -> Result<Self> {
         let mut basis = self.basis.clone();
         basis.refine(marked, m)?;
         let mut old = self.level_coefficients();
         let mut cps = Vec::with_capacity(basis.len());
         for &(l, f) in basis.active_functions() {
+            // a function active before and after keeps its coefficient: it is the blossom of
+            // the same piece on an active cell of its level in its support, both times
+            if let Some(k) = self.basis.index_of(l, f) {
+                cps.push(self.control_points[k]);
+                continue;
+            }
             let [ri, rj] = basis.support(l, f);
             let cell = rj
                 .flat_map(|j| ri.clone().map(move |i| [i, j]))
