@@ -16,7 +16,7 @@ use crate::{files, load_boundary, loft_cmd, multipatch_cmd, output};
 #[derive(Args, Debug)]
 pub(crate) struct CheckArgs {
     /// Map file (JSON map document or G+Smo XML; a volume: the trivariate certificate; a
-    /// multipatch file: every patch).
+    /// multipatch file: every patch; a THB map: every active cell).
     map: PathBuf,
     /// The input boundary: report the largest deviation of the map's boundary from it.
     #[arg(long)]
@@ -50,6 +50,9 @@ pub(crate) fn check(a: CheckArgs) -> Result<i32> {
         max_boxes: a.max_boxes.clamp(1, 1 << 24),
         excuse_corners: !a.strict_corners,
     };
+    if let Some((name, map)) = crate::thb_cmd::read(&a.map)? {
+        return crate::thb_cmd::check(&name, &map, &opts, a.json);
+    }
     let (name, map) = match files::read(&a.map)? {
         Document::Volume { name, volume } => {
             return loft_cmd::check_volume(&name, &volume, a.max_depth, a.max_boxes, a.json)

@@ -57,6 +57,12 @@ const CONVERT_NEEDS: &str =
 /// `winslow convert IN -o OUT`: certified again (the verdict travels with the file),
 /// written by the output's extension.
 pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
+    if let Some((name, map)) = crate::thb_cmd::read(&a.map)? {
+        return crate::thb_cmd::convert(&name, &map, &a.map, &a.output, a.thb);
+    }
+    if a.thb {
+        anyhow::bail!("--thb keeps a THB map hierarchical, and {} holds no THB map", a.map.display());
+    }
     let doc = files::read(&a.map)?;
     let (what, extensions) = match doc {
         Document::Volume { .. } => ("volume", files::ext::VOLUME),
@@ -105,11 +111,16 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
 
 #[derive(Args, Debug)]
 pub(crate) struct ConvertArgs {
-    /// Map file (JSON map document, G+Smo XML or IGES), multipatch result or volume.
+    /// Map file (JSON map document, G+Smo XML or IGES; a THB map too), multipatch result or volume.
     pub(crate) map: PathBuf,
     /// Output file; the format follows its extension.
     #[arg(short, long)]
     pub(crate) output: PathBuf,
+    /// A THB map stays a THB map (`.json` with the map kind "thb", `.xml` as G+Smo
+    /// THBSpline2); without it a THB map becomes the tensor map on its active cells' knot
+    /// lines (exact).
+    #[arg(long)]
+    pub(crate) thb: bool,
 }
 
 #[derive(Args, Debug)]

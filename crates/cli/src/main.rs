@@ -76,6 +76,7 @@ mod output;
 mod reference;
 mod solve_cmd;
 mod sweep_cmd;
+mod thb_cmd;
 
 use args::*;
 use bench_cmd::*;

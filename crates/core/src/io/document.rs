@@ -177,6 +177,9 @@ fn json_document(body: &str) -> Result<Document> {
     let v: Value =
         serde_json::from_str(body).map_err(|e| Error::Json { context: String::new(), message: e.to_string() })?;
     let Value::Object(obj) = &v else { return parse_json(body) };
+    if super::hierarchical::is_thb_json(&v) {
+        return Err(thb_kind());
+    }
     if let Some(Value::Array(patches)) = obj.get("patches") {
         let solved = !patches.is_empty() && patches.iter().all(|p| p.get("map").is_some());
         let layout = parse_json_multipatch(body)?;
@@ -207,7 +210,22 @@ fn json_document(body: &str) -> Result<Document> {
     parse_json(body)
 }
 
+/// A THB map is read by [`super::hierarchical`] (`winslow check` and `winslow convert`),
+/// not as a tensor map.
+fn thb_kind() -> Error {
+    Error::DocumentKind {
+        path: None,
+        found: "THB map".into(),
+        needed: "a tensor map or another document here (`winslow check` certifies a THB map, `winslow convert` \
+                 turns it into a tensor map)"
+            .into(),
+    }
+}
+
 fn xml_document(body: &str) -> Result<Document> {
+    if body.contains("\"THBSpline2\"") {
+        return Err(thb_kind());
+    }
     if body.contains("TensorBSpline3") || body.contains("TensorNurbs3") {
         return Ok(Document::Volume { name: String::new(), volume: parse_gismo_volume(body)? });
     }

@@ -154,7 +154,7 @@ fn curve(geom: Node, rational: bool, ctx: &str) -> Result<Curve> {
 }
 
 /// A `TensorBSplineBasis2`: the two univariate bases ordered by their `index` attribute.
-fn tensor_basis(node: Node, ctx: &str) -> Result<[KnotVector; 2]> {
+pub(super) fn tensor_basis(node: Node, ctx: &str) -> Result<[KnotVector; 2]> {
     if basis_type(&node) != "TensorBSplineBasis2" {
         return Err(xml_err(ctx, format!("expected a TensorBSplineBasis2, found type {:?}", basis_type(&node))));
     }

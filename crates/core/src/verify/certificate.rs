@@ -46,6 +46,7 @@
 mod bernstein;
 pub mod coefficients;
 mod element;
+pub mod hierarchical;
 mod search;
 pub mod volume;
 

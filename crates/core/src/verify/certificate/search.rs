@@ -361,15 +361,31 @@ pub(super) fn examine_surface(
     opts: &CertifyOptions,
     tmp: &mut [f64],
 ) -> SurfaceElement {
+    let shape = el.shape();
+    let sides = [e[1] == 0, e[0] + 1 == shape[0], e[1] + 1 == shape[1], e[0] == 0];
+    examine_surface_on(el, e, sides, opts, tmp)
+}
+
+/// Examine element `e` of a map of the plane whose sides south, east, north, west
+/// (`sides[k]`) lie on the domain's boundary or not: an element of a tensor map, or the
+/// Bézier patch of one cell of a map that the patch only covers in part (a THB map's
+/// active cell, [`super::hierarchical`]), where only the domain's corners and sides are
+/// excused.
+pub(super) fn examine_surface_on(
+    el: &Elements<'_, 2>,
+    e: [usize; 2],
+    sides: [bool; 4],
+    opts: &CertifyOptions,
+    tmp: &mut [f64],
+) -> SurfaceElement {
     let d = el.deg;
     let [du, dv] = d.0;
     let n = d.len();
     let mut c0 = vec![0.0; n];
     let (sc, nets) = el.coefficients(e, &mut c0);
-    let shape = el.shape();
     // domain corners at this element's local corners
-    let (x0, x1) = (e[0] == 0, e[0] + 1 == shape[0]);
-    let (y0, y1) = (e[1] == 0, e[1] + 1 == shape[1]);
+    let (x0, x1) = (sides[3], sides[1]);
+    let (y0, y1) = (sides[0], sides[2]);
     let at = [x0 && y0, x1 && y0, x1 && y1, x0 && y1];
     let corner_coef = [c0[0], c0[du], c0[n - 1], c0[dv * (du + 1)]];
     let mut forced = [None; 8];
@@ -382,7 +398,7 @@ pub(super) fn examine_surface(
                 forced[k] = Some(k);
                 negative[k] = corner_coef[k] < -sc.err;
             }
-        } else if !at[k] && opts.excuse_corners && corner_coef[k] <= sc.err && zero_speed_point(el, &nets, e, k) {
+        } else if !at[k] && opts.excuse_corners && corner_coef[k] <= sc.err && zero_speed_point(el, &nets, sides, k) {
             // a point of a side where the side's own speed vanishes: det J = x_ξ × x_η = 0
             // there for every map of that boundary (not a negative value: a fold nearby
             // is still a fold)
@@ -406,15 +422,15 @@ pub(super) fn examine_volume(el: &Elements<'_, 3>, e: [usize; 3], opts: &Certify
     (examine(el, e, det, opts, &mut tmp), integral)
 }
 
-/// Whether local corner `k` of element `e` lies on a side of the domain (not at one of
-/// its corners) where that side's tangent vanishes within rounding, one-sided from `e`.
-fn zero_speed_point(el: &Elements<'_, 2>, nets: &super::element::Nets<2>, e: [usize; 2], k: usize) -> bool {
-    let shape = el.shape();
+/// Whether local corner `k` of an element whose sides south, east, north, west lie on the
+/// domain's boundary where `sides` says lies on a side of the domain (not at one of its
+/// corners) where that side's tangent vanishes within rounding, one-sided from the element.
+fn zero_speed_point(el: &Elements<'_, 2>, nets: &super::element::Nets<2>, sides: [bool; 4], k: usize) -> bool {
     let bits = corner_bits(2, k);
     let (s, t) = (bits & 1, bits >> 1);
     // on a side eta = const (south or north): the tangent is x_ξ; xi = const: x_η
-    let on_eta_side = (t == 0 && e[1] == 0) || (t == 1 && e[1] + 1 == shape[1]);
-    let on_xi_side = (s == 0 && e[0] == 0) || (s == 1 && e[0] + 1 == shape[0]);
+    let on_eta_side = (t == 0 && sides[0]) || (t == 1 && sides[2]);
+    let on_xi_side = (s == 0 && sides[3]) || (s == 1 && sides[1]);
     (on_eta_side && el.zero_tangent(nets, 0, s, t)) || (on_xi_side && el.zero_tangent(nets, 1, s, t))
 }
 

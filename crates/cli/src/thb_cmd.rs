@@ -1,0 +1,69 @@
+//! THB maps (`winslow::spline::hierarchical`) in `winslow check` and `winslow convert`:
+//! a file holding a THB map (the JSON map kind `"thb"` or G+Smo `THBSpline2`) is certified
+//! active cell by active cell, and converted to the tensor map on the knot lines of its
+//! active cells (exact knot insertion) or, with `--thb`, written as a THB map again.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use winslow::io::hierarchical::{read_thb, write_thb};
+use winslow::io::Output;
+use winslow::spline::hierarchical::map::HierarchicalMap;
+use winslow::verify::certificate::hierarchical::certify_hierarchical;
+use winslow::verify::certificate::{certify, CertifyOptions, Finding};
+
+use crate::files;
+
+/// The THB map in `path`, `None` when the file holds another kind of document.
+pub(crate) fn read(path: &Path) -> Result<Option<(String, HierarchicalMap)>> {
+    read_thb(path).with_context(|| format!("reading {}", path.display()))
+}
+
+/// 0 certified or degenerate corner, 3 folded, 5 undecided.
+fn exit_code(v: &Finding) -> i32 {
+    match v {
+        Finding::Certified { .. } | Finding::DegenerateCorner { .. } => 0,
+        Finding::Folded { .. } => 3,
+        Finding::Undecided { .. } => 5,
+    }
+}
+
+/// `winslow check THB`: the certificate of a THB map, per active cell.
+pub(crate) fn check(name: &str, map: &HierarchicalMap, opts: &CertifyOptions, json: bool) -> Result<i32> {
+    let c = certify_hierarchical(map, opts).context("certifying the THB map")?;
+    if json {
+        let report = serde_json::json!({ "name": name, "kind": "thb", "certificate": &c });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        say!("{name}: {}", c.message());
+    }
+    Ok(exit_code(&c.verdict))
+}
+
+/// `winslow convert THB -o OUT [--thb]`: the tensor map (certified again, the verdict in
+/// the file) by the output's extension, or the THB map itself (`.json`, `.xml`).
+pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &Path, thb: bool) -> Result<i32> {
+    if thb {
+        files::OutputPlan::new().input(input).file("-o", output, "THB map", &["json", "xml"]).check()?;
+        let c = certify_hierarchical(map, &CertifyOptions::default()).context("certifying the THB map")?;
+        let extra = Some(serde_json::json!({ "report": { "certificate": &c } }));
+        write_thb(output, name, map, extra).with_context(|| format!("writing {}", output.display()))?;
+        files::record(output);
+        say!("certificate: {}", c.message());
+        return Ok(exit_code(&c.verdict));
+    }
+    files::OutputPlan::new().input(input).file("-o", output, "map", files::ext::MAP).check()?;
+    let tensor = map.to_surface().context("converting the THB map to a tensor map")?;
+    let certificate = certify(&tensor, &CertifyOptions::default()).context("certifying the map")?;
+    let label = format!("certificate: {}", certificate.message());
+    let extra = Some(serde_json::json!({ "certificate": &certificate }));
+    files::write(output, &Output::Map { name, map: &tensor, label: &label, extra })?;
+    say!(
+        "{} THB functions on {} levels -> tensor map of {} x {} control points; {label}",
+        map.basis.len(),
+        map.basis.num_levels(),
+        tensor.shape()[0],
+        tensor.shape()[1]
+    );
+    Ok(exit_code(&certificate.verdict))
+}

@@ -1,0 +1,80 @@
+//! THB maps from the command line: `winslow check` certifies a THB map per active cell
+//! (exit 0 certified, 3 folded), `winslow convert` writes the tensor map on the knot lines
+//! of its active cells (the same map, certified again) or, with `--thb`, the THB map as
+//! G+Smo `THBSpline2` and back, coefficient for coefficient.
+
+mod common;
+use common::*;
+
+use std::ffi::OsStr;
+use std::path::Path;
+
+fn run(args: &[&OsStr]) -> std::process::Output {
+    bin().args(args).output().unwrap()
+}
+
+#[test]
+fn check_and_convert_a_thb_map() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let src = data().join("thb/sector_thb.json");
+    let os = |p: &Path| p.as_os_str().to_owned();
+    // certified, active cell by active cell
+    let out = run(&["check".as_ref(), &os(&src), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    assert_eq!(report["kind"], "thb");
+    assert_eq!(report["certificate"]["verdict"]["kind"], "certified");
+    let levels = report["certificate"]["levels"].as_u64().unwrap();
+    assert!(levels >= 3, "{report}");
+    let functions = report["certificate"]["functions"].as_u64().unwrap() as usize;
+    // to a tensor map: same mean det J (the same map), certified again
+    let tensor = dir.join("tensor.json");
+    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&tensor)]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&["check".as_ref(), &os(&tensor), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0));
+    let t = stdout_json(&out);
+    let (a, b) =
+        (t["certificate"]["mean_det_j"].as_f64().unwrap(), report["certificate"]["mean_det_j"].as_f64().unwrap());
+    assert!((a - b).abs() < 1e-12 * b, "mean det J {a} vs {b}");
+    let tensor_cps = read_json(&tensor)["map"]["control_points"].as_array().unwrap().len();
+    assert!(tensor_cps > functions, "the tensor map has more unknowns ({tensor_cps}) than the THB map ({functions})");
+    // THB as G+Smo XML and back to JSON: the same coefficients, bit for bit
+    let xml = dir.join("sector.xml");
+    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&xml), "--thb".as_ref()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read_to_string(&xml).unwrap().contains("THBSpline2"));
+    let back = dir.join("back.json");
+    let out = run(&["convert".as_ref(), &os(&xml), "-o".as_ref(), &os(&back), "--thb".as_ref()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let (orig, again) = (read_json(&src), read_json(&back));
+    assert_eq!(orig["map"]["control_points"], again["map"]["control_points"]);
+    assert_eq!(orig["map"]["refined"], again["map"]["refined"]);
+    // --thb refuses other outputs, and the input is never replaced
+    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&dir.join("x.vtu")), "--thb".as_ref()]);
+    assert_eq!(out.status.code(), Some(1));
+    let out = run(&["convert".as_ref(), &os(&back), "-o".as_ref(), &os(&back), "--thb".as_ref()]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn a_folded_thb_map_exits_3() {
+    let scratch = tempfile::tempdir().unwrap();
+    let mut doc = read_json(&data().join("thb/sector_thb.json"));
+    // pull the last (finest) function's control point to the origin, across the sector
+    let cps = doc["map"]["control_points"].as_array_mut().unwrap();
+    let last = cps.len() - 1;
+    cps[last] = serde_json::json!([0.0, 0.0]);
+    let path = scratch.path().join("folded.json");
+    winslow::io::write_bytes(&path, doc.to_string().as_bytes()).unwrap();
+    let out = run(&["check".as_ref(), path.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stdout));
+    let report = stdout_json(&out);
+    assert_eq!(report["certificate"]["verdict"]["kind"], "folded");
+    assert!(!report["certificate"]["folds"].as_array().unwrap().is_empty());
+    // a THB map is not a tensor map: other commands name the kind
+    let out = run(&["render".as_ref(), path.as_os_str(), "--png".as_ref(), scratch.path().join("x.png").as_os_str()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("THB map"));
+}

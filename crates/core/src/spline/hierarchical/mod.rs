@@ -1,0 +1,410 @@
+//! Truncated hierarchical B-splines (THB-splines; Giannelli, Jüttler, Speleers 2012;
+//! paper §4: "a (truncated) hierarchical spline basis ... allowing for local refinement").
+//!
+//! **Hierarchy.** Level `0` is an open tensor space `S^0` with knot vectors `(T_ξ^0, T_η^0)`;
+//! level `l + 1` halves every element of level `l` (dyadic refinement,
+//! [`KnotVector::halved`]), so `S^0 ⊂ S^1 ⊂ ...` and a level-`l` cell `(i, j)` has the four
+//! children `(2i + a, 2j + b)`, `a, b ∈ {0, 1}`. The domains `Ω^0 = [0, 1]² ⊇ Ω^1 ⊇ ...` are
+//! unions of cells: `Ω^{l+1}` is the union of the level-`l` cells marked *refined*. A
+//! level-`l` cell is *active* when it lies in `Ω^l` and is not refined; the active cells
+//! tile the domain.
+//!
+//! **Functions.** The level-`l` B-spline `β` is *active* when `supp β ⊆ Ω^l` and
+//! `supp β ⊄ Ω^{l+1}` (the hierarchical basis of Kraft). The truncation of a function
+//! `s ∈ S^l` with respect to level `l + 1` drops its components along the finer functions
+//! that live inside `Ω^{l+1}`:
+//!
+//! `trunc^{l+1} s = Σ_{τ ∈ B^{l+1}, supp τ ⊄ Ω^{l+1}} c_τ^{l+1}(s) τ`,
+//!
+//! where `s = Σ_{τ ∈ B^{l+1}} c_τ^{l+1}(s) τ` is the two-scale (knot insertion) relation,
+//! and the THB function of an active `β ∈ B^l` is `Trunc β = trunc^{L}(... trunc^{l+1}(β))`.
+//! The THB functions are non-negative, a partition of unity, linearly independent and
+//! span the same space as the hierarchical basis (GJS 2012, Thm. 9 and Prop. 6).
+//!
+//! **Admissibility.** [`HierarchicalBasis::refine`] refines marked cells together with the
+//! cells needed to keep the mesh *admissible of class `m`*: on every active cell the
+//! non-zero THB functions come from at most `m` successive levels (Bracco, Giannelli,
+//! Vázquez 2018, Algorithm "refine_recursive" with the THB neighbourhood
+//! `N(Q, m) = {Q' active of level l - m + 1 : Q' ∩ S(Q, l - m + 2) ≠ ∅}`, `S(Q, k)` the
+//! union of the supports of the level-`k` B-splines non-zero on `Q`).
+//!
+//! Submodules: [`truncation`] (the two-scale relation and the restriction of the THB
+//! functions to an active cell), [`map`] (THB maps of the plane: control points,
+//! evaluation, per-cell Bézier nets, refinement and conversion to a tensor map).
+
+pub mod map;
+#[cfg(test)]
+mod tests;
+pub mod truncation;
+
+use std::collections::{BTreeSet, HashMap};
+use std::ops::Range;
+
+use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::spline::knots::KnotVector;
+
+/// A cell or a function of one level: its index per direction (`xi`, `eta`).
+pub type Index2 = [usize; 2];
+
+/// Levels a hierarchy may hold (level `0` included).
+pub const MAX_LEVELS: usize = 24;
+
+/// One level of the hierarchy: its tensor knot vectors and per direction the elements
+/// and, for each knot position `k`, the element that starts at `t_k`.
+#[derive(Debug, Clone)]
+struct Level {
+    knots: [KnotVector; 2],
+    /// `(span, a, b)` per element.
+    elements: [Vec<(usize, f64, f64)>; 2],
+    /// `first[k]`: the number of distinct knot values `< t_k` (the index of the element
+    /// starting at `t_k`).
+    first: [Vec<usize>; 2],
+}
+
+impl Level {
+    fn new(knots: [KnotVector; 2]) -> Self {
+        let elements = knots.each_ref().map(KnotVector::elements);
+        let first = knots.each_ref().map(|kv| {
+            let t = kv.knots();
+            let mut out = Vec::with_capacity(t.len());
+            let mut distinct = 0;
+            for k in 0..t.len() {
+                if k > 0 && t[k] > t[k - 1] {
+                    distinct += 1;
+                }
+                out.push(distinct);
+            }
+            // the first knot value is the domain start: element 0 starts there
+            out
+        });
+        Self { knots, elements, first }
+    }
+
+    /// Cells (element indices) of the support of function `f` in direction `d`.
+    fn support(&self, d: usize, f: usize) -> Range<usize> {
+        let p = self.knots[d].degree();
+        let n_el = self.elements[d].len();
+        self.first[d][f].min(n_el)..self.first[d][f + p + 1].min(n_el)
+    }
+
+    /// Functions non-zero on cell `e` in direction `d`.
+    fn functions(&self, d: usize, e: usize) -> Range<usize> {
+        let s = self.elements[d][e].0;
+        s - self.knots[d].degree()..s + 1
+    }
+}
+
+/// A truncated hierarchical B-spline basis of the unit square (see the module doc).
+#[derive(Debug, Clone)]
+pub struct HierarchicalBasis {
+    levels: Vec<Level>,
+    /// `refined[l]`: the level-`l` cells that are refined (their children make `Ω^{l+1}`).
+    refined: Vec<BTreeSet<Index2>>,
+    /// Active functions `(level, index)`, by level, then `eta` index, then `xi` index.
+    active: Vec<(usize, Index2)>,
+    lookup: HashMap<(usize, Index2), usize>,
+}
+
+impl HierarchicalBasis {
+    /// The hierarchy with the single level `S^0` on these open knot vectors.
+    pub fn new(knots: [KnotVector; 2]) -> Result<Self> {
+        for (kv, name) in knots.iter().zip(["xi", "eta"]) {
+            if kv.is_periodic() || !kv.is_open() {
+                return Err(Error::Knots {
+                    context: format!("hierarchical basis, direction {name}"),
+                    reason: "level 0 must be an open (clamped), non-periodic knot vector".into(),
+                });
+            }
+        }
+        let mut out = Self {
+            levels: vec![Level::new(knots)],
+            refined: vec![BTreeSet::new()],
+            active: vec![],
+            lookup: HashMap::new(),
+        };
+        out.update_active();
+        Ok(out)
+    }
+
+    /// Degrees `(p, q)`.
+    pub fn degrees(&self) -> [usize; 2] {
+        self.levels[0].knots.each_ref().map(KnotVector::degree)
+    }
+
+    /// Number of levels (the finest level is `num_levels() - 1`; it may hold no cell yet).
+    pub fn num_levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Knot vectors of level `l`.
+    pub fn knots(&self, l: usize) -> &[KnotVector; 2] {
+        &self.levels[l].knots
+    }
+
+    /// Number of active (THB) functions.
+    pub fn len(&self) -> usize {
+        self.active.len()
+    }
+
+    /// Whether the basis is empty (never: level 0 always holds a function).
+    pub fn is_empty(&self) -> bool {
+        self.active.is_empty()
+    }
+
+    /// The active functions `(level, index)` in the order of the coefficients.
+    pub fn active_functions(&self) -> &[(usize, Index2)] {
+        &self.active
+    }
+
+    /// The position of the active function `(l, f)` among [`Self::active_functions`].
+    pub fn index_of(&self, l: usize, f: Index2) -> Option<usize> {
+        self.lookup.get(&(l, f)).copied()
+    }
+
+    /// The refined cells of level `l` (empty past the finest level).
+    pub fn refined_cells(&self, l: usize) -> impl Iterator<Item = &Index2> {
+        self.refined.get(l).into_iter().flatten()
+    }
+
+    /// Number of cells per direction at level `l`.
+    pub fn cell_shape(&self, l: usize) -> [usize; 2] {
+        self.levels[l].elements.each_ref().map(Vec::len)
+    }
+
+    /// Parameter bounds `[[ξ_0, ξ_1], [η_0, η_1]]` of cell `c` of level `l`.
+    pub fn cell_bounds(&self, l: usize, c: Index2) -> [[f64; 2]; 2] {
+        std::array::from_fn(|d| {
+            let (_, a, b) = self.levels[l].elements[d][c[d]];
+            [a, b]
+        })
+    }
+
+    /// Knot spans `(s_ξ, s_η)` of cell `c` of level `l`.
+    pub fn cell_spans(&self, l: usize, c: Index2) -> Index2 {
+        std::array::from_fn(|d| self.levels[l].elements[d][c[d]].0)
+    }
+
+    /// Whether cell `c` of level `l` lies in `Ω^l`.
+    pub fn in_domain(&self, l: usize, c: Index2) -> bool {
+        l == 0 || self.refined.get(l - 1).is_some_and(|r| r.contains(&[c[0] / 2, c[1] / 2]))
+    }
+
+    /// Whether cell `c` of level `l` is refined (lies in `Ω^{l+1}`).
+    pub fn is_refined(&self, l: usize, c: Index2) -> bool {
+        self.refined.get(l).is_some_and(|r| r.contains(&c))
+    }
+
+    /// Whether cell `c` of level `l` is active.
+    pub fn is_active_cell(&self, l: usize, c: Index2) -> bool {
+        self.in_domain(l, c) && !self.is_refined(l, c)
+    }
+
+    /// The active cells, by level, then `eta`, then `xi`.
+    pub fn active_cells(&self) -> Vec<(usize, Index2)> {
+        let mut out = Vec::new();
+        let [nx, ny] = self.cell_shape(0);
+        for j in 0..ny {
+            for i in 0..nx {
+                if !self.is_refined(0, [i, j]) {
+                    out.push((0, [i, j]));
+                }
+            }
+        }
+        for l in 1..self.levels.len() {
+            let mut level: Vec<Index2> = self.domain_cells(l).filter(|&c| !self.is_refined(l, c)).collect();
+            level.sort_by_key(|c| (c[1], c[0]));
+            out.extend(level.into_iter().map(|c| (l, c)));
+        }
+        out
+    }
+
+    /// The active cell containing the parameter point `(u, v)` (a point on a cell boundary
+    /// goes to the cell above it, the last cell keeps the domain's end).
+    pub fn cell_at(&self, u: f64, v: f64) -> (usize, Index2) {
+        let locate = |level: &Level, d: usize, x: f64| {
+            let els = &level.elements[d];
+            els.partition_point(|&(_, a, _)| a <= x).saturating_sub(1).min(els.len() - 1)
+        };
+        let mut c = [locate(&self.levels[0], 0, u), locate(&self.levels[0], 1, v)];
+        let mut l = 0;
+        while self.is_refined(l, c) {
+            l += 1;
+            c = [locate(&self.levels[l], 0, u), locate(&self.levels[l], 1, v)];
+        }
+        (l, c)
+    }
+
+    /// Cells of level `l >= 1` in `Ω^l` (the children of the refined cells of level `l - 1`).
+    fn domain_cells(&self, l: usize) -> impl Iterator<Item = Index2> + '_ {
+        self.refined[l - 1]
+            .iter()
+            .flat_map(|&[i, j]| [[2 * i, 2 * j], [2 * i + 1, 2 * j], [2 * i, 2 * j + 1], [2 * i + 1, 2 * j + 1]])
+    }
+
+    /// Cells of the support of function `f` of level `l`, per direction.
+    pub fn support(&self, l: usize, f: Index2) -> [Range<usize>; 2] {
+        std::array::from_fn(|d| self.levels[l].support(d, f[d]))
+    }
+
+    /// Functions of level `l` non-zero on cell `c`, per direction (`p + 1` and `q + 1`).
+    pub fn functions_on(&self, l: usize, c: Index2) -> [Range<usize>; 2] {
+        std::array::from_fn(|d| self.levels[l].functions(d, c[d]))
+    }
+
+    /// Whether every cell of the support of `(l, f)` satisfies `pred`.
+    fn support_all(&self, l: usize, f: Index2, pred: impl Fn(Index2) -> bool) -> bool {
+        let [ri, rj] = self.support(l, f);
+        rj.into_iter().all(|j| ri.clone().all(|i| pred([i, j])))
+    }
+
+    /// Whether `supp β ⊆ Ω^l` for the level-`l` function `f`.
+    pub fn support_in_domain(&self, l: usize, f: Index2) -> bool {
+        l == 0 || self.support_all(l, f, |c| self.in_domain(l, c))
+    }
+
+    /// Whether the level-`l` function `f` is active: `supp ⊆ Ω^l`, `supp ⊄ Ω^{l+1}`.
+    pub fn is_active(&self, l: usize, f: Index2) -> bool {
+        self.support_in_domain(l, f) && !self.support_all(l, f, |c| self.is_refined(l, c))
+    }
+
+    fn update_active(&mut self) {
+        let mut active = Vec::new();
+        let n0 = self.levels[0].knots.each_ref().map(KnotVector::num_basis);
+        for j in 0..n0[1] {
+            for i in 0..n0[0] {
+                if self.is_active(0, [i, j]) {
+                    active.push((0, [i, j]));
+                }
+            }
+        }
+        for l in 1..self.levels.len() {
+            let mut cand = BTreeSet::new();
+            for c in self.domain_cells(l) {
+                let [fi, fj] = self.functions_on(l, c);
+                for j in fj {
+                    for i in fi.clone() {
+                        cand.insert([j, i]);
+                    }
+                }
+            }
+            active.extend(cand.into_iter().map(|[j, i]| [i, j]).filter(|&f| self.is_active(l, f)).map(|f| (l, f)));
+        }
+        self.lookup = active.iter().enumerate().map(|(k, &lf)| (lf, k)).collect();
+        self.active = active;
+    }
+
+    /// Cells of level `k` of the support extension `S(Q, k)` of cell `c` of level `l >= k`:
+    /// the union of the supports of the level-`k` functions non-zero on `Q`'s ancestor.
+    fn support_extension(&self, l: usize, c: Index2, k: usize) -> [Range<usize>; 2] {
+        let anc = c.map(|x| x >> (l - k));
+        let fs = self.functions_on(k, anc);
+        std::array::from_fn(|d| {
+            let lo = self.levels[k].support(d, fs[d].start).start;
+            let hi = self.levels[k].support(d, fs[d].end - 1).end;
+            lo..hi
+        })
+    }
+
+    /// Refine the active cells `marked` (`(level, cell)`) and, recursively, the coarser
+    /// active cells that keep the hierarchy admissible of class `m >= 2` (see the module
+    /// doc). A marked cell that is not active is a typed error; so is a level past
+    /// [`MAX_LEVELS`] or a knot vector past the size limit.
+    pub fn refine(&mut self, marked: &[(usize, Index2)], m: usize) -> Result<()> {
+        if m < 2 {
+            return Err(Error::Invalid(format!("admissibility class must be at least 2, got {m}")));
+        }
+        for &(l, c) in marked {
+            let shape = self.levels.get(l).map(|_| self.cell_shape(l));
+            if !shape.is_some_and(|s| c[0] < s[0] && c[1] < s[1]) || !self.is_active_cell(l, c) {
+                return Err(Error::Invalid(format!("cell ({}, {}) of level {l} is not an active cell", c[0], c[1])));
+            }
+        }
+        for &(l, c) in marked {
+            self.refine_recursive(l, c, m)?;
+        }
+        self.update_active();
+        Ok(())
+    }
+
+    fn refine_recursive(&mut self, l: usize, c: Index2, m: usize) -> Result<()> {
+        if !self.is_active_cell(l, c) {
+            return Ok(());
+        }
+        if l + 1 >= m {
+            let k = l + 1 - m; // level of the neighbourhood
+            let [ri, rj] = self.support_extension(l, c, k + 1);
+            let mut nb = BTreeSet::new();
+            for j in rj {
+                for i in ri.clone() {
+                    nb.insert([i / 2, j / 2]);
+                }
+            }
+            for q in nb {
+                if self.is_active_cell(k, q) {
+                    self.refine_recursive(k, q, m)?;
+                }
+            }
+        }
+        self.ensure_level(l + 1)?;
+        self.refined[l].insert(c);
+        Ok(())
+    }
+
+    /// Create the levels up to `l`.
+    fn ensure_level(&mut self, l: usize) -> Result<()> {
+        while self.levels.len() <= l {
+            if self.levels.len() >= MAX_LEVELS {
+                return Err(Error::TooLarge {
+                    context: "hierarchical basis".into(),
+                    what: "levels".into(),
+                    found: self.levels.len() + 1,
+                    limit: MAX_LEVELS,
+                });
+            }
+            let last = &self.levels[self.levels.len() - 1];
+            let knots = last.knots.each_ref().map(KnotVector::halved);
+            if let Some(kv) = knots.iter().find(|kv| kv.num_basis() > MAX_CONTROL_POINTS) {
+                return Err(Error::TooLarge {
+                    context: "hierarchical basis".into(),
+                    what: "functions per direction of a level".into(),
+                    found: kv.num_basis(),
+                    limit: MAX_CONTROL_POINTS,
+                });
+            }
+            self.levels.push(Level::new(knots));
+            self.refined.push(BTreeSet::new());
+        }
+        Ok(())
+    }
+
+    /// Level-`l` refined cells as a sorted list (for writers).
+    pub fn refined_list(&self, l: usize) -> Vec<Index2> {
+        let mut v: Vec<Index2> = self.refined_cells(l).copied().collect();
+        v.sort_by_key(|c| (c[1], c[0]));
+        v
+    }
+
+    /// Rebuild a hierarchy from level-0 knots and the refined cells per level (as written
+    /// by [`Self::refined_list`]); each refined cell must lie in `Ω^l`.
+    pub fn from_refined(knots: [KnotVector; 2], refined: &[Vec<Index2>]) -> Result<Self> {
+        let mut out = Self::new(knots)?;
+        for (l, cells) in refined.iter().enumerate() {
+            if cells.is_empty() {
+                continue;
+            }
+            out.ensure_level(l + 1)?;
+            let shape = out.cell_shape(l);
+            for &c in cells {
+                if c[0] >= shape[0] || c[1] >= shape[1] || !out.in_domain(l, c) {
+                    return Err(Error::Invalid(format!(
+                        "refined cell ({}, {}) of level {l} is outside the level's domain",
+                        c[0], c[1]
+                    )));
+                }
+                out.refined[l].insert(c);
+            }
+        }
+        out.update_active();
+        Ok(out)
+    }
+}

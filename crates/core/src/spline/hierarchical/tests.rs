@@ -1,0 +1,284 @@
+//! THB basis and maps against their mathematics: two-scale relation against knot
+//! insertion, partition of unity, linear independence, admissibility, exact
+//! reproduction and nestedness under refinement, Bézier patches and tensor conversion.
+
+use super::map::HierarchicalMap;
+use super::truncation::{insert_knot, LevelCoefficients, Sparse};
+use super::*;
+use crate::spline::refine::prolongation;
+use crate::spline::surface::Surface;
+use crate::testutil::Lcg;
+
+fn kv(p: usize, breaks: &[f64]) -> KnotVector {
+    KnotVector::open_from_breaks(p, breaks, 1)
+}
+
+/// A hierarchy refined towards the south-west corner and around an interior cell.
+fn sample_basis(p: usize, q: usize, m: usize) -> HierarchicalBasis {
+    let mut b =
+        HierarchicalBasis::new([kv(p, &[0.0, 0.2, 0.45, 0.6, 0.8, 1.0]), kv(q, &[0.0, 0.3, 0.5, 0.75, 1.0])]).unwrap();
+    b.refine(&[(0, [0, 0]), (0, [2, 1])], m).unwrap();
+    b.refine(&[(1, [0, 0]), (1, [5, 3])], m).unwrap();
+    b.refine(&[(2, [1, 0])], m).unwrap();
+    b
+}
+
+#[test]
+fn knot_insertion_of_one_function_matches_the_prolongation() {
+    for p in 1..=4 {
+        let coarse = kv(p, &[0.0, 0.1, 0.35, 0.5, 0.9, 1.0]);
+        let fine = coarse.halved();
+        let pm = prolongation(&coarse, &fine).unwrap();
+        let b = HierarchicalBasis::new([coarse.clone(), coarse.clone()]).unwrap();
+        for s in 0..coarse.num_basis() {
+            let ch = b.children_1d(0, 0, s);
+            for i in 0..fine.num_basis() {
+                let want: f64 = pm.row(i).filter(|e| e.0 == s).map(|e| e.1).sum();
+                let got: f64 = ch.iter().filter(|e| e.0 == i).map(|e| e.1).sum();
+                assert!((want - got).abs() < 1e-14, "p={p} s={s} i={i}: {got} vs {want}");
+            }
+        }
+    }
+    // a knot inserted into a local sequence keeps the function
+    let mut t = vec![0.0, 0.2, 0.3, 0.7, 0.9];
+    let mut c = vec![1.0];
+    insert_knot(3, &mut t, &mut c, 0.5);
+    assert_eq!(t, vec![0.0, 0.2, 0.3, 0.5, 0.7, 0.9]);
+    assert_eq!(c.len(), 2);
+}
+
+#[test]
+fn partition_of_unity_and_non_negativity() {
+    for (p, q, m) in [(2, 2, 2), (3, 2, 2), (3, 3, 3), (1, 2, 2)] {
+        let b = sample_basis(p, q, m);
+        assert!(b.num_levels() >= 4, "refined to level 3");
+        let mut rng = Lcg::new(3);
+        for _ in 0..300 {
+            let (u, v) = (rng.uniform(), rng.uniform());
+            let vals = b.eval_basis(u, v);
+            let s: f64 = vals.iter().map(|x| x.1[0]).sum();
+            let su: f64 = vals.iter().map(|x| x.1[1]).sum();
+            let sv: f64 = vals.iter().map(|x| x.1[2]).sum();
+            assert!((s - 1.0).abs() < 1e-13, "p={p} q={q}: sum {s} at ({u}, {v})");
+            assert!(su.abs() < 1e-10 && sv.abs() < 1e-10, "derivatives of unity {su} {sv}");
+            assert!(vals.iter().all(|x| x.1[0] >= -1e-14), "negative THB function at ({u}, {v})");
+        }
+    }
+}
+
+/// Rank of a dense matrix (rows of equal length) by Gaussian elimination with full pivoting.
+fn rank(mut a: Vec<Vec<f64>>, tol: f64) -> usize {
+    let (rows, cols) = (a.len(), a[0].len());
+    let mut r = 0;
+    for c in 0..cols {
+        let Some(piv) = (r..rows).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())) else { break };
+        if a[piv][c].abs() <= tol {
+            continue;
+        }
+        a.swap(r, piv);
+        for i in r + 1..rows {
+            let f = a[i][c] / a[r][c];
+            for k in c..cols {
+                a[i][k] -= f * a[r][k];
+            }
+        }
+        r += 1;
+    }
+    r
+}
+
+#[test]
+fn linear_independence_by_collocation() {
+    for (p, q, m) in [(2, 2, 2), (3, 3, 3), (1, 1, 2)] {
+        let b = sample_basis(p, q, m);
+        let n = b.len();
+        let mut rng = Lcg::new(11);
+        let rows: Vec<Vec<f64>> = (0..4 * n)
+            .map(|_| {
+                let mut row = vec![0.0; n];
+                for (k, v) in b.eval_basis(rng.uniform(), rng.uniform()) {
+                    row[k] = v[0];
+                }
+                row
+            })
+            .collect();
+        // plus points inside the small cells, so that every function is sampled
+        let mut rows = rows;
+        for (l, c) in b.active_cells() {
+            let [[a, bb], [cc, dd]] = b.cell_bounds(l, c);
+            for _ in 0..(p + 1) * (q + 1) {
+                let mut row = vec![0.0; n];
+                let (u, v) = (a + (bb - a) * rng.uniform(), cc + (dd - cc) * rng.uniform());
+                for (k, val) in b.eval_basis(u, v) {
+                    row[k] = val[0];
+                }
+                rows.push(row);
+            }
+        }
+        assert_eq!(rank(rows, 1e-12), n, "p={p} q={q}: {n} THB functions");
+    }
+}
+
+#[test]
+fn one_level_is_the_tensor_basis() {
+    let b = HierarchicalBasis::new([kv(2, &[0.0, 0.5, 1.0]), kv(3, &[0.0, 1.0])]).unwrap();
+    assert_eq!(b.len(), 4 * 4);
+    assert_eq!(b.num_levels(), 1);
+    assert_eq!(b.active_cells().len(), 2);
+}
+
+#[test]
+fn admissibility_bounds_the_levels_on_every_cell() {
+    for m in [2, 3] {
+        let mut b =
+            HierarchicalBasis::new([kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0]), kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0])]).unwrap();
+        // refine towards an interior point, five times
+        for _ in 0..5 {
+            let (l, c) = b.cell_at(0.51, 0.49);
+            b.refine(&[(l, c)], m).unwrap();
+        }
+        assert_eq!(b.cell_at(0.51, 0.49).0, 5);
+        for (l, c) in b.active_cells() {
+            let [[a, bb], [cc, dd]] = b.cell_bounds(l, c);
+            let vals = b.eval_basis(0.5 * (a + bb), 0.5 * (cc + dd));
+            let levels: BTreeSet<usize> = vals.iter().map(|v| b.active_functions()[v.0].0).collect();
+            let span = levels.last().unwrap() - levels.first().unwrap() + 1;
+            assert!(span <= m, "m={m}: cell ({l}, {c:?}) sees levels {levels:?}");
+        }
+    }
+    // a marked cell that is not active is a typed error
+    let mut b = sample_basis(2, 2, 2);
+    assert!(b.refine(&[(0, [0, 0])], 2).is_err());
+    assert!(b.refine(&[(0, [99, 0])], 2).is_err());
+    assert!(b.refine(&[(1, [0, 0])], 1).is_err());
+}
+
+fn random_surface(p: usize, q: usize, seed: u64) -> Surface {
+    let knots = [kv(p, &[0.0, 0.3, 0.5, 1.0]), kv(q, &[0.0, 0.4, 0.7, 1.0])];
+    let n = knots[0].num_basis() * knots[1].num_basis();
+    let mut rng = Lcg::new(seed);
+    let cps = (0..n).map(|_| [rng.uniform(), rng.uniform()]).collect();
+    Surface::new(knots, cps, None).unwrap()
+}
+
+#[test]
+fn tensor_map_is_reproduced_and_refinement_keeps_the_map() {
+    for (p, q) in [(2, 2), (3, 2), (2, 3), (1, 1)] {
+        let s = random_surface(p, q, 5 + p as u64);
+        let mut map = HierarchicalMap::from_surface(&s).unwrap();
+        let mut rng = Lcg::new(9);
+        for step in 0..4 {
+            // refine the active cell around a random point
+            let (l, c) = map.basis.cell_at(rng.uniform(), rng.uniform());
+            let (l2, c2) = map.basis.cell_at(0.01, 0.99);
+            map = map.refined(&[(l, c), (l2, c2)], 2).unwrap();
+            for _ in 0..200 {
+                let (u, v) = (rng.uniform(), rng.uniform());
+                let (a, b) = (map.derivs(u, v), s.derivs(u, v, 2));
+                for z in 0..2 {
+                    assert!((a.x[z] - b.x[z]).abs() < 1e-13, "p={p} q={q} step {step}: x");
+                    assert!((a.xu[z] - b.xu[z]).abs() < 1e-11 && (a.xv[z] - b.xv[z]).abs() < 1e-11, "gradient");
+                    assert!((a.xuv[z] - b.xuv[z]).abs() < 1e-8, "mixed derivative");
+                }
+            }
+        }
+        assert!(map.basis.num_levels() >= 4);
+    }
+}
+
+#[test]
+fn refinement_keeps_a_genuine_thb_map() {
+    // a map with coefficients only the THB space has (random on every active function)
+    let b = sample_basis(2, 3, 2);
+    let mut rng = Lcg::new(21);
+    let cps: Vec<[f64; 2]> = (0..b.len()).map(|_| [rng.uniform(), rng.uniform()]).collect();
+    let map = HierarchicalMap::new(b, cps).unwrap();
+    let cells: Vec<(usize, Index2)> = map.basis.active_cells().into_iter().step_by(5).take(4).collect();
+    let fine = map.refined(&cells, 3).unwrap();
+    assert!(fine.basis.len() > map.basis.len());
+    for _ in 0..300 {
+        let (u, v) = (rng.uniform(), rng.uniform());
+        let (a, b) = (map.eval(u, v), fine.eval(u, v));
+        assert!((a[0] - b[0]).abs() < 1e-13 && (a[1] - b[1]).abs() < 1e-13, "({u}, {v}): {a:?} vs {b:?}");
+    }
+    // and the tensor conversion is the same map
+    let t = fine.to_surface().unwrap();
+    for _ in 0..300 {
+        let (u, v) = (rng.uniform(), rng.uniform());
+        let (a, b) = (fine.derivs(u, v), t.derivs(u, v, 1));
+        for z in 0..2 {
+            assert!((a.x[z] - b.x[z]).abs() < 1e-12, "tensor conversion at ({u}, {v})");
+            assert!((a.xu[z] - b.xu[z]).abs() < 1e-9 && (a.xv[z] - b.xv[z]).abs() < 1e-9);
+        }
+    }
+    // the tensor space is the coarsest with the active cells' edges: fewer knots than the finest level
+    let finest = fine.basis.knots(fine.basis.num_levels() - 1);
+    assert!(t.knots[0].knots().len() < finest[0].knots().len());
+}
+
+#[test]
+fn map_derivatives_match_finite_differences() {
+    let b = sample_basis(3, 3, 2);
+    let mut rng = Lcg::new(2);
+    let cps: Vec<[f64; 2]> = (0..b.len()).map(|_| [rng.uniform(), rng.uniform()]).collect();
+    let map = HierarchicalMap::new(b, cps).unwrap();
+    let h = 1e-6;
+    for _ in 0..200 {
+        let (u, v) = (0.01 + 0.98 * rng.uniform(), 0.01 + 0.98 * rng.uniform());
+        let d = map.derivs(u, v);
+        let (xp, xm) = (map.eval(u + h, v), map.eval(u - h, v));
+        let (yp, ym) = (map.eval(u, v + h), map.eval(u, v - h));
+        for z in 0..2 {
+            // the map is C^2 for cubics: central differences across cell edges are fine
+            assert!(((xp[z] - xm[z]) / (2.0 * h) - d.xu[z]).abs() < 1e-6 * (1.0 + d.xu[z].abs()));
+            assert!(((yp[z] - ym[z]) / (2.0 * h) - d.xv[z]).abs() < 1e-6 * (1.0 + d.xv[z].abs()));
+        }
+    }
+}
+
+#[test]
+fn bezier_patches_equal_the_map_on_their_cells() {
+    let b = sample_basis(2, 3, 2);
+    let mut rng = Lcg::new(4);
+    let cps: Vec<[f64; 2]> = (0..b.len()).map(|_| [rng.uniform(), rng.uniform()]).collect();
+    let map = HierarchicalMap::new(b, cps).unwrap();
+    let patches = map.bezier_patches().unwrap();
+    assert_eq!(patches.len(), map.basis.active_cells().len());
+    for (l, c, patch) in &patches {
+        let [[a, bb], [cc, dd]] = map.basis.cell_bounds(*l, *c);
+        for _ in 0..10 {
+            let (u, v) = (a + (bb - a) * rng.uniform(), cc + (dd - cc) * rng.uniform());
+            let (x, y) = (map.eval(u, v), patch.eval(u, v));
+            assert!((x[0] - y[0]).abs() < 1e-13 && (x[1] - y[1]).abs() < 1e-13, "cell ({l}, {c:?})");
+        }
+    }
+}
+
+#[test]
+fn restriction_of_each_function_sums_to_the_map() {
+    // the level coefficients of the map are the combination of those of the functions
+    let b = sample_basis(2, 2, 2);
+    let mut rng = Lcg::new(8);
+    let cps: Vec<[f64; 2]> = (0..b.len()).map(|_| [rng.uniform(), rng.uniform()]).collect();
+    let map = HierarchicalMap::new(b.clone(), cps.clone()).unwrap();
+    let mut pts = map.level_coefficients();
+    let mut sparse = LevelCoefficients::<Sparse>::new(&b, |k| vec![(k, 1.0)]);
+    for (l, c) in b.active_cells() {
+        let (np, ns) = (pts.cell_net(l, c), sparse.cell_net(l, c));
+        for (x, s) in np.iter().zip(&ns) {
+            let y = s.iter().fold([0.0, 0.0], |a, &(k, w)| [a[0] + w * cps[k][0], a[1] + w * cps[k][1]]);
+            assert!((x[0] - y[0]).abs() < 1e-14 && (x[1] - y[1]).abs() < 1e-14);
+        }
+    }
+}
+
+#[test]
+fn from_refined_rebuilds_the_hierarchy() {
+    let b = sample_basis(2, 2, 2);
+    let refined: Vec<Vec<Index2>> = (0..b.num_levels()).map(|l| b.refined_list(l)).collect();
+    let c = HierarchicalBasis::from_refined(b.knots(0).clone(), &refined).unwrap();
+    assert_eq!(c.active_functions(), b.active_functions());
+    // a refined cell outside its level's domain is a typed error
+    let bad = vec![vec![], vec![[7, 7]]];
+    assert!(HierarchicalBasis::from_refined(b.knots(0).clone(), &bad).is_err());
+}
