@@ -104,8 +104,8 @@ pub const MAX_KRYLOV: usize = 2000;
 pub const AUTO_MAX_KRYLOV: usize = 500;
 
 /// Smoother of [`LinearMethod::Multigrid`]: ILU(0). On the metric Laplacian of a
-/// stretched, sheared quarter annulus (`p = 3`, 32² to 128² elements) a V(1,1)-cycle
-/// with ILU(0) reduces the residual by 0.012 per cycle at every size, with symmetric
+/// stretched, sheared quarter annulus (`p = 3`, 32² and 64² elements) a V(1,1)-cycle
+/// with ILU(0) reduces the residual by 0.012 per cycle at both sizes, with symmetric
 /// Gauss–Seidel by 0.54 (the smoothing of Gauss–Seidel degrades with the degree and the
 /// cells' aspect ratio); in the Newton solves the Gauss–Seidel cycle's GMRES iterations
 /// grew as `h` halved (BENCHMARKS.md "Multigrid").
