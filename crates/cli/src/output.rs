@@ -472,6 +472,16 @@ pub struct BenchRow {
     /// Seconds of one Newton iteration on the finest level (assembly plus linear solve,
     /// averaged over its iterations).
     pub newton_iteration_s: f64,
+    /// GMRES iterations per linear solve (Newton step) on the finest level, mean
+    /// (0 with direct solves).
+    pub krylov_mean: f64,
+    /// ... and the most of one solve.
+    pub krylov_max: usize,
+    /// Seconds of the finest level's linear solves spent assembling the preconditioner's
+    /// metric Laplacian and factorizing.
+    pub factor_s: f64,
+    /// Peak resident memory per finest-level unknown, in bytes.
+    pub peak_bytes_per_dof: f64,
     /// Verdict.
     pub verdict: Verdict,
     /// Tensor-product basis functions of the map.
@@ -507,6 +517,10 @@ impl BenchRow {
             certify_s: r.certificate.seconds,
             newton_iteration_s: last
                 .map_or(0.0, |l| (l.assembly_seconds + l.linear_seconds) / l.iterations.max(1) as f64),
+            krylov_mean: last.map_or(0.0, |l| l.krylov_iterations as f64 / l.linear_solves.max(1) as f64),
+            krylov_max: last.map_or(0, |l| l.krylov_max),
+            factor_s: last.map_or(0.0, |l| l.factor_seconds),
+            peak_bytes_per_dof: peak_memory_mib() * (1u64 << 20) as f64 / last.map_or(1, |l| l.unknowns.max(1)) as f64,
             verdict: r.verdict,
             basis: r.basis_functions,
             winslow: r.winslow,
@@ -554,23 +568,30 @@ pub fn bench_table(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| geometry | refine | DOFs | levels | Newton its | assembly s | solve s | total s | peak MiB | estimated MiB | elements | certify s | Newton it s | verdict | reparam (matches) | basis | Winslow | min scaled J |"
+        "| geometry | refine | DOFs | levels | Newton its | GMRES its/step (mean, max) | assembly s | solve s | factor s (finest) | total s | peak MiB | peak B/DOF | estimated MiB | elements | certify s | Newton it s | verdict | reparam (matches) | basis | Winslow | min scaled J |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|"
+    );
     for r in rows {
         let its = if r.pseudo > 0 { format!("{} (+{} pseudo-time)", r.newton, r.pseudo) } else { r.newton.to_string() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:.0} | {} | {:.4} | {:.4} | {:?} | {} ({}) | {} | {} | {:.4} |",
+            "| {} | {} | {} | {} | {} | {:.1}, {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.0} | {:.0} | {:.0} | {} | {:.4} | {:.4} | {:?} | {} ({}) | {} | {} | {:.4} |",
             r.geometry,
             r.refine,
             r.dofs,
             r.levels,
             its,
+            r.krylov_mean,
+            r.krylov_max,
             r.assembly_s,
             r.solve_s,
+            r.factor_s,
             r.total_s,
             r.peak_mib,
+            r.peak_bytes_per_dof,
             r.estimated_mib,
             r.elements,
             r.certify_s,

@@ -195,6 +195,30 @@ fn bench_prints_a_table() {
     );
 }
 
+/// `bench --json` reports the GMRES iterations per Newton step and the peak per unknown,
+/// and `--linear multigrid` gives the map of the factorized preconditioner.
+#[test]
+fn bench_json_reports_krylov_iterations_and_multigrid_agrees() {
+    let row = |linear: &str| -> serde_json::Value {
+        let out = bin()
+            .arg("bench")
+            .arg(data().join("quarter_annulus.json"))
+            .args(["--refinements", "2", "--json", "--linear", linear])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let (gmres, mg) = (row("gmres"), row("multigrid"));
+    for r in [&gmres, &mg] {
+        assert_eq!(r["verdict"], "certified", "{r}");
+        assert!(r["krylov_mean"].as_f64().unwrap() > 0.0 && r["krylov_max"].as_u64().unwrap() >= 1, "{r}");
+        assert!(r["peak_bytes_per_dof"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    let (a, b) = (gmres["winslow"].as_f64().unwrap(), mg["winslow"].as_f64().unwrap());
+    assert!((a - b).abs() <= 1e-9 * a, "Winslow {a} (factorization) against {b} (multigrid)");
+}
+
 /// Whether a GPU test may run: an adapter is there, or `WINSLOW_REQUIRE_GPU=1` demands
 /// one (then its absence fails the test through the command's error).
 fn gpu_available_or_required() -> bool {

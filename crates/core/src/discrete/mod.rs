@@ -8,6 +8,8 @@
 //! | [`dofs`] | [`DofMap`](dofs::DofMap): free versus fixed DOFs, gather and scatter of the unknowns `c` | eq. (9)-(10) |
 //! | [`pattern`] | [`SystemPattern`](pattern::SystemPattern): sparsity of the free-free systems, gather from stencil storage (periodic replicas summed) | |
 //! | [`tables`] | [`DirTable`](tables::DirTable): the univariate basis at the Gauss points | §4 |
+//! | [`stencil`] | the product of a system with a vector from its stencil storage (no sparse matrix) | eq. (12) |
+//! | [`transfers`] | the nested knot-halving spaces below a basis and the prolongations of their free unknowns (multigrid) | §6.3 |
 //! | [`assembly`] | [`Discretization`](assembly::Discretization): basis tables, patterns, the EGG residual and Jacobian kernels (eq. 8, 12, 23), mass, elasticity, metric Laplacian | §4, §6 |
 //!
 //! Symbolic work (tables, patterns, orderings) is done once per basis when a
@@ -17,5 +19,7 @@
 pub mod assembly;
 pub mod dofs;
 pub mod pattern;
+pub mod stencil;
 pub mod tables;
 pub mod topology;
+pub mod transfers;

@@ -26,6 +26,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0};
+use crate::linalg::multigrid::{Multigrid, Smoother};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
 use crate::linalg::split_cholesky::{SplitCholesky, SPLIT_MIN};
@@ -49,6 +50,15 @@ pub enum LinearMethod {
         value(help = "LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations")
     )]
     Auto,
+    /// Restarted flexible GMRES as [`LinearMethod::Gmres`], preconditioned by
+    /// `-diag(B, B)` with `B` one multigrid V-cycle for the problem's SPD approximation
+    /// `K` on the nested spaces set with [`LinearSolver::set_transfers`]
+    /// ([`crate::linalg::multigrid`]); without them as [`LinearMethod::Gmres`].
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "GMRES, preconditioned by a multigrid V-cycle on the knot-halving hierarchy")
+    )]
+    Multigrid,
     /// Sparse Cholesky `L L^T` (symmetric positive definite systems only).
     #[cfg_attr(feature = "clap", value(skip))]
     Cholesky,
@@ -92,6 +102,17 @@ pub const MAX_KRYLOV: usize = 2000;
 /// preconditioner that does not fit the operator (the weak form, eq. 14, on cells of
 /// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
 pub const AUTO_MAX_KRYLOV: usize = 500;
+
+/// Smoother of [`LinearMethod::Multigrid`]: ILU(0). On the metric Laplacian of a
+/// stretched, sheared quarter annulus (`p = 3`, 32² and 64² elements) a V(1,1)-cycle
+/// with ILU(0) reduces the residual by 0.012 per cycle at both sizes, with symmetric
+/// Gauss–Seidel by 0.54 (the smoothing of Gauss–Seidel degrades with the degree and the
+/// cells' aspect ratio); in the Newton solves the Gauss–Seidel cycle's GMRES iterations
+/// grew as `h` halved (BENCHMARKS.md "Multigrid").
+pub const MG_SMOOTHER: Smoother = Smoother::Ilu0;
+
+/// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
+pub const MG_SWEEPS: usize = 1;
 
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
 pub const REFRESH_KRYLOV: usize = 30;
@@ -291,6 +312,8 @@ enum Preconditioner {
     NegBlock(Box<Cholesky<f64>>),
     /// `P = diag(K_11, ..., K_cc)`, the diagonal blocks of the matrix (block Jacobi).
     BlockJacobi(Vec<Cholesky<f32>>),
+    /// `P = -diag(B, ..., B)`, `B` a multigrid V-cycle for `K`.
+    NegMultigrid(Box<Multigrid>),
 }
 
 impl Preconditioner {
@@ -316,11 +339,19 @@ impl Preconditioner {
                 let m = x.len() / blocks.len();
                 blocks.par_iter_mut().zip(x.par_chunks_mut(m)).for_each(|(k, xs)| k.solve_columns(xs));
             }
+            Self::NegMultigrid(mg) => {
+                let m = mg.size();
+                // the components on their own threads
+                b.par_chunks(m).zip(x.par_chunks_mut(m)).for_each(|(bs, xs)| {
+                    mg.apply(bs, xs);
+                    xs.iter_mut().for_each(|v| *v = -*v);
+                });
+            }
         }
     }
 
     fn is_block(&self) -> bool {
-        matches!(self, Self::NegBlock32(..) | Self::NegBlock(..))
+        matches!(self, Self::NegBlock32(..) | Self::NegBlock(..) | Self::NegMultigrid(..))
     }
 }
 
@@ -340,8 +371,14 @@ pub struct LinearSolver {
     matrix: Option<Csr>,
     /// Fill-reducing order of the `m` scalar unknowns (see [`LinearSolver::set_ordering`]).
     order: Option<Vec<usize>>,
+    /// The prolongations of the multigrid hierarchy (see [`LinearSolver::set_transfers`]).
+    transfers: Vec<Csr>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
+    /// The most GMRES iterations one solve took (diagnostics).
+    pub krylov_max: usize,
+    /// Solves so far (diagnostics).
+    pub solves: usize,
     last_krylov: usize,
     /// The preconditioner was factorized for the next solve.
     fresh: bool,
@@ -371,7 +408,10 @@ impl LinearSolver {
             precond: None,
             matrix: None,
             order: None,
+            transfers: Vec::new(),
             krylov_iterations: 0,
+            krylov_max: 0,
+            solves: 0,
             last_krylov: 0,
             fresh: false,
             double: false,
@@ -389,6 +429,13 @@ impl LinearSolver {
     /// Without it, approximate minimum degree.
     pub fn set_ordering(&mut self, order: &[usize]) {
         self.order = Some(order.to_vec());
+    }
+
+    /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l]` maps the free
+    /// scalar unknowns of space `l + 1` to those of space `l`, space 0 the one of the
+    /// problem's `m` scalar unknowns (see [`crate::discrete::transfers`]).
+    pub fn set_transfers(&mut self, transfers: Vec<Csr>) {
+        self.transfers = transfers;
     }
 
     /// The fill-reducing order for a matrix of `n` unknowns, if one is known.
@@ -442,7 +489,7 @@ impl LinearSolver {
     pub fn wants_preconditioner(&self, n: usize) -> bool {
         let fresh = !self.precond.as_ref().is_some_and(Preconditioner::is_block) || self.last_krylov > REFRESH_KRYLOV;
         match self.method {
-            LinearMethod::Gmres => fresh,
+            LinearMethod::Gmres | LinearMethod::Multigrid => fresh,
             LinearMethod::Auto => n > AUTO_LU_LIMIT,
             LinearMethod::Lu | LinearMethod::Cholesky | LinearMethod::NegCholesky | LinearMethod::Pcg => false,
         }
@@ -457,7 +504,7 @@ impl LinearSolver {
     /// `k` (SPD, `a.nrows` a multiple of its size) is given.
     pub fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
         self.resolve(a.nrows);
-        if matches!(self.method, LinearMethod::Gmres | LinearMethod::Pcg) {
+        if matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid | LinearMethod::Pcg) {
             // the Krylov methods multiply with `a`: keep it
             self.matrix_mut().update(a);
             self.factor_stored(k)
@@ -553,10 +600,21 @@ impl LinearSolver {
                 self.negated = neg;
                 self.llt = Some(r?);
             }
-            LinearMethod::Gmres => {
+            LinearMethod::Gmres | LinearMethod::Multigrid => {
                 let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
                 let previous = self.precond.take();
+                let multigrid = self.method == LinearMethod::Multigrid
+                    && block.is_some_and(|k| self.transfers.first().is_some_and(|p| p.nrows == k.nrows));
                 self.precond = match (block, previous) {
+                    // the multigrid hierarchy set up (again) for the new approximation
+                    (Some(k), previous) if multigrid => {
+                        let mut mg = match previous {
+                            Some(Preconditioner::NegMultigrid(mg)) => mg,
+                            _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
+                        };
+                        mg.factor(k)?;
+                        Some(Preconditioner::NegMultigrid(mg))
+                    }
                     // a new approximation: refactor in place (same pattern), in single
                     // precision unless that failed before or was not definite ...
                     (Some(k), previous) => Some(self.block_preconditioner(a, k, previous)?),
@@ -584,6 +642,7 @@ impl LinearSolver {
 
     /// Solve `a x = b` with the last factorized `a`.
     pub fn solve(&mut self, b: &[f64]) -> Result<Vec<f64>> {
+        self.solves += 1;
         let x = match self.method {
             LinearMethod::Lu if self.dense.is_some() => self.dense.as_ref().expect("checked").solve(b),
             LinearMethod::Lu => {
@@ -612,7 +671,7 @@ impl LinearSolver {
                 llt.solve_columns(&mut x);
                 x
             }
-            LinearMethod::Gmres => {
+            LinearMethod::Gmres | LinearMethod::Multigrid => {
                 let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 let pc = self.precond.as_mut().expect("set with matrix");
                 // a direct factorization of a small system costs few GMRES iterations
@@ -620,6 +679,7 @@ impl LinearSolver {
                 match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, cap) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
+                        self.krylov_max = self.krylov_max.max(it);
                         self.last_krylov = it;
                         if std::mem::take(&mut self.fresh)
                             && it > REFRESH_KRYLOV
@@ -634,6 +694,7 @@ impl LinearSolver {
                         self.method = LinearMethod::Lu;
                         self.fallback = false;
                         self.factor_stored(None).map_err(|f| Error::LinearSolver(format!("{e}; LU fallback: {f}")))?;
+                        self.solves -= 1;
                         return self.solve(b);
                     }
                     Err(e) => return Err(e),
@@ -653,6 +714,7 @@ impl LinearSolver {
                         self.method = LinearMethod::Cholesky;
                         self.precond = None;
                         self.factor_stored(None)?;
+                        self.solves -= 1;
                         return self.solve(b);
                     }
                 }

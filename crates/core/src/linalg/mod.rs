@@ -10,6 +10,7 @@
 //! | [`ordering`] | nested dissection of a grid of points, interleaving of component blocks |
 //! | [`linsolve`] | [`LinearSolver`](linsolve::LinearSolver): LU, Cholesky preconditioners (f32/f64), the choice of method |
 //! | [`krylov`] | flexible GMRES, preconditioned CG, ILU(0) |
+//! | [`multigrid`] | [`Multigrid`](multigrid::Multigrid): V-cycles on nested spaces given by their prolongations, Galerkin coarse operators |
 //!
 //! Why here and not in [`crate::discrete`]: the refinement operators of the spline layer
 //! (knot insertion, degree elevation, [`crate::spline::refine`]) are sparse matrices, so
@@ -19,6 +20,7 @@ pub mod banded;
 pub mod dense;
 pub mod krylov;
 pub mod linsolve;
+pub mod multigrid;
 pub mod ordering;
 pub mod sparse;
 pub mod split_cholesky;

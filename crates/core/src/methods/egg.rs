@@ -156,6 +156,11 @@ impl DiscreteProblem for EggProblem {
         Some(&self.state.disc.ordering)
     }
 
+    /// The knot-halving hierarchy below the basis ([`crate::discrete::transfers`]).
+    fn transfers(&self) -> Vec<Csr> {
+        crate::discrete::transfers::free_prolongations(&self.state.disc).unwrap_or_default()
+    }
+
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
         self.state.control_points(c)
     }

@@ -134,6 +134,13 @@ pub trait DiscreteProblem {
     fn ordering(&self) -> Option<&[usize]> {
         None
     }
+    /// The prolongations of the nested spaces below the problem's scalar space, finest
+    /// first, for a multigrid preconditioner of [`DiscreteProblem::preconditioner`]'s
+    /// `K` (see [`crate::linalg::linsolve::LinearSolver::set_transfers`]); empty (the
+    /// default) when the problem has none.
+    fn transfers(&self) -> Vec<Csr> {
+        Vec::new()
+    }
     /// All control points of the map with unknowns `c` (fixed ones as given).
     fn control_points(&self, c: &[f64]) -> Vec<Point>;
 }
@@ -174,6 +181,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn ordering(&self) -> Option<&[usize]> {
         (**self).ordering()
+    }
+    fn transfers(&self) -> Vec<Csr> {
+        (**self).transfers()
     }
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
         (**self).control_points(c)

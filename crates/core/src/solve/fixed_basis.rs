@@ -138,6 +138,7 @@ impl<P: DiscreteProblem> FixedBasisSolve<P> {
         self.drain()?;
         let (status, objective, timings) = (self.solver.status().clone(), self.solver.objective(), self.solver.timings);
         let (chord_steps, krylov_iterations) = (self.solver.chord_steps, self.solver.krylov_iterations());
+        let (krylov_max, linear_solves) = (self.solver.krylov_max(), self.solver.linear_solves());
         let (problem, c) = self.solver.into_parts();
         Ok(Solved {
             control_points: problem.control_points(&c),
@@ -148,6 +149,8 @@ impl<P: DiscreteProblem> FixedBasisSolve<P> {
             timings,
             chord_steps,
             krylov_iterations,
+            krylov_max,
+            linear_solves,
         })
     }
 }
@@ -178,6 +181,10 @@ pub struct Solved {
     pub chord_steps: usize,
     /// Krylov iterations spent (0 with direct solves).
     pub krylov_iterations: usize,
+    /// The most Krylov iterations of one linear solve (0 with direct solves).
+    pub krylov_max: usize,
+    /// Linear solves (Newton, chord and pseudo-time steps).
+    pub linear_solves: usize,
 }
 
 impl Solved {

@@ -181,6 +181,9 @@ pub struct Timings {
     pub assembly: Duration,
     /// Factorizations and solves.
     pub linear: Duration,
+    /// Of `linear`: assembling the preconditioner's SPD approximation and factorizing
+    /// (the system matrix, or the preconditioner of a Krylov solve).
+    pub factor: Duration,
 }
 
 /// An iterative solve in progress; `Iterator` over its [`Iterate`]s.
@@ -243,6 +246,9 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         if let Some(order) = problem.ordering() {
             lin.set_ordering(order);
         }
+        if linear == LinearMethod::Multigrid {
+            lin.set_transfers(problem.transfers());
+        }
         Self {
             problem,
             opts,
@@ -262,7 +268,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             status: Status::Running,
             started: false,
             chord_steps: 0,
-            timings: Timings { assembly, linear: Duration::ZERO },
+            timings: Timings { assembly, linear: Duration::ZERO, factor: Duration::ZERO },
         }
     }
 
@@ -279,6 +285,16 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     /// Krylov (GMRES) iterations spent so far; 0 with direct solves.
     pub fn krylov_iterations(&self) -> usize {
         self.lin.krylov_iterations
+    }
+
+    /// The most Krylov iterations one linear solve took so far; 0 with direct solves.
+    pub fn krylov_max(&self) -> usize {
+        self.lin.krylov_max
+    }
+
+    /// Linear solves so far (Newton and chord steps, pseudo-time steps).
+    pub fn linear_solves(&self) -> usize {
+        self.lin.solves
     }
 
     /// The current objective `J` of a minimization method (`None` for root-finding).
@@ -376,6 +392,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             None
         };
         self.lin.factor_stored(k)?;
+        self.timings.factor += t.elapsed();
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
         let dx = match (self.lin.solve(&rhs), self.problem.rank_one()) {
             (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),

@@ -67,8 +67,15 @@ pub struct LevelReport {
     pub assembly_seconds: f64,
     /// Seconds spent in linear solves.
     pub linear_seconds: f64,
+    /// Of `linear_seconds`: assembling the preconditioner's metric Laplacian and
+    /// factorizing.
+    pub factor_seconds: f64,
     /// GMRES iterations over all linear solves of the level (0 with direct LU).
     pub krylov_iterations: usize,
+    /// The most GMRES iterations of one linear solve of the level (0 with direct LU).
+    pub krylov_max: usize,
+    /// Linear solves of the level (Newton, chord and pseudo-time steps).
+    pub linear_solves: usize,
     /// Seconds for the whole level (set-up, initial guess, iterations).
     pub seconds: f64,
 }

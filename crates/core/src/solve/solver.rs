@@ -274,7 +274,10 @@ impl EggSolver {
             scaled_residuals: Vec::new(),
             assembly_seconds: 0.0,
             linear_seconds: 0.0,
+            factor_seconds: 0.0,
             krylov_iterations: 0,
+            krylov_max: 0,
+            linear_solves: 0,
             seconds: 0.0,
         };
         self.active = Some(Active { level: k, solver, report, started: t0, weights });
@@ -291,7 +294,9 @@ impl EggSolver {
         (a.report.residuals, a.report.scaled_residuals) = (h.residuals, h.scaled_residuals);
         a.report.assembly_seconds = solved.timings.assembly.as_secs_f64();
         a.report.linear_seconds = solved.timings.linear.as_secs_f64();
+        a.report.factor_seconds = solved.timings.factor.as_secs_f64();
         a.report.krylov_iterations = solved.krylov_iterations;
+        (a.report.krylov_max, a.report.linear_solves) = (solved.krylov_max, solved.linear_solves);
         a.report.seconds = a.started.elapsed().as_secs_f64();
         let knots = self.plan[a.level].knots.clone();
         self.previous = Some(Surface { knots, control_points: solved.control_points, weights: a.weights });

@@ -1,0 +1,235 @@
+//! Geometric multigrid for a symmetric positive definite scalar operator `A` on a
+//! hierarchy of nested spaces given by its prolongations (for the spline hierarchy:
+//! exact knot insertion, [`crate::discrete::transfers`]). Coarse operators are the
+//! Galerkin products `A_{l+1} = P_l^T A_l P_l` (the variational coarse operator: the
+//! bilinear form restricted to the coarse subspace, what rediscretization on the coarse
+//! basis with the fine geometry would give); the coarsest is factorized densely.
+//!
+//! One application is a V(ν, ν)-cycle from a zero guess: on level `l`, ν pre-smoothing
+//! sweeps, the restriction `r_{l+1} = P_l^T (b - A_l x)`, the cycle on level `l + 1`, the
+//! correction `x += P_l x_{l+1}`, ν post-smoothing sweeps. The smoother
+//! ([`Smoother`]) is symmetric Gauss–Seidel (forward before, backward after the
+//! coarse correction: the cycle is a symmetric operator) or ILU(0) on the level's
+//! pattern; see BENCHMARKS.md "Multigrid" for the measured choice.
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::linalg::dense::DenseCholesky;
+use crate::linalg::krylov::Ilu0;
+use crate::linalg::sparse::Csr;
+
+/// The smoother of every level but the coarsest.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Smoother {
+    /// Gauss–Seidel in the unknowns' order before the coarse correction, in reverse
+    /// order after it.
+    SymmetricGaussSeidel,
+    /// `x += (LU)^{-1} (b - A x)` with the incomplete factors of the level's operator.
+    Ilu0,
+}
+
+/// A multigrid V-cycle for `A` (see the module documentation).
+#[derive(Debug)]
+pub struct Multigrid {
+    /// `P_l` maps level `l + 1` to level `l` (level 0 the finest).
+    prolongations: Vec<Csr>,
+    restrictions: Vec<Csr>,
+    /// `A_l`, finest first; the last is the coarsest.
+    operators: Vec<Csr>,
+    /// Position of the diagonal entry of each row of each operator.
+    diagonals: Vec<Vec<usize>>,
+    ilu: Vec<Ilu0>,
+    coarse: DenseCholesky,
+    smoother: Smoother,
+    sweeps: usize,
+}
+
+/// `P^T A P` with `pt = P^T`, rows in parallel, a dense accumulator per thread.
+pub fn galerkin(pt: &Csr, a: &Csr, p: &Csr) -> Csr {
+    let nc = p.ncols;
+    let ap = {
+        let rows: Vec<Vec<(usize, f64)>> = (0..a.nrows)
+            .into_par_iter()
+            .map_init(
+                || (vec![0.0; nc], vec![false; nc], Vec::new()),
+                |(acc, seen, touched), i| {
+                    for (k, aik) in a.row(i) {
+                        for (j, pkj) in p.row(k) {
+                            if !seen[j] {
+                                seen[j] = true;
+                                touched.push(j);
+                            }
+                            acc[j] += aik * pkj;
+                        }
+                    }
+                    gather_row(acc, seen, touched)
+                },
+            )
+            .collect();
+        Csr::from_rows(nc, rows)
+    };
+    let rows: Vec<Vec<(usize, f64)>> = (0..pt.nrows)
+        .into_par_iter()
+        .map_init(
+            || (vec![0.0; nc], vec![false; nc], Vec::new()),
+            |(acc, seen, touched), i| {
+                for (k, pik) in pt.row(i) {
+                    for (j, v) in ap.row(k) {
+                        if !seen[j] {
+                            seen[j] = true;
+                            touched.push(j);
+                        }
+                        acc[j] += pik * v;
+                    }
+                }
+                gather_row(acc, seen, touched)
+            },
+        )
+        .collect();
+    Csr::from_rows(nc, rows)
+}
+
+/// The accumulated row (sorted by column), the accumulator cleared.
+fn gather_row(acc: &mut [f64], seen: &mut [bool], touched: &mut Vec<usize>) -> Vec<(usize, f64)> {
+    touched.sort_unstable();
+    let row = touched.iter().map(|&j| (j, acc[j])).collect();
+    for &j in touched.iter() {
+        acc[j] = 0.0;
+        seen[j] = false;
+    }
+    touched.clear();
+    row
+}
+
+fn diagonal_positions(a: &Csr) -> Result<Vec<usize>> {
+    (0..a.nrows)
+        .map(|i| a.position(i, i).ok_or_else(|| Error::LinearSolver(format!("multigrid: no diagonal in row {i}"))))
+        .collect()
+}
+
+impl Multigrid {
+    /// A cycle on the hierarchy `prolongations` (`P_l`: level `l + 1` to level `l`, finest
+    /// first), with `sweeps` smoothing sweeps before and after each coarse correction;
+    /// [`Multigrid::factor`] gives it its operator.
+    pub fn new(prolongations: Vec<Csr>, smoother: Smoother, sweeps: usize) -> Self {
+        let restrictions = prolongations.iter().map(Csr::transpose).collect();
+        Self {
+            prolongations,
+            restrictions,
+            operators: Vec::new(),
+            diagonals: Vec::new(),
+            ilu: Vec::new(),
+            coarse: DenseCholesky::default(),
+            smoother,
+            sweeps: sweeps.max(1),
+        }
+    }
+
+    /// Number of unknowns of the finest level.
+    pub fn size(&self) -> usize {
+        self.prolongations.first().map_or(self.coarse.size(), |p| p.nrows)
+    }
+
+    /// Number of levels (the finest included).
+    pub fn levels(&self) -> usize {
+        self.prolongations.len() + 1
+    }
+
+    /// Set up the cycle for the SPD `a` (of the finest level's size): the Galerkin coarse
+    /// operators, the smoothers and the coarsest factorization. Reuses the storage of a
+    /// previous set-up.
+    ///
+    /// Errors: [`Error::LinearSolver`] when `a`'s size does not match the hierarchy, a
+    /// row has no diagonal entry, or the coarsest operator is not positive definite.
+    pub fn factor(&mut self, a: &Csr) -> Result<()> {
+        let n0 = self.prolongations.first().map_or(a.nrows, |p| p.nrows);
+        if a.nrows != n0 || a.ncols != n0 {
+            return Err(Error::LinearSolver(format!(
+                "multigrid: a {} x {} operator on a hierarchy of {n0} fine unknowns",
+                a.nrows, a.ncols
+            )));
+        }
+        let mut operators = std::mem::take(&mut self.operators);
+        operators.resize_with(self.levels(), Csr::default);
+        operators[0].update(a);
+        for l in 0..self.prolongations.len() {
+            operators[l + 1] = galerkin(&self.restrictions[l], &operators[l], &self.prolongations[l]);
+        }
+        let smoothed = &operators[..operators.len() - 1];
+        self.diagonals = smoothed.iter().map(diagonal_positions).collect::<Result<_>>()?;
+        self.ilu = match self.smoother {
+            Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
+            Smoother::SymmetricGaussSeidel => Vec::new(),
+        };
+        self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
+        self.operators = operators;
+        Ok(())
+    }
+
+    /// `x = B b`, one V-cycle from `x = 0` (`B ≈ A^{-1}`).
+    pub fn apply(&self, b: &[f64], x: &mut [f64]) {
+        x.fill(0.0);
+        self.cycle(0, b, x);
+    }
+
+    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) {
+        if l + 1 == self.levels() {
+            x.copy_from_slice(b);
+            self.coarse.solve_columns(x);
+            return;
+        }
+        let a = &self.operators[l];
+        let mut r = vec![0.0; b.len()];
+        for _ in 0..self.sweeps {
+            self.smooth(l, b, x, &mut r, false);
+        }
+        a.mul_vec(x, &mut r);
+        for (ri, bi) in r.iter_mut().zip(b) {
+            *ri = bi - *ri;
+        }
+        let rc = self.restrictions[l].apply(&r);
+        let mut xc = vec![0.0; rc.len()];
+        self.cycle(l + 1, &rc, &mut xc);
+        self.prolongations[l].mul_vec(&xc, &mut r);
+        for (xi, ci) in x.iter_mut().zip(&r) {
+            *xi += ci;
+        }
+        for _ in 0..self.sweeps {
+            self.smooth(l, b, x, &mut r, true);
+        }
+    }
+
+    /// One smoothing sweep on level `l` (`r` scratch of the level's size).
+    fn smooth(&self, l: usize, b: &[f64], x: &mut [f64], r: &mut [f64], backward: bool) {
+        let a = &self.operators[l];
+        match self.smoother {
+            Smoother::SymmetricGaussSeidel => {
+                let diag = &self.diagonals[l];
+                let mut relax = |i: usize| {
+                    let mut s = b[i];
+                    for k in a.row_ptr[i]..a.row_ptr[i + 1] {
+                        s -= a.values[k] * x[a.col_idx[k]];
+                    }
+                    x[i] += s / a.values[diag[i]];
+                };
+                if backward {
+                    (0..a.nrows).rev().for_each(&mut relax);
+                } else {
+                    (0..a.nrows).for_each(&mut relax);
+                }
+            }
+            Smoother::Ilu0 => {
+                a.mul_vec(x, r);
+                for (ri, bi) in r.iter_mut().zip(b) {
+                    *ri = bi - *ri;
+                }
+                let mut z = vec![0.0; r.len()];
+                self.ilu[l].apply(r, &mut z);
+                for (xi, zi) in x.iter_mut().zip(&z) {
+                    *xi += zi;
+                }
+            }
+        }
+    }
+}
