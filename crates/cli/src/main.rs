@@ -75,6 +75,7 @@ mod output;
 mod reference;
 mod solve_cmd;
 mod sweep_cmd;
+mod volume_cmd;
 
 use args::*;
 use bench_cmd::*;
