@@ -282,19 +282,20 @@ impl WinslowVolume {
                         }
                     }
                     if hessian {
-                        // t[a][(col_b, comp_b)][comp_a] = Σ_col_a gr_a[col_a] hw[(col_a, comp_a)][(col_b, comp_b)]
                         for (a, ga) in qp.grads.iter().enumerate() {
+                            // t[ia][kb] = w Σ_ca ga[ca] hw[(ca, ia)][kb]
                             let mut t = [[0.0; 9]; 3];
-                            for ia in 0..3 {
-                                for kb in 0..9 {
-                                    t[ia][kb] = (0..3).map(|ca| ga[ca] * hw[3 * ca + ia][kb]).sum();
+                            for (ia, row) in t.iter_mut().enumerate() {
+                                for (kb, x) in row.iter_mut().enumerate() {
+                                    *x = qp.weight
+                                        * (ga[0] * hw[ia][kb] + ga[1] * hw[3 + ia][kb] + ga[2] * hw[6 + ia][kb]);
                                 }
                             }
                             for (b, gb) in qp.grads.iter().enumerate() {
-                                for ia in 0..3 {
+                                for (ia, row) in t.iter().enumerate() {
+                                    let base = (3 * a + ia) * 3 * m + 3 * b;
                                     for ib in 0..3 {
-                                        let v: f64 = (0..3).map(|cb| t[ia][3 * cb + ib] * gb[cb]).sum();
-                                        h[(3 * a + ia) * 3 * m + 3 * b + ib] += qp.weight * v;
+                                        h[base + ib] += row[ib] * gb[0] + row[3 + ib] * gb[1] + row[6 + ib] * gb[2];
                                     }
                                 }
                             }
