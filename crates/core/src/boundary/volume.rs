@@ -218,7 +218,7 @@ impl VolumeBoundary {
                     let (x, fs, ft) = f.derivs(s, t);
                     let n = cross(fs, ft);
                     let area = dist(n, [0.0; 3]);
-                    if !(area > 1e-9 * diam * diam) {
+                    if area.is_nan() || area <= 1e-9 * diam * diam {
                         return Err(face_error(
                             side.name(),
                             "",
@@ -243,7 +243,7 @@ impl VolumeBoundary {
                 .clone()
                 .map(|tau| (dist(curve(fa, tau), curve(fb, tau)), tau))
                 .fold((0.0, 0.0), |m, g| if g.0 > m.0 || g.0.is_nan() { g } else { m });
-            if !(gap <= tol) {
+            if gap.is_nan() || gap > tol {
                 let reversed = taus.map(|tau| dist(curve(fa, tau), curve(fb, 1.0 - tau))).fold(0.0, f64::max);
                 let p = curve(fa, at);
                 let reason = if reversed <= tol {
@@ -262,7 +262,7 @@ impl VolumeBoundary {
             }
         }
         let v = centred.enclosed_volume();
-        if !(v > 1e-9 * diam.powi(3)) {
+        if v.is_nan() || v <= 1e-9 * diam.powi(3) {
             return Err(face_error(
                 "all",
                 "",

@@ -40,7 +40,7 @@ pub fn density(d: &[Point3; 3], hessian: bool) -> Option<(f64, [f64; 9], [[f64; 
     let dot = |a: Point3, b: Point3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let cof: [Point3; 3] = std::array::from_fn(|a| cross(d[(a + 1) % 3], d[(a + 2) % 3]));
     let det = dot(d[0], cof[0]);
-    if !(det > 0.0) {
+    if det.is_nan() || det <= 0.0 {
         return None;
     }
     let n: f64 = cof.iter().map(|c| dot(*c, *c)).sum();
