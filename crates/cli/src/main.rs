@@ -77,6 +77,7 @@ mod reference;
 mod solve_cmd;
 mod sweep_cmd;
 mod thb_cmd;
+mod volume_cmd;
 
 use args::*;
 use bench_cmd::*;

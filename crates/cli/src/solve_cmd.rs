@@ -199,6 +199,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let doc = files::read(path)?;
+    if let Document::VolumeBoundary(b) = doc {
+        return super::volume_cmd::solve(b, &a, path);
+    }
     let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_));
     output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;

@@ -373,7 +373,7 @@ impl Scene {
                     .wrong_kind(None, "the viewer draws maps and solved layouts: `winslow solve` lays a domain out and solves it; open its output")
                     .into())
             }
-            doc @ Document::Volume { .. } => {
+            doc @ (Document::Volume { .. } | Document::VolumeBoundary(_)) => {
                 return Err(doc
                     .wrong_kind(None, "the viewer draws planar documents (`winslow convert` writes a volume as .vtu or .vtk for ParaView)")
                     .into())

@@ -16,6 +16,7 @@
 //! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
 //! | [`kinks`] | interior `C^0` points of the sides (`C^0` knots, zero speed, polygon corners), the smoothed basis `Σ¹` | §9 |
 //! | [`ring`] | ring (O-type) domains: two closed contours fitted on one periodic knot vector by arc length, and their hierarchy | §11.1 |
+//! | [`volume`] | [`VolumeBoundary`](volume::VolumeBoundary): the six faces of a hexahedral volume, their validation | §11.1 |
 //! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
@@ -39,6 +40,7 @@ pub mod ring;
 pub mod ring_fit;
 pub mod ring_reparam;
 pub mod validate;
+pub mod volume;
 
 use std::sync::Arc;
 

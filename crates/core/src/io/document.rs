@@ -6,6 +6,7 @@
 //! | JSON with `patches`, every patch a `map` | [`Document::Multipatch`] (a solved result) |
 //! | JSON with `patches` | [`Document::Layout`] |
 //! | JSON with `ring` | [`Document::Ring`] |
+//! | JSON with `volume_boundary` | [`Document::VolumeBoundary`] (validated) |
 //! | JSON with `map` of three degrees | [`Document::Volume`] |
 //! | JSON with `map` | [`Document::Map`] |
 //! | JSON with `boundary` or `contour` | [`Document::Boundary`] |
@@ -28,10 +29,12 @@ use super::json::parse_json;
 use super::multipatch::gismo::{is_gismo_multipatch, parse_gismo_multipatch};
 use super::multipatch::json::parse_json_multipatch;
 use super::ring::ring_of_json;
+use super::volume::boundary::parse_volume_boundary_json;
 use super::volume::gismo::parse_gismo_volume;
 use super::volume::json::parse_volume_json;
 use super::{iges, read_text, surface_boundary_area};
 use crate::boundary::ring::{signed_area, ClosedContour, Ring};
+use crate::boundary::volume::VolumeBoundary;
 use crate::boundary::{Boundary, SideCurve};
 use crate::domain::Domain;
 use crate::error::{Error, Result};
@@ -74,12 +77,15 @@ pub enum Document {
         /// The volume, knot domains mapped to `[0, 1]`.
         volume: Volume,
     },
+    /// The six boundary faces of a hexahedral volume (`formats.md`, "Volume boundary"),
+    /// validated.
+    VolumeBoundary(VolumeBoundary),
 }
 
 impl Document {
     /// The kind, for messages: `"boundary"`, `"map"`, `"ring map"` (a map with `eta`
     /// periodic), `"ring"`, `"multipatch layout"`, `"multipatch result"`, `"domain"`,
-    /// `"volume"`.
+    /// `"volume"`, `"volume boundary"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Document::Boundary(_) => "boundary",
@@ -90,6 +96,7 @@ impl Document {
             Document::Multipatch(_) => "multipatch result",
             Document::Domain(_) => "domain",
             Document::Volume { .. } => "volume",
+            Document::VolumeBoundary(_) => "volume boundary",
         }
     }
 
@@ -100,6 +107,7 @@ impl Document {
             Document::Ring(r) => &r.name,
             Document::Layout(l) | Document::Multipatch(l) => &l.name,
             Document::Domain(d) => &d.name,
+            Document::VolumeBoundary(b) => &b.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -110,6 +118,7 @@ impl Document {
             Document::Ring(r) => &mut r.name,
             Document::Layout(l) | Document::Multipatch(l) => &mut l.name,
             Document::Domain(d) => &mut d.name,
+            Document::VolumeBoundary(b) => &mut b.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -185,6 +194,9 @@ fn json_document(body: &str) -> Result<Document> {
         let layout = parse_json_multipatch(body)?;
         return Ok(if solved { Document::Multipatch(layout) } else { Document::Layout(layout) });
     }
+    if obj.contains_key("volume_boundary") {
+        return parse_volume_boundary_json(v).map(Document::VolumeBoundary);
+    }
     if obj.contains_key("ring") {
         return ring_of_json(v).map(Document::Ring);
     }
@@ -202,7 +214,7 @@ fn json_document(body: &str) -> Result<Document> {
                 path: None,
                 found: format!("{kind} (\"{key}\")"),
                 needed: "this version reads boundaries, contours, maps, rings, general domains, multipatch \
-                         layouts and results, and volumes"
+                         layouts and results, volumes and volume boundaries"
                     .into(),
             });
         }

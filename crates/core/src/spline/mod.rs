@@ -6,6 +6,7 @@
 //! | [`basis`] | [`BasisDerivs`](basis::BasisDerivs): non-allocating B-spline values and derivatives (Piegl–Tiller) | §3 |
 //! | [`curve`] | [`Curve`](curve::Curve): B-spline and NURBS curves | §3 |
 //! | [`surface`] | [`Surface`](surface::Surface): tensor-product maps `x: [0,1]² → R²`, sides, inversion | §3, eq. (1) |
+//! | [`face`] | [`Face`](face::Face): tensor-product surfaces in space (faces of a volume), insertion, elevation | §11.1 |
 //! | [`refine`] | knot insertion and degree elevation as sparse prolongation matrices | §5.4, §6.3 |
 //! | [`bezier`] | Bézier extraction of a tensor basis | §8.1 |
 //! | [`hierarchical`] | [`HierarchicalBasis`](hierarchical::HierarchicalBasis), [`HierarchicalMap`](hierarchical::map::HierarchicalMap): truncated hierarchical B-splines (THB), local refinement | §4, §8 |
@@ -17,6 +18,7 @@
 pub mod basis;
 pub mod bezier;
 pub mod curve;
+pub mod face;
 pub mod hierarchical;
 pub mod knots;
 pub mod loft;

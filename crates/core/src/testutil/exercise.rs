@@ -122,7 +122,11 @@ pub fn exercise_document(doc: Document, trace: &mut Trace) {
             }
         }
         // rings have their own exerciser (`exercise_ring_text`); layouts and volumes none
-        Document::Ring(_) | Document::Layout(_) | Document::Multipatch(_) | Document::Volume { .. } => {}
+        Document::Ring(_)
+        | Document::Layout(_)
+        | Document::Multipatch(_)
+        | Document::Volume { .. }
+        | Document::VolumeBoundary(_) => {}
     }
 }
 

@@ -5,12 +5,17 @@
 //! [`crate::io::gismo_writer::volume_to_gismo_xml`]) and VTK ([`vtk`]: a sampled
 //! structured grid with `det J`, and the exact map as Bézier hexahedra).
 //!
+//! The six boundary faces of a volume (`formats.md`, "Volume boundary") are read from
+//! JSON in [`boundary`].
+//!
 //! Volumes are read by [`crate::io::read`] (a JSON `map` whose `degree` has three
 //! entries, or an XML file with a `TensorBSpline3` / `TensorNurbs3` geometry, gives a
 //! [`crate::io::Document::Volume`]) and written by [`crate::io::write`].
 
+pub mod boundary;
 pub mod gismo;
 pub mod json;
 pub mod vtk;
 
+pub use boundary::{volume_boundary_to_json, FaceJson};
 pub use json::{volume_to_json, VolumeJson};

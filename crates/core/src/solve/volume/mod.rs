@@ -1,0 +1,391 @@
+//! Volumes from their six boundary faces (a hexahedral topology, paper §11.1 in 3D):
+//! the faces on common knot vectors, the trivariate Coons patch as the start
+//! ([`coons`]), the interior control points moved by Newton's method on the 3D Winslow
+//! functional ([`winslow`]), and the verdict of the volume certificate
+//! ([`certify_volume`]).
+//!
+//! **Continuation.** Winslow's functional needs a start with `det J > 0` at every
+//! quadrature point. When the Coons patch of the faces is not one (a strongly bulged or
+//! concave face), the boundary is moved there from the trilinear volume of the eight
+//! corners (itself a Coons patch, positive for any convex hexahedron of corners): the
+//! boundary net `B(t) = (1 - t) B₀ + t B₁`, `t` from 0 to 1, the interior moved with it by
+//! the Coons patch of the boundary's displacement and then relaxed by Newton at every
+//! accepted `t`; a step whose moved start leaves the barrier is halved. The first step
+//! tried is `t = 1`, i.e. the Coons patch of the faces itself.
+//!
+//! **Refinement.** A volume whose certificate is not `certified` is solved again with
+//! every element halved ([`VolumeOptions::max_refinements`] times at most); the result
+//! is the last volume with its certificate, whatever its verdict.
+
+pub mod coons;
+pub mod winslow;
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::boundary::volume::{CubeSide, VolumeBoundary};
+use crate::error::{Error, Result};
+use crate::linalg::linsolve::{LinearMethod, LinearSolver};
+use crate::linalg::sparse::Csr;
+use crate::spline::volume::{Point3, Volume};
+use crate::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeFinding};
+use crate::verify::certificate::CertifyOptions;
+use coons::{common_faces, coons_fill, volume_of, CommonFaces};
+use winslow::WinslowVolume;
+
+/// Options of [`solve_volume`].
+#[derive(Debug, Clone)]
+pub struct VolumeOptions {
+    /// Times every element of the common bases is halved before the solve.
+    pub refine: usize,
+    /// Further halvings tried when the certificate is not `certified`.
+    pub max_refinements: usize,
+    /// Newton iterations of the final minimisation.
+    pub max_iterations: usize,
+    /// Newton stops when `|∇E| <= tolerance |∇E(start)|` or `E` stops decreasing.
+    pub tolerance: f64,
+    /// Continuation steps at most (accepted and halved ones together).
+    pub max_continuation: usize,
+    /// Options of the volume certificate.
+    pub certify: CertifyOptions,
+}
+
+impl Default for VolumeOptions {
+    fn default() -> Self {
+        Self {
+            refine: 0,
+            max_refinements: 2,
+            max_iterations: 60,
+            tolerance: 1e-10,
+            max_continuation: 64,
+            certify: CertifyOptions::default(),
+        }
+    }
+}
+
+/// What a volume solve did.
+#[derive(Debug, Clone, Serialize)]
+pub struct VolumeSolveReport {
+    /// `winslow`.
+    pub method: &'static str,
+    /// Degrees of the volume.
+    pub degrees: [usize; 3],
+    /// Basis functions per direction.
+    pub shape: [usize; 3],
+    /// Free scalar unknowns (3 per interior control point).
+    pub unknowns: usize,
+    /// Halvings of the common bases.
+    pub refine: usize,
+    /// `coons` when the Coons patch of the faces was the start, `continuation` when the
+    /// boundary was moved there from the corners' trilinear volume.
+    pub start: &'static str,
+    /// Continuation steps accepted (1 when the Coons patch was the start).
+    pub continuation_steps: usize,
+    /// Newton iterations in all (continuation included).
+    pub newton_iterations: usize,
+    /// `E` of the Coons patch (`null` when it leaves the barrier).
+    pub energy_start: Option<f64>,
+    /// `E` of the result.
+    pub energy: f64,
+    /// `|∇E|` of the result, relative to that of its start.
+    pub relative_gradient: f64,
+    /// Largest distance between a face of the result and the input face, at sample
+    /// points.
+    pub boundary_deviation: f64,
+    /// Whether that distance is within `10⁻⁹` of the diameter.
+    pub boundary_kept: bool,
+    /// The certificate's verdict (`certified`, `folded`, `undecided`).
+    pub verdict: &'static str,
+    /// Seconds of the certificate.
+    pub certificate_seconds: f64,
+    /// Wall-clock seconds in all.
+    pub seconds: f64,
+}
+
+/// A volume solved from its faces, with its certificate.
+#[derive(Debug, Clone)]
+pub struct VolumeSolve {
+    /// The volume.
+    pub volume: Volume,
+    /// Its certificate.
+    pub certificate: VolumeCertificate,
+    /// The report.
+    pub report: VolumeSolveReport,
+}
+
+/// Statistics of one minimisation.
+#[derive(Debug, Clone, Copy)]
+struct Minimised {
+    iterations: usize,
+    energy: f64,
+    relative_gradient: f64,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// `a + s diag(|a|)`.
+fn shifted(a: &Csr, s: f64) -> Csr {
+    let mut b = a.clone();
+    if s > 0.0 {
+        for i in 0..b.nrows {
+            if let Some(p) = b.position(i, i) {
+                b.values[p] += s * b.values[p].abs().max(1e-300);
+            }
+        }
+    }
+    b
+}
+
+/// Newton's method with a backtracking (Armijo) line search on `E` over the free
+/// control points of `cps`, from a start inside the barrier; the Hessian is shifted on
+/// its diagonal where its Cholesky factorization fails or its step is not a descent.
+fn minimise(e: &WinslowVolume, cps: &mut [Point3], max_iterations: usize, tolerance: f64) -> Result<Minimised> {
+    let mut ev = e.evaluate(cps, true);
+    if !ev.energy.is_finite() {
+        return Err(Error::InfeasibleStart {
+            method: "the 3D Winslow functional".into(),
+            reason: "det J <= 0 at a quadrature point of the start".into(),
+        });
+    }
+    let g0 = norm(&ev.gradient).max(f64::MIN_POSITIVE);
+    let mut x = e.gather(cps);
+    let mut solver = LinearSolver::new(LinearMethod::Cholesky);
+    let mut shift = 0.0;
+    let mut iterations = 0;
+    while iterations < max_iterations && e.unknowns() > 0 {
+        let gn = norm(&ev.gradient);
+        if gn <= tolerance * g0 {
+            break;
+        }
+        let h = ev.hessian.as_ref().expect("evaluated with the Hessian");
+        let mut step = None;
+        for _ in 0..12 {
+            let hs = shifted(h, shift);
+            if solver.factor(&hs).is_ok() {
+                let rhs: Vec<f64> = ev.gradient.iter().map(|g| -g).collect();
+                let d = solver.solve(&rhs)?;
+                let slope: f64 = d.iter().zip(&ev.gradient).map(|(a, b)| a * b).sum();
+                if slope < 0.0 && d.iter().all(|v| v.is_finite()) {
+                    step = Some((d, slope));
+                    break;
+                }
+            }
+            shift = if shift == 0.0 { 1e-6 } else { shift * 10.0 };
+        }
+        let Some((d, slope)) = step else {
+            return Err(Error::NoConvergence("3D Winslow: no descent direction from the shifted Hessian".into()));
+        };
+        let mut alpha = 1.0;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let trial: Vec<f64> = x.iter().zip(&d).map(|(a, b)| a + alpha * b).collect();
+            let mut c = cps.to_vec();
+            e.scatter(&mut c, &trial);
+            let t = e.evaluate(&c, false);
+            if t.energy.is_finite() && t.energy <= ev.energy + 1e-4 * alpha * slope {
+                accepted = Some((trial, c, t.energy));
+                break;
+            }
+            alpha *= 0.5;
+        }
+        iterations += 1;
+        let Some((trial, c, energy)) = accepted else { break };
+        let decrease = ev.energy - energy;
+        x = trial;
+        cps.copy_from_slice(&c);
+        ev = e.evaluate(cps, true);
+        shift = if shift < 1e-5 { 0.0 } else { shift * 0.1 };
+        if decrease <= 1e-15 * energy.abs() {
+            break;
+        }
+    }
+    Ok(Minimised { iterations, energy: ev.energy, relative_gradient: norm(&ev.gradient) / g0 })
+}
+
+/// The similarity to unit size: `(centre, scale)` of the bounding box of `pts`.
+fn unit_frame(pts: &[Point3]) -> (Point3, f64) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in pts {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let centre = std::array::from_fn(|c| 0.5 * (lo[c] + hi[c]));
+    let scale = (0..3).map(|c| hi[c] - lo[c]).fold(0.0, f64::max);
+    (centre, scale)
+}
+
+/// The Cartesian boundary net of `cf` and its weights.
+fn boundary_points(cf: &CommonFaces) -> Result<(Vec<Point3>, Vec<f64>)> {
+    let h = cf.boundary_net()?;
+    let w: Vec<f64> = h.iter().map(|p| if p[3] == 0.0 { 1.0 } else { p[3] }).collect();
+    let pts = h.iter().zip(&w).map(|(p, w)| [p[0] / w, p[1] / w, p[2] / w]).collect();
+    Ok((pts, w))
+}
+
+/// Solve on the common bases `cf` (module doc): the volume (unit frame undone), the
+/// start's kind, continuation steps, Newton statistics and `E` of the Coons patch.
+fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<(Volume, &'static str, usize, Minimised, Option<f64>)> {
+    let shape = cf.shape();
+    let (target, weights) = boundary_points(cf)?;
+    let (centre, scale) = unit_frame(&target);
+    let to_unit = |p: &Point3| -> Point3 { std::array::from_fn(|c| (p[c] - centre[c]) / scale) };
+    let target: Vec<Point3> = target.iter().map(to_unit).collect();
+    let is_boundary = |lin: usize| {
+        let ijk = [lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1])];
+        (0..3).any(|d| ijk[d] == 0 || ijk[d] == shape[d] - 1)
+    };
+    let rational = cf.rational();
+    let template = volume_of(cf.knots.clone(), &vec![[0.0, 0.0, 0.0, 1.0]; target.len()], false);
+    let template = Volume { weights: rational.then(|| weights.clone()), ..template };
+    let degree = template.degrees().into_iter().max().unwrap_or(1);
+    let energy = WinslowVolume::new(&template, degree + 2);
+    // the corners' trilinear volume, at the Greville points
+    let corner = |i: usize, j: usize, k: usize| {
+        let lin = ((k * (shape[2] - 1)) * shape[1] + j * (shape[1] - 1)) * shape[0] + i * (shape[0] - 1);
+        target[lin]
+    };
+    let g: [Vec<f64>; 3] = std::array::from_fn(|d| cf.knots[d].greville());
+    let start: Vec<Point3> = (0..target.len())
+        .map(|lin| {
+            let (i, j, k) = (lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1]));
+            let (a, b, c) = (g[0][i], g[1][j], g[2][k]);
+            let mut p = [0.0; 3];
+            for (ci, wa) in [(0, 1.0 - a), (1, a)] {
+                for (cj, wb) in [(0, 1.0 - b), (1, b)] {
+                    for (ck, wc) in [(0, 1.0 - c), (1, c)] {
+                        let q = corner(ci, cj, ck);
+                        for z in 0..3 {
+                            p[z] += wa * wb * wc * q[z];
+                        }
+                    }
+                }
+            }
+            p
+        })
+        .collect();
+    let mut current = start.clone();
+    let (mut t, mut dt) = (0.0f64, 1.0f64);
+    let (mut steps, mut accepted, mut iterations) = (0, 0, 0);
+    let mut coons_energy = None;
+    while t < 1.0 {
+        steps += 1;
+        if steps > opts.max_continuation || dt < 1e-6 {
+            return Err(Error::NoConvergence(format!(
+                "3D Winslow continuation: the boundary could not be moved past t = {t:.6} from the corners' trilinear volume \
+                 in {} steps",
+                steps - 1
+            )));
+        }
+        let tn = (t + dt).min(1.0);
+        // displacement of the boundary, extended into the interior by the Coons patch
+        let disp: Vec<[f64; 3]> = (0..target.len())
+            .map(|lin| {
+                if is_boundary(lin) {
+                    std::array::from_fn(|c| start[lin][c] + tn * (target[lin][c] - start[lin][c]) - current[lin][c])
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
+        let disp = coons_fill(&cf.knots, disp);
+        let trial: Vec<Point3> = current.iter().zip(&disp).map(|(p, d)| std::array::from_fn(|c| p[c] + d[c])).collect();
+        let ev = energy.evaluate(&trial, false);
+        if steps == 1 {
+            coons_energy = ev.energy.is_finite().then_some(ev.energy * scale);
+        }
+        if !ev.energy.is_finite() {
+            dt *= 0.5;
+            continue;
+        }
+        current = trial;
+        t = tn;
+        accepted += 1;
+        if t < 1.0 {
+            iterations += minimise(&energy, &mut current, 20, 1e-6)?.iterations;
+            dt *= 2.0;
+        }
+    }
+    let mut stats = minimise(&energy, &mut current, opts.max_iterations, opts.tolerance)?;
+    stats.iterations += iterations;
+    stats.energy *= scale;
+    // exact boundary: the input's control points, not their unit image
+    let (orig, _) = boundary_points(cf)?;
+    let cps: Vec<Point3> = current
+        .iter()
+        .enumerate()
+        .map(|(lin, p)| if is_boundary(lin) { orig[lin] } else { std::array::from_fn(|c| centre[c] + scale * p[c]) })
+        .collect();
+    let volume = Volume::new(cf.knots.clone(), cps, template.weights.clone())?;
+    let kind = if accepted == 1 { "coons" } else { "continuation" };
+    Ok((volume, kind, accepted, stats, coons_energy))
+}
+
+/// Largest distance between the faces of `v` and those of `b` on a 17 x 17 grid per
+/// face.
+pub fn boundary_deviation(v: &Volume, b: &VolumeBoundary) -> f64 {
+    let mut worst = 0.0f64;
+    for side in CubeSide::ALL {
+        let (d, val) = side.fixed();
+        let [ps, pt] = side.params();
+        for i in 0..17 {
+            for j in 0..17 {
+                let (s, t) = (i as f64 / 16.0, j as f64 / 16.0);
+                let mut u = [0.0; 3];
+                u[d] = val;
+                u[ps] = s;
+                u[pt] = t;
+                let (x, y) = (v.eval(u), b.face(side).eval(s, t));
+                let dist = (0..3).map(|c| (x[c] - y[c]).powi(2)).sum::<f64>().sqrt();
+                worst = worst.max(if dist.is_nan() { f64::INFINITY } else { dist });
+            }
+        }
+    }
+    worst
+}
+
+/// The volume bounded by the faces of `b` (validated first; module doc): certified,
+/// or the last attempt with its certificate (the caller must not treat a volume whose
+/// verdict is not `certified` as valid).
+pub fn solve_volume(b: &VolumeBoundary, opts: &VolumeOptions) -> Result<VolumeSolve> {
+    let t0 = Instant::now();
+    b.validate()?;
+    let diameter = b.diameter();
+    let mut refine = opts.refine;
+    loop {
+        let cf = common_faces(b, refine)?;
+        let (volume, start, continuation_steps, stats, energy_start) = solve_on(&cf, opts)?;
+        let certificate = certify_volume(&volume, &opts.certify)?;
+        let certified = matches!(certificate.verdict, VolumeFinding::Certified { .. });
+        if certified || refine >= opts.refine + opts.max_refinements {
+            let deviation = boundary_deviation(&volume, b);
+            let report = VolumeSolveReport {
+                method: "winslow",
+                degrees: volume.degrees(),
+                shape: volume.shape(),
+                unknowns: 3 * volume.shape().iter().map(|n| n - 2).product::<usize>(),
+                refine,
+                start,
+                continuation_steps,
+                newton_iterations: stats.iterations,
+                energy_start,
+                energy: stats.energy,
+                relative_gradient: stats.relative_gradient,
+                boundary_deviation: deviation,
+                boundary_kept: deviation <= 1e-9 * diameter,
+                verdict: certificate.verdict.name(),
+                certificate_seconds: certificate.seconds,
+                seconds: t0.elapsed().as_secs_f64(),
+            };
+            return Ok(VolumeSolve { volume, certificate, report });
+        }
+        refine += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests;

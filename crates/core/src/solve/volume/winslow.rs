@@ -1,0 +1,447 @@
+//! The Winslow functional of a volume (the trivariate analogue of the paper's eq. 16):
+//!
+//! `E(c) = ∫ W(J) dξ`, `W(J) = |cof J|²_F / det J`,
+//!
+//! where `J = ∇x = [x_ξ x_η x_ζ]` and `cof J = det J · J⁻ᵀ`, with columns
+//! `x_η × x_ζ`, `x_ζ × x_ξ`, `x_ξ × x_η`. `E = ∫_Ω |∇ξ|² dx` is the Dirichlet energy of
+//! the inverse map, so its minimiser is the map whose inverse is harmonic (elliptic grid
+//! generation, eq. 5-6); in the plane `|cof J| = |J|` and `W` is the paper's
+//! `(g₁₁ + g₂₂)/det J`. `E = +∞` when `det J <= 0` at a quadrature point (a barrier:
+//! Newton's line search never leaves the maps positive at the quadrature points).
+//!
+//! # Derivatives
+//!
+//! With the columns `d_a` of `J`, `N = Σ_(a<b) |d_a × d_b|²`, `D = det J`:
+//!
+//! * `∂D/∂d_a = d_(a+1) × d_(a+2)` (cyclic), `∂²D/∂(d_a)_i ∂(d_b)_j = σ ε_ijk (d_c)_k`
+//!   (`σ` the sign of the permutation `(a, b, c)`);
+//! * for one pair, `f(a, b) = |a|²|b|² - (a·b)²`: `∂f/∂a = 2(|b|² a - (a·b) b)`,
+//!   `∂²f/∂a² = 2(|b|² I - b bᵀ)`, `∂²f/∂a∂b = 4 a bᵀ - 2 b aᵀ - 2 (a·b) I`;
+//! * `∇W = ∇N/D - N ∇D/D²`,
+//!   `∇²W = ∇²N/D - (∇N ∇Dᵀ + ∇D ∇Nᵀ)/D² + 2N ∇D ∇Dᵀ/D³ - N ∇²D/D²`.
+//!
+//! `x = Σ_A c_A R_A` is linear in the control points (the rational basis `R_A` with the
+//! weights fixed), so `∇E` and `∇²E` are quadrature sums of `∇W`, `∇²W` between the
+//! basis gradients `∇R_A`: no other term.
+
+use rayon::prelude::*;
+
+use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::volume::{Point3, Volume};
+
+/// `W`, `∇W` (9: `d_0, d_1, d_2`) and `∇²W` (9 x 9) at `J` (columns `d`), or `None`
+/// when `det J <= 0`.
+pub fn density(d: &[Point3; 3], hessian: bool) -> Option<(f64, [f64; 9], [[f64; 9]; 9])> {
+    let cross =
+        |a: Point3, b: Point3| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let dot = |a: Point3, b: Point3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cof: [Point3; 3] = std::array::from_fn(|a| cross(d[(a + 1) % 3], d[(a + 2) % 3]));
+    let det = dot(d[0], cof[0]);
+    if det.is_nan() || det <= 0.0 {
+        return None;
+    }
+    let n: f64 = cof.iter().map(|c| dot(*c, *c)).sum();
+    let mut gn = [0.0; 9];
+    let mut gd = [0.0; 9];
+    for a in 0..3 {
+        for &b in &[(a + 1) % 3, (a + 2) % 3] {
+            let (bb, ab) = (dot(d[b], d[b]), dot(d[a], d[b]));
+            for i in 0..3 {
+                gn[3 * a + i] += 2.0 * (bb * d[a][i] - ab * d[b][i]);
+            }
+        }
+        for i in 0..3 {
+            gd[3 * a + i] = cof[a][i];
+        }
+    }
+    let w = n / det;
+    let mut g = [0.0; 9];
+    for k in 0..9 {
+        g[k] = gn[k] / det - n * gd[k] / (det * det);
+    }
+    let mut h = [[0.0; 9]; 9];
+    if !hessian {
+        return Some((w, g, h));
+    }
+    // ∇²N and ∇²D
+    let mut hn = [[0.0; 9]; 9];
+    let mut hd = [[0.0; 9]; 9];
+    for a in 0..3 {
+        for b in 0..3 {
+            if a == b {
+                for &o in &[(a + 1) % 3, (a + 2) % 3] {
+                    let oo = dot(d[o], d[o]);
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            hn[3 * a + i][3 * a + j] += 2.0 * (if i == j { oo } else { 0.0 } - d[o][i] * d[o][j]);
+                        }
+                    }
+                }
+                continue;
+            }
+            let (u, v) = (d[a], d[b]);
+            let uv = dot(u, v);
+            let c = 3 - a - b;
+            // sign of the permutation (a, b, c)
+            let sigma = if (b + 3 - a) % 3 == 1 { 1.0 } else { -1.0 };
+            for i in 0..3 {
+                for j in 0..3 {
+                    hn[3 * a + i][3 * b + j] +=
+                        4.0 * u[i] * v[j] - 2.0 * v[i] * u[j] - if i == j { 2.0 * uv } else { 0.0 };
+                    if i != j {
+                        let k = 3 - i - j;
+                        let eps = if (j + 3 - i) % 3 == 1 { 1.0 } else { -1.0 };
+                        hd[3 * a + i][3 * b + j] = sigma * eps * d[c][k];
+                    }
+                }
+            }
+        }
+    }
+    let (d2, d3) = (det * det, det * det * det);
+    for k in 0..9 {
+        for l in 0..9 {
+            h[k][l] = hn[k][l] / det - (gn[k] * gd[l] + gd[k] * gn[l]) / d2 + 2.0 * n * gd[k] * gd[l] / d3
+                - n * hd[k][l] / d2;
+        }
+    }
+    Some((w, g, h))
+}
+
+/// One quadrature point of an element: weight and the gradients `∇R_A` of the
+/// element's non-zero basis functions (in the element's local order).
+#[derive(Debug, Clone)]
+struct QuadPoint {
+    weight: f64,
+    grads: Vec<Point3>,
+}
+
+/// The Winslow energy of volumes on one basis with the weights fixed, the boundary
+/// control points fixed and the interior ones free: precomputed quadrature.
+#[derive(Debug, Clone)]
+pub struct WinslowVolume {
+    shape: [usize; 3],
+    /// Per element: the global indices of its basis functions and its points.
+    elements: Vec<(Vec<usize>, Vec<QuadPoint>)>,
+    /// Free index of each control point (`usize::MAX` for fixed ones).
+    free_of: Vec<usize>,
+    /// Number of free control points.
+    free: usize,
+}
+
+/// Energy, gradient (of the free coordinates) and Hessian of [`WinslowVolume`].
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    /// `E(c)` (`+∞` when `det J <= 0` at a quadrature point).
+    pub energy: f64,
+    /// `∇E` over the free coordinates, `3 f + component`.
+    pub gradient: Vec<f64>,
+    /// `∇²E` over the free coordinates.
+    pub hessian: Option<Csr>,
+}
+
+impl WinslowVolume {
+    /// The energy on the basis of `vol` (its knots and weights), with `g` Gauss points
+    /// per direction and element (`max degree + 1` is enough for polynomial maps).
+    pub fn new(vol: &Volume, g: usize) -> Self {
+        let shape = vol.shape();
+        let rule = GaussLegendre::new(g);
+        let per_dir: [Vec<Vec<(BasisDerivs, f64)>>; 3] = std::array::from_fn(|d| {
+            let kv: &KnotVector = &vol.knots[d];
+            kv.elements()
+                .into_iter()
+                .map(|(s, a, b)| {
+                    rule.on(a, b)
+                        .map(|(u, w)| {
+                            let mut bd = BasisDerivs::default();
+                            bd.eval_in_span(kv, s, u, 1);
+                            (bd, w)
+                        })
+                        .collect()
+                })
+                .collect()
+        });
+        let ne = per_dir.each_ref().map(Vec::len);
+        let mut elements = Vec::with_capacity(ne.iter().product());
+        for ek in 0..ne[2] {
+            for ej in 0..ne[1] {
+                for ei in 0..ne[0] {
+                    let (bx, by, bz) = (&per_dir[0][ei], &per_dir[1][ej], &per_dir[2][ek]);
+                    let (f, p) = (
+                        [bx[0].0.first(), by[0].0.first(), bz[0].0.first()],
+                        [bx[0].0.degree, by[0].0.degree, bz[0].0.degree],
+                    );
+                    let mut idx = Vec::new();
+                    for c in 0..=p[2] {
+                        for b in 0..=p[1] {
+                            for a in 0..=p[0] {
+                                idx.push(((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a);
+                            }
+                        }
+                    }
+                    let mut pts = Vec::with_capacity(bx.len() * by.len() * bz.len());
+                    for (z, wz) in bz {
+                        for (y, wy) in by {
+                            for (x, wx) in bx {
+                                let mut vals = Vec::with_capacity(idx.len());
+                                let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
+                                for c in 0..=p[2] {
+                                    for b in 0..=p[1] {
+                                        for a in 0..=p[0] {
+                                            let lin = ((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a;
+                                            let w = vol.weights.as_ref().map_or(1.0, |w| w[lin]);
+                                            let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
+                                            let g = [
+                                                w * x.d[1][a] * y.d[0][b] * z.d[0][c],
+                                                w * x.d[0][a] * y.d[1][b] * z.d[0][c],
+                                                w * x.d[0][a] * y.d[0][b] * z.d[1][c],
+                                            ];
+                                            wsum += n;
+                                            for q in 0..3 {
+                                                wgrad[q] += g[q];
+                                            }
+                                            vals.push((n, g));
+                                        }
+                                    }
+                                }
+                                // R = w N / W, ∇R = (w ∇N W - w N ∇W) / W²
+                                let grads = vals
+                                    .iter()
+                                    .map(|(n, g)| std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum)))
+                                    .collect();
+                                pts.push(QuadPoint { weight: wx * wy * wz, grads });
+                            }
+                        }
+                    }
+                    elements.push((idx, pts));
+                }
+            }
+        }
+        let mut free_of = vec![usize::MAX; shape.iter().product()];
+        let mut free = 0;
+        for k in 1..shape[2] - 1 {
+            for j in 1..shape[1] - 1 {
+                for i in 1..shape[0] - 1 {
+                    free_of[(k * shape[1] + j) * shape[0] + i] = free;
+                    free += 1;
+                }
+            }
+        }
+        Self { shape, elements, free_of, free }
+    }
+
+    /// Number of free scalar unknowns (3 per interior control point).
+    pub fn unknowns(&self) -> usize {
+        3 * self.free
+    }
+
+    /// Basis functions per direction.
+    pub fn shape(&self) -> [usize; 3] {
+        self.shape
+    }
+
+    /// Free index of control point `lin`, if it is free.
+    pub fn free_index(&self, lin: usize) -> Option<usize> {
+        let f = self.free_of[lin];
+        (f != usize::MAX).then_some(f)
+    }
+
+    /// `E`, and `∇E` (and `∇²E` when `hessian`) at the control points `cps`; the
+    /// gradient is empty and the Hessian `None` when `E = +∞`.
+    pub fn evaluate(&self, cps: &[Point3], hessian: bool) -> Evaluation {
+        type Local = (f64, Vec<(usize, f64)>, Vec<(usize, usize, f64)>);
+        let locals: Option<Vec<Local>> = self
+            .elements
+            .par_iter()
+            .map(|(idx, pts)| {
+                let m = idx.len();
+                let mut e = 0.0;
+                let mut g = vec![0.0; 3 * m];
+                let mut h = if hessian { vec![0.0; 9 * m * m] } else { Vec::new() };
+                for qp in pts {
+                    let mut d = [[0.0; 3]; 3];
+                    for (a, gr) in qp.grads.iter().enumerate() {
+                        let c = cps[idx[a]];
+                        for col in 0..3 {
+                            for comp in 0..3 {
+                                d[col][comp] += c[comp] * gr[col];
+                            }
+                        }
+                    }
+                    let (w, gw, hw) = density(&d, hessian)?;
+                    e += qp.weight * w;
+                    for (a, gr) in qp.grads.iter().enumerate() {
+                        for comp in 0..3 {
+                            let mut s = 0.0;
+                            for col in 0..3 {
+                                s += gw[3 * col + comp] * gr[col];
+                            }
+                            g[3 * a + comp] += qp.weight * s;
+                        }
+                    }
+                    if hessian {
+                        for (a, ga) in qp.grads.iter().enumerate() {
+                            // t[ia][kb] = w Σ_ca ga[ca] hw[(ca, ia)][kb]
+                            let mut t = [[0.0; 9]; 3];
+                            for (ia, row) in t.iter_mut().enumerate() {
+                                for (kb, x) in row.iter_mut().enumerate() {
+                                    *x = qp.weight
+                                        * (ga[0] * hw[ia][kb] + ga[1] * hw[3 + ia][kb] + ga[2] * hw[6 + ia][kb]);
+                                }
+                            }
+                            for (b, gb) in qp.grads.iter().enumerate() {
+                                for (ia, row) in t.iter().enumerate() {
+                                    let base = (3 * a + ia) * 3 * m + 3 * b;
+                                    for ib in 0..3 {
+                                        h[base + ib] += row[ib] * gb[0] + row[3 + ib] * gb[1] + row[6 + ib] * gb[2];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                let mut gl = Vec::new();
+                let mut hl = Vec::new();
+                for a in 0..m {
+                    let Some(fa) = self.free_index(idx[a]) else { continue };
+                    for ia in 0..3 {
+                        gl.push((3 * fa + ia, g[3 * a + ia]));
+                        if hessian {
+                            for b in 0..m {
+                                let Some(fb) = self.free_index(idx[b]) else { continue };
+                                for ib in 0..3 {
+                                    hl.push((3 * fa + ia, 3 * fb + ib, h[(3 * a + ia) * 3 * m + 3 * b + ib]));
+                                }
+                            }
+                        }
+                    }
+                }
+                Some((e, gl, hl))
+            })
+            .collect();
+        let n = self.unknowns();
+        let Some(locals) = locals else {
+            return Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None };
+        };
+        let mut energy = 0.0;
+        let mut gradient = vec![0.0; n];
+        let mut trip = Vec::new();
+        for (e, gl, hl) in locals {
+            energy += e;
+            for (i, v) in gl {
+                gradient[i] += v;
+            }
+            trip.extend(hl);
+        }
+        let hessian = hessian.then(|| Csr::from_triplets(n, n, &trip));
+        Evaluation { energy, gradient, hessian }
+    }
+
+    /// The free coordinates of `cps` (`3 f + component`).
+    pub fn gather(&self, cps: &[Point3]) -> Vec<f64> {
+        let mut x = vec![0.0; self.unknowns()];
+        for (lin, p) in cps.iter().enumerate() {
+            if let Some(f) = self.free_index(lin) {
+                x[3 * f..3 * f + 3].copy_from_slice(p);
+            }
+        }
+        x
+    }
+
+    /// `cps` with the free coordinates set to `x`.
+    pub fn scatter(&self, cps: &mut [Point3], x: &[f64]) {
+        for (lin, p) in cps.iter_mut().enumerate() {
+            if let Some(f) = self.free_index(lin) {
+                p.copy_from_slice(&x[3 * f..3 * f + 3]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_j() -> [Point3; 3] {
+        [[1.2, 0.1, -0.2], [0.3, 0.9, 0.15], [-0.1, 0.25, 1.4]]
+    }
+
+    /// `∇W` and `∇²W` of the density against central differences.
+    #[test]
+    fn density_derivatives_match_finite_differences() {
+        let d = sample_j();
+        let (_, g, h) = density(&d, true).unwrap();
+        let eps = 1e-6;
+        for k in 0..9 {
+            let mut p = d;
+            let mut m = d;
+            p[k / 3][k % 3] += eps;
+            m[k / 3][k % 3] -= eps;
+            let (wp, gp, _) = density(&p, false).unwrap();
+            let (wm, gm, _) = density(&m, false).unwrap();
+            assert!((g[k] - (wp - wm) / (2.0 * eps)).abs() < 1e-7 * (1.0 + g[k].abs()), "grad {k}");
+            for l in 0..9 {
+                let fd = (gp[l] - gm[l]) / (2.0 * eps);
+                assert!((h[l][k] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "hess {l} {k}: {} vs {fd}", h[l][k]);
+            }
+        }
+        // W(I) = 3; W is homogeneous of degree 1; a reflection is outside the barrier
+        let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!((density(&id, false).unwrap().0 - 3.0).abs() < 1e-15);
+        let s = d.map(|c| c.map(|x| 2.0 * x));
+        let (w1, w2) = (density(&d, false).unwrap().0, density(&s, false).unwrap().0);
+        assert!((w2 - 2.0 * w1).abs() < 1e-12 * w1);
+        let mut flipped = d;
+        flipped[0] = flipped[0].map(|x| -x);
+        assert!(density(&flipped, false).is_none());
+    }
+
+    /// The assembled gradient and Hessian of the energy against central differences
+    /// of the energy and the gradient, on a rational curved volume.
+    #[test]
+    fn energy_gradient_and_hessian_match_finite_differences() {
+        let k = [
+            KnotVector::open_uniform(2, 2),
+            KnotVector::open_uniform(2, 1),
+            KnotVector::open_from_breaks(2, &[0.0, 0.4, 1.0], 1),
+        ];
+        let shape = k.each_ref().map(KnotVector::num_basis);
+        let n: usize = shape.iter().product();
+        let g: [Vec<f64>; 3] = std::array::from_fn(|d| k[d].greville());
+        let cps: Vec<Point3> = (0..n)
+            .map(|lin| {
+                let (i, j, l) = (lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1]));
+                let (a, b, c) = (g[0][i], g[1][j], g[2][l]);
+                let wob = 0.03 * ((lin * 7919) % 13) as f64 / 13.0;
+                [a + 0.2 * b * c + wob, b + 0.1 * a * a - wob, c + 0.15 * a * b + 0.5 * wob]
+            })
+            .collect();
+        let w: Vec<f64> = (0..n).map(|lin| 1.0 + 0.2 * ((lin * 31) % 5) as f64 / 5.0).collect();
+        let vol = Volume::new(k, cps.clone(), Some(w)).unwrap();
+        let e = WinslowVolume::new(&vol, 4);
+        assert_eq!(e.unknowns(), 3 * (shape[0] - 2) * (shape[1] - 2) * (shape[2] - 2));
+        let at = e.evaluate(&cps, true);
+        assert!(at.energy.is_finite());
+        let x0 = e.gather(&cps);
+        let h = at.hessian.unwrap();
+        let eps = 1e-6;
+        for k in 0..x0.len() {
+            let shifted = |s: f64| {
+                let mut x = x0.clone();
+                x[k] += s;
+                let mut c = cps.clone();
+                e.scatter(&mut c, &x);
+                e.evaluate(&c, false)
+            };
+            let (p, m) = (shifted(eps), shifted(-eps));
+            let fd = (p.energy - m.energy) / (2.0 * eps);
+            assert!((at.gradient[k] - fd).abs() < 1e-7 * (1.0 + fd.abs()), "grad {k}: {} vs {fd}", at.gradient[k]);
+            for l in 0..x0.len() {
+                let fd = (p.gradient[l] - m.gradient[l]) / (2.0 * eps);
+                assert!((h.get(l, k) - fd).abs() < 1e-6 * (1.0 + fd.abs()), "hess {l} {k}: {} vs {fd}", h.get(l, k));
+            }
+        }
+    }
+}
