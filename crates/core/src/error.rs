@@ -114,7 +114,7 @@ pub enum Error {
     /// An output file whose extension does not fit the kind of what is written.
     #[error("{path}: a {kind} cannot be written as {}; it is written as {accepted}", extension_name(.extension))]
     Extension { path: PathBuf, kind: String, extension: String, accepted: String },
-    /// The six faces of a volume boundary (`formats.md`, "Volume boundary") do not bound
+    /// The six faces of a volume boundary (`formats-extensions.md`, "Volume boundary") do not bound
     /// a hexahedral volume: `face` names the face (or the two faces of an edge, or `all`),
     /// `edge` the edge of the parameter cube (empty when none).
     #[error("volume boundary, {face} face{}: {reason}", edge_of(.edge))]

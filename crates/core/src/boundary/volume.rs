@@ -1,5 +1,5 @@
 //! The boundary of a hexahedral volume: six faces, the images of the six sides of the
-//! parameter cube (`formats.md`, "Volume boundary"). The face of the side `u_d = v`
+//! parameter cube (`formats-extensions.md`, "Volume boundary"). The face of the side `u_d = v`
 //! (`d` the fixed direction, `v ∈ {0, 1}`) has as its parameters `(s, t)` the two other
 //! cube parameters in their order, so `west(s, t) = x(0, s, t)`,
 //! `south(s, t) = x(s, 0, t)`, `bottom(s, t) = x(s, t, 0)`.

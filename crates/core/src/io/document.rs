@@ -77,7 +77,7 @@ pub enum Document {
         /// The volume, knot domains mapped to `[0, 1]`.
         volume: Volume,
     },
-    /// The six boundary faces of a hexahedral volume (`formats.md`, "Volume boundary"),
+    /// The six boundary faces of a hexahedral volume (`formats-extensions.md`, "Volume boundary"),
     /// validated.
     VolumeBoundary(VolumeBoundary),
 }

@@ -1,4 +1,4 @@
-//! THB maps ([`HierarchicalMap`]) in files: the JSON map kind `"thb"` (`formats.md`,
+//! THB maps ([`HierarchicalMap`]) in files: the JSON map kind `"thb"` (`formats-extensions.md`,
 //! "THB map") and G+Smo XML `THBSpline2` (a `THBSplineBasis2` over the level-0
 //! `TensorBSplineBasis2`, one `<box level="l">` per refined region). Both writers and
 //! readers round-trip bit for bit: numbers in the shortest round-trip form, the refined

@@ -1,4 +1,4 @@
-//! The volume boundary document (`formats.md`, "Volume boundary"):
+//! The volume boundary document (`formats-extensions.md`, "Volume boundary"):
 //!
 //! ```json
 //! { "name": "twisted-duct",

@@ -5,7 +5,7 @@
 //! [`crate::io::gismo_writer::volume_to_gismo_xml`]) and VTK ([`vtk`]: a sampled
 //! structured grid with `det J`, and the exact map as Bézier hexahedra).
 //!
-//! The six boundary faces of a volume (`formats.md`, "Volume boundary") are read from
+//! The six boundary faces of a volume (`formats-extensions.md`, "Volume boundary") are read from
 //! JSON in [`boundary`].
 //!
 //! Volumes are read by [`crate::io::read`] (a JSON `map` whose `degree` has three
