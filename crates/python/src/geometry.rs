@@ -394,6 +394,7 @@ pub fn write_document(path: &std::path::Path, doc: &Document) -> winslow::Result
             winslow::write(path, &Output::Multipatch(patches))
         }
         Document::Domain(d) => winslow::write(path, &Output::Domain(d)),
+        Document::VolumeBoundary(b) => winslow::write(path, &Output::VolumeBoundary(b)),
         Document::Volume { name, volume } => {
             winslow::write(path, &Output::Volume { name, volume, label: "", extra: None })
         }

@@ -74,6 +74,8 @@ pub enum Output<'a> {
     Ring(&'a Ring),
     /// A general planar domain.
     Domain(&'a Domain),
+    /// The six boundary faces of a hexahedral volume.
+    VolumeBoundary(&'a crate::boundary::volume::VolumeBoundary),
     /// A picture ([`super::picture::render`]).
     Picture(&'a Image),
 }
@@ -89,6 +91,7 @@ impl Output<'_> {
             Output::Boundary(_) => "boundary",
             Output::Ring(_) => "ring",
             Output::Domain(_) => "domain",
+            Output::VolumeBoundary(_) => "volume boundary",
             Output::Picture(_) => "picture",
         }
     }
@@ -99,7 +102,11 @@ impl Output<'_> {
             Output::Map { .. } => ".json, .xml, .igs, .iges, .vtu or .vtk",
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
-            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) => ".json",
+            Output::Layout(_)
+            | Output::Boundary(_)
+            | Output::Ring(_)
+            | Output::Domain(_)
+            | Output::VolumeBoundary(_) => ".json",
             Output::Picture(_) => ".png",
         }
     }
@@ -152,6 +159,7 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Boundary(b), "json" | "") => write_json(path, &boundary_to_json(b)),
         (Output::Ring(r), "json" | "") => write_json(path, &ring_to_json(r)),
         (Output::Domain(d), "json" | "") => write_json(path, &super::domain::domain_to_json(d)),
+        (Output::VolumeBoundary(b), "json" | "") => write_json(path, &super::volume::volume_boundary_to_json(b)),
         (Output::Picture(img), "png") => write_png(path, img),
         _ => Err(refused()),
     }
