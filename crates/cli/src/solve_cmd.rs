@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::files;
+use crate::domain_cmd::Planar;
 use winslow::multipatch::LayoutEvent;
 use winslow::{Input, Pipeline, Solved, Stage};
 
@@ -199,14 +200,16 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let doc = files::read(path)?;
-    let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_));
+    let multipatch =
+        matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_) | Document::Graph(_));
     output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => {
             return solve_layout(layout, &a, None, &sel);
         }
-        Document::Domain(domain) => return super::domain_cmd::solve(domain, &a, &sel),
+        Document::Domain(domain) => return super::domain_cmd::solve(Planar::Domain(domain), &a, &sel),
+        Document::Graph(graph) => return super::domain_cmd::solve(Planar::Graph(graph), &a, &sel),
         Document::Ring(ring) => Input::Ring(ring),
         // a ring map (a sweep's frame): the ring between its two contours
         doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),

@@ -25,6 +25,7 @@ pub mod document;
 pub mod domain;
 pub mod file;
 pub mod gismo;
+pub mod graph;
 pub mod gismo_writer;
 pub mod iges;
 pub mod json;

@@ -30,7 +30,7 @@ use super::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
 use super::vtk::{bezier_vtu, structured_grid_vtk};
 use crate::boundary::ring::Ring;
 use crate::boundary::Boundary;
-use crate::domain::Domain;
+use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::Surface;
@@ -74,6 +74,8 @@ pub enum Output<'a> {
     Ring(&'a Ring),
     /// A general planar domain.
     Domain(&'a Domain),
+    /// A plane graph.
+    Graph(&'a PlaneGraph),
     /// A picture ([`super::picture::render`]).
     Picture(&'a Image),
 }
@@ -89,6 +91,7 @@ impl Output<'_> {
             Output::Boundary(_) => "boundary",
             Output::Ring(_) => "ring",
             Output::Domain(_) => "domain",
+            Output::Graph(_) => "graph",
             Output::Picture(_) => "picture",
         }
     }
@@ -99,7 +102,9 @@ impl Output<'_> {
             Output::Map { .. } => ".json, .xml, .igs, .iges, .vtu or .vtk",
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
-            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) => ".json",
+            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => {
+                ".json"
+            }
             Output::Picture(_) => ".png",
         }
     }
@@ -152,6 +157,7 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Boundary(b), "json" | "") => write_json(path, &boundary_to_json(b)),
         (Output::Ring(r), "json" | "") => write_json(path, &ring_to_json(r)),
         (Output::Domain(d), "json" | "") => write_json(path, &super::domain::domain_to_json(d)),
+        (Output::Graph(g), "json" | "") => write_json(path, &super::graph::graph_to_json(g)),
         (Output::Picture(img), "png") => write_png(path, img),
         _ => Err(refused()),
     }
