@@ -6,7 +6,8 @@
 //!
 //! | module | holds |
 //! |---|---|
-//! | [`corpus`] | a seeded corpus: `N`-gons with curved sides, L, T, U, E and plus shapes with sharp or filleted reflex corners |
+//! | [`corpus`] | a seeded corpus: `N`-gons with curved sides, L, T, U, E and plus shapes with sharp or filleted reflex corners, plates with holes, plane graphs |
+//! | [`families`] | the generators of plates with holes, wiggly squares and motor-like sections |
 //! | [`validate`](mod@validate) | closed loops, no self-intersections, holes inside the outer loop and apart, orientation, area: typed errors naming the loop and curve |
 //! | [`harmonic`] | the discrete harmonic map of a regular `N`-gon onto a face (P1 finite elements), which places the template's vertices and cuts |
 //! | [`plane`] | plane graphs (`formats.md`, "Plane graph"): validation, their faces, holes, voids and labels |
@@ -20,6 +21,7 @@
 
 pub mod corpus;
 pub mod cycles;
+pub mod families;
 pub mod graph;
 pub mod harmonic;
 pub mod holes;

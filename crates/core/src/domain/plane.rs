@@ -269,13 +269,13 @@ pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphRep
     }
     let polys: Vec<Vec<Point>> = cycles.iter().map(|c| polyline(&g, c)).collect();
     let areas: Vec<f64> = polys.iter().map(|p| signed_area(p)).collect();
-    let outer: Vec<usize> = (0..cycles.len()).filter(|&i| areas[i] > 0.0).collect();
-    for &i in &outer {
-        if areas[i] <= tol * diameter {
-            let vs: Vec<usize> = cycles[i].iter().map(|&s| g.start(s)).collect();
+    for (i, c) in cycles.iter().enumerate() {
+        if areas[i].abs() <= tol * diameter {
+            let vs: Vec<usize> = c.iter().map(|&s| g.start(s)).collect();
             return Err(gerr(format!("face at vertices {vs:?}"), format!("has zero area ({:.3e})", areas[i])));
         }
     }
+    let outer: Vec<usize> = (0..cycles.len()).filter(|&i| areas[i] > 0.0).collect();
     // the smallest face around a point
     let around = |p: Point| outer.iter().copied().filter(|&i| inside(&polys[i], p)).min_by(|&a, &b| areas[a].total_cmp(&areas[b]));
     let mut holes: Vec<Vec<usize>> = vec![Vec::new(); cycles.len()];
@@ -314,6 +314,9 @@ pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphRep
         let mut face = Face::new(cycles[i].clone(), name);
         face.holes = holes[i].iter().map(|&h| cycles[h].clone()).collect();
         g.faces.push(face);
+    }
+    if g.faces.is_empty() {
+        return Err(gerr("", "has no face to lay out (every bounded region is a void)"));
     }
     let mut uses = vec![0usize; g.edges.len()];
     for f in &g.faces {

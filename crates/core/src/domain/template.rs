@@ -29,6 +29,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::cycles::{polyline, signed_area};
 use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
 use super::holes::{cut_holes, HoleCut};
@@ -128,8 +129,10 @@ fn dist(a: Point, b: Point) -> f64 {
 
 /// A spline curve through `pts` from its first to its last point (both kept exactly):
 /// the straight segment when the points are on it (to `1e-9` of the diameter), else the
-/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand.
-fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
+/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand relative to
+/// `scale` (the smaller of the diameter and ten times the face's area over its
+/// perimeter, so that a cut through a thin face keeps to it).
+fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
     let (a, b) = (pts[0], pts[pts.len() - 1]);
     let l = dist(a, b);
     let off =
@@ -138,7 +141,7 @@ fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
         return Ok(line(a, b));
     }
     let opts = FitOptions { max_elements: 16, max_levels: 6, ..*fit };
-    let tol = (10.0 * fit.tol).min(1e-2) * diameter;
+    let tol = (10.0 * fit.tol).min(1e-2) * scale.min(diameter);
     Ok(fit_side(Side::South, &SideCurve::Points(pts.to_vec()), (a, b), &opts, tol)?.finest().clone())
 }
 
@@ -241,11 +244,11 @@ fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
 }
 
 /// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
-fn spoke_curve(mut pts: Vec<Point>, from: Point, to: Point, diameter: f64, fit: &FitOptions) -> Result<Curve> {
+fn spoke_curve(mut pts: Vec<Point>, from: Point, to: Point, diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
     let last = pts.len() - 1;
     pts[0] = from;
     pts[last] = to;
-    fit_points(&pts, diameter, fit)
+    fit_points(&pts, diameter, scale, fit)
 }
 
 /// Lay out `domain` (see the module documentation).
@@ -304,6 +307,14 @@ fn lay_out_graph(
     let split = edges_to_split(&g);
     let nf = g.faces.len();
     let mut plans: Vec<(Template, usize, Option<HarmonicMap>)> = Vec::with_capacity(nf);
+    // per face: ten times its area over its perimeter (the fit scale of its cuts)
+    let scales: Vec<f64> = (0..nf)
+        .map(|f| {
+            let p = polyline(&g, &g.faces[f].sides);
+            let perimeter: f64 = (0..p.len()).map(|i| dist(p[i], p[(i + 1) % p.len()])).sum();
+            10.0 * signed_area(&p).abs() / perimeter.max(f64::MIN_POSITIVE)
+        })
+        .collect();
     for f in 0..nf {
         let sides = &g.faces[f].sides;
         let k = sides.len();
@@ -354,7 +365,7 @@ fn lay_out_graph(
                 };
                 let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
                 pts.extend(h.spoke(r + 2).into_iter().skip(1));
-                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, &opts.fit)?;
+                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, scales[f], &opts.fit)?;
                 let cut = g.add_edge(c, m0, m2, false);
                 g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
                 g.faces.push(Face::new(vec![b2, s3, a0, (cut, true)], label.clone()));
@@ -369,7 +380,7 @@ fn lay_out_graph(
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, &opts.fit)?;
+                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?;
                     spokes.push(g.add_edge(c, centre, m, false));
                     parts.push((a, b));
                 }
