@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use winslow::domain::corpus::{domain_corpus, DomainFamily, GraphFamily};
 use winslow::domain::{auto_layout, graph_layout, AutoLayout, Domain, LayoutOptions, PlaneGraph};
 use winslow::solve::report::Verdict;

@@ -1,5 +1,6 @@
 //! Holes cut away (issue 31): a face with holes becomes simply connected faces by
-//! straight horizontal cuts. From the leftmost and the rightmost point of every hole (the
+//! straight cuts along one direction `d` (horizontal below; the layout tries several,
+//! [`super::template`]). From the leftmost and the rightmost point of every hole (the
 //! middle of the part of the hole within 2 % of its width of the extreme, so that the
 //! middle of a vertical side is taken rather than its ends; an existing vertex within 5
 //! % of the width is taken instead of a new one) a cut runs left, resp. right, to the
@@ -51,7 +52,7 @@ fn segment_clear(g: &Graph, edges: &[usize], a: Point, b: Point, tol: f64) -> bo
 
 /// The vertex of hole `k` of face `f` from which the cut in direction `dir` (`-1`: left,
 /// `1`: right) starts (a new one on an edge when no vertex is near the extreme).
-fn extreme_vertex(g: &mut Graph, f: usize, k: usize, dir: f64) -> Result<usize> {
+fn extreme_vertex(g: &mut Graph, f: usize, k: usize, dir: f64, d: Point) -> Result<usize> {
     let cycle = g.faces[f].holes[k].clone();
     // samples in cycle order: (edge, parameter, point)
     let mut samples: Vec<(usize, f64, Point)> = Vec::new();
@@ -64,10 +65,11 @@ fn extreme_vertex(g: &mut Graph, f: usize, k: usize, dir: f64) -> Result<usize> 
             samples.push((e, u, c.eval(u)));
         }
     }
-    let xs = samples.iter().map(|s| s.2[0]);
+    let along = |p: Point| p[0] * d[0] + p[1] * d[1];
+    let xs = samples.iter().map(|s| along(s.2));
     let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
-    let best = samples.iter().map(|s| dir * s.2[0]).fold(f64::NEG_INFINITY, f64::max);
-    let near: Vec<bool> = samples.iter().map(|s| dir * s.2[0] >= best - 0.02 * width).collect();
+    let best = samples.iter().map(|s| dir * along(s.2)).fold(f64::NEG_INFINITY, f64::max);
+    let near: Vec<bool> = samples.iter().map(|s| dir * along(s.2) >= best - 0.02 * width).collect();
     // the longest run of near samples (cyclically), and its middle
     let n = samples.len();
     let start = (0..n).find(|&i| !near[i]).unwrap_or(0);
@@ -92,9 +94,44 @@ fn extreme_vertex(g: &mut Graph, f: usize, k: usize, dir: f64) -> Result<usize> 
     }
 }
 
-/// Cut every hole of every face away (see the module documentation).
-pub fn cut_holes(g: &mut Graph, diameter: f64, cuts: &mut Vec<HoleCut>) -> Result<()> {
+/// Points of `edges` (16 per knot span).
+fn samples_of(g: &Graph, edges: impl Iterator<Item = usize>) -> Vec<Point> {
+    edges
+        .flat_map(|e| {
+            let c = &g.edges[e].curve;
+            c.sample(16 * c.knots.num_elements().max(1))
+        })
+        .collect()
+}
+
+/// The unit direction from hole `k` of face `f` to the nearest point of the face's other
+/// loops, at their closest approach.
+fn nearest_direction(g: &Graph, f: usize, k: usize) -> Point {
+    let face = &g.faces[f];
+    let mine = samples_of(g, face.holes[k].iter().map(|s| s.0));
+    let others = samples_of(
+        g,
+        face.sides.iter().chain(face.holes.iter().enumerate().filter(|(j, _)| *j != k).flat_map(|(_, h)| h)).map(|s| s.0),
+    );
+    let mut best = (f64::INFINITY, [1.0, 0.0]);
+    for p in &mine {
+        for q in &others {
+            let d = dist(*p, *q);
+            if d < best.0 && d > 0.0 {
+                best = (d, [(q[0] - p[0]) / d, (q[1] - p[1]) / d]);
+            }
+        }
+    }
+    best.1
+}
+
+/// Cut every hole of every face away (see the module documentation), along the
+/// direction `theta` (degrees from the `x` axis), or, when `theta` is not a number,
+/// every hole along the direction to its nearest neighbour (another hole or the outer
+/// boundary), so that the cut crosses the narrowest gap.
+pub fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec<HoleCut>) -> Result<()> {
     let tol = 1e-9 * diameter;
+    let global = [theta.to_radians().cos(), theta.to_radians().sin()];
     for f in 0..g.faces.len() {
         let nh = g.faces[f].holes.len();
         if nh == 0 {
@@ -103,10 +140,11 @@ pub fn cut_holes(g: &mut Graph, diameter: f64, cuts: &mut Vec<HoleCut>) -> Resul
         let label = g.faces[f].label.clone();
         let mut cut_edges: Vec<usize> = Vec::new();
         for k in 0..nh {
-            for dir in [-1.0, 1.0] {
-                let v = extreme_vertex(g, f, k, dir)?;
+            let axis = if theta.is_nan() { nearest_direction(g, f, k) } else { global };
+            for dir in [1.0, -1.0] {
+                let v = extreme_vertex(g, f, k, dir, axis)?;
                 let o = g.vertices[v];
-                let d = [dir, 0.0];
+                let d = [dir * axis[0], dir * axis[1]];
                 // an earlier cut that already leaves v this way (two holes at one height)
                 let along = cut_edges.iter().any(|&c| {
                     let e = &g.edges[c];
@@ -114,7 +152,7 @@ pub fn cut_holes(g: &mut Graph, diameter: f64, cuts: &mut Vec<HoleCut>) -> Resul
                     other.is_some_and(|w| {
                         let q = g.vertices[w];
                         let l = dist(o, q);
-                        l > 0.0 && ((q[0] - o[0]) * dir) / l > (1.0f64).to_radians().cos()
+                        l > 0.0 && ((q[0] - o[0]) * d[0] + (q[1] - o[1]) * d[1]) / l > (1.0f64).to_radians().cos()
                     })
                 });
                 if along {
@@ -177,6 +215,12 @@ pub fn cut_holes(g: &mut Graph, diameter: f64, cuts: &mut Vec<HoleCut>) -> Resul
         halves.extend(cut_edges.iter().flat_map(|&c| [(c, true), (c, false)]));
         let cycles = trace(g, &halves)?;
         for c in &cycles {
+            if let Some(&(e, _)) = c.iter().find(|&&(e, d)| c.contains(&(e, !d))) {
+                return Err(Error::Domain {
+                    at: format!("face {f} (label {label})"),
+                    reason: format!("the cut from a hole along edge {e} has the same part on both sides"),
+                });
+            }
             let a = signed_area(&polyline(g, c));
             if a <= tol * diameter {
                 return Err(Error::Domain {

@@ -40,6 +40,7 @@ use super::{domain_error, Domain, LoopId};
 use crate::boundary::fit::{fit_side, FitOptions};
 use crate::boundary::SideCurve;
 use crate::error::{Error, Result};
+use crate::multipatch::check::validate_layout;
 use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
@@ -100,6 +101,12 @@ pub struct LayoutReport {
     pub area: f64,
     /// Cuts from holes ([`super::holes`]).
     pub hole_cuts: Vec<HoleCut>,
+    /// Their direction, degrees from the `x` axis (`None`: every hole toward its
+    /// nearest neighbour, or no holes).
+    pub hole_cut_direction: Option<f64>,
+    /// The directions tried (with holes): the valid layout with the largest smallest
+    /// corner angle is taken.
+    pub hole_cut_tries: Vec<HoleCutTry>,
     /// Cuts from reflex corners.
     pub cuts: Vec<CutReport>,
     /// The template of every face.
@@ -288,9 +295,16 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
     lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0)
 }
 
-/// Steps 2 to 4 on a graph of faces (with holes).
+/// The directions (degrees) of the cuts from holes that are tried; `NaN`: every hole
+/// toward its nearest neighbour ([`cut_holes`]).
+const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
+
+/// Steps 2 to 4 on a graph of faces (with holes). With holes, the layout is made for
+/// every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid one
+/// ([`validate_layout`]: no patch crossing itself or another) whose smallest patch
+/// corner angle is largest is kept; every try is in the report.
 fn lay_out_graph(
-    mut g: Graph,
+    g: Graph,
     name: &str,
     diameter: f64,
     area: f64,
@@ -298,8 +312,75 @@ fn lay_out_graph(
     opts: &LayoutOptions,
     t0: Instant,
 ) -> Result<AutoLayout> {
+    if g.faces.iter().all(|f| f.holes.is_empty()) {
+        return lay_out_with(g, name, diameter, area, checked, opts, t0, f64::NAN);
+    }
+    let mut best: Option<(AutoLayout, bool)> = None;
+    let mut first_err = None;
+    let mut tries = Vec::new();
+    for theta in HOLE_CUT_DIRECTIONS {
+        match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta) {
+            Ok(auto) => {
+                let valid = validate_layout(&auto.layout);
+                let min_angle = auto.report.corner_angles[0];
+                tries.push(HoleCutTry {
+                    direction: (!theta.is_nan()).then_some(theta),
+                    patches: auto.layout.patches.len(),
+                    min_corner_angle: Some(min_angle),
+                    error: valid.as_ref().err().map(ToString::to_string),
+                });
+                let better = best.as_ref().is_none_or(|(b, b_ok)| {
+                    (valid.is_ok() && !b_ok) || (valid.is_ok() == *b_ok && min_angle > b.report.corner_angles[0])
+                });
+                if better {
+                    best = Some((auto, valid.is_ok()));
+                }
+            }
+            Err(e) => {
+                tries.push(HoleCutTry { direction: (!theta.is_nan()).then_some(theta), patches: 0, min_corner_angle: None, error: Some(e.to_string()) });
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_err) {
+        (Some((mut auto, _)), _) => {
+            auto.report.hole_cut_tries = tries;
+            auto.report.seconds = t0.elapsed().as_secs_f64();
+            Ok(auto)
+        }
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(Error::Invalid("layout: no direction of cuts from holes was tried".into())),
+    }
+}
+
+/// One try of a direction of the cuts from holes.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoleCutTry {
+    /// The direction, degrees from the `x` axis (and the opposite one); `null`: every
+    /// hole toward its nearest neighbour.
+    pub direction: Option<f64>,
+    /// Patches of the layout.
+    pub patches: usize,
+    /// Its smallest patch corner angle, degrees.
+    pub min_corner_angle: Option<f64>,
+    /// Why the layout is not valid (or was not made).
+    pub error: Option<String>,
+}
+
+/// Steps 2 to 4 with the cuts from holes in direction `theta` (degrees).
+#[allow(clippy::too_many_arguments)]
+fn lay_out_with(
+    mut g: Graph,
+    name: &str,
+    diameter: f64,
+    area: f64,
+    checked: (Option<DomainReport>, Option<GraphReport>),
+    opts: &LayoutOptions,
+    t0: Instant,
+    theta: f64,
+) -> Result<AutoLayout> {
     let mut hole_cuts = Vec::new();
-    cut_holes(&mut g, diameter, &mut hole_cuts)?;
+    cut_holes(&mut g, diameter, theta, &mut hole_cuts)?;
     // 2. reflex corners
     let mut cuts = Vec::new();
     cut_reflex(&mut g, diameter, &mut cuts)?;
@@ -420,6 +501,8 @@ fn lay_out_graph(
         graph: checked.1,
         area,
         hole_cuts,
+        hole_cut_direction: (!theta.is_nan()).then_some(theta),
+        hole_cut_tries: Vec::new(),
         cuts,
         faces,
         irregular_vertices,
