@@ -79,7 +79,8 @@ pub fn run(
     }
     let mut domains: Vec<(&str, Item)> = Vec::new();
     if names.is_empty() || !families.is_empty() {
-        domains.extend(domain_corpus(&families, per_family, seed).into_iter().map(|(f, d)| (f.name(), Item::Domain(d))));
+        domains
+            .extend(domain_corpus(&families, per_family, seed).into_iter().map(|(f, d)| (f.name(), Item::Domain(d))));
     }
     for f in GraphFamily::ALL.into_iter().filter(|f| names.is_empty() || graph_families.contains(f)) {
         domains.extend((0..per_family as u64).map(|k| (f.name(), Item::Graph(f.generate(seed + k)))));

@@ -2,8 +2,8 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
-use crate::files;
 use crate::domain_cmd::Planar;
+use crate::files;
 use winslow::multipatch::LayoutEvent;
 use winslow::{Input, Pipeline, Solved, Stage};
 

@@ -107,11 +107,7 @@ fn bad_domains_are_typed_errors() {
 fn surface_groups(msh: &std::path::Path) -> Vec<String> {
     let text = std::fs::read_to_string(msh).unwrap();
     let block = text.split("$PhysicalNames").nth(1).unwrap().split("$EndPhysicalNames").next().unwrap();
-    block
-        .lines()
-        .filter(|l| l.starts_with("2 "))
-        .map(|l| l.split('"').nth(1).unwrap().to_string())
-        .collect()
+    block.lines().filter(|l| l.starts_with("2 ")).map(|l| l.split('"').nth(1).unwrap().to_string()).collect()
 }
 
 #[test]
@@ -120,7 +116,8 @@ fn a_plane_graph_is_laid_out_solved_and_meshed_by_face() {
     let dir = scratch.path();
     let graph = data().join("domains/motor12.json");
     let (layout, png, solved, msh) = (dir.join("l.json"), dir.join("l.png"), dir.join("m.json"), dir.join("m.msh"));
-    let out = bin().arg("layout").arg(&graph).arg("-o").arg(&layout).arg("--png").arg(&png).arg("--json").output().unwrap();
+    let out =
+        bin().arg("layout").arg(&graph).arg("-o").arg(&layout).arg("--png").arg(&png).arg("--json").output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let report = stdout_json(&out);
     // 12 slots, 12 teeth, rotor, air gap and yoke; the shaft is a void
@@ -140,7 +137,8 @@ fn a_plane_graph_is_laid_out_solved_and_meshed_by_face() {
         assert!(faces.contains(want), "{want}: {faces:?}");
     }
     // one conforming mesh, one physical surface per face
-    let out = bin().arg("mesh").arg(&solved).arg("-o").arg(&msh).arg("--structured").arg("5x5").arg("-q").output().unwrap();
+    let out =
+        bin().arg("mesh").arg(&solved).arg("-o").arg(&msh).arg("--structured").arg("5x5").arg("-q").output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let groups: std::collections::BTreeSet<String> = surface_groups(&msh).into_iter().collect();
     assert_eq!(groups, faces);

@@ -238,12 +238,7 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
         boundary.extend(edges);
         boundary_names.push(format!("{}.{}", patch_name(layout, ps.patch), ps.side.name()));
     }
-    let groups = Groups {
-        boundary: boundary_names,
-        edge_group,
-        cells: group_names,
-        cell_group,
-    };
+    let groups = Groups { boundary: boundary_names, edge_group, cells: group_names, cell_group };
     let mesh = Mesh {
         points: pts,
         params,

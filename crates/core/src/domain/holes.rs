@@ -111,7 +111,10 @@ fn nearest_direction(g: &Graph, f: usize, k: usize) -> Point {
     let mine = samples_of(g, face.holes[k].iter().map(|s| s.0));
     let others = samples_of(
         g,
-        face.sides.iter().chain(face.holes.iter().enumerate().filter(|(j, _)| *j != k).flat_map(|(_, h)| h)).map(|s| s.0),
+        face.sides
+            .iter()
+            .chain(face.holes.iter().enumerate().filter(|(j, _)| *j != k).flat_map(|(_, h)| h))
+            .map(|s| s.0),
     );
     let mut best = (f64::INFINITY, [1.0, 0.0]);
     for p in &mine {
@@ -148,7 +151,13 @@ pub fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec<HoleCu
                 // an earlier cut that already leaves v this way (two holes at one height)
                 let along = cut_edges.iter().any(|&c| {
                     let e = &g.edges[c];
-                    let other = if e.a == v { Some(e.b) } else if e.b == v { Some(e.a) } else { None };
+                    let other = if e.a == v {
+                        Some(e.b)
+                    } else if e.b == v {
+                        Some(e.a)
+                    } else {
+                        None
+                    };
                     other.is_some_and(|w| {
                         let q = g.vertices[w];
                         let l = dist(o, q);
@@ -180,9 +189,10 @@ pub fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec<HoleCu
                 }
                 let q = g.edges[e].curve.eval(u);
                 let ends = [g.edges[e].a, g.edges[e].b];
-                let snap = ends.into_iter().filter(|&w| w != v).min_by(|&a, &b| {
-                    dist(g.vertices[a], q).total_cmp(&dist(g.vertices[b], q))
-                });
+                let snap = ends
+                    .into_iter()
+                    .filter(|&w| w != v)
+                    .min_by(|&a, &b| dist(g.vertices[a], q).total_cmp(&dist(g.vertices[b], q)));
                 let (w, snapped) = match snap {
                     Some(w) if dist(g.vertices[w], q) <= 0.1 * s && segment_clear(g, &edges, o, g.vertices[w], tol) => {
                         (w, true)

@@ -197,7 +197,10 @@ pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphRep
     }
     for (k, e) in pg.edges.iter().enumerate() {
         if e.from >= n || e.to >= n {
-            return Err(gerr(format!("edge {k}"), format!("joins vertices {} and {}, but there are {n}", e.from, e.to)));
+            return Err(gerr(
+                format!("edge {k}"),
+                format!("joins vertices {} and {}, but there are {n}", e.from, e.to),
+            ));
         }
         if e.from == e.to {
             return Err(gerr(
@@ -238,7 +241,8 @@ pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphRep
         let e = pg.edges.iter().position(|e| e.from == v || e.to == v).unwrap_or(0);
         return Err(gerr(format!("edge {e}"), format!("dangles: its vertex {v} is on no other edge")));
     }
-    let curves: Vec<Curve> = (0..pg.edges.len()).map(|k| edge_curve(pg, k, tol, diameter, fit)).collect::<Result<_>>()?;
+    let curves: Vec<Curve> =
+        (0..pg.edges.len()).map(|k| edge_curve(pg, k, tol, diameter, fit)).collect::<Result<_>>()?;
     let lines: Vec<Vec<Point>> =
         curves.iter().map(|c| sample_side(&SideCurve::Spline(c.clone()), FLATNESS * diameter)).collect();
     let ends: Vec<(usize, usize)> = pg.edges.iter().map(|e| (e.from, e.to)).collect();
@@ -277,7 +281,9 @@ pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphRep
     }
     let outer: Vec<usize> = (0..cycles.len()).filter(|&i| areas[i] > 0.0).collect();
     // the smallest face around a point
-    let around = |p: Point| outer.iter().copied().filter(|&i| inside(&polys[i], p)).min_by(|&a, &b| areas[a].total_cmp(&areas[b]));
+    let around = |p: Point| {
+        outer.iter().copied().filter(|&i| inside(&polys[i], p)).min_by(|&a, &b| areas[a].total_cmp(&areas[b]))
+    };
     let mut holes: Vec<Vec<usize>> = vec![Vec::new(); cycles.len()];
     for i in (0..cycles.len()).filter(|&i| areas[i] <= 0.0) {
         if let Some(f) = around(point_left_of(&g, &cycles[i], 1e-7 * diameter)) {

@@ -185,7 +185,11 @@ fn add_loop(g: &mut Graph, d: &Domain, id: LoopId, diameter: f64, fit: &FitOptio
         let last = c.control_points.len() - 1;
         c.control_points[last] = g.vertices[first + (k + 1) % n];
     }
-    Ok(curves.into_iter().enumerate().map(|(k, c)| (g.add_edge(c, first + k, first + (k + 1) % n, true), true)).collect())
+    Ok(curves
+        .into_iter()
+        .enumerate()
+        .map(|(k, c)| (g.add_edge(c, first + k, first + (k + 1) % n, true), true))
+        .collect())
 }
 
 /// How a face is quadrangulated.
@@ -251,7 +255,14 @@ fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
 }
 
 /// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
-fn spoke_curve(mut pts: Vec<Point>, from: Point, to: Point, diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
+fn spoke_curve(
+    mut pts: Vec<Point>,
+    from: Point,
+    to: Point,
+    diameter: f64,
+    scale: f64,
+    fit: &FitOptions,
+) -> Result<Curve> {
     let last = pts.len() - 1;
     pts[0] = from;
     pts[last] = to;
@@ -337,7 +348,12 @@ fn lay_out_graph(
                 }
             }
             Err(e) => {
-                tries.push(HoleCutTry { direction: (!theta.is_nan()).then_some(theta), patches: 0, min_corner_angle: None, error: Some(e.to_string()) });
+                tries.push(HoleCutTry {
+                    direction: (!theta.is_nan()).then_some(theta),
+                    patches: 0,
+                    min_corner_angle: None,
+                    error: Some(e.to_string()),
+                });
                 first_err.get_or_insert(e);
             }
         }

@@ -272,7 +272,8 @@ fn graph_faces_name_their_patches() {
         }
     }
     // every labelled face has patches, and their areas add up to the annulus r0..1
-    let labels: std::collections::BTreeSet<&str> = auto.layout.patches.iter().filter_map(|p| p.face.as_deref()).collect();
+    let labels: std::collections::BTreeSet<&str> =
+        auto.layout.patches.iter().filter_map(|p| p.face.as_deref()).collect();
     assert_eq!(labels.len(), 2 * s + 3);
     let want = std::f64::consts::PI * (1.0 - r0 * r0);
     assert!((fine_area(&auto.layout) - want).abs() < 1e-10, "{} vs {want}", fine_area(&auto.layout));
@@ -319,12 +320,16 @@ fn straight_convex_graph_faces_are_laid_out_affinely() {
         }
     }
     // the square's cut runs from (0.5, 0) to (0.5, 1)
-    let square_cut = l.patches.iter().filter(|p| p.face.as_deref() == Some("0")).flat_map(|p| p.sides.iter()).any(|c| {
-        let (a, b) = c.endpoints();
-        let mut ends = [a, b];
-        ends.sort_by(|x, y| x[1].total_cmp(&y[1]));
-        (ends[0][0] - 0.5).abs() < 1e-12 && ends[0][1] == 0.0 && (ends[1][0] - 0.5).abs() < 1e-12 && ends[1][1] == 1.0
-    });
+    let square_cut =
+        l.patches.iter().filter(|p| p.face.as_deref() == Some("0")).flat_map(|p| p.sides.iter()).any(|c| {
+            let (a, b) = c.endpoints();
+            let mut ends = [a, b];
+            ends.sort_by(|x, y| x[1].total_cmp(&y[1]));
+            (ends[0][0] - 0.5).abs() < 1e-12
+                && ends[0][1] == 0.0
+                && (ends[1][0] - 0.5).abs() < 1e-12
+                && ends[1][1] == 1.0
+        });
     assert!(square_cut);
     assert!((total_area(l) - (1.0 + 0.5 * 0.9)).abs() < 1e-12);
     conforming_bit_for_bit(l);

@@ -23,8 +23,8 @@ use std::path::Path;
 use serde_json::Value;
 
 use super::domain::domain_of_json;
-use super::graph::graph_of_json;
 use super::gismo::parse_gismo_xml;
+use super::graph::graph_of_json;
 use super::json::parse_json;
 use super::multipatch::gismo::{is_gismo_multipatch, parse_gismo_multipatch};
 use super::multipatch::json::parse_json_multipatch;

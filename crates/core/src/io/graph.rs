@@ -74,7 +74,8 @@ pub fn graph_of_json(v: Value) -> Result<PlaneGraph> {
     };
     let vertices = points(g.remove("vertices").ok_or_else(|| jerr("graph.vertices", "missing"))?, "graph.vertices")?;
     let Some(Value::Array(list)) = g.remove("edges") else { return Err(jerr("graph.edges", "must be a list")) };
-    let edges = list.into_iter().enumerate().map(|(k, e)| edge(e, &format!("graph.edges[{k}]"))).collect::<Result<_>>()?;
+    let edges =
+        list.into_iter().enumerate().map(|(k, e)| edge(e, &format!("graph.edges[{k}]"))).collect::<Result<_>>()?;
     let labels = match g.remove("labels") {
         None | Some(Value::Null) => Vec::new(),
         Some(Value::Array(list)) => list
@@ -86,7 +87,10 @@ pub fn graph_of_json(v: Value) -> Result<PlaneGraph> {
                 let Some(Value::String(name)) = o.get("name").cloned() else {
                     return Err(jerr(format!("{ctx}.name"), "must be a string"));
                 };
-                let p = points(Value::Array(vec![o.get("point").cloned().unwrap_or(Value::Null)]), &format!("{ctx}.point"))?;
+                let p = points(
+                    Value::Array(vec![o.get("point").cloned().unwrap_or(Value::Null)]),
+                    &format!("{ctx}.point"),
+                )?;
                 Ok(PlaneLabel { name, point: p[0] })
             })
             .collect::<Result<_>>()?,
@@ -112,8 +116,7 @@ pub fn graph_to_json(g: &PlaneGraph) -> Value {
             o
         })
         .collect();
-    let labels: Vec<Value> =
-        g.labels.iter().map(|l| serde_json::json!({ "name": l.name, "point": l.point })).collect();
+    let labels: Vec<Value> = g.labels.iter().map(|l| serde_json::json!({ "name": l.name, "point": l.point })).collect();
     let mut graph = serde_json::json!({ "vertices": g.vertices, "edges": edges, "labels": labels });
     if !g.voids.is_empty() {
         graph["voids"] = serde_json::json!(g.voids);
@@ -139,7 +142,10 @@ mod tests {
                "labels": [{"name": "left", "point": [0.5, 0.5]}], "voids": [[9, 9]]}}"#,
         )
         .unwrap();
-        assert_eq!((g.name.as_str(), g.vertices.len(), g.edges.len(), g.labels.len(), g.voids.len()), ("two", 6, 7, 1, 1));
+        assert_eq!(
+            (g.name.as_str(), g.vertices.len(), g.edges.len(), g.labels.len(), g.voids.len()),
+            ("two", 6, 7, 1, 1)
+        );
         assert!(matches!(&g.edges[5].curve, Some(SideCurve::Points(p)) if p.len() == 3));
         let back = graph_of_json(graph_to_json(&g)).unwrap();
         assert_eq!(format!("{:?}", back), format!("{:?}", g));
@@ -151,9 +157,15 @@ mod tests {
             (r#"{"graph": {"edges": []}}"#, "graph.vertices"),
             (r#"{"graph": {"vertices": [[0,0]], "edges": 3}}"#, "graph.edges"),
             (r#"{"graph": {"vertices": [[0,0]], "edges": [{"from": -1, "to": 0}]}}"#, "graph.edges[0].from"),
-            (r#"{"graph": {"vertices": [[0,0]], "edges": [{"from": 0, "to": 0, "curve": 5}]}}"#, "graph.edges[0].curve"),
+            (
+                r#"{"graph": {"vertices": [[0,0]], "edges": [{"from": 0, "to": 0, "curve": 5}]}}"#,
+                "graph.edges[0].curve",
+            ),
             (r#"{"graph": {"vertices": [[0,0]], "edges": [], "labels": [{"point": [0,0]}]}}"#, "graph.labels[0].name"),
-            (r#"{"graph": {"vertices": [[0,0]], "edges": [], "labels": [{"name": "a", "point": [0]}]}}"#, "graph.labels[0].point"),
+            (
+                r#"{"graph": {"vertices": [[0,0]], "edges": [], "labels": [{"name": "a", "point": [0]}]}}"#,
+                "graph.labels[0].point",
+            ),
         ] {
             let e = parse(doc).unwrap_err().to_string();
             assert!(e.contains(want), "{want}: {e}");

@@ -102,9 +102,7 @@ impl Output<'_> {
             Output::Map { .. } => ".json, .xml, .igs, .iges, .vtu or .vtk",
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
-            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => {
-                ".json"
-            }
+            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => ".json",
             Output::Picture(_) => ".png",
         }
     }
