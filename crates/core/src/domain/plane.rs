@@ -10,9 +10,9 @@
 //! The faces are found by [`super::cycles::trace`] on both half-edges of every edge: a
 //! counter-clockwise cycle bounds a face; a clockwise one is the outside of a connected
 //! component, a hole of the smallest face around it (none: the outside of the graph). A
-//! face that contains a point of `voids` (a field added to the format: regions that are
-//! not part of the domain, such as a shaft bore) is left out; its edges bound the faces
-//! around it.
+//! face that contains a point of `voids` (a field this version adds to the format, not
+//! yet in formats.md: regions that are not part of the domain, such as a shaft bore) is
+//! left out; its edges bound the faces around it.
 
 use serde::Serialize;
 
