@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The automatic layout of general domains (issue 31): the seeded corpus of
 # `winslow corpus --general` (N-gons with curved sides, N = 3 ... 12; L, T, U, E and plus
-# shapes with sharp or filleted reflex corners) laid out and solved at the default
+# shapes with sharp or filleted reflex corners; plates with 1-5 holes; plane graphs:
+# wiggly squares of 4-60 faces, motor-like sections of 6-48 slots) laid out and solved at the default
 # settings: one line per domain (patches, cuts, patch corner angles, verdict, seconds of
 # layout and solve together), a table per family and the pass rate (a domain passes when
 # every patch is certified). Then the bundled domains of tests/data/domains, each solved

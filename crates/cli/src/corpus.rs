@@ -28,7 +28,7 @@ pub struct CorpusArgs {
     /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
     /// strip, cad, noisy-cloud, sparse-cloud; and cad-kinks (steps and V-notches at C0
     /// knots of spline sides), which the default corpus leaves out; with --general: ngon,
-    /// l, t, u, e, plus.
+    /// l, t, u, e, plus, plate (domains with holes), wiggly, motor (plane graphs).
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,
     /// Remove the documents (boundaries, or domains with --general) of an earlier run from the -o folder first (without
@@ -36,9 +36,11 @@ pub struct CorpusArgs {
     #[arg(long)]
     overwrite: bool,
     /// The corpus of general domains instead (issue 31): N-gons with curved sides
-    /// (N = 3 ... 12), L, T, U, E and plus shapes with sharp or filleted reflex corners;
-    /// written as domain documents, and with --solve laid out automatically and solved
-    /// (a domain counts as certified when every patch is).
+    /// (N = 3 ... 12), L, T, U, E and plus shapes with sharp or filleted reflex corners,
+    /// plates with 1 to 5 holes; and plane graphs: squares cut by wiggly curves into 4 to
+    /// 60 faces, motor-like sections with 6 to 48 slots; written as domain and graph
+    /// documents, and with --solve laid out automatically and solved (a domain counts as
+    /// certified when every patch is).
     #[arg(long)]
     general: bool,
     /// Solve every domain (default settings) and print the verdicts and a table per

@@ -1,16 +1,40 @@
-//! `winslow corpus --general`: the seeded corpus of general domains
-//! (`winslow::domain::corpus`): write the domain documents, and optionally lay each out
-//! automatically and solve it at the default settings, with a table per family.
+//! `winslow corpus --general`: the seeded corpus of general domains and plane graphs
+//! (`winslow::domain::corpus`): write the domain and graph documents, and optionally lay
+//! each out automatically and solve it at the default settings, with a table per family.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
-use winslow::domain::corpus::{domain_corpus, DomainFamily};
-use winslow::domain::{auto_layout, LayoutOptions};
+use anyhow::{bail, Result};
+use winslow::domain::corpus::{domain_corpus, DomainFamily, GraphFamily};
+use winslow::domain::{auto_layout, graph_layout, AutoLayout, Domain, LayoutOptions, PlaneGraph};
 use winslow::solve::report::Verdict;
 use winslow::{Pipeline, SolveOptions, Solved};
+
+/// A generated domain or plane graph.
+enum Item {
+    Domain(Domain),
+    Graph(PlaneGraph),
+}
+
+impl Item {
+    fn lay_out(&self) -> winslow::Result<AutoLayout> {
+        match self {
+            Item::Domain(d) => auto_layout(d, &LayoutOptions::default()),
+            Item::Graph(g) => graph_layout(g, &LayoutOptions::default()),
+        }
+    }
+}
+
+impl Item {
+    fn name(&self) -> &str {
+        match self {
+            Item::Domain(d) => &d.name,
+            Item::Graph(g) => &g.name,
+        }
+    }
+}
 
 #[derive(Default)]
 struct Tally {
@@ -29,10 +53,13 @@ pub fn run(
     solve: bool,
     overwrite: bool,
 ) -> Result<i32> {
-    let families: Vec<DomainFamily> = names
-        .iter()
-        .map(|n| DomainFamily::parse(n).with_context(|| format!("unknown family '{n}' (ngon, l, t, u, e, plus)")))
-        .collect::<Result<_>>()?;
+    for n in names {
+        if DomainFamily::parse(n).is_none() && GraphFamily::parse(n).is_none() {
+            bail!("unknown family '{n}' (ngon, l, t, u, e, plus, plate, wiggly, motor)");
+        }
+    }
+    let families: Vec<DomainFamily> = names.iter().filter_map(|n| DomainFamily::parse(n)).collect();
+    let graph_families: Vec<GraphFamily> = names.iter().filter_map(|n| GraphFamily::parse(n)).collect();
     if per_family == 0 || per_family > 10_000 {
         bail!("--per-family must be in 1..=10000, not {per_family}");
     }
@@ -44,31 +71,44 @@ pub fn run(
         // FAMILY-N.json of an earlier run
         let ours = |f: &str| {
             f.strip_suffix(".json").and_then(|s| s.rsplit_once('-')).is_some_and(|(family, n)| {
-                DomainFamily::parse(family).is_some() && n.bytes().all(|b| b.is_ascii_digit())
+                (DomainFamily::parse(family).is_some() || GraphFamily::parse(family).is_some())
+                    && n.bytes().all(|b| b.is_ascii_digit())
             })
         };
         crate::files::claim_folder("-o", dir, ours, overwrite)?;
     }
-    let domains = domain_corpus(&families, per_family, seed);
+    let mut domains: Vec<(&str, Item)> = Vec::new();
+    if names.is_empty() || !families.is_empty() {
+        domains
+            .extend(domain_corpus(&families, per_family, seed).into_iter().map(|(f, d)| (f.name(), Item::Domain(d))));
+    }
+    for f in GraphFamily::ALL.into_iter().filter(|f| names.is_empty() || graph_families.contains(f)) {
+        domains.extend((0..per_family as u64).map(|k| (f.name(), Item::Graph(f.generate(seed + k)))));
+    }
     if let Some(dir) = output {
-        for (_, d) in &domains {
-            crate::files::write(&dir.join(format!("{}.json", d.name)), &winslow::io::Output::Domain(d))?;
+        for (_, item) in &domains {
+            let (name, out) = match item {
+                Item::Domain(d) => (&d.name, winslow::io::Output::Domain(d)),
+                Item::Graph(g) => (&g.name, winslow::io::Output::Graph(g)),
+            };
+            crate::files::write(&dir.join(format!("{name}.json")), &out)?;
         }
     }
     if !solve {
         return Ok(0);
     }
     let mut tally: BTreeMap<&str, Tally> = BTreeMap::new();
-    for (family, d) in &domains {
+    for (family, item) in &domains {
         let t0 = Instant::now();
-        let outcome = auto_layout(d, &LayoutOptions::default()).and_then(|auto| {
+        let outcome = item.lay_out().and_then(|auto| {
             match Pipeline::new(auto.layout.clone(), SolveOptions::default()).solve()? {
                 Solved::Layout(sol) => Ok((auto, *sol)),
                 other => Err(winslow::Error::Invalid(format!("a layout solved into {:?}", other.verdict()))),
             }
         });
         let secs = t0.elapsed().as_secs_f64();
-        let t = tally.entry(family.name()).or_default();
+        let t = tally.entry(family).or_default();
+        let name = item.name();
         t.domains += 1;
         t.seconds += secs;
         match outcome {
@@ -78,7 +118,7 @@ pub fn run(
                 let good = sol.report.verdicts.iter().all(|v| *v == Verdict::Certified);
                 say!(
                     "{:<10} {:>3} patches {:>2} cuts, angles {:5.1}..{:5.1}: {:<18} {secs:6.2} s",
-                    d.name,
+                    name,
                     n,
                     auto.report.cuts.len(),
                     auto.report.corner_angles[0],
@@ -88,12 +128,12 @@ pub fn run(
                 if good {
                     t.certified += 1;
                 } else {
-                    t.failures.push(format!("{}: {}", d.name, sol.report.message));
+                    t.failures.push(format!("{name}: {}", sol.report.message));
                 }
             }
             Err(e) => {
-                say!("{:<10} error: {e}", d.name);
-                t.failures.push(format!("{}: {e}", d.name));
+                say!("{name:<10} error: {e}");
+                t.failures.push(format!("{name}: {e}"));
             }
         }
     }

@@ -1,36 +1,59 @@
-//! General planar domains (`formats.md`, "General planar domain") from the command
-//! line: `winslow solve DOMAIN.json` lays the domain out automatically
-//! ([`winslow::domain::auto_layout`]) and solves the layout like any multipatch layout;
+//! General planar domains and plane graphs (`formats.md`, "General planar domain",
+//! "Plane graph") from the command line: `winslow solve DOMAIN.json` (or `GRAPH.json`)
+//! lays the domain out automatically ([`winslow::domain::auto_layout`],
+//! [`winslow::domain::graph_layout`]) and solves the layout like any multipatch layout;
 //! `winslow layout DOMAIN.json` lays it out only, and writes the layout and its picture.
 
 use super::*;
 use crate::files;
-use winslow::domain::{auto_layout, AutoLayout, Domain, LayoutOptions};
+use winslow::domain::{auto_layout, graph_layout, AutoLayout, Domain, LayoutOptions, PlaneGraph};
 use winslow::io::picture::render_curves;
 
-/// Lay `domain` out with the fit options `fit`, or fail naming the domain.
-fn lay_out(domain: &Domain, fit: FitOptions) -> Result<AutoLayout> {
-    auto_layout(domain, &LayoutOptions { fit, ..Default::default() })
-        .with_context(|| format!("laying out the domain {}", domain.name))
+/// A document the automatic layout takes.
+pub(crate) enum Planar {
+    /// A general planar domain.
+    Domain(Domain),
+    /// A plane graph.
+    Graph(PlaneGraph),
+}
+
+/// Lay `input` out with the fit options `fit`, or fail naming it.
+fn lay_out(input: &Planar, fit: FitOptions) -> Result<AutoLayout> {
+    let opts = LayoutOptions { fit, ..Default::default() };
+    match input {
+        Planar::Domain(d) => auto_layout(d, &opts).with_context(|| format!("laying out the domain {}", d.name)),
+        Planar::Graph(g) => graph_layout(g, &opts).with_context(|| format!("laying out the plane graph {}", g.name)),
+    }
 }
 
 /// One line per cut, face and irregular vertex.
 fn summary(auto: &AutoLayout) -> String {
     let r = &auto.report;
+    let what = match (&r.domain, &r.graph) {
+        (Some(d), _) => format!("{} corners, {} holes", d.outer_corners, d.hole_corners.len()),
+        (_, Some(g)) => format!("{} vertices, {} edges, {} faces", g.vertices, g.edges, g.faces.len()),
+        _ => String::new(),
+    };
     let mut s = format!(
-        "{}: {} corners, area {:.6}; {} patches, {} cuts from reflex corners, {} irregular interior vertices; corner angles {:.1} to {:.1} degrees ({:.3} s)\n",
+        "{}: {what}, area {:.6}; {} patches, {} cuts from holes, {} cuts from reflex corners, {} irregular interior vertices; corner angles {:.1} to {:.1} degrees ({:.3} s)\n",
         auto.layout.name,
-        r.domain.outer_corners,
-        r.domain.area,
+        r.area,
         r.patches,
+        r.hole_cuts.len(),
         r.cuts.len(),
         r.irregular_vertices.len(),
         r.corner_angles[0],
         r.corner_angles[1],
         r.seconds
     );
-    for why in &r.domain.reoriented {
+    for why in r.domain.iter().flat_map(|d| &d.reoriented) {
         s.push_str(&format!("  note: {why}\n"));
+    }
+    for c in &r.hole_cuts {
+        s.push_str(&format!(
+            "  cut from {} at ({:.6}, {:.6}) to the {} ({:.6}, {:.6})\n",
+            c.hole, c.from[0], c.from[1], c.ends_on, c.to[0], c.to[1]
+        ));
     }
     for c in &r.cuts {
         s.push_str(&format!(
@@ -47,9 +70,9 @@ fn summary(auto: &AutoLayout) -> String {
     s
 }
 
-/// `winslow solve DOMAIN`: the automatic layout, then the multipatch solve.
-pub(super) fn solve(domain: Domain, a: &SolveArgs, sel: &Selected) -> Result<i32> {
-    let auto = lay_out(&domain, a.solver.options()?.fit)?;
+/// `winslow solve DOMAIN` (or `GRAPH`): the automatic layout, then the multipatch solve.
+pub(super) fn solve(input: Planar, a: &SolveArgs, sel: &Selected) -> Result<i32> {
+    let auto = lay_out(&input, a.solver.options()?.fit)?;
     if !(output::quiet() || a.json) {
         eprint!("{}", summary(&auto));
     }
@@ -57,10 +80,11 @@ pub(super) fn solve(domain: Domain, a: &SolveArgs, sel: &Selected) -> Result<i32
     super::solve_cmd::solve_layout(auto.layout, a, Some(made), sel)
 }
 
-/// `winslow layout`: lay a general domain out into four-sided patches.
+/// `winslow layout`: lay a general domain or a plane graph out into four-sided patches.
 #[derive(Args, Debug)]
 pub(super) struct LayoutArgs {
-    /// The domain document (`formats.md`, "General planar domain").
+    /// The domain or plane graph document (`formats.md`, "General planar domain",
+    /// "Plane graph").
     domain: PathBuf,
     /// Write the layout as a multipatch document (every patch a boundary, naming its
     /// face), which `winslow solve` takes.
@@ -84,10 +108,18 @@ pub(super) fn layout(a: LayoutArgs) -> Result<i32> {
         .maybe("--png", a.png.as_deref(), "picture", files::ext::PNG)
         .check()?;
     let doc = files::read(&a.domain)?;
-    let Document::Domain(domain) = doc else {
-        return Err(files::wrong_kind(&doc, &a.domain, "a general planar domain (\"domain\") is needed"));
+    let input = match doc {
+        Document::Domain(d) => Planar::Domain(d),
+        Document::Graph(g) => Planar::Graph(g),
+        doc => {
+            return Err(files::wrong_kind(
+                &doc,
+                &a.domain,
+                "a general planar domain (\"domain\") or a plane graph (\"graph\") is needed",
+            ))
+        }
     };
-    let auto = lay_out(&domain, fit_options(&a.fit))?;
+    let auto = lay_out(&input, fit_options(&a.fit))?;
     if let Some(p) = &a.output {
         files::write(p, &Output::Layout(&auto.layout))?;
     }

@@ -192,12 +192,14 @@ enum Command {
         after_help = "Example (the two halves of the `winslow split` example, solved):\n  winslow solve out/parts-a.json -o out/a.json -q\n  winslow solve out/parts-b.json -o out/b.json -q\n  winslow join out/a.json out/b.json -o out/joined.json"
     )]
     Join(multipatch_cmd::JoinArgs),
-    /// Lay a general planar domain (any number of corners) out into four-sided patches
-    /// automatically: cuts from reflex corners, a template per face placed by a harmonic
-    /// map; write the layout (which `winslow solve` takes) and draw it. `winslow solve`
-    /// on the domain lays it out and solves it in one go.
+    /// Lay a general planar domain (any number of corners, holes) or a plane graph out
+    /// into four-sided patches automatically: cuts from holes and reflex corners, a
+    /// template per face placed by a harmonic map; write the layout (which `winslow
+    /// solve` takes) and draw it. `winslow solve` on the domain or graph lays it out and
+    /// solves it in one go.
     #[command(after_help = "Example:
-  winslow layout tests/data/domains/pentagon.json -o out/pentagon-layout.json --png out/pentagon-layout.png")]
+  winslow layout tests/data/domains/pentagon.json -o out/pentagon-layout.json --png out/pentagon-layout.png
+  winslow layout tests/data/domains/motor12.json --png out/motor-layout.png")]
     Layout(domain_cmd::LayoutArgs),
     /// Print the command-line reference (docs/cli.md) generated from these definitions.
     #[command(hide = true)]

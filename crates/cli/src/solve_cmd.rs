@@ -2,6 +2,7 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
+use crate::domain_cmd::Planar;
 use crate::files;
 use winslow::multipatch::LayoutEvent;
 use winslow::{Input, Pipeline, Solved, Stage};
@@ -202,14 +203,16 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if let Document::VolumeBoundary(b) = doc {
         return super::volume_cmd::solve(b, &a, path);
     }
-    let multipatch = matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_));
+    let multipatch =
+        matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_) | Document::Graph(_));
     output_plan(&a, &[path], multipatch)?;
     let sel = a.backend.select(output::quiet() || a.json)?;
     let input = match doc {
         Document::Layout(layout) | Document::Multipatch(layout) => {
             return solve_layout(layout, &a, None, &sel);
         }
-        Document::Domain(domain) => return super::domain_cmd::solve(domain, &a, &sel),
+        Document::Domain(domain) => return super::domain_cmd::solve(Planar::Domain(domain), &a, &sel),
+        Document::Graph(graph) => return super::domain_cmd::solve(Planar::Graph(graph), &a, &sel),
         Document::Ring(ring) => Input::Ring(ring),
         // a ring map (a sweep's frame): the ring between its two contours
         doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),

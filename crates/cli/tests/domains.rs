@@ -102,3 +102,66 @@ fn bad_domains_are_typed_errors() {
         }
     }
 }
+
+/// The surface groups (`2 TAG "NAME"`) of a Gmsh file's `$PhysicalNames`.
+fn surface_groups(msh: &std::path::Path) -> Vec<String> {
+    let text = std::fs::read_to_string(msh).unwrap();
+    let block = text.split("$PhysicalNames").nth(1).unwrap().split("$EndPhysicalNames").next().unwrap();
+    block.lines().filter(|l| l.starts_with("2 ")).map(|l| l.split('"').nth(1).unwrap().to_string()).collect()
+}
+
+#[test]
+fn a_plane_graph_is_laid_out_solved_and_meshed_by_face() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let graph = data().join("domains/motor12.json");
+    let (layout, png, solved, msh) = (dir.join("l.json"), dir.join("l.png"), dir.join("m.json"), dir.join("m.msh"));
+    let out =
+        bin().arg("layout").arg(&graph).arg("-o").arg(&layout).arg("--png").arg(&png).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    // 12 slots, 12 teeth, rotor, air gap and yoke; the shaft is a void
+    assert_eq!(report["graph"]["faces"].as_array().unwrap().len(), 27);
+    assert_eq!(report["graph"]["voids"], 1);
+    assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+    let out = bin().arg("solve").arg(&graph).arg("-o").arg(&solved).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    assert_eq!(report["interface_mismatch"], 0.0);
+    assert!(report["verdicts"].as_array().unwrap().iter().all(|v| v == "certified"), "{}", report["message"]);
+    let doc = read_json(&solved);
+    let faces: std::collections::BTreeSet<String> =
+        doc["patches"].as_array().unwrap().iter().map(|p| p["face"].as_str().unwrap().to_string()).collect();
+    assert_eq!(faces.len(), 27);
+    for want in ["rotor", "airgap", "yoke", "slot-0", "tooth-11"] {
+        assert!(faces.contains(want), "{want}: {faces:?}");
+    }
+    // one conforming mesh, one physical surface per face
+    let out =
+        bin().arg("mesh").arg(&solved).arg("-o").arg(&msh).arg("--structured").arg("5x5").arg("-q").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let groups: std::collections::BTreeSet<String> = surface_groups(&msh).into_iter().collect();
+    assert_eq!(groups, faces);
+}
+
+#[test]
+fn bad_graphs_are_typed_errors() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let square = r#""vertices": [[0,0],[1,0],[1,1],[0,1]], "edges": [{"from":0,"to":1},{"from":1,"to":2},{"from":2,"to":3},{"from":3,"to":0}"#;
+    for (doc, want) in [
+        (format!(r#"{{"graph": {{{square}, {{"from":0,"to":2}}, {{"from":1,"to":3}}]}}}}"#), "graph edge 5"),
+        (format!(r#"{{"graph": {{{square}, {{"from":0,"to":9}}]}}}}"#), "graph edge 4"),
+        (format!(r#"{{"graph": {{{square}], "labels": [{{"name": "x", "point": [7, 7]}}]}}}}"#), "graph label 0 (x)"),
+    ] {
+        let input = dir.join("bad.json");
+        winslow::io::file::write_bytes(&input, doc.as_bytes()).unwrap();
+        for cmd in ["solve", "layout"] {
+            let out = bin().arg(cmd).arg(&input).arg("-o").arg(dir.join("never.json")).output().unwrap();
+            assert_eq!(out.status.code(), Some(1), "{cmd}: {doc}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains(want), "{cmd}: {want}: {err}");
+            assert!(!dir.join("never.json").exists());
+        }
+    }
+}

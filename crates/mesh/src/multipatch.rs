@@ -12,8 +12,10 @@
 //! Parameters are uniform, `t_k = k / (n - 1)`; a side that runs against its neighbour
 //! is paired end to start.
 //!
-//! Groups ([`crate::Groups`]): a cell group per patch (named by the patch) and a
-//! boundary group per outer side (`PATCH.SIDE`); interfaces are interior. Each node
+//! Groups ([`crate::Groups`]): a cell group per face (the patches' `face`, the label of
+//! the graph face or `domain` an automatic layout gives them: the physical groups of
+//! a plane graph's materials), or per patch (named by the patch) when no patch names a
+//! face; and a boundary group per outer side (`PATCH.SIDE`); interfaces are interior. Each node
 //! keeps the parameters of the first patch it was sampled on ([`Mesh::params`] are
 //! patch-local), and the nodes of an interface are evaluated on both sides and must
 //! agree to `1e-9` of the layout's diameter (the patches share their interface
@@ -68,6 +70,26 @@ fn patch_name(layout: &Layout, p: usize) -> String {
         "" => format!("patch{p}"),
         n => n.to_string(),
     }
+}
+
+/// The cell groups of `layout`: their names and the group of every patch; one per
+/// face (in the order of first appearance) when some patch names its face (a patch
+/// without one is a group of its own), else one per patch.
+pub fn cell_groups(layout: &Layout) -> (Vec<String>, Vec<usize>) {
+    let mut names: Vec<String> = Vec::new();
+    let mut of = Vec::with_capacity(layout.patches.len());
+    let by_face = layout.patches.iter().any(|p| p.face.is_some());
+    for (p, patch) in layout.patches.iter().enumerate() {
+        let name = match (&patch.face, by_face) {
+            (Some(f), true) => f.clone(),
+            _ => patch_name(layout, p),
+        };
+        of.push(names.iter().position(|n| *n == name).unwrap_or_else(|| {
+            names.push(name);
+            names.len() - 1
+        }));
+    }
+    (names, of)
 }
 
 /// The conforming linear mesh of `layout` (every patch a map) with about `points`
@@ -185,13 +207,14 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
         global[x] = global[r];
     }
     let id = |p: usize, ij: [usize; 2]| global[local(p, ij)];
+    let (group_names, group_of) = cell_groups(layout);
     let mut cells = Vec::new();
     let mut cell_group = Vec::new();
     for (p, &[nx, ny]) in patch_points.iter().enumerate() {
         for j in 0..ny - 1 {
             for i in 0..nx - 1 {
                 cells.extend([id(p, [i, j]), id(p, [i + 1, j]), id(p, [i + 1, j + 1]), id(p, [i, j + 1])]);
-                cell_group.push(p);
+                cell_group.push(group_of[p]);
             }
         }
     }
@@ -215,12 +238,7 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
         boundary.extend(edges);
         boundary_names.push(format!("{}.{}", patch_name(layout, ps.patch), ps.side.name()));
     }
-    let groups = Groups {
-        boundary: boundary_names,
-        edge_group,
-        cells: (0..maps.len()).map(|p| patch_name(layout, p)).collect(),
-        cell_group,
-    };
+    let groups = Groups { boundary: boundary_names, edge_group, cells: group_names, cell_group };
     let mesh = Mesh {
         points: pts,
         params,

@@ -368,7 +368,7 @@ impl Scene {
             }
             Document::Ring(ring) => Self::from_ring(ring),
             Document::Layout(layout) | Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
-            doc @ Document::Domain(_) => {
+            doc @ (Document::Domain(_) | Document::Graph(_)) => {
                 return Err(doc
                     .wrong_kind(None, "the viewer draws maps and solved layouts: `winslow solve` lays a domain out and solves it; open its output")
                     .into())

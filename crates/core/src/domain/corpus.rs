@@ -1,9 +1,10 @@
 //! A seeded corpus of general domains for the automatic layout (issue 31): `N`-gons with
-//! curved sides (`N = 3 ... 12`) and L-, T-, U-, E- and plus-shaped brackets with sharp
-//! or filleted reflex corners. The same seed gives the same domains on every machine
+//! curved sides (`N = 3 ... 12`), L-, T-, U-, E- and plus-shaped brackets with sharp
+//! or filleted reflex corners, plates with holes; and plane graphs ([`GraphFamily`]:
+//! wiggly squares and motor-like sections, [`super::families`]). The same seed gives the same domains on every machine
 //! (SplitMix64, as the hard corpus of [`crate::boundary::families`]).
 
-use super::{Domain, Loop};
+use super::{Domain, Loop, PlaneGraph};
 use crate::boundary::families::{between, Rng};
 use crate::boundary::SideCurve;
 use crate::spline::curve::{Curve, Point};
@@ -24,14 +25,23 @@ pub enum DomainFamily {
     E,
     /// A plus: four reflex corners.
     Plus,
+    /// A rectangular plate with 1 to 5 holes ([`super::families::plate`]).
+    Plate,
 }
 
 impl DomainFamily {
     /// Every family.
-    pub const ALL: [DomainFamily; 6] =
-        [DomainFamily::Ngon, DomainFamily::L, DomainFamily::T, DomainFamily::U, DomainFamily::E, DomainFamily::Plus];
+    pub const ALL: [DomainFamily; 7] = [
+        DomainFamily::Ngon,
+        DomainFamily::L,
+        DomainFamily::T,
+        DomainFamily::U,
+        DomainFamily::E,
+        DomainFamily::Plus,
+        DomainFamily::Plate,
+    ];
 
-    /// Its name: `ngon`, `l`, `t`, `u`, `e`, `plus`.
+    /// Its name: `ngon`, `l`, `t`, `u`, `e`, `plus`, `plate`.
     pub fn name(self) -> &'static str {
         match self {
             DomainFamily::Ngon => "ngon",
@@ -40,6 +50,7 @@ impl DomainFamily {
             DomainFamily::U => "u",
             DomainFamily::E => "e",
             DomainFamily::Plus => "plus",
+            DomainFamily::Plate => "plate",
         }
     }
 
@@ -52,6 +63,7 @@ impl DomainFamily {
     pub fn generate(self, seed: u64) -> Domain {
         let mut rng = Rng::new(seed.wrapping_mul(0x2545_F491).wrapping_add(self as u64 + 101));
         let sides = match self {
+            DomainFamily::Plate => return super::families::plate(seed),
             DomainFamily::Ngon => ngon(&mut rng, 3 + (seed % 10) as usize),
             letter => {
                 let pts = letter_polygon(letter, &mut rng);
@@ -60,6 +72,41 @@ impl DomainFamily {
             }
         };
         Domain { name: format!("{}-{seed}", self.name()), outer: Loop::new(sides), holes: Vec::new() }
+    }
+}
+
+/// A family of plane graphs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum GraphFamily {
+    /// The unit square cut by wiggly curves into 4 to 60 faces ([`super::families::wiggly`]).
+    Wiggly,
+    /// A motor-like section with 6 to 48 slots ([`super::families::motor`]).
+    Motor,
+}
+
+impl GraphFamily {
+    /// Every family.
+    pub const ALL: [GraphFamily; 2] = [GraphFamily::Wiggly, GraphFamily::Motor];
+
+    /// Its name: `wiggly`, `motor`.
+    pub fn name(self) -> &'static str {
+        match self {
+            GraphFamily::Wiggly => "wiggly",
+            GraphFamily::Motor => "motor",
+        }
+    }
+
+    /// The family called `name`.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// The graph of this family for `seed`, named `FAMILY-SEED`.
+    pub fn generate(self, seed: u64) -> PlaneGraph {
+        match self {
+            GraphFamily::Wiggly => super::families::wiggly(seed),
+            GraphFamily::Motor => super::families::motor(seed),
+        }
     }
 }
 
@@ -144,7 +191,7 @@ fn letter_polygon(f: DomainFamily, rng: &mut Rng) -> Vec<Point> {
                 [0.0, 3.0 * t + 2.0 * g],
             ]
         }
-        DomainFamily::Plus | DomainFamily::Ngon => {
+        DomainFamily::Plus | DomainFamily::Ngon | DomainFamily::Plate => {
             let (a, l1, l2, l3, l4) = (r(0.3, 0.6), r(1.0, 2.0), r(1.0, 2.0), r(1.0, 2.0), r(1.0, 2.0));
             vec![
                 [-a, -l1],

@@ -32,6 +32,16 @@ pub struct Face {
     pub sides: Vec<FaceSide>,
     /// The label of the region it belongs to (`"domain"`, or a graph face's label).
     pub label: String,
+    /// Holes (before they are cut away by [`super::holes`]): closed cycles of sides
+    /// with the face to their left (clockwise).
+    pub holes: Vec<Vec<FaceSide>>,
+}
+
+impl Face {
+    /// A face without holes.
+    pub fn new(sides: Vec<FaceSide>, label: impl Into<String>) -> Self {
+        Self { sides, label: label.into(), holes: Vec::new() }
+    }
 }
 
 /// Vertices, edges and faces.
@@ -157,6 +167,11 @@ impl Graph {
         }
     }
 
+    /// The vertex a face side ends at.
+    pub fn end(&self, s: FaceSide) -> usize {
+        self.start((s.0, !s.1))
+    }
+
     /// The vertex a face side starts at.
     pub fn start(&self, s: FaceSide) -> usize {
         let e = &self.edges[s.0];
@@ -207,9 +222,9 @@ impl Graph {
         self.edges[e].b = v;
         let e2 = self.edges.len();
         self.edges.push(Edge { curve: right, a: v, b, boundary });
-        for f in &mut self.faces {
-            let mut out = Vec::with_capacity(f.sides.len() + 1);
-            for &(x, fwd) in &f.sides {
+        let replace = |cycle: &mut Vec<FaceSide>| {
+            let mut out = Vec::with_capacity(cycle.len() + 1);
+            for &(x, fwd) in cycle.iter() {
                 if x != e {
                     out.push((x, fwd));
                 } else if fwd {
@@ -218,7 +233,11 @@ impl Graph {
                     out.extend([(e2, false), (e, false)]);
                 }
             }
-            f.sides = out;
+            *cycle = out;
+        };
+        for f in &mut self.faces {
+            replace(&mut f.sides);
+            f.holes.iter_mut().for_each(replace);
         }
         Ok((v, e2))
     }
@@ -236,7 +255,7 @@ impl Graph {
         b.push((cut, true));
         let label = self.faces[f].label.clone();
         self.faces[f].sides = a;
-        self.faces.push(Face { sides: b, label });
+        self.faces.push(Face::new(b, label));
         self.faces.len() - 1
     }
 
@@ -313,7 +332,7 @@ mod tests {
             g.add_vertex(p);
         }
         let sides = (0..4).map(|k| (g.add_edge(line(pts[k], pts[(k + 1) % 4]), k, (k + 1) % 4, true), true)).collect();
-        g.faces.push(Face { sides, label: "d".into() });
+        g.faces.push(Face::new(sides, "d"));
         for i in 0..4 {
             assert!((g.corner_angle(0, i) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         }

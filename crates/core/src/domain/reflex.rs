@@ -69,8 +69,17 @@ fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) -> bool {
 /// The first point where the ray from `o` in direction `d` meets a side of face `f`
 /// (other than at `o`): the side index, the parameter on its edge and the distance.
 fn ray_hit(g: &Graph, f: usize, o: Point, d: Point, tol: f64) -> Option<(usize, f64, f64)> {
+    let edges: Vec<usize> = g.faces[f].sides.iter().map(|s| s.0).collect();
+    let (e, u, s) = ray_hit_edges(g, &edges, o, d, tol)?;
+    Some((g.faces[f].sides.iter().position(|x| x.0 == e)?, u, s))
+}
+
+/// The first point where the ray from `o` in direction `d` meets one of `edges` (farther
+/// than `tol` from `o`), on polylines of 64 chords per knot span: the edge, the parameter
+/// on it and the distance.
+pub fn ray_hit_edges(g: &Graph, edges: &[usize], o: Point, d: Point, tol: f64) -> Option<(usize, f64, f64)> {
     let mut best: Option<(usize, f64, f64)> = None;
-    for (k, &(e, _)) in g.faces[f].sides.iter().enumerate() {
+    for &e in edges {
         let c = &g.edges[e].curve;
         let m = 64 * c.knots.num_elements().max(1);
         let pts = c.sample(m);
@@ -85,7 +94,7 @@ fn ray_hit(g: &Graph, f: usize, o: Point, d: Point, tol: f64) -> Option<(usize, 
             let s = (w[0] * v[1] - w[1] * v[0]) / den;
             let t = (w[0] * d[1] - w[1] * d[0]) / den;
             if s > tol && (-1e-12..=1.0 + 1e-12).contains(&t) && best.is_none_or(|b| s < b.2) {
-                best = Some((k, (i as f64 + t.clamp(0.0, 1.0)) / m as f64, s));
+                best = Some((e, (i as f64 + t.clamp(0.0, 1.0)) / m as f64, s));
             }
         }
     }

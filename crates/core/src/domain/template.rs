@@ -1,8 +1,13 @@
-//! The automatic quad layout of a general planar domain (issue 31), with no interaction:
+//! The automatic quad layout of a general planar domain or a plane graph (issue 31),
+//! with no interaction:
 //!
 //! 1. **Sides**: point clouds are fitted by the contour fit of §5 (`FitOptions`); the
-//!    outer loop becomes one face of a [`Graph`], its sides boundary edges.
-//! 2. **Reflex corners** are cut by straight edges into the face ([`super::reflex`]).
+//!    outer loop of a domain becomes one face of a [`Graph`] and its holes the face's
+//!    holes, their sides boundary edges; the faces of a plane graph are found by
+//!    [`build_graph`], each labelled. Holes are cut away by [`super::holes`].
+//! 2. **Reflex corners** are cut by straight edges into the face ([`super::reflex`]);
+//!    a cut ending inside an edge shared with another face gives that face a flat
+//!    corner, cut in turn.
 //! 3. **Templates**: a face with four corners stays one patch. Every other face with `N`
 //!    corners is cut into `N` quads around one interior vertex (valence `N`), the
 //!    midpoint template: the harmonic map of the regular `N`-gon onto the face
@@ -15,7 +20,7 @@
 //!    the layout stays conforming), or into four when both pairs are split.
 //! 4. **Layout**: every face is now a patch (south, east, reversed north and reversed west
 //!    are its four sides; an edge shared by two patches is an interface), named `p0`,
-//!    `p1`, ..., each with the label of its face (`"domain"`).
+//!    `p1`, ..., each with the label of its face (`"domain"`, or the graph face's).
 //!
 //! The report lists every cut, every face's template and the interior vertices whose
 //! valence is not 4.
@@ -24,14 +29,18 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::cycles::{polyline, signed_area};
 use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
+use super::holes::{cut_holes, HoleCut};
+use super::plane::{build_graph, GraphReport, PlaneGraph};
 use super::reflex::{cut_reflex, line, CutReport};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
 use crate::boundary::fit::{fit_side, FitOptions};
 use crate::boundary::SideCurve;
 use crate::error::{Error, Result};
+use crate::multipatch::check::validate_layout;
 use crate::multipatch::layout::{Interface, Layout, Patch, PatchSide};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::surface::Side;
@@ -82,8 +91,22 @@ pub struct IrregularVertex {
 /// What the automatic layout did.
 #[derive(Debug, Clone, Serialize)]
 pub struct LayoutReport {
-    /// The validation of the domain.
-    pub domain: DomainReport,
+    /// The validation of the domain (a `domain` document).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub domain: Option<DomainReport>,
+    /// The validation of the plane graph and its faces (a `graph` document).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub graph: Option<GraphReport>,
+    /// Area of the domain (holes and voids subtracted), from polylines.
+    pub area: f64,
+    /// Cuts from holes ([`super::holes`]).
+    pub hole_cuts: Vec<HoleCut>,
+    /// Their direction, degrees from the `x` axis (`None`: every hole toward its
+    /// nearest neighbour, or no holes).
+    pub hole_cut_direction: Option<f64>,
+    /// The directions tried (with holes): the valid layout with the largest smallest
+    /// corner angle is taken.
+    pub hole_cut_tries: Vec<HoleCutTry>,
     /// Cuts from reflex corners.
     pub cuts: Vec<CutReport>,
     /// The template of every face.
@@ -113,8 +136,10 @@ fn dist(a: Point, b: Point) -> f64 {
 
 /// A spline curve through `pts` from its first to its last point (both kept exactly):
 /// the straight segment when the points are on it (to `1e-9` of the diameter), else the
-/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand.
-fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
+/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand relative to
+/// `scale` (the smaller of the diameter and ten times the face's area over its
+/// perimeter, so that a cut through a thin face keeps to it).
+fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
     let (a, b) = (pts[0], pts[pts.len() - 1]);
     let l = dist(a, b);
     let off =
@@ -123,17 +148,16 @@ fn fit_points(pts: &[Point], diameter: f64, fit: &FitOptions) -> Result<Curve> {
         return Ok(line(a, b));
     }
     let opts = FitOptions { max_elements: 16, max_levels: 6, ..*fit };
-    let tol = (10.0 * fit.tol).min(1e-2) * diameter;
+    let tol = (10.0 * fit.tol).min(1e-2) * scale.min(diameter);
     Ok(fit_side(Side::South, &SideCurve::Points(pts.to_vec()), (a, b), &opts, tol)?.finest().clone())
 }
 
-/// The sides of `domain`'s outer loop as spline curves on `[0, 1]`.
-fn loop_curves(domain: &Domain, diameter: f64, fit: &FitOptions) -> Result<Vec<Curve>> {
-    let n = domain.outer.sides.len();
-    let corners: Vec<Point> = domain.outer.sides.iter().map(|s| s.endpoints().0).collect();
-    domain
-        .outer
-        .sides
+/// The sides of loop `id` of `domain` as spline curves on `[0, 1]`.
+fn loop_curves(domain: &Domain, id: LoopId, diameter: f64, fit: &FitOptions) -> Result<Vec<Curve>> {
+    let l = domain.loop_of(id);
+    let n = l.sides.len();
+    let corners: Vec<Point> = l.sides.iter().map(|s| s.endpoints().0).collect();
+    l.sides
         .iter()
         .enumerate()
         .map(|(k, s)| match s {
@@ -141,11 +165,31 @@ fn loop_curves(domain: &Domain, diameter: f64, fit: &FitOptions) -> Result<Vec<C
             other => {
                 let ends = (corners[k], corners[(k + 1) % n]);
                 let f = fit_side(Side::South, other, ends, fit, fit.tol * diameter)
-                    .map_err(|e| domain_error(LoopId::Outer, Some(k), format!("its fit failed: {e}")))?;
+                    .map_err(|e| domain_error(id, Some(k), format!("its fit failed: {e}")))?;
                 Ok(f.finest().clone())
             }
         })
         .collect()
+}
+
+/// The sides of loop `id` added to `g` as a closed cycle of boundary edges (each
+/// joint a vertex; the ends of consecutive curves made equal bit for bit).
+fn add_loop(g: &mut Graph, d: &Domain, id: LoopId, diameter: f64, fit: &FitOptions) -> Result<Vec<FaceSide>> {
+    let mut curves = loop_curves(d, id, diameter, fit)?;
+    let n = curves.len();
+    let first = g.vertices.len();
+    for c in &curves {
+        g.add_vertex(c.control_points[0]);
+    }
+    for (k, c) in curves.iter_mut().enumerate() {
+        let last = c.control_points.len() - 1;
+        c.control_points[last] = g.vertices[first + (k + 1) % n];
+    }
+    Ok(curves
+        .into_iter()
+        .enumerate()
+        .map(|(k, c)| (g.add_edge(c, first + k, first + (k + 1) % n, true), true))
+        .collect())
 }
 
 /// How a face is quadrangulated.
@@ -211,11 +255,18 @@ fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
 }
 
 /// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
-fn spoke_curve(mut pts: Vec<Point>, from: Point, to: Point, diameter: f64, fit: &FitOptions) -> Result<Curve> {
+fn spoke_curve(
+    mut pts: Vec<Point>,
+    from: Point,
+    to: Point,
+    diameter: f64,
+    scale: f64,
+    fit: &FitOptions,
+) -> Result<Curve> {
     let last = pts.len() - 1;
     pts[0] = from;
     pts[last] = to;
-    fit_points(&pts, diameter, fit)
+    fit_points(&pts, diameter, scale, fit)
 }
 
 /// Lay out `domain` (see the module documentation).
@@ -225,30 +276,127 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
     let mut d = domain.clone();
     let checked = validate_domain(&mut d)?;
     let diameter = checked.diameter;
-    if !d.holes.is_empty() {
-        return Err(domain_error(
-            LoopId::Hole(0),
-            None,
-            "holes are not laid out automatically by this version: cut the domain into hole-free parts, or give a multipatch layout",
-        ));
-    }
     let n = d.outer.sides.len();
-    if n < 3 {
+    if n < 3 && d.holes.is_empty() {
         return Err(domain_error(
             LoopId::Outer,
             None,
             format!("has {n} corner(s): the automatic layout needs at least 3 (list the corners, or give more curves)"),
         ));
     }
-    // 1. the outer loop as one face
-    let curves = loop_curves(&d, diameter, &opts.fit)?;
+    // 1. the outer loop as one face, the holes as its holes
     let mut g = Graph::default();
-    for c in &curves {
-        g.add_vertex(c.control_points[0]);
+    let sides = add_loop(&mut g, &d, LoopId::Outer, diameter, &opts.fit)?;
+    let mut face = Face::new(sides, "domain");
+    for k in 0..d.holes.len() {
+        face.holes.push(add_loop(&mut g, &d, LoopId::Hole(k), diameter, &opts.fit)?);
     }
-    let sides: Vec<FaceSide> =
-        curves.into_iter().enumerate().map(|(k, c)| (g.add_edge(c, k, (k + 1) % n, true), true)).collect();
-    g.faces.push(Face { sides, label: "domain".into() });
+    g.faces.push(face);
+    let area = checked.area;
+    lay_out_graph(g, &d.name, diameter, area, (Some(checked), None), opts, t0)
+}
+
+/// Lay out the plane graph `pg`: its faces (with their holes and labels) as
+/// [`build_graph`] finds them, then as a domain's (see the module documentation).
+pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout> {
+    let t0 = Instant::now();
+    opts.fit.validate()?;
+    let (g, report) = build_graph(pg, &opts.fit)?;
+    let (diameter, area) = (report.diameter, report.area);
+    lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0)
+}
+
+/// The directions (degrees) of the cuts from holes that are tried; `NaN`: every hole
+/// toward its nearest neighbour ([`cut_holes`]).
+const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
+
+/// Steps 2 to 4 on a graph of faces (with holes). With holes, the layout is made for
+/// every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid one
+/// ([`validate_layout`]: no patch crossing itself or another) whose smallest patch
+/// corner angle is largest is kept; every try is in the report.
+fn lay_out_graph(
+    g: Graph,
+    name: &str,
+    diameter: f64,
+    area: f64,
+    checked: (Option<DomainReport>, Option<GraphReport>),
+    opts: &LayoutOptions,
+    t0: Instant,
+) -> Result<AutoLayout> {
+    if g.faces.iter().all(|f| f.holes.is_empty()) {
+        return lay_out_with(g, name, diameter, area, checked, opts, t0, f64::NAN);
+    }
+    let mut best: Option<(AutoLayout, bool)> = None;
+    let mut first_err = None;
+    let mut tries = Vec::new();
+    for theta in HOLE_CUT_DIRECTIONS {
+        match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta) {
+            Ok(auto) => {
+                let valid = validate_layout(&auto.layout);
+                let min_angle = auto.report.corner_angles[0];
+                tries.push(HoleCutTry {
+                    direction: (!theta.is_nan()).then_some(theta),
+                    patches: auto.layout.patches.len(),
+                    min_corner_angle: Some(min_angle),
+                    error: valid.as_ref().err().map(ToString::to_string),
+                });
+                let better = best.as_ref().is_none_or(|(b, b_ok)| {
+                    (valid.is_ok() && !b_ok) || (valid.is_ok() == *b_ok && min_angle > b.report.corner_angles[0])
+                });
+                if better {
+                    best = Some((auto, valid.is_ok()));
+                }
+            }
+            Err(e) => {
+                tries.push(HoleCutTry {
+                    direction: (!theta.is_nan()).then_some(theta),
+                    patches: 0,
+                    min_corner_angle: None,
+                    error: Some(e.to_string()),
+                });
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_err) {
+        (Some((mut auto, _)), _) => {
+            auto.report.hole_cut_tries = tries;
+            auto.report.seconds = t0.elapsed().as_secs_f64();
+            Ok(auto)
+        }
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(Error::Invalid("layout: no direction of cuts from holes was tried".into())),
+    }
+}
+
+/// One try of a direction of the cuts from holes.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoleCutTry {
+    /// The direction, degrees from the `x` axis (and the opposite one); `null`: every
+    /// hole toward its nearest neighbour.
+    pub direction: Option<f64>,
+    /// Patches of the layout.
+    pub patches: usize,
+    /// Its smallest patch corner angle, degrees.
+    pub min_corner_angle: Option<f64>,
+    /// Why the layout is not valid (or was not made).
+    pub error: Option<String>,
+}
+
+/// Steps 2 to 4 with the cuts from holes in direction `theta` (degrees).
+#[allow(clippy::too_many_arguments)]
+fn lay_out_with(
+    mut g: Graph,
+    name: &str,
+    diameter: f64,
+    area: f64,
+    checked: (Option<DomainReport>, Option<GraphReport>),
+    opts: &LayoutOptions,
+    t0: Instant,
+    theta: f64,
+) -> Result<AutoLayout> {
+    let mut hole_cuts = Vec::new();
+    cut_holes(&mut g, diameter, theta, &mut hole_cuts)?;
     // 2. reflex corners
     let mut cuts = Vec::new();
     cut_reflex(&mut g, diameter, &mut cuts)?;
@@ -256,6 +404,14 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
     let split = edges_to_split(&g);
     let nf = g.faces.len();
     let mut plans: Vec<(Template, usize, Option<HarmonicMap>)> = Vec::with_capacity(nf);
+    // per face: ten times its area over its perimeter (the fit scale of its cuts)
+    let scales: Vec<f64> = (0..nf)
+        .map(|f| {
+            let p = polyline(&g, &g.faces[f].sides);
+            let perimeter: f64 = (0..p.len()).map(|i| dist(p[i], p[(i + 1) % p.len()])).sum();
+            10.0 * signed_area(&p).abs() / perimeter.max(f64::MIN_POSITIVE)
+        })
+        .collect();
     for f in 0..nf {
         let sides = &g.faces[f].sides;
         let k = sides.len();
@@ -306,10 +462,10 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
                 };
                 let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
                 pts.extend(h.spoke(r + 2).into_iter().skip(1));
-                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, &opts.fit)?;
+                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, scales[f], &opts.fit)?;
                 let cut = g.add_edge(c, m0, m2, false);
                 g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
-                g.faces.push(Face { sides: vec![b2, s3, a0, (cut, true)], label: label.clone() });
+                g.faces.push(Face::new(vec![b2, s3, a0, (cut, true)], label.clone()));
                 report.template = "split in two";
                 report.patches = 2;
             }
@@ -321,7 +477,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, &opts.fit)?;
+                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?;
                     spokes.push(g.add_edge(c, centre, m, false));
                     parts.push((a, b));
                 }
@@ -331,7 +487,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
                     if s == 0 {
                         g.faces[f].sides = sides;
                     } else {
-                        g.faces.push(Face { sides, label: label.clone() });
+                        g.faces.push(Face::new(sides, label.clone()));
                     }
                 }
                 report.template = "midpoint";
@@ -342,7 +498,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
         faces.push(report);
     }
     // 4. the layout
-    let layout = layout_of(&g, &d.name)?;
+    let layout = layout_of(&g, name)?;
     let valence = g.valences();
     let boundary = g.on_boundary();
     let irregular_vertices = (0..g.vertices.len())
@@ -357,7 +513,12 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
         }
     }
     let report = LayoutReport {
-        domain: checked,
+        domain: checked.0,
+        graph: checked.1,
+        area,
+        hole_cuts,
+        hole_cut_direction: (!theta.is_nan()).then_some(theta),
+        hole_cut_tries: Vec::new(),
         cuts,
         faces,
         irregular_vertices,
@@ -393,7 +554,7 @@ fn layout_of(g: &Graph, name: &str) -> Result<Layout> {
     let mut interfaces = Vec::new();
     for (e, u) in users.iter().enumerate() {
         match u.as_slice() {
-            [_] => {}
+            [] | [_] => {}
             [(a, ra), (b, rb)] => interfaces.push(Interface { first: *a, second: *b, reversed: ra != rb }),
             _ => return Err(Error::Invalid(format!("layout: edge {e} is a side of {} patches", u.len()))),
         }

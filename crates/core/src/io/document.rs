@@ -11,7 +11,7 @@
 //! | JSON with `map` | [`Document::Map`] |
 //! | JSON with `boundary` or `contour` | [`Document::Boundary`] |
 //! | JSON with `domain` | [`Document::Domain`] (not validated: [`crate::domain::validate_domain`]) |
-//! | JSON with `graph` | not read yet: [`Error::DocumentKind`] naming the kind |
+//! | JSON with `graph` | [`Document::Graph`] (not validated: [`crate::domain::plane::build_graph`]) |
 //! | XML with `TensorBSpline3` / `TensorNurbs3` | [`Document::Volume`] |
 //! | XML with a `<MultiPatch>` of surfaces (two patches or more, or interfaces) | [`Document::Layout`] |
 //! | XML with four curves / one tensor patch | [`Document::Boundary`] / [`Document::Map`] |
@@ -25,6 +25,7 @@ use serde_json::Value;
 
 use super::domain::domain_of_json;
 use super::gismo::parse_gismo_xml;
+use super::graph::graph_of_json;
 use super::json::parse_json;
 use super::multipatch::gismo::{is_gismo_multipatch, parse_gismo_multipatch};
 use super::multipatch::json::parse_json_multipatch;
@@ -36,7 +37,7 @@ use super::{iges, read_text, surface_boundary_area};
 use crate::boundary::ring::{signed_area, ClosedContour, Ring};
 use crate::boundary::volume::VolumeBoundary;
 use crate::boundary::{Boundary, SideCurve};
-use crate::domain::Domain;
+use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::{Side, Surface};
@@ -69,6 +70,8 @@ pub enum Document {
     /// A general planar domain: an outer loop with any number of corners and holes
     /// (`formats.md`, "General planar domain").
     Domain(Domain),
+    /// A plane graph: vertices, edges and labelled faces (`formats.md`, "Plane graph").
+    Graph(PlaneGraph),
     /// A trivariate map: a JSON map with three degrees, or G+Smo
     /// `TensorBSpline3` / `TensorNurbs3`.
     Volume {
@@ -85,7 +88,7 @@ pub enum Document {
 impl Document {
     /// The kind, for messages: `"boundary"`, `"map"`, `"ring map"` (a map with `eta`
     /// periodic), `"ring"`, `"multipatch layout"`, `"multipatch result"`, `"domain"`,
-    /// `"volume"`, `"volume boundary"`.
+    /// `"graph"`, `"volume"`, `"volume boundary"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Document::Boundary(_) => "boundary",
@@ -95,6 +98,7 @@ impl Document {
             Document::Layout(_) => "multipatch layout",
             Document::Multipatch(_) => "multipatch result",
             Document::Domain(_) => "domain",
+            Document::Graph(_) => "graph",
             Document::Volume { .. } => "volume",
             Document::VolumeBoundary(_) => "volume boundary",
         }
@@ -108,6 +112,7 @@ impl Document {
             Document::Layout(l) | Document::Multipatch(l) => &l.name,
             Document::Domain(d) => &d.name,
             Document::VolumeBoundary(b) => &b.name,
+            Document::Graph(g) => &g.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -119,6 +124,7 @@ impl Document {
             Document::Layout(l) | Document::Multipatch(l) => &mut l.name,
             Document::Domain(d) => &mut d.name,
             Document::VolumeBoundary(b) => &mut b.name,
+            Document::Graph(g) => &mut g.name,
             Document::Map { name, .. } | Document::Volume { name, .. } => name,
         }
     }
@@ -179,9 +185,6 @@ impl Document {
     }
 }
 
-/// The kinds of `formats.md` that are recognised but not read by this version.
-const NOT_READ: [(&str, &str); 1] = [("graph", "plane graph")];
-
 fn json_document(body: &str) -> Result<Document> {
     let v: Value =
         serde_json::from_str(body).map_err(|e| Error::Json { context: String::new(), message: e.to_string() })?;
@@ -203,21 +206,13 @@ fn json_document(body: &str) -> Result<Document> {
     if obj.contains_key("domain") && !["map", "boundary", "contour"].iter().any(|k| obj.contains_key(*k)) {
         return domain_of_json(v).map(Document::Domain);
     }
+    if obj.contains_key("graph") && !["map", "boundary", "contour"].iter().any(|k| obj.contains_key(*k)) {
+        return graph_of_json(v).map(Document::Graph);
+    }
     let volume = obj.get("map").and_then(|m| m.get("degree")).and_then(Value::as_array).is_some_and(|d| d.len() == 3);
     if volume {
         let (name, volume) = parse_volume_json(v)?;
         return Ok(Document::Volume { name, volume });
-    }
-    if !["map", "boundary", "contour", "patches"].iter().any(|k| obj.contains_key(*k)) {
-        if let Some((key, kind)) = NOT_READ.iter().find(|(k, _)| obj.contains_key(*k)) {
-            return Err(Error::DocumentKind {
-                path: None,
-                found: format!("{kind} (\"{key}\")"),
-                needed: "this version reads boundaries, contours, maps, rings, general domains, multipatch \
-                         layouts and results, volumes and volume boundaries"
-                    .into(),
-            });
-        }
     }
     parse_json(body)
 }
@@ -369,14 +364,14 @@ mod tests {
     }
 
     #[test]
-    fn domains_are_read_and_graphs_named_not_half_read() {
+    fn domains_and_graphs_are_read() {
         let domain = r#"{"name": "bracket", "domain": {"outer": {"points": [[0,0],[1,0],[1,1]], "corners": [0, 1, 2]}, "holes": []}}"#;
         let doc = parse_document(domain).unwrap();
         assert_eq!((doc.kind(), doc.name()), ("domain", "bracket"));
         assert!(matches!(&doc, Document::Domain(d) if d.outer.corners() == 3));
         let graph = r#"{"graph": {"vertices": [[0,0],[1,0]], "edges": [{"from": 0, "to": 1}]}}"#;
-        let e = parse_document(graph).unwrap_err();
-        assert!(matches!(&e, Error::DocumentKind { found, .. } if found.contains("plane graph")), "{e}");
+        let doc = parse_document(graph).unwrap();
+        assert!(matches!(&doc, Document::Graph(g) if g.edges.len() == 1 && g.vertices.len() == 2), "{doc:?}");
         let e = parse_document(r#"{"nothing": 1}"#).unwrap_err();
         assert!(matches!(e, Error::Json { .. }), "{e}");
     }

@@ -26,6 +26,7 @@ pub mod domain;
 pub mod file;
 pub mod gismo;
 pub mod gismo_writer;
+pub mod graph;
 pub mod hierarchical;
 pub mod iges;
 pub mod json;

@@ -30,7 +30,7 @@ use super::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
 use super::vtk::{bezier_vtu, structured_grid_vtk};
 use crate::boundary::ring::Ring;
 use crate::boundary::Boundary;
-use crate::domain::Domain;
+use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::spline::surface::Surface;
@@ -76,6 +76,8 @@ pub enum Output<'a> {
     Domain(&'a Domain),
     /// The six boundary faces of a hexahedral volume.
     VolumeBoundary(&'a crate::boundary::volume::VolumeBoundary),
+    /// A plane graph.
+    Graph(&'a PlaneGraph),
     /// A picture ([`super::picture::render`]).
     Picture(&'a Image),
 }
@@ -92,6 +94,7 @@ impl Output<'_> {
             Output::Ring(_) => "ring",
             Output::Domain(_) => "domain",
             Output::VolumeBoundary(_) => "volume boundary",
+            Output::Graph(_) => "graph",
             Output::Picture(_) => "picture",
         }
     }
@@ -106,6 +109,7 @@ impl Output<'_> {
             | Output::Boundary(_)
             | Output::Ring(_)
             | Output::Domain(_)
+            | Output::Graph(_)
             | Output::VolumeBoundary(_) => ".json",
             Output::Picture(_) => ".png",
         }
@@ -160,6 +164,7 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Ring(r), "json" | "") => write_json(path, &ring_to_json(r)),
         (Output::Domain(d), "json" | "") => write_json(path, &super::domain::domain_to_json(d)),
         (Output::VolumeBoundary(b), "json" | "") => write_json(path, &super::volume::volume_boundary_to_json(b)),
+        (Output::Graph(g), "json" | "") => write_json(path, &super::graph::graph_to_json(g)),
         (Output::Picture(img), "png") => write_png(path, img),
         _ => Err(refused()),
     }

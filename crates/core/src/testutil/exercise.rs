@@ -121,6 +121,12 @@ pub fn exercise_document(doc: Document, trace: &mut Trace) {
                 trace.record("layout", crate::domain::auto_layout(&d, &opts));
             }
         }
+        // a plane graph: validated and laid out (never a panic)
+        Document::Graph(g) => {
+            trace.boundaries += 1;
+            let opts = crate::domain::LayoutOptions { rings: 6, ..Default::default() };
+            trace.record("graph layout", crate::domain::graph_layout(&g, &opts));
+        }
         // rings have their own exerciser (`exercise_ring_text`); layouts and volumes none
         Document::Ring(_)
         | Document::Layout(_)
