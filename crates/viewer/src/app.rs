@@ -313,7 +313,7 @@ impl ViewerApp {
     fn side_panel(&mut self, ui: &mut Ui) {
         ui.add_space(4.0);
         let Some(scene) = &self.state.scene else {
-            ui.label("Open a boundary or map file: File > Open, drag and drop, or a path on the command line.");
+            ui.label("Open a boundary, ring, map, domain, graph or multipatch file: File > Open, drag and drop, or a path on the command line.");
             return;
         };
         file_section(ui, scene);
@@ -751,7 +751,11 @@ impl ViewerApp {
                 painter.text(
                     square.center(),
                     Align2::CENTER_CENTER,
-                    "no map yet: solve the boundary",
+                    if scene.layout.is_some() {
+                        "no maps yet: solve the layout"
+                    } else {
+                        "no map yet: solve the boundary"
+                    },
                     FontId::proportional(14.0),
                     Color32::GRAY,
                 );
