@@ -379,7 +379,15 @@ impl Scene {
                 }
             }
             Document::Ring(ring) => Self::from_ring(ring),
-            Document::Layout(layout) | Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
+            // a layout as given (G+Smo's patches are maps, the input's initial ones) is
+            // solved from its patches' sides; a result is only shown
+            Document::Layout(layout) => {
+                let view = LayoutView::new(layout.clone(), None);
+                let mut scene = Self::from_layout(layout, sampler, settings)?;
+                scene.layout.get_or_insert(view);
+                scene
+            }
+            Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
             Document::Domain(d) => {
                 let auto = auto_layout(&d, &LayoutOptions::default())
                     .with_context(|| format!("laying out the domain {}", d.name))?;
