@@ -726,6 +726,28 @@ mod tests {
         assert_eq!(s.scene.as_ref().unwrap().kind, "graph");
     }
 
+    /// The bundled motor-like section (a plane graph of many faces) opens as the core's
+    /// layout: the same patches, faces and irregular vertices.
+    #[test]
+    fn opens_the_bundled_motor_graph() {
+        let path = data("domains/motor12.json");
+        let winslow::Document::Graph(g) = winslow::read(&path).unwrap() else { panic!("not a graph") };
+        let auto = winslow::domain::graph_layout(&g, &Default::default()).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "graph");
+        let l = scene.layout.as_ref().unwrap();
+        assert_eq!(l.layout.patches.len(), auto.layout.patches.len());
+        let faces = |l: &winslow::multipatch::Layout| l.patches.iter().map(|p| p.face.clone()).collect::<Vec<_>>();
+        assert_eq!(faces(&l.layout), faces(&auto.layout));
+        let irregular = |v: &[winslow::domain::template::IrregularVertex]| {
+            v.iter().map(|v| (v.point, v.valence)).collect::<Vec<_>>()
+        };
+        assert_eq!(irregular(l.irregular()), irregular(&auto.report.irregular_vertices));
+        assert!(s.can_solve());
+    }
+
     /// A multipatch layout of boundaries (G+Smo's plate with a hole, as JSON) opens as a
     /// layout to solve and solves like a domain's layout.
     #[test]
