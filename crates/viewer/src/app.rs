@@ -16,10 +16,12 @@ use winslow::Point;
 use crate::colour::{colour_at, fold_colour, is_positive, ColourScale, ScaleKind};
 use crate::export::write_png;
 use crate::mesh_overlay::{mesh_section, paint_overlay};
-use crate::paint::{control_net, crosshair, element_outline, heat_mesh, side_colours};
+use crate::paint::{control_net, crosshair, element_outline, heat_mesh, irregular_colour, side_colours};
 use crate::sampler::DetJSampler;
 use crate::scene::RESOLUTION_RANGE;
-use crate::sections::{certificate_section, file_section, folds_section, quality_section, residual_plot, section};
+use crate::sections::{
+    certificate_section, file_section, folds_section, layout_section, quality_section, residual_plot, section,
+};
 use crate::solve_job::JobState;
 use crate::state::{Probe, ViewKind, ViewerState};
 use crate::view::ViewTransform;
@@ -311,10 +313,13 @@ impl ViewerApp {
     fn side_panel(&mut self, ui: &mut Ui) {
         ui.add_space(4.0);
         let Some(scene) = &self.state.scene else {
-            ui.label("Open a boundary or map file: File > Open, drag and drop, or a path on the command line.");
+            ui.label("Open a boundary, ring, map, domain, graph or multipatch file: File > Open, drag and drop, or a path on the command line.");
             return;
         };
         file_section(ui, scene);
+        if let Some(l) = &scene.layout {
+            section(ui, "Layout", |ui| layout_section(ui, l));
+        }
         if let Some(mv) = self.state.scene.as_ref().and_then(|s| s.map.as_ref()) {
             section(ui, "Certificate", |ui| certificate_section(ui, mv));
             let folds = mv.folds.iter().filter(|f| !f.forced_corner).count();
@@ -420,7 +425,7 @@ impl ViewerApp {
         let compare = ui
             .horizontal(|ui| {
                 let b = ui
-                    .add_enabled(self.state.can_solve(), egui::Button::new("Compare methods"))
+                    .add_enabled(self.state.can_compare(), egui::Button::new("Compare methods"))
                     .on_hover_text("EGG, the variational harmonic method (eq. 46) and the quasi-conformal functional (eq. 47-48) on one basis; switch between their maps below");
                 ui.checkbox(&mut self.state.compare_gravesen, "with Gravesen's").on_hover_text(
                     "also max-z (eq. 49) from the Coons patch and the Liao, Winslow and area-orthogonality functionals subject to d(c) >= eps from the EGG map; they need the fitted (polynomial) basis with at most 3000 unknowns",
@@ -635,7 +640,31 @@ impl ViewerApp {
                 _ => {}
             }
         }
-        if d.boundary || scene.map.is_none() {
+        if let Some(l) = &scene.layout {
+            // patch borders, the domain's outline and the irregular vertices
+            if d.boundary || scene.map.is_none() {
+                let border = Stroke::new(if scene.map.is_some() { 1.0 } else { 1.4 }, Color32::from_gray(90));
+                for line in l.borders.iter().flatten() {
+                    painter.add(Shape::line(line.iter().map(|&p| to(p)).collect(), border));
+                }
+            }
+            for line in &l.outline {
+                painter.add(Shape::line(line.iter().map(|&p| to(p)).collect(), Stroke::new(2.2, Color32::BLACK)));
+            }
+            for v in l.irregular() {
+                let c = to(v.point);
+                painter.circle_filled(c, 5.0, irregular_colour(v.valence));
+                painter.circle_stroke(c, 5.0, Stroke::new(1.0, Color32::BLACK));
+                painter.text(
+                    c + egui::vec2(7.0, -7.0),
+                    Align2::LEFT_BOTTOM,
+                    v.valence.to_string(),
+                    FontId::proportional(12.0),
+                    Color32::BLACK,
+                );
+            }
+        }
+        if scene.layout.is_none() && (d.boundary || scene.map.is_none()) {
             let colours = side_colours();
             for (k, line) in scene.boundary.polylines.iter().enumerate() {
                 let w = if scene.map.is_some() { 1.0 } else { 2.0 };
@@ -722,7 +751,11 @@ impl ViewerApp {
                 painter.text(
                     square.center(),
                     Align2::CENTER_CENTER,
-                    "no map yet: solve the boundary",
+                    if scene.layout.is_some() {
+                        "no maps yet: solve the layout"
+                    } else {
+                        "no map yet: solve the boundary"
+                    },
                     FontId::proportional(14.0),
                     Color32::GRAY,
                 );

@@ -136,6 +136,26 @@ impl Certificate {
         Self { verdict: r.verdict, message: r.message.clone(), source: CertificateSource::Solver, details }
     }
 
+    /// The verdict of one patch of a layout solve (§11.2): the core's certificate of the
+    /// patch's map with its conforming sides.
+    pub fn of_patch(p: &winslow::multipatch::solve::PatchSolution) -> Self {
+        let c = &p.certificate;
+        let mut details = vec![("patch".to_string(), p.name.clone())];
+        if verdict_is_good(p.verdict) {
+            details.push(("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)));
+        } else {
+            details.push(("smallest det J found".to_string(), format!("{:.4e}", c.min_value_found)));
+        }
+        details.push(("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)));
+        if let Some(l) = p.solve.levels.last() {
+            details.push((
+                "finest level".to_string(),
+                format!("{}x{} basis, {} iterations", l.shape[0], l.shape[1], l.iterations),
+            ));
+        }
+        Self { verdict: p.verdict, message: c.message(), source: CertificateSource::Solver, details }
+    }
+
     /// The verdict of a report stored in a map file (`None` if it has none we know).
     pub fn from_stored(report: &serde_json::Value) -> Option<Self> {
         let verdict = verdict_from_name(report.get("verdict")?.as_str()?)?;

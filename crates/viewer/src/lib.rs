@@ -3,7 +3,9 @@
 //! The desktop viewer of winslow: open a boundary or a map, look at its `det J` heat
 //! map (paper eq. 43) in the physical domain and in the parameter square, its grid
 //! lines and control net, the folded elements and the verdict of the solver, and solve
-//! a boundary in a background thread while watching the residuals.
+//! a boundary in a background thread while watching the residuals. A general domain or
+//! plane graph opens as its automatic multipatch layout (patch borders, irregular
+//! vertices), solved like any layout.
 //!
 //! The numbers all come from the core crate `winslow`; this crate only arranges and
 //! draws them. State and logic (loading, the view transform, the colour scale, the
@@ -15,6 +17,7 @@ pub mod certificate;
 pub mod colour;
 pub mod export;
 pub mod folds;
+pub mod layout_view;
 pub mod mesh_overlay;
 mod paint;
 pub mod sampler;

@@ -1,5 +1,6 @@
-//! `winslow-viewer`: the desktop viewer. `winslow-viewer [FILE]` opens a boundary or map
-//! file; `--solve` solves a boundary at start; `--screenshot PNG` writes the window to a
+//! `winslow-viewer`: the desktop viewer. `winslow-viewer [FILE]` opens a boundary, ring,
+//! map, multipatch, domain or graph file (a domain or graph as its automatic layout);
+//! `--solve` solves a boundary, ring or layout at start; `--screenshot PNG` writes the window to a
 //! PNG once everything is drawn, then exits (for the README picture; under Xvfb on a
 //! machine without a display).
 
@@ -16,9 +17,10 @@ use winslow_viewer::ViewerApp;
 #[derive(Debug, Parser)]
 #[command(name = "winslow-viewer", version)]
 struct Args {
-    /// Boundary, contour or map file (JSON or G+Smo XML) to open.
+    /// Boundary, ring, map, multipatch layout, domain or plane-graph file (JSON or G+Smo
+    /// XML) to open; a domain or graph opens as its automatic layout.
     file: Option<PathBuf>,
-    /// Solve the boundary as soon as it is open.
+    /// Solve the boundary, ring or layout as soon as it is open.
     #[arg(long)]
     solve: bool,
     /// Smallest number of elements per direction of the finest level (with --solve).
@@ -112,7 +114,7 @@ fn run(args: Args) -> Result<()> {
             if solve {
                 let ctx = cc.egui_ctx.clone();
                 if !app.state.start_solve(move || ctx.request_repaint()) {
-                    eprintln!("--solve: nothing to solve (no valid boundary loaded)");
+                    eprintln!("--solve: nothing to solve (no valid boundary or layout loaded)");
                 }
             }
             Ok(Box::new(app))

@@ -94,3 +94,12 @@ pub(crate) fn element_outline(mv: &MapView, xi: [f64; 2], eta: [f64; 2]) -> Vec<
     }
     out
 }
+
+/// The marker colour of an irregular vertex of a layout: blue below valence 4, red above.
+pub(crate) fn irregular_colour(valence: usize) -> Color32 {
+    if valence < 4 {
+        Color32::from_rgb(40, 110, 230)
+    } else {
+        Color32::from_rgb(230, 60, 40)
+    }
+}

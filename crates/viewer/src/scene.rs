@@ -8,13 +8,16 @@ use std::path::{Path, PathBuf};
 use winslow::boundary::ring::{ClosedContour, Ring};
 use winslow::boundary::ring_fit::{check_ring, cut_open};
 use winslow::boundary::validate::sample_side;
+use winslow::domain::{auto_layout, graph_layout, LayoutOptions};
 use winslow::io::{checked_boundary, read_with_report, Document, ReadOptions};
+use winslow::multipatch::MultipatchSolution;
 use winslow::solve::report::Solution;
 use winslow::verify::quality::DetJSample;
 use winslow::{Boundary, Point, Side, SideCurve, Surface};
 
 use crate::certificate::{Certificate, Quality};
 use crate::folds::{folded_elements, FoldedElement};
+use crate::layout_view::LayoutView;
 use crate::sampler::DetJSampler;
 use crate::view::{bounds_of, Bounds};
 
@@ -264,7 +267,8 @@ pub struct Scene {
     pub name: String,
     /// File it came from.
     pub path: Option<PathBuf>,
-    /// What the file was ("boundary", "map", "multipatch", "ring", "ring map").
+    /// What the file was ("boundary", "map", "multipatch", "ring", "ring map", "domain",
+    /// "graph", "layout").
     pub kind: &'static str,
     /// The ring (O-grid, `eta` periodic) a solve fits: of a ring document, or the two
     /// contours of a map with `eta` periodic.
@@ -277,6 +281,9 @@ pub struct Scene {
     /// (the one the side panel and the parameter view describe), these are drawn beside
     /// it in the physical view, on one colour scale.
     pub patches: Vec<MapView>,
+    /// A multipatch layout to solve (a laid-out domain or plane graph, or a layout of
+    /// boundaries): its borders, outline and irregular vertices; what `solve` uses.
+    pub layout: Option<LayoutView>,
 }
 
 /// Display settings that change what the scene computes.
@@ -304,7 +311,8 @@ impl Scene {
         // a map file may carry the solver's report
         let report = report.filter(|_| matches!(doc, Document::Map { .. }));
         let stored = report.as_ref().and_then(Certificate::from_stored);
-        let mut scene = Self::from_document(doc, sampler, settings, stored)?;
+        let mut scene = Self::from_document(doc, sampler, settings, stored)
+            .with_context(|| format!("opening {}", path.display()))?;
         if let (Some(mv), Some(r)) = (scene.map.as_mut(), &report) {
             mv.matches = stored_matches(r);
             mv.kinks = winslow::boundary::kinks::kinks_in_report(r);
@@ -324,6 +332,7 @@ impl Scene {
             map: None,
             patches: Vec::new(),
             ring: Some(ring),
+            layout: None,
         }
     }
 
@@ -334,6 +343,7 @@ impl Scene {
         settings: SceneSettings,
         certificate: Option<Certificate>,
     ) -> anyhow::Result<Self> {
+        use anyhow::Context;
         Ok(match doc {
             Document::Boundary(b) => Self {
                 name: b.name.clone(),
@@ -343,6 +353,7 @@ impl Scene {
                 map: None,
                 patches: Vec::new(),
                 ring: None,
+                layout: None,
             },
             Document::Map { name, map } => {
                 let res = settings.resolution.unwrap_or_else(|| default_resolution(&map));
@@ -364,14 +375,28 @@ impl Scene {
                     map: Some(MapView::new(map, sampler, res, settings.density, certificate)),
                     patches: Vec::new(),
                     ring,
+                    layout: None,
                 }
             }
             Document::Ring(ring) => Self::from_ring(ring),
-            Document::Layout(layout) | Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
-            doc @ (Document::Domain(_) | Document::Graph(_)) => {
-                return Err(doc
-                    .wrong_kind(None, "the viewer draws maps and solved layouts: `winslow solve` lays a domain out and solves it; open its output")
-                    .into())
+            // a layout as given (G+Smo's patches are maps, the input's initial ones) is
+            // solved from its patches' sides; a result is only shown
+            Document::Layout(layout) => {
+                let view = LayoutView::new(layout.clone(), None);
+                let mut scene = Self::from_layout(layout, sampler, settings)?;
+                scene.layout.get_or_insert(view);
+                scene
+            }
+            Document::Multipatch(layout) => Self::from_layout(layout, sampler, settings)?,
+            Document::Domain(d) => {
+                let auto = auto_layout(&d, &LayoutOptions::default())
+                    .with_context(|| format!("laying out the domain {}", d.name))?;
+                Self::from_layout_view(LayoutView::of_auto(auto), "domain")?
+            }
+            Document::Graph(g) => {
+                let auto = graph_layout(&g, &LayoutOptions::default())
+                    .with_context(|| format!("laying out the plane graph {}", g.name))?;
+                Self::from_layout_view(LayoutView::of_auto(auto), "graph")?
             }
             doc @ (Document::Volume { .. } | Document::VolumeBoundary(_)) => {
                 return Err(doc
@@ -381,24 +406,42 @@ impl Scene {
         })
     }
 
-    /// A scene of a multipatch layout whose patches are maps (a G+Smo multipatch file,
+    /// A scene of a layout to solve (kind `kind`): its borders, outline and irregular
+    /// vertices, no map until it is solved ([`Scene::set_layout_solution`]). The boundary
+    /// is the first patch's (drawn only through the borders).
+    pub fn from_layout_view(view: LayoutView, kind: &'static str) -> anyhow::Result<Self> {
+        let layout = &view.layout;
+        let Some(first) = layout.patches.first() else {
+            anyhow::bail!("the multipatch layout {} has no patches", layout.name)
+        };
+        let boundary = Boundary { name: first.name.clone(), sides: first.sides.clone().map(SideCurve::Spline) };
+        Ok(Self {
+            name: format!("{} ({} patches)", layout.name, layout.patches.len()),
+            path: None,
+            kind,
+            boundary: BoundaryView::new(boundary),
+            map: None,
+            patches: Vec::new(),
+            ring: None,
+            layout: Some(view),
+        })
+    }
+
+    /// A scene of a multipatch layout. Patches that are maps (a G+Smo multipatch file,
     /// or the output of `winslow solve` on a layout): the first patch is `map`, the
-    /// others are `patches`; each is judged by the exact certificate. A layout of
-    /// boundaries (an input document) has nothing to draw yet: an error says to solve it.
+    /// others are `patches`; each is judged by the exact certificate. A layout with a
+    /// patch given by its boundary (an input document) is a layout to solve
+    /// ([`Scene::from_layout_view`]).
     pub fn from_layout(
         layout: winslow::multipatch::Layout,
         sampler: &dyn DetJSampler,
         settings: SceneSettings,
     ) -> anyhow::Result<Self> {
+        if layout.patches.is_empty() || layout.patches.iter().any(|p| p.map.is_none()) {
+            return Self::from_layout_view(LayoutView::new(layout, None), "layout");
+        }
         let mut views = Vec::with_capacity(layout.patches.len());
-        for p in &layout.patches {
-            let Some(map) = &p.map else {
-                anyhow::bail!(
-                    "patch {} of the multipatch layout {} is a boundary, not a map: solve the layout with `winslow solve` and open its output",
-                    p.name,
-                    layout.name
-                )
-            };
+        for map in layout.patches.iter().filter_map(|p| p.map.as_ref()) {
             let res = settings.resolution.unwrap_or_else(|| default_resolution(map));
             views.push(MapView::new(map.clone(), sampler, res, settings.density, None));
         }
@@ -412,7 +455,38 @@ impl Scene {
             map: Some(first),
             patches: views,
             ring: None,
+            layout: None,
         })
+    }
+
+    /// Put a solved layout into the scene: every patch's map with its certificate from
+    /// the layout solve, the first as `map`, on one colour scale; the layout's borders,
+    /// outline and irregular vertices stay.
+    pub fn set_layout_solution(
+        &mut self,
+        solution: MultipatchSolution,
+        sampler: &dyn DetJSampler,
+        settings: SceneSettings,
+    ) {
+        let mut views: Vec<MapView> = solution
+            .patches
+            .into_iter()
+            .map(|p| {
+                let res = settings.resolution.unwrap_or_else(|| default_resolution(&p.map));
+                let cert = Certificate::of_patch(&p);
+                let mut mv = MapView::new(p.map, sampler, res, settings.density, Some(cert));
+                mv.report = Some(p.solve);
+                mv
+            })
+            .collect();
+        if views.is_empty() {
+            return;
+        }
+        self.map = Some(views.remove(0));
+        self.patches = views;
+        if let Some(l) = self.layout.as_mut() {
+            l.solved = Some(solution.report);
+        }
     }
 
     /// Every map of the scene: the map, then the other patches.
@@ -440,11 +514,7 @@ impl Scene {
 
     /// Recompute what depends on the settings (after a change of resolution or density).
     pub fn apply_settings(&mut self, sampler: &dyn DetJSampler, settings: SceneSettings) {
-        for mv in &mut self.patches {
-            let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
-            *mv = MapView::new(mv.map.clone(), sampler, res, settings.density, None);
-        }
-        if let Some(mv) = self.map.take() {
+        let again = |mv: MapView| {
             let res = settings.resolution.unwrap_or_else(|| default_resolution(&mv.map));
             let (report, matches, kinks) = (mv.report, mv.matches, mv.kinks);
             use crate::certificate::CertificateSource;
@@ -454,13 +524,18 @@ impl Scene {
             new.report = report;
             new.matches = matches;
             new.kinks = kinks;
-            self.map = Some(new);
-        }
+            new
+        };
+        self.patches = std::mem::take(&mut self.patches).into_iter().map(again).collect();
+        self.map = self.map.take().map(again);
     }
 
     /// Bounds of what is drawn in the physical view.
     pub fn bounds(&self) -> Bounds {
-        let b = self.boundary.bounds();
+        let b = match &self.layout {
+            Some(l) => l.bounds(),
+            None => self.boundary.bounds(),
+        };
         let b = self.patches.iter().fold(b, |acc, m| match acc {
             Some(a) => Some([
                 [a[0][0].min(m.bounds[0][0]), a[0][1].min(m.bounds[0][1])],

@@ -1,10 +1,12 @@
 //! The side panel's read-only sections: the file, the verdict, the map's quality
-//! numbers, the folded-element list and the residual plot of a solve.
+//! numbers, the folded-element list, the residual plot of a solve and a multipatch
+//! layout's patches, templates and irregular vertices.
 
 use egui::{Color32, RichText, Ui};
 use egui_plot::{Line, Plot, PlotPoints};
 
 use crate::certificate::{verdict_is_good, Certificate};
+use crate::layout_view::LayoutView;
 use crate::scene::{MapView, Scene};
 
 /// Folded elements listed at most.
@@ -40,6 +42,10 @@ pub(crate) fn file_section(ui: &mut Ui, scene: &Scene) {
             ui.end_row();
         }
     });
+    if scene.layout.is_some() {
+        // a layout's patches are in its own section
+        return;
+    }
     egui::CollapsingHeader::new("boundary sides").default_open(scene.map.is_none()).show(ui, |ui| {
         for (s, side) in winslow::Side::ALL.iter().zip(&scene.boundary.boundary.sides) {
             ui.label(format!("{s}: {}", side.describe()));
@@ -50,6 +56,58 @@ pub(crate) fn file_section(ui: &mut Ui, scene: &Scene) {
     });
     if let Some(p) = &scene.boundary.problem {
         ui.colored_label(Color32::from_rgb(200, 40, 40), p);
+    }
+}
+
+/// A multipatch layout: patches and interfaces; for an automatic layout its cuts, the
+/// template of every face and the irregular vertices with their valence; once solved,
+/// the verdicts over the patches.
+pub(crate) fn layout_section(ui: &mut Ui, view: &LayoutView) {
+    let l = &view.layout;
+    egui::Grid::new("layout").num_columns(2).show(ui, |ui| {
+        ui.label("patches");
+        ui.label(l.patches.len().to_string());
+        ui.end_row();
+        ui.label("interfaces");
+        ui.label(l.interfaces.len().to_string());
+        ui.end_row();
+        if let Some(r) = &view.report {
+            ui.label("area");
+            ui.label(format!("{:.6}", r.area));
+            ui.end_row();
+            ui.label("cuts");
+            ui.label(format!("{} from holes, {} from reflex corners", r.hole_cuts.len(), r.cuts.len()));
+            ui.end_row();
+            ui.label("corner angles");
+            ui.label(format!("{:.1} to {:.1} degrees", r.corner_angles[0], r.corner_angles[1]));
+            ui.end_row();
+            ui.label("irregular vertices");
+            ui.label(r.irregular_vertices.len().to_string());
+            ui.end_row();
+        }
+    });
+    if let Some(r) = &view.report {
+        egui::CollapsingHeader::new("faces and templates").default_open(false).show(ui, |ui| {
+            for f in &r.faces {
+                ui.label(format!("{} ({} corners): {}, {} patches", f.label, f.corners, f.template, f.patches));
+            }
+        });
+        egui::CollapsingHeader::new("irregular vertices").default_open(true).show(ui, |ui| {
+            for v in &r.irregular_vertices {
+                ui.label(format!("valence {} at ({:.5}, {:.5})", v.valence, v.point[0], v.point[1]));
+            }
+        });
+    }
+    if let Some(s) = &view.solved {
+        let good = s.verdicts.iter().filter(|&&v| verdict_is_good(v)).count();
+        let colour =
+            if verdict_is_good(s.verdict) { Color32::from_rgb(20, 130, 40) } else { Color32::from_rgb(200, 40, 40) };
+        ui.colored_label(
+            colour,
+            format!("{good} of {} patches certified; worst: {}", s.verdicts.len(), s.verdict.name()),
+        );
+        ui.label(format!("interface mismatch {:.2e}", s.interface_mismatch));
+        ui.label(&s.message);
     }
 }
 

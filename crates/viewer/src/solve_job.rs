@@ -3,7 +3,8 @@
 //! progress (level, iteration, residual) and the residual history for the live plot. A
 //! cancel flag is checked at every stage; the observer then stops the pipeline. The same job runs a comparison of methods (paper §10,
 //! [`compare`]): every method's solver events stream the same way, and the comparison,
-//! one map per method, arrives at the end.
+//! one map per method, arrives at the end. A multipatch layout (§11.2; a laid-out domain
+//! or plane graph) streams the layout solve's events and ends with every patch's map.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver, TryRecvError};
@@ -12,7 +13,10 @@ use std::thread::JoinHandle;
 
 use winslow::boundary::ring::Ring;
 use winslow::methods::egg::CpuAssembler;
+use winslow::multipatch::layout::Layout;
+use winslow::multipatch::solve::{LayoutEvent, MultipatchSolution};
 use winslow::pipeline::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
+use winslow::pipeline::Solved;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
@@ -40,8 +44,12 @@ pub enum Msg {
         /// Number of methods.
         count: usize,
     },
+    /// An event of a layout's solve (its bases, a round of patch solves, the free stage).
+    Layout(LayoutEvent),
     /// The solve finished.
     Finished(Box<Solution>),
+    /// The solve of a layout finished: every patch's map, certificate and the report.
+    SolvedLayout(Box<MultipatchSolution>),
     /// The comparison finished.
     Compared(Box<Comparison>),
     /// The solve failed.
@@ -50,9 +58,10 @@ pub enum Msg {
     Cancelled,
 }
 
-/// Run the pipeline on `input` (a boundary, or a ring: paper §11.1), sending every
-/// stage to `send`; checks `cancel` before the fit and at every stage. Always ends with
-/// `Finished`, `Failed` or `Cancelled`. With the default basis `auto`, a map on the input
+/// Run the pipeline on `input` (a boundary, a ring: paper §11.1, or a multipatch layout:
+/// §11.2), sending every stage to `send`; checks `cancel` before the fit and at every
+/// stage. Always ends with `Finished` (`SolvedLayout` for a layout), `Failed` or
+/// `Cancelled`. With the default basis `auto`, a map on the input
 /// basis that is not certified is solved again on the fitted basis, as the CLI does.
 pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dyn FnMut(Msg)) {
     let cancelled = || cancel.load(Ordering::Relaxed);
@@ -65,12 +74,18 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
                 send(Msg::Fitted { levels: hierarchy.levels.len(), tolerance: hierarchy.physical_tol_abs() })
             }
             Stage::Solver(e) => send(Msg::Event((*e).clone())),
+            Stage::Layout(e) => send(Msg::Layout((*e).clone())),
             _ => {}
         }
         !cancelled()
     });
-    match out.and_then(|solved| solved.into_map()) {
-        Ok(sol) => send(Msg::Finished(Box::new(sol))),
+    match out {
+        Ok(Solved::Map(sol)) => send(Msg::Finished(sol)),
+        Ok(Solved::Layout(sol)) => send(Msg::SolvedLayout(sol)),
+        Ok(other) => send(Msg::Failed(format!(
+            "the pipeline returned a result the viewer does not draw (verdict {})",
+            other.verdict().name()
+        ))),
         Err(winslow::Error::Cancelled) => send(Msg::Cancelled),
         Err(e) => send(Msg::Failed(e.to_string())),
     }
@@ -139,6 +154,8 @@ pub struct Progress {
     pub levels_done: usize,
     /// In a comparison: the method being solved, its position and the number of methods.
     pub method: Option<(String, usize, usize)>,
+    /// In a layout's solve: the last stage, in words.
+    pub layout: Option<String>,
 }
 
 impl Progress {
@@ -164,7 +181,8 @@ impl Progress {
                 self.method = Some((method.clone(), *index, *count));
                 self.level = None;
             }
-            Msg::Finished(_) | Msg::Compared(_) | Msg::Failed(_) | Msg::Cancelled => {}
+            Msg::Layout(e) => self.layout = Some(layout_text(e)),
+            Msg::Finished(_) | Msg::SolvedLayout(_) | Msg::Compared(_) | Msg::Failed(_) | Msg::Cancelled => {}
         }
     }
 
@@ -182,6 +200,9 @@ impl Progress {
     }
 
     fn level_text(&self) -> String {
+        if let Some(l) = &self.layout {
+            return l.clone();
+        }
         let Some((level, levels)) = self.level else {
             return match self.fit_levels {
                 Some(n) => format!("fitted {n} hierarchy levels; starting"),
@@ -202,6 +223,23 @@ impl Progress {
             ));
         }
         s
+    }
+}
+
+/// One line on a layout solve's event.
+fn layout_text(e: &LayoutEvent) -> String {
+    match e {
+        LayoutEvent::Bases { patches, classes, basis_functions } => {
+            format!("{patches} patches, {classes} interface classes, {basis_functions} basis functions; solving the patches")
+        }
+        LayoutEvent::Round { round, solved, failing } if failing.is_empty() => {
+            format!("round {round}: {solved} patches solved, all certified")
+        }
+        LayoutEvent::Round { round, solved, failing } => {
+            format!("round {round}: {solved} patches solved; not certified: {}", failing.join(", "))
+        }
+        LayoutEvent::Free { functional } => format!("free interfaces ({functional})"),
+        _ => "solving the layout".to_string(),
     }
 }
 
@@ -234,6 +272,8 @@ pub struct SolveJob {
     handle: Option<JoinHandle<()>>,
     /// A finished comparison, until taken ([`SolveJob::take_comparison`]).
     comparison: Option<Comparison>,
+    /// A finished layout solve, until taken ([`SolveJob::take_layout`]).
+    layout: Option<MultipatchSolution>,
 }
 
 impl SolveJob {
@@ -262,6 +302,13 @@ impl SolveJob {
         Self::spawn(name, notify, move |cancel, send| run(Input::Ring(ring), &opts, cancel, send))
     }
 
+    /// Start solving a multipatch layout ([`run`]) in a new thread; the solution is
+    /// taken with [`SolveJob::take_layout`] once finished.
+    pub fn start_layout(layout: Layout, opts: SolveOptions, notify: impl Fn() + Send + 'static) -> Self {
+        let name = layout.name.clone();
+        Self::spawn(name, notify, move |cancel, send| run(Input::Layout(layout), &opts, cancel, send))
+    }
+
     fn spawn(
         name: String,
         notify: impl Fn() + Send + 'static,
@@ -284,12 +331,17 @@ impl SolveJob {
             .ok();
         let state =
             if handle.is_some() { JobState::Running } else { JobState::Failed("could not start a thread".into()) };
-        Self { name, state, progress: Progress::default(), rx, cancel, handle, comparison: None }
+        Self { name, state, progress: Progress::default(), rx, cancel, handle, comparison: None, layout: None }
     }
 
     /// The comparison, once, after a comparison job finished.
     pub fn take_comparison(&mut self) -> Option<Comparison> {
         self.comparison.take()
+    }
+
+    /// The layout's solution, once, after a layout job finished.
+    pub fn take_layout(&mut self) -> Option<MultipatchSolution> {
+        self.layout.take()
     }
 
     /// Ask the thread to stop at the next event.
@@ -316,6 +368,10 @@ impl SolveJob {
             Msg::Compared(c) => {
                 self.state = JobState::Finished;
                 self.comparison = Some(*c);
+            }
+            Msg::SolvedLayout(s) => {
+                self.state = JobState::Finished;
+                self.layout = Some(*s);
             }
             Msg::Failed(e) => self.state = JobState::Failed(e),
             Msg::Cancelled => self.state = JobState::Cancelled,
@@ -464,6 +520,47 @@ mod tests {
         let mut msgs = Vec::new();
         run_compare(&annulus(), &[MethodChoice::Vhm], &opts, &cancel, &mut |m| msgs.push(m));
         assert!(matches!(msgs.last(), Some(Msg::Cancelled)), "{msgs:?}");
+    }
+
+    /// The automatic layout of the bundled pentagon (five patches).
+    fn pentagon() -> Layout {
+        let winslow::Document::Domain(d) = winslow::read(&winslow::testutil::data("domains/pentagon.json")).unwrap()
+        else {
+            panic!("not a domain")
+        };
+        winslow::domain::auto_layout(&d, &Default::default()).unwrap().layout
+    }
+
+    /// A layout streams its bases and rounds and ends with every patch's map; the
+    /// progress line is the last stage; the cancel flag stops it at the first event.
+    #[test]
+    fn run_streams_a_layout_solve() {
+        let mut msgs = Vec::new();
+        run(Input::Layout(pentagon()), &quick(), &AtomicBool::new(false), &mut |m| msgs.push(m));
+        assert!(matches!(msgs.first(), Some(Msg::Layout(LayoutEvent::Bases { patches: 5, .. }))), "{msgs:?}");
+        let Some(Msg::SolvedLayout(sol)) = msgs.last() else { panic!("{:?}", msgs.last()) };
+        assert_eq!(sol.patches.len(), 5);
+        assert_eq!(sol.report.verdict, Verdict::Certified);
+        let mut p = Progress::default();
+        for m in &msgs {
+            p.apply(m);
+        }
+        assert!(p.text().contains("all certified") || p.text().starts_with("free interfaces"), "{}", p.text());
+
+        let cancel = AtomicBool::new(false);
+        let mut msgs = Vec::new();
+        run(Input::Layout(pentagon()), &quick(), &cancel, &mut |m| {
+            cancel.store(true, Ordering::Relaxed);
+            msgs.push(m);
+        });
+        assert_eq!(msgs.len(), 2, "{msgs:?}");
+        assert!(matches!(msgs.last(), Some(Msg::Cancelled)), "{msgs:?}");
+
+        let mut job = SolveJob::start_layout(pentagon(), quick(), || {});
+        assert!(job.wait().is_none(), "a layout's solution is not one map");
+        assert_eq!(job.state, JobState::Finished);
+        assert_eq!(job.take_layout().map(|s| s.patches.len()), Some(5));
+        assert!(job.take_layout().is_none(), "handed out once");
     }
 
     #[test]

@@ -243,10 +243,18 @@ impl ViewerState {
         self.selected_fold = None;
     }
 
-    /// Whether a solve can start: a valid boundary and no solve running.
+    /// Whether a solve can start: a valid boundary or a layout to solve, and no solve
+    /// running. (An opened multipatch result is not solved again patch by patch.)
     pub fn can_solve(&self) -> bool {
-        // a multipatch layout is solved by `winslow solve`, not patch by patch here
-        self.scene.as_ref().is_some_and(|s| s.boundary.problem.is_none() && s.patches.is_empty()) && !self.solving()
+        self.scene
+            .as_ref()
+            .is_some_and(|s| s.layout.is_some() || (s.boundary.problem.is_none() && s.patches.is_empty()))
+            && !self.solving()
+    }
+
+    /// Whether a comparison of methods can start: a boundary (not a layout) to solve.
+    pub fn can_compare(&self) -> bool {
+        self.can_solve() && self.scene.as_ref().is_some_and(|s| s.layout.is_none())
     }
 
     /// Whether a solve is running.
@@ -261,9 +269,10 @@ impl ViewerState {
             return false;
         }
         let scene = self.scene.as_ref().expect("can_solve");
-        self.job = Some(match &scene.ring {
-            Some(ring) => SolveJob::start_ring(ring.clone(), self.solve.options(), notify),
-            None => SolveJob::start(scene.boundary.boundary.clone(), self.solve.options(), notify),
+        self.job = Some(match (&scene.layout, &scene.ring) {
+            (Some(l), _) => SolveJob::start_layout(l.layout.clone(), self.solve.options(), notify),
+            (None, Some(ring)) => SolveJob::start_ring(ring.clone(), self.solve.options(), notify),
+            (None, None) => SolveJob::start(scene.boundary.boundary.clone(), self.solve.options(), notify),
         });
         self.comparison = None;
         self.selected_method = None;
@@ -276,7 +285,7 @@ impl ViewerState {
     /// [`ViewerState::compare_gravesen`]) on the scene's boundary with the solver
     /// settings; `notify` as for [`ViewerState::start_solve`].
     pub fn start_compare(&mut self, notify: impl Fn() + Send + 'static) -> bool {
-        if !self.can_solve() {
+        if !self.can_compare() {
             return false;
         }
         let scene = self.scene.as_ref().expect("can_solve");
@@ -328,6 +337,10 @@ impl ViewerState {
             self.set_comparison(c);
             return true;
         }
+        if let Some(l) = job.take_layout() {
+            self.set_layout_solution(l);
+            return true;
+        }
         let Some(job) = self.job.as_mut() else { return false };
         let changed = solution.is_some() || before != (job.state.clone(), job.progress.history.len());
         match (&job.state, solution) {
@@ -346,12 +359,25 @@ impl ViewerState {
         changed
     }
 
+    /// Put a solved layout into the scene (every patch's map on one colour scale).
+    fn set_layout_solution(&mut self, sol: winslow::multipatch::MultipatchSolution) {
+        self.status = Some(format!("solved {}: {}", sol.layout.name, sol.report.message));
+        if let Some(scene) = self.scene.as_mut() {
+            scene.set_layout_solution(sol, self.sampler.as_ref(), self.settings);
+            self.refit = true;
+            self.selected_fold = None;
+        }
+    }
+
     /// Block until a running solve ends and take its result (for `--screenshot`).
     pub fn wait_for_solve(&mut self) {
         if let Some(job) = self.job.as_mut() {
             let solution = job.wait();
             if let Some(c) = job.take_comparison() {
                 self.set_comparison(c);
+            }
+            if let Some(l) = self.job.as_mut().and_then(|j| j.take_layout()) {
+                self.set_layout_solution(l);
             }
             if let Some(sol) = solution {
                 self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
@@ -564,19 +590,192 @@ mod tests {
         for mv in scene.maps() {
             assert!(mv.quality.det_j_max > 0.0 && mv.sample.values.len() == (mv.resolution() + 1).pow(2));
         }
-        // a layout of boundaries has nothing to draw: a clear error, the scene stays
+        // G+Smo's patches are the input's maps: the layout solves from their sides
+        let l = scene.layout.as_ref().expect("a layout to solve");
+        assert_eq!(l.layout.patches.len(), 5);
+        assert!(s.can_solve() && !s.can_compare());
+        s.solve.min_elements = 4;
+        assert!(s.start_solve(|| {}));
+        s.wait_for_solve();
+        let sum: f64 = s.scene.as_ref().unwrap().maps().map(|m| m.quality.functionals.area).sum();
+        assert_eq!(check_solved_layout(&s, sum), 5);
+        let area0: f64 = l_area(&data("gismo/xml/multipatch/TUDflame.xml"));
+        assert!((sum - area0).abs() <= 1e-6 * area0, "{sum} vs {area0}");
+    }
+
+    /// The area of the maps of a multipatch file (exact quadrature of the core).
+    fn l_area(path: &Path) -> f64 {
+        let mut t = state();
+        t.open(path).unwrap();
+        t.scene.as_ref().unwrap().maps().map(|m| m.quality.functionals.area).sum()
+    }
+
+    /// Every patch of a solved layout is drawn with its certificate, the patches cover the
+    /// area `area` and the irregular vertices stay; returns the number of patches drawn.
+    fn check_solved_layout(s: &ViewerState, area: f64) -> usize {
+        let scene = s.scene.as_ref().unwrap();
+        let l = scene.layout.as_ref().expect("the layout stays");
+        let solved = l.solved.as_ref().expect("the layout's report");
+        assert_eq!(solved.verdicts.len(), l.layout.patches.len());
+        let maps: Vec<&crate::scene::MapView> = scene.maps().collect();
+        assert_eq!(maps.len(), l.layout.patches.len());
+        for (mv, v) in maps.iter().zip(&solved.verdicts) {
+            assert_eq!(mv.certificate.verdict, *v);
+            assert_eq!(mv.certificate.verdict, Verdict::Certified, "{}", mv.certificate.message);
+            assert!(mv.quality.det_j_min > 0.0);
+            assert_eq!(mv.sample.values.len(), (mv.resolution() + 1).pow(2));
+        }
+        // conforming interfaces, one colour scale over every patch
+        assert_eq!(solved.interface_mismatch, 0.0);
+        let hi = maps.iter().map(|m| m.sample.max).fold(0.0, f64::max);
+        assert_eq!(s.colour_scale().unwrap().hi, hi);
+        // the patches cover the domain: their areas (quadrature) sum to its area (polylines)
+        let sum: f64 = maps.iter().map(|m| m.quality.functionals.area).sum();
+        assert!((sum - area).abs() <= 1e-3 * area, "{sum} vs {area}");
+        maps.len()
+    }
+
+    /// A `domain` document opens as its automatic layout (the core's, patch for patch,
+    /// with the same irregular vertices), solves in the background job as a layout and
+    /// shows every patch certified on one colour scale.
+    #[test]
+    fn opens_lays_out_and_solves_a_domain() {
+        let path = data("domains/pentagon.json");
+        let winslow::Document::Domain(d) = winslow::read(&path).unwrap() else { panic!("not a domain") };
+        let auto = winslow::domain::auto_layout(&d, &Default::default()).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "domain");
+        assert!(scene.map.is_none());
+        let l = scene.layout.as_ref().unwrap();
+        assert_eq!(l.layout.patches.len(), auto.layout.patches.len());
+        assert_eq!(l.borders.len(), auto.layout.patches.len());
+        // a pentagon: five quads around one vertex of valence 5
+        assert_eq!(auto.report.irregular_vertices.len(), 1);
+        assert_eq!(l.irregular().len(), 1);
+        for (a, b) in l.irregular().iter().zip(&auto.report.irregular_vertices) {
+            assert_eq!((a.point, a.valence), (b.point, b.valence));
+        }
+        assert_eq!(l.irregular()[0].valence, 5);
+        // the outline is the five sides, each split at its midpoint: ten patch sides
+        assert_eq!(l.outline.len(), 10);
+        let b = scene.bounds();
+        for p in l.outline.iter().flatten() {
+            assert!(p[0] >= b[0][0] && p[0] <= b[1][0] && p[1] >= b[0][1] && p[1] <= b[1][1]);
+        }
+        assert!(s.can_solve() && !s.can_compare());
+        s.solve.min_elements = 4;
+        assert!(s.start_solve(|| {}));
+        assert!(s.solving() && !s.can_solve());
+        s.wait_for_solve();
+        assert_eq!(check_solved_layout(&s, auto.report.area), 5);
+        assert!(s.status.as_deref().unwrap().starts_with("solved"), "{:?}", s.status);
+        assert_eq!(s.scene.as_ref().unwrap().layout.as_ref().unwrap().irregular().len(), 1);
+        // a new resolution resamples every patch and keeps the solver's verdicts
+        let mut settings = s.settings;
+        settings.resolution = Some(24);
+        s.set_settings(settings);
+        for mv in s.scene.as_ref().unwrap().maps() {
+            assert_eq!(mv.resolution(), 24);
+            assert_eq!(mv.certificate.source, crate::certificate::CertificateSource::Solver);
+        }
+    }
+
+    /// A `graph` document: a square cut by its diagonal into two triangles, each three
+    /// quads around a vertex of valence 3; a layout error goes to the status line.
+    #[test]
+    fn opens_lays_out_and_solves_a_graph() {
         let scratch = tempfile::tempdir().unwrap();
-        let dir = scratch.path();
+        let path = scratch.path().join("square.json");
+        let doc = serde_json::json!({ "name": "square", "graph": {
+            "vertices": [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            "edges": [{ "from": 0, "to": 1 }, { "from": 1, "to": 2 }, { "from": 2, "to": 3 }, { "from": 3, "to": 0 }, { "from": 0, "to": 2 }],
+            "labels": [{ "name": "lower", "point": [0.7, 0.2] }, { "name": "upper", "point": [0.2, 0.7] }] } });
+        winslow::io::file::write_bytes(&path, serde_json::to_vec(&doc).unwrap().as_slice()).unwrap();
+        let winslow::Document::Graph(g) = winslow::read(&path).unwrap() else { panic!("not a graph") };
+        let auto = winslow::domain::graph_layout(&g, &Default::default()).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "graph");
+        let l = scene.layout.as_ref().unwrap();
+        assert_eq!(l.layout.patches.len(), 6);
+        assert_eq!(auto.layout.patches.len(), 6);
+        let valences: Vec<usize> = l.irregular().iter().map(|v| v.valence).collect();
+        assert_eq!(valences, auto.report.irregular_vertices.iter().map(|v| v.valence).collect::<Vec<_>>());
+        assert_eq!(valences, [3, 3]);
+        // the patches name their faces
+        let faces: Vec<&str> = l.layout.patches.iter().filter_map(|p| p.face.as_deref()).collect();
+        assert_eq!(faces.iter().filter(|&&f| f == "lower").count(), 3);
+        assert_eq!(faces.iter().filter(|&&f| f == "upper").count(), 3);
+        s.solve.min_elements = 4;
+        assert!(s.start_solve(|| {}));
+        s.wait_for_solve();
+        assert_eq!(check_solved_layout(&s, 1.0), 6);
+
+        // a dangling edge: the core's typed error on the status line, the scene stays
+        let bad = scratch.path().join("bad.json");
+        let doc = serde_json::json!({ "graph": {
+            "vertices": [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [2.0, 2.0]],
+            "edges": [{ "from": 0, "to": 1 }, { "from": 1, "to": 2 }, { "from": 2, "to": 3 }, { "from": 3, "to": 0 }, { "from": 2, "to": 4 }] } });
+        winslow::io::file::write_bytes(&bad, serde_json::to_vec(&doc).unwrap().as_slice()).unwrap();
+        let e = s.open(&bad).unwrap_err();
+        assert_eq!(s.status.as_deref(), Some(e.as_str()));
+        assert!(e.contains("bad.json") && e.contains("edge 4") && e.contains("dangles"), "{e}");
+        assert_eq!(s.scene.as_ref().unwrap().kind, "graph");
+    }
+
+    /// The bundled motor-like section (a plane graph of many faces) opens as the core's
+    /// layout: the same patches, faces and irregular vertices.
+    #[test]
+    fn opens_the_bundled_motor_graph() {
+        let path = data("domains/motor12.json");
+        let winslow::Document::Graph(g) = winslow::read(&path).unwrap() else { panic!("not a graph") };
+        let auto = winslow::domain::graph_layout(&g, &Default::default()).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "graph");
+        let l = scene.layout.as_ref().unwrap();
+        assert_eq!(l.layout.patches.len(), auto.layout.patches.len());
+        let faces = |l: &winslow::multipatch::Layout| l.patches.iter().map(|p| p.face.clone()).collect::<Vec<_>>();
+        assert_eq!(faces(&l.layout), faces(&auto.layout));
+        let irregular = |v: &[winslow::domain::template::IrregularVertex]| {
+            v.iter().map(|v| (v.point, v.valence)).collect::<Vec<_>>()
+        };
+        assert_eq!(irregular(l.irregular()), irregular(&auto.report.irregular_vertices));
+        assert!(s.can_solve());
+    }
+
+    /// A multipatch layout of boundaries (G+Smo's plate with a hole, as JSON) opens as a
+    /// layout to solve and solves like a domain's layout.
+    #[test]
+    fn opens_and_solves_a_layout_of_boundaries() {
+        let scratch = tempfile::tempdir().unwrap();
         let winslow::Document::Layout(layout) =
             winslow::read(&data("gismo/xml/multipatch/plateWithHoleMP.xml")).unwrap()
         else {
             panic!("not a layout")
         };
-        winslow::write(&dir.join("input.json"), &winslow::Output::Layout(&layout)).unwrap();
-        assert!(!s.can_solve(), "a layout is not solved patch by patch");
-        let e = s.open(&dir.join("input.json")).unwrap_err();
-        assert!(e.contains("winslow solve"), "{e}");
-        assert_eq!(s.scene.as_ref().unwrap().kind, "multipatch");
+        let path = scratch.path().join("input.json");
+        winslow::write(&path, &winslow::Output::Layout(&layout)).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        let scene = s.scene.as_ref().unwrap();
+        assert_eq!(scene.kind, "layout");
+        let l = scene.layout.as_ref().unwrap();
+        assert_eq!(l.layout.patches.len(), layout.patches.len());
+        assert!(l.irregular().is_empty() && l.report.is_none());
+        // the outline is every side on no interface
+        let inner = 2 * layout.interfaces.len();
+        assert_eq!(l.outline.len(), 4 * layout.patches.len() - inner);
+        assert!(s.can_solve() && !s.can_compare());
+        s.solve.min_elements = 4;
+        assert!(s.start_solve(|| {}));
+        s.wait_for_solve();
+        let sum: f64 = s.scene.as_ref().unwrap().maps().map(|m| m.quality.functionals.area).sum();
+        assert_eq!(check_solved_layout(&s, sum), layout.patches.len());
     }
 
     #[test]

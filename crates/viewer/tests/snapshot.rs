@@ -257,3 +257,38 @@ fn multipatch_view_snapshot() {
     h.run();
     h.snapshot("multipatch_view");
 }
+
+#[test]
+fn domain_layout_snapshot() {
+    // the bundled plate with holes laid out automatically: patch borders, the outline and
+    // the irregular vertices marked with their valence, before the solve
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("domains/plate_holes.json")).unwrap();
+    let scene = app.state.scene.as_ref().unwrap();
+    assert_eq!(scene.kind, "domain");
+    assert!(scene.map.is_none());
+    let l = scene.layout.as_ref().unwrap();
+    assert!(!l.irregular().is_empty());
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label("faces and templates");
+    h.snapshot("domain_layout");
+}
+
+#[test]
+fn solved_domain_layout_snapshot() {
+    // the same layout solved in the viewer's background job: every patch's det J on one
+    // scale, the irregular vertices kept
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("domains/plate_holes.json")).unwrap();
+    app.state.solve.min_elements = 4;
+    assert!(app.state.start_solve(|| {}));
+    app.state.wait_for_solve();
+    let scene = app.state.scene.as_ref().unwrap();
+    let l = scene.layout.as_ref().unwrap();
+    assert_eq!(scene.maps().count(), l.layout.patches.len());
+    assert!(scene.maps().all(|m| m.quality.det_j_min > 0.0));
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("solved_domain_layout");
+}
