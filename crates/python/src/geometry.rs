@@ -395,6 +395,7 @@ pub fn write_document(path: &std::path::Path, doc: &Document) -> winslow::Result
         }
         Document::Domain(d) => winslow::write(path, &Output::Domain(d)),
         Document::VolumeBoundary(b) => winslow::write(path, &Output::VolumeBoundary(b)),
+        Document::Graph(g) => winslow::write(path, &Output::Graph(g)),
         Document::Volume { name, volume } => {
             winslow::write(path, &Output::Volume { name, volume, label: "", extra: None })
         }
