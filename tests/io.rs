@@ -618,17 +618,24 @@ fn read_returns_the_kind_of_every_bundled_document() {
             .unwrap();
         assert_eq!(winslow::read(&path).unwrap().kind(), "volume", "{file}");
     }
-    // a general domain is read; a plane graph is named, not half read
+    // a general domain and a plane graph are read (and validated when laid out: a vertex
+    // on no edge is named there)
     let domain = dir.join("domain.json");
     write_json(&domain, &json!({ "name": "d", "domain": { "outer": { "points": [[0, 0], [1, 0], [1, 1]] } } }))
         .unwrap();
     assert_eq!(winslow::read(&domain).unwrap().kind(), "domain");
     let graph = dir.join("graph.json");
-    write_json(&graph, &json!({ "name": "g", "graph": { "vertices": [[0, 0], [1, 0], [1, 1]], "edges": [] } }))
+    let triangle = json!([{ "from": 0, "to": 1 }, { "from": 1, "to": 2 }, { "from": 2, "to": 0 }]);
+    write_json(&graph, &json!({ "name": "g", "graph": { "vertices": [[0, 0], [1, 0], [1, 1]], "edges": triangle } }))
         .unwrap();
-    let e = winslow::read(&graph).unwrap_err();
-    assert!(matches!(&e, Error::DocumentKind { path: Some(p), .. } if p == &graph), "{e}");
-    assert!(e.to_string().contains("graph"), "{e}");
+    let Ok(winslow::Document::Graph(g)) = winslow::read(&graph) else { panic!("a graph") };
+    let opts = winslow::domain::LayoutOptions::default();
+    assert_eq!(winslow::domain::graph_layout(&g, &opts).unwrap().layout.patches.len(), 3);
+    write_json(&graph, &json!({ "name": "g", "graph": { "vertices": [[0, 0], [1, 0], [1, 1], [2, 2]], "edges": triangle } }))
+        .unwrap();
+    let Ok(winslow::Document::Graph(g)) = winslow::read(&graph) else { panic!("a graph") };
+    let e = winslow::domain::graph_layout(&g, &opts).unwrap_err();
+    assert!(matches!(&e, Error::Domain { .. }) && e.to_string().contains("vertex 3"), "{e}");
     // a ring is not a boundary: the error names both
     let e = read_boundary(&data("rings/eccentric_annulus.json"), &ReadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("a ring document, where a four-sided boundary"), "{e}");

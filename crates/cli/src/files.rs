@@ -14,7 +14,7 @@ use winslow::{Error, Surface};
 /// A core error with the file named: errors that name it already (I/O, a document of
 /// the wrong kind, an extension that does not fit) pass as they are; the others (a
 /// malformed document) get `"{action} {path}"` in front.
-fn named(e: Error, action: &str, path: &Path) -> anyhow::Error {
+pub(crate) fn named(e: Error, action: &str, path: &Path) -> anyhow::Error {
     match e {
         Error::Io { .. } | Error::DocumentKind { path: Some(_), .. } | Error::Extension { .. } => e.into(),
         e => anyhow::Error::new(e).context(format!("{action} {}", path.display())),

@@ -16,7 +16,8 @@ use crate::files;
 
 /// The THB map in `path`, `None` when the file holds another kind of document.
 pub(crate) fn read(path: &Path) -> Result<Option<(String, HierarchicalMap)>> {
-    read_thb(path).with_context(|| format!("reading {}", path.display()))
+    // named once, as every command's read names its file (`files::named`)
+    read_thb(path).map_err(|e| files::named(e, "reading", path))
 }
 
 /// 0 certified or degenerate corner, 3 folded, 5 undecided.

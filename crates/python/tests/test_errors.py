@@ -61,8 +61,13 @@ def test_file_errors(tmp_path, data):
     assert isinstance(ring, winslow.Document) and ring.kind == "ring"
     assert kind_of(lambda: winslow.check(ring)) == "document_kind"
     graph = tmp_path / "graph.json"
+    # a graph document without its vertices is malformed; a triangle reads as a graph
     graph.write_text(json.dumps({"graph": {}}))
-    assert kind_of(lambda: winslow.read(graph)) == "document_kind"
+    assert kind_of(lambda: winslow.read(graph)) == "json"
+    edges = [{"from": 0, "to": 1}, {"from": 1, "to": 2}, {"from": 2, "to": 0}]
+    graph.write_text(json.dumps({"name": "g", "graph": {"vertices": [[0, 0], [1, 0], [1, 1]], "edges": edges}}))
+    g = winslow.read(graph)
+    assert isinstance(g, winslow.Document) and g.kind == "graph"
     with pytest.raises(TypeError):
         winslow.check(42)
 
