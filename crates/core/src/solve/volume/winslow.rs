@@ -115,7 +115,7 @@ pub fn density(d: &[Point3; 3], hessian: bool) -> Option<(f64, [f64; 9], [[f64; 
 type Tables = Vec<(BasisDerivs, f64)>;
 
 /// What one element adds: `E_e`, `∇E_e` over its `m` basis functions (`3 a + i`) and
-/// `∇²E_e` as `K[(i_b, a, i_a), b]`, column-major `9m x m` (empty without the Hessian).
+/// `∇²E_e` as `K[(i_b, i_a, a), b]`, column-major `9m x m` (empty without the Hessian).
 struct Local {
     idx: Vec<usize>,
     energy: f64,
@@ -242,10 +242,8 @@ impl WinslowVolume {
     /// Global indices of the element's basis functions (`a` fastest).
     fn element_indices(&self, e: usize) -> Vec<usize> {
         let [bx, by, bz] = self.element_tables(e);
-        let (f, p) = (
-            [bx[0].0.first(), by[0].0.first(), bz[0].0.first()],
-            [bx[0].0.degree, by[0].0.degree, bz[0].0.degree],
-        );
+        let (f, p) =
+            ([bx[0].0.first(), by[0].0.first(), bz[0].0.first()], [bx[0].0.degree, by[0].0.degree, bz[0].0.degree]);
         let shape = self.shape;
         let mut idx = Vec::with_capacity((p[0] + 1) * (p[1] + 1) * (p[2] + 1));
         for c in 0..=p[2] {
@@ -294,10 +292,9 @@ impl WinslowVolume {
                             }
                         }
                     }
-                    grads.extend(
-                        vals.iter()
-                            .map(|(n, g)| -> Point3 { std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum)) }),
-                    );
+                    grads.extend(vals.iter().map(|(n, g)| -> Point3 {
+                        std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum))
+                    }));
                     weights.push(wx * wy * wz);
                 }
             }
@@ -308,9 +305,9 @@ impl WinslowVolume {
     /// Element `e`'s energy, gradient and Hessian (see [`Local`]); `None` when
     /// `det J <= 0` at one of its points.
     ///
-    /// The Hessian is one matrix product: with `U[(i_b, a, i_a), (q, c')] =
+    /// The Hessian is one matrix product: with `U[(i_b, i_a, a), (q, c')] =
     /// w_q Σ_c ∂_c R_a(q) ∂²W/∂(d_c)_(i_a) ∂(d_c')_(i_b)` and `G[(q, c'), b] = ∂_c' R_b(q)`,
-    /// `∂²E_e / ∂x_(a, i_a) ∂x_(b, i_b) = (U G)[(i_b, a, i_a), b]`.
+    /// `∂²E_e / ∂x_(a, i_a) ∂x_(b, i_b) = (U G)[(i_b, i_a, a), b]`.
     fn element(&self, e: usize, cps: &[Point3], hessian: bool) -> Option<Local> {
         let idx = self.element_indices(e);
         let (weights, grads) = self.element_points(e, &idx);
@@ -318,6 +315,9 @@ impl WinslowVolume {
         let mut energy = 0.0;
         let mut g = vec![0.0; 3 * m];
         let mut u = if hessian { vec![0.0; 27 * m * nq] } else { Vec::new() };
+        // the gradients by component, for the columns of U
+        let soa: [Vec<f64>; 3] =
+            if hessian { std::array::from_fn(|c| grads.iter().map(|g| g[c]).collect()) } else { Default::default() };
         for (q, &wq) in weights.iter().enumerate() {
             let gq = &grads[q * m..(q + 1) * m];
             let mut d = [[0.0; 3]; 3];
@@ -341,14 +341,17 @@ impl WinslowVolume {
                 }
             }
             if hessian {
+                let (gx, gy, gz) =
+                    (&soa[0][q * m..(q + 1) * m], &soa[1][q * m..(q + 1) * m], &soa[2][q * m..(q + 1) * m]);
                 for cb in 0..3 {
                     let column = &mut u[(3 * q + cb) * 9 * m..(3 * q + cb + 1) * 9 * m];
                     for ib in 0..3 {
                         let kb = 3 * cb + ib;
-                        for (a, ga) in gq.iter().enumerate() {
-                            for ia in 0..3 {
-                                column[ib * 3 * m + 3 * a + ia] =
-                                    wq * (ga[0] * hw[ia][kb] + ga[1] * hw[3 + ia][kb] + ga[2] * hw[6 + ia][kb]);
+                        for ia in 0..3 {
+                            let (h0, h1, h2) = (wq * hw[ia][kb], wq * hw[3 + ia][kb], wq * hw[6 + ia][kb]);
+                            let out = &mut column[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
+                            for (a, o) in out.iter_mut().enumerate() {
+                                *o = h0 * gx[a] + h1 * gy[a] + h2 * gz[a];
                             }
                         }
                     }
@@ -428,7 +431,7 @@ impl WinslowVolume {
                         for ia in 0..3 {
                             let p = self.pattern.row_ptr[3 * fa + ia] + at;
                             for ib in 0..3 {
-                                values[p + ib] += l.hessian[b * 9 * m + ib * 3 * m + 3 * a + ia];
+                                values[p + ib] += l.hessian[b * 9 * m + (3 * ib + ia) * m + a];
                             }
                         }
                     }
