@@ -110,25 +110,43 @@ pub fn density(d: &[Point3; 3], hessian: bool) -> Option<(f64, [f64; 9], [[f64; 
     Some((w, g, h))
 }
 
-/// One quadrature point of an element: weight and the gradients `∇R_A` of the
-/// element's non-zero basis functions (in the element's local order).
-#[derive(Debug, Clone)]
-struct QuadPoint {
-    weight: f64,
-    grads: Vec<Point3>,
+/// The univariate tables of one element in one direction: the basis functions and
+/// their first derivatives at the element's Gauss points, with the Gauss weights.
+type Tables = Vec<(BasisDerivs, f64)>;
+
+/// What one element adds: `E_e`, `∇E_e` over its `m` basis functions (`3 a + i`) and
+/// `∇²E_e` as `K[(i_b, i_a, a), b]`, column-major `9m x m` (empty without the Hessian).
+struct Local {
+    idx: Vec<usize>,
+    energy: f64,
+    gradient: Vec<f64>,
+    hessian: Vec<f64>,
 }
 
 /// The Winslow energy of volumes on one basis with the weights fixed, the boundary
-/// control points fixed and the interior ones free: precomputed quadrature.
+/// control points fixed and the interior ones free.
+///
+/// Quadrature is stored as univariate tables per direction and element (the tensor
+/// products `∇R_A` are formed per element when it is evaluated, so memory grows with
+/// the number of knot spans, not with elements x points x functions); the sparsity
+/// pattern of `∇²E` is built once, and every evaluation adds the element matrices into
+/// its values.
 #[derive(Debug, Clone)]
 pub struct WinslowVolume {
     shape: [usize; 3],
-    /// Per element: the global indices of its basis functions and its points.
-    elements: Vec<(Vec<usize>, Vec<QuadPoint>)>,
+    /// `tables[d][e]`: the tables of element `e` in direction `d`.
+    tables: [Vec<Tables>; 3],
+    /// Weights of the rational basis.
+    weights: Option<Vec<f64>>,
     /// Free index of each control point (`usize::MAX` for fixed ones).
     free_of: Vec<usize>,
     /// Number of free control points.
     free: usize,
+    /// The pattern of `∇²E` (values zero): row `3 f + i` holds the columns `3 g + j`,
+    /// `g` over `neighbours[f]`, `j = 0, 1, 2`.
+    pattern: Csr,
+    /// Per free control point, the sorted free control points sharing an element with it.
+    neighbours: Vec<Vec<usize>>,
 }
 
 /// Energy, gradient (of the free coordinates) and Hessian of [`WinslowVolume`].
@@ -148,7 +166,7 @@ impl WinslowVolume {
     pub fn new(vol: &Volume, g: usize) -> Self {
         let shape = vol.shape();
         let rule = GaussLegendre::new(g);
-        let per_dir: [Vec<Vec<(BasisDerivs, f64)>>; 3] = std::array::from_fn(|d| {
+        let tables: [Vec<Tables>; 3] = std::array::from_fn(|d| {
             let kv: &KnotVector = &vol.knots[d];
             kv.elements()
                 .into_iter()
@@ -163,62 +181,6 @@ impl WinslowVolume {
                 })
                 .collect()
         });
-        let ne = per_dir.each_ref().map(Vec::len);
-        let mut elements = Vec::with_capacity(ne.iter().product());
-        for ek in 0..ne[2] {
-            for ej in 0..ne[1] {
-                for ei in 0..ne[0] {
-                    let (bx, by, bz) = (&per_dir[0][ei], &per_dir[1][ej], &per_dir[2][ek]);
-                    let (f, p) = (
-                        [bx[0].0.first(), by[0].0.first(), bz[0].0.first()],
-                        [bx[0].0.degree, by[0].0.degree, bz[0].0.degree],
-                    );
-                    let mut idx = Vec::new();
-                    for c in 0..=p[2] {
-                        for b in 0..=p[1] {
-                            for a in 0..=p[0] {
-                                idx.push(((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a);
-                            }
-                        }
-                    }
-                    let mut pts = Vec::with_capacity(bx.len() * by.len() * bz.len());
-                    for (z, wz) in bz {
-                        for (y, wy) in by {
-                            for (x, wx) in bx {
-                                let mut vals = Vec::with_capacity(idx.len());
-                                let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
-                                for c in 0..=p[2] {
-                                    for b in 0..=p[1] {
-                                        for a in 0..=p[0] {
-                                            let lin = ((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a;
-                                            let w = vol.weights.as_ref().map_or(1.0, |w| w[lin]);
-                                            let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
-                                            let g = [
-                                                w * x.d[1][a] * y.d[0][b] * z.d[0][c],
-                                                w * x.d[0][a] * y.d[1][b] * z.d[0][c],
-                                                w * x.d[0][a] * y.d[0][b] * z.d[1][c],
-                                            ];
-                                            wsum += n;
-                                            for q in 0..3 {
-                                                wgrad[q] += g[q];
-                                            }
-                                            vals.push((n, g));
-                                        }
-                                    }
-                                }
-                                // R = w N / W, ∇R = (w ∇N W - w N ∇W) / W²
-                                let grads = vals
-                                    .iter()
-                                    .map(|(n, g)| std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum)))
-                                    .collect();
-                                pts.push(QuadPoint { weight: wx * wy * wz, grads });
-                            }
-                        }
-                    }
-                    elements.push((idx, pts));
-                }
-            }
-        }
         let mut free_of = vec![usize::MAX; shape.iter().product()];
         let mut free = 0;
         for k in 1..shape[2] - 1 {
@@ -229,7 +191,192 @@ impl WinslowVolume {
                 }
             }
         }
-        Self { shape, elements, free_of, free }
+        let mut e = Self {
+            shape,
+            tables,
+            weights: vol.weights.clone(),
+            free_of,
+            free,
+            pattern: Csr::default(),
+            neighbours: Vec::new(),
+        };
+        let mut neighbours = vec![Vec::new(); free];
+        for el in 0..e.elements() {
+            let fs: Vec<usize> = e.element_indices(el).into_iter().filter_map(|lin| e.free_index(lin)).collect();
+            for &f in &fs {
+                neighbours[f].extend_from_slice(&fs);
+            }
+        }
+        neighbours.par_iter_mut().for_each(|r| {
+            r.sort_unstable();
+            r.dedup();
+        });
+        let mut row_ptr = Vec::with_capacity(3 * free + 1);
+        let mut col_idx = Vec::new();
+        row_ptr.push(0);
+        for r in &neighbours {
+            for _ in 0..3 {
+                for &g in r {
+                    col_idx.extend([3 * g, 3 * g + 1, 3 * g + 2]);
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        let nnz = col_idx.len();
+        e.pattern = Csr { nrows: 3 * free, ncols: 3 * free, row_ptr, col_idx, values: vec![0.0; nnz] };
+        e.neighbours = neighbours;
+        e
+    }
+
+    /// Number of elements (knot spans per direction multiplied).
+    fn elements(&self) -> usize {
+        self.tables.iter().map(Vec::len).product()
+    }
+
+    /// The element's tables per direction (element `e = (k n₁ + j) n₀ + i`).
+    fn element_tables(&self, e: usize) -> [&Tables; 3] {
+        let (n0, n1) = (self.tables[0].len(), self.tables[1].len());
+        [&self.tables[0][e % n0], &self.tables[1][(e / n0) % n1], &self.tables[2][e / (n0 * n1)]]
+    }
+
+    /// Global indices of the element's basis functions (`a` fastest).
+    fn element_indices(&self, e: usize) -> Vec<usize> {
+        let [bx, by, bz] = self.element_tables(e);
+        let (f, p) =
+            ([bx[0].0.first(), by[0].0.first(), bz[0].0.first()], [bx[0].0.degree, by[0].0.degree, bz[0].0.degree]);
+        let shape = self.shape;
+        let mut idx = Vec::with_capacity((p[0] + 1) * (p[1] + 1) * (p[2] + 1));
+        for c in 0..=p[2] {
+            for b in 0..=p[1] {
+                for a in 0..=p[0] {
+                    idx.push(((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a);
+                }
+            }
+        }
+        idx
+    }
+
+    /// The element's quadrature: weights `w_q` and `∇R_A` at every point (`q m + a`),
+    /// tensor products of the univariate tables, `R = w N / W`,
+    /// `∇R = (w ∇N W - w N ∇W) / W²`.
+    fn element_points(&self, e: usize, idx: &[usize]) -> (Vec<f64>, Vec<Point3>) {
+        let [bx, by, bz] = self.element_tables(e);
+        let p = [bx[0].0.degree, by[0].0.degree, bz[0].0.degree];
+        let m = idx.len();
+        let nq = bx.len() * by.len() * bz.len();
+        let mut weights = Vec::with_capacity(nq);
+        let mut grads = Vec::with_capacity(nq * m);
+        let mut vals = Vec::with_capacity(m);
+        for (z, wz) in bz {
+            for (y, wy) in by {
+                for (x, wx) in bx {
+                    vals.clear();
+                    let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
+                    let mut lin = idx.iter();
+                    for c in 0..=p[2] {
+                        for b in 0..=p[1] {
+                            for a in 0..=p[0] {
+                                let l = *lin.next().expect("one index per basis function");
+                                let w = self.weights.as_ref().map_or(1.0, |w| w[l]);
+                                let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
+                                let g = [
+                                    w * x.d[1][a] * y.d[0][b] * z.d[0][c],
+                                    w * x.d[0][a] * y.d[1][b] * z.d[0][c],
+                                    w * x.d[0][a] * y.d[0][b] * z.d[1][c],
+                                ];
+                                wsum += n;
+                                for q in 0..3 {
+                                    wgrad[q] += g[q];
+                                }
+                                vals.push((n, g));
+                            }
+                        }
+                    }
+                    grads.extend(vals.iter().map(|(n, g)| -> Point3 {
+                        std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum))
+                    }));
+                    weights.push(wx * wy * wz);
+                }
+            }
+        }
+        (weights, grads)
+    }
+
+    /// Element `e`'s energy, gradient and Hessian (see [`Local`]); `None` when
+    /// `det J <= 0` at one of its points.
+    ///
+    /// The Hessian is one matrix product: with `U[(i_b, i_a, a), (q, c')] =
+    /// w_q Σ_c ∂_c R_a(q) ∂²W/∂(d_c)_(i_a) ∂(d_c')_(i_b)` and `G[(q, c'), b] = ∂_c' R_b(q)`,
+    /// `∂²E_e / ∂x_(a, i_a) ∂x_(b, i_b) = (U G)[(i_b, i_a, a), b]`.
+    fn element(&self, e: usize, cps: &[Point3], hessian: bool) -> Option<Local> {
+        let idx = self.element_indices(e);
+        let (weights, grads) = self.element_points(e, &idx);
+        let (m, nq) = (idx.len(), weights.len());
+        let mut energy = 0.0;
+        let mut g = vec![0.0; 3 * m];
+        let mut u = if hessian { vec![0.0; 27 * m * nq] } else { Vec::new() };
+        // the gradients by component, for the columns of U
+        let soa: [Vec<f64>; 3] =
+            if hessian { std::array::from_fn(|c| grads.iter().map(|g| g[c]).collect()) } else { Default::default() };
+        for (q, &wq) in weights.iter().enumerate() {
+            let gq = &grads[q * m..(q + 1) * m];
+            let mut d = [[0.0; 3]; 3];
+            for (a, gr) in gq.iter().enumerate() {
+                let c = cps[idx[a]];
+                for col in 0..3 {
+                    for comp in 0..3 {
+                        d[col][comp] += c[comp] * gr[col];
+                    }
+                }
+            }
+            let (w, gw, hw) = density(&d, hessian)?;
+            energy += wq * w;
+            for (a, gr) in gq.iter().enumerate() {
+                for comp in 0..3 {
+                    let mut s = 0.0;
+                    for col in 0..3 {
+                        s += gw[3 * col + comp] * gr[col];
+                    }
+                    g[3 * a + comp] += wq * s;
+                }
+            }
+            if hessian {
+                let (gx, gy, gz) =
+                    (&soa[0][q * m..(q + 1) * m], &soa[1][q * m..(q + 1) * m], &soa[2][q * m..(q + 1) * m]);
+                for cb in 0..3 {
+                    let column = &mut u[(3 * q + cb) * 9 * m..(3 * q + cb + 1) * 9 * m];
+                    for ib in 0..3 {
+                        let kb = 3 * cb + ib;
+                        for ia in 0..3 {
+                            let (h0, h1, h2) = (wq * hw[ia][kb], wq * hw[3 + ia][kb], wq * hw[6 + ia][kb]);
+                            let out = &mut column[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
+                            for (a, o) in out.iter_mut().enumerate() {
+                                *o = h0 * gx[a] + h1 * gy[a] + h2 * gz[a];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut k = Vec::new();
+        if hessian {
+            let mut gm = vec![0.0; 3 * nq * m];
+            for b in 0..m {
+                for q in 0..nq {
+                    gm[b * 3 * nq + 3 * q..b * 3 * nq + 3 * q + 3].copy_from_slice(&grads[q * m + b]);
+                }
+            }
+            k = vec![0.0; 9 * m * m];
+            faer::linalg::matmul::matmul(
+                faer::MatMut::from_column_major_slice_mut(&mut k, 9 * m, m),
+                faer::Accum::Replace,
+                faer::MatRef::from_column_major_slice(&u, 9 * m, 3 * nq),
+                faer::MatRef::from_column_major_slice(&gm, 3 * nq, m),
+                1.0,
+                faer::Par::Seq,
+            );
+        }
+        Some(Local { idx, energy, gradient: g, hessian: k })
     }
 
     /// Number of free scalar unknowns (3 per interior control point).
@@ -250,92 +397,48 @@ impl WinslowVolume {
 
     /// `E`, and `∇E` (and `∇²E` when `hessian`) at the control points `cps`; the
     /// gradient is empty and the Hessian `None` when `E = +∞`.
+    ///
+    /// Elements are evaluated in parallel in batches and added in element order (the
+    /// same sums as a sequential loop), the Hessian's into the values of the fixed
+    /// pattern.
     pub fn evaluate(&self, cps: &[Point3], hessian: bool) -> Evaluation {
-        type Local = (f64, Vec<(usize, f64)>, Vec<(usize, usize, f64)>);
-        let locals: Option<Vec<Local>> = self
-            .elements
-            .par_iter()
-            .map(|(idx, pts)| {
-                let m = idx.len();
-                let mut e = 0.0;
-                let mut g = vec![0.0; 3 * m];
-                let mut h = if hessian { vec![0.0; 9 * m * m] } else { Vec::new() };
-                for qp in pts {
-                    let mut d = [[0.0; 3]; 3];
-                    for (a, gr) in qp.grads.iter().enumerate() {
-                        let c = cps[idx[a]];
-                        for col in 0..3 {
-                            for comp in 0..3 {
-                                d[col][comp] += c[comp] * gr[col];
-                            }
-                        }
-                    }
-                    let (w, gw, hw) = density(&d, hessian)?;
-                    e += qp.weight * w;
-                    for (a, gr) in qp.grads.iter().enumerate() {
-                        for comp in 0..3 {
-                            let mut s = 0.0;
-                            for col in 0..3 {
-                                s += gw[3 * col + comp] * gr[col];
-                            }
-                            g[3 * a + comp] += qp.weight * s;
-                        }
-                    }
-                    if hessian {
-                        for (a, ga) in qp.grads.iter().enumerate() {
-                            // t[ia][kb] = w Σ_ca ga[ca] hw[(ca, ia)][kb]
-                            let mut t = [[0.0; 9]; 3];
-                            for (ia, row) in t.iter_mut().enumerate() {
-                                for (kb, x) in row.iter_mut().enumerate() {
-                                    *x = qp.weight
-                                        * (ga[0] * hw[ia][kb] + ga[1] * hw[3 + ia][kb] + ga[2] * hw[6 + ia][kb]);
-                                }
-                            }
-                            for (b, gb) in qp.grads.iter().enumerate() {
-                                for (ia, row) in t.iter().enumerate() {
-                                    let base = (3 * a + ia) * 3 * m + 3 * b;
-                                    for ib in 0..3 {
-                                        h[base + ib] += row[ib] * gb[0] + row[3 + ib] * gb[1] + row[6 + ib] * gb[2];
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                let mut gl = Vec::new();
-                let mut hl = Vec::new();
-                for a in 0..m {
-                    let Some(fa) = self.free_index(idx[a]) else { continue };
-                    for ia in 0..3 {
-                        gl.push((3 * fa + ia, g[3 * a + ia]));
-                        if hessian {
-                            for b in 0..m {
-                                let Some(fb) = self.free_index(idx[b]) else { continue };
-                                for ib in 0..3 {
-                                    hl.push((3 * fa + ia, 3 * fb + ib, h[(3 * a + ia) * 3 * m + 3 * b + ib]));
-                                }
-                            }
-                        }
-                    }
-                }
-                Some((e, gl, hl))
-            })
-            .collect();
+        let infinite = Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None };
         let n = self.unknowns();
-        let Some(locals) = locals else {
-            return Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None };
-        };
+        let ne = self.elements();
         let mut energy = 0.0;
         let mut gradient = vec![0.0; n];
-        let mut trip = Vec::new();
-        for (e, gl, hl) in locals {
-            energy += e;
-            for (i, v) in gl {
-                gradient[i] += v;
+        let mut values = if hessian { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
+        let batch = 32 * rayon::current_num_threads().max(1);
+        for start in (0..ne).step_by(batch) {
+            let locals: Option<Vec<Local>> =
+                (start..(start + batch).min(ne)).into_par_iter().map(|e| self.element(e, cps, hessian)).collect();
+            let Some(locals) = locals else { return infinite };
+            for l in locals {
+                energy += l.energy;
+                let m = l.idx.len();
+                for a in 0..m {
+                    let Some(fa) = self.free_index(l.idx[a]) else { continue };
+                    for ia in 0..3 {
+                        gradient[3 * fa + ia] += l.gradient[3 * a + ia];
+                    }
+                    if !hessian {
+                        continue;
+                    }
+                    let row = &self.neighbours[fa];
+                    for b in 0..m {
+                        let Some(fb) = self.free_index(l.idx[b]) else { continue };
+                        let at = 3 * row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        for ia in 0..3 {
+                            let p = self.pattern.row_ptr[3 * fa + ia] + at;
+                            for ib in 0..3 {
+                                values[p + ib] += l.hessian[b * 9 * m + (3 * ib + ia) * m + a];
+                            }
+                        }
+                    }
+                }
             }
-            trip.extend(hl);
         }
-        let hessian = hessian.then(|| Csr::from_triplets(n, n, &trip));
+        let hessian = hessian.then(|| Csr { values, ..self.pattern.clone() });
         Evaluation { energy, gradient, hessian }
     }
 
