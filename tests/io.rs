@@ -631,8 +631,11 @@ fn read_returns_the_kind_of_every_bundled_document() {
     let Ok(winslow::Document::Graph(g)) = winslow::read(&graph) else { panic!("a graph") };
     let opts = winslow::domain::LayoutOptions::default();
     assert_eq!(winslow::domain::graph_layout(&g, &opts).unwrap().layout.patches.len(), 3);
-    write_json(&graph, &json!({ "name": "g", "graph": { "vertices": [[0, 0], [1, 0], [1, 1], [2, 2]], "edges": triangle } }))
-        .unwrap();
+    write_json(
+        &graph,
+        &json!({ "name": "g", "graph": { "vertices": [[0, 0], [1, 0], [1, 1], [2, 2]], "edges": triangle } }),
+    )
+    .unwrap();
     let Ok(winslow::Document::Graph(g)) = winslow::read(&graph) else { panic!("a graph") };
     let e = winslow::domain::graph_layout(&g, &opts).unwrap_err();
     assert!(matches!(&e, Error::Domain { .. }) && e.to_string().contains("vertex 3"), "{e}");
