@@ -79,7 +79,7 @@ pub struct FaceReport {
     pub harmonic_min_area_ratio: Option<f64>,
     /// The harmonic map folds (`harmonic_min_area_ratio <= 0`), so its spokes may leave
     /// the face: the cuts are straight instead, from a point the face is star-shaped
-    /// about ([`star_centre`]) to the side midpoints, or the straight segment between the
+    /// about (see `star_centre`) to the side midpoints, or the straight segment between the
     /// two midpoints of a face split in two when it lies inside.
     pub straight: bool,
 }
