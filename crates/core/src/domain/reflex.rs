@@ -49,7 +49,7 @@ fn face_polyline(g: &Graph, f: usize) -> Vec<(Point, usize)> {
 
 /// Whether the straight segment `a b` stays inside face `f` (it touches the face's
 /// boundary only at its ends).
-fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) -> bool {
+pub(super) fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) -> bool {
     let poly = face_polyline(g, f);
     let n = poly.len();
     // the segment without its ends, which lie on the boundary

@@ -34,7 +34,7 @@ use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
 use super::holes::{cut_holes, HoleCut};
 use super::plane::{build_graph, GraphReport, PlaneGraph};
-use super::reflex::{cut_reflex, line, CutReport};
+use super::reflex::{cut_reflex, line, segment_inside, CutReport};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
 use crate::boundary::fit::{fit_side, FitOptions};
@@ -77,6 +77,11 @@ pub struct FaceReport {
     /// Smallest ratio of image to parameter area over the harmonic map's triangles
     /// (negative: the discrete map folds and the cuts may leave the face).
     pub harmonic_min_area_ratio: Option<f64>,
+    /// The harmonic map folds (`harmonic_min_area_ratio <= 0`), so its spokes may leave
+    /// the face: the cuts are straight instead, from a point the face is star-shaped
+    /// about (see `star_centre`) to the side midpoints, or the straight segment between the
+    /// two midpoints of a face split in two when it lies inside.
+    pub straight: bool,
 }
 
 /// An interior vertex whose valence is not 4.
@@ -252,6 +257,31 @@ fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
         }
     }
     out
+}
+
+/// A point about which the closed counter-clockwise polyline `p` is strictly
+/// star-shaped (every `(p_i - c) × (p_{i+1} - c) > 0`, so every ray from `c` meets the
+/// boundary once and the straight segments from `c` to boundary points cut the face
+/// into simple sectors): `first` if it is one, else the area centroid, else the mean
+/// of the vertices; `None` when none is.
+pub(super) fn star_centre(p: &[Point], first: Point) -> Option<Point> {
+    let n = p.len();
+    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        let (u, v) = (p[i], p[(i + 1) % n]);
+        let w = u[0] * v[1] - v[0] * u[1];
+        a += w;
+        cx += (u[0] + v[0]) * w;
+        cy += (u[1] + v[1]) * w;
+    }
+    let centroid = [cx / (3.0 * a), cy / (3.0 * a)];
+    let mean = p.iter().fold([0.0, 0.0], |m, q| [m[0] + q[0] / n as f64, m[1] + q[1] / n as f64]);
+    [first, centroid, mean].into_iter().find(|c| {
+        (0..n).all(|i| {
+            let (u, v) = (p[i], p[(i + 1) % n]);
+            (u[0] - c[0]) * (v[1] - c[1]) - (u[1] - c[1]) * (v[0] - c[0]) > 0.0
+        })
+    })
 }
 
 /// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
@@ -451,6 +481,7 @@ fn lay_out_with(
             patches: 1,
             centre: None,
             harmonic_min_area_ratio: h.as_ref().map(|h| h.min_area_ratio),
+            straight: false,
         };
         match (template, h) {
             (Template::One, _) | (_, None) => {}
@@ -460,9 +491,15 @@ fn lay_out_with(
                 else {
                     return Err(Error::Invalid(format!("layout: face {f} is not split in two as planned")));
                 };
-                let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
-                pts.extend(h.spoke(r + 2).into_iter().skip(1));
-                let c = spoke_curve(pts, g.vertices[m0], g.vertices[m2], diameter, scales[f], &opts.fit)?;
+                let (p0, p2) = (g.vertices[m0], g.vertices[m2]);
+                let c = if h.min_area_ratio <= 0.0 && segment_inside(&g, f, p0, p2, 1e-9 * diameter) {
+                    report.straight = true;
+                    line(p0, p2)
+                } else {
+                    let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
+                    pts.extend(h.spoke(r + 2).into_iter().skip(1));
+                    spoke_curve(pts, p0, p2, diameter, scales[f], &opts.fit)?
+                };
                 let cut = g.add_edge(c, m0, m2, false);
                 g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
                 g.faces.push(Face::new(vec![b2, s3, a0, (cut, true)], label.clone()));
@@ -470,14 +507,24 @@ fn lay_out_with(
                 report.patches = 2;
             }
             (Template::Midpoint, Some(h)) => {
-                let centre = g.add_vertex(h.centre());
+                // a folded harmonic map: straight spokes from a point the face is
+                // star-shaped about, where there is one
+                let star = (h.min_area_ratio <= 0.0)
+                    .then(|| star_centre(&polyline(&g, &g.faces[f].sides), h.centre()))
+                    .flatten();
+                report.straight = star.is_some();
+                let centre = g.add_vertex(star.unwrap_or_else(|| h.centre()));
                 let mut spokes = Vec::with_capacity(k);
                 let mut parts = Vec::with_capacity(k);
                 for (s, side) in hv.iter().enumerate() {
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    let c = spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?;
+                    let c = if star.is_some() {
+                        line(g.vertices[centre], g.vertices[m])
+                    } else {
+                        spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?
+                    };
                     spokes.push(g.add_edge(c, centre, m, false));
                     parts.push((a, b));
                 }
@@ -492,7 +539,7 @@ fn lay_out_with(
                 }
                 report.template = "midpoint";
                 report.patches = k;
-                report.centre = Some(h.centre());
+                report.centre = Some(g.vertices[centre]);
             }
         }
         faces.push(report);
