@@ -24,9 +24,9 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
     for p in entries {
         if p.is_dir() {
             // regression inputs of the fuzzer are invalid on purpose; multipatch layouts,
-            // general domains and THB maps are not single-patch documents
+            // general domains, volume boundaries and THB maps are not single-patch documents
             // (their readers have their own tests)
-            let skip = ["fuzz", "multipatch", "domains", "thb"];
+            let skip = ["fuzz", "multipatch", "domains", "volumes", "thb"];
             if p.file_name().is_some_and(|n| !skip.iter().any(|s| n == *s)) {
                 collect(&p, out);
             }
