@@ -376,7 +376,8 @@ fn opens_and_solves_a_ring() {
     t.wait_for_solve();
     assert!(t.scene.as_ref().unwrap().map.as_ref().unwrap().map.knots[1].is_periodic());
     let bad = dir.join("bad.json");
-    std::fs::write(&bad, r#"{"ring": {"inner": {"points": [[0,0],[2,0],[2,2],[0,2]]}, "outer": {"points": [[0.5,0.5],[1,0.5],[1,1],[0.5,1]]}}}"#).unwrap();
+    let text = r#"{"ring": {"inner": {"points": [[0,0],[2,0],[2,2],[0,2]]}, "outer": {"points": [[0.5,0.5],[1,0.5],[1,1],[0.5,1]]}}}"#;
+    winslow::io::file::write_bytes(&bad, text.as_bytes()).unwrap();
     t.open(&bad).unwrap();
     let p = t.scene.as_ref().unwrap().boundary.problem.clone().unwrap();
     assert!(p.contains("not inside") && !t.can_solve(), "{p}");
