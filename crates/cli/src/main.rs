@@ -107,7 +107,7 @@ enum Command {
     Inspect(InspectArgs),
     /// Solve the EGG equations for a boundary and write the map (with a report).
     #[command(
-        after_help = "Example:\n  winslow solve tests/data/wavy_lid.json -o out/wavy_lid.json --png out/wavy_lid.png"
+        after_help = "Example:\n  winslow solve tests/data/wavy_lid.json -o out/wavy_lid.json --png out/wavy_lid.png\nExample (a plane graph, laid out automatically):\n  winslow solve tests/data/domains/motor12.json -o out/motor12.json -q\nExample (a volume from its six boundary faces):\n  winslow solve tests/data/volumes/twisted-duct.json -o out/twisted-duct-volume.json -q"
     )]
     Solve(Box<SolveArgs>),
     /// Draw a map, a ring map or a multipatch result as a PNG (grid lines coloured by det J).
@@ -130,7 +130,7 @@ enum Command {
     /// Certify a map's bijectivity (exact Bernstein bounds of det J) and measure its
     /// quality; optionally its boundary deviation and the Poisson benchmark Q(x).
     #[command(
-        after_help = "Example (a map written by `winslow solve`):\n  winslow check out/wavy_lid.json --boundary tests/data/wavy_lid.json --poisson"
+        after_help = "Example (a map written by `winslow solve`):\n  winslow check out/wavy_lid.json --boundary tests/data/wavy_lid.json --poisson\nExample (a THB map, certified cell by active cell):\n  winslow check tests/data/thb/sector_thb.json"
     )]
     Check(check_cmd::CheckArgs),
     /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
@@ -138,7 +138,7 @@ enum Command {
     /// Bézier cells), .vtk (sampled structured grid); a multipatch result as .json, .xml
     /// or .vtm; a volume as .json, .xml, .vtu or .vtk. The map is certified again.
     #[command(
-        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml"
+        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml\nExample (a THB map to its exact tensor map):\n  winslow convert tests/data/thb/sector_thb.json -o out/sector_tensor.json"
     )]
     Convert(ConvertArgs),
     /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,

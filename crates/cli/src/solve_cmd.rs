@@ -366,8 +366,9 @@ fn output_plan(a: &SolveArgs, inputs: &[&Path], multipatch: bool) -> Result<()> 
 
 #[derive(Args, Debug)]
 pub(crate) struct SolveArgs {
-    /// Boundary file (with `--start`: optional, the map's boundary deviation from it is
-    /// reported).
+    /// Input file: a four-sided boundary, a ring, a multipatch layout, a general domain or
+    /// plane graph (laid out automatically), or the six boundary faces of a volume (with
+    /// `--start`: an optional boundary, the map's boundary deviation from it is reported).
     #[arg(required_unless_present = "start")]
     pub(crate) boundary: Option<PathBuf>,
     /// Start from this map document (made by `winslow solve` or another tool) instead of
