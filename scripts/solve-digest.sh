@@ -7,6 +7,8 @@
 #   - every ring (tests/data/rings), solved;
 #   - every multipatch layout (tests/data/gismo/xml/multipatch), with fixed and with free
 #     interfaces;
+#   - every general domain and plane graph (tests/data/domains), laid out automatically;
+#   - every volume boundary (tests/data/volumes), and a THB map converted (tests/data/thb);
 #   - a map improved on its own basis (`solve --start`, Winslow);
 #   - the comparison of methods on one basis (`compare --json`);
 #   - a short sliding-grid sweep of a ring and the volume lofted from its frames.
@@ -75,6 +77,20 @@ for f in tests/data/gismo/xml/multipatch/*.xml; do
     solve_to_digest "mp_${name}_$interfaces" "$f" --interfaces "$interfaces" "$@"
   done
 done
+
+# general domains and plane graphs, laid out automatically (default settings)
+for f in tests/data/domains/*.json; do
+  solve_to_digest "domain_$(basename "$f" .json)" "$f"
+done
+
+# volumes from their six boundary faces
+for f in tests/data/volumes/*.json; do
+  solve_to_digest "volume_$(basename "$f" .json)" "$f"
+done
+
+# a THB map converted to its exact tensor map (certified again)
+run thb_sector convert tests/data/thb/sector_thb.json -o "$scratch/thb_sector.json"
+[ -f "$scratch/thb_sector.json" ] && digest "$scratch/thb_sector.json" thb_sector
 
 # a map improved on its own basis from the certified EGG map of wavy_lid
 if [ -f "$scratch/wavy_lid.json" ]; then
