@@ -195,16 +195,27 @@ pub fn human(n: u64) -> String {
     }
 }
 
-/// A point cloud of `n` points read at `context` within [`MAX_CONTROL_POINTS`], or the
-/// error [`Error::TooLarge`] naming it.
-pub(crate) fn check_point_count(n: usize, context: &str) -> Result<()> {
+/// `n` (the `what` read at `context`) within [`MAX_CONTROL_POINTS`], or the error
+/// [`Error::TooLarge`] naming it.
+fn check_count(n: usize, context: &str, what: &str) -> Result<()> {
     if n > MAX_CONTROL_POINTS {
         return Err(Error::TooLarge {
             context: context.into(),
-            what: "number of points".into(),
+            what: what.into(),
             found: n,
             limit: MAX_CONTROL_POINTS,
         });
     }
     Ok(())
+}
+
+/// A point cloud of `n` points read at `context` within [`MAX_CONTROL_POINTS`].
+pub(crate) fn check_point_count(n: usize, context: &str) -> Result<()> {
+    check_count(n, context, "number of points")
+}
+
+/// A spline of `n` control points (curve, map, face or volume) read at `context` within
+/// [`MAX_CONTROL_POINTS`].
+pub(crate) fn check_control_point_count(n: usize, context: &str) -> Result<()> {
+    check_count(n, context, "number of control points")
 }

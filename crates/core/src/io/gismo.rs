@@ -186,14 +186,7 @@ pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
         (tensor_basis(basis, &bctx)?, None)
     };
     let n = kv[0].num_basis().saturating_mul(kv[1].num_basis());
-    if n > MAX_CONTROL_POINTS {
-        return Err(Error::TooLarge {
-            context: ctx.into(),
-            what: "number of control points".into(),
-            found: n,
-            limit: MAX_CONTROL_POINTS,
-        });
-    }
+    crate::error::check_control_point_count(n, ctx)?;
     let cps = coefs(geom, n, ctx)?;
     let s = Surface::new(kv, cps, w).map_err(|e| e.within(ctx))?;
     let knots = [normalized_knots(&s.knots[0])?, normalized_knots(&s.knots[1])?];

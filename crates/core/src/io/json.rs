@@ -167,9 +167,7 @@ impl CurveJson {
 
     /// Validate (lengths, knots, degree, finiteness, weights) and map the domain to `[0, 1]`.
     pub fn to_curve(self) -> Result<Curve> {
-        if self.control_points.len() > MAX_CONTROL_POINTS {
-            return Err(too_large("number of control points", self.control_points.len()));
-        }
+        crate::error::check_control_point_count(self.control_points.len(), "")?;
         let kv = KnotVector::with_periodic(self.degree, self.knots, self.periodic).map_err(|e| e.within("knots"))?;
         let c = Curve::new(kv, self.control_points, self.weights)?;
         normalized_curve(&c)
@@ -244,9 +242,7 @@ impl MapJson {
 
     /// Validate and map both knot domains to `[0, 1]`.
     pub fn to_surface(self) -> Result<Surface> {
-        if self.control_points.len() > MAX_CONTROL_POINTS {
-            return Err(too_large("number of control points", self.control_points.len()));
-        }
+        crate::error::check_control_point_count(self.control_points.len(), "")?;
         let [k0, k1] = self.knots;
         let kv0 = KnotVector::with_periodic(self.degree[0], k0, self.periodic[0]).map_err(|e| e.within("knots[0]"))?;
         let kv1 = KnotVector::with_periodic(self.degree[1], k1, self.periodic[1]).map_err(|e| e.within("knots[1]"))?;

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 use crate::boundary::volume::{CubeSide, VolumeBoundary};
-use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::error::{Error, Result};
 use crate::io::normalized_knots;
 use crate::spline::face::Face;
 use crate::spline::knots::KnotVector;
@@ -48,14 +48,7 @@ impl FaceJson {
 
     /// Validate and map the knot domains to `[0, 1]`; errors name the field.
     pub fn to_face(self) -> Result<Face> {
-        if self.control_points.len() > MAX_CONTROL_POINTS {
-            return Err(Error::TooLarge {
-                context: String::new(),
-                what: "number of control points".into(),
-                found: self.control_points.len(),
-                limit: MAX_CONTROL_POINTS,
-            });
-        }
+        crate::error::check_control_point_count(self.control_points.len(), "")?;
         let mut kvs = Vec::with_capacity(2);
         for (d, k) in self.knots.into_iter().enumerate() {
             let ctx = format!("knots[{d}]");

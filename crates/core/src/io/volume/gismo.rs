@@ -7,7 +7,7 @@
 
 use roxmltree::Node;
 
-use crate::error::{Error, Result, MAX_CONTROL_POINTS};
+use crate::error::{Error, Result};
 use crate::io::gismo::{
     basis_type, bspline_basis, children, nesting_exceeds, numbers, only_child, weights, xml_err, MAX_DEPTH, MAX_NODES,
 };
@@ -48,14 +48,7 @@ fn volume(geom: Node, rational: bool, ctx: &str) -> Result<Volume> {
         (tensor_basis3(basis, &bctx)?, bctx.clone())
     };
     let n = kv.iter().fold(1usize, |a, k| a.saturating_mul(k.num_basis()));
-    if n > MAX_CONTROL_POINTS {
-        return Err(Error::TooLarge {
-            context: ctx.into(),
-            what: "number of control points".into(),
-            found: n,
-            limit: MAX_CONTROL_POINTS,
-        });
-    }
+    crate::error::check_control_point_count(n, ctx)?;
     let w = if rational { Some(weights(basis, n, &tensor_ctx)?) } else { None };
     let node = only_child(geom, "coefs", ctx)?;
     let cctx = format!("{ctx}.coefs");
