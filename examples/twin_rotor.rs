@@ -224,7 +224,7 @@ fn main() -> Res<()> {
         // free interfaces: the layout improved by the Winslow functional
         let improve = (interfaces == Interfaces::Free).then_some(Improve::Winslow);
         let opts = SolveOptions { improve, ..Default::default() };
-        let Solved::Layout(sol) = Pipeline::new(layout.clone(), opts).solve()? else {
+        let Solved::Layout { solution: sol, .. } = Pipeline::new(layout.clone(), opts).solve()? else {
             unreachable!("a layout's solve")
         };
         let r = &sol.report;

@@ -200,7 +200,7 @@ fn similar_xml(text: &str, a: Point, s: f64) -> String {
 /// The pipeline's solve of a layout with `opts`.
 fn solve_layout(layout: &Layout, opts: &SolveOptions) -> winslow::Result<MultipatchSolution> {
     match Pipeline::new(layout.clone(), opts.clone()).solve()? {
-        Solved::Layout(sol) => Ok(*sol),
+        Solved::Layout { solution, .. } => Ok(*solution),
         other => panic!("a layout gave {:?}", other.verdict()),
     }
 }

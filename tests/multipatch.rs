@@ -61,7 +61,7 @@ fn gismo_multipatch_round_trip_is_exact() {
 fn solve_layout(layout: &Layout, functional: Option<Functional>) -> MultipatchSolution {
     let opts = SolveOptions { improve: functional, ..Default::default() };
     match Pipeline::new(layout.clone(), opts).solve() {
-        Ok(Solved::Layout(sol)) => *sol,
+        Ok(Solved::Layout { solution, .. }) => *solution,
         other => panic!("{}: {other:?}", layout.name),
     }
 }

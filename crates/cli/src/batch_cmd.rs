@@ -109,11 +109,7 @@ fn input_of(shape: &Shape, reorient: bool) -> winslow::Result<Input> {
         Source::File(p) => winslow::read(p)?,
         Source::Inline(v) => winslow::io::parse_document(&v.to_string())?,
     };
-    Ok(match doc {
-        Document::Ring(r) => Input::Ring(r),
-        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(doc.into_ring()?),
-        doc => Input::Boundary(checked_boundary(doc.into_boundary()?, &ReadOptions { reorient })?.0),
-    })
+    doc.into_input(&ReadOptions { reorient })
 }
 
 /// The kind of a core error (its variant in snake case, as the Python package's

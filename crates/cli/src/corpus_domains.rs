@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use winslow::domain::corpus::{domain_corpus, DomainFamily, GraphFamily};
-use winslow::domain::{auto_layout, graph_layout, AutoLayout, Domain, LayoutOptions, PlaneGraph};
+use winslow::domain::{Domain, PlaneGraph};
 use winslow::solve::report::Verdict;
 use winslow::{Pipeline, SolveOptions, Solved};
 
@@ -19,10 +19,11 @@ enum Item {
 }
 
 impl Item {
-    fn lay_out(&self) -> winslow::Result<AutoLayout> {
+    /// The pipeline's input: laid out, then solved.
+    fn input(&self) -> winslow::Input {
         match self {
-            Item::Domain(d) => auto_layout(d, &LayoutOptions::default()),
-            Item::Graph(g) => graph_layout(g, &LayoutOptions::default()),
+            Item::Domain(d) => winslow::Input::Domain(d.clone()),
+            Item::Graph(g) => winslow::Input::Graph(g.clone()),
         }
     }
 }
@@ -100,12 +101,11 @@ pub fn run(
     let mut tally: BTreeMap<&str, Tally> = BTreeMap::new();
     for (family, item) in &domains {
         let t0 = Instant::now();
-        let outcome = item.lay_out().and_then(|auto| {
-            match Pipeline::new(auto.layout.clone(), SolveOptions::default()).solve()? {
-                Solved::Layout(sol) => Ok((auto, *sol)),
-                other => Err(winslow::Error::Invalid(format!("a layout solved into {:?}", other.verdict()))),
-            }
-        });
+        let outcome = match Pipeline::new(item.input(), SolveOptions::default()).solve() {
+            Ok(Solved::Layout { solution, laid_out: Some(auto) }) => Ok((auto, solution)),
+            Ok(other) => Err(winslow::Error::Invalid(format!("a domain solved into a {}", other.kind()))),
+            Err(e) => Err(e),
+        };
         let secs = t0.elapsed().as_secs_f64();
         let t = tally.entry(family).or_default();
         let name = item.name();
@@ -120,9 +120,9 @@ pub fn run(
                     "{:<10} {:>3} patches {:>2} cuts, angles {:5.1}..{:5.1}: {:<18} {secs:6.2} s",
                     name,
                     n,
-                    auto.report.cuts.len(),
-                    auto.report.corner_angles[0],
-                    auto.report.corner_angles[1],
+                    auto.cuts.len(),
+                    auto.corner_angles[0],
+                    auto.corner_angles[1],
                     sol.report.verdict.name()
                 );
                 if good {

@@ -1,8 +1,8 @@
 //! General planar domains and plane graphs (`formats.md`, "General planar domain",
-//! "Plane graph") from the command line: `winslow solve DOMAIN.json` (or `GRAPH.json`)
-//! lays the domain out automatically ([`winslow::domain::auto_layout`],
-//! [`winslow::domain::graph_layout`]) and solves the layout like any multipatch layout;
-//! `winslow layout DOMAIN.json` lays it out only, and writes the layout and its picture.
+//! "Plane graph") from the command line: `winslow layout DOMAIN.json` lays the domain out
+//! only ([`winslow::domain::auto_layout`], [`winslow::domain::graph_layout`]) and writes
+//! the layout and its picture; `winslow solve DOMAIN.json` runs the pipeline, which lays
+//! it out and solves the layout, and prints the layout with [`summary`].
 
 use super::*;
 use crate::files;
@@ -27,7 +27,7 @@ fn lay_out(input: &Planar, fit: FitOptions) -> Result<AutoLayout> {
 }
 
 /// One line per cut, face and irregular vertex.
-fn summary(auto: &AutoLayout) -> String {
+pub(super) fn summary(auto: &AutoLayout) -> String {
     let r = &auto.report;
     let what = match (&r.domain, &r.graph) {
         (Some(d), _) => format!("{} corners, {} holes", d.outer_corners, d.hole_corners.len()),
@@ -68,16 +68,6 @@ fn summary(auto: &AutoLayout) -> String {
         s.push_str(&format!("  irregular vertex of valence {} at ({:.6}, {:.6})\n", v.valence, v.point[0], v.point[1]));
     }
     s
-}
-
-/// `winslow solve DOMAIN` (or `GRAPH`): the automatic layout, then the multipatch solve.
-pub(super) fn solve(input: Planar, a: &SolveArgs, sel: &Selected) -> Result<i32> {
-    let auto = lay_out(&input, a.solver.options()?.fit)?;
-    if !(output::quiet() || a.json) {
-        eprint!("{}", summary(&auto));
-    }
-    let made = serde_json::to_value(&auto.report)?;
-    super::solve_cmd::solve_layout(auto.layout, a, Some(made), sel)
 }
 
 /// `winslow layout`: lay a general domain or a plane graph out into four-sided patches.

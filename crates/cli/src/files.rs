@@ -92,6 +92,18 @@ pub(crate) fn boundary_of(doc: Document, path: &Path) -> Result<winslow::Boundar
     })
 }
 
+/// The pipeline input of `doc`, read from `path` ([`Document::into_input`]), a boundary
+/// validated and, with `reorient`, turned counter-clockwise; errors name the file.
+pub(crate) fn input_of(doc: Document, path: &Path, reorient: bool) -> Result<winslow::Input> {
+    let opts = winslow::ReadOptions { reorient };
+    doc.into_input(&opts).map_err(|e| match e {
+        Error::DocumentKind { found, needed, .. } => {
+            Error::DocumentKind { path: Some(path.to_path_buf()), found, needed }.into()
+        }
+        e => anyhow::Error::new(e).context(format!("validating {}", path.display())),
+    })
+}
+
 /// The ring of a ring document or a ring map ([`Document::into_ring`]); any other kind is
 /// the error naming it.
 pub(crate) fn ring_of(doc: Document, path: &Path) -> Result<winslow::boundary::ring::Ring> {

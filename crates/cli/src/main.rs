@@ -18,14 +18,14 @@ use winslow::io::{checked_boundary, Document, Output, ReadOptions};
 use winslow::linalg::linsolve::LinearMethod;
 use winslow::methods::egg::{EggAssembler, EggMethod};
 use winslow::methods::Method;
-use winslow::solve::improve::{improve, Improve};
+use winslow::solve::improve::Improve;
 use winslow::solve::memory::MemoryLimit;
 use winslow::solve::newton::NonlinearMethod;
 use winslow::solve::options::{KinksLocal, SolveOptions};
 use winslow::solve::report::Verdict;
 use winslow::solve::solver::Event;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};
-use winslow::verify::quality::{boundary_deviation, quality};
+use winslow::verify::quality::quality;
 use winslow::{Boundary, Side, Surface};
 use winslow_gpu::{Backend, Precision, Selected};
 

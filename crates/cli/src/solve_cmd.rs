@@ -2,7 +2,6 @@
 //! report writers, and `--start MAP` (improve a certified map on its own basis).
 
 use super::*;
-use crate::domain_cmd::Planar;
 use crate::files;
 use winslow::multipatch::LayoutEvent;
 use winslow::{Input, Pipeline, Solved, Stage};
@@ -122,6 +121,17 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
             writeln!(e, "  method: {} (start: {:?})", method.name(), method.start())
         }
         Stage::Fallback { reason } => writeln!(e, "basis auto: {reason}"),
+        Stage::LaidOut(auto) => {
+            write!(e, "{}", super::domain_cmd::summary(auto))?;
+            let l = &auto.layout;
+            writeln!(e, "{}: multipatch layout, {} patches, {} interfaces", l.name, l.patches.len(), l.interfaces.len())
+        }
+        Stage::Volume { options } => writeln!(
+            e,
+            "volume: common bases halved {} time(s), Coons start, 3D Winslow by Newton (at most {} iterations), \
+             up to {} further halving(s) while not certified",
+            options.refine, options.max_iterations, options.max_refinements
+        ),
         Stage::Layout(LayoutEvent::Bases { patches, classes, basis_functions }) => {
             writeln!(
                 e,
@@ -163,28 +173,10 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
     }
 }
 
-/// `winslow solve` of a layout, or of the layout made from a general domain (whose
-/// report `made` joins the result as `auto_layout`): the pipeline, then the files and
-/// the summary of `multipatch_cmd::finish`.
-pub(super) fn solve_layout(
-    layout: winslow::multipatch::Layout,
-    a: &SolveArgs,
-    made: Option<serde_json::Value>,
-    sel: &Selected,
-) -> Result<i32> {
-    let opts = super::multipatch_cmd::options(a)?;
-    if !(output::quiet() || a.json) {
-        super::multipatch_cmd::announce(&layout, &opts);
-    }
-    let name = layout.name.clone();
-    let solved = run_pipeline(layout, &opts, sel.as_assembler(), output::quiet() || a.json)
-        .with_context(|| format!("solving the layout {name}"))?;
-    match solved {
-        Solved::Layout(sol) => super::multipatch_cmd::finish(*sol, a, made),
-        _ => bail!("the solve of the layout {name} gave no multipatch result"),
-    }
-}
-
+/// `winslow solve INPUT`: the input read as whatever it is ([`Document::into_input`]:
+/// boundary, map, ring, ring map, layout, domain, graph, volume boundary), every output
+/// path checked, the pipeline run with its stages on stderr, then the result written and
+/// summarised by the writer of its kind.
 pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let wants_mesh = a.mesh_spec.structured.is_some() || a.mesh_spec.unstructured;
     if wants_mesh != a.mesh.is_some() {
@@ -196,34 +188,30 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if let Some(start) = &a.start {
         return solve_from_start(&a, start);
     }
-    let mut opts = a.solver.options()?;
-    opts.poisson = a.poisson;
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
-    let doc = files::read(path)?;
-    if let Document::VolumeBoundary(b) = doc {
-        return super::volume_cmd::solve(b, &a, path);
+    let input = files::input_of(files::read(path)?, path, a.solver.fit.reorient)?;
+    let mut opts = if input.is_multipatch() { super::multipatch_cmd::options(&a)? } else { a.solver.options()? };
+    opts.poisson = a.poisson;
+    match &input {
+        Input::Volume(_) => super::volume_cmd::plan(&a, path)?,
+        input => output_plan(&a, &[path], input.is_multipatch())?,
     }
-    let multipatch =
-        matches!(doc, Document::Layout(_) | Document::Multipatch(_) | Document::Domain(_) | Document::Graph(_));
-    output_plan(&a, &[path], multipatch)?;
-    let sel = a.backend.select(output::quiet() || a.json)?;
-    let input = match doc {
-        Document::Layout(layout) | Document::Multipatch(layout) => {
-            return solve_layout(layout, &a, None, &sel);
+    let quiet = output::quiet() || a.json;
+    if let (Input::Layout(layout), false) = (&input, quiet) {
+        super::multipatch_cmd::announce(layout, &opts);
+    }
+    let sel = a.backend.select(quiet)?;
+    let (name, what) = (input.name().to_string(), input.kind());
+    let solved =
+        run_pipeline(input, &opts, sel.as_assembler(), quiet).with_context(|| format!("solving the {what} {name}"))?;
+    let sol = match solved {
+        Solved::Layout { solution, laid_out } => {
+            let made = laid_out.map(|r| serde_json::to_value(&*r)).transpose()?;
+            return super::multipatch_cmd::finish(*solution, &a, made);
         }
-        Document::Domain(domain) => return super::domain_cmd::solve(Planar::Domain(domain), &a, &sel),
-        Document::Graph(graph) => return super::domain_cmd::solve(Planar::Graph(graph), &a, &sel),
-        Document::Ring(ring) => Input::Ring(ring),
-        // a ring map (a sweep's frame): the ring between its two contours
-        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(files::ring_of(doc, path)?),
-        doc => {
-            let boundary = files::boundary_of(doc, path)?;
-            let (boundary, _) = checked_boundary(boundary, &ReadOptions { reorient: a.solver.fit.reorient })
-                .with_context(|| format!("validating {}", path.display()))?;
-            Input::Boundary(boundary)
-        }
+        Solved::Volume(v) => return super::volume_cmd::finish(&name, *v, &a),
+        solved => solved.into_map()?,
     };
-    let sol = run_pipeline(input, &opts, sel.as_assembler(), output::quiet() || a.json)?.into_map()?;
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let extra = Some(serde_json::json!({ "report": report }));
@@ -256,9 +244,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     Ok(output::solve_exit_code(&sol.report))
 }
 
-/// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: improve a
-/// certified map on its own basis (its boundary fixed), certify the result, keep it
-/// only when certified.
+/// `winslow solve --start MAP.json --method winslow|weak|egg [BOUNDARY]`: the pipeline
+/// on the map ([`Input::Map`]): improved on its own basis (its boundary fixed),
+/// certified, kept only when certified.
 pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
     let opts = a.solver.options()?;
     let (name, map) = files::map_of(files::read(start)?, start, "--start needs a map")?;
@@ -276,31 +264,16 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         Some(p) => Some(load_boundary(p, a.solver.fit.reorient)?),
         None => None,
     };
-    let diameter = map.control_diameter();
-    let t0 = std::time::Instant::now();
-    let cert = certify(&map, &opts.certify).context("certifying the start")?;
-    let out = improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)
-        .with_context(|| format!("improving {}", start.display()))?;
-    let deviation = boundary.as_ref().map(|b| boundary_deviation(&out.map, b, 400));
-    let verdict = Verdict::of_certificate(&out.certificate);
-    let q = quality(&out.map);
-    let w = q.functionals.winslow;
-    let report = serde_json::json!({
-        "version": env!("CARGO_PKG_VERSION"),
-        "start": start.display().to_string(),
-        "method": method.name(),
-        "verdict": verdict,
-        "message": format!("{}; {}", out.certificate.message(), out.report.message),
-        "certificate": out.certificate,
-        "quality": q,
-        "winslow": w.is_finite().then_some(w),
-        "boundary_deviation": deviation,
-        "improvement": out.report,
-        "seconds": t0.elapsed().as_secs_f64(),
-    });
-    let label = format!("verdict {verdict:?}: {}", out.certificate.message());
+    let input = Input::Map { name, map, boundary };
+    let solved =
+        Pipeline::new(input, opts).method(method).solve().with_context(|| format!("improving {}", start.display()))?;
+    let Solved::Improved(out) = solved else { bail!("the pipeline gave a {} for a start map", solved.kind()) };
+    let r = &out.report;
+    let mut report = serde_json::to_value(r)?;
+    report["start"] = serde_json::Value::String(start.display().to_string());
+    let label = format!("verdict {:?}: {}", r.verdict, r.certificate.message());
     let extra = Some(serde_json::json!({ "report": report }));
-    let map = Output::Map { name: &name, map: &out.map, label: &label, extra };
+    let map = Output::Map { name: &out.name, map: &out.map, label: &label, extra };
     files::write(&a.output, &map)?;
     for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu"), (&a.vtk, "vtk")] {
         if let Some(p) = path {
@@ -315,13 +288,14 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         files::print_json(report)?;
     } else {
         let mut s = format!(
-            "{name}: {} from {}\n  {}\n",
-            output::verdict_word(verdict),
+            "{}: {} from {}\n  {}\n",
+            out.name,
+            output::verdict_word(r.verdict),
             start.display(),
-            out.certificate.message()
+            r.certificate.message()
         );
-        output::improvement_lines(&mut s, &out.report, t0.elapsed().as_secs_f64());
-        if let Some(d) = deviation {
+        output::improvement_lines(&mut s, &r.improvement, r.seconds);
+        if let Some(d) = r.boundary_deviation {
             s.push_str(&format!(
                 "  boundary deviation from {} (S, E, N, W): {:.3e} {:.3e} {:.3e} {:.3e}\n",
                 a.boundary.as_ref().map_or(String::new(), |p| p.display().to_string()),
@@ -333,7 +307,7 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         }
         say_raw!("{s}");
     }
-    Ok(output::exit_code(verdict))
+    Ok(output::exit_code(r.verdict))
 }
 
 /// Check every output of `solve` before the work ([`files::OutputPlan`]): a single map's

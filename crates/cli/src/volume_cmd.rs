@@ -1,19 +1,20 @@
 //! `winslow solve VOLUME_BOUNDARY.json -o volume.json`: a volume from its six boundary
-//! faces (`formats.md`, "Volume boundary"; [`winslow::solve::volume`]): common bases,
+//! faces (`formats-extensions.md`, "Volume boundary"), run by the pipeline
+//! ([`winslow::Input::Volume`], [`winslow::solve::volume`]): common bases,
 //! the trivariate Coons patch as the start, the 3D Winslow functional minimised by
 //! Newton, the verdict of the trivariate certificate. Exit codes as for a map: 0
 //! certified, 3 folded, 5 undecided, 6 certified but the faces not kept.
 
 use super::*;
 use crate::files;
-use winslow::boundary::volume::VolumeBoundary;
-use winslow::solve::volume::{solve_volume, VolumeOptions};
+use winslow::solve::volume::VolumeSolve;
 
-/// Solve the volume bounded by `b` (read from `path`) with the options of `solve` that
-/// apply to volumes: `--refine` (halvings of the common bases), `--repair` /
-/// `--no-repair` (further halvings while not certified), `-o`, `--vtk`, `--vtu`,
-/// `--gismo`, `--json`.
-pub(super) fn solve(b: VolumeBoundary, a: &solve_cmd::SolveArgs, path: &Path) -> Result<i32> {
+/// Check the options of `solve` for a volume boundary read from `path`: the flags that
+/// apply to planar maps only are refused; the outputs `-o`, `--vtk`, `--vtu`, `--gismo`
+/// are checked before the solve. The solve itself is the pipeline's
+/// ([`winslow::Input::Volume`]: `--refine` halvings of the common bases, `--repair` /
+/// `--no-repair` further halvings while not certified).
+pub(super) fn plan(a: &solve_cmd::SolveArgs, path: &Path) -> Result<()> {
     let unsupported = [
         ("--png", a.png.is_some()),
         ("--iges", a.iges.is_some()),
@@ -30,17 +31,16 @@ pub(super) fn solve(b: VolumeBoundary, a: &solve_cmd::SolveArgs, path: &Path) ->
         .maybe("--vtk", a.vtk.as_deref(), "VTK grid", ext::VTK)
         .maybe("--vtu", a.vtu.as_deref(), "VTK Bézier file", ext::VTU)
         .maybe("--gismo", a.gismo.as_deref(), "G+Smo XML file", ext::XML)
-        .check()?;
-    let opts = VolumeOptions {
-        refine: a.solver.refine,
-        max_refinements: if a.solver.no_repair { 0 } else { a.solver.repair },
-        ..Default::default()
-    };
-    let out = solve_volume(&b, &opts).with_context(|| format!("solving the volume bounded by {}", path.display()))?;
+        .check()
+}
+
+/// Write the solved volume `out` of the geometry `name` where `a` asks, summarise it;
+/// the exit code of its certificate (6 when certified but the faces not kept).
+pub(super) fn finish(name: &str, out: VolumeSolve, a: &solve_cmd::SolveArgs) -> Result<i32> {
     let (cert, report) = (&out.certificate, &out.report);
     let label = format!("volume certificate: {}", cert.message());
     let extra = Some(serde_json::json!({ "report": report, "certificate": cert }));
-    let doc = Output::Volume { name: &b.name, volume: &out.volume, label: &label, extra };
+    let doc = Output::Volume { name, volume: &out.volume, label: &label, extra };
     files::write(&a.output, &doc)?;
     for (p, e) in [(&a.vtk, "vtk"), (&a.vtu, "vtu"), (&a.gismo, "xml")] {
         if let Some(p) = p {
@@ -54,7 +54,7 @@ pub(super) fn solve(b: VolumeBoundary, a: &solve_cmd::SolveArgs, path: &Path) ->
         say!(
             "{}: volume of degrees ({}, {}, {}), {} x {} x {} control points, {} unknowns; start {} ({} continuation step(s)), \
              {} Newton iteration(s), Winslow energy {:.6e}",
-            b.name,
+            name,
             d[0],
             d[1],
             d[2],

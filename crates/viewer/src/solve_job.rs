@@ -81,7 +81,7 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
     });
     match out {
         Ok(Solved::Map(sol)) => send(Msg::Finished(sol)),
-        Ok(Solved::Layout(sol)) => send(Msg::SolvedLayout(sol)),
+        Ok(Solved::Layout { solution, .. }) => send(Msg::SolvedLayout(solution)),
         Ok(other) => send(Msg::Failed(format!(
             "the pipeline returned a result the viewer does not draw (verdict {})",
             other.verdict().name()

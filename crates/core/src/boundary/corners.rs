@@ -15,6 +15,7 @@ use crate::spline::surface::Side;
 
 /// Angle of the domain at a corner and whether it forces `det J <= 0` there.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct CornerReport {
     /// "south-west", ...
     pub corner: &'static str,
@@ -32,6 +33,7 @@ pub const FORCED_ANGLE: f64 = 179.0;
 /// zero-speed knot, or a point cloud's corner; kept exactly by the `C^0` route or rounded
 /// by the `C^1` fit.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct KinkReport {
     /// Side name.
     pub side: &'static str,

@@ -24,6 +24,7 @@ pub const CORNER_GAP_TOL: f64 = 1e-6;
 
 /// Which basis was asked for, which was used, and why they differ.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct BasisReport {
     /// What was asked for.
     pub requested: BasisChoice,

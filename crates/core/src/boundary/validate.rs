@@ -52,6 +52,7 @@ pub enum Orientation {
 
 /// What [`inspect`] found out about a boundary.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ValidationReport {
     /// Lower-left corner of the bounding box of the sampled contour.
     pub bbox_min: Point,

@@ -77,6 +77,7 @@ pub struct GraphFace {
 
 /// What the validation of a plane graph found.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct GraphReport {
     /// Vertices.
     pub vertices: usize,

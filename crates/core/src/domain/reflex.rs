@@ -19,6 +19,7 @@ use crate::spline::knots::KnotVector;
 
 /// A cut from a reflex corner.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct CutReport {
     /// The reflex corner.
     pub from: Point,

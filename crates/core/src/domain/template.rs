@@ -63,6 +63,7 @@ impl Default for LayoutOptions {
 
 /// The template of one face.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct FaceReport {
     /// The face's label.
     pub label: String,
@@ -95,6 +96,7 @@ pub struct IrregularVertex {
 
 /// What the automatic layout did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct LayoutReport {
     /// The validation of the domain (a `domain` document).
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -129,9 +129,18 @@ fn curved_pentagon_is_solved_conforming_and_certified() {
     let d = Domain { name: "bulge".into(), outer: Loop::new(sides), holes: Vec::new() };
     let auto = auto_layout(&d, &LayoutOptions::default()).unwrap();
     assert_eq!(auto.layout.patches.len(), 5);
-    let Solved::Layout(sol) = Pipeline::new(auto.layout.clone(), Default::default()).solve().unwrap() else {
-        panic!("a layout gave one map")
-    };
+    // the pipeline lays the domain out itself, as `auto_layout` does, and solves that layout
+    let mut laid = None;
+    let solved = Pipeline::new(d.clone(), Default::default())
+        .run(&mut |stage| {
+            if let crate::pipeline::Stage::LaidOut(a) = stage {
+                laid = Some(a.layout.patches.len());
+            }
+            true
+        })
+        .unwrap();
+    let Solved::Layout { solution: sol, laid_out: Some(report) } = solved else { panic!("a domain gave one map") };
+    assert_eq!((laid, report.patches, sol.patches.len()), (Some(5), 5, 5));
     assert!(sol.report.verdicts.iter().all(|v| *v == Verdict::Certified), "{}", sol.report.message);
     assert_eq!(sol.report.interface_mismatch, 0.0);
     // the patch areas sum to the domain's
@@ -405,7 +414,8 @@ fn every_bad_graph_is_a_typed_error() {
 
 /// Solve a layout; every patch certified and the interfaces conforming.
 fn certified(auto: &AutoLayout, name: &str) {
-    let Solved::Layout(sol) = Pipeline::new(auto.layout.clone(), Default::default()).solve().unwrap() else {
+    let Solved::Layout { solution: sol, .. } = Pipeline::new(auto.layout.clone(), Default::default()).solve().unwrap()
+    else {
         panic!("{name}: a layout gave one map")
     };
     assert!(sol.report.verdicts.iter().all(|v| *v == Verdict::Certified), "{name}: {}", sol.report.message);

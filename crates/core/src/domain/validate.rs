@@ -18,6 +18,7 @@ use crate::spline::curve::Point;
 
 /// What the validation measured.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct DomainReport {
     /// Corners of the outer loop.
     pub outer_corners: usize,

@@ -40,6 +40,7 @@ use crate::boundary::{Boundary, SideCurve};
 use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
+use crate::pipeline::Input;
 use crate::spline::surface::{Side, Surface};
 use crate::spline::volume::Volume;
 
@@ -182,6 +183,32 @@ impl Document {
             }
             other => Err(other.wrong_kind(None, "a ring or a ring map is needed")),
         }
+    }
+
+    /// The pipeline input this document is ([`Input`]): a boundary (validated and, with
+    /// `opts.reorient`, turned counter-clockwise; a map stands for its boundary), a ring
+    /// or a ring map (its two contours), a multipatch layout or result (solved again from
+    /// its patches' sides), a domain, a plane graph, or a volume boundary. A volume, which
+    /// has nothing left to solve, is an [`Error::DocumentKind`].
+    pub fn into_input(self, opts: &super::ReadOptions) -> Result<Input> {
+        Ok(match self {
+            Document::Layout(l) | Document::Multipatch(l) => Input::Layout(l),
+            Document::Domain(d) => Input::Domain(d),
+            Document::Graph(g) => Input::Graph(g),
+            Document::VolumeBoundary(v) => Input::Volume(v),
+            doc @ (Document::Ring(_) | Document::Map { .. })
+                if doc.is_ring_map() || matches!(doc, Document::Ring(_)) =>
+            {
+                Input::Ring(doc.into_ring()?)
+            }
+            doc @ Document::Volume { .. } => {
+                return Err(doc.wrong_kind(
+                    None,
+                    "a boundary, ring, layout, domain, graph or volume boundary is needed (a volume is already solved)",
+                ))
+            }
+            doc => Input::Boundary(super::checked_boundary(doc.into_boundary()?, opts)?.0),
+        })
     }
 }
 

@@ -23,6 +23,7 @@ pub const SHARED_TOL: f64 = 1e-9;
 
 /// What [`validate_layout`] measured.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct LayoutReport {
     /// Number of patches.
     pub patches: usize,

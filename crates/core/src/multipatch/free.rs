@@ -27,6 +27,7 @@ use crate::verify::quality::quality;
 
 /// What the free-interface stage did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct FreeReport {
     /// `"winslow"` or `"weak-form"`.
     pub functional: &'static str,

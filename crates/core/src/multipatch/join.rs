@@ -90,6 +90,7 @@ fn homogeneous(op: &Csr, cps: &[Point], weights: Option<&[f64]>) -> (Vec<Point>,
 
 /// What [`join_maps`] did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct JoinReport {
     /// The shared side of the first and of the second map.
     pub sides: [&'static str; 2],

@@ -128,6 +128,7 @@ pub struct PatchSolution {
 
 /// One direction class of the layout's bases.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct ClassReport {
     /// Degree.
     pub degree: usize,
@@ -139,6 +140,7 @@ pub struct ClassReport {
 
 /// The report of a multipatch solve.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct MultipatchReport {
     /// Crate version.
     pub version: &'static str,

@@ -73,6 +73,7 @@ impl Default for SplitOptions {
 
 /// What [`split_map`] did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct SplitReport {
     /// The parameter curve used.
     pub path: SplitPath,

@@ -9,6 +9,9 @@
 //!     not certified
 //! layout (§11.2): conforming bases → every patch solved as above on them, in parallel
 //!   → layout refinement around the patches not certified → free interfaces (improvement)
+//! domain, plane graph: automatic layout (crate::domain) → as a layout
+//! volume boundary: common bases → Coons start → 3D Winslow (Newton) → trivariate
+//!   certificate → halving while not certified
 //! ```
 //!
 //! ```no_run
@@ -32,100 +35,30 @@
 //! O-grid ([`sweep`], §11.1).
 
 pub mod compare;
+mod input;
+pub mod start;
 pub mod sweep;
+
+pub use input::{Input, Solved};
+pub use start::{Improved, ImprovedReport};
 
 use std::sync::Arc;
 
 use crate::boundary::fit::FitOptions;
 use crate::boundary::hierarchy::{build_hierarchy, Hierarchy};
-use crate::boundary::ring::Ring;
 use crate::boundary::ring_fit::{ring_hierarchy_with, EtaRefinement};
 use crate::boundary::{BasisChoice, Boundary};
 use crate::discrete::topology::Topology;
+use crate::domain::{auto_layout, graph_layout, AutoLayout, LayoutOptions};
 use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
-use crate::multipatch::{solve_multipatch, Layout, LayoutEvent, MultipatchSolution};
+use crate::multipatch::{solve_multipatch, LayoutEvent};
 use crate::solve::memory::MemoryEstimate;
 use crate::solve::options::SolveOptions;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
-
-/// What the pipeline solves.
-#[derive(Debug, Clone)]
-#[non_exhaustive]
-pub enum Input {
-    /// A four-sided boundary: the map of the unit square onto the domain it bounds.
-    Boundary(Boundary),
-    /// A ring (paper §11.1): an O-grid between two closed contours, `eta` periodic.
-    Ring(Ring),
-    /// A multipatch layout (§11.2): four-sided patches and the interfaces between them,
-    /// solved conforming ([`multipatch::solve`](mod@crate::multipatch::solve); free interfaces when the options ask for
-    /// an improvement).
-    Layout(Layout),
-}
-
-impl Input {
-    /// Name of the geometry.
-    pub fn name(&self) -> &str {
-        match self {
-            Input::Boundary(b) => &b.name,
-            Input::Ring(r) => &r.name,
-            Input::Layout(l) => &l.name,
-        }
-    }
-}
-
-impl From<Boundary> for Input {
-    fn from(b: Boundary) -> Self {
-        Input::Boundary(b)
-    }
-}
-
-impl From<Ring> for Input {
-    fn from(r: Ring) -> Self {
-        Input::Ring(r)
-    }
-}
-
-impl From<Layout> for Input {
-    fn from(l: Layout) -> Self {
-        Input::Layout(l)
-    }
-}
-
-/// What the pipeline gives back: one map, or a conforming map per patch.
-#[derive(Debug, Clone)]
-#[non_exhaustive]
-pub enum Solved {
-    /// The map of a boundary or a ring.
-    Map(Box<Solution>),
-    /// The maps of a layout.
-    Layout(Box<MultipatchSolution>),
-}
-
-impl Solved {
-    /// The verdict (for a layout the worst over its patches).
-    pub fn verdict(&self) -> Verdict {
-        match self {
-            Solved::Map(s) => s.report.verdict,
-            Solved::Layout(s) => s.report.verdict,
-        }
-    }
-
-    /// The one map of a boundary or a ring; a layout's maps are the error
-    /// [`Error::DocumentKind`].
-    pub fn into_map(self) -> Result<Solution> {
-        match self {
-            Solved::Map(s) => Ok(*s),
-            Solved::Layout(_) => Err(Error::DocumentKind {
-                path: None,
-                found: "multipatch result".into(),
-                needed: "one map is needed".into(),
-            }),
-        }
-    }
-}
+use crate::solve::volume::{solve_volume, VolumeOptions};
 
 /// A stage of the pipeline, as the observer sees it.
 #[derive(Debug)]
@@ -151,9 +84,24 @@ pub enum Stage<'a> {
         /// Why.
         reason: &'a str,
     },
+    /// A general domain or a plane graph was laid out automatically: the layout solved
+    /// next and what the layout did.
+    LaidOut(&'a AutoLayout),
     /// An event of a layout's solve: its bases, a round of patch solves, the
     /// free-interface stage.
     Layout(&'a LayoutEvent),
+    /// A map given as the input is improved by `method` on its own basis
+    /// ([`start`](mod@start)).
+    Improve {
+        /// The method.
+        method: &'a dyn Method,
+    },
+    /// A volume boundary's solve starts (common bases, Coons start, the trivariate
+    /// Winslow minimisation, its certificate; [`solve_volume`]).
+    Volume {
+        /// The options it runs with, made from the pipeline's.
+        options: &'a VolumeOptions,
+    },
 }
 
 /// The observer of a run: sees every [`Stage`]; returns `false` to stop the solve.
@@ -216,19 +164,77 @@ impl Pipeline {
     }
 
     /// Solve, every stage to `observer`; [`Error::Cancelled`] when it returned `false`.
-    pub fn run(self, observer: &mut Observer<'_>) -> Result<Solved> {
-        if let Input::Layout(layout) = &self.input {
-            self.opts.validate()?;
-            if self.method.is_some() {
-                return Err(Error::Invalid(
-                    "a layout solves EGG on every patch; its free-interface stage is the options' improvement".into(),
-                ));
+    pub fn run(mut self, observer: &mut Observer<'_>) -> Result<Solved> {
+        match &self.input {
+            Input::Boundary(_) | Input::Ring(_) => {
+                self.run_keeping_hierarchy(observer).map(|(sol, _)| Solved::Map(Box::new(sol)))
             }
-            let assembler = self.assembler.clone();
-            return solve_multipatch(layout, &self.opts, assembler, &mut |e| observer(&Stage::Layout(e)))
-                .map(|s| Solved::Layout(Box::new(s)));
+            Input::Layout(_) => self.run_layout(None, observer),
+            Input::Domain(_) | Input::Graph(_) => {
+                self.opts.validate()?;
+                let auto = self.lay_out()?;
+                if !observer(&Stage::LaidOut(&auto)) {
+                    return Err(Error::Cancelled);
+                }
+                self.input = Input::Layout(auto.layout);
+                self.run_layout(Some(Box::new(auto.report)), observer)
+            }
+            Input::Volume(b) => {
+                self.opts.validate()?;
+                self.refuse_method("a volume")?;
+                let options = volume_options(&self.opts);
+                if !observer(&Stage::Volume { options: &options }) {
+                    return Err(Error::Cancelled);
+                }
+                solve_volume(b, &options).map(|v| Solved::Volume(Box::new(v)))
+            }
+            Input::Map { name, map, boundary } => {
+                self.opts.validate()?;
+                let method = self.method.clone().unwrap_or_else(|| crate::solve::improve::Improve::Winslow.method());
+                if !observer(&Stage::Improve { method: &*method }) {
+                    return Err(Error::Cancelled);
+                }
+                start::improve_start(name, map, boundary.as_ref(), &*method, &self.opts)
+                    .map(|m| Solved::Improved(Box::new(m)))
+            }
         }
-        self.run_keeping_hierarchy(observer).map(|(sol, _)| Solved::Map(Box::new(sol)))
+    }
+
+    /// The automatic layout of a domain or a graph, with the options' fit.
+    fn lay_out(&self) -> Result<AutoLayout> {
+        let opts = LayoutOptions { fit: self.opts.fit, ..Default::default() };
+        match &self.input {
+            Input::Domain(d) => auto_layout(d, &opts),
+            Input::Graph(g) => graph_layout(g, &opts),
+            other => Err(Error::Invalid(format!("a {} is not laid out", other.kind()))),
+        }
+    }
+
+    /// [`Error::Invalid`] when a method was set: `what` solves its own.
+    fn refuse_method(&self, what: &str) -> Result<()> {
+        match &self.method {
+            Some(_) => Err(Error::Invalid(format!(
+                "{what} solves its own method; the method replaces EGG on the levels of a boundary or a ring"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The conforming solve of the layout input, `laid_out` the report of the automatic
+    /// layout that made it.
+    fn run_layout(
+        self,
+        laid_out: Option<Box<crate::domain::LayoutReport>>,
+        observer: &mut Observer<'_>,
+    ) -> Result<Solved> {
+        let Input::Layout(layout) = &self.input else {
+            return Err(Error::Invalid(format!("a {} is not a layout", self.input.kind())));
+        };
+        self.opts.validate()?;
+        self.refuse_method("a layout (EGG on every patch; its free-interface stage is the options' improvement)")?;
+        let assembler = self.assembler.clone();
+        solve_multipatch(layout, &self.opts, assembler, &mut |e| observer(&Stage::Layout(e)))
+            .map(|s| Solved::Layout { solution: Box::new(s), laid_out })
     }
 
     /// [`Pipeline::run`] of a boundary or a ring, with the hierarchy the solution was
@@ -251,8 +257,18 @@ impl Pipeline {
     /// first attempt; of a layout, the conforming bases of all patches), nothing solved. `winslow bench` prints it next to the measured peak.
     pub fn estimate(&self) -> Result<MemoryEstimate> {
         self.opts.validate()?;
-        if let Input::Layout(layout) = &self.input {
-            return crate::multipatch::solve::layout_estimate(layout, &self.opts);
+        match &self.input {
+            Input::Layout(layout) => return crate::multipatch::solve::layout_estimate(layout, &self.opts),
+            Input::Domain(_) | Input::Graph(_) => {
+                return crate::multipatch::solve::layout_estimate(&self.lay_out()?.layout, &self.opts)
+            }
+            Input::Volume(_) | Input::Map { .. } => {
+                return Err(Error::Invalid(format!(
+                    "the memory estimate of a {} is not modelled yet",
+                    self.input.kind()
+                )))
+            }
+            Input::Boundary(_) | Input::Ring(_) => {}
         }
         let (_, _, solver) = self.plan(&self.opts)?;
         Ok(MemoryEstimate::for_levels(solver.plan()))
@@ -266,7 +282,7 @@ impl Pipeline {
                 let (h, cut) = ring_hierarchy_with(r, &opts.fit, self.eta_refinement)?;
                 (cut, h, ring_options(opts))
             }
-            Input::Layout(_) => return Err(Error::Invalid("a layout has one map per patch, not one hierarchy".into())),
+            other => return Err(Error::Invalid(format!("a {} has no one hierarchy", other.kind()))),
         };
         let hierarchy = Arc::new(hierarchy);
         let solver = match &self.method {
@@ -299,6 +315,13 @@ impl Pipeline {
 /// Fit `boundary`, then solve coarse to fine on the CPU ([`Pipeline::solve`]).
 pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
     Pipeline::new(boundary.clone(), opts.clone()).solve()?.into_map()
+}
+
+/// The options of a volume solve made from the pipeline's: `refine` extra halvings of
+/// the common bases, at most `repair` further halvings while the map is not certified,
+/// the certificate's options.
+pub(crate) fn volume_options(opts: &SolveOptions) -> VolumeOptions {
+    VolumeOptions { refine: opts.refine, max_refinements: opts.repair, ..Default::default() }
 }
 
 /// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
@@ -538,7 +561,7 @@ mod tests {
             })
             .unwrap();
         let verdict = solved.verdict();
-        let Solved::Layout(sol) = solved else { panic!("a layout gave one map") };
+        let Solved::Layout { solution: sol, laid_out: None } = solved else { panic!("a layout gave one map") };
         assert_eq!((sol.report.interfaces, verdict), ("free", Verdict::Certified), "{}", sol.report.message);
         assert!(matches!(events[0], LayoutEvent::Bases { patches, .. } if patches == layout.patches.len()));
         let rounds = events.iter().filter(|e| matches!(e, LayoutEvent::Round { .. })).count();
@@ -546,7 +569,8 @@ mod tests {
         assert!(matches!(events.last(), Some(LayoutEvent::Free { functional: "winslow" })), "{events:?}");
         assert!(matches!(events[rounds], LayoutEvent::Round { ref failing, .. } if failing.is_empty()));
         // one map is not what a layout gives
-        assert!(matches!(Solved::Layout(sol).into_map(), Err(Error::DocumentKind { .. })));
+        let solved = Solved::Layout { solution: sol, laid_out: None };
+        assert!(matches!(solved.into_map(), Err(Error::DocumentKind { .. })));
         // stopped at its first event
         let out = Pipeline::new(layout.clone(), opts).run(&mut |_| false);
         assert!(matches!(out, Err(Error::Cancelled)), "{out:?}");

@@ -127,6 +127,7 @@ impl Default for SweepOptions {
 
 /// One row of the per-frame table.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct FrameReport {
     /// Frame index (0 is the cold solve).
     pub frame: usize,

@@ -92,6 +92,7 @@ impl SliceBoundary<'_> {
 
 /// One slice of the final volume.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct SliceReport {
     /// Height.
     pub z: f64,
@@ -126,6 +127,7 @@ pub struct LoftRound {
 
 /// The report of a loft.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct LoftReport {
     /// Interpolation in `z`.
     pub interpolation: Interpolation,

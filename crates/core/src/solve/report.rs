@@ -31,6 +31,7 @@ pub enum InitialGuess {
 
 /// Summary of one solved level.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct LevelReport {
     /// Index among the solved levels.
     pub level: usize,
@@ -129,6 +130,7 @@ impl Verdict {
 
 /// Contour-fit summary per side.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct FitReport {
     /// Side name.
     pub side: &'static str,
@@ -144,6 +146,7 @@ pub struct FitReport {
 
 /// The report stored in the map file and printed by the CLI.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct Report {
     /// Crate version.
     pub version: &'static str,

@@ -192,6 +192,7 @@ pub fn poisson_errors(map: &Surface, uh: &[f64], exact: &dyn Fn([f64; 2]) -> (f6
 
 /// Result of the grid-quality benchmark.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct PoissonReport {
     /// Length scales `a1, a2` of `u*`.
     pub a: [f64; 2],

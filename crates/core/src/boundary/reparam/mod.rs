@@ -291,6 +291,7 @@ pub struct Match {
 
 /// What the reparameterization did, for the solve report.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct ReparamReport {
     /// The requested method.
     pub requested: Reparam,

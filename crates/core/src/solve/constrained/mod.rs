@@ -122,6 +122,7 @@ impl Default for ConstrainedOptions {
 
 /// What [`max_z`] did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct MaxZReport {
     /// `"maxz"`.
     pub name: &'static str,
@@ -151,6 +152,7 @@ pub struct MaxZ {
 
 /// What [`optimise`] did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct OptimiseReport {
     /// The functional's name (`liao`, `winslow`, `ao`).
     pub name: &'static str,

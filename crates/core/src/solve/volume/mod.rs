@@ -66,6 +66,7 @@ impl Default for VolumeOptions {
 
 /// What a volume solve did.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct VolumeSolveReport {
     /// `winslow`.
     pub method: &'static str,
