@@ -241,14 +241,14 @@ fn batch_warm_start_chains() {
         let used = w["report"]["warm_start"]["used"].as_bool().unwrap_or(false);
         assert_eq!(used, k % 3 != 0, "{name}: {}", w["report"]["warm_start"]);
         let cp = |v: &serde_json::Value| -> Vec<f64> {
-            v["control_points"]
+            v["map"]["control_points"]
                 .as_array()
                 .unwrap()
                 .iter()
                 .flat_map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
                 .collect()
         };
-        assert_eq!(c["knots"], w["knots"], "{name}");
+        assert_eq!(c["map"]["knots"], w["map"]["knots"], "{name}");
         let (a, b) = (cp(&c), cp(&w));
         assert_eq!(a.len(), b.len());
         let d = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
