@@ -33,7 +33,7 @@ use crate::solve::{document_arg, notify, outcome, PySolution};
 /// the automatic layout, as `winslow solve DOMAIN` puts it under `auto_layout`); the
 /// other documents given back.
 pub fn layout_of(doc: Document, opts: &Options) -> winslow::Result<Result<(Layout, Option<Value>), Document>> {
-    let lo = LayoutOptions { fit: opts.solve.fit.clone(), ..Default::default() };
+    let lo = LayoutOptions { fit: opts.solve.fit, ..Default::default() };
     let auto = match doc {
         Document::Layout(l) | Document::Multipatch(l) => return Ok(Ok((l, None))),
         Document::Domain(d) => auto_layout(&d, &lo)?,
@@ -363,7 +363,7 @@ pub fn sweep<'py>(
             doc => return Err(errors::to_py(&doc.wrong_kind(None, "inner_frames are ring documents"))),
         }
     }
-    if rotate_inner.is_some() == !contours.is_empty() {
+    if rotate_inner.is_some() != contours.is_empty() {
         return Err(invalid("sweep needs exactly one of rotate_inner=DEGREES (with steps=N) and inner_frames=[...]"));
     }
     let (step, steps) = match (rotate_inner, steps) {

@@ -36,6 +36,7 @@ pub struct PySolution {
 
 /// How one shape was solved: cold by the pipeline (with the reason a warm start asked
 /// for did not apply), or from the previous map ([`warm_start`]).
+#[derive(Debug)]
 pub enum Outcome {
     /// The pipeline's solution; why the start given was not used.
     Cold(Box<Solution>, Option<String>),
