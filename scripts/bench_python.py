@@ -5,11 +5,14 @@
    and certified through `winslow.solve_many` on `--workers` threads, against N
    invocations of the CLI (`winslow solve`, `--workers` at a time) and one
    `winslow batch --jobs workers`.
+   `--warm` instead: the family through `solve_many` cold and with `warm_start=True`
+   (each shape from the previous shape's map, `workers` chains), and `winslow batch`
+   with and without `--warm-start`.
 2. The Python call overhead of `winslow.solve` on a 100-function map
    (cooks_membrane: 10 x 10 functions): the wall time of the call against the wall
    time of the pipeline inside it (`Solution.pipeline_seconds`), summed over 200 calls.
 
-Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2]
+Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2] [--warm]
 """
 
 import argparse
@@ -61,10 +64,43 @@ def main():
     ap.add_argument("--shapes", type=int, default=1000)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--overhead-only", action="store_true")
+    ap.add_argument("--warm", action="store_true", help="cold against warm-started family solves only")
     a = ap.parse_args()
+    if a.warm:
+        warm_rows(a)
+        return
     if not a.overhead_only:
         family_rows(a)
     overhead()
+
+
+def warm_rows(a):
+    """The family cold and warm-started, through solve_many and winslow batch."""
+    shapes = family(a.shapes)
+    for warm in (False, True):
+        t0 = time.perf_counter()
+        res = winslow.solve_many(shapes, workers=a.workers, warm_start=warm)
+        dt = time.perf_counter() - t0
+        ok = sum(isinstance(r, winslow.Solution) and r.certified for r in res)
+        used = sum(isinstance(r, winslow.Solution) and r.report.get("warm_start", {}).get("used", False) for r in res)
+        print(f"solve_many(warm_start={warm}): {len(shapes)} shapes on {a.workers} workers: {dt:.2f} s, "
+              f"{ok} bijective, {used} warm-started")
+        if warm:
+            errs = [np.abs(c.map.control_points - w.map.control_points).max() / np.ptp(c.map.control_points, 0).max()
+                    for c, w in zip(cold, res) if c.map.shape == w.map.shape]
+            print(f"  largest distance warm - cold map (relative to the size): {max(errs):.2e} "
+                  f"over {len(errs)} shapes on the same basis")
+        cold = res
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        lines = [json.dumps({"name": s.name, "document": json.loads(s.to_json())}) for s in shapes]
+        (tmp / "family.jsonl").write_text("\n".join(lines) + "\n")
+        for warm in (False, True):
+            t0 = time.perf_counter()
+            subprocess.run([a.winslow, "batch", "--manifest", str(tmp / "family.jsonl"), "--jobs", str(a.workers),
+                            "-q", "-o", str(tmp / f"batch-{warm}")] + (["--warm-start"] if warm else []), check=False)
+            print(f"winslow batch --jobs {a.workers}{' --warm-start' if warm else ''}: {time.perf_counter() - t0:.2f} s")
+    print(f"load average: {os.getloadavg()}")
 
 
 def family_rows(a):

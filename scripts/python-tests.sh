@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's tests: a virtual environment from the Python registry (maturin,
 # numpy, pytest, meshio, dask[distributed]), the extension built into it by `maturin develop` (the dev
-# profile, in cargo's target folder), then pytest on crates/python/tests.
+# profile, in cargo's target folder), then pytest on crates/python/tests. The CLI is built
+# too (WINSLOW_BIN): tests check the package's results against the command line's JSON.
 # Installs python3 and its venv module when they are missing and we are root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,4 +27,8 @@ fi
 source "$venv/bin/activate"
 python -m pip install -q --disable-pip-version-check "maturin>=1.9,<2" numpy pytest meshio "dask[distributed]"
 maturin develop -q -m crates/python/Cargo.toml
-python -m pytest -q crates/python/tests "$@"
+if [ -z "${WINSLOW_BIN:-}" ]; then
+  cargo build -q -p winslow-cli
+  export WINSLOW_BIN="$target/debug/winslow"
+fi
+python -m pytest -q -rs crates/python/tests "$@"

@@ -3,11 +3,15 @@
 //! as it finishes, a typed failure record `DIR/NAME.error.json` per failing shape, and
 //! the summary `DIR/batch.jsonl` and `DIR/batch.csv` (name, status, verdict, seconds,
 //! unknowns, quality). Re-running skips the shapes whose map is already there, so a
-//! killed batch resumes where it stopped; `--overwrite` starts afresh.
+//! killed batch resumes where it stopped; `--overwrite` starts afresh. With
+//! `--warm-start` (a shape family in sequence) the shapes are cut into `--jobs`
+//! contiguous chains, each solved in order from the previous shape's map
+//! ([`winslow::solve::warm::warm_start`]; cold where it does not apply).
 
 use super::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use winslow::solve::warm::{warm_start, Warm};
 use winslow::{Input, Pipeline};
 
 #[derive(Args, Debug)]
@@ -31,6 +35,12 @@ pub(super) struct BatchArgs {
     /// whose map is there are skipped, and outputs of other shapes are an error).
     #[arg(long)]
     overwrite: bool,
+    /// A family in sequence: solve each shape from the previous shape's map, on its basis
+    /// (the shapes cut into --jobs contiguous chains, each in order; a shape whose sides
+    /// are not on that basis, or whose warm start is not certified, is solved cold). The
+    /// report says which ("warm_start").
+    #[arg(long)]
+    warm_start: bool,
     #[command(flatten)]
     solver: SolverArgs,
 }
@@ -133,31 +143,75 @@ fn row_of(name: &str, report: &Value) -> Value {
         "status": "solved",
         "verdict": report["verdict"],
         "seconds": report["seconds"],
-        "unknowns": report["levels"].as_array().and_then(|l| l.last()).map_or(Value::Null, |l| l["unknowns"].clone()),
+        // a warm-started shape's report has its unknowns at the top
+        "unknowns": report["levels"]
+            .as_array()
+            .and_then(|l| l.last())
+            .map_or_else(|| report["unknowns"].clone(), |l| l["unknowns"].clone()),
         "quality": report["quality"]["scaled_jacobian"]["min"],
     })
 }
 
-/// Solve one shape and write its map or failure record; its summary row.
-fn run_one(shape: &Shape, dir: &Path, opts: &SolveOptions, reorient: bool) -> Result<Value> {
+/// A solved shape: its map, report, whether it is bijective, and its label.
+struct Solved {
+    map: Surface,
+    report: Value,
+    bijective: bool,
+    label: String,
+}
+
+/// Solve one shape: from `start` (the previous map of its chain) when given and the warm
+/// start applies, else cold by the pipeline.
+fn solve_shape(input: Input, start: Option<&Surface>, opts: &SolveOptions) -> winslow::Result<Solved> {
+    let mut why = None;
+    if let Some(prev) = start {
+        match &input {
+            Input::Boundary(b) => match warm_start(prev, b, opts) {
+                Ok(Warm::Solved(w)) => {
+                    let mut report = serde_json::to_value(&*w).map_err(|e| winslow::Error::Invalid(e.to_string()))?;
+                    report["warm_start"] = json!({ "used": true });
+                    let label = format!("verdict {:?}: {}", w.verdict, w.message);
+                    return Ok(Solved { map: w.map, report, bijective: true, label });
+                }
+                Ok(Warm::Cold(reason)) => why = Some(reason),
+                Err(e) => why = Some(format!("the warm start failed: {e}")),
+            },
+            _ => why = Some("a ring is solved cold".to_string()),
+        }
+    }
+    let sol = Pipeline::new(input, opts.clone()).solve()?.into_map()?;
+    let mut report = serde_json::to_value(&sol.report).map_err(|e| winslow::Error::Invalid(e.to_string()))?;
+    if let Some(why) = why {
+        report["warm_start"] = json!({ "used": false, "reason": why });
+    }
+    let bijective = matches!(sol.report.verdict, Verdict::Certified | Verdict::DegenerateCorner);
+    let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+    Ok(Solved { map: sol.map, report, bijective, label })
+}
+
+/// Solve one shape and write its map or failure record; its summary row, and its map
+/// when bijective (the start of the next shape of a chain).
+fn run_one(
+    shape: &Shape,
+    dir: &Path,
+    opts: &SolveOptions,
+    reorient: bool,
+    start: Option<&Surface>,
+) -> Result<(Value, Option<Surface>)> {
     let t0 = Instant::now();
-    let solved = input_of(shape, reorient)
-        .and_then(|input| Pipeline::new(input, opts.clone()).solve())
-        .and_then(winslow::Solved::into_map);
+    let solved = input_of(shape, reorient).and_then(|input| solve_shape(input, start, opts));
     let failure = dir.join(format!("{}.error.json", shape.name));
     match solved {
         Ok(sol) => {
-            let report = serde_json::to_value(&sol.report)?;
-            let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
-            let extra = Some(json!({ "report": report }));
+            let extra = Some(json!({ "report": sol.report }));
             files::write(
                 &dir.join(format!("{}.json", shape.name)),
-                &Output::Map { name: &shape.name, map: &sol.map, label: &label, extra },
+                &Output::Map { name: &shape.name, map: &sol.map, label: &sol.label, extra },
             )?;
             if failure.exists() {
                 std::fs::remove_file(&failure).with_context(|| format!("removing {}", failure.display()))?;
             }
-            Ok(row_of(&shape.name, &report))
+            Ok((row_of(&shape.name, &sol.report), sol.bijective.then_some(sol.map)))
         }
         Err(e) => {
             let record = json!({
@@ -168,8 +222,21 @@ fn run_one(shape: &Shape, dir: &Path, opts: &SolveOptions, reorient: bool) -> Re
                 "seconds": t0.elapsed().as_secs_f64(),
             });
             files::write_json(&failure, &record)?;
-            Ok(record)
+            Ok((record, None))
         }
+    }
+}
+
+/// The map a finished shape left in the folder, when bijective (a resumed chain goes on
+/// from it).
+fn done_map(dir: &Path, name: &str) -> Option<Surface> {
+    match winslow::io::read_with_report(&dir.join(format!("{name}.json"))) {
+        Ok((Document::Map { map, .. }, Some(r)))
+            if matches!(r["verdict"].as_str(), Some("certified" | "degenerate-corner")) =>
+        {
+            Some(map)
+        }
+        _ => None,
     }
 }
 
@@ -232,20 +299,44 @@ pub(super) fn run(a: BatchArgs) -> Result<i32> {
     );
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.jobs.unwrap_or(0)).stack_size(16 << 20).build()?;
     let done = std::sync::atomic::AtomicUsize::new(0);
+    // chains of shapes solved in order: with --warm-start one per worker over all shapes
+    // (a finished shape's map starts the next), else one per shape to solve
+    let chains: Vec<Vec<usize>> = if a.warm_start {
+        let per = shapes.len().div_ceil(pool.current_num_threads().max(1)).max(1);
+        (0..shapes.len()).collect::<Vec<_>>().chunks(per).map(<[usize]>::to_vec).collect()
+    } else {
+        todo.iter().map(|&i| vec![i]).collect()
+    };
+    let finished: Vec<bool> = rows.iter().map(Option::is_some).collect();
     let results: Vec<(usize, Result<Value>)> = pool.install(|| {
-        todo.par_iter()
-            .map(|&i| {
-                let r = run_one(&shapes[i], &a.output, &opts, reorient);
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if let Ok(row) = &r {
-                    note!(
-                        "[{k}/{}] {}: {}",
-                        todo.len(),
-                        shapes[i].name,
-                        row["verdict"].as_str().or(row["kind"].as_str()).unwrap_or("")
-                    );
+        chains
+            .par_iter()
+            .flat_map_iter(|chain| {
+                let mut prev: Option<Surface> = None;
+                let mut out = Vec::new();
+                for &i in chain {
+                    if finished[i] {
+                        prev = done_map(&a.output, &shapes[i].name).or(prev);
+                        continue;
+                    }
+                    let start = prev.as_ref().filter(|_| a.warm_start);
+                    let r = run_one(&shapes[i], &a.output, &opts, reorient, start);
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    if let Ok((row, _)) = &r {
+                        note!(
+                            "[{k}/{}] {}: {}",
+                            todo.len(),
+                            shapes[i].name,
+                            row["verdict"].as_str().or(row["kind"].as_str()).unwrap_or("")
+                        );
+                    }
+                    let r = r.map(|(row, map)| {
+                        prev = map.or(prev.take());
+                        row
+                    });
+                    out.push((i, r));
                 }
-                (i, r)
+                out
             })
             .collect()
     });

@@ -175,3 +175,90 @@ fn batch_resumes_after_a_kill() {
         std::fs::read_to_string(whole.join("batch.jsonl")).unwrap().lines().count()
     );
 }
+
+/// A family of perturbed ducks (every side's control points moved by the smooth field
+/// `eps (sin(pi s), sin(pi t)) C_k` of the normalised position `(s, t)`), as manifest
+/// lines of inline boundary documents.
+fn duck_family(n: usize) -> Vec<serde_json::Value> {
+    let text = std::fs::read_to_string(data().join("gismo/duck.json")).unwrap();
+    let duck: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let points = |v: &serde_json::Value| -> Vec<[f64; 2]> {
+        v.as_array().unwrap().iter().map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()]).collect()
+    };
+    const SIDES: [&str; 4] = ["south", "east", "north", "west"];
+    let all: Vec<[f64; 2]> = SIDES.iter().flat_map(|s| points(&duck["boundary"][s]["control_points"])).collect();
+    let lo = [0, 1].map(|d| all.iter().map(|p| p[d]).fold(f64::INFINITY, f64::min));
+    let hi = [0, 1].map(|d| all.iter().map(|p| p[d]).fold(f64::NEG_INFINITY, f64::max));
+    let l = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    (0..n)
+        .map(|k| {
+            let c = [[0.3, -0.2], [0.1 * k as f64 - 0.15, 0.25 - 0.05 * k as f64]];
+            let mut doc = duck.clone();
+            for name in SIDES {
+                let side = &mut doc["boundary"][name];
+                let moved: Vec<serde_json::Value> = points(&side["control_points"])
+                    .iter()
+                    .map(|p| {
+                        let (s, t) = ((p[0] - lo[0]) / l, (p[1] - lo[1]) / l);
+                        let f = [(std::f64::consts::PI * s).sin(), (std::f64::consts::PI * t).sin()];
+                        let d = [0, 1].map(|j| 0.02 * l * (f[0] * c[0][j] + f[1] * c[1][j]));
+                        serde_json::json!([p[0] + d[0], p[1] + d[1]])
+                    })
+                    .collect();
+                side["control_points"] = serde_json::Value::Array(moved);
+            }
+            serde_json::json!({ "name": format!("duck{k}"), "document": doc })
+        })
+        .collect()
+}
+
+/// `--warm-start`: two chains of three ducks, the first of each solved cold, the others
+/// from the previous map: the same verdicts, and maps on the same basis within the
+/// solver's tolerance of the cold batch's; a re-run of a partial folder goes on from the
+/// maps there.
+#[test]
+fn batch_warm_start_chains() {
+    let scratch = tempfile::tempdir().unwrap();
+    let manifest = scratch.path().join("ducks.jsonl");
+    let text: String = duck_family(6).iter().map(|l| format!("{l}\n")).collect();
+    winslow::io::file::write_bytes(&manifest, text.as_bytes()).unwrap();
+    let (cold, warm) = (scratch.path().join("cold"), scratch.path().join("warm"));
+    let run = |out: &Path, warm: bool| {
+        let mut c = bin();
+        c.arg("batch").arg("--manifest").arg(&manifest).args(["--jobs", "2", "-q", "-o"]).arg(out);
+        if warm {
+            c.arg("--warm-start");
+        }
+        c.status().unwrap()
+    };
+    assert_eq!(run(&cold, false).code(), Some(0));
+    assert_eq!(run(&warm, true).code(), Some(0));
+    for k in 0..6 {
+        let name = format!("duck{k}.json");
+        let (c, w) = (read_json(&cold.join(&name)), read_json(&warm.join(&name)));
+        assert_eq!(c["report"]["verdict"], "certified");
+        assert_eq!(w["report"]["verdict"], "certified", "{name}");
+        let used = w["report"]["warm_start"]["used"].as_bool().unwrap_or(false);
+        assert_eq!(used, k % 3 != 0, "{name}: {}", w["report"]["warm_start"]);
+        let cp = |v: &serde_json::Value| -> Vec<f64> {
+            v["map"]["control_points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+                .collect()
+        };
+        assert_eq!(c["map"]["knots"], w["map"]["knots"], "{name}");
+        let (a, b) = (cp(&c), cp(&w));
+        assert_eq!(a.len(), b.len());
+        let d = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        assert!(d < 1e-6, "{name}: {d}");
+    }
+    let rows = std::fs::read_to_string(warm.join("batch.jsonl")).unwrap();
+    assert!(rows.lines().all(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["unknowns"].is_u64()));
+    // a partial folder: the chains go on from the maps that are there
+    std::fs::remove_file(warm.join("duck2.json")).unwrap();
+    assert_eq!(run(&warm, true).code(), Some(0));
+    let again = read_json(&warm.join("duck2.json"));
+    assert_eq!(again["report"]["warm_start"]["used"], true);
+}

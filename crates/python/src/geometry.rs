@@ -157,6 +157,32 @@ impl PyMap {
         Ok((py.import("winslow")?.getattr("parse")?, (self.to_json(),)))
     }
 
+    /// The map as a pygismo `gsTensorBSpline2` (`gsTensorNurbs2` when rational); needs
+    /// pygismo (`winslow.interop`).
+    fn to_gismo<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        slf.py().import("winslow.interop")?.call_method1("to_gismo", (slf,))
+    }
+
+    /// A `Map` from a pygismo `gsTensorBSpline2`/`gsTensorNurbs2` (or the first patch
+    /// of a `gsMultiPatch`); `winslow.interop`.
+    #[staticmethod]
+    fn from_gismo<'py>(py: Python<'py>, obj: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("winslow.interop")?.call_method1("from_gismo", (obj,))
+    }
+
+    /// The map as a splinepy `BSpline` (`NURBS` when rational); needs splinepy
+    /// (`winslow.interop`).
+    fn to_splinepy<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        slf.py().import("winslow.interop")?.call_method1("to_splinepy", (slf,))
+    }
+
+    /// A `Map` from a splinepy `BSpline` or `NURBS` of parametric and physical
+    /// dimension 2; `winslow.interop`.
+    #[staticmethod]
+    fn from_splinepy<'py>(py: Python<'py>, obj: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("winslow.interop")?.call_method1("from_splinepy", (obj,))
+    }
+
     fn __repr__(&self) -> String {
         let (s, d) = (self.map.shape(), self.map.degrees());
         format!(
@@ -358,6 +384,22 @@ impl PyDocument {
             Document::Layout(l) | Document::Multipatch(l) => {
                 l.patches.iter().map(|p| p.map.clone().map(|map| PyMap { name: p.name.clone(), map })).collect()
             }
+            _ => None,
+        }
+    }
+
+    /// The patches of a layout or multipatch result, each a `Boundary` (its four sides,
+    /// named after the patch); `None` for the other kinds.
+    fn patches(&self) -> Option<Vec<PyBoundary>> {
+        match &self.doc {
+            Document::Layout(l) | Document::Multipatch(l) => Some(
+                l.patches
+                    .iter()
+                    .map(|p| PyBoundary {
+                        boundary: Boundary { name: p.name.clone(), sides: p.sides.clone().map(SideCurve::Spline) },
+                    })
+                    .collect(),
+            ),
             _ => None,
         }
     }

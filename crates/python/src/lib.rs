@@ -2,7 +2,8 @@
 //! `crates/python/pyproject.toml`): documents as objects whose knots, control points and
 //! weights are numpy arrays, `read`/`write` of every document, `solve` (the pipeline,
 //! GIL released, progress callback, Ctrl-C), `solve_many` (a thread pool), `check` (the
-//! certificate), `mesh`. The user guide is `docs/python.md`; the Python layer
+//! certificate), `mesh`, and the runs built on the pipeline (`layout`, `improve`,
+//! `compare`, `sweep`; layouts, domains and plane graphs in `solve`). The user guide is `docs/python.md`; the Python layer
 //! (`python/winslow/__init__.py`) adds the `meshio.Mesh` of a mesh.
 //!
 //! The crate never embeds an interpreter: cargo builds it as an extension module
@@ -14,6 +15,7 @@ mod convert;
 mod errors;
 mod geometry;
 mod options;
+mod runs;
 mod solve;
 
 use std::path::PathBuf;
@@ -116,6 +118,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBoundary>()?;
     m.add_class::<PyDocument>()?;
     m.add_class::<PySolution>()?;
+    m.add_class::<runs::PyLayoutSolution>()?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(parse, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
@@ -124,5 +127,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::check, m)?)?;
     m.add_function(wrap_pyfunction!(solve::solution_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::layout, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::improve, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::sweep, m)?)?;
     Ok(())
 }

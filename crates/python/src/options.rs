@@ -49,9 +49,8 @@ pub struct Options {
 }
 
 /// A value of a command-line enum by its command-line name (`"scaled"`, `"newton"`).
-fn choice<T: ValueEnum>(key: &str, v: &Bound<'_, PyAny>) -> PyResult<T> {
-    let s: String = v.extract()?;
-    T::from_str(&s, true).map_err(|_| {
+pub fn choice<T: ValueEnum>(key: &str, s: &str) -> PyResult<T> {
+    T::from_str(s, true).map_err(|_| {
         let names: Vec<String> = T::value_variants()
             .iter()
             .filter_map(|x| x.to_possible_value())
@@ -63,7 +62,12 @@ fn choice<T: ValueEnum>(key: &str, v: &Bound<'_, PyAny>) -> PyResult<T> {
 
 /// The options of `kwargs` over the defaults.
 pub fn parse(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
-    let mut o = SolveOptions::default();
+    parse_onto(SolveOptions::default(), kwargs)
+}
+
+/// The options of `kwargs` over `base` (a command's own defaults, as `compare`'s).
+pub fn parse_onto(base: SolveOptions, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
+    let mut o = base;
     let mut reorient = false;
     if let Some(kw) = kwargs {
         for (k, v) in kw.iter() {
@@ -71,12 +75,12 @@ pub fn parse(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
             match key.as_str() {
                 "degree" => o.fit.degree = v.extract()?,
                 "fit_tol" => o.fit.tol = v.extract()?,
-                "basis" => o.fit.basis = choice::<BasisChoice>(&key, &v)?,
-                "reparam" => o.fit.reparam.method = choice(&key, &v)?,
+                "basis" => o.fit.basis = choice::<BasisChoice>(&key, &v.extract::<String>()?)?,
+                "reparam" => o.fit.reparam.method = choice(&key, &v.extract::<String>()?)?,
                 "tol" => o.nonlinear.tol = v.extract()?,
-                "iteration" => o.nonlinear.method = choice::<NonlinearMethod>(&key, &v)?,
-                "linear" => o.nonlinear.linear = choice::<LinearMethod>(&key, &v)?,
-                "operator" => o.operator = choice::<Operator>(&key, &v)?,
+                "iteration" => o.nonlinear.method = choice::<NonlinearMethod>(&key, &v.extract::<String>()?)?,
+                "linear" => o.nonlinear.linear = choice::<LinearMethod>(&key, &v.extract::<String>()?)?,
+                "operator" => o.operator = choice::<Operator>(&key, &v.extract::<String>()?)?,
                 "min_elements" => o.min_elements = v.extract()?,
                 "refine" => o.refine = v.extract()?,
                 "levels" => o.max_levels = v.extract()?,
@@ -87,7 +91,8 @@ pub fn parse(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
                 "repair_freeze" => o.repair_freeze = v.extract()?,
                 "poisson" => o.poisson = v.extract()?,
                 "improve" => {
-                    o.improve = if v.is_none() { None } else { Some(choice::<Improve>(&key, &v)?) };
+                    o.improve =
+                        if v.is_none() { None } else { Some(choice::<Improve>(&key, &v.extract::<String>()?)?) };
                 }
                 "max_memory" => {
                     let s: String = v.extract()?;

@@ -12,8 +12,10 @@ use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use winslow::io::{checked_boundary, ReadOptions};
+use winslow::pipeline::Observer;
 use winslow::solve::report::Solution;
-use winslow::{Document, Error, Input, Output, Pipeline, Stage};
+use winslow::solve::warm::{warm_start, Warm, WarmStart};
+use winslow::{Document, Error, Input, Output, Pipeline, Stage, Surface};
 
 use crate::convert::{json_to_py, to_py};
 use crate::errors::{self, IntoPy};
@@ -32,7 +34,81 @@ pub struct PySolution {
     pub pipeline_seconds: f64,
 }
 
+/// How one shape was solved: cold by the pipeline (with the reason a warm start asked
+/// for did not apply), or from the previous map ([`warm_start`]).
+#[derive(Debug)]
+pub enum Outcome {
+    /// The pipeline's solution; why the start given was not used.
+    Cold(Box<Solution>, Option<String>),
+    /// Solved from the previous map; the shape's name.
+    Warm(Box<WarmStart>, String),
+}
+
+impl Outcome {
+    /// The map to start the next shape of a family from: this one's, when bijective.
+    pub fn start_for_next(&self) -> Option<&Surface> {
+        match self {
+            Outcome::Cold(s, _) => {
+                matches!(s.report.verdict, winslow::Verdict::Certified | winslow::Verdict::DegenerateCorner)
+                    .then_some(&s.map)
+            }
+            Outcome::Warm(w, _) => Some(&w.map),
+        }
+    }
+}
+
+/// Solve `input`: from `start` (the previous map of its family) when given and the warm
+/// start applies and is certified ([`warm_start`]), else by the pipeline, every stage
+/// to `observer`.
+pub fn solve_input(
+    input: Input,
+    start: Option<&Surface>,
+    opts: &winslow::SolveOptions,
+    observer: &mut Observer<'_>,
+) -> winslow::Result<Outcome> {
+    let mut why = None;
+    if let Some(prev) = start {
+        match &input {
+            Input::Boundary(b) => match warm_start(prev, b, opts) {
+                Ok(Warm::Solved(w)) => return Ok(Outcome::Warm(w, b.name.clone())),
+                Ok(Warm::Cold(reason)) => why = Some(reason),
+                Err(e) => why = Some(format!("the warm start failed: {e}")),
+            },
+            _ => why = Some("a ring is solved cold".to_string()),
+        }
+    }
+    let sol = Pipeline::new(input, opts.clone()).run(observer).and_then(winslow::Solved::into_map)?;
+    Ok(Outcome::Cold(Box::new(sol), why))
+}
+
 impl PySolution {
+    /// The solution of an [`Outcome`] that took `seconds`: a warm one's report is the
+    /// [`WarmStart`] (with `"warm_start": {"used": true}`), a cold one's the pipeline's
+    /// (with `"warm_start": {"used": false, "reason": ...}` when a start was given).
+    pub fn of_outcome(outcome: Outcome, seconds: f64) -> PyResult<Self> {
+        match outcome {
+            Outcome::Cold(sol, why) => {
+                let mut s = Self::of((*sol, seconds))?;
+                if let Some(why) = why {
+                    s.report["warm_start"] = json!({ "used": false, "reason": why });
+                }
+                Ok(s)
+            }
+            Outcome::Warm(w, name) => {
+                let mut report = serde_json::to_value(&*w).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+                report["warm_start"] = json!({ "used": true });
+                let verdict = w.verdict.name().to_string();
+                Ok(Self {
+                    name: name.clone(),
+                    map: PyMap { name, map: w.map },
+                    report,
+                    verdict,
+                    pipeline_seconds: seconds,
+                })
+            }
+        }
+    }
+
     fn of((sol, pipeline_seconds): (Solution, f64)) -> PyResult<Self> {
         let report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
         let verdict = report["verdict"].as_str().unwrap_or_default().to_string();
@@ -119,11 +195,15 @@ impl PySolution {
 /// The pipeline's input of a Python object: a `Boundary`, a `Map` (its boundary), a
 /// ring `Document`, or a path to any of those.
 pub fn input_of(py: Python<'_>, obj: &Bound<'_, PyAny>, reorient: bool) -> PyResult<Input> {
-    let doc = match obj.extract::<PathBuf>() {
-        Ok(path) if !obj.is_instance_of::<pyo3::types::PyBytes>() => py.detach(|| winslow::read(&path)).py_err()?,
-        _ => document_of(obj)?,
-    };
-    input_of_document(doc, reorient).py_err()
+    input_of_document(document_arg(py, obj)?, reorient).py_err()
+}
+
+/// The document of an argument: a winslow object, or a path read (without the GIL).
+pub fn document_arg(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Document> {
+    match obj.extract::<PathBuf>() {
+        Ok(path) if !obj.is_instance_of::<pyo3::types::PyBytes>() => py.detach(|| winslow::read(&path)).py_err(),
+        _ => document_of(obj),
+    }
 }
 
 /// The pipeline's input of a document (a boundary checked as the CLI does).
@@ -132,9 +212,8 @@ pub fn input_of_document(doc: Document, reorient: bool) -> winslow::Result<Input
         Document::Ring(ring) => Input::Ring(ring),
         doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(doc.into_ring()?),
         Document::Layout(l) => {
-            return Err(
-                Document::Layout(l).wrong_kind(None, "solve takes a boundary, map or ring (use the CLI for layouts)")
-            )
+            return Err(Document::Layout(l)
+                .wrong_kind(None, "solve_many takes boundaries, maps and rings (winslow.solve solves a layout)"))
         }
         doc => {
             let (b, _) = checked_boundary(doc.into_boundary()?, &ReadOptions { reorient })?;
@@ -163,43 +242,58 @@ pub fn event(stage: &Stage<'_>) -> Value {
     }
 }
 
-/// Run the pipeline without the GIL; every stage goes to `progress` (with the GIL, a
-/// return value of `False` stops the run) and pending signals are checked (Ctrl-C stops
-/// the run). A Python exception raised there is the result.
-fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>>) -> PyResult<(Solution, f64)> {
-    let mut raised: Option<PyErr> = None;
-    let t0 = Instant::now();
-    let result = py.detach(|| {
-        let pipeline = Pipeline::new(input, opts.solve.clone());
-        pipeline.run(&mut |stage| {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    raised = Some(e);
-                    return false;
-                }
-                let Some(cb) = progress else { return true };
-                let ev = match json_to_py(py, &event(stage)) {
-                    Ok(ev) => ev,
-                    Err(e) => {
-                        raised = Some(e);
-                        return false;
-                    }
-                };
-                match cb.call1(py, (ev,)) {
-                    Ok(r) => !r.bind(py).is(pyo3::types::PyBool::new(py, false).to_owned()),
-                    Err(e) => {
-                        raised = Some(e);
-                        false
-                    }
-                }
-            })
-        })
-    });
-    let seconds = t0.elapsed().as_secs_f64();
-    if let Some(e) = raised {
-        return Err(e);
+/// One stage of a run for Python (called without the GIL): takes the GIL, checks pending
+/// signals (Ctrl-C stops the run), hands `json()` to `progress` (a return value of
+/// `False` stops the run). An exception goes to `raised` and stops the run. Whether to
+/// go on.
+pub fn notify(progress: Option<&Py<PyAny>>, raised: &mut Option<PyErr>, json: impl FnOnce() -> Value) -> bool {
+    Python::attach(|py| {
+        if let Err(e) = py.check_signals() {
+            *raised = Some(e);
+            return false;
+        }
+        let Some(cb) = progress else { return true };
+        let ev = match json_to_py(py, &json()) {
+            Ok(ev) => ev,
+            Err(e) => {
+                *raised = Some(e);
+                return false;
+            }
+        };
+        match cb.call1(py, (ev,)) {
+            Ok(r) => !r.bind(py).is(pyo3::types::PyBool::new(py, false).to_owned()),
+            Err(e) => {
+                *raised = Some(e);
+                false
+            }
+        }
+    })
+}
+
+/// The result of a run whose stages went through [`notify`]: the exception raised
+/// there first, then the run's own error.
+pub fn outcome<T>(raised: Option<PyErr>, result: winslow::Result<T>) -> PyResult<T> {
+    match raised {
+        Some(e) => Err(e),
+        None => result.py_err(),
     }
-    Ok((result.and_then(winslow::Solved::into_map).py_err()?, seconds))
+}
+
+/// [`solve_input`] without the GIL, its stages as [`event`]s through [`notify`]; the
+/// seconds it took.
+fn run(
+    py: Python<'_>,
+    input: Input,
+    start: Option<&Surface>,
+    opts: &Options,
+    progress: Option<&Py<PyAny>>,
+) -> PyResult<(Outcome, f64)> {
+    let mut raised = None;
+    let t0 = Instant::now();
+    let result =
+        py.detach(|| solve_input(input, start, &opts.solve, &mut |s| notify(progress, &mut raised, || event(s))));
+    let seconds = t0.elapsed().as_secs_f64();
+    Ok((outcome(raised, result)?, seconds))
 }
 
 /// Solve the map of a boundary, map (its boundary) or ring: fit, coarse-to-fine EGG
@@ -207,17 +301,42 @@ fn run(py: Python<'_>, input: Input, opts: &Options, progress: Option<&Py<PyAny>
 /// solve; `progress(event: dict)` is called for every stage (returning `False` stops the
 /// solve with a `WinslowError` of kind `"cancelled"`); Ctrl-C stops it with
 /// `KeyboardInterrupt`. Options as keywords (see `winslow.SOLVE_OPTIONS`).
+///
+/// `start` (a `Map` or `Solution`: the previous shape of a family) solves a boundary on
+/// that map's basis from the map moved onto the new boundary (`report["warm_start"]`
+/// says whether it was used, and why not); a layout, domain or plane graph gives a
+/// `LayoutSolution`.
 #[pyfunction]
-#[pyo3(signature = (input, *, progress=None, **options))]
-pub fn solve(
-    py: Python<'_>,
-    input: Bound<'_, PyAny>,
+#[pyo3(signature = (input, *, start=None, progress=None, **options))]
+pub fn solve<'py>(
+    py: Python<'py>,
+    input: Bound<'py, PyAny>,
+    start: Option<Bound<'py, PyAny>>,
     progress: Option<Py<PyAny>>,
-    options: Option<&Bound<'_, PyDict>>,
-) -> PyResult<PySolution> {
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
     let opts = options::parse(options)?;
-    let input = input_of(py, &input, opts.reorient)?;
-    PySolution::of(run(py, input, &opts, progress.as_ref())?)
+    let doc = match crate::runs::layout_of(document_arg(py, &input)?, &opts).py_err()? {
+        Ok(layout) => {
+            if start.is_some() {
+                return Err(errors::invalid("start= is for a boundary; a layout is solved cold"));
+            }
+            return Ok(Bound::new(py, crate::runs::solve_layout(py, layout, &opts, progress.as_ref())?)?.into_any());
+        }
+        Err(doc) => doc,
+    };
+    let start = start.map(|s| start_map(&s)).transpose()?;
+    let input = input_of_document(doc, opts.reorient).py_err()?;
+    let (outcome, seconds) = run(py, input, start.as_ref(), &opts, progress.as_ref())?;
+    Ok(Bound::new(py, PySolution::of_outcome(outcome, seconds)?)?.into_any())
+}
+
+/// The map of a `start=` argument (a `Map` or `Solution`).
+fn start_map(obj: &Bound<'_, PyAny>) -> PyResult<Surface> {
+    match document_of(obj)? {
+        Document::Map { map, .. } => Ok(map),
+        doc => Err(errors::to_py(&doc.wrong_kind(None, "start= needs a map"))),
+    }
 }
 
 /// Solve many shapes on `workers` threads (default: all cores), the GIL released: a
@@ -230,14 +349,21 @@ pub fn solve(
 /// solved map whose knot vectors differ from the first solved map's is replaced by a
 /// `WinslowError` of kind `"invalid"`: the solutions returned are comparable coefficient
 /// by coefficient.
+///
+/// `warm_start=True` (a family in sequence): the inputs are cut into `workers`
+/// contiguous chains, each solved in order, every shape from the previous shape's map
+/// (`solve(..., start=previous)`; the first of a chain, and a shape after one that is
+/// not bijective, cold).
 #[pyfunction]
-#[pyo3(signature = (inputs, *, workers=None, on_result=None, same_basis=false, **options))]
+#[pyo3(signature = (inputs, *, workers=None, on_result=None, same_basis=false, warm_start=false, **options))]
+#[allow(clippy::too_many_arguments)]
 pub fn solve_many<'py>(
     py: Python<'py>,
     inputs: Vec<Bound<'py, PyAny>>,
     workers: Option<usize>,
     on_result: Option<Py<PyAny>>,
     same_basis: bool,
+    warm_start: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyList>> {
     let mut opts = options::parse(options)?;
@@ -259,31 +385,44 @@ pub fn solve_many<'py>(
         prepared.iter().enumerate().filter_map(|(i, p)| p.as_ref().ok().map(|x| (i, x.clone()))).collect();
     let mut results: Vec<Option<PyResult<PySolution>>> = prepared.into_iter().map(|p| p.err().map(Err)).collect();
     let mut interrupted = None;
+    // one chain per worker (warm start), else one job per shape
+    let chains = if warm_start { pool.current_num_threads().max(1) } else { jobs.len().max(1) };
+    let per = jobs.len().div_ceil(chains).max(1);
+    let mut chunks: Vec<Vec<(usize, Input)>> = Vec::new();
+    let mut jobs = jobs.into_iter().peekable();
+    while jobs.peek().is_some() {
+        chunks.push(jobs.by_ref().take(per).collect());
+    }
     py.detach(|| {
-        let (tx, rx) = mpsc::channel::<(usize, winslow::Result<(Solution, f64)>)>();
+        let (tx, rx) = mpsc::channel::<(usize, winslow::Result<(Outcome, f64)>)>();
         std::thread::scope(|s| {
             let (stop, opts) = (&stop, &opts.solve);
             s.spawn(move || {
                 pool.install(|| {
-                    jobs.into_par_iter().for_each_with(tx, |tx, (i, input)| {
-                        if stop.load(Ordering::Relaxed) {
-                            let _ = tx.send((i, Err(Error::Cancelled)));
-                            return;
+                    chunks.into_par_iter().for_each_with(tx, |tx, chain| {
+                        let mut prev: Option<Surface> = None;
+                        for (i, input) in chain {
+                            if stop.load(Ordering::Relaxed) {
+                                let _ = tx.send((i, Err(Error::Cancelled)));
+                                continue;
+                            }
+                            let t0 = Instant::now();
+                            let r = solve_input(input, prev.as_ref(), opts, &mut |_| !stop.load(Ordering::Relaxed));
+                            if warm_start {
+                                if let Ok(o) = &r {
+                                    prev = o.start_for_next().cloned().or(prev.take());
+                                }
+                            }
+                            // the receiver lives until every sender is dropped
+                            let _ = tx.send((i, r.map(|o| (o, t0.elapsed().as_secs_f64()))));
                         }
-                        let t0 = Instant::now();
-                        let r = Pipeline::new(input, opts.clone())
-                            .run(&mut |_| !stop.load(Ordering::Relaxed))
-                            .and_then(winslow::Solved::into_map)
-                            .map(|s| (s, t0.elapsed().as_secs_f64()));
-                        // the receiver lives until every sender is dropped
-                        let _ = tx.send((i, r));
                     });
                 });
             });
             loop {
                 match rx.recv_timeout(Duration::from_millis(50)) {
                     Ok((i, r)) => {
-                        let r = r.map_err(|e| errors::to_py(&e)).and_then(PySolution::of);
+                        let r = r.map_err(|e| errors::to_py(&e)).and_then(|(o, t)| PySolution::of_outcome(o, t));
                         if let Some(cb) = &on_result {
                             Python::attach(|py| -> PyResult<()> {
                                 let arg = match &r {

@@ -17,6 +17,7 @@
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified; the same stage on a layout (one patch: a one-patch layout) serves the free interfaces of [`multipatch`](crate::multipatch) | §4.1, §9, §11.2 |
 //! | [`constrained`] | Gravesen's feasible start [`max_z`](constrained::max_z) (`max z`, `d(c) >= z 1`) and the constrained optimisation [`optimise`](constrained::optimise) of the Liao, Winslow or area-orthogonality functional subject to `d(c) >= ε` (SQP, Clarabel subproblems), from the EGG map or the max-z point: [`run`](constrained::run) | §10.3, eq. (49), Table 3 |
 //! | [`kinks`] | [`keep_kinks`](kinks::keep_kinks): the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |
+//! | [`warm`] | [`warm_start`](warm::warm_start): the previous map of a shape family moved onto the next boundary (elasticity) and solved on its basis as [`improve`](improve::improve) runs EGG, kept only when certified | §6.3, issue 34 |
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod constrained;
@@ -33,3 +34,4 @@ pub mod repair;
 pub mod report;
 pub mod solver;
 pub mod volume;
+pub mod warm;

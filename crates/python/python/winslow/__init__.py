@@ -5,8 +5,12 @@ Documents are objects whose knots, control points and weights are numpy arrays
 of the command line (JSON, G+Smo XML, IGES, VTK); ``solve`` runs the pipeline of
 ``winslow solve`` with the GIL released; ``solve_many`` solves many shapes on a thread
 pool; ``check`` is the certificate of ``winslow check``; ``mesh`` returns arrays, or a
-``meshio.Mesh`` when meshio is installed. Errors are ``WinslowError`` with ``kind`` and
-``message``. The guide: docs/python.md.
+``meshio.Mesh`` when meshio is installed; ``improve``, ``compare``, ``sweep`` and
+``layout`` are the runs of the commands of those names; ``solve(boundary,
+start=previous)`` and ``solve_many(..., warm_start=True)`` solve a shape family from the
+previous map. ``Map.to_gismo``/``from_gismo`` and ``to_splinepy``/``from_splinepy``
+convert to pygismo and splinepy objects when those are installed. Errors are
+``WinslowError`` with ``kind`` and ``message``. The guide: docs/python.md.
 """
 
 from ._native import (  # noqa: F401
@@ -14,17 +18,23 @@ from ._native import (  # noqa: F401
     Boundary,
     Curve,
     Document,
+    LayoutSolution,
     Map,
     Solution,
     WinslowError,
     __version__,
     check,
+    compare,
+    improve,
+    layout,
     parse,
     read,
     solve,
     solve_many,
+    sweep,
     write,
 )
+from . import interop  # noqa: F401
 from ._native import mesh_arrays as _mesh_arrays
 
 __all__ = [
@@ -32,16 +42,22 @@ __all__ = [
     "Boundary",
     "Curve",
     "Document",
+    "LayoutSolution",
     "Map",
     "Solution",
     "WinslowError",
     "__version__",
     "check",
+    "compare",
+    "improve",
+    "interop",
+    "layout",
     "mesh",
     "parse",
     "read",
     "solve",
     "solve_many",
+    "sweep",
     "write",
 ]
 
