@@ -203,8 +203,10 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     let seam = winslow_mesh::seam::seams(map)?;
     let cluster = wall_sides(&spec.cluster, map, seam.dir())?;
     let linear = if let Some(s) = &spec.structured {
-        let opts =
-            StructuredOptions { points: parse_points(s)?, distribution: distributions(&cluster, &spec.equidistribute)? };
+        let opts = StructuredOptions {
+            points: parse_points(s)?,
+            distribution: distributions(&cluster, &spec.equidistribute)?,
+        };
         structured(map, &opts)?
     } else if spec.unstructured {
         if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {

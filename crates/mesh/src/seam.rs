@@ -91,7 +91,7 @@ pub fn seams(map: &Surface) -> Result<Seams> {
         let (a, b) = (&sides[s0 as usize], &sides[s1 as usize]);
         let length: f64 = a.windows(2).map(|w| w[0].distance(w[1])).sum();
         // a side (nearly) collapsed to a point is a degenerate corner, not a seam
-        if !(length > 100.0 * tol) {
+        if length.is_nan() || length <= 100.0 * tol {
             continue;
         }
         let same = a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max);
@@ -112,10 +112,7 @@ pub fn seams(map: &Surface) -> Result<Seams> {
         }
     }
     if out.dirs == [true, true] {
-        return Err(MeshError::param(
-            "map",
-            "both directions are periodic or cut seams (a torus has no planar mesh)",
-        ));
+        return Err(MeshError::param("map", "both directions are periodic or cut seams (a torus has no planar mesh)"));
     }
     Ok(out)
 }
@@ -139,7 +136,7 @@ impl Seams {
         let Some(dir) = self.cut() else { return Ok(0.0) };
         let [s0, s1] = ends(dir);
         let gap = at.iter().map(|&t| on_side(map, s0, t).distance(on_side(map, s1, t))).fold(0.0, f64::max);
-        if !(gap <= SEAM_TOLERANCE * self.diameter) {
+        if gap.is_nan() || gap > SEAM_TOLERANCE * self.diameter {
             return Err(MeshError::param(
                 "map",
                 format!(

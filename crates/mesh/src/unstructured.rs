@@ -203,7 +203,13 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
     let boundary: Vec<DVec2> = lists.concat();
     let nb = boundary.len();
     let edges: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
-    let scale = parameter_scale(map);
+    let mut scale = parameter_scale(map);
+    if let Some(d) = sd {
+        // a power of two across the seam: spade splits a segment at `w0 a + w1 b` with
+        // `w0 = 1 - w1`, which is exactly `L` for `a = b = L = 2^k`, so the end side's
+        // points stay on it bit for bit and their copies land on it
+        scale[d] = 2f64.powi(scale[d].log2().round() as i32);
+    }
     // vertices of an equilateral mesh of edge `size` over the area (shoelace of the
     // boundary points), the yardstick of the guard against refinement that does not settle
     let area = {
@@ -246,7 +252,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             )));
         }
         // map the new vertices (in parallel: one spline evaluation each)
-        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| v.position()).collect();
+        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| snap(v.position(), scale)).collect();
         // vertices from `first_new` on are new since the last scan: a triangle or segment of
         // older vertices only existed then and passed (inserting a point only makes
         // triangles that have it as a vertex; a split edge's triangles are gone)
@@ -425,7 +431,7 @@ fn seam_mirrors(cdt: &Cdt, d: usize, scale: DVec2) -> Vec<Point2<f64>> {
     let make = |fixed: f64, along: f64| if d == 0 { Point2::new(fixed, along) } else { Point2::new(along, fixed) };
     let (mut lo, mut hi) = (BTreeSet::new(), BTreeSet::new());
     for v in cdt.vertices() {
-        let (fixed, along) = split(v.position());
+        let (fixed, along) = split(snap(v.position(), scale));
         if fixed == 0.0 {
             lo.insert(along.to_bits());
         } else if fixed == end {
@@ -435,6 +441,23 @@ fn seam_mirrors(cdt: &Cdt, d: usize, scale: DVec2) -> Vec<Point2<f64>> {
     let mut out: Vec<Point2<f64>> = lo.difference(&hi).map(|&a| make(end, f64::from_bits(a))).collect();
     out.extend(hi.difference(&lo).map(|&a| make(0.0, f64::from_bits(a))));
     out
+}
+
+/// A vertex position with a coordinate within `1e-12` (relative) of a side of the
+/// rectangle `[0, L_xi] x [0, L_eta]` put on it: spade splits a segment at
+/// `w0 a + w1 b`, which can miss `L` by an ulp; the vertex is on the segment all the same
+/// (spade inserts it into the edge).
+fn snap(p: Point2<f64>, scale: DVec2) -> Point2<f64> {
+    let s = |x: f64, l: f64| {
+        if (x - l).abs() <= 1e-12 * l {
+            l
+        } else if x.abs() <= 1e-12 * l {
+            0.0
+        } else {
+            x
+        }
+    };
+    Point2::new(s(p.x, scale.x), s(p.y, scale.y))
 }
 
 /// The side of a boundary edge from its parameters.
@@ -456,37 +479,37 @@ fn side_of(a: DVec2, b: DVec2) -> Option<Side> {
 /// seam's end side are identified with the start side's and its edges are no boundary.
 fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2, seam: Option<(usize, [&str; 2])>) -> Result<Mesh> {
     // x / L is exactly 0 or 1 on the sides (their points are exactly 0 or L)
-    let mut params: Vec<DVec2> =
-        cdt.vertices().map(|v| DVec2::new(v.position().x / scale.x, v.position().y / scale.y)).collect();
+    let mut params: Vec<DVec2> = cdt
+        .vertices()
+        .map(|v| {
+            let p = snap(v.position(), scale);
+            DVec2::new(p.x / scale.x, p.y / scale.y)
+        })
+        .collect();
     let mut points = points;
     // the index of each vertex in the mesh (a seam's end side: its start-side partner's)
     let mut index: Vec<usize> = (0..params.len()).collect();
     if let Some((d, _)) = seam {
         let start: HashMap<u64, usize> =
-            (0..params.len()).filter(|&i| params[i][d] == 0.0).map(|i| (params[i][1 - d].to_bits(), i)).collect();
-        for i in 0..params.len() {
-            if params[i][d] == 1.0 {
-                index[i] = *start.get(&params[i][1 - d].to_bits()).ok_or_else(|| {
-                    MeshError::Triangulation(format!("seam vertex {i} at {} has no partner", params[i]))
-                })?;
-            }
+            params.iter().enumerate().filter(|(_, q)| q[d] == 0.0).map(|(i, q)| (q[1 - d].to_bits(), i)).collect();
+        for (i, q) in params.iter().enumerate().filter(|(_, q)| q[d] == 1.0) {
+            index[i] = *start
+                .get(&q[1 - d].to_bits())
+                .ok_or_else(|| MeshError::Triangulation(format!("seam vertex {i} at {q} has no partner")))?;
         }
-        let mut next = 0;
+        // the kept vertices numbered in order; an end-side vertex takes its partner's number
         let mut new = vec![usize::MAX; params.len()];
-        for i in 0..params.len() {
+        let mut next = 0;
+        for (i, slot) in new.iter_mut().enumerate() {
             if index[i] == i {
-                new[i] = next;
+                *slot = next;
                 next += 1;
             }
         }
-        for i in 0..params.len() {
-            index[i] = new[index[i]];
-        }
-        let keep: Vec<bool> = (0..params.len()).map(|i| params[i][d] != 1.0).collect();
-        let mut k = 0;
-        params.retain(|_| (keep[k], k += 1).0);
-        let mut k = 0;
-        points.retain(|_| (keep[k], k += 1).0);
+        index = index.iter().map(|&k| new[k]).collect();
+        let keep: Vec<bool> = params.iter().map(|q| q[d] != 1.0).collect();
+        params = params.iter().zip(&keep).filter(|(_, &k)| k).map(|(q, _)| *q).collect();
+        points = points.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| *p).collect();
     }
     let mut cells = Vec::with_capacity(3 * cdt.num_inner_faces());
     for f in cdt.inner_faces() {
@@ -501,7 +524,7 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2, seam: Option<(usize, [&str
         let [va, vb] = e.vertices();
         let [a, b] = [va, vb].map(|h| h.fix().index());
         let param = |p: Point2<f64>| DVec2::new(p.x / scale.x, p.y / scale.y);
-        let (pa, pb) = (param(va.position()), param(vb.position()));
+        let (pa, pb) = (param(snap(va.position(), scale)), param(snap(vb.position(), scale)));
         let Some(side) = side_of(pa, pb) else {
             return Err(MeshError::Triangulation(format!("constraint edge {a}-{b} is not on a side")));
         };

@@ -25,7 +25,11 @@ fn cases() -> Vec<(Mesh, winslow::Surface)> {
     vec![
         (structured(&map, &opts).unwrap(), map.clone()),
         (unstructured(&map, &UnstructuredOptions { size: 0.25, ..Default::default() }).unwrap(), map),
-        (structured(&ring(), &StructuredOptions { points: [5, 24], distribution: opts.distribution.clone() }).unwrap(), ring()),
+        (
+            structured(&ring(), &StructuredOptions { points: [5, 24], distribution: opts.distribution.clone() })
+                .unwrap(),
+            ring(),
+        ),
         (tri(&ring()), ring()),
         (tri(&cut), cut.clone()),
         (structured(&cut, &StructuredOptions::uniform(24, 5)).unwrap(), cut),

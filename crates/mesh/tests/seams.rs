@@ -175,7 +175,7 @@ fn rings_are_triangulated_with_the_seam_shared() {
         (cut_ring(true, 0.0), [Side::North, Side::South], 0),
     ] {
         let mesh = unstructured(&map, &UnstructuredOptions { size: 0.2, ..Default::default() }).unwrap();
-        assert_eq!(mesh.periodic[dir], true);
+        assert!(mesh.periodic[dir]);
         assert_annulus(&mesh, walls);
         assert_on_map(&mesh, &map);
         // no node on the end side of the seam, and seam nodes on the start side shared by
