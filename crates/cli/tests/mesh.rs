@@ -208,6 +208,15 @@ fn a_ring_meshes_without_a_seam_structured_and_unstructured() {
     assert!(nodes > 0 && cells > 0);
     let (ok, _, err) = run(&["mesh", &map, "-o", &d("ring-u3.msh"), "--unstructured", "--size", "0.3", "--order", "3"]);
     assert!(ok, "{err}");
+    // the eccentric annulus at 0.05: spade splits wall segments off the power-of-two
+    // midpoints there (its constraint edges once left their side by an ulp)
+    let ecc = data().join("rings/eccentric_annulus.json").to_string_lossy().into_owned();
+    let (ok, _, err) = run(&["solve", &ecc, "-o", &d("ecc.json"), "-q"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = run(&["mesh", &d("ecc.json"), "-o", &d("ecc.su2"), "--unstructured", "--size", "0.05"]);
+    assert!(ok, "{err}");
+    let (np, distinct, markers, closed) = su2_summary(&d("ecc.su2"));
+    assert!(np > 1000 && np == distinct && closed && markers == ["outer", "inner"], "{np} {distinct} {markers:?}");
     // layers on the seam, inner/outer on a four-sided map: refused
     let (ok, _, _) = run(&[
         "mesh",
