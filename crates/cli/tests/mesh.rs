@@ -285,6 +285,15 @@ fn a_cut_ring_is_meshed_with_its_seam_merged() {
     let (ok, _, err) = run(&["mesh", &ca, "-o", &d("ca-s.su2"), "--structured", "64x17"]);
     assert!(ok, "{err}");
     assert_eq!(su2_summary(&d("ca-s.su2")), (64 * 17, 64 * 17, vec!["outer".into(), "inner".into()], true));
+    // G+Smo's cut ring triangulated: slivers where the gap is narrow, but one node per
+    // seam point, the seam interior, every cell counter-clockwise
+    let (ok, _, err) = run(&["mesh", &map, "-o", &d("cut-tri.su2"), "--unstructured", "--size", "2"]);
+    assert!(ok, "{err}");
+    let (np, distinct, markers, closed) = su2_summary(&d("cut-tri.su2"));
+    assert!(np > 1000 && np == distinct && closed && markers == ["outer", "inner"], "{np} {distinct} {markers:?}");
+    let (ok, _, err) = run(&["mesh", &map, "-o", &d("cut-tri.msh"), "--unstructured", "--size", "2"]);
+    assert!(ok, "{err}");
+    assert_eq!(msh_cells(&d("cut-tri.msh")).2, 0);
     // layers on the cut (west) are refused: it is the seam
     let (ok, _, err) =
         run(&["mesh", &ca, "-o", &d("ca-w.su2"), "--structured", "64x17", "--cluster", "west:first-height:1e-3"]);

@@ -39,6 +39,11 @@
 //! with the start side's (same coordinate along the seam, bit for bit), so the seam is
 //! one line of nodes shared by the triangles on both sides, with no boundary edge on
 //! it; the walls are the groups `inner` and `outer` ([`crate::seam::wall_names`]).
+//! A ring's rectangle is its mean length around by its mean width (area over length
+//! around; the seam's own width may be the narrowest place), the extent around rounded
+//! to a power of two (spade's splits of the seam's segments stay on them bit for bit),
+//! and spade's refinement stops at the guard's vertex count (a ring whose width varies a
+//! hundredfold makes slivers, refined without end).
 //!
 //! The minimum angle holds in the stretched parameter rectangle (spade's guarantee);
 //! the physical angles are reported by [`crate::quality`].
@@ -203,19 +208,25 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
     let boundary: Vec<DVec2> = lists.concat();
     let nb = boundary.len();
     let edges: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
-    let mut scale = parameter_scale(map);
-    if let Some(d) = sd {
-        // a power of two across the seam: spade splits a segment at `w0 a + w1 b` with
-        // `w0 = 1 - w1`, which is exactly `L` for `a = b = L = 2^k`, so the end side's
-        // points stay on it bit for bit and their copies land on it
-        scale[d] = 2f64.powi(scale[d].log2().round() as i32);
-    }
     // vertices of an equilateral mesh of edge `size` over the area (shoelace of the
     // boundary points), the yardstick of the guard against refinement that does not settle
     let area = {
         let x: Vec<DVec2> = boundary.iter().map(|q| at(map, *q)).collect();
         0.5 * (0..x.len()).map(|k| x[k].perp_dot(x[(k + 1) % x.len()])).sum::<f64>()
     };
+    let mut scale = parameter_scale(map);
+    if let Some(d) = sd {
+        // across a ring: its mean width (area over the length around), not the width at
+        // the seam, which may be the narrowest or the widest place
+        let across = area.abs() / scale[d];
+        if across.is_finite() && across > 0.0 {
+            scale[1 - d] = across;
+        }
+        // a power of two around: spade splits a segment at `w0 a + w1 b` with
+        // `w0 = 1 - w1`, which is exactly `L` for `a = b = L = 2^k`, so the end side's
+        // points stay on it bit for bit and their copies land on it
+        scale[d] = 2f64.powi(scale[d].log2().round() as i32);
+    }
     let expected = (area.abs() / (0.433 * opts.size * opts.size) / 2.0) as usize + nb;
     let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x * scale.x, q.y * scale.y)).collect();
     let mut cdt = Cdt::bulk_load_cdt(verts, edges).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
@@ -230,7 +241,10 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
     stats.boundary = lap();
     for round in 0..200 {
         stats.rounds = round + 1;
-        let budget = opts.max_vertices.saturating_sub(cdt.num_vertices());
+        // a ring's rectangle may stretch triangles into slivers where its width varies
+        // strongly: spade's refinement stops at the guard below instead of running on
+        let most = if sd.is_some() { opts.max_vertices.min(50 * expected + 10_000) } else { opts.max_vertices };
+        let budget = most.saturating_sub(cdt.num_vertices());
         // the first round also bounds the area by the equilateral triangle of edge `size`
         // in the stretched rectangle: most vertices come from spade's own refinement
         let mut params = RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget);
