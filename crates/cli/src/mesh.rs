@@ -30,7 +30,9 @@ pub struct MeshSpec {
     /// clustered at SIDE), `SIDE:first-height:H[:GROWTH]` (geometric layers whose first
     /// cell is H long in physical units on every grid line, growth ratio limit GROWTH,
     /// default 1.2). DIR is xi or eta; SIDE is south, east, north or west, or on a ring
-    /// inner (= west) or outer (= east); a ring's south and north are its periodic seam.
+    /// (a periodic map, or a ring cut into a four-sided map whose opposite sides
+    /// coincide) inner or outer, its walls named by the area they enclose; the seam's
+    /// two sides are not walls.
     #[arg(long, value_name = "SPEC")]
     pub cluster: Vec<String>,
     /// Equidistribute a structured mesh's points along the boundary, repeatable:
@@ -166,6 +168,27 @@ pub fn distributions(specs: &[String], equi: &[String]) -> Result<[Distribution;
     Ok(out)
 }
 
+/// The `--cluster` specs with a ring's `inner` and `outer` replaced by the sides they
+/// are (the walls at the ends of the direction across the seam `seam_dir`, named by the
+/// area they enclose); refused on a map without a seam.
+fn wall_sides(specs: &[String], map: &Surface, seam_dir: Option<usize>) -> Result<Vec<String>> {
+    specs
+        .iter()
+        .map(|c| {
+            let Some((wall, rest)) = c.split_once(':').filter(|(w, _)| *w == "inner" || *w == "outer") else {
+                return Ok(c.clone());
+            };
+            let Some(d) = seam_dir else {
+                bail!("--cluster {c}: inner and outer name the walls of a ring (a periodic map, or a cut ring whose opposite sides coincide); this map has south, east, north and west");
+            };
+            let names = winslow_mesh::seam::wall_names(map, d);
+            let sides = winslow_mesh::seam::ends(1 - d);
+            let k = usize::from(names[1] == wall);
+            Ok(format!("{}:{rest}", sides[k].name()))
+        })
+        .collect()
+}
+
 fn parse_points(s: &str) -> Result<[usize; 2]> {
     let (a, b) = s.split_once(['x', 'X']).with_context(|| format!("--structured {s}: expected NXxNY, e.g. 401x35"))?;
     let n = |t: &str| t.trim().parse::<usize>().with_context(|| format!("--structured {s}: '{t}' is not a count"));
@@ -177,16 +200,12 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     let format = Format::from_path(output)?;
     let t = Instant::now();
     let mut stats: Option<MeshingStats> = None;
-    let ring = winslow_mesh::periodic_directions(map)[1];
-    if let Some(c) = spec.cluster.iter().find(|c| c.starts_with("inner:") || c.starts_with("outer:")) {
-        if !ring {
-            bail!("--cluster {c}: inner and outer name the walls of a ring (a periodic map); this map has south, east, north and west");
-        }
-    }
+    let seam = winslow_mesh::seam::seams(map)?;
+    let cluster = wall_sides(&spec.cluster, map, seam.dir())?;
     let linear = if let Some(s) = &spec.structured {
         let opts = StructuredOptions {
             points: parse_points(s)?,
-            distribution: distributions(&spec.cluster, &spec.equidistribute)?,
+            distribution: distributions(&cluster, &spec.equidistribute)?,
         };
         structured(map, &opts)?
     } else if spec.unstructured {
@@ -226,6 +245,9 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
             format.name()
         );
         say_raw!("{}", q.table());
+        if let Some(line) = seam.describe() {
+            say!("  {line}");
+        }
         say!("  built in {built:.3} s, quality in {measured:.3} s, checked and written in {written:.3} s");
         if let Some(st) = stats {
             say!(

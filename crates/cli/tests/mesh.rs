@@ -131,8 +131,43 @@ fn solve_then_mesh_in_every_format() {
     assert!(!dir.join("x.msh").exists());
 }
 
+/// An SU2 file read back: points, distinct points, marker names, and whether every
+/// edge used by one cell only is on a marker (the seam interior).
+fn su2_summary(path: &str) -> (usize, usize, Vec<String>, bool) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('%')).collect();
+    let ne: usize = lines[1].strip_prefix("NELEM= ").unwrap().parse().unwrap();
+    let mut uses: std::collections::HashMap<(usize, usize), usize> = Default::default();
+    for l in &lines[2..2 + ne] {
+        let v: Vec<usize> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+        let c = &v[1..v.len() - 1];
+        for e in 0..c.len() {
+            let (a, b) = (c[e], c[(e + 1) % c.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let np: usize = lines[2 + ne].strip_prefix("NPOIN= ").unwrap().parse().unwrap();
+    let distinct: std::collections::HashSet<&str> =
+        lines[3 + ne..3 + ne + np].iter().map(|l| l.rsplit_once(char::is_whitespace).map_or(*l, |p| p.0)).collect();
+    let mut markers = Vec::new();
+    let mut marked = std::collections::HashSet::new();
+    let mut at = 4 + ne + np;
+    while at < lines.len() {
+        markers.push(lines[at].strip_prefix("MARKER_TAG= ").unwrap().to_string());
+        let k: usize = lines[at + 1].strip_prefix("MARKER_ELEMS= ").unwrap().parse().unwrap();
+        for l in &lines[at + 2..at + 2 + k] {
+            let v: Vec<usize> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            marked.insert((v[1].min(v[2]), v[1].max(v[2])));
+        }
+        at += 2 + k;
+    }
+    let open: std::collections::HashSet<(usize, usize)> =
+        uses.iter().filter(|(_, &n)| n == 1).map(|(&e, _)| e).collect();
+    (np, distinct.len(), markers, open == marked && uses.values().all(|&n| n <= 2))
+}
+
 #[test]
-fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
+fn a_ring_meshes_without_a_seam_structured_and_unstructured() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     let d = |f: &str| dir.join(f).to_string_lossy().into_owned();
@@ -154,10 +189,35 @@ fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
         let (ok, _, err) = run(&args);
         assert!(ok, "{out}: {err}");
     }
+    // markers in side order: east (outer), then west (inner)
+    assert_eq!(su2_summary(&d("ring.su2")), (61 * 64, 61 * 64, vec!["outer".into(), "inner".into()], true));
     assert!(dir.join("ring-case/constant/polyMesh/boundary").exists());
     let boundary = std::fs::read_to_string(dir.join("ring-case/constant/polyMesh/boundary")).unwrap();
     assert!(boundary.contains("    inner\n") && boundary.contains("    outer\n") && !boundary.contains("south"));
-    // layers on the seam, inner/outer on a four-sided map, an unstructured ring: refused
+    // unstructured: the seam shared, the walls inner and outer, in every format
+    for out in ["ring-u.su2", "ring-u.msh", "ring-u.vtu", "ring-u-case/"] {
+        let (ok, _, err) = run(&["mesh", &map, "-o", &d(out), "--unstructured", "--size", "0.3"]);
+        assert!(ok, "{out}: {err}");
+    }
+    let (np, distinct, markers, closed) = su2_summary(&d("ring-u.su2"));
+    assert!(np > 50 && np == distinct && closed, "{np} points, {distinct} distinct");
+    assert_eq!(markers, ["outer", "inner"]);
+    let (nodes, cells, clockwise) = msh_cells(&d("ring-u.msh"));
+    // an annulus: V - E + F = 0 with E = (3 F + boundary edges) / 2
+    assert_eq!(clockwise, 0);
+    assert!(nodes > 0 && cells > 0);
+    let (ok, _, err) = run(&["mesh", &map, "-o", &d("ring-u3.msh"), "--unstructured", "--size", "0.3", "--order", "3"]);
+    assert!(ok, "{err}");
+    // the eccentric annulus at 0.05: spade splits wall segments off the power-of-two
+    // midpoints there (its constraint edges once left their side by an ulp)
+    let ecc = data().join("rings/eccentric_annulus.json").to_string_lossy().into_owned();
+    let (ok, _, err) = run(&["solve", &ecc, "-o", &d("ecc.json"), "-q"]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = run(&["mesh", &d("ecc.json"), "-o", &d("ecc.su2"), "--unstructured", "--size", "0.05"]);
+    assert!(ok, "{err}");
+    let (np, distinct, markers, closed) = su2_summary(&d("ecc.su2"));
+    assert!(np > 1000 && np == distinct && closed && markers == ["outer", "inner"], "{np} {distinct} {markers:?}");
+    // layers on the seam, inner/outer on a four-sided map: refused
     let (ok, _, _) = run(&[
         "mesh",
         &d("ring.json"),
@@ -168,8 +228,6 @@ fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
         "--cluster",
         "south:first-height:1e-3",
     ]);
-    assert!(!ok);
-    let (ok, _, _) = run(&["mesh", &d("ring.json"), "-o", &d("seam.msh"), "--unstructured", "--size", "0.3"]);
     assert!(!ok);
     let lid = data().join("wavy_lid.json").to_string_lossy().into_owned();
     let (ok, _, _) = run(&["solve", &lid, "-o", &d("lid.json"), "-q"]);
@@ -185,13 +243,62 @@ fn a_ring_meshes_without_a_seam_and_a_cut_ring_is_refused() {
         "inner:first-height:1e-3",
     ]);
     assert!(!ok);
-    // a ring cut into a four-sided map has coinciding nodes at the cut: refused, unwritten
+    assert!(!dir.join("seam.su2").exists() && !dir.join("seam.msh").exists());
+}
+
+#[test]
+fn a_cut_ring_is_meshed_with_its_seam_merged() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let d = |f: &str| dir.join(f).to_string_lossy().into_owned();
+    // G+Smo's cut ring: west and east coincide to 2.2e-7 of the diameter; xi runs around
     let cut = data().join("gismo/male_casing_ring.json").to_string_lossy().into_owned();
     let (ok, _, err) = run(&["solve", &cut, "-o", &d("cut.json"), "-q"]);
     assert!(ok, "{err}");
-    let (ok, _, _) = run(&["mesh", &d("cut.json"), "-o", &d("seam.su2"), "--structured", "101x33"]);
-    assert!(!ok);
-    assert!(!dir.join("seam.su2").exists() && !dir.join("seam.msh").exists());
+    let layers = ["--cluster", "inner:first-height:1e-4:1.2", "--cluster", "outer:first-height:1e-4:1.2"];
+    let map = d("cut.json");
+    for out in ["cut.su2", "cut.msh", "cut.vtu", "cut-case/", "cut.xyz"] {
+        let mut args = vec!["mesh", &map[..], "-o"];
+        let o = d(out);
+        args.extend([&o[..], "--structured", "201x121"]);
+        args.extend(layers);
+        let (ok, stdout, err) = run(&args);
+        assert!(ok, "{out}: {err}");
+        assert!(stdout.contains("merged"), "{stdout}");
+    }
+    // 201 points around make 201 cells: no node repeated, the seam interior
+    assert_eq!(su2_summary(&d("cut.su2")), (201 * 121, 201 * 121, vec!["outer".into(), "inner".into()], true));
+    let (nodes, cells, clockwise) = msh_cells(&d("cut.msh"));
+    assert_eq!((nodes, cells, clockwise), (201 * 121, 201 * 120, 0));
+    let boundary = std::fs::read_to_string(dir.join("cut-case/constant/polyMesh/boundary")).unwrap();
+    assert!(boundary.contains("    inner\n") && boundary.contains("    outer\n") && !boundary.contains("west"));
+    // a cut annulus (exact circles, west = east): unstructured too
+    let ca = data().join("maps/cut_annulus.json").to_string_lossy().into_owned();
+    for out in ["ca.su2", "ca.msh", "ca.vtu", "ca-case/"] {
+        let (ok, _, err) = run(&["mesh", &ca, "-o", &d(out), "--unstructured", "--size", "0.2"]);
+        assert!(ok, "{out}: {err}");
+    }
+    let (np, distinct, markers, closed) = su2_summary(&d("ca.su2"));
+    assert!(np > 100 && np == distinct && closed, "{np} points, {distinct} distinct");
+    assert_eq!(markers, ["outer", "inner"]);
+    assert_eq!(msh_cells(&d("ca.msh")).2, 0);
+    let (ok, _, err) = run(&["mesh", &ca, "-o", &d("ca-s.su2"), "--structured", "64x17"]);
+    assert!(ok, "{err}");
+    assert_eq!(su2_summary(&d("ca-s.su2")), (64 * 17, 64 * 17, vec!["outer".into(), "inner".into()], true));
+    // G+Smo's cut ring triangulated: slivers where the gap is narrow, but one node per
+    // seam point, the seam interior, every cell counter-clockwise
+    let (ok, _, err) = run(&["mesh", &map, "-o", &d("cut-tri.su2"), "--unstructured", "--size", "2"]);
+    assert!(ok, "{err}");
+    let (np, distinct, markers, closed) = su2_summary(&d("cut-tri.su2"));
+    assert!(np > 1000 && np == distinct && closed && markers == ["outer", "inner"], "{np} {distinct} {markers:?}");
+    let (ok, _, err) = run(&["mesh", &map, "-o", &d("cut-tri.msh"), "--unstructured", "--size", "2"]);
+    assert!(ok, "{err}");
+    assert_eq!(msh_cells(&d("cut-tri.msh")).2, 0);
+    // layers on the cut (west) are refused: it is the seam
+    let (ok, _, err) =
+        run(&["mesh", &ca, "-o", &d("ca-w.su2"), "--structured", "64x17", "--cluster", "west:first-height:1e-3"]);
+    assert!(!ok && err.contains("seam"), "{err}");
+    assert!(!dir.join("ca-w.su2").exists());
 }
 
 /// The physical names of a Gmsh file: `(dimension, name)`.

@@ -11,6 +11,7 @@
 //! | [`unstructured`](mod@unstructured) | constrained Delaunay triangulations of the parameter square (spade), refined against physical sizes |
 //! | [`high_order`] | curved quadratic and cubic elements with nodes on the map, their Jacobians checked |
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
+//! | [`seam`] | periodic seams: a ring's periodic direction, or two coinciding sides of a ring cut into a four-sided map, merged into one line of nodes; walls named `inner`/`outer` |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
 //! | [`multipatch`](mod@multipatch) | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
 //! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
@@ -20,8 +21,9 @@
 //! Every mesh is a [`Mesh`]: nodes (physical and parameter coordinates), cells of one
 //! [`ElementKind`] and order with nodes in Gmsh's ordering, and boundary edges labelled
 //! by [`Side`] and named by [`Mesh::names`] (`inner`/`outer` on a ring). A periodic
-//! direction of the map (a ring's `eta`) has one node per seam point and no boundary on
-//! its seam. Writers refuse a mesh that breaks a rule of the format
+//! direction of the map (a ring's `eta`), or one whose two end sides coincide (a cut
+//! ring, [`seam`]), has one node per seam point and no boundary on its seam, in
+//! structured and unstructured meshes alike. Writers refuse a mesh that breaks a rule of the format
 //! ([`validate::validate`]).
 
 pub mod distribution;
@@ -31,6 +33,7 @@ pub mod formats;
 pub mod high_order;
 pub mod multipatch;
 pub mod quality;
+pub mod seam;
 pub mod structured;
 pub mod topology;
 pub mod unstructured;
@@ -115,8 +118,9 @@ pub struct Mesh {
     /// `xi` fastest (linear structured meshes only); a periodic direction has as many
     /// points as cells (its seam is not repeated).
     pub structured: Option<[usize; 2]>,
-    /// Periodic parameter directions (`[false, true]` for a ring): parameters in `[0, 1)`,
-    /// cells wrap around the seam, no boundary edges on it.
+    /// Periodic parameter directions (`[false, true]` for a ring, and for a ring cut
+    /// into a four-sided map whose south and north coincide, [`seam`]): parameters in
+    /// `[0, 1)`, cells wrap around the seam, no boundary edges on it.
     pub periodic: [bool; 2],
     /// Name of the boundary group of each side (indexed by `Side as usize`): the side
     /// names for a four-sided map, `inner`/`outer` for the walls of a ring.

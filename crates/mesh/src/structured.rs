@@ -15,8 +15,10 @@
 //!
 //! A periodic direction (a ring's `eta`) has as many points as cells, its parameters in
 //! `[0, 1)`: the seam is one line of nodes shared by the cells on both sides, and it is
-//! not a boundary. The two walls of a ring are named `inner` and `outer` (by the area
-//! they enclose).
+//! not a boundary. So has a direction whose two end sides coincide (a ring cut into a
+//! four-sided map, [`crate::seam`]): the end side's nodes are those of the start side.
+//! The two walls of a ring are named `inner` and `outer` (by the area they enclose,
+//! [`crate::seam::wall_names`]).
 
 use glam::DVec2;
 use rayon::prelude::*;
@@ -25,7 +27,8 @@ use winslow::{Side, Surface};
 use crate::distribution::{layer_sizes, points_from_sizes, Distribution};
 use crate::equidistribution::equidistributed;
 use crate::error::{MeshError, Result};
-use crate::{map_points, periodic_directions, side_names, BoundaryEdge, ElementKind, Mesh};
+use crate::seam::{seams, wall_names, Seams};
+use crate::{map_points, side_names, BoundaryEdge, ElementKind, Mesh};
 
 /// Options of a structured mesh.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,12 +135,13 @@ fn layer_lines(
     d: &Distribution,
     others: &[f64],
     shared: bool,
+    seam: &Seams,
 ) -> Result<Vec<Vec<f64>>> {
     let Distribution::Layers { start, end, growth } = *d else {
         return Err(MeshError::param(["xi", "eta"][dir], "layers expected"));
     };
-    // the walls of a ring (the other direction periodic) are named inner and outer
-    let [s0, s1] = if periodic_directions(map)[1 - dir] { ["inner", "outer"] } else { sides(dir).map(Side::name) };
+    // the walls of a ring (the other direction a seam) are named inner and outer
+    let [s0, s1] = if seam.dirs[1 - dir] { wall_names(map, 1 - dir) } else { sides(dir).map(Side::name) };
     let heights: Vec<(Option<f64>, Option<f64>)> = others
         .par_iter()
         .map(|&o| {
@@ -190,12 +194,11 @@ fn layer_lines(
 /// the grid stays a tensor product (each direction's own points would move the other's
 /// first edges off their lines): one spacing per wall, the height met where the first
 /// edge is longest, a few fixed-point sweeps; the report gives the smallest first cell.
-/// A periodic direction refuses layers: its ends are the seam, not walls.
+/// A periodic direction (or a cut seam, [`crate::seam`]) refuses layers: its ends are
+/// the seam, not walls.
 pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<Grid> {
-    let periodic = periodic_directions(map);
-    if periodic == [true, true] {
-        return Err(MeshError::param("map", "both directions are periodic (a torus has no planar mesh)"));
-    }
+    let seam_of = seams(map)?;
+    let periodic = seam_of.dirs;
     for (k, name) in ["xi", "eta"].iter().enumerate() {
         let least = if periodic[k] { 3 } else { 2 };
         if opts.points[k] < least {
@@ -212,15 +215,19 @@ pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<Grid> {
                 None => (s1, end.unwrap_or(0.0)),
             };
             let walls = sides(1 - k);
+            let names = wall_names(map, k);
+            let what = if seam_of.periodic_knots[k] { "periodic" } else { "a cut seam: its ends coincide" };
             return Err(MeshError::Layer {
                 side: seam.name().into(),
                 height,
                 growth: *growth,
                 why: format!(
-                    "{} is the periodic seam of this ring ({name} is periodic), not a wall: the walls are {} (inner) and {} (outer); put the layers there",
+                    "{} is the seam of this ring ({name} is {what}), not a wall: the walls are {} ({}) and {} ({}); put the layers there",
                     seam.name(),
                     walls[0].name(),
-                    walls[1].name()
+                    names[0],
+                    walls[1].name(),
+                    names[1]
                 ),
             });
         }
@@ -246,7 +253,7 @@ pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<Grid> {
             if layers[dir] {
                 let others = mean(&lines[1 - dir], 1 - dir);
                 let shared = layers == [true, true];
-                lines[dir] = Some(layer_lines(map, dir, n[dir], &opts.distribution[dir], &others, shared)?);
+                lines[dir] = Some(layer_lines(map, dir, n[dir], &opts.distribution[dir], &others, shared, &seam_of)?);
             }
         }
     }
@@ -258,12 +265,22 @@ pub fn parameters(map: &Surface, opts: &StructuredOptions) -> Result<Grid> {
         .flat_map(|j| (0..n[0]).map(move |i| (i, j)))
         .map(|(i, j)| DVec2::new(coord(0, i, j), coord(1, j, i)))
         .collect();
-    Ok(Grid { n, periodic, params })
+    let grid = Grid { n, periodic, params };
+    // a cut seam is merged only where the two sides coincide at the mesh's own nodes
+    if let Some(d) = seam_of.cut() {
+        let along: Vec<f64> = if d == 1 {
+            (0..n[0]).map(|i| grid.params[i].x).collect()
+        } else {
+            (0..n[1]).map(|j| grid.params[j * n[0]].y).collect()
+        };
+        seam_of.confirm(map, &along)?;
+    }
+    Ok(grid)
 }
 
 /// A linear structured mesh of `map`: nodes `x(xi_i, eta_j)` stored `xi` fastest, cells
 /// counter-clockwise `(i, j), (i+1, j), (i+1, j+1), (i, j+1)` (wrapping around a periodic
-/// seam), boundary edges labelled by side. Not checked for inverted cells: see
+/// or cut seam, [`crate::seam`]), boundary edges labelled by side. Not checked for inverted cells: see
 /// [`Mesh::check`].
 pub fn structured(map: &Surface, opts: &StructuredOptions) -> Result<Mesh> {
     let grid = parameters(map, opts)?;
@@ -301,19 +318,10 @@ pub fn grid_mesh(map: &Surface, grid: &Grid) -> Mesh {
     for dir in 0..2 {
         if grid.periodic[dir] {
             // the walls are the ends of the other direction: inner encloses less area
-            let wall = |k: usize| -> f64 {
-                let ring: Vec<DVec2> =
-                    (0..grid.n[dir]).map(|s| if dir == 1 { points[id(k, s)] } else { points[id(s, k)] }).collect();
-                let o = ring[0];
-                let twice: f64 = (0..ring.len()).map(|s| (ring[s] - o).perp_dot(ring[(s + 1) % ring.len()] - o)).sum();
-                twice.abs()
-            };
-            let last = grid.n[1 - dir] - 1;
             let [s0, s1] = sides(1 - dir);
-            let (a0, a1) = (wall(0), wall(last));
-            let (i0, o0) = if a0 <= a1 { ("inner", "outer") } else { ("outer", "inner") };
-            names[s0 as usize] = i0.into();
-            names[s1 as usize] = o0.into();
+            let [n0, n1] = wall_names(map, dir);
+            names[s0 as usize] = n0.into();
+            names[s1 as usize] = n1.into();
         }
     }
     Mesh {

@@ -30,9 +30,25 @@
 //! inserted, which costs `O(sqrt n)` steps a point); [`MeshingStats`] says where the time
 //! goes (printed by `winslow mesh`).
 //!
+//! A ring (a periodic direction, or two coinciding sides of a ring cut into a four-sided
+//! map, [`crate::seam`]) is triangulated in the same rectangle with its seam's two sides
+//! kept identical: the end side gets the start side's points, every point that
+//! refinement puts on one of them (spade's encroachment splits, the size criterion) is
+//! inserted on the other too before a round may end (`seam_mirrors`), and no triangle may
+//! touch both (its longest edge is split). The end side's vertices are then identified
+//! with the start side's (same coordinate along the seam, bit for bit), so the seam is
+//! one line of nodes shared by the triangles on both sides, with no boundary edge on
+//! it; the walls are the groups `inner` and `outer` ([`crate::seam::wall_names`]).
+//! A ring's rectangle is its mean length around by its mean width (area over length
+//! around; the seam's own width may be the narrowest place), the extent around rounded
+//! to a power of two (spade's splits of the seam's segments stay on them bit for bit),
+//! and spade's refinement stops at the guard's vertex count (a ring whose width varies a
+//! hundredfold makes slivers, refined without end).
+//!
 //! The minimum angle holds in the stretched parameter rectangle (spade's guarantee);
 //! the physical angles are reported by [`crate::quality`].
 
+use std::collections::{BTreeSet, HashMap};
 use std::time::Instant;
 
 use glam::DVec2;
@@ -165,16 +181,9 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         clock = Instant::now();
         t
     };
-    if crate::periodic_directions(map).contains(&true) {
-        // the triangulation of the parameter square would leave the seam a crack of
-        // duplicated nodes, which no solver accepts
-        return Err(MeshError::Unsupported {
-            format: "an unstructured mesh",
-            why:
-                "the map is periodic (a ring): its seam would be a crack; use --structured NXxNY, whose seam is merged"
-                    .into(),
-        });
-    }
+    // a ring's seam (periodic, or two coinciding sides): its two sides get one point set
+    let seam = crate::seam::seams(map)?;
+    let sd = seam.dir();
     if !(opts.size.is_finite() && opts.size > 0.0) {
         return Err(MeshError::param("size", format!("must be positive, got {}", opts.size)));
     }
@@ -182,19 +191,42 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         return Err(MeshError::param("min angle", format!("must be in [0, 34] degrees, got {}", opts.min_angle)));
     }
     let chord_tol = opts.chord_tol.unwrap_or(opts.size / 20.0);
-    let mut boundary: Vec<DVec2> = Vec::new();
-    for side in Side::ALL {
-        boundary.extend(side_points(map, side, opts.size));
+    let mut lists = Side::ALL.map(|side| side_points(map, side, opts.size));
+    if let Some(d) = sd {
+        // the end side: its first corner, then the start side's interior points in
+        // reverse (both run counter-clockwise around the square)
+        let [s0, s1] = crate::seam::ends(d);
+        let start = &lists[s0 as usize];
+        let mut end = vec![lists[s1 as usize][0]];
+        end.extend(start[1..].iter().rev().map(|q| {
+            let mut q = *q;
+            q[d] = 1.0;
+            q
+        }));
+        lists[s1 as usize] = end;
     }
+    let boundary: Vec<DVec2> = lists.concat();
     let nb = boundary.len();
     let edges: Vec<[usize; 2]> = (0..nb).map(|i| [i, (i + 1) % nb]).collect();
-    let scale = parameter_scale(map);
     // vertices of an equilateral mesh of edge `size` over the area (shoelace of the
     // boundary points), the yardstick of the guard against refinement that does not settle
     let area = {
         let x: Vec<DVec2> = boundary.iter().map(|q| at(map, *q)).collect();
         0.5 * (0..x.len()).map(|k| x[k].perp_dot(x[(k + 1) % x.len()])).sum::<f64>()
     };
+    let mut scale = parameter_scale(map);
+    if let Some(d) = sd {
+        // across a ring: its mean width (area over the length around), not the width at
+        // the seam, which may be the narrowest or the widest place
+        let across = area.abs() / scale[d];
+        if across.is_finite() && across > 0.0 {
+            scale[1 - d] = across;
+        }
+        // a power of two around: spade splits a segment at `w0 a + w1 b` with
+        // `w0 = 1 - w1`, which is exactly `L` for `a = b = L = 2^k`, so the end side's
+        // points stay on it bit for bit and their copies land on it
+        scale[d] = 2f64.powi(scale[d].log2().round() as i32);
+    }
     let expected = (area.abs() / (0.433 * opts.size * opts.size) / 2.0) as usize + nb;
     let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x * scale.x, q.y * scale.y)).collect();
     let mut cdt = Cdt::bulk_load_cdt(verts, edges).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
@@ -209,7 +241,10 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
     stats.boundary = lap();
     for round in 0..200 {
         stats.rounds = round + 1;
-        let budget = opts.max_vertices.saturating_sub(cdt.num_vertices());
+        // a ring's rectangle may stretch triangles into slivers where its width varies
+        // strongly: spade's refinement stops at the guard below instead of running on
+        let most = if sd.is_some() { opts.max_vertices.min(50 * expected + 10_000) } else { opts.max_vertices };
+        let budget = most.saturating_sub(cdt.num_vertices());
         // the first round also bounds the area by the equilateral triangle of edge `size`
         // in the stretched rectangle: most vertices come from spade's own refinement
         let mut params = RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget);
@@ -231,7 +266,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             )));
         }
         // map the new vertices (in parallel: one spline evaluation each)
-        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| v.position()).collect();
+        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| snap(v.position(), scale)).collect();
         // vertices from `first_new` on are new since the last scan: a triangle or segment of
         // older vertices only existed then and passed (inserting a point only makes
         // triangles that have it as a vertex; a split edge's triangles are gone)
@@ -274,12 +309,19 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
                     opts.det_j_ratio.is_some_and(|r| longest > opts.size / 8.0 && dmin > 0.0 && dmax > r * dmin);
                 // an inverted image is split while it is not tiny (a folded map stays folded)
                 let inverted = (area.is_nan() || area <= 0.0) && longest > opts.size / 64.0;
+                // a triangle on both sides of a seam would fold when they are identified
+                let spans = sd.is_some_and(|d| {
+                    let q = v.map(|i| pos[i]);
+                    let end = if d == 0 { scale.x } else { scale.y };
+                    let c = |p: Point2<f64>| if d == 0 { p.x } else { p.y };
+                    q.iter().any(|&p| c(p) == 0.0) && q.iter().any(|&p| c(p) == end)
+                });
                 let curved_bad = || {
                     probe
                         .as_ref()
                         .is_some_and(|pr| longest > opts.size / 64.0 && pr.curved_min(map, &v.map(param)) <= 0.0)
                 };
-                (longest > opts.size || inverted || varies || curved_bad()).then(|| {
+                (longest > opts.size || inverted || varies || spans || curved_bad()).then(|| {
                     let (a, b) = (v[e], v[(e + 1) % 3]);
                     // an edge k times too long is cut into k pieces at once (fewer rounds)
                     let k = if longest > 2.0 * opts.size { (longest / opts.size).ceil().min(64.0) as usize } else { 2 };
@@ -300,6 +342,10 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             .filter_map(|&[a, b]| {
                 let (p, q) = (param(a), param(b));
                 let side = side_of(p, q)?;
+                // the seam is interior: no chord to keep near a side
+                if sd.is_some_and(|d| crate::seam::ends(d).contains(&side)) {
+                    return None;
+                }
                 let (t0, t1) = match side {
                     Side::South | Side::North => (p.x, q.x),
                     Side::East | Side::West => (p.y, q.y),
@@ -313,8 +359,8 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         split.sort_unstable_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)).then(y.2.cmp(&x.2)));
         split.dedup_by_key(|x| (x.0, x.1));
         stats.criteria += lap();
-        if split.is_empty() {
-            let mesh = build(&cdt, phys, scale)?;
+        if split.is_empty() && sd.is_none_or(|d| seam_mirrors(&cdt, d, scale).is_empty()) {
+            let mesh = build(&cdt, phys, scale, sd.map(|d| (d, crate::seam::wall_names(map, d))))?;
             stats.build = lap();
             return Ok((mesh, stats));
         }
@@ -342,6 +388,12 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
                 let hint = spade::handles::FixedVertexHandle::from_index(a);
                 let h = cdt.insert_with_hint(m, hint).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
                 inserted.push(h);
+            }
+        }
+        // the points refinement put on one side of a seam, copied to the other
+        if let Some(d) = sd {
+            for m in seam_mirrors(&cdt, d, scale) {
+                inserted.push(cdt.insert(m).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?);
             }
         }
         settled = inserted.iter().all(|&h| star_meets_limits(&cdt, h, limit));
@@ -383,6 +435,45 @@ fn star_meets_limits(cdt: &Cdt, v: spade::handles::FixedVertexHandle, limit: Ang
     })
 }
 
+/// The points to insert so that the two sides of the seam across direction `d` (at
+/// coordinate `0` and `L_d` of the stretched rectangle) hold the same points: each
+/// vertex of one side without a partner at the same coordinate along the side (bit for
+/// bit) on the other, copied there. Sorted (deterministic).
+fn seam_mirrors(cdt: &Cdt, d: usize, scale: DVec2) -> Vec<Point2<f64>> {
+    let end = scale[d];
+    let split = |p: Point2<f64>| if d == 0 { (p.x, p.y) } else { (p.y, p.x) };
+    let make = |fixed: f64, along: f64| if d == 0 { Point2::new(fixed, along) } else { Point2::new(along, fixed) };
+    let (mut lo, mut hi) = (BTreeSet::new(), BTreeSet::new());
+    for v in cdt.vertices() {
+        let (fixed, along) = split(snap(v.position(), scale));
+        if fixed == 0.0 {
+            lo.insert(along.to_bits());
+        } else if fixed == end {
+            hi.insert(along.to_bits());
+        }
+    }
+    let mut out: Vec<Point2<f64>> = lo.difference(&hi).map(|&a| make(end, f64::from_bits(a))).collect();
+    out.extend(hi.difference(&lo).map(|&a| make(0.0, f64::from_bits(a))));
+    out
+}
+
+/// A vertex position with a coordinate within `1e-12` (relative) of a side of the
+/// rectangle `[0, L_xi] x [0, L_eta]` put on it: spade splits a segment at
+/// `w0 a + w1 b`, which can miss `L` by an ulp; the vertex is on the segment all the same
+/// (spade inserts it into the edge).
+fn snap(p: Point2<f64>, scale: DVec2) -> Point2<f64> {
+    let s = |x: f64, l: f64| {
+        if (x - l).abs() <= 1e-12 * l {
+            l
+        } else if x.abs() <= 1e-12 * l {
+            0.0
+        } else {
+            x
+        }
+    };
+    Point2::new(s(p.x, scale.x), s(p.y, scale.y))
+}
+
 /// The side of a boundary edge from its parameters.
 fn side_of(a: DVec2, b: DVec2) -> Option<Side> {
     if a.y == 0.0 && b.y == 0.0 {
@@ -398,26 +489,72 @@ fn side_of(a: DVec2, b: DVec2) -> Option<Side> {
     }
 }
 
-fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
+/// The mesh of the triangulation; with a seam `(d, wall names)`, the vertices of the
+/// seam's end side are identified with the start side's and its edges are no boundary.
+fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2, seam: Option<(usize, [&str; 2])>) -> Result<Mesh> {
     // x / L is exactly 0 or 1 on the sides (their points are exactly 0 or L)
-    let params: Vec<DVec2> =
-        cdt.vertices().map(|v| DVec2::new(v.position().x / scale.x, v.position().y / scale.y)).collect();
+    let mut params: Vec<DVec2> = cdt
+        .vertices()
+        .map(|v| {
+            let p = snap(v.position(), scale);
+            DVec2::new(p.x / scale.x, p.y / scale.y)
+        })
+        .collect();
+    let mut points = points;
+    // the index of each vertex in the mesh (a seam's end side: its start-side partner's)
+    let mut index: Vec<usize> = (0..params.len()).collect();
+    if let Some((d, _)) = seam {
+        let start: HashMap<u64, usize> =
+            params.iter().enumerate().filter(|(_, q)| q[d] == 0.0).map(|(i, q)| (q[1 - d].to_bits(), i)).collect();
+        for (i, q) in params.iter().enumerate().filter(|(_, q)| q[d] == 1.0) {
+            index[i] = *start
+                .get(&q[1 - d].to_bits())
+                .ok_or_else(|| MeshError::Triangulation(format!("seam vertex {i} at {q} has no partner")))?;
+        }
+        // the kept vertices numbered in order; an end-side vertex takes its partner's number
+        let mut new = vec![usize::MAX; params.len()];
+        let mut next = 0;
+        for (i, slot) in new.iter_mut().enumerate() {
+            if index[i] == i {
+                *slot = next;
+                next += 1;
+            }
+        }
+        index = index.iter().map(|&k| new[k]).collect();
+        let keep: Vec<bool> = params.iter().map(|q| q[d] != 1.0).collect();
+        params = params.iter().zip(&keep).filter(|(_, &k)| k).map(|(q, _)| *q).collect();
+        points = points.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| *p).collect();
+    }
     let mut cells = Vec::with_capacity(3 * cdt.num_inner_faces());
     for f in cdt.inner_faces() {
-        cells.extend(f.vertices().map(|h| h.fix().index()));
+        let v = f.vertices().map(|h| index[h.fix().index()]);
+        if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
+            return Err(MeshError::Triangulation(format!("triangle {v:?} collapses where the seam is merged")));
+        }
+        cells.extend(v);
     }
     let mut boundary = Vec::new();
     for e in cdt.undirected_edges().filter(|e| e.is_constraint_edge()) {
-        let [a, b] = e.vertices().map(|h| h.fix().index());
-        let Some(side) = side_of(params[a], params[b]) else {
+        let [va, vb] = e.vertices();
+        let [a, b] = [va, vb].map(|h| h.fix().index());
+        let param = |p: Point2<f64>| DVec2::new(p.x / scale.x, p.y / scale.y);
+        let (pa, pb) = (param(snap(va.position(), scale)), param(snap(vb.position(), scale)));
+        let Some(side) = side_of(pa, pb) else {
             return Err(MeshError::Triangulation(format!("constraint edge {a}-{b} is not on a side")));
         };
+        if seam.is_some_and(|(d, _)| crate::seam::ends(d).contains(&side)) {
+            continue;
+        }
+        let [a, b] = [index[a], index[b]];
+        if a == b {
+            return Err(MeshError::Triangulation(format!("wall edge at node {a} collapses where the seam is merged")));
+        }
         // counter-clockwise around the square
         let forward = match side {
-            Side::South => params[a].x < params[b].x,
-            Side::East => params[a].y < params[b].y,
-            Side::North => params[a].x > params[b].x,
-            Side::West => params[a].y > params[b].y,
+            Side::South => pa.x < pb.x,
+            Side::East => pa.y < pb.y,
+            Side::North => pa.x > pb.x,
+            Side::West => pa.y > pb.y,
         };
         let nodes = if forward { vec![a, b] } else { vec![b, a] };
         boundary.push(BoundaryEdge { side, nodes });
@@ -433,6 +570,14 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
         }
     };
     boundary.sort_by(|a, b| (a.side as usize).cmp(&(b.side as usize)).then(along(a).total_cmp(&along(b))));
+    let mut names = crate::side_names();
+    let mut periodic = [false, false];
+    if let Some((d, walls)) = seam {
+        periodic[d] = true;
+        for (side, name) in crate::seam::ends(1 - d).into_iter().zip(walls) {
+            names[side as usize] = name.into();
+        }
+    }
     Ok(Mesh {
         points,
         params,
@@ -441,8 +586,8 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2) -> Result<Mesh> {
         cells,
         boundary,
         structured: None,
-        periodic: [false, false],
-        names: crate::side_names(),
+        periodic,
+        names,
         groups: None,
     })
 }

@@ -184,7 +184,7 @@ pub fn validate(mesh: &Mesh, format: Format) -> Result<()> {
             "no duplicate nodes",
             dup.len(),
             format!("nodes {a} and {b} coincide at ({}, {})", p.x, p.y),
-            "a seam left open (a ring cut into a four-sided map?): solve the ring as a ring document, whose periodic seam is merged",
+            "a seam left open: two sides of the map meet but do not coincide within 1e-6 of the diameter, so they are not merged as a cut ring's seam (crates/mesh/src/seam.rs); solve the ring as a ring document, whose periodic seam is merged",
         ));
     }
     if format == Format::OpenFoam {

@@ -6,31 +6,38 @@ mod common;
 use std::collections::HashMap;
 use std::path::Path;
 
-use common::{annulus, ring, signed_area};
+use common::{annulus, cut_ring, ring, signed_area};
 use winslow_mesh::formats::{write, Format};
 use winslow_mesh::high_order::elevate;
 use winslow_mesh::{structured, unstructured, DVec2, Distribution, Mesh, Side, StructuredOptions, UnstructuredOptions};
 
-fn meshes() -> Vec<Mesh> {
+/// Meshes and the maps they were made on: a quarter annulus structured and
+/// unstructured, a periodic ring structured, then rings whose seam is shared: the ring
+/// and a cut ring (west = east) triangulated, the cut ring structured.
+fn cases() -> Vec<(Mesh, winslow::Surface)> {
     let map = annulus();
     let opts = StructuredOptions {
         points: [13, 7],
         distribution: [Distribution::Uniform, Distribution::Arctan { strength: 6.0 }],
     };
+    let tri = |m: &winslow::Surface| unstructured(m, &UnstructuredOptions { size: 0.4, ..Default::default() }).unwrap();
+    let cut = cut_ring(true, 0.0);
     vec![
-        structured(&map, &opts).unwrap(),
-        unstructured(&map, &UnstructuredOptions { size: 0.25, ..Default::default() }).unwrap(),
-        structured(&ring(), &StructuredOptions { points: [5, 24], distribution: opts.distribution.clone() }).unwrap(),
+        (structured(&map, &opts).unwrap(), map.clone()),
+        (unstructured(&map, &UnstructuredOptions { size: 0.25, ..Default::default() }).unwrap(), map),
+        (
+            structured(&ring(), &StructuredOptions { points: [5, 24], distribution: opts.distribution.clone() })
+                .unwrap(),
+            ring(),
+        ),
+        (tri(&ring()), ring()),
+        (tri(&cut), cut.clone()),
+        (structured(&cut, &StructuredOptions::uniform(24, 5)).unwrap(), cut),
     ]
 }
 
-/// The map a mesh of [`meshes`] was made on.
-fn map_of(mesh: &Mesh) -> winslow::Surface {
-    if mesh.periodic[1] {
-        ring()
-    } else {
-        annulus()
-    }
+fn meshes() -> Vec<Mesh> {
+    cases().into_iter().map(|c| c.0).collect()
 }
 
 fn side_counts(mesh: &Mesh) -> [usize; 4] {
@@ -127,9 +134,9 @@ fn read_msh(text: &str, mesh: &Mesh) {
 #[test]
 fn gmsh_round_trip() {
     let scratch = tempfile::tempdir().unwrap();
-    for mesh in meshes() {
+    for (mesh, map) in cases() {
         for p in 1..=3 {
-            let m = elevate(&mesh, &map_of(&mesh), p).unwrap();
+            let m = elevate(&mesh, &map, p).unwrap();
             let path = scratch.path().join(format!("m{p}.msh"));
             write(&m, &path, Format::Gmsh).unwrap();
             read_msh(&std::fs::read_to_string(&path).unwrap(), &m);
@@ -149,9 +156,9 @@ fn xml_array<'a>(text: &'a str, name: &str) -> Vec<&'a str> {
 #[test]
 fn vtu_round_trip() {
     let scratch = tempfile::tempdir().unwrap();
-    for mesh in meshes() {
+    for (mesh, map) in cases() {
         for p in 1..=3 {
-            let m = elevate(&mesh, &map_of(&mesh), p).unwrap();
+            let m = elevate(&mesh, &map, p).unwrap();
             let path = scratch.path().join(format!("m{p}.vtu"));
             write(&m, &path, Format::Vtu).unwrap();
             let text = std::fs::read_to_string(&path).unwrap();
@@ -284,7 +291,8 @@ fn su2_round_trip() {
 #[test]
 fn plot3d_round_trip_and_refusals() {
     let scratch = tempfile::tempdir().unwrap();
-    let [s, u, r] = &meshes()[..] else { unreachable!() };
+    let all = meshes();
+    let (s, u, r) = (&all[0], &all[1], &all[2]);
     // a ring is an O-grid closed by repeating its seam line (JMAX = 24 + 1)
     let path = scratch.path().join("r.xyz");
     write(r, &path, Format::Plot3d).unwrap();

@@ -182,11 +182,9 @@ fn first_cell_heights_on_a_ring_lie_within_h_over_g_and_h() {
         Err(MeshError::Layer { side, why, .. }) => assert!(side == "south" && why.contains("seam"), "{why}"),
         other => panic!("{other:?}"),
     }
-    // an unstructured mesh would leave the seam a crack: refused
-    assert!(matches!(
-        unstructured(&map, &UnstructuredOptions { size: 0.3, ..Default::default() }),
-        Err(MeshError::Unsupported { .. })
-    ));
+    // an unstructured mesh shares the seam (tests/seams.rs): no boundary on it
+    let tri = unstructured(&map, &UnstructuredOptions { size: 0.3, ..Default::default() }).unwrap();
+    assert_eq!(tri.boundary_sides(), [Side::East, Side::West]);
 }
 
 #[test]

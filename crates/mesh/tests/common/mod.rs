@@ -64,3 +64,54 @@ pub fn ring() -> Surface {
     }
     Surface::new([ku, kv], cps, None).unwrap()
 }
+
+/// A ring cut into a four-sided map: between the circle of radius 0.5 about `(0.3, 0)`
+/// and the circle of radius 2 about the origin, linear across, around along exact NURBS
+/// circles (quadratic, four arcs, clamped knots) cut at angle 0, so two opposite sides
+/// are the same segment `[0.8, 2] x {0}` (to `gap`: the end side is moved by `gap` in
+/// `y`). `along_xi = false`: `xi` radial from the inner circle, `eta` counter-clockwise,
+/// south = north (the seam), walls west (inner) and east (outer); `along_xi = true`:
+/// `xi` counter-clockwise, `eta` from the outer circle inward (G+Smo's
+/// `male_casing_ring`), west = east, walls south (outer) and north (inner).
+pub fn cut_ring(along_xi: bool, gap: f64) -> Surface {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    // the nine control points and weights of a full circle of radius 1 about 0
+    let circle: Vec<([f64; 2], f64)> = vec![
+        ([1.0, 0.0], 1.0),
+        ([1.0, 1.0], w),
+        ([0.0, 1.0], 1.0),
+        ([-1.0, 1.0], w),
+        ([-1.0, 0.0], 1.0),
+        ([-1.0, -1.0], w),
+        ([0.0, -1.0], 1.0),
+        ([1.0, -1.0], w),
+        ([1.0, 0.0], 1.0),
+    ];
+    let around = KnotVector::new(2, vec![0.0, 0.0, 0.0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1.0, 1.0, 1.0]).unwrap();
+    let across = KnotVector::open_uniform(1, 1);
+    let wall = |k: usize, (c, r): (f64, f64)| {
+        let (p, _) = circle[k];
+        let dy = if k == 8 { gap } else { 0.0 };
+        [c + r * p[0], r * p[1] + dy]
+    };
+    let (inner, outer) = ((0.3, 0.5), (0.0, 2.0));
+    let mut cps = Vec::new();
+    let mut ws = Vec::new();
+    if along_xi {
+        for wall_of in [outer, inner] {
+            for (k, (_, wk)) in circle.iter().enumerate() {
+                cps.push(wall(k, wall_of));
+                ws.push(*wk);
+            }
+        }
+        Surface::new([around, across], cps, Some(ws)).unwrap()
+    } else {
+        for (k, (_, wk)) in circle.iter().enumerate() {
+            for wall_of in [inner, outer] {
+                cps.push(wall(k, wall_of));
+                ws.push(*wk);
+            }
+        }
+        Surface::new([across, around], cps, Some(ws)).unwrap()
+    }
+}
