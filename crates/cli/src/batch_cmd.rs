@@ -11,7 +11,6 @@
 use super::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use winslow::solve::warm::{warm_start, Warm};
 use winslow::{Input, Pipeline};
 
 #[derive(Args, Debug)]
@@ -163,30 +162,25 @@ struct Solved {
 /// Solve one shape: from `start` (the previous map of its chain) when given and the warm
 /// start applies, else cold by the pipeline.
 fn solve_shape(input: Input, start: Option<&Surface>, opts: &SolveOptions) -> winslow::Result<Solved> {
-    let mut why = None;
+    let mut pipeline = Pipeline::new(input, opts.clone());
     if let Some(prev) = start {
-        match &input {
-            Input::Boundary(b) => match warm_start(prev, b, opts) {
-                Ok(Warm::Solved(w)) => {
-                    let mut report = serde_json::to_value(&*w).map_err(|e| winslow::Error::Invalid(e.to_string()))?;
-                    report["warm_start"] = json!({ "used": true });
-                    let label = format!("verdict {:?}: {}", w.verdict, w.message);
-                    return Ok(Solved { map: w.map, report, bijective: true, label });
-                }
-                Ok(Warm::Cold(reason)) => why = Some(reason),
-                Err(e) => why = Some(format!("the warm start failed: {e}")),
-            },
-            _ => why = Some("a ring is solved cold".to_string()),
+        pipeline = pipeline.warm_start(prev.clone());
+    }
+    let to_json = |v: Result<Value, serde_json::Error>| v.map_err(|e| winslow::Error::Invalid(e.to_string()));
+    match pipeline.solve()? {
+        winslow::Solved::Warm(w) => {
+            let report = to_json(serde_json::to_value(&*w))?;
+            let label = format!("verdict {:?}: {}", w.verdict, w.message);
+            Ok(Solved { map: w.map, report, bijective: true, label })
+        }
+        solved => {
+            let sol = solved.into_map()?;
+            let report = to_json(serde_json::to_value(&sol.report))?;
+            let bijective = matches!(sol.report.verdict, Verdict::Certified | Verdict::DegenerateCorner);
+            let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+            Ok(Solved { map: sol.map, report, bijective, label })
         }
     }
-    let sol = Pipeline::new(input, opts.clone()).solve()?.into_map()?;
-    let mut report = serde_json::to_value(&sol.report).map_err(|e| winslow::Error::Invalid(e.to_string()))?;
-    if let Some(why) = why {
-        report["warm_start"] = json!({ "used": false, "reason": why });
-    }
-    let bijective = matches!(sol.report.verdict, Verdict::Certified | Verdict::DegenerateCorner);
-    let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
-    Ok(Solved { map: sol.map, report, bijective, label })
 }
 
 /// Solve one shape and write its map or failure record; its summary row, and its map

@@ -4,7 +4,6 @@
 //! `compare` (`winslow compare`: [`compare`]) and `sweep` (`winslow sweep`: [`Sweep`]).
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -18,9 +17,7 @@ use winslow::methods::Method;
 use winslow::multipatch::{Layout, MultipatchSolution};
 use winslow::pipeline::compare::{compare as core_compare, CompareEvent, CompareOptions, MethodChoice};
 use winslow::pipeline::sweep::{Seam, Sweep, SweepOptions};
-use winslow::solve::improve::{improve as core_improve, Improve};
-use winslow::verify::certificate::certify;
-use winslow::verify::quality::{boundary_deviation, quality};
+use winslow::solve::improve::Improve;
 use winslow::{Document, Error, Output, Pipeline, Solved, Verdict};
 
 use crate::convert::{json_to_py, to_py};
@@ -125,24 +122,25 @@ impl PyLayoutSolution {
     }
 }
 
-/// Solve a layout without the GIL (`winslow solve LAYOUT`), its stages to `progress`.
+/// Solve a layout, or a domain or plane graph laid out by the pipeline, without the GIL
+/// (`winslow solve LAYOUT`), its stages to `progress`.
 pub fn solve_layout(
     py: Python<'_>,
-    (layout, made): (Layout, Option<Value>),
+    input: winslow::Input,
     opts: &Options,
     progress: Option<&Py<PyAny>>,
 ) -> PyResult<PyLayoutSolution> {
     let mut raised = None;
     let result = py.detach(|| {
-        Pipeline::new(layout, opts.solve.clone()).run(&mut |s| notify(progress, &mut raised, || crate::solve::event(s)))
+        Pipeline::new(input, opts.solve.clone()).run(&mut |s| notify(progress, &mut raised, || crate::solve::event(s)))
     });
-    let sol = match outcome(raised, result)? {
-        Solved::Layout(sol) => *sol,
-        _ => return Err(invalid("the solve of a layout gave no multipatch result")),
+    let Solved::Layout { solution, laid_out } = outcome(raised, result)? else {
+        return Err(invalid("the solve of a layout gave no multipatch result"));
     };
+    let sol = *solution;
     let mut report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
-    if let Some(m) = made {
-        report["auto_layout"] = m;
+    if let Some(m) = laid_out {
+        report["auto_layout"] = serde_json::to_value(&*m).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
     }
     Ok(PyLayoutSolution { sol, report })
 }
@@ -201,38 +199,16 @@ pub fn improve<'py>(
         }
         None => None,
     };
-    let t0 = Instant::now();
-    let (out, deviation) = py
-        .detach(|| -> winslow::Result<_> {
-            let diameter = map.control_diameter();
-            let cert = certify(&map, &opts.certify)?;
-            let out = core_improve(&map, &cert, &*method, &opts.topology, opts.nonlinear, &opts.certify, diameter)?;
-            let deviation = boundary.as_ref().map(|b| boundary_deviation(&out.map, b, 400));
-            Ok((out, deviation))
-        })
-        .py_err()?;
-    let verdict = Verdict::of_certificate(&out.certificate);
-    let q = quality(&out.map);
-    let w = q.functionals.winslow;
-    let seconds = t0.elapsed().as_secs_f64();
-    let report = json!({
-        "version": env!("CARGO_PKG_VERSION"),
-        "method": method.name(),
-        "verdict": verdict,
-        "message": format!("{}; {}", out.certificate.message(), out.report.message),
-        "certificate": out.certificate,
-        "quality": q,
-        "winslow": w.is_finite().then_some(w),
-        "boundary_deviation": deviation,
-        "improvement": out.report,
-        "seconds": seconds,
-    });
+    let input = winslow::Input::Map { name, map, boundary };
+    let solved = py.detach(|| Pipeline::new(input, opts).method(method).solve()).py_err()?;
+    let Solved::Improved(out) = solved else { return Err(invalid("the improvement gave no map")) };
+    let report = serde_json::to_value(&out.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
     Ok(PySolution {
-        name: name.clone(),
-        map: PyMap { name, map: out.map },
+        name: out.name.clone(),
+        verdict: out.report.verdict.name().to_string(),
+        pipeline_seconds: out.report.seconds,
+        map: PyMap { name: out.name, map: out.map },
         report,
-        verdict: verdict.name().to_string(),
-        pipeline_seconds: seconds,
     })
 }
 

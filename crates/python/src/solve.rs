@@ -11,10 +11,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use winslow::io::{checked_boundary, ReadOptions};
+use winslow::io::ReadOptions;
 use winslow::pipeline::Observer;
 use winslow::solve::report::Solution;
-use winslow::solve::warm::{warm_start, Warm, WarmStart};
+use winslow::solve::warm::WarmStart;
 use winslow::{Document, Error, Input, Output, Pipeline, Stage, Surface};
 
 use crate::convert::{json_to_py, to_py};
@@ -35,11 +35,12 @@ pub struct PySolution {
 }
 
 /// How one shape was solved: cold by the pipeline (with the reason a warm start asked
-/// for did not apply), or from the previous map ([`warm_start`]).
+/// for did not apply), or from the previous map ([`Pipeline::warm_start`]).
 #[derive(Debug)]
 pub enum Outcome {
-    /// The pipeline's solution; why the start given was not used.
-    Cold(Box<Solution>, Option<String>),
+    /// The pipeline's solution (its report's `warm_start` says why a start given was not
+    /// used).
+    Cold(Box<Solution>),
     /// Solved from the previous map; the shape's name.
     Warm(Box<WarmStart>, String),
 }
@@ -48,7 +49,7 @@ impl Outcome {
     /// The map to start the next shape of a family from: this one's, when bijective.
     pub fn start_for_next(&self) -> Option<&Surface> {
         match self {
-            Outcome::Cold(s, _) => {
+            Outcome::Cold(s) => {
                 matches!(s.report.verdict, winslow::Verdict::Certified | winslow::Verdict::DegenerateCorner)
                     .then_some(&s.map)
             }
@@ -66,19 +67,15 @@ pub fn solve_input(
     opts: &winslow::SolveOptions,
     observer: &mut Observer<'_>,
 ) -> winslow::Result<Outcome> {
-    let mut why = None;
+    let name = input.name().to_string();
+    let mut pipeline = Pipeline::new(input, opts.clone());
     if let Some(prev) = start {
-        match &input {
-            Input::Boundary(b) => match warm_start(prev, b, opts) {
-                Ok(Warm::Solved(w)) => return Ok(Outcome::Warm(w, b.name.clone())),
-                Ok(Warm::Cold(reason)) => why = Some(reason),
-                Err(e) => why = Some(format!("the warm start failed: {e}")),
-            },
-            _ => why = Some("a ring is solved cold".to_string()),
-        }
+        pipeline = pipeline.warm_start(prev.clone());
     }
-    let sol = Pipeline::new(input, opts.clone()).run(observer).and_then(winslow::Solved::into_map)?;
-    Ok(Outcome::Cold(Box::new(sol), why))
+    match pipeline.run(observer)? {
+        winslow::Solved::Warm(w) => Ok(Outcome::Warm(w, name)),
+        solved => Ok(Outcome::Cold(Box::new(solved.into_map()?))),
+    }
 }
 
 impl PySolution {
@@ -87,16 +84,9 @@ impl PySolution {
     /// (with `"warm_start": {"used": false, "reason": ...}` when a start was given).
     pub fn of_outcome(outcome: Outcome, seconds: f64) -> PyResult<Self> {
         match outcome {
-            Outcome::Cold(sol, why) => {
-                let mut s = Self::of((*sol, seconds))?;
-                if let Some(why) = why {
-                    s.report["warm_start"] = json!({ "used": false, "reason": why });
-                }
-                Ok(s)
-            }
+            Outcome::Cold(sol) => Self::of((*sol, seconds)),
             Outcome::Warm(w, name) => {
-                let mut report = serde_json::to_value(&*w).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
-                report["warm_start"] = json!({ "used": true });
+                let report = serde_json::to_value(&*w).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
                 let verdict = w.verdict.name().to_string();
                 Ok(Self {
                     name: name.clone(),
@@ -206,20 +196,20 @@ pub fn document_arg(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Document
     }
 }
 
-/// The pipeline's input of a document (a boundary checked as the CLI does).
+/// The pipeline's input of a document for one map ([`Document::into_input`]: a boundary
+/// checked as the CLI does, a map's boundary, a ring); layouts, domains, graphs and volume
+/// boundaries are refused (`winslow.solve` solves those one at a time).
 pub fn input_of_document(doc: Document, reorient: bool) -> winslow::Result<Input> {
-    Ok(match doc {
-        Document::Ring(ring) => Input::Ring(ring),
-        doc @ Document::Map { .. } if doc.is_ring_map() => Input::Ring(doc.into_ring()?),
-        Document::Layout(l) => {
-            return Err(Document::Layout(l)
-                .wrong_kind(None, "solve_many takes boundaries, maps and rings (winslow.solve solves a layout)"))
-        }
-        doc => {
-            let (b, _) = checked_boundary(doc.into_boundary()?, &ReadOptions { reorient })?;
-            Input::Boundary(b)
-        }
-    })
+    let kind = doc.kind();
+    match doc.into_input(&ReadOptions { reorient })? {
+        input @ (Input::Boundary(_) | Input::Ring(_)) => Ok(input),
+        _ => Err(Error::DocumentKind {
+            path: None,
+            found: kind.into(),
+            needed: "solve_many takes boundaries, maps and rings (winslow.solve solves the others one at a time)"
+                .into(),
+        }),
+    }
 }
 
 /// One stage as a JSON event for the progress callback.
@@ -316,17 +306,14 @@ pub fn solve<'py>(
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let opts = options::parse(options)?;
-    let doc = match crate::runs::layout_of(document_arg(py, &input)?, &opts).py_err()? {
-        Ok(layout) => {
-            if start.is_some() {
-                return Err(errors::invalid("start= is for a boundary; a layout is solved cold"));
-            }
-            return Ok(Bound::new(py, crate::runs::solve_layout(py, layout, &opts, progress.as_ref())?)?.into_any());
+    let input = document_arg(py, &input)?.into_input(&ReadOptions { reorient: opts.reorient }).py_err()?;
+    if input.is_multipatch() {
+        if start.is_some() {
+            return Err(errors::invalid("start= is for a boundary; a layout is solved cold"));
         }
-        Err(doc) => doc,
-    };
+        return Ok(Bound::new(py, crate::runs::solve_layout(py, input, &opts, progress.as_ref())?)?.into_any());
+    }
     let start = start.map(|s| start_map(&s)).transpose()?;
-    let input = input_of_document(doc, opts.reorient).py_err()?;
     let (outcome, seconds) = run(py, input, start.as_ref(), &opts, progress.as_ref())?;
     Ok(Bound::new(py, PySolution::of_outcome(outcome, seconds)?)?.into_any())
 }

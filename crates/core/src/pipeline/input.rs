@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::multipatch::{Layout, MultipatchSolution};
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::volume::VolumeSolve;
+use crate::solve::warm::WarmStart;
 use crate::spline::surface::Surface;
 
 use super::start::Improved;
@@ -138,6 +139,8 @@ pub enum Solved {
     Volume(Box<VolumeSolve>),
     /// A map improved from a start ([`Input::Map`]).
     Improved(Box<Improved>),
+    /// A boundary solved from the previous shape's map ([`super::Pipeline::warm_start`]).
+    Warm(Box<WarmStart>),
 }
 
 impl Solved {
@@ -149,6 +152,7 @@ impl Solved {
             Solved::Layout { solution, .. } => solution.report.verdict,
             Solved::Volume(v) => Verdict::of_finding(&v.certificate.verdict),
             Solved::Improved(m) => m.report.verdict,
+            Solved::Warm(w) => w.verdict,
         }
     }
 
@@ -170,6 +174,7 @@ impl Solved {
             Solved::Layout { .. } => "multipatch result",
             Solved::Volume(_) => "volume",
             Solved::Improved(_) => "improved map",
+            Solved::Warm(_) => "warm-started map",
         }
     }
 }

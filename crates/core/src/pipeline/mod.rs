@@ -59,6 +59,8 @@ use crate::solve::options::SolveOptions;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
 use crate::solve::volume::{solve_volume, VolumeOptions};
+use crate::solve::warm::{warm_start, Warm, WarmNote, WarmStart};
+use crate::spline::surface::Surface;
 
 /// A stage of the pipeline, as the observer sees it.
 #[derive(Debug)]
@@ -90,6 +92,14 @@ pub enum Stage<'a> {
     /// An event of a layout's solve: its bases, a round of patch solves, the
     /// free-interface stage.
     Layout(&'a LayoutEvent),
+    /// A warm start was asked for ([`Pipeline::warm_start`]): whether it was used, and
+    /// why not (the cold solve's stages follow).
+    WarmStart {
+        /// Whether the shape is solved from the previous map.
+        used: bool,
+        /// Why not, when not.
+        reason: Option<&'a str>,
+    },
     /// A map given as the input is improved by `method` on its own basis
     /// ([`start`](mod@start)).
     Improve {
@@ -114,6 +124,7 @@ pub struct Pipeline {
     assembler: Arc<dyn EggAssembler>,
     method: Option<Arc<dyn Method>>,
     eta_refinement: EtaRefinement,
+    warm: Option<Surface>,
 }
 
 impl std::fmt::Debug for Pipeline {
@@ -135,7 +146,18 @@ impl Pipeline {
             assembler: Arc::new(CpuAssembler),
             method: None,
             eta_refinement: EtaRefinement::Adaptive,
+            warm: None,
         }
+    }
+
+    /// Start a boundary's solve from `previous`, the map of the previous shape of a family
+    /// ([`crate::solve::warm`]: the new sides knot-inserted onto its basis, the elasticity
+    /// correction, EGG on that fixed basis, the certificate): [`Solved::Warm`] when that
+    /// applies and is bijective; otherwise the solve runs cold and its report's
+    /// `warm_start` says why not ([`Stage::WarmStart`] tells the observer either way).
+    pub fn warm_start(mut self, previous: Surface) -> Self {
+        self.warm = Some(previous);
+        self
     }
 
     /// Assemble on `assembler` (the GPU crate's, or the CPU's, the default).
@@ -167,7 +189,16 @@ impl Pipeline {
     pub fn run(mut self, observer: &mut Observer<'_>) -> Result<Solved> {
         match &self.input {
             Input::Boundary(_) | Input::Ring(_) => {
-                self.run_keeping_hierarchy(observer).map(|(sol, _)| Solved::Map(Box::new(sol)))
+                let why = match self.warm.take() {
+                    Some(previous) => match self.try_warm(&previous, observer)? {
+                        Ok(w) => return Ok(Solved::Warm(w)),
+                        Err(why) => Some(why),
+                    },
+                    None => None,
+                };
+                let (mut sol, _) = self.run_keeping_hierarchy(observer)?;
+                sol.report.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
+                Ok(Solved::Map(Box::new(sol)))
             }
             Input::Layout(_) => self.run_layout(None, observer),
             Input::Domain(_) | Input::Graph(_) => {
@@ -198,6 +229,29 @@ impl Pipeline {
                     .map(|m| Solved::Improved(Box::new(m)))
             }
         }
+    }
+
+    /// The warm start from `previous` ([`Pipeline::warm_start`]): the solved shape, or
+    /// why it is solved cold; [`Stage::WarmStart`] to the observer.
+    fn try_warm(
+        &self,
+        previous: &Surface,
+        observer: &mut Observer<'_>,
+    ) -> Result<std::result::Result<Box<WarmStart>, String>> {
+        self.opts.validate()?;
+        let out = match &self.input {
+            Input::Boundary(b) => match warm_start(previous, b, &self.opts) {
+                Ok(Warm::Solved(w)) => Ok(w),
+                Ok(Warm::Cold(reason)) => Err(reason),
+                Err(e) => Err(format!("the warm start failed: {e}")),
+            },
+            other => Err(format!("a {} is solved cold", other.kind())),
+        };
+        let reason = out.as_ref().err().map(String::as_str);
+        if !observer(&Stage::WarmStart { used: out.is_ok(), reason }) {
+            return Err(Error::Cancelled);
+        }
+        Ok(out)
     }
 
     /// The automatic layout of a domain or a graph, with the options' fit.

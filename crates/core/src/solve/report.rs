@@ -233,6 +233,10 @@ pub struct Report {
     /// The similarity `x = centre + scale x̂` from the normalised coordinates the solve ran
     /// in (`boundary::normalise`); `null` when the input was solved as given.
     pub normalisation: Option<crate::boundary::normalise::Similarity>,
+    /// When a warm start was asked for ([`crate::Pipeline::warm_start`]) and did not
+    /// apply: `{"used": false, "reason": ...}`; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<crate::solve::warm::WarmNote>,
 }
 
 impl Report {
@@ -419,6 +423,7 @@ impl Solution {
             basis: h.basis.clone(),
             improvement: ctx.improvement,
             normalisation: (!h.similarity.is_identity()).then_some(h.similarity),
+            warm_start: None,
         };
         Self { name: name.to_string(), map, report }
     }

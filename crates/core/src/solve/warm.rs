@@ -40,12 +40,24 @@ use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate};
 use crate::verify::quality::{quality, Quality};
 
+/// Whether a warm start was used, and why not (the `warm_start` field of a report).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WarmNote {
+    /// Whether the shape was solved from the previous map.
+    pub used: bool,
+    /// Why not, when not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
 /// A shape solved from the previous shape's map.
 #[derive(Debug, Clone, Serialize)]
 pub struct WarmStart {
     /// The map (on the previous map's basis).
     #[serde(skip)]
     pub map: Surface,
+    /// `{"used": true}`.
+    pub warm_start: WarmNote,
     /// `"certified"` or `"degenerate-corner"` (a warm start is kept only when bijective).
     pub verdict: Verdict,
     /// The certificate's message and the solve's.
@@ -179,6 +191,7 @@ pub fn warm_start(prev: &Surface, boundary: &Boundary, opts: &SolveOptions) -> R
     Ok(Warm::Solved(Box::new(WarmStart {
         quality: quality(&map),
         map,
+        warm_start: WarmNote { used: true, reason: None },
         verdict,
         message,
         certificate: cert,
