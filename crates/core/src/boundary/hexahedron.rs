@@ -286,7 +286,7 @@ fn symmetry_sign(psi: &[usize; 8]) -> Option<f64> {
     let pi: Vec<usize> = axes.iter().map(|&a| [1, 2, 4].iter().position(|&b| b == a)).collect::<Option<_>>()?;
     let inversions = (0..3).flat_map(|i| (i + 1..3).map(move |j| (i, j))).filter(|&(i, j)| pi[i] > pi[j]).count();
     let flips = f.count_ones() as usize;
-    Some(if (inversions + flips) % 2 == 0 { 1.0 } else { -1.0 })
+    Some(if (inversions + flips).is_multiple_of(2) { 1.0 } else { -1.0 })
 }
 
 /// Six faces in any order and orientation as a validated [`VolumeBoundary`] named

@@ -214,7 +214,7 @@ pub fn volume_boundary_to_gismo_xml(b: &VolumeBoundary, comment: &str) -> String
                     let (sa, sb) = (face_side(a, db, vb), face_side(b, da, va));
                     // G+Smo's direction numbers: 0 = u (normal of sides 1, 2), 1 = v
                     let normal = |s: usize| usize::from(s >= 3);
-                    let at_end = |s: usize| s % 2 == 0;
+                    let at_end = |s: usize| s.is_multiple_of(2);
                     let (mut m, mut o) = ([0usize; 2], [1u8; 2]);
                     m[normal(sa)] = normal(sb);
                     m[1 - normal(sa)] = 1 - normal(sb);
