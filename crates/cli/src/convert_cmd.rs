@@ -1,7 +1,8 @@
 //! `winslow render` and `winslow convert`: a solved document drawn as a PNG, or written
 //! in another format (by the output's extension). Both take every document they can
 //! act on — a map (a ring map included), a multipatch result (or a G+Smo multipatch
-//! file, whose patches are maps), and for `convert` a volume — and name the kind they
+//! file, whose patches are maps), and for `convert` a volume or the six faces of one
+//! (JSON <-> G+Smo `<MultiPatch>`) — and name the kind they
 //! got otherwise.
 
 use super::*;
@@ -52,7 +53,7 @@ fn planar_exit(v: &Finding) -> i32 {
 }
 
 const CONVERT_NEEDS: &str =
-    "convert writes a map, a ring map, a multipatch result or a volume (run `winslow solve` first)";
+    "convert writes a map, a ring map, a multipatch result, a volume (run `winslow solve` first) or the faces of a volume";
 
 /// `winslow convert IN -o OUT`: certified again (the verdict travels with the file),
 /// written by the output's extension.
@@ -66,6 +67,7 @@ pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
     let doc = files::read(&a.map)?;
     let (what, extensions) = match doc {
         Document::Volume { .. } => ("volume", files::ext::VOLUME),
+        Document::VolumeBoundary(_) => ("volume boundary", files::ext::VOLUME_BOUNDARY),
         Document::Layout(_) | Document::Multipatch(_) => ("multipatch result", files::ext::MULTIPATCH),
         _ => ("map", files::ext::MAP),
     };
@@ -80,6 +82,12 @@ pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
             Ok(planar_exit(&certificate.verdict))
         }
         Document::Volume { name, volume } => loft_cmd::convert_volume(&name, &volume, &a.output),
+        // validated on read: the six faces share their edges and enclose a positive volume
+        Document::VolumeBoundary(b) => {
+            files::write(&a.output, &Output::VolumeBoundary(&b))?;
+            say!("{}: six faces, validated", b.name);
+            Ok(0)
+        }
         Document::Layout(ref layout) | Document::Multipatch(ref layout) => {
             let Some(maps) = patch_maps(layout) else { return Err(files::wrong_kind(&doc, &a.map, CONVERT_NEEDS)) };
             convert_patches(layout, maps, &a.output)
@@ -111,7 +119,8 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
 
 #[derive(Args, Debug)]
 pub(crate) struct ConvertArgs {
-    /// Map file (JSON map document, G+Smo XML or IGES; a THB map too), multipatch result or volume.
+    /// Map file (JSON map document, G+Smo XML or IGES; a THB map too), multipatch result, volume or
+    /// volume boundary.
     pub(crate) map: PathBuf,
     /// Output file; the format follows its extension.
     #[arg(short, long)]

@@ -128,6 +128,8 @@ pub(crate) mod ext {
     pub const MAP: &[&str] = &["json", "", "xml", "igs", "iges", "vtu", "vtk"];
     /// A volume.
     pub const VOLUME: &[&str] = &["json", "", "xml", "vtu", "vtk"];
+    /// The six faces of a volume (JSON or a G+Smo multipatch).
+    pub const VOLUME_BOUNDARY: &[&str] = &["json", "", "xml"];
     /// A multipatch result.
     pub const MULTIPATCH: &[&str] = &["json", "", "xml", "vtm"];
     /// A JSON document (layout, boundary).

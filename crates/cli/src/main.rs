@@ -136,9 +136,10 @@ enum Command {
     /// Write a map (JSON, G+Smo XML or IGES) in another format, chosen by the output's
     /// extension: .json, .xml (G+Smo), .igs/.iges (IGES 5.3 entity 128), .vtu (exact
     /// Bézier cells), .vtk (sampled structured grid); a multipatch result as .json, .xml
-    /// or .vtm; a volume as .json, .xml, .vtu or .vtk. The map is certified again.
+    /// or .vtm; a volume as .json, .xml, .vtu or .vtk; the six faces of a volume as .json
+    /// or .xml (a G+Smo multipatch). The map is certified again.
     #[command(
-        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml\nExample (a THB map to its exact tensor map):\n  winslow convert tests/data/thb/sector_thb.json -o out/sector_tensor.json"
+        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml\nExample (a THB map to its exact tensor map):\n  winslow convert tests/data/thb/sector_thb.json -o out/sector_tensor.json\nExample (the six faces of a volume as a G+Smo multipatch):\n  winslow convert tests/data/volumes/twisted-duct.json -o out/twisted-duct-faces.xml"
     )]
     Convert(ConvertArgs),
     /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,

@@ -27,6 +27,7 @@ use crate::state::{Probe, ViewKind, ViewerState};
 use crate::view::ViewTransform;
 
 mod side_panel;
+mod volume;
 
 /// Width of the colour bar strip in points.
 const BAR_WIDTH: f32 = 96.0;
@@ -312,6 +313,10 @@ impl ViewerApp {
 
     fn central(&mut self, ui: &mut Ui) {
         let full = ui.available_rect_before_wrap();
+        if self.volume_views(ui, full) {
+            self.drop_hint(ui, full);
+            return;
+        }
         if self.state.scene.is_none() {
             ui.painter().text(
                 full.center(),

@@ -5,7 +5,8 @@
 //! lines and control net, the folded elements and the verdict of the solver, and solve
 //! a boundary in a background thread while watching the residuals. A general domain or
 //! plane graph opens as its automatic multipatch layout (patch borders, irregular
-//! vertices), solved like any layout.
+//! vertices), solved like any layout. A volume (trivariate map) opens as three
+//! orthogonal slices with their `det J` heat maps, one slider per parameter direction.
 //!
 //! The numbers all come from the core crate `winslow`; this crate only arranges and
 //! draws them. State and logic (loading, the view transform, the colour scale, the
@@ -26,6 +27,7 @@ mod sections;
 pub mod solve_job;
 pub mod state;
 pub mod view;
+pub mod volume_view;
 
 pub use app::ViewerApp;
 pub use sampler::{CpuSampler, DetJSampler};

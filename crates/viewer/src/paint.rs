@@ -29,8 +29,12 @@ pub(crate) fn crosshair(painter: &egui::Painter, c: Pos2) {
 /// samples at their corners, and every cell with a non-positive corner painted flat in
 /// the fold colour on top (no blend of fold and scale colours).
 pub(crate) fn heat_mesh(mv: &MapView, scale: &ColourScale, pos: impl Fn(usize) -> Pos2) -> Shape {
-    let n = mv.sample.n;
-    let values = &mv.sample.values;
+    heat_mesh_values(mv.sample.n, &mv.sample.values, scale, pos)
+}
+
+/// [`heat_mesh`] of the `(n + 1)²` values of any uniform grid, `i` fastest (a volume's
+/// slice).
+pub(crate) fn heat_mesh_values(n: usize, values: &[f64], scale: &ColourScale, pos: impl Fn(usize) -> Pos2) -> Shape {
     let mut mesh = Mesh::default();
     mesh.vertices.reserve((n + 1) * (n + 1));
     for (k, &v) in values.iter().enumerate() {

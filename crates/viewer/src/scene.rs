@@ -308,6 +308,18 @@ impl Scene {
     pub fn open(path: &Path, sampler: &dyn DetJSampler, settings: SceneSettings) -> anyhow::Result<Self> {
         use anyhow::Context;
         let (doc, report) = read_with_report(path).with_context(|| format!("reading {}", path.display()))?;
+        Self::from_read(path, doc, report, sampler, settings)
+    }
+
+    /// [`Scene::open`] of a document already read from `path` with its stored report.
+    pub fn from_read(
+        path: &Path,
+        doc: Document,
+        report: Option<serde_json::Value>,
+        sampler: &dyn DetJSampler,
+        settings: SceneSettings,
+    ) -> anyhow::Result<Self> {
+        use anyhow::Context;
         // a map file may carry the solver's report
         let report = report.filter(|_| matches!(doc, Document::Map { .. }));
         let stored = report.as_ref().and_then(Certificate::from_stored);
@@ -400,7 +412,7 @@ impl Scene {
             }
             doc @ (Document::Volume { .. } | Document::VolumeBoundary(_)) => {
                 return Err(doc
-                    .wrong_kind(None, "the viewer draws planar documents (`winslow convert` writes a volume as .vtu or .vtk for ParaView)")
+                    .wrong_kind(None, "a planar document here (the viewer opens a volume file as three slices; the faces of a volume are solved by `winslow solve`)")
                     .into())
             }
         })

@@ -18,6 +18,16 @@ use crate::sampler::DetJSampler;
 use crate::scene::{Scene, SceneSettings};
 use crate::solve_job::{JobState, SolveJob};
 use crate::view::ViewTransform;
+use crate::volume_view::VolumeView;
+use winslow::io::Document;
+
+/// What a file opens as.
+// one value per open: no boxing
+#[allow(clippy::large_enum_variant)]
+enum Opened {
+    Scene(Scene),
+    Volume(VolumeView),
+}
 
 /// What is drawn (no effect on what is computed).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,6 +136,8 @@ impl Probe {
 pub struct ViewerState {
     /// What is loaded.
     pub scene: Option<Scene>,
+    /// A volume (trivariate map) loaded instead of a scene: three slices.
+    pub volume: Option<VolumeView>,
     /// Resolution and iso-line density.
     pub settings: SceneSettings,
     /// What is drawn.
@@ -174,6 +186,7 @@ impl ViewerState {
     pub fn new(sampler: Arc<dyn DetJSampler>) -> Self {
         Self {
             scene: None,
+            volume: None,
             settings: SceneSettings::default(),
             display: DisplayOptions::default(),
             solve: SolveSettings::default(),
@@ -200,9 +213,19 @@ impl ViewerState {
     /// Open a file; on failure the current scene stays and the error goes to the status
     /// line (and is returned).
     pub fn open(&mut self, path: &Path) -> Result<(), String> {
-        match Scene::open(path, self.sampler.as_ref(), self.settings) {
-            Ok(scene) => {
-                self.set_scene(scene);
+        use anyhow::Context;
+        let opened = winslow::io::read_with_report(path)
+            .with_context(|| format!("reading {}", path.display()))
+            .and_then(|(doc, report)| match doc {
+                Document::Volume { name, volume } => Ok(Opened::Volume(VolumeView::new(name, volume))),
+                doc => Scene::from_read(path, doc, report, self.sampler.as_ref(), self.settings).map(Opened::Scene),
+            });
+        match opened {
+            Ok(loaded) => {
+                match loaded {
+                    Opened::Scene(scene) => self.set_scene(scene),
+                    Opened::Volume(volume) => self.set_volume(volume),
+                }
                 self.status = Some(format!(
                     "opened {}",
                     path.file_name().map_or(path.display().to_string(), |n| n.to_string_lossy().into_owned())
@@ -217,8 +240,29 @@ impl ViewerState {
         }
     }
 
+    /// Show a volume instead of the scene (cancels a running solve).
+    pub fn set_volume(&mut self, volume: VolumeView) {
+        if let Some(job) = self.job.as_mut() {
+            job.cancel();
+        }
+        self.job = None;
+        self.comparison = None;
+        self.selected_method = None;
+        self.scene = None;
+        self.volume = Some(volume);
+        self.probe = None;
+        self.selected_fold = None;
+    }
+
+    /// Move the volume's slice of direction `dir` (0 `ξ`, 1 `η`, 2 `ζ`) to `at`
+    /// ([`VolumeView::set_slice`]); false without a volume or when nothing moved.
+    pub fn set_volume_slice(&mut self, dir: usize, at: f64) -> bool {
+        self.volume.as_mut().is_some_and(|v| v.set_slice(dir, at))
+    }
+
     /// Replace the scene (cancels a running solve).
     pub fn set_scene(&mut self, scene: Scene) {
+        self.volume = None;
         if let Some(job) = self.job.as_mut() {
             job.cancel();
         }
@@ -391,6 +435,9 @@ impl ViewerState {
 
     /// The colour scale of the current heat map.
     pub fn colour_scale(&self) -> Option<ColourScale> {
+        if let Some(v) = &self.volume {
+            return Some(v.colour_scale(self.display.scale));
+        }
         let scene = self.scene.as_ref()?;
         let mv = scene.map.as_ref()?;
         if scene.patches.is_empty() {

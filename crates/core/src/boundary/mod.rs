@@ -17,6 +17,7 @@
 //! | [`kinks`] | interior `C^0` points of the sides (`C^0` knots, zero speed, polygon corners), the smoothed basis `Σ¹` | §9 |
 //! | [`ring`] | ring (O-type) domains: two closed contours fitted on one periodic knot vector by arc length, and their hierarchy | §11.1 |
 //! | [`volume`] | [`VolumeBoundary`](volume::VolumeBoundary): the six faces of a hexahedral volume, their validation | §11.1 |
+//! | [`hexahedron`] | six faces in any order and orientation identified as the sides of the parameter cube | |
 //! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
@@ -30,6 +31,7 @@ pub mod cord_length;
 pub mod corners;
 pub mod families;
 pub mod fit;
+pub mod hexahedron;
 pub mod hierarchy;
 pub mod input_basis;
 pub mod kinks;

@@ -13,6 +13,7 @@
 //! | JSON with `domain` | [`Document::Domain`] (not validated: [`crate::domain::validate_domain`]) |
 //! | JSON with `graph` | [`Document::Graph`] (not validated: [`crate::domain::plane::build_graph`]) |
 //! | XML with `TensorBSpline3` / `TensorNurbs3` | [`Document::Volume`] |
+//! | XML with a `<MultiPatch>` of surfaces in space (`geoDim="3"`, not all in one plane `z = const`) | [`Document::VolumeBoundary`] (faces identified, validated) |
 //! | XML with a `<MultiPatch>` of surfaces (two patches or more, or interfaces) | [`Document::Layout`] |
 //! | XML with four curves / one tensor patch | [`Document::Boundary`] / [`Document::Map`] |
 //! | IGES (entity 128) | [`Document::Map`] |
@@ -31,6 +32,7 @@ use super::multipatch::gismo::{is_gismo_multipatch, parse_gismo_multipatch};
 use super::multipatch::json::parse_json_multipatch;
 use super::ring::ring_of_json;
 use super::volume::boundary::parse_volume_boundary_json;
+use super::volume::boundary_gismo::parse_gismo_faces;
 use super::volume::gismo::parse_gismo_volume;
 use super::volume::json::parse_volume_json;
 use super::{iges, read_text, surface_boundary_area};
@@ -264,6 +266,9 @@ fn xml_document(body: &str) -> Result<Document> {
         return Ok(Document::Volume { name: String::new(), volume: parse_gismo_volume(body)? });
     }
     if is_gismo_multipatch(body) {
+        if let Some(b) = parse_gismo_faces(body)? {
+            return Ok(Document::VolumeBoundary(b));
+        }
         let layout = parse_gismo_multipatch(body)?;
         // G+Smo wraps single patches in <MultiPatch> too: that is a map
         if layout.patches.len() != 1 || !layout.interfaces.is_empty() {

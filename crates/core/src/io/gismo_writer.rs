@@ -23,7 +23,7 @@ pub fn number(x: f64) -> String {
     }
 }
 
-fn knot_vector(out: &mut String, kv: &KnotVector, index: usize, indent: &str) {
+pub(crate) fn knot_vector(out: &mut String, kv: &KnotVector, index: usize, indent: &str) {
     let knots: Vec<String> = kv.knots().iter().map(|&k| number(k)).collect();
     let _ = writeln!(out, "{indent}<Basis type=\"BSplineBasis\" index=\"{index}\">");
     let _ = writeln!(out, "{indent}  <KnotVector degree=\"{}\">{}</KnotVector>", kv.degree(), knots.join(" "));

@@ -8,6 +8,7 @@
 //! | volume | `.json`, `.xml` (G+Smo `TensorBSpline3`), `.vtu` (Bézier hexahedra), `.vtk` (sampled grid) |
 //! | multipatch | `.json` (multipatch document), `.xml` (G+Smo `<MultiPatch>`), `.vtm` (VTK multiblock, one `.vtu` per patch in a folder beside it) |
 //! | layout, boundary, ring | `.json` |
+//! | volume boundary | `.json`, `.xml` (G+Smo `<MultiPatch>` of six faces, `geoDim="3"`) |
 //! | picture | `.png` |
 //!
 //! A file without an extension is JSON (pictures excepted). Any other extension is an
@@ -105,12 +106,8 @@ impl Output<'_> {
             Output::Map { .. } => ".json, .xml, .igs, .iges, .vtu or .vtk",
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
-            Output::Layout(_)
-            | Output::Boundary(_)
-            | Output::Ring(_)
-            | Output::Domain(_)
-            | Output::Graph(_)
-            | Output::VolumeBoundary(_) => ".json",
+            Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => ".json",
+            Output::VolumeBoundary(_) => ".json or .xml",
             Output::Picture(_) => ".png",
         }
     }
@@ -164,6 +161,7 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Ring(r), "json" | "") => write_json(path, &ring_to_json(r)),
         (Output::Domain(d), "json" | "") => write_json(path, &super::domain::domain_to_json(d)),
         (Output::VolumeBoundary(b), "json" | "") => write_json(path, &super::volume::volume_boundary_to_json(b)),
+        (Output::VolumeBoundary(b), "xml") => text(super::volume::volume_boundary_to_gismo_xml(b, &b.name)),
         (Output::Graph(g), "json" | "") => write_json(path, &super::graph::graph_to_json(g)),
         (Output::Picture(img), "png") => write_png(path, img),
         _ => Err(refused()),

@@ -134,6 +134,56 @@ impl Face {
         Ok(Self::from_slab(self.slab().elevated_in(dir)?))
     }
 
+    /// The same surface with `s` and `t` exchanged: `g(s, t) = f(t, s)` (control point
+    /// `(i, j)` of `f` becomes `(j, i)`).
+    pub fn transposed(&self) -> Self {
+        let [ns, nt] = self.shape();
+        let perm = |k: usize| (k % nt) * ns + k / nt;
+        Self {
+            knots: [self.knots[1].clone(), self.knots[0].clone()],
+            control_points: (0..ns * nt).map(|k| self.control_points[perm(k)]).collect(),
+            weights: self.weights.as_ref().map(|w| (0..ns * nt).map(|k| w[perm(k)]).collect()),
+        }
+    }
+
+    /// The same surface with direction `dir` reversed on its domain `[a, b]`:
+    /// `g(.., u_dir, ..) = f(.., a + b - u_dir, ..)` (knots `a + b - u` in reverse order,
+    /// control points reversed in that direction).
+    pub fn reversed_in(&self, dir: usize) -> Result<Self> {
+        let kv = &self.knots[dir];
+        let (a, b) = kv.domain();
+        let knots: Vec<f64> = kv
+            .knots()
+            .iter()
+            .rev()
+            .map(|&u| {
+                if u == a {
+                    b
+                } else if u == b {
+                    a
+                } else {
+                    a + b - u
+                }
+            })
+            .collect();
+        let mut out_knots = self.knots.clone();
+        out_knots[dir] = KnotVector::new(kv.degree(), knots)?;
+        let [ns, nt] = self.shape();
+        let perm = |k: usize| {
+            let (i, j) = (k % ns, k / ns);
+            if dir == 0 {
+                j * ns + (ns - 1 - i)
+            } else {
+                (nt - 1 - j) * ns + i
+            }
+        };
+        Ok(Self {
+            knots: out_knots,
+            control_points: (0..ns * nt).map(|k| self.control_points[perm(k)]).collect(),
+            weights: self.weights.as_ref().map(|w| (0..ns * nt).map(|k| w[perm(k)]).collect()),
+        })
+    }
+
     /// The same surface with knot domains mapped to `[0, 1]`.
     pub fn normalized(&self) -> Self {
         Self { knots: self.knots.each_ref().map(KnotVector::normalized), ..self.clone() }
@@ -181,6 +231,24 @@ mod tests {
                 assert!((ds[c] - (p[c] - m[c]) / (2.0 * h)).abs() < 1e-6);
                 assert!((dt[c] - (q[c] - n[c]) / (2.0 * h)).abs() < 1e-6);
             }
+        }
+    }
+
+    /// Transposition and reversal are the surface composed with `(s, t) -> (t, s)` and
+    /// `s -> 1 - s` / `t -> 1 - t`, B-spline and NURBS; twice is the identity.
+    #[test]
+    fn symmetries_compose_the_parameters() {
+        for rational in [false, true] {
+            let f = sample(rational);
+            let (tr, r0, r1) = (f.transposed(), f.reversed_in(0).unwrap(), f.reversed_in(1).unwrap());
+            for &(s, t) in &[(0.1, 0.7), (0.5, 0.25), (0.93, 0.02), (0.0, 1.0)] {
+                let close = |a: Point3, b: Point3| (0..3).all(|c| (a[c] - b[c]).abs() < 1e-12);
+                assert!(close(tr.eval(t, s), f.eval(s, t)));
+                assert!(close(r0.eval(1.0 - s, t), f.eval(s, t)));
+                assert!(close(r1.eval(s, 1.0 - t), f.eval(s, t)));
+            }
+            assert_eq!(tr.transposed(), f);
+            assert_eq!(r1.reversed_in(1).unwrap().control_points, f.control_points);
         }
     }
 

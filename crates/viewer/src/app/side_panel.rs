@@ -6,8 +6,11 @@ use super::*;
 impl ViewerApp {
     pub(super) fn side_panel(&mut self, ui: &mut Ui) {
         ui.add_space(4.0);
+        if self.volume_panel(ui) {
+            return;
+        }
         let Some(scene) = &self.state.scene else {
-            ui.label("Open a boundary, ring, map, domain, graph or multipatch file: File > Open, drag and drop, or a path on the command line.");
+            ui.label("Open a boundary, ring, map, domain, graph, multipatch or volume file: File > Open, drag and drop, or a path on the command line.");
             return;
         };
         file_section(ui, scene);

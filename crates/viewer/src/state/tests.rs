@@ -382,3 +382,86 @@ fn opens_and_solves_a_ring() {
     let p = t.scene.as_ref().unwrap().boundary.problem.clone().unwrap();
     assert!(p.contains("not inside") && !t.can_solve(), "{p}");
 }
+
+/// A curved volume of degrees (2, 2, 1) with `det J > 0`, rational when `weights`.
+fn curved_volume(rational: bool) -> winslow::spline::volume::Volume {
+    use winslow::spline::knots::KnotVector;
+    let k = [KnotVector::open_uniform(2, 2), KnotVector::open_uniform(2, 1), KnotVector::open_uniform(1, 2)];
+    let shape = k.each_ref().map(KnotVector::num_basis);
+    let n: usize = shape.iter().product();
+    let cps = (0..n)
+        .map(|q| {
+            let (i, j, l) =
+                ((q % shape[0]) as f64, (q / shape[0] % shape[1]) as f64, (q / (shape[0] * shape[1])) as f64);
+            [i + 0.1 * j * l, j + 0.05 * i * i, 0.8 * l + 0.1 * i]
+        })
+        .collect();
+    let w = rational.then(|| (0..n).map(|q| 1.0 + 0.2 * ((q * 5) % 3) as f64).collect());
+    winslow::spline::volume::Volume::new(k, cps, w).unwrap()
+}
+
+/// A volume file opens as three slices; each slice's surface and samples are the volume
+/// at the slice parameter (B-spline and NURBS), its heat map the volume's `det J`
+/// there; moving a slider moves the slice; opening a map afterwards drops the volume.
+#[test]
+fn a_volume_opens_as_three_slices_of_the_volume() {
+    let scratch = tempfile::tempdir().unwrap();
+    for rational in [false, true] {
+        let vol = curved_volume(rational);
+        let path = scratch.path().join(format!("vol-{rational}.json"));
+        let out = winslow::Output::Volume { name: "vol", volume: &vol, label: "", extra: None };
+        winslow::write(&path, &out).unwrap();
+        let mut s = state();
+        s.open(&path).unwrap();
+        assert!(s.scene.is_none());
+        let v = s.volume.as_ref().unwrap();
+        assert_eq!(v.verdict(), v.certificate.as_ref().unwrap().message());
+        assert!(matches!(
+            v.certificate.as_ref().unwrap().verdict,
+            winslow::verify::certificate::volume::VolumeFinding::Certified { .. }
+        ));
+        let check = |s: &ViewerState, dir: usize, at: f64| {
+            let v = s.volume.as_ref().unwrap();
+            let slice = &v.slices[dir];
+            assert_eq!((slice.dir, slice.at), (dir, at));
+            let free = crate::volume_view::free_directions(dir);
+            let at_u = |a: f64, b: f64| {
+                let mut u = [at; 3];
+                u[free[0]] = a;
+                u[free[1]] = b;
+                u
+            };
+            // the spline surface between the samples
+            for &(a, b) in &[(0.13, 0.71), (0.5, 0.5), (0.97, 0.02), (0.0, 1.0)] {
+                let (p, q) = (slice.surface.eval(a, b), v.volume.eval(at_u(a, b)));
+                assert!((0..3).all(|c| (p[c] - q[c]).abs() < 1e-12), "{dir} {at} ({a}, {b}): {p:?} {q:?}");
+            }
+            // the samples and their det J
+            let n = slice.n;
+            assert_eq!(slice.points.len(), (n + 1) * (n + 1));
+            for k in [0, 7, n * (n + 1) / 2, (n + 1) * (n + 1) - 1] {
+                let (a, b) = ((k % (n + 1)) as f64 / n as f64, (k / (n + 1)) as f64 / n as f64);
+                let q = v.volume.eval(at_u(a, b));
+                assert!((0..3).all(|c| (slice.points[k][c] - q[c]).abs() < 1e-12));
+                let d = v.volume.derivs(at_u(a, b)).det_j();
+                assert!((slice.det_j[k] - d).abs() <= 1e-12 * d.abs());
+                assert!(d > 0.0);
+            }
+        };
+        for dir in 0..3 {
+            check(&s, dir, 0.5);
+        }
+        assert!(s.set_volume_slice(1, 0.25) && !s.set_volume_slice(1, 0.25));
+        assert!(s.set_volume_slice(2, 1.0) && s.set_volume_slice(0, 0.0));
+        check(&s, 1, 0.25);
+        check(&s, 2, 1.0);
+        check(&s, 0, 0.0);
+        // one colour scale over the three slices
+        let scale = s.colour_scale().unwrap();
+        let v = s.volume.as_ref().unwrap();
+        let hi = v.slices.iter().flat_map(|s| s.det_j.iter().copied()).fold(0.0, f64::max);
+        assert_eq!(scale.hi, hi);
+        s.open(&data("quarter_annulus.json")).unwrap();
+        assert!(s.volume.is_none() && s.scene.is_some() && !s.set_volume_slice(0, 0.3));
+    }
+}

@@ -85,7 +85,7 @@ fn transposed_side(s: Side) -> Side {
     }
 }
 
-fn integers(node: roxmltree::Node, ctx: &str) -> Result<Vec<i64>> {
+pub(crate) fn integers(node: roxmltree::Node, ctx: &str) -> Result<Vec<i64>> {
     let mut out = Vec::new();
     for t in node.descendants().filter(|n| n.is_text()) {
         for tok in t.text().unwrap_or("").split_whitespace() {
@@ -96,6 +96,20 @@ fn integers(node: roxmltree::Node, ctx: &str) -> Result<Vec<i64>> {
         }
     }
     Ok(out)
+}
+
+/// The geometry ids of the patches of a `<MultiPatch>` element, in order (`<patches>`
+/// of type `id_range` or `id_index`).
+pub(crate) fn patch_ids(mp: roxmltree::Node) -> Result<Vec<i64>> {
+    let pnode = children(mp, "patches").next().ok_or_else(|| xml_err("MultiPatch", "missing <patches>"))?;
+    Ok(match pnode.attribute("type").unwrap_or("") {
+        "id_range" => match integers(pnode, "MultiPatch.patches")?.as_slice() {
+            &[first, last] if first <= last && last - first < 1 << 16 => (first..=last).collect(),
+            other => return Err(xml_err("MultiPatch.patches", format!("id_range needs 'first last', got {other:?}"))),
+        },
+        "id_index" => integers(pnode, "MultiPatch.patches")?,
+        other => return Err(xml_err("MultiPatch.patches", format!("unknown type {other:?} (id_range or id_index)"))),
+    })
 }
 
 /// Parse a G+Smo multipatch file into a layout (see the module documentation); the
@@ -124,15 +138,7 @@ pub fn parse_gismo_multipatch(text: &str) -> Result<Layout> {
             by_id.insert(id, g);
         }
     }
-    let pnode = children(mp, "patches").next().ok_or_else(|| xml_err("MultiPatch", "missing <patches>"))?;
-    let ids: Vec<i64> = match pnode.attribute("type").unwrap_or("") {
-        "id_range" => match integers(pnode, "MultiPatch.patches")?.as_slice() {
-            &[first, last] if first <= last && last - first < 1 << 16 => (first..=last).collect(),
-            other => return Err(xml_err("MultiPatch.patches", format!("id_range needs 'first last', got {other:?}"))),
-        },
-        "id_index" => integers(pnode, "MultiPatch.patches")?,
-        other => return Err(xml_err("MultiPatch.patches", format!("unknown type {other:?} (id_range or id_index)"))),
-    };
+    let ids = patch_ids(mp)?;
     let index: HashMap<i64, usize> = ids.iter().enumerate().map(|(k, &id)| (id, k)).collect();
     let mut patches = Vec::with_capacity(ids.len());
     let mut transposed = Vec::with_capacity(ids.len());

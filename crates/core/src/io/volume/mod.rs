@@ -6,16 +6,19 @@
 //! structured grid with `det J`, and the exact map as Bézier hexahedra).
 //!
 //! The six boundary faces of a volume (`formats-extensions.md`, "Volume boundary") are read from
-//! JSON in [`boundary`].
+//! JSON in [`boundary`], and from and to a G+Smo `<MultiPatch>` of six surfaces in
+//! [`boundary_gismo`] (any order and orientation, identified by their shared edges).
 //!
 //! Volumes are read by [`crate::io::read`] (a JSON `map` whose `degree` has three
 //! entries, or an XML file with a `TensorBSpline3` / `TensorNurbs3` geometry, gives a
 //! [`crate::io::Document::Volume`]) and written by [`crate::io::write`].
 
 pub mod boundary;
+pub mod boundary_gismo;
 pub mod gismo;
 pub mod json;
 pub mod vtk;
 
 pub use boundary::{volume_boundary_to_json, FaceJson};
+pub use boundary_gismo::volume_boundary_to_gismo_xml;
 pub use json::{volume_to_json, VolumeJson};
