@@ -26,6 +26,7 @@ pub mod graph;
 pub mod harmonic;
 pub mod holes;
 pub mod plane;
+pub mod polygon_map;
 pub mod reflex;
 pub mod template;
 pub mod validate;
