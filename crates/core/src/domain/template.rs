@@ -18,6 +18,10 @@
 //!    split edge is split too, by the image of the segment between the midpoints of that
 //!    edge and the opposite one (so the splits run through chains of four-sided faces and
 //!    the layout stays conforming), or into four when both pairs are split.
+//!    When the layout so made is not valid (a cut leaves its face or crosses another, in
+//!    every direction of the hole cuts), it is made again with the interior vertex and
+//!    the cuts placed by the inverse of the map of the face onto the polygon
+//!    ([`PolygonMap`], one-to-one on every face).
 //! 4. **Layout**: every face is now a patch (south, east, reversed north and reversed west
 //!    are its four sides; an edge shared by two patches is an interface), named `p0`,
 //!    `p1`, ..., each with the label of its face (`"domain"`, or the graph face's).
