@@ -18,6 +18,10 @@
 //!    split edge is split too, by the image of the segment between the midpoints of that
 //!    edge and the opposite one (so the splits run through chains of four-sided faces and
 //!    the layout stays conforming), or into four when both pairs are split.
+//!    When the layout so made is not valid (a cut leaves its face or crosses another, in
+//!    every direction of the hole cuts), it is made again with the interior vertex and
+//!    the cuts placed by the inverse of the map of the face onto the polygon
+//!    ([`PolygonMap`], one-to-one on every face).
 //! 4. **Layout**: every face is now a patch (south, east, reversed north and reversed west
 //!    are its four sides; an edge shared by two patches is an interface), named `p0`,
 //!    `p1`, ..., each with the label of its face (`"domain"`, or the graph face's).
@@ -34,6 +38,7 @@ use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
 use super::holes::{cut_holes, HoleCut};
 use super::plane::{build_graph, GraphReport, PlaneGraph};
+use super::polygon_map::PolygonMap;
 use super::reflex::{cut_reflex, line, segment_inside, CutReport};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
@@ -83,6 +88,10 @@ pub struct FaceReport {
     /// about (see `star_centre`) to the side midpoints, or the straight segment between the
     /// two midpoints of a face split in two when it lies inside.
     pub straight: bool,
+    /// The cuts are the preimages of the polygon's segments under the map of the face
+    /// onto the polygon ([`PolygonMap`], one-to-one on every face), taken when the layout
+    /// by the harmonic map of the polygon onto the faces is not valid.
+    pub inverse: bool,
 }
 
 /// An interior vertex whose valence is not 4.
@@ -338,6 +347,12 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
     lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0)
 }
 
+/// Refinements of the triangulation of a face for its [`PolygonMap`].
+const POLYGON_MAP_LEVELS: usize = 2;
+
+/// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
+const SPOKE_SAMPLES: usize = 64;
+
 /// The directions (degrees) of the cuts from holes that are tried; `NaN`: every hole
 /// toward its nearest neighbour ([`cut_holes`]).
 const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
@@ -356,37 +371,55 @@ fn lay_out_graph(
     t0: Instant,
 ) -> Result<AutoLayout> {
     if g.faces.iter().all(|f| f.holes.is_empty()) {
-        return lay_out_with(g, name, diameter, area, checked, opts, t0, f64::NAN);
+        let auto = lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, f64::NAN, false)?;
+        if validate_layout(&auto.layout).is_ok() {
+            return Ok(auto);
+        }
+        // the harmonic maps' cuts leave a face or cross: their preimages under the maps
+        // of the faces onto the polygons instead
+        return Ok(match lay_out_with(g, name, diameter, area, checked, opts, t0, f64::NAN, true) {
+            Ok(inv) if validate_layout(&inv.layout).is_ok() => inv,
+            _ => auto,
+        });
     }
     let mut best: Option<(AutoLayout, bool)> = None;
     let mut first_err = None;
     let mut tries = Vec::new();
-    for theta in HOLE_CUT_DIRECTIONS {
-        match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta) {
-            Ok(auto) => {
-                let valid = validate_layout(&auto.layout);
-                let min_angle = auto.report.corner_angles[0];
-                tries.push(HoleCutTry {
-                    direction: (!theta.is_nan()).then_some(theta),
-                    patches: auto.layout.patches.len(),
-                    min_corner_angle: Some(min_angle),
-                    error: valid.as_ref().err().map(ToString::to_string),
-                });
-                let better = best.as_ref().is_none_or(|(b, b_ok)| {
-                    (valid.is_ok() && !b_ok) || (valid.is_ok() == *b_ok && min_angle > b.report.corner_angles[0])
-                });
-                if better {
-                    best = Some((auto, valid.is_ok()));
+    for inverse in [false, true] {
+        if best.as_ref().is_some_and(|b| b.1) {
+            break;
+        }
+        for theta in HOLE_CUT_DIRECTIONS {
+            match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta, inverse) {
+                Ok(auto) => {
+                    let valid = validate_layout(&auto.layout);
+                    let min_angle = auto.report.corner_angles[0];
+                    tries.push(HoleCutTry {
+                        direction: (!theta.is_nan()).then_some(theta),
+                        inverse,
+                        patches: auto.layout.patches.len(),
+                        min_corner_angle: Some(min_angle),
+                        error: valid.as_ref().err().map(ToString::to_string),
+                    });
+                    let better = best.as_ref().is_none_or(|(b, b_ok)| {
+                        (valid.is_ok() && !b_ok)
+                            || (!inverse && valid.is_ok() == *b_ok && min_angle > b.report.corner_angles[0])
+                            || (inverse && valid.is_ok() && min_angle > b.report.corner_angles[0])
+                    });
+                    if better {
+                        best = Some((auto, valid.is_ok()));
+                    }
                 }
-            }
-            Err(e) => {
-                tries.push(HoleCutTry {
-                    direction: (!theta.is_nan()).then_some(theta),
-                    patches: 0,
-                    min_corner_angle: None,
-                    error: Some(e.to_string()),
-                });
-                first_err.get_or_insert(e);
+                Err(e) => {
+                    tries.push(HoleCutTry {
+                        direction: (!theta.is_nan()).then_some(theta),
+                        inverse,
+                        patches: 0,
+                        min_corner_angle: None,
+                        error: Some(e.to_string()),
+                    });
+                    first_err.get_or_insert(e);
+                }
             }
         }
     }
@@ -407,6 +440,9 @@ pub struct HoleCutTry {
     /// The direction, degrees from the `x` axis (and the opposite one); `null`: every
     /// hole toward its nearest neighbour.
     pub direction: Option<f64>,
+    /// The cuts of the faces' templates by the maps of the faces onto the polygons
+    /// ([`PolygonMap`]; tried when no direction gives a valid layout otherwise).
+    pub inverse: bool,
     /// Patches of the layout.
     pub patches: usize,
     /// Its smallest patch corner angle, degrees.
@@ -426,6 +462,7 @@ fn lay_out_with(
     opts: &LayoutOptions,
     t0: Instant,
     theta: f64,
+    inverse: bool,
 ) -> Result<AutoLayout> {
     let mut hole_cuts = Vec::new();
     cut_holes(&mut g, diameter, theta, &mut hole_cuts)?;
@@ -435,7 +472,8 @@ fn lay_out_with(
     // 3. templates: harmonic maps on the faces as they are, then the splits
     let split = edges_to_split(&g);
     let nf = g.faces.len();
-    let mut plans: Vec<(Template, usize, Option<HarmonicMap>)> = Vec::with_capacity(nf);
+    #[allow(clippy::type_complexity)]
+    let mut plans: Vec<(Template, usize, Option<HarmonicMap>, Option<PolygonMap>)> = Vec::with_capacity(nf);
     // per face: ten times its area over its perimeter (the fit scale of its cuts)
     let scales: Vec<f64> = (0..nf)
         .map(|f| {
@@ -456,11 +494,14 @@ fn lay_out_with(
         } else {
             Template::One
         };
-        let h = (template != Template::One).then(|| {
-            let curves: Vec<Curve> = sides.iter().map(|&s| g.side_curve(s)).collect();
-            HarmonicMap::new(&curves, opts.rings)
-        });
-        plans.push((template, k, h));
+        let curves: Vec<Curve> =
+            if template == Template::One { Vec::new() } else { sides.iter().map(|&s| g.side_curve(s)).collect() };
+        let h = (template != Template::One).then(|| HarmonicMap::new(&curves, opts.rings));
+        // a face the map cannot be built on keeps the harmonic map's cuts
+        let pm = (inverse && template != Template::One)
+            .then(|| PolygonMap::new(&curves, opts.rings, POLYGON_MAP_LEVELS).ok())
+            .flatten();
+        plans.push((template, k, h, pm));
     }
     let mut mids: Vec<Option<usize>> = Vec::new();
     for e in 0..split.len() {
@@ -473,7 +514,7 @@ fn lay_out_with(
     }
     mids.resize(g.vertices.len(), None);
     let mut faces = Vec::with_capacity(nf);
-    for (f, (template, k, h)) in plans.into_iter().enumerate() {
+    for (f, (template, k, h, pm)) in plans.into_iter().enumerate() {
         let label = g.faces[f].label.clone();
         let hv = halves(&g, f, &mids, k);
         let mut report = FaceReport {
@@ -484,6 +525,7 @@ fn lay_out_with(
             centre: None,
             harmonic_min_area_ratio: h.as_ref().map(|h| h.min_area_ratio),
             straight: false,
+            inverse: false,
         };
         match (template, h) {
             (Template::One, _) | (_, None) => {}
@@ -494,7 +536,15 @@ fn lay_out_with(
                     return Err(Error::Invalid(format!("layout: face {f} is not split in two as planned")));
                 };
                 let (p0, p2) = (g.vertices[m0], g.vertices[m2]);
-                let c = if h.min_area_ratio <= 0.0 && segment_inside(&g, f, p0, p2, 1e-9 * diameter) {
+                let through = pm.as_ref().and_then(|pm| {
+                    let mut pts: Vec<Point> = pm.spoke(r, SPOKE_SAMPLES)?.into_iter().rev().collect();
+                    pts.extend(pm.spoke(r + 2, SPOKE_SAMPLES)?.into_iter().skip(1));
+                    Some(pts)
+                });
+                let c = if let Some(pts) = through {
+                    report.inverse = true;
+                    spoke_curve(pts, p0, p2, diameter, scales[f], &opts.fit)?
+                } else if h.min_area_ratio <= 0.0 && segment_inside(&g, f, p0, p2, 1e-9 * diameter) {
                     report.straight = true;
                     line(p0, p2)
                 } else {
@@ -511,18 +561,32 @@ fn lay_out_with(
             (Template::Midpoint, Some(h)) => {
                 // a folded harmonic map: straight spokes from a point the face is
                 // star-shaped about, where there is one
-                let star = (h.min_area_ratio <= 0.0)
+                let inv = pm.as_ref().and_then(|pm| {
+                    let spokes: Option<Vec<Vec<Point>>> = (0..k).map(|s| pm.spoke(s, SPOKE_SAMPLES)).collect();
+                    Some((pm.centre()?, spokes?))
+                });
+                let star = (inv.is_none() && h.min_area_ratio <= 0.0)
                     .then(|| star_centre(&polyline(&g, &g.faces[f].sides), h.centre()))
                     .flatten();
                 report.straight = star.is_some();
-                let centre = g.add_vertex(star.unwrap_or_else(|| h.centre()));
+                report.inverse = inv.is_some();
+                let centre = g.add_vertex(inv.as_ref().map(|i| i.0).or(star).unwrap_or_else(|| h.centre()));
                 let mut spokes = Vec::with_capacity(k);
                 let mut parts = Vec::with_capacity(k);
                 for (s, side) in hv.iter().enumerate() {
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    let c = if star.is_some() {
+                    let c = if let Some((_, spokes)) = &inv {
+                        spoke_curve(
+                            spokes[s].clone(),
+                            g.vertices[centre],
+                            g.vertices[m],
+                            diameter,
+                            scales[f],
+                            &opts.fit,
+                        )?
+                    } else if star.is_some() {
                         line(g.vertices[centre], g.vertices[m])
                     } else {
                         spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?

@@ -467,3 +467,36 @@ fn folded_harmonic_maps_give_straight_cuts_from_a_star_centre() {
     conforming_bit_for_bit(&auto.layout);
     certified(&auto, &g.name);
 }
+
+/// The plates whose holes are within 1-5 % of the contour and of each other (seeds 1, 3,
+/// 7 and 9 of the corpus) and the U shape of seed 3: the harmonic maps of the polygons
+/// onto their thin faces put cuts outside the faces in every direction of the hole cuts;
+/// the preimages under the maps of the faces onto the polygons (one-to-one on every
+/// face) stay inside: the layout is valid, conforming, its patches' areas add up to the
+/// domain's, and plate 1 and the U shape are certified.
+#[test]
+fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
+    use super::corpus::DomainFamily;
+    use crate::domain::families::plate;
+    let mut domains: Vec<Domain> = [1, 3, 7, 9].into_iter().map(plate).collect();
+    domains.push(DomainFamily::U.generate(3));
+    for d in &domains {
+        let auto = auto_layout(d, &LayoutOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+        validate_layout(&auto.layout).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+        assert!(auto.report.faces.iter().any(|f| f.inverse), "{}", d.name);
+        conforming_bit_for_bit(&auto.layout);
+        let mut want = 0.0;
+        for (_, lp) in d.loops() {
+            for s in &lp.sides {
+                if let SideCurve::Spline(c) = s {
+                    want += green_fine(c);
+                }
+            }
+        }
+        let got = fine_area(&auto.layout);
+        assert!((got - want).abs() < 1e-10 * want, "{}: {got} vs {want}", d.name);
+        if d.name == "plate-1" || d.name.starts_with("u-") {
+            certified(&auto, &d.name);
+        }
+    }
+}
