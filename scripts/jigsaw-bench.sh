@@ -39,7 +39,7 @@ for f in "$tmp"/in/*.json; do
   fi
   row=$(jq -r --arg name "$name" --arg rc "$rc" --arg s "$secs" '
     (.kinks // []) as $k |
-    "| \($name) | \($rc) | \(.verdict) | \([$k[] | select(.kept)] | length)/\($k | length) | \(.basis.functions // .functions // "-") | \($s | tonumber * 10 | round / 10) |"' \
+    "| \($name) | \($rc) | \(.verdict) | \([$k[] | select(.kept)] | length)/\($k | length) | \(.basis_functions // "-") | \($s | tonumber * 10 | round / 10) |"' \
     "$tmp/$name.report.json")
   echo "$row"
   if [ "$rc" = 0 ] && jq -e '.verdict == "certified"' "$tmp/$name.report.json" >/dev/null &&

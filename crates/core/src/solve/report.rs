@@ -233,10 +233,13 @@ pub struct Report {
 }
 
 impl Report {
-    /// A success: certified (or the best map a forced degenerate corner admits) and its
-    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]).
+    /// A success: certified (or the best map a forced degenerate corner admits), its
+    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]) and the
+    /// kinks of the `C^0` route kept ([`Report::kinks_kept`]).
     pub fn success(&self) -> bool {
-        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner) && self.boundary_kept && self.kinks_kept()
+        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+            && self.boundary_kept
+            && self.kinks_kept()
     }
 
     /// Whether the `C^0` route of §9, where it ran, kept its kinks: a kink it could not
