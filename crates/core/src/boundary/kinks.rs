@@ -382,16 +382,17 @@ mod tests {
             .collect()
     }
 
-    /// The detection's scale (a window of 1 % of the side's length, here 0.02, and a
-    /// quarter of it) on a right-angled corner rounded by a fillet and sampled every
-    /// `5e-4`: a fillet resolved by three points (radius `1e-3`, arc `1.6e-3`) is a corner
-    /// turning nearly 90 degrees; so is one of 31 points (radius `1e-2`, arc `0.016`,
-    /// shorter than the window: its chords at `0.005` turn by `1` radian; those at `0.02`
-    /// by about `90 - 2 atan(0.0029 / 0.019)`, 73 degrees); a fillet of radius `0.05` (arc
-    /// `0.079`) is not (the chords at `0.005` turn by `0.2` radians).
+    /// The detection's scale (a window `w` of 1 % of the side's length, here 0.02, and
+    /// `w / 4`) on a right-angled corner rounded by a fillet of radius `R` and sampled
+    /// every `5e-4`: the chords at `w / 4` on the fillet turn by `w / (4R)` radians, so a
+    /// fillet counts as a corner up to `R` of about `w / 2` (30 degrees): one resolved by
+    /// three points (`R = 1e-3`, arc `1.6e-3`) turns by nearly 90 degrees at the window
+    /// `w`, one of 16 points (`R = 5e-3`, arc `7.9e-3`) by about 81; one of 31 points
+    /// (`R = 1e-2`) is not a corner (the chords at `w / 4` turn by 0.5 radians), nor is
+    /// one of radius `0.05`.
     #[test]
     fn cloud_corners_resolve_fillets_shorter_than_the_window() {
-        for (r, least) in [(1e-3, Some(85.0)), (1e-2, Some(60.0)), (5e-2, None)] {
+        for (r, least) in [(1e-3, Some(85.0)), (5e-3, Some(78.0)), (1e-2, None), (5e-2, None)] {
             let pts = filleted_corner(r, 5e-4);
             let c = cloud_corners(&pts, CLOUD_CORNER_DEGREES);
             if let Some(least) = least {
