@@ -27,7 +27,9 @@ pub struct CorpusArgs {
     seed: u64,
     /// Only these families (comma-separated): clearance, spiral, sharp-corner, puzzle,
     /// strip, cad, noisy-cloud, sparse-cloud; and cad-kinks (steps and V-notches at C0
-    /// knots of spline sides), which the default corpus leaves out; with --general: ngon,
+    /// knots of spline sides), jigsaw (jigsaw pieces with barely rounded necks, dense
+    /// clouds) and pinched (a channel pinched to 3e-4 of its length), which the default
+    /// corpus leaves out; with --general: ngon,
     /// l, t, u, e, plus, plate (domains with holes), wiggly, motor (plane graphs).
     #[arg(long, value_delimiter = ',')]
     families: Vec<String>,

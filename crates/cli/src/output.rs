@@ -20,7 +20,17 @@ pub fn summary(sol: &Solution) -> String {
     let r = &sol.report;
     let mut s = String::new();
     let last = r.levels.last();
-    if r.boundary_kept {
+    if r.boundary_kept && !r.kinks_kept() {
+        let rounded = r.kinks.iter().filter(|k| !k.kept).count();
+        let dev = r.kinks.iter().filter(|k| !k.kept).fold(0.0f64, |m, k| m.max(k.deviation));
+        let _ = writeln!(
+            s,
+            "{}: {}, but its boundary is NOT the input's: {rounded} kinks not kept (the C0 route failed; rounded by up \
+             to {dev:.3e}, within the fit tolerance)",
+            sol.name,
+            verdict_word(r.verdict)
+        );
+    } else if r.boundary_kept {
         let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
     } else {
         let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
@@ -706,10 +716,11 @@ pub fn quiet() -> bool {
 /// The exit code of a verdict: 0 certified or degenerate corner (the best map the
 /// boundary allows), 3 folded, 4 not converged, 5 undecided.
 /// The exit code of a solve: its verdict's ([`exit_code`]), but 6 for a bijective map
-/// whose boundary is not the input's within the fit tolerance ([`winslow::Report::boundary_kept`]).
+/// whose boundary is not the input's within the fit tolerance ([`winslow::Report::boundary_kept`])
+/// or whose kinks the `C^0` route could not keep ([`winslow::Report::kinks_kept`]).
 pub fn solve_exit_code(r: &winslow::Report) -> i32 {
     match exit_code(r.verdict) {
-        0 if !r.boundary_kept => 6,
+        0 if !r.boundary_kept || !r.kinks_kept() => 6,
         code => code,
     }
 }

@@ -68,3 +68,26 @@ fn a_boundary_off_the_input_exits_6() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(stdout_json(&out)["boundary_kept"], true);
 }
+
+/// A kink the `C^0` route cannot keep (a rectangular step out of the domain, whose two
+/// reflex kinks the continuation reaches only part of the way with 3 refinement rounds)
+/// is not a success: exit 6, the route's `kept: false`, its four kinks reported rounded,
+/// the summary's first line says so; the map written is the bijective one on the smoothed
+/// basis.
+#[test]
+fn a_kink_not_kept_exits_6() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("step_out.json");
+    let input = data().join("cad_kinks/step_out.json");
+    let out = bin().arg("solve").arg(&input).arg("-o").arg(&map).args(["--repair", "3"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(6), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.contains("NOT") && first.contains("kinks not kept"), "{first}");
+    let r = &read_json(&map)["report"];
+    assert_eq!(r["verdict"], "certified", "{}", r["message"]);
+    assert_eq!(r["c0_route"]["kept"], false, "{}", r["c0_route"]);
+    assert!(r["c0_route"]["alpha"].as_f64().unwrap() < 1.0);
+    let kinks = r["kinks"].as_array().unwrap();
+    assert!(kinks.len() == 4 && kinks.iter().all(|k| k["kept"] == false && k["deviation"].as_f64().unwrap() > 0.0));
+}

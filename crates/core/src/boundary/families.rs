@@ -11,6 +11,8 @@
 //! | `strip` | a wavy strip of aspect ratio 20 to 200 |
 //! | `cad` | B-spline/NURBS sides: non-uniform non-dyadic knots, an exact circular arc, an interior `C0` kink, different degrees on opposite sides |
 //! | `cad-kinks` | degree-2 B-spline sides with `C0` knots: rectangular steps (reflex kinks turning back by 90°) and V-notches turning 30° to 130° at the tip, one to three per side, into the domain or out of it (not in the default corpus: `winslow corpus --families cad-kinks`) |
+//! | `jigsaw` | unit-square jigsaw pieces: one to three tabs per side, in or out, on narrow necks whose corners are rounded at 1/30 to 1/8 of the tab radius, every side a dense point cloud (1500 to 3000 points; not in the default corpus) |
+//! | `pinched` | a channel of length 1 whose walls close in to a gap of `3e-4` of its length, dense point clouds (not in the default corpus) |
 //! | `noisy-cloud` | 1000 to 3000 points per side with noise `1e-4` |
 //! | `sparse-cloud` | 8 to 15 points per side |
 //!
@@ -43,6 +45,10 @@ pub enum Family {
     CadKinks,
     /// Very sparse point clouds.
     SparseCloud,
+    /// Jigsaw pieces with narrow, barely rounded necks, as dense point clouds.
+    Jigsaw,
+    /// A channel pinched to a hair-thin gap.
+    Pinched,
 }
 
 impl Family {
@@ -60,7 +66,7 @@ impl Family {
 
     /// Families generated only on request (`winslow corpus --families`), not part of the
     /// default corpus of [`Family::ALL`].
-    pub const EXTRA: [Family; 1] = [Family::CadKinks];
+    pub const EXTRA: [Family; 3] = [Family::CadKinks, Family::Jigsaw, Family::Pinched];
 
     /// Kebab-case name.
     pub fn name(self) -> &'static str {
@@ -74,6 +80,8 @@ impl Family {
             Family::NoisyCloud => "noisy-cloud",
             Family::CadKinks => "cad-kinks",
             Family::SparseCloud => "sparse-cloud",
+            Family::Jigsaw => "jigsaw",
+            Family::Pinched => "pinched",
         }
     }
 
@@ -93,6 +101,8 @@ impl Family {
             Family::Strip => strip(&mut rng),
             Family::Cad => cad(&mut rng),
             Family::CadKinks => cad_kinks(&mut rng),
+            Family::Jigsaw => jigsaw(&mut rng),
+            Family::Pinched => pinched(&mut rng),
             Family::NoisyCloud => {
                 let n = 1000 + (rng.uniform() * 2000.0) as usize;
                 deformed_square(&mut rng, n, 1e-4)
@@ -403,6 +413,120 @@ fn cad_kinks(rng: &mut Rng) -> [SideCurve; 4] {
     [south, east, north, west]
 }
 
+/// The sharp outline of one jigsaw side in local coordinates `(s, h)` (`s` along the side,
+/// `h` towards the inside): straight pieces and tab circles, as a dense polyline, with the
+/// tabs' radii.
+fn jigsaw_outline(rng: &mut Rng) -> (Vec<[f64; 2]>, Vec<f64>) {
+    let tabs = 1 + (rng.uniform() * 3.0) as usize;
+    let size = 1.0 / tabs as f64;
+    let mut pts = vec![[0.0, 0.0]];
+    let mut radii = Vec::new();
+    for k in 0..tabs {
+        let dir = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
+        let c = (k as f64 + 0.5 + between(rng, -0.05, 0.05)) * size;
+        let r = between(rng, 0.09, 0.12) * size;
+        // the neck's half-width and height
+        let n = between(rng, 0.45, 0.7) * r;
+        let neck = between(rng, 0.3, 0.6) * r;
+        let delta = (n / r).asin();
+        let yc = neck + r * delta.cos();
+        pts.push([c - n, 0.0]);
+        pts.push([c - n, dir * neck]);
+        let (a0, a1) = (-std::f64::consts::FRAC_PI_2 - delta, -2.5 * std::f64::consts::PI + delta);
+        for j in 1..256 {
+            let a = a0 + (a1 - a0) * j as f64 / 256.0;
+            pts.push([c + r * a.cos(), dir * (yc + r * a.sin())]);
+        }
+        pts.push([c + n, dir * neck]);
+        pts.push([c + n, 0.0]);
+        radii.push(r);
+    }
+    pts.push([1.0, 0.0]);
+    (pts, radii)
+}
+
+/// `m + 1` points evenly spaced in arc length along the polyline `pts`.
+fn resample(pts: &[[f64; 2]], m: usize) -> Vec<[f64; 2]> {
+    let mut s = vec![0.0];
+    for w in pts.windows(2) {
+        s.push(s[s.len() - 1] + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
+    }
+    let total = s[s.len() - 1];
+    let mut i = 0;
+    (0..=m)
+        .map(|k| {
+            let t = total * k as f64 / m as f64;
+            while i + 2 < s.len() && s[i + 1] < t {
+                i += 1;
+            }
+            let f = if s[i + 1] > s[i] { ((t - s[i]) / (s[i + 1] - s[i])).clamp(0.0, 1.0) } else { 0.0 };
+            [pts[i][0] + f * (pts[i + 1][0] - pts[i][0]), pts[i][1] + f * (pts[i + 1][1] - pts[i][1])]
+        })
+        .collect()
+}
+
+/// One jigsaw side ([`jigsaw_outline`]) as a cloud of 1500 to 3000 points evenly spaced in
+/// arc length, its corners rounded at `ρ = r / k`, `k ∈ [8, 30]` (`r` the smallest tab's
+/// radius): two passes of a moving average over the arc length `±ρ` (a straight piece is
+/// kept exactly, the ends stay), which turns a corner into a curve of extent about `2ρ`.
+fn jigsaw_side(rng: &mut Rng) -> Vec<[f64; 2]> {
+    let (sharp, radii) = jigsaw_outline(rng);
+    let rho = radii.iter().fold(f64::INFINITY, |a, &b| a.min(b)) / between(rng, 8.0, 30.0);
+    let m = 1500 + (rng.uniform() * 1500.0) as usize;
+    // the averaging runs on a grid eight times finer than the cloud
+    let fine = resample(&sharp, 8 * m);
+    let mut s = vec![0.0];
+    for w in fine.windows(2) {
+        s.push(s[s.len() - 1] + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
+    }
+    let half = ((rho / (s[s.len() - 1] / (8 * m) as f64)).round() as usize).max(1);
+    let mut out = fine;
+    for _ in 0..2 {
+        let n = out.len();
+        let mut prefix = vec![[0.0, 0.0]; n + 1];
+        for j in 0..n {
+            prefix[j + 1] = [prefix[j][0] + out[j][0], prefix[j][1] + out[j][1]];
+        }
+        out = (0..n)
+            .map(|j| {
+                let w = half.min(j).min(n - 1 - j);
+                let (a, b) = (j - w, j + w + 1);
+                let c = (b - a) as f64;
+                [(prefix[b][0] - prefix[a][0]) / c, (prefix[b][1] - prefix[a][1]) / c]
+            })
+            .collect();
+    }
+    out.into_iter().step_by(8).collect()
+}
+
+/// The unit square with a jigsaw side ([`jigsaw_side`]) on every side.
+fn jigsaw(rng: &mut Rng) -> [SideCurve; 4] {
+    let south = jigsaw_side(rng);
+    let east = jigsaw_side(rng).into_iter().map(|[s, h]| [1.0 - h, s]).collect();
+    let north = jigsaw_side(rng).into_iter().map(|[s, h]| [s, 1.0 - h]).collect();
+    let west = jigsaw_side(rng).into_iter().map(|[s, h]| [h, s]).collect();
+    [SideCurve::Points(south), SideCurve::Points(east), SideCurve::Points(north), SideCurve::Points(west)]
+}
+
+/// The smallest gap of [`pinched`], relative to the channel's length.
+pub const PINCH_GAP: f64 = 3e-4;
+
+/// A channel `[0, 1] × [0, w]`, `w ∈ [0.1, 0.2]`, whose walls close in by the Gaussian
+/// bumps `(w - g) / 2 · exp(-((x - x0) / σ)²)` to the gap `g` = [`PINCH_GAP`] at `x0 ∈
+/// [0.35, 0.65]`, `σ ∈ [0.03, 0.1]`; walls of 2001 points evenly spaced in `x`.
+fn pinched(rng: &mut Rng) -> [SideCurve; 4] {
+    let w = between(rng, 0.1, 0.2);
+    let x0 = between(rng, 0.35, 0.65);
+    let sigma = between(rng, 0.03, 0.1);
+    let bump = move |x: f64| 0.5 * (w - PINCH_GAP) * (-((x - x0) / sigma).powi(2)).exp();
+    let n = 2000;
+    let xs: Vec<f64> = (0..=n).map(|k| k as f64 / n as f64).collect();
+    let south: Vec<Point> = xs.iter().map(|&x| [x, bump(x)]).collect();
+    let north: Vec<Point> = xs.iter().map(|&x| [x, w - bump(x)]).collect();
+    let (sw, se, nw, ne) = (south[0], south[n], north[0], north[n]);
+    [SideCurve::Points(south), segment(se, ne), SideCurve::Points(north), segment(sw, nw)]
+}
+
 /// The image of the unit square's sides under `x = u + e1 sin(2π v + φ1)`, `y = v + e2
 /// sin(2π u + φ2)` (bijective: `|e1 e2| 4π² < 1`), `n` points per side, each moved by
 /// Gaussian noise of standard deviation `noise` along the normal, except the corners.
@@ -491,6 +615,27 @@ mod tests {
                 let turn = (d0[0] * d1[1] - d0[1] * d1[0]).atan2(d0[0] * d1[0] + d0[1] * d1[1]).abs().to_degrees();
                 assert!((14.9..=130.1).contains(&turn) || turn < 1e-9, "turn {turn}");
             }
+        }
+        // jigsaw: 1501 to 3001 points per side, the necks rounded: where a sharp outline
+        // turns by 90 degrees at one point, no point of the cloud turns by more than 45
+        let turn = |a: Point, b: Point, c: Point| {
+            let (d0, d1) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+            (d0[0] * d1[1] - d0[1] * d1[0]).atan2(d0[0] * d1[0] + d0[1] * d1[1]).abs().to_degrees()
+        };
+        for seed in 0..12 {
+            for side in &Family::Jigsaw.generate(seed).sides {
+                let SideCurve::Points(p) = side else { panic!() };
+                assert!((1501..=3001).contains(&p.len()), "{}", p.len());
+                let sharpest = p.windows(3).map(|w| turn(w[0], w[1], w[2])).fold(0.0f64, f64::max);
+                assert!((1.0..=45.0).contains(&sharpest), "jigsaw-{seed}: a point turns by {sharpest} degrees");
+            }
+        }
+        // pinched: the narrowest gap between the walls is PINCH_GAP (to the sampling)
+        for seed in 0..12 {
+            let b = Family::Pinched.generate(seed);
+            let (SideCurve::Points(s), SideCurve::Points(n)) = (&b.sides[0], &b.sides[2]) else { panic!() };
+            let gap = s.iter().zip(n).map(|(a, b)| b[1] - a[1]).fold(f64::INFINITY, f64::min);
+            assert!((PINCH_GAP..=1.1 * PINCH_GAP).contains(&gap), "gap {gap}");
         }
         // the clearance gaps: the narrowest vertical extent is between 3e-3 and 1e-2
         for seed in 0..12 {

@@ -361,6 +361,52 @@ mod tests {
         assert!(cloud_corners(&arc, 30.0).is_empty());
     }
 
+    /// Two legs of length 1 meeting at a right angle, the corner replaced by a circular
+    /// fillet of radius `r`, sampled every `h` of arc length.
+    fn filleted_corner(r: f64, h: f64) -> Vec<Point> {
+        let arc = std::f64::consts::FRAC_PI_2 * r;
+        let total = 2.0 * (1.0 - r) + arc;
+        let n = (total / h).round() as usize;
+        (0..=n)
+            .map(|k| {
+                let s = total * k as f64 / n as f64;
+                if s <= 1.0 - r {
+                    [s, 0.0]
+                } else if s <= 1.0 - r + arc {
+                    let a = (s - (1.0 - r)) / r;
+                    [1.0 - r + r * a.sin(), r - r * a.cos()]
+                } else {
+                    [1.0, r + s - (1.0 - r + arc)]
+                }
+            })
+            .collect()
+    }
+
+    /// The detection's scale (a window `w` of 1 % of the side's length, here 0.02, and
+    /// `w / 4`) on a right-angled corner rounded by a fillet of radius `R` and sampled
+    /// every `5e-4`: the chords at `w / 4` on the fillet turn by `w / (4R)` radians, so a
+    /// fillet counts as a corner up to `R` of about `w / 2` (30 degrees): one resolved by
+    /// three points (`R = 1e-3`, arc `1.6e-3`) turns by nearly 90 degrees at the window
+    /// `w`, one of 16 points (`R = 5e-3`, arc `7.9e-3`) by about 81; one of 31 points
+    /// (`R = 1e-2`) is not a corner (the chords at `w / 4` turn by 0.5 radians), nor is
+    /// one of radius `0.05`.
+    #[test]
+    fn cloud_corners_resolve_fillets_shorter_than_the_window() {
+        for (r, least) in [(1e-3, Some(85.0)), (5e-3, Some(78.0)), (1e-2, None), (5e-2, None)] {
+            let pts = filleted_corner(r, 5e-4);
+            let c = cloud_corners(&pts, CLOUD_CORNER_DEGREES);
+            if let Some(least) = least {
+                assert_eq!(c.len(), 1, "radius {r}: {c:?}");
+                let p = pts[c[0].0];
+                // the vertex found lies on the fillet, and the turning is nearly the corner's
+                assert!((p[0] - 1.0).hypot(p[1]) <= r * 2f64.sqrt() + 5e-4, "radius {r}: {p:?}");
+                assert!(c[0].1 > least && c[0].1 <= 90.0 + 1e-9, "radius {r}: {c:?}");
+            } else {
+                assert!(c.is_empty(), "radius {r}: {c:?}");
+            }
+        }
+    }
+
     #[test]
     fn kinks_are_read_from_a_stored_report() {
         let r = serde_json::json!({ "kinks": [

@@ -461,10 +461,12 @@ pub fn kink_reports(
 
 #[cfg(test)]
 mod tests {
+    use crate::boundary::families::Family;
     use crate::io::{read_boundary, ReadOptions};
     use crate::pipeline::solve;
     use crate::solve::options::SolveOptions;
     use crate::solve::report::Verdict;
+    use crate::spline::surface::Side;
     use crate::testutil::data;
 
     /// A V-notch pointing into the unit square (degree 2, C0 knots at its base and tip; the
@@ -487,6 +489,33 @@ mod tests {
             }
             // the whole boundary, kinks included, is the input's to rounding
             assert!(r.boundary_deviation.iter().all(|&d| d <= 1e-12), "{name}: {:?}", r.boundary_deviation);
+        }
+    }
+
+    /// Two domains of the `cad-kinks` family the route keeps (seed 2: a V-notch into the
+    /// domain and one out of it; seed 17: one into it): certified, and at every kink's
+    /// knot line the map's side passes through the input's `C^0` knot point to rounding,
+    /// and its one-sided tangents there (chords of `1e-7` in the parameter; the pieces are
+    /// straight) turn by the input's angle: a kink of the map, not a rounding.
+    #[test]
+    fn generated_kinks_keep_their_points_and_angles() {
+        for seed in [2, 17] {
+            let b = Family::CadKinks.generate(seed);
+            let sol = solve(&b, &SolveOptions::default()).unwrap();
+            let r = &sol.report;
+            assert_eq!(r.verdict, Verdict::Certified, "seed {seed}: {}", r.message);
+            assert!(r.kinks_kept() && r.success() && r.kinks.len() >= 3, "seed {seed}: {}", r.message);
+            for k in &r.kinks {
+                let side = Side::ALL.into_iter().find(|s| s.name() == k.side).unwrap();
+                let curve = sol.map.boundary(side);
+                let t = k.map_parameter.expect("a kept kink has its knot line");
+                let y = curve.eval(t);
+                assert!((y[0] - k.point[0]).hypot(y[1] - k.point[1]) <= 1e-12, "seed {seed}: {k:?} at {y:?}");
+                let (a, c) = (curve.eval(t - 1e-7), curve.eval(t + 1e-7));
+                let (d0, d1) = ([y[0] - a[0], y[1] - a[1]], [c[0] - y[0], c[1] - y[1]]);
+                let turn = (d0[0] * d1[1] - d0[1] * d1[0]).atan2(d0[0] * d1[0] + d0[1] * d1[1]).abs().to_degrees();
+                assert!((turn - k.turning_degrees).abs() <= 1e-4, "seed {seed}: turns {turn}, input {k:?}");
+            }
         }
     }
 }

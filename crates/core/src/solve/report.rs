@@ -240,10 +240,20 @@ pub struct Report {
 }
 
 impl Report {
-    /// A success: certified (or the best map a forced degenerate corner admits) and its
-    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]).
+    /// A success: certified (or the best map a forced degenerate corner admits), its
+    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]) and the
+    /// kinks of the `C^0` route kept ([`Report::kinks_kept`]).
     pub fn success(&self) -> bool {
-        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner) && self.boundary_kept
+        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+            && self.boundary_kept
+            && self.kinks_kept()
+    }
+
+    /// Whether the `C^0` route of §9, where it ran, kept its kinks: a kink it could not
+    /// keep is rounded, and the run is not a success ([`Report::success`]) even where the
+    /// rounding stays within the fit tolerance.
+    pub fn kinks_kept(&self) -> bool {
+        self.c0_route.as_ref().is_none_or(|r| r.kept)
     }
 }
 
@@ -349,6 +359,7 @@ impl Solution {
             message.push_str(&format!("; {}", r.message));
         }
         let input = h.basis.used == crate::boundary::BasisChoice::Input;
+        let route_failed = ctx.c0_route.as_ref().is_some_and(|r| !r.kept);
         for k in &kinks {
             let at = format!(
                 "the {} side's kink at ({:.6}, {:.6}) (tangent turns {:.1} degrees)",
@@ -356,6 +367,8 @@ impl Solution {
             );
             message.push_str(&if k.kept {
                 format!("; {at} is kept exactly (deviation {:.1e})", k.deviation)
+            } else if route_failed {
+                format!("; {at} is NOT kept (the C0 route failed, above): rounded, deviation {:.3e}", k.deviation)
             } else if input {
                 format!(
                     "; note: {at} is not kept by a C0 knot line: the map's boundary is the input's, whose speed vanishes \
