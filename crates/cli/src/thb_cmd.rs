@@ -116,7 +116,7 @@ pub(crate) fn repair(
         files::record(p);
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        files::print_json(report)?;
     } else {
         say!(
             "{}: tensor solve {:?} without repair; {} THB round(s) -> {} functions on {} levels ({unknowns} unknowns)",
