@@ -10,8 +10,8 @@ use winslow::io::hierarchical::{read_thb, write_thb};
 use winslow::io::Output;
 use winslow::solve::hierarchical::{repair_thb, ThbRepairOptions};
 use winslow::solve::options::SolveOptions;
-use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::solve::report::Solution;
+use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::verify::certificate::hierarchical::certify_hierarchical;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 

@@ -17,7 +17,11 @@ fn puzzle4_is_repaired_with_fewer_unknowns_than_tensor_refinement() {
     let boundary = read_boundary(&winslow::testutil::data("gismo/puzzle4.json"), &ReadOptions::default()).unwrap();
     let thb_opts = SolveOptions { refinement: Refinement::Thb, ..Default::default() };
     let unrepaired = Pipeline::new(boundary.clone(), thb_opts.clone()).solve().unwrap().into_map().unwrap();
-    assert!(matches!(unrepaired.report.verdict, Verdict::Folded | Verdict::Undecided), "{:?}", unrepaired.report.verdict);
+    assert!(
+        matches!(unrepaired.report.verdict, Verdict::Folded | Verdict::Undecided),
+        "{:?}",
+        unrepaired.report.verdict
+    );
     let tensor = Pipeline::new(boundary, SolveOptions::default()).solve().unwrap().into_map().unwrap();
     assert!(matches!(tensor.report.verdict, Verdict::Certified | Verdict::DegenerateCorner));
     let tensor_unknowns = 2 * tensor.map.control_points.len();

@@ -579,7 +579,8 @@ impl Discretization {
                     let k = kv * nq[0] + ku;
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
-                    let rows = want_mat.then(|| EggRows { wa: &mut s.wa[k * nloc..(k + 1) * nloc], tz: &mut s.tz, k, nqp });
+                    let rows =
+                        want_mat.then(|| EggRows { wa: &mut s.wa[k * nloc..(k + 1) * nloc], tz: &mut s.tz, k, nqp });
                     egg_point(&s.b, &g, wq, op, &mut s.re, rows);
                 }
             }

@@ -97,9 +97,8 @@ impl HierarchicalDiscretization {
     pub fn new(basis: HierarchicalBasis) -> Self {
         let [p, q] = basis.degrees();
         let nq = p.max(q) + 1;
-        let tables: Vec<[DirTable; 2]> = (0..basis.num_levels())
-            .map(|l| basis.knots(l).each_ref().map(|kv| DirTable::new(kv, nq)))
-            .collect();
+        let tables: Vec<[DirTable; 2]> =
+            (0..basis.num_levels()).map(|l| basis.knots(l).each_ref().map(|kv| DirTable::new(kv, nq))).collect();
         let active = basis.active_cells();
         let mut lc = LevelCoefficients::<Sparse>::new(&basis, |k| vec![(k, 1.0)]);
         let nets: Vec<Vec<Sparse>> = active.iter().map(|&(l, c)| lc.cell_net(l, c)).collect();

@@ -123,7 +123,11 @@ pub fn marked_cells(map: &HierarchicalMap, offending: &[CellIndex], ring: usize)
 /// Solve EGG (eq. 8) on the THB discretization of `map` from its control points (the
 /// fixed ones are the Dirichlet data); returns the solved map, the Newton iterations and
 /// whether Newton converged.
-pub fn solve_egg(map: &HierarchicalMap, operator: Operator, nonlinear: NonlinearOptions) -> Result<(HierarchicalMap, usize, bool)> {
+pub fn solve_egg(
+    map: &HierarchicalMap,
+    operator: Operator,
+    nonlinear: NonlinearOptions,
+) -> Result<(HierarchicalMap, usize, bool)> {
     let disc = Arc::new(HierarchicalDiscretization::new(map.basis.clone()));
     if disc.num_free() == 0 {
         return Ok((map.clone(), 0, true));

@@ -4,12 +4,12 @@
 //! Newton to the affine map (which solves eq. 8 and minimizes eq. 16).
 use super::*;
 use crate::discrete::assembly::Discretization;
+use crate::linalg::linsolve::LinearMethod;
 use crate::methods::density::tests::{affine, curved, problem_fd};
 use crate::methods::jacobian_fd_mismatch;
 use crate::methods::winslow::{winslow_gradient, winslow_objective};
 use crate::solve::newton::{NonlinearOptions, NonlinearSolver, Status};
 use crate::spline::hierarchical::map::HierarchicalMap;
-use crate::linalg::linsolve::LinearMethod;
 use crate::spline::surface::Surface;
 
 fn thb_of(disc: &Discretization, cps: &[Point]) -> HierarchicalMap {
