@@ -121,18 +121,19 @@ pub fn marked_cells(map: &HierarchicalMap, offending: &[CellIndex], ring: usize)
 }
 
 /// Solve EGG (eq. 8) on the THB discretization of `map` from its control points (the
-/// fixed ones are the Dirichlet data); returns the solved map, the Newton iterations and
-/// whether Newton converged.
+/// fixed ones are the Dirichlet data); returns the solved map, the Newton iterations,
+/// whether Newton converged and the number of unknowns.
 pub fn solve_egg(
     map: &HierarchicalMap,
     operator: Operator,
     nonlinear: NonlinearOptions,
-) -> Result<(HierarchicalMap, usize, bool)> {
+) -> Result<(HierarchicalMap, usize, bool, usize)> {
     let disc = Arc::new(HierarchicalDiscretization::new(map.basis.clone()));
     if disc.num_free() == 0 {
-        return Ok((map.clone(), 0, true));
+        return Ok((map.clone(), 0, true, 0));
     }
     let c0 = disc.gather(&map.control_points);
+    let unknowns = c0.len();
     let prob = HierarchicalEggProblem::new(disc, map.control_points.clone(), operator);
     let opts = NonlinearOptions { linear: LinearMethod::Lu, ..nonlinear };
     let mut solver = NonlinearSolver::new(prob, c0, opts);
@@ -146,7 +147,7 @@ pub fn solve_egg(
     if cps.iter().flatten().any(|x| !x.is_finite()) {
         return Err(Error::Invalid("the THB solve produced non-finite control points".into()));
     }
-    Ok((HierarchicalMap::new(map.basis.clone(), cps)?, iterations, converged))
+    Ok((HierarchicalMap::new(map.basis.clone(), cps)?, iterations, converged, unknowns))
 }
 
 /// Local defect correction of `map` (see the module documentation): at most
@@ -164,8 +165,7 @@ pub fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRe
             break;
         }
         let refined = map.refined(&marked, opts.admissibility)?;
-        let (solved, iterations, converged) = solve_egg(&refined, opts.operator, opts.nonlinear)?;
-        let unknowns = 2 * HierarchicalDiscretization::new(solved.basis.clone()).num_free();
+        let (solved, iterations, converged, unknowns) = solve_egg(&refined, opts.operator, opts.nonlinear)?;
         map = solved;
         let verdict = cert.verdict.name();
         cert = certify_hierarchical(&map, &opts.certify)?;

@@ -47,7 +47,7 @@ fn the_ring_holds_the_neighbouring_active_cells() {
 #[test]
 fn a_planted_fold_is_refined_around_and_solved_away() {
     let coarse = annulus(3, 8);
-    let (egg, _, converged) = solve_egg(&coarse, Operator::Scaled, NonlinearOptions::default()).unwrap();
+    let (egg, _, converged, _) = solve_egg(&coarse, Operator::Scaled, NonlinearOptions::default()).unwrap();
     assert!(converged);
     let opts = ThbRepairOptions::default();
     assert!(accepted(&certify_hierarchical(&egg, &opts.certify).unwrap()));
