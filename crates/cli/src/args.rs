@@ -172,6 +172,11 @@ pub(crate) struct SolverArgs {
     /// Do not repair a folded map (same as --repair 0).
     #[arg(long)]
     pub(crate) no_repair: bool,
+    /// How a repair round refines: `tensor` bisects the offending knot spans across the
+    /// whole basis; `thb` refines only the offending cells and a ring around them on a
+    /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml).
+    #[arg(long, value_enum, default_value = "tensor")]
+    pub(crate) refinement: Refinement,
     /// In repair rounds, solve only for the control points within this many spans of
     /// the offending elements (the rest stay frozen at the prolonged map).
     #[arg(long)]
@@ -229,6 +234,7 @@ impl SolverArgs {
         o.nonlinear.linear = self.linear;
         o.repair = if self.no_repair { 0 } else { self.repair };
         o.repair_freeze = self.repair_freeze;
+        o.refinement = self.refinement;
         o.operator = self.operator;
         o.max_levels = self.levels;
         o.min_elements = self.min_elements.max(1);

@@ -112,6 +112,7 @@ impl CompareArgs {
             repair: self.repair,
             no_repair: false,
             repair_freeze: None,
+            refinement: Refinement::Tensor,
             improve: None,
             kinks_local: KinksLocal::All,
             memory: self.memory.clone(),

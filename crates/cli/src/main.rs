@@ -21,7 +21,7 @@ use winslow::methods::Method;
 use winslow::solve::improve::Improve;
 use winslow::solve::memory::MemoryLimit;
 use winslow::solve::newton::NonlinearMethod;
-use winslow::solve::options::{KinksLocal, SolveOptions};
+use winslow::solve::options::{KinksLocal, Refinement, SolveOptions};
 use winslow::solve::report::Verdict;
 use winslow::solve::solver::Event;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};

@@ -192,6 +192,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let input = files::input_of(files::read(path)?, path, a.solver.fit.reorient)?;
     let mut opts = if input.is_multipatch() { super::multipatch_cmd::options(&a)? } else { a.solver.options()? };
     opts.poisson = a.poisson;
+    if opts.refinement == Refinement::Thb {
+        thb_outputs(&a, input.is_multipatch())?;
+    }
     match &input {
         Input::Volume(_) => super::volume_cmd::plan(&a, path)?,
         input => output_plan(&a, &[path], input.is_multipatch())?,
@@ -212,6 +215,12 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
         Solved::Volume(v) => return super::volume_cmd::finish(&name, *v, &a),
         solved => solved.into_map()?,
     };
+    if opts.refinement == Refinement::Thb
+        && opts.repair > 0
+        && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
+    {
+        return super::thb_cmd::repair(&sol, &opts, &a.output, a.gismo.as_deref(), a.json);
+    }
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let extra = Some(serde_json::json!({ "report": report }));
@@ -308,6 +317,21 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         say_raw!("{s}");
     }
     Ok(output::exit_code(r.verdict))
+}
+
+/// With `--refinement thb` the map may come out as a THB map: a single patch, `-o` JSON or
+/// G+Smo XML, no outputs that need a tensor map.
+fn thb_outputs(a: &SolveArgs, multipatch: bool) -> Result<()> {
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if multipatch || !matches!(ext.as_str(), "json" | "xml") {
+        bail!("--refinement thb solves a single patch and writes a JSON or G+Smo XML map (-o .json or .xml)");
+    }
+    let tensor_only = [("--png", a.png.is_some()), ("--vtk", a.vtk.is_some()), ("--iges", a.iges.is_some())];
+    let more = [("--vtu", a.vtu.is_some()), ("--mesh", a.mesh.is_some()), ("--poisson", a.poisson)];
+    if let Some((flag, _)) = tensor_only.iter().chain(&more).find(|(_, on)| *on) {
+        bail!("{flag} needs a tensor map: not with --refinement thb (convert the THB map first: winslow convert)");
+    }
+    Ok(())
 }
 
 /// Check every output of `solve` before the work ([`files::OutputPlan`]): a single map's

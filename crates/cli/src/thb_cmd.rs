@@ -8,6 +8,9 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use winslow::io::hierarchical::{read_thb, write_thb};
 use winslow::io::Output;
+use winslow::solve::hierarchical::{repair_thb, ThbRepairOptions};
+use winslow::solve::options::SolveOptions;
+use winslow::solve::report::Solution;
 use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::verify::certificate::hierarchical::certify_hierarchical;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};
@@ -67,4 +70,63 @@ pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &
         tensor.shape()[1]
     );
     Ok(exit_code(&certificate.verdict))
+}
+
+/// `winslow solve --refinement thb`: the pipeline's map folds or is undecided without
+/// tensor repair; the THB defect correction ([`repair_thb`]) refines only around the
+/// offending cells, and the THB map is written (`-o`, and `--gismo` as `THBSpline2`) with
+/// its certificate, the rounds and the tensor solve's report.
+pub(crate) fn repair(
+    sol: &Solution,
+    opts: &SolveOptions,
+    output: &Path,
+    gismo: Option<&Path>,
+    json: bool,
+) -> Result<i32> {
+    let t0 = std::time::Instant::now();
+    let start = HierarchicalMap::from_surface(&sol.map).context("THB refinement of the solved map")?;
+    let topts = ThbRepairOptions {
+        rounds: opts.repair,
+        ring: opts.repair_halo,
+        operator: opts.operator,
+        nonlinear: opts.nonlinear,
+        certify: opts.certify,
+        ..Default::default()
+    };
+    let out = repair_thb(start, &topts).context("THB defect correction")?;
+    let c = &out.certificate;
+    let unknowns = out.rounds.last().map_or(0, |r| r.unknowns);
+    let report = serde_json::json!({
+        "refinement": "thb",
+        "verdict": c.verdict.name(),
+        "message": c.message(),
+        "certificate": c,
+        "functions": out.map.basis.len(),
+        "levels": out.map.basis.num_levels(),
+        "unknowns": unknowns,
+        "thb_rounds": &out.rounds,
+        "thb_seconds": t0.elapsed().as_secs_f64(),
+        "solve": &sol.report,
+    });
+    let extra = Some(serde_json::json!({ "report": &report }));
+    write_thb(output, &sol.name, &out.map, extra.clone()).with_context(|| format!("writing {}", output.display()))?;
+    files::record(output);
+    if let Some(p) = gismo {
+        write_thb(p, &sol.name, &out.map, extra).with_context(|| format!("writing {}", p.display()))?;
+        files::record(p);
+    }
+    if json {
+        files::print_json(report)?;
+    } else {
+        say!(
+            "{}: tensor solve {:?} without repair; {} THB round(s) -> {} functions on {} levels ({unknowns} unknowns)",
+            sol.name,
+            sol.report.verdict,
+            out.rounds.len(),
+            out.map.basis.len(),
+            out.map.basis.num_levels()
+        );
+        say!("certificate: {}", c.message());
+    }
+    Ok(exit_code(&c.verdict))
 }

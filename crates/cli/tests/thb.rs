@@ -78,3 +78,52 @@ fn a_folded_thb_map_exits_3() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("THB map"));
 }
+
+/// `winslow solve --refinement thb`: puzzle4 folds without repair; the THB rounds refine
+/// only around the folds and the THB map written is certified by `winslow check`, with
+/// fewer functions than the tensor repair's map. THB output is JSON or G+Smo XML only.
+#[test]
+fn solve_with_thb_refinement_writes_a_certified_thb_map() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let src = data().join("gismo/puzzle4.json");
+    let (thb, tensor) = (dir.join("thb.json"), dir.join("tensor.json"));
+    let out = run(&[
+        "solve".as_ref(),
+        src.as_os_str(),
+        "-o".as_ref(),
+        thb.as_os_str(),
+        "--refinement".as_ref(),
+        "thb".as_ref(),
+        "--json".as_ref(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    assert_eq!(report["refinement"], "thb");
+    assert!(!report["thb_rounds"].as_array().unwrap().is_empty());
+    assert!(report["levels"].as_u64().unwrap() >= 2);
+    let functions = report["functions"].as_u64().unwrap();
+    let out = run(&["check".as_ref(), thb.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0));
+    let checked = stdout_json(&out);
+    assert_eq!(checked["kind"], "thb");
+    assert_eq!(checked["certificate"]["functions"].as_u64(), Some(functions));
+    let out = run(&["solve".as_ref(), src.as_os_str(), "-o".as_ref(), tensor.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0));
+    let tensor_functions = stdout_json(&out)["basis_functions"].as_u64().unwrap();
+    assert!(functions < tensor_functions, "THB {functions} vs tensor {tensor_functions}");
+    // outputs that need a tensor map are refused up front, nothing written
+    let png = dir.join("x.png");
+    let out = run(&[
+        "solve".as_ref(),
+        src.as_os_str(),
+        "-o".as_ref(),
+        dir.join("again.json").as_os_str(),
+        "--png".as_ref(),
+        png.as_os_str(),
+        "--refinement".as_ref(),
+        "thb".as_ref(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!png.exists() && !dir.join("again.json").exists());
+}

@@ -76,12 +76,12 @@ pub enum Operator {
 
 /// Geometry of the map at one quadrature point.
 #[derive(Debug, Clone, Copy, Default)]
-struct Geo {
-    xu: [f64; 2],
-    xv: [f64; 2],
-    xuu: [f64; 2],
-    xuv: [f64; 2],
-    xvv: [f64; 2],
+pub(crate) struct Geo {
+    pub(crate) xu: [f64; 2],
+    pub(crate) xv: [f64; 2],
+    pub(crate) xuu: [f64; 2],
+    pub(crate) xuv: [f64; 2],
+    pub(crate) xvv: [f64; 2],
 }
 
 impl Geo {
@@ -90,6 +90,70 @@ impl Geo {
     fn metric(&self) -> (f64, f64, f64) {
         let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
         (dot(self.xu, self.xu), dot(self.xu, self.xv), dot(self.xv, self.xv))
+    }
+}
+
+/// The test-weight row and the trial-derivative rows of one quadrature point in the
+/// element-matrix operands of [`egg_point`].
+pub(crate) struct EggRows<'a> {
+    /// `w_k w_a / s` of the point (length `nloc`).
+    pub(crate) wa: &'a mut [f64],
+    /// `dL_z/dc^d_b` at `((z * 2 + d) * nqp + k) * nloc + b`.
+    pub(crate) tz: &'a mut [f64],
+    /// The point.
+    pub(crate) k: usize,
+    /// Points per element.
+    pub(crate) nqp: usize,
+}
+
+/// The EGG integrand (eq. 8) at one quadrature point of weight `wq`, with the `nloc`
+/// basis functions' `(w, w_u, w_v, w_uu, w_uv, w_vv)` in `b` and the map's derivatives
+/// in `g`: adds `wq w_a L(z) / s` to `re[z * nloc + a]` and, with `rows`, writes the
+/// operands of the Jacobian's element product (see [`Discretization::egg`] for the
+/// formulas). Shared by the tensor assembly and the THB assembly
+/// ([`crate::discrete::hierarchical`]).
+#[inline]
+pub(crate) fn egg_point(b: &[[f64; 6]], g: &Geo, wq: f64, op: Operator, re: &mut [f64], rows: Option<EggRows<'_>>) {
+    let nloc = b.len();
+    let (g11, g12, g22) = g.metric();
+    let l = [
+        g22 * g.xuu[0] - 2.0 * g12 * g.xuv[0] + g11 * g.xvv[0],
+        g22 * g.xuu[1] - 2.0 * g12 * g.xuv[1] + g11 * g.xvv[1],
+    ];
+    let (scale, sden) = match op {
+        Operator::Plain => (1.0, 0.0),
+        Operator::Scaled => {
+            let sd = g11 + g22;
+            (1.0 / sd, sd)
+        }
+    };
+    for a in 0..nloc {
+        let wa = wq * b[a][0] * scale;
+        re[a] += wa * l[0];
+        re[nloc + a] += wa * l[1];
+    }
+    let Some(EggRows { wa, tz, k, nqp }) = rows else { return };
+    // quotient-rule factor L(z) / s, once per point (no division per entry)
+    let ls = if op == Operator::Scaled { [l[0] / sden, l[1] / sden] } else { [0.0; 2] };
+    for (a, w) in wa.iter_mut().enumerate() {
+        *w = wq * b[a][0] * scale;
+    }
+    for (bi, wb) in b.iter().enumerate() {
+        let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
+        for d in 0..2 {
+            let dg11 = 2.0 * g.xu[d] * wb[1];
+            let dg12 = g.xu[d] * wb[2] + g.xv[d] * wb[1];
+            let dg22 = 2.0 * g.xv[d] * wb[2];
+            let ds = 2.0 * (g.xu[d] * wb[1] + g.xv[d] * wb[2]);
+            for z in 0..2 {
+                let mut v = dg22 * g.xuu[z] - 2.0 * dg12 * g.xuv[z] + dg11 * g.xvv[z];
+                if z == d {
+                    v += lw;
+                }
+                v -= ls[z] * ds;
+                tz[((z * 2 + d) * nqp + k) * nloc + bi] = v;
+            }
+        }
     }
 }
 
@@ -515,49 +579,9 @@ impl Discretization {
                     let k = kv * nq[0] + ku;
                     let wq = self.tensor_basis(ex, ey, ku, kv, s);
                     let g = self.geometry(ex, ey, cps, s);
-                    let (g11, g12, g22) = g.metric();
-                    let l = [
-                        g22 * g.xuu[0] - 2.0 * g12 * g.xuv[0] + g11 * g.xvv[0],
-                        g22 * g.xuu[1] - 2.0 * g12 * g.xuv[1] + g11 * g.xvv[1],
-                    ];
-                    let (scale, sden) = match op {
-                        Operator::Plain => (1.0, 0.0),
-                        Operator::Scaled => {
-                            let sd = g11 + g22;
-                            (1.0 / sd, sd)
-                        }
-                    };
-                    for a in 0..nloc {
-                        let wa = wq * s.b[a][0] * scale;
-                        s.re[a] += wa * l[0];
-                        s.re[nloc + a] += wa * l[1];
-                    }
-                    if !want_mat {
-                        continue;
-                    }
-                    // quotient-rule factor L(z) / s, once per point (no division per entry)
-                    let ls = if op == Operator::Scaled { [l[0] / sden, l[1] / sden] } else { [0.0; 2] };
-                    for (a, w) in s.wa[k * nloc..(k + 1) * nloc].iter_mut().enumerate() {
-                        *w = wq * s.b[a][0] * scale;
-                    }
-                    for b in 0..nloc {
-                        let wb = &s.b[b];
-                        let lw = g22 * wb[3] - 2.0 * g12 * wb[4] + g11 * wb[5];
-                        for d in 0..2 {
-                            let dg11 = 2.0 * g.xu[d] * wb[1];
-                            let dg12 = g.xu[d] * wb[2] + g.xv[d] * wb[1];
-                            let dg22 = 2.0 * g.xv[d] * wb[2];
-                            let ds = 2.0 * (g.xu[d] * wb[1] + g.xv[d] * wb[2]);
-                            for z in 0..2 {
-                                let mut v = dg22 * g.xuu[z] - 2.0 * dg12 * g.xuv[z] + dg11 * g.xvv[z];
-                                if z == d {
-                                    v += lw;
-                                }
-                                v -= ls[z] * ds;
-                                s.tz[((z * 2 + d) * nqp + k) * nloc + b] = v;
-                            }
-                        }
-                    }
+                    let rows =
+                        want_mat.then(|| EggRows { wa: &mut s.wa[k * nloc..(k + 1) * nloc], tz: &mut s.tz, k, nqp });
+                    egg_point(&s.b, &g, wq, op, &mut s.re, rows);
                 }
             }
             if want_mat {

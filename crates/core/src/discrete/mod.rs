@@ -10,6 +10,7 @@
 //! | [`tables`] | [`DirTable`](tables::DirTable): the univariate basis at the Gauss points | §4 |
 //! | [`stencil`] | the product of a system with a vector from its stencil storage (no sparse matrix) | eq. (12) |
 //! | [`transfers`] | the nested knot-halving spaces below a basis and the prolongations of their free unknowns (multigrid) | §6.3 |
+//! | [`hierarchical`] | [`HierarchicalDiscretization`](hierarchical::HierarchicalDiscretization): a THB basis cell by cell (element extraction of the truncated functions at the Gauss points), its free/fixed split and patterns | §4 |
 //! | [`assembly`] | [`Discretization`](assembly::Discretization): basis tables, patterns, the EGG residual and Jacobian kernels (eq. 8, 12, 23), mass, elasticity, metric Laplacian | §4, §6 |
 //!
 //! Symbolic work (tables, patterns, orderings) is done once per basis when a
@@ -18,6 +19,7 @@
 
 pub mod assembly;
 pub mod dofs;
+pub mod hierarchical;
 pub mod pattern;
 pub mod stencil;
 pub mod tables;

@@ -10,6 +10,7 @@
 //! | [`density`] | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
 //! | [`harmonic`] | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: [`VariationalHarmonicMethod`](harmonic::VariationalHarmonicMethod) | eq. (46) |
 //! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
+//! | [`hierarchical`] | EGG (eq. 8) and the Winslow functional (eq. 16) on a THB discretization, with the same point kernels: [`HierarchicalEggProblem`](hierarchical::HierarchicalEggProblem), [`HierarchicalWinslowProblem`](hierarchical::HierarchicalWinslowProblem) | §4, eq. (8), (16) |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
@@ -47,6 +48,7 @@ pub mod egg;
 pub mod flux;
 pub mod galerkin;
 pub mod harmonic;
+pub mod hierarchical;
 pub mod metric_norms;
 pub mod quasi_conformal;
 pub mod weak_form;

@@ -55,7 +55,7 @@ use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
 use crate::multipatch::{solve_multipatch, LayoutEvent};
 use crate::solve::memory::MemoryEstimate;
-use crate::solve::options::SolveOptions;
+use crate::solve::options::{Refinement, SolveOptions};
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
 use crate::solve::volume::{solve_volume, VolumeOptions};
@@ -297,7 +297,13 @@ impl Pipeline {
     pub(crate) fn run_keeping_hierarchy(self, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
         self.opts.validate()?;
         let first = self.attempt(&self.opts, observer)?;
-        let Some((fitted, why)) = auto_fallback(&first.0, &self.opts.fit) else { return Ok(first) };
+        // with THB refinement a folded or undecided map on the input basis is repaired
+        // locally by the front end (`solve::hierarchical`), on the input basis
+        let thb_repairs = self.opts.refinement == Refinement::Thb
+            && self.opts.repair > 0
+            && matches!(first.0.report.verdict, Verdict::Folded | Verdict::Undecided);
+        let fallback = if thb_repairs { None } else { auto_fallback(&first.0, &self.opts.fit) };
+        let Some((fitted, why)) = fallback else { return Ok(first) };
         if !observer(&Stage::Fallback { reason: &why }) {
             return Err(Error::Cancelled);
         }

@@ -47,6 +47,10 @@ pub struct SolveOptions {
     /// the offending elements widened by this many spans; the others keep the values of
     /// the prolonged map (paper §8.2: fewer unknowns).
     pub repair_freeze: Option<usize>,
+    /// How defect correction refines: tensor knot spans across the patch (the rounds of
+    /// `repair` in the solve), or THB cells around the defect only
+    /// ([`crate::solve::hierarchical`], run by the front end on the unrepaired map).
+    pub refinement: Refinement,
     /// Options of the bijectivity certificate.
     pub certify: CertifyOptions,
     /// Run the grid-quality benchmark Q(x) of §10 on the final map.
@@ -66,6 +70,20 @@ pub struct SolveOptions {
     /// [`Error::Memory`] before anything large is allocated (default: the memory
     /// available when the solve starts).
     pub max_memory: MemoryLimit,
+}
+
+/// How the defect correction (paper §8.2) refines the basis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Refinement {
+    /// Bisect the offending knot spans (and a halo) across the whole tensor basis.
+    #[default]
+    #[cfg_attr(feature = "clap", value(help = "Bisect the offending knot spans across the tensor basis"))]
+    Tensor,
+    /// Refine the offending cells (and a ring) of a THB basis only.
+    #[cfg_attr(feature = "clap", value(help = "Refine only the offending cells and a ring around them (THB-splines)"))]
+    Thb,
 }
 
 /// Which control points the `C^0` route's final Winslow minimisation moves (paper §9,
@@ -164,6 +182,7 @@ impl Default for SolveOptions {
             repair: 6,
             repair_halo: 1,
             repair_freeze: None,
+            refinement: Refinement::Tensor,
             certify: CertifyOptions::default(),
             poisson: false,
             topology: Topology::dirichlet(),

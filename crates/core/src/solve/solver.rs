@@ -17,7 +17,7 @@ use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
 use super::memory::MemoryEstimate;
 use super::newton::{Iterate, NonlinearOptions};
-use super::options::SolveOptions;
+use super::options::{Refinement, SolveOptions};
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
 use super::report::{InitialGuess, LevelReport, ReportContext, Solution};
 use crate::boundary::hierarchy::{Hierarchy, Level};
@@ -435,7 +435,8 @@ impl EggSolver {
             self.certificate = Some(certify(&self.sim.physical_surface(map)?, &self.opts.certify)?);
         }
         let cert = self.certificate.as_ref().expect("set above");
-        if self.repairs >= self.opts.repair {
+        // THB refinement repairs the unrepaired map afterwards (`solve::hierarchical`)
+        if self.repairs >= self.opts.repair || self.opts.refinement == Refinement::Thb {
             return Ok(false);
         }
         let (halo, freeze) = (self.opts.repair_halo, self.opts.repair_freeze);

@@ -1,0 +1,77 @@
+//! The THB defect correction's parts: the marked ring, and one round on a map folded by
+//! a planted interior control point (refined around the fold only, solved, certified).
+//! The repair of folds that the coarse EGG map itself has (puzzle4) is in
+//! `crates/core/tests/thb_repair.rs`.
+use super::*;
+use crate::spline::knots::KnotVector;
+use crate::spline::surface::Surface;
+
+/// The quarter annulus `r in [1, 2]`, angle in `[0, π/2]`, by Greville interpolation of
+/// its polar parameterization on a `p`, `n x n` basis.
+fn annulus(p: usize, n: usize) -> HierarchicalMap {
+    let kv = KnotVector::open_uniform(p, n);
+    let g = kv.greville();
+    let cps: Vec<[f64; 2]> = g
+        .iter()
+        .flat_map(|&v| {
+            g.iter().map(move |&u| {
+                let (r, t) = (1.0 + u, std::f64::consts::FRAC_PI_2 * v);
+                [r * t.cos(), r * t.sin()]
+            })
+        })
+        .collect();
+    HierarchicalMap::from_surface(&Surface::new([kv.clone(), kv], cps, None).unwrap()).unwrap()
+}
+
+/// Ring 0 marks the offending cell alone, ring 1 its eight neighbours too (fewer at the
+/// border), on one level and across levels.
+#[test]
+fn the_ring_holds_the_neighbouring_active_cells() {
+    let map = annulus(2, 6);
+    let at = |l, c| CellIndex { level: l, cell: c };
+    assert_eq!(marked_cells(&map, &[at(0, [2, 3])], 0), vec![(0, [2, 3])]);
+    assert_eq!(marked_cells(&map, &[at(0, [2, 3])], 1).len(), 9);
+    assert_eq!(marked_cells(&map, &[at(0, [0, 0])], 1).len(), 4);
+    let fine = map.refined(&[(0, [2, 3])], 2).unwrap();
+    // a level-1 cell in the corner of the refined cell: its ring meets three coarse cells
+    let m = marked_cells(&fine, &[at(1, [4, 6])], 1);
+    assert_eq!(m.iter().filter(|c| c.0 == 1).count(), 4, "{m:?}");
+    assert_eq!(m.iter().filter(|c| c.0 == 0).count(), 3, "{m:?}");
+}
+
+/// A fold planted by pulling one interior control point of the EGG map across its
+/// neighbours: one round refines the cells around the fold only (fewer functions than
+/// one uniform refinement), solves EGG on the THB basis from the prolonged map and the
+/// certificate proves the result bijective; it is the EGG map of the same boundary on a
+/// finer space, close to the coarse one.
+#[test]
+fn a_planted_fold_is_refined_around_and_solved_away() {
+    let coarse = annulus(3, 8);
+    let (egg, _, converged, _) = solve_egg(&coarse, Operator::Scaled, NonlinearOptions::default()).unwrap();
+    assert!(converged);
+    let opts = ThbRepairOptions::default();
+    assert!(accepted(&certify_hierarchical(&egg, &opts.certify).unwrap()));
+    let mut planted = egg.clone();
+    let disc = HierarchicalDiscretization::new(planted.basis.clone());
+    let k = disc.free()[disc.num_free() / 2];
+    planted.control_points[k][0] += 0.8;
+    let cert = certify_hierarchical(&planted, &opts.certify).unwrap();
+    assert!(!accepted(&cert), "the planted point folds the map");
+    let out = repair_thb(planted, &opts).unwrap();
+    assert!(accepted(&out.certificate), "{}", out.certificate.message());
+    assert_eq!(out.rounds.len(), 1);
+    let r = &out.rounds[0];
+    assert!(r.offending_cells > 0 && r.marked_cells < 64 && r.converged, "{r:?}");
+    assert_eq!(out.map.basis.num_levels(), 2);
+    let uniform = (3 + 16) * (3 + 16);
+    assert!(out.map.basis.len() < uniform, "{} THB functions, {uniform} uniform", out.map.basis.len());
+    // the repaired map is the EGG map of the boundary on the refined basis: close to
+    // the coarse EGG map everywhere (both approximate the same harmonic inverse)
+    for i in 0..=20 {
+        for j in 0..=20 {
+            let (u, v) = (i as f64 / 20.0, j as f64 / 20.0);
+            let (a, b) = (out.map.eval(u, v), egg.eval(u, v));
+            assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-2, "({u}, {v}): {a:?} vs {b:?}");
+        }
+    }
+}
