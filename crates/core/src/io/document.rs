@@ -197,7 +197,7 @@ impl Document {
             Document::Layout(l) | Document::Multipatch(l) => Input::Layout(l),
             Document::Domain(d) => Input::Domain(d),
             Document::Graph(g) => Input::Graph(g),
-            Document::VolumeBoundary(v) => Input::Volume(v),
+            Document::VolumeBoundary(v) => Input::Volume(Box::new(v)),
             doc @ (Document::Ring(_) | Document::Map { .. })
                 if doc.is_ring_map() || matches!(doc, Document::Ring(_)) =>
             {

@@ -36,7 +36,7 @@ pub enum Input {
     Graph(PlaneGraph),
     /// The six boundary faces of a hexahedral volume: the trivariate Winslow solve from
     /// the Coons start ([`crate::solve::volume::solve_volume`]).
-    Volume(VolumeBoundary),
+    Volume(Box<VolumeBoundary>),
     /// A certified map, improved on its own basis by the pipeline's method (the Winslow
     /// functional by default) with its boundary fixed, and kept only when certified
     /// ([`super::start`]).
@@ -116,7 +116,7 @@ impl From<PlaneGraph> for Input {
 
 impl From<VolumeBoundary> for Input {
     fn from(v: VolumeBoundary) -> Self {
-        Input::Volume(v)
+        Input::Volume(Box::new(v))
     }
 }
 
