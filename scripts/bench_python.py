@@ -8,11 +8,14 @@
    `--warm` instead: the family through `solve_many` cold and with `warm_start=True`
    (each shape from the previous shape's map, `workers` chains), and `winslow batch`
    with and without `--warm-start`.
+   `--dask` instead: the family's throughput per worker on a local `dask.distributed`
+   cluster of `--workers` single-threaded worker processes (`winslow.solve` mapped over
+   the shapes' documents), against one thread of `solve_many` (issue 34: within 20 %).
 2. The Python call overhead of `winslow.solve` on a 100-function map
    (cooks_membrane: 10 x 10 functions): the wall time of the call against the wall
    time of the pipeline inside it (`Solution.pipeline_seconds`), summed over 200 calls.
 
-Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2] [--warm]
+Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2] [--warm | --dask]
 """
 
 import argparse
@@ -65,13 +68,47 @@ def main():
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--overhead-only", action="store_true")
     ap.add_argument("--warm", action="store_true", help="cold against warm-started family solves only")
+    ap.add_argument("--dask", action="store_true", help="throughput per worker on a local Dask cluster only")
     a = ap.parse_args()
+    if a.dask:
+        dask_rows(a)
+        return
     if a.warm:
         warm_rows(a)
         return
     if not a.overhead_only:
         family_rows(a)
     overhead()
+
+
+def solve_text(text):
+    """Solve one shape given as its document's text (on a Dask worker): its verdict."""
+    return winslow.solve(winslow.parse(text)).verdict
+
+
+def dask_rows(a):
+    """Shapes per second per worker: one thread of solve_many, then a local Dask cluster
+    of `workers` single-threaded processes mapping `winslow.solve` over the documents."""
+    from dask.distributed import Client, LocalCluster
+
+    shapes = family(a.shapes)
+    t0 = time.perf_counter()
+    res = winslow.solve_many(shapes, workers=1)
+    alone = len(shapes) / (time.perf_counter() - t0)
+    ok = sum(isinstance(r, winslow.Solution) and r.certified for r in res)
+    print(f"solve_many, 1 worker: {alone:.2f} shapes/s ({ok} of {len(shapes)} bijective)")
+    texts = [s.to_json() for s in shapes]
+    with LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True) as cluster, Client(cluster) as client:
+        # the workers import winslow and solve one shape each before the clock starts
+        client.gather(client.map(solve_text, texts[: a.workers], pure=False))
+        t0 = time.perf_counter()
+        verdicts = client.gather(client.map(solve_text, texts, pure=False))
+        dt = time.perf_counter() - t0
+    per_worker = len(shapes) / dt / a.workers
+    ok = sum(v in ("certified", "degenerate-corner") for v in verdicts)
+    print(f"Dask, {a.workers} worker processes: {len(shapes) / dt:.2f} shapes/s, {per_worker:.2f} per worker "
+          f"({per_worker / alone:.2f} of one solve_many thread; {ok} bijective)")
+    print(f"load average: {os.getloadavg()}")
 
 
 def warm_rows(a):

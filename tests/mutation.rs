@@ -32,6 +32,9 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
             }
         } else if p.extension().is_some_and(|e| e == "json" || e == "xml" || e == "igs")
             && p.metadata().unwrap().len() <= MAX_BYTES
+            // a ring cut into a four-sided map: its west and east sides coincide (the seam
+            // the mesher merges), so its boundary is not a valid four-sided one by design
+            && p.file_name().is_some_and(|n| n != "cut_annulus.json")
         {
             out.push(p);
         }

@@ -326,8 +326,9 @@ fn start_map(obj: &Bound<'_, PyAny>) -> PyResult<Surface> {
     }
 }
 
-/// Solve many shapes on `workers` threads (default: all cores), the GIL released: a
-/// list in the order of `inputs`, each a `Solution` or the `WinslowError` of that shape
+/// Solve many shapes on `workers` threads (default: all cores), the GIL released:
+/// `inputs` any iterable of shapes (a list, or a generator of a family); a list in the
+/// order of `inputs`, each a `Solution` or the `WinslowError` of that shape
 /// (not raised). `on_result(index, result)` is called (with the GIL) as each finishes.
 /// Ctrl-C stops the shapes not yet started and raises `KeyboardInterrupt`.
 ///
@@ -346,13 +347,23 @@ fn start_map(obj: &Bound<'_, PyAny>) -> PyResult<Surface> {
 #[allow(clippy::too_many_arguments)]
 pub fn solve_many<'py>(
     py: Python<'py>,
-    inputs: Vec<Bound<'py, PyAny>>,
+    inputs: Bound<'py, PyAny>,
     workers: Option<usize>,
     on_result: Option<Py<PyAny>>,
     same_basis: bool,
     warm_start: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyList>> {
+    // any iterable of shapes (a list, a generator of a family), but not one path
+    if inputs.is_instance_of::<pyo3::types::PyString>()
+        || inputs.is_instance_of::<pyo3::types::PyBytes>()
+        || inputs.hasattr("__fspath__")?
+    {
+        return Err(errors::invalid(
+            "inputs must be an iterable of shapes (boundaries, maps, rings or paths), not one path",
+        ));
+    }
+    let inputs: Vec<Bound<'py, PyAny>> = inputs.try_iter()?.collect::<PyResult<_>>()?;
     let mut opts = options::parse(options)?;
     if same_basis {
         if options.is_some_and(|o| o.contains("basis").unwrap_or(false)) {

@@ -3,6 +3,7 @@ solve_many(warm_start=True)): the same certified verdict and, on the same basis,
 discrete map as a cold solve within the solver's tolerance."""
 
 import numpy as np
+import pytest
 
 import winslow
 from test_solve import perturbed_ducks
@@ -62,3 +63,18 @@ def test_solve_many_warm_start_chains(data):
     # same_basis and warm_start together: one basis, every map from the previous one
     both = winslow.solve_many(family, workers=1, warm_start=True, same_basis=True)
     assert [r.report.get("warm_start", {}).get("used", False) for r in both] == [False] + [True] * 5
+
+
+def test_solve_many_takes_a_generator_of_a_family(data):
+    """A Python generator of shapes (a family produced on the fly) gives the list's
+    results bit for bit; one path is not an iterable of shapes."""
+    family = perturbed_ducks(data, 4, seed=5)
+    listed = winslow.solve_many(family, workers=2, warm_start=True)
+    generated = winslow.solve_many((b for b in family), workers=2, warm_start=True)
+    assert len(generated) == len(listed) == 4
+    for a, b in zip(listed, generated):
+        assert a.verdict == b.verdict
+        assert np.array_equal(a.map.control_points, b.map.control_points)
+    with pytest.raises(winslow.WinslowError) as e:
+        winslow.solve_many(str(data / "gismo" / "duck.json"))
+    assert e.value.kind == "invalid"

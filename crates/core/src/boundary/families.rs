@@ -508,7 +508,7 @@ fn jigsaw(rng: &mut Rng) -> [SideCurve; 4] {
     [SideCurve::Points(south), SideCurve::Points(east), SideCurve::Points(north), SideCurve::Points(west)]
 }
 
-/// The smallest gap of [`pinched`], relative to the channel's length.
+/// The smallest gap of `pinched`, relative to the channel's length.
 pub const PINCH_GAP: f64 = 3e-4;
 
 /// A channel `[0, 1] × [0, w]`, `w ∈ [0.1, 0.2]`, whose walls close in by the Gaussian

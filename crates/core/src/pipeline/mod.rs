@@ -56,10 +56,11 @@ use crate::methods::Method;
 use crate::multipatch::{solve_multipatch, LayoutEvent};
 use crate::solve::memory::MemoryEstimate;
 use crate::solve::options::{Refinement, SolveOptions};
+use crate::solve::report::WarmNote;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
 use crate::solve::volume::{solve_volume, VolumeOptions};
-use crate::solve::warm::{warm_start, Warm, WarmNote, WarmStart};
+use crate::solve::warm::{warm_start, Warm, WarmStart};
 use crate::spline::surface::Surface;
 
 /// A stage of the pipeline, as the observer sees it.

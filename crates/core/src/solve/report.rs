@@ -236,7 +236,7 @@ pub struct Report {
     /// When a warm start was asked for ([`crate::Pipeline::warm_start`]) and did not
     /// apply: `{"used": false, "reason": ...}`; absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub warm_start: Option<crate::solve::warm::WarmNote>,
+    pub warm_start: Option<WarmNote>,
 }
 
 impl Report {
@@ -440,4 +440,14 @@ impl Solution {
         };
         Self { name: name.to_string(), map, report }
     }
+}
+
+/// Whether a warm start was used, and why not (the `warm_start` field of a report).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WarmNote {
+    /// Whether the shape was solved from the previous map.
+    pub used: bool,
+    /// Why not, when not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }

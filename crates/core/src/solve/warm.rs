@@ -30,7 +30,7 @@ use super::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
 use super::improve::{improve, Improvement};
 use super::initial::{elasticity_correction, set_boundary};
 use super::options::SolveOptions;
-use super::report::Verdict;
+use super::report::{Verdict, WarmNote};
 use crate::boundary::{Boundary, SideCurve};
 use crate::discrete::assembly::Discretization;
 use crate::error::Result;
@@ -39,16 +39,6 @@ use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate};
 use crate::verify::quality::{quality, Quality};
-
-/// Whether a warm start was used, and why not (the `warm_start` field of a report).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WarmNote {
-    /// Whether the shape was solved from the previous map.
-    pub used: bool,
-    /// Why not, when not.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
-}
 
 /// A shape solved from the previous shape's map.
 #[derive(Debug, Clone, Serialize)]

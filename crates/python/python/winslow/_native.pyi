@@ -1,7 +1,7 @@
 """Type stubs of the native module of winslow (re-exported by ``winslow``)."""
 
 from os import PathLike
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -149,7 +149,7 @@ def solve(
     """A ``Solution``; a ``LayoutSolution`` of a layout, domain or plane graph. ``start``:
     the previous map of a shape family (``report["warm_start"]`` says if it was used)."""
 def solve_many(
-    inputs: Sequence[Input],
+    inputs: Iterable[Input],
     *,
     workers: Optional[int] = None,
     on_result: Optional[Callable[[int, Union[Solution, WinslowError]], None]] = None,
