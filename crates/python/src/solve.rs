@@ -228,6 +228,9 @@ pub fn event(stage: &Stage<'_>) -> Value {
         Stage::Solver(Event::LevelFinished(r)) => json!({ "stage": "level_finished", "report": r }),
         Stage::Fallback { reason } => json!({ "stage": "fallback", "reason": reason }),
         Stage::Layout(e) => json!({ "stage": "layout", "event": format!("{e:?}") }),
+        Stage::LaidOut(auto) => json!({ "stage": "laid_out", "report": auto.report }),
+        Stage::WarmStart { used, reason } => json!({ "stage": "warm_start", "used": used, "reason": reason }),
+        Stage::Improve { method } => json!({ "stage": "improve", "method": method.name() }),
         _ => json!({ "stage": "other" }),
     }
 }
