@@ -170,8 +170,15 @@ pub(super) fn tensor_basis(node: Node, ctx: &str) -> Result<[KnotVector; 2]> {
     Ok([bspline_basis(a, &format!("{ctx}.Basis[0]"))?, bspline_basis(b, &format!("{ctx}.Basis[1]"))?])
 }
 
-/// A `TensorBSpline2` or `TensorNurbs2` geometry, knot domains mapped to `[0, 1]`.
-pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
+/// The basis of a `TensorBSpline2` (`rational` false) or `TensorNurbs2` geometry: its
+/// two knot vectors (as given), its weights when rational, and its number of functions
+/// (checked against the control-point limit). Planar patches and the faces of a volume
+/// boundary (`io::volume::boundary_gismo`) read their bases with it.
+pub(crate) fn tensor_basis2(
+    geom: Node,
+    rational: bool,
+    ctx: &str,
+) -> Result<([KnotVector; 2], Option<Vec<f64>>, usize)> {
     let basis = only_child(geom, "Basis", ctx)?;
     let bctx = format!("{ctx}.Basis");
     let (kv, w) = if rational {
@@ -187,6 +194,12 @@ pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
     };
     let n = kv[0].num_basis().saturating_mul(kv[1].num_basis());
     crate::error::check_control_point_count(n, ctx)?;
+    Ok((kv, w, n))
+}
+
+/// A `TensorBSpline2` or `TensorNurbs2` geometry, knot domains mapped to `[0, 1]`.
+pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
+    let (kv, w, n) = tensor_basis2(geom, rational, ctx)?;
     let cps = coefs(geom, n, ctx)?;
     let s = Surface::new(kv, cps, w).map_err(|e| e.within(ctx))?;
     let knots = [normalized_knots(&s.knots[0])?, normalized_knots(&s.knots[1])?];

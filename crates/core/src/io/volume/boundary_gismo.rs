@@ -24,12 +24,11 @@ use roxmltree::Node;
 use crate::boundary::hexahedron::{assemble, FaceSet};
 use crate::boundary::volume::{CubeSide, VolumeBoundary};
 use crate::error::{Error, Result};
-use crate::io::gismo::{
-    basis_type, children, nesting_exceeds, numbers, only_child, tensor_basis, weights, xml_err, MAX_DEPTH, MAX_NODES,
-};
+use crate::io::gismo::{children, nesting_exceeds, only_child, tensor_basis2, xml_err, MAX_DEPTH, MAX_NODES};
 use crate::io::gismo_writer::{knot_vector, number};
 use crate::io::multipatch::gismo::{integers, patch_ids};
 use crate::io::normalized_knots;
+use crate::io::volume::gismo::points3;
 use crate::spline::face::Face;
 use crate::spline::knots::KnotVector;
 
@@ -45,31 +44,8 @@ fn face(geom: Node, ctx: &str) -> Result<Option<Face>> {
     if coefs.attribute("geoDim").map(str::trim) != Some("3") {
         return Ok(None);
     }
-    let basis = only_child(geom, "Basis", ctx)?;
-    let bctx = format!("{ctx}.Basis");
-    let (kv, w) = if rational {
-        if basis_type(&basis) != "TensorNurbsBasis2" {
-            return Err(xml_err(&bctx, format!("expected a TensorNurbsBasis2, found type {:?}", basis_type(&basis))));
-        }
-        let kv = tensor_basis(only_child(basis, "Basis", &bctx)?, &format!("{bctx}.Basis"))?;
-        let n = kv[0].num_basis().saturating_mul(kv[1].num_basis());
-        (kv, Some(weights(basis, n, &bctx)?))
-    } else {
-        (tensor_basis(basis, &bctx)?, None)
-    };
-    let n = kv[0].num_basis().saturating_mul(kv[1].num_basis());
-    crate::error::check_control_point_count(n, ctx)?;
-    let cctx = format!("{ctx}.coefs");
-    let vals = numbers(coefs, &cctx)?;
-    if vals.len() != 3 * n {
-        return Err(Error::Length {
-            context: cctx,
-            what: "coefficients (geoDim 3)".into(),
-            found: vals.len(),
-            expected: 3 * n,
-        });
-    }
-    let cps = vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let (kv, w, n) = tensor_basis2(geom, rational, ctx)?;
+    let cps = points3(coefs, n, &format!("{ctx}.coefs"))?;
     let mut knots = Vec::with_capacity(2);
     for (d, k) in kv.iter().enumerate() {
         knots.push(normalized_knots(k).map_err(|e| e.within(&format!("{ctx}.Basis[{d}]")))?);

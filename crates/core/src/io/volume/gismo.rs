@@ -35,6 +35,21 @@ fn tensor_basis3(node: Node, ctx: &str) -> Result<[KnotVector; 3]> {
     out.try_into().map_err(|_| xml_err(ctx, "three bases expected"))
 }
 
+/// The `n` points in space of a `<coefs geoDim="3">` node (a volume's, or a face's of a
+/// volume boundary), three numbers each.
+pub(crate) fn points3(node: Node, n: usize, ctx: &str) -> Result<Vec<[f64; 3]>> {
+    let vals = numbers(node, ctx)?;
+    if vals.len() != 3 * n {
+        return Err(Error::Length {
+            context: ctx.to_string(),
+            what: "coefficients (geoDim 3)".into(),
+            found: vals.len(),
+            expected: 3 * n,
+        });
+    }
+    Ok(vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
 fn volume(geom: Node, rational: bool, ctx: &str) -> Result<Volume> {
     let basis = only_child(geom, "Basis", ctx)?;
     let bctx = format!("{ctx}.Basis");
@@ -55,16 +70,7 @@ fn volume(geom: Node, rational: bool, ctx: &str) -> Result<Volume> {
     if let Some(d) = node.attribute("geoDim").filter(|d| d.trim() != "3") {
         return Err(xml_err(&cctx, format!("geoDim {d:?}: a volume needs geoDim 3")));
     }
-    let vals = numbers(node, &cctx)?;
-    if vals.len() != 3 * n {
-        return Err(Error::Length {
-            context: cctx,
-            what: "coefficients (geoDim 3)".into(),
-            found: vals.len(),
-            expected: 3 * n,
-        });
-    }
-    let cps = vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let cps = points3(node, n, &cctx)?;
     let v = Volume::new(kv, cps, w).map_err(|e| e.within(ctx))?;
     let mut norm = Vec::with_capacity(3);
     for k in &v.knots {
