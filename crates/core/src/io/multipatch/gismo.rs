@@ -85,6 +85,21 @@ fn transposed_side(s: Side) -> Side {
     }
 }
 
+/// The rows of a `<MultiPatch>`'s `<interfaces>` (none without one): eight integers each,
+/// `p1 s1 p2 s2 m0 m1 o0 o1` (patch ids, sides 1 west, 2 east, 3 south, 4 north (5, 6
+/// bottom, top), the matching and orientation flags).
+pub(crate) fn interface_rows(mp: roxmltree::Node) -> Result<Vec<[i64; 8]>> {
+    let Some(node) = children(mp, "interfaces").next() else { return Ok(Vec::new()) };
+    let v = integers(node, "MultiPatch.interfaces")?;
+    if v.len() % 8 != 0 {
+        return Err(xml_err(
+            "MultiPatch.interfaces",
+            format!("{} numbers: 8 per interface (p1 s1 p2 s2 m0 m1 o0 o1)", v.len()),
+        ));
+    }
+    Ok(v.chunks_exact(8).map(|r| std::array::from_fn(|i| r[i])).collect())
+}
+
 pub(crate) fn integers(node: roxmltree::Node, ctx: &str) -> Result<Vec<i64>> {
     let mut out = Vec::new();
     for t in node.descendants().filter(|n| n.is_text()) {
@@ -167,44 +182,35 @@ pub fn parse_gismo_multipatch(text: &str) -> Result<Layout> {
         Ok(PatchSide { patch: p, side: if transposed[p] { transposed_side(side) } else { side } })
     };
     let mut interfaces = Vec::new();
-    if let Some(node) = children(mp, "interfaces").next() {
-        let v = integers(node, "MultiPatch.interfaces")?;
-        if v.len() % 8 != 0 {
+    for (k, r) in interface_rows(mp)?.iter().enumerate() {
+        let ctx = format!("MultiPatch.interfaces[{k}]");
+        let (s1, s2) = (
+            side_of_gismo(r[1]).ok_or_else(|| xml_err(&ctx, format!("side {}", r[1])))?,
+            side_of_gismo(r[3]).ok_or_else(|| xml_err(&ctx, format!("side {}", r[3])))?,
+        );
+        let (m, o) = ([r[4], r[5]], [r[6], r[7]]);
+        if m.iter().any(|&x| !(0..2).contains(&x)) || o.iter().any(|&x| !(0..2).contains(&x)) {
+            return Err(xml_err(&ctx, format!("direction map {m:?} and orientation {o:?} must be 0 or 1")));
+        }
+        // G+Smo's direction numbers: 0 = u (normal of west/east), 1 = v
+        let normal = |s: Side| usize::from(matches!(s, Side::South | Side::North));
+        let t = 1 - normal(s1);
+        if m[t] != (1 - normal(s2)) as i64 {
             return Err(xml_err(
-                "MultiPatch.interfaces",
-                format!("{} numbers: 8 per interface (p1 s1 p2 s2 m0 m1 o0 o1)", v.len()),
+                &ctx,
+                format!(
+                    "direction map {m:?} sends the direction along side {} ({}) to direction {}, which is not the direction along side {} ({})",
+                    r[1],
+                    ["u", "v"][t],
+                    m[t],
+                    r[3],
+                    ["u", "v"][1 - normal(s2)]
+                ),
             ));
         }
-        for (k, r) in v.chunks_exact(8).enumerate() {
-            let ctx = format!("MultiPatch.interfaces[{k}]");
-            let (s1, s2) = (
-                side_of_gismo(r[1]).ok_or_else(|| xml_err(&ctx, format!("side {}", r[1])))?,
-                side_of_gismo(r[3]).ok_or_else(|| xml_err(&ctx, format!("side {}", r[3])))?,
-            );
-            let (m, o) = ([r[4], r[5]], [r[6], r[7]]);
-            if m.iter().any(|&x| !(0..2).contains(&x)) || o.iter().any(|&x| !(0..2).contains(&x)) {
-                return Err(xml_err(&ctx, format!("direction map {m:?} and orientation {o:?} must be 0 or 1")));
-            }
-            // G+Smo's direction numbers: 0 = u (normal of west/east), 1 = v
-            let normal = |s: Side| usize::from(matches!(s, Side::South | Side::North));
-            let t = 1 - normal(s1);
-            if m[t] != (1 - normal(s2)) as i64 {
-                return Err(xml_err(
-                    &ctx,
-                    format!(
-                        "direction map {m:?} sends the direction along side {} ({}) to direction {}, which is not the direction along side {} ({})",
-                        r[1],
-                        ["u", "v"][t],
-                        m[t],
-                        r[3],
-                        ["u", "v"][1 - normal(s2)]
-                    ),
-                ));
-            }
-            let first = patch_side(r[0], r[1], &ctx)?;
-            let second = patch_side(r[2], r[3], &ctx)?;
-            interfaces.push(Interface { first, second, reversed: o[t] == 0 });
-        }
+        let first = patch_side(r[0], r[1], &ctx)?;
+        let second = patch_side(r[2], r[3], &ctx)?;
+        interfaces.push(Interface { first, second, reversed: o[t] == 0 });
     }
     let layout = Layout { name: String::new(), patches, interfaces };
     if let Some(node) = children(mp, "boundary").next() {

@@ -26,7 +26,7 @@ use crate::boundary::volume::{CubeSide, VolumeBoundary};
 use crate::error::{Error, Result};
 use crate::io::gismo::{children, nesting_exceeds, only_child, tensor_basis2, xml_err, MAX_DEPTH, MAX_NODES};
 use crate::io::gismo_writer::{knot_vector, number};
-use crate::io::multipatch::gismo::{integers, patch_ids};
+use crate::io::multipatch::gismo::{integers, interface_rows, patch_ids};
 use crate::io::normalized_knots;
 use crate::io::volume::gismo::points3;
 use crate::spline::face::Face;
@@ -90,31 +90,19 @@ pub fn parse_gismo_faces(text: &str) -> Result<Option<VolumeBoundary>> {
     let index = |id: i64, ctx: &str| {
         ids.iter().position(|&i| i == id).ok_or_else(|| xml_err(ctx, format!("patch id {id} is not in <patches>")))
     };
-    if let Some(node) = children(mp, "interfaces").next() {
-        let v = integers(node, "MultiPatch.interfaces")?;
-        if v.len() % 8 != 0 {
-            return Err(xml_err(
-                "MultiPatch.interfaces",
-                format!("{} numbers: 8 per interface (p1 s1 p2 s2 m0 m1 o0 o1)", v.len()),
-            ));
-        }
-        for (k, r) in v.chunks_exact(8).enumerate() {
-            let ctx = format!("MultiPatch.interfaces[{k}]");
-            let (a, b) = (index(r[0], &ctx)?, index(r[2], &ctx)?);
-            let side = |s: i64| {
-                usize::try_from(s - 1)
-                    .ok()
-                    .filter(|&s| s < 4)
-                    .ok_or_else(|| xml_err(&ctx, format!("side {s} (1 to 4)")))
-            };
-            let (sa, sb) = (side(r[1])?, side(r[3])?);
-            if set.edge_of(a, sa) != set.edge_of(b, sb) {
-                return Err(Error::VolumeBoundary {
-                    face: format!("{}/{}", names[a], names[b]),
-                    edge: format!("interface {k}: sides {} and {}", r[1], r[3]),
-                    reason: "the interface joins two sides that do not meet: their end points differ".into(),
-                });
-            }
+    for (k, r) in interface_rows(mp)?.iter().enumerate() {
+        let ctx = format!("MultiPatch.interfaces[{k}]");
+        let (a, b) = (index(r[0], &ctx)?, index(r[2], &ctx)?);
+        let side = |s: i64| {
+            usize::try_from(s - 1).ok().filter(|&s| s < 4).ok_or_else(|| xml_err(&ctx, format!("side {s} (1 to 4)")))
+        };
+        let (sa, sb) = (side(r[1])?, side(r[3])?);
+        if set.edge_of(a, sa) != set.edge_of(b, sb) {
+            return Err(Error::VolumeBoundary {
+                face: format!("{}/{}", names[a], names[b]),
+                edge: format!("interface {k}: sides {} and {}", r[1], r[3]),
+                reason: "the interface joins two sides that do not meet: their end points differ".into(),
+            });
         }
     }
     if let Some(node) = children(mp, "boundary").next() {
