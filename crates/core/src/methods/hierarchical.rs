@@ -19,7 +19,7 @@ use std::sync::Arc;
 
 use super::density::{lowered, raised, shift_diagonal};
 use super::galerkin::block_mass;
-use super::winslow::{projected_density_hessian, winslow_density, PROJECTION_FIRST};
+use super::winslow::{projected_density_hessian, projection_lowered, projection_raised, winslow_density};
 use super::DiscreteProblem;
 use crate::discrete::assembly::{egg_point, element_product, EggRows, Geo, Operator};
 use crate::discrete::hierarchical::{CellQuadrature, HierarchicalDiscretization};
@@ -308,11 +308,7 @@ impl DiscreteProblem for HierarchicalWinslowProblem {
         if !std::mem::take(&mut self.raised) {
             // a new point: one stage back towards the exact Hessian
             self.shift = lowered(self.shift);
-            self.projected = match self.projected {
-                x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
-                x if x > PROJECTION_FIRST => PROJECTION_FIRST,
-                _ => 0.0,
-            };
+            self.projected = projection_lowered(self.projected);
         }
         let s = &mut self.state;
         s.load(c);
@@ -340,7 +336,7 @@ impl DiscreteProblem for HierarchicalWinslowProblem {
     fn raise_shift(&mut self) -> bool {
         self.raised = true;
         if self.projected < 1.0 {
-            self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
+            self.projected = projection_raised(self.projected);
             return true;
         }
         let Some(next) = raised(self.shift) else { return false };

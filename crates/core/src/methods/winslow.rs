@@ -388,6 +388,26 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
 /// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
 pub const PROJECTION_FIRST: f64 = 0.3;
 
+/// The projection share one stage stronger after a failed factorization: none, then
+/// [`PROJECTION_FIRST`], then three times that, then 1 (the whole negative part).
+pub(crate) fn projection_raised(projected: f64) -> f64 {
+    if projected == 0.0 {
+        PROJECTION_FIRST
+    } else {
+        (3.0 * projected).min(1.0)
+    }
+}
+
+/// The projection share one stage weaker at a new point (towards the exact Hessian):
+/// the inverse of [`projection_raised`].
+pub(crate) fn projection_lowered(projected: f64) -> f64 {
+    match projected {
+        x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
+        x if x > PROJECTION_FIRST => PROJECTION_FIRST,
+        _ => 0.0,
+    }
+}
+
 /// The Winslow functional on one level: discretization, control points (fixed ones hold
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
@@ -472,11 +492,7 @@ impl DiscreteProblem for WinslowProblem {
             // stronger modification than the one it started with, its modification
             // is kept for this one (the stages it failed would fail here too)
             self.shift = lowered(self.shift);
-            self.projected = match self.projected {
-                x if x >= 1.0 => 3.0 * PROJECTION_FIRST,
-                x if x > PROJECTION_FIRST => PROJECTION_FIRST,
-                _ => 0.0,
-            };
+            self.projected = projection_lowered(self.projected);
         }
         let s = &mut self.state;
         if !self.assembled.as_ref().is_some_and(|(at, pr)| at == c && *pr == self.projected) {
@@ -516,7 +532,7 @@ impl DiscreteProblem for WinslowProblem {
         self.raised = true;
         self.raised_at_point = true;
         if self.projected < 1.0 {
-            self.projected = if self.projected == 0.0 { PROJECTION_FIRST } else { (3.0 * self.projected).min(1.0) };
+            self.projected = projection_raised(self.projected);
             return true;
         }
         let Some(next) = raised(self.shift) else { return false };
