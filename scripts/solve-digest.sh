@@ -8,7 +8,8 @@
 #   - every multipatch layout (tests/data/gismo/xml/multipatch), with fixed and with free
 #     interfaces;
 #   - every general domain and plane graph (tests/data/domains), laid out automatically;
-#   - every volume boundary (tests/data/volumes), and a THB map converted (tests/data/thb);
+#   - every volume boundary (tests/data/volumes), a THB map converted (tests/data/thb) and
+#     a solve with THB defect correction (`--refinement thb`, puzzle4);
 #   - a map improved on its own basis (`solve --start`, Winslow);
 #   - the comparison of methods on one basis (`compare --json`);
 #   - a short sliding-grid sweep of a ring and the volume lofted from its frames.
@@ -91,6 +92,9 @@ done
 # a THB map converted to its exact tensor map (certified again)
 run thb_sector convert tests/data/thb/sector_thb.json -o "$scratch/thb_sector.json"
 [ -f "$scratch/thb_sector.json" ] && digest "$scratch/thb_sector.json" thb_sector
+
+# the THB defect correction of puzzle4 (it folds without repair): the THB map with its report
+solve_to_digest thb_puzzle4 tests/data/gismo/puzzle4.json --refinement thb
 
 # a map improved on its own basis from the certified EGG map of wavy_lid
 if [ -f "$scratch/wavy_lid.json" ]; then
