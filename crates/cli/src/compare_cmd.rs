@@ -1,4 +1,4 @@
-//! `winslow compare BOUNDARY [--methods egg,vhm,qc,maxz,liao,winslow-functional,ao]
+//! `winslow compare BOUNDARY [--methods egg,vhm,qc,maxz,liao,winslow,ao]
 //! [--json] [--png-dir DIR]`: the methods of paper §10 on one basis, one table row each
 //! ([`winslow::pipeline::compare`]): iterations, the certificate's verdict, `Q(x) / Q(x_G)`,
 //! the Winslow, Liao and area-orthogonality values, the smallest scaled Jacobian, time.
@@ -15,7 +15,7 @@ pub(super) struct CompareArgs {
     /// Methods, comma-separated: egg (eq. 8, always run: its map is x_G), vhm (the
     /// variational harmonic method, eq. 46), qc (the quasi-conformal functional, eq.
     /// 47-48), and Gravesen's: maxz (eq. 49 from the Coons patch, stopped at z > 0), liao,
-    /// winslow-functional, ao (the Liao, Winslow eq. 16 or area-orthogonality functional
+    /// winslow, ao (the Liao, Winslow eq. 16 or area-orthogonality functional
     /// minimised subject to d(c) >= eps from x_G, as `winslow optimise --from egg`).
     /// Gravesen's need a polynomial basis (--basis fitted where the input is NURBS) and
     /// the constrained ones at most 3000 unknowns (a coarse --fit-tol); else their rows
@@ -34,11 +34,11 @@ pub(super) struct CompareArgs {
     /// (Levenberg-Marquardt, the default) or the exact Hessian (Newton's method).
     #[arg(long, value_enum, default_value = "gauss-newton")]
     qc_hessian: QcHessian,
-    /// eps of the constraints d(c) >= eps of liao, winslow-functional and ao, relative to
+    /// eps of the constraints d(c) >= eps of liao, winslow and ao, relative to
     /// the mean det J.
     #[arg(long, default_value_t = ConstrainedOptions::default().eps)]
     eps: f64,
-    /// Most SQP iterations of liao, winslow-functional and ao.
+    /// Most SQP iterations of liao, winslow and ao.
     #[arg(long, default_value_t = ConstrainedOptions::default().max_iterations)]
     max_sqp: usize,
     #[command(flatten)]

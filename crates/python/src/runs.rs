@@ -216,7 +216,7 @@ pub fn improve<'py>(
 /// `basis`, `degree`, `poisson_scales` and `rows` (one per method, EGG first: `method`,
 /// `start`, `iterations`, `converged`, `failure`, `measures`, `q_ratio`, `seconds`,
 /// `notes`, and `map`, the method's `Map` or `None`). `methods` by their command-line
-/// names (`egg`, `vhm`, `qc`, `maxz`, `liao`, `winslow-functional`, `ao`); the other
+/// names (`egg`, `vhm`, `qc`, `maxz`, `liao`, `winslow`, `ao`); the other
 /// keywords as `winslow compare`'s flags (`levels=1`, `max_newton=200`, no repair by
 /// default), solver options as in `solve`. `progress(event)` sees `started` and
 /// `finished` per method.

@@ -29,7 +29,7 @@
 //! | `qc` | quasi-conformal, eq. (47)-(48) | Coons patch | Levenberg-Marquardt / Newton iterations |
 //! | `maxz` | Gravesen's feasible start, eq. (49), stopped at `z > 0` | Coons patch | LPs |
 //! | `liao` | Liao functional (eq. 3) subject to `d(c) >= ε` | `x_G` | QPs of the SQP (+ restoration LPs) |
-//! | `winslow-functional` | Winslow functional (eq. 16) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
+//! | `winslow` | Winslow functional (eq. 16) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
 //! | `ao` | area orthogonality (eq. 3) subject to `d(c) >= ε` | `x_G` | QPs (+ LPs) |
 //!
 //! Gravesen's methods (the last four, [`ConstrainedRun`], [`MaxZRun`]) need a polynomial
@@ -85,7 +85,7 @@ pub enum MethodChoice {
     /// ([`run`](crate::solve::constrained::run)).
     Liao,
     /// The Winslow functional (eq. 16) minimised subject to `d(c) >= ε` from `x_G`.
-    WinslowFunctional,
+    Winslow,
     /// The area-orthogonality functional (eq. 3) minimised subject to `d(c) >= ε` from `x_G`.
     Ao,
 }
@@ -98,7 +98,7 @@ impl MethodChoice {
         MethodChoice::Qc,
         MethodChoice::MaxZ,
         MethodChoice::Liao,
-        MethodChoice::WinslowFunctional,
+        MethodChoice::Winslow,
         MethodChoice::Ao,
     ];
 
@@ -115,7 +115,7 @@ impl MethodChoice {
             MethodChoice::Qc => "qc",
             MethodChoice::MaxZ => "maxz",
             MethodChoice::Liao => "liao",
-            MethodChoice::WinslowFunctional => "winslow-functional",
+            MethodChoice::Winslow => "winslow",
             MethodChoice::Ao => "ao",
         }
     }
@@ -127,13 +127,18 @@ impl MethodChoice {
         match self {
             MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.max_levels != Some(1) => "hierarchy",
             MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc | MethodChoice::MaxZ => "coons",
-            MethodChoice::Liao | MethodChoice::WinslowFunctional | MethodChoice::Ao => "egg",
+            MethodChoice::Liao | MethodChoice::Winslow | MethodChoice::Ao => "egg",
         }
     }
 
-    /// The method called `name`; [`Error::Invalid`] listing the known names otherwise.
+    /// The method called `name` (`winslow-functional`, the name of earlier versions, is
+    /// `winslow`: the same functional as `winslow optimise --functional winslow`);
+    /// [`Error::Invalid`] listing the known names otherwise.
     pub fn parse(name: &str) -> Result<Self> {
         let name = name.trim().to_ascii_lowercase();
+        if name == "winslow-functional" {
+            return Ok(MethodChoice::Winslow);
+        }
         Self::ALL.into_iter().find(|m| m.name() == name).ok_or_else(|| {
             let known: Vec<&str> = Self::ALL.iter().map(|m| m.name()).collect();
             Error::Invalid(format!("unknown method '{name}' (known: {})", known.join(", ")))
@@ -154,7 +159,7 @@ impl MethodChoice {
             )),
             MethodChoice::MaxZ => Box::new(MaxZRun),
             MethodChoice::Liao => Box::new(ConstrainedRun::new(self.name(), Functional::Liao)),
-            MethodChoice::WinslowFunctional => Box::new(ConstrainedRun::new(self.name(), Functional::Winslow)),
+            MethodChoice::Winslow => Box::new(ConstrainedRun::new(self.name(), Functional::Winslow)),
             MethodChoice::Ao => Box::new(ConstrainedRun::new(self.name(), Functional::AreaOrthogonality)),
         }
     }

@@ -75,6 +75,8 @@ fn names_parse_and_unknown_names_are_errors() {
         assert_eq!(MethodChoice::parse(m.name()).unwrap(), m);
     }
     assert_eq!(MethodChoice::parse(" VHM ").unwrap(), MethodChoice::Vhm);
+    // the name of earlier versions
+    assert_eq!(MethodChoice::parse("winslow-functional").unwrap(), MethodChoice::Winslow);
     let e = MethodChoice::parse("ipopt").unwrap_err().to_string();
     assert!(e.contains("ipopt") && e.contains("egg, vhm, qc"), "{e}");
 }
@@ -109,10 +111,10 @@ fn gravesens_methods_keep_the_affine_map_of_an_affine_boundary() {
         solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
         ..Default::default()
     };
-    let methods = [MethodChoice::MaxZ, MethodChoice::Liao, MethodChoice::WinslowFunctional, MethodChoice::Ao];
+    let methods = [MethodChoice::MaxZ, MethodChoice::Liao, MethodChoice::Winslow, MethodChoice::Ao];
     let cmp = compare(&b, &methods, &opts, Arc::new(CpuAssembler), &mut |_| true).unwrap().unwrap();
     let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
-    assert_eq!(names, ["egg", "maxz", "liao", "winslow-functional", "ao"]);
+    assert_eq!(names, ["egg", "maxz", "liao", "winslow", "ao"]);
     let starts: Vec<&str> = cmp.rows.iter().map(|r| r.start).collect();
     assert_eq!(starts, ["coons", "coons", "egg", "egg", "egg"]);
     let shape = cmp.rows[0].measures.as_ref().unwrap().shape;
