@@ -31,18 +31,18 @@ pub mod cord_length;
 pub mod corners;
 pub mod families;
 pub mod fit;
-pub mod hexahedron;
+pub(crate) mod hexahedron;
 pub mod hierarchy;
-pub mod input_basis;
+pub(crate) mod input_basis;
 pub mod kinks;
-pub mod level;
-pub mod normalise;
+pub(crate) mod level;
+pub(crate) mod normalise;
 pub mod reparam;
 pub mod ring;
 pub mod ring_fit;
-pub mod ring_reparam;
+pub(crate) mod ring_reparam;
 pub mod validate;
-pub mod volume;
+pub(crate) mod volume;
 
 use std::sync::Arc;
 

@@ -19,9 +19,9 @@
 
 pub mod assembly;
 pub mod dofs;
-pub mod hierarchical;
-pub mod pattern;
-pub mod stencil;
+pub(crate) mod hierarchical;
+pub(crate) mod pattern;
+pub(crate) mod stencil;
 pub mod tables;
 pub mod topology;
-pub mod transfers;
+pub(crate) mod transfers;

@@ -21,16 +21,16 @@
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
 
 pub mod corpus;
-pub mod cycles;
-pub mod families;
-pub mod graph;
-pub mod harmonic;
-pub mod holes;
-pub mod plane;
-pub mod polygon_map;
-pub mod reflex;
+pub(crate) mod cycles;
+pub(crate) mod families;
+pub(crate) mod graph;
+pub(crate) mod harmonic;
+pub(crate) mod holes;
+pub(crate) mod plane;
+pub(crate) mod polygon_map;
+pub(crate) mod reflex;
 pub mod template;
-pub mod validate;
+pub(crate) mod validate;
 
 use crate::boundary::SideCurve;
 use crate::error::Error;

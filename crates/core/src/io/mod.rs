@@ -21,21 +21,21 @@
 //! counter-clockwise [`Boundary`]. All inputs are untrusted: every malformed file gives
 //! an [`Error`] naming what is wrong and where, never a panic.
 
-pub mod document;
-pub mod domain;
+pub(crate) mod document;
+pub(crate) mod domain;
 pub mod file;
 pub mod gismo;
-pub mod gismo_writer;
-pub mod graph;
+pub(crate) mod gismo_writer;
+pub(crate) mod graph;
 pub mod hierarchical;
 pub mod iges;
 pub mod json;
 pub mod multipatch;
 pub mod output;
 pub mod picture;
-pub mod ring;
-pub mod volume;
-pub mod vtk;
+pub(crate) mod ring;
+pub(crate) mod volume;
+pub(crate) mod vtk;
 
 use std::path::Path;
 

@@ -16,11 +16,11 @@
 //! (knot insertion, degree elevation, [`crate::spline::refine`]) are sparse matrices, so
 //! sparse storage must sit below the splines; none of these modules knows what a spline is.
 
-pub mod banded;
-pub mod dense;
-pub mod krylov;
+pub(crate) mod banded;
+pub(crate) mod dense;
+pub(crate) mod krylov;
 pub mod linsolve;
-pub mod multigrid;
+pub(crate) mod multigrid;
 pub mod ordering;
 pub mod sparse;
 pub mod split_cholesky;

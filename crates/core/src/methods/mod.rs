@@ -43,15 +43,15 @@
 //! The quadrature back end (CPU here, WGSL in the GPU crate) sits behind the EGG method:
 //! [`EggAssembler`](egg::EggAssembler).
 
-pub mod density;
+pub(crate) mod density;
 pub mod egg;
-pub mod flux;
-pub mod galerkin;
-pub mod harmonic;
-pub mod hierarchical;
-pub mod metric_norms;
+pub(crate) mod flux;
+pub(crate) mod galerkin;
+pub(crate) mod harmonic;
+pub(crate) mod hierarchical;
+pub(crate) mod metric_norms;
 pub mod quasi_conformal;
-pub mod weak_form;
+pub(crate) mod weak_form;
 pub mod winslow;
 
 use std::sync::Arc;

@@ -13,13 +13,13 @@
 //! | [`split`] | a domain split by the image of a parameter curve (straight or shortest in the map's metric) into two patches |
 //! | [`check`] | validation of a layout: shared sides identical, orientations consistent, counter-clockwise patches, complete interfaces, no crossing boundaries |
 
-pub mod check;
+pub(crate) mod check;
 pub mod classes;
-pub mod dofs;
-pub mod free;
+pub(crate) mod dofs;
+pub(crate) mod free;
 pub mod join;
 pub mod layout;
-pub mod problem;
+pub(crate) mod problem;
 pub mod solve;
 pub mod split;
 

@@ -36,7 +36,7 @@
 
 pub mod compare;
 mod input;
-pub mod start;
+pub(crate) mod start;
 pub mod sweep;
 
 pub use input::{Input, Solved};

@@ -22,17 +22,17 @@
 //! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod constrained;
-pub mod fixed_basis;
+pub(crate) mod fixed_basis;
 pub mod hierarchical;
 pub mod improve;
 pub mod initial;
-pub mod kinks;
-pub mod levels;
+pub(crate) mod kinks;
+pub(crate) mod levels;
 pub mod loft;
 pub mod memory;
 pub mod newton;
 pub mod options;
-pub mod repair;
+pub(crate) mod repair;
 pub mod report;
 pub mod solver;
 pub mod volume;

@@ -16,14 +16,14 @@
 //! | [`volume`] | [`Volume`](volume::Volume): trivariate tensor-product maps `x: [0,1]³ → R³`, knot insertion, elevation, Bézier nets | §11.1 |
 
 pub mod basis;
-pub mod bezier;
+pub(crate) mod bezier;
 pub mod curve;
 pub mod face;
 pub mod hierarchical;
 pub mod knots;
 pub mod loft;
-pub mod periodic;
-pub mod quadrature;
-pub mod refine;
+pub(crate) mod periodic;
+pub(crate) mod quadrature;
+pub(crate) mod refine;
 pub mod surface;
 pub mod volume;

@@ -17,8 +17,8 @@
 //! every element halved ([`VolumeOptions::max_refinements`] times at most); the result
 //! is the last volume with its certificate, whatever its verdict.
 
-pub mod coons;
-pub mod winslow;
+pub(crate) mod coons;
+pub(crate) mod winslow;
 
 use std::time::Instant;
 

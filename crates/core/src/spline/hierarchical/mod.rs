@@ -35,7 +35,7 @@
 pub mod map;
 #[cfg(test)]
 mod tests;
-pub mod truncation;
+pub(crate) mod truncation;
 
 use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;
