@@ -251,7 +251,7 @@ fn within_side(e: Error, s: Side) -> Error {
 /// (side shorter than that tolerance), [`Error::SelfIntersection`],
 /// [`Error::DegenerateContour`] (no area, so no orientation) and [`Error::Range`]
 /// (a size whose `det J` leaves `f64`'s range). The geometry is measured in the
-/// normalised coordinates of [`Similarity`] and reported in the input's.
+/// normalised coordinates of `Similarity` and reported in the input's.
 pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
     for s in Side::ALL {
         let side = boundary.side(s);

@@ -102,7 +102,7 @@ pub enum Stage<'a> {
         reason: Option<&'a str>,
     },
     /// A map given as the input is improved by `method` on its own basis
-    /// ([`start`](mod@start)).
+    /// (`start`).
     Improve {
         /// The method.
         method: &'a dyn Method,

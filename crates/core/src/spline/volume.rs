@@ -6,9 +6,9 @@
 //! Control point `(i, j, k)` is stored at `(k n_η + j) n_ξ + i` (`ξ` fastest, then `η`).
 //! Knot insertion and degree elevation act on one direction at a time, on the
 //! homogeneous coordinates `(w x, w y, w z, w)`, with the univariate operators of
-//! [`crate::spline::refine`] (so periodic directions work as for curves); the map is
+//! `spline::refine` (so periodic directions work as for curves); the map is
 //! reproduced exactly (to rounding). Bézier extraction per element is the tensor product
-//! of the univariate operators of [`crate::spline::bezier`].
+//! of the univariate operators of `spline::bezier`.
 
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
