@@ -69,6 +69,10 @@
 //! are objects that yield their iterates ([`EggSolver`] is an `Iterator` of
 //! [`solve::solver::Event`]s).
 
+// A small public API: every type a public signature or field shows can be named (no public
+// item of a `pub(crate)` module leaks out unnamed; re-export it at its group instead).
+#![warn(unnameable_types)]
+
 pub mod boundary;
 pub mod discrete;
 pub mod domain;

@@ -44,6 +44,9 @@ pub(crate) mod ring_reparam;
 pub mod validate;
 pub(crate) mod volume;
 
+pub use normalise::Similarity;
+pub use volume::{CubeSide, VolumeBoundary};
+
 use std::sync::Arc;
 
 use crate::error::{Error, Result};

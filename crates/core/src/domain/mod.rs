@@ -36,7 +36,9 @@ use crate::boundary::SideCurve;
 use crate::error::Error;
 use crate::spline::curve::Point;
 
-pub use plane::{PlaneEdge, PlaneGraph, PlaneLabel};
+pub use holes::HoleCut;
+pub use plane::{GraphFace, GraphReport, PlaneEdge, PlaneGraph, PlaneLabel};
+pub use reflex::CutReport;
 pub use template::{auto_layout, graph_layout, AutoLayout, LayoutOptions, LayoutReport};
 pub use validate::{validate_domain, DomainReport};
 

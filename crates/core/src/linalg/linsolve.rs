@@ -109,7 +109,7 @@ pub const AUTO_MAX_KRYLOV: usize = 500;
 /// Gauss–Seidel by 0.54 (the smoothing of Gauss–Seidel degrades with the degree and the
 /// cells' aspect ratio); in the Newton solves the Gauss–Seidel cycle's GMRES iterations
 /// grew as `h` halved (BENCHMARKS.md "Multigrid").
-pub const MG_SMOOTHER: Smoother = Smoother::Ilu0;
+pub(crate) const MG_SMOOTHER: Smoother = Smoother::Ilu0;
 
 /// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
 pub const MG_SWEEPS: usize = 1;

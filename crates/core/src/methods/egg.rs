@@ -103,7 +103,7 @@ impl Method for EggMethod {
 /// requested once up front), the operator and the quadrature back end.
 pub struct EggProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     /// Which operator.
     pub op: Operator,
     assembler: Arc<dyn EggAssembler>,

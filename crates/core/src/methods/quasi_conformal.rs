@@ -191,7 +191,7 @@ fn value_on(disc: &Discretization, cps: &[Point], area: f64) -> (f64, f64) {
 /// Hessian and the rank-one term of the eliminated `k`.
 pub struct QuasiConformalProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     hessian: ShiftedHessian,
     /// `∫ 1` on the quadrature (the parameter square's area, 1 up to rounding).
     area: f64,

@@ -412,7 +412,7 @@ pub(crate) fn projection_lowered(projected: f64) -> f64 {
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     /// Positions of the diagonal entries in the vector pattern's values.
     diag: Vec<usize>,
     /// Relative diagonal shift `τ` of the presented Hessian.

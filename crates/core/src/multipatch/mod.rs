@@ -24,6 +24,7 @@ pub mod solve;
 pub mod split;
 
 pub use check::{validate_layout, LayoutReport};
+pub use free::FreeReport;
 pub use layout::{Interface, Layout, Patch, PatchSide};
 pub use problem::Functional;
 pub(crate) use solve::solve_multipatch;

@@ -37,3 +37,6 @@ pub mod report;
 pub mod solver;
 pub mod volume;
 pub mod warm;
+
+pub use kinks::KinkStage;
+pub use repair::RepairRound;

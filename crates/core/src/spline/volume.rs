@@ -290,7 +290,7 @@ impl Volume {
     }
 
     /// Bézier extraction: per direction, the univariate operators.
-    pub fn extraction(&self) -> Result<[BezierExtraction; 3]> {
+    pub(crate) fn extraction(&self) -> Result<[BezierExtraction; 3]> {
         Ok([
             BezierExtraction::new(&self.knots[0])?,
             BezierExtraction::new(&self.knots[1])?,
@@ -301,7 +301,7 @@ impl Volume {
     /// The homogeneous Bézier net `(w x, w y, w z, w)` of element `e` (indices of the
     /// element per direction), `(p + 1)(q + 1)(r + 1)` points, first index fastest:
     /// `H_abc = Σ_ijk h_ijk C^ξ_ia C^η_jb C^ζ_kc` with the extraction operators `C`.
-    pub fn bezier_net(&self, ex: &[BezierExtraction; 3], e: [usize; 3]) -> Vec<[f64; 4]> {
+    pub(crate) fn bezier_net(&self, ex: &[BezierExtraction; 3], e: [usize; 3]) -> Vec<[f64; 4]> {
         let [p, q, r] = self.degrees();
         let [nx, ny, _] = self.shape();
         let spans = [0, 1, 2].map(|d| ex[d].elements[e[d]].0);

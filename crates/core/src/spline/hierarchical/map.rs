@@ -72,7 +72,7 @@ impl HierarchicalMap {
     }
 
     /// The level coefficients of the map (see `truncation`).
-    pub fn level_coefficients(&self) -> LevelCoefficients<'_, Point> {
+    pub(crate) fn level_coefficients(&self) -> LevelCoefficients<'_, Point> {
         LevelCoefficients::new(&self.basis, |k| self.control_points[k])
     }
 
@@ -115,7 +115,7 @@ impl HierarchicalMap {
     }
 
     /// The Bézier patch of the active cell `c` of level `l`.
-    pub fn bezier_patch(&self, lc: &mut LevelCoefficients<'_, Point>, l: usize, c: Index2) -> Result<Surface> {
+    pub(crate) fn bezier_patch(&self, lc: &mut LevelCoefficients<'_, Point>, l: usize, c: Index2) -> Result<Surface> {
         let [p, q] = self.basis.degrees();
         let net = lc.cell_net(l, c);
         let spans = self.basis.cell_spans(l, c);
