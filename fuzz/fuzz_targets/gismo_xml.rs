@@ -1,4 +1,4 @@
-//! Text to [`winslow::io::gismo::parse_gismo_xml`] (four curves or one patch), then
+//! Text to [`winslow::io::parse_gismo_xml`] (four curves or one patch), then
 //! validation, certification and the writers' round trips.
 #![no_main]
 

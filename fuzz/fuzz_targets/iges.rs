@@ -1,4 +1,4 @@
-//! Text to [`winslow::io::iges::parse_iges`] and, by content, to
+//! Text to the IGES reader ([`Reader::Iges`]: the core's `io::iges::parse_iges`) and, by content, to
 //! [`winslow::io::parse_document`]; then certification, the writers' round trips and
 //! validation of the map's boundary.
 #![no_main]

@@ -6,26 +6,29 @@
 //! framework of isogeometric analysis applications*; section and equation numbers below
 //! are the paper's).
 //!
-//! ## The pipeline, one module group per step
+//! ## The public API
 //!
-//! | group | what lives there |
-//! |---|---|
-//! | [`linalg`] | sparse storage, orderings, linear solvers (LU, Cholesky, GMRES, CG, ILU) |
-//! | [`spline`] | knot vectors, bases, curves, tensor-product maps, refinement, Bézier extraction, quadrature (§3) |
-//! | [`boundary`] | the boundary, its validation, corners and kinks, reparameterization (§7), contour fit (§5), the nested hierarchy (§5.4) |
-//! | [`discrete`] | topology (boundary conditions per side), DOF map, assembly kernels on one basis (§4, §6) |
-//! | [`methods`] | the parameterization methods behind one interface ([`Method`], [`DiscreteProblem`]): EGG (eq. 8) |
-//! | [`solve`](mod@solve) | Newton and pseudo time, initial guesses, the coarse-to-fine solver and its event stream, defect correction, the report (§6, §8.2) |
-//! | [`verify`] | the bijectivity certificate (§8.1), quality functionals, the Poisson benchmark (§10) |
-//! | [`multipatch`] | multipatch domains (§11.2): layouts, conforming bases, fixed and free interfaces, join and split |
-//! | [`domain`] | general planar domains (any number of corners): validation and the automatic quad layout into a multipatch layout |
-//! | [`pipeline`] | the one observable entry ([`Pipeline`]) of every input (boundary, ring, layout); the runs built on it: the comparison of methods ([`pipeline::compare`]), the sliding grid ([`pipeline::sweep`]) |
-//! | [`io`] | [`read()`] and [`write()`]: every document kind (boundary, map, ring, multipatch layout and result, volume) in JSON, G+Smo XML, IGES, VTK and PNG |
+//! What a program needs is re-exported at the crate root; the module groups hold the rest
+//! of the public surface, and every other module is internal (`pub(crate)`).
 //!
-//! Dependencies point one way, down this table read from the bottom: `io` uses every
-//! group above it (it reads and writes boundaries, maps, layouts and their solutions),
-//! `pipeline` uses `multipatch` and what it uses, `multipatch` uses `solve` and what `solve` uses, `solve` uses `methods`, which use
-//! `verify`, `discrete`, `spline` and `linalg`; no module imports a module that imports it back. Two places differ from a
+//! | task | the front (at the crate root) | more in |
+//! |---|---|---|
+//! | read and write files | [`read()`] gives a [`Document`] (boundary, map, ring, multipatch layout or result, volume), [`write()`] writes an [`Output`] by the file's extension; [`read_boundary`] with [`ReadOptions`] reads a validated four-sided boundary | [`io`]: JSON, G+Smo XML, IGES, VTK and PNG; the atomic writer [`io::write_with`] |
+//! | solve: the pipeline | [`Pipeline`]`::new(input, options).run(&mut observer)` owns fit, hierarchy, solve, certificate, fallback and improvement of an [`Input`] (boundary, ring, layout, domain, plane graph, volume boundary, map) and returns [`Solved`]; the observer sees every [`Stage`] and may stop the run; [`solve()`]: a boundary in one call | [`pipeline`]: the comparison of methods ([`pipeline::compare`]), the sliding grid ([`pipeline::sweep`]) |
+//! | options | [`SolveOptions`] (one list for every stage), [`FitOptions`] (the contour fit) | [`solve::options`] |
+//! | report | [`Solution`]: the map and its [`Report`] (the fit, every level, the certificate, quality and `det J`); [`Verdict`], the one verdict of every run (from the certificate) | [`solve::report`] |
+//! | certify | [`certify()`] gives the [`Certificate`] of a map: `det J > 0` proven or refuted (§8.1, eq. 43) | [`verify`]: quality functionals, the Poisson benchmark, the certificates of THB maps and volumes |
+//! | the main types | [`Boundary`] (four [`SideCurve`]s: an [`Analytic`] curve or a [`Curve`]), [`Curve`] and [`Surface`] (a [`KnotVector`] per direction and control [`Point`]s; [`Side`]), [`Volume`](spline::volume::Volume) | [`spline`], [`boundary`] |
+//! | validate and fit a boundary | [`validate()`] gives a [`ValidationReport`], [`fit_side`] a [`SideFit`], [`build_hierarchy`] / [`hierarchy_from_fits`] the [`Hierarchy`] of nested [`Level`]s (§5.4) | [`boundary`] |
+//! | methods and solvers | a [`Method`] gives a [`DiscreteProblem`]; EGG ([`EggMethod`], eq. 8) assembled by an [`EggAssembler`] ([`CpuAssembler`], or the GPU crate's), solved coarse to fine by an [`EggSolver`] (an `Iterator` of [`Event`]s) on a patch's [`Topology`] ([`SideCondition`] per side) | [`methods`], [`solve`](mod@solve), [`discrete`], [`linalg`] |
+//! | several patches, general domains | | [`multipatch`]: layouts, conforming bases, interfaces, join and split (§11.2); [`domain`]: any number of corners and holes, the automatic quad layout |
+//! | errors | [`Error`] (typed: what is wrong and where), [`Result`] | [`error`] |
+//!
+//! The module groups are layered in the order `error`, [`linalg`], [`spline`],
+//! [`boundary`], [`discrete`], [`verify`], [`methods`], [`solve`](mod@solve),
+//! [`multipatch`], [`domain`], [`pipeline`], [`io`]: each uses only groups before it
+//! (`io` reads and writes boundaries, maps, layouts and their solutions, so it comes
+//! last); no module imports a module that imports it back. Two places differ from a
 //! plain "one folder per pipeline step": sparse storage sits in [`linalg`], *below*
 //! [`spline`], because the refinement operators of the splines (knot insertion,
 //! degree elevation) are sparse matrices; and the quadrature back end of EGG
@@ -39,24 +42,24 @@
 //! |---|---|---|
 //! | §3, eq. (1) | B-splines, NURBS, tensor-product maps | [`spline::basis`], [`spline::curve`], [`spline::surface`] |
 //! | §5.1-§5.3, eq. (17)-(18), (36)-(37) | contour fit of one side, cord length | [`boundary::fit`], [`boundary::cord_length`] |
-//! | §5.4 | nested hierarchy of bases | [`boundary::hierarchy`], [`spline::refine`] |
+//! | §5.4 | nested hierarchy of bases | [`boundary::hierarchy`], refinement operators in `spline::refine` |
 //! | §4, eq. (8), (12), (23) | EGG Galerkin form, residual, exact Jacobian | [`methods::egg`], kernels in [`discrete::assembly`] |
 //! | eq. (9)-(10) | free / fixed DOFs, unknowns `c` | [`discrete::dofs`], [`discrete::topology`] |
-//! | eq. (14) | weak form with `det J` (needs a bijective start) | [`methods::weak_form::WeakFormMethod`] ([`methods::Start::Bijective`]; residual and exact Jacobian in [`methods::flux`]) |
+//! | eq. (14) | weak form with `det J` (needs a bijective start) | `methods::weak_form` ([`methods::Start::Bijective`]; residual and exact Jacobian in `methods::flux`) |
 //! | eq. (15)-(16) | Winslow functional | value: [`verify::quality::functionals`]; as a minimization method: [`methods::winslow::WinslowMethod`] (objective, exact gradient and Hessian) |
 //! | §6.1, eq. (24)-(27) | damped Newton, line search | [`solve::newton`] |
 //! | §6.2, eq. (28)-(33) | pseudo time-stepping, SER | [`solve::newton`] |
-//! | §6.3, §9 | Coons start, prolongation plus elasticity, continuation | [`solve::initial`], levels in [`solve::levels`], the walk in [`solve::solver`] |
+//! | §6.3, §9 | Coons start, prolongation plus elasticity, continuation | [`solve::initial`], levels in `solve::levels`, the walk in [`solve::solver`] |
 //! | §7, eq. (38)-(42) | reparameterization | [`boundary::reparam`] |
 //! | §8.1, eq. (43) | bijectivity certificate | [`verify::certificate`]; corners that force `det J <= 0`: [`boundary::corners`] |
-//! | §8.2 | local defect correction | [`solve::repair`] |
+//! | §8.2 | local defect correction | `solve::repair` |
 //! | §10, eq. (44)-(45) | Poisson benchmark `Q(x)` | [`verify::poisson`] |
-//! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | [`verify::certificate::coefficients`], [`solve::constrained`], functionals in [`methods::metric_norms`] |
-//! | §10.1, eq. (46) | variational harmonic method | [`methods::harmonic`] (kernel of second-derivative functionals: [`methods::density`]) |
+//! | §10.3, eq. (49) | Bernstein coefficients `d(c)` of `det J` and `∂d/∂c`; max-z feasible start; constrained optimisation (Liao, Winslow, area orthogonality) | `verify::certificate::coefficients`, [`solve::constrained`], functionals in `methods::metric_norms` |
+//! | §10.1, eq. (46) | variational harmonic method | `methods::harmonic` (kernel of second-derivative functionals: `methods::density`) |
 //! | §10.2, eq. (47)-(48) | quasi-conformal functional, `k` eliminated | [`methods::quasi_conformal`] (rank-one term: [`methods::DiscreteProblem::rank_one`]) |
 //! | §10, Tables 1-3 | the comparison of methods on one basis: EGG, VHM (eq. 46), quasi-conformal (eq. 47-48), max-z (eq. 49), constrained Liao / Winslow / area orthogonality from `x_G` | [`pipeline::compare`] |
 //! | §2 | quality functionals, cell statistics | [`verify::quality`] |
-//! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files in [`io::volume`] |
+//! | §11.1, Fig. 23 | volumes from planar slices: trivariate maps, their certificate, the loft | [`spline::volume`], [`verify::certificate::volume`], [`spline::loft`], [`solve::loft`], files through [`read()`] and [`write()`] (`io::volume`) |
 //! | §11.2 | multipatch layouts, one knot vector per interface, fixed and free interfaces, joining and splitting | [`multipatch`] |
 //!
 //! A geometry is a basis plus coefficients ([`Surface`], [`Curve`]); one DOF map
@@ -65,6 +68,10 @@
 //! ([`discrete::assembly::Discretization`]) and numeric work per Newton step; solvers
 //! are objects that yield their iterates ([`EggSolver`] is an `Iterator` of
 //! [`solve::solver::Event`]s).
+
+// A small public API: every type a public signature or field shows can be named (no public
+// item of a `pub(crate)` module leaks out unnamed; re-export it at its group instead).
+#![warn(unnameable_types)]
 
 pub mod boundary;
 pub mod discrete;

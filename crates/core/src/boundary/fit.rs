@@ -98,7 +98,7 @@ pub struct FitOptions {
     /// Reparameterization of the sides before the fit (paper §7). Default `auto`.
     pub reparam: ReparamOptions,
     /// The basis: `Auto` (default: the input's own basis, boundary kept exactly, when its
-    /// map certifies, else fitted), `Fitted` or `Input` ([`super::input_basis`], §5.2).
+    /// map certifies, else fitted), `Fitted` or `Input` (`input_basis`, §5.2).
     pub basis: BasisChoice,
     /// Which kinks inside the sides are kept exactly (paper §9, [`super::kinks`]).
     pub kinks: KinkMode,

@@ -109,14 +109,14 @@ impl Hierarchy {
 }
 
 /// With `opts.basis` = [`BasisChoice::Input`] or [`BasisChoice::Auto`] (the default), the
-/// hierarchy on the input's own basis ([`input_levels`](crate::boundary::input_basis::input_levels)) when the sides allow it;
+/// hierarchy on the input's own basis (`input_levels`) when the sides allow it;
 /// otherwise, and with [`BasisChoice::Fitted`]:
 /// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
 /// §7), fit the four sides adaptively (see [`fit_side_with`](crate::boundary::fit::fit_side_with)) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
 ///
-/// The boundary is first brought to unit size at the origin ([`Similarity`]); the
+/// The boundary is first brought to unit size at the origin (`Similarity`); the
 /// hierarchy is built, and lives, in those coordinates.
 pub fn build_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierarchy> {
     opts.validate()?;

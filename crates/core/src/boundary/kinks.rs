@@ -15,7 +15,7 @@
 //! multiplicity lowered by one and the contour projected onto it ([`smoothed_level`]).
 //! The solver solves (8) on `Σ¹`, prolongs to `Σ⁰` and imposes the difference of the
 //! boundary control points by the damped elasticity step, then minimises the Winslow
-//! functional (16) on `Σ⁰` ([`crate::solve::kinks`]).
+//! functional (16) on `Σ⁰` (`solve::kinks`).
 
 use serde::Serialize;
 

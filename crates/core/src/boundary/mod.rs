@@ -6,19 +6,19 @@
 //! |---|---|---|
 //! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
 //! | [`families`] | seeded families of hard domains (the hard corpus) | |
-//! | [`normalise`] | the similarity to unit size at the origin, and back | |
+//! | `normalise` | the similarity to unit size at the origin, and back | |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
 //! | [`corners`] | corner angles and the `det J` they force, kinks inside sides | §8.1 |
 //! | [`cord_length`] | cord-length abscissae of point clouds | eq. (36)-(37) |
 //! | [`reparam`] | arc-length and constrained cord-length reparameterization | §7, eq. (38)-(42) |
 //! | [`fit`] | adaptive least-squares fit of one side | §5.1-§5.3, eq. (17)-(18) |
-//! | [`level`] | one level: a tensor basis, the four sides on it, its rational weights | §5.4, §5.2 |
+//! | `level` | one level: a tensor basis, the four sides on it, its rational weights | §5.4, §5.2 |
 //! | [`hierarchy`] | the nested tensor-product bases from the four fits | §5.4 |
 //! | [`kinks`] | interior `C^0` points of the sides (`C^0` knots, zero speed, polygon corners), the smoothed basis `Σ¹` | §9 |
 //! | [`ring`] | ring (O-type) domains: two closed contours fitted on one periodic knot vector by arc length, and their hierarchy | §11.1 |
-//! | [`volume`] | [`VolumeBoundary`](volume::VolumeBoundary): the six faces of a hexahedral volume, their validation | §11.1 |
-//! | [`hexahedron`] | six faces in any order and orientation identified as the sides of the parameter cube | |
-//! | [`input_basis`] | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
+//! | `volume` | `VolumeBoundary`: the six faces of a hexahedral volume, their validation | §11.1 |
+//! | `hexahedron` | six faces in any order and orientation identified as the sides of the parameter cube | |
+//! | `input_basis` | the input's own basis, boundary kept exactly, with an artificial coarse hierarchy | §5.2, §6.3 |
 //!
 //! The arrows point one way: `fit` uses `reparam` (a reparameterized side is fitted as
 //! `f ∘ g`), both use `cord_length`; `input_basis` uses `fit` (its coarse levels are
@@ -31,18 +31,21 @@ pub mod cord_length;
 pub mod corners;
 pub mod families;
 pub mod fit;
-pub mod hexahedron;
+pub(crate) mod hexahedron;
 pub mod hierarchy;
-pub mod input_basis;
+pub(crate) mod input_basis;
 pub mod kinks;
-pub mod level;
-pub mod normalise;
+pub(crate) mod level;
+pub(crate) mod normalise;
 pub mod reparam;
 pub mod ring;
 pub mod ring_fit;
-pub mod ring_reparam;
+pub(crate) mod ring_reparam;
 pub mod validate;
-pub mod volume;
+pub(crate) mod volume;
+
+pub use normalise::Similarity;
+pub use volume::{CubeSide, VolumeBoundary};
 
 use std::sync::Arc;
 

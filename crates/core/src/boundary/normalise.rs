@@ -66,7 +66,7 @@ impl Similarity {
     /// sampled points are not all finite, or whose bounding box has zero size, gets the
     /// identity: the validator names the side that is at fault.
     ///
-    /// Errors: [`Error::Range`] when the half-width is outside `2^±`[`MAX_LOG2`].
+    /// Errors: [`Error::Range`] when the half-width is outside `2^±MAX_LOG2` (`MAX_LOG2 = 508`).
     pub fn for_boundary(boundary: &Boundary) -> Result<Self> {
         let (lo, hi) = bounding_box(boundary);
         Self::for_box(lo, hi, &format!("boundary '{}'", boundary.name))

@@ -13,7 +13,7 @@
 //! shifted by that crossing's fraction `s_0`: `eta_outer = (s - s_0) mod 1`.
 //! **Narrow gaps.** Where the contours come close, facing points are matched at the same
 //! `eta` by a monotone periodic reparameterization of the outer contour (§7.2 on closed
-//! curves, the seam kept): [`crate::boundary::ring_reparam`].
+//! curves, the seam kept): `boundary::ring_reparam`.
 //!
 //! **Fit**, **normalisation** and the **hierarchy** of bases: [`crate::boundary::ring_fit`]
 //! (adaptive and dyadic in `eta`, in unit coordinates).

@@ -1,7 +1,7 @@
 //! The contour fit of a ring (paper §5 on closed contours, §11.1): both contours of a
 //! [`Ring`] on one periodic knot vector in `eta`, parameterized by arc length with the
 //! seam of [`crate::boundary::ring`] (narrow gaps matched by
-//! [`crate::boundary::ring_reparam`]), and the hierarchy of bases the solver walks.
+//! `boundary::ring_reparam`), and the hierarchy of bases the solver walks.
 //!
 //! **Fit.** Least squares `min sum_k |C(eta_k) - x_k|^2` over the `d` distinct control
 //! points (wrapped collocation matrix) on one periodic knot vector for both contours, at
@@ -17,7 +17,7 @@
 //! when no element is marked or the next level would pass the element cap.
 //!
 //! **Normalisation.** Like a four-sided boundary
-//! ([`crate::boundary::normalise::Similarity`]), a ring far from the origin or of extreme
+//! (`boundary::normalise::Similarity`), a ring far from the origin or of extreme
 //! size is fitted and solved in the coordinates `(x - c) / s` of its outer contour's
 //! bounding box and mapped back; [`RingFit`] lives in those coordinates.
 use super::fit::{FitOptions, SideFit, REGULARIZATION};
@@ -87,7 +87,7 @@ pub struct RingFit {
     /// well-placed ring); lengths above are in the fit's coordinates.
     pub similarity: Similarity,
     /// The reparameterization: arc length, or the matching of narrow gaps
-    /// ([`crate::boundary::ring_reparam`]); matched points in the fit's coordinates.
+    /// (`boundary::ring_reparam`); matched points in the fit's coordinates.
     pub reparam: ReparamReport,
 }
 
@@ -224,9 +224,9 @@ fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Cur
 }
 
 /// Validate a ring (closed contours, counter-clockwise, the inner inside the outer),
-/// bring it to unit size ([`Similarity`]), reparameterize both contours by arc length
+/// bring it to unit size (`Similarity`), reparameterize both contours by arc length
 /// with the seam of the module documentation (and match narrow gaps: the default
-/// [`ReparamOptions`], `auto`, see [`crate::boundary::ring_reparam`]), and fit them
+/// [`ReparamOptions`], `auto`, see `boundary::ring_reparam`), and fit them
 /// adaptively on dyadic periodic knot vectors of degree `degree` until `tol * diameter`
 /// is met (at most `max_elements` elements).
 pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
@@ -238,7 +238,7 @@ pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Re
 /// bounding box `[lo, hi]`.
 ///
 /// Like a four-sided boundary's validation, the checks run in the normalised
-/// coordinates of the outer contour's box ([`Similarity`]) and report in the input's:
+/// coordinates of the outer contour's box (`Similarity`) and report in the input's:
 /// far from the origin, `Σ x_k y_{k+1} − x_{k+1} y_k` of the raw coordinates cancels
 /// every digit of the area (a ring of size 1 at `1e9` got a signed area of `−4e3`), and
 /// the closure gap of a spline evaluated there is rounding of the position, not of the

@@ -38,9 +38,6 @@ const MAX_BISECTIONS: u32 = 10;
 /// Budget of initial chords for one spline side (huge inputs get fewer per span).
 const MAX_INITIAL_CHORDS: usize = 1 << 22;
 
-/// The corners of the parameter square, in the order of [`ValidationReport::corners`].
-pub const CORNER_NAMES: [&str; 4] = ["south-west", "south-east", "north-east", "north-west"];
-
 /// Direction in which south, east, reversed north, reversed west run around the domain.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Orientation {
@@ -251,7 +248,7 @@ fn within_side(e: Error, s: Side) -> Error {
 /// (side shorter than that tolerance), [`Error::SelfIntersection`],
 /// [`Error::DegenerateContour`] (no area, so no orientation) and [`Error::Range`]
 /// (a size whose `det J` leaves `f64`'s range). The geometry is measured in the
-/// normalised coordinates of [`Similarity`] and reported in the input's.
+/// normalised coordinates of `Similarity` and reported in the input's.
 pub fn inspect(boundary: &Boundary) -> Result<ValidationReport> {
     for s in Side::ALL {
         let side = boundary.side(s);

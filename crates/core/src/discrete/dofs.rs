@@ -6,7 +6,7 @@
 //!
 //! **Shared (periodic) DOFs.** In a periodic direction with `d` distinct functions and
 //! degree `q` the basis stores `d + q` functions whose last `q` repeat the first `q`
-//! ([`crate::spline::periodic`]): the stored function `(i, j)`, `j >= d`, is a *replica*
+//! (`spline::periodic`): the stored function `(i, j)`, `j >= d`, is a *replica*
 //! of its *primary* `(i, j - d)`. Both carry the same control point, so the periodic
 //! basis function is `N_(i,j) + N_(i,j+d)` and everything assembled per stored function
 //! is summed over replicas: residual rows ([`super::assembly::Discretization::restrict`]),

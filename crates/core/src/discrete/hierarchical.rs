@@ -37,10 +37,6 @@ use crate::spline::hierarchical::{HierarchicalBasis, Index2};
 /// One active cell: its THB functions and their values at the Gauss points.
 #[derive(Debug, Clone)]
 pub struct CellQuadrature {
-    /// Level of the cell.
-    pub level: usize,
-    /// Index of the cell in its level.
-    pub cell: Index2,
     /// THB functions non-zero on the cell (indices into the active functions, increasing).
     pub funcs: Vec<usize>,
     /// Quadrature weight (times the cell's area) per point, `ξ` fastest.
@@ -56,11 +52,6 @@ impl CellQuadrature {
         self.funcs.len()
     }
 
-    /// Whether no function is non-zero on the cell (never for a valid basis).
-    pub fn is_empty(&self) -> bool {
-        self.funcs.is_empty()
-    }
-
     /// The values of every function at point `k`.
     pub fn at(&self, k: usize) -> &[[f64; 6]] {
         let n = self.funcs.len();
@@ -73,8 +64,6 @@ impl CellQuadrature {
 /// free-free systems.
 #[derive(Debug, Clone)]
 pub struct HierarchicalDiscretization {
-    /// The basis.
-    pub basis: HierarchicalBasis,
     /// Gauss points per cell and direction.
     pub nq: usize,
     /// The active cells (in [`HierarchicalBasis::active_cells`] order).
@@ -124,7 +113,7 @@ impl HierarchicalDiscretization {
         let cells: Vec<CellQuadrature> = active
             .par_iter()
             .zip(nets.par_iter())
-            .map(|(&(l, c), net)| cell_quadrature(&tables[l], l, c, net, [p, q], nq))
+            .map(|(&(l, c), net)| cell_quadrature(&tables[l], c, net, [p, q], nq))
             .collect();
         let mut free_of = vec![FIXED; basis.len()];
         let mut free = Vec::new();
@@ -148,7 +137,7 @@ impl HierarchicalDiscretization {
             .map(|r| r.iter().map(|&c| (c, 0.0)).chain(r.iter().map(|&c| (m + c, 0.0))).collect())
             .collect();
         let vector = Csr::from_rows(2 * m, vrows);
-        Self { basis, nq, cells, free_of, free, scalar, vector }
+        Self { nq, cells, free_of, free, scalar, vector }
     }
 
     /// Number of THB functions.
@@ -161,12 +150,8 @@ impl HierarchicalDiscretization {
         self.free.len()
     }
 
-    /// Free index of THB function `k`, or [`FIXED`].
-    pub fn free_index(&self, k: usize) -> usize {
-        self.free_of[k]
-    }
-
     /// THB functions of the free unknowns.
+    #[cfg(test)]
     pub fn free(&self) -> &[usize] {
         &self.free
     }
@@ -275,7 +260,6 @@ impl HierarchicalDiscretization {
 /// from the cell's extraction rows `net` (see the module documentation).
 fn cell_quadrature(
     tables: &[DirTable; 2],
-    level: usize,
     cell: Index2,
     net: &[Sparse],
     [p, q]: [usize; 2],
@@ -311,7 +295,7 @@ fn cell_quadrature(
             }
         }
     }
-    CellQuadrature { level, cell, funcs, weights, values }
+    CellQuadrature { funcs, weights, values }
 }
 
 #[cfg(test)]
@@ -336,8 +320,8 @@ mod tests {
         let area: f64 = disc.cells.iter().flat_map(|c| c.weights.iter()).sum();
         assert!((area - 1.0).abs() < 1e-13, "{area}");
         let g = crate::spline::quadrature::GaussLegendre::new(disc.nq);
-        for cell in &disc.cells {
-            let [[a, bb], [c, d]] = b.cell_bounds(cell.level, cell.cell);
+        for (cell, &(level, index)) in disc.cells.iter().zip(&b.active_cells()) {
+            let [[a, bb], [c, d]] = b.cell_bounds(level, index);
             let pts_u: Vec<f64> = g.on(a, bb).map(|x| x.0).collect();
             let pts_v: Vec<f64> = g.on(c, d).map(|x| x.0).collect();
             for (kv, &v) in pts_v.iter().enumerate() {
@@ -367,7 +351,7 @@ mod tests {
         }
         assert!(disc.num_free() > 0 && disc.num_free() < b.len());
         for (k, &t) in trace.iter().enumerate() {
-            assert_eq!(disc.free_index(k) == FIXED, t > 1e-12, "function {k}: trace {t}");
+            assert_eq!(disc.free_of[k] == FIXED, t > 1e-12, "function {k}: trace {t}");
         }
     }
 }

@@ -6,11 +6,11 @@
 //! |---|---|---|
 //! | [`topology`] | [`Topology`](topology::Topology): the boundary condition of each side of a patch (Dirichlet, periodic, interface) | §4, §11.1, §11.2 |
 //! | [`dofs`] | [`DofMap`](dofs::DofMap): free versus fixed DOFs, gather and scatter of the unknowns `c` | eq. (9)-(10) |
-//! | [`pattern`] | [`SystemPattern`](pattern::SystemPattern): sparsity of the free-free systems, gather from stencil storage (periodic replicas summed) | |
+//! | `pattern` | [`SystemPattern`](pattern::SystemPattern): sparsity of the free-free systems, gather from stencil storage (periodic replicas summed) | |
 //! | [`tables`] | [`DirTable`](tables::DirTable): the univariate basis at the Gauss points | §4 |
-//! | [`stencil`] | the product of a system with a vector from its stencil storage (no sparse matrix) | eq. (12) |
-//! | [`transfers`] | the nested knot-halving spaces below a basis and the prolongations of their free unknowns (multigrid) | §6.3 |
-//! | [`hierarchical`] | [`HierarchicalDiscretization`](hierarchical::HierarchicalDiscretization): a THB basis cell by cell (element extraction of the truncated functions at the Gauss points), its free/fixed split and patterns | §4 |
+//! | `stencil` | the product of a system with a vector from its stencil storage (no sparse matrix) | eq. (12) |
+//! | `transfers` | the nested knot-halving spaces below a basis and the prolongations of their free unknowns (multigrid) | §6.3 |
+//! | `hierarchical` | `HierarchicalDiscretization`: a THB basis cell by cell (element extraction of the truncated functions at the Gauss points), its free/fixed split and patterns | §4 |
 //! | [`assembly`] | [`Discretization`](assembly::Discretization): basis tables, patterns, the EGG residual and Jacobian kernels (eq. 8, 12, 23), mass, elasticity, metric Laplacian | §4, §6 |
 //!
 //! Symbolic work (tables, patterns, orderings) is done once per basis when a
@@ -19,9 +19,9 @@
 
 pub mod assembly;
 pub mod dofs;
-pub mod hierarchical;
-pub mod pattern;
-pub mod stencil;
+pub(crate) mod hierarchical;
+pub(crate) mod pattern;
+pub(crate) mod stencil;
 pub mod tables;
 pub mod topology;
-pub mod transfers;
+pub(crate) mod transfers;

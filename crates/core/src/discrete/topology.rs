@@ -86,11 +86,6 @@ impl Topology {
         self.side(s) == SideCondition::Dirichlet
     }
 
-    /// Whether all four sides are Dirichlet.
-    pub fn all_dirichlet(&self) -> bool {
-        Side::ALL.iter().all(|&s| self.is_dirichlet(s))
-    }
-
     /// Consistency: periodic sides come in opposite pairs; an interface names a side of
     /// another patch (`own` is this patch's index, `None` for a lone patch).
     pub fn validate(&self, own: Option<usize>) -> Result<()> {

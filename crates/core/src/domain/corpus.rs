@@ -1,7 +1,7 @@
 //! A seeded corpus of general domains for the automatic layout (issue 31): `N`-gons with
 //! curved sides (`N = 3 ... 12`), L-, T-, U-, E- and plus-shaped brackets with sharp
 //! or filleted reflex corners, plates with holes; and plane graphs ([`GraphFamily`]:
-//! wiggly squares and motor-like sections, [`super::families`]). The same seed gives the same domains on every machine
+//! wiggly squares and motor-like sections, `families`). The same seed gives the same domains on every machine
 //! (SplitMix64, as the hard corpus of [`crate::boundary::families`]).
 
 use super::{Domain, Loop, PlaneGraph};
@@ -25,7 +25,7 @@ pub enum DomainFamily {
     E,
     /// A plus: four reflex corners.
     Plus,
-    /// A rectangular plate with 1 to 5 holes ([`super::families::plate`]).
+    /// A rectangular plate with 1 to 5 holes (`families::plate`).
     Plate,
 }
 
@@ -78,9 +78,9 @@ impl DomainFamily {
 /// A family of plane graphs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum GraphFamily {
-    /// The unit square cut by wiggly curves into 4 to 60 faces ([`super::families::wiggly`]).
+    /// The unit square cut by wiggly curves into 4 to 60 faces (`families::wiggly`).
     Wiggly,
-    /// A motor-like section with 6 to 48 slots ([`super::families::motor`]).
+    /// A motor-like section with 6 to 48 slots (`families::motor`).
     Motor,
 }
 

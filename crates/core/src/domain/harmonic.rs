@@ -65,8 +65,6 @@ pub struct HarmonicMap {
     /// Smallest signed area of an image triangle over its parameter area (negative:
     /// the discrete map folds there).
     pub min_area_ratio: f64,
-    /// Conjugate-gradient iterations.
-    pub iterations: usize,
 }
 
 fn offset(n: usize, r: usize) -> usize {
@@ -173,14 +171,14 @@ impl HarmonicMap {
                 x[node(n, r, k)] = [mean[0] + f * (q[0] - mean[0]), mean[1] + f * (q[1] - mean[1])];
             }
         }
-        let iterations = cg(&rows, &mut x, boundary);
+        cg(&rows, &mut x, boundary);
         let mut min_area_ratio = f64::INFINITY;
         for t in &tris {
             let a0 = area(pos[t[0]], pos[t[1]], pos[t[2]]);
             let a1 = area(x[t[0]], x[t[1]], x[t[2]]);
             min_area_ratio = min_area_ratio.min(a1 / a0);
         }
-        Self { n, m, values: x, min_area_ratio, iterations }
+        Self { n, m, values: x, min_area_ratio }
     }
 
     /// The image of the centre of the polygon.

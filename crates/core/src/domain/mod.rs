@@ -7,36 +7,38 @@
 //! | module | holds |
 //! |---|---|
 //! | [`corpus`] | a seeded corpus: `N`-gons with curved sides, L, T, U, E and plus shapes with sharp or filleted reflex corners, plates with holes, plane graphs |
-//! | [`families`] | the generators of plates with holes, wiggly squares and motor-like sections |
-//! | [`validate`](mod@validate) | closed loops, no self-intersections, holes inside the outer loop and apart, orientation, area: typed errors naming the loop and curve |
-//! | [`harmonic`] | the discrete harmonic map of a regular `N`-gon onto a face (P1 finite elements), which places the template's vertices and cuts |
-//! | [`polygon_map`] | the map of a face onto the regular `N`-gon (Floater's mean value map, one-to-one on every face) and its piecewise-linear inverse, which places the template's vertices and cuts where the harmonic map's layout is not valid |
-//! | [`plane`] | plane graphs (`formats.md`, "Plane graph"): validation, their faces, holes, voids and labels |
-//! | [`cycles`] | the faces of a plane graph as cycles of half-edges |
-//! | [`graph`] | the faces, edges and vertices of a layout under construction: edges split at a point, faces split by a new edge |
-//! | [`holes`] | cuts from every hole to the outer boundary or another hole |
-//! | [`reflex`] | cuts from reflex corners into the face |
+//! | `families` | the generators of plates with holes, wiggly squares and motor-like sections |
+//! | `validate` | closed loops, no self-intersections, holes inside the outer loop and apart, orientation, area: typed errors naming the loop and curve |
+//! | `harmonic` | the discrete harmonic map of a regular `N`-gon onto a face (P1 finite elements), which places the template's vertices and cuts |
+//! | `polygon_map` | the map of a face onto the regular `N`-gon (Floater's mean value map, one-to-one on every face) and its piecewise-linear inverse, which places the template's vertices and cuts where the harmonic map's layout is not valid |
+//! | `plane` | plane graphs (`formats.md`, "Plane graph"): validation, their faces, holes, voids and labels |
+//! | `cycles` | the faces of a plane graph as cycles of half-edges |
+//! | `graph` | the faces, edges and vertices of a layout under construction: edges split at a point, faces split by a new edge |
+//! | `holes` | cuts from every hole to the outer boundary or another hole |
+//! | `reflex` | cuts from reflex corners into the face |
 //! | [`template`] | the quadrangulation of every face by its template and the assembly of the multipatch layout |
 //!
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
 
 pub mod corpus;
-pub mod cycles;
-pub mod families;
-pub mod graph;
-pub mod harmonic;
-pub mod holes;
-pub mod plane;
-pub mod polygon_map;
-pub mod reflex;
+pub(crate) mod cycles;
+pub(crate) mod families;
+pub(crate) mod graph;
+pub(crate) mod harmonic;
+pub(crate) mod holes;
+pub(crate) mod plane;
+pub(crate) mod polygon_map;
+pub(crate) mod reflex;
 pub mod template;
-pub mod validate;
+pub(crate) mod validate;
 
 use crate::boundary::SideCurve;
 use crate::error::Error;
 use crate::spline::curve::Point;
 
-pub use plane::{PlaneEdge, PlaneGraph, PlaneLabel};
+pub use holes::HoleCut;
+pub use plane::{GraphFace, GraphReport, PlaneEdge, PlaneGraph, PlaneLabel};
+pub use reflex::CutReport;
 pub use template::{auto_layout, graph_layout, AutoLayout, LayoutOptions, LayoutReport};
 pub use validate::{validate_domain, DomainReport};
 

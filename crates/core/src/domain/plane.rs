@@ -47,7 +47,7 @@ pub struct PlaneLabel {
     pub point: Point,
 }
 
-/// A plane graph as read (not yet validated: [`build_graph`]).
+/// A plane graph as read (not yet validated: `build_graph`).
 #[derive(Debug, Clone, Default)]
 pub struct PlaneGraph {
     /// Name of the geometry.

@@ -42,8 +42,6 @@ pub struct PolygonMap {
     pub images: Vec<Point>,
     /// Triangles, counter-clockwise in the face.
     pub triangles: Vec<[usize; 3]>,
-    /// Smallest ratio of image to face area over the triangles (positive: one-to-one).
-    pub min_area_ratio: f64,
     /// Buckets of the triangles over the face and over the polygon.
     grids: [Buckets; 2],
 }
@@ -396,16 +394,8 @@ impl PolygonMap {
             mesh.refine();
         }
         mesh.solve()?;
-        let min_area_ratio = mesh
-            .tris
-            .iter()
-            .map(|t| {
-                cross(mesh.images[t[0]], mesh.images[t[1]], mesh.images[t[2]])
-                    / cross(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]])
-            })
-            .fold(f64::INFINITY, f64::min);
         let grids = [Buckets::new(&mesh.nodes, &mesh.tris), Buckets::new(&mesh.images, &mesh.tris)];
-        Ok(Self { n, nodes: mesh.nodes, images: mesh.images, triangles: mesh.tris, min_area_ratio, grids })
+        Ok(Self { n, nodes: mesh.nodes, images: mesh.images, triangles: mesh.tris, grids })
     }
 
     /// The point of `to` at the barycentric coordinates that `q` has in the triangle of
@@ -434,8 +424,17 @@ impl PolygonMap {
         Some([l[0] * a[0] + l[1] * b[0] + l[2] * c[0], l[0] * a[1] + l[1] * b[1] + l[2] * c[1]])
     }
 
+    /// Smallest ratio of image to face area over the triangles (positive: one-to-one).
+    #[cfg(test)]
+    fn min_area_ratio(&self) -> f64 {
+        let (x, y) = (&self.nodes, &self.images);
+        let ratio = |t: &[usize; 3]| cross(y[t[0]], y[t[1]], y[t[2]]) / cross(x[t[0]], x[t[1]], x[t[2]]);
+        self.triangles.iter().map(ratio).fold(f64::INFINITY, f64::min)
+    }
+
     /// The image of a point of the face (`None` outside its triangulation).
-    pub fn forward(&self, x: Point) -> Option<Point> {
+    #[cfg(test)]
+    fn forward(&self, x: Point) -> Option<Point> {
         self.carry(&self.grids[0], &self.nodes, &self.images, x)
     }
 
@@ -484,7 +483,7 @@ mod tests {
             for (x, u) in m.nodes.iter().zip(&m.images) {
                 assert!(close(f(*u), *x, 1e-10), "{n}: f({u:?}) = {:?}, not {x:?}", f(*u));
             }
-            assert!(m.min_area_ratio > 0.0);
+            assert!(m.min_area_ratio() > 0.0);
             assert!(close(m.centre().unwrap(), [3.0, -1.0], 1e-10));
         }
     }
@@ -520,7 +519,7 @@ mod tests {
             ),
         ];
         let m = PolygonMap::new(&sides, 24, 2).unwrap();
-        assert!(m.min_area_ratio > 0.0, "{}", m.min_area_ratio);
+        assert!(m.min_area_ratio() > 0.0, "{}", m.min_area_ratio());
         // the inner side is a polyline of 12.5-degree chords of the circle of radius 0.8,
         // which comes as near to the centre as 0.8 cos(6.25 degrees)
         let r_min = 0.8 * 6.25f64.to_radians().cos();

@@ -2,16 +2,16 @@
 //! with no interaction:
 //!
 //! 1. **Sides**: point clouds are fitted by the contour fit of §5 (`FitOptions`); the
-//!    outer loop of a domain becomes one face of a [`Graph`] and its holes the face's
+//!    outer loop of a domain becomes one face of a `Graph` and its holes the face's
 //!    holes, their sides boundary edges; the faces of a plane graph are found by
-//!    [`build_graph`], each labelled. Holes are cut away by [`super::holes`].
-//! 2. **Reflex corners** are cut by straight edges into the face ([`super::reflex`]);
+//!    `build_graph`, each labelled. Holes are cut away by `holes`.
+//! 2. **Reflex corners** are cut by straight edges into the face (`reflex`);
 //!    a cut ending inside an edge shared with another face gives that face a flat
 //!    corner, cut in turn.
 //! 3. **Templates**: a face with four corners stays one patch. Every other face with `N`
 //!    corners is cut into `N` quads around one interior vertex (valence `N`), the
 //!    midpoint template: the harmonic map of the regular `N`-gon onto the face
-//!    ([`HarmonicMap`], Hinz & Buffa) places the interior vertex (the image of the
+//!    (`HarmonicMap`, Hinz & Buffa) places the interior vertex (the image of the
 //!    polygon's centre) and the cuts (the images of the segments from the centre to the
 //!    midpoints of the sides, fitted by splines); the sides are split at their arc-length
 //!    midpoints, the images of the polygon's side midpoints. A four-sided face beside a
@@ -21,7 +21,7 @@
 //!    When the layout so made is not valid (a cut leaves its face or crosses another, in
 //!    every direction of the hole cuts), it is made again with the interior vertex and
 //!    the cuts placed by the inverse of the map of the face onto the polygon
-//!    ([`PolygonMap`], one-to-one on every face).
+//!    (`PolygonMap`, one-to-one on every face).
 //! 4. **Layout**: every face is now a patch (south, east, reversed north and reversed west
 //!    are its four sides; an edge shared by two patches is an interface), named `p0`,
 //!    `p1`, ..., each with the label of its face (`"domain"`, or the graph face's).
@@ -89,7 +89,7 @@ pub struct FaceReport {
     /// two midpoints of a face split in two when it lies inside.
     pub straight: bool,
     /// The cuts are the preimages of the polygon's segments under the map of the face
-    /// onto the polygon ([`PolygonMap`], one-to-one on every face), taken when the layout
+    /// onto the polygon (`PolygonMap`, one-to-one on every face), taken when the layout
     /// by the harmonic map of the polygon onto the faces is not valid.
     pub inverse: bool,
 }
@@ -115,7 +115,7 @@ pub struct LayoutReport {
     pub graph: Option<GraphReport>,
     /// Area of the domain (holes and voids subtracted), from polylines.
     pub area: f64,
-    /// Cuts from holes ([`super::holes`]).
+    /// Cuts from holes (`holes`).
     pub hole_cuts: Vec<HoleCut>,
     /// Their direction, degrees from the `x` axis (`None`: every hole toward its
     /// nearest neighbour, or no holes).
@@ -338,7 +338,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
 }
 
 /// Lay out the plane graph `pg`: its faces (with their holes and labels) as
-/// [`build_graph`] finds them, then as a domain's (see the module documentation).
+/// `build_graph` finds them, then as a domain's (see the module documentation).
 pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout> {
     let t0 = Instant::now();
     opts.fit.validate()?;
@@ -441,7 +441,7 @@ pub struct HoleCutTry {
     /// hole toward its nearest neighbour.
     pub direction: Option<f64>,
     /// The cuts of the faces' templates by the maps of the faces onto the polygons
-    /// ([`PolygonMap`]; tried when no direction gives a valid layout otherwise).
+    /// (`PolygonMap`; tried when no direction gives a valid layout otherwise).
     pub inverse: bool,
     /// Patches of the layout.
     pub patches: usize,

@@ -207,7 +207,7 @@ pub(crate) fn patch(geom: Node, rational: bool, ctx: &str) -> Result<Surface> {
 }
 
 /// Parse a G+Smo XML file: four curves give a [`Document::Boundary`] (sides assigned by
-/// [`assign_sides`]), one planar tensor patch gives a [`Document::Map`] (transposed when
+/// `assign_sides`), one planar tensor patch gives a [`Document::Map`] (transposed when
 /// the signed area enclosed by its boundary is negative, so that it preserves
 /// orientation). The name is left empty.
 pub fn parse_gismo_xml(text: &str) -> Result<Document> {

@@ -202,12 +202,6 @@ impl SideJson {
 }
 
 impl BoundaryDoc {
-    /// The JSON form of a boundary.
-    pub fn from_boundary(b: &Boundary) -> Self {
-        let [south, east, north, west] = b.sides.each_ref().map(SideJson::from_side);
-        BoundaryDoc { name: b.name.clone(), boundary: SidesJson { south, east, north, west } }
-    }
-
     /// Convert to a boundary (sides converted by [`SideJson::to_side`]; errors name the side).
     pub fn to_boundary(self) -> Result<Boundary> {
         let SidesJson { south, east, north, west } = self.boundary;

@@ -5,37 +5,37 @@
 //!
 //! | module | holds |
 //! |---|---|
-//! | [`document`] | the kinds of document and the reader that tells them apart |
+//! | `document` | the kinds of document and the reader that tells them apart |
 //! | [`output`] | what can be written, and the dispatch by extension |
 //! | [`mod@file`] | reading text with a size limit; the atomic writer |
 //! | [`json`] | the JSON exchange formats of `formats.md`: boundary, contour, map |
-//! | [`ring`] | ring (O-type) documents |
+//! | `ring` | ring (O-type) documents |
 //! | [`multipatch`] | multipatch layouts and results: JSON, G+Smo `<MultiPatch>`, VTK multiblock |
-//! | [`volume`] | trivariate maps: JSON, G+Smo `TensorBSpline3`, VTK |
-//! | [`gismo`] / [`gismo_writer`] | G+Smo XML, read and written |
-//! | [`iges`] | IGES 5.3 rational B-spline surfaces (entity 128), both ways |
-//! | [`vtk`] | a sampled structured grid, and the exact map as Bézier cells |
+//! | `volume` | trivariate maps: JSON, G+Smo `TensorBSpline3`, VTK |
+//! | `gismo` / `gismo_writer` | G+Smo XML, read and written |
+//! | `iges` | IGES 5.3 rational B-spline surfaces (entity 128), both ways |
+//! | `vtk` | a sampled structured grid, and the exact map as Bézier cells |
 //! | [`picture`] | pictures of a map, grid lines coloured by `det J`, encoded as PNG |
 //!
 //! [`read_boundary`] turns any document with a four-sided boundary into a validated,
 //! counter-clockwise [`Boundary`]. All inputs are untrusted: every malformed file gives
 //! an [`Error`] naming what is wrong and where, never a panic.
 
-pub mod document;
-pub mod domain;
+pub(crate) mod document;
+pub(crate) mod domain;
 pub mod file;
-pub mod gismo;
-pub mod gismo_writer;
-pub mod graph;
+pub(crate) mod gismo;
+pub(crate) mod gismo_writer;
+pub(crate) mod graph;
 pub mod hierarchical;
-pub mod iges;
+pub(crate) mod iges;
 pub mod json;
 pub mod multipatch;
 pub mod output;
 pub mod picture;
-pub mod ring;
-pub mod volume;
-pub mod vtk;
+pub(crate) mod ring;
+pub(crate) mod volume;
+pub(crate) mod vtk;
 
 use std::path::Path;
 

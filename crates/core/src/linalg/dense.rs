@@ -88,11 +88,6 @@ impl DenseLu {
         Ok(())
     }
 
-    /// Size of the factorized system.
-    pub fn size(&self) -> usize {
-        self.n
-    }
-
     /// `x = A^{-1} b`: forward substitution with `L` on `P b`, back substitution with `U`.
     pub fn solve(&self, b: &[f64]) -> Vec<f64> {
         let n = self.n;

@@ -1,6 +1,6 @@
 //! Linear solvers behind one interface: sparse LU (faer; the symbolic factorization is
 //! computed once per sparsity pattern and reused for every numeric factorization; dense
-//! LU for systems of at most [`DENSE_LIMIT`] unknowns, [`crate::linalg::dense`]), sparse
+//! LU for systems of at most `DENSE_LIMIT` unknowns, `linalg::dense`), sparse
 //! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
@@ -35,7 +35,7 @@ use crate::linalg::split_cholesky::{SplitCholesky, SPLIT_MIN};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LinearMethod {
-    /// Sparse direct LU; dense ([`DenseLu`]) up to [`DENSE_LIMIT`] unknowns.
+    /// Sparse direct LU; dense (`DenseLu`) up to `DENSE_LIMIT` unknowns.
     #[default]
     #[cfg_attr(feature = "clap", value(help = "Sparse direct LU"))]
     Lu,
@@ -53,7 +53,7 @@ pub enum LinearMethod {
     /// Restarted flexible GMRES as [`LinearMethod::Gmres`], preconditioned by
     /// `-diag(B, B)` with `B` one multigrid V-cycle for the problem's SPD approximation
     /// `K` on the nested spaces set with [`LinearSolver::set_transfers`]
-    /// ([`crate::linalg::multigrid`]); without them as [`LinearMethod::Gmres`].
+    /// (`linalg::multigrid`); without them as [`LinearMethod::Gmres`].
     #[cfg_attr(
         feature = "clap",
         value(help = "GMRES, preconditioned by a multigrid V-cycle on the knot-halving hierarchy")
@@ -109,7 +109,7 @@ pub const AUTO_MAX_KRYLOV: usize = 500;
 /// Gauss–Seidel by 0.54 (the smoothing of Gauss–Seidel degrades with the degree and the
 /// cells' aspect ratio); in the Newton solves the Gauss–Seidel cycle's GMRES iterations
 /// grew as `h` halved (BENCHMARKS.md "Multigrid").
-pub const MG_SMOOTHER: Smoother = Smoother::Ilu0;
+pub(crate) const MG_SMOOTHER: Smoother = Smoother::Ilu0;
 
 /// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
 pub const MG_SWEEPS: usize = 1;
@@ -433,7 +433,7 @@ impl LinearSolver {
 
     /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l]` maps the free
     /// scalar unknowns of space `l + 1` to those of space `l`, space 0 the one of the
-    /// problem's `m` scalar unknowns (see [`crate::discrete::transfers`]).
+    /// problem's `m` scalar unknowns (see `discrete::transfers`).
     pub fn set_transfers(&mut self, transfers: Vec<Csr>) {
         self.transfers = transfers;
     }

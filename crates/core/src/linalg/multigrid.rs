@@ -23,7 +23,8 @@ use crate::linalg::sparse::Csr;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Smoother {
     /// Gauss–Seidel in the unknowns' order before the coarse correction, in reverse
-    /// order after it.
+    /// order after it (compared with ILU(0) in the tests, BENCHMARKS.md "Multigrid").
+    #[cfg_attr(not(test), allow(dead_code))]
     SymmetricGaussSeidel,
     /// `x += (LU)^{-1} (b - A x)` with the incomplete factors of the level's operator.
     Ilu0,

@@ -99,11 +99,11 @@ impl Method for EggMethod {
     }
 }
 
-/// EGG on one level: the [`GalerkinState`] (discretization, control points, storage
+/// EGG on one level: the `GalerkinState` (discretization, control points, storage
 /// requested once up front), the operator and the quadrature back end.
 pub struct EggProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     /// Which operator.
     pub op: Operator,
     assembler: Arc<dyn EggAssembler>,
@@ -156,7 +156,7 @@ impl DiscreteProblem for EggProblem {
         Some(&self.state.disc.ordering)
     }
 
-    /// The knot-halving hierarchy below the basis ([`crate::discrete::transfers`]).
+    /// The knot-halving hierarchy below the basis (`discrete::transfers`).
     fn transfers(&self) -> Vec<Csr> {
         crate::discrete::transfers::free_prolongations(&self.state.disc).unwrap_or_default()
     }

@@ -273,13 +273,9 @@ impl HarmonicProblem {
     }
 
     /// The current unknown vector.
+    #[cfg(test)]
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.unknowns()
-    }
-
-    /// The relative diagonal shift `τ` the last Jacobian carried.
-    pub fn shift(&self) -> f64 {
-        self.hessian.shift()
     }
 
     fn assemble(&mut self, with_hessian: bool) {

@@ -17,8 +17,10 @@
 
 use std::sync::Arc;
 
+#[cfg(test)]
 use super::density::{lowered, raised, shift_diagonal};
 use super::galerkin::block_mass;
+#[cfg(test)]
 use super::winslow::{projected_density_hessian, projection_lowered, projection_raised, winslow_density};
 use super::DiscreteProblem;
 use crate::discrete::assembly::{egg_point, element_product, EggRows, Geo, Operator};
@@ -98,6 +100,7 @@ fn geometry(cell: &CellQuadrature, k: usize, cps: &[Point]) -> Geo {
 }
 
 /// `e = (x_ξ, x_η, y_ξ, y_η)` at point `k` of `cell`.
+#[cfg(test)]
 fn gradient(cell: &CellQuadrature, k: usize, cps: &[Point]) -> [f64; 4] {
     let mut e = [0.0; 4];
     for (b, &f) in cell.at(k).iter().zip(&cell.funcs) {
@@ -153,6 +156,7 @@ impl HierarchicalEggProblem {
     }
 
     /// The current unknowns.
+    #[cfg(test)]
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.disc.gather(&self.state.cps)
     }
@@ -191,6 +195,7 @@ impl DiscreteProblem for HierarchicalEggProblem {
 
 /// `J = ∫ W` (eq. 16) on a THB discretization, `+∞` when `det J <= 0` at a quadrature
 /// point; summed cell by cell in order.
+#[cfg(test)]
 pub fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[Point]) -> f64 {
     use rayon::prelude::*;
     let cells: Vec<f64> = disc
@@ -217,6 +222,7 @@ pub fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[
 /// `projected` towards its positive semidefinite projection (as
 /// [`winslow_gradient_with`](super::winslow::winslow_gradient_with)):
 /// `∂F^z_a/∂c^d_b = -∫ Σ_ij ∂_i w_a (∂²W/∂e_{2z+i}∂e_{2d+j}) ∂_j w_b`.
+#[cfg(test)]
 pub fn hierarchical_winslow_gradient(
     disc: &HierarchicalDiscretization,
     cps: &[Point],
@@ -268,6 +274,7 @@ pub fn hierarchical_winslow_gradient(
 /// start; the Hessian modified as [`WinslowProblem`](super::winslow::WinslowProblem)'s
 /// (partial, then full projection of each point's density Hessian, then diagonal shifts)
 /// where Newton finds it not definite.
+#[cfg(test)]
 #[derive(Debug)]
 pub struct HierarchicalWinslowProblem {
     /// Discretization, control points and storage.
@@ -278,6 +285,7 @@ pub struct HierarchicalWinslowProblem {
     raised: bool,
 }
 
+#[cfg(test)]
 impl HierarchicalWinslowProblem {
     /// Set up with all control points `cps` (free ones are the start).
     pub fn new(disc: Arc<HierarchicalDiscretization>, cps: Vec<Point>) -> Self {
@@ -287,11 +295,13 @@ impl HierarchicalWinslowProblem {
     }
 
     /// The current unknowns.
+    #[cfg(test)]
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.disc.gather(&self.state.cps)
     }
 }
 
+#[cfg(test)]
 impl DiscreteProblem for HierarchicalWinslowProblem {
     fn size(&self) -> usize {
         2 * self.state.disc.num_free()

@@ -137,6 +137,7 @@ impl MetricNormProblem {
     }
 
     /// The current unknown vector.
+    #[cfg(test)]
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.unknowns()
     }

@@ -4,13 +4,13 @@
 //! | module | method | paper |
 //! |---|---|---|
 //! | [`egg`] | EGG, Galerkin form with the plain operator `L` or the scaled `L / (g11 + g22)`: [`EggMethod`](egg::EggMethod) | eq. (8), (12), (23) |
-//! | [`weak_form`] | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: [`WeakFormMethod`](weak_form::WeakFormMethod), [`Start::Bijective`] | eq. (13), (14) |
-//! | [`flux`] | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
-//! | [`metric_norms`] | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): [`MetricNormMethod`](metric_norms::MetricNormMethod) | eq. (3), §10.3 |
-//! | [`density`] | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
-//! | [`harmonic`] | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: [`VariationalHarmonicMethod`](harmonic::VariationalHarmonicMethod) | eq. (46) |
+//! | `weak_form` | weak form `∫ ∇w_i · ∇ξ dx = 0`, `∫ ∇w_i · ∇η dx = 0` pulled back (first derivatives only: `C⁰` bases allowed), exact Jacobian, not admissible where `det J <= 0` at a quadrature point: `WeakFormMethod`, [`Start::Bijective`] | eq. (13), (14) |
+//! | `flux` | the shared kernel of first-order forms `∫ ∇w_a · G(∇x)` with exact Jacobian (eq. 14 and the gradient of eq. 16) | eq. (14), (16) |
+//! | `metric_norms` | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): `MetricNormMethod` | eq. (3), §10.3 |
+//! | `density` | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
+//! | `harmonic` | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: `VariationalHarmonicMethod` | eq. (46) |
 //! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
-//! | [`hierarchical`] | EGG (eq. 8) and the Winslow functional (eq. 16) on a THB discretization, with the same point kernels: [`HierarchicalEggProblem`](hierarchical::HierarchicalEggProblem), [`HierarchicalWinslowProblem`](hierarchical::HierarchicalWinslowProblem) | §4, eq. (8), (16) |
+//! | `hierarchical` | EGG (eq. 8) and the Winslow functional (eq. 16) on a THB discretization, with the same point kernels: `HierarchicalEggProblem`, `HierarchicalWinslowProblem` | §4, eq. (8), (16) |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
 //! # The interface
@@ -43,15 +43,15 @@
 //! The quadrature back end (CPU here, WGSL in the GPU crate) sits behind the EGG method:
 //! [`EggAssembler`](egg::EggAssembler).
 
-pub mod density;
+pub(crate) mod density;
 pub mod egg;
-pub mod flux;
-pub mod galerkin;
-pub mod harmonic;
-pub mod hierarchical;
-pub mod metric_norms;
+pub(crate) mod flux;
+pub(crate) mod galerkin;
+pub(crate) mod harmonic;
+pub(crate) mod hierarchical;
+pub(crate) mod metric_norms;
 pub mod quasi_conformal;
-pub mod weak_form;
+pub(crate) mod weak_form;
 pub mod winslow;
 
 use std::sync::Arc;

@@ -25,7 +25,7 @@
 //! `∇²T* = ∫ 2 (∇f ∇fᵀ + (f − f̄) ∇²f) − (2 / ∫ 1) g gᵀ`,  `g = ∫ ∇f`,
 //!
 //! a sparse matrix (the density `(f − s)²` at fixed `s = f̄`, assembled by
-//! [`super::density`]) minus a dense rank-one term, which [`QuasiConformalProblem`]
+//! `density`) minus a dense rank-one term, which [`QuasiConformalProblem`]
 //! presents through [`DiscreteProblem::rank_one`] and the Newton solver applies by the
 //! Sherman-Morrison formula: the steps of the bordered system on the shared sparse
 //! factorizations, without a matrix with a dense row and column, and without an extra
@@ -44,7 +44,7 @@
 //! `H_GN = ∫ 2 ∇f ∇fᵀ − (2 / ∫ 1) g gᵀ = 2 ∫ (∇f − ḡ)(∇f − ḡ)ᵀ`,  `ḡ = g / ∫ 1`,
 //!
 //! (the covariance of `∇f`: positive semidefinite at every map, so every direction
-//! descends), plus the shift `τ diag(|H_ii|)` of [`ShiftedHessian`], which the Armijo
+//! descends), plus the shift `τ diag(|H_ii|)` of `ShiftedHessian`, which the Armijo
 //! line search of [`crate::solve::newton`] drives as an LM method drives its damping: a
 //! heavily damped step raises `τ`, a full step lowers it. The exact Hessian (the extra
 //! term `∫ 2 (f − f̄) ∇²f`, [`QcHessian::Exact`]) is available and tested, but is not the
@@ -187,11 +187,11 @@ fn value_on(disc: &Discretization, cps: &[Point], area: f64) -> (f64, f64) {
     (t, mean.sqrt())
 }
 
-/// The quasi-conformal functional on one level: the [`GalerkinState`], the shifted
+/// The quasi-conformal functional on one level: the `GalerkinState`, the shifted
 /// Hessian and the rank-one term of the eliminated `k`.
 pub struct QuasiConformalProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     hessian: ShiftedHessian,
     /// `∫ 1` on the quadrature (the parameter square's area, 1 up to rounding).
     area: f64,

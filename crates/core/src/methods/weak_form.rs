@@ -129,6 +129,7 @@ impl WeakFormProblem {
     }
 
     /// The current unknown vector.
+    #[cfg(test)]
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.unknowns()
     }

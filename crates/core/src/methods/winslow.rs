@@ -177,7 +177,7 @@ pub fn winslow_value_and_gradient(disc: &Discretization, cps: &[Point], res: &mu
 
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
-/// form of [`flux_form`](super::flux::flux_form) with `G = -∂W/∂e`.
+/// form of `flux_form` with `G = -∂W/∂e`.
 pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
     if stencil.is_empty() {
         // the gradient only: `∂W/∂e = 2 e / D - W D' / D` without the Hessian
@@ -412,7 +412,7 @@ pub(crate) fn projection_lowered(projected: f64) -> f64 {
 /// the boundary) and storage requested once.
 pub struct WinslowProblem {
     /// Basis, control points and storage.
-    pub state: GalerkinState,
+    pub(crate) state: GalerkinState,
     /// Positions of the diagonal entries in the vector pattern's values.
     diag: Vec<usize>,
     /// Relative diagonal shift `τ` of the presented Hessian.

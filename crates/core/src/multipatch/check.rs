@@ -107,7 +107,7 @@ fn bbox(poly: &[Point]) -> (Point, Point) {
 /// Validate `layout` (see the module documentation).
 ///
 /// The checks run in the normalised coordinates of the layout's bounding box
-/// ([`Similarity`], as a four-sided boundary's and a ring's), so that a layout translated
+/// (`Similarity`, as a four-sided boundary's and a ring's), so that a layout translated
 /// far from the origin or scaled to an extreme size gets the verdicts it gets where it
 /// is: far out, a NURBS side evaluated in raw coordinates is rounded to the position's
 /// precision and two sides of one interface seem to differ. The report is in the

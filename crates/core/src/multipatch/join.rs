@@ -126,7 +126,7 @@ fn diameter(maps: &[&Surface]) -> f64 {
 /// `a` becomes `xi ∈ [0, s]`, `b` `xi ∈ [s, 1]`, with a `C⁰` knot at `s`.
 ///
 /// Errors: [`Error::Invalid`] when the maps share no whole side (the same curve at equal
-/// parameters, to [`SHARED_TOL`] of the diameter), lie on the same side of it, or have
+/// parameters, to `SHARED_TOL` of the diameter), lie on the same side of it, or have
 /// weights along it that no scaling makes equal.
 pub fn join_maps(a: &Surface, b: &Surface) -> Result<(Surface, JoinReport)> {
     if a.knots.iter().chain(&b.knots).any(KnotVector::is_periodic) {

@@ -5,7 +5,7 @@
 //! ([`Layout::topologies`]: [`SideCondition::Interface`] on shared sides, Dirichlet on the
 //! outer boundary), and so do the direction classes of the knot vectors
 //! ([`super::classes`]) and the global numbering of shared control points
-//! ([`super::dofs`]).
+//! (`dofs`).
 
 use serde::Serialize;
 

@@ -9,9 +9,9 @@
 //! neighbours are refined with it, so the layout stays conforming) and the layout is
 //! solved again, at most
 //! [`LAYOUT_REPAIR`] times. With [`Interfaces::Free`] the certified layout
-//! is then improved with its interfaces free ([`super::free`]).
+//! is then improved with its interfaces free (`free`).
 //!
-//! The layout is solved in the normalised coordinates of one [`Similarity`] for all
+//! The layout is solved in the normalised coordinates of one `Similarity` for all
 //! patches (the identity for a well-placed domain), so that the maps brought back are
 //! still conforming bit for bit.
 

@@ -172,7 +172,7 @@ pub struct CompareOptions {
     /// operator.
     pub solve: SolveOptions,
     /// `λ₁` of the variational harmonic method (dimensionless, relative to the domain's
-    /// diameter; see [`crate::methods::harmonic`]).
+    /// diameter; see `methods::harmonic`).
     pub lambda1: f64,
     /// `λ₂` of the variational harmonic method.
     pub lambda2: f64,

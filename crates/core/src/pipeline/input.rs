@@ -39,7 +39,7 @@ pub enum Input {
     Volume(Box<VolumeBoundary>),
     /// A certified map, improved on its own basis by the pipeline's method (the Winslow
     /// functional by default) with its boundary fixed, and kept only when certified
-    /// ([`super::start`]).
+    /// (`start`).
     Map {
         /// Name of the geometry.
         name: String,

@@ -36,7 +36,7 @@
 
 pub mod compare;
 mod input;
-pub mod start;
+pub(crate) mod start;
 pub mod sweep;
 
 pub use input::{Input, Solved};
@@ -102,7 +102,7 @@ pub enum Stage<'a> {
         reason: Option<&'a str>,
     },
     /// A map given as the input is improved by `method` on its own basis
-    /// ([`start`](mod@start)).
+    /// (`start`).
     Improve {
         /// The method.
         method: &'a dyn Method,

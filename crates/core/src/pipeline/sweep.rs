@@ -33,7 +33,7 @@
 //!   moves with the rotor's material, and the grid lines twist by the angle turned.
 //!
 //! For `σ != 0` the shifted curve is not in the spline space (its knots moved by `-σ`);
-//! the boundary is its exact `L2` projection ([`PeriodicTranslate`]), which is `C^{2p}`
+//! the boundary is its exact `L2` projection (`PeriodicTranslate`), which is `C^{2p}`
 //! in `σ`, so the boundary control points, and with them the interior ones, move
 //! smoothly in time.
 //!
@@ -42,7 +42,7 @@
 //!
 //! **Reparameterization.** Every frame keeps frame 0's: the outer boundary is frame 0's
 //! and the inner one is frame 0's moved as above. Frame 0 is fitted by arc length unless
-//! the matching of narrow gaps ([`crate::boundary::ring_reparam`]) is asked for
+//! the matching of narrow gaps (`boundary::ring_reparam`) is asked for
 //! explicitly ([`Reparam::Constrained`]): `auto` reads as arc length here
 //! ([`frame0_options`]). Matched pairs belong to one position of the inner contour; as it
 //! turns, the outer parameter stays bunched where frame 0's lobe tips were (the rotor

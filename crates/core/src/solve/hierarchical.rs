@@ -3,7 +3,7 @@
 //! cells, only those cells and a ring of active cells around them are refined
 //! ([`HierarchicalMap::refined`], admissible of class `m`), the map is prolonged onto the
 //! refined basis (exactly: the THB spaces are nested) and EGG (eq. 8) is solved again on
-//! the THB discretization ([`HierarchicalEggProblem`]). Where a tensor repair bisects
+//! the THB discretization (`HierarchicalEggProblem`). Where a tensor repair bisects
 //! whole knot spans across the patch, this one adds functions only near the defect.
 
 use std::sync::Arc;

@@ -36,7 +36,7 @@ pub enum Improve {
     #[default]
     #[cfg_attr(feature = "clap", value(help = "Minimize the Winslow functional (eq. 16)"))]
     Winslow,
-    /// Solve the weak form (eq. 14) from the map: [`WeakFormMethod`].
+    /// Solve the weak form (eq. 14) from the map: `WeakFormMethod`.
     #[cfg_attr(feature = "clap", value(name = "weak", help = "Solve the weak form (eq. 14) from the certified map"))]
     WeakForm,
 }

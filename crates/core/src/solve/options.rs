@@ -29,7 +29,7 @@ pub struct SolveOptions {
     /// Basis growth factor between solved levels (the paper advises 4).
     pub growth: f64,
     /// Largest mean physical aspect ratio of the elements; the coarser direction of a
-    /// level is halved until it is met (see [`prepare_levels`](super::levels::prepare_levels)).
+    /// level is halved until it is met (see `prepare_levels`).
     pub aspect: f64,
     /// `det J` is sampled on an `(n+1)^2` grid for the report.
     pub sample: usize,

@@ -24,8 +24,6 @@ pub fn bernstein(p: usize, t: f64, out: &mut [f64]) {
 /// Per-element extraction operators of a univariate basis.
 #[derive(Debug, Clone)]
 pub struct BezierExtraction {
-    /// Degree `p`.
-    pub degree: usize,
     /// Elements as `(span, a, b)`.
     pub elements: Vec<(usize, f64, f64)>,
     /// For element `e`, `ops[e][j * (p + 1) + k]` is the coefficient of Bernstein `k`
@@ -41,7 +39,7 @@ impl BezierExtraction {
         let p = kv.degree();
         if kv.is_periodic() {
             let (elements, ops) = crate::spline::periodic::periodic_extraction(kv);
-            return Ok(Self { degree: p, elements, ops });
+            return Ok(Self { elements, ops });
         }
         let bm = kv.breaks_with_multiplicity();
         if let Some(&(u, m)) = bm[1..bm.len() - 1].iter().find(|&&(_, m)| m > p) {
@@ -65,7 +63,7 @@ impl BezierExtraction {
             }
             ops.push(op);
         }
-        Ok(Self { degree: p, elements, ops })
+        Ok(Self { elements, ops })
     }
 }
 

@@ -86,7 +86,7 @@ pub(crate) fn check_wrapped(
 
 impl Curve {
     /// Validate lengths, finiteness and weights; for a periodic knot vector, that the
-    /// last `p` control points repeat the first `p` ([`crate::spline::periodic`]).
+    /// last `p` control points repeat the first `p` (`spline::periodic`).
     pub fn new(knots: KnotVector, control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots.num_basis();
         if control_points.len() != n {

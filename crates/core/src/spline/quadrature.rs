@@ -48,16 +48,6 @@ impl GaussLegendre {
         Self { points, weights }
     }
 
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.points.len()
-    }
-
-    /// Whether the rule is empty (never, by construction).
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-
     /// Points and weights mapped affinely to `[a, b]`.
     pub fn on(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
         let h = 0.5 * (b - a);

@@ -96,7 +96,7 @@ impl SurfaceDerivs {
 
 impl Surface {
     /// Validate lengths, finiteness and weights, and that the control points of a
-    /// periodic direction wrap ([`crate::spline::periodic`]).
+    /// periodic direction wrap (`spline::periodic`).
     pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
         let n = knots[0].num_basis() * knots[1].num_basis();
         if control_points.len() != n {

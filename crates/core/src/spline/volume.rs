@@ -6,9 +6,9 @@
 //! Control point `(i, j, k)` is stored at `(k n_η + j) n_ξ + i` (`ξ` fastest, then `η`).
 //! Knot insertion and degree elevation act on one direction at a time, on the
 //! homogeneous coordinates `(w x, w y, w z, w)`, with the univariate operators of
-//! [`crate::spline::refine`] (so periodic directions work as for curves); the map is
+//! `spline::refine` (so periodic directions work as for curves); the map is
 //! reproduced exactly (to rounding). Bézier extraction per element is the tensor product
-//! of the univariate operators of [`crate::spline::bezier`].
+//! of the univariate operators of `spline::bezier`.
 
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
@@ -290,7 +290,7 @@ impl Volume {
     }
 
     /// Bézier extraction: per direction, the univariate operators.
-    pub fn extraction(&self) -> Result<[BezierExtraction; 3]> {
+    pub(crate) fn extraction(&self) -> Result<[BezierExtraction; 3]> {
         Ok([
             BezierExtraction::new(&self.knots[0])?,
             BezierExtraction::new(&self.knots[1])?,
@@ -301,7 +301,7 @@ impl Volume {
     /// The homogeneous Bézier net `(w x, w y, w z, w)` of element `e` (indices of the
     /// element per direction), `(p + 1)(q + 1)(r + 1)` points, first index fastest:
     /// `H_abc = Σ_ijk h_ijk C^ξ_ia C^η_jb C^ζ_kc` with the extraction operators `C`.
-    pub fn bezier_net(&self, ex: &[BezierExtraction; 3], e: [usize; 3]) -> Vec<[f64; 4]> {
+    pub(crate) fn bezier_net(&self, ex: &[BezierExtraction; 3], e: [usize; 3]) -> Vec<[f64; 4]> {
         let [p, q, r] = self.degrees();
         let [nx, ny, _] = self.shape();
         let spans = [0, 1, 2].map(|d| ex[d].elements[e[d]].0);

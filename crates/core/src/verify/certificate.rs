@@ -44,7 +44,7 @@
 //! reports [`Fold`] and [`Undecided`].
 
 mod bernstein;
-pub mod coefficients;
+pub(crate) mod coefficients;
 mod element;
 pub mod hierarchical;
 mod search;

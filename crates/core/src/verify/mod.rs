@@ -8,7 +8,7 @@
 //! | [`poisson`] | the Poisson benchmark `Q(x)` solved by IGA on the map | §10, eq. (44)-(45) |
 //!
 //! Defect correction (§8.2), which acts on the certificate's verdict, is a step of the
-//! solve: [`crate::solve::repair`].
+//! solve: `solve::repair`.
 
 pub mod certificate;
 pub mod poisson;

@@ -155,7 +155,7 @@ pub fn constrained_params(
 /// (every k-th point, ends kept), the pairs are returned as indices of the full clouds, and only
 /// pairs with `c1` strictly increasing inside `(0, 1)` and `c2` strictly increasing are
 /// kept (repeated points can give equal parameters). Shared by the four-sided
-/// [`constrained_params`] and the ring matching ([`crate::boundary::ring_reparam`]).
+/// [`constrained_params`] and the ring matching (`boundary::ring_reparam`).
 pub fn match_clouds(
     p1: &[Point],
     c1: &[f64],

@@ -19,7 +19,7 @@
 //!   length between consecutive matches (eq. 41-42). See [`constrained_params`].
 //!
 //! Rings (closed contours, `eta` periodic) use the same matching on the two contours
-//! cut open at the seam: [`crate::boundary::ring_reparam`].
+//! cut open at the seam: `boundary::ring_reparam`.
 //!
 //! Parametric sides are turned into point clouds by dense sampling
 //! ([`sample_side`]); the resulting abscissae `ξ_k` of the samples `t_k` define

@@ -47,7 +47,7 @@ impl FaceJson {
     }
 
     /// Validate and map the knot domains to `[0, 1]`; errors name the field.
-    pub fn to_face(self) -> Result<Face> {
+    pub fn into_face(self) -> Result<Face> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let mut kvs = Vec::with_capacity(2);
         for (d, k) in self.knots.into_iter().enumerate() {
@@ -89,7 +89,7 @@ pub(crate) fn parse_volume_boundary_json(mut v: Value) -> Result<VolumeBoundary>
             .ok_or_else(|| Error::Json { context: ctx.clone(), message: "missing face".into() })?;
         let fj: FaceJson =
             serde_json::from_value(f).map_err(|e| Error::Json { context: ctx.clone(), message: e.to_string() })?;
-        faces.push(fj.to_face().map_err(|e| e.within(&ctx))?);
+        faces.push(fj.into_face().map_err(|e| e.within(&ctx))?);
     }
     let faces: [Face; 6] = faces.try_into().map_err(|_| Error::Invalid("six faces expected".into()))?;
     let b = VolumeBoundary { name, faces };

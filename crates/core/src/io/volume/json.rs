@@ -52,7 +52,7 @@ impl VolumeJson {
     }
 
     /// Validate and map the knot domains to `[0, 1]`; errors name the field.
-    pub fn to_volume(self) -> Result<Volume> {
+    pub fn into_volume(self) -> Result<Volume> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let mut kvs = Vec::with_capacity(3);
         for (d, k) in self.knots.into_iter().enumerate() {
@@ -84,7 +84,7 @@ pub(crate) fn parse_volume_json(mut v: Value) -> Result<(String, Volume)> {
     let map = v.get_mut("map").map(Value::take).unwrap_or(Value::Null);
     let vj: VolumeJson =
         serde_json::from_value(map).map_err(|e| Error::Json { context: "map".into(), message: e.to_string() })?;
-    Ok((name, vj.to_volume().map_err(|e| e.within("map"))?))
+    Ok((name, vj.into_volume().map_err(|e| e.within("map"))?))
 }
 
 /// A trivariate map document `{"name", "map": {...}}`; the fields of `extra` (an object,

@@ -19,6 +19,5 @@ pub mod gismo;
 pub mod json;
 pub mod vtk;
 
-pub use boundary::{volume_boundary_to_json, FaceJson};
+pub use boundary::volume_boundary_to_json;
 pub use boundary_gismo::volume_boundary_to_gismo_xml;
-pub use json::{volume_to_json, VolumeJson};

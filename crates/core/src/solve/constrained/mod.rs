@@ -3,7 +3,7 @@
 //! started from a feasible map.
 //!
 //! Let `d(c)` be the Bernstein coefficients of `det J` on every element
-//! ([`DetCoefficients`]): `d > 0` proves `det J > 0` (convex hull), so every feasible
+//! (`DetCoefficients`): `d > 0` proves `det J > 0` (convex hull), so every feasible
 //! map is bijective. The coefficients fixed by the boundary alone (`det J` at the four
 //! corners) are no constraints; they must be positive for any map of this boundary to be
 //! feasible.

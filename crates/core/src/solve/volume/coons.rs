@@ -123,6 +123,7 @@ impl CommonFaces {
     }
 
     /// The trivariate Coons patch of the faces (module doc).
+    #[cfg(test)]
     pub fn coons(&self) -> Result<Volume> {
         let h = self.boundary_net()?;
         let h = coons_fill(&self.knots, h);

@@ -1,7 +1,7 @@
 //! Volumes from their six boundary faces (a hexahedral topology, paper §11.1 in 3D):
 //! the faces on common knot vectors, the trivariate Coons patch as the start
-//! ([`coons`]), the interior control points moved by Newton's method on the 3D Winslow
-//! functional ([`winslow`]), and the verdict of the volume certificate
+//! (`coons`), the interior control points moved by Newton's method on the 3D Winslow
+//! functional (`winslow`), and the verdict of the volume certificate
 //! ([`certify_volume`]).
 //!
 //! **Continuation.** Winslow's functional needs a start with `det J > 0` at every
@@ -17,8 +17,8 @@
 //! every element halved ([`VolumeOptions::max_refinements`] times at most); the result
 //! is the last volume with its certificate, whatever its verdict.
 
-pub mod coons;
-pub mod winslow;
+pub(crate) mod coons;
+pub(crate) mod winslow;
 
 use std::time::Instant;
 

@@ -384,11 +384,6 @@ impl WinslowVolume {
         3 * self.free
     }
 
-    /// Basis functions per direction.
-    pub fn shape(&self) -> [usize; 3] {
-        self.shape
-    }
-
     /// Free index of control point `lin`, if it is free.
     pub fn free_index(&self, lin: usize) -> Option<usize> {
         let f = self.free_of[lin];

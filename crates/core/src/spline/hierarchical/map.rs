@@ -2,8 +2,8 @@
 //! (truncated) hierarchical basis).
 //!
 //! On an active cell `Q` of level `l` the map is the polynomial `Σ_τ d^l_τ τ` of its local
-//! net ([`super::truncation`]); everything here is read off that net by blossoming
-//! ([`blossom`]): the Bézier net of the cell (the blossom at `(a^{p-k}, b^k)`), the
+//! net (`truncation`); everything here is read off that net by blossoming
+//! (`blossom`): the Bézier net of the cell (the blossom at `(a^{p-k}, b^k)`), the
 //! coefficients after a refinement (the blossom of the old piece at the new function's
 //! interior knots, exact since the old map lies in the refined space) and the tensor map
 //! on the knot lines of all active cells (knot insertion, exact: the THB space is a
@@ -71,8 +71,8 @@ impl HierarchicalMap {
         Self::new(basis, map.control_points.clone())
     }
 
-    /// The level coefficients of the map (see [`super::truncation`]).
-    pub fn level_coefficients(&self) -> LevelCoefficients<'_, Point> {
+    /// The level coefficients of the map (see `truncation`).
+    pub(crate) fn level_coefficients(&self) -> LevelCoefficients<'_, Point> {
         LevelCoefficients::new(&self.basis, |k| self.control_points[k])
     }
 
@@ -115,7 +115,7 @@ impl HierarchicalMap {
     }
 
     /// The Bézier patch of the active cell `c` of level `l`.
-    pub fn bezier_patch(&self, lc: &mut LevelCoefficients<'_, Point>, l: usize, c: Index2) -> Result<Surface> {
+    pub(crate) fn bezier_patch(&self, lc: &mut LevelCoefficients<'_, Point>, l: usize, c: Index2) -> Result<Surface> {
         let [p, q] = self.basis.degrees();
         let net = lc.cell_net(l, c);
         let spans = self.basis.cell_spans(l, c);

@@ -28,14 +28,14 @@
 //! `N(Q, m) = {Q' active of level l - m + 1 : Q' ∩ S(Q, l - m + 2) ≠ ∅}`, `S(Q, k)` the
 //! union of the supports of the level-`k` B-splines non-zero on `Q`).
 //!
-//! Submodules: [`truncation`] (the two-scale relation and the restriction of the THB
+//! Submodules: `truncation` (the two-scale relation and the restriction of the THB
 //! functions to an active cell), [`map`] (THB maps of the plane: control points,
 //! evaluation, per-cell Bézier nets, refinement and conversion to a tensor map).
 
 pub mod map;
 #[cfg(test)]
 mod tests;
-pub mod truncation;
+pub(crate) mod truncation;
 
 use std::collections::{BTreeSet, HashMap};
 use std::ops::Range;

@@ -98,11 +98,6 @@ impl DetCoefficients {
         a * b * self.per_element()
     }
 
-    /// Whether there is no coefficient (never for a valid basis).
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Parameter area of element `e` (row-major, `ξ` fastest).
     pub fn element_area(&self, e: usize) -> f64 {
         let n = self.shape()[0];
