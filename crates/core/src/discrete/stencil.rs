@@ -90,6 +90,32 @@ impl Discretization {
     }
 }
 
+impl Discretization {
+    /// The diagonal block `A_zz` (free-free, in the scalar pattern [`Discretization::scalar`])
+    /// of the `ncomp`-component system whose stencil storage is `stencil`: the block the
+    /// gathered matrix has in rows and columns `z m .. (z + 1) m`, entry for entry. Only
+    /// for a basis without periodic replicas (`None` otherwise).
+    pub fn stencil_diagonal_block(
+        &self,
+        ncomp: usize,
+        stencil: &[f64],
+        z: usize,
+    ) -> Option<crate::linalg::sparse::Csr> {
+        if !self.dofs.replicas().is_empty() || z >= ncomp || stencil.len() != self.stencil_len(ncomp) {
+            return None;
+        }
+        let sw = self.stencil_width();
+        let mut block = self.scalar.csr.clone();
+        // the scalar pattern reads function `k`'s slot `s` at `k sw + s`; the block
+        // (z, z) of the system stores it at `k ncomp² sw + (z ncomp + z) sw + s`
+        for (v, &src) in block.values.iter_mut().zip(&self.scalar.src) {
+            let (k, s) = (src / sw, src % sw);
+            *v = stencil[k * ncomp * ncomp * sw + (z * ncomp + z) * sw + s];
+        }
+        Some(block)
+    }
+}
+
 /// The free-free system of `ncomp` components held as stencil storage, as an operator
 /// for the Krylov methods ([`MatVec`]): the EGG Jacobian of eq. (12) without its CSR
 /// copies. Only for a basis without periodic replicas
@@ -105,8 +131,11 @@ impl<'a> StencilOperator<'a> {
     /// The system of `ncomp` components whose stencil storage is `stencil` on `disc`;
     /// `None` when `disc` has periodic replicas or `stencil` has the wrong length.
     pub fn new(disc: &'a Discretization, ncomp: usize, stencil: &'a [f64]) -> Option<Self> {
-        (disc.dofs.replicas().is_empty() && stencil.len() == disc.stencil_len(ncomp))
-            .then_some(Self { disc, ncomp, stencil })
+        (disc.dofs.replicas().is_empty() && stencil.len() == disc.stencil_len(ncomp)).then_some(Self {
+            disc,
+            ncomp,
+            stencil,
+        })
     }
 }
 

@@ -637,6 +637,23 @@ impl LinearSolver {
         self.factor_krylov(n, None, k)
     }
 
+    /// [`LinearMethod::Pcg`] for a system held as an operator: the block-Jacobi
+    /// preconditioner from the diagonal blocks `blocks` of the system (each SPD, of the
+    /// size of the ordering given with [`LinearSolver::set_ordering`]), factorized in
+    /// single precision as [`LinearSolver::factor`] of the whole matrix factorizes them;
+    /// [`LinearSolver::solve_operator`] then runs CG with the operator.
+    ///
+    /// Errors: [`Error::LinearSolver`] for the other methods, or when a block is not
+    /// positive definite.
+    pub fn factor_blocks(&mut self, blocks: &[Csr]) -> Result<()> {
+        if self.method != LinearMethod::Pcg {
+            return Err(Error::LinearSolver(format!("{:?} has no block-Jacobi preconditioner", self.method)));
+        }
+        let factors = blocks.par_iter().map(|b| self.cholesky::<f32>(b, None)).collect::<Result<Vec<_>>>()?;
+        self.precond = Some(Preconditioner::BlockJacobi(factors));
+        Ok(())
+    }
+
     /// The preconditioner of the GMRES methods for a system of `n` unknowns, the matrix
     /// `a` when there is one (for ILU(0)).
     fn factor_krylov(&mut self, n: usize, a: Option<&Csr>, k: Option<&Csr>) -> Result<()> {
@@ -673,11 +690,13 @@ impl LinearSolver {
         self.solve_with(None, b)
     }
 
-    /// Solve `a x = b` by GMRES with the operator `a` (the system
-    /// [`LinearSolver::factor_operator`] set up the preconditioner for): the same
-    /// iterates as [`LinearSolver::solve`] with the matrix whose product `a` computes.
+    /// Solve `a x = b` by GMRES (CG for [`LinearMethod::Pcg`]) with the operator `a` (the
+    /// system [`LinearSolver::factor_operator`] or [`LinearSolver::factor_blocks`] set up
+    /// the preconditioner for): the same iterates as [`LinearSolver::solve`] with the
+    /// matrix whose product `a` computes, without its fallback to a direct factorization
+    /// (an error instead).
     pub fn solve_operator(&mut self, a: &dyn MatVec, b: &[f64]) -> Result<Vec<f64>> {
-        if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid) {
+        if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid | LinearMethod::Pcg) {
             return Err(Error::LinearSolver(format!("{:?} solves with a matrix, not an operator", self.method)));
         }
         self.solve_with(Some(a), b)
@@ -748,13 +767,17 @@ impl LinearSolver {
                 }
             }
             LinearMethod::Pcg => {
-                let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let pc = self.precond.as_mut().expect("set with matrix");
+                let a: &dyn MatVec = match op {
+                    Some(op) => op,
+                    None => self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?,
+                };
+                let pc = self.precond.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 match cg(a, b, |r, z| pc.apply(r, z), self.krylov_tol, MAX_PCG) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
                         x
                     }
+                    Err(e) if op.is_some() => return Err(e),
                     Err(_) => {
                         // slow convergence (a thin domain has a poor Korn constant):
                         // factorize the whole system instead

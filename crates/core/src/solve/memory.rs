@@ -34,6 +34,7 @@
 use crate::boundary::hierarchy::Level;
 pub use crate::error::human;
 use crate::error::{Error, Result};
+use crate::linalg::linsolve::LinearMethod;
 use crate::spline::knots::KnotVector;
 
 /// Resident memory of the process before a problem is allocated (binary, thread pool,
@@ -46,6 +47,22 @@ pub const BYTES_PER_NONZERO: u64 = 68;
 
 /// Peak bytes per unknown of the finest level (see the module documentation).
 pub const BYTES_PER_UNKNOWN: u64 = 200;
+
+/// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
+/// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
+/// stencil storage (8 B per nonzero, [`crate::discrete::stencil::StencilOperator`]) and the
+/// vector Jacobian is never gathered into a matrix; what remains per nonzero `z` (`z_1 =
+/// z / 4` of the scalar pattern) is the scalar pattern with its gather map (`24 z_1`), the
+/// metric Laplacian `K` in stencil storage and in CSR (`8 z_1 + 16 z_1`), the V-cycle's
+/// copy of `K` and its ILU(0) factors (`32 z_1`) and the coarse levels (about a third of
+/// that): about 30 B per nonzero counted; calibrated on the measured peaks
+/// (BENCHMARKS.md, "Toward 10^6 unknowns").
+pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 34;
+
+/// Peak bytes per unknown of the finest level with `--linear multigrid`: the flexible
+/// GMRES basis (two vectors per iteration) and the vectors of the Newton step (see
+/// [`MULTIGRID_BYTES_PER_NONZERO`]).
+pub const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 400;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
@@ -88,12 +105,24 @@ pub fn interacting_pairs(kv: &KnotVector) -> usize {
 impl MemoryEstimate {
     /// The estimate for a solve whose finest level has the knot vectors `knots`.
     pub fn for_knots(knots: &[KnotVector; 2]) -> Self {
+        Self::for_knots_with(knots, LinearMethod::Auto)
+    }
+
+    /// The estimate for a solve whose finest level has the knot vectors `knots` and
+    /// whose Newton systems are solved by `linear`: [`MULTIGRID_BYTES_PER_NONZERO`] and
+    /// [`MULTIGRID_BYTES_PER_UNKNOWN`] for [`LinearMethod::Multigrid`],
+    /// [`BYTES_PER_NONZERO`] and [`BYTES_PER_UNKNOWN`] otherwise.
+    pub fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
         let functions = knots[0].dim() * knots[1].dim();
         let nonzeros = 4 * interacting_pairs(&knots[0]) * interacting_pairs(&knots[1]);
         let unknowns = 2 * functions;
+        let (per_unknown, per_nonzero) = match linear {
+            LinearMethod::Multigrid => (MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO),
+            _ => (BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
+        };
         let bytes = BASE
-            .saturating_add(BYTES_PER_UNKNOWN.saturating_mul(unknowns as u64))
-            .saturating_add(BYTES_PER_NONZERO.saturating_mul(nonzeros as u64));
+            .saturating_add(per_unknown.saturating_mul(unknowns as u64))
+            .saturating_add(per_nonzero.saturating_mul(nonzeros as u64));
         Self { functions, unknowns, nonzeros, bytes }
     }
 
@@ -118,7 +147,13 @@ impl MemoryEstimate {
 
     /// The estimate for the levels a solve walks (the largest; the finest in practice).
     pub fn for_levels(levels: &[Level]) -> Self {
-        levels.iter().map(|l| Self::for_knots(&l.knots)).max_by_key(|e| e.bytes).unwrap_or(Self {
+        Self::for_levels_with(levels, LinearMethod::Auto)
+    }
+
+    /// [`MemoryEstimate::for_levels`] for Newton systems solved by `linear`
+    /// ([`MemoryEstimate::for_knots_with`]).
+    pub fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
+        levels.iter().map(|l| Self::for_knots_with(&l.knots, linear)).max_by_key(|e| e.bytes).unwrap_or(Self {
             functions: 0,
             unknowns: 0,
             nonzeros: 0,
