@@ -27,8 +27,8 @@ fn sum_as_csr(terms: &[f64]) -> f64 {
     let chunks = terms.chunks_exact(4);
     let rest = chunks.remainder();
     for t in chunks {
-        for l in 0..4 {
-            acc[l] += t[l];
+        for (a, v) in acc.iter_mut().zip(t) {
+            *a += v;
         }
     }
     let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);

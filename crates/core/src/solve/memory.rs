@@ -50,19 +50,21 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 
 /// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
 /// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
-/// stencil storage (8 B per nonzero, [`crate::discrete::stencil::StencilOperator`]) and the
-/// vector Jacobian is never gathered into a matrix; what remains per nonzero `z` (`z_1 =
-/// z / 4` of the scalar pattern) is the scalar pattern with its gather map (`24 z_1`), the
-/// metric Laplacian `K` in stencil storage and in CSR (`8 z_1 + 16 z_1`), the V-cycle's
-/// copy of `K` and its ILU(0) factors (`32 z_1`) and the coarse levels (about a third of
-/// that): about 30 B per nonzero counted; calibrated on the measured peaks
-/// (BENCHMARKS.md, "Toward 10^6 unknowns").
-pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 34;
+/// stencil storage ([`crate::discrete::stencil::StencilOperator`], 8 B per nonzero) and the
+/// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
+/// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
+/// gather map, the metric Laplacian `K` in stencil storage and in CSR, and the V-cycle's
+/// copy of `K`, its ILU(0) factors and coarse levels. With [`MULTIGRID_BYTES_PER_UNKNOWN`]
+/// fitted by least squares to the peaks (`VmHWM`, dev profile, one geometry per process)
+/// of wavy_lid (279 k unknowns), male_rotor (541 k) and puzzle4 (461 k) at `--refine 5`:
+/// measured over estimated 0.92-1.08 (BENCHMARKS.md, "Toward 10^6 unknowns").
+pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
 
-/// Peak bytes per unknown of the finest level with `--linear multigrid`: the flexible
-/// GMRES basis (two vectors per iteration) and the vectors of the Newton step (see
-/// [`MULTIGRID_BYTES_PER_NONZERO`]).
-pub const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 400;
+/// Peak bytes per unknown of the finest level with `--linear multigrid` (see
+/// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
+/// iteration, up to 100), the vectors of a Newton step, and the single-precision
+/// Cholesky factors of the elasticity prolongation's two diagonal blocks.
+pub const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 1700;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
