@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::discrete::dofs::{DofMap, FIXED};
 use crate::discrete::pattern::stencil_neighbours;
-pub use crate::discrete::pattern::SystemPattern;
+pub use crate::discrete::pattern::{LazyPattern, SystemPattern};
 use crate::discrete::tables::DirTable;
 use crate::discrete::topology::Topology;
 use crate::error::Result;
@@ -45,8 +45,9 @@ pub struct Discretization {
     pub tables: [DirTable; 2],
     /// Free versus fixed DOFs.
     pub dofs: DofMap,
-    /// Pattern of the 2-component systems (EGG Jacobian, elasticity, block mass).
-    pub vector: SystemPattern,
+    /// Pattern of the 2-component systems (EGG Jacobian, elasticity, block mass), built
+    /// on first use.
+    pub vector: LazyPattern,
     /// Pattern of scalar systems (mass, Laplacian).
     pub scalar: SystemPattern,
     /// Fill-reducing (nested-dissection) order of the free scalar unknowns for sparse
@@ -253,7 +254,7 @@ impl Discretization {
     pub fn with_dofs(knots: [KnotVector; 2], nq: usize, dofs: DofMap) -> Self {
         let tables = [DirTable::new(&knots[0], nq), DirTable::new(&knots[1], nq)];
         let (p, q) = (knots[0].degree(), knots[1].degree());
-        let vector = SystemPattern::new(&dofs, p, q, 2);
+        let vector = LazyPattern::new(&dofs, p, q, 2);
         let scalar = SystemPattern::new(&dofs, p, q, 1);
         let nx = dofs.shape()[0];
         let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();

@@ -118,6 +118,53 @@ impl SystemPattern {
     }
 }
 
+/// A [`SystemPattern`] built on first use: `Deref` builds it from the DOF map and the
+/// degrees it keeps. The vector pattern of a basis ([`super::assembly::Discretization`]'s
+/// `vector`) is the largest array of a discretization (three words per nonzero of the
+/// two-component system) and a solve that multiplies with the stencil storage
+/// ([`super::stencil::StencilOperator`]) never needs it.
+#[derive(Debug, Clone)]
+pub struct LazyPattern {
+    dofs: DofMap,
+    degrees: [usize; 2],
+    ncomp: usize,
+    cell: std::sync::OnceLock<SystemPattern>,
+}
+
+impl LazyPattern {
+    /// The pattern of `ncomp` components for `dofs` on a basis of degrees `(p, q)`, not
+    /// built yet.
+    pub(crate) fn new(dofs: &DofMap, p: usize, q: usize, ncomp: usize) -> Self {
+        Self { dofs: dofs.clone(), degrees: [p, q], ncomp, cell: std::sync::OnceLock::new() }
+    }
+
+    /// Whether the pattern has been built.
+    pub fn is_built(&self) -> bool {
+        self.cell.get().is_some()
+    }
+
+    fn build(&self) -> SystemPattern {
+        SystemPattern::new(&self.dofs, self.degrees[0], self.degrees[1], self.ncomp)
+    }
+}
+
+impl std::ops::Deref for LazyPattern {
+    type Target = SystemPattern;
+    fn deref(&self) -> &SystemPattern {
+        self.cell.get_or_init(|| self.build())
+    }
+}
+
+impl std::ops::DerefMut for LazyPattern {
+    fn deref_mut(&mut self) -> &mut SystemPattern {
+        if self.cell.get().is_none() {
+            let built = self.build();
+            let _ = self.cell.set(built);
+        }
+        self.cell.get_mut().expect("built above")
+    }
+}
+
 /// Where one tensor basis's stencil storage lies in the storage a [`summed_pattern`]
 /// reads: its basis shape, degrees and first position.
 #[derive(Debug, Clone, Copy)]

@@ -8,6 +8,20 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 
+/// A square linear operator `y = A x` as the Krylov methods use it: an assembled sparse
+/// matrix ([`Csr`]) or a product computed without one (the stencil product of a Galerkin
+/// system, [`crate::discrete::stencil`]).
+pub trait MatVec {
+    /// `y = A x` (`x` and `y` of the operator's size).
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]);
+}
+
+impl MatVec for Csr {
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        Csr::mul_vec(self, x, y);
+    }
+}
+
 /// Incomplete LU factorization with zero fill-in on the pattern of `a`.
 #[derive(Debug, Clone)]
 pub struct Ilu0 {
@@ -80,8 +94,8 @@ impl Ilu0 {
 /// Preconditioned conjugate gradients for the SPD system `a x = b` from `x = 0`,
 /// stopping at `||b - a x|| <= tol ||b||`; `m(r, z)` applies `z = P^{-1} r` (SPD).
 /// Returns the solution and the iteration count, an error after `max_iter` iterations.
-pub fn cg(
-    a: &Csr,
+pub fn cg<A: MatVec + ?Sized>(
+    a: &A,
     b: &[f64],
     mut m: impl FnMut(&[f64], &mut [f64]),
     tol: f64,
@@ -139,8 +153,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// precision) or that changes between iterations does not limit the attainable
 /// accuracy. Krylov vectors are allocated in the first cycle and reused by the next.
 /// Returns the solution and the iteration count.
-pub fn gmres(
-    a: &Csr,
+pub fn gmres<A: MatVec + ?Sized>(
+    a: &A,
     b: &[f64],
     mut m: impl FnMut(&[f64], &mut [f64]),
     restart: usize,

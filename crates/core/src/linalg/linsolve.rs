@@ -25,7 +25,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
-use crate::linalg::krylov::{cg, gmres, Ilu0};
+use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
 use crate::linalg::multigrid::{Multigrid, Smoother};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
@@ -459,7 +459,12 @@ impl LinearSolver {
     /// while that works (definite, and GMRES converging within [`REFRESH_KRYLOV`]
     /// iterations right after a factorization), in double precision after that, ILU(0)
     /// of `a` when `K` is not definite.
-    fn block_preconditioner(&mut self, a: &Csr, k: &Csr, previous: Option<Preconditioner>) -> Result<Preconditioner> {
+    fn block_preconditioner(
+        &mut self,
+        a: Option<&Csr>,
+        k: &Csr,
+        previous: Option<Preconditioner>,
+    ) -> Result<Preconditioner> {
         let (slot32, slot64) = match previous {
             Some(Preconditioner::NegBlock32(c)) => (Some(*c), None),
             Some(Preconditioner::NegBlock(c)) => (None, Some(*c)),
@@ -471,9 +476,10 @@ impl LinearSolver {
                 Err(_) => self.double = true,
             }
         }
-        Ok(match self.cholesky::<f64>(k, slot64) {
-            Ok(c) => Preconditioner::NegBlock(Box::new(c)),
-            Err(_) => Preconditioner::Ilu(Ilu0::new(a)?),
+        Ok(match (self.cholesky::<f64>(k, slot64), a) {
+            (Ok(c), _) => Preconditioner::NegBlock(Box::new(c)),
+            (Err(_), Some(a)) => Preconditioner::Ilu(Ilu0::new(a)?),
+            (Err(e), None) => return Err(e),
         })
     }
 
@@ -600,32 +606,7 @@ impl LinearSolver {
                 self.negated = neg;
                 self.llt = Some(r?);
             }
-            LinearMethod::Gmres | LinearMethod::Multigrid => {
-                let block = k.filter(|k| k.nrows > 0 && a.nrows.is_multiple_of(k.nrows));
-                let previous = self.precond.take();
-                let multigrid = self.method == LinearMethod::Multigrid
-                    && block.is_some_and(|k| self.transfers.first().is_some_and(|p| p.nrows == k.nrows));
-                self.precond = match (block, previous) {
-                    // the multigrid hierarchy set up (again) for the new approximation
-                    (Some(k), previous) if multigrid => {
-                        let mut mg = match previous {
-                            Some(Preconditioner::NegMultigrid(mg)) => mg,
-                            _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
-                        };
-                        mg.factor(k)?;
-                        Some(Preconditioner::NegMultigrid(mg))
-                    }
-                    // a new approximation: refactor in place (same pattern), in single
-                    // precision unless that failed before or was not definite ...
-                    (Some(k), previous) => Some(self.block_preconditioner(a, k, previous)?),
-                    // ... or keep the previous one (frozen preconditioner)
-                    (None, Some(p)) if p.is_block() => Some(p),
-                    // none at all: ILU(0)
-                    (None, _) => Some(Preconditioner::Ilu(Ilu0::new(a)?)),
-                };
-                self.fresh = true;
-                self.last_krylov = 0;
-            }
+            LinearMethod::Gmres | LinearMethod::Multigrid => self.factor_krylov(a.nrows, Some(a), k)?,
             LinearMethod::Pcg => {
                 let blocks = self.order.as_ref().map_or(1, |o| a.nrows / o.len().max(1)).max(1);
                 let m = a.nrows / blocks;
@@ -640,8 +621,90 @@ impl LinearSolver {
         Ok(())
     }
 
+    /// As [`LinearSolver::factor_stored`] for a system of `n` unknowns that is held as an
+    /// operator, not a matrix ([`LinearSolver::solve_operator`] multiplies with it): sets
+    /// up the preconditioner of [`LinearMethod::Gmres`] or [`LinearMethod::Multigrid`]
+    /// from `k` (`P = -diag(K, K)` or its V-cycle), or keeps the frozen one when `k` is
+    /// `None`.
+    ///
+    /// Errors: [`Error::LinearSolver`] for the other methods, and when there is no
+    /// preconditioner to keep or `k` is not definite (ILU(0) would need the matrix).
+    pub fn factor_operator(&mut self, n: usize, k: Option<&Csr>) -> Result<()> {
+        self.resolve(n);
+        if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid) {
+            return Err(Error::LinearSolver(format!("{:?} needs the matrix, not an operator", self.method)));
+        }
+        self.factor_krylov(n, None, k)
+    }
+
+    /// [`LinearMethod::Pcg`] for a system held as an operator: the block-Jacobi
+    /// preconditioner from the diagonal blocks `blocks` of the system (each SPD, of the
+    /// size of the ordering given with [`LinearSolver::set_ordering`]), factorized in
+    /// single precision as [`LinearSolver::factor`] of the whole matrix factorizes them;
+    /// [`LinearSolver::solve_operator`] then runs CG with the operator.
+    ///
+    /// Errors: [`Error::LinearSolver`] for the other methods, or when a block is not
+    /// positive definite.
+    pub fn factor_blocks(&mut self, blocks: &[Csr]) -> Result<()> {
+        if self.method != LinearMethod::Pcg {
+            return Err(Error::LinearSolver(format!("{:?} has no block-Jacobi preconditioner", self.method)));
+        }
+        let factors = blocks.par_iter().map(|b| self.cholesky::<f32>(b, None)).collect::<Result<Vec<_>>>()?;
+        self.precond = Some(Preconditioner::BlockJacobi(factors));
+        Ok(())
+    }
+
+    /// The preconditioner of the GMRES methods for a system of `n` unknowns, the matrix
+    /// `a` when there is one (for ILU(0)).
+    fn factor_krylov(&mut self, n: usize, a: Option<&Csr>, k: Option<&Csr>) -> Result<()> {
+        let block = k.filter(|k| k.nrows > 0 && n.is_multiple_of(k.nrows));
+        let previous = self.precond.take();
+        let multigrid = self.method == LinearMethod::Multigrid
+            && block.is_some_and(|k| self.transfers.first().is_some_and(|p| p.nrows == k.nrows));
+        let no_matrix = || Error::LinearSolver("ILU(0) needs the matrix: no preconditioner for an operator".into());
+        self.precond = match (block, previous) {
+            // the multigrid hierarchy set up (again) for the new approximation
+            (Some(k), previous) if multigrid => {
+                let mut mg = match previous {
+                    Some(Preconditioner::NegMultigrid(mg)) => mg,
+                    _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
+                };
+                mg.factor(k)?;
+                Some(Preconditioner::NegMultigrid(mg))
+            }
+            // a new approximation: refactor in place (same pattern), in single
+            // precision unless that failed before or was not definite ...
+            (Some(k), previous) => Some(self.block_preconditioner(a, k, previous)?),
+            // ... or keep the previous one (frozen preconditioner)
+            (None, Some(p)) if p.is_block() => Some(p),
+            // none at all: ILU(0)
+            (None, _) => Some(Preconditioner::Ilu(Ilu0::new(a.ok_or_else(no_matrix)?)?)),
+        };
+        self.fresh = true;
+        self.last_krylov = 0;
+        Ok(())
+    }
+
     /// Solve `a x = b` with the last factorized `a`.
     pub fn solve(&mut self, b: &[f64]) -> Result<Vec<f64>> {
+        self.solve_with(None, b)
+    }
+
+    /// Solve `a x = b` by GMRES (CG for [`LinearMethod::Pcg`]) with the operator `a` (the
+    /// system [`LinearSolver::factor_operator`] or [`LinearSolver::factor_blocks`] set up
+    /// the preconditioner for): the same iterates as [`LinearSolver::solve`] with the
+    /// matrix whose product `a` computes, without its fallback to a direct factorization
+    /// (an error instead).
+    pub fn solve_operator(&mut self, a: &dyn MatVec, b: &[f64]) -> Result<Vec<f64>> {
+        if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid | LinearMethod::Pcg) {
+            return Err(Error::LinearSolver(format!("{:?} solves with a matrix, not an operator", self.method)));
+        }
+        self.solve_with(Some(a), b)
+    }
+
+    /// [`LinearSolver::solve`], with the operator `op` instead of the stored matrix for
+    /// the GMRES methods when given.
+    fn solve_with(&mut self, op: Option<&dyn MatVec>, b: &[f64]) -> Result<Vec<f64>> {
         self.solves += 1;
         let x = match self.method {
             LinearMethod::Lu if self.dense.is_some() => self.dense.as_ref().expect("checked").solve(b),
@@ -672,8 +735,11 @@ impl LinearSolver {
                 x
             }
             LinearMethod::Gmres | LinearMethod::Multigrid => {
-                let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let pc = self.precond.as_mut().expect("set with matrix");
+                let a: &dyn MatVec = match op {
+                    Some(op) => op,
+                    None => self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?,
+                };
+                let pc = self.precond.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 // a direct factorization of a small system costs few GMRES iterations
                 let cap = if self.fallback { (b.len() / 8).clamp(100, AUTO_MAX_KRYLOV) } else { MAX_KRYLOV };
                 match gmres(a, b, |r, z| pc.apply(r, z), 50, self.krylov_tol, cap) {
@@ -689,7 +755,7 @@ impl LinearSolver {
                         }
                         x
                     }
-                    Err(e) if self.fallback => {
+                    Err(e) if self.fallback && op.is_none() => {
                         // GMRES did not converge: factorize this matrix directly instead
                         self.method = LinearMethod::Lu;
                         self.fallback = false;
@@ -701,13 +767,17 @@ impl LinearSolver {
                 }
             }
             LinearMethod::Pcg => {
-                let a = self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
-                let pc = self.precond.as_mut().expect("set with matrix");
+                let a: &dyn MatVec = match op {
+                    Some(op) => op,
+                    None => self.matrix.as_ref().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?,
+                };
+                let pc = self.precond.as_mut().ok_or_else(|| Error::LinearSolver("solve before factor".into()))?;
                 match cg(a, b, |r, z| pc.apply(r, z), self.krylov_tol, MAX_PCG) {
                     Ok((x, it)) => {
                         self.krylov_iterations += it;
                         x
                     }
+                    Err(e) if op.is_some() => return Err(e),
                     Err(_) => {
                         // slow convergence (a thin domain has a poor Korn constant):
                         // factorize the whole system instead

@@ -147,6 +147,24 @@ impl DiscreteProblem for EggProblem {
         s.gather_jacobian(jac);
     }
 
+    /// The Jacobian left in the stencil storage ([`crate::discrete::stencil`]): on a
+    /// basis without periodic replicas.
+    fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
+        let s = &mut self.state;
+        if !s.disc.dofs.replicas().is_empty() {
+            return false;
+        }
+        s.load_for_jacobian(c);
+        self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
+        s.restrict_residual(f);
+        true
+    }
+
+    fn jacobian_product(&self, x: &[f64], y: &mut [f64]) {
+        let s = &self.state;
+        s.disc.stencil_product(2, &s.stencil, x, y);
+    }
+
     fn mass(&mut self) -> &Csr {
         let assembler = &self.assembler;
         self.state.mass(|disc, st| assembler.mass(disc, st))

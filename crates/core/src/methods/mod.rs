@@ -86,6 +86,17 @@ pub trait DiscreteProblem {
     /// this problem's fixed pattern from an earlier call (then only the values are
     /// written: no allocation, no copy of the pattern per Newton step).
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr);
+    /// `F(c)` into `f` and the Jacobian `dF/dc` kept by the problem in a form that
+    /// [`DiscreteProblem::jacobian_product`] multiplies with, no matrix built (the stencil
+    /// storage of eq. 12, [`crate::discrete::stencil`]); `false` (the default) when the
+    /// problem has no such form: then call [`DiscreteProblem::jacobian`].
+    fn jacobian_operator(&mut self, _c: &[f64], _f: &mut [f64]) -> bool {
+        false
+    }
+    /// `y = (dF/dc) x` with the Jacobian of the last [`DiscreteProblem::jacobian_operator`]
+    /// call that returned `true`: the product of the matrix [`DiscreteProblem::jacobian`]
+    /// would give, with the same bits.
+    fn jacobian_product(&self, _x: &[f64], _y: &mut [f64]) {}
     /// The block mass matrix `diag(M, M)` of eq. (30), in the Jacobian's pattern.
     fn mass(&mut self) -> &Csr;
     /// The objective `J(c)` of a minimization method (`F = -∇J`), `+∞` outside the
@@ -156,6 +167,12 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr) {
         (**self).jacobian(c, f, jac)
+    }
+    fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
+        (**self).jacobian_operator(c, f)
+    }
+    fn jacobian_product(&self, x: &[f64], y: &mut [f64]) {
+        (**self).jacobian_product(x, y)
     }
     fn mass(&mut self) -> &Csr {
         (**self).mass()

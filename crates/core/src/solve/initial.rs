@@ -8,6 +8,7 @@ use std::sync::Arc;
 use super::fixed_basis::FixedBasisSolve;
 use super::newton::NonlinearOptions;
 use crate::discrete::assembly::Discretization;
+use crate::discrete::stencil::StencilOperator;
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
@@ -124,8 +125,37 @@ pub fn elasticity_displacement_with(
     }
     let mut st = vec![0.0; disc.stencil_len(2)];
     assembler.elasticity(disc, base, LAME.0, LAME.1, &mut st);
-    let k = disc.vector.matrix(&st);
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
+    let u = match stencil_elasticity(disc, &st, &rhs) {
+        Some(u) => u,
+        None => matrix_elasticity(disc, &st, &rhs)?,
+    };
+    disc.dofs.scatter(&u, &mut diff);
+    Ok(diff)
+}
+
+/// The elasticity system of stencil storage `st` solved as [`matrix_elasticity`] solves
+/// it above [`ITERATIVE_ELASTICITY`] unknowns (block-Jacobi CG), with the product taken
+/// from the stencil storage ([`StencilOperator`]: no matrix, no vector pattern) and the
+/// diagonal blocks gathered alone: the same iterates bit for bit. `None` below that size,
+/// on a basis with periodic replicas, or when CG does not converge (the matrix path
+/// then decides).
+fn stencil_elasticity(disc: &Discretization, st: &[f64], rhs: &[f64]) -> Option<Vec<f64>> {
+    if rhs.len() <= ITERATIVE_ELASTICITY {
+        return None;
+    }
+    let op = StencilOperator::new(disc, 2, st)?;
+    let blocks = (0..2).map(|z| disc.stencil_diagonal_block(2, st, z)).collect::<Option<Vec<_>>>()?;
+    let mut lin = LinearSolver::new(LinearMethod::Pcg);
+    lin.set_ordering(&disc.ordering);
+    lin.krylov_tol = ELASTICITY_TOL;
+    lin.factor_blocks(&blocks).ok()?;
+    lin.solve_operator(&op, rhs).ok()
+}
+
+/// The elasticity system of stencil storage `st` gathered into a matrix and solved.
+fn matrix_elasticity(disc: &Discretization, st: &[f64], rhs: &[f64]) -> Result<Vec<f64>> {
+    let k = disc.vector.matrix(st);
     // symmetric positive definite: Cholesky, or block-Jacobi CG on large systems (whose
     // vector Cholesky factor costs 8 times a scalar one), with LU/GMRES as a safety net
     let method = if k.nrows > ITERATIVE_ELASTICITY { LinearMethod::Pcg } else { LinearMethod::Cholesky };
@@ -136,9 +166,7 @@ pub fn elasticity_displacement_with(
         lin = LinearSolver::new(LinearMethod::Auto);
         lin.factor(&k)?;
     }
-    let u = lin.solve(&rhs)?;
-    disc.dofs.scatter(&u, &mut diff);
-    Ok(diff)
+    lin.solve(rhs)
 }
 
 /// `base + alpha u` for a displacement `u` from [`elasticity_displacement`].

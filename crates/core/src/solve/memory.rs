@@ -34,6 +34,7 @@
 use crate::boundary::hierarchy::Level;
 pub use crate::error::human;
 use crate::error::{Error, Result};
+use crate::linalg::linsolve::LinearMethod;
 use crate::spline::knots::KnotVector;
 
 /// Resident memory of the process before a problem is allocated (binary, thread pool,
@@ -46,6 +47,24 @@ pub const BYTES_PER_NONZERO: u64 = 68;
 
 /// Peak bytes per unknown of the finest level (see the module documentation).
 pub const BYTES_PER_UNKNOWN: u64 = 200;
+
+/// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
+/// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
+/// stencil storage ([`crate::discrete::stencil::StencilOperator`], 8 B per nonzero) and the
+/// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
+/// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
+/// gather map, the metric Laplacian `K` in stencil storage and in CSR, and the V-cycle's
+/// copy of `K`, its ILU(0) factors and coarse levels. With [`MULTIGRID_BYTES_PER_UNKNOWN`]
+/// fitted by least squares to the peaks (`VmHWM`, dev profile, one geometry per process)
+/// of wavy_lid (279 k unknowns), male_rotor (541 k) and puzzle4 (461 k) at `--refine 5`:
+/// measured over estimated 0.92-1.08 (BENCHMARKS.md, "Toward 10^6 unknowns").
+pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
+
+/// Peak bytes per unknown of the finest level with `--linear multigrid` (see
+/// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
+/// iteration, up to 100), the vectors of a Newton step, and the single-precision
+/// Cholesky factors of the elasticity prolongation's two diagonal blocks.
+pub const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 1700;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
@@ -88,12 +107,24 @@ pub fn interacting_pairs(kv: &KnotVector) -> usize {
 impl MemoryEstimate {
     /// The estimate for a solve whose finest level has the knot vectors `knots`.
     pub fn for_knots(knots: &[KnotVector; 2]) -> Self {
+        Self::for_knots_with(knots, LinearMethod::Auto)
+    }
+
+    /// The estimate for a solve whose finest level has the knot vectors `knots` and
+    /// whose Newton systems are solved by `linear`: [`MULTIGRID_BYTES_PER_NONZERO`] and
+    /// [`MULTIGRID_BYTES_PER_UNKNOWN`] for [`LinearMethod::Multigrid`],
+    /// [`BYTES_PER_NONZERO`] and [`BYTES_PER_UNKNOWN`] otherwise.
+    pub fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
         let functions = knots[0].dim() * knots[1].dim();
         let nonzeros = 4 * interacting_pairs(&knots[0]) * interacting_pairs(&knots[1]);
         let unknowns = 2 * functions;
+        let (per_unknown, per_nonzero) = match linear {
+            LinearMethod::Multigrid => (MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO),
+            _ => (BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
+        };
         let bytes = BASE
-            .saturating_add(BYTES_PER_UNKNOWN.saturating_mul(unknowns as u64))
-            .saturating_add(BYTES_PER_NONZERO.saturating_mul(nonzeros as u64));
+            .saturating_add(per_unknown.saturating_mul(unknowns as u64))
+            .saturating_add(per_nonzero.saturating_mul(nonzeros as u64));
         Self { functions, unknowns, nonzeros, bytes }
     }
 
@@ -118,7 +149,13 @@ impl MemoryEstimate {
 
     /// The estimate for the levels a solve walks (the largest; the finest in practice).
     pub fn for_levels(levels: &[Level]) -> Self {
-        levels.iter().map(|l| Self::for_knots(&l.knots)).max_by_key(|e| e.bytes).unwrap_or(Self {
+        Self::for_levels_with(levels, LinearMethod::Auto)
+    }
+
+    /// [`MemoryEstimate::for_levels`] for Newton systems solved by `linear`
+    /// ([`MemoryEstimate::for_knots_with`]).
+    pub fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
+        levels.iter().map(|l| Self::for_knots_with(&l.knots, linear)).max_by_key(|e| e.bytes).unwrap_or(Self {
             functions: 0,
             unknowns: 0,
             nonzeros: 0,

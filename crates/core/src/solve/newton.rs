@@ -29,6 +29,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use crate::error::Result;
+use crate::linalg::krylov::MatVec;
 use crate::linalg::linsolve::{LinearMethod, LinearSolver, KRYLOV_TOL};
 use crate::methods::DiscreteProblem;
 
@@ -206,6 +207,9 @@ pub struct NonlinearSolver<P: DiscreteProblem> {
     method: NonlinearMethod,
     dt: f64,
     lin: LinearSolver,
+    /// The last Newton matrix is the problem's Jacobian operator
+    /// ([`DiscreteProblem::jacobian_operator`]), not a matrix in `lin`.
+    operator: bool,
     status: Status,
     started: bool,
     /// Chord steps taken ([`NonlinearOptions::chord`]).
@@ -265,6 +269,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             method: opts.method,
             dt: 0.0,
             lin,
+            operator: false,
             status: Status::Running,
             started: false,
             chord_steps: 0,
@@ -367,9 +372,17 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     fn linear_step(&mut self, shift: Option<f64>) -> Result<Vec<f64>> {
         let t = Instant::now();
         let mut f = std::mem::take(&mut self.f);
-        // the problem writes the Jacobian straight into the linear solver's matrix: no
-        // allocation and no copy per step (the pattern is written on the first step only)
-        self.problem.jacobian(&self.c, &mut f, self.lin.matrix_mut());
+        // with the multigrid preconditioner GMRES multiplies with the problem's Jacobian
+        // operator (the stencil product: no matrix at all) ...
+        self.operator = shift.is_none()
+            && self.lin.method() == LinearMethod::Multigrid
+            && self.problem.jacobian_operator(&self.c, &mut f);
+        if !self.operator {
+            // ... otherwise the problem writes the Jacobian straight into the linear
+            // solver's matrix: no allocation and no copy per step (the pattern is written
+            // on the first step only)
+            self.problem.jacobian(&self.c, &mut f, self.lin.matrix_mut());
+        }
         self.f = f;
         self.timings.assembly += t.elapsed();
         if let Some(dt) = shift {
@@ -391,15 +404,31 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         } else {
             None
         };
-        self.lin.factor_stored(k)?;
+        if self.operator {
+            self.lin.factor_operator(n, k)?;
+        } else {
+            self.lin.factor_stored(k)?;
+        }
         self.timings.factor += t.elapsed();
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let dx = match (self.lin.solve(&rhs), self.problem.rank_one()) {
-            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
-            (dx, _) => dx,
-        };
+        let dx = self.newton_solve(&rhs);
         self.timings.linear += t.elapsed();
         dx
+    }
+
+    /// `x` of `F'(c) x = b` with the Newton matrix of the last [`Self::linear_step`] (the
+    /// stored factorization or preconditioner, the matrix or the problem's Jacobian
+    /// operator) and the problem's rank-one term.
+    fn newton_solve(&mut self, b: &[f64]) -> Result<Vec<f64>> {
+        let (lin, problem, operator) = (&mut self.lin, &self.problem, self.operator);
+        let mut solve = |b: &[f64]| match operator {
+            true => lin.solve_operator(&JacobianProduct(problem), b),
+            false => lin.solve(b),
+        };
+        match (solve(b), problem.rank_one()) {
+            (Ok(x), Some((sigma, u))) => sherman_morrison(solve, x, sigma, u),
+            (x, _) => x,
+        }
     }
 
     /// Forcing term `eta_k` of the inexact Newton method, the relative residual at which
@@ -534,10 +563,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
     fn chord_direction(&mut self) -> Option<Vec<f64>> {
         let t = Instant::now();
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let dz = match (self.lin.solve(&rhs), self.problem.rank_one()) {
-            (Ok(x), Some((sigma, u))) => sherman_morrison(&mut self.lin, x, sigma, u),
-            (dz, _) => dz,
-        };
+        let dz = self.newton_solve(&rhs);
         self.timings.linear += t.elapsed();
         dz.ok()
     }
@@ -604,12 +630,27 @@ pub fn extrapolated_root_step(f0: &[f64], f1: &[f64]) -> Option<f64> {
 /// Longest step factor [`extrapolated_step`] and [`extrapolated_root_step`] propose.
 pub const EXTRAPOLATE_MAX: f64 = 3.0;
 
-/// `(A + σ u uᵀ)⁻¹ b` from `x = A⁻¹ b` and the factorization of `A` in `lin` (the
-/// rank-one term of [`DiscreteProblem::rank_one`]): `x − σ (uᵀx) / (1 + σ uᵀz) z` with
-/// `z = A⁻¹ u` (Sherman-Morrison); an error when `1 + σ uᵀz` vanishes (the updated
-/// matrix is singular).
-fn sherman_morrison(lin: &mut LinearSolver, x: Vec<f64>, sigma: f64, u: &[f64]) -> Result<Vec<f64>> {
-    let z = lin.solve(u)?;
+/// The Jacobian operator of a problem ([`DiscreteProblem::jacobian_product`]) for the
+/// Krylov methods.
+struct JacobianProduct<'a, P>(&'a P);
+
+impl<P: DiscreteProblem> MatVec for JacobianProduct<'_, P> {
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        self.0.jacobian_product(x, y);
+    }
+}
+
+/// `(A + σ u uᵀ)⁻¹ b` from `x = A⁻¹ b` and `solve`, which applies `A⁻¹` (the rank-one
+/// term of [`DiscreteProblem::rank_one`]): `x − σ (uᵀx) / (1 + σ uᵀz) z` with `z = A⁻¹
+/// u` (Sherman-Morrison); an error when `1 + σ uᵀz` vanishes (the updated matrix is
+/// singular).
+fn sherman_morrison(
+    mut solve: impl FnMut(&[f64]) -> Result<Vec<f64>>,
+    x: Vec<f64>,
+    sigma: f64,
+    u: &[f64],
+) -> Result<Vec<f64>> {
+    let z = solve(u)?;
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
     let (uz, ux) = (sigma * dot(u, &z), sigma * dot(u, &x));
     let denom = 1.0 + uz;
