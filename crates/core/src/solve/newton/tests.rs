@@ -288,8 +288,8 @@ fn stencil_operator_newton_equals_matrix_newton() {
     use crate::methods::egg::{CpuAssembler, EggProblem};
     use crate::spline::knots::KnotVector;
     use std::sync::Arc;
-    let kx = KnotVector::open_uniform(3, 36);
-    let ky = KnotVector::open_uniform(2, 30).with_inserted(&[0.5]);
+    let kx = KnotVector::open_uniform(3, 48);
+    let ky = KnotVector::open_uniform(2, 40).with_inserted(&[0.5]);
     let (gx, gy) = (kx.greville(), ky.greville());
     let mut rng = crate::testutil::Lcg::new(17);
     let mut cps = Vec::new();
@@ -298,7 +298,7 @@ fn stencil_operator_newton_equals_matrix_newton() {
             let r = 1.0 + 2.0 * v * v;
             let t = 1.3 * u + 0.2 * v * u;
             let inner = i > 0 && j > 0 && i + 1 < gx.len() && j + 1 < gy.len();
-            let noise = if inner { 0.02 } else { 0.0 };
+            let noise = if inner { 0.01 } else { 0.0 };
             cps.push([r * t.cos() + noise * (rng.uniform() - 0.5), r * t.sin() + noise * (rng.uniform() - 0.5)]);
         }
     }
