@@ -17,6 +17,14 @@ pub(super) fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
     (Boundary { name: "parallelogram".into(), sides }, f)
 }
 
+/// The comparison's solve options with at least 4 elements per direction on the finest
+/// level.
+fn coarse() -> SolveOptions {
+    let mut o = CompareOptions::default().solve;
+    o.levels.min_elements = 4;
+    o
+}
+
 /// On an affine boundary every method returns the affine map (EGG and VHM to
 /// rounding; the quasi-conformal minimizer is degenerate, see
 /// [`crate::methods::quasi_conformal`], and resolved to its stopping rule), each
@@ -25,7 +33,7 @@ pub(super) fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
 fn every_method_returns_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
     let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
+        solve: coarse(),
         ..Default::default()
     };
     let mut events = Vec::new();
@@ -84,7 +92,7 @@ fn names_parse_and_unknown_names_are_errors() {
 fn progress_can_cancel() {
     let (b, _) = parallelogram();
     let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
+        solve: coarse(),
         ..Default::default()
     };
     let mut seen = 0;
@@ -106,7 +114,7 @@ fn progress_can_cancel() {
 fn gravesens_methods_keep_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
     let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
+        solve: coarse(),
         ..Default::default()
     };
     let methods = [MethodChoice::MaxZ, MethodChoice::Liao, MethodChoice::WinslowFunctional, MethodChoice::Ao];
