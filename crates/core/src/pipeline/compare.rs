@@ -125,7 +125,9 @@ impl MethodChoice {
     /// more than one level) or `egg` (the EGG map `x_G`).
     pub fn start(self, opts: &CompareOptions) -> &'static str {
         match self {
-            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.levels.max_levels != Some(1) => "hierarchy",
+            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.levels.max_levels != Some(1) => {
+                "hierarchy"
+            }
             MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc | MethodChoice::MaxZ => "coons",
             MethodChoice::Liao | MethodChoice::WinslowFunctional | MethodChoice::Ao => "egg",
         }

@@ -207,11 +207,11 @@ impl SolveOptions {
         if l.aspect.is_nan() || l.aspect < 1.0 {
             return Err(Error::Invalid(format!("the aspect bound must be at least 1, got {}", l.aspect)));
         }
-        if l.min_elements == 0 || self.report.sample < 2 {
-            return Err(Error::Invalid(format!(
-                "min_elements must be at least 1 and sample at least 2, got {} and {}",
-                l.min_elements, self.report.sample
-            )));
+        if l.min_elements == 0 {
+            return Err(Error::Invalid("min_elements must be at least 1, got 0".into()));
+        }
+        if self.report.sample < 2 {
+            return Err(Error::Invalid(format!("the report's sample must be at least 2, got {}", self.report.sample)));
         }
         if self.max_memory == MemoryLimit::Bytes(0) {
             return Err(Error::Invalid("the memory limit (max_memory) must be positive".into()));
@@ -241,6 +241,35 @@ impl Default for SolveOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every group is checked: the defaults pass, and one bad value in the fit, the
+    /// levels, the nonlinear iteration, the report or the memory limit is refused with a
+    /// message naming the option.
+    #[test]
+    fn validate_checks_every_group() {
+        assert!(SolveOptions::default().validate().is_ok());
+        type Edit = fn(&mut SolveOptions);
+        let cases: [(&str, Edit); 8] = [
+            ("fit tolerance", |o| o.fit.tol = 1.5),
+            ("nonlinear tolerance", |o| o.nonlinear.tol = f64::NAN),
+            ("growth", |o| o.levels.growth = 0.5),
+            ("growth", |o| o.levels.growth = f64::INFINITY),
+            ("aspect", |o| o.levels.aspect = 0.9),
+            ("min_elements", |o| o.levels.min_elements = 0),
+            ("sample", |o| o.report.sample = 1),
+            ("max_memory", |o| o.max_memory = MemoryLimit::Bytes(0)),
+        ];
+        for (what, edit) in cases {
+            let mut o = SolveOptions::default();
+            edit(&mut o);
+            let e = o.validate().expect_err(what);
+            assert!(matches!(e, Error::Invalid(_)) && e.to_string().contains(what), "{what}: {e}");
+        }
+        // the edges of the accepted ranges
+        let mut o = SolveOptions::default();
+        (o.levels.growth, o.levels.aspect, o.levels.min_elements, o.report.sample) = (1.0, 1.0, 1, 2);
+        assert!(o.validate().is_ok());
+    }
 
     /// `auto` moves all control points up to the threshold and a few spans around each
     /// kink above it; the spelled-out choices are taken as given.

@@ -414,7 +414,11 @@ impl Solution {
             repair_rounds: ctx.rounds,
             certificate,
             quality,
-            poisson: if opts.report.poisson { crate::verify::poisson::poisson_benchmark(&map, None).ok() } else { None },
+            poisson: if opts.report.poisson {
+                crate::verify::poisson::poisson_benchmark(&map, None).ok()
+            } else {
+                None
+            },
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: away,

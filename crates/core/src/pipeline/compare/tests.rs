@@ -32,10 +32,7 @@ fn coarse() -> SolveOptions {
 #[test]
 fn every_method_returns_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
-    let opts = CompareOptions {
-        solve: coarse(),
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let mut events = Vec::new();
     let cmp = compare(
         &b,
@@ -91,10 +88,7 @@ fn names_parse_and_unknown_names_are_errors() {
 #[test]
 fn progress_can_cancel() {
     let (b, _) = parallelogram();
-    let opts = CompareOptions {
-        solve: coarse(),
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let mut seen = 0;
     let out = compare(&b, &[MethodChoice::Vhm], &opts, Arc::new(CpuAssembler), &mut |_| {
         seen += 1;
@@ -113,10 +107,7 @@ fn progress_can_cancel() {
 #[test]
 fn gravesens_methods_keep_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
-    let opts = CompareOptions {
-        solve: coarse(),
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let methods = [MethodChoice::MaxZ, MethodChoice::Liao, MethodChoice::WinslowFunctional, MethodChoice::Ao];
     let cmp = compare(&b, &methods, &opts, Arc::new(CpuAssembler), &mut |_| true).unwrap().unwrap();
     let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
