@@ -77,7 +77,8 @@ fn nearest(c: &Closed, x: Point) -> f64 {
 
 /// A cubic spline within `tol` of `f` on `[0, 1]`, with the ends `f(0)`, `f(1)` exactly.
 fn fitted(f: impl Fn(f64) -> Point + Send + Sync + 'static, ends: (Point, Point), tol: f64) -> Res<Curve> {
-    let opts = FitOptions { degree: 3, tol, ..Default::default() };
+    let mut opts = FitOptions::default();
+    (opts.degree, opts.tol) = (3, tol);
     let fit = fit_side(Side::South, &SideCurve::Analytic(Analytic::new(f)), ends, &opts, tol)?;
     let mut c = fit.finest().clone();
     let last = c.control_points.len() - 1;
@@ -223,7 +224,8 @@ fn main() -> Res<()> {
     for interfaces in [Interfaces::Fixed, Interfaces::Free] {
         // free interfaces: the layout improved by the Winslow functional
         let improve = (interfaces == Interfaces::Free).then_some(Improve::Winslow);
-        let opts = SolveOptions { improve, ..Default::default() };
+        let mut opts = SolveOptions::default();
+        opts.improve = improve;
         let Solved::Layout { solution: sol, .. } = Pipeline::new(layout.clone(), opts).solve()? else {
             unreachable!("a layout's solve")
         };

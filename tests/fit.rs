@@ -63,11 +63,10 @@ const GEOMETRIES: [&str; 19] = [
 /// The fitted basis with the dyadic `C^{p-1}` fits of §5 only: these tests are about the
 /// fit itself (kinks kept by knots of multiplicity p: tests/kinks.rs).
 fn fitted() -> FitOptions {
-    FitOptions {
-        basis: winslow::boundary::BasisChoice::Fitted,
-        kinks: winslow::boundary::KinkMode::None,
-        ..FitOptions::default()
-    }
+    let mut o = FitOptions::default();
+    o.basis = winslow::boundary::BasisChoice::Fitted;
+    o.kinks = winslow::boundary::KinkMode::None;
+    o
 }
 
 fn dist(a: Point, b: Point) -> f64 {
@@ -232,7 +231,8 @@ fn low_degree_sides_are_reproduced_on_the_coarsest_level() {
 #[test]
 fn other_degrees_and_initial_meshes_converge() {
     for (p, ie) in [(2, 1), (4, 3), (5, 2)] {
-        let opts = FitOptions { degree: p, initial_elements: ie, ..fitted() };
+        let mut opts = fitted();
+        (opts.degree, opts.initial_elements) = (p, ie);
         for rel in GEOMETRIES {
             let h = build_hierarchy(&load(rel), &opts).unwrap();
             assert!(h.converged(), "{rel} p={p} ie={ie}");

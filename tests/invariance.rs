@@ -219,7 +219,8 @@ fn layouts_translated_and_scaled_solve_alike() {
         let text = std::fs::read_to_string(winslow::testutil::data(file)).unwrap();
         for interfaces in [Interfaces::Fixed, Interfaces::Free] {
             let improve = (interfaces == Interfaces::Free).then_some(Functional::Winslow);
-            let opts = SolveOptions { improve, ..Default::default() };
+            let mut opts = SolveOptions::default();
+            opts.improve = improve;
             let orig = solve_layout(&parse_gismo_multipatch(&text).unwrap(), &opts).unwrap();
             for (a, s) in similarities(orig.report.layout.diameter) {
                 let what = format!("{file} {interfaces:?} moved by {a:?}, scaled by {s:e}");

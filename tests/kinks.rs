@@ -169,7 +169,8 @@ fn l_shape_certifies_with_its_reflex_corner_kept() {
 #[test]
 fn the_local_winslow_stage_moves_only_the_control_points_near_the_kinks() {
     let global = opts(BasisChoice::Auto, KinkMode::Auto);
-    let local = SolveOptions { kinks_local: KinksLocal::Spans(1), ..global.clone() };
+    let mut local = global.clone();
+    local.kinks_local = KinksLocal::Spans(1);
     let (_, g) = run("notched_square.json", &global);
     let (_, l) = run("notched_square.json", &local);
     for sol in [&g, &l] {

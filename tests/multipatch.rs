@@ -59,7 +59,8 @@ fn gismo_multipatch_round_trip_is_exact() {
 
 /// The pipeline's solve of `layout`, improved (free interfaces) by `functional`.
 fn solve_layout(layout: &Layout, functional: Option<Functional>) -> MultipatchSolution {
-    let opts = SolveOptions { improve: functional, ..Default::default() };
+    let mut opts = SolveOptions::default();
+    opts.improve = functional;
     match Pipeline::new(layout.clone(), opts).solve() {
         Ok(Solved::Layout { solution, .. }) => *solution,
         other => panic!("{}: {other:?}", layout.name),

@@ -68,7 +68,7 @@ fn radius_error(map: &Surface, side: Side, r: f64) -> f64 {
 fn exact_arcs_stay_circles() {
     for refine in [0, 2] {
         let mut opts = input_basis();
-        opts.refine = refine;
+        opts.levels.refine = refine;
         let sol = solve(&exact_quarter_annulus(), &opts).unwrap();
         let r = &sol.report;
         assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);

@@ -148,11 +148,9 @@ fn hard_geometries_run_and_report() {
 fn quarter_annulus_converges_under_refinement() {
     let maps: Vec<_> = (0..3)
         .map(|r| {
-            let opts = SolveOptions {
-                refine: r,
-                fit: winslow::FitOptions { tol: 1e-9, ..Default::default() },
-                ..Default::default()
-            };
+            let mut opts = SolveOptions::default();
+            opts.levels.refine = r;
+            opts.fit.tol = 1e-9;
             run("quarter_annulus.json", &opts).map
         })
         .collect();
@@ -174,13 +172,13 @@ fn quarter_annulus_converges_under_refinement() {
 
 /// One level on a coarse basis (fit tolerance 1e-3, at least 2 elements), no repair.
 fn coarse_one_level() -> SolveOptions {
-    SolveOptions {
-        fit: winslow::FitOptions { tol: 1e-3, basis: winslow::boundary::BasisChoice::Fitted, ..Default::default() },
-        max_levels: Some(1),
-        min_elements: 2,
-        repair: 0,
-        ..Default::default()
-    }
+    let mut o = SolveOptions::default();
+    o.fit.tol = 1e-3;
+    o.fit.basis = winslow::boundary::BasisChoice::Fitted;
+    o.levels.max_levels = Some(1);
+    o.levels.min_elements = 2;
+    o.repair.rounds = 0;
+    o
 }
 
 /// Defect correction (paper §8.2): puzzle3 on a coarse basis (one level, fit tolerance
@@ -188,11 +186,12 @@ fn coarse_one_level() -> SolveOptions {
 /// prolonged map remove the fold, and the map ends certified.
 #[test]
 fn local_repair_removes_a_fold() {
-    let coarse = coarse_one_level();
+    let mut coarse = coarse_one_level();
     let folded = run("gismo/puzzle3.json", &coarse);
     assert_eq!(folded.report.verdict, Verdict::Folded, "{}", folded.report.message);
     assert!(folded.report.repair_rounds.is_empty());
-    let sol = run("gismo/puzzle3.json", &SolveOptions { repair: 3, ..coarse });
+    coarse.repair.rounds = 3;
+    let sol = run("gismo/puzzle3.json", &coarse);
     let r = &sol.report;
     assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
     assert!(!r.repair_rounds.is_empty() && r.repairs == r.repair_rounds.len());
@@ -210,9 +209,11 @@ fn local_repair_removes_a_fold() {
 /// the fold are unknowns; the others keep the prolonged map's values exactly.
 #[test]
 fn local_repair_with_frozen_dofs() {
-    let coarse = coarse_one_level();
+    let mut coarse = coarse_one_level();
     let folded = run("gismo/puzzle3.json", &coarse);
-    let sol = run("gismo/puzzle3.json", &SolveOptions { repair: 3, repair_freeze: Some(2), ..coarse });
+    coarse.repair.rounds = 3;
+    coarse.repair.freeze = Some(2);
+    let sol = run("gismo/puzzle3.json", &coarse);
     let r = &sol.report;
     assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
     assert!(!r.repair_rounds.is_empty(), "{:?}", r.repair_rounds);
@@ -285,7 +286,7 @@ fn auto_basis_falls_back_when_the_input_basis_does_not_certify() {
     use winslow::boundary::BasisChoice;
     let mut opts = SolveOptions::default();
     assert_eq!(opts.fit.basis, BasisChoice::Auto);
-    opts.repair = 1;
+    opts.repair.rounds = 1;
     let sol = run("gismo/puzzle4.json", &opts);
     let r = &sol.report;
     assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
@@ -293,7 +294,7 @@ fn auto_basis_falls_back_when_the_input_basis_does_not_certify() {
     let why = r.basis.fallback.as_deref().unwrap_or_default();
     assert!(why.contains("input basis") && why.contains("folded") && why.contains("fitted"), "{why}");
     // with enough rounds the input basis certifies and is kept
-    opts.repair = 6;
+    opts.repair.rounds = 6;
     let r = run("gismo/puzzle4.json", &opts).report;
     assert_eq!((r.verdict, r.basis.used, r.basis.fallback), (Verdict::Certified, BasisChoice::Input, None));
 }

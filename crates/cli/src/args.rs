@@ -148,7 +148,7 @@ pub(crate) struct SolverArgs {
     #[arg(long, default_value_t = 0)]
     pub(crate) refine: usize,
     /// Basis growth factor between solved levels (1 solves every level of the hierarchy).
-    #[arg(long, default_value_t = SolveOptions::default().growth)]
+    #[arg(long, default_value_t = SolveOptions::default().levels.growth)]
     pub(crate) growth: f64,
     /// Nonlinear iteration (Newton falls back to pseudo time-stepping when it stalls).
     #[arg(long, value_enum, default_value = "newton")]
@@ -167,7 +167,7 @@ pub(crate) struct SolverArgs {
     pub(crate) linear: LinearMethod,
     /// Rounds of defect correction: while the certificate says folded or undecided,
     /// refine around the offending elements and solve again, at most this often.
-    #[arg(long, default_value_t = SolveOptions::default().repair)]
+    #[arg(long, default_value_t = SolveOptions::default().repair.rounds)]
     pub(crate) repair: usize,
     /// Do not repair a folded map (same as --repair 0).
     #[arg(long)]
@@ -224,7 +224,8 @@ impl SolverArgs {
     }
 
     pub(crate) fn options(&self) -> Result<SolveOptions> {
-        let mut o = SolveOptions { fit: fit_options(&self.fit), ..Default::default() };
+        let mut o = SolveOptions::default();
+        o.fit = fit_options(&self.fit);
         o.nonlinear.tol = self.tol;
         o.nonlinear.method = match self.method {
             MethodArg::Newton => NonlinearMethod::Newton,
@@ -232,14 +233,14 @@ impl SolverArgs {
             MethodArg::Egg | MethodArg::Weak | MethodArg::Winslow => self.iteration,
         };
         o.nonlinear.linear = self.linear;
-        o.repair = if self.no_repair { 0 } else { self.repair };
-        o.repair_freeze = self.repair_freeze;
-        o.refinement = self.refinement;
+        o.repair.rounds = if self.no_repair { 0 } else { self.repair };
+        o.repair.freeze = self.repair_freeze;
+        o.repair.refinement = self.refinement;
         o.operator = self.operator;
-        o.max_levels = self.levels;
-        o.min_elements = self.min_elements.max(1);
-        o.refine = self.refine;
-        o.growth = self.growth.max(1.0);
+        o.levels.max_levels = self.levels;
+        o.levels.min_elements = self.min_elements;
+        o.levels.refine = self.refine;
+        o.levels.growth = self.growth;
         o.kinks_local = self.kinks_local;
         o.improve = self.improve;
         o.max_memory = self.memory.max_memory;
@@ -256,12 +257,11 @@ impl SolverArgs {
 }
 
 pub(crate) fn fit_options(f: &FitArgs) -> FitOptions {
-    let reparam = ReparamOptions {
-        method: f.reparam,
-        gap: f.reparam_gap,
-        separation: f.reparam_separation,
-        fill: f.reparam_fill,
-        ..Default::default()
-    };
-    FitOptions { degree: f.degree, tol: f.fit_tol, reparam, basis: f.basis, kinks: f.kinks, ..Default::default() }
+    let mut o = FitOptions::default();
+    o.reparam.method = f.reparam;
+    o.reparam.gap = f.reparam_gap;
+    o.reparam.separation = f.reparam_separation;
+    o.reparam.fill = f.reparam_fill;
+    (o.degree, o.tol, o.basis, o.kinks) = (f.degree, f.fit_tol, f.basis, f.kinks);
+    o
 }

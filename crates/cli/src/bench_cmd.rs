@@ -69,7 +69,8 @@ pub(crate) fn bench(a: BenchArgs) -> Result<i32> {
             }
         };
         for &r in &a.refinements {
-            let o = SolveOptions { refine: r, ..opts.clone() };
+            let mut o = opts.clone();
+            o.levels.refine = r;
             let estimate = winslow::Pipeline::new(boundary.clone(), o.clone()).estimate()?;
             output::reset_peak_memory();
             let t = Instant::now();

@@ -61,7 +61,7 @@ pub(super) struct CompareArgs {
     #[arg(long, default_value_t = 0)]
     refine: usize,
     /// Basis growth factor between solved levels.
-    #[arg(long, default_value_t = SolveOptions::default().growth)]
+    #[arg(long, default_value_t = SolveOptions::default().levels.growth)]
     growth: f64,
     /// Operator of EGG: L of eq. (4) or L / (g11 + g22).
     #[arg(long, value_enum, default_value = "scaled")]

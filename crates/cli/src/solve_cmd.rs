@@ -191,8 +191,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let path = a.boundary.as_ref().context("a boundary file is needed without --start")?;
     let input = files::input_of(files::read(path)?, path, a.solver.fit.reorient)?;
     let mut opts = if input.is_multipatch() { super::multipatch_cmd::options(&a)? } else { a.solver.options()? };
-    opts.poisson = a.poisson;
-    if opts.refinement == Refinement::Thb {
+    opts.report.poisson = a.poisson;
+    if opts.repair.refinement == Refinement::Thb {
         thb_outputs(&a, input.is_multipatch())?;
     }
     match &input {
@@ -215,8 +215,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
         Solved::Volume(v) => return super::volume_cmd::finish(&name, *v, &a),
         solved => solved.into_map()?,
     };
-    if opts.refinement == Refinement::Thb
-        && opts.repair > 0
+    if opts.repair.refinement == Refinement::Thb
+        && opts.repair.rounds > 0
         && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
     {
         return super::thb_cmd::repair(&sol, &opts, &a.output, a.gismo.as_deref(), a.json);

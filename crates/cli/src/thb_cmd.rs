@@ -86,8 +86,8 @@ pub(crate) fn repair(
     let t0 = std::time::Instant::now();
     let start = HierarchicalMap::from_surface(&sol.map).context("THB refinement of the solved map")?;
     let topts = ThbRepairOptions {
-        rounds: opts.repair,
-        ring: opts.repair_halo,
+        rounds: opts.repair.rounds,
+        ring: opts.repair.halo,
         operator: opts.operator,
         nonlinear: opts.nonlinear,
         certify: opts.certify,

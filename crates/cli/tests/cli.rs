@@ -182,6 +182,28 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// Out-of-range solver flags are refused by the core's `SolveOptions::validate` (exit 1,
+/// the option named, nothing written), by `solve` and `compare` alike: the CLI has no
+/// checks of its own that could drift from the library's.
+#[test]
+fn out_of_range_solver_flags_are_the_cores_typed_error() {
+    let scratch = tempfile::tempdir().unwrap();
+    let map = scratch.path().join("map.json");
+    let input = data().join("quarter_annulus.json");
+    for (flag, value, needle) in
+        [("--min-elements", "0", "min_elements"), ("--growth", "0.5", "growth"), ("--tol", "0", "tol")]
+    {
+        let out = bin().args(["solve", "-q", flag, value]).arg(&input).arg("-o").arg(&map).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains("invalid argument") && err.contains(needle), "{flag} {value}: {err}");
+        assert!(!map.exists(), "{flag} {value}");
+        let out = bin().args(["compare", "--json", flag, value]).arg(&input).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "compare {flag} {value}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(needle), "compare {flag} {value}");
+    }
+}
+
 #[test]
 fn bench_prints_a_table() {
     let out =

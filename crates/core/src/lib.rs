@@ -99,7 +99,7 @@ pub use io::{read, read_boundary, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
 pub use pipeline::{solve, Input, Pipeline, Solved, Stage};
-pub use solve::options::SolveOptions;
+pub use solve::options::{LevelOptions, RepairOptions, ReportOptions, SolveOptions};
 pub use solve::report::{Report, Solution, Verdict};
 pub use solve::solver::{EggSolver, Event};
 pub use spline::curve::{Curve, Point};

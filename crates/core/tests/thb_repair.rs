@@ -15,7 +15,8 @@ use winslow::Pipeline;
 #[test]
 fn puzzle4_is_repaired_with_fewer_unknowns_than_tensor_refinement() {
     let boundary = read_boundary(&winslow::testutil::data("gismo/puzzle4.json"), &ReadOptions::default()).unwrap();
-    let thb_opts = SolveOptions { refinement: Refinement::Thb, ..Default::default() };
+    let mut thb_opts = SolveOptions::default();
+    thb_opts.repair.refinement = Refinement::Thb;
     let unrepaired = Pipeline::new(boundary.clone(), thb_opts.clone()).solve().unwrap().into_map().unwrap();
     assert!(
         matches!(unrepaired.report.verdict, Verdict::Folded | Verdict::Undecided),

@@ -49,7 +49,9 @@ fn gpu(precision: Precision) -> Option<Arc<GpuAssembler>> {
 /// converged map).
 fn shared_case(file: &str, degree: usize, level: usize) -> (Discretization, Vec<Point>) {
     let b = read_boundary(&data(file), &ReadOptions::default()).expect("shared geometry");
-    let h = build_hierarchy(&b, &FitOptions { degree, ..Default::default() }).expect("fit");
+    let mut fit = FitOptions::default();
+    fit.degree = degree;
+    let h = build_hierarchy(&b, &fit).expect("fit");
     let l = &h.levels[level.min(h.levels.len() - 1)];
     let mut cps = coons(&l.knots, &l.sides).expect("coons");
     let disc = Discretization::new(l.knots.clone());
@@ -239,7 +241,8 @@ fn gpu_render_equals_cpu_render_geometry() {
 fn solve_on_the_gpu_gives_the_cpu_map() {
     let Some(g) = gpu(Precision::F64) else { return };
     let b = read_boundary(&data("quarter_annulus.json"), &ReadOptions::default()).expect("boundary");
-    let opts = SolveOptions { min_elements: 6, ..Default::default() };
+    let mut opts = SolveOptions::default();
+    opts.levels.min_elements = 6;
     let h = build_hierarchy(&b, &opts.fit).expect("fit");
     let cpu = Pipeline::new(b.clone(), opts.clone()).solve().and_then(|s| s.into_map()).unwrap();
     let gpu =

@@ -452,7 +452,10 @@ mod tests {
     }
 
     fn quick() -> SolveOptions {
-        SolveOptions { min_elements: 4, sample: 64, ..Default::default() }
+        let mut o = SolveOptions::default();
+        o.levels.min_elements = 4;
+        o.report.sample = 64;
+        o
     }
 
     #[test]
@@ -499,7 +502,8 @@ mod tests {
     /// row per method, EGG first; the progress line names the method.
     #[test]
     fn run_compare_streams_methods_and_the_comparison() {
-        let opts = CompareOptions { solve: quick(), ..Default::default() };
+        let mut opts = CompareOptions::default();
+        opts.solve = quick();
         let mut msgs = Vec::new();
         run_compare(&annulus(), &[MethodChoice::Vhm], &opts, &AtomicBool::new(false), &mut |m| msgs.push(m));
         let started: Vec<String> = msgs
@@ -585,7 +589,9 @@ mod tests {
         job.cancel();
         assert_eq!(job.state, JobState::Finished);
 
-        let mut job = SolveJob::start(annulus(), SolveOptions { refine: 2, ..quick() }, || {});
+        let mut refined = quick();
+        refined.levels.refine = 2;
+        let mut job = SolveJob::start(annulus(), refined, || {});
         job.cancel();
         assert_eq!(job.state, JobState::Cancelling);
         // the flag is set long before a refined solve could end

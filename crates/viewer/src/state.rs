@@ -74,8 +74,8 @@ impl Default for SolveSettings {
         let d = SolveOptions::default();
         Self {
             operator: d.operator,
-            min_elements: d.min_elements,
-            refine: d.refine,
+            min_elements: d.levels.min_elements,
+            refine: d.levels.refine,
             fit_tol: d.fit.tol,
             basis: d.fit.basis,
             kinks: d.fit.kinks,
@@ -86,12 +86,10 @@ impl Default for SolveSettings {
 impl SolveSettings {
     /// The core's options with these settings.
     pub fn options(&self) -> SolveOptions {
-        let mut o = SolveOptions {
-            operator: self.operator,
-            min_elements: self.min_elements.max(1),
-            refine: self.refine,
-            ..Default::default()
-        };
+        let mut o = SolveOptions::default();
+        o.operator = self.operator;
+        o.levels.min_elements = self.min_elements.max(1);
+        o.levels.refine = self.refine;
         o.fit.tol = self.fit_tol;
         o.fit.basis = self.basis;
         o.fit.kinks = self.kinks;
@@ -337,8 +335,8 @@ impl ViewerState {
         let base = self.solve.options();
         opts.solve.fit = base.fit;
         opts.solve.operator = base.operator;
-        opts.solve.min_elements = base.min_elements;
-        opts.solve.refine = base.refine;
+        opts.solve.levels.min_elements = base.levels.min_elements;
+        opts.solve.levels.refine = base.levels.refine;
         let methods = if self.compare_gravesen { MethodChoice::ALL.to_vec() } else { MethodChoice::DEFAULT.to_vec() };
         self.job = Some(SolveJob::start_compare(scene.boundary.boundary.clone(), methods, opts, notify));
         self.status = Some(format!("comparing methods on {}", scene.name));

@@ -84,6 +84,7 @@ pub const NOISE_MIN_POINTS: usize = 12;
 
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct FitOptions {
     /// Degree `p >= 2` of the fitted curves (and of the tensor basis). Default 3.
     pub degree: usize,

@@ -65,13 +65,14 @@ impl Interfaces {
     }
 }
 
-/// Layout refinement rounds at most while a patch is not certified ([`SolveOptions::repair`]
-/// when lower): a layout refinement refines whole chains of patches.
+/// Layout refinement rounds at most while a patch is not certified
+/// ([`RepairOptions::rounds`](crate::solve::options::RepairOptions::rounds) when lower): a
+/// layout refinement refines whole chains of patches.
 pub const LAYOUT_REPAIR: usize = 3;
 
 /// How the options of one solve apply to a layout: every patch is solved with `opts`
-/// (method, nonlinear iteration, certificate), but `refine` refines the layout's bases,
-/// `repair` counts layout refinement rounds (at most [`LAYOUT_REPAIR`]), and `improve`
+/// (method, nonlinear iteration, certificate), but `levels.refine` refines the layout's
+/// bases, `repair.rounds` counts layout refinement rounds (at most [`LAYOUT_REPAIR`]), and `improve`
 /// is the free-interface stage (paper §11.2: improving a layout, one patch being a
 /// one-patch layout): [`Interfaces::Free`] with that functional.
 pub fn interfaces_of(opts: &SolveOptions) -> Interfaces {
@@ -253,14 +254,14 @@ fn solve_patch(
         similarity: Similarity::IDENTITY,
     };
     let mut o = opts.clone();
-    o.refine = 0;
-    o.repair = 0;
+    o.levels.refine = 0;
+    o.repair.rounds = 0;
     o.improve = None;
     o.fit.basis = BasisChoice::Input;
     // the report's det J sample (information only: the verdict is the certificate's) at
     // 8 points per element of the finer direction, not more than asked for
     let finest = h.levels.last().map_or(1, |l| l.knots[0].num_elements().max(l.knots[1].num_elements()));
-    o.sample = o.sample.min(8 * finest.max(4));
+    o.report.sample = o.report.sample.min(8 * finest.max(4));
     let sol = EggSolver::new(&boundary, Arc::new(h), o, assembler)?.finish()?;
     let mut map = sol.map;
     // the boundary control points are the conforming sides' exactly
@@ -297,13 +298,13 @@ fn coarse_directions(sides: &[Curve; 4], knots: &[crate::spline::knots::KnotVect
 
 /// A patch's map, report and certificate, and the knot vectors it was solved on.
 /// The estimated peak memory of solving `layout` with `opts` ([`MemoryEstimate::for_patches`]
-/// of the conforming bases of the first round, after `opts.refine` halvings).
+/// of the conforming bases of the first round, after `opts.levels.refine` halvings).
 pub(crate) fn layout_estimate(layout: &Layout, opts: &SolveOptions) -> Result<MemoryEstimate> {
     validate_layout(layout)?;
     let (lo, hi) = layout.bounding_box();
     let sim = Similarity::for_box(lo, hi, &format!("layout '{}'", layout.name))?;
     let mut bases = LayoutBases::new(&layout.similar(&sim))?;
-    for _ in 0..opts.refine {
+    for _ in 0..opts.levels.refine {
         bases = bases.refined(None);
     }
     let knots: Vec<_> = (0..layout.patches.len()).map(|p| bases.patch_knots(p)).collect();
@@ -325,7 +326,7 @@ pub(crate) fn solve_multipatch(
     let t0 = Instant::now();
     let interfaces = interfaces_of(opts);
     let functional = opts.improve.unwrap_or_default();
-    let repair = opts.repair.min(LAYOUT_REPAIR);
+    let repair = opts.repair.rounds.min(LAYOUT_REPAIR);
     let mut tell = |e: LayoutEvent| if observer(&e) { Ok(()) } else { Err(Error::Cancelled) };
     let checked = validate_layout(layout)?;
     let validation_seconds = t0.elapsed().as_secs_f64();
@@ -333,14 +334,14 @@ pub(crate) fn solve_multipatch(
     let sim = Similarity::for_box(lo, hi, &format!("layout '{}'", layout.name))?;
     let unit = layout.similar(&sim);
     let mut bases = LayoutBases::new(&unit)?;
-    for _ in 0..opts.refine {
+    for _ in 0..opts.levels.refine {
         bases = bases.refined(None);
     }
     let n = unit.patches.len();
     let fits = |bases: &LayoutBases| {
         let knots: Vec<_> = (0..n).map(|p| bases.patch_knots(p)).collect();
         let estimate = MemoryEstimate::for_patches(&knots, interfaces == Interfaces::Free);
-        opts.max_memory.check(&estimate, opts.refine, &format!("solving layout '{}' ({n} patches)", layout.name))
+        opts.max_memory.check(&estimate, opts.levels.refine, &format!("solving layout '{}' ({n} patches)", layout.name))
     };
     fits(&bases)?;
     tell(LayoutEvent::Bases { patches: n, classes: bases.classes.len(), basis_functions: bases.num_basis() })?;

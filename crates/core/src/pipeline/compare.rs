@@ -125,7 +125,9 @@ impl MethodChoice {
     /// more than one level) or `egg` (the EGG map `x_G`).
     pub fn start(self, opts: &CompareOptions) -> &'static str {
         match self {
-            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.max_levels != Some(1) => "hierarchy",
+            MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc if opts.solve.levels.max_levels != Some(1) => {
+                "hierarchy"
+            }
             MethodChoice::Egg | MethodChoice::Vhm | MethodChoice::Qc | MethodChoice::MaxZ => "coons",
             MethodChoice::Liao | MethodChoice::Winslow | MethodChoice::Ao => "egg",
         }
@@ -167,6 +169,7 @@ impl MethodChoice {
 
 /// Options of a comparison.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct CompareOptions {
     /// Fit, levels, nonlinear iteration, certificate (shared by every method); the EGG
     /// operator.
@@ -196,7 +199,9 @@ impl Default for CompareOptions {
     /// handful: the quasi-conformal functional converges linearly, its minimizers being
     /// degenerate) and 100 pseudo-time steps after them.
     fn default() -> Self {
-        let mut solve = SolveOptions { repair: 0, max_levels: Some(1), ..Default::default() };
+        let mut solve = SolveOptions::default();
+        solve.repair.rounds = 0;
+        solve.levels.max_levels = Some(1);
         solve.nonlinear.max_newton = 200;
         solve.nonlinear.max_pseudo = 100;
         Self {

@@ -300,8 +300,8 @@ impl Pipeline {
         let first = self.attempt(&self.opts, observer)?;
         // with THB refinement a folded or undecided map on the input basis is repaired
         // locally by the front end (`solve::hierarchical`), on the input basis
-        let thb_repairs = self.opts.refinement == Refinement::Thb
-            && self.opts.repair > 0
+        let thb_repairs = self.opts.repair.refinement == Refinement::Thb
+            && self.opts.repair.rounds > 0
             && matches!(first.0.report.verdict, Verdict::Folded | Verdict::Undecided);
         let fallback = if thb_repairs { None } else { auto_fallback(&first.0, &self.opts.fit) };
         let Some((fitted, why)) = fallback else { return Ok(first) };
@@ -358,7 +358,7 @@ impl Pipeline {
     fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
         let (boundary, hierarchy, mut solver) = self.plan(opts)?;
         let estimate = MemoryEstimate::for_levels_with(solver.plan(), opts.nonlinear.linear);
-        opts.max_memory.check(&estimate, opts.refine, &format!("solving '{}'", self.input.name()))?;
+        opts.max_memory.check(&estimate, opts.levels.refine, &format!("solving '{}'", self.input.name()))?;
         let fitted =
             Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };
         if !observer(&fitted) {
@@ -382,7 +382,7 @@ pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
 /// the common bases, at most `repair` further halvings while the map is not certified,
 /// the certificate's options.
 pub(crate) fn volume_options(opts: &SolveOptions) -> VolumeOptions {
-    VolumeOptions { refine: opts.refine, max_refinements: opts.repair, ..Default::default() }
+    VolumeOptions { refine: opts.levels.refine, max_refinements: opts.repair.rounds, ..Default::default() }
 }
 
 /// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input
@@ -466,7 +466,8 @@ mod tests {
     #[test]
     fn the_observer_sees_every_stage_of_a_fallback() {
         // puzzle4's input basis folds after one repair round: solved again on the fitted basis
-        let opts = SolveOptions { repair: 1, ..Default::default() };
+        let mut opts = SolveOptions::default();
+        opts.repair.rounds = 1;
         let mut seen = Vec::new();
         let mut residuals = Vec::new();
         let sol = Pipeline::new(puzzle4(), opts.clone())
@@ -518,7 +519,8 @@ mod tests {
     /// the limit, before any stage; [`Pipeline::estimate`] gives the same estimate.
     #[test]
     fn a_solve_above_the_memory_limit_is_refused_before_it_starts() {
-        let opts = SolveOptions { refine: 2, ..Default::default() };
+        let mut opts = SolveOptions::default();
+        opts.levels.refine = 2;
         let estimate = Pipeline::new(puzzle4(), opts.clone()).estimate().unwrap();
         assert!(estimate.bytes > crate::solve::memory::BASE && estimate.unknowns > 0);
         let limit = estimate.bytes - 1;
@@ -549,7 +551,11 @@ mod tests {
                 o.nonlinear.tol = 0.0;
                 o
             }),
-            ("growth", SolveOptions { growth: f64::NAN, ..Default::default() }),
+            ("growth", {
+                let mut o = SolveOptions::default();
+                o.levels.growth = f64::NAN;
+                o
+            }),
             ("fit tolerance", {
                 let mut o = SolveOptions::default();
                 o.fit.tol = 1.5;
@@ -577,16 +583,20 @@ mod tests {
             crate::io::Document::Layout(l) => l,
             other => panic!("TUDflame is a {}", other.kind()),
         };
-        let at = |refine| Pipeline::new(layout.clone(), SolveOptions { refine, ..Default::default() }).estimate();
+        let refined = |refine| {
+            let mut o = SolveOptions::default();
+            o.levels.refine = refine;
+            o
+        };
+        let at = |refine| Pipeline::new(layout.clone(), refined(refine)).estimate();
         let (e1, e2) = (at(1).unwrap(), at(2).unwrap());
         let ratio = (e2.bytes - BASE) as f64 / (e1.bytes - BASE) as f64;
         assert!((3.0..5.0).contains(&ratio) && e2.unknowns > 3 * e1.unknowns, "{e1:?} {e2:?}");
         // the free-interface stage factors all patches at once: twice the fixed stage's terms
-        let free =
-            SolveOptions { refine: 2, improve: Some(crate::solve::improve::Improve::Winslow), ..Default::default() };
+        let free = SolveOptions { improve: Some(crate::solve::improve::Improve::Winslow), ..refined(2) };
         let e2_free = Pipeline::new(layout.clone(), free).estimate().unwrap();
         assert_eq!(e2_free.bytes - BASE, 2 * (e2.bytes - BASE));
-        let opts = SolveOptions { refine: 2, max_memory: MemoryLimit::Bytes(e2.bytes - 1), ..Default::default() };
+        let opts = SolveOptions { max_memory: MemoryLimit::Bytes(e2.bytes - 1), ..refined(2) };
         let mut events = 0;
         match Pipeline::new(layout.clone(), opts).run(&mut |_| {
             events += 1;

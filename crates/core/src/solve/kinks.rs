@@ -343,10 +343,10 @@ fn elasticity_start(
             Some((cps, c)) if cps == out.guess => c,
             _ => certify(&surface(&out.guess), &opts.certify)?,
         };
-        if bijective(&cert) || report.refinements >= opts.repair {
+        if bijective(&cert) || report.refinements >= opts.repair.rounds {
             break (disc, weights, out.guess, cert);
         }
-        let Some(r) = plan_repair(&level, &cert, report.refinements + 1, opts.repair_halo, None)? else {
+        let Some(r) = plan_repair(&level, &cert, report.refinements + 1, opts.repair.halo, None)? else {
             break (disc, weights, out.guess, cert);
         };
         let reached = surface(&out.base);

@@ -3,7 +3,7 @@
 //! against ([`MemoryLimit`], `--max-memory`).
 //!
 //! **Model.** The finest level dominates (the levels below it are at least
-//! [`growth`](super::options::SolveOptions::growth) times smaller and freed before it
+//! [`growth`](super::options::LevelOptions::growth) times smaller and freed before it
 //! starts). On a tensor basis of `n_ξ × n_η` functions of degrees `(p, q)` two functions
 //! interact when their supports share an element, so the scalar pattern has
 //! `z_1 = z(Ξ) z(H)` nonzeros, `z(Ξ) = Σ_i #{j : supp B_i ∩ supp B_j ≠ ∅}`

@@ -46,7 +46,7 @@ pub struct Repair {
 }
 
 /// The defect-correction level (§8.2) after `last`, whose map has certificate `cert`:
-/// the offending (folded or undecided) elements and `opts.repair_halo` spans around
+/// the offending (folded or undecided) elements and `opts.repair.halo` spans around
 /// them bisected in both directions, the sides refined exactly. `None` when nothing
 /// offends or the refined basis would exceed [`MAX_BASIS`]. With `freeze = Some(r)` the
 /// round also gives the parameter boxes (the offending elements widened by `r` spans)

@@ -314,7 +314,7 @@ pub(crate) struct ReportContext<'a> {
 impl Solution {
     pub(crate) fn new(name: &str, map: Surface, levels: Vec<LevelReport>, ctx: ReportContext<'_>) -> Self {
         let (h, opts) = (ctx.hierarchy, ctx.opts);
-        let sample = sample_det_j(&map, opts.sample);
+        let sample = sample_det_j(&map, opts.report.sample);
         let quality = quality(&map);
         let fun = quality.functionals;
         let certificate = ctx.certificate;
@@ -414,7 +414,11 @@ impl Solution {
             repair_rounds: ctx.rounds,
             certificate,
             quality,
-            poisson: if opts.poisson { crate::verify::poisson::poisson_benchmark(&map, None).ok() } else { None },
+            poisson: if opts.report.poisson {
+                crate::verify::poisson::poisson_benchmark(&map, None).ok()
+            } else {
+                None
+            },
             det_j_min: sample.min,
             det_j_min_interior: sample.min_interior,
             det_j_min_away_from_forced_corners: away,

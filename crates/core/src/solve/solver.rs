@@ -140,9 +140,9 @@ impl EggSolver {
         // boundary stays the input's
         let (min_elements, aspect) = match (hierarchy.basis.requested, hierarchy.basis.used) {
             (BasisChoice::Input, BasisChoice::Input) => (1, f64::INFINITY),
-            _ => (opts.min_elements, opts.aspect),
+            _ => (opts.levels.min_elements, opts.levels.aspect),
         };
-        let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.refine, aspect)?;
+        let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.levels.refine, aspect)?;
         // kinks kept (§9): the levels hold them at multiplicity p (Σ⁰); solve on Σ¹, the
         // finest prepared Σ⁰ is where the C0 route ends
         let (levels, c0) = match hierarchy.kinked {
@@ -155,7 +155,7 @@ impl EggSolver {
             BasisChoice::Input => DIRECT_REFINED_MAX_FUNCTIONS,
             BasisChoice::Fitted | BasisChoice::Auto => 0,
         };
-        let chosen = select_levels(&sizes, opts.growth, opts.max_levels, direct_max);
+        let chosen = select_levels(&sizes, opts.levels.growth, opts.levels.max_levels, direct_max);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
         Ok(Self {
             plan,
@@ -436,10 +436,10 @@ impl EggSolver {
         }
         let cert = self.certificate.as_ref().expect("set above");
         // THB refinement repairs the unrepaired map afterwards (`solve::hierarchical`)
-        if self.repairs >= self.opts.repair || self.opts.refinement == Refinement::Thb {
+        if self.repairs >= self.opts.repair.rounds || self.opts.repair.refinement == Refinement::Thb {
             return Ok(false);
         }
-        let (halo, freeze) = (self.opts.repair_halo, self.opts.repair_freeze);
+        let (halo, freeze) = (self.opts.repair.halo, self.opts.repair.freeze);
         let Some(r) = plan_repair(last, cert, self.repairs + 1, halo, freeze)? else { return Ok(false) };
         if let Some(boxes) = r.free_boxes {
             self.free_boxes.push((self.plan.len(), boxes));

@@ -93,6 +93,7 @@ pub enum Fill {
 
 /// Options of the reparameterization.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ReparamOptions {
     /// The method. Default [`Reparam::Auto`].
     pub method: Reparam,

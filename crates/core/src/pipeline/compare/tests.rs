@@ -17,6 +17,14 @@ pub(super) fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
     (Boundary { name: "parallelogram".into(), sides }, f)
 }
 
+/// The comparison's solve options with at least 4 elements per direction on the finest
+/// level.
+fn coarse() -> SolveOptions {
+    let mut o = CompareOptions::default().solve;
+    o.levels.min_elements = 4;
+    o
+}
+
 /// On an affine boundary every method returns the affine map (EGG and VHM to
 /// rounding; the quasi-conformal minimizer is degenerate, see
 /// [`crate::methods::quasi_conformal`], and resolved to its stopping rule), each
@@ -24,10 +32,7 @@ pub(super) fn parallelogram() -> (Boundary, impl Fn(f64, f64) -> [f64; 2]) {
 #[test]
 fn every_method_returns_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
-    let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let mut events = Vec::new();
     let cmp = compare(
         &b,
@@ -85,10 +90,7 @@ fn names_parse_and_unknown_names_are_errors() {
 #[test]
 fn progress_can_cancel() {
     let (b, _) = parallelogram();
-    let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let mut seen = 0;
     let out = compare(&b, &[MethodChoice::Vhm], &opts, Arc::new(CpuAssembler), &mut |_| {
         seen += 1;
@@ -107,10 +109,7 @@ fn progress_can_cancel() {
 #[test]
 fn gravesens_methods_keep_the_affine_map_of_an_affine_boundary() {
     let (b, f) = parallelogram();
-    let opts = CompareOptions {
-        solve: SolveOptions { min_elements: 4, ..CompareOptions::default().solve },
-        ..Default::default()
-    };
+    let opts = CompareOptions { solve: coarse(), ..Default::default() };
     let methods = [MethodChoice::MaxZ, MethodChoice::Liao, MethodChoice::Winslow, MethodChoice::Ao];
     let cmp = compare(&b, &methods, &opts, Arc::new(CpuAssembler), &mut |_| true).unwrap().unwrap();
     let names: Vec<&str> = cmp.rows.iter().map(|r| r.method.as_str()).collect();
