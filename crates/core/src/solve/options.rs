@@ -49,7 +49,7 @@ pub struct SolveOptions {
     pub repair_freeze: Option<usize>,
     /// How defect correction refines: tensor knot spans across the patch (the rounds of
     /// `repair` in the solve), or THB cells around the defect only
-    /// ([`crate::solve::hierarchical`], run by the front end on the unrepaired map).
+    /// ([`crate::solve::hierarchical`], run by the pipeline on the unrepaired map).
     pub refinement: Refinement,
     /// Options of the bijectivity certificate.
     pub certify: CertifyOptions,
