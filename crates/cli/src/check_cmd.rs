@@ -50,10 +50,8 @@ pub(crate) fn check(a: CheckArgs) -> Result<i32> {
         max_boxes: a.max_boxes.clamp(1, 1 << 24),
         excuse_corners: !a.strict_corners,
     };
-    if let Some((name, map)) = crate::thb_cmd::read(&a.map)? {
-        return crate::thb_cmd::check(&name, &map, &opts, a.json);
-    }
     let (name, map) = match files::read(&a.map)? {
+        Document::Thb { name, map } => return crate::thb_cmd::check(&name, &map, &opts, a.json),
         Document::Volume { name, volume } => {
             return loft_cmd::check_volume(&name, &volume, a.max_depth, a.max_boxes, a.json)
         }

@@ -58,13 +58,13 @@ const CONVERT_NEEDS: &str =
 /// `winslow convert IN -o OUT`: certified again (the verdict travels with the file),
 /// written by the output's extension.
 pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
-    if let Some((name, map)) = crate::thb_cmd::read(&a.map)? {
-        return crate::thb_cmd::convert(&name, &map, &a.map, &a.output, a.thb);
+    let doc = files::read(&a.map)?;
+    if let Document::Thb { name, map } = &doc {
+        return crate::thb_cmd::convert(name, map, &a.map, &a.output, a.thb);
     }
     if a.thb {
         anyhow::bail!("--thb keeps a THB map hierarchical, and {} holds no THB map", a.map.display());
     }
-    let doc = files::read(&a.map)?;
     let (what, extensions) = match doc {
         Document::Volume { .. } => ("volume", files::ext::VOLUME),
         Document::VolumeBoundary(_) => ("volume boundary", files::ext::VOLUME_BOUNDARY),

@@ -157,6 +157,20 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
             shape[1]
         ),
         Stage::Solver(Event::Iterate { iterate, .. }) => writeln!(e, "  {}", output::iterate_line(iterate)),
+        Stage::ThbRound(r) => writeln!(
+            e,
+            "THB round {}: {} offending cell(s) of a {} map, {} refined -> {} functions on {} levels; {} Newton \
+             iterations{}, {:.3} s",
+            r.round,
+            r.offending_cells,
+            r.verdict,
+            r.marked_cells,
+            r.functions,
+            r.levels,
+            r.iterations,
+            if r.converged { "" } else { " (NOT converged)" },
+            r.seconds
+        ),
         Stage::Solver(Event::LevelFinished(r)) => writeln!(
             e,
             "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",
@@ -213,14 +227,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
             return super::multipatch_cmd::finish(*solution, &a, made);
         }
         Solved::Volume(v) => return super::volume_cmd::finish(&name, *v, &a),
+        Solved::Thb(t) => return super::thb_cmd::finish(&t, &a.output, a.gismo.as_deref(), a.json),
         solved => solved.into_map()?,
     };
-    if opts.repair.refinement == Refinement::Thb
-        && opts.repair.rounds > 0
-        && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
-    {
-        return super::thb_cmd::repair(&sol, &opts, &a.output, a.gismo.as_deref(), a.json);
-    }
     let report = serde_json::to_value(&sol.report)?;
     let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
     let extra = Some(serde_json::json!({ "report": report }));

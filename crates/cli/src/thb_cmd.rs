@@ -1,27 +1,20 @@
-//! THB maps (`winslow::spline::hierarchical`) in `winslow check` and `winslow convert`:
-//! a file holding a THB map (the JSON map kind `"thb"` or G+Smo `THBSpline2`) is certified
-//! active cell by active cell, and converted to the tensor map on the knot lines of its
-//! active cells (exact knot insertion) or, with `--thb`, written as a THB map again.
+//! THB maps (`winslow::spline::hierarchical`) in `winslow check`, `winslow convert` and
+//! `winslow solve --refinement thb`: a file holding a THB map (read by `winslow::read` as
+//! `Document::Thb`) is certified active cell by active cell, and converted to the tensor
+//! map on the knot lines of its active cells (exact knot insertion) or, with `--thb`,
+//! written as a THB map again; the pipeline's THB result (`Solved::Thb`) is written with
+//! its report.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use winslow::io::hierarchical::{read_thb, write_thb};
 use winslow::io::Output;
-use winslow::solve::hierarchical::{repair_thb, ThbRepairOptions};
-use winslow::solve::options::SolveOptions;
-use winslow::solve::report::Solution;
 use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::verify::certificate::hierarchical::certify_hierarchical;
 use winslow::verify::certificate::{certify, CertifyOptions, Finding};
+use winslow::ThbSolution;
 
 use crate::files;
-
-/// The THB map in `path`, `None` when the file holds another kind of document.
-pub(crate) fn read(path: &Path) -> Result<Option<(String, HierarchicalMap)>> {
-    // named once, as every command's read names its file (`files::named`)
-    read_thb(path).map_err(|e| files::named(e, "reading", path))
-}
 
 /// 0 certified or degenerate corner, 3 folded, 5 undecided.
 fn exit_code(v: &Finding) -> i32 {
@@ -51,8 +44,8 @@ pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &
         files::OutputPlan::new().input(input).file("-o", output, "THB map", &["json", "xml"]).check()?;
         let c = certify_hierarchical(map, &CertifyOptions::default()).context("certifying the THB map")?;
         let extra = Some(serde_json::json!({ "report": { "certificate": &c } }));
-        write_thb(output, name, map, extra).with_context(|| format!("writing {}", output.display()))?;
-        files::record(output);
+        let label = format!("certificate: {}", c.message());
+        files::write(output, &Output::Thb { name, map, label: &label, extra })?;
         say!("certificate: {}", c.message());
         return Ok(exit_code(&c.verdict));
     }
@@ -72,59 +65,30 @@ pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &
     Ok(exit_code(&certificate.verdict))
 }
 
-/// `winslow solve --refinement thb`: the pipeline's map folds or is undecided without
-/// tensor repair; the THB defect correction ([`repair_thb`]) refines only around the
-/// offending cells, and the THB map is written (`-o`, and `--gismo` as `THBSpline2`) with
-/// its certificate, the rounds and the tensor solve's report.
-pub(crate) fn repair(
-    sol: &Solution,
-    opts: &SolveOptions,
-    output: &Path,
-    gismo: Option<&Path>,
-    json: bool,
-) -> Result<i32> {
-    let t0 = std::time::Instant::now();
-    let start = HierarchicalMap::from_surface(&sol.map).context("THB refinement of the solved map")?;
-    let topts = ThbRepairOptions {
-        rounds: opts.repair.rounds,
-        ring: opts.repair.halo,
-        operator: opts.operator,
-        nonlinear: opts.nonlinear,
-        certify: opts.certify,
-        ..Default::default()
-    };
-    let out = repair_thb(start, &topts).context("THB defect correction")?;
-    let c = &out.certificate;
-    let unknowns = out.rounds.last().map_or(0, |r| r.unknowns);
-    let report = serde_json::json!({
-        "refinement": "thb",
-        "verdict": c.verdict.name(),
-        "message": c.message(),
-        "certificate": c,
-        "functions": out.map.basis.len(),
-        "levels": out.map.basis.num_levels(),
-        "unknowns": unknowns,
-        "thb_rounds": &out.rounds,
-        "thb_seconds": t0.elapsed().as_secs_f64(),
-        "solve": &sol.report,
-    });
+/// `winslow solve --refinement thb` when the pipeline repaired the map by THB defect
+/// correction: the THB map written (`-o`, and `--gismo` as `THBSpline2`) with its report
+/// (the certificate, the rounds and the tensor solve's report), which `--json` prints.
+pub(crate) fn finish(out: &ThbSolution, output: &Path, gismo: Option<&Path>, json: bool) -> Result<i32> {
+    let report = serde_json::to_value(&out.report)?;
+    let c = &out.report.certificate;
+    let label = format!("verdict {:?}: {}", out.report.verdict, out.report.message);
     let extra = Some(serde_json::json!({ "report": &report }));
-    write_thb(output, &sol.name, &out.map, extra.clone()).with_context(|| format!("writing {}", output.display()))?;
-    files::record(output);
+    let thb = Output::Thb { name: &out.name, map: &out.map, label: &label, extra };
+    files::write(output, &thb)?;
     if let Some(p) = gismo {
-        write_thb(p, &sol.name, &out.map, extra).with_context(|| format!("writing {}", p.display()))?;
-        files::record(p);
+        files::write_as(p, "xml", &thb)?;
     }
     if json {
         files::print_json(report)?;
     } else {
         say!(
-            "{}: tensor solve {:?} without repair; {} THB round(s) -> {} functions on {} levels ({unknowns} unknowns)",
-            sol.name,
-            sol.report.verdict,
-            out.rounds.len(),
+            "{}: tensor solve {:?} without repair; {} THB round(s) -> {} functions on {} levels ({} unknowns)",
+            out.name,
+            out.report.solve.verdict,
+            out.report.thb_rounds.len(),
             out.map.basis.len(),
-            out.map.basis.num_levels()
+            out.map.basis.num_levels(),
+            out.report.unknowns
         );
         say!("certificate: {}", c.message());
     }

@@ -98,7 +98,7 @@ pub use error::{Error, Result};
 pub use io::{read, read_boundary, write, Document, Output, ReadOptions};
 pub use methods::egg::{CpuAssembler, EggAssembler, EggMethod};
 pub use methods::{DiscreteProblem, Method};
-pub use pipeline::{solve, Input, Pipeline, Solved, Stage};
+pub use pipeline::{solve, Input, Pipeline, Solved, Stage, ThbReport, ThbSolution};
 pub use solve::options::{LevelOptions, RepairOptions, ReportOptions, SolveOptions};
 pub use solve::report::{Report, Solution, Verdict};
 pub use solve::solver::{EggSolver, Event};

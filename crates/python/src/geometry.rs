@@ -441,6 +441,7 @@ pub fn write_document(path: &std::path::Path, doc: &Document) -> winslow::Result
         Document::Volume { name, volume } => {
             winslow::write(path, &Output::Volume { name, volume, label: "", extra: None })
         }
+        Document::Thb { name, map } => winslow::write(path, &Output::Thb { name, map, label: "", extra: None }),
     }
 }
 

@@ -231,6 +231,7 @@ pub fn event(stage: &Stage<'_>) -> Value {
         Stage::LaidOut(auto) => json!({ "stage": "laid_out", "report": auto.report }),
         Stage::WarmStart { used, reason } => json!({ "stage": "warm_start", "used": used, "reason": reason }),
         Stage::Improve { method } => json!({ "stage": "improve", "method": method.name() }),
+        Stage::ThbRound(r) => json!({ "stage": "thb_round", "round": r }),
         _ => json!({ "stage": "other" }),
     }
 }

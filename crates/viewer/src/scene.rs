@@ -415,6 +415,11 @@ impl Scene {
                     .wrong_kind(None, "a planar document here (the viewer opens a volume file as three slices; the faces of a volume are solved by `winslow solve`)")
                     .into())
             }
+            doc @ Document::Thb { .. } => {
+                return Err(doc
+                    .wrong_kind(None, "a tensor map here (the viewer draws tensor maps: `winslow convert` turns a THB map into its exact tensor map)")
+                    .into())
+            }
         })
     }
 

@@ -82,6 +82,12 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
     match out {
         Ok(Solved::Map(sol)) => send(Msg::Finished(sol)),
         Ok(Solved::Layout { solution, .. }) => send(Msg::SolvedLayout(solution)),
+        Ok(Solved::Thb(t)) => send(Msg::Failed(format!(
+            "{}: the THB map (verdict {}) is not drawn by the viewer, which draws tensor maps: write it with \
+             `winslow solve --refinement thb` and `winslow convert` turns it into its exact tensor map",
+            t.name,
+            t.report.verdict.name()
+        ))),
         Ok(other) => send(Msg::Failed(format!(
             "the pipeline returned a result the viewer does not draw (verdict {})",
             other.verdict().name()

@@ -154,51 +154,129 @@ fn chord_turning(points: &[Point], s: &[f64], j: usize, w: f64) -> f64 {
 /// (closer than `w`) the one turning most at the window `w` is the vertex: at a polygon's
 /// vertex both chords lie along its edges. Returns `(index, turning degrees)`.
 pub fn cloud_corners(points: &[Point], threshold: f64) -> Vec<(usize, f64)> {
-    let n = points.len();
-    if n < 3 {
-        return Vec::new();
-    }
-    let mut s = vec![0.0; n];
-    for j in 1..n {
-        s[j] = s[j - 1] + (points[j][0] - points[j - 1][0]).hypot(points[j][1] - points[j - 1][1]);
-    }
-    let w = CORNER_WINDOW * s[n - 1];
-    let mut out: Vec<(usize, f64)> = Vec::new();
-    for j in 1..n - 1 {
-        if s[j] == s[j - 1] || s[j + 1] == s[j] {
-            continue;
+    CornerTurnings::of(points, threshold).corners(threshold)
+}
+
+/// The turnings of a point cloud's interior vertices that [`cloud_corners`] measures, for
+/// every vertex turning at least `floor` degrees at the window `w`: the corners for any
+/// threshold `>= floor` follow without measuring again ([`CornerTurnings::corners`]).
+#[derive(Debug, Clone, Default)]
+struct CornerTurnings {
+    /// The window `w`.
+    w: f64,
+    /// `(index, cumulative cord length, turning at w, turning at w / 4)`.
+    at: Vec<(usize, f64, f64, f64)>,
+}
+
+impl CornerTurnings {
+    fn of(points: &[Point], floor: f64) -> Self {
+        let n = points.len();
+        if n < 3 {
+            return Self::default();
         }
-        let turn = chord_turning(points, &s, j, w);
-        if turn < threshold || chord_turning(points, &s, j, 0.25 * w) < threshold {
-            continue;
+        let mut s = vec![0.0; n];
+        for j in 1..n {
+            s[j] = s[j - 1] + (points[j][0] - points[j - 1][0]).hypot(points[j][1] - points[j - 1][1]);
         }
-        match out.last_mut() {
-            Some(last) if s[j] - s[last.0] < w => {
-                if turn > last.1 {
-                    *last = (j, turn);
-                }
+        let w = CORNER_WINDOW * s[n - 1];
+        let mut at = Vec::new();
+        for j in 1..n - 1 {
+            if s[j] == s[j - 1] || s[j + 1] == s[j] {
+                continue;
             }
-            _ => out.push((j, turn)),
+            let turn = chord_turning(points, &s, j, w);
+            if turn < floor {
+                continue;
+            }
+            at.push((j, s[j], turn, chord_turning(points, &s, j, 0.25 * w)));
         }
+        Self { w, at }
     }
-    out
+
+    /// The corners turning at least `threshold` at both windows, of neighbours (closer
+    /// than `w`) the one turning most at `w` (see [`cloud_corners`]).
+    fn corners(&self, threshold: f64) -> Vec<(usize, f64)> {
+        let mut out: Vec<(usize, f64, f64)> = Vec::new();
+        for &(j, sj, turn, quarter) in &self.at {
+            if turn < threshold || quarter < threshold {
+                continue;
+            }
+            match out.last_mut() {
+                Some(last) if sj - last.2 < self.w => {
+                    if turn > last.1 {
+                        *last = (j, turn, sj);
+                    }
+                }
+                _ => out.push((j, turn, sj)),
+            }
+        }
+        out.into_iter().map(|(j, turn, _)| (j, turn)).collect()
+    }
 }
 
 /// The kinks of `boundary` that `mode` keeps (south, east, north, west, each by
 /// parameter), or that the report names when `mode` is [`KinkMode::None`] and `report`
 /// is set (then with the thresholds of [`KinkMode::Auto`]). `input_basis`: every `C^0`
 /// knot of a spline side counts whatever its angle (the input basis is `C^0` there).
-/// Analytic sides have none.
+/// Analytic sides have none. [`Candidates`] finds them once for several modes.
 pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kink> {
-    let mut out = Vec::new();
-    let (Some(spline_min), Some(cloud_min)) = (mode.spline_threshold(), mode.cloud_threshold()) else {
-        return out;
-    };
-    for s in Side::ALL {
-        match boundary.side(s) {
-            SideCurve::Spline(c) => {
-                for k in spline_kinks(c) {
-                    if (input_basis && k.c0_knot) || k.turning_degrees > spline_min {
+    match mode.cloud_threshold() {
+        Some(floor) => Candidates::find(boundary, floor).kinks(mode, input_basis),
+        None => Vec::new(),
+    }
+}
+
+/// The candidate kinks of a boundary's sides, measured once ([`Candidates::find`]): the
+/// interior knots of spline sides that [`spline_kinks`] lists, and the turnings of point
+/// clouds' vertices; [`Candidates::kinks`] gives the kinks of any mode from them, as
+/// [`detect`] does (the hierarchy keeps those of `--kinks`, the report names those of
+/// [`KinkMode::Auto`] that were rounded).
+#[derive(Debug, Clone, Default)]
+pub struct Candidates {
+    sides: [SideCandidates; 4],
+}
+
+#[derive(Debug, Clone, Default)]
+enum SideCandidates {
+    #[default]
+    None,
+    Spline(Vec<KnotKink>),
+    Cloud {
+        params: Vec<f64>,
+        points: Vec<Point>,
+        turnings: CornerTurnings,
+    },
+}
+
+impl Candidates {
+    /// Measure the sides of `boundary`; point-cloud vertices turning less than `floor`
+    /// degrees at the window `w` are not kept (no mode below it is asked for later).
+    pub fn find(boundary: &Boundary, floor: f64) -> Self {
+        let side = |s: Side| match boundary.side(s) {
+            SideCurve::Spline(c) => SideCandidates::Spline(spline_kinks(c)),
+            SideCurve::Points(pts) => match crate::boundary::cord_length::cord_length_params(pts) {
+                Some(params) => {
+                    SideCandidates::Cloud { params, points: pts.clone(), turnings: CornerTurnings::of(pts, floor) }
+                }
+                None => SideCandidates::None,
+            },
+            SideCurve::Analytic(_) => SideCandidates::None,
+        };
+        Self { sides: Side::ALL.map(side) }
+    }
+
+    /// The kinks `mode` keeps, as [`detect`] with the same arguments finds them (a mode
+    /// whose point-cloud threshold is below the floor of [`Candidates::find`] misses the
+    /// corners between the two).
+    pub fn kinks(&self, mode: KinkMode, input_basis: bool) -> Vec<Kink> {
+        let mut out = Vec::new();
+        let (Some(spline_min), Some(cloud_min)) = (mode.spline_threshold(), mode.cloud_threshold()) else {
+            return out;
+        };
+        for (s, side) in Side::ALL.into_iter().zip(&self.sides) {
+            match side {
+                SideCandidates::Spline(list) => {
+                    for k in list.iter().filter(|k| (input_basis && k.c0_knot) || k.turning_degrees > spline_min) {
                         out.push(Kink {
                             side: s,
                             parameter: k.t,
@@ -210,25 +288,44 @@ pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kin
                         });
                     }
                 }
-            }
-            SideCurve::Points(pts) => {
-                let Some(params) = crate::boundary::cord_length::cord_length_params(pts) else { continue };
-                for (j, turn) in cloud_corners(pts, cloud_min) {
-                    out.push(Kink {
-                        side: s,
-                        parameter: params[j],
-                        point: pts[j],
-                        turning_degrees: turn,
-                        kind: KinkKind::Corner,
-                        index: Some(j),
-                        map_parameter: None,
-                    });
+                SideCandidates::Cloud { params, points, turnings } => {
+                    for (j, turn) in turnings.corners(cloud_min) {
+                        out.push(Kink {
+                            side: s,
+                            parameter: params[j],
+                            point: points[j],
+                            turning_degrees: turn,
+                            kind: KinkKind::Corner,
+                            index: Some(j),
+                            map_parameter: None,
+                        });
+                    }
                 }
+                SideCandidates::None => {}
             }
-            SideCurve::Analytic(_) => {}
+        }
+        out
+    }
+}
+
+impl Kink {
+    /// The kink's point on `boundary`'s side: the vertex of its index on a point cloud,
+    /// the side at its knot on a spline (the knot whose normalised value is
+    /// [`Kink::parameter`]); exactly the point [`detect`] gives on `boundary` when the
+    /// kink was found on a boundary with the same knots and vertex count (e.g. its
+    /// normalised copy, [`Similarity::unit_boundary`](crate::boundary::normalise::Similarity::unit_boundary)).
+    /// `None` when the side has no such vertex or knot.
+    pub fn point_on(&self, boundary: &Boundary) -> Option<Point> {
+        match boundary.side(self.side) {
+            SideCurve::Points(pts) => self.index.and_then(|j| pts.get(j).copied()),
+            SideCurve::Spline(c) => {
+                let (a, b) = c.domain();
+                let breaks = c.knots.breaks_with_multiplicity();
+                breaks.iter().map(|&(u, _)| u).find(|&u| (u - a) / (b - a) == self.parameter).map(|u| c.eval(u))
+            }
+            SideCurve::Analytic(_) => None,
         }
     }
-    out
 }
 
 /// The kinks stored in a map document's `"report"` (`kinks[].point` and `kinks[].kept`

@@ -431,6 +431,7 @@ pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefine
         side_fit(Side::North, None),
         side_fit(Side::West, Some(0)),
     ];
+    let cut = cut_open(ring, seam.map(|p| fit.similarity.to_physical(p)));
     let h = Hierarchy {
         levels,
         fits,
@@ -440,8 +441,10 @@ pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefine
         basis: BasisReport::fitted(),
         kinked: None,
         similarity: fit.similarity,
+        // on the cut-open boundary, in the input's coordinates (the report measures there)
+        detected: crate::boundary::kinks::detect(&cut, crate::boundary::KinkMode::Auto, false),
     };
-    Ok((h, cut_open(ring, seam.map(|p| fit.similarity.to_physical(p)))))
+    Ok((h, cut))
 }
 
 #[cfg(test)]

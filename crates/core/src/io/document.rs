@@ -3,6 +3,7 @@
 //!
 //! | content | document |
 //! |---|---|
+//! | JSON with `map` of kind `"thb"` | [`Document::Thb`] |
 //! | JSON with `patches`, every patch a `map` | [`Document::Multipatch`] (a solved result) |
 //! | JSON with `patches` | [`Document::Layout`] |
 //! | JSON with `ring` | [`Document::Ring`] |
@@ -12,6 +13,7 @@
 //! | JSON with `boundary` or `contour` | [`Document::Boundary`] |
 //! | JSON with `domain` | [`Document::Domain`] (not validated: [`crate::domain::validate_domain`]) |
 //! | JSON with `graph` | [`Document::Graph`] (not validated: [`crate::domain::plane::build_graph`]) |
+//! | XML with a `THBSpline2` geometry | [`Document::Thb`] |
 //! | XML with `TensorBSpline3` / `TensorNurbs3` | [`Document::Volume`] |
 //! | XML with a `<MultiPatch>` of surfaces in space (`geoDim="3"`, not all in one plane `z = const`) | [`Document::VolumeBoundary`] (faces identified, validated) |
 //! | XML with a `<MultiPatch>` of surfaces (two patches or more, or interfaces) | [`Document::Layout`] |
@@ -43,6 +45,7 @@ use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
 use crate::pipeline::Input;
+use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::spline::surface::{Side, Surface};
 use crate::spline::volume::Volume;
 
@@ -86,12 +89,20 @@ pub enum Document {
     /// The six boundary faces of a hexahedral volume (`formats-extensions.md`, "Volume boundary"),
     /// validated.
     VolumeBoundary(VolumeBoundary),
+    /// A THB map (`formats-extensions.md`, "THB map"): a JSON map of kind `"thb"`, or G+Smo
+    /// `THBSpline2` ([`super::hierarchical`]).
+    Thb {
+        /// Name of the geometry.
+        name: String,
+        /// The map.
+        map: HierarchicalMap,
+    },
 }
 
 impl Document {
     /// The kind, for messages: `"boundary"`, `"map"`, `"ring map"` (a map with `eta`
     /// periodic), `"ring"`, `"multipatch layout"`, `"multipatch result"`, `"domain"`,
-    /// `"graph"`, `"volume"`, `"volume boundary"`.
+    /// `"graph"`, `"volume"`, `"volume boundary"`, `"THB map"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Document::Boundary(_) => "boundary",
@@ -104,6 +115,7 @@ impl Document {
             Document::Graph(_) => "graph",
             Document::Volume { .. } => "volume",
             Document::VolumeBoundary(_) => "volume boundary",
+            Document::Thb { .. } => "THB map",
         }
     }
 
@@ -116,7 +128,7 @@ impl Document {
             Document::Domain(d) => &d.name,
             Document::VolumeBoundary(b) => &b.name,
             Document::Graph(g) => &g.name,
-            Document::Map { name, .. } | Document::Volume { name, .. } => name,
+            Document::Map { name, .. } | Document::Volume { name, .. } | Document::Thb { name, .. } => name,
         }
     }
 
@@ -128,7 +140,7 @@ impl Document {
             Document::Domain(d) => &mut d.name,
             Document::VolumeBoundary(b) => &mut b.name,
             Document::Graph(g) => &mut g.name,
-            Document::Map { name, .. } | Document::Volume { name, .. } => name,
+            Document::Map { name, .. } | Document::Volume { name, .. } | Document::Thb { name, .. } => name,
         }
     }
 
@@ -190,8 +202,8 @@ impl Document {
     /// The pipeline input this document is ([`Input`]): a boundary (validated and, with
     /// `opts.reorient`, turned counter-clockwise; a map stands for its boundary), a ring
     /// or a ring map (its two contours), a multipatch layout or result (solved again from
-    /// its patches' sides), a domain, a plane graph, or a volume boundary. A volume, which
-    /// has nothing left to solve, is an [`Error::DocumentKind`].
+    /// its patches' sides), a domain, a plane graph, or a volume boundary. A volume or a
+    /// THB map, which have nothing left to solve, are an [`Error::DocumentKind`].
     pub fn into_input(self, opts: &super::ReadOptions) -> Result<Input> {
         Ok(match self {
             Document::Layout(l) | Document::Multipatch(l) => Input::Layout(l),
@@ -209,6 +221,11 @@ impl Document {
                     "a boundary, ring, layout, domain, graph or volume boundary is needed (a volume is already solved)",
                 ))
             }
+            doc @ Document::Thb { .. } => return Err(doc.wrong_kind(
+                None,
+                "a boundary, ring, layout, domain, graph or volume boundary is needed (a THB map is already solved: \
+                     `winslow check` certifies it, `winslow convert` turns it into a tensor map)",
+            )),
             doc => Input::Boundary(super::checked_boundary(doc.into_boundary()?, opts)?.0),
         })
     }
@@ -219,7 +236,8 @@ fn json_document(body: &str) -> Result<Document> {
         serde_json::from_str(body).map_err(|e| Error::Json { context: String::new(), message: e.to_string() })?;
     let Value::Object(obj) = &v else { return parse_json(body) };
     if super::hierarchical::is_thb_json(&v) {
-        return Err(thb_kind());
+        let (name, map) = super::hierarchical::thb_of_json(v)?;
+        return Ok(Document::Thb { name, map });
     }
     if let Some(Value::Array(patches)) = obj.get("patches") {
         let solved = !patches.is_empty() && patches.iter().all(|p| p.get("map").is_some());
@@ -246,21 +264,9 @@ fn json_document(body: &str) -> Result<Document> {
     parse_json(body)
 }
 
-/// A THB map is read by [`super::hierarchical`] (`winslow check` and `winslow convert`),
-/// not as a tensor map.
-fn thb_kind() -> Error {
-    Error::DocumentKind {
-        path: None,
-        found: "THB map".into(),
-        needed: "a tensor map or another document here (`winslow check` certifies a THB map, `winslow convert` \
-                 turns it into a tensor map)"
-            .into(),
-    }
-}
-
 fn xml_document(body: &str) -> Result<Document> {
     if body.contains("\"THBSpline2\"") {
-        return Err(thb_kind());
+        return Ok(Document::Thb { name: String::new(), map: super::hierarchical::parse_thb_xml(body)? });
     }
     if body.contains("TensorBSpline3") || body.contains("TensorNurbs3") {
         return Ok(Document::Volume { name: String::new(), volume: parse_gismo_volume(body)? });

@@ -1,6 +1,8 @@
 //! THB maps ([`HierarchicalMap`]) in files: the JSON map kind `"thb"` (`formats-extensions.md`,
 //! "THB map") and G+Smo XML `THBSpline2` (a `THBSplineBasis2` over the level-0
-//! `TensorBSplineBasis2`, one `<box level="l">` per refined region). Both writers and
+//! `TensorBSplineBasis2`, one `<box level="l">` per refined region), read as
+//! [`Document::Thb`](super::Document::Thb) by [`read`](super::read) and written as
+//! [`Output::Thb`](super::Output::Thb) by [`write`](super::write()). Both writers and
 //! readers round-trip bit for bit: numbers in the shortest round-trip form, the refined
 //! cells listed level by level, the control points in the order of the active functions
 //! (by level, then the `eta` index, then the `xi` index: G+Smo's order too).
@@ -12,7 +14,6 @@
 //! cells dyadically; the writer writes one box per refined cell.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
 use roxmltree::Node;
 use serde::{Deserialize, Serialize};
@@ -58,16 +59,6 @@ pub fn is_thb_json(v: &Value) -> bool {
     v.get("map").and_then(|m| m.get("kind")).and_then(Value::as_str) == Some("thb")
 }
 
-/// Whether a text is a THB map document: JSON with `map.kind == "thb"`, or G+Smo XML with a
-/// `THBSpline2` geometry.
-pub fn is_thb_text(text: &str) -> bool {
-    let body = text.trim_start_matches('\u{feff}').trim_start();
-    if body.starts_with('{') {
-        return body.contains("\"thb\"") && serde_json::from_str::<Value>(body).is_ok_and(|v| is_thb_json(&v));
-    }
-    body.starts_with('<') && body.contains("\"THBSpline2\"")
-}
-
 fn map_of(map: ThbJson, ctx: &str) -> Result<HierarchicalMap> {
     let bad = |m: String| Error::Json { context: ctx.to_string(), message: m };
     if map.kind != "thb" {
@@ -88,23 +79,17 @@ pub fn parse_thb(text: &str) -> Result<(String, HierarchicalMap)> {
     if body.starts_with('<') {
         return Ok((String::new(), parse_thb_xml(body)?));
     }
-    let doc: ThbDoc =
+    let v: Value =
         serde_json::from_str(body).map_err(|e| Error::Json { context: "THB map".into(), message: e.to_string() })?;
-    Ok((doc.name, map_of(doc.map, "map")?))
+    thb_of_json(v)
 }
 
-/// Read a file if it holds a THB map (`None` otherwise); a THB map without a name is named
-/// after the file stem.
-pub fn read_thb(path: &Path) -> Result<Option<(String, HierarchicalMap)>> {
-    let text = super::read_text(path)?;
-    if !is_thb_text(&text) {
-        return Ok(None);
-    }
-    let (mut name, map) = parse_thb(&text).map_err(|e| e.within(&path.display().to_string()))?;
-    if name.is_empty() {
-        name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    }
-    Ok(Some((name, map)))
+/// The name (empty when none) and map of a THB map document given as JSON; further
+/// top-level fields (e.g. `report`) are ignored.
+pub(crate) fn thb_of_json(v: Value) -> Result<(String, HierarchicalMap)> {
+    let doc: ThbDoc =
+        serde_json::from_value(v).map_err(|e| Error::Json { context: "THB map".into(), message: e.to_string() })?;
+    Ok((doc.name, map_of(doc.map, "map")?))
 }
 
 /// The JSON document of a THB map; `extra` (e.g. `{"report": ...}`) is merged at the top.
@@ -236,20 +221,6 @@ pub fn parse_thb_xml(text: &str) -> Result<HierarchicalMap> {
     HierarchicalMap::new(b, vals.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
 }
 
-/// Write a THB map by extension: `.json` (the `thb` map kind) or `.xml` (G+Smo
-/// `THBSpline2`), through the atomic writer.
-pub fn write_thb(path: &Path, name: &str, map: &HierarchicalMap, extra: Option<Value>) -> Result<()> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    match ext.as_str() {
-        "json" => super::json::write_json(path, &thb_to_json(name, map, extra)),
-        "xml" => super::write_bytes(path, thb_to_gismo_xml(map, "").as_bytes()),
-        _ => Err(Error::Invalid(format!(
-            "{}: a THB map is written as .json or .xml (G+Smo THBSpline2), not .{ext}",
-            path.display()
-        ))),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -272,7 +243,6 @@ mod tests {
     fn json_round_trip_is_bit_for_bit() {
         let map = sample();
         let text = serde_json::to_string_pretty(&thb_to_json("t", &map, None)).unwrap();
-        assert!(is_thb_text(&text));
         let (name, back) = parse_thb(&text).unwrap();
         assert_eq!(name, "t");
         assert_eq!(back.basis.active_functions(), map.basis.active_functions());
@@ -285,7 +255,6 @@ mod tests {
     fn gismo_xml_round_trip_is_bit_for_bit() {
         let map = sample();
         let xml = thb_to_gismo_xml(&map, "");
-        assert!(is_thb_text(&xml));
         let back = parse_thb_xml(&xml).unwrap();
         assert_eq!(back.basis.active_functions(), map.basis.active_functions());
         assert_eq!(back.control_points, map.control_points);
@@ -323,7 +292,7 @@ mod tests {
         let (l, c) = map.basis.cell_at(0.3, 0.3);
         let map = map.refined(&[(l, c)], 2).unwrap();
         let text = serde_json::to_string_pretty(&thb_to_json("sector_thb", &map, None)).unwrap() + "\n";
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/thb/sector_thb.json");
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/thb/sector_thb.json");
         if std::env::var_os("WINSLOW_BLESS").is_some() {
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();
             crate::io::write_bytes(&path, text.as_bytes()).unwrap();

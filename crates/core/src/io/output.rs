@@ -5,6 +5,7 @@
 //! | output | extensions |
 //! |---|---|
 //! | map | `.json` (map document with the extra fields), `.xml` (G+Smo), `.igs`/`.iges` (IGES 5.3 entity 128), `.vtu` (exact Bézier cells), `.vtk` (sampled structured grid) |
+//! | THB map | `.json` (the `thb` map kind with the extra fields), `.xml` (G+Smo `THBSpline2`) |
 //! | volume | `.json`, `.xml` (G+Smo `TensorBSpline3`), `.vtu` (Bézier hexahedra), `.vtk` (sampled grid) |
 //! | multipatch | `.json` (multipatch document), `.xml` (G+Smo `<MultiPatch>`), `.vtm` (VTK multiblock, one `.vtu` per patch in a folder beside it) |
 //! | layout, boundary, ring | `.json` |
@@ -20,6 +21,7 @@ use serde_json::Value;
 
 use super::file::{write_bytes, write_with};
 use super::gismo_writer::{surface_to_gismo_xml, volume_to_gismo_xml};
+use super::hierarchical::{thb_to_gismo_xml, thb_to_json};
 use super::iges::surface_to_iges;
 use super::json::{boundary_to_json, map_to_json, write_json};
 use super::multipatch::json::layout_to_json;
@@ -34,6 +36,7 @@ use crate::boundary::Boundary;
 use crate::domain::{Domain, PlaneGraph};
 use crate::error::{Error, Result};
 use crate::multipatch::Layout;
+use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::spline::surface::Surface;
 use crate::spline::volume::Volume;
 
@@ -49,6 +52,17 @@ pub enum Output<'a> {
         name: &'a str,
         /// The map.
         map: &'a Surface,
+        /// One line (e.g. the verdict) for the file's comment, where the format has one.
+        label: &'a str,
+        /// Further top-level fields of the JSON document (e.g. `{"report": ...}`).
+        extra: Option<Value>,
+    },
+    /// A THB map ([`super::hierarchical`]).
+    Thb {
+        /// Name of the geometry (the JSON `name`).
+        name: &'a str,
+        /// The map.
+        map: &'a HierarchicalMap,
         /// One line (e.g. the verdict) for the file's comment, where the format has one.
         label: &'a str,
         /// Further top-level fields of the JSON document (e.g. `{"report": ...}`).
@@ -88,6 +102,7 @@ impl Output<'_> {
     pub fn kind(&self) -> &'static str {
         match self {
             Output::Map { .. } => "map",
+            Output::Thb { .. } => "THB map",
             Output::Volume { .. } => "volume",
             Output::Multipatch(_) => "multipatch result",
             Output::Layout(_) => "multipatch layout",
@@ -107,7 +122,7 @@ impl Output<'_> {
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
             Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => ".json",
-            Output::VolumeBoundary(_) => ".json or .xml",
+            Output::VolumeBoundary(_) | Output::Thb { .. } => ".json or .xml",
             Output::Picture(_) => ".png",
         }
     }
@@ -144,6 +159,8 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         }
         (Output::Map { map, label, .. }, "vtu") => text(bezier_vtu(map, label)?),
         (Output::Map { map, .. }, "vtk") => text(structured_grid_vtk(map, MAP_VTK_SAMPLES)),
+        (Output::Thb { name, map, extra, .. }, "json" | "") => write_json(path, &thb_to_json(name, map, extra.clone())),
+        (Output::Thb { map, label, .. }, "xml") => text(thb_to_gismo_xml(map, label)),
         (Output::Volume { name, volume, extra, .. }, "json" | "") => {
             write_json(path, &volume_to_json(name, volume, extra.clone()))
         }

@@ -24,3 +24,5 @@ pub(crate) mod multigrid;
 pub mod ordering;
 pub mod sparse;
 pub mod split_cholesky;
+
+pub use krylov::MatVec;

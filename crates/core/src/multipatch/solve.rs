@@ -252,6 +252,7 @@ fn solve_patch(
         basis: BasisReport { requested: BasisChoice::Input, used: BasisChoice::Input, fallback: None, kinks: None },
         kinked: None,
         similarity: Similarity::IDENTITY,
+        detected: crate::boundary::kinks::detect(&boundary, crate::boundary::KinkMode::Auto, true),
     };
     let mut o = opts.clone();
     o.levels.refine = 0;

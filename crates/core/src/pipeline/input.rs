@@ -15,6 +15,7 @@ use crate::solve::warm::WarmStart;
 use crate::spline::surface::Surface;
 
 use super::start::Improved;
+use super::thb::ThbSolution;
 
 /// What the pipeline solves.
 #[derive(Debug, Clone)]
@@ -141,6 +142,9 @@ pub enum Solved {
     Improved(Box<Improved>),
     /// A boundary solved from the previous shape's map ([`super::Pipeline::warm_start`]).
     Warm(Box<WarmStart>),
+    /// With [`Refinement::Thb`](crate::solve::options::Refinement::Thb): the map of a
+    /// boundary or a ring that folded, repaired by THB defect correction.
+    Thb(Box<ThbSolution>),
 }
 
 impl Solved {
@@ -153,6 +157,7 @@ impl Solved {
             Solved::Volume(v) => Verdict::of_finding(&v.certificate.verdict),
             Solved::Improved(m) => m.report.verdict,
             Solved::Warm(w) => w.verdict,
+            Solved::Thb(t) => t.report.verdict,
         }
     }
 
@@ -167,7 +172,8 @@ impl Solved {
         }
     }
 
-    /// The kind of result, for messages: `"map"`, `"multipatch result"`, `"volume"`.
+    /// The kind of result, for messages: `"map"`, `"multipatch result"`, `"volume"`,
+    /// `"improved map"`, `"warm-started map"`, `"THB map"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Solved::Map(_) => "map",
@@ -175,6 +181,7 @@ impl Solved {
             Solved::Volume(_) => "volume",
             Solved::Improved(_) => "improved map",
             Solved::Warm(_) => "warm-started map",
+            Solved::Thb(_) => "THB map",
         }
     }
 }

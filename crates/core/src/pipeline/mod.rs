@@ -5,6 +5,8 @@
 //! boundary, ring: fit (§5, §7) → hierarchy (§5.4) → coarse-to-fine solve (§6.3)
 //!   → defect correction (§8.2) → kinks kept (§9) → improvement (§4.1)
 //!   → certificate (§8.1) → report
+//!   → with `--refinement thb` and a folded or undecided map: THB defect correction (§8.2
+//!     on a THB basis, [`thb`](mod@thb)), a THB map
 //!   → with `--basis auto`: solved again on the fitted basis when the input basis' map is
 //!     not certified
 //! layout (§11.2): conforming bases → every patch solved as above on them, in parallel
@@ -38,9 +40,11 @@ pub mod compare;
 mod input;
 pub(crate) mod start;
 pub mod sweep;
+mod thb;
 
 pub use input::{Input, Solved};
 pub use start::{Improved, ImprovedReport};
+pub use thb::{ThbReport, ThbSolution};
 
 use std::sync::Arc;
 
@@ -54,8 +58,9 @@ use crate::error::{Error, Result};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
 use crate::methods::Method;
 use crate::multipatch::{solve_multipatch, LayoutEvent};
+use crate::solve::hierarchical::ThbRound;
 use crate::solve::memory::MemoryEstimate;
-use crate::solve::options::{Refinement, SolveOptions};
+use crate::solve::options::SolveOptions;
 use crate::solve::report::WarmNote;
 use crate::solve::report::{Solution, Verdict};
 use crate::solve::solver::{EggSolver, Event};
@@ -107,6 +112,10 @@ pub enum Stage<'a> {
         /// The method.
         method: &'a dyn Method,
     },
+    /// A round of the THB defect correction finished ([`Solved::Thb`]): the offending
+    /// cells of the map it started from, the cells refined, the solve on the refined
+    /// basis.
+    ThbRound(&'a ThbRound),
     /// A volume boundary's solve starts (common bases, Coons start, the trivariate
     /// Winslow minimisation, its certificate; [`solve_volume`]).
     Volume {
@@ -197,8 +206,12 @@ impl Pipeline {
                     },
                     None => None,
                 };
+                let opts = self.opts.clone();
                 let (mut sol, _) = self.run_keeping_hierarchy(observer)?;
                 sol.report.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
+                if thb::repairs(&sol, &opts) {
+                    return thb::repair(sol, &opts, observer).map(|t| Solved::Thb(Box::new(t)));
+                }
                 Ok(Solved::Map(Box::new(sol)))
             }
             Input::Layout(_) => self.run_layout(None, observer),
@@ -299,11 +312,8 @@ impl Pipeline {
         self.opts.validate()?;
         let first = self.attempt(&self.opts, observer)?;
         // with THB refinement a folded or undecided map on the input basis is repaired
-        // locally by the front end (`solve::hierarchical`), on the input basis
-        let thb_repairs = self.opts.repair.refinement == Refinement::Thb
-            && self.opts.repair.rounds > 0
-            && matches!(first.0.report.verdict, Verdict::Folded | Verdict::Undecided);
-        let fallback = if thb_repairs { None } else { auto_fallback(&first.0, &self.opts.fit) };
+        // locally ([`thb`](mod@thb)), on the input basis
+        let fallback = if thb::repairs(&first.0, &self.opts) { None } else { auto_fallback(&first.0, &self.opts.fit) };
         let Some((fitted, why)) = fallback else { return Ok(first) };
         if !observer(&Stage::Fallback { reason: &why }) {
             return Err(Error::Cancelled);

@@ -154,6 +154,16 @@ pub fn solve_egg(
 /// `opts.rounds` rounds; stops as soon as the certificate accepts the map, or when a
 /// round has nothing to refine.
 pub fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRepair> {
+    repair_thb_observed(map, opts, &mut |_| true)
+}
+
+/// [`repair_thb`], every finished round to `observer`; [`Error::Cancelled`] when it
+/// returns `false` (the pipeline's [`Stage::ThbRound`](crate::pipeline::Stage::ThbRound)).
+pub fn repair_thb_observed(
+    map: HierarchicalMap,
+    opts: &ThbRepairOptions,
+    observer: &mut dyn FnMut(&ThbRound) -> bool,
+) -> Result<ThbRepair> {
     let mut map = map;
     let mut cert = certify_hierarchical(&map, &opts.certify)?;
     let mut rounds = Vec::new();
@@ -169,7 +179,7 @@ pub fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRe
         map = solved;
         let verdict = cert.verdict.name();
         cert = certify_hierarchical(&map, &opts.certify)?;
-        rounds.push(ThbRound {
+        let round = ThbRound {
             round: rounds.len() + 1,
             verdict,
             offending_cells: offending.len(),
@@ -180,7 +190,11 @@ pub fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRe
             iterations,
             converged,
             seconds: t0.elapsed().as_secs_f64(),
-        });
+        };
+        if !observer(&round) {
+            return Err(Error::Cancelled);
+        }
+        rounds.push(round);
     }
     Ok(ThbRepair { map, certificate: cert, rounds })
 }

@@ -414,19 +414,18 @@ fn distance_to_curve(c: &crate::spline::curve::Curve, x: Point) -> f64 {
 }
 
 /// The kinks of the report: those the hierarchy keeps (`kept` says whether the `C^0`
-/// route kept them on `map`) and those [`detect`](crate::boundary::kinks::detect) finds
-/// with the thresholds of `--kinks auto` but nothing keeps (rounded), each with the
-/// distance of `map` (in the input's coordinates, like `boundary`) from the point.
+/// route kept them on `map`) and those it detected with the thresholds of `--kinks auto`
+/// ([`Hierarchy::detected`](crate::boundary::hierarchy::Hierarchy::detected)) but nothing
+/// keeps (rounded, their points those of `boundary`'s sides), each with the distance of
+/// `map` (in the input's coordinates, like `boundary`) from the point.
 pub fn kink_reports(
     boundary: &crate::boundary::Boundary,
     h: &crate::boundary::hierarchy::Hierarchy,
     map: &Surface,
     kept: bool,
 ) -> Vec<crate::boundary::corners::KinkReport> {
-    use crate::boundary::kinks::{detect, Kink, KinkMode};
-    use crate::boundary::BasisChoice;
+    use crate::boundary::kinks::Kink;
     let kept_list: &[Kink] = h.kinked.as_ref().map_or(&[], |k| &k.kinks);
-    let input = h.basis.used == BasisChoice::Input;
     let entry = |k: &Kink, point: Point, kept: bool| {
         let side = map.boundary(k.side);
         let at = if kept { k.map_parameter } else { None };
@@ -449,9 +448,10 @@ pub fn kink_reports(
         }
     };
     let mut out: Vec<_> = kept_list.iter().map(|k| entry(k, h.similarity.to_physical(k.point), kept)).collect();
-    for k in detect(boundary, KinkMode::Auto, input) {
+    for k in &h.detected {
         if !kept_list.iter().any(|x| x.side == k.side && (x.parameter - k.parameter).abs() <= 1e-12) {
-            out.push(entry(&k, k.point, false));
+            let point = k.point_on(boundary).unwrap_or_else(|| h.similarity.to_physical(k.point));
+            out.push(entry(k, point, false));
         }
     }
     let side = |name: &str| Side::ALL.iter().position(|s| s.name() == name);

@@ -99,8 +99,8 @@ pub struct RepairOptions {
     /// the prolonged map (paper §8.2: fewer unknowns).
     pub freeze: Option<usize>,
     /// How defect correction refines: tensor knot spans across the patch (the rounds of
-    /// the solve), or THB cells around the defect only ([`crate::solve::hierarchical`],
-    /// run on the unrepaired map).
+    /// `rounds` in the solve), or THB cells around the defect only
+    /// ([`crate::solve::hierarchical`], run by the pipeline on the unrepaired map).
     pub refinement: Refinement,
 }
 

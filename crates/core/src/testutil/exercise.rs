@@ -132,7 +132,8 @@ pub fn exercise_document(doc: Document, trace: &mut Trace) {
         | Document::Layout(_)
         | Document::Multipatch(_)
         | Document::Volume { .. }
-        | Document::VolumeBoundary(_) => {}
+        | Document::VolumeBoundary(_)
+        | Document::Thb { .. } => {}
     }
 }
 

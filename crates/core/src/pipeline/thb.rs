@@ -1,0 +1,192 @@
+//! The THB defect correction as a stage of the pipeline (paper §8.2 on a truncated
+//! hierarchical basis, §4; issue 35). With [`Refinement::Thb`] the coarse-to-fine solve
+//! runs without tensor repair rounds; when its map is folded or undecided and repair
+//! rounds are allowed, the map becomes a THB map on the same basis (exact: a one-level
+//! hierarchy) and [`repair_thb_observed`] refines only the offending cells and a ring
+//! around them, round by round ([`Stage::ThbRound`](super::Stage::ThbRound)), until the
+//! certificate accepts the map or the rounds run out. The result is
+//! [`Solved::Thb`](super::Solved::Thb): the THB map and its [`ThbReport`].
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::{Observer, Stage};
+use crate::error::Result;
+use crate::solve::hierarchical::{repair_thb_observed, ThbRepairOptions, ThbRound};
+use crate::solve::options::{Refinement, SolveOptions};
+use crate::solve::report::{Report, Solution, Verdict};
+use crate::spline::hierarchical::map::HierarchicalMap;
+use crate::verify::certificate::hierarchical::HierarchicalCertificate;
+
+/// A THB map solved by the pipeline: the tensor solve's map repaired by THB defect
+/// correction.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct ThbSolution {
+    /// Name of the geometry.
+    pub name: String,
+    /// The THB map.
+    pub map: HierarchicalMap,
+    /// What the tensor solve and the THB rounds did.
+    pub report: ThbReport,
+}
+
+/// The report of a THB solve (the `report` of the THB map document `winslow solve
+/// --refinement thb` writes, and its `--json` output).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct ThbReport {
+    /// Always [`Refinement::Thb`] (`"thb"`).
+    pub refinement: Refinement,
+    /// The verdict of the THB map's certificate.
+    pub verdict: Verdict,
+    /// The certificate's summary.
+    pub message: String,
+    /// The certificate of the THB map, active cell by active cell.
+    pub certificate: HierarchicalCertificate,
+    /// THB functions of the map.
+    pub functions: usize,
+    /// Levels of its hierarchy.
+    pub levels: usize,
+    /// Free unknowns of the last round's solve (0 when no round ran).
+    pub unknowns: usize,
+    /// The rounds of the defect correction.
+    pub thb_rounds: Vec<ThbRound>,
+    /// Seconds of the THB stage (the conversion, the rounds, the certificates).
+    pub thb_seconds: f64,
+    /// The report of the tensor solve the THB stage started from.
+    pub solve: Report,
+}
+
+impl ThbSolution {
+    /// Whether the map is certified (or degenerate only at corners the boundary forces).
+    pub fn success(&self) -> bool {
+        matches!(self.report.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+    }
+}
+
+/// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`], repair
+/// rounds allowed, and the map folded or undecided.
+pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
+    opts.repair.refinement == Refinement::Thb
+        && opts.repair.rounds > 0
+        && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
+}
+
+/// The THB defect correction of the tensor solve `sol` (see the module documentation):
+/// at most `opts.repair.rounds` rounds, each refining the offending cells and `opts.repair.halo`
+/// cells around them, EGG with the options' operator and Newton options, the
+/// certificate with theirs; every round to `observer`.
+pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<ThbSolution> {
+    let t0 = Instant::now();
+    let start = HierarchicalMap::from_surface(&sol.map)?;
+    let topts = ThbRepairOptions {
+        rounds: opts.repair.rounds,
+        ring: opts.repair.halo,
+        operator: opts.operator,
+        nonlinear: opts.nonlinear,
+        certify: opts.certify,
+        ..Default::default()
+    };
+    let out = repair_thb_observed(start, &topts, &mut |round| observer(&Stage::ThbRound(round)))?;
+    let c = out.certificate;
+    let report = ThbReport {
+        refinement: Refinement::Thb,
+        verdict: Verdict::of_finding(&c.verdict),
+        message: c.message(),
+        functions: out.map.basis.len(),
+        levels: out.map.basis.num_levels(),
+        unknowns: out.rounds.last().map_or(0, |r| r.unknowns),
+        certificate: c,
+        thb_rounds: out.rounds,
+        thb_seconds: t0.elapsed().as_secs_f64(),
+        solve: sol.report,
+    };
+    Ok(ThbSolution { name: sol.name, map: out.map, report })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Pipeline, Solved};
+    use super::*;
+    use crate::error::Error;
+    use crate::io::{read_boundary, ReadOptions};
+    use crate::solve::hierarchical::{accepted, repair_thb};
+    use crate::testutil::data;
+
+    /// puzzle4 with `--refinement thb` (the geometry of the CLI's THB test): the
+    /// pipeline's THB result is, bit for bit, what the front end made before the stage
+    /// moved into the pipeline (the tensor solve without repair, then [`repair_thb`] with
+    /// the options' rounds, halo, operator, Newton and certificate options); the observer
+    /// sees every round, in order, after the tensor solve's stages, and stops the run at
+    /// the first round with [`Error::Cancelled`].
+    #[test]
+    fn the_thb_stage_gives_what_the_front_end_gave_and_is_observed() {
+        let b = read_boundary(&data("gismo/puzzle4.json"), &ReadOptions::default()).unwrap();
+        let mut opts = SolveOptions::default();
+        opts.repair.refinement = Refinement::Thb;
+        // the former path: the pipeline's map (no tensor repair, no fallback), then the repair
+        let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
+        assert!(repairs(&unrepaired, &opts), "{:?}", unrepaired.report.verdict);
+        let topts = ThbRepairOptions {
+            rounds: opts.repair.rounds,
+            ring: opts.repair.halo,
+            operator: opts.operator,
+            nonlinear: opts.nonlinear,
+            certify: opts.certify,
+            ..Default::default()
+        };
+        let before = repair_thb(HierarchicalMap::from_surface(&unrepaired.map).unwrap(), &topts).unwrap();
+        assert!(accepted(&before.certificate), "{}", before.certificate.message());
+
+        let mut seen = Vec::new();
+        let solved = Pipeline::new(b.clone(), opts.clone())
+            .run(&mut |stage| {
+                seen.push(match stage {
+                    Stage::ThbRound(r) => format!("round {} {}", r.round, r.functions),
+                    _ => "tensor".to_string(),
+                });
+                true
+            })
+            .unwrap();
+        assert_eq!(solved.kind(), "THB map");
+        assert_eq!(solved.verdict(), Verdict::of_finding(&before.certificate.verdict));
+        let Solved::Thb(t) = solved else { unreachable!() };
+        assert_eq!(t.name, "puzzle4");
+        assert_eq!(t.map.basis.active_functions(), before.map.basis.active_functions());
+        assert_eq!(t.map.control_points, before.map.control_points);
+        let r = &t.report;
+        assert_eq!((r.functions, r.levels), (before.map.basis.len(), before.map.basis.num_levels()));
+        assert_eq!(r.unknowns, before.rounds.last().unwrap().unknowns);
+        assert_eq!(r.message, before.certificate.message());
+        assert_eq!(r.solve.verdict, unrepaired.report.verdict);
+        let strip = |rounds: &[ThbRound]| -> Vec<_> {
+            rounds.iter().map(|x| (x.round, x.offending_cells, x.marked_cells, x.functions, x.iterations)).collect()
+        };
+        assert_eq!(strip(&r.thb_rounds), strip(&before.rounds));
+        // the report's JSON fields, as the CLI wrote them by hand before
+        let v = serde_json::to_value(r).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        for k in ["refinement", "verdict", "message", "certificate", "functions", "levels", "unknowns"] {
+            assert!(keys.contains(&k), "{k} in {keys:?}");
+        }
+        for k in ["thb_rounds", "thb_seconds", "solve"] {
+            assert!(keys.contains(&k), "{k} in {keys:?}");
+        }
+        assert_eq!(
+            (v["refinement"].as_str(), v["verdict"].as_str()),
+            (Some("thb"), Some(before.certificate.verdict.name()))
+        );
+        // every round observed, after the tensor stages
+        let rounds: Vec<&String> = seen.iter().filter(|s| s.starts_with("round")).collect();
+        let expected: Vec<String> =
+            before.rounds.iter().map(|x| format!("round {} {}", x.round, x.functions)).collect();
+        assert_eq!(rounds, expected.iter().collect::<Vec<_>>());
+        let first = seen.iter().position(|s| s.starts_with("round")).unwrap();
+        assert!(first > 0 && seen[first..].iter().all(|s| s.starts_with("round")), "{seen:?}");
+        // stopped at the first round
+        let out = Pipeline::new(b, opts).run(&mut |stage| !matches!(stage, Stage::ThbRound(_)));
+        assert!(matches!(out, Err(Error::Cancelled)), "{:?}", out.map(|s| s.kind()));
+    }
+}
