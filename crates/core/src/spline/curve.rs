@@ -60,7 +60,8 @@ impl Curve {
     /// Validate lengths, finiteness and weights; for a periodic knot vector, that the
     /// last `p` control points repeat the first `p` ([`crate::spline::periodic`]).
     pub fn new(knots: KnotVector, control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
-        let TensorSpline { knots: [knots], control_points, weights } = TensorSpline::checked([knots], control_points, weights)?;
+        let TensorSpline { knots: [knots], control_points, weights } =
+            TensorSpline::checked([knots], control_points, weights)?;
         Ok(Self { knots, control_points, weights })
     }
 

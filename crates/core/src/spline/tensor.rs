@@ -39,7 +39,11 @@ pub(crate) type Homogeneous<const D: usize> = ([f64; D], f64);
 /// the stored control points (and weights) `i_dir >= d` must repeat `i_dir - d`
 /// (wrapped indices, see [`crate::spline::periodic`]), to `1e-12` relative to the
 /// largest coordinate.
-pub(crate) fn check_wrapped<const D: usize>(knots: &[KnotVector], pts: &[[f64; D]], weights: Option<&[f64]>) -> Result<()> {
+pub(crate) fn check_wrapped<const D: usize>(
+    knots: &[KnotVector],
+    pts: &[[f64; D]],
+    weights: Option<&[f64]>,
+) -> Result<()> {
     let shape: Vec<usize> = knots.iter().map(KnotVector::num_basis).collect();
     let scale = pts.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
     let show = |p: &[f64; D]| p.map(|x| x.to_string()).join(", ");
@@ -130,7 +134,11 @@ pub(crate) fn projected<const D: usize>(h: &[Homogeneous<D>]) -> Vec<[f64; D]> {
 impl<const P: usize, const D: usize> TensorSpline<P, D> {
     /// Validate lengths, finiteness and weights, and that the control points of a periodic
     /// direction wrap ([`crate::spline::periodic`]); weights that are all 1 are dropped.
-    pub(crate) fn checked(knots: [KnotVector; P], control_points: Vec<[f64; D]>, weights: Option<Vec<f64>>) -> Result<Self> {
+    pub(crate) fn checked(
+        knots: [KnotVector; P],
+        control_points: Vec<[f64; D]>,
+        weights: Option<Vec<f64>>,
+    ) -> Result<Self> {
         let n: usize = knots.iter().map(KnotVector::num_basis).product();
         if control_points.len() != n {
             return Err(Error::Length {

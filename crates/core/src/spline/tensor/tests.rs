@@ -33,6 +33,15 @@ fn annulus() -> TensorSpline<2, 2> {
     TensorSpline::checked(knots, cps, Some(vec![1.0, w, 1.0, 1.0, w, 1.0])).unwrap()
 }
 
+/// The annulus extruded along `z ∈ [0, 1]`: a shell of a cylinder, rational in `u`.
+fn shell() -> TensorSpline<3, 3> {
+    let a = annulus();
+    let [k0, k1] = a.knots.clone();
+    let cps = [0.0, 1.0].iter().flat_map(|&z| a.control_points.iter().map(move |p| [p[0], p[1], z])).collect();
+    let w = a.weights.as_ref().unwrap();
+    TensorSpline::checked([k0, k1, KnotVector::open_uniform(1, 1)], cps, Some([w.clone(), w.clone()].concat())).unwrap()
+}
+
 fn value<const P: usize, const D: usize>(t: &TensorSpline<P, D>, u: [f64; P]) -> ([f64; D], [[f64; D]; P]) {
     let b: [BasisDerivs; P] = std::array::from_fn(|d| BasisDerivs::at(&t.knots[d], u[d], 1));
     t.first_derivs(b.each_ref())
@@ -44,7 +53,8 @@ const POINTS: [[f64; 3]; 5] = [[0.0, 0.0, 0.0], [0.3, 0.7, 0.2], [0.55, 0.1, 0.9
 fn insertion_and_elevation_reproduce_a_trivariate_polynomial() {
     let t = polynomial3();
     let fine = [t.knots[0].with_inserted(&[0.3, 0.3, 0.6]), t.knots[1].halved(), t.knots[2].with_inserted(&[0.25])];
-    let variants = [t.refined(&fine).unwrap(), t.elevated_in(1).unwrap().elevated_in(0).unwrap().refined_in(2, &fine[2]).unwrap()];
+    let variants =
+        [t.refined(&fine).unwrap(), t.elevated_in(1).unwrap().elevated_in(0).unwrap().refined_in(2, &fine[2]).unwrap()];
     for v in &variants {
         for u in POINTS {
             let (x, _) = value(v, u);
@@ -60,12 +70,31 @@ fn insertion_and_elevation_reproduce_a_trivariate_polynomial() {
 fn insertion_and_elevation_keep_a_rational_map_exact() {
     let a = annulus();
     let fine = [a.knots[0].with_inserted(&[0.2, 0.5, 0.5]), a.knots[1].with_inserted(&[0.4])];
-    for v in [a.refined(&fine).unwrap(), a.elevated_in(0).unwrap().elevated_in(1).unwrap(), a.refined_in(1, &fine[1]).unwrap()] {
+    for v in [
+        a.refined(&fine).unwrap(),
+        a.elevated_in(0).unwrap().elevated_in(1).unwrap(),
+        a.refined_in(1, &fine[1]).unwrap(),
+    ] {
         for [s, t, _] in POINTS {
             // radius 1 + t, at the angle of the original map
             let (x, _) = value(&v, [s, t]);
             let (y, _) = value(&a, [s, t]);
             assert!((x[0].hypot(x[1]) - (1.0 + t)).abs() < 1e-14, "{x:?}");
+            assert!((x[1].atan2(x[0]) - y[1].atan2(y[0])).abs() < 1e-14);
+        }
+    }
+}
+
+#[test]
+fn insertion_and_elevation_keep_a_rational_volume_exact() {
+    let v = shell();
+    let fine = [v.knots[0].with_inserted(&[0.5, 0.7]), v.knots[1].clone(), v.knots[2].with_inserted(&[0.3, 0.3])];
+    for f in [v.refined(&fine).unwrap(), v.elevated_in(2).unwrap().elevated_in(0).unwrap()] {
+        assert!(f.weights.is_some());
+        for u in POINTS {
+            let (x, _) = value(&f, u);
+            let (y, _) = value(&v, u);
+            assert!((x[0].hypot(x[1]) - (1.0 + u[1])).abs() < 1e-14 && (x[2] - u[2]).abs() < 1e-14, "{x:?} at {u:?}");
             assert!((x[1].atan2(x[0]) - y[1].atan2(y[0])).abs() < 1e-14);
         }
     }
@@ -109,6 +138,9 @@ fn indices_and_validation() {
     let mut bad = cps.clone();
     bad[5][2] = f64::INFINITY;
     assert!(matches!(TensorSpline::checked(knots.clone(), bad, None), Err(Error::NonFinite { .. })));
-    assert!(matches!(TensorSpline::checked(knots.clone(), cps.clone(), Some(vec![0.0; 12])), Err(Error::Weight { .. })));
+    assert!(matches!(
+        TensorSpline::checked(knots.clone(), cps.clone(), Some(vec![0.0; 12])),
+        Err(Error::Weight { .. })
+    ));
     assert_eq!(TensorSpline::checked(knots, cps, Some(vec![1.0; 12])).unwrap().weights, None);
 }
