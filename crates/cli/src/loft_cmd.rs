@@ -102,20 +102,13 @@ pub(super) fn run(a: LoftArgs) -> Result<i32> {
             "peak_memory_mib": output::peak_memory_mib() });
         files::print_json(v)?;
     } else {
-        let d = out.volume.degrees();
-        let s = out.volume.shape();
         say!(
             "{name}: {} slices ({} given, {inserted} inserted, boundary of inserted slices interpolated), {} interpolation, \
-             degrees ({}, {}, {}), {} x {} x {} control points, {} elements",
+             {}, {} elements",
             out.slices.len(),
             slices.len(),
             interpolation.name(),
-            d[0],
-            d[1],
-            d[2],
-            s[0],
-            s[1],
-            s[2],
+            crate::volume_cmd::degrees_and_shape(out.volume.degrees(), out.volume.shape()),
             cert.elements
         );
         say!("{}", cert.message());

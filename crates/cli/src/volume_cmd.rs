@@ -50,17 +50,10 @@ pub(super) fn finish(name: &str, out: VolumeSolve, a: &solve_cmd::SolveArgs) -> 
     if a.json {
         files::print_json(serde_json::json!({ "report": report, "certificate": cert }))?;
     } else {
-        let (d, s) = (report.degrees, report.shape);
         say!(
-            "{}: volume of degrees ({}, {}, {}), {} x {} x {} control points, {} unknowns; start {} ({} continuation step(s)), \
-             {} Newton iteration(s), Winslow energy {:.6e}",
+            "{}: volume of {}, {} unknowns; start {} ({} continuation step(s)), {} Newton iteration(s), Winslow energy {:.6e}",
             name,
-            d[0],
-            d[1],
-            d[2],
-            s[0],
-            s[1],
-            s[2],
+            degrees_and_shape(report.degrees, report.shape),
             report.unknowns,
             report.start,
             report.continuation_steps,
@@ -72,4 +65,10 @@ pub(super) fn finish(name: &str, out: VolumeSolve, a: &solve_cmd::SolveArgs) -> 
     }
     let code = output::exit_code(Verdict::of_finding(&cert.verdict));
     Ok(if code == 0 && !report.boundary_kept { 6 } else { code })
+}
+
+/// `degrees (p, q, r), n x m x l control points`: the basis of a volume in the printed
+/// summaries of `volume` and `loft`.
+pub(crate) fn degrees_and_shape(d: [usize; 3], s: [usize; 3]) -> String {
+    format!("degrees ({}, {}, {}), {} x {} x {} control points", d[0], d[1], d[2], s[0], s[1], s[2])
 }

@@ -248,12 +248,13 @@ pub(super) fn cells_and_end(out: &mut String, ne: usize, npe: usize, cell_type: 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::spline::knots::KnotVector;
 
-    /// Reads the arrays of a VTU written by [`bezier_vtu`] (a test-side parser).
-    fn arrays(vtu: &str) -> std::collections::BTreeMap<String, Vec<f64>> {
+    /// Reads the arrays of a VTU written by [`bezier_vtu`] or the volume writer (a
+    /// test-side parser).
+    pub(crate) fn arrays(vtu: &str) -> std::collections::BTreeMap<String, Vec<f64>> {
         let doc = roxmltree::Document::parse(vtu).unwrap();
         let mut out = std::collections::BTreeMap::new();
         for a in doc.descendants().filter(|n| n.has_tag_name("DataArray")) {

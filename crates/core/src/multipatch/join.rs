@@ -17,7 +17,6 @@ use super::check::SHARED_TOL;
 use super::problem::Functional;
 use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
-use crate::linalg::sparse::Csr;
 use crate::methods::weak_form::WeakFormMethod;
 use crate::methods::winslow::WinslowMethod;
 use crate::methods::Method;
@@ -25,7 +24,6 @@ use crate::solve::improve::{improve, Improvement};
 use crate::solve::newton::NonlinearOptions;
 use crate::spline::curve::Point;
 use crate::spline::knots::KnotVector;
-use crate::spline::refine::elevation;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate, CertifyOptions};
 
@@ -64,28 +62,9 @@ pub fn turned(map: &Surface, s: Side, target: Side) -> Surface {
 pub fn elevated_in(map: &Surface, d: usize, p: usize) -> Result<Surface> {
     let mut m = map.clone();
     while m.knots[d].degree() < p {
-        let (kv, e) = elevation(&m.knots[d])?;
-        let id = Csr::identity(m.knots[1 - d].num_basis());
-        let op = if d == 0 { id.kron(&e) } else { e.kron(&id) };
-        let (cps, w) = homogeneous(&op, &m.control_points, m.weights.as_deref());
-        let mut knots = m.knots.clone();
-        knots[d] = kv;
-        m = Surface { knots, control_points: cps, weights: w };
+        m = m.elevated_in(d)?;
     }
     Ok(m)
-}
-
-/// Apply `op` to the homogeneous coordinates `(w x, w y, w)`.
-fn homogeneous(op: &Csr, cps: &[Point], weights: Option<&[f64]>) -> (Vec<Point>, Option<Vec<f64>>) {
-    match weights {
-        None => (op.apply_points(cps), None),
-        Some(w) => {
-            let wc: Vec<Point> = cps.iter().zip(w).map(|(c, &w)| [c[0] * w, c[1] * w]).collect();
-            let wn = op.apply(w);
-            let cn = op.apply_points(&wc).into_iter().zip(&wn).map(|(c, &w)| [c[0] / w, c[1] / w]).collect();
-            (cn, Some(wn))
-        }
-    }
 }
 
 /// What [`join_maps`] did.

@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::spline::basis::BasisDerivs;
 use crate::spline::knots::KnotVector;
+use crate::spline::tensor::TensorSpline;
 
 /// A point or vector in the plane.
 pub type Point = [f64; 2];
@@ -30,13 +31,11 @@ pub struct CurveDerivs {
     pub d2: Point,
 }
 
-pub(crate) fn check_points(pts: &[Point], what: &str) -> Result<()> {
+pub(crate) fn check_points<const D: usize>(pts: &[[f64; D]], what: &str) -> Result<()> {
     for (i, p) in pts.iter().enumerate() {
-        if !p[0].is_finite() || !p[1].is_finite() {
-            return Err(Error::NonFinite {
-                context: String::new(),
-                what: format!("{what} {i} is ({}, {})", p[0], p[1]),
-            });
+        if p.iter().any(|x| !x.is_finite()) {
+            let p = p.map(|x| x.to_string()).join(", ");
+            return Err(Error::NonFinite { context: String::new(), what: format!("{what} {i} is ({p})") });
         }
     }
     Ok(())
@@ -57,54 +56,12 @@ pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
     Ok(())
 }
 
-/// For a periodic basis of dimension `d` with `n` stored functions: the stored control
-/// points (and weights) `k >= d` must repeat `k - d` (wrapped indices, see
-/// [`crate::spline::periodic`]), to `1e-12` relative to the largest coordinate. `at`
-/// maps a stored index to its position in `pts` (`stride` apart for tensor maps).
-pub(crate) fn check_wrapped(
-    pts: &[Point],
-    weights: Option<&[f64]>,
-    n: usize,
-    d: usize,
-    at: impl Fn(usize) -> Vec<usize>,
-) -> Result<()> {
-    let scale = pts.iter().fold(1.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
-    for k in d..n {
-        for (a, b) in at(k).into_iter().zip(at(k - d)) {
-            let gap = (pts[a][0] - pts[b][0]).abs().max((pts[a][1] - pts[b][1]).abs());
-            let wgap = weights.map_or(0.0, |w| (w[a] - w[b]).abs() / w[b]);
-            if gap > 1e-12 * scale || wgap > 1e-12 {
-                return Err(Error::Invalid(format!(
-                    "periodic control points must wrap: stored point {a} ({}, {}) must repeat point {b} ({}, {}) (the last p of {n} repeat the first p)",
-                    pts[a][0], pts[a][1], pts[b][0], pts[b][1]
-                )));
-            }
-        }
-    }
-    Ok(())
-}
-
 impl Curve {
     /// Validate lengths, finiteness and weights; for a periodic knot vector, that the
     /// last `p` control points repeat the first `p` (`spline::periodic`).
     pub fn new(knots: KnotVector, control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
-        let n = knots.num_basis();
-        if control_points.len() != n {
-            return Err(Error::Length {
-                context: String::new(),
-                what: "control_points".into(),
-                found: control_points.len(),
-                expected: n,
-            });
-        }
-        check_points(&control_points, "control point")?;
-        if let Some(w) = &weights {
-            check_weights(w, n)?;
-        }
-        if knots.is_periodic() {
-            check_wrapped(&control_points, weights.as_deref(), n, knots.dim(), |k| vec![k])?;
-        }
-        let weights = weights.filter(|w| w.iter().any(|&x| x != w[0]) || w[0] != 1.0);
+        let TensorSpline { knots: [knots], control_points, weights } =
+            TensorSpline::checked([knots], control_points, weights)?;
         Ok(Self { knots, control_points, weights })
     }
 

@@ -3,24 +3,17 @@
 //! `f = Σ w_ij c_ij N_i M_j / Σ w_ij N_i M_j`; control point `(i, j)` is stored at
 //! `j n_s + i` (`s` fastest).
 //!
-//! Knot insertion and degree elevation are those of [`Volume`] (exact, on homogeneous
-//! coordinates), applied to the face extruded into a slab of two equal layers.
+//! Validation, evaluation, knot insertion and degree elevation are those of the tensor
+//! core [`TensorSpline`] (exact, on homogeneous coordinates).
 
 use crate::error::{Error, Result};
 use crate::spline::basis::BasisDerivs;
 use crate::spline::knots::KnotVector;
-use crate::spline::volume::{Point3, Volume};
+use crate::spline::tensor::TensorSpline;
+use crate::spline::volume::Point3;
 
 /// A tensor-product B-spline or NURBS surface in space.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Face {
-    /// Knot vectors in `s` and `t`.
-    pub knots: [KnotVector; 2],
-    /// Control points, `s` index fastest.
-    pub control_points: Vec<Point3>,
-    /// Positive weights (NURBS) or `None`.
-    pub weights: Option<Vec<f64>>,
-}
+pub type Face = TensorSpline<2, 3>;
 
 /// Value and first derivatives `(f, f_s, f_t)` of a face.
 pub type FaceDerivs = (Point3, Point3, Point3);
@@ -32,118 +25,19 @@ impl Face {
         if knots.iter().any(KnotVector::is_periodic) {
             return Err(Error::Invalid("a face of a volume boundary cannot be periodic".into()));
         }
-        let v = Volume::new(
-            Self::slab_knots(&knots),
-            Self::doubled(&control_points),
-            weights.as_deref().map(Self::doubled),
-        )?;
-        let n = control_points.len();
-        let weights = v.weights.map(|mut w| {
-            w.truncate(n);
-            w
-        });
-        Ok(Self { knots, control_points, weights })
-    }
-
-    fn slab_knots(knots: &[KnotVector; 2]) -> [KnotVector; 3] {
-        [knots[0].clone(), knots[1].clone(), KnotVector::open_uniform(1, 1)]
-    }
-
-    fn doubled<T: Clone>(v: &[T]) -> Vec<T> {
-        v.iter().chain(v.iter()).cloned().collect()
-    }
-
-    /// The face as the slab `x(s, t, r) = f(s, t)` (two equal layers in `r`).
-    fn slab(&self) -> Volume {
-        Volume {
-            knots: Self::slab_knots(&self.knots),
-            control_points: Self::doubled(&self.control_points),
-            weights: self.weights.as_deref().map(Self::doubled),
-        }
-    }
-
-    fn from_slab(v: Volume) -> Self {
-        let [k0, k1, _] = v.knots;
-        let n = k0.num_basis() * k1.num_basis();
-        let mut control_points = v.control_points;
-        control_points.truncate(n);
-        let weights = v.weights.map(|mut w| {
-            w.truncate(n);
-            w
-        });
-        Self { knots: [k0, k1], control_points, weights }
-    }
-
-    /// Number of basis functions per direction.
-    pub fn shape(&self) -> [usize; 2] {
-        self.knots.each_ref().map(KnotVector::num_basis)
-    }
-
-    /// Degrees per direction.
-    pub fn degrees(&self) -> [usize; 2] {
-        self.knots.each_ref().map(KnotVector::degree)
-    }
-
-    /// Weight of control point `k` (1 for B-splines).
-    pub fn weight(&self, k: usize) -> f64 {
-        self.weights.as_ref().map_or(1.0, |w| w[k])
+        Self::checked(knots, control_points, weights)
     }
 
     /// `f(s, t)` and its first derivatives.
     pub fn derivs(&self, s: f64, t: f64) -> FaceDerivs {
         let b = [BasisDerivs::at(&self.knots[0], s, 1), BasisDerivs::at(&self.knots[1], t, 1)];
-        let ns = self.shape()[0];
-        let mut h = [[0.0f64; 4]; 3];
-        for jb in 0..=b[1].degree {
-            let j = b[1].first() + jb;
-            for ia in 0..=b[0].degree {
-                let i = b[0].first() + ia;
-                let k = j * ns + i;
-                let w = self.weight(k);
-                let c = self.control_points[k];
-                let vals =
-                    [b[0].d[0][ia] * b[1].d[0][jb], b[0].d[1][ia] * b[1].d[0][jb], b[0].d[0][ia] * b[1].d[1][jb]];
-                for (hh, &n) in h.iter_mut().zip(&vals) {
-                    let n = n * w;
-                    hh[0] += n * c[0];
-                    hh[1] += n * c[1];
-                    hh[2] += n * c[2];
-                    hh[3] += n;
-                }
-            }
-        }
-        let w = h[0][3];
-        let x = [h[0][0] / w, h[0][1] / w, h[0][2] / w];
-        let d = |a: usize| std::array::from_fn(|c| (h[a][c] - h[a][3] * x[c]) / w);
-        (x, d(1), d(2))
+        let (x, [ds, dt]) = self.first_derivs(b.each_ref());
+        (x, ds, dt)
     }
 
     /// `f(s, t)`.
     pub fn eval(&self, s: f64, t: f64) -> Point3 {
         self.derivs(s, t).0
-    }
-
-    /// Knot insertion in direction `dir`: the same surface on the finer `fine`.
-    pub fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
-        Ok(Self::from_slab(self.slab().refined_in(dir, fine)?))
-    }
-
-    /// The same surface with the degree in direction `dir` raised by one (continuity
-    /// kept).
-    pub fn elevated_in(&self, dir: usize) -> Result<Self> {
-        Ok(Self::from_slab(self.slab().elevated_in(dir)?))
-    }
-
-    /// The same surface with `s` and `t` exchanged: `g(s, t) = f(t, s)` (control point
-    /// `(i, j)` of `f` becomes `(j, i)`).
-    pub fn transposed(&self) -> Self {
-        let [ns, nt] = self.shape();
-        let perm = |k: usize| (k % nt) * ns + k / nt;
-        Self {
-            knots: [self.knots[1].clone(), self.knots[0].clone()],
-            control_points: (0..ns * nt).map(|k| self.control_points[perm(k)]).collect(),
-            weights: self.weights.as_ref().map(|w| (0..ns * nt).map(|k| w[perm(k)]).collect()),
-        }
     }
 
     /// The same surface with direction `dir` reversed on its domain `[a, b]`:
@@ -182,11 +76,6 @@ impl Face {
             control_points: (0..ns * nt).map(|k| self.control_points[perm(k)]).collect(),
             weights: self.weights.as_ref().map(|w| (0..ns * nt).map(|k| w[perm(k)]).collect()),
         })
-    }
-
-    /// The same surface with knot domains mapped to `[0, 1]`.
-    pub fn normalized(&self) -> Self {
-        Self { knots: self.knots.each_ref().map(KnotVector::normalized), ..self.clone() }
     }
 }
 

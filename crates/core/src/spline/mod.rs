@@ -13,6 +13,7 @@
 //! | `periodic` | periodic splines (wrapped control points): knot insertion, elevation and Bézier extraction by blossoming | §11.1 |
 //! | `quadrature` | Gauss–Legendre rules | §4 |
 //! | [`loft`] | volumes from planar slices: one common basis, linear or `C²` cubic interpolation in `z` | §11.1, Fig. 23 |
+//! | [`tensor`] | [`TensorSpline`](tensor::TensorSpline): the tensor-product core of surfaces, faces and volumes (`P` parameters into `R^D`): validation, evaluation, insertion, elevation | §3, §11.1 |
 //! | [`volume`] | [`Volume`](volume::Volume): trivariate tensor-product maps `x: [0,1]³ → R³`, knot insertion, elevation, Bézier nets | §11.1 |
 
 pub mod basis;
@@ -26,4 +27,5 @@ pub(crate) mod periodic;
 pub(crate) mod quadrature;
 pub(crate) mod refine;
 pub mod surface;
+pub mod tensor;
 pub mod volume;

@@ -5,9 +5,10 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::curve::{Curve, Point};
+use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
+use crate::spline::tensor::apply_homogeneous;
 
 type SparseRow = Vec<(usize, f64)>;
 
@@ -105,20 +106,6 @@ pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     Ok((fine, Csr::from_rows(n_c, rows)))
 }
 
-/// Apply a linear operator to the homogeneous coordinates `(w x, w y, w)` of a
-/// (possibly rational) set of control points.
-fn apply_homogeneous(op: &Csr, cps: &[Point], weights: Option<&[f64]>) -> (Vec<Point>, Option<Vec<f64>>) {
-    match weights {
-        None => (op.apply_points(cps), None),
-        Some(w) => {
-            let wc: Vec<Point> = cps.iter().zip(w).map(|(c, &w)| [c[0] * w, c[1] * w]).collect();
-            let wn = op.apply(w);
-            let cn = op.apply_points(&wc).into_iter().zip(&wn).map(|(c, &w)| [c[0] / w, c[1] / w]).collect();
-            (cn, Some(wn))
-        }
-    }
-}
-
 impl Curve {
     /// The same curve on the finer knot vector `fine` (which must contain this one's).
     pub fn refined(&self, fine: &KnotVector) -> Result<Curve> {
@@ -136,20 +123,6 @@ impl Curve {
 }
 
 impl Surface {
-    /// The 2-D prolongation `P_eta ⊗ P_xi` from this map's basis to `fine`.
-    pub fn prolongation_to(&self, fine: &[KnotVector; 2]) -> Result<Csr> {
-        let px = prolongation(&self.knots[0], &fine[0])?;
-        let py = prolongation(&self.knots[1], &fine[1])?;
-        Ok(py.kron(&px))
-    }
-
-    /// The same map on the finer tensor basis `fine`.
-    pub fn refined(&self, fine: &[KnotVector; 2]) -> Result<Surface> {
-        let p = self.prolongation_to(fine)?;
-        let (cp, w) = apply_homogeneous(&p, &self.control_points, self.weights.as_deref());
-        Ok(Surface { knots: fine.clone(), control_points: cp, weights: w })
-    }
-
     /// The same map with both degrees raised by one.
     pub fn elevated(&self) -> Result<Surface> {
         let (kx, ex) = elevation(&self.knots[0])?;
@@ -157,17 +130,6 @@ impl Surface {
         let op = ey.kron(&ex);
         let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
         Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
-    }
-
-    /// The same map with the degree of direction `dir` (0: `xi`, 1: `eta`) raised by one.
-    pub fn elevated_in(&self, dir: usize) -> Result<Surface> {
-        let (kv, e) = elevation(&self.knots[dir])?;
-        let [nx, ny] = self.shape();
-        let op = if dir == 0 { Csr::identity(ny).kron(&e) } else { e.kron(&Csr::identity(nx)) };
-        let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
-        let mut knots = self.knots.clone();
-        knots[dir] = kv;
-        Ok(Surface { knots, control_points: cp, weights: w })
     }
 }
 

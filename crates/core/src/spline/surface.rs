@@ -1,10 +1,11 @@
 //! Tensor-product B-spline / NURBS maps of the unit square: a geometry is a basis
 //! (two knot vectors) plus control points, `x(xi, eta) = sum_ij c_ij N_i(xi) M_j(eta)`.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::curve::{check_points, check_weights, check_wrapped, Curve, Point};
+use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
+use crate::spline::tensor::TensorSpline;
 
 /// The four sides of the parameter square, in the order south, east, north, west.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -59,16 +60,9 @@ impl std::fmt::Display for Side {
     }
 }
 
-/// A tensor-product map; control point `(i, j)` is stored at `j * n_xi + i`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Surface {
-    /// Knot vectors in `xi` and `eta`.
-    pub knots: [KnotVector; 2],
-    /// Control points, `xi` index fastest.
-    pub control_points: Vec<Point>,
-    /// Positive weights (NURBS) or `None`.
-    pub weights: Option<Vec<f64>>,
-}
+/// A tensor-product map of the unit square into the plane; control point `(i, j)` is
+/// stored at `j * n_xi + i`.
+pub type Surface = TensorSpline<2, 2>;
 
 /// Value, gradient and Hessian of a map at a parameter point.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -98,32 +92,7 @@ impl Surface {
     /// Validate lengths, finiteness and weights, and that the control points of a
     /// periodic direction wrap (`spline::periodic`).
     pub fn new(knots: [KnotVector; 2], control_points: Vec<Point>, weights: Option<Vec<f64>>) -> Result<Self> {
-        let n = knots[0].num_basis() * knots[1].num_basis();
-        if control_points.len() != n {
-            return Err(Error::Length {
-                context: String::new(),
-                what: "control_points".into(),
-                found: control_points.len(),
-                expected: n,
-            });
-        }
-        check_points(&control_points, "control point")?;
-        if let Some(w) = &weights {
-            check_weights(w, n)?;
-        }
-        let [nx, ny] = [knots[0].num_basis(), knots[1].num_basis()];
-        if knots[0].is_periodic() {
-            check_wrapped(&control_points, weights.as_deref(), nx, knots[0].dim(), |i| {
-                (0..ny).map(|j| j * nx + i).collect()
-            })?;
-        }
-        if knots[1].is_periodic() {
-            check_wrapped(&control_points, weights.as_deref(), ny, knots[1].dim(), |j| {
-                (0..nx).map(|i| j * nx + i).collect()
-            })?;
-        }
-        let weights = weights.filter(|w| w.iter().any(|&x| x != 1.0));
-        Ok(Self { knots, control_points, weights })
+        Self::checked(knots, control_points, weights)
     }
 
     /// The diameter of the control points' bounding box, which contains the map (convex
@@ -137,16 +106,6 @@ impl Surface {
             }
         }
         (hi[0] - lo[0]).hypot(hi[1] - lo[1])
-    }
-
-    /// Number of basis functions per direction.
-    pub fn shape(&self) -> [usize; 2] {
-        [self.knots[0].num_basis(), self.knots[1].num_basis()]
-    }
-
-    /// Degrees per direction.
-    pub fn degrees(&self) -> [usize; 2] {
-        [self.knots[0].degree(), self.knots[1].degree()]
     }
 
     /// Control point `(i, j)`.
@@ -170,26 +129,14 @@ impl Surface {
 
     /// Value and derivatives from precomputed univariate basis values.
     pub fn derivs_with(&self, bu: &BasisDerivs, bv: &BasisDerivs, nd: usize) -> SurfaceDerivs {
-        let nx = self.shape()[0];
-        let (fu, fv) = (bu.first(), bv.first());
-        // h[a][b] = d^a/du^a d^b/dv^b of (w x, w y, w)
+        // h[a][b] = d^a/du^a d^b/dv^b of (w x, w y, w), the orders up to nd first
+        const ORDERS: [[usize; 2]; 6] = [[0, 0], [1, 0], [0, 1], [2, 0], [1, 1], [0, 2]];
+        let mut sums = [([0.0; 2], 0.0); 6];
+        let count = [1, 3, 6][nd];
+        self.homogeneous_derivs([bu, bv], &ORDERS[..count], &mut sums[..count]);
         let mut h = [[[0.0f64; 3]; 3]; 3];
-        for jb in 0..=bv.degree {
-            let j = fv + jb;
-            for ia in 0..=bu.degree {
-                let i = fu + ia;
-                let k = j * nx + i;
-                let w = self.weights.as_ref().map_or(1.0, |w| w[k]);
-                let c = self.control_points[k];
-                for a in 0..=nd {
-                    for b in 0..=(nd - a) {
-                        let n = bu.d[a][ia] * bv.d[b][jb] * w;
-                        h[a][b][0] += n * c[0];
-                        h[a][b][1] += n * c[1];
-                        h[a][b][2] += n;
-                    }
-                }
-            }
+        for ([a, b], (p, w)) in ORDERS.into_iter().zip(sums) {
+            h[a][b] = [p[0], p[1], w];
         }
         let pt = |a: usize, b: usize| [h[a][b][0], h[a][b][1]];
         if self.weights.is_none() {
@@ -286,22 +233,6 @@ impl Surface {
             control_points: idx.iter().map(|&k| self.control_points[k]).collect(),
             weights: self.weights.as_ref().map(|w| idx.iter().map(|&k| w[k]).collect()),
         }
-    }
-
-    /// Transpose the parameter directions (`xi <-> eta`); flips orientation.
-    pub fn transposed(&self) -> Self {
-        let [nx, ny] = self.shape();
-        let mut cp = Vec::with_capacity(nx * ny);
-        let mut w = self.weights.as_ref().map(|_| Vec::with_capacity(nx * ny));
-        for i in 0..nx {
-            for j in 0..ny {
-                cp.push(self.control_points[j * nx + i]);
-                if let (Some(w), Some(src)) = (w.as_mut(), self.weights.as_ref()) {
-                    w.push(src[j * nx + i]);
-                }
-            }
-        }
-        Self { knots: [self.knots[1].clone(), self.knots[0].clone()], control_points: cp, weights: w }
     }
 }
 

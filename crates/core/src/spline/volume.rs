@@ -4,32 +4,23 @@
 //! `x = Σ w_ijk c_ijk N_i M_j L_k / Σ w_ijk N_i M_j L_k`.
 //!
 //! Control point `(i, j, k)` is stored at `(k n_η + j) n_ξ + i` (`ξ` fastest, then `η`).
-//! Knot insertion and degree elevation act on one direction at a time, on the
-//! homogeneous coordinates `(w x, w y, w z, w)`, with the univariate operators of
-//! `spline::refine` (so periodic directions work as for curves); the map is
-//! reproduced exactly (to rounding). Bézier extraction per element is the tensor product
-//! of the univariate operators of `spline::bezier`.
+//! Validation, indexing, evaluation, knot insertion and degree elevation are those of the
+//! tensor core [`TensorSpline`] (one direction at a time, on the homogeneous coordinates
+//! `(w x, w y, w z, w)`, periodic directions included); Bézier extraction per element is
+//! the tensor product of the univariate operators of `spline::bezier`.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::bezier::BezierExtraction;
 use crate::spline::knots::KnotVector;
-use crate::spline::refine::{elevation, prolongation};
+use crate::spline::tensor::{apply_along, projected, TensorSpline};
 
 /// A point or vector in space.
 pub type Point3 = [f64; 3];
 
 /// A trivariate tensor-product B-spline or NURBS map.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Volume {
-    /// Knot vectors in `ξ`, `η`, `ζ`.
-    pub knots: [KnotVector; 3],
-    /// Control points, `ξ` index fastest, then `η`.
-    pub control_points: Vec<Point3>,
-    /// Positive weights (NURBS) or `None`.
-    pub weights: Option<Vec<f64>>,
-}
+pub type Volume = TensorSpline<3, 3>;
 
 /// Value and first derivatives of a volume at a parameter point.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -52,120 +43,12 @@ impl VolumeDerivs {
     }
 }
 
-/// The homogeneous control net `(w x, w y, w z, w)` of a volume.
-type Homogeneous = Vec<[f64; 4]>;
-
-/// Apply the univariate operator `op` (`n_new x n_dir`) along direction `dir` of a
-/// tensor array of shape `shape` (first index fastest).
-fn apply_along(op: &Csr, dir: usize, shape: [usize; 3], h: &[[f64; 4]]) -> (Homogeneous, [usize; 3]) {
-    let mut out_shape = shape;
-    out_shape[dir] = op.nrows;
-    let stride = |s: [usize; 3], d: usize| match d {
-        0 => 1,
-        1 => s[0],
-        _ => s[0] * s[1],
-    };
-    let (si, so) = (stride(shape, dir), stride(out_shape, dir));
-    let mut out = vec![[0.0; 4]; out_shape.iter().product()];
-    // the two other directions
-    let others: Vec<usize> = (0..3).filter(|&d| d != dir).collect();
-    for a in 0..shape[others[0]] {
-        for b in 0..shape[others[1]] {
-            let base_in = a * stride(shape, others[0]) + b * stride(shape, others[1]);
-            let base_out = a * stride(out_shape, others[0]) + b * stride(out_shape, others[1]);
-            for r in 0..op.nrows {
-                let mut acc = [0.0; 4];
-                for (c, v) in op.row(r) {
-                    let x = &h[base_in + c * si];
-                    for z in 0..4 {
-                        acc[z] += v * x[z];
-                    }
-                }
-                out[base_out + r * so] = acc;
-            }
-        }
-    }
-    (out, out_shape)
-}
-
 impl Volume {
     /// Validate lengths, finiteness and weights, and that the control points of a
     /// periodic direction wrap (the last `p` layers repeat the first `p`, to `1e-12`
     /// relative to the largest coordinate).
     pub fn new(knots: [KnotVector; 3], control_points: Vec<Point3>, weights: Option<Vec<f64>>) -> Result<Self> {
-        let shape = knots.each_ref().map(KnotVector::num_basis);
-        let n: usize = shape.iter().product();
-        if control_points.len() != n {
-            return Err(Error::Length {
-                context: String::new(),
-                what: "control_points".into(),
-                found: control_points.len(),
-                expected: n,
-            });
-        }
-        if let Some((i, p)) = control_points.iter().enumerate().find(|(_, p)| p.iter().any(|x| !x.is_finite())) {
-            return Err(Error::NonFinite {
-                context: String::new(),
-                what: format!("control point {i} is ({}, {}, {})", p[0], p[1], p[2]),
-            });
-        }
-        if let Some(w) = &weights {
-            crate::spline::curve::check_weights(w, n)?;
-        }
-        let v = Self { knots, control_points, weights };
-        for d in 0..3 {
-            if v.knots[d].is_periodic() {
-                v.check_wrapped(d)?;
-            }
-        }
-        let weights = v.weights.filter(|w| w.iter().any(|&x| x != 1.0));
-        Ok(Self { weights, ..v })
-    }
-
-    fn check_wrapped(&self, dir: usize) -> Result<()> {
-        let shape = self.shape();
-        let dim = self.knots[dir].dim();
-        let scale = self.control_points.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
-        for (lin, p) in self.control_points.iter().enumerate() {
-            let mut idx = self.unindex(lin);
-            if idx[dir] < dim {
-                continue;
-            }
-            idx[dir] -= dim;
-            let other = self.index(idx);
-            let q = self.control_points[other];
-            let gap = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f64::max);
-            let wgap = self.weights.as_ref().map_or(0.0, |w| (w[lin] - w[other]).abs() / w[other]);
-            if gap > 1e-12 * scale || wgap > 1e-12 {
-                return Err(Error::Invalid(format!(
-                    "periodic control points must wrap in direction {dir}: stored point {lin} ({}, {}, {}) must repeat point {other} ({}, {}, {}) (the last p of {} layers repeat the first p)",
-                    p[0], p[1], p[2], q[0], q[1], q[2], shape[dir]
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// Number of basis functions per direction.
-    pub fn shape(&self) -> [usize; 3] {
-        self.knots.each_ref().map(KnotVector::num_basis)
-    }
-
-    /// Degrees per direction.
-    pub fn degrees(&self) -> [usize; 3] {
-        self.knots.each_ref().map(KnotVector::degree)
-    }
-
-    /// Linear index of control point `(i, j, k)`.
-    pub fn index(&self, ijk: [usize; 3]) -> usize {
-        let [nx, ny, _] = self.shape();
-        (ijk[2] * ny + ijk[1]) * nx + ijk[0]
-    }
-
-    /// `(i, j, k)` of a linear index.
-    pub fn unindex(&self, lin: usize) -> [usize; 3] {
-        let [nx, ny, _] = self.shape();
-        [lin % nx, (lin / nx) % ny, lin / (nx * ny)]
+        Self::checked(knots, control_points, weights)
     }
 
     /// `x(ξ, η, ζ)`.
@@ -186,93 +69,8 @@ impl Volume {
     /// Value and first derivatives from precomputed univariate basis values (with at
     /// least first derivatives; the caller picks the spans, e.g. on element boundaries).
     pub fn derivs_with(&self, b: &[BasisDerivs; 3]) -> VolumeDerivs {
-        let [nx, ny, _] = self.shape();
-        // h[a] = (w x, w y, w z, w) and its derivative in direction a - 1
-        let mut h = [[0.0f64; 4]; 4];
-        for kc in 0..=b[2].degree {
-            let k = b[2].first() + kc;
-            for jb in 0..=b[1].degree {
-                let j = b[1].first() + jb;
-                for ia in 0..=b[0].degree {
-                    let i = b[0].first() + ia;
-                    let lin = (k * ny + j) * nx + i;
-                    let w = self.weights.as_ref().map_or(1.0, |w| w[lin]);
-                    let c = self.control_points[lin];
-                    let vals = [
-                        b[0].d[0][ia] * b[1].d[0][jb] * b[2].d[0][kc],
-                        b[0].d[1][ia] * b[1].d[0][jb] * b[2].d[0][kc],
-                        b[0].d[0][ia] * b[1].d[1][jb] * b[2].d[0][kc],
-                        b[0].d[0][ia] * b[1].d[0][jb] * b[2].d[1][kc],
-                    ];
-                    for (hh, &n) in h.iter_mut().zip(&vals) {
-                        let n = n * w;
-                        hh[0] += n * c[0];
-                        hh[1] += n * c[1];
-                        hh[2] += n * c[2];
-                        hh[3] += n;
-                    }
-                }
-            }
-        }
-        let w = h[0][3];
-        let x = [h[0][0] / w, h[0][1] / w, h[0][2] / w];
-        let mut d = [[0.0; 3]; 3];
-        for a in 0..3 {
-            for c in 0..3 {
-                d[a][c] = (h[a + 1][c] - h[a + 1][3] * x[c]) / w;
-            }
-        }
+        let (x, d) = self.first_derivs(b.each_ref());
         VolumeDerivs { x, d }
-    }
-
-    fn homogeneous(&self) -> Homogeneous {
-        self.control_points
-            .iter()
-            .enumerate()
-            .map(|(k, c)| {
-                let w = self.weights.as_ref().map_or(1.0, |w| w[k]);
-                [w * c[0], w * c[1], w * c[2], w]
-            })
-            .collect()
-    }
-
-    fn from_homogeneous(knots: [KnotVector; 3], h: Homogeneous, rational: bool) -> Self {
-        let control_points = h.iter().map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]]).collect();
-        let weights = rational.then(|| h.iter().map(|p| p[3]).collect());
-        Self { knots, control_points, weights }
-    }
-
-    /// The same map with the univariate operator `op` (onto the basis `kv`) applied in
-    /// direction `dir`.
-    fn mapped(&self, dir: usize, kv: KnotVector, op: &Csr) -> Self {
-        let (h, _) = apply_along(op, dir, self.shape(), &self.homogeneous());
-        let mut knots = self.knots.clone();
-        knots[dir] = kv;
-        Self::from_homogeneous(knots, h, self.weights.is_some())
-    }
-
-    /// Knot insertion in direction `dir`: the same map on the finer knot vector `fine`
-    /// (which must contain this one's).
-    pub fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
-        let op = prolongation(&self.knots[dir], fine)?;
-        Ok(self.mapped(dir, fine.clone(), &op))
-    }
-
-    /// The same map on the finer tensor basis `fine` (knot insertion in every direction).
-    pub fn refined(&self, fine: &[KnotVector; 3]) -> Result<Self> {
-        let mut v = self.clone();
-        for (d, kv) in fine.iter().enumerate() {
-            if kv != &v.knots[d] {
-                v = v.refined_in(d, kv)?;
-            }
-        }
-        Ok(v)
-    }
-
-    /// The same map with the degree in direction `dir` raised by one (continuity kept).
-    pub fn elevated_in(&self, dir: usize) -> Result<Self> {
-        let (kv, op) = elevation(&self.knots[dir])?;
-        Ok(self.mapped(dir, kv, &op))
     }
 
     /// The control net of the isoparametric surface `u_dir = t`: the control points
@@ -283,10 +81,8 @@ impl Volume {
         let rows: Vec<Vec<(usize, f64)>> =
             vec![b.ders(0).iter().enumerate().map(|(j, &v)| (b.first() + j, v)).collect()];
         let op = Csr::from_rows(self.shape()[dir], rows);
-        let (h, _) = apply_along(&op, dir, self.shape(), &self.homogeneous());
-        let pts = h.iter().map(|p| [p[0] / p[3], p[1] / p[3], p[2] / p[3]]).collect();
-        let w = self.weights.as_ref().map(|_| h.iter().map(|p| p[3]).collect());
-        (pts, w)
+        let h = apply_along(&op, dir, self.shape(), &self.homogeneous());
+        (projected(&h), self.weights.as_ref().map(|_| h.iter().map(|p| p.1).collect()))
     }
 
     /// Bézier extraction: per direction, the univariate operators.
@@ -344,6 +140,7 @@ impl Volume {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
     use crate::spline::bezier::bernstein;
     use crate::testutil::Lcg;
 

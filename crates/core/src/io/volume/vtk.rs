@@ -180,18 +180,9 @@ pub fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::vtk::tests::arrays;
     use crate::spline::bezier::bernstein;
     use crate::spline::knots::KnotVector;
-
-    fn arrays(vtu: &str) -> std::collections::BTreeMap<String, Vec<f64>> {
-        let doc = roxmltree::Document::parse(vtu).unwrap();
-        let mut out = std::collections::BTreeMap::new();
-        for a in doc.descendants().filter(|n| n.has_tag_name("DataArray")) {
-            let name = a.attribute("Name").unwrap_or("Points").to_string();
-            out.insert(name, a.text().unwrap_or("").split_whitespace().map(|t| t.parse().unwrap()).collect());
-        }
-        out
-    }
 
     fn curved(rational: bool) -> Volume {
         let k = [KnotVector::open_uniform(2, 2), KnotVector::open_uniform(1, 2), KnotVector::open_uniform(3, 1)];
