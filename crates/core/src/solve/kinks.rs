@@ -21,7 +21,9 @@
 //! singular, `x_ξ → 0`, and a coarse basis cannot follow), the offending elements and a
 //! halo are bisected as in the defect correction (§8.2), the last certified map of the
 //! continuation is prolonged onto the refined basis and the continuation goes on from
-//! there, at most `repair` rounds.
+//! there, at most `repair` rounds. Where neither `p + 2` nor `p + 4` Gauss points give a
+//! bijective start, a last try pins the control point next to each kink inside the kink's
+//! wedge (`corner_pins`): the folds left sit at the kink point itself.
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -559,6 +561,57 @@ pub fn kink_reports(
 
 #[cfg(test)]
 mod tests {
+    use super::corner_pins;
+    use crate::boundary::kinks::{Kink, KinkKind};
+    use crate::spline::curve::Point;
+    use crate::spline::knots::KnotVector;
+    use crate::spline::surface::Surface;
+
+    /// A degree-2 net on `[0, 1]²` (a `C^0` knot at `ξ = 1/2`, the greville grid) whose
+    /// south side turns at `(1/2, 0)` by `turn` degrees (down and back for a reflex kink,
+    /// up for a convex one): where the control point above the kink leaves `det J` of one
+    /// element at the kink non-positive, the pinned one makes it positive from both sides,
+    /// `det(t_∓, x_η) > 0` at the kink evaluated on the map itself, at the same distance
+    /// from the kink.
+    #[test]
+    fn pinned_control_point_makes_det_j_positive_at_the_kink() {
+        let knots =
+            [KnotVector::new(2, vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0]).unwrap(), KnotVector::open_uniform(2, 2)];
+        let (gu, gv) = (knots[0].greville(), knots[1].greville());
+        for (turn, below) in [(-100.0f64, -0.25), (-152.0, -0.3), (-60.0, -0.2), (40.0, 0.15)] {
+            let mut cps: Vec<Point> = gv.iter().flat_map(|&v| gu.iter().map(move |&u| [u, v])).collect();
+            // P1 on the incoming line, P3 leaving the kink at `turn` from east
+            let a = turn.to_radians();
+            cps[3] = [0.5 + below.abs() * a.cos(), below.abs() * a.sin()];
+            let det_at_kink = |cps: &[Point]| {
+                let m = Surface { knots: knots.clone(), control_points: cps.to_vec(), weights: None };
+                [m.derivs(0.5 - 1e-9, 0.0, 1).det_j(), m.derivs(0.5 + 1e-9, 0.0, 1).det_j()]
+            };
+            let kink = Kink {
+                side: crate::spline::surface::Side::South,
+                parameter: 0.5,
+                point: [0.5, 0.0],
+                turning_degrees: turn.abs(),
+                kind: KinkKind::C0Knot,
+                index: None,
+                map_parameter: Some(0.5),
+            };
+            let pins = corner_pins(&knots, &[kink], &cps, &cps);
+            assert_eq!(pins.len(), 1);
+            let (k, x) = pins[0];
+            assert_eq!(k, gu.len() + 2, "the control point above the kink");
+            let before = det_at_kink(&cps);
+            let l = |p: Point| (p[0] - 0.5).hypot(p[1]);
+            assert!((l(x) - l(cps[k])).abs() <= 1e-14);
+            cps[k] = x;
+            let after = det_at_kink(&cps);
+            assert!(after.iter().all(|&d| d > 0.0), "turn {turn}: det J {after:?} (before {before:?})");
+            if turn < -90.0 {
+                assert!(before.iter().any(|&d| d <= 0.0), "turn {turn}: det J {before:?} already positive");
+            }
+        }
+    }
+
     use crate::boundary::families::Family;
     use crate::io::{read_boundary, ReadOptions};
     use crate::pipeline::solve;
