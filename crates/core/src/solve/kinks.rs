@@ -285,11 +285,11 @@ pub fn keep_kinks(
     Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
 }
 
-/// The tries of [`keep_kinks`] that gave no bijective start, `((p + extra, certified),
+/// The tries of [`keep_kinks`] that gave no bijective start, `((p + extra, pinned),
 /// damped solves, refinement rounds, α reached)`, in words.
 fn tried_text(failed: &[((usize, bool), usize, usize, f64)]) -> String {
-    let text = |&((extra, certified), steps, rounds, alpha): &((usize, bool), usize, usize, f64)| {
-        let every = if certified { " with the control points next to the kinks pinned" } else { "" };
+    let text = |&((extra, pinned), steps, rounds, alpha): &((usize, bool), usize, usize, f64)| {
+        let every = if pinned { " with the control points next to the kinks pinned" } else { "" };
         format!(
             "p + {extra} Gauss points per direction{every} ({steps} damped solves, {rounds} refinement round(s), \
              {alpha:.3} of the boundary displacement reached)"
