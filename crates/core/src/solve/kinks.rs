@@ -21,7 +21,9 @@
 //! singular, `x_ξ → 0`, and a coarse basis cannot follow), the offending elements and a
 //! halo are bisected as in the defect correction (§8.2), the last certified map of the
 //! continuation is prolonged onto the refined basis and the continuation goes on from
-//! there, at most `repair` rounds.
+//! there, at most `repair` rounds. Where neither `p + 2` nor `p + 4` Gauss points give a
+//! bijective start, a last try pins the control point next to each kink inside the kink's
+//! wedge (`corner_pins`): the folds left sit at the kink point itself.
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -38,7 +40,7 @@ use super::repair::{frozen_dofs, plan_repair};
 use crate::boundary::kinks::{Kink, KinkedLevel};
 use crate::boundary::level::Level;
 use crate::discrete::assembly::Discretization;
-use crate::discrete::dofs::DofMap;
+use crate::discrete::dofs::{DofMap, FIXED};
 use crate::error::Result;
 use crate::methods::egg::EggAssembler;
 use crate::methods::winslow::{winslow_objective, WinslowMethod};
@@ -172,25 +174,42 @@ pub fn keep_kinks(
     // (tests/data/cad_kinks/vnotch.json: 332 degrees inside) the damped minimisers with
     // p + 2 points folded between them at 0.77 of the boundary displacement whatever the
     // refinement, while p + 4 reach the kinked boundary with no refinement
-    let mut first = elasticity_start(map, c0, QUADRATURE_EXTRA[0], opts, assembler, diameter, &mut report)?;
-    let (mut extra, mut retried) = (QUADRATURE_EXTRA[0], String::new());
-    if !bijective(&first.cert) {
-        let mut again = report.clone();
-        let second = elasticity_start(map, c0, QUADRATURE_EXTRA[1], opts, assembler, diameter, &mut again)?;
-        if bijective(&second.cert) {
-            retried = format!(
-                "; p + {} Gauss points per direction, since p + {} gave no bijective start ({} damped solves, {:.3} of \
-                 the boundary displacement reached)",
-                QUADRATURE_EXTRA[1], QUADRATURE_EXTRA[0], first.cont.steps, report.alpha
-            );
-            report = again;
-            let earlier = first.cont;
-            first = second;
-            first.cont.steps += earlier.steps;
-            first.cont.iterations += earlier.iterations;
-            extra = QUADRATURE_EXTRA[1];
+    // where that gives none either, a last try from the Σ¹ map with p + 4 and the control
+    // point next to each kink pinned inside the kink's wedge ([`corner_pins`]): the
+    // Winslow barrier does not see `det J` at the kink itself, where the folds sit
+    let tries = [(QUADRATURE_EXTRA[0], false), (QUADRATURE_EXTRA[1], false), (QUADRATURE_EXTRA[1], true)];
+    let mut first = elasticity_start(map, c0, tries[0].0, &[], opts, assembler, diameter, &mut report)?;
+    let (mut chosen, mut retried, mut spent) = (tries[0], String::new(), Continuation::default());
+    let mut failed = vec![(tries[0], first.cont.steps, report.refinements, report.alpha)];
+    for &next in &tries[1..] {
+        if bijective(&first.cert) {
+            break;
         }
+        let mut again = report.clone();
+        let pinned: &[Kink] = if next.1 { &kinked.kinks } else { &[] };
+        let attempt = elasticity_start(map, c0, next.0, pinned, opts, assembler, diameter, &mut again)?;
+        spent.steps += attempt.cont.steps;
+        spent.iterations += attempt.cont.iterations;
+        if !bijective(&attempt.cert) {
+            failed.push((next, attempt.cont.steps, again.refinements, again.alpha));
+            continue;
+        }
+        retried = match next.1 {
+            false => format!(
+                "; p + {} Gauss points per direction, since p + {} gave no bijective start ({} damped solves, {:.3} \
+                 of the boundary displacement reached)",
+                next.0, tries[0].0, first.cont.steps, report.alpha
+            ),
+            true => format!("; the control point next to each kink pinned, since {}", tried_text(&failed)),
+        };
+        report = again;
+        let earlier = first.cont;
+        first = attempt;
+        first.cont.steps = earlier.steps + spent.steps;
+        first.cont.iterations = earlier.iterations + spent.iterations;
+        chosen = next;
     }
+    let extra = chosen.0;
     let ElasticityStart { level, disc, weights, start, cert: start_cert, cont } = first;
     let [p, q] = map.degrees();
     let method = WinslowMethod;
@@ -210,6 +229,10 @@ pub fn keep_kinks(
             report.alpha,
             start_cert.message()
         );
+        let why = match failed.len() {
+            1 => why,
+            _ => format!("{why}; tried {}", tried_text(&failed)),
+        };
         report.certificate = start_cert.message();
         report.message = format!("kinks not kept: {why}; the map is the one on the smoothed basis Σ¹");
         report.failure = Some(why);
@@ -262,6 +285,19 @@ pub fn keep_kinks(
     Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
 }
 
+/// The tries of [`keep_kinks`] that gave no bijective start, `((p + extra, pinned),
+/// damped solves, refinement rounds, α reached)`, in words.
+fn tried_text(failed: &[((usize, bool), usize, usize, f64)]) -> String {
+    let text = |&((extra, pinned), steps, rounds, alpha): &((usize, bool), usize, usize, f64)| {
+        let every = if pinned { " with the control points next to the kinks pinned" } else { "" };
+        format!(
+            "p + {extra} Gauss points per direction{every} ({steps} damped solves, {rounds} refinement round(s), \
+             {alpha:.3} of the boundary displacement reached)"
+        )
+    };
+    failed.iter().map(text).collect::<Vec<_>>().join(", ")
+}
+
 /// What [`elasticity_start`] returns: the level, discretization, weights and control
 /// points of the start of the final minimisation, its certificate and the continuation's
 /// counts.
@@ -276,12 +312,15 @@ struct ElasticityStart {
 
 /// Step 2 of the module documentation from the `Σ¹` map `map` to the `Σ⁰` level `c0`,
 /// with `p + extra` Gauss points per direction (in the elasticity step, the damped Winslow
-/// solves and the discretization returned); `report` gets `boundary_shift`, `refinements`
-/// and `alpha`.
+/// solves and the discretization returned), with the control points next to the kinks
+/// of `pinned` fixed inside the kinks' wedges ([`corner_pins`]); `report` gets
+/// `boundary_shift`, `refinements` and `alpha`.
+#[allow(clippy::too_many_arguments)]
 fn elasticity_start(
     map: &Surface,
     c0: &Level,
     extra: usize,
+    pinned: &[Kink],
     opts: &SolveOptions,
     assembler: &dyn EggAssembler,
     diameter: f64,
@@ -290,7 +329,6 @@ fn elasticity_start(
     let mut level = joined_level(map, c0)?;
     let mut base = map.refined(&level.knots)?.control_points;
     let [p, q] = map.degrees();
-    let method = WinslowMethod;
     let mut cont = Continuation::default();
     report.refinements = 0;
     report.alpha = 0.0;
@@ -299,12 +337,26 @@ fn elasticity_start(
     // last certified map, prolonged
     let (disc, weights, start, cert) = loop {
         let weights = level.weights()?;
-        let dofs = DofMap::for_basis(&level.knots, &opts.topology)?;
+        let mut dofs = DofMap::for_basis(&level.knots, &opts.topology)?;
+        let mut target = base.clone();
+        set_boundary(dofs.shape(), &level.sides, &mut target)?;
+        let pins = match dofs.replicas().is_empty() {
+            true => corner_pins(&level.knots, pinned, &base, &target),
+            false => Vec::new(),
+        };
+        if !pins.is_empty() {
+            let nx = dofs.shape()[0];
+            let all = dofs;
+            dofs = DofMap::from_predicate(all.shape(), |i, j| {
+                all.free_index(j * nx + i) != FIXED && !pins.iter().any(|&(k, _)| k == j * nx + i)
+            });
+            for &(k, x) in &pins {
+                target[k] = x;
+            }
+        }
         let disc = Arc::new(
             Discretization::with_dofs(level.knots.clone(), p.max(q) + extra, dofs).with_weights(weights.clone())?,
         );
-        let mut target = base.clone();
-        set_boundary(disc.shape(), &level.sides, &mut target)?;
         if report.refinements == 0 {
             report.boundary_shift =
                 base.iter().zip(&target).fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1]))) / diameter;
@@ -316,7 +368,7 @@ fn elasticity_start(
         };
         // the continuation's last certificate, reused for its guess below
         let last: RefCell<Option<(Vec<Point>, Certificate)>> = RefCell::new(None);
-        let certified = |cps: &[Point]| match certify(&surface(cps), &opts.certify) {
+        let positive = |cps: &[Point]| match certify(&surface(cps), &opts.certify) {
             Ok(c) => {
                 let ok = bijective(&c);
                 *last.borrow_mut() = Some((cps.to_vec(), c));
@@ -329,13 +381,14 @@ fn elasticity_start(
         // the Newton step's length, feasible at the quadrature points only, folded
         // l_shape's map between them (the continuation then ran 35 damped solves and 6
         // refinement rounds and gave up at 0.8 of the boundary displacement)
+        let method = WinslowMethod;
         let nl = NonlinearOptions {
             extrapolate: false,
             ..from_bijective_start(opts.nonlinear, &method, diameter, disc.dofs.num_free())
         };
         // the damped steps are counted per round (the cap of the continuation is per basis)
         let mut round = Continuation::default();
-        let out = continuation_with(&method, assembler, &disc, base, &target, nl, diameter, &mut round, &certified)?;
+        let out = continuation_with(&method, assembler, &disc, base, &target, nl, diameter, &mut round, &positive)?;
         cont.steps += round.steps;
         cont.iterations += round.iterations;
         report.alpha = report.alpha.max(out.alpha);
@@ -355,6 +408,53 @@ fn elasticity_start(
         report.refinements += 1;
     };
     Ok(ElasticityStart { level, disc, weights, start, cert, cont })
+}
+
+/// The control point next to each kink (one row into the domain from the kink's boundary
+/// control point, which the `C^0` knot of multiplicity `p` makes interpolating) with a
+/// position inside the kink's wedge: at the kink `det J` from either side is
+/// `det(t_∓, x_across)` up to the orientation, with `t_∓` the side's one-sided tangents
+/// and `x_across ∝ P_1 - P_0`, so both are positive when `P_1 - P_0` points along
+/// `n_- + n_+` (the unit left normals of the tangents, for the south and east sides; the
+/// opposite for north and west: `det(t_∓, n_- + n_+) = 1 + cos θ > 0` for a turn `θ`
+/// other than ±180°). `P_1` keeps its distance from `P_0` in `base`; `target` holds the
+/// kinked sides. Pairs `(control point index, position)`.
+fn corner_pins(knots: &[KnotVector; 2], kinks: &[Kink], base: &[Point], target: &[Point]) -> Vec<(usize, Point)> {
+    let (nx, ny) = (knots[0].num_basis(), knots[1].num_basis());
+    let greville = [knots[0].greville(), knots[1].greville()];
+    let unit = |v: Point| {
+        let l = v[0].hypot(v[1]);
+        [v[0] / l, v[1] / l]
+    };
+    kinks
+        .iter()
+        .filter_map(|k| {
+            let t = k.map_parameter?;
+            let d = k.side.direction();
+            let g = &greville[d];
+            let i = (0..g.len()).min_by(|&a, &b| (g[a] - t).abs().total_cmp(&(g[b] - t).abs()))?;
+            if i == 0 || i + 1 >= g.len() {
+                return None;
+            }
+            // the index of the control point `along` on the side and `across` rows in
+            let at = |along: usize, across: usize| match k.side {
+                Side::South => across * nx + along,
+                Side::North => (ny - 1 - across) * nx + along,
+                Side::West => along * nx + across,
+                Side::East => along * nx + nx - 1 - across,
+            };
+            let (a, b, c) = (target[at(i - 1, 0)], target[at(i, 0)], target[at(i + 1, 0)]);
+            let (t0, t1) = (unit([b[0] - a[0], b[1] - a[1]]), unit([c[0] - b[0], c[1] - b[1]]));
+            let sign = match k.side {
+                Side::South | Side::East => 1.0,
+                Side::North | Side::West => -1.0,
+            };
+            let v = unit([sign * (-t0[1] - t1[1]), sign * (t0[0] + t1[0])]);
+            let (p0, p1) = (base[at(i, 0)], base[at(i, 1)]);
+            let l = (p1[0] - p0[0]).hypot(p1[1] - p0[1]);
+            (v[0].is_finite() && v[1].is_finite()).then(|| (at(i, 1), [b[0] + l * v[0], b[1] + l * v[1]]))
+        })
+        .collect()
 }
 
 /// The parameter boxes `[ξ0, ξ1, η0, η1]` reaching `spans` knot spans of `knots` along
@@ -461,6 +561,57 @@ pub fn kink_reports(
 
 #[cfg(test)]
 mod tests {
+    use super::corner_pins;
+    use crate::boundary::kinks::{Kink, KinkKind};
+    use crate::spline::curve::Point;
+    use crate::spline::knots::KnotVector;
+    use crate::spline::surface::Surface;
+
+    /// A degree-2 net on `[0, 1]²` (a `C^0` knot at `ξ = 1/2`, the greville grid) whose
+    /// south side turns at `(1/2, 0)` by `turn` degrees (down and back for a reflex kink,
+    /// up for a convex one): where the control point above the kink leaves `det J` of one
+    /// element at the kink non-positive, the pinned one makes it positive from both sides,
+    /// `det(t_∓, x_η) > 0` at the kink evaluated on the map itself, at the same distance
+    /// from the kink.
+    #[test]
+    fn pinned_control_point_makes_det_j_positive_at_the_kink() {
+        let knots =
+            [KnotVector::new(2, vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0]).unwrap(), KnotVector::open_uniform(2, 2)];
+        let (gu, gv) = (knots[0].greville(), knots[1].greville());
+        for turn in [-100.0f64, -152.0, -60.0, 40.0] {
+            let mut cps: Vec<Point> = gv.iter().flat_map(|&v| gu.iter().map(move |&u| [u, v])).collect();
+            // P1 on the incoming line, P3 leaving the kink at `turn` from east
+            let a = turn.to_radians();
+            cps[3] = [0.5 + 0.25 * a.cos(), 0.25 * a.sin()];
+            let det_at_kink = |cps: &[Point]| {
+                let m = Surface { knots: knots.clone(), control_points: cps.to_vec(), weights: None };
+                [m.derivs(0.5 - 1e-9, 0.0, 1).det_j(), m.derivs(0.5 + 1e-9, 0.0, 1).det_j()]
+            };
+            let kink = Kink {
+                side: crate::spline::surface::Side::South,
+                parameter: 0.5,
+                point: [0.5, 0.0],
+                turning_degrees: turn.abs(),
+                kind: KinkKind::C0Knot,
+                index: None,
+                map_parameter: Some(0.5),
+            };
+            let pins = corner_pins(&knots, &[kink], &cps, &cps);
+            assert_eq!(pins.len(), 1);
+            let (k, x) = pins[0];
+            assert_eq!(k, gu.len() + 2, "the control point above the kink");
+            let before = det_at_kink(&cps);
+            let l = |p: Point| (p[0] - 0.5).hypot(p[1]);
+            assert!((l(x) - l(cps[k])).abs() <= 1e-14);
+            cps[k] = x;
+            let after = det_at_kink(&cps);
+            assert!(after.iter().all(|&d| d > 0.0), "turn {turn}: det J {after:?} (before {before:?})");
+            if turn < -90.0 {
+                assert!(before.iter().any(|&d| d <= 0.0), "turn {turn}: det J {before:?} already positive");
+            }
+        }
+    }
+
     use crate::boundary::families::Family;
     use crate::io::{read_boundary, ReadOptions};
     use crate::pipeline::solve;
