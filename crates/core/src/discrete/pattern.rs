@@ -122,7 +122,7 @@ impl SystemPattern {
 /// degrees it keeps. The vector pattern of a basis ([`super::assembly::Discretization`]'s
 /// `vector`) is the largest array of a discretization (three words per nonzero of the
 /// two-component system) and a solve that multiplies with the stencil storage
-/// ([`super::stencil::StencilOperator`]) never needs it.
+/// (`discrete::stencil::StencilOperator`) never needs it.
 #[derive(Debug, Clone)]
 pub struct LazyPattern {
     dofs: DofMap,

@@ -10,7 +10,7 @@ use crate::linalg::sparse::Csr;
 
 /// A square linear operator `y = A x` as the Krylov methods use it: an assembled sparse
 /// matrix ([`Csr`]) or a product computed without one (the stencil product of a Galerkin
-/// system, [`crate::discrete::stencil`]).
+/// system, `discrete::stencil`).
 pub trait MatVec {
     /// `y = A x` (`x` and `y` of the operator's size).
     fn mul_vec(&self, x: &[f64], y: &mut [f64]);

@@ -147,7 +147,7 @@ impl DiscreteProblem for EggProblem {
         s.gather_jacobian(jac);
     }
 
-    /// The Jacobian left in the stencil storage ([`crate::discrete::stencil`]): on a
+    /// The Jacobian left in the stencil storage (`discrete::stencil`): on a
     /// basis without periodic replicas.
     fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
         let s = &mut self.state;

@@ -88,7 +88,7 @@ pub trait DiscreteProblem {
     fn jacobian(&mut self, c: &[f64], f: &mut [f64], jac: &mut Csr);
     /// `F(c)` into `f` and the Jacobian `dF/dc` kept by the problem in a form that
     /// [`DiscreteProblem::jacobian_product`] multiplies with, no matrix built (the stencil
-    /// storage of eq. 12, [`crate::discrete::stencil`]); `false` (the default) when the
+    /// storage of eq. 12, `discrete::stencil`); `false` (the default) when the
     /// problem has no such form: then call [`DiscreteProblem::jacobian`].
     fn jacobian_operator(&mut self, _c: &[f64], _f: &mut [f64]) -> bool {
         false

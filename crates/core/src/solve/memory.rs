@@ -50,7 +50,7 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 
 /// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
 /// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
-/// stencil storage ([`crate::discrete::stencil::StencilOperator`], 8 B per nonzero) and the
+/// stencil storage (`discrete::stencil::StencilOperator`, 8 B per nonzero) and the
 /// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
 /// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
 /// gather map, the metric Laplacian `K` in stencil storage and in CSR, and the V-cycle's

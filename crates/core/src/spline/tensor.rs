@@ -7,7 +7,7 @@
 //! `Σ_d i_d Π_{e<d} n_e` (first index fastest).
 //!
 //! Knot insertion and degree elevation apply the univariate operators of
-//! [`crate::spline::refine`] (periodic directions included) to the homogeneous
+//! `spline::refine` (periodic directions included) to the homogeneous
 //! coordinates `(w c, w)`, so the map is kept exactly (to rounding). Maps into the plane
 //! keep the rounding of the planar operators (weights through [`Csr::apply`], polynomial
 //! nets not divided by the transformed unit weights); maps into space sum `(w c, w)`
