@@ -9,7 +9,7 @@
 use std::fmt::Write as _;
 
 use crate::spline::knots::KnotVector;
-use crate::spline::periodic::open_equivalent;
+use crate::spline::surface::open_equivalent;
 use crate::spline::surface::Surface;
 
 /// A finite `f64` as the shortest text that parses back to the same value: plain

@@ -85,8 +85,8 @@ use crate::solve::options::SolveOptions;
 use crate::solve::report::Solution;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
-use crate::spline::periodic::PeriodicTranslate;
 use crate::spline::surface::Surface;
+use crate::spline::translate::PeriodicTranslate;
 use crate::verify::certificate::{certify, Finding};
 
 /// Where `eta = 0` sits on a turning inner contour (see the module documentation).

@@ -1,9 +1,11 @@
 //! B-spline and NURBS curves in the plane: a basis (knot vector) plus control points.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::knots::KnotVector;
-use crate::spline::tensor::TensorSpline;
+use crate::spline::refine::{elevation, prolongation};
+use crate::spline::tensor::{apply_homogeneous, TensorSpline};
+pub(crate) use crate::spline::tensor::{check_points, check_weights};
 
 /// A point or vector in the plane.
 pub type Point = [f64; 2];
@@ -29,31 +31,6 @@ pub struct CurveDerivs {
     pub d1: Point,
     /// `C''(u)`.
     pub d2: Point,
-}
-
-pub(crate) fn check_points<const D: usize>(pts: &[[f64; D]], what: &str) -> Result<()> {
-    for (i, p) in pts.iter().enumerate() {
-        if p.iter().any(|x| !x.is_finite()) {
-            let p = p.map(|x| x.to_string()).join(", ");
-            return Err(Error::NonFinite { context: String::new(), what: format!("{what} {i} is ({p})") });
-        }
-    }
-    Ok(())
-}
-
-pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
-    if w.len() != expected {
-        return Err(Error::Length { context: String::new(), what: "weights".into(), found: w.len(), expected });
-    }
-    for (i, &x) in w.iter().enumerate() {
-        if !x.is_finite() {
-            return Err(Error::NonFinite { context: String::new(), what: format!("weight {i} is {x}") });
-        }
-        if x <= 0.0 {
-            return Err(Error::Weight { context: String::new(), index: i, value: x });
-        }
-    }
-    Ok(())
 }
 
 impl Curve {
@@ -163,9 +140,26 @@ impl Curve {
     }
 }
 
+impl Curve {
+    /// The same curve on the finer knot vector `fine` (which must contain this one's).
+    pub fn refined(&self, fine: &KnotVector) -> Result<Curve> {
+        let p = prolongation(&self.knots, fine)?;
+        let (cp, w) = apply_homogeneous(&p, &self.control_points, self.weights.as_deref());
+        Ok(Curve { knots: fine.clone(), control_points: cp, weights: w })
+    }
+
+    /// The same curve with its degree raised by one.
+    pub fn elevated(&self) -> Result<Curve> {
+        let (kv, e) = elevation(&self.knots)?;
+        let (cp, w) = apply_homogeneous(&e, &self.control_points, self.weights.as_deref());
+        Ok(Curve { knots: kv, control_points: cp, weights: w })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     #[test]
     fn nurbs_quarter_circle_is_exact() {

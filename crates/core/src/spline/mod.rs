@@ -11,6 +11,7 @@
 //! | `bezier` | Bézier extraction of a tensor basis | §8.1 |
 //! | [`hierarchical`] | [`HierarchicalBasis`](hierarchical::HierarchicalBasis), [`HierarchicalMap`](hierarchical::map::HierarchicalMap): truncated hierarchical B-splines (THB), local refinement | §4, §8 |
 //! | `periodic` | periodic splines (wrapped control points): knot insertion, elevation and Bézier extraction by blossoming | §11.1 |
+//! | `translate` | the `L2` projection of parameter translates onto a periodic space (the sliding boundary of a ring) | §11.1 |
 //! | `quadrature` | Gauss–Legendre rules | §4 |
 //! | [`loft`] | volumes from planar slices: one common basis, linear or `C²` cubic interpolation in `z` | §11.1, Fig. 23 |
 //! | [`tensor`] | [`TensorSpline`](tensor::TensorSpline): the tensor-product core of surfaces, faces and volumes (`P` parameters into `R^D`): validation, evaluation, insertion, elevation | §3, §11.1 |
@@ -28,4 +29,5 @@ pub(crate) mod quadrature;
 pub(crate) mod refine;
 pub mod surface;
 pub mod tensor;
+pub(crate) mod translate;
 pub mod volume;

@@ -73,7 +73,7 @@ fn extended_span(kv: &KnotVector, u: f64) -> isize {
 }
 
 /// Append `w` to the sparse row `row` at wrapped column `col mod d`.
-fn add_wrapped(row: &mut Vec<(usize, f64)>, col: isize, d: usize, w: f64) {
+pub(super) fn add_wrapped(row: &mut Vec<(usize, f64)>, col: isize, d: usize, w: f64) {
     let c = col.rem_euclid(d as isize) as usize;
     match row.iter_mut().find(|e| e.0 == c) {
         Some(e) => e.1 += w,
@@ -200,48 +200,6 @@ pub fn periodic_to_open(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     Ok((open, Csr::from_rows(kv.num_basis(), rows)))
 }
 
-/// `map` with every periodic direction written on its open knot vector
-/// ([`periodic_to_open`]): the same map on its domain (weights kept, control points in
-/// homogeneous form), for formats without periodic bases. Maps without a periodic
-/// direction come back unchanged.
-pub fn open_equivalent(map: &crate::spline::surface::Surface) -> Result<crate::spline::surface::Surface> {
-    let mut out = map.clone();
-    for dir in 0..2 {
-        if !out.knots[dir].is_periodic() {
-            continue;
-        }
-        let (open, c) = periodic_to_open(&out.knots[dir])?;
-        let [nx, ny] = out.shape();
-        let (n_old, n_new) = ([nx, ny][dir], open.num_basis());
-        let idx = |i: usize, j: usize, n0: usize| if dir == 0 { j * n0 + i } else { i * nx + j };
-        let other = [ny, nx][dir];
-        let w = |k: usize| out.weights.as_ref().map_or(1.0, |w| w[k]);
-        let mut cps = vec![[0.0; 2]; n_new * other];
-        let mut ws = vec![0.0; n_new * other];
-        let n0 = if dir == 0 { n_new } else { nx };
-        for o in 0..other {
-            for r in 0..n_new {
-                let (mut x, mut y, mut wt) = (0.0, 0.0, 0.0);
-                for (col, v) in c.row(r) {
-                    let k = idx(col, o, nx);
-                    x += v * w(k) * out.control_points[k][0];
-                    y += v * w(k) * out.control_points[k][1];
-                    wt += v * w(k);
-                }
-                let k = idx(r, o, n0);
-                cps[k] = [x / wt, y / wt];
-                ws[k] = wt;
-            }
-        }
-        debug_assert_eq!(c.ncols, n_old);
-        let mut knots = out.knots.clone();
-        knots[dir] = open;
-        let weights = out.weights.is_some().then_some(ws);
-        out = crate::spline::surface::Surface::new(knots, cps, weights)?;
-    }
-    Ok(out)
-}
-
 /// An element `(span, a, b)`: `[t_span, t_span+1] = [a, b]`.
 pub type Element = (usize, f64, f64);
 
@@ -268,111 +226,12 @@ pub fn periodic_extraction(kv: &KnotVector) -> (Vec<Element>, Vec<Vec<f64>>) {
     (elements, ops)
 }
 
-/// The `L2` projection of parameter translates onto a periodic spline space `V` (knots
-/// `t`, period `L`): for a curve `s(u) = sum_k c_k N_k(u)` in `V` and a shift `sigma`,
-///
-/// `P s_sigma = sum_i x_i N_i`, `M x = b`, `M_ij = ∫ N_i N_j du`, `b_i = ∫ N_i(u) s(u + sigma) du`,
-///
-/// integrals over one period with wrapped indices, computed exactly by `p + 1`-point Gauss
-/// rules on the pieces between the period's knots and the knots moved by `-sigma` (both
-/// factors are polynomials there). `P` is linear in the control points and reproduces
-/// constants, so it commutes with affine maps of the plane (a rigid motion of the curve
-/// moves its projection the same way); `sigma = 0`, and a shift that maps the knots onto
-/// themselves (a multiple of `h` on a uniform vector), give the curve back exactly.
-///
-/// **Smoothness in `sigma`.** `b_i(sigma) = sum_k c_k ∫ N_i(u) N_k(u + sigma) du` is a
-/// cross-correlation of two degree-`p` B-splines: piecewise polynomial of degree `2p + 1`
-/// and `C^{2p}` in `sigma` (the `(p+1)`-th derivatives are sums of Dirac masses). A
-/// parameter that slides along a curve (the sliding grid of §11.1) then moves the control
-/// points smoothly in time, and the time extrapolation of `pipeline::sweep` keeps its
-/// order; a refit to shifted samples would only be `C^{p-1}`.
-#[derive(Debug)]
-pub struct PeriodicTranslate {
-    kv: KnotVector,
-    mass: crate::linalg::linsolve::LinearSolver,
-    gauss: crate::spline::quadrature::GaussLegendre,
-}
-
-impl PeriodicTranslate {
-    /// The projector onto the periodic space of `kv` (its mass matrix factored once).
-    pub fn new(kv: &KnotVector) -> Result<Self> {
-        if !kv.is_periodic() {
-            return Err(Error::Invalid("a translate projection needs a periodic knot vector".into()));
-        }
-        let (p, d) = (kv.degree(), kv.dim());
-        let gauss = crate::spline::quadrature::GaussLegendre::new(p + 1);
-        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); d];
-        for (span, a, b) in kv.elements() {
-            for (u, w) in gauss.on(a, b) {
-                let mut nd = BasisDerivs::default();
-                nd.eval_in_span(kv, span, u, 0);
-                for (ja, &va) in nd.ders(0).iter().enumerate() {
-                    for (jb, &vb) in nd.ders(0).iter().enumerate() {
-                        add_wrapped(&mut rows[(span - p + ja) % d], (span - p + jb) as isize, d, w * va * vb);
-                    }
-                }
-            }
-        }
-        for r in &mut rows {
-            r.sort_by_key(|e| e.0);
-        }
-        let m = Csr::from_rows(d, rows);
-        let mut mass = crate::linalg::linsolve::LinearSolver::new(crate::linalg::linsolve::LinearMethod::Cholesky);
-        mass.factor(&m)?;
-        Ok(Self { kv: kv.clone(), mass, gauss })
-    }
-
-    /// `P s_sigma` (see the type) for a polynomial curve `s` on this projector's knots.
-    pub fn translate(&mut self, s: &crate::spline::curve::Curve, sigma: f64) -> Result<crate::spline::curve::Curve> {
-        if s.knots != self.kv || s.is_rational() || !sigma.is_finite() {
-            return Err(Error::Invalid(format!(
-                "a translate projection needs a polynomial curve on the projector's knots and a finite shift (rational {}, same knots {}, shift {sigma})",
-                s.is_rational(),
-                s.knots == self.kv
-            )));
-        }
-        let kv = &self.kv;
-        let (p, d) = (kv.degree(), kv.dim());
-        let (a, l) = (kv.domain().0, kv.length());
-        let wrap = |u: f64| a + (u - a).rem_euclid(l);
-        let shift = (sigma / l).fract() * l;
-        let mut cuts: Vec<f64> = kv.period_knots().iter().flat_map(|&t| [t, wrap(t - shift)]).collect();
-        cuts.push(a + l);
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|x, y| (*x - *y).abs() <= 1e-14 * l);
-        let mut b = vec![[0.0f64; 2]; d];
-        let mut nd = BasisDerivs::default();
-        for w2 in cuts.windows(2) {
-            let (lo, hi) = (w2[0], w2[1]);
-            if hi <= lo {
-                continue;
-            }
-            let span = kv.find_span(0.5 * (lo + hi));
-            for (u, w) in self.gauss.on(lo, hi) {
-                nd.eval_in_span(kv, span, u, 0);
-                let x = s.eval(wrap(u + shift));
-                for (j, &v) in nd.ders(0).iter().enumerate() {
-                    let i = (span - p + j) % d;
-                    b[i][0] += w * v * x[0];
-                    b[i][1] += w * v * x[1];
-                }
-            }
-        }
-        let mut cols = [vec![0.0; d], vec![0.0; d]];
-        for (c, col) in cols.iter_mut().enumerate() {
-            let rhs: Vec<f64> = b.iter().map(|v| v[c]).collect();
-            *col = self.mass.solve(&rhs)?;
-        }
-        let cps = (0..kv.num_basis()).map(|k| [cols[0][k % d], cols[1][k % d]]).collect();
-        Ok(crate::spline::curve::Curve::polynomial(kv.clone(), cps))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::spline::bezier::{bernstein, BezierExtraction};
     use crate::spline::curve::{Curve, Point};
+    use crate::spline::translate::PeriodicTranslate;
     use crate::testutil::Lcg;
 
     /// A random closed curve on a periodic vector of `d` non-uniform knots per period

@@ -5,10 +5,7 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
-use crate::spline::surface::Surface;
-use crate::spline::tensor::apply_homogeneous;
 
 type SparseRow = Vec<(usize, f64)>;
 
@@ -106,36 +103,10 @@ pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     Ok((fine, Csr::from_rows(n_c, rows)))
 }
 
-impl Curve {
-    /// The same curve on the finer knot vector `fine` (which must contain this one's).
-    pub fn refined(&self, fine: &KnotVector) -> Result<Curve> {
-        let p = prolongation(&self.knots, fine)?;
-        let (cp, w) = apply_homogeneous(&p, &self.control_points, self.weights.as_deref());
-        Ok(Curve { knots: fine.clone(), control_points: cp, weights: w })
-    }
-
-    /// The same curve with its degree raised by one.
-    pub fn elevated(&self) -> Result<Curve> {
-        let (kv, e) = elevation(&self.knots)?;
-        let (cp, w) = apply_homogeneous(&e, &self.control_points, self.weights.as_deref());
-        Ok(Curve { knots: kv, control_points: cp, weights: w })
-    }
-}
-
-impl Surface {
-    /// The same map with both degrees raised by one.
-    pub fn elevated(&self) -> Result<Surface> {
-        let (kx, ex) = elevation(&self.knots[0])?;
-        let (ky, ey) = elevation(&self.knots[1])?;
-        let op = ey.kron(&ex);
-        let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
-        Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spline::curve::Curve;
     use crate::testutil::Lcg;
 
     fn random_curve(rng: &mut Lcg, p: usize, ne: usize, rational: bool) -> Curve {

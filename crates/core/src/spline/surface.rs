@@ -5,7 +5,8 @@ use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
-use crate::spline::tensor::TensorSpline;
+use crate::spline::refine::elevation;
+use crate::spline::tensor::{apply_homogeneous, TensorSpline};
 
 /// The four sides of the parameter square, in the order south, east, north, west.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -234,6 +235,59 @@ impl Surface {
             weights: self.weights.as_ref().map(|w| idx.iter().map(|&k| w[k]).collect()),
         }
     }
+}
+
+impl Surface {
+    /// The same map with both degrees raised by one.
+    pub fn elevated(&self) -> Result<Surface> {
+        let (kx, ex) = elevation(&self.knots[0])?;
+        let (ky, ey) = elevation(&self.knots[1])?;
+        let op = ey.kron(&ex);
+        let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
+        Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
+    }
+}
+
+/// `map` with every periodic direction written on its open knot vector
+/// (`periodic_to_open`): the same map on its domain (weights kept, control points in
+/// homogeneous form), for formats without periodic bases. Maps without a periodic
+/// direction come back unchanged.
+pub fn open_equivalent(map: &crate::spline::surface::Surface) -> Result<crate::spline::surface::Surface> {
+    let mut out = map.clone();
+    for dir in 0..2 {
+        if !out.knots[dir].is_periodic() {
+            continue;
+        }
+        let (open, c) = crate::spline::periodic::periodic_to_open(&out.knots[dir])?;
+        let [nx, ny] = out.shape();
+        let (n_old, n_new) = ([nx, ny][dir], open.num_basis());
+        let idx = |i: usize, j: usize, n0: usize| if dir == 0 { j * n0 + i } else { i * nx + j };
+        let other = [ny, nx][dir];
+        let w = |k: usize| out.weights.as_ref().map_or(1.0, |w| w[k]);
+        let mut cps = vec![[0.0; 2]; n_new * other];
+        let mut ws = vec![0.0; n_new * other];
+        let n0 = if dir == 0 { n_new } else { nx };
+        for o in 0..other {
+            for r in 0..n_new {
+                let (mut x, mut y, mut wt) = (0.0, 0.0, 0.0);
+                for (col, v) in c.row(r) {
+                    let k = idx(col, o, nx);
+                    x += v * w(k) * out.control_points[k][0];
+                    y += v * w(k) * out.control_points[k][1];
+                    wt += v * w(k);
+                }
+                let k = idx(r, o, n0);
+                cps[k] = [x / wt, y / wt];
+                ws[k] = wt;
+            }
+        }
+        debug_assert_eq!(c.ncols, n_old);
+        let mut knots = out.knots.clone();
+        knots[dir] = open;
+        let weights = out.weights.is_some().then_some(ws);
+        out = crate::spline::surface::Surface::new(knots, cps, weights)?;
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -17,9 +17,36 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::curve::{check_points, check_weights};
 use crate::spline::knots::KnotVector;
 use crate::spline::refine::{elevation, prolongation};
+
+/// Every coordinate of every point finite ([`Error::NonFinite`] naming `what` and its index).
+pub(crate) fn check_points<const D: usize>(pts: &[[f64; D]], what: &str) -> Result<()> {
+    for (i, p) in pts.iter().enumerate() {
+        if p.iter().any(|x| !x.is_finite()) {
+            let p = p.map(|x| x.to_string()).join(", ");
+            return Err(Error::NonFinite { context: String::new(), what: format!("{what} {i} is ({p})") });
+        }
+    }
+    Ok(())
+}
+
+/// `expected` weights, finite and positive ([`Error::Length`], [`Error::NonFinite`],
+/// [`Error::Weight`]).
+pub(crate) fn check_weights(w: &[f64], expected: usize) -> Result<()> {
+    if w.len() != expected {
+        return Err(Error::Length { context: String::new(), what: "weights".into(), found: w.len(), expected });
+    }
+    for (i, &x) in w.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(Error::NonFinite { context: String::new(), what: format!("weight {i} is {x}") });
+        }
+        if x <= 0.0 {
+            return Err(Error::Weight { context: String::new(), index: i, value: x });
+        }
+    }
+    Ok(())
+}
 
 /// A tensor-product B-spline or NURBS map `[0,1]^P → R^D` (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
