@@ -74,6 +74,19 @@ pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
         && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
 }
 
+/// The options of the THB defect correction from those of the solve: its repair rounds
+/// and halo, operator, Newton and certificate options.
+fn thb_options(opts: &SolveOptions) -> ThbRepairOptions {
+    ThbRepairOptions {
+        rounds: opts.repair.rounds,
+        ring: opts.repair.halo,
+        operator: opts.operator,
+        nonlinear: opts.nonlinear,
+        certify: opts.certify,
+        ..Default::default()
+    }
+}
+
 /// The THB defect correction of the tensor solve `sol` (see the module documentation):
 /// at most `opts.repair.rounds` rounds, each refining the offending cells and `opts.repair.halo`
 /// cells around them, EGG with the options' operator and Newton options, the
@@ -81,15 +94,7 @@ pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
 pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<ThbSolution> {
     let t0 = Instant::now();
     let start = HierarchicalMap::from_surface(&sol.map)?;
-    let topts = ThbRepairOptions {
-        rounds: opts.repair.rounds,
-        ring: opts.repair.halo,
-        operator: opts.operator,
-        nonlinear: opts.nonlinear,
-        certify: opts.certify,
-        ..Default::default()
-    };
-    let out = repair_thb_observed(start, &topts, &mut |round| observer(&Stage::ThbRound(round)))?;
+    let out = repair_thb_observed(start, &thb_options(opts), &mut |round| observer(&Stage::ThbRound(round)))?;
     let c = out.certificate;
     let report = ThbReport {
         refinement: Refinement::Thb,
@@ -129,15 +134,7 @@ mod tests {
         // the former path: the pipeline's map (no tensor repair, no fallback), then the repair
         let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
         assert!(repairs(&unrepaired, &opts), "{:?}", unrepaired.report.verdict);
-        let topts = ThbRepairOptions {
-            rounds: opts.repair.rounds,
-            ring: opts.repair.halo,
-            operator: opts.operator,
-            nonlinear: opts.nonlinear,
-            certify: opts.certify,
-            ..Default::default()
-        };
-        let before = repair_thb(HierarchicalMap::from_surface(&unrepaired.map).unwrap(), &topts).unwrap();
+        let before = repair_thb(HierarchicalMap::from_surface(&unrepaired.map).unwrap(), &thb_options(&opts)).unwrap();
         assert!(accepted(&before.certificate), "{}", before.certificate.message());
 
         let mut seen = Vec::new();
