@@ -124,19 +124,13 @@ impl CompareArgs {
         opts.solve = solver.options()?;
         opts.solve.nonlinear.max_newton = self.max_newton.max(1);
         opts.solve.nonlinear.max_pseudo = max_pseudo;
-        for (name, v) in [("--lambda1", self.lambda1), ("--lambda2", self.lambda2)] {
-            if !(v.is_finite() && v >= 0.0) {
-                bail!("{name} must be finite and not negative, got {v}");
-            }
-        }
         (opts.lambda1, opts.lambda2) = (self.lambda1, self.lambda2);
         opts.qc_hessian = self.qc_hessian;
-        if !(self.eps > 0.0 && self.eps < 1.0) {
-            bail!("--eps must be in (0, 1) (a fraction of the mean det J), got {}", self.eps);
-        }
         opts.constrained.eps = self.eps;
-        opts.constrained.max_iterations = self.max_sqp.max(1);
+        opts.constrained.max_iterations = self.max_sqp;
         opts.poisson_scales = self.poisson_scales;
+        // every value checked by the core, the same as for the library and Python
+        opts.validate()?;
         Ok((methods, opts))
     }
 }

@@ -94,9 +94,6 @@ struct Row {
 }
 
 pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
-    if !(a.eps > 0.0 && a.eps < 1.0) {
-        bail!("--eps must be in (0, 1) (a fraction of the mean det J), got {}", a.eps);
-    }
     let mut opts = a.solver.options()?;
     if opts.fit.basis == BasisChoice::Auto {
         opts.fit.basis = BasisChoice::Fitted;
@@ -104,6 +101,16 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     if opts.fit.basis == BasisChoice::Input {
         bail!("--basis input may be rational: the det J coefficient constraints need --basis fitted");
     }
+    let copts = ConstrainedOptions {
+        eps: a.eps,
+        max_iterations: a.max_iterations,
+        tol: a.opt_tol,
+        lagrangian_hessian: a.lagrangian_hessian,
+        certify: opts.certify,
+        ..Default::default()
+    };
+    // checked by the core before the EGG solve it starts from
+    copts.validate()?;
     let quiet = output::quiet() || a.json;
     crate::files::OutputPlan::new()
         .input(&a.boundary)
@@ -113,14 +120,6 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
     let boundary = load_boundary(&a.boundary, a.solver.fit.reorient)?;
     let sol = solve_cmd::run_pipeline(boundary.clone(), &opts, Arc::new(CpuAssembler), quiet)?.into_map()?;
     let egg = &sol.map;
-    let copts = ConstrainedOptions {
-        eps: a.eps,
-        max_iterations: a.max_iterations,
-        tol: a.opt_tol,
-        lagrangian_hessian: a.lagrangian_hessian,
-        certify: opts.certify,
-        ..Default::default()
-    };
     let functional = a.functional;
     let starts = match a.from {
         FromArg::Egg => vec![StartFrom::Egg],

@@ -202,6 +202,25 @@ fn out_of_range_solver_flags_are_the_cores_typed_error() {
         assert_eq!(out.status.code(), Some(1), "compare {flag} {value}");
         assert!(String::from_utf8_lossy(&out.stderr).contains(needle), "compare {flag} {value}");
     }
+    // the comparison's and the constrained optimisation's own options: the core's
+    // CompareOptions::validate and ConstrainedOptions::validate, before any solve
+    for (command, flag, value, needle) in [
+        ("compare", "--lambda1", "-0.5", "lambda1"),
+        ("compare", "--eps", "1.5", "eps"),
+        ("compare", "--max-sqp", "0", "iteration limits"),
+        ("optimise", "--eps", "0", "eps"),
+    ] {
+        let mut cmd = bin();
+        cmd.args([command, "-q", &format!("{flag}={value}")]).arg(&input);
+        if command == "optimise" {
+            cmd.arg("-o").arg(&map);
+        }
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{command} {flag} {value}: {err}");
+        assert!(err.contains("invalid argument") && err.contains(needle), "{command} {flag} {value}: {err}");
+        assert!(!map.exists(), "{command} {flag} {value}");
+    }
 }
 
 #[test]

@@ -189,6 +189,29 @@ pub struct CompareOptions {
     pub constrained: ConstrainedOptions,
 }
 
+impl CompareOptions {
+    /// The solve's options ([`SolveOptions::validate`]), `λ₁` and `λ₂` finite and not
+    /// negative, the Poisson scales positive and finite, Gravesen's options
+    /// ([`ConstrainedOptions::validate`]); [`Error::Invalid`] naming the option otherwise.
+    pub fn validate(&self) -> Result<()> {
+        self.solve.validate()?;
+        for (name, v) in [("lambda1", self.lambda1), ("lambda2", self.lambda2)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Invalid(format!("{name} must be finite and not negative, got {v}")));
+            }
+        }
+        if let Some(s) = self.poisson_scales {
+            if !s.iter().all(|v| v.is_finite() && *v > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "the Poisson scales must be positive and finite, got {}, {}",
+                    s[0], s[1]
+                )));
+            }
+        }
+        self.constrained.validate()
+    }
+}
+
 impl Default for CompareOptions {
     /// The solver's defaults, except: one level (every method starts from the Coons patch
     /// of the finest basis: one start and one basis for all, as in the paper's Table 3;
@@ -475,6 +498,7 @@ pub fn compare(
     assembler: Arc<dyn EggAssembler>,
     progress: &mut dyn FnMut(CompareEvent) -> bool,
 ) -> Result<Option<Comparison>> {
+    opts.validate()?;
     let mut order = vec![MethodChoice::Egg];
     for &m in methods {
         if !order.contains(&m) {

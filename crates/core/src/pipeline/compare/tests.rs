@@ -145,3 +145,26 @@ fn serialised_names_are_the_names() {
         assert_eq!(serde_json::to_value(m).unwrap(), m.name());
     }
 }
+
+/// Every option of the comparison is checked by the core: the solve's, `λ₁`, `λ₂`, the
+/// Poisson scales and Gravesen's `ε`, iteration limits, tolerance and trust radius.
+#[test]
+fn options_are_validated_by_the_core() {
+    assert!(CompareOptions::default().validate().is_ok());
+    type Spoil = fn(&mut CompareOptions);
+    let bad: [(&str, Spoil); 7] = [
+        ("min_elements", |o| o.solve.levels.min_elements = 0),
+        ("lambda1", |o| o.lambda1 = -1.0),
+        ("lambda2", |o| o.lambda2 = f64::NAN),
+        ("Poisson scales", |o| o.poisson_scales = Some([1.0, 0.0])),
+        ("eps", |o| o.constrained.eps = 1.0),
+        ("iteration limits", |o| o.constrained.max_iterations = 0),
+        ("radius", |o| o.constrained.radius = f64::INFINITY),
+    ];
+    for (needle, spoil) in bad {
+        let mut o = CompareOptions::default();
+        spoil(&mut o);
+        let e = o.validate().unwrap_err().to_string();
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+}

@@ -120,6 +120,32 @@ impl Default for ConstrainedOptions {
     }
 }
 
+impl ConstrainedOptions {
+    /// [`Error::Invalid`] naming the option when `ε` is not in `(0, 1)` (a fraction of the
+    /// mean `det J`), an iteration limit is 0, or the tolerance or the trust radius is not
+    /// positive and finite.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.eps > 0.0 && self.eps < 1.0) {
+            return Err(Error::Invalid(format!(
+                "eps must be in (0, 1) (a fraction of the mean det J), got {}",
+                self.eps
+            )));
+        }
+        if self.max_iterations == 0 || self.max_z_iterations == 0 {
+            return Err(Error::Invalid(format!(
+                "the SQP and LP iteration limits must be at least 1, got {} and {}",
+                self.max_iterations, self.max_z_iterations
+            )));
+        }
+        for (name, v) in [("tol", self.tol), ("radius", self.radius)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Invalid(format!("{name} must be positive and finite, got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// What [`max_z`] did.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
@@ -368,6 +394,7 @@ fn outcome_certificate(map: &Surface, opts: &ConstrainedOptions) -> Result<(Cert
 /// Eq. (49) alone on `map`'s basis from the Coons patch of its boundary, stopped at
 /// `z > 0`, certified.
 pub fn run_max_z(map: &Surface, topology: &Topology, opts: &ConstrainedOptions) -> Result<Outcome> {
+    opts.validate()?;
     let t0 = Instant::now();
     let disc = discretization(map, topology)?;
     let coons = coons_start(map)?;
@@ -401,6 +428,7 @@ pub fn run(
     topology: &Topology,
     opts: &ConstrainedOptions,
 ) -> Result<Outcome> {
+    opts.validate()?;
     let t0 = Instant::now();
     let disc = discretization(egg, topology)?;
     let (start, stage) = match from {
