@@ -153,3 +153,46 @@ fn gravesens_methods_refuse_a_rational_or_large_basis_clearly() {
     let n: usize = why.split(" unknowns").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
     assert!(n > 3000, "{why}");
 }
+
+/// Out-of-range flags are refused by the core (exit 1, the option named, nothing
+/// written): the solver's by `SolveOptions::validate`, in `solve` and `compare` alike, and
+/// those of the comparison and the constrained optimisation by `CompareOptions::validate`
+/// and `ConstrainedOptions::validate`: the CLI has no checks of its own that could drift
+/// from the library's.
+#[test]
+fn out_of_range_solver_flags_are_the_cores_typed_error() {
+    let scratch = tempfile::tempdir().unwrap();
+    let map = scratch.path().join("map.json");
+    let input = data().join("quarter_annulus.json");
+    for (flag, value, needle) in
+        [("--min-elements", "0", "min_elements"), ("--growth", "0.5", "growth"), ("--tol", "0", "tol")]
+    {
+        let out = bin().args(["solve", "-q", flag, value]).arg(&input).arg("-o").arg(&map).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains("invalid argument") && err.contains(needle), "{flag} {value}: {err}");
+        assert!(!map.exists(), "{flag} {value}");
+        let out = bin().args(["compare", "--json", flag, value]).arg(&input).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "compare {flag} {value}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(needle), "compare {flag} {value}");
+    }
+    // the comparison's and the constrained optimisation's own options: the core's
+    // CompareOptions::validate and ConstrainedOptions::validate, before any solve
+    for (command, flag, value, needle) in [
+        ("compare", "--lambda1", "-0.5", "lambda1"),
+        ("compare", "--eps", "1.5", "eps"),
+        ("compare", "--max-sqp", "0", "iteration limits"),
+        ("optimise", "--eps", "0", "eps"),
+    ] {
+        let mut cmd = bin();
+        cmd.args([command, "-q", &format!("{flag}={value}")]).arg(&input);
+        if command == "optimise" {
+            cmd.arg("-o").arg(&map);
+        }
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{command} {flag} {value}: {err}");
+        assert!(err.contains("invalid argument") && err.contains(needle), "{command} {flag} {value}: {err}");
+        assert!(!map.exists(), "{command} {flag} {value}");
+    }
+}
