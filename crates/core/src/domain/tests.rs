@@ -194,6 +194,22 @@ fn conforming_bit_for_bit(l: &Layout) {
     }
 }
 
+/// The layout's area equals the domain's exactly: the rectangle minus circles, ellipses
+/// (`pi a b`) and squares, from the loops' own boundaries (Green's theorem on the input
+/// curves; holes run clockwise, so their integrals are negative).
+fn assert_area_is_the_domains(d: &Domain, layout: &Layout) {
+    let mut want = 0.0;
+    for (_, lp) in d.loops() {
+        for s in &lp.sides {
+            if let SideCurve::Spline(c) = s {
+                want += green_fine(c);
+            }
+        }
+    }
+    let got = fine_area(layout);
+    assert!((got - want).abs() < 1e-10 * want, "{}: {got} vs {want}", d.name);
+}
+
 /// `∫ (x y' - y x') / 2` along any curve, 24 Gauss points per knot span (rational
 /// curves: to rounding for the arcs here).
 fn green_fine(c: &Curve) -> f64 {
@@ -229,19 +245,7 @@ fn plates_with_holes_near_the_contour_and_each_other() {
         let auto = auto_layout(&d, &LayoutOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", d.name));
         validate_layout(&auto.layout).unwrap();
         conforming_bit_for_bit(&auto.layout);
-        // exact area: the rectangle minus circles, ellipses (pi a b) and squares, from
-        // the holes' own boundaries (Green's theorem on the input curves)
-        let mut want = 0.0;
-        for (_, lp) in d.loops() {
-            for s in &lp.sides {
-                if let SideCurve::Spline(c) = s {
-                    want += green_fine(c);
-                }
-            }
-        }
-        // holes run clockwise: their integrals are negative
-        let got = fine_area(&auto.layout);
-        assert!((got - want).abs() < 1e-10 * want, "{}: {got} vs {want}", d.name);
+        assert_area_is_the_domains(&d, &auto.layout);
     }
 }
 
@@ -485,16 +489,7 @@ fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
         validate_layout(&auto.layout).unwrap_or_else(|e| panic!("{}: {e}", d.name));
         assert!(auto.report.faces.iter().any(|f| f.inverse), "{}", d.name);
         conforming_bit_for_bit(&auto.layout);
-        let mut want = 0.0;
-        for (_, lp) in d.loops() {
-            for s in &lp.sides {
-                if let SideCurve::Spline(c) = s {
-                    want += green_fine(c);
-                }
-            }
-        }
-        let got = fine_area(&auto.layout);
-        assert!((got - want).abs() < 1e-10 * want, "{}: {got} vs {want}", d.name);
+        assert_area_is_the_domains(d, &auto.layout);
         if d.name == "plate-1" || d.name.starts_with("u-") {
             certified(&auto, &d.name);
         }
