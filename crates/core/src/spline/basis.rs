@@ -48,6 +48,10 @@ impl BasisDerivs {
         debug_assert!(nd <= MAX_DERIV && p <= MAX_DEGREE);
         self.span = span;
         self.degree = p;
+        if nd == 0 {
+            self.values_in_span(t, span, u);
+            return;
+        }
         let mut ndu = [[0.0f64; W]; W];
         let mut left = [0.0f64; W];
         let mut right = [0.0f64; W];
@@ -71,6 +75,7 @@ impl BasisDerivs {
         }
         let nd = nd.min(p);
         if nd == 0 {
+            // `p = 0`: only the value
             for k in 1..=MAX_DERIV {
                 self.d[k][..=p].fill(0.0);
             }
@@ -111,6 +116,32 @@ impl BasisDerivs {
             fac *= (p - k) as f64;
         }
         for k in nd + 1..=MAX_DERIV {
+            self.d[k][..=p].fill(0.0);
+        }
+    }
+
+    /// The values alone (A2.2 of Piegl & Tiller): the same operations, in the same order,
+    /// as the upper triangle of A2.3's table `ndu`, so the values are bit-identical to
+    /// those of [`BasisDerivs::eval_in_span`] with derivatives, without filling the
+    /// `(MAX_DEGREE + 1)²` table (most of the cost of a value at low degree).
+    fn values_in_span(&mut self, t: &[f64], span: usize, u: f64) {
+        let p = self.degree;
+        let mut left = [0.0f64; W];
+        let mut right = [0.0f64; W];
+        let n = &mut self.d[0];
+        n[0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - t[span + 1 - j];
+            right[j] = t[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let temp = n[r] / (right[r + 1] + left[j - r]);
+                n[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            n[j] = saved;
+        }
+        for k in 1..=MAX_DERIV {
             self.d[k][..=p].fill(0.0);
         }
     }
@@ -192,6 +223,29 @@ mod tests {
                         let scale2 = 1.0 + bd.d[2][j].abs();
                         assert!((fd2 - bd.d[2][j]).abs() < 1e-5 * scale2, "p={p} d2 {fd2} vs {}", bd.d[2][j]);
                     }
+                }
+            }
+        }
+    }
+
+    /// The values alone (A2.2) are the values of A2.3 to the last bit, at every degree,
+    /// on knots with repeated entries, at knots and between them.
+    #[test]
+    fn values_alone_are_the_values_with_derivatives_bit_for_bit() {
+        let mut rng = Lcg::new(11);
+        for p in 0..=MAX_DEGREE {
+            for _ in 0..10 {
+                let kv =
+                    if p == 0 { KnotVector::open_from_breaks(0, &[0.0, 0.3, 1.0], 1) } else { random_kv(&mut rng, p) };
+                let (a, b) = kv.domain();
+                let knots: Vec<f64> = kv.knots().to_vec();
+                let params = (0..30).map(|_| a + (b - a) * rng.uniform()).chain(knots);
+                for u in params {
+                    let (v, d) = (BasisDerivs::at(&kv, u, 0), BasisDerivs::at(&kv, u, 2));
+                    assert_eq!(v.span, d.span);
+                    let bits = |x: &[f64]| x.iter().map(|y| y.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(v.ders(0)), bits(d.ders(0)), "p = {p}, u = {u}");
+                    assert!(v.ders(1).iter().chain(v.ders(2)).all(|&x| x == 0.0));
                 }
             }
         }

@@ -371,7 +371,17 @@ pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n
     Side::ALL.map(|s| {
         let side = SideSamples::of(boundary.side(s));
         let curve = map.boundary(s);
-        (0..=n).map(|k| side.distance(curve.eval(k as f64 / n as f64))).fold(0.0, f64::max)
+        // the nearest chord of every point first (cheap), then the curve's nearest points,
+        // the points of the farthest chords first: a point whose distance is found not to
+        // exceed the largest one so far stops early, which leaves the maximum exact
+        let mut near: Vec<([f64; 2], (f64, usize))> = (0..=n)
+            .map(|k| {
+                let p = curve.eval(k as f64 / n as f64);
+                (p, side.nearest_chord(p))
+            })
+            .collect();
+        near.sort_by(|a, b| b.1 .0.total_cmp(&a.1 .0));
+        near.iter().fold(0.0, |max: f64, &(p, chord)| max.max(side.distance_beyond(p, chord, max)))
     })
 }
 
@@ -380,6 +390,9 @@ struct SideSamples<'a> {
     side: &'a crate::boundary::SideCurve,
     /// `(t, x(t))`, increasing `t` (for a point cloud `t` is the index).
     points: Vec<(f64, [f64; 2])>,
+    /// The side's `C^0` knots (a spline's knots of multiplicity at least its degree), where
+    /// the distance need not be unimodal.
+    kinks: Vec<f64>,
 }
 
 impl<'a> SideSamples<'a> {
@@ -407,7 +420,17 @@ impl<'a> SideSamples<'a> {
                 })
                 .collect(),
         };
-        Self { side, points }
+        let kinks = match side {
+            SideCurve::Spline(c) => c
+                .knots
+                .breaks_with_multiplicity()
+                .into_iter()
+                .filter(|&(_, m)| m >= c.knots.degree())
+                .map(|(u, _)| u)
+                .collect(),
+            _ => Vec::new(),
+        };
+        Self { side, points, kinks }
     }
 
     fn eval(&self, t: f64) -> [f64; 2] {
@@ -419,20 +442,38 @@ impl<'a> SideSamples<'a> {
         }
     }
 
-    /// Distance from `p` to the side (see [`boundary_deviation`]).
-    fn distance(&self, p: [f64; 2]) -> f64 {
+    /// The distance from `p` to the nearest chord of the sampling and that chord's index
+    /// (the first of equally near ones).
+    fn nearest_chord(&self, p: [f64; 2]) -> (f64, usize) {
         let pts = &self.points;
         if pts.len() < 2 {
-            return pts.first().map_or(f64::INFINITY, |q| (p[0] - q.1[0]).hypot(p[1] - q.1[1]));
+            return (pts.first().map_or(f64::INFINITY, |q| (p[0] - q.1[0]).hypot(p[1] - q.1[1])), 0);
         }
+        // the nearest chord, the first of equally near ones; a chord whose squared
+        // distance exceeds `best²` by more than rounding is farther and needs no `hypot`
+        // (near ties and squares that are not normal numbers take the distance itself)
         let (mut best, mut at) = (f64::INFINITY, 0);
         for (i, w) in pts.windows(2).enumerate() {
-            let d = point_segment_distance(p, w[0].1, w[1].1);
+            let e = point_segment_offset(p, w[0].1, w[1].1);
+            let b2 = best * best;
+            if b2.is_normal() && e[0] * e[0] + e[1] * e[1] > b2 * (1.0 + 1e-10) {
+                continue;
+            }
+            let d = e[0].hypot(e[1]);
             if d < best {
                 (best, at) = (d, i);
             }
         }
-        if matches!(self.side, crate::boundary::SideCurve::Points(_)) {
+        (best, at)
+    }
+
+    /// Distance from `p` to the side (see [`boundary_deviation`]), from its nearest chord
+    /// `(best, at)` ([`SideSamples::nearest_chord`]) — exactly when it exceeds `floor`,
+    /// otherwise some value at most `floor` (the search stops once the distance is known
+    /// not to exceed it).
+    fn distance_beyond(&self, p: [f64; 2], (best, at): (f64, usize), floor: f64) -> f64 {
+        let pts = &self.points;
+        if pts.len() < 2 || matches!(self.side, crate::boundary::SideCurve::Points(_)) {
             return best;
         }
         let dist = |t: f64| {
@@ -443,12 +484,17 @@ impl<'a> SideSamples<'a> {
         // between the side's C0 knots there (across a kink the distance need not be
         // unimodal: on a narrow V-notch the search slid from a point of one flank to the
         // other flank)
+        // (`min(fa, fb)` never grows, so once `min(found, fa, fb) <= floor` the result is
+        // at most `floor`)
         let golden = |mut lo: f64, mut hi: f64| {
             let found = dist(lo).min(dist(hi));
             let r = 0.5 * (5f64.sqrt() - 1.0);
             let (mut a, mut b) = (hi - r * (hi - lo), lo + r * (hi - lo));
             let (mut fa, mut fb) = (dist(a), dist(b));
             for _ in 0..80 {
+                if found.min(fa).min(fb) <= floor {
+                    break;
+                }
                 if fa <= fb {
                     (hi, b, fb) = (b, a, fa);
                     a = hi - r * (hi - lo);
@@ -465,17 +511,8 @@ impl<'a> SideSamples<'a> {
             found.min(fa).min(fb)
         };
         let (lo, hi) = (pts[at.saturating_sub(1)].0, pts[(at + 2).min(pts.len() - 1)].0);
-        let kinks: Vec<f64> = match self.side {
-            crate::boundary::SideCurve::Spline(c) => c
-                .knots
-                .breaks_with_multiplicity()
-                .into_iter()
-                .filter(|&(u, m)| m >= c.knots.degree() && u > lo && u < hi)
-                .map(|(u, _)| u)
-                .collect(),
-            _ => Vec::new(),
-        };
-        if kinks.is_empty() {
+        let mut kinks = self.kinks.iter().copied().filter(|&u| u > lo && u < hi).peekable();
+        if kinks.peek().is_none() {
             return golden(lo, hi);
         }
         let mut ends = vec![lo];
@@ -485,11 +522,12 @@ impl<'a> SideSamples<'a> {
     }
 }
 
-fn point_segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+/// `p - q`, where `q` is the point of the segment `[a, b]` nearest to `p`.
+fn point_segment_offset(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+    [p[0] - a[0] - t * dx, p[1] - a[1] - t * dy]
 }
 
 #[cfg(test)]
