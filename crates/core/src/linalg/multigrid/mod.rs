@@ -19,6 +19,8 @@ use crate::linalg::dense::DenseCholesky;
 use crate::linalg::krylov::Ilu0;
 use crate::linalg::sparse::Csr;
 
+mod lines;
+
 /// The smoother of every level but the coarsest.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Smoother {
@@ -28,6 +30,9 @@ pub enum Smoother {
     SymmetricGaussSeidel,
     /// `x += (LU)^{-1} (b - A x)` with the incomplete factors of the level's operator.
     Ilu0,
+    /// Alternating line Gauss–Seidel: block Gauss–Seidel over the lines of direction 0,
+    /// then over those of direction 1 (in reverse after the coarse correction).
+    Lines,
 }
 
 /// A multigrid V-cycle for `A` (see the module documentation).
@@ -41,9 +46,31 @@ pub struct Multigrid {
     /// Position of the diagonal entry of each row of each operator.
     diagonals: Vec<Vec<usize>>,
     ilu: Vec<Ilu0>,
+    lines: Vec<[lines::Lines; 2]>,
+    /// Coarse corrections per level: 1 for a V-cycle, 2 for a W-cycle.
+    gamma: usize,
+    probe: bool,
     coarse: DenseCholesky,
     smoother: Smoother,
     sweeps: usize,
+}
+
+/// Diagnostics: a variant of the cycle named by `spec` (comma-separated: `ilu`, `sgs`,
+/// `lines`, `w`, `2`, `3`).
+fn variant(spec: &str, mut smoother: Smoother, mut sweeps: usize) -> (Smoother, usize, usize) {
+    let mut gamma = 1;
+    for part in spec.split(',') {
+        match part {
+            "ilu" => smoother = Smoother::Ilu0,
+            "sgs" => smoother = Smoother::SymmetricGaussSeidel,
+            "lines" => smoother = Smoother::Lines,
+            "w" => gamma = 2,
+            "2" => sweeps = 2,
+            "3" => sweeps = 3,
+            _ => {}
+        }
+    }
+    (smoother, sweeps, gamma)
 }
 
 /// `P^T A P` with `pt = P^T`, rows in parallel, a dense accumulator per thread.
@@ -115,12 +142,26 @@ impl Multigrid {
     /// [`Multigrid::factor`] gives it its operator.
     pub fn new(prolongations: Vec<Csr>, smoother: Smoother, sweeps: usize) -> Self {
         let restrictions = prolongations.iter().map(Csr::transpose).collect();
+        let (smoother, sweeps, gamma) = match std::env::var("WINSLOW_MG") {
+            Ok(v) => variant(&v, smoother, sweeps),
+            Err(_) => (smoother, sweeps, 1),
+        };
+        let mut mg = Self::with(prolongations, restrictions, smoother, sweeps);
+        mg.gamma = gamma;
+        mg.probe = std::env::var_os("WINSLOW_MG_PROBE").is_some();
+        mg
+    }
+
+    fn with(prolongations: Vec<Csr>, restrictions: Vec<Csr>, smoother: Smoother, sweeps: usize) -> Self {
         Self {
             prolongations,
             restrictions,
             operators: Vec::new(),
             diagonals: Vec::new(),
             ilu: Vec::new(),
+            lines: Vec::new(),
+            gamma: 1,
+            probe: false,
             coarse: DenseCholesky::default(),
             smoother,
             sweeps: sweeps.max(1),
@@ -161,11 +202,76 @@ impl Multigrid {
         self.diagonals = smoothed.iter().map(diagonal_positions).collect::<Result<_>>()?;
         self.ilu = match self.smoother {
             Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel => Vec::new(),
+            _ => Vec::new(),
+        };
+        self.lines = match self.smoother {
+            Smoother::Lines => smoothed
+                .iter()
+                .map(|a| {
+                    let nx = lines::grid_width(a);
+                    Ok([lines::Lines::new(a, nx, 0)?, lines::Lines::new(a, nx, 1)?])
+                })
+                .collect::<Result<_>>()?,
+            _ => Vec::new(),
         };
         self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
         self.operators = operators;
+        if self.probe {
+            self.print_probe();
+        }
         Ok(())
+    }
+
+    /// Diagnostics: the level sizes and the residual reduction of the stationary
+    /// iteration `x += B (b - A x)`, `b` pseudo-random, per cycle.
+    fn print_probe(&self) {
+        let spec = std::env::var("WINSLOW_MG_PROBE").unwrap_or_default();
+        for v in spec.split(';').filter(|v| !v.is_empty()) {
+            let (smoother, sweeps, gamma) = variant(v, self.smoother, self.sweeps);
+            let mut mg = Self::with(self.prolongations.clone(), self.restrictions.clone(), smoother, sweeps);
+            mg.gamma = gamma;
+            match mg.factor(&self.operators[0]) {
+                Ok(()) => mg.probe_one(v),
+                Err(e) => eprintln!("MGPROBE {v}: {e}"),
+            }
+        }
+    }
+
+    fn probe_one(&self, name: &str) {
+        let a = &self.operators[0];
+        let n = a.nrows;
+        let mut seed = 12345u64;
+        let b: Vec<f64> = (0..n)
+            .map(|_| {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        let norm = |v: &[f64]| v.iter().map(|t| t * t).sum::<f64>().sqrt();
+        let (mut x, mut r, mut z) = (vec![0.0; n], b.clone(), vec![0.0; n]);
+        let r0 = norm(&r);
+        let mut out = Vec::new();
+        let mut prev = r0;
+        for _ in 0..10 {
+            self.apply(&r, &mut z);
+            x.iter_mut().zip(&z).for_each(|(xi, zi)| *xi += zi);
+            a.mul_vec(&x, &mut r);
+            r.iter_mut().zip(&b).for_each(|(ri, bi)| *ri = bi - *ri);
+            let nr = norm(&r);
+            out.push(nr / prev);
+            prev = nr;
+        }
+        let sizes: Vec<String> = self
+            .operators
+            .iter()
+            .map(|o| format!("{}x{}", lines::grid_width(o), o.nrows / lines::grid_width(o).max(1)))
+            .collect();
+        let mean = (prev / r0).powf(0.1);
+        eprintln!(
+            "MGPROBE n={n} {name:<10} mean={mean:.4} levels=[{}] per-cycle=[{}]",
+            sizes.join(" "),
+            out.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>().join(" ")
+        );
     }
 
     /// `x = B b`, one V-cycle from `x = 0` (`B ≈ A^{-1}`).
@@ -196,6 +302,19 @@ impl Multigrid {
         for (xi, ci) in x.iter_mut().zip(&r) {
             *xi += ci;
         }
+        if self.gamma > 1 && l + 2 < self.levels() {
+            a.mul_vec(x, &mut r);
+            for (ri, bi) in r.iter_mut().zip(b) {
+                *ri = bi - *ri;
+            }
+            let rc = self.restrictions[l].apply(&r);
+            let mut xc = vec![0.0; rc.len()];
+            self.cycle(l + 1, &rc, &mut xc);
+            self.prolongations[l].mul_vec(&xc, &mut r);
+            for (xi, ci) in x.iter_mut().zip(&r) {
+                *xi += ci;
+            }
+        }
         for _ in 0..self.sweeps {
             self.smooth(l, b, x, &mut r, true);
         }
@@ -218,6 +337,17 @@ impl Multigrid {
                     (0..a.nrows).rev().for_each(&mut relax);
                 } else {
                     (0..a.nrows).for_each(&mut relax);
+                }
+            }
+            Smoother::Lines => {
+                let mut scratch = Vec::new();
+                let [l0, l1] = &self.lines[l];
+                if backward {
+                    l1.sweep(a, b, x, true, &mut scratch);
+                    l0.sweep(a, b, x, true, &mut scratch);
+                } else {
+                    l0.sweep(a, b, x, false, &mut scratch);
+                    l1.sweep(a, b, x, false, &mut scratch);
                 }
             }
             Smoother::Ilu0 => {
