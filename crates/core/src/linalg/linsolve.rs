@@ -98,13 +98,15 @@ pub const MAX_KRYLOV: usize = 2000;
 /// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
 pub const AUTO_MAX_KRYLOV: usize = 500;
 
-/// Smoother of [`LinearMethod::Multigrid`]: ILU(0). On the metric Laplacian of a
-/// stretched, sheared quarter annulus (`p = 3`, 32² and 64² elements) a V(1,1)-cycle
-/// with ILU(0) reduces the residual by 0.012 per cycle at both sizes, with symmetric
-/// Gauss–Seidel by 0.54 (the smoothing of Gauss–Seidel degrades with the degree and the
-/// cells' aspect ratio); in the Newton solves the Gauss–Seidel cycle's GMRES iterations
-/// grew as `h` halved (BENCHMARKS.md "Multigrid").
-pub(crate) const MG_SMOOTHER: Smoother = Smoother::Ilu0;
+/// Smoother of [`LinearMethod::Multigrid`]: alternating line Gauss–Seidel. On the metric
+/// Laplacians of the Newton solves themselves (puzzle4 at 3 600, 57 600 and 230 400
+/// scalar unknowns) the V(1,1)-cycle with ILU(0) reduced the residual by 0.078, 0.78 and
+/// 2.9 per cycle (divergent: ILU(0) of these non-M-matrices is not a convergent
+/// smoother), with symmetric Gauss–Seidel by 0.91 at every size, with the lines by 0.18,
+/// 0.42, 0.53; the lines solve the stiff direction of a narrow gap exactly
+/// (BENCHMARKS.md "Multigrid", the test
+/// `discrete::transfers::tests::multigrid_reduction_is_independent_of_h`).
+pub(crate) const MG_SMOOTHER: Smoother = Smoother::Lines;
 
 /// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
 pub const MG_SWEEPS: usize = 1;

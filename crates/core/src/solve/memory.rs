@@ -54,10 +54,12 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 /// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
 /// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
 /// gather map, the metric Laplacian `K` in stencil storage and in CSR, and the V-cycle's
-/// copy of `K`, its ILU(0) factors and coarse levels. With [`MULTIGRID_BYTES_PER_UNKNOWN`]
+/// copy of `K`, its line factors and coarse levels. With [`MULTIGRID_BYTES_PER_UNKNOWN`]
 /// fitted by least squares to the peaks (`VmHWM`, dev profile, one geometry per process)
-/// of wavy_lid (279 k unknowns), male_rotor (541 k) and puzzle4 (461 k) at `--refine 5`:
-/// measured over estimated 0.92-1.08 (BENCHMARKS.md, "Toward 10^6 unknowns").
+/// of wavy_lid (279 k unknowns), male_rotor (541 k) and puzzle4 (461 k) at `--refine 5`
+/// with the ILU(0)-smoothed V-cycle: measured over estimated 0.92-1.08 (BENCHMARKS.md,
+/// "Toward 10^6 unknowns"); with the line smoother, which keeps no ILU(0) copy of `K`
+/// and needs fewer GMRES vectors, 0.73-0.88 at the same sizes (an upper bound now).
 pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see

@@ -8,9 +8,12 @@
 //! One application is a V(ν, ν)-cycle from a zero guess: on level `l`, ν pre-smoothing
 //! sweeps, the restriction `r_{l+1} = P_l^T (b - A_l x)`, the cycle on level `l + 1`, the
 //! correction `x += P_l x_{l+1}`, ν post-smoothing sweeps. The smoother
-//! ([`Smoother`]) is symmetric Gauss–Seidel (forward before, backward after the
-//! coarse correction: the cycle is a symmetric operator) or ILU(0) on the level's
-//! pattern; see BENCHMARKS.md "Multigrid" for the measured choice.
+//! ([`Smoother`]) is alternating line Gauss–Seidel (the lines of both directions of the
+//! tensor grid, each line's banded block solved exactly: robust where the metric makes
+//! one direction stiff, `g11 >> g22` in a narrow gap), symmetric Gauss–Seidel or ILU(0)
+//! on the level's pattern, each forward before and backward after the coarse correction;
+//! BENCHMARKS.md "Multigrid" has the measured choice (ILU(0) diverges as a smoother on
+//! the metrics of puzzle4's necks).
 
 use rayon::prelude::*;
 
@@ -19,6 +22,10 @@ use crate::linalg::dense::DenseCholesky;
 use crate::linalg::krylov::Ilu0;
 use crate::linalg::sparse::Csr;
 
+mod lines;
+
+use lines::{grid_width, Lines};
+
 /// The smoother of every level but the coarsest.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Smoother {
@@ -26,8 +33,14 @@ pub enum Smoother {
     /// order after it (compared with ILU(0) in the tests, BENCHMARKS.md "Multigrid").
     #[cfg_attr(not(test), allow(dead_code))]
     SymmetricGaussSeidel,
-    /// `x += (LU)^{-1} (b - A x)` with the incomplete factors of the level's operator.
+    /// `x += (LU)^{-1} (b - A x)` with the incomplete factors of the level's operator
+    /// (compared in the tests; not convergent on strongly stretched metrics).
+    #[cfg_attr(not(test), allow(dead_code))]
     Ilu0,
+    /// Alternating line Gauss–Seidel: block Gauss–Seidel over the lines of direction 0,
+    /// then over those of direction 1 (the reverse after the coarse correction), each
+    /// line's block `A_LL` factorized once ([`lines`]).
+    Lines,
 }
 
 /// A multigrid V-cycle for `A` (see the module documentation).
@@ -41,6 +54,8 @@ pub struct Multigrid {
     /// Position of the diagonal entry of each row of each operator.
     diagonals: Vec<Vec<usize>>,
     ilu: Vec<Ilu0>,
+    /// The lines of both directions of each smoothed level ([`Smoother::Lines`]).
+    lines: Vec<[Lines; 2]>,
     coarse: DenseCholesky,
     smoother: Smoother,
     sweeps: usize,
@@ -121,6 +136,7 @@ impl Multigrid {
             operators: Vec::new(),
             diagonals: Vec::new(),
             ilu: Vec::new(),
+            lines: Vec::new(),
             coarse: DenseCholesky::default(),
             smoother,
             sweeps: sweeps.max(1),
@@ -158,10 +174,23 @@ impl Multigrid {
             operators[l + 1] = galerkin(&self.restrictions[l], &operators[l], &self.prolongations[l]);
         }
         let smoothed = &operators[..operators.len() - 1];
-        self.diagonals = smoothed.iter().map(diagonal_positions).collect::<Result<_>>()?;
+        self.diagonals = match self.smoother {
+            Smoother::SymmetricGaussSeidel => smoothed.iter().map(diagonal_positions).collect::<Result<_>>()?,
+            _ => Vec::new(),
+        };
         self.ilu = match self.smoother {
             Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel => Vec::new(),
+            Smoother::SymmetricGaussSeidel | Smoother::Lines => Vec::new(),
+        };
+        self.lines = match self.smoother {
+            Smoother::Lines => smoothed
+                .iter()
+                .map(|a| {
+                    let nx = grid_width(a);
+                    Ok([Lines::new(a, nx, 0)?, Lines::new(a, nx, 1)?])
+                })
+                .collect::<Result<_>>()?,
+            Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
         };
         self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
         self.operators = operators;
@@ -218,6 +247,17 @@ impl Multigrid {
                     (0..a.nrows).rev().for_each(&mut relax);
                 } else {
                     (0..a.nrows).for_each(&mut relax);
+                }
+            }
+            Smoother::Lines => {
+                let mut scratch = Vec::new();
+                let [l0, l1] = &self.lines[l];
+                if backward {
+                    l1.sweep(a, b, x, true, &mut scratch);
+                    l0.sweep(a, b, x, true, &mut scratch);
+                } else {
+                    l0.sweep(a, b, x, false, &mut scratch);
+                    l1.sweep(a, b, x, false, &mut scratch);
                 }
             }
             Smoother::Ilu0 => {
