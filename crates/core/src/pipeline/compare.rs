@@ -280,7 +280,7 @@ pub struct MethodRun {
 impl MethodRun {
     /// The run of a coarse-to-fine solve.
     pub fn of_solution(method: &str, sol: &Solution, seconds: f64) -> Self {
-        let levels = &sol.report.levels;
+        let levels = &sol.report.solve.levels;
         let last = levels.last();
         Self {
             method: method.to_string(),

@@ -152,7 +152,7 @@ impl Solved {
     /// trivariate certificate).
     pub fn verdict(&self) -> Verdict {
         match self {
-            Solved::Map(s) => s.report.verdict,
+            Solved::Map(s) => s.report.outcome.verdict,
             Solved::Layout { solution, .. } => solution.report.verdict,
             Solved::Volume(v) => Verdict::of_finding(&v.certificate.verdict),
             Solved::Improved(m) => m.report.verdict,

@@ -274,7 +274,7 @@ impl Sweep {
         let sol = Pipeline::new(ring.clone(), frame0_options(opts)).eta_refinement(refinement).solve()?.into_map()?;
         let opts = ring_options(opts);
         // the sweep runs in the coordinates the cold solve ran in (normalised rings)
-        let sim = sol.report.normalisation.unwrap_or(Similarity::IDENTITY);
+        let sim = sol.report.fit.normalisation.unwrap_or(Similarity::IDENTITY);
         let unit_cps: Vec<Point> = sol.map.control_points.iter().map(|&p| sim.to_unit(p)).collect();
         let map = &sol.map;
         let knots = map.knots.clone();
@@ -285,8 +285,8 @@ impl Sweep {
         let center = sweep.center.map_or(centroid, |c| sim.to_unit(c));
         let start = inner0.eval(knots[1].domain().0);
         let seam_dir = [start[0] - centroid[0], start[1] - centroid[1]];
-        let (v, lb) = verdict(&sol.report.certificate.verdict);
-        let levels = &sol.report.levels;
+        let (v, lb) = verdict(&sol.report.outcome.certificate.verdict);
+        let levels = &sol.report.solve.levels;
         let last = levels.last();
         let report = FrameReport {
             frame: 0,
@@ -298,7 +298,7 @@ impl Sweep {
             residual_before: last.and_then(|l| l.residuals.first().copied()).unwrap_or(f64::NAN),
             residual_after: last.and_then(|l| l.residuals.last().copied()).unwrap_or(f64::NAN),
             converged: last.is_some_and(|l| l.converged),
-            inner_fit_error: sol.report.fit[3].max_error,
+            inner_fit_error: sol.report.fit.sides[3].max_error,
             inner_shift: 0.0,
             seam_offset_degrees: 0.0,
             seconds: t0.elapsed().as_secs_f64(),
@@ -314,7 +314,7 @@ impl Sweep {
             seam_dir,
             inner0,
             sigma: [0.0; 2],
-            diameter: sol.report.diameter / sim.scale,
+            diameter: sol.report.fit.diameter / sim.scale,
             history: vec![(0.0, unit_cps)],
             sim,
             knots,

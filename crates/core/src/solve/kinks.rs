@@ -631,15 +631,15 @@ mod tests {
             let b = read_boundary(&data(&format!("cad_kinks/{name}.json")), &ReadOptions::default()).unwrap();
             let sol = solve(&b, &SolveOptions::default()).unwrap();
             let r = &sol.report;
-            assert_eq!(r.verdict, Verdict::Certified, "{name}: {}", r.message);
-            let c0 = r.c0_route.as_ref().expect("the C0 route ran");
+            assert_eq!(r.outcome.verdict, Verdict::Certified, "{name}: {}", r.outcome.message);
+            let c0 = r.boundary.c0_route.as_ref().expect("the C0 route ran");
             assert!(c0.kept && c0.kinks == kinks, "{name}: {}", c0.message);
-            assert_eq!(r.kinks.len(), kinks);
-            for k in &r.kinks {
+            assert_eq!(r.boundary.kinks.len(), kinks);
+            for k in &r.boundary.kinks {
                 assert!(k.kept && k.deviation <= 1e-12, "{name}: {k:?}");
             }
             // the whole boundary, kinks included, is the input's to rounding
-            assert!(r.boundary_deviation.iter().all(|&d| d <= 1e-12), "{name}: {:?}", r.boundary_deviation);
+            assert!(r.boundary.deviation.iter().all(|&d| d <= 1e-12), "{name}: {:?}", r.boundary.deviation);
         }
     }
 
@@ -654,9 +654,9 @@ mod tests {
             let b = Family::CadKinks.generate(seed);
             let sol = solve(&b, &SolveOptions::default()).unwrap();
             let r = &sol.report;
-            assert_eq!(r.verdict, Verdict::Certified, "seed {seed}: {}", r.message);
-            assert!(r.kinks_kept() && r.success() && r.kinks.len() >= 3, "seed {seed}: {}", r.message);
-            for k in &r.kinks {
+            assert_eq!(r.outcome.verdict, Verdict::Certified, "seed {seed}: {}", r.outcome.message);
+            assert!(r.kinks_kept() && r.success() && r.boundary.kinks.len() >= 3, "seed {seed}: {}", r.outcome.message);
+            for k in &r.boundary.kinks {
                 let side = Side::ALL.into_iter().find(|s| s.name() == k.side).unwrap();
                 let curve = sol.map.boundary(side);
                 let t = k.map_parameter.expect("a kept kink has its knot line");
