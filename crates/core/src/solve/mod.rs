@@ -19,7 +19,7 @@
 //! | [`constrained`] | Gravesen's feasible start [`max_z`](constrained::max_z) (`max z`, `d(c) >= z 1`) and the constrained optimisation [`optimise`](constrained::optimise) of the Liao, Winslow or area-orthogonality functional subject to `d(c) >= ε` (SQP, Clarabel subproblems), from the EGG map or the max-z point: [`run`](constrained::run) | §10.3, eq. (49), Table 3 |
 //! | `kinks` | `keep_kinks`: the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |
 //! | [`warm`] | [`warm_start`](warm::warm_start): the previous map of a shape family moved onto the next boundary (elasticity) and solved on its basis as [`improve`](improve::improve) runs EGG, kept only when certified | §6.3, issue 34 |
-//! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
+//! | [`report`] | [`Solution`](report::Solution), [`Report`](report::Report) grouped by stage ([`SetupReport`](report::SetupReport), [`FitStage`](report::FitStage), [`SolveStage`](report::SolveStage), [`Outcome`](report::Outcome), [`DetJReport`](report::DetJReport), [`QualityReport`](report::QualityReport), [`BoundaryReport`](report::BoundaryReport)), [`Verdict`](report::Verdict), [`LevelReport`](report::LevelReport) | §8.1, §10 |
 
 pub mod constrained;
 pub(crate) mod fixed_basis;

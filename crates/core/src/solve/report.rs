@@ -167,7 +167,7 @@ pub struct Report {
     pub det_j: DetJReport,
     /// The quality functionals (§2, §4.1), the area and the Poisson benchmark (§10).
     #[serde(flatten)]
-    pub measures: Measures,
+    pub measures: QualityReport,
     /// The boundary of the map: corners, kinks, the `C^0` route (§9), the deviation.
     #[serde(flatten)]
     pub boundary: BoundaryReport,
@@ -277,7 +277,7 @@ pub struct DetJReport {
 /// The quality of the map: functionals, cell statistics, area, the Poisson benchmark.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
-pub struct Measures {
+pub struct QualityReport {
     /// Quality functionals and cell statistics.
     pub quality: Quality,
     /// Winslow functional (eq. 15-16); `null` when `det J <= 0` at a quadrature point.
@@ -509,7 +509,7 @@ impl Solution {
                 argmin: sample.argmin,
                 sample: sample.n,
             },
-            measures: Measures {
+            measures: QualityReport {
                 quality,
                 winslow: fun.winslow.is_finite().then_some(fun.winslow),
                 area: fun.area,
