@@ -21,7 +21,7 @@ use crate::spline::surface::Side;
 
 /// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
 /// relative to the diameter (readers enforce the stricter `1e-9` of `formats.md`).
-pub const CORNER_GAP_TOL: f64 = 1e-6;
+pub(crate) const CORNER_GAP_TOL: f64 = 1e-6;
 
 /// Which basis was asked for, which was used, and why they differ.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -106,7 +106,7 @@ impl Hierarchy {
     }
 
     /// The reparameterization report with its matched points in the input's coordinates.
-    pub fn physical_reparam(&self) -> ReparamReport {
+    pub(crate) fn physical_reparam(&self) -> ReparamReport {
         let mut r = self.reparam.clone();
         for m in &mut r.matches {
             m.points = m.points.map(|p| self.similarity.to_physical(p));
@@ -231,7 +231,7 @@ const CLOUD_AUTO: f64 = super::CLOUD_CORNER_DEGREES;
 
 /// Samples per input element of a spline side with a zero-speed kink, fitted as a point
 /// cloud on the fitted basis.
-pub const ZERO_SPEED_SAMPLES: usize = 64;
+pub(crate) const ZERO_SPEED_SAMPLES: usize = 64;
 
 /// The hierarchy `h` (levels `Σ⁰`, holding the kinks `kept` at multiplicity `p`) with its
 /// finest level and the kinks in [`Hierarchy::kinked`], and [`BasisReport::kinks`] saying
@@ -361,7 +361,7 @@ pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
 }
 
 /// The (start, end) corners of a side in its orientation.
-pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
+pub(crate) fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
     let [sw, se, ne, nw] = *corners;
     match side {
         Side::South => (sw, se),

@@ -139,7 +139,7 @@ impl KinkMode {
     }
 
     /// Smallest turning (degrees) of a spline kink kept; `None`: none kept.
-    pub fn spline_threshold(self) -> Option<f64> {
+    pub(crate) fn spline_threshold(self) -> Option<f64> {
         match self {
             KinkMode::Auto => Some(SPLINE_KINK_DEGREES),
             KinkMode::None => None,
@@ -148,7 +148,7 @@ impl KinkMode {
     }
 
     /// Smallest turning (degrees) of a point-cloud corner kept; `None`: none kept.
-    pub fn cloud_threshold(self) -> Option<f64> {
+    pub(crate) fn cloud_threshold(self) -> Option<f64> {
         match self {
             KinkMode::Auto => Some(CLOUD_CORNER_DEGREES),
             KinkMode::None => None,
@@ -269,7 +269,7 @@ impl Boundary {
 /// Lower-left and upper-right corner of a bounding box of the boundary: point clouds
 /// exactly, spline sides sampled at 16 points per input element, analytic sides at 1025
 /// points.
-pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
+pub(crate) fn bounding_box(boundary: &Boundary) -> (Point, Point) {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut add = |p: Point| {

@@ -207,7 +207,7 @@ pub fn fit_contour(contour: &ClosedContour, kv: &KnotVector) -> Result<(Curve, f
 /// Like [`fit_contour`], with `eta = 0` put where the ray from `origin` towards `toward`
 /// first crosses the contour (the arc-length parameter shifted by that crossing's
 /// fraction; the contour's own start when the ray misses it).
-pub fn fit_contour_seam(
+pub(crate) fn fit_contour_seam(
     contour: &ClosedContour,
     kv: &KnotVector,
     origin: Point,
@@ -229,7 +229,7 @@ fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Cur
 /// [`ReparamOptions`], `auto`, see `boundary::ring_reparam`), and fit them
 /// adaptively on dyadic periodic knot vectors of degree `degree` until `tol * diameter`
 /// is met (at most `max_elements` elements).
-pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
+pub(crate) fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
     fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive, &ReparamOptions::default())
 }
 
@@ -380,18 +380,12 @@ pub fn cut_open(ring: &Ring, seam: [Point; 2]) -> Boundary {
     Boundary { name: ring.name.clone(), sides: [s.clone(), ring.outer.as_side(), s, ring.inner.as_side()] }
 }
 
-/// The hierarchy of a ring for the solver (with `eta` periodic): one level per dyadic
-/// fit of [`fit_ring`] (degree, tolerance and element cap from `opts`), basis
-/// `Ξ × H_k` with `Ξ` one open element (the solver balances and refines it), west the
-/// inner and east the outer fit, south and north the seam segment (not a boundary:
-/// periodic sides are skipped by the initial guesses). Returns the hierarchy and the
-/// cut-open boundary ([`cut_open`]) the report measures against.
-pub fn ring_hierarchy(ring: &Ring, opts: &FitOptions) -> Result<(Hierarchy, Boundary)> {
-    ring_hierarchy_with(ring, opts, EtaRefinement::Adaptive)
-}
-
 /// [`ring_hierarchy`] with the refinement in `eta` chosen.
-pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefinement) -> Result<(Hierarchy, Boundary)> {
+pub(crate) fn ring_hierarchy_with(
+    ring: &Ring,
+    opts: &FitOptions,
+    refinement: EtaRefinement,
+) -> Result<(Hierarchy, Boundary)> {
     opts.validate()?;
     let fit = fit_ring_with(ring, opts.degree, opts.tol, opts.max_elements, refinement, &opts.reparam)?;
     let p = opts.degree;

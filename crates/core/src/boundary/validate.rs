@@ -19,20 +19,20 @@ use crate::spline::curve::{check_points, check_weights, Curve, Point};
 use crate::spline::surface::Side;
 
 /// Corner gaps and side lengths are compared against this times the bounding-box diameter.
-pub const CORNER_TOL: f64 = 1e-9;
+pub(crate) const CORNER_TOL: f64 = 1e-9;
 /// Largest distance between a sampled chord's midpoint and the curve point at the
 /// parameter midpoint, relative to the bounding-box diameter.
-pub const FLATNESS: f64 = 1e-5;
+pub(crate) const FLATNESS: f64 = 1e-5;
 /// Contacts of the contour with itself closer than this times the bounding-box diameter
 /// to one of the four corner points are not reported: they are the shared corners, or
 /// pinches and seams below the resolution of the data (`male_casing_ring` is a ring cut
 /// open along a seam whose two sides meet at one corner and cross within `3e-8` of the
 /// diameter of another).
-pub const CORNER_NEIGHBOURHOOD: f64 = 1e-6;
+pub(crate) const CORNER_NEIGHBOURHOOD: f64 = 1e-6;
 /// Minimum number of chords per non-empty knot span when sampling a spline side.
-pub const SAMPLES_PER_SPAN: usize = 16;
+pub(crate) const SAMPLES_PER_SPAN: usize = 16;
 /// Number of initial chords on an analytic side (refined adaptively).
-pub const ANALYTIC_SAMPLES: usize = 256;
+pub(crate) const ANALYTIC_SAMPLES: usize = 256;
 /// Deepest bisection of one initial chord during adaptive sampling.
 const MAX_BISECTIONS: u32 = 10;
 /// Budget of initial chords for one spline side (huge inputs get fewer per span).

@@ -114,7 +114,7 @@ impl DofMap {
     }
 
     /// Free where `is_free(i, j)` holds.
-    pub fn from_predicate(shape: [usize; 2], is_free: impl Fn(usize, usize) -> bool) -> Self {
+    pub(crate) fn from_predicate(shape: [usize; 2], is_free: impl Fn(usize, usize) -> bool) -> Self {
         let [nx, ny] = shape;
         let mut free_of = vec![FIXED; nx * ny];
         let mut free = Vec::new();

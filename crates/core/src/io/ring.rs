@@ -78,7 +78,7 @@ pub(crate) fn ring_of_json(v: Value) -> Result<Ring> {
 }
 
 /// The JSON form of a ring; analytic contours become point clouds of 1024 points.
-pub fn ring_to_json(ring: &Ring) -> Value {
+pub(crate) fn ring_to_json(ring: &Ring) -> Value {
     let c = |c: &ClosedContour| match c {
         ClosedContour::Spline(c) => serde_json::to_value(CurveJson::from_curve(c)).expect("serializable"),
         ClosedContour::Points(p) => json!({ "points": p }),

@@ -20,10 +20,10 @@ use crate::spline::surface::Surface;
 use crate::verify::quality::sample_det_j;
 
 /// VTK cell type of a Bézier quadrilateral.
-pub const VTK_BEZIER_QUADRILATERAL: u8 = 77;
+pub(crate) const VTK_BEZIER_QUADRILATERAL: u8 = 77;
 
 /// Legacy-VTK structured grid of the map sampled on `(n + 1)²` points with `det J`.
-pub fn structured_grid_vtk(map: &Surface, n: usize) -> String {
+pub(crate) fn structured_grid_vtk(map: &Surface, n: usize) -> String {
     let s = sample_det_j(map, n);
     let mut out = String::new();
     let _ = writeln!(out, "# vtk DataFile Version 3.0\nwinslow map\nASCII\nDATASET STRUCTURED_GRID");
@@ -45,7 +45,7 @@ pub fn structured_grid_vtk(map: &Surface, n: usize) -> String {
 /// `(p, q)`: the four corners, then the edges `j = 0`, `i = p`, `j = q`, `i = 0` (each
 /// with its free index increasing), then the interior with `i` fastest
 /// (`vtkHigherOrderQuadrilateral::PointIndexFromIJK`).
-pub fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
+pub(crate) fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
     let ib = i == 0 || i == p;
     let jb = j == 0 || j == q;
     match (ib, jb) {
@@ -174,7 +174,7 @@ fn bezier_elements(map: &Surface) -> Result<Vec<BezierElement>> {
 
 /// The map as a VTK XML unstructured grid of Bézier quadrilaterals (see the module
 /// documentation). `comment` (e.g. the certificate's verdict) goes into an XML comment.
-pub fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
+pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     let elements = bezier_elements(map)?;
     let [p, q] = map.degrees();
     let npe = (p + 1) * (q + 1);

@@ -103,7 +103,7 @@ impl std::fmt::Debug for SplitCholesky {
 /// unknowns form exactly two connected components, `[0, k)` and `[k, t)` (the halves),
 /// the rest `[t, n)` being the separator. `None` when the order has no such part, or the
 /// halves are unbalanced (each at least `n / 8`) or the separator large (over `n / 4`).
-pub fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
+pub(crate) fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
     let n = order.len();
     let inv = ordering::inverse(order);
     let mut parent: Vec<usize> = (0..n).collect();

@@ -86,7 +86,7 @@ impl Method for WinslowMethod {
 
 /// The Winslow density `W = N / D` of `e = (x_ξ, x_η, y_ξ, y_η)` with its gradient and
 /// Hessian in `e` (formulas in the module documentation). Not finite when `D <= 0`.
-pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
+pub(crate) fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
     let [a, b, c, d] = e;
     let n = a * a + b * b + c * c + d * d;
     let det = a * d - b * c;
@@ -114,7 +114,7 @@ pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
 /// `J = ∫ W` (eq. 16) of the map with control points `cps` by the quadrature of `disc`;
 /// `+∞` when `det J <= 0` at a quadrature point. Element rows in parallel, summed in
 /// order (deterministic).
-pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
+pub(crate) fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
     integrate(disc, cps, Order::First, |e| {
         let [a, b, c, d] = first_derivatives(e);
         let det = a * d - b * c;
@@ -178,7 +178,7 @@ pub fn winslow_value_and_gradient(disc: &Discretization, cps: &[Point], res: &mu
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
 /// form of `flux_form` with `G = -∂W/∂e`.
-pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
+pub(crate) fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
     if stencil.is_empty() {
         // the gradient only: `∂W/∂e = 2 e / D - W D' / D` without the Hessian
         flux_form_with(disc, cps, res, stencil, true, |e| {
@@ -232,7 +232,7 @@ pub fn winslow_gradient_with(
 /// ((a - d)/2, (c + b)/2)`, `σ₁,₂ = q ± r`), and with `U = R(φ)`, `Vᵀ = R(θ)`, `φ ± θ = α₂,
 /// α₁`: `U Vᵀ = R(α₂)`, `U Z Vᵀ = R(α₁) Z`, `U [[0,1],[1,0]] Vᵀ = R(α₁ + π/2) Z`; the
 /// eigenvector `(u₁, u₂)` of the `2 x 2` block is `∝ (λ - h₂₂, h₁₂)`.
-pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
+pub(crate) fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
     let [a, b, c, d] = e;
     let (ee, ff, gg, hh) = (0.5 * (a + d), 0.5 * (a - d), 0.5 * (c + b), 0.5 * (c - b));
     let (q, r) = (ee.hypot(hh), ff.hypot(gg));
@@ -273,9 +273,10 @@ pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
     out
 }
 
+#[cfg(test)]
 /// The symmetric `h` with its negative eigenvalues set to zero, `Q max(Λ, 0) Qᵀ`, by
 /// cyclic Jacobi rotations (to rounding).
-pub fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
+pub(crate) fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
     let mut a = h;
     let mut q = [[0.0; 4]; 4];
     for (i, row) in q.iter_mut().enumerate() {
@@ -328,7 +329,7 @@ pub fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
 /// `∂²W/∂e²` (the `x`-`x` and `y`-`y` couplings, which carry the cell's anisotropy),
 /// its eigenvalues raised to at least `10⁻³` of its trace so that `K` is definite, plus
 /// `shift` times the mass matrix, into a scalar stencil.
-pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
+pub(crate) fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
     let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
@@ -386,7 +387,7 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
 
 /// The first partial projection of a modified Hessian (see
 /// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
-pub const PROJECTION_FIRST: f64 = 0.3;
+pub(crate) const PROJECTION_FIRST: f64 = 0.3;
 
 /// The projection share one stage stronger after a failed factorization: none, then
 /// [`PROJECTION_FIRST`], then three times that, then 1 (the whole negative part).

@@ -148,7 +148,7 @@ impl MethodChoice {
     }
 
     /// The contender that runs this method with `opts`.
-    pub fn contender(self, opts: &CompareOptions) -> Box<dyn Contender> {
+    pub(crate) fn contender(self, opts: &CompareOptions) -> Box<dyn Contender> {
         match self {
             MethodChoice::Egg => Box::new(HierarchyRun::new(self.name(), None)),
             MethodChoice::Vhm => {
@@ -239,7 +239,7 @@ impl Default for CompareOptions {
 }
 
 /// What a contender sees.
-pub struct CompareContext<'a> {
+pub(crate) struct CompareContext<'a> {
     /// The boundary.
     pub boundary: &'a Boundary,
     /// The hierarchy of bases every method uses (EGG's).
@@ -260,7 +260,7 @@ impl std::fmt::Debug for CompareContext<'_> {
 
 /// What a contender returns: the measures are computed from `map` by the comparison.
 #[derive(Debug, Clone)]
-pub struct MethodRun {
+pub(crate) struct MethodRun {
     /// Method name.
     pub method: String,
     /// Nonlinear iterations in all, continuation solves included.
@@ -295,7 +295,7 @@ impl MethodRun {
 }
 
 /// A method of the comparison (see the module documentation).
-pub trait Contender: Send + Sync + std::fmt::Debug {
+pub(crate) trait Contender: Send + Sync + std::fmt::Debug {
     /// Name in tables and reports.
     fn name(&self) -> &str;
     /// Run on the context's hierarchy; `progress` sees the solver's events and returns
@@ -307,13 +307,13 @@ pub trait Contender: Send + Sync + std::fmt::Debug {
 /// from the Coons patch and the elasticity prolongations, as EGG is; `None` is EGG with
 /// the options' operator and the context's assembler.
 #[derive(Debug, Clone)]
-pub struct HierarchyRun {
+pub(crate) struct HierarchyRun {
     name: String,
     method: Option<Arc<dyn MethodFactory>>,
 }
 
 /// Makes the method of a [`HierarchyRun`] for one hierarchy.
-pub trait MethodFactory: Send + Sync + std::fmt::Debug {
+pub(crate) trait MethodFactory: Send + Sync + std::fmt::Debug {
     /// The method for `hierarchy`.
     fn method(&self, hierarchy: &Hierarchy) -> Arc<dyn Method>;
 }

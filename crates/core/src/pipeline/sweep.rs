@@ -187,7 +187,7 @@ pub struct Frame {
 
 /// The Lagrange extrapolation (see the module documentation) of the control points
 /// `values[i]` given at the distinct times `times[i]`, evaluated at `t`.
-pub fn extrapolate(times: &[f64], values: &[&[Point]], t: f64) -> Vec<Point> {
+pub(crate) fn extrapolate(times: &[f64], values: &[&[Point]], t: f64) -> Vec<Point> {
     let n = values[0].len();
     let mut out = vec![[0.0; 2]; n];
     for (i, (&ti, vi)) in times.iter().zip(values).enumerate() {

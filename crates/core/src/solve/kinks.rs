@@ -133,7 +133,7 @@ impl KinkStage {
 
 /// The outcome of [`keep_kinks`]: the map with the kinks and its certificate when kept.
 #[derive(Debug, Clone)]
-pub struct KinkOutcome {
+pub(crate) struct KinkOutcome {
     /// The certified `Σ⁰` map (`None`: not kept).
     pub map: Option<Surface>,
     /// Its certificate.
@@ -158,7 +158,7 @@ fn joined_level(map: &Surface, c0: &Level) -> Result<Level> {
 /// The `C^0` route (module documentation) from the `Σ¹` map `map`, certified bijective,
 /// to the `C^0` level `c0` (the kinks `kinked` at multiplicity `p`): the map on `Σ⁰` with
 /// the kinks kept exactly, certified, or why not.
-pub fn keep_kinks(
+pub(crate) fn keep_kinks(
     map: &Surface,
     c0: &Level,
     kinked: &KinkedLevel,
@@ -518,7 +518,7 @@ fn distance_to_curve(c: &crate::spline::curve::Curve, x: Point) -> f64 {
 /// ([`Hierarchy::detected`](crate::boundary::hierarchy::Hierarchy::detected)) but nothing
 /// keeps (rounded, their points those of `boundary`'s sides), each with the distance of
 /// `map` (in the input's coordinates, like `boundary`) from the point.
-pub fn kink_reports(
+pub(crate) fn kink_reports(
     boundary: &crate::boundary::Boundary,
     h: &crate::boundary::hierarchy::Hierarchy,
     map: &Surface,

@@ -161,10 +161,10 @@ pub enum KinksLocal {
 }
 
 /// Unknowns of the `C^0` basis above which [`KinksLocal::Auto`] minimises locally.
-pub const KINKS_LOCAL_ABOVE: usize = 50_000;
+pub(crate) const KINKS_LOCAL_ABOVE: usize = 50_000;
 
 /// Knot spans around each kink that [`KinksLocal::Auto`] moves above [`KINKS_LOCAL_ABOVE`].
-pub const KINKS_LOCAL_SPANS: usize = 3;
+pub(crate) const KINKS_LOCAL_SPANS: usize = 3;
 
 impl KinksLocal {
     /// The spans around each kink to move for a `C^0` basis with `unknowns` free

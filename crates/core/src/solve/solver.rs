@@ -126,7 +126,7 @@ impl EggSolver {
 
     /// A solver of `method` over the levels of `hierarchy` (the fit of `boundary`);
     /// `assembler` assembles the hierarchy's operators (elasticity, continuation samples).
-    pub fn with_method(
+    pub(crate) fn with_method(
         boundary: &Boundary,
         hierarchy: Arc<Hierarchy>,
         opts: SolveOptions,

@@ -200,8 +200,9 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
         (0..P).rev().fold(0, |lin, d| lin * shape[d] + i[d])
     }
 
+    #[cfg(test)]
     /// The multi-index of a linear index.
-    pub fn unindex(&self, mut lin: usize) -> [usize; P] {
+    pub(crate) fn unindex(&self, mut lin: usize) -> [usize; P] {
         let shape = self.shape();
         std::array::from_fn(|d| {
             let i = lin % shape[d];
@@ -287,20 +288,20 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
 
     /// Knot insertion in direction `dir`: the same map on the finer knot vector `fine`
     /// (which must contain this one's).
-    pub fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
+    pub(crate) fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
         let op = prolongation(&self.knots[dir], fine)?;
         Ok(self.mapped(dir, fine.clone(), &op))
     }
 
     /// The same map with the degree in direction `dir` raised by one (continuity kept).
-    pub fn elevated_in(&self, dir: usize) -> Result<Self> {
+    pub(crate) fn elevated_in(&self, dir: usize) -> Result<Self> {
         let (kv, op) = elevation(&self.knots[dir])?;
         Ok(self.mapped(dir, kv, &op))
     }
 
     /// The prolongation `P_{P-1} ⊗ .. ⊗ P_0` from this map's basis to the finer tensor
     /// basis `fine`.
-    pub fn prolongation_to(&self, fine: &[KnotVector; P]) -> Result<Csr> {
+    pub(crate) fn prolongation_to(&self, fine: &[KnotVector; P]) -> Result<Csr> {
         let mut op = prolongation(&self.knots[P - 1], &fine[P - 1])?;
         for d in (0..P - 1).rev() {
             op = op.kron(&prolongation(&self.knots[d], &fine[d])?);

@@ -68,7 +68,7 @@ impl Volume {
 
     /// Value and first derivatives from precomputed univariate basis values (with at
     /// least first derivatives; the caller picks the spans, e.g. on element boundaries).
-    pub fn derivs_with(&self, b: &[BasisDerivs; 3]) -> VolumeDerivs {
+    pub(crate) fn derivs_with(&self, b: &[BasisDerivs; 3]) -> VolumeDerivs {
         let (x, d) = self.first_derivs(b.each_ref());
         VolumeDerivs { x, d }
     }

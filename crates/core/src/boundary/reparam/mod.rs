@@ -29,8 +29,8 @@ mod arc_length;
 mod matching;
 mod monotone_cubic;
 
-pub use arc_length::*;
-pub use matching::*;
+pub(crate) use arc_length::*;
+pub(crate) use matching::*;
 pub use monotone_cubic::MonotoneCubic;
 
 use serde::Serialize;
@@ -165,7 +165,7 @@ impl ParamMap {
     }
 
     /// `g(ξ)` and `g'(ξ)`.
-    pub fn eval_d(&self, xi: f64) -> (f64, f64) {
+    pub(crate) fn eval_d(&self, xi: f64) -> (f64, f64) {
         match self {
             ParamMap::Monotone(m) => m.eval_d(xi),
             ParamMap::Spline { knots, coefs } => {
@@ -245,7 +245,7 @@ pub fn sample_side(side: &SideCurve, per_element: usize) -> SideSample {
 /// Monotone map `g` with `g(ξ_k) = t_k` from abscissae `ξ_k` of samples at parameters
 /// `t_k` (both non-decreasing, from 0 to 1); samples whose `ξ` or `t` repeats the previous
 /// one are dropped (a stationary stretch of the curve).
-pub fn interpolating_map(xi: &[f64], t: &[f64]) -> Result<ParamMap> {
+pub(crate) fn interpolating_map(xi: &[f64], t: &[f64]) -> Result<ParamMap> {
     let (mut x, mut y) = (Vec::with_capacity(xi.len()), Vec::with_capacity(xi.len()));
     for (&a, &b) in xi.iter().zip(t) {
         if let (Some(&pa), Some(&pb)) = (x.last(), y.last()) {

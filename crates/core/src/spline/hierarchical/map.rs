@@ -109,7 +109,7 @@ impl HierarchicalMap {
 
     /// The Bézier patch of every active cell, `(level, cell, patch)`: a one-element tensor
     /// map on the cell's parameter box equal to the THB map there (element extraction).
-    pub fn bezier_patches(&self) -> Result<Vec<(usize, Index2, Surface)>> {
+    pub(crate) fn bezier_patches(&self) -> Result<Vec<(usize, Index2, Surface)>> {
         let mut lc = self.level_coefficients();
         self.basis.active_cells().into_iter().map(|(l, c)| Ok((l, c, self.bezier_patch(&mut lc, l, c)?))).collect()
     }
@@ -186,7 +186,7 @@ impl HierarchicalMap {
 
     /// The knot vectors of the coarsest tensor space containing this THB space: the
     /// level-0 knots and, once each, every edge of an active cell of a finer level.
-    pub fn tensor_knots(&self) -> Result<[KnotVector; 2]> {
+    pub(crate) fn tensor_knots(&self) -> Result<[KnotVector; 2]> {
         let mut edges: [BTreeSet<u64>; 2] = [BTreeSet::new(), BTreeSet::new()];
         for (l, c) in self.basis.active_cells() {
             if l == 0 {
