@@ -20,7 +20,7 @@
 //!   of degree `q` (two more when it is rational, `p + 6` for analytic sides);
 //! * for a point cloud `p_1, ..., p_K` (§5.3) the discrete distance (eq. 18)
 //!   `E(f) = Σ_j ||f(ξ_j) - p_j||^2` at the cord-length abscissae `ξ_j` of eq. 36-37,
-//!   plus a tiny smoothing term `λ Σ_e h_e^3 ∫_e ||f''||^2 dξ` (see [`REGULARIZATION`]):
+//!   plus a tiny smoothing term `λ Σ_e h_e^3 ∫_e ||f''||^2 dξ` (see `REGULARIZATION`):
 //!   an element without points (or a side of two points) would otherwise leave the
 //!   normal equations singular. The term vanishes on straight lines traversed with
 //!   constant speed, so a two-point side becomes exactly that segment. There is no
@@ -579,7 +579,7 @@ pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Poin
 /// `tol_abs`, refit, and repeat until no element is marked or `max_levels` /
 /// `max_elements` is reached (then `converged` is false and the finest fit is the best
 /// one). When more elements are marked than `max_elements` allows, the worst ones are
-/// bisected first. A point cloud also stops at its noise floor (see [`NOISE_STALL`];
+/// bisected first. A point cloud also stops at its noise floor (see `NOISE_STALL`;
 /// `converged` is then false and the last fit is the one before the bisection that did
 /// not help).
 pub fn fit_side(

@@ -73,9 +73,9 @@ pub struct Hierarchy {
     pub kinked: Option<KinkedLevel>,
     /// Every kink the thresholds of [`KinkMode::Auto`] find on the sides (on the input
     /// basis every `C^0` knot too), kept or not: measured once with the kinks kept
-    /// ([`Candidates`]), on the boundary the hierarchy was built from (the normalised one;
+    /// (`Candidates`), on the boundary the hierarchy was built from (the normalised one;
     /// a ring's cut-open boundary); the report names those not kept as rounded, their
-    /// points taken from the input's sides ([`Kink::point_on`]).
+    /// points taken from the input's sides (`Kink::point_on`).
     pub detected: Vec<Kink>,
 }
 
@@ -119,7 +119,7 @@ impl Hierarchy {
 /// hierarchy on the input's own basis (`input_levels`) when the sides allow it;
 /// otherwise, and with [`BasisChoice::Fitted`]:
 /// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
-/// §7), fit the four sides adaptively (see [`fit_side_with`](crate::boundary::fit::fit_side_with)) with `tol_abs = tol *
+/// §7), fit the four sides adaptively (see `fit_side_with`) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
 ///
@@ -330,7 +330,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
 
 /// The four corners south-west, south-east, north-east, north-west, each the average of
 /// the two adjacent sides' end points; errors when two ends are further apart than
-/// [`CORNER_GAP_TOL`]` * diameter`.
+/// `CORNER_GAP_TOL`` * diameter`.
 pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
     let ends = boundary.sides.each_ref().map(SideCurve::endpoints);
     let [s, e, n, w] = ends;

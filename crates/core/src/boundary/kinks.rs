@@ -7,12 +7,12 @@
 //! * a **zero-speed knot** (repeated control points, e.g. plate_with_hole's north side):
 //!   the curve is `C^1` in its own parameter but its tangent turns where the speed
 //!   vanishes;
-//! * a **corner of a point cloud** (a polygon vertex), found by [`cloud_corners`].
+//! * a **corner of a point cloud** (a polygon vertex), found by `cloud_corners`.
 //!
 //! To keep them, the basis gets a knot of multiplicity `p` at each kink's parameter
 //! (`Σ⁰`; the knot line runs through the domain, so the opposite side's knot vector
 //! holds it too, as a regular knot line of a smooth curve); `Σ¹` is `Σ⁰` with that
-//! multiplicity lowered by one and the contour projected onto it ([`smoothed_level`]).
+//! multiplicity lowered by one and the contour projected onto it (`smoothed_level`).
 //! The solver solves (8) on `Σ¹`, prolongs to `Σ⁰` and imposes the difference of the
 //! boundary control points by the damped elasticity step, then minimises the Winslow
 //! functional (16) on `Σ⁰` (`solve::kinks`).

@@ -4,7 +4,7 @@
 //!
 //! | module | holds | paper |
 //! |---|---|---|
-//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
+//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], `bounding_box`, [`diameter`], [`BasisChoice`] | §5, §5.2 |
 //! | [`families`] | seeded families of hard domains (the hard corpus) | |
 //! | `normalise` | the similarity to unit size at the origin, and back | |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
@@ -167,9 +167,9 @@ impl std::fmt::Display for KinkMode {
 /// report names it; `--kinks auto` keeps it).
 pub const SPLINE_KINK_DEGREES: f64 = 1.0;
 
-/// A point cloud's turning of at least this (degrees), measured by [`kinks::cloud_corners`], is a
+/// A point cloud's turning of at least this (degrees), measured by `kinks::cloud_corners`, is a
 /// corner (`--kinks auto` keeps it, the report names it otherwise). A sampled smooth
-/// curve turns less at the scale of [`CORNER_WINDOW`](kinks::CORNER_WINDOW) unless its radius of curvature is
+/// curve turns less at the scale of `CORNER_WINDOW` unless its radius of curvature is
 /// below about twice the window.
 pub const CLOUD_CORNER_DEGREES: f64 = 30.0;
 
@@ -294,7 +294,7 @@ pub(crate) fn bounding_box(boundary: &Boundary) -> (Point, Point) {
     (lo, hi)
 }
 
-/// Diameter of [`bounding_box`].
+/// Diameter of `bounding_box`.
 pub fn diameter(boundary: &Boundary) -> f64 {
     let (lo, hi) = bounding_box(boundary);
     (hi[0] - lo[0]).hypot(hi[1] - lo[1])

@@ -5,7 +5,7 @@
 //!
 //! **Fit.** Least squares `min sum_k |C(eta_k) - x_k|^2` over the `d` distinct control
 //! points (wrapped collocation matrix) on one periodic knot vector for both contours, at
-//! [`DENSE`](super::ring::DENSE) arc-length samples of a parametric contour (the points of a cloud), refined
+//! `DENSE` arc-length samples of a parametric contour (the points of a cloud), refined
 //! adaptively and dyadically in `eta` as in §5: from `n_0 = 4` uniform elements (at least
 //! `p + 1`), every element where either contour deviates by more than `tol * diameter`
 //! at a sample is bisected (knots stay dyadic, `k / (n_0 2^l)`), and both contours are
@@ -13,7 +13,7 @@
 //! each half keeps at least `p + 1` samples of every contour that misses the tolerance
 //! there (more elements cannot bring a sparse cloud closer); the other contour's fit
 //! stays well posed on elements without samples by the tiny smoothing term of the
-//! four-sided point fits ([`REGULARIZATION`], `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
+//! four-sided point fits (`REGULARIZATION`, `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
 //! when no element is marked or the next level would pass the element cap.
 //!
 //! **Normalisation.** Like a four-sided boundary
@@ -300,7 +300,7 @@ pub enum EtaRefinement {
     Uniform,
 }
 
-/// [`fit_ring`] with the refinement in `eta` and the reparameterization chosen.
+/// `fit_ring` with the refinement in `eta` and the reparameterization chosen.
 pub fn fit_ring_with(
     ring: &Ring,
     degree: usize,

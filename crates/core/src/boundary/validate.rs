@@ -7,8 +7,8 @@
 //! additionally rejects clockwise contours.
 //!
 //! The contour is checked on a polyline: point clouds as given, spline sides sampled
-//! adaptively ([`sample_side`]) with at least [`SAMPLES_PER_SPAN`] points per knot span
-//! and chords within [`FLATNESS`] times the bounding-box diameter of the curve, so that
+//! adaptively ([`sample_side`]) with at least `SAMPLES_PER_SPAN` points per knot span
+//! and chords within `FLATNESS` times the bounding-box diameter of the curve, so that
 //! chords cannot create false crossings in narrow gaps (two sides `g` apart can only
 //! appear to cross when `g < 2 * FLATNESS * diameter`).
 
@@ -157,9 +157,9 @@ fn refine(
 
 /// Sample a side into a polyline from its start to its end.
 ///
-/// Point clouds are returned as given. A spline side gets at least [`SAMPLES_PER_SPAN`]
+/// Point clouds are returned as given. A spline side gets at least `SAMPLES_PER_SPAN`
 /// chords per non-empty knot span (fewer only on curves with more than 2^18 spans, to
-/// bound the work), an analytic side [`ANALYTIC_SAMPLES`] chords; each chord
+/// bound the work), an analytic side `ANALYTIC_SAMPLES` chords; each chord
 /// is then bisected (at most 10 times) until the curve point at its parameter midpoint is
 /// within `flat_tol` of the chord's midpoint. `flat_tol = f64::INFINITY` gives the
 /// uniform initial sampling.

@@ -9,7 +9,7 @@
 //! (`spline::periodic`): the stored function `(i, j)`, `j >= d`, is a *replica*
 //! of its *primary* `(i, j - d)`. Both carry the same control point, so the periodic
 //! basis function is `N_(i,j) + N_(i,j+d)` and everything assembled per stored function
-//! is summed over replicas: residual rows ([`super::assembly::Discretization::restrict`]),
+//! is summed over replicas: residual rows (`super::assembly::Discretization::restrict`),
 //! Jacobian rows and columns (the pattern's extra sources), Dirichlet lifts. Assemblers
 //! keep working on the stored (unwrapped) tensor basis unchanged.
 

@@ -370,7 +370,7 @@ pub(crate) fn side_to_json(s: &SideCurve) -> Value {
 }
 
 /// A boundary document `{"name", "boundary": {...}}`; analytic sides are written as
-/// point clouds of [`ANALYTIC_WRITE_POINTS`] points.
+/// point clouds of `ANALYTIC_WRITE_POINTS` points.
 pub fn boundary_to_json(b: &Boundary) -> Value {
     json!({
         "name": b.name,
@@ -385,7 +385,7 @@ pub fn boundary_to_json(b: &Boundary) -> Value {
 
 /// A contour document: the sides concatenated counter-clockwise (south, east, reversed
 /// north, reversed west, shared corners once, first point not repeated). Spline and
-/// analytic sides are sampled at [`ANALYTIC_WRITE_POINTS`] uniform parameters.
+/// analytic sides are sampled at `ANALYTIC_WRITE_POINTS` uniform parameters.
 pub fn boundary_to_contour_json(b: &Boundary) -> Value {
     let pts: Vec<Vec<Point>> = b
         .sides

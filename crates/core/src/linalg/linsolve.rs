@@ -4,10 +4,10 @@
 //! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
-//! [`crate::discrete::assembly::Discretization::metric_laplace`]) or by ILU(0).
+//! `crate::discrete::assembly::Discretization::metric_laplace`) or by ILU(0).
 //!
 //! The Cholesky factorizations follow the problem's fill-reducing order when it gives one
-//! ([`LinearSolver::set_ordering`], nested dissection of the spline grid, see
+//! (`LinearSolver::set_ordering`, nested dissection of the spline grid, see
 //! [`crate::linalg::ordering`]), approximate minimum degree otherwise; their symbolic analysis,
 //! numeric storage and scratch memory are allocated once and reused by every
 //! refactorization and solve.
@@ -38,8 +38,8 @@ pub enum LinearMethod {
     /// SPD approximation when it offers one, by ILU(0) otherwise.
     #[cfg_attr(feature = "clap", value(help = "GMRES, preconditioned by the metric Laplacian"))]
     Gmres,
-    /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
-    /// does not converge within [`AUTO_MAX_KRYLOV`] iterations.
+    /// LU up to `AUTO_LU_LIMIT` unknowns, GMRES above; GMRES falls back to LU when it
+    /// does not converge within `AUTO_MAX_KRYLOV` iterations.
     #[cfg_attr(
         feature = "clap",
         value(help = "LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations")
@@ -47,7 +47,7 @@ pub enum LinearMethod {
     Auto,
     /// Restarted flexible GMRES as [`LinearMethod::Gmres`], preconditioned by
     /// `-diag(B, B)` with `B` one multigrid V-cycle for the problem's SPD approximation
-    /// `K` on the nested spaces set with [`LinearSolver::set_transfers`]
+    /// `K` on the nested spaces set with `LinearSolver::set_transfers`
     /// (`linalg::multigrid`); without them as [`LinearMethod::Gmres`].
     #[cfg_attr(
         feature = "clap",
@@ -65,10 +65,10 @@ pub enum LinearMethod {
     NegCholesky,
     /// Conjugate gradients for symmetric positive definite systems of `c` components
     /// (`c m` unknowns in component blocks, `m` the length of the ordering given with
-    /// [`LinearSolver::set_ordering`]), preconditioned by the single-precision Cholesky
+    /// `LinearSolver::set_ordering`), preconditioned by the single-precision Cholesky
     /// factors of the `c` diagonal blocks (block Jacobi: for linear elasticity the
     /// iteration count is bounded by Korn's inequality, not by the mesh size). Falls
-    /// back to [`LinearMethod::Cholesky`] when CG does not converge in [`MAX_PCG`]
+    /// back to [`LinearMethod::Cholesky`] when CG does not converge in `MAX_PCG`
     /// iterations.
     #[cfg_attr(feature = "clap", value(skip))]
     Pcg,

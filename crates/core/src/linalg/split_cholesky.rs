@@ -152,7 +152,7 @@ pub(crate) fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
 
 impl SplitCholesky {
     /// Symbolic analysis of the SPD pattern of `a` in the nested-dissection order `order`
-    /// (`order[new] = old`); `None` when [`top_split`] finds no split or faer's analysis
+    /// (`order[new] = old`); `None` when `top_split` finds no split or faer's analysis
     /// of a half is not supernodal. (Worth it from [`SPLIT_MIN`] unknowns on two threads
     /// or more: the caller decides.)
     pub fn analyze(a: &Csr, order: &[usize]) -> Option<Self> {

@@ -7,7 +7,7 @@
 //! `f = (N − 2D) / (N + 2D) = |μ|²`, the squared modulus of the Beltrami coefficient
 //! `μ = x_z̄ / x_z`: `f = 0` for a conformal map, `0 <= f < 1` where `D > 0`, `f > 1` where
 //! the map folds, and `f` is undefined only where `N + 2D = 0` (an anti-conformal
-//! point), where [`QuasiConformalMethod`] returns `+∞`. Minimizing `T` makes the
+//! point), where `QuasiConformalMethod` returns `+∞`. Minimizing `T` makes the
 //! distortion `|μ|` as uniform as the boundary allows (a Teichmüller-like map); nothing
 //! in `T` forbids folds, so the certificate decides.
 //!
@@ -25,7 +25,7 @@
 //! `∇²T* = ∫ 2 (∇f ∇fᵀ + (f − f̄) ∇²f) − (2 / ∫ 1) g gᵀ`,  `g = ∫ ∇f`,
 //!
 //! a sparse matrix (the density `(f − s)²` at fixed `s = f̄`, assembled by
-//! `density`) minus a dense rank-one term, which [`QuasiConformalProblem`]
+//! `density`) minus a dense rank-one term, which `QuasiConformalProblem`
 //! presents through [`DiscreteProblem::rank_one`] and the Newton solver applies by the
 //! Sherman-Morrison formula: the steps of the bordered system on the shared sparse
 //! factorizations, without a matrix with a dense row and column, and without an extra

@@ -32,7 +32,7 @@
 //! 0` proves `δᵀ ∇²J δ <= 0`). It then calls [`DiscreteProblem::raise_shift`], which
 //! modifies the presented Hessian step by step: first `∇²J + m (P - ∇²J)` with `P` the
 //! assembly of every quadrature point's `∂²W/∂e²` projected onto the positive
-//! semidefinite matrices ([`project_psd`]), `m = 0.3, 0.9, 1` (`m = 1` is positive
+//! semidefinite matrices (`project_psd`), `m = 0.3, 0.9, 1` (`m = 1` is positive
 //! semidefinite, definite with the boundary fixed, and its Newton step has a moderate
 //! length where a diagonal shift of an indefinite Hessian gives huge steps along its
 //! near-null directions, which fold the map and force the line search down to 1/10),
@@ -134,7 +134,7 @@ fn neg_density_gradient(e: [f64; 4], w: f64, inv: f64) -> [f64; 4] {
     std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv)
 }
 
-/// `J = ∫ W` (eq. 16, as [`winslow_objective`], bit for bit) and `F = -∇J` (full,
+/// `J = ∫ W` (eq. 16, as `winslow_objective`, bit for bit) and `F = -∇J` (full,
 /// component-interleaved, length `2 n`, into `res`) in one pass over the quadrature
 /// points: a line search that accepts a point needs both there, and the basis values and
 /// `∇x` at a point are the larger part of either pass. `+∞` (and `res` meaningless) when
@@ -192,9 +192,9 @@ pub(crate) fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [
     winslow_gradient_with(disc, cps, res, stencil, 0.0);
 }
 
-/// [`winslow_gradient`] with the Hessian of the density at each quadrature point moved by
+/// `winslow_gradient` with the Hessian of the density at each quadrature point moved by
 /// the fraction `projected` towards its projection `P` onto the positive semidefinite
-/// matrices ([`project_psd`]): `H + projected (P - H)`. With `projected = 1` the
+/// matrices (`project_psd`): `H + projected (P - H)`. With `projected = 1` the
 /// assembled matrix is positive semidefinite (definite with the boundary fixed) wherever
 /// the map is, and its Newton direction descends.
 pub fn winslow_gradient_with(
@@ -225,7 +225,7 @@ pub fn winslow_gradient_with(
 /// Vᵀ/√2` with `(W_σ₁ - W_σ₂)/(σ₁ - σ₂) = (σ₁ + σ₂)² / (σ₁σ₂)² > 0`, and two in the span of `U diag(1,0) Vᵀ`,
 /// `U diag(0,1) Vᵀ` from the `2 x 2` Hessian of `W(σ₁, σ₂)`, whose determinant is
 /// `-(1/σ₁² - 1/σ₂²)² <= 0`: one of each sign. Negative eigenvalues are dropped. The
-/// same as [`project_psd`] of [`winslow_density`]'s Hessian, about 20 times cheaper.
+/// same as `project_psd` of [`winslow_density`]'s Hessian, about 20 times cheaper.
 ///
 /// No angle is computed: `∇x = [[a, b], [c, d]] = q R(α₂) + r R(α₁) Z` (`R` a rotation,
 /// `Z = diag(1, -1)`; `q (cos α₂, sin α₂) = ((a + d)/2, (c - b)/2)`, `r (cos α₁, sin α₁) =
@@ -522,7 +522,7 @@ impl DiscreteProblem for WinslowProblem {
     }
 
     /// First the partly, then fully projected Hessian ([`winslow_gradient_with`] with
-    /// [`PROJECTION_FIRST`], then three times that, then 1: positive semidefinite per
+    /// `PROJECTION_FIRST`, then three times that, then 1: positive semidefinite per
     /// point, a descent direction of moderate length where the exact one is indefinite),
     /// then diagonal shifts on top of it.
     fn modified(&self) -> bool {
@@ -541,7 +541,7 @@ impl DiscreteProblem for WinslowProblem {
         true
     }
 
-    /// `K` of [`winslow_laplace`] on the current control points.
+    /// `K` of `winslow_laplace` on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         Some(self.state.preconditioner(|disc, cps, st| winslow_laplace(disc, cps, shift, st)))
     }

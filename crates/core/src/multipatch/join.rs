@@ -67,7 +67,7 @@ pub(crate) fn elevated_in(map: &Surface, d: usize, p: usize) -> Result<Surface> 
     Ok(m)
 }
 
-/// What [`join_maps`] did.
+/// What `join_maps` did.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct JoinReport {
@@ -230,11 +230,11 @@ pub struct Joined {
     pub smoothing: Improvement,
 }
 
-/// [`join_maps`], then smooth the joined map by `functional` (the weak form, eq. 14, as
+/// `join_maps`, then smooth the joined map by `functional` (the weak form, eq. 14, as
 /// in the paper, or the Winslow functional, eq. 16) from it, certified before and after
 /// ([`crate::solve::improve::improve`]).
 ///
-/// Errors: those of [`join_maps`]; [`Error::InfeasibleStart`] when the joined map is not
+/// Errors: those of `join_maps`; [`Error::InfeasibleStart`] when the joined map is not
 /// certified bijective (one of the two maps was not).
 pub fn join_and_smooth(
     a: &Surface,

@@ -2,7 +2,7 @@
 //! sides as spline curves in the orientation of `formats.md` (south and north with
 //! increasing `xi`, west and east with increasing `eta`), and the interfaces between
 //! pairs of patch sides. The boundary conditions of every patch side follow from it
-//! ([`Layout::topologies`]: [`SideCondition::Interface`] on shared sides, Dirichlet on the
+//! (`Layout::topologies`: [`SideCondition::Interface`] on shared sides, Dirichlet on the
 //! outer boundary), and so do the direction classes of the knot vectors
 //! ([`super::classes`]) and the global numbering of shared control points
 //! (`dofs`).
@@ -204,7 +204,7 @@ impl Layout {
         (lo, hi)
     }
 
-    /// Diameter of [`Layout::bounding_box`].
+    /// Diameter of `Layout::bounding_box`.
     pub fn diameter(&self) -> f64 {
         let (lo, hi) = self.bounding_box();
         (hi[0] - lo[0]).hypot(hi[1] - lo[1])

@@ -8,18 +8,18 @@
 //! # Methods and the extension point
 //!
 //! [`MethodChoice`] is the registry of the methods `compare` knows by name; each gives a
-//! [`Contender`], which runs on a [`CompareContext`] (boundary, hierarchy, options, the
-//! EGG reference run) and returns a [`MethodRun`]: its name, nonlinear iterations,
+//! `Contender`, which runs on a `CompareContext` (boundary, hierarchy, options, the
+//! EGG reference run) and returns a `MethodRun`: its name, nonlinear iterations,
 //! whether it converged and why not, the map, the seconds. The measures are computed here,
 //! uniformly, from the map alone ([`Measures::of`]); a contender never reports its own
-//! verdict. A new method is a new [`MethodChoice`] variant and a [`Contender`]
-//! implementation (a minimization or root-finding [`Method`] can use [`HierarchyRun`]).
+//! verdict. A new method is a new [`MethodChoice`] variant and a `Contender`
+//! implementation (a minimization or root-finding [`Method`] can use `HierarchyRun`).
 //!
 //! EGG always runs first: its map is `x_G`, and with the basis `auto` its run decides
 //! the basis (the input's own basis when its map is certified, else the fitted one, as
 //! `winslow solve` does); every other method then runs on that basis, from the same
 //! start: by default the Coons patch of the finest basis ([`CompareOptions::default`]),
-//! with more levels the coarse-to-fine walk of §6.3 ([`HierarchyRun`]). Defect
+//! with more levels the coarse-to-fine walk of §6.3 (`HierarchyRun`). Defect
 //! correction (§8.2) is off by default: it would refine each method's basis differently.
 //!
 //! | name | method | start | IT counts |
@@ -181,7 +181,7 @@ pub struct CompareOptions {
     pub lambda2: f64,
     /// The Hessian of the quasi-conformal iteration (Gauss-Newton by default).
     pub qc_hessian: QcHessian,
-    /// Length scales of the Poisson benchmark's `u*` (default: [`default_scales`] of the
+    /// Length scales of the Poisson benchmark's `u*` (default: `default_scales` of the
     /// EGG map), the same for every method.
     pub poisson_scales: Option<[f64; 2]>,
     /// `ε`, iteration limits and tolerances of Gravesen's methods (max-z and the
@@ -432,7 +432,7 @@ pub struct CompareRow {
     pub q_ratio: Option<f64>,
     /// Seconds of the run (measures not included).
     pub seconds: f64,
-    /// What the run did beyond its iterations ([`MethodRun::notes`]).
+    /// What the run did beyond its iterations (`MethodRun::notes`).
     pub notes: Vec<String>,
     /// The map, when there is one.
     #[serde(skip)]

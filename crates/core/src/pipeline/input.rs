@@ -36,7 +36,7 @@ pub enum Input {
     /// across shared edges, then solved as one layout.
     Graph(PlaneGraph),
     /// The six boundary faces of a hexahedral volume: the trivariate Winslow solve from
-    /// the Coons start ([`crate::solve::volume::solve_volume`]).
+    /// the Coons start (`crate::solve::volume::solve_volume`).
     Volume(Box<VolumeBoundary>),
     /// A certified map, improved on its own basis by the pipeline's method (the Winslow
     /// functional by default) with its boundary fixed, and kept only when certified

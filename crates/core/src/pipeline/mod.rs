@@ -117,7 +117,7 @@ pub enum Stage<'a> {
     /// basis.
     ThbRound(&'a ThbRound),
     /// A volume boundary's solve starts (common bases, Coons start, the trivariate
-    /// Winslow minimisation, its certificate; [`solve_volume`]).
+    /// Winslow minimisation, its certificate; `solve_volume`).
     Volume {
         /// The options it runs with, made from the pipeline's.
         options: &'a VolumeOptions,

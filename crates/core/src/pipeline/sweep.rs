@@ -26,7 +26,7 @@
 //!   symmetric the frames repeat after `2π / n`.
 //! - [`Seam::Ray`] (the paper's literal choice, `c_r(eta)_y = 0`): `σ(θ)` puts `eta = 0`
 //!   on the seam ray, the ray from the (turned) inner centroid in the frame-0 direction
-//!   of `c_0(0)` ([`ray_parameter`], tracked continuously). Where that ray grazes a lobe
+//!   of `c_0(0)` (`ray_parameter`, tracked continuously). Where that ray grazes a lobe
 //!   flank of a screw rotor, `σ` runs fast and the grid folds (the male rotor folds
 //!   after about 40 degrees, see BENCHMARKS.md).
 //! - [`Seam::Material`]: `σ = 0`, the control points of `c_0` turned: exact, `eta`

@@ -122,7 +122,7 @@ mod tests {
 
     /// puzzle4 with `--refinement thb` (the geometry of the CLI's THB test): the
     /// pipeline's THB result is, bit for bit, what the front end made before the stage
-    /// moved into the pipeline (the tensor solve without repair, then [`repair_thb`] with
+    /// moved into the pipeline (the tensor solve without repair, then `repair_thb` with
     /// the options' rounds, halo, operator, Newton and certificate options); the observer
     /// sees every round, in order, after the tensor solve's stages, and stops the run at
     /// the first round with [`Error::Cancelled`].

@@ -79,7 +79,7 @@ pub struct ThbRound {
     pub seconds: f64,
 }
 
-/// The result of [`repair_thb`]: the last map, its certificate and the rounds.
+/// The result of `repair_thb`: the last map, its certificate and the rounds.
 #[derive(Debug, Clone)]
 pub(crate) struct ThbRepair {
     /// The map.
@@ -158,7 +158,7 @@ pub(crate) fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Resul
     repair_thb_observed(map, opts, &mut |_| true)
 }
 
-/// [`repair_thb`], every finished round to `observer`; [`Error::Cancelled`] when it
+/// `repair_thb`, every finished round to `observer`; [`Error::Cancelled`] when it
 /// returns `false` (the pipeline's [`Stage::ThbRound`](crate::pipeline::Stage::ThbRound)).
 pub(crate) fn repair_thb_observed(
     map: HierarchicalMap,

@@ -162,7 +162,7 @@ impl MemoryEstimate {
 /// The most memory a solve may take (`--max-memory`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum MemoryLimit {
-    /// What the machine has available when the solve starts ([`available_memory`]); no
+    /// What the machine has available when the solve starts (`available_memory`); no
     /// limit where that cannot be read (systems other than Linux).
     #[default]
     Available,

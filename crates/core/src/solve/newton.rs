@@ -86,7 +86,7 @@ pub struct NonlinearOptions {
     pub max_modified: Option<usize>,
     /// A minimisation has converged after a full Newton step with the exact Hessian
     /// whose decrement (the decrease its quadratic model predicts) is at most this
-    /// fraction of `|J|` (see [`DECREMENT_TOL`]); 0: off.
+    /// fraction of `|J|` (see `DECREMENT_TOL`); 0: off.
     pub decrement_tol: f64,
     /// A root-finding Newton step whose line search fails on a GMRES direction is solved
     /// again once with sparse direct LU (kept for the rest of the solve) before the solver
@@ -118,7 +118,7 @@ pub struct NonlinearOptions {
     /// [`extrapolated_step`] (on the Winslow functional, eq. 16, from the EGG map the first
     /// Newton steps are too short: `J` falls to 1.3-2 times the full step), for a
     /// root-finding method the minimiser of a quadratic model of `F` along the direction,
-    /// [`extrapolated_root_step`].
+    /// `extrapolated_root_step`.
     pub extrapolate: bool,
 }
 

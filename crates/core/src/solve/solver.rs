@@ -4,7 +4,7 @@
 //!
 //! The solver talks to the discrete problem only through [`Method`] and
 //! [`DiscreteProblem`](crate::methods::DiscreteProblem): EGG (eq. 8) by default, any
-//! other method through [`EggSolver::with_method`]. The patch's boundary conditions are
+//! other method through `EggSolver::with_method`. The patch's boundary conditions are
 //! data ([`SolveOptions::topology`]), read by the DOF map of every level.
 
 use std::sync::Arc;

@@ -34,7 +34,7 @@ impl BasisDerivs {
         out
     }
 
-    /// Evaluate in place at `u` in the span found by [`KnotVector::find_span`].
+    /// Evaluate in place at `u` in the span found by `KnotVector::find_span`.
     pub fn eval(&mut self, kv: &KnotVector, u: f64, nd: usize) {
         let span = kv.find_span(u);
         self.eval_in_span(kv, span, u, nd);

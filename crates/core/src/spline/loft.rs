@@ -5,7 +5,7 @@
 //! **One basis.** The slices are first brought to one tensor basis, exactly: every slice
 //! is degree-elevated to the largest degree per direction (continuity kept), then
 //! refined by knot insertion to the union of all knot vectors (every break with its
-//! largest multiplicity), [`common_basis`]. Periodic directions (ring maps) stay periodic.
+//! largest multiplicity), `common_basis`. Periodic directions (ring maps) stay periodic.
 //!
 //! **In `z`.** The parameter of slice `i` is `ζ_i = (z_i - z_0) / (z_{m-1} - z_0)`, so
 //! that `z(ζ)` is affine and `det J = (z_{m-1} - z_0) det J_xy` where the slices share

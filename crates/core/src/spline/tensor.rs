@@ -310,7 +310,7 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
     }
 
     /// The same map on the finer tensor basis `fine` (knot insertion in every direction;
-    /// for `D = 2` with the whole [`Self::prolongation_to`] at once).
+    /// for `D = 2` with the whole `Self::prolongation_to` at once).
     pub fn refined(&self, fine: &[KnotVector; P]) -> Result<Self> {
         if D == 2 {
             let op = self.prolongation_to(fine)?;

@@ -179,7 +179,7 @@ pub struct ExcusedPoint {
 }
 
 /// An element where `det J < 0` was proven at a point (`D = 2`: of a map of the plane,
-/// [`FoldInfo`]; `D = 3`: of a volume, [`volume::VolumeFold`]).
+/// `FoldInfo`; `D = 3`: of a volume, `volume::VolumeFold`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(bound(serialize = "[usize; D]: Serialize, [f64; D]: Serialize"))]
 pub struct Fold<const D: usize> {
@@ -199,7 +199,7 @@ pub struct Fold<const D: usize> {
 pub(crate) type FoldInfo = Fold<2>;
 
 /// An element neither proven positive nor shown to fold (`D = 2`: of a map of the plane,
-/// [`UndecidedInfo`]; `D = 3`: of a volume, [`volume::VolumeUndecided`]).
+/// `UndecidedInfo`; `D = 3`: of a volume, `volume::VolumeUndecided`).
 #[derive(Debug, Clone, Serialize)]
 #[serde(bound(serialize = "[usize; D]: Serialize"))]
 pub struct Undecided<const D: usize> {

@@ -238,7 +238,7 @@ pub(crate) fn default_scales(map: &Surface) -> [f64; 2] {
 }
 
 /// Run the benchmark of eq. (44)-(45) on `map` with length scales `a` (default:
-/// [`default_scales`]).
+/// `default_scales`).
 pub fn poisson_benchmark(map: &Surface, a: Option<[f64; 2]>) -> Result<PoissonReport> {
     let t0 = Instant::now();
     let a = a.unwrap_or_else(|| default_scales(map));

@@ -8,7 +8,7 @@
 //!   basis with `c_0 = 0`, `c_n = 1`, minimizing (eq. 39)
 //!   `A(c) = ∫_0^1 ||(f̄ ∘ g)'(ξ)||^2 dξ`; by Cauchy-Schwarz `A >= L^2` (`L` the length of
 //!   the side) with equality exactly for the arc-length parameterization. See
-//!   [`arc_length_map`]. The contour is then re-fitted in the solver's basis as
+//!   `arc_length_map`. The contour is then re-fitted in the solver's basis as
 //!   `f̄ ∘ g` ([`crate::boundary::fit`]).
 //! * **Constrained cord length** (§7.2, eq. 40-42). For two opposite sides `P_1` (cord
 //!   length, `Ξ_1`) and `P_2`, the closest pair `(p^1_i, p^2_j)` within the threshold
@@ -16,7 +16,7 @@
 //!   index ranges below and above the match, after removing the points within a minimum
 //!   cord-length separation `δ` of it. The unmatched abscissae of `P_2` are filled either
 //!   by a Fritsch-Carlson monotone cubic through the matched values or by piecewise cord
-//!   length between consecutive matches (eq. 41-42). See [`constrained_params`].
+//!   length between consecutive matches (eq. 41-42). See `constrained_params`.
 //!
 //! Rings (closed contours, `eta` periodic) use the same matching on the two contours
 //! cut open at the seam: `boundary::ring_reparam`.

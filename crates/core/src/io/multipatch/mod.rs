@@ -42,7 +42,7 @@ pub struct Patches<'a> {
 }
 
 impl<'a> Patches<'a> {
-    /// The patches of a solved layout with their reports ([`patch_report`]).
+    /// The patches of a solved layout with their reports (`patch_report`).
     pub fn of_solution(sol: &'a MultipatchSolution) -> Result<Self> {
         Ok(Self {
             layout: &sol.layout,

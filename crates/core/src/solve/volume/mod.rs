@@ -34,7 +34,7 @@ use crate::verify::certificate::CertifyOptions;
 use coons::{common_faces, coons_fill, volume_of, CommonFaces};
 use winslow::WinslowVolume;
 
-/// Options of [`solve_volume`].
+/// Options of `solve_volume`.
 #[derive(Debug, Clone)]
 pub struct VolumeOptions {
     /// Times every element of the common bases is halved before the solve.

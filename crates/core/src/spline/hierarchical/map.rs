@@ -24,7 +24,7 @@ use crate::spline::surface::{Surface, SurfaceDerivs};
 pub struct HierarchicalMap {
     /// The basis.
     pub basis: HierarchicalBasis,
-    /// Control points in the order of [`HierarchicalBasis::active_functions`].
+    /// Control points in the order of `HierarchicalBasis::active_functions`.
     pub control_points: Vec<Point>,
 }
 
@@ -209,7 +209,7 @@ impl HierarchicalMap {
         Ok([out[0].clone(), out[1].clone()])
     }
 
-    /// The same map as a tensor-product map on [`Self::tensor_knots`] (exact: every
+    /// The same map as a tensor-product map on `Self::tensor_knots` (exact: every
     /// coefficient is the blossom of the piece on an element of its support).
     pub fn to_surface(&self) -> Result<Surface> {
         let kv = self.tensor_knots()?;

@@ -308,7 +308,7 @@ impl HierarchicalBasis {
     /// Refine the active cells `marked` (`(level, cell)`) and, recursively, the coarser
     /// active cells that keep the hierarchy admissible of class `m >= 2` (see the module
     /// doc). A marked cell that is not active is a typed error; so is a level past
-    /// [`MAX_LEVELS`] or a knot vector past the size limit.
+    /// `MAX_LEVELS` or a knot vector past the size limit.
     pub fn refine(&mut self, marked: &[(usize, Index2)], m: usize) -> Result<()> {
         if m < 2 {
             return Err(Error::Invalid(format!("admissibility class must be at least 2, got {m}")));
