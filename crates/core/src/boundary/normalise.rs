@@ -102,12 +102,12 @@ impl Similarity {
     }
 
     /// `x̂ = (x − c) / s`.
-    pub(crate) fn to_unit(&self, p: Point) -> Point {
+    pub(crate) fn to_unit(self, p: Point) -> Point {
         [(p[0] - self.centre[0]) / self.scale, (p[1] - self.centre[1]) / self.scale]
     }
 
     /// `x = c + s x̂`.
-    pub(crate) fn to_physical(&self, p: Point) -> Point {
+    pub(crate) fn to_physical(self, p: Point) -> Point {
         [self.centre[0] + self.scale * p[0], self.centre[1] + self.scale * p[1]]
     }
 

@@ -32,7 +32,7 @@ fn side(v: Value, ctx: &str) -> Result<SideCurve> {
             if c.periodic {
                 return Err(jerr(ctx, "a periodic curve cannot be one side of a loop (give it as the whole loop)"));
             }
-            Ok(SideCurve::Spline(c.to_curve().map_err(|e| e.within(ctx))?))
+            Ok(SideCurve::Spline(c.into_curve().map_err(|e| e.within(ctx))?))
         }
     }
 }

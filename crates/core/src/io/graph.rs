@@ -52,7 +52,7 @@ fn edge(v: Value, ctx: &str) -> Result<PlaneEdge> {
                     if c.periodic {
                         return Err(jerr(&cctx, "a periodic curve cannot be an edge (split it at two vertices)"));
                     }
-                    SideCurve::Spline(c.to_curve().map_err(|e| e.within(&cctx))?)
+                    SideCurve::Spline(c.into_curve().map_err(|e| e.within(&cctx))?)
                 }
             })
         }

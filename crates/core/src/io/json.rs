@@ -166,7 +166,7 @@ impl CurveJson {
     }
 
     /// Validate (lengths, knots, degree, finiteness, weights) and map the domain to `[0, 1]`.
-    pub(crate) fn to_curve(self) -> Result<Curve> {
+    pub(crate) fn into_curve(self) -> Result<Curve> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let kv = KnotVector::with_periodic(self.degree, self.knots, self.periodic).map_err(|e| e.within("knots"))?;
         let c = Curve::new(kv, self.control_points, self.weights)?;
@@ -190,9 +190,9 @@ impl SideJson {
 
     /// Convert to a side: curves are validated and normalized to `[0, 1]`; point clouds
     /// are only checked for size here (the rest is [`crate::boundary::validate::validate`]'s job).
-    pub(crate) fn to_side(self) -> Result<SideCurve> {
+    pub(crate) fn into_side(self) -> Result<SideCurve> {
         match self {
-            SideJson::Curve(c) => c.to_curve().map(SideCurve::Spline),
+            SideJson::Curve(c) => c.into_curve().map(SideCurve::Spline),
             SideJson::Points(p) => {
                 crate::error::check_point_count(p.points.len(), "")?;
                 Ok(SideCurve::Points(p.points))
@@ -203,7 +203,7 @@ impl SideJson {
 
 impl ContourDoc {
     /// Split the polygon into the four sides ([`split_contour`]).
-    pub(crate) fn to_boundary(self) -> Result<Boundary> {
+    pub(crate) fn into_boundary(self) -> Result<Boundary> {
         let sides = split_contour(&self.contour.points, self.contour.corners)?;
         Ok(Boundary { name: self.name, sides: sides.map(SideCurve::Points) })
     }
@@ -291,14 +291,14 @@ pub fn parse_json(text: &str) -> Result<Document> {
                 .remove(s.name())
                 .ok_or_else(|| Error::Json { context: "boundary".into(), message: format!("missing side \"{s}\"") })?;
             let side = SideJson::from_value(v).map_err(json_err(&ctx))?;
-            out.push(side.to_side().map_err(|e| e.within(&ctx))?);
+            out.push(side.into_side().map_err(|e| e.within(&ctx))?);
         }
         let sides: [SideCurve; 4] = out.try_into().map_err(|_| Error::Invalid("four sides expected".into()))?;
         return Ok(Document::Boundary(Boundary { name, sides }));
     }
     if let Some(c) = obj.remove("contour") {
         let contour: ContourJson = serde_json::from_value(c).map_err(json_err("contour"))?;
-        return ContourDoc { name, contour }.to_boundary().map(Document::Boundary);
+        return ContourDoc { name, contour }.into_boundary().map(Document::Boundary);
     }
     Err(Error::Json {
         context: String::new(),

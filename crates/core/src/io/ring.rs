@@ -31,7 +31,7 @@ fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
         }
         Value::Object(_) => {
             let c: CurveJson = serde_json::from_value(v).map_err(jerr)?;
-            Ok(ClosedContour::Spline(c.to_curve().map_err(|e| e.within(ctx))?))
+            Ok(ClosedContour::Spline(c.into_curve().map_err(|e| e.within(ctx))?))
         }
         other => Err(Error::Json {
             context: ctx.into(),

@@ -43,7 +43,7 @@ fn curve_of(v: Value, ctx: &str) -> Result<Curve> {
     if c.periodic {
         return Err(jerr(ctx, "a periodic curve cannot be a patch side"));
     }
-    c.to_curve().map_err(|e| e.within(ctx))
+    c.into_curve().map_err(|e| e.within(ctx))
 }
 
 /// Parse a multipatch document (see the module documentation); the layout is not
