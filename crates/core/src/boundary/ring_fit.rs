@@ -229,6 +229,7 @@ fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Cur
 /// [`ReparamOptions`], `auto`, see `boundary::ring_reparam`), and fit them
 /// adaptively on dyadic periodic knot vectors of degree `degree` until `tol * diameter`
 /// is met (at most `max_elements` elements).
+#[cfg(any(test, feature = "testutil"))]
 pub(crate) fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
     fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive, &ReparamOptions::default())
 }

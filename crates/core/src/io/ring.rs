@@ -6,7 +6,7 @@
 //! a closed loop exported by CAD systems, e.g. the G+Smo loops), or `{"points": [...]}`,
 //! an ordered closed point cloud; a last point equal to the first (within `1e-12` of
 //! the cloud's extent) is dropped. Closedness, orientation and nesting are checked by
-//! [`crate::boundary::ring_fit::fit_ring`].
+//! [`crate::boundary::ring_fit::check_ring`].
 
 use serde_json::{json, Value};
 
