@@ -138,9 +138,9 @@ pub(crate) fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
                 }
                 let coef = along(&inv[2], deg, 2, &along(&inv[1], deg, 1, &along(&inv[0], deg, 0, &vals)));
                 for &k in &order {
-                    let h = net[k];
-                    let _ = write!(pts, "{:?} {:?} {:?} ", h[0] / h[3], h[1] / h[3], h[2] / h[3]);
-                    let _ = write!(wts, "{:?} ", h[3]);
+                    let (h, w) = net[k];
+                    let _ = write!(pts, "{:?} {:?} {:?} ", h[0] / w, h[1] / w, h[2] / w);
+                    let _ = write!(wts, "{:?} ", w);
                     let _ = write!(dets, "{:?} ", coef[k]);
                 }
                 pts.push('\n');
