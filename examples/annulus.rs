@@ -42,15 +42,15 @@ fn run() -> winslow::Result<(Verdict, f64)> {
     println!(
         "{}: {:?}, det J min {:.4}, area {:.6} (exact {:.6})",
         solution.name,
-        r.verdict,
-        r.det_j_min,
-        r.area,
+        r.outcome.verdict,
+        r.det_j.min,
+        r.measures.area,
         0.75 * PI * 3.0
     );
-    for f in &r.fit {
+    for f in &r.fit.sides {
         println!("  fit {}: {} elements, max error {:.2e}, converged {}", f.side, f.elements, f.max_error, f.converged);
     }
-    Ok((r.verdict, (r.area - 0.75 * PI * 3.0).abs() / (0.75 * PI * 3.0)))
+    Ok((r.outcome.verdict, (r.measures.area - 0.75 * PI * 3.0).abs() / (0.75 * PI * 3.0)))
 }
 
 fn main() {

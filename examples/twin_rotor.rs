@@ -166,18 +166,19 @@ fn main() -> Res<()> {
     let sep = winslow::solve(&separator, &SolveOptions::default())?;
     println!(
         "separator: {} ({:.3} s, {} functions, basis {})",
-        sep.report.message,
-        sep.report.seconds,
-        sep.report.basis_functions,
-        sep.report.basis.used.name()
+        sep.report.outcome.message,
+        sep.report.solve.seconds,
+        sep.report.setup.basis_functions,
+        sep.report.setup.basis.used.name()
     );
-    let separator_map = Output::Map { name: "separator", map: &sep.map, label: &sep.report.message, extra: None };
+    let separator_map =
+        Output::Map { name: "separator", map: &sep.map, label: &sep.report.outcome.message, extra: None };
     winslow::write(&out.join("separator.json"), &separator_map)?;
     // split it from the top cusp to the bottom cusp through the map
     let (from, _) = nearest_boundary_point(&sep.map, top);
     let (to, _) = nearest_boundary_point(&sep.map, bot);
     let opts = SplitOptions { path, ..Default::default() };
-    let split = split_map("middle", &sep.map, &sep.report.certificate, from, to, &opts)?;
+    let split = split_map("middle", &sep.map, &sep.report.outcome.certificate, from, to, &opts)?;
     println!(
         "split ({:?}): curve of {} elements, length {:.4}, areas {:.3} / {:.3}",
         path, split.report.elements, split.report.length, split.report.areas[0], split.report.areas[1]

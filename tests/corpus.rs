@@ -14,11 +14,11 @@ fn certified(family: Family, seed: u64) {
     let b = family.generate(seed);
     let sol = solve(&b, &SolveOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", b.name));
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}: {}", b.name, r.message);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}: {}", b.name, r.outcome.message);
     // every side is fitted within the tolerance (at the points of a cloud), except the
     // noise of a noisy cloud (1e-4, up to ~4.5 sigma), which is not fitted
-    let slack = if family == Family::NoisyCloud { 5e-4 } else { r.fit_tolerance };
-    for f in &r.fit {
+    let slack = if family == Family::NoisyCloud { 5e-4 } else { r.fit.fit_tolerance };
+    for f in &r.fit.sides {
         assert!(f.max_error <= slack, "{} {}: fit error {:.3e}, allowed {slack:.3e}", b.name, f.side, f.max_error);
     }
 }

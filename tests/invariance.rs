@@ -41,18 +41,28 @@ fn solved(b: &Boundary) -> Solution {
 fn assert_same(file: &str, orig: &Solution, moved: &Solution, a: Point, s: f64, tol: f64) {
     let (r0, r1) = (&orig.report, &moved.report);
     let what = format!("{file} moved by {a:?}, scaled by {s:e}");
-    assert_eq!(r1.verdict, r0.verdict, "{what}: {}", r1.message);
-    assert_eq!(r1.levels.len(), r0.levels.len(), "{what}");
-    for (l0, l1) in r0.levels.iter().zip(&r1.levels) {
+    assert_eq!(r1.outcome.verdict, r0.outcome.verdict, "{what}: {}", r1.outcome.message);
+    assert_eq!(r1.solve.levels.len(), r0.solve.levels.len(), "{what}");
+    for (l0, l1) in r0.solve.levels.iter().zip(&r1.solve.levels) {
         assert_eq!(l1.shape, l0.shape, "{what}");
         assert_eq!(l1.newton_iterations, l0.newton_iterations, "{what}: level {}", l0.level);
         assert_eq!(l1.pseudo_time_iterations, l0.pseudo_time_iterations, "{what}: level {}", l0.level);
     }
-    let rel = |x: f64, y: f64| (x - y).abs() / (s.abs() * r0.diameter);
-    assert!(rel(r1.diameter, s * r0.diameter) < tol, "{what}: diameter {} vs {}", r1.diameter, r0.diameter);
-    assert!((r1.area / (s * s * r0.area) - 1.0).abs() < tol, "{what}: area {} vs {}", r1.area, r0.area);
-    let dj = (r1.det_j_min / (s * s * r0.det_j_min) - 1.0).abs();
-    assert!(dj < 1e-6_f64.max(100.0 * tol), "{what}: det J min {} vs {}", r1.det_j_min, r0.det_j_min);
+    let rel = |x: f64, y: f64| (x - y).abs() / (s.abs() * r0.fit.diameter);
+    assert!(
+        rel(r1.fit.diameter, s * r0.fit.diameter) < tol,
+        "{what}: diameter {} vs {}",
+        r1.fit.diameter,
+        r0.fit.diameter
+    );
+    assert!(
+        (r1.measures.area / (s * s * r0.measures.area) - 1.0).abs() < tol,
+        "{what}: area {} vs {}",
+        r1.measures.area,
+        r0.measures.area
+    );
+    let dj = (r1.det_j.min / (s * s * r0.det_j.min) - 1.0).abs();
+    assert!(dj < 1e-6_f64.max(100.0 * tol), "{what}: det J min {} vs {}", r1.det_j.min, r0.det_j.min);
     let (m0, m1) = (&orig.map, &moved.map);
     assert_eq!(m1.knots, m0.knots, "{what}");
     let worst = m0
@@ -69,7 +79,7 @@ fn translated_and_scaled_geometries_solve_alike() {
     for file in ["gismo/duck.json", "quarter_annulus.json", "gismo/puzzle3.json"] {
         let b = load(file);
         let orig = solved(&b);
-        let d = orig.report.diameter;
+        let d = orig.report.fit.diameter;
         // far from the origin: the input itself is rounded to ~1e9 eps of its size, and
         // the map can follow it no closer than that
         for (a, s, tol) in [
@@ -148,7 +158,7 @@ fn similar_ring(r: &Ring, a: Point, s: f64) -> Ring {
 
 /// Verdict and Newton iterations per level.
 fn summary(sol: &Solution) -> (Verdict, Vec<usize>) {
-    (sol.report.verdict, sol.report.levels.iter().map(|l| l.newton_iterations).collect())
+    (sol.report.outcome.verdict, sol.report.solve.levels.iter().map(|l| l.newton_iterations).collect())
 }
 
 /// A ring translated by 1e9 times its size was refused as running clockwise (its signed
@@ -159,7 +169,7 @@ fn rings_translated_and_scaled_solve_alike() {
     for file in ["rings/eccentric_annulus.json", "rings/annulus_periodic.json"] {
         let r = ring(file);
         let orig = Pipeline::new(r.clone(), SolveOptions::default()).solve().and_then(Solved::into_map).unwrap();
-        let d = orig.report.diameter;
+        let d = orig.report.fit.diameter;
         for (a, s) in similarities(d) {
             let moved = Pipeline::new(similar_ring(&r, a, s), SolveOptions::default())
                 .solve()
@@ -206,7 +216,7 @@ fn solve_layout(layout: &Layout, opts: &SolveOptions) -> winslow::Result<Multipa
 }
 
 fn layout_summary(m: &MultipatchSolution) -> (Vec<Verdict>, Vec<Vec<usize>>, Option<usize>) {
-    let its = m.patches.iter().map(|p| p.solve.levels.iter().map(|l| l.newton_iterations).collect()).collect();
+    let its = m.patches.iter().map(|p| p.solve.solve.levels.iter().map(|l| l.newton_iterations).collect()).collect();
     (m.report.verdicts.clone(), its, m.report.free.as_ref().map(|f| f.iterations))
 }
 

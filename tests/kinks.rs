@@ -37,11 +37,11 @@ fn run(file: &str, o: &SolveOptions) -> (Boundary, Solution) {
 /// diameter, and the map's knot vector along it holds the kink with multiplicity `p`.
 fn kinks_kept(sol: &Solution, expect: usize) {
     let r = &sol.report;
-    assert_eq!(r.kinks.len(), expect, "{:#?}", r.kinks);
-    assert!(r.c0_route.as_ref().is_some_and(|c| c.kept), "{}", r.message);
-    for k in &r.kinks {
+    assert_eq!(r.boundary.kinks.len(), expect, "{:#?}", r.boundary.kinks);
+    assert!(r.boundary.c0_route.as_ref().is_some_and(|c| c.kept), "{}", r.outcome.message);
+    for k in &r.boundary.kinks {
         assert!(k.kept, "{k:?}");
-        assert!(k.deviation <= 1e-12 * r.diameter, "{k:?}");
+        assert!(k.deviation <= 1e-12 * r.fit.diameter, "{k:?}");
         let t = k.map_parameter.expect("a kept kink has its knot line");
         let d = if k.side == "south" || k.side == "north" { 0 } else { 1 };
         let kv = &sol.map.knots[d];
@@ -56,22 +56,26 @@ fn kinks_kept(sol: &Solution, expect: usize) {
 fn rotor_sector_keeps_its_c0_knots_on_the_input_basis() {
     let (_, sol) = run("gismo/rotor_sector.json", &opts(BasisChoice::Input, KinkMode::Auto));
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert_eq!(r.basis.used, BasisChoice::Input);
-    assert!(r.basis.kinks.is_some());
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert_eq!(r.setup.basis.used, BasisChoice::Input);
+    assert!(r.setup.basis.kinks.is_some());
     kinks_kept(&sol, 2);
-    assert!(r.kinks.iter().any(|k| k.side == "north" && (k.turning_degrees - 35.83).abs() < 0.01));
-    assert!(r.kinks.iter().all(|k| k.kind == KinkKind::C0Knot));
-    let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-    assert!(dev <= 1e-12 * r.diameter, "boundary deviation {dev}");
+    assert!(r.boundary.kinks.iter().any(|k| k.side == "north" && (k.turning_degrees - 35.83).abs() < 0.01));
+    assert!(r.boundary.kinks.iter().all(|k| k.kind == KinkKind::C0Knot));
+    let dev = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    assert!(dev <= 1e-12 * r.fit.diameter, "boundary deviation {dev}");
     // the Winslow stage on Σ⁰ lowered the functional from its start
-    let c = r.c0_route.as_ref().unwrap();
+    let c = r.boundary.c0_route.as_ref().unwrap();
     assert!(c.winslow[1].unwrap() <= c.winslow[0].unwrap(), "{c:?}");
     // `--kinks none` does not round them silently: the input basis is refused, and why
     let (_, none) = run("gismo/rotor_sector.json", &opts(BasisChoice::Input, KinkMode::None));
-    assert_eq!(none.report.basis.used, BasisChoice::Fitted);
-    assert!(none.report.basis.fallback.as_deref().is_some_and(|w| w.contains("C0")), "{:?}", none.report.basis);
-    let north = none.report.kinks.iter().find(|k| k.side == "north").expect("the rounded kink is reported");
+    assert_eq!(none.report.setup.basis.used, BasisChoice::Fitted);
+    assert!(
+        none.report.setup.basis.fallback.as_deref().is_some_and(|w| w.contains("C0")),
+        "{:?}",
+        none.report.setup.basis
+    );
+    let north = none.report.boundary.kinks.iter().find(|k| k.side == "north").expect("the rounded kink is reported");
     assert!(!north.kept && north.deviation > 1e-9, "{north:?}");
 }
 
@@ -80,7 +84,7 @@ fn rotor_sector_keeps_its_c0_knots_on_the_input_basis() {
 #[test]
 fn rotor_sector_keeps_its_kink_on_the_fitted_basis() {
     let (_, sol) = run("gismo/rotor_sector.json", &opts(BasisChoice::Fitted, KinkMode::Auto));
-    assert_eq!(sol.report.verdict, Verdict::Certified, "{}", sol.report.message);
+    assert_eq!(sol.report.outcome.verdict, Verdict::Certified, "{}", sol.report.outcome.message);
     kinks_kept(&sol, 1);
 }
 
@@ -93,23 +97,23 @@ fn rotor_sector_keeps_its_kink_on_the_fitted_basis() {
 fn plate_with_hole_keeps_its_zero_speed_kink() {
     let (_, sol) = run("gismo/plate_with_hole.json", &opts(BasisChoice::Input, KinkMode::Auto));
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::DegenerateCorner, "{}", r.message);
+    assert_eq!(r.outcome.verdict, Verdict::DegenerateCorner, "{}", r.outcome.message);
     kinks_kept(&sol, 1);
-    assert_eq!(r.kinks[0].kind, KinkKind::ZeroSpeed);
-    let c = &r.certificate;
+    assert_eq!(r.boundary.kinks[0].kind, KinkKind::ZeroSpeed);
+    let c = &r.outcome.certificate;
     assert_eq!(c.excused_points.len(), 1, "{:?}", c.excused_points);
     assert!((c.excused_points[0].point[0] + 4.0).abs() < 1e-12 && (c.excused_points[0].point[1] - 4.0).abs() < 1e-12);
     assert!(c.corners.iter().all(|k| k.excused_extent.is_none()));
     let ext = c.excused_points[0].extent;
     assert!(ext[0] < 1e-3 && ext[1] < 1e-3, "the excused neighbourhood shrinks: {ext:?}");
-    let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-    assert!(dev <= 1e-12 * r.diameter, "boundary deviation {dev}");
+    let dev = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    assert!(dev <= 1e-12 * r.fit.diameter, "boundary deviation {dev}");
 
     let (_, auto) = run("gismo/plate_with_hole.json", &opts(BasisChoice::Auto, KinkMode::Auto));
     let r = &auto.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert_eq!(r.basis.used, BasisChoice::Fitted);
-    assert!(r.basis.fallback.as_deref().is_some_and(|w| w.contains("zero speed")), "{:?}", r.basis);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert_eq!(r.setup.basis.used, BasisChoice::Fitted);
+    assert!(r.setup.basis.fallback.as_deref().is_some_and(|w| w.contains("zero speed")), "{:?}", r.setup.basis);
     kinks_kept(&auto, 1);
 }
 
@@ -137,14 +141,14 @@ fn a_fold_next_to_a_zero_speed_point_is_a_fold() {
 fn star_polygon_certifies_with_its_kinks_kept() {
     let (_, sol) = run("contours/star8.json", &opts(BasisChoice::Auto, KinkMode::Auto));
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
     kinks_kept(&sol, 12);
-    let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-    assert!(dev <= 1e-12 * r.diameter, "the straight edges are exact: {dev}");
+    let dev = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    assert!(dev <= 1e-12 * r.fit.diameter, "the straight edges are exact: {dev}");
     let (_, none) = run("contours/star8.json", &opts(BasisChoice::Auto, KinkMode::None));
-    assert!(none.report.kinks.iter().all(|k| !k.kept));
-    let dev = none.report.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-    assert!(dev > 1e-2 * none.report.diameter, "without kinks the polygon is rounded: {dev}");
+    assert!(none.report.boundary.kinks.iter().all(|k| !k.kept));
+    let dev = none.report.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    assert!(dev > 1e-2 * none.report.fit.diameter, "without kinks the polygon is rounded: {dev}");
 }
 
 /// An L-shaped polygon: its reflex corner and the convex one opposite it are kinks inside
@@ -156,9 +160,9 @@ fn star_polygon_certifies_with_its_kinks_kept() {
 fn l_shape_certifies_with_its_reflex_corner_kept() {
     let (_, sol) = run("contours/l_shape.json", &opts(BasisChoice::Auto, KinkMode::Auto));
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
     kinks_kept(&sol, 2);
-    let c0 = r.c0_route.as_ref().expect("the C0 route ran");
+    let c0 = r.boundary.c0_route.as_ref().expect("the C0 route ran");
     assert!(c0.failure.is_none(), "{}", c0.message);
 }
 
@@ -174,10 +178,10 @@ fn the_local_winslow_stage_moves_only_the_control_points_near_the_kinks() {
     let (_, g) = run("notched_square.json", &global);
     let (_, l) = run("notched_square.json", &local);
     for sol in [&g, &l] {
-        assert_eq!(sol.report.verdict, Verdict::Certified, "{}", sol.report.message);
+        assert_eq!(sol.report.outcome.verdict, Verdict::Certified, "{}", sol.report.outcome.message);
         kinks_kept(sol, 1);
     }
-    let (cg, cl) = (g.report.c0_route.as_ref().unwrap(), l.report.c0_route.as_ref().unwrap());
+    let (cg, cl) = (g.report.boundary.c0_route.as_ref().unwrap(), l.report.boundary.c0_route.as_ref().unwrap());
     assert_eq!((cg.local_spans, cl.local_spans), (None, Some(1)));
     assert!(0 < cl.unknowns && cl.unknowns < cg.unknowns / 2, "{} of {}", cl.unknowns, cg.unknowns);
     let ([start, wg], [start_l, wl]) = (cg.winslow.map(Option::unwrap), cl.winslow.map(Option::unwrap));

@@ -71,8 +71,8 @@ fn exact_arcs_stay_circles() {
         opts.levels.refine = refine;
         let sol = solve(&exact_quarter_annulus(), &opts).unwrap();
         let r = &sol.report;
-        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-        assert_eq!((r.basis.used, r.basis.fallback.as_deref()), (BasisChoice::Input, None));
+        assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+        assert_eq!((r.setup.basis.used, r.setup.basis.fallback.as_deref()), (BasisChoice::Input, None));
         let map = &sol.map;
         let w = map.weights.as_ref().expect("a rational map");
         let [nx, ny] = map.shape();
@@ -84,11 +84,11 @@ fn exact_arcs_stay_circles() {
         }
         assert!(radius_error(map, Side::West, 1.0) < 4e-16, "inner arc {:e}", radius_error(map, Side::West, 1.0));
         assert!(radius_error(map, Side::East, 2.0) < 8e-16, "outer arc {:e}", radius_error(map, Side::East, 2.0));
-        let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
+        let dev = r.boundary.deviation.iter().cloned().fold(0.0, f64::max);
         assert!(dev < 1e-14, "boundary deviation {dev:e}");
         // area of the quarter annulus, 3π/4, by the report's Gauss rule (not exact for the
         // rational integrand: 3e-5 relative on one element)
-        let area = sol.report.area;
+        let area = sol.report.measures.area;
         assert!((area / (0.75 * std::f64::consts::PI) - 1.0).abs() < 1e-4, "area {area}");
     }
 }
@@ -103,8 +103,8 @@ fn disk_keeps_its_arcs() {
     let b = read_boundary(&path, &ReadOptions::default()).unwrap();
     let sol = solve(&b, &input_basis()).unwrap();
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::DegenerateCorner, "{}", r.message);
-    assert_eq!(r.basis.used, BasisChoice::Input);
+    assert_eq!(r.outcome.verdict, Verdict::DegenerateCorner, "{}", r.outcome.message);
+    assert_eq!(r.setup.basis.used, BasisChoice::Input);
     let c = sol.map.boundary(Side::South).eval(0.0);
     let radius = c[0].hypot(c[1]);
     for s in Side::ALL {

@@ -32,14 +32,18 @@ fn with(method: Reparam) -> SolveOptions {
 
 fn assert_positive(file: &str, sol: &Solution) {
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{file}: {}", r.message);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{file}: {}", r.outcome.message);
     let s = sample_det_j(&sol.map, 600);
     assert!(s.min_interior > 0.0, "{file}: det J min {} at {:?}", s.min_interior, s.argmin);
-    assert!(r.quality.scaled_jacobian.min > 0.0);
+    assert!(r.measures.quality.scaled_jacobian.min > 0.0);
     // the contour is preserved: the map's boundary is the input's to the fit tolerance
     // (measured against the input's polyline, whose corners a smooth fit may cut a little)
-    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
-    assert!(dev <= 4.0 * r.fit_tolerance, "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}", r.fit_tolerance);
+    let dev = r.boundary.deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        dev <= 4.0 * r.fit.fit_tolerance,
+        "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}",
+        r.fit.fit_tolerance
+    );
 }
 
 /// Matched pairs lie at the same parameter on the two fitted sides: evaluating both
@@ -66,9 +70,9 @@ fn narrow_tube_auto_is_constrained_and_bijective() {
     let b = boundary("narrow_tube.json");
     let sol = solve(&b, &fitted()).unwrap();
     let r = &sol.report;
-    assert_eq!(r.reparam.requested, Reparam::Auto);
-    assert_eq!(r.reparam.used, Reparam::Constrained, "gap ratios {:?}", r.reparam.gap_ratio);
-    assert!(!r.reparam.matches.is_empty());
+    assert_eq!(r.fit.reparam.requested, Reparam::Auto);
+    assert_eq!(r.fit.reparam.used, Reparam::Constrained, "gap ratios {:?}", r.fit.reparam.gap_ratio);
+    assert!(!r.fit.reparam.matches.is_empty());
     assert_positive("narrow_tube", &sol);
     assert!(assert_matches_on_fit(&b, &fitted().fit) > 0);
 }
@@ -99,10 +103,14 @@ fn arc_length_on_spline_sides() {
     let b = boundary("gismo/rotor_sector.json");
     let sol = solve(&b, &with(Reparam::ArcLength)).unwrap();
     let r = &sol.report;
-    assert_eq!(r.reparam.used, Reparam::ArcLength);
-    assert!(r.reparam.arc_length_ratio.iter().flatten().all(|&a| (1.0 - 1e-9..1.01).contains(&a)), "{:?}", r.reparam);
-    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
-    assert!(dev <= 2.0 * r.fit_tolerance, "deviation {dev:e}");
+    assert_eq!(r.fit.reparam.used, Reparam::ArcLength);
+    assert!(
+        r.fit.reparam.arc_length_ratio.iter().flatten().all(|&a| (1.0 - 1e-9..1.01).contains(&a)),
+        "{:?}",
+        r.fit.reparam
+    );
+    let dev = r.boundary.deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(dev <= 2.0 * r.fit.fit_tolerance, "deviation {dev:e}");
     assert_positive("rotor_sector", &sol);
 }
 
@@ -112,7 +120,7 @@ fn arc_length_on_spline_sides() {
 fn male_casing_ring_auto_is_bijective() {
     let b = boundary("gismo/male_casing_ring.json");
     let sol = solve(&b, &fitted()).unwrap();
-    assert_eq!(sol.report.reparam.used, Reparam::Constrained);
+    assert_eq!(sol.report.fit.reparam.used, Reparam::Constrained);
     assert_positive("male_casing_ring", &sol);
 }
 

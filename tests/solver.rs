@@ -24,13 +24,17 @@ fn fitted() -> SolveOptions {
 fn assert_bijective(file: &str) {
     let sol = run(file, &fitted());
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{file}: {}", r.message);
-    let last = r.levels.last().unwrap();
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{file}: {}", r.outcome.message);
+    let last = r.solve.levels.last().unwrap();
     assert!(last.converged, "{file}: {last:?}");
     // the map's boundary is the input boundary up to the fit tolerance (point clouds are
     // measured against their polyline, whose corners a smooth fit may cut a little)
-    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
-    assert!(dev <= 4.0 * r.fit_tolerance, "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}", r.fit_tolerance);
+    let dev = r.boundary.deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        dev <= 4.0 * r.fit.fit_tolerance,
+        "{file}: boundary deviation {dev:.3e}, tolerance {:.3e}",
+        r.fit.fit_tolerance
+    );
     // target: <= 5 Newton iterations on the finest level (the paper reports 3-5)
     assert!(last.newton_iterations <= 5 && last.pseudo_time_iterations == 0, "{file}: {} its", last.newton_iterations);
     // dense interior sample, independent of the report's grid
@@ -97,15 +101,19 @@ fn degenerate_corners_are_named() {
         let r = &sol.report;
         // the fitted boundary may round an exact 180-degree corner enough for the
         // certificate to prove det J > 0 (disk); the corner is named either way
-        assert!(matches!(r.verdict, Verdict::DegenerateCorner | Verdict::Certified), "{file}: {}", r.message);
-        let forced: Vec<_> = r.corners.iter().filter(|c| c.forces_nonpositive_det_j).collect();
+        assert!(
+            matches!(r.outcome.verdict, Verdict::DegenerateCorner | Verdict::Certified),
+            "{file}: {}",
+            r.outcome.message
+        );
+        let forced: Vec<_> = r.boundary.corners.iter().filter(|c| c.forces_nonpositive_det_j).collect();
         assert!(!forced.is_empty(), "{file}");
         assert!(
-            forced.iter().all(|c| c.angle_degrees >= 179.0 && r.message.contains(c.corner)),
+            forced.iter().all(|c| c.angle_degrees >= 179.0 && r.outcome.message.contains(c.corner)),
             "{file}: {}",
-            r.message
+            r.outcome.message
         );
-        assert!(r.det_j_min_away_from_forced_corners > 0.0, "{file}");
+        assert!(r.det_j.min_away_from_forced_corners > 0.0, "{file}");
     }
 }
 
@@ -116,14 +124,14 @@ fn degenerate_corners_are_named() {
 fn kinks_in_spline_sides_are_named() {
     let sol = run("gismo/plate_with_hole.json", &SolveOptions::default());
     let r = &sol.report;
-    assert_eq!(r.kinks.len(), 1, "{:?}", r.kinks);
-    let k = &r.kinks[0];
+    assert_eq!(r.boundary.kinks.len(), 1, "{:?}", r.boundary.kinks);
+    let k = &r.boundary.kinks[0];
     assert_eq!(k.side, "north");
     assert!(
         (k.turning_degrees - 90.0).abs() < 1.0 && (k.point[0] + 4.0).abs() < 1e-12 && (k.point[1] - 4.0).abs() < 1e-12
     );
-    assert!(r.message.contains("kink") && r.message.contains("north"), "{}", r.message);
-    assert_eq!(r.verdict, Verdict::Certified);
+    assert!(r.outcome.message.contains("kink") && r.outcome.message.contains("north"), "{}", r.outcome.message);
+    assert_eq!(r.outcome.verdict, Verdict::Certified);
 }
 
 /// The geometries that needed the reparameterization (§7.2) and defect-correction (§8.2)
@@ -134,8 +142,8 @@ fn hard_geometries_run_and_report() {
     for (file, expected) in [("narrow_tube.json", Verdict::Certified), ("spiral_channel.json", Verdict::Certified)] {
         let sol = run(file, &SolveOptions::default());
         let r = &sol.report;
-        assert!(!r.levels.is_empty() && !r.message.is_empty());
-        assert_eq!(r.verdict, expected, "{file}: {}", r.message);
+        assert!(!r.solve.levels.is_empty() && !r.outcome.message.is_empty());
+        assert_eq!(r.outcome.verdict, expected, "{file}: {}", r.outcome.message);
         // the verdict agrees with an independent dense sample
         let s = sample_det_j(&sol.map, 400);
         assert!(s.min > 0.0, "{file}: det J min {} at {:?}", s.min, s.argmin);
@@ -188,21 +196,21 @@ fn coarse_one_level() -> SolveOptions {
 fn local_repair_removes_a_fold() {
     let mut coarse = coarse_one_level();
     let folded = run("gismo/puzzle3.json", &coarse);
-    assert_eq!(folded.report.verdict, Verdict::Folded, "{}", folded.report.message);
-    assert!(folded.report.repair_rounds.is_empty());
+    assert_eq!(folded.report.outcome.verdict, Verdict::Folded, "{}", folded.report.outcome.message);
+    assert!(folded.report.solve.repair_rounds.is_empty());
     coarse.repair.rounds = 3;
     let sol = run("gismo/puzzle3.json", &coarse);
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert!(!r.repair_rounds.is_empty() && r.repairs == r.repair_rounds.len());
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert!(!r.solve.repair_rounds.is_empty() && r.solve.repairs == r.solve.repair_rounds.len());
     let before = folded.map.knots.clone().map(|k| k.num_elements());
-    let first = &r.repair_rounds[0];
+    let first = &r.solve.repair_rounds[0];
     assert_eq!(first.verdict, "folded");
     // local: far fewer spans bisected than a uniform refinement would
     assert!(2 * first.spans_refined[0] < before[0] && 2 * first.spans_refined[1] < before[1], "{first:?}");
     assert_eq!(first.elements, [before[0] + first.spans_refined[0], before[1] + first.spans_refined[1]]);
     // the dense sample agrees with the certificate
-    assert!(r.det_j_min_away_from_forced_corners > 0.0);
+    assert!(r.det_j.min_away_from_forced_corners > 0.0);
 }
 
 /// The same defect correction with frozen DOFs (paper §8.2): only the control points near
@@ -215,23 +223,23 @@ fn local_repair_with_frozen_dofs() {
     coarse.repair.freeze = Some(2);
     let sol = run("gismo/puzzle3.json", &coarse);
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert!(!r.repair_rounds.is_empty(), "{:?}", r.repair_rounds);
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert!(!r.solve.repair_rounds.is_empty(), "{:?}", r.solve.repair_rounds);
     // fewer unknowns than the full interior
-    let last = r.levels.last().unwrap();
+    let last = r.solve.levels.last().unwrap();
     let [nx, ny] = last.shape;
     assert!(last.unknowns < 2 * (nx - 2) * (ny - 2) / 4, "{} of {}", last.unknowns, 2 * (nx - 2) * (ny - 2));
     // control points far from the folds are those of the prolonged folded map: at most
     // the unknowns of the repair levels moved
     let prolonged = folded.map.refined(&sol.map.knots).unwrap();
-    let tol = 1e-12 * r.diameter;
+    let tol = 1e-12 * r.fit.diameter;
     let same = prolonged
         .control_points
         .iter()
         .zip(&sol.map.control_points)
         .filter(|(a, b)| (a[0] - b[0]).abs() <= tol && (a[1] - b[1]).abs() <= tol)
         .count();
-    let moved: usize = r.levels.iter().skip(1).map(|l| l.unknowns / 2).sum();
+    let moved: usize = r.solve.levels.iter().skip(1).map(|l| l.unknowns / 2).sum();
     assert!(same >= nx * ny - moved, "{same} unchanged of {}, {moved} unknowns in the repairs", nx * ny);
 }
 
@@ -249,20 +257,28 @@ fn input_basis_keeps_the_boundary_exactly() {
     let b = read_boundary(&path, &ReadOptions::default()).unwrap();
     let sol = solve(&b, &opts).unwrap();
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert_eq!((r.basis.used, r.basis.fallback.as_deref()), (BasisChoice::Input, None));
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert_eq!((r.setup.basis.used, r.setup.basis.fallback.as_deref()), (BasisChoice::Input, None));
     assert_eq!(sol.map.shape(), [8, 10]);
     // 80 functions: solved directly from the Coons patch (no coarse levels)
-    assert_eq!(r.levels.len(), 1, "a direct solve: {:?}", r.levels.iter().map(|l| l.shape).collect::<Vec<_>>());
-    let dev = r.boundary_deviation.iter().cloned().fold(0.0, f64::max);
-    assert!(dev <= 1e-14 * r.diameter, "boundary deviation {dev:.3e}");
+    assert_eq!(
+        r.solve.levels.len(),
+        1,
+        "a direct solve: {:?}",
+        r.solve.levels.iter().map(|l| l.shape).collect::<Vec<_>>()
+    );
+    let dev = r.boundary.deviation.iter().cloned().fold(0.0, f64::max);
+    assert!(dev <= 1e-14 * r.fit.diameter, "boundary deviation {dev:.3e}");
     // control points of each side: the input's, after the same (here: no) insertions
     for s in Side::ALL {
         let SideCurve::Spline(c) = b.side(s) else { panic!("duck has spline sides") };
         let mine = sol.map.boundary(s);
         assert_eq!(mine.control_points.len(), c.control_points.len(), "{s}");
         for (p, q) in mine.control_points.iter().zip(&c.control_points) {
-            assert!((p[0] - q[0]).abs() <= 1e-14 * r.diameter && (p[1] - q[1]).abs() <= 1e-14 * r.diameter, "{s}");
+            assert!(
+                (p[0] - q[0]).abs() <= 1e-14 * r.fit.diameter && (p[1] - q[1]).abs() <= 1e-14 * r.fit.diameter,
+                "{s}"
+            );
         }
     }
     // a C0 knot inside a side is not rounded silently: kept by the C0 route of §9 (the
@@ -289,12 +305,15 @@ fn auto_basis_falls_back_when_the_input_basis_does_not_certify() {
     opts.repair.rounds = 1;
     let sol = run("gismo/puzzle4.json", &opts);
     let r = &sol.report;
-    assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-    assert_eq!((r.basis.requested, r.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
-    let why = r.basis.fallback.as_deref().unwrap_or_default();
+    assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+    assert_eq!((r.setup.basis.requested, r.setup.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
+    let why = r.setup.basis.fallback.as_deref().unwrap_or_default();
     assert!(why.contains("input basis") && why.contains("folded") && why.contains("fitted"), "{why}");
     // with enough rounds the input basis certifies and is kept
     opts.repair.rounds = 6;
     let r = run("gismo/puzzle4.json", &opts).report;
-    assert_eq!((r.verdict, r.basis.used, r.basis.fallback), (Verdict::Certified, BasisChoice::Input, None));
+    assert_eq!(
+        (r.outcome.verdict, r.setup.basis.used, r.setup.basis.fallback),
+        (Verdict::Certified, BasisChoice::Input, None)
+    );
 }

@@ -176,8 +176,8 @@ fn solve_shape(input: Input, start: Option<&Surface>, opts: &SolveOptions) -> wi
         solved => {
             let sol = solved.into_map()?;
             let report = to_json(serde_json::to_value(&sol.report))?;
-            let bijective = matches!(sol.report.verdict, Verdict::Certified | Verdict::DegenerateCorner);
-            let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+            let bijective = matches!(sol.report.outcome.verdict, Verdict::Certified | Verdict::DegenerateCorner);
+            let label = format!("verdict {:?}: {}", sol.report.outcome.verdict, sol.report.outcome.message);
             Ok(Solved { map: sol.map, report, bijective, label })
         }
     }

@@ -107,8 +107,11 @@ pub fn run(a: CorpusArgs) -> Result<i32> {
         let (verdict, detail) = match solve(b, &opts) {
             Ok(sol) => {
                 let r = &sol.report;
-                let its: Vec<String> = r.levels.iter().map(|l| l.iterations.to_string()).collect();
-                (r.verdict.name().to_string(), format!("{} functions, iterations {}", r.basis_functions, its.join("/")))
+                let its: Vec<String> = r.solve.levels.iter().map(|l| l.iterations.to_string()).collect();
+                (
+                    r.outcome.verdict.name().to_string(),
+                    format!("{} functions, iterations {}", r.setup.basis_functions, its.join("/")),
+                )
             }
             Err(e) => ("error".to_string(), e.to_string()),
         };

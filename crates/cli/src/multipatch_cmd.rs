@@ -119,7 +119,7 @@ pub(super) fn summary(sol: &MultipatchSolution) -> String {
     let mut s = format!("{}: {}\n  {}\n", r.name, output::verdict_word(r.verdict), r.message);
     for (p, v) in sol.patches.iter().zip(&r.verdicts) {
         let [nx, ny] = p.map.shape();
-        let last = p.solve.levels.last();
+        let last = p.solve.solve.levels.last();
         s.push_str(&format!(
             "  patch {:<10} {:>3}x{:<3} functions, {} Newton iterations: {} ({})\n",
             p.name,

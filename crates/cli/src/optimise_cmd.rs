@@ -137,7 +137,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
             rows.push(Row { start_values: Values::of(&o.start_map), values: Values::of(&o.map), outcome: o });
         }
     }
-    let egg_iterations: usize = sol.report.levels.iter().map(|l| l.iterations).sum();
+    let egg_iterations: usize = sol.report.solve.levels.iter().map(|l| l.iterations).sum();
     let [nx, ny] = egg.shape();
     let unknowns = constrained::discretization(egg, &opts.topology)?.dofs.num_free() * 2;
     let first = &rows[0].outcome;
@@ -150,7 +150,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
         "eps": a.eps,
         "egg": {
             "iterations": egg_iterations,
-            "verdict": sol.report.verdict,
+            "verdict": sol.report.outcome.verdict,
             "values": Values::of(egg),
         },
         "runs": &rows,
@@ -172,7 +172,7 @@ pub(super) fn run(a: OptimiseArgs) -> Result<i32> {
             sol.name,
             egg.degrees(),
             a.eps,
-            output::verdict_word(sol.report.verdict)
+            output::verdict_word(sol.report.outcome.verdict)
         );
         for r in &rows {
             row_text(&mut s, r);

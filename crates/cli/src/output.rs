@@ -19,63 +19,63 @@ use winslow::{Boundary, Side, SideCurve};
 pub fn summary(sol: &Solution) -> String {
     let r = &sol.report;
     let mut s = String::new();
-    let last = r.levels.last();
-    if r.boundary_kept && !r.kinks_kept() {
-        let rounded = r.kinks.iter().filter(|k| !k.kept).count();
-        let dev = r.kinks.iter().filter(|k| !k.kept).fold(0.0f64, |m, k| m.max(k.deviation));
+    let last = r.solve.levels.last();
+    if r.boundary.kept && !r.kinks_kept() {
+        let rounded = r.boundary.kinks.iter().filter(|k| !k.kept).count();
+        let dev = r.boundary.kinks.iter().filter(|k| !k.kept).fold(0.0f64, |m, k| m.max(k.deviation));
         let _ = writeln!(
             s,
             "{}: {}, but its boundary is NOT the input's: {rounded} kinks not kept (the C0 route failed; rounded by up \
              to {dev:.3e}, within the fit tolerance)",
             sol.name,
-            verdict_word(r.verdict)
+            verdict_word(r.outcome.verdict)
         );
-    } else if r.boundary_kept {
-        let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.verdict));
+    } else if r.boundary.kept {
+        let _ = writeln!(s, "{}: {}", sol.name, verdict_word(r.outcome.verdict));
     } else {
-        let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-        let rounded = r.kinks.iter().filter(|k| !k.kept).count();
+        let dev = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+        let rounded = r.boundary.kinks.iter().filter(|k| !k.kept).count();
         let _ = writeln!(
             s,
             "{}: {}, but its boundary is NOT the input's: deviation {dev:.3e} above the fit tolerance {:.3e}{}",
             sol.name,
-            verdict_word(r.verdict),
-            r.fit_tolerance,
+            verdict_word(r.outcome.verdict),
+            r.fit.fit_tolerance,
             if rounded > 0 { format!(" ({rounded} kinks not kept)") } else { String::new() }
         );
     }
-    let _ = writeln!(s, "  {}", r.message);
-    let _ = writeln!(s, "  backend: {}", r.backend);
+    let _ = writeln!(s, "  {}", r.outcome.message);
+    let _ = writeln!(s, "  backend: {}", r.setup.backend);
     if let Some(l) = last {
         let _ = writeln!(
             s,
             "  map: degree {:?}, {}x{} control points, {} levels, {} iterations on the finest level",
-            r.degree,
+            r.setup.degree,
             l.shape[0],
             l.shape[1],
-            r.levels.len(),
+            r.solve.levels.len(),
             l.iterations
         );
     }
     let _ = writeln!(
         s,
         "  det J: min {:.4e} (interior {:.4e}), max {:.4e}; Winslow {}; time {:.3} s",
-        r.det_j_min,
-        r.det_j_min_interior,
-        r.det_j_max,
-        r.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
-        r.seconds
+        r.det_j.min,
+        r.det_j.min_interior,
+        r.det_j.max,
+        r.measures.winslow.map_or("infinite (det J <= 0)".to_string(), |w| format!("{w:.6}")),
+        r.solve.seconds
     );
-    certificate_lines(&mut s, &r.certificate, false);
-    quality_lines(&mut s, &r.quality);
-    if let Some(p) = &r.poisson {
+    certificate_lines(&mut s, &r.outcome.certificate, false);
+    quality_lines(&mut s, &r.measures.quality);
+    if let Some(p) = &r.measures.poisson {
         poisson_line(&mut s, p);
     }
     kink_lines(&mut s, r);
-    if let Some(imp) = &r.improvement {
-        improvement_lines(&mut s, imp, r.seconds);
+    if let Some(imp) = &r.solve.improvement {
+        improvement_lines(&mut s, imp, r.solve.seconds);
     }
-    for round in &r.repair_rounds {
+    for round in &r.solve.repair_rounds {
         let _ = writeln!(
             s,
             "  repair round {}: {} with {} offending element(s); bisected {}x{} spans -> {}x{} basis",
@@ -88,17 +88,17 @@ pub fn summary(sol: &Solution) -> String {
             round.shape[1]
         );
     }
-    let dev = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+    let dev = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
     let _ = writeln!(
         s,
         "  basis functions: {} ({} basis{}); boundary deviation from the input {:.3e} ({:.1e} of the diameter)",
-        r.basis_functions,
-        r.basis.used.name(),
-        r.basis.fallback.as_ref().map_or(String::new(), |why| format!(", input basis not used: {why}")),
+        r.setup.basis_functions,
+        r.setup.basis.used.name(),
+        r.setup.basis.fallback.as_ref().map_or(String::new(), |why| format!(", input basis not used: {why}")),
         dev,
-        dev / r.diameter
+        dev / r.fit.diameter
     );
-    let rp = &r.reparam;
+    let rp = &r.fit.reparam;
     let gap = |g: f64| if g.is_finite() { format!("{g:.2e}") } else { "-".into() };
     if sol.map.knots[1].is_periodic() {
         // a ring: one pair of contours, the gap over the outer contour's diameter
@@ -186,7 +186,7 @@ fn quality_lines(s: &mut String, q: &Quality) {
 
 /// The kinks (kept or rounded, with the deviation at each) and the `C^0` route of §9.
 fn kink_lines(s: &mut String, r: &winslow::Report) {
-    if let Some(c) = &r.c0_route {
+    if let Some(c) = &r.boundary.c0_route {
         let w = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.6}"));
         let _ = writeln!(
             s,
@@ -206,7 +206,7 @@ fn kink_lines(s: &mut String, r: &winslow::Report) {
             let _ = writeln!(s, "    why: {why}");
         }
     }
-    for k in &r.kinks {
+    for k in &r.boundary.kinks {
         let _ = writeln!(
             s,
             "    kink {} at {:.6} ({}, turns {:.1} deg) at ({:.6}, {:.6}): {}, deviation {:.2e} ({:.1e} of the diameter)",
@@ -218,10 +218,10 @@ fn kink_lines(s: &mut String, r: &winslow::Report) {
             k.point[1],
             if k.kept { "kept exactly" } else { "rounded" },
             k.deviation,
-            k.deviation / r.diameter
+            k.deviation / r.fit.diameter
         );
     }
-    for p in &r.certificate.excused_points {
+    for p in &r.outcome.certificate.excused_points {
         let _ = writeln!(
             s,
             "    {} side's zero-speed point ({:.6}, {:.6}): det J = 0 there for every map of this boundary; excused \
@@ -510,33 +510,33 @@ impl BenchRow {
     /// Row from a solution.
     pub fn new(sol: &Solution, refine: usize, total_s: f64, estimated_bytes: u64) -> Self {
         let r = &sol.report;
-        let last = r.levels.last();
+        let last = r.solve.levels.last();
         Self {
             geometry: sol.name.clone(),
             refine,
             dofs: last.map_or(0, |l| l.unknowns),
-            levels: r.levels.len(),
+            levels: r.solve.levels.len(),
             newton: last.map_or(0, |l| l.newton_iterations),
             pseudo: last.map_or(0, |l| l.pseudo_time_iterations),
-            assembly_s: r.levels.iter().map(|l| l.assembly_seconds).sum(),
-            solve_s: r.levels.iter().map(|l| l.linear_seconds).sum(),
+            assembly_s: r.solve.levels.iter().map(|l| l.assembly_seconds).sum(),
+            solve_s: r.solve.levels.iter().map(|l| l.linear_seconds).sum(),
             total_s,
             peak_mib: peak_memory_mib(),
             estimated_mib: estimated_bytes as f64 / (1u64 << 20) as f64,
-            elements: r.certificate.elements,
-            certify_s: r.certificate.seconds,
+            elements: r.outcome.certificate.elements,
+            certify_s: r.outcome.certificate.seconds,
             newton_iteration_s: last
                 .map_or(0.0, |l| (l.assembly_seconds + l.linear_seconds) / l.iterations.max(1) as f64),
             krylov_mean: last.map_or(0.0, |l| l.krylov_iterations as f64 / l.linear_solves.max(1) as f64),
             krylov_max: last.map_or(0, |l| l.krylov_max),
             factor_s: last.map_or(0.0, |l| l.factor_seconds),
             peak_bytes_per_dof: peak_memory_mib() * (1u64 << 20) as f64 / last.map_or(1, |l| l.unknowns.max(1)) as f64,
-            verdict: r.verdict,
-            basis: r.basis_functions,
-            winslow: r.winslow,
-            scaled_jacobian_min: r.quality.scaled_jacobian.min,
-            reparam: r.reparam.used.name(),
-            matches: r.reparam.matches.len(),
+            verdict: r.outcome.verdict,
+            basis: r.setup.basis_functions,
+            winslow: r.measures.winslow,
+            scaled_jacobian_min: r.measures.quality.scaled_jacobian.min,
+            reparam: r.fit.reparam.used.name(),
+            matches: r.fit.reparam.matches.len(),
         }
     }
 }
@@ -716,11 +716,11 @@ pub fn quiet() -> bool {
 /// The exit code of a verdict: 0 certified or degenerate corner (the best map the
 /// boundary allows), 3 folded, 4 not converged, 5 undecided.
 /// The exit code of a solve: its verdict's ([`exit_code`]), but 6 for a bijective map
-/// whose boundary is not the input's within the fit tolerance ([`winslow::Report::boundary_kept`])
+/// whose boundary is not the input's within the fit tolerance ([`BoundaryReport::kept`](winslow::solve::report::BoundaryReport::kept))
 /// or whose kinks the `C^0` route could not keep ([`winslow::Report::kinks_kept`]).
 pub fn solve_exit_code(r: &winslow::Report) -> i32 {
-    match exit_code(r.verdict) {
-        0 if !r.boundary_kept || !r.kinks_kept() => 6,
+    match exit_code(r.outcome.verdict) {
+        0 if !r.boundary.kept || !r.kinks_kept() => 6,
         code => code,
     }
 }

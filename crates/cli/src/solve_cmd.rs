@@ -231,7 +231,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
         solved => solved.into_map()?,
     };
     let report = serde_json::to_value(&sol.report)?;
-    let label = format!("verdict {:?}: {}", sol.report.verdict, sol.report.message);
+    let label = format!("verdict {:?}: {}", sol.report.outcome.verdict, sol.report.outcome.message);
     let extra = Some(serde_json::json!({ "report": report }));
     let map = Output::Map { name: &sol.name, map: &sol.map, label: &label, extra };
     files::write(&a.output, &map)?;
@@ -241,8 +241,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
         }
     }
     if let Some(p) = &a.png {
-        let segments = if a.no_png_matches { Vec::new() } else { sol.report.reparam.segments() };
-        let kinks = sol.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
+        let segments = if a.no_png_matches { Vec::new() } else { sol.report.fit.reparam.segments() };
+        let kinks = sol.report.boundary.kinks.iter().map(|k| (k.point, k.kept)).collect();
         let image = picture(&sel, &sol.map, &PictureOptions { segments, kinks, ..Default::default() })?;
         files::write(p, &Output::Picture(&image))?;
     }

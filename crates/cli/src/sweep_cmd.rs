@@ -256,8 +256,8 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             sol.map.shape()[1],
             f0.report.seconds,
             f0.report.verdict,
-            sol.report.reparam.used.name(),
-            sol.report.reparam.matches.len(),
+            sol.report.fit.reparam.used.name(),
+            sol.report.fit.reparam.matches.len(),
         );
         // the sliding seam moves the parameter by |Δθ| / 2π of a period per step; the
         // prediction is good while that is a small part of the smallest element
@@ -335,7 +335,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
             cold_checks.push(serde_json::json!({
                 "frame": k,
                 "seconds": seconds,
-                "verdict": cold.report.verdict.name(),
+                "verdict": cold.report.outcome.verdict.name(),
                 "shape": cold.map.shape(),
             }));
         }
@@ -366,7 +366,7 @@ pub(super) fn run(a: SweepArgs) -> Result<i32> {
         "seam": serde_json::to_value(seam)?,
         // frame 0's parameterization, which every frame keeps (arc length unless
         // `--reparam constrained`: see `winslow::pipeline::sweep`)
-        "reparam": serde_json::to_value(&sol.report.reparam)?,
+        "reparam": serde_json::to_value(&sol.report.fit.reparam)?,
         "frames": rows,
         "cold_seconds": cold,
         "failures": failures,

@@ -84,7 +84,7 @@ pub(crate) fn finish(out: &ThbSolution, output: &Path, gismo: Option<&Path>, jso
         say!(
             "{}: tensor solve {:?} without repair; {} THB round(s) -> {} functions on {} levels ({} unknowns)",
             out.name,
-            out.report.solve.verdict,
+            out.report.solve.outcome.verdict,
             out.report.thb_rounds.len(),
             out.map.basis.len(),
             out.map.basis.num_levels(),

@@ -35,7 +35,7 @@ fn bench(c: &mut Criterion) {
         let sol = solve(&boundary, &opts).expect("the EGG solve");
         let map = sol.map;
         let cert = certify(&map, &opts.certify).expect("the certificate");
-        let diameter = sol.report.diameter;
+        let diameter = sol.report.fit.diameter;
         let top = Topology::dirichlet();
         g.bench_with_input(BenchmarkId::new("stage", label), &(), |b, _| {
             b.iter(|| {

@@ -175,7 +175,7 @@ impl Error {
 }
 
 /// Largest polynomial degree accepted anywhere (evaluation uses fixed scratch).
-pub const MAX_DEGREE: usize = 12;
+pub(crate) const MAX_DEGREE: usize = 12;
 /// Largest number of control points per direction accepted from a file.
 pub const MAX_CONTROL_POINTS: usize = 1 << 20;
 

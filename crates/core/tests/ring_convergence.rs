@@ -99,10 +99,10 @@ fn shared_rings_solve_and_certify() {
         let mut opts = SolveOptions::default();
         opts.fit.tol = fit_tol;
         let sol = winslow::Pipeline::new(ring, opts.clone()).solve().and_then(|s| s.into_map()).unwrap();
-        assert_eq!(sol.report.verdict, Verdict::Certified, "{name}: {}", sol.report.message);
-        let dev = sol.report.boundary_deviation;
+        assert_eq!(sol.report.outcome.verdict, Verdict::Certified, "{name}: {}", sol.report.outcome.message);
+        let dev = sol.report.boundary.deviation;
         assert!(
-            dev[1] < 2.0 * fit_tol * sol.report.diameter && dev[3] < 2.0 * fit_tol * sol.report.diameter,
+            dev[1] < 2.0 * fit_tol * sol.report.fit.diameter && dev[3] < 2.0 * fit_tol * sol.report.fit.diameter,
             "{name}: {dev:?}"
         );
     }

@@ -19,9 +19,13 @@ fn puzzle4_is_repaired_with_fewer_unknowns_than_tensor_refinement() {
         panic!("puzzle4 folds without tensor repair: the pipeline repairs it by THB refinement")
     };
     // the tensor solve without repair folds (or is undecided)
-    assert!(matches!(out.report.solve.verdict, Verdict::Folded | Verdict::Undecided), "{:?}", out.report.solve.verdict);
+    assert!(
+        matches!(out.report.solve.outcome.verdict, Verdict::Folded | Verdict::Undecided),
+        "{:?}",
+        out.report.solve.outcome.verdict
+    );
     let tensor = Pipeline::new(boundary, SolveOptions::default()).solve().unwrap().into_map().unwrap();
-    assert!(matches!(tensor.report.verdict, Verdict::Certified | Verdict::DegenerateCorner));
+    assert!(matches!(tensor.report.outcome.verdict, Verdict::Certified | Verdict::DegenerateCorner));
     let tensor_unknowns = 2 * tensor.map.control_points.len();
 
     assert!(out.success(), "{}", out.report.message);

@@ -247,8 +247,8 @@ fn solve_on_the_gpu_gives_the_cpu_map() {
     let cpu = Pipeline::new(b.clone(), opts.clone()).solve().and_then(|s| s.into_map()).unwrap();
     let gpu =
         Pipeline::new(b, opts).backend(g.clone() as Arc<dyn EggAssembler>).solve().and_then(|s| s.into_map()).unwrap();
-    assert!(gpu.report.backend.starts_with("gpu: "), "{}", gpu.report.backend);
-    assert!(!gpu.report.backend.contains("fell back"), "{}", gpu.report.backend);
+    assert!(gpu.report.setup.backend.starts_with("gpu: "), "{}", gpu.report.setup.backend);
+    assert!(!gpu.report.setup.backend.contains("fell back"), "{}", gpu.report.setup.backend);
     assert_eq!(cpu.map.knots, gpu.map.knots);
     let diam = h.diameter;
     let err = cpu
@@ -258,7 +258,7 @@ fn solve_on_the_gpu_gives_the_cpu_map() {
         .zip(&gpu.map.control_points)
         .fold(0.0f64, |m, (a, b)| m.max((a[0] - b[0]).abs()).max((a[1] - b[1]).abs()));
     assert!(err <= 1e-9 * diam, "maps differ by {err:e}");
-    assert_eq!(cpu.report.verdict, gpu.report.verdict);
+    assert_eq!(cpu.report.outcome.verdict, gpu.report.outcome.verdict);
 }
 
 #[test]

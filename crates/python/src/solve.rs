@@ -50,7 +50,7 @@ impl Outcome {
     pub fn start_for_next(&self) -> Option<&Surface> {
         match self {
             Outcome::Cold(s) => {
-                matches!(s.report.verdict, winslow::Verdict::Certified | winslow::Verdict::DegenerateCorner)
+                matches!(s.report.outcome.verdict, winslow::Verdict::Certified | winslow::Verdict::DegenerateCorner)
                     .then_some(&s.map)
             }
             Outcome::Warm(w, _) => Some(&w.map),

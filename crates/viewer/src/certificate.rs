@@ -112,11 +112,11 @@ impl Certificate {
     /// The verdict of a solver report.
     pub fn from_report(r: &Report) -> Self {
         let mut details = vec![
-            ("backend".to_string(), r.backend.clone()),
-            ("operator".to_string(), r.operator.to_string()),
-            ("levels".to_string(), r.levels.len().to_string()),
+            ("backend".to_string(), r.setup.backend.clone()),
+            ("operator".to_string(), r.setup.operator.to_string()),
+            ("levels".to_string(), r.solve.levels.len().to_string()),
         ];
-        if let Some(l) = r.levels.last() {
+        if let Some(l) = r.solve.levels.last() {
             details.push((
                 "finest level".to_string(),
                 format!(
@@ -128,12 +128,17 @@ impl Certificate {
                 ),
             ));
         }
-        details.push(("repairs".to_string(), r.repairs.to_string()));
+        details.push(("repairs".to_string(), r.solve.repairs.to_string()));
         details.push((
             "boundary deviation".to_string(),
-            format!("{:.2e}", r.boundary_deviation.iter().copied().fold(0.0, f64::max)),
+            format!("{:.2e}", r.boundary.deviation.iter().copied().fold(0.0, f64::max)),
         ));
-        Self { verdict: r.verdict, message: r.message.clone(), source: CertificateSource::Solver, details }
+        Self {
+            verdict: r.outcome.verdict,
+            message: r.outcome.message.clone(),
+            source: CertificateSource::Solver,
+            details,
+        }
     }
 
     /// The verdict of one patch of a layout solve (§11.2): the core's certificate of the
@@ -147,7 +152,7 @@ impl Certificate {
             details.push(("smallest det J found".to_string(), format!("{:.4e}", c.min_value_found)));
         }
         details.push(("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)));
-        if let Some(l) = p.solve.levels.last() {
+        if let Some(l) = p.solve.solve.levels.last() {
             details.push((
                 "finest level".to_string(),
                 format!("{}x{} basis, {} iterations", l.shape[0], l.shape[1], l.iterations),

@@ -516,8 +516,8 @@ impl Scene {
         let res = settings.resolution.unwrap_or_else(|| default_resolution(&solution.map));
         let cert = Certificate::from_report(&solution.report);
         let mut mv = MapView::new(solution.map, sampler, res, settings.density, Some(cert));
-        mv.matches = solution.report.reparam.segments();
-        mv.kinks = solution.report.kinks.iter().map(|k| (k.point, k.kept)).collect();
+        mv.matches = solution.report.fit.reparam.segments();
+        mv.kinks = solution.report.boundary.kinks.iter().map(|k| (k.point, k.kept)).collect();
         mv.report = Some(solution.report);
         self.map = Some(mv);
     }

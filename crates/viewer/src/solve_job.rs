@@ -471,20 +471,24 @@ mod tests {
         assert!(matches!(msgs.first(), Some(Msg::Fitted { levels, .. }) if *levels >= 1));
         assert!(matches!(msgs.get(1), Some(Msg::Event(Event::LevelStarted { level: 0, .. }))));
         let Some(Msg::Finished(sol)) = msgs.last() else { panic!("{:?}", msgs.last()) };
-        assert_eq!(sol.report.verdict, Verdict::Certified);
+        assert_eq!(sol.report.outcome.verdict, Verdict::Certified);
         let mut p = Progress::default();
         for m in &msgs {
             p.apply(m);
         }
         // the history is the solver's own residual record, level by level
-        let recorded: Vec<f64> = sol.report.levels.iter().flat_map(|l| l.residuals.clone()).collect();
+        let recorded: Vec<f64> = sol.report.solve.levels.iter().flat_map(|l| l.residuals.clone()).collect();
         let streamed: Vec<f64> = p.history.iter().map(|h| h.residual).collect();
         assert_eq!(streamed, recorded);
-        assert_eq!(p.levels_done, sol.report.levels.len());
+        assert_eq!(p.levels_done, sol.report.solve.levels.len());
         assert!(p.history.windows(2).all(|w| w[1].step == w[0].step + 1));
         // converged: the last scaled residual is below the tolerance
         assert!(p.last().unwrap().scaled_residual < quick().nonlinear.tol);
-        assert!(p.text().starts_with(&format!("level {}/{}", sol.report.levels.len(), sol.report.levels.len())));
+        assert!(p.text().starts_with(&format!(
+            "level {}/{}",
+            sol.report.solve.levels.len(),
+            sol.report.solve.levels.len()
+        )));
     }
 
     #[test]

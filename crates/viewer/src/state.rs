@@ -387,7 +387,7 @@ impl ViewerState {
         let changed = solution.is_some() || before != (job.state.clone(), job.progress.history.len());
         match (&job.state, solution) {
             (JobState::Finished, Some(sol)) => {
-                self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
+                self.status = Some(format!("solved {}: {}", sol.name, sol.report.outcome.message));
                 if let Some(scene) = self.scene.as_mut() {
                     scene.set_solution(sol, self.sampler.as_ref(), self.settings);
                     self.refit = true;
@@ -422,7 +422,7 @@ impl ViewerState {
                 self.set_layout_solution(l);
             }
             if let Some(sol) = solution {
-                self.status = Some(format!("solved {}: {}", sol.name, sol.report.message));
+                self.status = Some(format!("solved {}: {}", sol.name, sol.report.outcome.message));
                 if let Some(scene) = self.scene.as_mut() {
                     scene.set_solution(sol, self.sampler.as_ref(), self.settings);
                     self.refit = true;

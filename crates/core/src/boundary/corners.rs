@@ -27,7 +27,7 @@ pub struct CornerReport {
 }
 
 /// Corner angles at or above this (degrees) force `det J <= 0` up to the fit tolerance.
-pub const FORCED_ANGLE: f64 = 179.0;
+pub(crate) const FORCED_ANGLE: f64 = 179.0;
 
 /// A kink inside a side (paper §9, [`super::kinks`]): a spline side's `C^0` knot or
 /// zero-speed knot, or a point cloud's corner; kept exactly by the `C^0` route or rounded
@@ -57,7 +57,7 @@ pub struct KinkReport {
 /// Geometry of one corner of a patch: interior angle, `x_xi x x_eta` (det J there) and
 /// `|x_xi| |x_eta|`.
 #[derive(Debug, Clone, Copy)]
-pub struct CornerGeometry {
+pub(crate) struct CornerGeometry {
     /// "south-west", "south-east", "north-east" or "north-west".
     pub name: &'static str,
     /// Interior angle in degrees.
@@ -72,7 +72,7 @@ pub struct CornerGeometry {
 /// tangents `d(side, at_end)`: the interior angle is 180 degrees minus the turning angle
 /// between the incoming and outgoing tangents of the counter-clockwise traversal (south,
 /// east, reversed north, reversed west).
-pub fn corner_geometry(d: impl Fn(Side, bool) -> Point) -> [CornerGeometry; 4] {
+pub(crate) fn corner_geometry(d: impl Fn(Side, bool) -> Point) -> [CornerGeometry; 4] {
     // (name, x_xi, x_eta) at the corner; det J = x_xi x x_eta.
     let corners = [
         ("south-west", d(Side::South, false), d(Side::West, false)),

@@ -509,7 +509,7 @@ fn jigsaw(rng: &mut Rng) -> [SideCurve; 4] {
 }
 
 /// The smallest gap of `pinched`, relative to the channel's length.
-pub const PINCH_GAP: f64 = 3e-4;
+pub(crate) const PINCH_GAP: f64 = 3e-4;
 
 /// A channel `[0, 1] × [0, w]`, `w ∈ [0.1, 0.2]`, whose walls close in by the Gaussian
 /// bumps `(w - g) / 2 · exp(-((x - x0) / σ)²)` to the gap `g` = [`PINCH_GAP`] at `x0 ∈

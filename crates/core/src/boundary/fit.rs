@@ -20,7 +20,7 @@
 //!   of degree `q` (two more when it is rational, `p + 6` for analytic sides);
 //! * for a point cloud `p_1, ..., p_K` (§5.3) the discrete distance (eq. 18)
 //!   `E(f) = Σ_j ||f(ξ_j) - p_j||^2` at the cord-length abscissae `ξ_j` of eq. 36-37,
-//!   plus a tiny smoothing term `λ Σ_e h_e^3 ∫_e ||f''||^2 dξ` (see [`REGULARIZATION`]):
+//!   plus a tiny smoothing term `λ Σ_e h_e^3 ∫_e ||f''||^2 dξ` (see `REGULARIZATION`):
 //!   an element without points (or a side of two points) would otherwise leave the
 //!   normal equations singular. The term vanishes on straight lines traversed with
 //!   constant speed, so a two-point side becomes exactly that segment. There is no
@@ -63,24 +63,24 @@ use crate::spline::surface::Side;
 /// `Σ_e h_e^3 ∫_e N_i'' N_j''` (`λ = 1` when no point constrains a free unknown). The
 /// factor `h_e^3` makes the term scale-free (like squared second differences of the
 /// control points), so it stays negligible against the data on fine elements too.
-pub const REGULARIZATION: f64 = 1e-10;
+pub(crate) const REGULARIZATION: f64 = 1e-10;
 
 /// Samples per input piece and fit element used to estimate the maximal deviation of a
 /// curve fit (the piece's end points included).
-pub const SAMPLES_PER_PIECE: usize = 8;
+pub(crate) const SAMPLES_PER_PIECE: usize = 8;
 
 /// A point cloud's fit stops refining when bisecting the marked elements keeps more than
 /// this fraction of their points' squared deviation (an RMS ratio of 0.8) and that
 /// deviation is uncorrelated ([`NOISE_LAG_ONE`]): the rest is noise ([`fit_side_with`]).
-pub const NOISE_STALL: f64 = 0.64;
+pub(crate) const NOISE_STALL: f64 = 0.64;
 
 /// ... and when the residual's lag-one autocorrelation there is below this (white noise:
 /// about 0; a smooth residual sampled densely: about 1).
-pub const NOISE_LAG_ONE: f64 = 0.5;
+pub(crate) const NOISE_LAG_ONE: f64 = 0.5;
 
 /// ... judged only where the bisected elements hold this many points each on average
 /// (fewer say nothing about noise: a cubic through a handful of points interpolates).
-pub const NOISE_MIN_POINTS: usize = 12;
+pub(crate) const NOISE_MIN_POINTS: usize = 12;
 
 /// Options of the adaptive contour fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -351,7 +351,7 @@ fn dist2(a: Point, b: Point) -> f64 {
 
 /// The knot vector `kv` with every kink parameter `t` of `kinks` at multiplicity `p`
 /// (an existing break within `1e-12` of the length is taken as `t`).
-pub fn with_kink_knots(kv: &KnotVector, kinks: &[f64]) -> KnotVector {
+pub(crate) fn with_kink_knots(kv: &KnotVector, kinks: &[f64]) -> KnotVector {
     let p = kv.degree();
     let mut new = Vec::new();
     for &t in kinks {
@@ -579,7 +579,7 @@ pub fn project_side(curve: &SideCurve, knots: &KnotVector, corners: (Point, Poin
 /// `tol_abs`, refit, and repeat until no element is marked or `max_levels` /
 /// `max_elements` is reached (then `converged` is false and the finest fit is the best
 /// one). When more elements are marked than `max_elements` allows, the worst ones are
-/// bisected first. A point cloud also stops at its noise floor (see [`NOISE_STALL`];
+/// bisected first. A point cloud also stops at its noise floor (see `NOISE_STALL`;
 /// `converged` is then false and the last fit is the one before the bisection that did
 /// not help).
 pub fn fit_side(
@@ -594,7 +594,7 @@ pub fn fit_side(
 
 /// [`fit_side`] with the side parameterized by `param` (paper §7): point clouds at the
 /// given abscissae, parametric sides as `f̄ ∘ g`.
-pub fn fit_side_with(
+pub(crate) fn fit_side_with(
     side: Side,
     curve: &SideCurve,
     param: &SideParam,
@@ -610,7 +610,7 @@ pub fn fit_side_with(
 /// (the curve interpolates `x` at `t`, only `C^0` there); the pieces between kinks are
 /// fitted independently, and refinement bisects elements as usual, so the kinks stay.
 /// `t` is in the fit's parameter (for a point cloud the abscissa of its vertex).
-pub fn fit_side_kinked(
+pub(crate) fn fit_side_kinked(
     side: Side,
     curve: &SideCurve,
     param: &SideParam,

@@ -30,7 +30,7 @@ use crate::spline::volume::Point3;
 /// parameters onto the given face's: `g(s, t) = f(σ(s, t))` with `(a, b) = (t, s)` when
 /// `swap`, else `(s, t)`, and `σ = (a or 1 - a, b or 1 - b)` by `flip`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SquareSymmetry {
+pub(crate) struct SquareSymmetry {
     /// Exchange `s` and `t`.
     pub swap: bool,
     /// Reverse the first / second parameter of `f` (after the exchange).
@@ -39,7 +39,7 @@ pub struct SquareSymmetry {
 
 impl SquareSymmetry {
     /// The identity.
-    pub const IDENTITY: SquareSymmetry = SquareSymmetry { swap: false, flip: [false, false] };
+    pub(crate) const IDENTITY: SquareSymmetry = SquareSymmetry { swap: false, flip: [false, false] };
 
     /// All eight, the identity first.
     pub fn all() -> impl Iterator<Item = SquareSymmetry> {
@@ -67,7 +67,7 @@ impl SquareSymmetry {
 
 /// Where an input face went: the cube side it is, and how it was turned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Placement {
+pub(crate) struct Placement {
     /// Index of the face in the input.
     pub input: usize,
     /// The side of the cube it is the image of.
@@ -78,7 +78,7 @@ pub struct Placement {
 
 /// The sides of a face's own parameter square, G+Smo's numbering minus one: `s = 0`,
 /// `s = 1`, `t = 0`, `t = 1`, as pairs of corners `s + 2 t`.
-pub const FACE_SIDES: [(&str, [usize; 2]); 4] =
+pub(crate) const FACE_SIDES: [(&str, [usize; 2]); 4] =
     [("s = 0", [0, 2]), ("s = 1", [1, 3]), ("t = 0", [0, 1]), ("t = 1", [2, 3])];
 
 fn err(face: impl Into<String>, edge: impl Into<String>, reason: String) -> Error {
@@ -98,7 +98,7 @@ fn dist(a: Point3, b: Point3) -> f64 {
 /// The combinatorics of six faces: their corners as vertex ids, and the faces' sides
 /// on each edge.
 #[derive(Debug, Clone)]
-pub struct FaceSet {
+pub(crate) struct FaceSet {
     /// Vertex id of corner `s + 2 t` of each face.
     pub corners: Vec<[usize; 4]>,
     /// For each edge (sorted pair of vertex ids) the faces' sides on it: `(face, side)`
@@ -108,7 +108,7 @@ pub struct FaceSet {
 
 impl FaceSet {
     /// The edge of side `side` of face `f`.
-    pub fn edge_of(&self, f: usize, side: usize) -> (usize, usize) {
+    pub(crate) fn edge_of(&self, f: usize, side: usize) -> (usize, usize) {
         let [a, b] = FACE_SIDES[side].1.map(|c| self.corners[f][c]);
         (a.min(b), a.max(b))
     }
@@ -291,7 +291,7 @@ fn symmetry_sign(psi: &[usize; 8]) -> Option<f64> {
 
 /// Six faces in any order and orientation as a validated [`VolumeBoundary`] named
 /// `name` (module doc), and where each face went. `names` name the faces in errors.
-pub fn assemble(name: &str, faces: &[Face], names: &[String]) -> Result<(VolumeBoundary, [Placement; 6])> {
+pub(crate) fn assemble(name: &str, faces: &[Face], names: &[String]) -> Result<(VolumeBoundary, [Placement; 6])> {
     let set = FaceSet::new(faces, names)?;
     let candidates: Vec<([usize; 8], [Placement; 6])> =
         set.candidates().into_iter().filter_map(|phi| set.placements(&phi).map(|p| (phi, p))).collect();

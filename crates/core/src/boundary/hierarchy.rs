@@ -21,7 +21,7 @@ use crate::spline::surface::Side;
 
 /// Largest gap between the ends of adjacent sides that [`build_hierarchy`] accepts,
 /// relative to the diameter (readers enforce the stricter `1e-9` of `formats.md`).
-pub const CORNER_GAP_TOL: f64 = 1e-6;
+pub(crate) const CORNER_GAP_TOL: f64 = 1e-6;
 
 /// Which basis was asked for, which was used, and why they differ.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -73,9 +73,9 @@ pub struct Hierarchy {
     pub kinked: Option<KinkedLevel>,
     /// Every kink the thresholds of [`KinkMode::Auto`] find on the sides (on the input
     /// basis every `C^0` knot too), kept or not: measured once with the kinks kept
-    /// ([`Candidates`]), on the boundary the hierarchy was built from (the normalised one;
+    /// (`Candidates`), on the boundary the hierarchy was built from (the normalised one;
     /// a ring's cut-open boundary); the report names those not kept as rounded, their
-    /// points taken from the input's sides ([`Kink::point_on`]).
+    /// points taken from the input's sides (`Kink::point_on`).
     pub detected: Vec<Kink>,
 }
 
@@ -106,7 +106,7 @@ impl Hierarchy {
     }
 
     /// The reparameterization report with its matched points in the input's coordinates.
-    pub fn physical_reparam(&self) -> ReparamReport {
+    pub(crate) fn physical_reparam(&self) -> ReparamReport {
         let mut r = self.reparam.clone();
         for m in &mut r.matches {
             m.points = m.points.map(|p| self.similarity.to_physical(p));
@@ -119,7 +119,7 @@ impl Hierarchy {
 /// hierarchy on the input's own basis (`input_levels`) when the sides allow it;
 /// otherwise, and with [`BasisChoice::Fitted`]:
 /// reparameterize the sides as `opts.reparam` says ([`crate::boundary::reparam::plan`], paper
-/// §7), fit the four sides adaptively (see [`fit_side_with`](crate::boundary::fit::fit_side_with)) with `tol_abs = tol *
+/// §7), fit the four sides adaptively (see `fit_side_with`) with `tol_abs = tol *
 /// diameter` and the corners of [`corners`], then build the nested hierarchy of
 /// tensor-product bases (paper §5.4) with [`hierarchy_from_fits`].
 ///
@@ -231,7 +231,7 @@ const CLOUD_AUTO: f64 = super::CLOUD_CORNER_DEGREES;
 
 /// Samples per input element of a spline side with a zero-speed kink, fitted as a point
 /// cloud on the fitted basis.
-pub const ZERO_SPEED_SAMPLES: usize = 64;
+pub(crate) const ZERO_SPEED_SAMPLES: usize = 64;
 
 /// The hierarchy `h` (levels `Σ⁰`, holding the kinks `kept` at multiplicity `p`) with its
 /// finest level and the kinks in [`Hierarchy::kinked`], and [`BasisReport::kinks`] saying
@@ -330,7 +330,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
 
 /// The four corners south-west, south-east, north-east, north-west, each the average of
 /// the two adjacent sides' end points; errors when two ends are further apart than
-/// [`CORNER_GAP_TOL`]` * diameter`.
+/// `CORNER_GAP_TOL`` * diameter`.
 pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
     let ends = boundary.sides.each_ref().map(SideCurve::endpoints);
     let [s, e, n, w] = ends;
@@ -361,7 +361,7 @@ pub fn corners(boundary: &Boundary, diameter: f64) -> Result<[Point; 4]> {
 }
 
 /// The (start, end) corners of a side in its orientation.
-pub fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
+pub(crate) fn side_corners(corners: &[Point; 4], side: Side) -> (Point, Point) {
     let [sw, se, ne, nw] = *corners;
     match side {
         Side::South => (sw, se),

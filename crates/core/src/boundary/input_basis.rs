@@ -119,7 +119,7 @@ fn harmonise_corner_weights(sides: &mut [Curve]) -> std::result::Result<(), Stri
 /// butterfly 625: 0.24 s against 0.69 s), while from a few thousand functions on the
 /// hierarchy is faster (butterfly at 8281: 3.0 s against 8.3 s, puzzle3 at 17161: 4.0 s
 /// against 9.5 s): `bash scripts/bench-basis.sh`, BENCHMARKS.md.
-pub const DIRECT_SOLVE_MAX_FUNCTIONS: usize = 1024;
+pub(crate) const DIRECT_SOLVE_MAX_FUNCTIONS: usize = 1024;
 
 /// Remove every other distinct interior break (with all its multiplicity).
 fn coarsened(kv: &KnotVector) -> KnotVector {
@@ -151,7 +151,7 @@ fn coarsening(kv: &KnotVector) -> Vec<KnotVector> {
 /// The levels on the input basis, coarse to fine, and the four sides' sequences of
 /// projections (the last one exact).
 #[derive(Debug, Clone)]
-pub struct InputLevels {
+pub(crate) struct InputLevels {
     /// Knot vectors (`xi`, `eta`) and the four sides (south, east, north, west) on them.
     pub levels: Vec<([KnotVector; 2], [Curve; 4])>,
     /// Per side: the projections onto the coarse levels and the exact side last, with
@@ -161,14 +161,14 @@ pub struct InputLevels {
 
 /// The levels on the input basis (see the module documentation), or the reason why the
 /// boundary cannot be kept in it.
-pub fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLevels, String>> {
+pub(crate) fn input_levels(boundary: &Boundary) -> Result<std::result::Result<InputLevels, String>> {
     input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS, &[])
 }
 
 /// [`input_levels`] with the coarse levels built only above `direct_max` functions, and
 /// the kinks `kept` (their knots at multiplicity `p` on every level that holds them: the
 /// `C^0` bases `Σ⁰` of §9, smoothed by the caller).
-pub fn input_levels_with(
+pub(crate) fn input_levels_with(
     boundary: &Boundary,
     direct_max: usize,
     kept: &[Kink],

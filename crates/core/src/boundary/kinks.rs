@@ -7,12 +7,12 @@
 //! * a **zero-speed knot** (repeated control points, e.g. plate_with_hole's north side):
 //!   the curve is `C^1` in its own parameter but its tangent turns where the speed
 //!   vanishes;
-//! * a **corner of a point cloud** (a polygon vertex), found by [`cloud_corners`].
+//! * a **corner of a point cloud** (a polygon vertex), found by `cloud_corners`.
 //!
 //! To keep them, the basis gets a knot of multiplicity `p` at each kink's parameter
 //! (`Σ⁰`; the knot line runs through the domain, so the opposite side's knot vector
 //! holds it too, as a regular knot line of a smooth curve); `Σ¹` is `Σ⁰` with that
-//! multiplicity lowered by one and the contour projected onto it ([`smoothed_level`]).
+//! multiplicity lowered by one and the contour projected onto it (`smoothed_level`).
 //! The solver solves (8) on `Σ¹`, prolongs to `Σ⁰` and imposes the difference of the
 //! boundary control points by the damped elasticity step, then minimises the Winslow
 //! functional (16) on `Σ⁰` (`solve::kinks`).
@@ -30,7 +30,7 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::Side;
 
 /// The window of [`cloud_corners`], relative to the side's length.
-pub const CORNER_WINDOW: f64 = 0.01;
+pub(crate) const CORNER_WINDOW: f64 = 0.01;
 
 /// What makes a kink.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -71,7 +71,7 @@ pub struct Kink {
 /// just off the knot, robust to a zero speed at it), whether the speed vanishes there and
 /// whether the basis is only `C^0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct KnotKink {
+pub(crate) struct KnotKink {
     /// The knot in the curve's own parameter.
     pub u: f64,
     /// The knot normalised to `[0, 1]`.
@@ -89,7 +89,7 @@ pub struct KnotKink {
 
 /// The interior knots of `c` that are `C^0` knots or where the tangent turns more than
 /// [`SPLINE_KINK_DEGREES`].
-pub fn spline_kinks(c: &Curve) -> Vec<KnotKink> {
+pub(crate) fn spline_kinks(c: &Curve) -> Vec<KnotKink> {
     let p = c.degree();
     let (a, b) = c.domain();
     let bm = c.knots.breaks_with_multiplicity();
@@ -153,7 +153,7 @@ fn chord_turning(points: &[Point], s: &[f64], j: usize, w: f64) -> f64 {
 /// of amplitude `ε` moves the angles by about `ε / w` only). Of neighbouring candidates
 /// (closer than `w`) the one turning most at the window `w` is the vertex: at a polygon's
 /// vertex both chords lie along its edges. Returns `(index, turning degrees)`.
-pub fn cloud_corners(points: &[Point], threshold: f64) -> Vec<(usize, f64)> {
+pub(crate) fn cloud_corners(points: &[Point], threshold: f64) -> Vec<(usize, f64)> {
     CornerTurnings::of(points, threshold).corners(threshold)
 }
 
@@ -219,7 +219,7 @@ impl CornerTurnings {
 /// is set (then with the thresholds of [`KinkMode::Auto`]). `input_basis`: every `C^0`
 /// knot of a spline side counts whatever its angle (the input basis is `C^0` there).
 /// Analytic sides have none. [`Candidates`] finds them once for several modes.
-pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kink> {
+pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kink> {
     match mode.cloud_threshold() {
         Some(floor) => Candidates::find(boundary, floor).kinks(mode, input_basis),
         None => Vec::new(),
@@ -232,7 +232,7 @@ pub fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> Vec<Kin
 /// [`detect`] does (the hierarchy keeps those of `--kinks`, the report names those of
 /// [`KinkMode::Auto`] that were rounded).
 #[derive(Debug, Clone, Default)]
-pub struct Candidates {
+pub(crate) struct Candidates {
     sides: [SideCandidates; 4],
 }
 
@@ -315,7 +315,7 @@ impl Kink {
     /// kink was found on a boundary with the same knots and vertex count (e.g. its
     /// normalised copy, [`Similarity::unit_boundary`](crate::boundary::normalise::Similarity::unit_boundary)).
     /// `None` when the side has no such vertex or knot.
-    pub fn point_on(&self, boundary: &Boundary) -> Option<Point> {
+    pub(crate) fn point_on(&self, boundary: &Boundary) -> Option<Point> {
         match boundary.side(self.side) {
             SideCurve::Points(pts) => self.index.and_then(|j| pts.get(j).copied()),
             SideCurve::Spline(c) => {
@@ -359,7 +359,7 @@ pub fn lowered(kv: &KnotVector) -> KnotVector {
 /// The least-squares projection (§5.2, corners kept) of `c` onto the space of `kv`; a
 /// rational curve is projected in homogeneous coordinates (`w x`, `w y` and `w`), so a
 /// curve that lies in the space is reproduced with its weights.
-pub fn project_curve(c: &Curve, kv: &KnotVector) -> Result<Curve> {
+pub(crate) fn project_curve(c: &Curve, kv: &KnotVector) -> Result<Curve> {
     let Some(w) = &c.weights else {
         let ends = c.endpoints();
         return Ok(project_side(&SideCurve::Spline(c.clone()), kv, ends)?.curve);
@@ -385,7 +385,7 @@ pub fn project_curve(c: &Curve, kv: &KnotVector) -> Result<Curve> {
 /// ([`lowered`]) and every side whose knot vector changed projected onto it
 /// ([`project_curve`]: a smooth side, in the space already, is reproduced; a kinked one is
 /// rounded).
-pub fn smoothed_level(level: &Level) -> Result<Level> {
+pub(crate) fn smoothed_level(level: &Level) -> Result<Level> {
     let knots = [lowered(&level.knots[0]), lowered(&level.knots[1])];
     if knots == level.knots {
         return Ok(level.clone());
@@ -402,7 +402,7 @@ pub fn smoothed_level(level: &Level) -> Result<Level> {
 
 /// Every level smoothed ([`smoothed_level`]); levels that end up with equal knot vectors
 /// are merged (the finer one's sides kept).
-pub fn smoothed_levels(levels: &[Level]) -> Result<Vec<Level>> {
+pub(crate) fn smoothed_levels(levels: &[Level]) -> Result<Vec<Level>> {
     let mut out: Vec<Level> = Vec::with_capacity(levels.len());
     for l in levels {
         let l = smoothed_level(l)?;

@@ -4,7 +4,7 @@
 //!
 //! | module | holds | paper |
 //! |---|---|---|
-//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], [`bounding_box`], [`diameter`], [`BasisChoice`] | §5, §5.2 |
+//! | this module | [`Boundary`], [`SideCurve`], [`Analytic`], `bounding_box`, [`diameter`], [`BasisChoice`] | §5, §5.2 |
 //! | [`families`] | seeded families of hard domains (the hard corpus) | |
 //! | `normalise` | the similarity to unit size at the origin, and back | |
 //! | [`mod@validate`] | corner gaps, orientation, self-intersections, degenerate sides | |
@@ -139,7 +139,7 @@ impl KinkMode {
     }
 
     /// Smallest turning (degrees) of a spline kink kept; `None`: none kept.
-    pub fn spline_threshold(self) -> Option<f64> {
+    pub(crate) fn spline_threshold(self) -> Option<f64> {
         match self {
             KinkMode::Auto => Some(SPLINE_KINK_DEGREES),
             KinkMode::None => None,
@@ -148,7 +148,7 @@ impl KinkMode {
     }
 
     /// Smallest turning (degrees) of a point-cloud corner kept; `None`: none kept.
-    pub fn cloud_threshold(self) -> Option<f64> {
+    pub(crate) fn cloud_threshold(self) -> Option<f64> {
         match self {
             KinkMode::Auto => Some(CLOUD_CORNER_DEGREES),
             KinkMode::None => None,
@@ -167,9 +167,9 @@ impl std::fmt::Display for KinkMode {
 /// report names it; `--kinks auto` keeps it).
 pub const SPLINE_KINK_DEGREES: f64 = 1.0;
 
-/// A point cloud's turning of at least this (degrees), measured by [`kinks::cloud_corners`], is a
+/// A point cloud's turning of at least this (degrees), measured by `kinks::cloud_corners`, is a
 /// corner (`--kinks auto` keeps it, the report names it otherwise). A sampled smooth
-/// curve turns less at the scale of [`CORNER_WINDOW`](kinks::CORNER_WINDOW) unless its radius of curvature is
+/// curve turns less at the scale of `CORNER_WINDOW` unless its radius of curvature is
 /// below about twice the window.
 pub const CLOUD_CORNER_DEGREES: f64 = 30.0;
 
@@ -269,7 +269,7 @@ impl Boundary {
 /// Lower-left and upper-right corner of a bounding box of the boundary: point clouds
 /// exactly, spline sides sampled at 16 points per input element, analytic sides at 1025
 /// points.
-pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
+pub(crate) fn bounding_box(boundary: &Boundary) -> (Point, Point) {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut add = |p: Point| {
@@ -294,7 +294,7 @@ pub fn bounding_box(boundary: &Boundary) -> (Point, Point) {
     (lo, hi)
 }
 
-/// Diameter of [`bounding_box`].
+/// Diameter of `bounding_box`.
 pub fn diameter(boundary: &Boundary) -> f64 {
     let (lo, hi) = bounding_box(boundary);
     (hi[0] - lo[0]).hypot(hi[1] - lo[1])

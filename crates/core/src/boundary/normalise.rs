@@ -32,11 +32,11 @@ use crate::spline::surface::Surface;
 use super::{bounding_box, Analytic, Boundary, SideCurve};
 
 /// The centre is moved to the origin when it lies more than this many half-widths away.
-pub const TRANSLATE_ABOVE: f64 = 16.0;
+pub(crate) const TRANSLATE_ABOVE: f64 = 16.0;
 /// The size is scaled when the half-width is outside `[2^-20, 2^20]`.
-pub const SCALE_OUTSIDE_LOG2: i32 = 20;
+pub(crate) const SCALE_OUTSIDE_LOG2: i32 = 20;
 /// Largest accepted `|log2(half-width)|`.
-pub const MAX_LOG2: i32 = 508;
+pub(crate) const MAX_LOG2: i32 = 508;
 
 /// `x = centre + scale · x̂`, `scale` a power of two.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -55,7 +55,7 @@ impl Default for Similarity {
 
 impl Similarity {
     /// `c = 0`, `s = 1`.
-    pub const IDENTITY: Similarity = Similarity { centre: [0.0, 0.0], scale: 1.0 };
+    pub(crate) const IDENTITY: Similarity = Similarity { centre: [0.0, 0.0], scale: 1.0 };
 
     /// Whether this is the identity (the pipeline then runs on the raw coordinates).
     pub fn is_identity(&self) -> bool {
@@ -67,13 +67,13 @@ impl Similarity {
     /// identity: the validator names the side that is at fault.
     ///
     /// Errors: [`Error::Range`] when the half-width is outside `2^±MAX_LOG2` (`MAX_LOG2 = 508`).
-    pub fn for_boundary(boundary: &Boundary) -> Result<Self> {
+    pub(crate) fn for_boundary(boundary: &Boundary) -> Result<Self> {
         let (lo, hi) = bounding_box(boundary);
         Self::for_box(lo, hi, &format!("boundary '{}'", boundary.name))
     }
 
     /// The normalisation of the box `[lo, hi]`; `what` names it in errors.
-    pub fn for_box(lo: Point, hi: Point, what: &str) -> Result<Self> {
+    pub(crate) fn for_box(lo: Point, hi: Point, what: &str) -> Result<Self> {
         if !(lo.iter().chain(&hi).all(|v| v.is_finite())) {
             return Ok(Self::IDENTITY);
         }
@@ -102,12 +102,12 @@ impl Similarity {
     }
 
     /// `x̂ = (x − c) / s`.
-    pub fn to_unit(&self, p: Point) -> Point {
+    pub(crate) fn to_unit(self, p: Point) -> Point {
         [(p[0] - self.centre[0]) / self.scale, (p[1] - self.centre[1]) / self.scale]
     }
 
     /// `x = c + s x̂`.
-    pub fn to_physical(&self, p: Point) -> Point {
+    pub(crate) fn to_physical(self, p: Point) -> Point {
         [self.centre[0] + self.scale * p[0], self.centre[1] + self.scale * p[1]]
     }
 
@@ -123,7 +123,7 @@ impl Similarity {
 
     /// The boundary in normalised coordinates (control points and samples mapped; NURBS
     /// weights and parameterizations unchanged, so every side is the same curve).
-    pub fn unit_boundary(&self, boundary: &Boundary) -> Boundary {
+    pub(crate) fn unit_boundary(&self, boundary: &Boundary) -> Boundary {
         if self.is_identity() {
             return boundary.clone();
         }
@@ -140,14 +140,14 @@ impl Similarity {
     }
 
     /// A curve of the normalised problem in physical coordinates.
-    pub fn physical_curve(&self, c: &Curve) -> Curve {
+    pub(crate) fn physical_curve(&self, c: &Curve) -> Curve {
         let sim = *self;
         self.map_curve(c, |p| sim.to_physical(p))
     }
 
     /// A map of the normalised problem in physical coordinates. Errors:
     /// [`Error::Range`] when a control point overflows.
-    pub fn physical_surface(&self, map: &Surface) -> Result<Surface> {
+    pub(crate) fn physical_surface(&self, map: &Surface) -> Result<Surface> {
         if self.is_identity() {
             return Ok(map.clone());
         }

@@ -52,7 +52,7 @@ pub(super) struct Samples {
 }
 
 /// Arc-length samples of a parametric contour (a B-spline, NURBS or analytic curve).
-pub const DENSE: usize = 1 << 15;
+pub(crate) const DENSE: usize = 1 << 15;
 
 pub(super) fn dist(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
@@ -193,7 +193,7 @@ pub(super) fn inside(poly: &[Point], p: Point) -> bool {
 /// `near`, else bracketed on `8` samples per element and refined by bisection to
 /// rounding. `None` when the ray misses the curve. Used to keep a seam on a ray while the
 /// curve turns (a sliding grid).
-pub fn ray_parameter(c: &Curve, origin: Point, dir: Point, near: f64) -> Option<f64> {
+pub(crate) fn ray_parameter(c: &Curve, origin: Point, dir: Point, near: f64) -> Option<f64> {
     let (a, b) = c.domain();
     let l = b - a;
     let wrap = |u: f64| a + (u - a).rem_euclid(l);

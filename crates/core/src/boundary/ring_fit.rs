@@ -5,7 +5,7 @@
 //!
 //! **Fit.** Least squares `min sum_k |C(eta_k) - x_k|^2` over the `d` distinct control
 //! points (wrapped collocation matrix) on one periodic knot vector for both contours, at
-//! [`DENSE`](super::ring::DENSE) arc-length samples of a parametric contour (the points of a cloud), refined
+//! `DENSE` arc-length samples of a parametric contour (the points of a cloud), refined
 //! adaptively and dyadically in `eta` as in §5: from `n_0 = 4` uniform elements (at least
 //! `p + 1`), every element where either contour deviates by more than `tol * diameter`
 //! at a sample is bisected (knots stay dyadic, `k / (n_0 2^l)`), and both contours are
@@ -13,7 +13,7 @@
 //! each half keeps at least `p + 1` samples of every contour that misses the tolerance
 //! there (more elements cannot bring a sparse cloud closer); the other contour's fit
 //! stays well posed on elements without samples by the tiny smoothing term of the
-//! four-sided point fits ([`REGULARIZATION`], `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
+//! four-sided point fits (`REGULARIZATION`, `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
 //! when no element is marked or the next level would pass the element cap.
 //!
 //! **Normalisation.** Like a four-sided boundary
@@ -207,7 +207,7 @@ pub fn fit_contour(contour: &ClosedContour, kv: &KnotVector) -> Result<(Curve, f
 /// Like [`fit_contour`], with `eta = 0` put where the ray from `origin` towards `toward`
 /// first crosses the contour (the arc-length parameter shifted by that crossing's
 /// fraction; the contour's own start when the ray misses it).
-pub fn fit_contour_seam(
+pub(crate) fn fit_contour_seam(
     contour: &ClosedContour,
     kv: &KnotVector,
     origin: Point,
@@ -229,7 +229,8 @@ fn fit_contour_shifted(kv: &KnotVector, smp: Samples, shift: f64) -> Result<(Cur
 /// [`ReparamOptions`], `auto`, see `boundary::ring_reparam`), and fit them
 /// adaptively on dyadic periodic knot vectors of degree `degree` until `tol * diameter`
 /// is met (at most `max_elements` elements).
-pub fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
+#[cfg(any(test, feature = "testutil"))]
+pub(crate) fn fit_ring(ring: &Ring, degree: usize, tol: f64, max_elements: usize) -> Result<RingFit> {
     fit_ring_with(ring, degree, tol, max_elements, EtaRefinement::Adaptive, &ReparamOptions::default())
 }
 
@@ -300,7 +301,7 @@ pub enum EtaRefinement {
     Uniform,
 }
 
-/// [`fit_ring`] with the refinement in `eta` and the reparameterization chosen.
+/// `fit_ring` with the refinement in `eta` and the reparameterization chosen.
 pub fn fit_ring_with(
     ring: &Ring,
     degree: usize,
@@ -380,18 +381,12 @@ pub fn cut_open(ring: &Ring, seam: [Point; 2]) -> Boundary {
     Boundary { name: ring.name.clone(), sides: [s.clone(), ring.outer.as_side(), s, ring.inner.as_side()] }
 }
 
-/// The hierarchy of a ring for the solver (with `eta` periodic): one level per dyadic
-/// fit of [`fit_ring`] (degree, tolerance and element cap from `opts`), basis
-/// `Ξ × H_k` with `Ξ` one open element (the solver balances and refines it), west the
-/// inner and east the outer fit, south and north the seam segment (not a boundary:
-/// periodic sides are skipped by the initial guesses). Returns the hierarchy and the
-/// cut-open boundary ([`cut_open`]) the report measures against.
-pub fn ring_hierarchy(ring: &Ring, opts: &FitOptions) -> Result<(Hierarchy, Boundary)> {
-    ring_hierarchy_with(ring, opts, EtaRefinement::Adaptive)
-}
-
 /// [`ring_hierarchy`] with the refinement in `eta` chosen.
-pub fn ring_hierarchy_with(ring: &Ring, opts: &FitOptions, refinement: EtaRefinement) -> Result<(Hierarchy, Boundary)> {
+pub(crate) fn ring_hierarchy_with(
+    ring: &Ring,
+    opts: &FitOptions,
+    refinement: EtaRefinement,
+) -> Result<(Hierarchy, Boundary)> {
     opts.validate()?;
     let fit = fit_ring_with(ring, opts.degree, opts.tol, opts.max_elements, refinement, &opts.reparam)?;
     let p = opts.degree;

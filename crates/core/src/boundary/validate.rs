@@ -7,8 +7,8 @@
 //! additionally rejects clockwise contours.
 //!
 //! The contour is checked on a polyline: point clouds as given, spline sides sampled
-//! adaptively ([`sample_side`]) with at least [`SAMPLES_PER_SPAN`] points per knot span
-//! and chords within [`FLATNESS`] times the bounding-box diameter of the curve, so that
+//! adaptively ([`sample_side`]) with at least `SAMPLES_PER_SPAN` points per knot span
+//! and chords within `FLATNESS` times the bounding-box diameter of the curve, so that
 //! chords cannot create false crossings in narrow gaps (two sides `g` apart can only
 //! appear to cross when `g < 2 * FLATNESS * diameter`).
 
@@ -19,20 +19,20 @@ use crate::spline::curve::{check_points, check_weights, Curve, Point};
 use crate::spline::surface::Side;
 
 /// Corner gaps and side lengths are compared against this times the bounding-box diameter.
-pub const CORNER_TOL: f64 = 1e-9;
+pub(crate) const CORNER_TOL: f64 = 1e-9;
 /// Largest distance between a sampled chord's midpoint and the curve point at the
 /// parameter midpoint, relative to the bounding-box diameter.
-pub const FLATNESS: f64 = 1e-5;
+pub(crate) const FLATNESS: f64 = 1e-5;
 /// Contacts of the contour with itself closer than this times the bounding-box diameter
 /// to one of the four corner points are not reported: they are the shared corners, or
 /// pinches and seams below the resolution of the data (`male_casing_ring` is a ring cut
 /// open along a seam whose two sides meet at one corner and cross within `3e-8` of the
 /// diameter of another).
-pub const CORNER_NEIGHBOURHOOD: f64 = 1e-6;
+pub(crate) const CORNER_NEIGHBOURHOOD: f64 = 1e-6;
 /// Minimum number of chords per non-empty knot span when sampling a spline side.
-pub const SAMPLES_PER_SPAN: usize = 16;
+pub(crate) const SAMPLES_PER_SPAN: usize = 16;
 /// Number of initial chords on an analytic side (refined adaptively).
-pub const ANALYTIC_SAMPLES: usize = 256;
+pub(crate) const ANALYTIC_SAMPLES: usize = 256;
 /// Deepest bisection of one initial chord during adaptive sampling.
 const MAX_BISECTIONS: u32 = 10;
 /// Budget of initial chords for one spline side (huge inputs get fewer per span).
@@ -157,9 +157,9 @@ fn refine(
 
 /// Sample a side into a polyline from its start to its end.
 ///
-/// Point clouds are returned as given. A spline side gets at least [`SAMPLES_PER_SPAN`]
+/// Point clouds are returned as given. A spline side gets at least `SAMPLES_PER_SPAN`
 /// chords per non-empty knot span (fewer only on curves with more than 2^18 spans, to
-/// bound the work), an analytic side [`ANALYTIC_SAMPLES`] chords; each chord
+/// bound the work), an analytic side `ANALYTIC_SAMPLES` chords; each chord
 /// is then bisected (at most 10 times) until the curve point at its parameter midpoint is
 /// within `flat_tol` of the chord's midpoint. `flat_tol = f64::INFINITY` gives the
 /// uniform initial sampling.

@@ -64,7 +64,7 @@ impl CubeSide {
     }
 
     /// `+1` when `f_s × f_t` of the identity cube points out of this side, else `-1`.
-    pub fn outward_sign(self) -> f64 {
+    pub(crate) fn outward_sign(self) -> f64 {
         let (d, v) = self.fixed();
         let positive_at_one = d != 1;
         if (v == 1.0) == positive_at_one {
@@ -177,7 +177,7 @@ impl VolumeBoundary {
     /// The volume enclosed by the faces, `(1/3) Σ σ ∫∫ f · (f_s × f_t)` (module doc):
     /// exact for polynomial faces (Gauss rule of `3 max(p, q)` points per element and
     /// direction), accurate to quadrature for rational ones.
-    pub fn enclosed_volume(&self) -> f64 {
+    pub(crate) fn enclosed_volume(&self) -> f64 {
         let mut total = 0.0;
         for side in CubeSide::ALL {
             let f = self.face(side);

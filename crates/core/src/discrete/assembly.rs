@@ -27,14 +27,14 @@ type RowChunks<'a> = ((usize, Option<&'a mut [f64]>), Option<&'a mut [f64]>);
 
 /// Quadrature points below which the assembly of a basis runs on the calling thread: waking
 /// the rayon pool for each of its `q + 1` colours costs more than the work below it.
-pub const SERIAL_ASSEMBLY_POINTS: usize = 4096;
+pub(crate) const SERIAL_ASSEMBLY_POINTS: usize = 4096;
 
 /// Quadrature points below which `Discretization::tensor_basis_first` reads the
 /// first-order basis values from a table made on first use (`24 nloc` bytes a point: at
 /// most 1.5 MB for p = 3) instead of forming them at every pass: on such bases the
 /// products and, on a NURBS basis, the quotient rule are a sizeable part of a pass (the
 /// Winslow stage on disk 1.44 -> 1.20 ms, BENCHMARKS.md).
-pub const FIRST_ORDER_TABLE_POINTS: usize = 4096;
+pub(crate) const FIRST_ORDER_TABLE_POINTS: usize = 4096;
 
 /// Everything computed once per basis: tables, DOF map, patterns.
 #[derive(Debug, Clone)]
@@ -631,7 +631,7 @@ impl Discretization {
     /// Newton systems. `det A = (det J)^2 >= 0` and `tr A > 0`: `K` is symmetric positive
     /// (semi)definite even on a folded map; a relative `1e-10 tr A` is added to the diagonal
     /// of `A` to keep it definite.
-    pub fn metric_laplace(&self, cps: &[[f64; 2]], op: Operator, shift: f64, stencil: &mut [f64]) {
+    pub(crate) fn metric_laplace(&self, cps: &[[f64; 2]], op: Operator, shift: f64, stencil: &mut [f64]) {
         let nq = [self.tables[0].nq, self.tables[1].nq];
         let nqp = nq[0] * nq[1];
         // K_ab = sum_k (A grad w_a)_u w_b,u + (A grad w_a)_v w_b,v (+ shift w_a w_b): one
@@ -721,7 +721,7 @@ impl Discretization {
 
     /// Restrict a full component-interleaved vector (length `ncomp n`) to the free
     /// unknowns `(z * m + f)`, summing the rows of periodic replicas into their primary's.
-    pub fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
+    pub(crate) fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
         let m = self.dofs.num_free();
         let mut out = vec![0.0; ncomp * m];
         for (f, &k) in self.dofs.free().iter().enumerate() {
@@ -750,7 +750,7 @@ impl Discretization {
 
     /// `K_free,fixed * u_fixed` for a scalar stencil operator: the right-hand side
     /// contribution of Dirichlet data `u` (full, per basis function).
-    pub fn apply_to_fixed_scalar(&self, stencil: &[f64], u: &[f64]) -> Vec<f64> {
+    pub(crate) fn apply_to_fixed_scalar(&self, stencil: &[f64], u: &[f64]) -> Vec<f64> {
         let (p, q) = self.degrees();
         let sw = self.stencil_width();
         let mut out = vec![0.0; self.dofs.num_free()];
@@ -766,7 +766,7 @@ impl Discretization {
 
     /// `K_free,fixed * u_fixed` for a 2-component stencil operator: the right-hand side
     /// contribution of Dirichlet data `u` (full, per basis function) in a linear problem.
-    pub fn apply_to_fixed(&self, stencil: &[f64], u: &[[f64; 2]]) -> Vec<f64> {
+    pub(crate) fn apply_to_fixed(&self, stencil: &[f64], u: &[[f64; 2]]) -> Vec<f64> {
         let (p, q) = self.degrees();
         let sw = self.stencil_width();
         let row_len = 4 * sw;

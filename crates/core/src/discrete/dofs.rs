@@ -9,7 +9,7 @@
 //! (`spline::periodic`): the stored function `(i, j)`, `j >= d`, is a *replica*
 //! of its *primary* `(i, j - d)`. Both carry the same control point, so the periodic
 //! basis function is `N_(i,j) + N_(i,j+d)` and everything assembled per stored function
-//! is summed over replicas: residual rows ([`super::assembly::Discretization::restrict`]),
+//! is summed over replicas: residual rows (`super::assembly::Discretization::restrict`),
 //! Jacobian rows and columns (the pattern's extra sources), Dirichlet lifts. Assemblers
 //! keep working on the stored (unwrapped) tensor basis unchanged.
 
@@ -114,7 +114,7 @@ impl DofMap {
     }
 
     /// Free where `is_free(i, j)` holds.
-    pub fn from_predicate(shape: [usize; 2], is_free: impl Fn(usize, usize) -> bool) -> Self {
+    pub(crate) fn from_predicate(shape: [usize; 2], is_free: impl Fn(usize, usize) -> bool) -> Self {
         let [nx, ny] = shape;
         let mut free_of = vec![FIXED; nx * ny];
         let mut free = Vec::new();

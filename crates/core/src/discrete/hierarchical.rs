@@ -36,7 +36,7 @@ use crate::spline::hierarchical::{HierarchicalBasis, Index2};
 
 /// One active cell: its THB functions and their values at the Gauss points.
 #[derive(Debug, Clone)]
-pub struct CellQuadrature {
+pub(crate) struct CellQuadrature {
     /// THB functions non-zero on the cell (indices into the active functions, increasing).
     pub funcs: Vec<usize>,
     /// Quadrature weight (times the cell's area) per point, `ξ` fastest.
@@ -63,7 +63,7 @@ impl CellQuadrature {
 /// patterns of the scalar (`m x m`) and vector (`2m x 2m`, unknowns `c = (c^x, c^y)`)
 /// free-free systems.
 #[derive(Debug, Clone)]
-pub struct HierarchicalDiscretization {
+pub(crate) struct HierarchicalDiscretization {
     /// Gauss points per cell and direction.
     pub nq: usize,
     /// The active cells (in [`HierarchicalBasis::active_cells`] order).
@@ -182,7 +182,7 @@ impl HierarchicalDiscretization {
     /// rows and columns of `matrix` (the values of [`Self::scalar`] for `ncomp = 1`, of
     /// [`Self::vector`] for `ncomp = 2`; may be empty). The kernel gets zeroed storage; the
     /// sums run in cell order (deterministic).
-    pub fn assemble<K>(&self, ncomp: usize, res: &mut [f64], matrix: &mut [f64], kernel: K)
+    pub(crate) fn assemble<K>(&self, ncomp: usize, res: &mut [f64], matrix: &mut [f64], kernel: K)
     where
         K: Fn(&CellQuadrature, &mut [f64], &mut [f64]) + Sync,
     {
@@ -244,7 +244,7 @@ impl HierarchicalDiscretization {
 
     /// Restrict a full component-interleaved vector (length `ncomp n`) to the free
     /// unknowns `(z m + f)`.
-    pub fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
+    pub(crate) fn restrict(&self, full: &[f64], ncomp: usize) -> Vec<f64> {
         let m = self.num_free();
         let mut out = vec![0.0; ncomp * m];
         for (f, &k) in self.free.iter().enumerate() {

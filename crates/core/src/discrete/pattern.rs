@@ -93,7 +93,7 @@ impl SystemPattern {
     }
 
     /// Copy the stencil storage into `values` (this pattern's entries), in parallel.
-    pub fn gather_into(&self, stencil: &[f64], values: &mut [f64]) {
+    pub(crate) fn gather_into(&self, stencil: &[f64], values: &mut [f64]) {
         const CHUNK: usize = 1 << 14;
         values.par_chunks_mut(CHUNK).zip(self.src.par_chunks(CHUNK)).for_each(|(v, src)| {
             for (v, &s) in v.iter_mut().zip(src) {
@@ -138,8 +138,9 @@ impl LazyPattern {
         Self { dofs: dofs.clone(), degrees: [p, q], ncomp, cell: std::sync::OnceLock::new() }
     }
 
+    #[cfg(test)]
     /// Whether the pattern has been built.
-    pub fn is_built(&self) -> bool {
+    pub(crate) fn is_built(&self) -> bool {
         self.cell.get().is_some()
     }
 

@@ -46,7 +46,7 @@ impl Discretization {
     /// [`crate::linalg::sparse::Csr::mul_vec`] adds them). Periodic replicas are not
     /// summed: for a basis with replicas use the gathered matrix (this returns `false`
     /// and leaves `y` alone).
-    pub fn stencil_product(&self, ncomp: usize, stencil: &[f64], x: &[f64], y: &mut [f64]) -> bool {
+    pub(crate) fn stencil_product(&self, ncomp: usize, stencil: &[f64], x: &[f64], y: &mut [f64]) -> bool {
         if !self.dofs.replicas().is_empty() {
             return false;
         }
@@ -95,7 +95,7 @@ impl Discretization {
     /// of the `ncomp`-component system whose stencil storage is `stencil`: the block the
     /// gathered matrix has in rows and columns `z m .. (z + 1) m`, entry for entry. Only
     /// for a basis without periodic replicas (`None` otherwise).
-    pub fn stencil_diagonal_block(
+    pub(crate) fn stencil_diagonal_block(
         &self,
         ncomp: usize,
         stencil: &[f64],
@@ -121,7 +121,7 @@ impl Discretization {
 /// copies. Only for a basis without periodic replicas
 /// ([`StencilOperator::new`] says `None` otherwise).
 #[derive(Debug, Clone, Copy)]
-pub struct StencilOperator<'a> {
+pub(crate) struct StencilOperator<'a> {
     disc: &'a Discretization,
     ncomp: usize,
     stencil: &'a [f64],

@@ -72,7 +72,7 @@ impl Topology {
     }
 
     /// Whether the `eta` direction is periodic (south and north glued).
-    pub fn eta_periodic(&self) -> bool {
+    pub(crate) fn eta_periodic(&self) -> bool {
         self.side(Side::South) == SideCondition::Periodic
     }
 
@@ -82,7 +82,7 @@ impl Topology {
     }
 
     /// Whether side `s` is Dirichlet.
-    pub fn is_dirichlet(&self, s: Side) -> bool {
+    pub(crate) fn is_dirichlet(&self, s: Side) -> bool {
         self.side(s) == SideCondition::Dirichlet
     }
 

@@ -18,13 +18,13 @@ use crate::spline::refine::prolongation;
 
 /// Coarsest space the hierarchy goes down to: at most this many free scalar unknowns
 /// (its operator is factorized directly, [`crate::linalg::multigrid`]).
-pub const COARSEST_FREE: usize = 400;
+pub(crate) const COARSEST_FREE: usize = 400;
 
 /// `kv` with every second interior element boundary removed (the breaks at odd
 /// positions kept, with their multiplicities), or `None` when `kv` has fewer than
 /// three elements or is periodic. The result's knots are a subset of `kv`'s, so its
 /// space is nested in `kv`'s.
-pub fn coarsened(kv: &KnotVector) -> Option<KnotVector> {
+pub(crate) fn coarsened(kv: &KnotVector) -> Option<KnotVector> {
     if kv.is_periodic() || !kv.is_open() || kv.num_elements() < 3 {
         return None;
     }
@@ -55,7 +55,7 @@ fn coarsened_basis(knots: &[KnotVector; 2]) -> Option<[KnotVector; 2]> {
 /// The prolongation of the interior (free) functions of the coarse tensor basis to
 /// those of the fine one: `P_eta ⊗ P_xi` with the rows and columns of boundary
 /// functions left out.
-pub fn interior_prolongation(coarse: &[KnotVector; 2], fine: &[KnotVector; 2]) -> Result<Csr> {
+pub(crate) fn interior_prolongation(coarse: &[KnotVector; 2], fine: &[KnotVector; 2]) -> Result<Csr> {
     let px = prolongation(&coarse[0], &fine[0])?;
     let py = prolongation(&coarse[1], &fine[1])?;
     let full = py.kron(&px);
@@ -81,7 +81,7 @@ pub fn interior_prolongation(coarse: &[KnotVector; 2], fine: &[KnotVector; 2]) -
 /// to the first's, ..., down to a space of at most [`COARSEST_FREE`] free functions (or
 /// one that cannot be coarsened). Empty when `disc` is not a patch with every boundary
 /// function fixed (periodic or interface sides), or is small already.
-pub fn free_prolongations(disc: &Discretization) -> Result<Vec<Csr>> {
+pub(crate) fn free_prolongations(disc: &Discretization) -> Result<Vec<Csr>> {
     let shape = disc.shape();
     if disc.dofs != DofMap::interior(shape) {
         return Ok(Vec::new());

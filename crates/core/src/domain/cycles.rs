@@ -97,7 +97,7 @@ pub fn signed_area(p: &[Point]) -> f64 {
 
 /// A point just to the left of the middle of the first side of `cycle` (inside the face
 /// the cycle bounds), `off` away from it.
-pub fn point_left_of(g: &Graph, cycle: &[FaceSide], off: f64) -> Point {
+pub(crate) fn point_left_of(g: &Graph, cycle: &[FaceSide], off: f64) -> Point {
     let (e, fwd) = cycle[0];
     let c = &g.edges[e].curve;
     let d = c.derivs(0.5, 1);

@@ -215,7 +215,7 @@ pub fn motor(seed: u64) -> PlaneGraph {
 /// `seed`: shaft radius `r0`, rotor `r1`, air gap to `r2`, slots and teeth to `r3`,
 /// yoke to 1; every circle has vertices at the `2 S` angles of the slots' sides.
 /// Faces labelled `rotor`, `airgap`, `slot-J`, `tooth-J`, `yoke`.
-pub fn motor_with_slots(slots: usize, seed: u64) -> PlaneGraph {
+pub(crate) fn motor_with_slots(slots: usize, seed: u64) -> PlaneGraph {
     let mut rng = Rng::new(seed.wrapping_mul(0x5851_F42D).wrapping_add(31));
     let s = slots.max(2);
     let r0 = between(&mut rng, 0.12, 0.22);

@@ -11,7 +11,7 @@ use crate::spline::knots::KnotVector;
 
 /// An edge: a curve on `[0, 1]` from vertex `a` to vertex `b`.
 #[derive(Debug, Clone)]
-pub struct Edge {
+pub(crate) struct Edge {
     /// The curve (normalised).
     pub curve: Curve,
     /// Start vertex.
@@ -23,7 +23,7 @@ pub struct Edge {
 }
 
 /// A side of a face: an edge and whether the face runs along it (`true`) or against it.
-pub type FaceSide = (usize, bool);
+pub(crate) type FaceSide = (usize, bool);
 
 /// A face: its sides counter-clockwise (the face to their left) and its label.
 #[derive(Debug, Clone)]
@@ -58,7 +58,7 @@ pub struct Graph {
 /// `c` split at the parameter `u` strictly inside its domain: the curve before and after
 /// (knot insertion up to multiplicity `p`, so both halves are exactly the curve and share
 /// the control point at `u`), each normalised to `[0, 1]`.
-pub fn split_curve(c: &Curve, u: f64) -> Result<(Curve, Curve)> {
+pub(crate) fn split_curve(c: &Curve, u: f64) -> Result<(Curve, Curve)> {
     let p = c.degree();
     // a knot within the knot tolerance of u is where the curve is split
     let u = if c.knots.multiplicity(u) > 0 {
@@ -114,7 +114,7 @@ fn standard_weights(mut c: Curve) -> Curve {
 }
 
 /// The angle in `[0, 2π)` by which the direction `a` turns counter-clockwise to `b`.
-pub fn ccw_angle(a: Point, b: Point) -> f64 {
+pub(crate) fn ccw_angle(a: Point, b: Point) -> f64 {
     let t = (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
     if t < 0.0 {
         t + 2.0 * std::f64::consts::PI
@@ -134,7 +134,7 @@ fn unit(d: Point) -> Point {
 
 /// The unit tangent of `c` at its start (`end = false`) or end, in its direction (the
 /// chord to a nearby point where the derivative vanishes).
-pub fn end_tangent(c: &Curve, end: bool) -> Point {
+pub(crate) fn end_tangent(c: &Curve, end: bool) -> Point {
     let u = if end { 1.0 } else { 0.0 };
     let d = c.derivs(u, 1).d1;
     if d[0].hypot(d[1]) > 0.0 && d[0].is_finite() && d[1].is_finite() {
@@ -146,19 +146,19 @@ pub fn end_tangent(c: &Curve, end: bool) -> Point {
 
 impl Graph {
     /// Add a vertex; returns its index.
-    pub fn add_vertex(&mut self, p: Point) -> usize {
+    pub(crate) fn add_vertex(&mut self, p: Point) -> usize {
         self.vertices.push(p);
         self.vertices.len() - 1
     }
 
     /// Add an edge; returns its index.
-    pub fn add_edge(&mut self, curve: Curve, a: usize, b: usize, boundary: bool) -> usize {
+    pub(crate) fn add_edge(&mut self, curve: Curve, a: usize, b: usize, boundary: bool) -> usize {
         self.edges.push(Edge { curve: curve.normalized(), a, b, boundary });
         self.edges.len() - 1
     }
 
     /// The curve of a face side in the face's direction.
-    pub fn side_curve(&self, s: FaceSide) -> Curve {
+    pub(crate) fn side_curve(&self, s: FaceSide) -> Curve {
         let c = &self.edges[s.0].curve;
         if s.1 {
             c.clone()
@@ -188,7 +188,7 @@ impl Graph {
     }
 
     /// The interior angle (radians) of face `f` at its corner `i`.
-    pub fn corner_angle(&self, f: usize, i: usize) -> f64 {
+    pub(crate) fn corner_angle(&self, f: usize, i: usize) -> f64 {
         let sides = &self.faces[f].sides;
         let n = sides.len();
         let t_in = end_tangent(&self.side_curve(sides[(i + n - 1) % n]), true);
@@ -202,7 +202,7 @@ impl Graph {
     /// The directions at corner `i` of face `f`: the outgoing side's tangent and the
     /// reversed incoming side's tangent (the interior lies counter-clockwise from the
     /// first to the second).
-    pub fn corner_directions(&self, f: usize, i: usize) -> (Point, Point) {
+    pub(crate) fn corner_directions(&self, f: usize, i: usize) -> (Point, Point) {
         let sides = &self.faces[f].sides;
         let n = sides.len();
         let t_in = end_tangent(&self.side_curve(sides[(i + n - 1) % n]), true);
@@ -213,7 +213,7 @@ impl Graph {
     /// Split edge `e` at its parameter `u` in `(0, 1)`: `e` keeps the first part, a new
     /// edge the second, and every face along `e` gets the new vertex. Returns the new
     /// vertex and edge.
-    pub fn split_edge(&mut self, e: usize, u: f64) -> Result<(usize, usize)> {
+    pub(crate) fn split_edge(&mut self, e: usize, u: f64) -> Result<(usize, usize)> {
         let (left, right) = split_curve(&self.edges[e].curve, u)?;
         // the control point the two halves share (exactly the curve's point at u)
         let v = self.add_vertex(left.control_points[left.control_points.len() - 1]);
@@ -246,7 +246,7 @@ impl Graph {
     /// `j`: `f` keeps the part from corner `i` to `j` (closed by the cut backwards), the
     /// new face the part from `j` to `i` (closed by the cut forwards). Returns the new
     /// face.
-    pub fn split_face(&mut self, f: usize, i: usize, j: usize, cut: usize) -> usize {
+    pub(crate) fn split_face(&mut self, f: usize, i: usize, j: usize, cut: usize) -> usize {
         let sides = self.faces[f].sides.clone();
         let n = sides.len();
         let mut a: Vec<FaceSide> = (0..(j + n - i) % n).map(|k| sides[(i + k) % n]).collect();
@@ -270,7 +270,7 @@ impl Graph {
     }
 
     /// Whether every vertex is on a boundary edge, per vertex.
-    pub fn on_boundary(&self) -> Vec<bool> {
+    pub(crate) fn on_boundary(&self) -> Vec<bool> {
         let mut v = vec![false; self.vertices.len()];
         for e in self.edges.iter().filter(|e| e.boundary) {
             v[e.a] = true;

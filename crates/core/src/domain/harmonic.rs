@@ -57,7 +57,7 @@ impl ArcLength {
 
 /// The discrete harmonic map of the regular `n`-gon onto a face.
 #[derive(Debug, Clone)]
-pub struct HarmonicMap {
+pub(crate) struct HarmonicMap {
     n: usize,
     m: usize,
     /// Image of every node (ring by ring, the centre first).
@@ -85,7 +85,7 @@ fn node(n: usize, r: usize, k: usize) -> usize {
 }
 
 /// Vertex `s` of the regular `n`-gon inscribed in the unit circle.
-pub fn polygon_vertex(n: usize, s: usize) -> Point {
+pub(crate) fn polygon_vertex(n: usize, s: usize) -> Point {
     let a = 2.0 * std::f64::consts::PI * (s % n) as f64 / n as f64;
     [a.cos(), a.sin()]
 }
@@ -189,7 +189,7 @@ impl HarmonicMap {
     /// The images of `m + 1` points on the segment from the centre of the polygon to the
     /// midpoint of its side `s` (ring by ring: on an odd ring the midpoint of the
     /// element edge the segment crosses, where the P1 map is the mean of its ends).
-    pub fn spoke(&self, s: usize) -> Vec<Point> {
+    pub(crate) fn spoke(&self, s: usize) -> Vec<Point> {
         let (n, m) = (self.n, self.m);
         (0..=m)
             .map(|r| {

@@ -132,7 +132,7 @@ fn nearest_direction(g: &Graph, f: usize, k: usize) -> Point {
 /// direction `theta` (degrees from the `x` axis), or, when `theta` is not a number,
 /// every hole along the direction to its nearest neighbour (another hole or the outer
 /// boundary), so that the cut crosses the narrowest gap.
-pub fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec<HoleCut>) -> Result<()> {
+pub(crate) fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec<HoleCut>) -> Result<()> {
     let tol = 1e-9 * diameter;
     let global = [theta.to_radians().cos(), theta.to_radians().sin()];
     for f in 0..g.faces.len() {

@@ -75,7 +75,7 @@ impl Loop {
 
 /// Which loop of a domain: the outer one or a hole (by index).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LoopId {
+pub(crate) enum LoopId {
     /// The outer loop.
     Outer,
     /// Hole `k`.
@@ -104,7 +104,7 @@ pub struct Domain {
 
 impl Domain {
     /// The loop `id`.
-    pub fn loop_of(&self, id: LoopId) -> &Loop {
+    pub(crate) fn loop_of(&self, id: LoopId) -> &Loop {
         match id {
             LoopId::Outer => &self.outer,
             LoopId::Hole(k) => &self.holes[k],
@@ -112,14 +112,14 @@ impl Domain {
     }
 
     /// Every loop with its id, the outer one first.
-    pub fn loops(&self) -> impl Iterator<Item = (LoopId, &Loop)> {
+    pub(crate) fn loops(&self) -> impl Iterator<Item = (LoopId, &Loop)> {
         std::iter::once((LoopId::Outer, &self.outer))
             .chain(self.holes.iter().enumerate().map(|(k, l)| (LoopId::Hole(k), l)))
     }
 }
 
 /// The error [`Error::Domain`] at loop `id` (and curve `curve`, if any).
-pub fn domain_error(id: LoopId, curve: Option<usize>, reason: impl Into<String>) -> Error {
+pub(crate) fn domain_error(id: LoopId, curve: Option<usize>, reason: impl Into<String>) -> Error {
     let at = match curve {
         Some(c) => format!("{id}, curve {c}"),
         None => id.to_string(),

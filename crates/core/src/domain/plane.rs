@@ -186,7 +186,7 @@ fn crossing(lines: &[Vec<Point>], ends: &[(usize, usize)], tol: f64) -> Option<(
 /// Validate `pg` (see the module documentation) and build the graph of its faces: every
 /// face with its outer cycle, its holes and its label, boundary edges marked. Returns
 /// the graph and the report.
-pub fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphReport)> {
+pub(crate) fn build_graph(pg: &PlaneGraph, fit: &FitOptions) -> Result<(Graph, GraphReport)> {
     let n = pg.vertices.len();
     if pg.edges.is_empty() {
         return Err(gerr("", "has no edges"));

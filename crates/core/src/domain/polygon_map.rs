@@ -34,7 +34,7 @@ use std::collections::HashMap;
 /// The piecewise-linear map of a face onto the regular polygon (see the module
 /// documentation).
 #[derive(Debug, Clone)]
-pub struct PolygonMap {
+pub(crate) struct PolygonMap {
     n: usize,
     /// Nodes in the face.
     pub nodes: Vec<Point>,
@@ -450,7 +450,7 @@ impl PolygonMap {
 
     /// The preimages of `samples + 1` evenly spaced points on the segment from the
     /// centre of the polygon to the midpoint of its side `s`.
-    pub fn spoke(&self, s: usize, samples: usize) -> Option<Vec<Point>> {
+    pub(crate) fn spoke(&self, s: usize, samples: usize) -> Option<Vec<Point>> {
         let (a, b) = (polygon_vertex(self.n, s), polygon_vertex(self.n, s + 1));
         let mid = lerp(a, b, 0.5);
         (0..=samples).map(|i| self.inverse(lerp([0.0, 0.0], mid, i as f64 / samples as f64))).collect()

@@ -78,7 +78,7 @@ fn ray_hit(g: &Graph, f: usize, o: Point, d: Point, tol: f64) -> Option<(usize, 
 /// The first point where the ray from `o` in direction `d` meets one of `edges` (farther
 /// than `tol` from `o`), on polylines of 64 chords per knot span: the edge, the parameter
 /// on it and the distance.
-pub fn ray_hit_edges(g: &Graph, edges: &[usize], o: Point, d: Point, tol: f64) -> Option<(usize, f64, f64)> {
+pub(crate) fn ray_hit_edges(g: &Graph, edges: &[usize], o: Point, d: Point, tol: f64) -> Option<(usize, f64, f64)> {
     let mut best: Option<(usize, f64, f64)> = None;
     for &e in edges {
         let c = &g.edges[e].curve;
@@ -120,7 +120,7 @@ type Target = (Option<usize>, Option<(usize, f64)>, Point, Point, Point);
 const FLAT: f64 = 1e-6;
 
 /// Cut every reflex and flat corner of every face (see the module documentation).
-pub fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Result<()> {
+pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Result<()> {
     let tol = 1e-9 * diameter;
     let pi = std::f64::consts::PI;
     for _ in 0..10_000 {

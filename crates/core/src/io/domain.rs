@@ -32,7 +32,7 @@ fn side(v: Value, ctx: &str) -> Result<SideCurve> {
             if c.periodic {
                 return Err(jerr(ctx, "a periodic curve cannot be one side of a loop (give it as the whole loop)"));
             }
-            Ok(SideCurve::Spline(c.to_curve().map_err(|e| e.within(ctx))?))
+            Ok(SideCurve::Spline(c.into_curve().map_err(|e| e.within(ctx))?))
         }
     }
 }
@@ -133,7 +133,7 @@ fn loop_of(v: Value, ctx: &str) -> Result<Loop> {
 
 /// The domain document of `d` (every loop as `"curves"`): what [`domain_of_json`]
 /// reads back as the same domain.
-pub fn domain_to_json(d: &Domain) -> Value {
+pub(crate) fn domain_to_json(d: &Domain) -> Value {
     let lp = |l: &Loop| serde_json::json!({ "curves": l.sides.iter().map(side_to_json).collect::<Vec<_>>() });
     serde_json::json!({
         "name": d.name,
@@ -143,7 +143,7 @@ pub fn domain_to_json(d: &Domain) -> Value {
 
 /// The domain of a JSON document with a top-level `"domain"` field (see the module
 /// documentation). Errors name the place (`domain.outer.curves[2].knots`, ...).
-pub fn domain_of_json(v: Value) -> Result<Domain> {
+pub(crate) fn domain_of_json(v: Value) -> Result<Domain> {
     let Value::Object(mut obj) = v else { return Err(jerr("", "the document must be an object")) };
     let name = match obj.remove("name") {
         Some(Value::String(s)) => s,

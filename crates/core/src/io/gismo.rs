@@ -32,7 +32,7 @@ pub(crate) const MAX_NODES: u32 = 1 << 24;
 pub(crate) const MAX_DEPTH: usize = 256;
 /// Relative corner tolerance used to *choose* the side assignment of four curves; the
 /// stricter check of `formats.md` is done by validation afterwards.
-pub const ASSIGN_TOL: f64 = 1e-6;
+pub(crate) const ASSIGN_TOL: f64 = 1e-6;
 
 pub(crate) fn xml_err(context: &str, message: impl Into<String>) -> Error {
     Error::Xml { context: context.to_string(), message: message.into() }
@@ -261,7 +261,7 @@ pub fn parse_gismo_xml(text: &str) -> Result<Document> {
 /// 1 = east, 2 = south, 3 = north, as stored; transposed when it runs clockwise), then
 /// counter-clockwise ones, then the fewest reversed curves; a clockwise choice is
 /// transposed. (All eight assignments describing one closed loop have the same gaps.)
-pub fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
+pub(crate) fn assign_sides(curves: [Curve; 4]) -> Result<Boundary> {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in curves.iter().flat_map(|c| &c.control_points) {
         for k in 0..2 {

@@ -40,7 +40,7 @@ pub(crate) fn knot_vector(out: &mut String, kv: &KnotVector, index: usize, inden
 /// every reader (G+Smo, IGES, ParaView) takes as a patch; the seam becomes two
 /// coinciding rows of control points, and the continuity across it, no longer in the
 /// basis, is that of the map.
-pub fn surface_to_gismo_xml(map: &Surface, comment: &str) -> String {
+pub(crate) fn surface_to_gismo_xml(map: &Surface, comment: &str) -> String {
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<xml>\n");
     if !comment.is_empty() {
         let _ = writeln!(out, "  <!-- {} -->", comment.replace("--", "- -"));
@@ -91,7 +91,7 @@ pub fn surface_to_gismo_xml(map: &Surface, comment: &str) -> String {
 /// with its weights), three `BSplineBasis` children of a `TensorBSplineBasis3` (`index`
 /// 0, 1, 2 for `xi`, `eta`, `zeta`), coefficients `xi` fastest then `eta`, `geoDim="3"`
 /// — the layout [`crate::io::volume`] reads back bit for bit.
-pub fn volume_to_gismo_xml(vol: &crate::spline::volume::Volume, comment: &str) -> String {
+pub(crate) fn volume_to_gismo_xml(vol: &crate::spline::volume::Volume, comment: &str) -> String {
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<xml>\n");
     if !comment.is_empty() {
         let _ = writeln!(out, "  <!-- {} -->", comment.replace("--", "- -"));

@@ -52,7 +52,7 @@ fn edge(v: Value, ctx: &str) -> Result<PlaneEdge> {
                     if c.periodic {
                         return Err(jerr(&cctx, "a periodic curve cannot be an edge (split it at two vertices)"));
                     }
-                    SideCurve::Spline(c.to_curve().map_err(|e| e.within(&cctx))?)
+                    SideCurve::Spline(c.into_curve().map_err(|e| e.within(&cctx))?)
                 }
             })
         }
@@ -62,7 +62,7 @@ fn edge(v: Value, ctx: &str) -> Result<PlaneEdge> {
 
 /// The plane graph of a JSON document with a top-level `"graph"` field (see the module
 /// documentation). Errors name the place (`graph.edges[3].curve`, ...).
-pub fn graph_of_json(v: Value) -> Result<PlaneGraph> {
+pub(crate) fn graph_of_json(v: Value) -> Result<PlaneGraph> {
     let Value::Object(mut obj) = v else { return Err(jerr("", "the document must be an object")) };
     let name = match obj.remove("name") {
         Some(Value::String(s)) => s,
@@ -104,7 +104,7 @@ pub fn graph_of_json(v: Value) -> Result<PlaneGraph> {
 }
 
 /// The graph document of `g`: what [`graph_of_json`] reads back as the same graph.
-pub fn graph_to_json(g: &PlaneGraph) -> Value {
+pub(crate) fn graph_to_json(g: &PlaneGraph) -> Value {
     let edges: Vec<Value> = g
         .edges
         .iter()

@@ -30,7 +30,7 @@ use crate::spline::knots::KnotVector;
 /// The `map` object of a THB map document.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ThbJson {
+pub(crate) struct ThbJson {
     /// Always `"thb"`.
     pub kind: String,
     /// `[p, q]`.
@@ -55,7 +55,7 @@ struct ThbDoc {
 }
 
 /// Whether a JSON value is a THB map document (`map.kind == "thb"`).
-pub fn is_thb_json(v: &Value) -> bool {
+pub(crate) fn is_thb_json(v: &Value) -> bool {
     v.get("map").and_then(|m| m.get("kind")).and_then(Value::as_str) == Some("thb")
 }
 
@@ -73,8 +73,9 @@ fn map_of(map: ThbJson, ctx: &str) -> Result<HierarchicalMap> {
     HierarchicalMap::new(basis, map.control_points).map_err(|e| e.within(ctx))
 }
 
+#[cfg(test)]
 /// Parse a THB map document (JSON or G+Smo XML): its name (empty when none) and map.
-pub fn parse_thb(text: &str) -> Result<(String, HierarchicalMap)> {
+pub(crate) fn parse_thb(text: &str) -> Result<(String, HierarchicalMap)> {
     let body = text.trim_start_matches('\u{feff}').trim_start();
     if body.starts_with('<') {
         return Ok((String::new(), parse_thb_xml(body)?));
@@ -93,7 +94,7 @@ pub(crate) fn thb_of_json(v: Value) -> Result<(String, HierarchicalMap)> {
 }
 
 /// The JSON document of a THB map; `extra` (e.g. `{"report": ...}`) is merged at the top.
-pub fn thb_to_json(name: &str, map: &HierarchicalMap, extra: Option<Value>) -> Value {
+pub(crate) fn thb_to_json(name: &str, map: &HierarchicalMap, extra: Option<Value>) -> Value {
     let b = &map.basis;
     let mut refined: Vec<Vec<Index2>> = (0..b.num_levels()).map(|l| b.refined_list(l)).collect();
     while refined.last().is_some_and(Vec::is_empty) {
@@ -115,7 +116,7 @@ pub fn thb_to_json(name: &str, map: &HierarchicalMap, extra: Option<Value>) -> V
 }
 
 /// The G+Smo XML document (`THBSpline2`) of a THB map; `comment` goes into an XML comment.
-pub fn thb_to_gismo_xml(map: &HierarchicalMap, comment: &str) -> String {
+pub(crate) fn thb_to_gismo_xml(map: &HierarchicalMap, comment: &str) -> String {
     let b = &map.basis;
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<xml>\n");
     if !comment.is_empty() {
@@ -154,7 +155,7 @@ fn integers(node: Node, ctx: &str) -> Result<Vec<usize>> {
 }
 
 /// Parse a G+Smo XML document with one `THBSpline2` geometry.
-pub fn parse_thb_xml(text: &str) -> Result<HierarchicalMap> {
+pub(crate) fn parse_thb_xml(text: &str) -> Result<HierarchicalMap> {
     if super::gismo::nesting_exceeds(text, MAX_DEPTH) {
         return Err(xml_err("", format!("elements are nested more than {MAX_DEPTH} levels deep")));
     }

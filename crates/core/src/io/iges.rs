@@ -22,7 +22,7 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
 
 /// Entity type of a rational B-spline surface.
-pub const RATIONAL_BSPLINE_SURFACE: usize = 128;
+pub(crate) const RATIONAL_BSPLINE_SURFACE: usize = 128;
 
 /// Hollerith string `nHtext` of the Global section.
 fn hollerith(s: &str) -> String {
@@ -54,7 +54,7 @@ fn section(letter: char, k: usize) -> String {
 
 /// The IGES document of `map` as one entity 128. `comment` goes into the Start section
 /// (e.g. the certificate's verdict); `name` is the file name of the Global section.
-pub fn surface_to_iges(map: &Surface, name: &str, comment: &str) -> String {
+pub(crate) fn surface_to_iges(map: &Surface, name: &str, comment: &str) -> String {
     let e = |x: f64| number(x).replace('e', "E");
     let [kx, ky] = &map.knots;
     let (n1, n2) = (kx.num_basis(), ky.num_basis());
@@ -168,7 +168,7 @@ fn iges_err(message: impl Into<String>) -> Error {
 
 /// Whether `text` looks like an IGES file: its first record has the section letter `S`
 /// in column 73.
-pub fn is_iges(text: &str) -> bool {
+pub(crate) fn is_iges(text: &str) -> bool {
     text.lines().next().is_some_and(|l| l.len() >= 73 && l.as_bytes()[72] == b'S')
 }
 

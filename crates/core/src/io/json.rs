@@ -18,7 +18,7 @@ use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
 
 /// Number of points an analytic side is sampled with when written (`t = k / 1024`).
-pub const ANALYTIC_WRITE_POINTS: usize = 1025;
+pub(crate) const ANALYTIC_WRITE_POINTS: usize = 1025;
 
 fn is_false(b: &bool) -> bool {
     !*b
@@ -155,7 +155,7 @@ fn too_large(what: &str, found: usize) -> Error {
 
 impl CurveJson {
     /// The JSON form of a curve.
-    pub fn from_curve(c: &Curve) -> Self {
+    pub(crate) fn from_curve(c: &Curve) -> Self {
         CurveJson {
             degree: c.degree(),
             knots: c.knots.knots().to_vec(),
@@ -166,7 +166,7 @@ impl CurveJson {
     }
 
     /// Validate (lengths, knots, degree, finiteness, weights) and map the domain to `[0, 1]`.
-    pub fn to_curve(self) -> Result<Curve> {
+    pub(crate) fn into_curve(self) -> Result<Curve> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let kv = KnotVector::with_periodic(self.degree, self.knots, self.periodic).map_err(|e| e.within("knots"))?;
         let c = Curve::new(kv, self.control_points, self.weights)?;
@@ -177,7 +177,7 @@ impl CurveJson {
 impl SideJson {
     /// The JSON form of a side; analytic sides become point clouds of
     /// [`ANALYTIC_WRITE_POINTS`] points at uniform parameters.
-    pub fn from_side(s: &SideCurve) -> Self {
+    pub(crate) fn from_side(s: &SideCurve) -> Self {
         match s {
             SideCurve::Spline(c) => SideJson::Curve(CurveJson::from_curve(c)),
             SideCurve::Points(p) => SideJson::Points(PointsJson { points: p.clone() }),
@@ -190,9 +190,9 @@ impl SideJson {
 
     /// Convert to a side: curves are validated and normalized to `[0, 1]`; point clouds
     /// are only checked for size here (the rest is [`crate::boundary::validate::validate`]'s job).
-    pub fn to_side(self) -> Result<SideCurve> {
+    pub(crate) fn into_side(self) -> Result<SideCurve> {
         match self {
-            SideJson::Curve(c) => c.to_curve().map(SideCurve::Spline),
+            SideJson::Curve(c) => c.into_curve().map(SideCurve::Spline),
             SideJson::Points(p) => {
                 crate::error::check_point_count(p.points.len(), "")?;
                 Ok(SideCurve::Points(p.points))
@@ -201,22 +201,9 @@ impl SideJson {
     }
 }
 
-impl BoundaryDoc {
-    /// Convert to a boundary (sides converted by [`SideJson::to_side`]; errors name the side).
-    pub fn to_boundary(self) -> Result<Boundary> {
-        let SidesJson { south, east, north, west } = self.boundary;
-        let mut sides = Vec::with_capacity(4);
-        for (s, j) in Side::ALL.into_iter().zip([south, east, north, west]) {
-            sides.push(j.to_side().map_err(|e| e.within(&format!("boundary.{s}")))?);
-        }
-        let sides: [SideCurve; 4] = sides.try_into().map_err(|_| Error::Invalid("four sides expected".into()))?;
-        Ok(Boundary { name: self.name, sides })
-    }
-}
-
 impl ContourDoc {
     /// Split the polygon into the four sides ([`split_contour`]).
-    pub fn to_boundary(self) -> Result<Boundary> {
+    pub(crate) fn into_boundary(self) -> Result<Boundary> {
         let sides = split_contour(&self.contour.points, self.contour.corners)?;
         Ok(Boundary { name: self.name, sides: sides.map(SideCurve::Points) })
     }
@@ -304,14 +291,14 @@ pub fn parse_json(text: &str) -> Result<Document> {
                 .remove(s.name())
                 .ok_or_else(|| Error::Json { context: "boundary".into(), message: format!("missing side \"{s}\"") })?;
             let side = SideJson::from_value(v).map_err(json_err(&ctx))?;
-            out.push(side.to_side().map_err(|e| e.within(&ctx))?);
+            out.push(side.into_side().map_err(|e| e.within(&ctx))?);
         }
         let sides: [SideCurve; 4] = out.try_into().map_err(|_| Error::Invalid("four sides expected".into()))?;
         return Ok(Document::Boundary(Boundary { name, sides }));
     }
     if let Some(c) = obj.remove("contour") {
         let contour: ContourJson = serde_json::from_value(c).map_err(json_err("contour"))?;
-        return ContourDoc { name, contour }.to_boundary().map(Document::Boundary);
+        return ContourDoc { name, contour }.into_boundary().map(Document::Boundary);
     }
     Err(Error::Json {
         context: String::new(),
@@ -383,7 +370,7 @@ pub(crate) fn side_to_json(s: &SideCurve) -> Value {
 }
 
 /// A boundary document `{"name", "boundary": {...}}`; analytic sides are written as
-/// point clouds of [`ANALYTIC_WRITE_POINTS`] points.
+/// point clouds of `ANALYTIC_WRITE_POINTS` points.
 pub fn boundary_to_json(b: &Boundary) -> Value {
     json!({
         "name": b.name,
@@ -398,7 +385,7 @@ pub fn boundary_to_json(b: &Boundary) -> Value {
 
 /// A contour document: the sides concatenated counter-clockwise (south, east, reversed
 /// north, reversed west, shared corners once, first point not repeated). Spline and
-/// analytic sides are sampled at [`ANALYTIC_WRITE_POINTS`] uniform parameters.
+/// analytic sides are sampled at `ANALYTIC_WRITE_POINTS` uniform parameters.
 pub fn boundary_to_contour_json(b: &Boundary) -> Value {
     let pts: Vec<Vec<Point>> = b
         .sides

@@ -43,10 +43,10 @@ impl Default for PictureOptions {
 }
 
 /// Colour of a kink kept exactly ([`PictureOptions::kinks`]).
-pub const KEPT_KINK_COLOUR: [u8; 3] = [200, 0, 0];
+pub(crate) const KEPT_KINK_COLOUR: [u8; 3] = [200, 0, 0];
 
 /// Colour of a kink rounded by the fit.
-pub const ROUNDED_KINK_COLOUR: [u8; 3] = [240, 140, 0];
+pub(crate) const ROUNDED_KINK_COLOUR: [u8; 3] = [240, 140, 0];
 
 /// Colour of non-positive `det J`.
 pub const FOLD_COLOUR: [u8; 3] = [255, 0, 255];
@@ -212,7 +212,7 @@ pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOption
 }
 
 /// [`render_sampled`] of several patches in one picture (one colour scale).
-pub fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], opts: &PictureOptions) -> Image {
+pub(crate) fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], opts: &PictureOptions) -> Image {
     for (pts, det) in patches {
         assert_eq!(pts.len(), (n + 1) * (n + 1), "render_sampled: {} points for n = {n}", pts.len());
         assert_eq!(det.len(), pts.len(), "render_sampled: det and points differ in length");

@@ -6,7 +6,7 @@
 //! a closed loop exported by CAD systems, e.g. the G+Smo loops), or `{"points": [...]}`,
 //! an ordered closed point cloud; a last point equal to the first (within `1e-12` of
 //! the cloud's extent) is dropped. Closedness, orientation and nesting are checked by
-//! [`crate::boundary::ring_fit::fit_ring`].
+//! [`crate::boundary::ring_fit::check_ring`].
 
 use serde_json::{json, Value};
 
@@ -31,7 +31,7 @@ fn closed(v: Value, ctx: &str) -> Result<ClosedContour> {
         }
         Value::Object(_) => {
             let c: CurveJson = serde_json::from_value(v).map_err(jerr)?;
-            Ok(ClosedContour::Spline(c.to_curve().map_err(|e| e.within(ctx))?))
+            Ok(ClosedContour::Spline(c.into_curve().map_err(|e| e.within(ctx))?))
         }
         other => Err(Error::Json {
             context: ctx.into(),
@@ -78,7 +78,7 @@ pub(crate) fn ring_of_json(v: Value) -> Result<Ring> {
 }
 
 /// The JSON form of a ring; analytic contours become point clouds of 1024 points.
-pub fn ring_to_json(ring: &Ring) -> Value {
+pub(crate) fn ring_to_json(ring: &Ring) -> Value {
     let c = |c: &ClosedContour| match c {
         ClosedContour::Spline(c) => serde_json::to_value(CurveJson::from_curve(c)).expect("serializable"),
         ClosedContour::Points(p) => json!({ "points": p }),

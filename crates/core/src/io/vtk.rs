@@ -15,15 +15,15 @@ use std::fmt::Write as _;
 
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::bezier::{bernstein, BezierExtraction};
+use crate::spline::bezier::bernstein;
 use crate::spline::surface::Surface;
 use crate::verify::quality::sample_det_j;
 
 /// VTK cell type of a Bézier quadrilateral.
-pub const VTK_BEZIER_QUADRILATERAL: u8 = 77;
+pub(crate) const VTK_BEZIER_QUADRILATERAL: u8 = 77;
 
 /// Legacy-VTK structured grid of the map sampled on `(n + 1)²` points with `det J`.
-pub fn structured_grid_vtk(map: &Surface, n: usize) -> String {
+pub(crate) fn structured_grid_vtk(map: &Surface, n: usize) -> String {
     let s = sample_det_j(map, n);
     let mut out = String::new();
     let _ = writeln!(out, "# vtk DataFile Version 3.0\nwinslow map\nASCII\nDATASET STRUCTURED_GRID");
@@ -45,7 +45,7 @@ pub fn structured_grid_vtk(map: &Surface, n: usize) -> String {
 /// `(p, q)`: the four corners, then the edges `j = 0`, `i = p`, `j = q`, `i = 0` (each
 /// with its free index increasing), then the interior with `i` fastest
 /// (`vtkHigherOrderQuadrilateral::PointIndexFromIJK`).
-pub fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
+pub(crate) fn vtk_quad_index(i: usize, j: usize, p: usize, q: usize) -> usize {
     let ib = i == 0 || i == p;
     let jb = j == 0 || j == q;
     match (ib, jb) {
@@ -103,39 +103,14 @@ struct BezierElement {
 
 /// The Bézier elements of `map`, element rows in `eta`, `xi` fastest.
 fn bezier_elements(map: &Surface) -> Result<Vec<BezierElement>> {
-    let ex = [BezierExtraction::new(&map.knots[0])?, BezierExtraction::new(&map.knots[1])?];
+    let ex = map.extraction()?;
     let [p, q] = map.degrees();
-    let nx = map.shape()[0];
     let (inv_u, inv_v) = (bernstein_interpolation(p), bernstein_interpolation(q));
-    let w = |k: usize| map.weights.as_ref().map_or(1.0, |w| w[k]);
     let mut out = Vec::with_capacity(ex[0].elements.len() * ex[1].elements.len());
     let (mut bu, mut bv) = (BasisDerivs::default(), BasisDerivs::default());
     for (e1, &(s1, v0, v1)) in ex[1].elements.iter().enumerate() {
         for (e0, &(s0, u0, u1)) in ex[0].elements.iter().enumerate() {
-            let (c0, c1) = (&ex[0].ops[e0], &ex[1].ops[e1]);
-            let mut hom = vec![[0.0f64; 3]; (p + 1) * (q + 1)];
-            for l in 0..=q {
-                for k in 0..=p {
-                    let h = &mut hom[l * (p + 1) + k];
-                    for i in 0..=q {
-                        let b = c1[i * (q + 1) + l];
-                        if b == 0.0 {
-                            continue;
-                        }
-                        for j in 0..=p {
-                            let a = c0[j * (p + 1) + k];
-                            if a == 0.0 {
-                                continue;
-                            }
-                            let g = (s1 - q + i) * nx + (s0 - p + j);
-                            let (c, wg) = (map.control_points[g], w(g));
-                            h[0] += a * b * wg * c[0];
-                            h[1] += a * b * wg * c[1];
-                            h[2] += a * b * wg;
-                        }
-                    }
-                }
-            }
+            let hom = map.bezier_net(&ex, [e0, e1]);
             // det J at the uniform nodes, evaluated inside this element's span
             let mut vals = vec![0.0; (p + 1) * (q + 1)];
             for b in 0..=q {
@@ -163,8 +138,8 @@ fn bezier_elements(map: &Surface) -> Result<Vec<BezierElement>> {
                 }
             }
             out.push(BezierElement {
-                points: hom.iter().map(|h| [h[0] / h[2], h[1] / h[2]]).collect(),
-                weights: hom.iter().map(|h| h[2]).collect(),
+                points: hom.iter().map(|(h, w)| [h[0] / w, h[1] / w]).collect(),
+                weights: hom.iter().map(|h| h.1).collect(),
                 det_j,
             });
         }
@@ -174,7 +149,7 @@ fn bezier_elements(map: &Surface) -> Result<Vec<BezierElement>> {
 
 /// The map as a VTK XML unstructured grid of Bézier quadrilaterals (see the module
 /// documentation). `comment` (e.g. the certificate's verdict) goes into an XML comment.
-pub fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
+pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     let elements = bezier_elements(map)?;
     let [p, q] = map.degrees();
     let npe = (p + 1) * (q + 1);
@@ -294,7 +269,7 @@ pub(crate) mod tests {
             let a = arrays(&vtu);
             let [p, q] = map.degrees();
             let npe = (p + 1) * (q + 1);
-            let ex = [BezierExtraction::new(&map.knots[0]).unwrap(), BezierExtraction::new(&map.knots[1]).unwrap()];
+            let ex = map.extraction().unwrap();
             let ne = ex[0].elements.len() * ex[1].elements.len();
             assert_eq!(a["types"], vec![77.0; ne]);
             assert_eq!(a["offsets"].last().copied(), Some((ne * npe) as f64));

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 /// Symmetric banded matrix, `band[i][d] = A[i][i + d]` for `d <= bw`: the normal
 /// equations of a least-squares fit in a B-spline basis of degree `p` have bandwidth `p`.
 #[derive(Debug, Clone)]
-pub struct Banded {
+pub(crate) struct Banded {
     /// Bandwidth.
     pub bw: usize,
     /// `band[i][d] = A[i][i + d]`.
@@ -34,7 +34,7 @@ impl Banded {
 
     /// Solve `A[lo..hi, lo..hi] x = rhs` (`rhs.len() == hi - lo`, two right-hand sides,
     /// the `x` and `y` coordinates) by banded Cholesky `A = L Lᵀ`, `O(n bw²)`.
-    pub fn solve_block(&self, lo: usize, hi: usize, rhs: &mut [[f64; 2]]) -> Result<()> {
+    pub(crate) fn solve_block(&self, lo: usize, hi: usize, rhs: &mut [[f64; 2]]) -> Result<()> {
         let n = hi - lo;
         let bw = self.bw;
         // l[i][d] = L(i, i - d)

@@ -20,11 +20,11 @@ use crate::linalg::sparse::Csr;
 /// and 334 -> 171 µs for the first (faer's symbolic analysis); cooks_membrane, 2
 /// unknowns, 8 -> 4.6 µs (time stamps around each step, a throwaway probe;
 /// BENCHMARKS.md, "Same-basis race against G+Smo").
-pub const DENSE_LIMIT: usize = 64;
+pub(crate) const DENSE_LIMIT: usize = 64;
 
 /// The factors `P A = L U` of a square matrix, row-major.
 #[derive(Debug, Clone, Default)]
-pub struct DenseLu {
+pub(crate) struct DenseLu {
     n: usize,
     /// `L` (strictly below the diagonal, unit diagonal implied) and `U` (on and above).
     lu: Vec<f64>,
@@ -110,7 +110,7 @@ impl DenseLu {
 /// The Cholesky factor `A = L Lᵀ` of a symmetric positive definite matrix (or of `-A`,
 /// see [`DenseCholesky::factor`]), `L` lower triangular, row-major.
 #[derive(Debug, Clone, Default)]
-pub struct DenseCholesky {
+pub(crate) struct DenseCholesky {
     n: usize,
     l: Vec<f64>,
 }

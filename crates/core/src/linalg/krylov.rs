@@ -24,7 +24,7 @@ impl MatVec for Csr {
 
 /// Incomplete LU factorization with zero fill-in on the pattern of `a`.
 #[derive(Debug, Clone)]
-pub struct Ilu0 {
+pub(crate) struct Ilu0 {
     lu: Csr,
     diag: Vec<usize>,
 }

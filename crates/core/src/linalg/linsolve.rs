@@ -4,10 +4,10 @@
 //! Cholesky for symmetric positive definite systems, and restarted GMRES for systems past
 //! what LU handles, preconditioned either by the problem's own SPD approximation
 //! `-diag(K, K)` of the Jacobian (a sparse Cholesky of the scalar `K`, see
-//! [`crate::discrete::assembly::Discretization::metric_laplace`]) or by ILU(0).
+//! `crate::discrete::assembly::Discretization::metric_laplace`) or by ILU(0).
 //!
 //! The Cholesky factorizations follow the problem's fill-reducing order when it gives one
-//! ([`LinearSolver::set_ordering`], nested dissection of the spline grid, see
+//! (`LinearSolver::set_ordering`, nested dissection of the spline grid, see
 //! [`crate::linalg::ordering`]), approximate minimum degree otherwise; their symbolic analysis,
 //! numeric storage and scratch memory are allocated once and reused by every
 //! refactorization and solve.
@@ -38,8 +38,8 @@ pub enum LinearMethod {
     /// SPD approximation when it offers one, by ILU(0) otherwise.
     #[cfg_attr(feature = "clap", value(help = "GMRES, preconditioned by the metric Laplacian"))]
     Gmres,
-    /// LU up to [`AUTO_LU_LIMIT`] unknowns, GMRES above; GMRES falls back to LU when it
-    /// does not converge within [`AUTO_MAX_KRYLOV`] iterations.
+    /// LU up to `AUTO_LU_LIMIT` unknowns, GMRES above; GMRES falls back to LU when it
+    /// does not converge within `AUTO_MAX_KRYLOV` iterations.
     #[cfg_attr(
         feature = "clap",
         value(help = "LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations")
@@ -47,7 +47,7 @@ pub enum LinearMethod {
     Auto,
     /// Restarted flexible GMRES as [`LinearMethod::Gmres`], preconditioned by
     /// `-diag(B, B)` with `B` one multigrid V-cycle for the problem's SPD approximation
-    /// `K` on the nested spaces set with [`LinearSolver::set_transfers`]
+    /// `K` on the nested spaces set with `LinearSolver::set_transfers`
     /// (`linalg::multigrid`); without them as [`LinearMethod::Gmres`].
     #[cfg_attr(
         feature = "clap",
@@ -65,30 +65,30 @@ pub enum LinearMethod {
     NegCholesky,
     /// Conjugate gradients for symmetric positive definite systems of `c` components
     /// (`c m` unknowns in component blocks, `m` the length of the ordering given with
-    /// [`LinearSolver::set_ordering`]), preconditioned by the single-precision Cholesky
+    /// `LinearSolver::set_ordering`), preconditioned by the single-precision Cholesky
     /// factors of the `c` diagonal blocks (block Jacobi: for linear elasticity the
     /// iteration count is bounded by Korn's inequality, not by the mesh size). Falls
-    /// back to [`LinearMethod::Cholesky`] when CG does not converge in [`MAX_PCG`]
+    /// back to [`LinearMethod::Cholesky`] when CG does not converge in `MAX_PCG`
     /// iterations.
     #[cfg_attr(feature = "clap", value(skip))]
     Pcg,
 }
 
 /// Iterations after which [`LinearMethod::Pcg`] gives up for a direct factorization.
-pub const MAX_PCG: usize = 500;
+pub(crate) const MAX_PCG: usize = 500;
 
 /// Largest system that [`LinearMethod::Auto`] factorizes directly. Preconditioned GMRES
 /// overtakes faer's sparse LU on the EGG Jacobian at about 64 unknowns (measured on the
 /// shared G+Smo geometries on their input bases: 96 unknowns 1.9 against 2.1 ms per
 /// solve, 384: 5.1 against 12 ms, 988: 29 against 71 ms; 32-50 unknowns: LU faster by
 /// 0.1-0.6 ms).
-pub const AUTO_LU_LIMIT: usize = 64;
+pub(crate) const AUTO_LU_LIMIT: usize = 64;
 
 /// Default relative residual at which GMRES stops.
-pub const KRYLOV_TOL: f64 = 1e-10;
+pub(crate) const KRYLOV_TOL: f64 = 1e-10;
 
 /// GMRES iterations per solve after which [`LinearMethod::Gmres`] gives up.
-pub const MAX_KRYLOV: usize = 2000;
+pub(crate) const MAX_KRYLOV: usize = 2000;
 
 /// GMRES iterations per solve after which [`LinearMethod::Auto`] factorizes the system
 /// by LU instead (for the rest of the solve); `n / 8` (at least 100) for `n < 4000`
@@ -96,7 +96,7 @@ pub const MAX_KRYLOV: usize = 2000;
 /// at most 30 iterations on the shared geometries; one that takes this many has a
 /// preconditioner that does not fit the operator (the weak form, eq. 14, on cells of
 /// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
-pub const AUTO_MAX_KRYLOV: usize = 500;
+pub(crate) const AUTO_MAX_KRYLOV: usize = 500;
 
 /// Smoother of [`LinearMethod::Multigrid`]: alternating line Gauss–Seidel. On the metric
 /// Laplacians of the Newton solves themselves (puzzle4 at 3 600, 57 600 and 230 400
@@ -109,10 +109,10 @@ pub const AUTO_MAX_KRYLOV: usize = 500;
 pub(crate) const MG_SMOOTHER: Smoother = Smoother::Lines;
 
 /// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
-pub const MG_SWEEPS: usize = 1;
+pub(crate) const MG_SWEEPS: usize = 1;
 
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
-pub const REFRESH_KRYLOV: usize = 30;
+pub(crate) const REFRESH_KRYLOV: usize = 30;
 
 /// A GMRES preconditioner.
 #[derive(Debug)]
@@ -239,14 +239,14 @@ impl LinearSolver {
     /// factorizations: of the scalar preconditioner `K` (size `m`) directly, of a system
     /// of `c` component blocks (size `c m`) point by point ([`crate::linalg::ordering::interleave`]).
     /// Without it, approximate minimum degree.
-    pub fn set_ordering(&mut self, order: &[usize]) {
+    pub(crate) fn set_ordering(&mut self, order: &[usize]) {
         self.order = Some(order.to_vec());
     }
 
     /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l]` maps the free
     /// scalar unknowns of space `l + 1` to those of space `l`, space 0 the one of the
     /// problem's `m` scalar unknowns (see `discrete::transfers`).
-    pub fn set_transfers(&mut self, transfers: Vec<Csr>) {
+    pub(crate) fn set_transfers(&mut self, transfers: Vec<Csr>) {
         self.transfers = transfers;
     }
 
@@ -304,7 +304,7 @@ impl LinearSolver {
     /// for a system of `n` unknowns: only GMRES uses one, and it keeps the last one
     /// (a frozen preconditioner across Newton steps) while GMRES needs at most
     /// [`REFRESH_KRYLOV`] iterations with it.
-    pub fn wants_preconditioner(&self, n: usize) -> bool {
+    pub(crate) fn wants_preconditioner(&self, n: usize) -> bool {
         let fresh = !self.precond.as_ref().is_some_and(Preconditioner::is_block) || self.last_krylov > REFRESH_KRYLOV;
         match self.method {
             LinearMethod::Gmres | LinearMethod::Multigrid => fresh,
@@ -320,7 +320,7 @@ impl LinearSolver {
 
     /// As [`LinearSolver::factor`]; GMRES uses `P = -diag(K, K)` as preconditioner when
     /// `k` (SPD, `a.nrows` a multiple of its size) is given.
-    pub fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
+    pub(crate) fn factor_preconditioned(&mut self, a: &Csr, k: Option<&Csr>) -> Result<()> {
         self.resolve(a.nrows);
         if matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid | LinearMethod::Pcg) {
             // the Krylov methods multiply with `a`: keep it
@@ -341,7 +341,7 @@ impl LinearSolver {
     /// The solver's storage of the system matrix: fill it (with
     /// [`Csr::update`] the pattern is copied once) and call
     /// [`LinearSolver::factor_stored`], without a copy of the matrix per factorization.
-    pub fn matrix_mut(&mut self) -> &mut Csr {
+    pub(crate) fn matrix_mut(&mut self) -> &mut Csr {
         self.matrix.get_or_insert_with(Csr::default)
     }
 
@@ -349,7 +349,7 @@ impl LinearSolver {
     /// [`LinearSolver::matrix_mut`]; GMRES uses `P = -diag(K, K)` as preconditioner when
     /// `k` (SPD, `a.nrows` a multiple of its size) is given. The CSR storage of `a` is
     /// the CSC storage of `a^T`; faer factors `a^T` and we solve with its transpose.
-    pub fn factor_stored(&mut self, k: Option<&Csr>) -> Result<()> {
+    pub(crate) fn factor_stored(&mut self, k: Option<&Csr>) -> Result<()> {
         let a = self.matrix.take().ok_or_else(|| Error::LinearSolver("no matrix to factor".into()))?;
         let r = self.factor_matrix(&a, k);
         self.matrix = Some(a);
@@ -441,7 +441,7 @@ impl LinearSolver {
     ///
     /// Errors: [`Error::LinearSolver`] for the other methods, and when there is no
     /// preconditioner to keep or `k` is not definite (ILU(0) would need the matrix).
-    pub fn factor_operator(&mut self, n: usize, k: Option<&Csr>) -> Result<()> {
+    pub(crate) fn factor_operator(&mut self, n: usize, k: Option<&Csr>) -> Result<()> {
         self.resolve(n);
         if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid) {
             return Err(Error::LinearSolver(format!("{:?} needs the matrix, not an operator", self.method)));
@@ -457,7 +457,7 @@ impl LinearSolver {
     ///
     /// Errors: [`Error::LinearSolver`] for the other methods, or when a block is not
     /// positive definite.
-    pub fn factor_blocks(&mut self, blocks: &[Csr]) -> Result<()> {
+    pub(crate) fn factor_blocks(&mut self, blocks: &[Csr]) -> Result<()> {
         if self.method != LinearMethod::Pcg {
             return Err(Error::LinearSolver(format!("{:?} has no block-Jacobi preconditioner", self.method)));
         }
@@ -507,7 +507,7 @@ impl LinearSolver {
     /// the preconditioner for): the same iterates as [`LinearSolver::solve`] with the
     /// matrix whose product `a` computes, without its fallback to a direct factorization
     /// (an error instead).
-    pub fn solve_operator(&mut self, a: &dyn MatVec, b: &[f64]) -> Result<Vec<f64>> {
+    pub(crate) fn solve_operator(&mut self, a: &dyn MatVec, b: &[f64]) -> Result<Vec<f64>> {
         if !matches!(self.method, LinearMethod::Gmres | LinearMethod::Multigrid | LinearMethod::Pcg) {
             return Err(Error::LinearSolver(format!("{:?} solves with a matrix, not an operator", self.method)));
         }
@@ -629,7 +629,7 @@ fn diagonal_block(a: &Csr, first: usize, m: usize) -> Csr {
 
 /// Dense solve `A X = B` (`A` is `n x n`, row-major; `B` is `n x m`) by faer's LU with
 /// partial pivoting.
-pub fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
+pub(crate) fn dense_solve(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
     use faer::linalg::solvers::Solve;
     let n = a.len();
     let m = b.first().map_or(0, |r| r.len());

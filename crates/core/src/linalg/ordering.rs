@@ -16,7 +16,7 @@ const LEAF: usize = 64;
 /// Nested-dissection order of the grid points `nodes` (`[i, j]` per unknown) for a
 /// matrix that couples points up to `reach = [p, q]` apart in each direction. Returns
 /// `order` with `order[new] = old`, a permutation of `0..nodes.len()`.
-pub fn nested_dissection(nodes: &[[usize; 2]], reach: [usize; 2]) -> Vec<usize> {
+pub(crate) fn nested_dissection(nodes: &[[usize; 2]], reach: [usize; 2]) -> Vec<usize> {
     let mut work: Vec<([usize; 2], usize)> = nodes.iter().enumerate().map(|(k, &ij)| (ij, k)).collect();
     let mut order = Vec::with_capacity(nodes.len());
     dissect(&mut work, reach, &mut order);

@@ -20,7 +20,7 @@ pub struct Csr {
 
 impl Csr {
     /// Build from `(row, col, value)` triplets; duplicates are summed.
-    pub fn from_triplets(nrows: usize, ncols: usize, triplets: &[(usize, usize, f64)]) -> Self {
+    pub(crate) fn from_triplets(nrows: usize, ncols: usize, triplets: &[(usize, usize, f64)]) -> Self {
         let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nrows];
         for &(i, j, v) in triplets {
             debug_assert!(i < nrows && j < ncols);
@@ -30,7 +30,7 @@ impl Csr {
     }
 
     /// Build from per-row lists of `(col, value)`; duplicates are summed.
-    pub fn from_rows(ncols: usize, rows: Vec<Vec<(usize, f64)>>) -> Self {
+    pub(crate) fn from_rows(ncols: usize, rows: Vec<Vec<(usize, f64)>>) -> Self {
         let nrows = rows.len();
         let mut row_ptr = Vec::with_capacity(nrows + 1);
         let mut col_idx = Vec::new();
@@ -58,7 +58,7 @@ impl Csr {
     }
 
     /// Number of stored entries.
-    pub fn nnz(&self) -> usize {
+    pub(crate) fn nnz(&self) -> usize {
         self.col_idx.len()
     }
 
@@ -84,7 +84,7 @@ impl Csr {
     }
 
     /// Overwrite with a copy of `src`, reusing this matrix's allocations.
-    pub fn assign(&mut self, src: &Csr) {
+    pub(crate) fn assign(&mut self, src: &Csr) {
         self.nrows = src.nrows;
         self.ncols = src.ncols;
         self.row_ptr.clone_from(&src.row_ptr);
@@ -96,7 +96,7 @@ impl Csr {
     /// pattern of one problem, recognised by its row pointers; the column indices are
     /// compared in debug builds only), with a full [`Csr::assign`] otherwise. Copies a
     /// third of what `assign` copies.
-    pub fn update(&mut self, src: &Csr) {
+    pub(crate) fn update(&mut self, src: &Csr) {
         if self.ncols == src.ncols && self.values.len() == src.values.len() && self.row_ptr == src.row_ptr {
             debug_assert_eq!(self.col_idx, src.col_idx);
             self.values.copy_from_slice(&src.values);
@@ -106,7 +106,7 @@ impl Csr {
     }
 
     /// `y = A x`; rows in parallel above `2^16` entries.
-    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+    pub(crate) fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         debug_assert_eq!(x.len(), self.ncols);
         const CHUNK: usize = 2048;
         if self.nnz() < 1 << 16 {
@@ -145,20 +145,6 @@ impl Csr {
         y
     }
 
-    /// Apply to 2-D points (each coordinate separately).
-    pub fn apply_points(&self, x: &[[f64; 2]]) -> Vec<[f64; 2]> {
-        (0..self.nrows)
-            .map(|i| {
-                let mut p = [0.0; 2];
-                for (j, v) in self.row(i) {
-                    p[0] += v * x[j][0];
-                    p[1] += v * x[j][1];
-                }
-                p
-            })
-            .collect()
-    }
-
     /// The transpose.
     pub fn transpose(&self) -> Self {
         let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.ncols];
@@ -172,7 +158,7 @@ impl Csr {
 
     /// Kronecker product `self ⊗ other`: entry `(i1*m + i2, j1*n + j2) = a[i1,j1] b[i2,j2]`.
     /// For tensor-product bases with `xi` fastest, the 2-D prolongation is `P_eta ⊗ P_xi`.
-    pub fn kron(&self, other: &Self) -> Self {
+    pub(crate) fn kron(&self, other: &Self) -> Self {
         let nrows = self.nrows * other.nrows;
         let ncols = self.ncols * other.ncols;
         let mut row_ptr = Vec::with_capacity(nrows + 1);
@@ -193,8 +179,9 @@ impl Csr {
         Self { nrows, ncols, row_ptr, col_idx, values }
     }
 
+    #[cfg(test)]
     /// Product `self * other`.
-    pub fn matmul(&self, other: &Self) -> Self {
+    pub(crate) fn matmul(&self, other: &Self) -> Self {
         assert_eq!(self.ncols, other.nrows);
         let rows = (0..self.nrows)
             .map(|i| {
@@ -210,8 +197,9 @@ impl Csr {
         Self::from_rows(other.ncols, rows)
     }
 
+    #[cfg(test)]
     /// A dense copy (row-major), for tests and small problems.
-    pub fn to_dense(&self) -> Vec<Vec<f64>> {
+    pub(crate) fn to_dense(&self) -> Vec<Vec<f64>> {
         let mut d = vec![vec![0.0; self.ncols]; self.nrows];
         for i in 0..self.nrows {
             for (j, v) in self.row(i) {

@@ -103,7 +103,7 @@ impl std::fmt::Debug for SplitCholesky {
 /// unknowns form exactly two connected components, `[0, k)` and `[k, t)` (the halves),
 /// the rest `[t, n)` being the separator. `None` when the order has no such part, or the
 /// halves are unbalanced (each at least `n / 8`) or the separator large (over `n / 4`).
-pub fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
+pub(crate) fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
     let n = order.len();
     let inv = ordering::inverse(order);
     let mut parent: Vec<usize> = (0..n).collect();
@@ -152,7 +152,7 @@ pub fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
 
 impl SplitCholesky {
     /// Symbolic analysis of the SPD pattern of `a` in the nested-dissection order `order`
-    /// (`order[new] = old`); `None` when [`top_split`] finds no split or faer's analysis
+    /// (`order[new] = old`); `None` when `top_split` finds no split or faer's analysis
     /// of a half is not supernodal. (Worth it from [`SPLIT_MIN`] unknowns on two threads
     /// or more: the caller decides.)
     pub fn analyze(a: &Csr, order: &[usize]) -> Option<Self> {

@@ -35,13 +35,13 @@ use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
 /// Length of the jet `E` (module documentation).
-pub const JET: usize = 10;
+pub(crate) const JET: usize = 10;
 
 /// The jet `E` of the map at one point (module documentation).
-pub type Jet = [f64; JET];
+pub(crate) type Jet = [f64; JET];
 
 /// A `JET x JET` matrix (the Hessian of a density in the jet).
-pub type JetMatrix = [[f64; JET]; JET];
+pub(crate) type JetMatrix = [[f64; JET]; JET];
 
 /// Which derivatives a density reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -83,14 +83,14 @@ pub(crate) fn jet_at(disc: &Discretization, ex: usize, ey: usize, cps: &[Point],
 }
 
 /// The first derivatives `(x_ξ, x_η, y_ξ, y_η)` held in a jet (its slots 0, 1, 5, 6).
-pub fn first_derivatives(e: &Jet) -> [f64; 4] {
+pub(crate) fn first_derivatives(e: &Jet) -> [f64; 4] {
     [e[0], e[1], e[5], e[6]]
 }
 
 /// `Σ_q w_q ψ(E_q)` over the quadrature points of `disc` for the map with control points
 /// `cps`; `+∞` when `ψ` is not finite at a point (outside the density's domain). Rows of
 /// elements in parallel, summed in order (deterministic).
-pub fn integrate<F>(disc: &Discretization, cps: &[Point], order: Order, psi: F) -> f64
+pub(crate) fn integrate<F>(disc: &Discretization, cps: &[Point], order: Order, psi: F) -> f64
 where
     F: Fn(&Jet) -> f64 + Sync,
 {
@@ -134,8 +134,14 @@ where
 /// is non-empty, `dF/dc = -∇²J` into the vector stencil storage of `disc`, for
 /// `J = ∫ ψ(E)`. `dpsi(E, hessian)` returns `∂ψ/∂E` and, when `hessian` is true,
 /// `∂²ψ/∂E²` (only the slots of `order` are read).
-pub fn assemble<F>(disc: &Discretization, cps: &[Point], order: Order, res: &mut [f64], stencil: &mut [f64], dpsi: F)
-where
+pub(crate) fn assemble<F>(
+    disc: &Discretization,
+    cps: &[Point],
+    order: Order,
+    res: &mut [f64],
+    stencil: &mut [f64],
+    dpsi: F,
+) where
     F: Fn(&Jet, bool) -> (Jet, JetMatrix) + Sync,
 {
     let nd = order.slots();
@@ -202,9 +208,9 @@ where
 }
 
 /// Smallest relative diagonal shift `τ` of a presented Hessian.
-pub const SHIFT_MIN: f64 = 1e-4;
+pub(crate) const SHIFT_MIN: f64 = 1e-4;
 /// Largest relative diagonal shift `τ`.
-pub const SHIFT_MAX: f64 = 1e8;
+pub(crate) const SHIFT_MAX: f64 = 1e8;
 
 /// The Levenberg-Marquardt shift of a minimization problem's Hessian (module
 /// documentation): `-∇²J - τ diag(max(|∇²J_ii|, 10⁻⁸ mean))` presented as the Jacobian.
@@ -221,7 +227,7 @@ pub const SHIFT_MAX: f64 = 1e8;
 /// 34, 23 and 19. The stencil's point
 /// is remembered, so that a raised shift is applied without assembling again.
 #[derive(Debug, Clone)]
-pub struct ShiftedHessian {
+pub(crate) struct ShiftedHessian {
     /// Positions of the diagonal entries in the vector pattern's values.
     diag: Vec<usize>,
     shift: f64,
@@ -234,9 +240,9 @@ pub struct ShiftedHessian {
 
 /// An accepted damping at or below this raises the shift for the next point (the line
 /// search's first backtrack is at most 0.5: any backtracking).
-pub const POOR_MODEL: f64 = 0.5;
+pub(crate) const POOR_MODEL: f64 = 0.5;
 /// The shift a poor model raises a zero shift to.
-pub const FIRST_RAISE: f64 = 1e-3;
+pub(crate) const FIRST_RAISE: f64 = 1e-3;
 
 impl ShiftedHessian {
     /// For the vector pattern of `disc`.
@@ -276,12 +282,12 @@ impl ShiftedHessian {
     }
 
     /// The stencil now holds the Hessian at `c`.
-    pub fn assembled_at(&mut self, c: &[f64]) {
+    pub(crate) fn assembled_at(&mut self, c: &[f64]) {
         self.assembled = Some(c.to_vec());
     }
 
     /// The stencil's storage was overwritten (a residual evaluation elsewhere).
-    pub fn invalidate(&mut self) {
+    pub(crate) fn invalidate(&mut self) {
         self.assembled = None;
     }
 
@@ -291,7 +297,7 @@ impl ShiftedHessian {
     }
 
     /// Raise `τ` tenfold (to [`SHIFT_MIN`] from zero); `false` past [`SHIFT_MAX`].
-    pub fn raise(&mut self) -> bool {
+    pub(crate) fn raise(&mut self) -> bool {
         let Some(next) = raised(self.shift) else { return false };
         self.shift = next;
         self.next = lowered(next);

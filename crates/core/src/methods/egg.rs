@@ -183,7 +183,7 @@ impl DiscreteProblem for EggProblem {
         self.state.control_points(c)
     }
 
-    /// `K` of [`Discretization::metric_laplace`] on the current control points.
+    /// `K` of `Discretization::metric_laplace` on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         let op = self.op;
         Some(self.state.preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))

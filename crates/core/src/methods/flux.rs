@@ -38,7 +38,7 @@ pub(crate) fn gradient_at(disc: &Discretization, ex: usize, ey: usize, cps: &[Po
 /// The first-order form of the module documentation: `F` into `res` (full,
 /// component-interleaved, length `2 n`) and, when `stencil` is non-empty, `dF/dc` into
 /// the vector stencil storage. `flux(e)` returns `G(e)` and `∂G/∂e`.
-pub fn flux_form<G>(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64], flux: G)
+pub(crate) fn flux_form<G>(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64], flux: G)
 where
     G: Fn([f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) + Sync,
 {
@@ -48,7 +48,7 @@ where
 /// [`flux_form`]; with `symmetric` (`∂G/∂e` symmetric, as for the gradient of a
 /// functional) the block `(1, 0)` of the Jacobian is the transpose of block `(0, 1)`
 /// and is not computed: a quarter of the element products saved.
-pub fn flux_form_with<G>(
+pub(crate) fn flux_form_with<G>(
     disc: &Discretization,
     cps: &[Point],
     res: &mut [f64],

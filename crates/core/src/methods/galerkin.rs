@@ -13,7 +13,7 @@ use crate::spline::curve::Point;
 
 /// See the module documentation.
 #[derive(Debug)]
-pub struct GalerkinState {
+pub(crate) struct GalerkinState {
     /// Tables, DOF map and patterns of the basis.
     pub disc: Arc<Discretization>,
     /// All control points; the free ones are overwritten from `c` on every call.
@@ -65,7 +65,7 @@ impl GalerkinState {
     }
 
     /// Load `c` and make sure the stencil storage of the vector system exists.
-    pub fn load_for_jacobian(&mut self, c: &[f64]) {
+    pub(crate) fn load_for_jacobian(&mut self, c: &[f64]) {
         self.load(c);
         if self.stencil.is_empty() {
             self.stencil = vec![0.0; self.disc.stencil_len(2)];
@@ -73,13 +73,13 @@ impl GalerkinState {
     }
 
     /// The free rows of the full residual into `f`.
-    pub fn restrict_residual(&self, f: &mut [f64]) {
+    pub(crate) fn restrict_residual(&self, f: &mut [f64]) {
         f.copy_from_slice(&self.disc.restrict(&self.res_full, 2));
     }
 
     /// The stencil storage gathered into `jac` (the vector pattern is written into it
     /// on the first call only).
-    pub fn gather_jacobian(&self, jac: &mut Csr) {
+    pub(crate) fn gather_jacobian(&self, jac: &mut Csr) {
         let pattern = &self.disc.vector;
         if jac.values.len() != pattern.src.len() || jac.nrows != pattern.csr.nrows {
             jac.assign(&pattern.csr);

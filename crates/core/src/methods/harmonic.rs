@@ -42,7 +42,7 @@ use crate::spline::curve::Point;
 /// The variational harmonic method of eq. (46), minimized by Newton's method from any
 /// start (the functional is defined for folded maps too).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VariationalHarmonicMethod {
+pub(crate) struct VariationalHarmonicMethod {
     /// Weight `λ₁` of the uniformity term (dimensionless; see the module documentation).
     pub lambda1: f64,
     /// Weight `λ₂` of the area-orthogonality term (dimensionless).
@@ -148,7 +148,7 @@ impl Metric {
 /// The density of eq. (46) with weights `(w1, w2)` (already multiplied by the reference
 /// length, [`VariationalHarmonicMethod::weights`]): value, gradient and, when `hessian`,
 /// Hessian in the jet (formulas in the module documentation).
-pub fn vhm_density(e: &Jet, w1: f64, w2: f64, hessian: bool) -> (f64, Jet, JetMatrix) {
+pub(crate) fn vhm_density(e: &Jet, w1: f64, w2: f64, hessian: bool) -> (f64, Jet, JetMatrix) {
     let m = Metric::of(e);
     let [g11, g12, g22] = m.g;
     let mut v = 0.0;
@@ -199,7 +199,7 @@ pub fn vhm_density(e: &Jet, w1: f64, w2: f64, hessian: bool) -> (f64, Jet, JetMa
 }
 
 /// `VH(c)` (eq. 46) of the map with control points `cps` on the quadrature of `disc`.
-pub fn vhm_objective(disc: &Discretization, cps: &[Point], method: &VariationalHarmonicMethod) -> f64 {
+pub(crate) fn vhm_objective(disc: &Discretization, cps: &[Point], method: &VariationalHarmonicMethod) -> f64 {
     let (w1, w2) = method.weights();
     integrate(disc, cps, Order::Second, |e| vhm_density(e, w1, w2, false).0)
 }
@@ -209,7 +209,7 @@ pub fn vhm_objective(disc: &Discretization, cps: &[Point], method: &VariationalH
 /// with `L̃(w) = g₂₂ w_ξξ − 2 g₁₂ w_ξη + g₁₁ w_ηη` (the terms of `2 ∂L_z ∂L_zᵀ` with
 /// two second derivatives, the same for both components); symmetric positive definite for
 /// a non-degenerate metric, since `L̃` is elliptic and `w_a` vanish on the boundary.
-pub fn vhm_principal(disc: &Discretization, cps: &[Point], w1: f64, shift: f64, stencil: &mut [f64]) {
+pub(crate) fn vhm_principal(disc: &Discretization, cps: &[Point], w1: f64, shift: f64, stencil: &mut [f64]) {
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
     let blocks = 1 + if w1 != 0.0 { 3 } else { 0 } + usize::from(shift != 0.0);
@@ -248,7 +248,7 @@ pub fn vhm_principal(disc: &Discretization, cps: &[Point], w1: f64, shift: f64, 
 
 /// VHM on one level: the [`GalerkinState`], the method's weights and the shifted
 /// Hessian.
-pub struct HarmonicProblem {
+pub(crate) struct HarmonicProblem {
     /// Basis, control points and storage.
     pub state: GalerkinState,
     method: VariationalHarmonicMethod,

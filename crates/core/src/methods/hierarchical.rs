@@ -30,7 +30,7 @@ use crate::spline::curve::Point;
 
 /// Control points and storage of a problem on a THB discretization.
 #[derive(Debug)]
-pub struct HierarchicalState {
+pub(crate) struct HierarchicalState {
     /// The discretization.
     pub disc: Arc<HierarchicalDiscretization>,
     /// All control points; the free ones are overwritten from `c` on every call.
@@ -115,7 +115,7 @@ fn gradient(cell: &CellQuadrature, k: usize, cps: &[Point]) -> [f64; 4] {
 
 /// The EGG residual (eq. 8, full, interleaved) and, with a non-empty `values` (of the
 /// vector pattern), its exact Jacobian (eq. 23) on a THB discretization.
-pub fn hierarchical_egg(
+pub(crate) fn hierarchical_egg(
     disc: &HierarchicalDiscretization,
     cps: &[Point],
     op: Operator,
@@ -142,7 +142,7 @@ pub fn hierarchical_egg(
 
 /// EGG (eq. 8) on a THB discretization, plain or scaled operator.
 #[derive(Debug)]
-pub struct HierarchicalEggProblem {
+pub(crate) struct HierarchicalEggProblem {
     /// Discretization, control points and storage.
     pub state: HierarchicalState,
     /// Which operator.
@@ -196,7 +196,7 @@ impl DiscreteProblem for HierarchicalEggProblem {
 /// `J = ∫ W` (eq. 16) on a THB discretization, `+∞` when `det J <= 0` at a quadrature
 /// point; summed cell by cell in order.
 #[cfg(test)]
-pub fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[Point]) -> f64 {
+pub(crate) fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[Point]) -> f64 {
     use rayon::prelude::*;
     let cells: Vec<f64> = disc
         .cells
@@ -223,7 +223,7 @@ pub fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[
 /// [`winslow_gradient_with`](super::winslow::winslow_gradient_with)):
 /// `∂F^z_a/∂c^d_b = -∫ Σ_ij ∂_i w_a (∂²W/∂e_{2z+i}∂e_{2d+j}) ∂_j w_b`.
 #[cfg(test)]
-pub fn hierarchical_winslow_gradient(
+pub(crate) fn hierarchical_winslow_gradient(
     disc: &HierarchicalDiscretization,
     cps: &[Point],
     projected: f64,
@@ -276,7 +276,7 @@ pub fn hierarchical_winslow_gradient(
 /// where Newton finds it not definite.
 #[cfg(test)]
 #[derive(Debug)]
-pub struct HierarchicalWinslowProblem {
+pub(crate) struct HierarchicalWinslowProblem {
     /// Discretization, control points and storage.
     pub state: HierarchicalState,
     diag: Vec<usize>,

@@ -41,7 +41,7 @@ use crate::spline::curve::Point;
 /// Which norm of the metric tensor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum MetricNorm {
+pub(crate) enum MetricNorm {
     /// `∫ g11² + g22² + 2 g12²` (Liao).
     Liao,
     /// `∫ g11² + g22²` (area orthogonality).
@@ -68,7 +68,7 @@ impl MetricNorm {
 
 /// The density `W = g11² + g22² + ω g12²` of `e = (x_ξ, x_η, y_ξ, y_η)` with its gradient
 /// and Hessian in `e` (formulas in the module documentation).
-pub fn metric_density(norm: MetricNorm, e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
+pub(crate) fn metric_density(norm: MetricNorm, e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
     let [a, b, c, d] = e;
     let w12 = norm.omega();
     let (g11, g22, g12) = (a * a + c * c, b * b + d * d, a * b + c * d);
@@ -94,13 +94,13 @@ pub fn metric_density(norm: MetricNorm, e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4
 
 /// `∫ W(∇x) dξ` of a density `W` of `e = (x_ξ, x_η, y_ξ, y_η)` by the quadrature of
 /// `disc`; rows of elements in parallel, summed in order (deterministic).
-pub fn density_integral(disc: &Discretization, cps: &[Point], density: impl Fn([f64; 4]) -> f64 + Sync) -> f64 {
+pub(crate) fn density_integral(disc: &Discretization, cps: &[Point], density: impl Fn([f64; 4]) -> f64 + Sync) -> f64 {
     integrate(disc, cps, Order::First, |e| density(first_derivatives(e)))
 }
 
 /// A metric norm (Liao or area orthogonality) minimized from any start.
 #[derive(Debug, Clone, Copy)]
-pub struct MetricNormMethod(pub MetricNorm);
+pub(crate) struct MetricNormMethod(pub MetricNorm);
 
 impl Method for MetricNormMethod {
     fn name(&self) -> &'static str {
@@ -124,7 +124,7 @@ impl Method for MetricNormMethod {
 
 /// A metric norm on one level: `F = -∇J`, `dF/dc = -∇²J` (exact), objective `J`.
 #[derive(Debug)]
-pub struct MetricNormProblem {
+pub(crate) struct MetricNormProblem {
     norm: MetricNorm,
     /// Basis, control points and storage.
     pub state: GalerkinState,

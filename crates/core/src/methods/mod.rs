@@ -9,7 +9,7 @@
 //! | `metric_norms` | Liao `∫ g11² + g22² + 2 g12²` and area orthogonality `∫ g11² + g22²`, minimized with exact gradient and Hessian (convex; the unconstrained minimizer may fold): `MetricNormMethod` | eq. (3), §10.3 |
 //! | `density` | the shared kernel of functionals `∫ ψ(∇x, ∇²x)` with exact gradient and Hessian, and the Levenberg-Marquardt shift of indefinite Hessians | §10 |
 //! | `harmonic` | variational harmonic method `∫ L(x)² + L(y)² + λ₁ (uniformity) + λ₂ (area orthogonality)`, Newton from any start: `VariationalHarmonicMethod` | eq. (46) |
-//! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: [`QuasiConformalMethod`](quasi_conformal::QuasiConformalMethod) | eq. (47), (48) |
+//! | [`quasi_conformal`] | quasi-conformal functional `∫ (f − k²)²` with the eliminated scalar `k`, Newton from any start: `QuasiConformalMethod` | eq. (47), (48) |
 //! | `hierarchical` | EGG (eq. 8) and the Winslow functional (eq. 16) on a THB discretization, with the same point kernels: `HierarchicalEggProblem`, `HierarchicalWinslowProblem` | §4, eq. (8), (16) |
 //! | [`winslow`] | Winslow functional `∫ (x_ξ² + x_η² + y_ξ² + y_η²) / det J`, minimized with its exact gradient and Hessian (diagonal shift where not definite), `+∞` when `det J <= 0` at a quadrature point: [`WinslowMethod`](winslow::WinslowMethod), [`Start::Bijective`] | eq. (15), (16) |
 //!
@@ -143,13 +143,13 @@ pub trait DiscreteProblem {
         None
     }
     /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
-    /// factorizations (see [`crate::linalg::linsolve::LinearSolver::set_ordering`]).
+    /// factorizations (see `crate::linalg::linsolve::LinearSolver::set_ordering`).
     fn ordering(&self) -> Option<&[usize]> {
         None
     }
     /// The prolongations of the nested spaces below the problem's scalar space, finest
     /// first, for a multigrid preconditioner of [`DiscreteProblem::preconditioner`]'s
-    /// `K` (see [`crate::linalg::linsolve::LinearSolver::set_transfers`]); empty (the
+    /// `K` (see `crate::linalg::linsolve::LinearSolver::set_transfers`); empty (the
     /// default) when the problem has none.
     fn transfers(&self) -> Vec<Csr> {
         Vec::new()

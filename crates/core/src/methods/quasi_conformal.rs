@@ -7,7 +7,7 @@
 //! `f = (N − 2D) / (N + 2D) = |μ|²`, the squared modulus of the Beltrami coefficient
 //! `μ = x_z̄ / x_z`: `f = 0` for a conformal map, `0 <= f < 1` where `D > 0`, `f > 1` where
 //! the map folds, and `f` is undefined only where `N + 2D = 0` (an anti-conformal
-//! point), where [`QuasiConformalMethod`] returns `+∞`. Minimizing `T` makes the
+//! point), where `QuasiConformalMethod` returns `+∞`. Minimizing `T` makes the
 //! distortion `|μ|` as uniform as the boundary allows (a Teichmüller-like map); nothing
 //! in `T` forbids folds, so the certificate decides.
 //!
@@ -25,7 +25,7 @@
 //! `∇²T* = ∫ 2 (∇f ∇fᵀ + (f − f̄) ∇²f) − (2 / ∫ 1) g gᵀ`,  `g = ∫ ∇f`,
 //!
 //! a sparse matrix (the density `(f − s)²` at fixed `s = f̄`, assembled by
-//! `density`) minus a dense rank-one term, which [`QuasiConformalProblem`]
+//! `density`) minus a dense rank-one term, which `QuasiConformalProblem`
 //! presents through [`DiscreteProblem::rank_one`] and the Newton solver applies by the
 //! Sherman-Morrison formula: the steps of the bordered system on the shared sparse
 //! factorizations, without a matrix with a dense row and column, and without an extra
@@ -75,7 +75,7 @@ use crate::spline::curve::Point;
 /// The quasi-conformal functional of eq. (47)-(48), minimized from any start by
 /// Levenberg-Marquardt (or Newton's method), `k` eliminated (module documentation).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct QuasiConformalMethod {
+pub(crate) struct QuasiConformalMethod {
     /// Which Hessian the iteration uses.
     pub hessian: QcHessian,
 }
@@ -117,7 +117,7 @@ const SLOTS: [usize; 4] = [0, 1, 5, 6];
 
 /// `f` of eq. (48) with its gradient and, when `hessian`, Hessian in the jet; `f = +∞`
 /// where the denominator `N + 2D` is not positive.
-pub fn beltrami(e: &Jet, hessian: bool) -> (f64, Jet, JetMatrix) {
+pub(crate) fn beltrami(e: &Jet, hessian: bool) -> (f64, Jet, JetMatrix) {
     let (a, b, c, d) = (e[0], e[1], e[5], e[6]);
     let (pm, pp) = (a - d, b + c);
     let (qp, qm) = (a + d, c - b);
@@ -167,10 +167,11 @@ fn deviation_derivatives(e: &Jet, s: f64, hessian: Option<QcHessian>) -> (Jet, J
     (grad, hess)
 }
 
+#[cfg(test)]
 /// The value of eq. (47) at its optimal `k` and that `k`: `(T*, k)` with
 /// `k² = f̄ = ∫ f / ∫ 1` (module documentation), on the quadrature of `disc`; `T* = +∞`
 /// (and `k` not finite) where `f` is undefined at a quadrature point.
-pub fn quasi_conformal_value(disc: &Discretization, cps: &[Point]) -> (f64, f64) {
+pub(crate) fn quasi_conformal_value(disc: &Discretization, cps: &[Point]) -> (f64, f64) {
     value_on(disc, cps, integrate(disc, cps, Order::First, |_| 1.0))
 }
 
@@ -189,7 +190,7 @@ fn value_on(disc: &Discretization, cps: &[Point], area: f64) -> (f64, f64) {
 
 /// The quasi-conformal functional on one level: the `GalerkinState`, the shifted
 /// Hessian and the rank-one term of the eliminated `k`.
-pub struct QuasiConformalProblem {
+pub(crate) struct QuasiConformalProblem {
     /// Basis, control points and storage.
     pub(crate) state: GalerkinState,
     hessian: ShiftedHessian,
@@ -233,19 +234,10 @@ impl QuasiConformalProblem {
         }
     }
 
+    #[cfg(test)]
     /// The current unknown vector.
     pub fn unknowns(&self) -> Vec<f64> {
         self.state.unknowns()
-    }
-
-    /// `k = √f̄` at the last evaluated point.
-    pub fn k(&self) -> f64 {
-        self.mean.sqrt()
-    }
-
-    /// The relative diagonal shift `τ` the last Jacobian carried.
-    pub fn shift(&self) -> f64 {
-        self.hessian.shift()
     }
 
     /// `f̄` of the loaded control points, then `-∇T*` into the full residual and, with

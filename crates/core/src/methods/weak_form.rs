@@ -29,7 +29,7 @@ use crate::spline::curve::Point;
 
 /// The weak form (eq. 14), solved from a bijective start.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct WeakFormMethod;
+pub(crate) struct WeakFormMethod;
 
 impl Method for WeakFormMethod {
     fn name(&self) -> &'static str {
@@ -56,7 +56,7 @@ impl Method for WeakFormMethod {
 }
 
 /// The flux `G(e) = (g22, -g12, -g12, g11) / D` of eq. (14) and `∂G/∂e`.
-pub fn weak_flux(e: [f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
+pub(crate) fn weak_flux(e: [f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
     let [a, b, c, d] = e;
     let inv = 1.0 / (a * d - b * c);
     let (g11, g12, g22) = (a * a + c * c, a * b + c * d, b * b + d * d);
@@ -76,7 +76,7 @@ pub fn weak_flux(e: [f64; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
 
 /// `K_ab = ∫ ∇w_a · A ∇w_b / det J` (`A = [[g22, -g12], [-g12, g11]]`), plus `shift` times
 /// the mass matrix, into a scalar stencil; `|det J|` where it is not positive.
-pub fn weak_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
+pub(crate) fn weak_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
     let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
@@ -110,7 +110,7 @@ pub fn weak_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &
 
 /// Eq. (14) on one level: the [`GalerkinState`] and a scratch net for the feasibility
 /// test.
-pub struct WeakFormProblem {
+pub(crate) struct WeakFormProblem {
     /// Basis, control points and storage.
     pub state: GalerkinState,
     scratch: Vec<Point>,

@@ -32,7 +32,7 @@
 //! 0` proves `δᵀ ∇²J δ <= 0`). It then calls [`DiscreteProblem::raise_shift`], which
 //! modifies the presented Hessian step by step: first `∇²J + m (P - ∇²J)` with `P` the
 //! assembly of every quadrature point's `∂²W/∂e²` projected onto the positive
-//! semidefinite matrices ([`project_psd`]), `m = 0.3, 0.9, 1` (`m = 1` is positive
+//! semidefinite matrices (`project_psd`), `m = 0.3, 0.9, 1` (`m = 1` is positive
 //! semidefinite, definite with the boundary fixed, and its Newton step has a moderate
 //! length where a diagonal shift of an indefinite Hessian gives huge steps along its
 //! near-null directions, which fold the map and force the line search down to 1/10),
@@ -86,7 +86,7 @@ impl Method for WinslowMethod {
 
 /// The Winslow density `W = N / D` of `e = (x_ξ, x_η, y_ξ, y_η)` with its gradient and
 /// Hessian in `e` (formulas in the module documentation). Not finite when `D <= 0`.
-pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
+pub(crate) fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
     let [a, b, c, d] = e;
     let n = a * a + b * b + c * c + d * d;
     let det = a * d - b * c;
@@ -114,7 +114,7 @@ pub fn winslow_density(e: [f64; 4]) -> (f64, [f64; 4], [[f64; 4]; 4]) {
 /// `J = ∫ W` (eq. 16) of the map with control points `cps` by the quadrature of `disc`;
 /// `+∞` when `det J <= 0` at a quadrature point. Element rows in parallel, summed in
 /// order (deterministic).
-pub fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
+pub(crate) fn winslow_objective(disc: &Discretization, cps: &[Point]) -> f64 {
     integrate(disc, cps, Order::First, |e| {
         let [a, b, c, d] = first_derivatives(e);
         let det = a * d - b * c;
@@ -134,7 +134,7 @@ fn neg_density_gradient(e: [f64; 4], w: f64, inv: f64) -> [f64; 4] {
     std::array::from_fn(|i| -(2.0 * e[i] - w * dd[i]) * inv)
 }
 
-/// `J = ∫ W` (eq. 16, as [`winslow_objective`], bit for bit) and `F = -∇J` (full,
+/// `J = ∫ W` (eq. 16, as `winslow_objective`, bit for bit) and `F = -∇J` (full,
 /// component-interleaved, length `2 n`, into `res`) in one pass over the quadrature
 /// points: a line search that accepts a point needs both there, and the basis values and
 /// `∇x` at a point are the larger part of either pass. `+∞` (and `res` meaningless) when
@@ -178,7 +178,7 @@ pub fn winslow_value_and_gradient(disc: &Discretization, cps: &[Point], res: &mu
 /// `F = -∇J` (full, component-interleaved, length `2 n`) and, when `stencil` is
 /// non-empty, `dF/dc = -∇²J` in the vector stencil storage of `disc`: the first-order
 /// form of `flux_form` with `G = -∂W/∂e`.
-pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
+pub(crate) fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], stencil: &mut [f64]) {
     if stencil.is_empty() {
         // the gradient only: `∂W/∂e = 2 e / D - W D' / D` without the Hessian
         flux_form_with(disc, cps, res, stencil, true, |e| {
@@ -192,9 +192,9 @@ pub fn winslow_gradient(disc: &Discretization, cps: &[Point], res: &mut [f64], s
     winslow_gradient_with(disc, cps, res, stencil, 0.0);
 }
 
-/// [`winslow_gradient`] with the Hessian of the density at each quadrature point moved by
+/// `winslow_gradient` with the Hessian of the density at each quadrature point moved by
 /// the fraction `projected` towards its projection `P` onto the positive semidefinite
-/// matrices ([`project_psd`]): `H + projected (P - H)`. With `projected = 1` the
+/// matrices (`project_psd`): `H + projected (P - H)`. With `projected = 1` the
 /// assembled matrix is positive semidefinite (definite with the boundary fixed) wherever
 /// the map is, and its Newton direction descends.
 pub fn winslow_gradient_with(
@@ -225,14 +225,14 @@ pub fn winslow_gradient_with(
 /// Vᵀ/√2` with `(W_σ₁ - W_σ₂)/(σ₁ - σ₂) = (σ₁ + σ₂)² / (σ₁σ₂)² > 0`, and two in the span of `U diag(1,0) Vᵀ`,
 /// `U diag(0,1) Vᵀ` from the `2 x 2` Hessian of `W(σ₁, σ₂)`, whose determinant is
 /// `-(1/σ₁² - 1/σ₂²)² <= 0`: one of each sign. Negative eigenvalues are dropped. The
-/// same as [`project_psd`] of [`winslow_density`]'s Hessian, about 20 times cheaper.
+/// same as `project_psd` of [`winslow_density`]'s Hessian, about 20 times cheaper.
 ///
 /// No angle is computed: `∇x = [[a, b], [c, d]] = q R(α₂) + r R(α₁) Z` (`R` a rotation,
 /// `Z = diag(1, -1)`; `q (cos α₂, sin α₂) = ((a + d)/2, (c - b)/2)`, `r (cos α₁, sin α₁) =
 /// ((a - d)/2, (c + b)/2)`, `σ₁,₂ = q ± r`), and with `U = R(φ)`, `Vᵀ = R(θ)`, `φ ± θ = α₂,
 /// α₁`: `U Vᵀ = R(α₂)`, `U Z Vᵀ = R(α₁) Z`, `U [[0,1],[1,0]] Vᵀ = R(α₁ + π/2) Z`; the
 /// eigenvector `(u₁, u₂)` of the `2 x 2` block is `∝ (λ - h₂₂, h₁₂)`.
-pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
+pub(crate) fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
     let [a, b, c, d] = e;
     let (ee, ff, gg, hh) = (0.5 * (a + d), 0.5 * (a - d), 0.5 * (c + b), 0.5 * (c - b));
     let (q, r) = (ee.hypot(hh), ff.hypot(gg));
@@ -273,9 +273,10 @@ pub fn projected_density_hessian(e: [f64; 4]) -> [[f64; 4]; 4] {
     out
 }
 
+#[cfg(test)]
 /// The symmetric `h` with its negative eigenvalues set to zero, `Q max(Λ, 0) Qᵀ`, by
 /// cyclic Jacobi rotations (to rounding).
-pub fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
+pub(crate) fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
     let mut a = h;
     let mut q = [[0.0; 4]; 4];
     for (i, row) in q.iter_mut().enumerate() {
@@ -328,7 +329,7 @@ pub fn project_psd(h: [[f64; 4]; 4]) -> [[f64; 4]; 4] {
 /// `∂²W/∂e²` (the `x`-`x` and `y`-`y` couplings, which carry the cell's anisotropy),
 /// its eigenvalues raised to at least `10⁻³` of its trace so that `K` is definite, plus
 /// `shift` times the mass matrix, into a scalar stencil.
-pub fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
+pub(crate) fn winslow_laplace(disc: &Discretization, cps: &[Point], shift: f64, stencil: &mut [f64]) {
     let nq = [disc.tables[0].nq, disc.tables[1].nq];
     let nqp = nq[0] * nq[1];
     let nrows = if shift != 0.0 { 3 * nqp } else { 2 * nqp };
@@ -386,7 +387,7 @@ fn definite_mean_block(e: [f64; 4]) -> [f64; 3] {
 
 /// The first partial projection of a modified Hessian (see
 /// [`WinslowProblem`]'s `raise_shift`): `H + 0.3 (P - H)`, then `0.9`, then `1`.
-pub const PROJECTION_FIRST: f64 = 0.3;
+pub(crate) const PROJECTION_FIRST: f64 = 0.3;
 
 /// The projection share one stage stronger after a failed factorization: none, then
 /// [`PROJECTION_FIRST`], then three times that, then 1 (the whole negative part).
@@ -521,7 +522,7 @@ impl DiscreteProblem for WinslowProblem {
     }
 
     /// First the partly, then fully projected Hessian ([`winslow_gradient_with`] with
-    /// [`PROJECTION_FIRST`], then three times that, then 1: positive semidefinite per
+    /// `PROJECTION_FIRST`, then three times that, then 1: positive semidefinite per
     /// point, a descent direction of moderate length where the exact one is indefinite),
     /// then diagonal shifts on top of it.
     fn modified(&self) -> bool {
@@ -540,7 +541,7 @@ impl DiscreteProblem for WinslowProblem {
         true
     }
 
-    /// `K` of [`winslow_laplace`] on the current control points.
+    /// `K` of `winslow_laplace` on the current control points.
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         Some(self.state.preconditioner(|disc, cps, st| winslow_laplace(disc, cps, shift, st)))
     }

@@ -19,7 +19,7 @@ use crate::spline::surface::Side;
 
 /// Two interface sides must agree at equal parameters to this times the layout's
 /// diameter (the corner tolerance of `formats.md`).
-pub const SHARED_TOL: f64 = 1e-9;
+pub(crate) const SHARED_TOL: f64 = 1e-9;
 
 /// What [`validate_layout`] measured.
 #[derive(Debug, Clone, Serialize)]
@@ -47,7 +47,7 @@ fn dist(a: Point, b: Point) -> f64 {
 
 /// Largest distance between `a(t)` and `b(t)` (`b(1 - t)` when `reversed`) at 8 points
 /// per knot span of either curve.
-pub fn parametric_gap(a: &Curve, b: &Curve, reversed: bool) -> f64 {
+pub(crate) fn parametric_gap(a: &Curve, b: &Curve, reversed: bool) -> f64 {
     let mut ts: Vec<f64> = Vec::new();
     for c in [a, b] {
         for (_, u0, u1) in c.knots.elements() {

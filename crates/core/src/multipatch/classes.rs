@@ -196,7 +196,7 @@ impl LayoutBases {
     }
 
     /// The knot vector of direction `d` of patch `p`.
-    pub fn knots_of(&self, p: usize, d: usize) -> KnotVector {
+    pub(crate) fn knots_of(&self, p: usize, d: usize) -> KnotVector {
         let (c, flip) = self.classes.member[p][d];
         let kv = if flip { flipped(&self.knots[c]) } else { self.knots[c].clone() };
         let own = &self.own[p][d];
@@ -217,7 +217,7 @@ impl LayoutBases {
     }
 
     /// The two knot vectors of patch `p`.
-    pub fn patch_knots(&self, p: usize) -> [KnotVector; 2] {
+    pub(crate) fn patch_knots(&self, p: usize) -> [KnotVector; 2] {
         [self.knots_of(p, 0), self.knots_of(p, 1)]
     }
 
@@ -281,7 +281,7 @@ impl LayoutBases {
 /// The corner points of every patch (south-west, south-east, north-east, north-west),
 /// with the corners that are one point of the layout (joined through interfaces) given
 /// the value of the first of them.
-pub fn vertex_points(layout: &Layout) -> Vec<[Point; 4]> {
+pub(crate) fn vertex_points(layout: &Layout) -> Vec<[Point; 4]> {
     let groups = vertex_groups(layout);
     let mut first: HashMap<usize, Point> = HashMap::new();
     let mut out = Vec::with_capacity(layout.patches.len());
@@ -294,7 +294,7 @@ pub fn vertex_points(layout: &Layout) -> Vec<[Point; 4]> {
 
 /// For corner `k` (south-west, south-east, north-east, north-west) of patch `p`, at
 /// `4 p + k`: the number of the layout vertex it is.
-pub fn vertex_groups(layout: &Layout) -> Vec<usize> {
+pub(crate) fn vertex_groups(layout: &Layout) -> Vec<usize> {
     let n = 4 * layout.patches.len();
     let mut parent: Vec<usize> = (0..n).collect();
     // the corners at the start and end of a side

@@ -19,7 +19,7 @@ use crate::spline::surface::{Side, Surface};
 
 /// The global free / fixed / shared split of the control points of all patches.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GlobalDofs {
+pub(crate) struct GlobalDofs {
     /// Basis shape `[n_xi, n_eta]` per patch.
     pub shapes: Vec<[usize; 2]>,
     /// Per patch: the global free index of each control point, or [`FIXED`].

@@ -66,7 +66,7 @@ pub struct FreeReport {
 /// The outcome of [`free_interfaces`]: the maps to use (the result or the start), their
 /// certificates, and the report.
 #[derive(Debug, Clone)]
-pub struct Freed {
+pub(crate) struct Freed {
     /// One map per patch.
     pub maps: Vec<Surface>,
     /// Their certificates.
@@ -76,7 +76,7 @@ pub struct Freed {
 }
 
 /// Total Winslow value of `maps` (`None` when one folds at a quadrature point).
-pub fn total_winslow(maps: &[Surface]) -> Option<f64> {
+pub(crate) fn total_winslow(maps: &[Surface]) -> Option<f64> {
     let w: f64 = maps.iter().map(|m| quality(m).functionals.winslow).sum();
     w.is_finite().then_some(w)
 }
@@ -87,7 +87,7 @@ pub fn total_winslow(maps: &[Surface]) -> Option<f64> {
 ///
 /// Errors: [`Error::InfeasibleStart`] when a patch is not certified bijective; an
 /// [`Error::Layout`] when the maps are not conforming.
-pub fn free_interfaces(
+pub(crate) fn free_interfaces(
     layout: &Layout,
     maps: &[Surface],
     certificates: &[Certificate],

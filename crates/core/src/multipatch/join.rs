@@ -28,7 +28,7 @@ use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate, CertifyOptions};
 
 /// `map` with direction `d` reversed (`t -> 1 - t`).
-pub fn reversed_dir(map: &Surface, d: usize) -> Surface {
+pub(crate) fn reversed_dir(map: &Surface, d: usize) -> Surface {
     let [nx, ny] = map.shape();
     let src = |i: usize, j: usize| if d == 0 { j * nx + (nx - 1 - i) } else { (ny - 1 - j) * nx + i };
     let mut cps = Vec::with_capacity(nx * ny);
@@ -59,7 +59,7 @@ pub fn turned(map: &Surface, s: Side, target: Side) -> Surface {
 }
 
 /// `map` with the degree of direction `d` raised to `p` (exactly).
-pub fn elevated_in(map: &Surface, d: usize, p: usize) -> Result<Surface> {
+pub(crate) fn elevated_in(map: &Surface, d: usize, p: usize) -> Result<Surface> {
     let mut m = map.clone();
     while m.knots[d].degree() < p {
         m = m.elevated_in(d)?;
@@ -67,7 +67,7 @@ pub fn elevated_in(map: &Surface, d: usize, p: usize) -> Result<Surface> {
     Ok(m)
 }
 
-/// What [`join_maps`] did.
+/// What `join_maps` did.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct JoinReport {
@@ -107,7 +107,7 @@ fn diameter(maps: &[&Surface]) -> f64 {
 /// Errors: [`Error::Invalid`] when the maps share no whole side (the same curve at equal
 /// parameters, to `SHARED_TOL` of the diameter), lie on the same side of it, or have
 /// weights along it that no scaling makes equal.
-pub fn join_maps(a: &Surface, b: &Surface) -> Result<(Surface, JoinReport)> {
+pub(crate) fn join_maps(a: &Surface, b: &Surface) -> Result<(Surface, JoinReport)> {
     if a.knots.iter().chain(&b.knots).any(KnotVector::is_periodic) {
         return Err(Error::Invalid("periodic maps (rings) cannot be joined".into()));
     }
@@ -230,11 +230,11 @@ pub struct Joined {
     pub smoothing: Improvement,
 }
 
-/// [`join_maps`], then smooth the joined map by `functional` (the weak form, eq. 14, as
+/// `join_maps`, then smooth the joined map by `functional` (the weak form, eq. 14, as
 /// in the paper, or the Winslow functional, eq. 16) from it, certified before and after
 /// ([`crate::solve::improve::improve`]).
 ///
-/// Errors: those of [`join_maps`]; [`Error::InfeasibleStart`] when the joined map is not
+/// Errors: those of `join_maps`; [`Error::InfeasibleStart`] when the joined map is not
 /// certified bijective (one of the two maps was not).
 pub fn join_and_smooth(
     a: &Surface,

@@ -2,7 +2,7 @@
 //! sides as spline curves in the orientation of `formats.md` (south and north with
 //! increasing `xi`, west and east with increasing `eta`), and the interfaces between
 //! pairs of patch sides. The boundary conditions of every patch side follow from it
-//! ([`Layout::topologies`]: [`SideCondition::Interface`] on shared sides, Dirichlet on the
+//! (`Layout::topologies`: [`SideCondition::Interface`] on shared sides, Dirichlet on the
 //! outer boundary), and so do the direction classes of the knot vectors
 //! ([`super::classes`]) and the global numbering of shared control points
 //! (`dofs`).
@@ -78,7 +78,7 @@ impl Patch {
     }
 
     /// A patch from a tensor map: its boundary curves are the sides.
-    pub fn from_map(name: impl Into<String>, map: Surface) -> Self {
+    pub(crate) fn from_map(name: impl Into<String>, map: Surface) -> Self {
         let sides = Side::ALL.map(|s| map.boundary(s).normalized());
         Self { name: name.into(), sides, map: Some(map), face: None }
     }
@@ -160,7 +160,7 @@ impl Layout {
     /// The boundary condition of every side of every patch: `Interface` with the patch
     /// side across (and whether it runs against this one) where an interface joins it,
     /// `Dirichlet` (outer boundary) elsewhere.
-    pub fn topologies(&self) -> Vec<Topology> {
+    pub(crate) fn topologies(&self) -> Vec<Topology> {
         (0..self.patches.len())
             .map(|p| {
                 let mut t = Topology::dirichlet();
@@ -190,7 +190,7 @@ impl Layout {
     }
 
     /// Lower-left and upper-right corner of the control points of all sides.
-    pub fn bounding_box(&self) -> (Point, Point) {
+    pub(crate) fn bounding_box(&self) -> (Point, Point) {
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
         for c in self.patches.iter().flat_map(|p| &p.sides) {
@@ -204,21 +204,21 @@ impl Layout {
         (lo, hi)
     }
 
-    /// Diameter of [`Layout::bounding_box`].
+    /// Diameter of `Layout::bounding_box`.
     pub fn diameter(&self) -> f64 {
         let (lo, hi) = self.bounding_box();
         (hi[0] - lo[0]).hypot(hi[1] - lo[1])
     }
 
     /// The index of the patch called `name`.
-    pub fn patch_index(&self, name: &str) -> Option<usize> {
+    pub(crate) fn patch_index(&self, name: &str) -> Option<usize> {
         self.patches.iter().position(|p| p.name == name)
     }
 }
 
 /// A side of a patch whose knot vector runs the other way than the curve's: the same
 /// control points and weights in reverse order on the given knot vector `knots`.
-pub fn reversed_on(c: &Curve, knots: crate::spline::knots::KnotVector) -> Curve {
+pub(crate) fn reversed_on(c: &Curve, knots: crate::spline::knots::KnotVector) -> Curve {
     let mut control_points = c.control_points.clone();
     control_points.reverse();
     let weights = c.weights.as_ref().map(|w| w.iter().rev().copied().collect());

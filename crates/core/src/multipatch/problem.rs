@@ -34,7 +34,7 @@ use crate::spline::surface::Surface;
 pub use crate::solve::improve::Improve as Functional;
 
 /// The global problem (see the module documentation).
-pub struct MultipatchProblem {
+pub(crate) struct MultipatchProblem {
     functional: Functional,
     discs: Vec<Arc<Discretization>>,
     dofs: Arc<GlobalDofs>,
@@ -134,7 +134,7 @@ impl MultipatchProblem {
     }
 
     /// The control points of every patch with unknowns `c`.
-    pub fn patch_control_points(&self, c: &[f64]) -> Vec<Vec<Point>> {
+    pub(crate) fn patch_control_points(&self, c: &[f64]) -> Vec<Vec<Point>> {
         let mut cps = self.cps.clone();
         self.dofs.scatter(c, &mut cps);
         cps

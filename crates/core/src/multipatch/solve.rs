@@ -275,7 +275,7 @@ fn solve_patch(
             map.control_points[k] = *q;
         }
     }
-    let cert = if changed { certify(&map, &opts.certify)? } else { sol.report.certificate.clone() };
+    let cert = if changed { certify(&map, &opts.certify)? } else { sol.report.outcome.certificate.clone() };
     Ok((map, sol.report, cert))
 }
 
@@ -366,7 +366,7 @@ pub(crate) fn solve_multipatch(
         let failing: Vec<usize> = (0..n)
             .filter(|&p| {
                 let s = solved[p].as_ref().expect("every patch solved");
-                let converged = s.1.levels.last().is_some_and(|l| l.converged);
+                let converged = s.1.solve.levels.last().is_some_and(|l| l.converged);
                 !converged || !matches!(s.2.verdict, Finding::Certified { .. } | Finding::DegenerateCorner { .. })
             })
             .collect();
@@ -395,7 +395,7 @@ pub(crate) fn solve_multipatch(
     let mut converged = Vec::with_capacity(n);
     for s in solved {
         let (map, report, cert, _) = s.expect("every patch solved");
-        converged.push(report.levels.last().is_some_and(|l| l.converged));
+        converged.push(report.solve.levels.last().is_some_and(|l| l.converged));
         maps.push(map);
         certs.push(cert);
         reports.push(report);

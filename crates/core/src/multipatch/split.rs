@@ -110,7 +110,7 @@ fn dist(a: Point, b: Point) -> f64 {
 
 /// `c` cut at parameter `t ∈ (0, 1)` into the parts on `[0, t]` and `[t, 1]`, each on
 /// `[0, 1]` (knot insertion to full multiplicity: exact).
-pub fn split_curve(c: &Curve, t: f64) -> Result<(Curve, Curve)> {
+pub(crate) fn split_curve(c: &Curve, t: f64) -> Result<(Curve, Curve)> {
     if !(t > 0.0 && t < 1.0) {
         return Err(Error::Invalid(format!("cannot cut a curve at {t}: the parameter must be inside (0, 1)")));
     }

@@ -8,18 +8,18 @@
 //! # Methods and the extension point
 //!
 //! [`MethodChoice`] is the registry of the methods `compare` knows by name; each gives a
-//! [`Contender`], which runs on a [`CompareContext`] (boundary, hierarchy, options, the
-//! EGG reference run) and returns a [`MethodRun`]: its name, nonlinear iterations,
+//! `Contender`, which runs on a `CompareContext` (boundary, hierarchy, options, the
+//! EGG reference run) and returns a `MethodRun`: its name, nonlinear iterations,
 //! whether it converged and why not, the map, the seconds. The measures are computed here,
 //! uniformly, from the map alone ([`Measures::of`]); a contender never reports its own
-//! verdict. A new method is a new [`MethodChoice`] variant and a [`Contender`]
-//! implementation (a minimization or root-finding [`Method`] can use [`HierarchyRun`]).
+//! verdict. A new method is a new [`MethodChoice`] variant and a `Contender`
+//! implementation (a minimization or root-finding [`Method`] can use `HierarchyRun`).
 //!
 //! EGG always runs first: its map is `x_G`, and with the basis `auto` its run decides
 //! the basis (the input's own basis when its map is certified, else the fitted one, as
 //! `winslow solve` does); every other method then runs on that basis, from the same
 //! start: by default the Coons patch of the finest basis ([`CompareOptions::default`]),
-//! with more levels the coarse-to-fine walk of §6.3 ([`HierarchyRun`]). Defect
+//! with more levels the coarse-to-fine walk of §6.3 (`HierarchyRun`). Defect
 //! correction (§8.2) is off by default: it would refine each method's basis differently.
 //!
 //! | name | method | start | IT counts |
@@ -148,7 +148,7 @@ impl MethodChoice {
     }
 
     /// The contender that runs this method with `opts`.
-    pub fn contender(self, opts: &CompareOptions) -> Box<dyn Contender> {
+    pub(crate) fn contender(self, opts: &CompareOptions) -> Box<dyn Contender> {
         match self {
             MethodChoice::Egg => Box::new(HierarchyRun::new(self.name(), None)),
             MethodChoice::Vhm => {
@@ -181,7 +181,7 @@ pub struct CompareOptions {
     pub lambda2: f64,
     /// The Hessian of the quasi-conformal iteration (Gauss-Newton by default).
     pub qc_hessian: QcHessian,
-    /// Length scales of the Poisson benchmark's `u*` (default: [`default_scales`] of the
+    /// Length scales of the Poisson benchmark's `u*` (default: `default_scales` of the
     /// EGG map), the same for every method.
     pub poisson_scales: Option<[f64; 2]>,
     /// `ε`, iteration limits and tolerances of Gravesen's methods (max-z and the
@@ -239,7 +239,7 @@ impl Default for CompareOptions {
 }
 
 /// What a contender sees.
-pub struct CompareContext<'a> {
+pub(crate) struct CompareContext<'a> {
     /// The boundary.
     pub boundary: &'a Boundary,
     /// The hierarchy of bases every method uses (EGG's).
@@ -260,7 +260,7 @@ impl std::fmt::Debug for CompareContext<'_> {
 
 /// What a contender returns: the measures are computed from `map` by the comparison.
 #[derive(Debug, Clone)]
-pub struct MethodRun {
+pub(crate) struct MethodRun {
     /// Method name.
     pub method: String,
     /// Nonlinear iterations in all, continuation solves included.
@@ -280,7 +280,7 @@ pub struct MethodRun {
 impl MethodRun {
     /// The run of a coarse-to-fine solve.
     pub fn of_solution(method: &str, sol: &Solution, seconds: f64) -> Self {
-        let levels = &sol.report.levels;
+        let levels = &sol.report.solve.levels;
         let last = levels.last();
         Self {
             method: method.to_string(),
@@ -295,7 +295,7 @@ impl MethodRun {
 }
 
 /// A method of the comparison (see the module documentation).
-pub trait Contender: Send + Sync + std::fmt::Debug {
+pub(crate) trait Contender: Send + Sync + std::fmt::Debug {
     /// Name in tables and reports.
     fn name(&self) -> &str;
     /// Run on the context's hierarchy; `progress` sees the solver's events and returns
@@ -307,13 +307,13 @@ pub trait Contender: Send + Sync + std::fmt::Debug {
 /// from the Coons patch and the elasticity prolongations, as EGG is; `None` is EGG with
 /// the options' operator and the context's assembler.
 #[derive(Debug, Clone)]
-pub struct HierarchyRun {
+pub(crate) struct HierarchyRun {
     name: String,
     method: Option<Arc<dyn MethodFactory>>,
 }
 
 /// Makes the method of a [`HierarchyRun`] for one hierarchy.
-pub trait MethodFactory: Send + Sync + std::fmt::Debug {
+pub(crate) trait MethodFactory: Send + Sync + std::fmt::Debug {
     /// The method for `hierarchy`.
     fn method(&self, hierarchy: &Hierarchy) -> Arc<dyn Method>;
 }
@@ -432,7 +432,7 @@ pub struct CompareRow {
     pub q_ratio: Option<f64>,
     /// Seconds of the run (measures not included).
     pub seconds: f64,
-    /// What the run did beyond its iterations ([`MethodRun::notes`]).
+    /// What the run did beyond its iterations (`MethodRun::notes`).
     pub notes: Vec<String>,
     /// The map, when there is one.
     #[serde(skip)]

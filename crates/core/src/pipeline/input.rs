@@ -36,7 +36,7 @@ pub enum Input {
     /// across shared edges, then solved as one layout.
     Graph(PlaneGraph),
     /// The six boundary faces of a hexahedral volume: the trivariate Winslow solve from
-    /// the Coons start ([`crate::solve::volume::solve_volume`]).
+    /// the Coons start (`crate::solve::volume::solve_volume`).
     Volume(Box<VolumeBoundary>),
     /// A certified map, improved on its own basis by the pipeline's method (the Winslow
     /// functional by default) with its boundary fixed, and kept only when certified
@@ -152,7 +152,7 @@ impl Solved {
     /// trivariate certificate).
     pub fn verdict(&self) -> Verdict {
         match self {
-            Solved::Map(s) => s.report.verdict,
+            Solved::Map(s) => s.report.outcome.verdict,
             Solved::Layout { solution, .. } => solution.report.verdict,
             Solved::Volume(v) => Verdict::of_finding(&v.certificate.verdict),
             Solved::Improved(m) => m.report.verdict,

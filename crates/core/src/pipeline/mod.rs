@@ -117,7 +117,7 @@ pub enum Stage<'a> {
     /// basis.
     ThbRound(&'a ThbRound),
     /// A volume boundary's solve starts (common bases, Coons start, the trivariate
-    /// Winslow minimisation, its certificate; [`solve_volume`]).
+    /// Winslow minimisation, its certificate; `solve_volume`).
     Volume {
         /// The options it runs with, made from the pipeline's.
         options: &'a VolumeOptions,
@@ -208,7 +208,7 @@ impl Pipeline {
                 };
                 let opts = self.opts.clone();
                 let (mut sol, _) = self.run_keeping_hierarchy(observer)?;
-                sol.report.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
+                sol.report.solve.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
                 if thb::repairs(&sol, &opts) {
                     return thb::repair(sol, &opts, observer).map(|t| Solved::Thb(Box::new(t)));
                 }
@@ -401,18 +401,18 @@ pub(crate) fn volume_options(opts: &SolveOptions) -> VolumeOptions {
 /// one is not certified either (its boundary is the exact one). The time of both solves
 /// counts.
 fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
-    if first.report.verdict == Verdict::DegenerateCorner && again.report.verdict != Verdict::Certified {
+    if first.report.outcome.verdict == Verdict::DegenerateCorner && again.report.outcome.verdict != Verdict::Certified {
         let mut first = first;
-        first.report.seconds += again.report.seconds;
-        first.report.message.push_str(&format!(
+        first.report.solve.seconds += again.report.solve.seconds;
+        first.report.outcome.message.push_str(&format!(
             "; solved again on the fitted basis too, where the map is {}: the input basis' map is kept",
-            again.report.verdict.name()
+            again.report.outcome.verdict.name()
         ));
         return first;
     }
-    again.report.basis.requested = BasisChoice::Auto;
-    again.report.basis.fallback = Some(why);
-    again.report.seconds += first.report.seconds;
+    again.report.setup.basis.requested = BasisChoice::Auto;
+    again.report.setup.basis.fallback = Some(why);
+    again.report.solve.seconds += first.report.solve.seconds;
     again
 }
 
@@ -424,27 +424,27 @@ fn auto_choice(first: Solution, mut again: Solution, why: String) -> Solution {
 /// the reason to solve again with them. `None` when `sol` stands.
 fn auto_fallback(sol: &Solution, fit: &FitOptions) -> Option<(FitOptions, String)> {
     let r = &sol.report;
-    if r.basis.requested != BasisChoice::Auto || r.basis.used != BasisChoice::Input {
+    if r.setup.basis.requested != BasisChoice::Auto || r.setup.basis.used != BasisChoice::Input {
         return None;
     }
-    let zero_speed_only = r.verdict == Verdict::DegenerateCorner
-        && !r.certificate.excused_points.is_empty()
-        && r.certificate.corners.iter().all(|c| c.excused_extent.is_none());
-    if r.verdict == Verdict::Certified || (r.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
+    let zero_speed_only = r.outcome.verdict == Verdict::DegenerateCorner
+        && !r.outcome.certificate.excused_points.is_empty()
+        && r.outcome.certificate.corners.iter().all(|c| c.excused_extent.is_none());
+    if r.outcome.verdict == Verdict::Certified || (r.outcome.verdict == Verdict::DegenerateCorner && !zero_speed_only) {
         return None;
     }
     let why = if zero_speed_only {
         format!(
             "on the input basis ({} functions) det J = 0 where the input's parameterization has zero speed; solved \
              again on the fitted basis, which reparameterizes the side there",
-            r.basis_functions
+            r.setup.basis_functions
         )
     } else {
         format!(
             "on the input basis ({} functions, {} repair rounds) the map is {}; solved again on the fitted basis",
-            r.basis_functions,
-            r.repairs,
-            r.verdict.name()
+            r.setup.basis_functions,
+            r.solve.repairs,
+            r.outcome.verdict.name()
         )
     };
     Some((FitOptions { basis: BasisChoice::Fitted, ..*fit }, why))
@@ -497,18 +497,18 @@ mod tests {
             .and_then(Solved::into_map)
             .unwrap();
         let r = &sol.report;
-        assert_eq!((r.basis.requested, r.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
+        assert_eq!((r.setup.basis.requested, r.setup.basis.used), (BasisChoice::Auto, BasisChoice::Fitted));
         let fallback = seen.iter().position(|s| s.starts_with("fallback")).expect("a fallback stage");
         assert_eq!(seen[0], "fitted Input");
         assert_eq!(seen[fallback + 1], "fitted Fitted");
-        assert_eq!(seen[fallback], format!("fallback {}", r.basis.fallback.as_deref().unwrap()));
+        assert_eq!(seen[fallback], format!("fallback {}", r.setup.basis.fallback.as_deref().unwrap()));
         assert_eq!(seen.iter().filter(|s| s.starts_with("fitted")).count(), 2);
         // the fitted basis' iterates are the report's, in order
-        let recorded: Vec<f64> = r.levels.iter().flat_map(|l| l.residuals.clone()).collect();
+        let recorded: Vec<f64> = r.solve.levels.iter().flat_map(|l| l.residuals.clone()).collect();
         assert_eq!(residuals[residuals.len() - recorded.len()..], recorded[..]);
         let again = solve(&puzzle4(), &opts).unwrap();
         assert_eq!(again.map.control_points, sol.map.control_points);
-        assert_eq!(again.report.verdict, r.verdict);
+        assert_eq!(again.report.outcome.verdict, r.outcome.verdict);
     }
 
     /// The observer stops the solve at its first iterate: `Error::Cancelled`, and nothing
@@ -672,13 +672,13 @@ mod tests {
         opts.fit.basis = BasisChoice::Fitted;
         opts.fit.tol = 1e-6;
         let good = solve(&b, &opts).unwrap();
-        assert!(good.report.boundary_kept && good.report.success(), "{}", good.report.message);
+        assert!(good.report.boundary.kept && good.report.success(), "{}", good.report.outcome.message);
         opts.fit.max_levels = 1;
         let short = solve(&b, &opts).unwrap();
         let r = &short.report;
-        let deviation = r.boundary_deviation.iter().fold(0.0f64, |m, &d| m.max(d));
-        assert!(deviation > r.fit_tolerance, "{deviation:e} <= {:e}", r.fit_tolerance);
-        assert!(!r.boundary_kept && !r.success(), "{}", r.message);
-        assert!(r.message.contains("NOT the input's"), "{}", r.message);
+        let deviation = r.boundary.deviation.iter().fold(0.0f64, |m, &d| m.max(d));
+        assert!(deviation > r.fit.fit_tolerance, "{deviation:e} <= {:e}", r.fit.fit_tolerance);
+        assert!(!r.boundary.kept && !r.success(), "{}", r.outcome.message);
+        assert!(r.outcome.message.contains("NOT the input's"), "{}", r.outcome.message);
     }
 }

@@ -26,7 +26,7 @@
 //!   symmetric the frames repeat after `2π / n`.
 //! - [`Seam::Ray`] (the paper's literal choice, `c_r(eta)_y = 0`): `σ(θ)` puts `eta = 0`
 //!   on the seam ray, the ray from the (turned) inner centroid in the frame-0 direction
-//!   of `c_0(0)` ([`ray_parameter`], tracked continuously). Where that ray grazes a lobe
+//!   of `c_0(0)` (`ray_parameter`, tracked continuously). Where that ray grazes a lobe
 //!   flank of a screw rotor, `σ` runs fast and the grid folds (the male rotor folds
 //!   after about 40 degrees, see BENCHMARKS.md).
 //! - [`Seam::Material`]: `σ = 0`, the control points of `c_0` turned: exact, `eta`
@@ -187,7 +187,7 @@ pub struct Frame {
 
 /// The Lagrange extrapolation (see the module documentation) of the control points
 /// `values[i]` given at the distinct times `times[i]`, evaluated at `t`.
-pub fn extrapolate(times: &[f64], values: &[&[Point]], t: f64) -> Vec<Point> {
+pub(crate) fn extrapolate(times: &[f64], values: &[&[Point]], t: f64) -> Vec<Point> {
     let n = values[0].len();
     let mut out = vec![[0.0; 2]; n];
     for (i, (&ti, vi)) in times.iter().zip(values).enumerate() {
@@ -274,7 +274,7 @@ impl Sweep {
         let sol = Pipeline::new(ring.clone(), frame0_options(opts)).eta_refinement(refinement).solve()?.into_map()?;
         let opts = ring_options(opts);
         // the sweep runs in the coordinates the cold solve ran in (normalised rings)
-        let sim = sol.report.normalisation.unwrap_or(Similarity::IDENTITY);
+        let sim = sol.report.fit.normalisation.unwrap_or(Similarity::IDENTITY);
         let unit_cps: Vec<Point> = sol.map.control_points.iter().map(|&p| sim.to_unit(p)).collect();
         let map = &sol.map;
         let knots = map.knots.clone();
@@ -285,8 +285,8 @@ impl Sweep {
         let center = sweep.center.map_or(centroid, |c| sim.to_unit(c));
         let start = inner0.eval(knots[1].domain().0);
         let seam_dir = [start[0] - centroid[0], start[1] - centroid[1]];
-        let (v, lb) = verdict(&sol.report.certificate.verdict);
-        let levels = &sol.report.levels;
+        let (v, lb) = verdict(&sol.report.outcome.certificate.verdict);
+        let levels = &sol.report.solve.levels;
         let last = levels.last();
         let report = FrameReport {
             frame: 0,
@@ -298,7 +298,7 @@ impl Sweep {
             residual_before: last.and_then(|l| l.residuals.first().copied()).unwrap_or(f64::NAN),
             residual_after: last.and_then(|l| l.residuals.last().copied()).unwrap_or(f64::NAN),
             converged: last.is_some_and(|l| l.converged),
-            inner_fit_error: sol.report.fit[3].max_error,
+            inner_fit_error: sol.report.fit.sides[3].max_error,
             inner_shift: 0.0,
             seam_offset_degrees: 0.0,
             seconds: t0.elapsed().as_secs_f64(),
@@ -314,7 +314,7 @@ impl Sweep {
             seam_dir,
             inner0,
             sigma: [0.0; 2],
-            diameter: sol.report.diameter / sim.scale,
+            diameter: sol.report.fit.diameter / sim.scale,
             history: vec![(0.0, unit_cps)],
             sim,
             knots,

@@ -71,7 +71,7 @@ impl ThbSolution {
 pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
     opts.repair.refinement == Refinement::Thb
         && opts.repair.rounds > 0
-        && matches!(sol.report.verdict, Verdict::Folded | Verdict::Undecided)
+        && matches!(sol.report.outcome.verdict, Verdict::Folded | Verdict::Undecided)
 }
 
 /// The options of the THB defect correction from those of the solve: its repair rounds
@@ -122,7 +122,7 @@ mod tests {
 
     /// puzzle4 with `--refinement thb` (the geometry of the CLI's THB test): the
     /// pipeline's THB result is, bit for bit, what the front end made before the stage
-    /// moved into the pipeline (the tensor solve without repair, then [`repair_thb`] with
+    /// moved into the pipeline (the tensor solve without repair, then `repair_thb` with
     /// the options' rounds, halo, operator, Newton and certificate options); the observer
     /// sees every round, in order, after the tensor solve's stages, and stops the run at
     /// the first round with [`Error::Cancelled`].
@@ -133,7 +133,7 @@ mod tests {
         opts.repair.refinement = Refinement::Thb;
         // the former path: the pipeline's map (no tensor repair, no fallback), then the repair
         let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
-        assert!(repairs(&unrepaired, &opts), "{:?}", unrepaired.report.verdict);
+        assert!(repairs(&unrepaired, &opts), "{:?}", unrepaired.report.outcome.verdict);
         let before = repair_thb(HierarchicalMap::from_surface(&unrepaired.map).unwrap(), &thb_options(&opts)).unwrap();
         assert!(accepted(&before.certificate), "{}", before.certificate.message());
 
@@ -157,7 +157,7 @@ mod tests {
         assert_eq!((r.functions, r.levels), (before.map.basis.len(), before.map.basis.num_levels()));
         assert_eq!(r.unknowns, before.rounds.last().unwrap().unknowns);
         assert_eq!(r.message, before.certificate.message());
-        assert_eq!(r.solve.verdict, unrepaired.report.verdict);
+        assert_eq!(r.solve.outcome.verdict, unrepaired.report.outcome.verdict);
         let strip = |rounds: &[ThbRound]| -> Vec<_> {
             rounds.iter().map(|x| (x.round, x.offending_cells, x.marked_cells, x.functions, x.iterations)).collect()
         };

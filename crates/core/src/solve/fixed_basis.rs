@@ -20,7 +20,12 @@ use crate::verify::certificate::{Certificate, Finding};
 /// `diameter`: the residual made dimensionless by [`Method::residual_scale`] (for EGG
 /// `|F| sqrt(m) / residual_size`, eq. 8 with `∫ w_i ~ 1/m`) and the step tolerance
 /// `max(step_tol, 10⁻¹³) diameter` in length units.
-pub fn scaled_options(nonlinear: NonlinearOptions, method: &dyn Method, diameter: f64, m: usize) -> NonlinearOptions {
+pub(crate) fn scaled_options(
+    nonlinear: NonlinearOptions,
+    method: &dyn Method,
+    diameter: f64,
+    m: usize,
+) -> NonlinearOptions {
     let mut nl = nonlinear;
     nl.scale = method.residual_scale(diameter, m);
     nl.step_tol = nonlinear.step_tol.max(1e-13) * diameter;
@@ -36,7 +41,7 @@ pub fn bijective(c: &Certificate) -> bool {
 
 /// Whether `after` is at least as well certified as `before`: a certified start needs a
 /// certified result, a degenerate-corner start a [`bijective`] one.
-pub fn as_well_certified(before: &Certificate, after: &Certificate) -> bool {
+pub(crate) fn as_well_certified(before: &Certificate, after: &Certificate) -> bool {
     match before.verdict {
         Finding::Certified { .. } => matches!(after.verdict, Finding::Certified { .. }),
         _ => bijective(after),
@@ -45,7 +50,7 @@ pub fn as_well_certified(before: &Certificate, after: &Certificate) -> bool {
 
 /// The iterates of one solve, recorded as they come.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct History {
+pub(crate) struct History {
     /// The number of the last iterate (0: the start met the stopping rule or failed).
     pub iterations: usize,
     /// Iterates after the start produced by Newton steps.
@@ -75,7 +80,7 @@ impl History {
     }
 
     /// `|F|` at the start and at the last iterate (NaN before the first iterate).
-    pub fn residuals_before_after(&self) -> (f64, f64) {
+    pub(crate) fn residuals_before_after(&self) -> (f64, f64) {
         let at = |r: Option<&f64>| r.copied().unwrap_or(f64::NAN);
         (at(self.residuals.first()), at(self.residuals.last()))
     }
@@ -83,7 +88,7 @@ impl History {
 
 /// A solve on a fixed basis in progress; an `Iterator` over its [`Iterate`]s (each one
 /// recorded in its [`History`]), finished by [`FixedBasisSolve::finish`].
-pub struct FixedBasisSolve<P: DiscreteProblem = Box<dyn DiscreteProblem + Send>> {
+pub(crate) struct FixedBasisSolve<P: DiscreteProblem = Box<dyn DiscreteProblem + Send>> {
     solver: NonlinearSolver<P>,
     history: History,
     start_objective: Option<f64>,
@@ -107,14 +112,14 @@ impl FixedBasisSolve {
 
 impl<P: DiscreteProblem> FixedBasisSolve<P> {
     /// `problem` from the unknowns `c0`.
-    pub fn with_problem(problem: P, c0: Vec<f64>, nonlinear: NonlinearOptions) -> Self {
+    pub(crate) fn with_problem(problem: P, c0: Vec<f64>, nonlinear: NonlinearOptions) -> Self {
         let solver = NonlinearSolver::new(problem, c0, nonlinear);
         let start_objective = solver.objective();
         Self { solver, history: History::default(), start_objective }
     }
 
     /// The objective `J` at the start (`None` for a root-finding method).
-    pub fn start_objective(&self) -> Option<f64> {
+    pub(crate) fn start_objective(&self) -> Option<f64> {
         self.start_objective
     }
 
@@ -128,7 +133,7 @@ impl<P: DiscreteProblem> FixedBasisSolve<P> {
     }
 
     /// Run the remaining iterations.
-    pub fn drain(&mut self) -> Result<()> {
+    pub(crate) fn drain(&mut self) -> Result<()> {
         while self.step()?.is_some() {}
         Ok(())
     }

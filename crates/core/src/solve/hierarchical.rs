@@ -25,7 +25,7 @@ use crate::verify::certificate::{CertifyOptions, Finding};
 
 /// Options of the THB defect correction.
 #[derive(Debug, Clone, Copy)]
-pub struct ThbRepairOptions {
+pub(crate) struct ThbRepairOptions {
     /// Rounds at most.
     pub rounds: usize,
     /// Active cells within this many cell widths (of the offending cell's level) of an
@@ -79,9 +79,9 @@ pub struct ThbRound {
     pub seconds: f64,
 }
 
-/// The result of [`repair_thb`]: the last map, its certificate and the rounds.
+/// The result of `repair_thb`: the last map, its certificate and the rounds.
 #[derive(Debug, Clone)]
-pub struct ThbRepair {
+pub(crate) struct ThbRepair {
     /// The map.
     pub map: HierarchicalMap,
     /// Its certificate.
@@ -123,7 +123,7 @@ pub fn marked_cells(map: &HierarchicalMap, offending: &[CellIndex], ring: usize)
 /// Solve EGG (eq. 8) on the THB discretization of `map` from its control points (the
 /// fixed ones are the Dirichlet data); returns the solved map, the Newton iterations,
 /// whether Newton converged and the number of unknowns.
-pub fn solve_egg(
+pub(crate) fn solve_egg(
     map: &HierarchicalMap,
     operator: Operator,
     nonlinear: NonlinearOptions,
@@ -150,16 +150,17 @@ pub fn solve_egg(
     Ok((HierarchicalMap::new(map.basis.clone(), cps)?, iterations, converged, unknowns))
 }
 
+#[cfg(test)]
 /// Local defect correction of `map` (see the module documentation): at most
 /// `opts.rounds` rounds; stops as soon as the certificate accepts the map, or when a
 /// round has nothing to refine.
-pub fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRepair> {
+pub(crate) fn repair_thb(map: HierarchicalMap, opts: &ThbRepairOptions) -> Result<ThbRepair> {
     repair_thb_observed(map, opts, &mut |_| true)
 }
 
-/// [`repair_thb`], every finished round to `observer`; [`Error::Cancelled`] when it
+/// `repair_thb`, every finished round to `observer`; [`Error::Cancelled`] when it
 /// returns `false` (the pipeline's [`Stage::ThbRound`](crate::pipeline::Stage::ThbRound)).
-pub fn repair_thb_observed(
+pub(crate) fn repair_thb_observed(
     map: HierarchicalMap,
     opts: &ThbRepairOptions,
     observer: &mut dyn FnMut(&ThbRound) -> bool,

@@ -176,7 +176,7 @@ pub struct Improved {
 /// ([`NonlinearOptions::extrapolate`]); a minimisation stops
 /// when its decrement is negligible ([`crate::solve::newton::DECREMENT_TOL`]) or after
 /// [`MAX_MODIFIED_STEPS`] steps with a modified Hessian.
-pub fn from_bijective_start(
+pub(crate) fn from_bijective_start(
     nonlinear: NonlinearOptions,
     method: &dyn Method,
     diameter: f64,
@@ -203,7 +203,7 @@ pub fn from_bijective_start(
 /// slowly along a long valley while its smallest scaled Jacobian falls (30 modified steps:
 /// Winslow value -1.2 %, smallest scaled Jacobian 0.12 -> 0.014): BENCHMARKS.md,
 /// "Improving the EGG map".
-pub const MAX_MODIFIED_STEPS: usize = 4;
+pub(crate) const MAX_MODIFIED_STEPS: usize = 4;
 
 /// Whether an improvement is kept: its certificate is at least as good as the start's
 /// ([`as_well_certified`], `as_good`) and, for a minimisation, its Winslow value `after`

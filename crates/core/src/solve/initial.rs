@@ -20,7 +20,7 @@ use crate::spline::surface::{Side, Surface};
 /// control net of shape `shape`. The curves must live on the net's knot vectors. When
 /// west and east live on a periodic vector (a ring, §11.1), `eta` is periodic: south and
 /// north are no boundary and are skipped.
-pub fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) -> Result<()> {
+pub(crate) fn set_boundary(shape: [usize; 2], sides: &[Curve; 4], cps: &mut [Point]) -> Result<()> {
     let eta_periodic = sides[Side::West as usize].knots.is_periodic();
     for s in Side::ALL {
         if eta_periodic && s.direction() == 0 {
@@ -87,12 +87,12 @@ pub fn coons(knots: &[crate::spline::knots::KnotVector; 2], sides: &[Curve; 4]) 
 }
 
 /// Unknowns above which the elasticity system is solved by CG ([`LinearMethod::Pcg`]).
-pub const ITERATIVE_ELASTICITY: usize = 20_000;
+pub(crate) const ITERATIVE_ELASTICITY: usize = 20_000;
 
 /// Relative residual of the iterative elasticity solve. The displacement is only an
 /// initial guess, and the boundary control points are Dirichlet data set exactly, so
 /// this error reaches the interior only.
-pub const ELASTICITY_TOL: f64 = 1e-8;
+pub(crate) const ELASTICITY_TOL: f64 = 1e-8;
 
 /// Lamé constants of the elasticity prolongation (E = 1, nu = 0.3).
 pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
@@ -101,12 +101,12 @@ pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 /// `K_ff u_f = -K_fb (target - base)_b` on the physical domain of `base`, returned for
 /// every control point (the fixed ones carry `target - base`). It is linear in the
 /// boundary displacement, so `base + alpha u` moves the boundary by `alpha`.
-pub fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
+pub(crate) fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
     elasticity_displacement_with(&CpuAssembler, disc, base, target)
 }
 
 /// [`elasticity_displacement`] with the elasticity operator assembled by `assembler`.
-pub fn elasticity_displacement_with(
+pub(crate) fn elasticity_displacement_with(
     assembler: &dyn EggAssembler,
     disc: &Discretization,
     base: &[Point],
@@ -170,22 +170,27 @@ fn matrix_elasticity(disc: &Discretization, st: &[f64], rhs: &[f64]) -> Result<V
 }
 
 /// `base + alpha u` for a displacement `u` from [`elasticity_displacement`].
-pub fn displaced(base: &[Point], u: &[Point], alpha: f64) -> Vec<Point> {
+pub(crate) fn displaced(base: &[Point], u: &[Point], alpha: f64) -> Vec<Point> {
     base.iter().zip(u).map(|(b, d)| [b[0] + alpha * d[0], b[1] + alpha * d[1]]).collect()
 }
 
 /// Linear-elasticity correction (§6.3): move the fixed (boundary) control points of
 /// `base` to those of `target` and spread the displacement into the interior
 /// ([`elasticity_displacement`]). Returns `base + u`.
-pub fn elasticity_correction(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
+pub(crate) fn elasticity_correction(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
     let u = elasticity_displacement(disc, base, target)?;
     Ok(displaced(base, &u, 1.0))
 }
 
+#[cfg(test)]
 /// Prolong `coarse` onto the basis of `disc` and correct the boundary discrepancy with
 /// linear elasticity (§6.3): with `x_p = P c` and the fitted boundary `b`, the result is
 /// [`elasticity_correction`]`(x_p, b)`.
-pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &[Curve; 4]) -> Result<Vec<Point>> {
+pub(crate) fn elasticity_prolongation(
+    coarse: &Surface,
+    disc: &Discretization,
+    sides: &[Curve; 4],
+) -> Result<Vec<Point>> {
     let fine = coarse.refined(&disc.knots)?;
     let mut target = fine.control_points.clone();
     set_boundary(disc.shape(), sides, &mut target)?;
@@ -194,7 +199,7 @@ pub fn elasticity_prolongation(coarse: &Surface, disc: &Discretization, sides: &
 
 /// Bookkeeping of the boundary continuation of one level.
 #[derive(Debug, Default, Clone, Copy)]
-pub struct Continuation {
+pub(crate) struct Continuation {
     /// Damped boundary solves.
     pub steps: usize,
     /// Nonlinear iterations spent in them.
@@ -210,14 +215,14 @@ pub fn det_j_min(assembler: &dyn EggAssembler, disc: &Discretization, cps: &[Poi
 }
 
 /// Smallest fraction of the boundary displacement tried in one continuation step.
-pub const MIN_CONTINUATION_STEP: f64 = 1.0 / 64.0;
+pub(crate) const MIN_CONTINUATION_STEP: f64 = 1.0 / 64.0;
 
 /// Most damped boundary solves per level.
-pub const MAX_CONTINUATION_STEPS: usize = 24;
+pub(crate) const MAX_CONTINUATION_STEPS: usize = 24;
 
 /// The outcome of [`continuation_with`].
 #[derive(Debug, Clone)]
-pub struct Continued {
+pub(crate) struct Continued {
     /// The guess with the full target boundary (positive unless the steps ran out).
     pub guess: Vec<Point>,
     /// The last positive map reached (the start, or the solution of the last damped
@@ -241,7 +246,7 @@ pub struct Continued {
 /// `method` poses the damped solves, `assembler` assembles the elasticity operator; `nl`
 /// are the level's nonlinear options (scaled as the level's final solve), `diameter` the
 /// domain's.
-pub fn continuation_with(
+pub(crate) fn continuation_with(
     method: &dyn Method,
     assembler: &dyn EggAssembler,
     disc: &Arc<Discretization>,

@@ -133,7 +133,7 @@ impl KinkStage {
 
 /// The outcome of [`keep_kinks`]: the map with the kinks and its certificate when kept.
 #[derive(Debug, Clone)]
-pub struct KinkOutcome {
+pub(crate) struct KinkOutcome {
     /// The certified `Σ⁰` map (`None`: not kept).
     pub map: Option<Surface>,
     /// Its certificate.
@@ -158,7 +158,7 @@ fn joined_level(map: &Surface, c0: &Level) -> Result<Level> {
 /// The `C^0` route (module documentation) from the `Σ¹` map `map`, certified bijective,
 /// to the `C^0` level `c0` (the kinks `kinked` at multiplicity `p`): the map on `Σ⁰` with
 /// the kinks kept exactly, certified, or why not.
-pub fn keep_kinks(
+pub(crate) fn keep_kinks(
     map: &Surface,
     c0: &Level,
     kinked: &KinkedLevel,
@@ -518,7 +518,7 @@ fn distance_to_curve(c: &crate::spline::curve::Curve, x: Point) -> f64 {
 /// ([`Hierarchy::detected`](crate::boundary::hierarchy::Hierarchy::detected)) but nothing
 /// keeps (rounded, their points those of `boundary`'s sides), each with the distance of
 /// `map` (in the input's coordinates, like `boundary`) from the point.
-pub fn kink_reports(
+pub(crate) fn kink_reports(
     boundary: &crate::boundary::Boundary,
     h: &crate::boundary::hierarchy::Hierarchy,
     map: &Surface,
@@ -631,15 +631,15 @@ mod tests {
             let b = read_boundary(&data(&format!("cad_kinks/{name}.json")), &ReadOptions::default()).unwrap();
             let sol = solve(&b, &SolveOptions::default()).unwrap();
             let r = &sol.report;
-            assert_eq!(r.verdict, Verdict::Certified, "{name}: {}", r.message);
-            let c0 = r.c0_route.as_ref().expect("the C0 route ran");
+            assert_eq!(r.outcome.verdict, Verdict::Certified, "{name}: {}", r.outcome.message);
+            let c0 = r.boundary.c0_route.as_ref().expect("the C0 route ran");
             assert!(c0.kept && c0.kinks == kinks, "{name}: {}", c0.message);
-            assert_eq!(r.kinks.len(), kinks);
-            for k in &r.kinks {
+            assert_eq!(r.boundary.kinks.len(), kinks);
+            for k in &r.boundary.kinks {
                 assert!(k.kept && k.deviation <= 1e-12, "{name}: {k:?}");
             }
             // the whole boundary, kinks included, is the input's to rounding
-            assert!(r.boundary_deviation.iter().all(|&d| d <= 1e-12), "{name}: {:?}", r.boundary_deviation);
+            assert!(r.boundary.deviation.iter().all(|&d| d <= 1e-12), "{name}: {:?}", r.boundary.deviation);
         }
     }
 
@@ -654,9 +654,9 @@ mod tests {
             let b = Family::CadKinks.generate(seed);
             let sol = solve(&b, &SolveOptions::default()).unwrap();
             let r = &sol.report;
-            assert_eq!(r.verdict, Verdict::Certified, "seed {seed}: {}", r.message);
-            assert!(r.kinks_kept() && r.success() && r.kinks.len() >= 3, "seed {seed}: {}", r.message);
-            for k in &r.kinks {
+            assert_eq!(r.outcome.verdict, Verdict::Certified, "seed {seed}: {}", r.outcome.message);
+            assert!(r.kinks_kept() && r.success() && r.boundary.kinks.len() >= 3, "seed {seed}: {}", r.outcome.message);
+            for k in &r.boundary.kinks {
                 let side = Side::ALL.into_iter().find(|s| s.name() == k.side).unwrap();
                 let curve = sol.map.boundary(side);
                 let t = k.map_parameter.expect("a kept kink has its knot line");

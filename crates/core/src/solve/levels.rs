@@ -15,7 +15,7 @@ use crate::spline::surface::Side;
 /// costs a full solve and gains nothing. The coarsest level always stays, unless the
 /// finest has at most `direct_max` functions: then it is solved alone (see
 /// [`DIRECT_REFINED_MAX_FUNCTIONS`]; 0: never).
-pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>, direct_max: usize) -> Vec<usize> {
+pub(crate) fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>, direct_max: usize) -> Vec<usize> {
     let last = sizes.len() - 1;
     if sizes[last] <= direct_max {
         return vec![last];
@@ -51,10 +51,10 @@ pub fn select_levels(sizes: &[usize], growth: f64, max_levels: Option<usize>, di
 /// `bash scripts/bench-peers.sh`, BENCHMARKS.md): the same verdicts in 10-40 % less time
 /// (cooks_membrane refined once 168 -> 97 µs); at 81 (lake) and 252 functions (duck) the
 /// coarse level saves one or two fine Newton steps and the hierarchy is faster.
-pub const DIRECT_REFINED_MAX_FUNCTIONS: usize = 64;
+pub(crate) const DIRECT_REFINED_MAX_FUNCTIONS: usize = 64;
 
 /// Size ratio below which two levels count as one size in [`select_levels`].
-pub const SAME_SIZE: f64 = 1.5;
+pub(crate) const SAME_SIZE: f64 = 1.5;
 
 fn polyline_length(c: &Curve) -> f64 {
     let n = 16 * c.knots.num_elements().max(4);
@@ -63,7 +63,7 @@ fn polyline_length(c: &Curve) -> f64 {
 
 /// Two sides count as a seam (see [`prepare_levels`]) when the mean distance between
 /// the other two sides exceeds their mean length by this factor.
-pub const SEAM_FACTOR: f64 = 4.0;
+pub(crate) const SEAM_FACTOR: f64 = 4.0;
 
 /// Mean distance `|b(t) - a(t)|` between two opposite sides at equal parameters: the
 /// mean length of the straight lines joining them, which is the extent of the domain
@@ -92,7 +92,12 @@ fn mean_gap(a: &Curve, b: &Curve) -> f64 {
 /// 2. append `refine` uniformly halved copies of the finest level.
 ///
 /// Sides are refined exactly (knot insertion), so the fitted contours are unchanged.
-pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize, aspect: f64) -> Result<Vec<Level>> {
+pub(crate) fn prepare_levels(
+    mut levels: Vec<Level>,
+    min_elements: usize,
+    refine: usize,
+    aspect: f64,
+) -> Result<Vec<Level>> {
     let last = levels.last().ok_or_else(|| Error::Invalid("empty hierarchy".into()))?;
     // mean physical length of the xi sides (south, north) and of the eta sides (west, east)
     let len_xi =
@@ -170,7 +175,7 @@ pub fn prepare_levels(mut levels: Vec<Level>, min_elements: usize, refine: usize
 }
 
 /// Largest tensor basis the solver accepts (about 8 million unknowns).
-pub const MAX_BASIS: usize = 1 << 22;
+pub(crate) const MAX_BASIS: usize = 1 << 22;
 
 #[cfg(test)]
 mod tests {

@@ -63,7 +63,7 @@ impl Default for LoftOptions {
 /// A family's boundary: given `z` and the interpolated section (on the common basis),
 /// the map whose boundary control points are the true boundary at `z` (its interior
 /// control points are ignored).
-pub type BoundaryFamily<'a> = dyn Fn(f64, &Surface) -> Result<Surface> + 'a;
+pub(crate) type BoundaryFamily<'a> = dyn Fn(f64, &Surface) -> Result<Surface> + 'a;
 
 /// Where the boundary of an inserted slice comes from.
 #[derive(Clone, Copy)]

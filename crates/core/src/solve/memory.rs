@@ -60,18 +60,18 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 /// with the ILU(0)-smoothed V-cycle: measured over estimated 0.92-1.08 (BENCHMARKS.md,
 /// "Toward 10^6 unknowns"); with the line smoother, which keeps no ILU(0) copy of `K`
 /// and needs fewer GMRES vectors, 0.73-0.88 at the same sizes (an upper bound now).
-pub const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
+pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see
 /// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
 /// iteration, up to 100), the vectors of a Newton step, and the single-precision
 /// Cholesky factors of the elasticity prolongation's two diagonal blocks.
-pub const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 1700;
+pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 1700;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
 /// and free 102, 358, 1435 MiB against a sum of 67, 214, 800 MiB.
-pub const FREE_INTERFACE_FACTOR: u64 = 2;
+pub(crate) const FREE_INTERFACE_FACTOR: u64 = 2;
 
 /// The estimated peak of a solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -89,7 +89,7 @@ pub struct MemoryEstimate {
 /// Pairs of functions of `kv` whose supports share an element: `z(Ξ)` of the module
 /// documentation (counted exactly from the knots; a periodic vector's `dim` functions
 /// each meet `2p + 1`, or all of them when there are fewer).
-pub fn interacting_pairs(kv: &KnotVector) -> usize {
+pub(crate) fn interacting_pairs(kv: &KnotVector) -> usize {
     let p = kv.degree();
     if kv.is_periodic() {
         let d = kv.dim();
@@ -108,7 +108,7 @@ pub fn interacting_pairs(kv: &KnotVector) -> usize {
 
 impl MemoryEstimate {
     /// The estimate for a solve whose finest level has the knot vectors `knots`.
-    pub fn for_knots(knots: &[KnotVector; 2]) -> Self {
+    pub(crate) fn for_knots(knots: &[KnotVector; 2]) -> Self {
         Self::for_knots_with(knots, LinearMethod::Auto)
     }
 
@@ -116,7 +116,7 @@ impl MemoryEstimate {
     /// whose Newton systems are solved by `linear`: [`MULTIGRID_BYTES_PER_NONZERO`] and
     /// [`MULTIGRID_BYTES_PER_UNKNOWN`] for [`LinearMethod::Multigrid`],
     /// [`BYTES_PER_NONZERO`] and [`BYTES_PER_UNKNOWN`] otherwise.
-    pub fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
+    pub(crate) fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
         let functions = knots[0].dim() * knots[1].dim();
         let nonzeros = 4 * interacting_pairs(&knots[0]) * interacting_pairs(&knots[1]);
         let unknowns = 2 * functions;
@@ -135,7 +135,7 @@ impl MemoryEstimate {
     /// per-nonzero terms are summed over the patches (one [`BASE`]); the free-interface
     /// stage (`free`) factors the vector Hessian of all patches at once, which takes
     /// [`FREE_INTERFACE_FACTOR`] times that sum.
-    pub fn for_patches<'a>(patches: impl IntoIterator<Item = &'a [KnotVector; 2]>, free: bool) -> Self {
+    pub(crate) fn for_patches<'a>(patches: impl IntoIterator<Item = &'a [KnotVector; 2]>, free: bool) -> Self {
         let mut sum = Self { functions: 0, unknowns: 0, nonzeros: 0, bytes: 0 };
         for k in patches {
             let e = Self::for_knots(k);
@@ -149,14 +149,9 @@ impl MemoryEstimate {
         sum
     }
 
-    /// The estimate for the levels a solve walks (the largest; the finest in practice).
-    pub fn for_levels(levels: &[Level]) -> Self {
-        Self::for_levels_with(levels, LinearMethod::Auto)
-    }
-
     /// [`MemoryEstimate::for_levels`] for Newton systems solved by `linear`
     /// ([`MemoryEstimate::for_knots_with`]).
-    pub fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
+    pub(crate) fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
         levels.iter().map(|l| Self::for_knots_with(&l.knots, linear)).max_by_key(|e| e.bytes).unwrap_or(Self {
             functions: 0,
             unknowns: 0,
@@ -169,7 +164,7 @@ impl MemoryEstimate {
 /// The most memory a solve may take (`--max-memory`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum MemoryLimit {
-    /// What the machine has available when the solve starts ([`available_memory`]); no
+    /// What the machine has available when the solve starts (`available_memory`); no
     /// limit where that cannot be read (systems other than Linux).
     #[default]
     Available,
@@ -203,7 +198,7 @@ impl MemoryLimit {
     }
 
     /// The limit in bytes and where it comes from; `None`: no limit.
-    pub fn resolve(&self) -> Option<(u64, String)> {
+    pub(crate) fn resolve(&self) -> Option<(u64, String)> {
         match *self {
             MemoryLimit::Available => available_memory(),
             MemoryLimit::Bytes(b) => Some((b, "--max-memory".into())),
@@ -246,7 +241,7 @@ fn advice(estimate: &MemoryEstimate, refine: usize) -> String {
 /// (v2 `memory.max`, v1 `memory.limit_in_bytes`) and the address-space limit (`ulimit
 /// -v`, `/proc/self/limits`) less the address space in use. `None` where none of them
 /// can be read (systems other than Linux): no default limit there.
-pub fn available_memory() -> Option<(u64, String)> {
+pub(crate) fn available_memory() -> Option<(u64, String)> {
     let read = |p: &str| std::fs::read_to_string(p).ok();
     let num = |s: Option<String>| s.and_then(|s| s.trim().parse::<u64>().ok());
     let mut best: Option<(u64, String)> = None;
@@ -302,9 +297,10 @@ pub fn reserve(bytes: u64, what: &str) -> Result<()> {
     })
 }
 
+#[cfg(test)]
 /// A vector of `n` copies of `value`, [`Error::Memory`] instead of an abort when it
 /// cannot be allocated.
-pub fn try_filled<T: Clone>(n: usize, value: T, what: &str) -> Result<Vec<T>> {
+pub(crate) fn try_filled<T: Clone>(n: usize, value: T, what: &str) -> Result<Vec<T>> {
     let mut v = Vec::new();
     let bytes = (n as u64).saturating_mul(std::mem::size_of::<T>() as u64);
     v.try_reserve_exact(n).map_err(|_| Error::Memory {

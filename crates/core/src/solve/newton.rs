@@ -39,10 +39,10 @@ use crate::methods::DiscreteProblem;
 /// step agrees with the minimum to about 1e-9 relative, the control points to about 1e-6
 /// of the diameter), which saves one to three of the iterations the gradient test `|∇J|
 /// diam <= tol` takes.
-pub const DECREMENT_TOL: f64 = 1e-6;
+pub(crate) const DECREMENT_TOL: f64 = 1e-6;
 
 /// Largest forcing term of the inexact Newton method (see `NonlinearSolver::forcing`).
-pub const ETA_MAX: f64 = 1e-2;
+pub(crate) const ETA_MAX: f64 = 1e-2;
 
 /// Nonlinear iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
@@ -86,7 +86,7 @@ pub struct NonlinearOptions {
     pub max_modified: Option<usize>,
     /// A minimisation has converged after a full Newton step with the exact Hessian
     /// whose decrement (the decrease its quadratic model predicts) is at most this
-    /// fraction of `|J|` (see [`DECREMENT_TOL`]); 0: off.
+    /// fraction of `|J|` (see `DECREMENT_TOL`); 0: off.
     pub decrement_tol: f64,
     /// A root-finding Newton step whose line search fails on a GMRES direction is solved
     /// again once with sparse direct LU (kept for the rest of the solve) before the solver
@@ -118,7 +118,7 @@ pub struct NonlinearOptions {
     /// [`extrapolated_step`] (on the Winslow functional, eq. 16, from the EGG map the first
     /// Newton steps are too short: `J` falls to 1.3-2 times the full step), for a
     /// root-finding method the minimiser of a quadratic model of `F` along the direction,
-    /// [`extrapolated_root_step`].
+    /// `extrapolated_root_step`.
     pub extrapolate: bool,
 }
 
@@ -613,7 +613,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
 /// |F₀|²`, `B = F₀·F₁`, `C = |F₁|²`) minimised over `[1, EXTRAPOLATE_MAX]` on a grid of
 /// `0.05`; proposed when `t >= 1.1` and the model's norm² is below `0.9 C`. Outside the
 /// quadratic regime only (`|F₁| > |F₀| / 4`): `None` there.
-pub fn extrapolated_root_step(f0: &[f64], f1: &[f64]) -> Option<f64> {
+pub(crate) fn extrapolated_root_step(f0: &[f64], f1: &[f64]) -> Option<f64> {
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
     let (a, b, c) = (dot(f0, f0), dot(f0, f1), dot(f1, f1));
     if !(a > 0.0 && c.is_finite() && c > 0.0625 * a) {
@@ -628,7 +628,7 @@ pub fn extrapolated_root_step(f0: &[f64], f1: &[f64]) -> Option<f64> {
 }
 
 /// Longest step factor [`extrapolated_step`] and [`extrapolated_root_step`] propose.
-pub const EXTRAPOLATE_MAX: f64 = 3.0;
+pub(crate) const EXTRAPOLATE_MAX: f64 = 3.0;
 
 /// The Jacobian operator of a problem ([`DiscreteProblem::jacobian_product`]) for the
 /// Krylov methods.

@@ -146,8 +146,8 @@ pub enum Refinement {
 /// control points that correspond to the C0-continuities").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KinksLocal {
-    /// All interior ones up to [`KINKS_LOCAL_ABOVE`] unknowns, those within
-    /// [`KINKS_LOCAL_SPANS`] knot spans of a kink above: the global minimisation improves
+    /// All interior ones up to `KINKS_LOCAL_ABOVE` unknowns, those within
+    /// `KINKS_LOCAL_SPANS` knot spans of a kink above: the global minimisation improves
     /// the whole map a little but costs a Cholesky factorization of the whole vector
     /// Hessian per Newton step (puzzle-5 of the hard corpus, 224 k unknowns: 34 s of a
     /// 51 s solve, against 3 s locally; BENCHMARKS.md).
@@ -161,10 +161,10 @@ pub enum KinksLocal {
 }
 
 /// Unknowns of the `C^0` basis above which [`KinksLocal::Auto`] minimises locally.
-pub const KINKS_LOCAL_ABOVE: usize = 50_000;
+pub(crate) const KINKS_LOCAL_ABOVE: usize = 50_000;
 
 /// Knot spans around each kink that [`KinksLocal::Auto`] moves above [`KINKS_LOCAL_ABOVE`].
-pub const KINKS_LOCAL_SPANS: usize = 3;
+pub(crate) const KINKS_LOCAL_SPANS: usize = 3;
 
 impl KinksLocal {
     /// The spans around each kink to move for a `C^0` basis with `unknowns` free

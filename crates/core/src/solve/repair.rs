@@ -36,7 +36,7 @@ pub struct RepairRound {
 /// A planned repair round: the refined level, its report entry and, when only the
 /// control points near the defect are solved for, their parameter boxes.
 #[derive(Debug, Clone)]
-pub struct Repair {
+pub(crate) struct Repair {
     /// The refined level to solve next.
     pub level: Level,
     /// The round's report entry.
@@ -51,7 +51,7 @@ pub struct Repair {
 /// offends or the refined basis would exceed [`MAX_BASIS`]. With `freeze = Some(r)` the
 /// round also gives the parameter boxes (the offending elements widened by `r` spans)
 /// whose control points stay free.
-pub fn plan_repair(
+pub(crate) fn plan_repair(
     last: &Level,
     cert: &Certificate,
     round: usize,
@@ -109,7 +109,7 @@ pub fn plan_repair(
 /// A discretization whose free DOFs are the functions free under `topology` whose
 /// support meets one of `boxes` (`[u0, u1, v0, v1]`); all free ones when that leaves
 /// none (paper §8.2: fewer unknowns in a repair round), and on a periodic basis.
-pub fn frozen_discretization(
+pub(crate) fn frozen_discretization(
     knots: &[KnotVector; 2],
     boxes: &[[f64; 4]],
     topology: &Topology,
@@ -124,7 +124,7 @@ pub fn frozen_discretization(
 /// The DOF map of [`frozen_discretization`]: free are the functions free under
 /// `topology` whose support meets one of `boxes`; `None` (all free ones) when that leaves
 /// none, and on a periodic basis (which shares DOFs across the seam).
-pub fn frozen_dofs(knots: &[KnotVector; 2], boxes: &[[f64; 4]], topology: &Topology) -> Result<Option<DofMap>> {
+pub(crate) fn frozen_dofs(knots: &[KnotVector; 2], boxes: &[[f64; 4]], topology: &Topology) -> Result<Option<DofMap>> {
     let shape = [knots[0].num_basis(), knots[1].num_basis()];
     let (p, q) = (knots[0].degree(), knots[1].degree());
     let (tu, tv) = (knots[0].knots(), knots[1].knots());

@@ -144,10 +144,39 @@ pub struct FitReport {
     pub converged: bool,
 }
 
-/// The report stored in the map file and printed by the CLI.
+/// The report stored in the map file and printed by the CLI, grouped by the stage each
+/// part describes. Every group is flattened into the one JSON object of the map file
+/// (`docs/formats.md`): the keys are the groups' fields, named as before the grouping.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct Report {
+    /// The problem: version, back end, degree, operator and basis of the map.
+    #[serde(flatten)]
+    pub setup: SetupReport,
+    /// The fit of the boundary (§5, §7): tolerance, per-side fits, reparameterization.
+    #[serde(flatten)]
+    pub fit: FitStage,
+    /// The solve: levels, repair rounds (§8.2), improvement, warm start, time.
+    #[serde(flatten)]
+    pub solve: SolveStage,
+    /// The outcome: the certificate (§8.1), the verdict and its message.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// `det J` on the sample grid (information; the verdict comes from the certificate).
+    #[serde(flatten)]
+    pub det_j: DetJReport,
+    /// The quality functionals (§2, §4.1), the area and the Poisson benchmark (§10).
+    #[serde(flatten)]
+    pub measures: QualityReport,
+    /// The boundary of the map: corners, kinks, the `C^0` route (§9), the deviation.
+    #[serde(flatten)]
+    pub boundary: BoundaryReport,
+}
+
+/// The problem a report describes: what was solved, how, and in which basis.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct SetupReport {
     /// Crate version.
     pub version: &'static str,
     /// Assembly back end.
@@ -156,42 +185,113 @@ pub struct Report {
     pub degree: [usize; 2],
     /// Operator.
     pub operator: &'static str,
+    /// Tensor-product basis functions of the map (`n_xi * n_eta`).
+    pub basis_functions: usize,
+    /// The basis of the map: fitted (§5) or the input's own (§5.2), and why the input
+    /// basis was not used when it was asked for.
+    pub basis: BasisReport,
+}
+
+/// The fit of the boundary (§5) and its preparation: normalisation and
+/// reparameterization (§7).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct FitStage {
     /// Absolute fit tolerance and the diameter it is relative to.
     pub fit_tolerance: f64,
     /// Bounding-box diameter of the boundary.
     pub diameter: f64,
-    /// Per-side fit summary.
-    pub fit: Vec<FitReport>,
+    /// Per-side fit summary (the `fit` key).
+    #[serde(rename = "fit")]
+    pub sides: Vec<FitReport>,
+    /// The boundary reparameterization (paper §7): method used and matched pairs.
+    pub reparam: crate::boundary::reparam::ReparamReport,
+    /// The similarity `x = centre + scale x̂` from the normalised coordinates the solve ran
+    /// in (`boundary::normalise`); `null` when the input was solved as given.
+    pub normalisation: Option<crate::boundary::normalise::Similarity>,
+}
+
+/// The solve: every level, the repair rounds and the improvement stage.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct SolveStage {
     /// Per-level summaries.
     pub levels: Vec<LevelReport>,
     /// Defect-correction rounds run because the finest map folded or was undecided.
     pub repairs: usize,
     /// Each defect-correction round.
     pub repair_rounds: Vec<RepairRound>,
+    /// The improvement stage after the solve (`--improve winslow`): quality before and
+    /// after, iterations, time; `null` when none was asked for.
+    pub improvement: Option<Improvement>,
+    /// Seconds of the solve: the levels (initial guesses, iterations), repair rounds,
+    /// the improvement stage and the certificate of the map written; not the fit of
+    /// the boundary before it, nor the report's own measurements of the map after it
+    /// (boundary deviation, det J sample, quality functionals).
+    pub seconds: f64,
+    /// When a warm start was asked for ([`crate::Pipeline::warm_start`]) and did not
+    /// apply: `{"used": false, "reason": ...}`; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<WarmNote>,
+}
+
+/// The outcome of a solve: the certificate and the verdict drawn from it.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct Outcome {
     /// The bijectivity certificate of the map.
     pub certificate: Certificate,
-    /// Quality functionals and cell statistics.
-    pub quality: Quality,
-    /// The Poisson benchmark of §10 (when asked for, and when it could be solved).
-    pub poisson: Option<crate::verify::poisson::PoissonReport>,
-    /// `det J` minimum on the sample grid (corners included; the sample is additional
-    /// information, the verdict comes from the certificate).
-    pub det_j_min: f64,
+    /// The outcome.
+    pub verdict: Verdict,
+    /// Plain-language summary of the verdict.
+    pub message: String,
+}
+
+/// `det J` on the sample grid (corners included; the sample is additional information,
+/// the verdict comes from the certificate). Keys `det_j_min`, `det_j_min_interior`,
+/// `det_j_min_away_from_forced_corners`, `det_j_max`, `det_j_argmin`, `det_j_sample`.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct DetJReport {
+    /// `det J` minimum on the sample grid.
+    #[serde(rename = "det_j_min")]
+    pub min: f64,
     /// `det J` minimum away from the four corners.
-    pub det_j_min_interior: f64,
+    #[serde(rename = "det_j_min_interior")]
+    pub min_interior: f64,
     /// `det J` minimum away from the corners the boundary forces (two spans around
     /// each); the verdict is `folded` when this is not positive.
-    pub det_j_min_away_from_forced_corners: f64,
+    #[serde(rename = "det_j_min_away_from_forced_corners")]
+    pub min_away_from_forced_corners: f64,
     /// `det J` maximum on the sample grid.
-    pub det_j_max: f64,
+    #[serde(rename = "det_j_max")]
+    pub max: f64,
     /// Parameter point of the minimum.
-    pub det_j_argmin: [f64; 2],
+    #[serde(rename = "det_j_argmin")]
+    pub argmin: [f64; 2],
     /// Sample grid size.
-    pub det_j_sample: usize,
+    #[serde(rename = "det_j_sample")]
+    pub sample: usize,
+}
+
+/// The quality of the map: functionals, cell statistics, area, the Poisson benchmark.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct QualityReport {
+    /// Quality functionals and cell statistics.
+    pub quality: Quality,
     /// Winslow functional (eq. 15-16); `null` when `det J <= 0` at a quadrature point.
     pub winslow: Option<f64>,
     /// Area of the mapped domain.
     pub area: f64,
+    /// The Poisson benchmark of §10 (when asked for, and when it could be solved).
+    pub poisson: Option<crate::verify::poisson::PoissonReport>,
+}
+
+/// The boundary of the map: its corners and kinks and how far it is from the input's.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct BoundaryReport {
     /// Corner angles.
     pub corners: Vec<CornerReport>,
     /// Kinks inside the sides (spline sides' `C^0` and zero-speed knots, point clouds'
@@ -203,49 +303,24 @@ pub struct Report {
     pub c0_route: Option<KinkStage>,
     /// Largest distance of the map's boundary from the input boundary, per side
     /// (south, east, north, west): [`crate::verify::quality::boundary_deviation`], the
-    /// measure `winslow check --boundary` reports too.
-    pub boundary_deviation: [f64; 4],
+    /// measure `winslow check --boundary` reports too (the `boundary_deviation` key).
+    #[serde(rename = "boundary_deviation")]
+    pub deviation: [f64; 4],
     /// Whether the map's boundary is the input's within the stated tolerance: the largest
-    /// [`boundary_deviation`](Self::boundary_deviation) at most
-    /// [`fit_tolerance`](Self::fit_tolerance). A bijective map whose boundary is not (kinks
-    /// the `C^0` route of §9 could not keep, a fit short of its tolerance) is not a
-    /// success ([`Report::success`]).
-    pub boundary_kept: bool,
-    /// The outcome.
-    pub verdict: Verdict,
-    /// Plain-language summary of the verdict.
-    pub message: String,
-    /// Seconds of the solve: the levels (initial guesses, iterations), repair rounds,
-    /// the improvement stage and the certificate of the map written; not the fit of
-    /// the boundary before it, nor the report's own measurements of the map after it
-    /// (boundary deviation, det J sample, quality functionals).
-    pub seconds: f64,
-    /// Tensor-product basis functions of the map (`n_xi * n_eta`).
-    pub basis_functions: usize,
-    /// The boundary reparameterization (paper §7): method used and matched pairs.
-    pub reparam: crate::boundary::reparam::ReparamReport,
-    /// The basis of the map: fitted (§5) or the input's own (§5.2), and why the input
-    /// basis was not used when it was asked for.
-    pub basis: BasisReport,
-    /// The improvement stage after the solve (`--improve winslow`): quality before and
-    /// after, iterations, time; `null` when none was asked for.
-    pub improvement: Option<Improvement>,
-    /// The similarity `x = centre + scale x̂` from the normalised coordinates the solve ran
-    /// in (`boundary::normalise`); `null` when the input was solved as given.
-    pub normalisation: Option<crate::boundary::normalise::Similarity>,
-    /// When a warm start was asked for ([`crate::Pipeline::warm_start`]) and did not
-    /// apply: `{"used": false, "reason": ...}`; absent otherwise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub warm_start: Option<WarmNote>,
+    /// [`deviation`](Self::deviation) at most [`FitStage::fit_tolerance`]. A bijective map
+    /// whose boundary is not (kinks the `C^0` route of §9 could not keep, a fit short of
+    /// its tolerance) is not a success ([`Report::success`]); the `boundary_kept` key.
+    #[serde(rename = "boundary_kept")]
+    pub kept: bool,
 }
 
 impl Report {
     /// A success: certified (or the best map a forced degenerate corner admits), its
-    /// boundary the input's within the fit tolerance ([`Report::boundary_kept`]) and the
+    /// boundary the input's within the fit tolerance ([`BoundaryReport::kept`]) and the
     /// kinks of the `C^0` route kept ([`Report::kinks_kept`]).
     pub fn success(&self) -> bool {
-        matches!(self.verdict, Verdict::Certified | Verdict::DegenerateCorner)
-            && self.boundary_kept
+        matches!(self.outcome.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+            && self.boundary.kept
             && self.kinks_kept()
     }
 
@@ -253,7 +328,7 @@ impl Report {
     /// keep is rounded, and the run is not a success ([`Report::success`]) even where the
     /// rounding stays within the fit tolerance.
     pub fn kinks_kept(&self) -> bool {
-        self.c0_route.as_ref().is_none_or(|r| r.kept)
+        self.boundary.c0_route.as_ref().is_none_or(|r| r.kept)
     }
 }
 
@@ -399,48 +474,58 @@ impl Solution {
             })
             .collect();
         let report = Report {
-            version: env!("CARGO_PKG_VERSION"),
-            backend: ctx.backend,
-            degree: map.degrees(),
-            operator: match opts.operator {
-                Operator::Plain => "plain",
-                Operator::Scaled => "scaled",
+            setup: SetupReport {
+                version: env!("CARGO_PKG_VERSION"),
+                backend: ctx.backend,
+                degree: map.degrees(),
+                operator: match opts.operator {
+                    Operator::Plain => "plain",
+                    Operator::Scaled => "scaled",
+                },
+                basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
+                basis: h.basis.clone(),
             },
-            fit_tolerance,
-            diameter: h.physical_diameter(),
-            fit,
-            levels,
-            repairs: ctx.repairs,
-            repair_rounds: ctx.rounds,
-            certificate,
-            quality,
-            poisson: if opts.report.poisson {
-                crate::verify::poisson::poisson_benchmark(&map, None).ok()
-            } else {
-                None
+            fit: FitStage {
+                fit_tolerance,
+                diameter: h.physical_diameter(),
+                sides: fit,
+                reparam: h.physical_reparam(),
+                normalisation: (!h.similarity.is_identity()).then_some(h.similarity),
             },
-            det_j_min: sample.min,
-            det_j_min_interior: sample.min_interior,
-            det_j_min_away_from_forced_corners: away,
-            det_j_max: sample.max,
-            det_j_argmin: sample.argmin,
-            det_j_sample: sample.n,
-            winslow: fun.winslow.is_finite().then_some(fun.winslow),
-            area: fun.area,
-            corners,
-            kinks,
-            c0_route: ctx.c0_route,
-            boundary_deviation: ctx.boundary_deviation,
-            boundary_kept,
-            verdict,
-            message,
-            seconds: ctx.elapsed.as_secs_f64(),
-            basis_functions: map.knots[0].num_basis() * map.knots[1].num_basis(),
-            reparam: h.physical_reparam(),
-            basis: h.basis.clone(),
-            improvement: ctx.improvement,
-            normalisation: (!h.similarity.is_identity()).then_some(h.similarity),
-            warm_start: None,
+            solve: SolveStage {
+                levels,
+                repairs: ctx.repairs,
+                repair_rounds: ctx.rounds,
+                improvement: ctx.improvement,
+                seconds: ctx.elapsed.as_secs_f64(),
+                warm_start: None,
+            },
+            outcome: Outcome { certificate, verdict, message },
+            det_j: DetJReport {
+                min: sample.min,
+                min_interior: sample.min_interior,
+                min_away_from_forced_corners: away,
+                max: sample.max,
+                argmin: sample.argmin,
+                sample: sample.n,
+            },
+            measures: QualityReport {
+                quality,
+                winslow: fun.winslow.is_finite().then_some(fun.winslow),
+                area: fun.area,
+                poisson: if opts.report.poisson {
+                    crate::verify::poisson::poisson_benchmark(&map, None).ok()
+                } else {
+                    None
+                },
+            },
+            boundary: BoundaryReport {
+                corners,
+                kinks,
+                c0_route: ctx.c0_route,
+                deviation: ctx.boundary_deviation,
+                kept: boundary_kept,
+            },
         };
         Self { name: name.to_string(), map, report }
     }

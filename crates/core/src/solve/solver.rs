@@ -4,7 +4,7 @@
 //!
 //! The solver talks to the discrete problem only through [`Method`] and
 //! [`DiscreteProblem`](crate::methods::DiscreteProblem): EGG (eq. 8) by default, any
-//! other method through [`EggSolver::with_method`]. The patch's boundary conditions are
+//! other method through `EggSolver::with_method`. The patch's boundary conditions are
 //! data ([`SolveOptions::topology`]), read by the DOF map of every level.
 
 use std::sync::Arc;
@@ -126,7 +126,7 @@ impl EggSolver {
 
     /// A solver of `method` over the levels of `hierarchy` (the fit of `boundary`);
     /// `assembler` assembles the hierarchy's operators (elasticity, continuation samples).
-    pub fn with_method(
+    pub(crate) fn with_method(
         boundary: &Boundary,
         hierarchy: Arc<Hierarchy>,
         opts: SolveOptions,
@@ -518,10 +518,14 @@ mod tests {
         let b = annulus(1.0, 2.0, std::f64::consts::FRAC_PI_2);
         let sol = solve(&b, &SolveOptions::default()).unwrap();
         let r = &sol.report;
-        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
-        let last = r.levels.last().unwrap();
+        assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+        let last = r.solve.levels.last().unwrap();
         assert!(last.converged && last.newton_iterations <= 5, "{last:?}");
-        assert!((r.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit_tolerance * r.diameter, "area {}", r.area);
+        assert!(
+            (r.measures.area - 0.75 * std::f64::consts::PI).abs() < 10.0 * r.fit.fit_tolerance * r.fit.diameter,
+            "area {}",
+            r.measures.area
+        );
     }
 
     fn circle(r: f64, c: [f64; 2]) -> crate::boundary::ring::ClosedContour {
@@ -540,12 +544,15 @@ mod tests {
         };
         let sol = Pipeline::new(ring, SolveOptions::default()).solve().and_then(|s| s.into_map()).unwrap();
         let r = &sol.report;
-        assert_eq!(r.verdict, Verdict::Certified, "{}", r.message);
+        assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
         assert!(sol.map.knots[1].is_periodic() && !sol.map.knots[0].is_periodic());
         let area = std::f64::consts::PI * (1.0 - 0.16);
-        assert!((r.area - area).abs() < 1e-3, "area {} vs {area}", r.area);
-        assert!(r.boundary_deviation[1] < 10.0 * r.fit_tolerance && r.boundary_deviation[3] < 10.0 * r.fit_tolerance);
-        assert!(r.corners.is_empty());
+        assert!((r.measures.area - area).abs() < 1e-3, "area {} vs {area}", r.measures.area);
+        assert!(
+            r.boundary.deviation[1] < 10.0 * r.fit.fit_tolerance
+                && r.boundary.deviation[3] < 10.0 * r.fit.fit_tolerance
+        );
+        assert!(r.boundary.corners.is_empty());
     }
 
     /// A ring with a narrow gap (the lobe tip 1e-3 of the casing's diameter from it,
@@ -562,9 +569,9 @@ mod tests {
             opts.fit.reparam.method = method;
             let sol = Pipeline::new(ring.clone(), opts).solve().and_then(|s| s.into_map()).unwrap();
             let r = &sol.report;
-            assert_eq!(r.reparam.used == Reparam::Constrained, method == Reparam::Auto);
-            assert_eq!(r.reparam.matches.is_empty(), method == Reparam::ArcLength);
-            if let Some(m) = r.reparam.matches.iter().min_by(|a, b| {
+            assert_eq!(r.fit.reparam.used == Reparam::Constrained, method == Reparam::Auto);
+            assert_eq!(r.fit.reparam.matches.is_empty(), method == Reparam::ArcLength);
+            if let Some(m) = r.fit.reparam.matches.iter().min_by(|a, b| {
                 let d = |m: &crate::boundary::reparam::Match| {
                     (m.points[0][0] - m.points[1][0]).hypot(m.points[0][1] - m.points[1][1])
                 };
@@ -583,7 +590,12 @@ mod tests {
                     local = local.min(d.det_j() / (d.xu[0].hypot(d.xu[1]) * d.xv[0].hypot(d.xv[1])));
                 }
             }
-            q.push((r.verdict, r.quality.scaled_jacobian.min, r.quality.orthogonality_degrees.max, local));
+            q.push((
+                r.outcome.verdict,
+                r.measures.quality.scaled_jacobian.min,
+                r.measures.quality.orthogonality_degrees.max,
+                local,
+            ));
         }
         // measured (BENCHMARKS.md): matched min scaled J 0.38, orthogonality 67 degrees,
         // near the gap 0.90; arc length 0.003, 89.8 degrees, near the gap 0.0035 (its

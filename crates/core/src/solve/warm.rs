@@ -7,7 +7,7 @@
 //! With `x⁻` the previous map (control points `c⁻` on the basis `Ξ × H`) and the new
 //! boundary's sides refined onto `Ξ` and `H` by knot insertion (exact: the new map's
 //! boundary is the input's), the start is the linear-elasticity correction of §6.3,
-//! `c⁰ = c⁻ + u` with `K_ff u_f = -K_fb (b - c⁻)_b` ([`elasticity_correction`]); from
+//! `c⁰ = c⁻ + u` with `K_ff u_f = -K_fb (b - c⁻)_b` (`elasticity_correction`); from
 //! there EGG (eq. 8) runs on the fixed basis as a sweep frame does (`FixedBasisSolve`
 //! on the discretization of the pipeline's levels, [`Discretization::for_topology`],
 //! with the options scaled by the map's size, `scaled_options`), so that on the same

@@ -5,7 +5,7 @@ use crate::error::MAX_DEGREE;
 use crate::spline::knots::KnotVector;
 
 /// Highest derivative order evaluated by [`BasisDerivs`].
-pub const MAX_DERIV: usize = 2;
+pub(crate) const MAX_DERIV: usize = 2;
 const W: usize = MAX_DEGREE + 1;
 
 /// The `p + 1` non-zero basis functions `N_{s-p..=s}` at one point and their first
@@ -34,7 +34,7 @@ impl BasisDerivs {
         out
     }
 
-    /// Evaluate in place at `u` in the span found by [`KnotVector::find_span`].
+    /// Evaluate in place at `u` in the span found by `KnotVector::find_span`.
     pub fn eval(&mut self, kv: &KnotVector, u: f64, nd: usize) {
         let span = kv.find_span(u);
         self.eval_in_span(kv, span, u, nd);
@@ -42,7 +42,7 @@ impl BasisDerivs {
 
     /// Evaluate in place at `u` in the given span (useful on element boundaries, where the
     /// caller picks the element). Implements A2.3 of Piegl & Tiller.
-    pub fn eval_in_span(&mut self, kv: &KnotVector, span: usize, u: f64, nd: usize) {
+    pub(crate) fn eval_in_span(&mut self, kv: &KnotVector, span: usize, u: f64, nd: usize) {
         let p = kv.degree();
         let t = kv.knots();
         debug_assert!(nd <= MAX_DERIV && p <= MAX_DEGREE);
@@ -152,13 +152,14 @@ impl BasisDerivs {
     }
 
     /// The `k`-th derivatives of the non-zero functions.
-    pub fn ders(&self, k: usize) -> &[f64] {
+    pub(crate) fn ders(&self, k: usize) -> &[f64] {
         &self.d[k][..=self.degree]
     }
 }
 
+#[cfg(test)]
 /// Values of all `n` basis functions at `u` (dense; for tests and small fits).
-pub fn dense_values(kv: &KnotVector, u: f64) -> Vec<f64> {
+pub(crate) fn dense_values(kv: &KnotVector, u: f64) -> Vec<f64> {
     let b = BasisDerivs::at(kv, u, 0);
     let mut v = vec![0.0; kv.num_basis()];
     for (j, &x) in b.ders(0).iter().enumerate() {

@@ -7,7 +7,7 @@ use crate::spline::knots::KnotVector;
 use crate::spline::refine::prolongation;
 
 /// Bernstein polynomials `B_k^p(t) = binom(p, k) t^k (1 - t)^(p - k)`, `k = 0..=p`, at `t`.
-pub fn bernstein(p: usize, t: f64, out: &mut [f64]) {
+pub(crate) fn bernstein(p: usize, t: f64, out: &mut [f64]) {
     out[0] = 1.0;
     let s = 1.0 - t;
     for j in 1..=p {
@@ -23,7 +23,7 @@ pub fn bernstein(p: usize, t: f64, out: &mut [f64]) {
 
 /// Per-element extraction operators of a univariate basis.
 #[derive(Debug, Clone)]
-pub struct BezierExtraction {
+pub(crate) struct BezierExtraction {
     /// Elements as `(span, a, b)`.
     pub elements: Vec<(usize, f64, f64)>,
     /// For element `e`, `ops[e][j * (p + 1) + k]` is the coefficient of Bernstein `k`

@@ -100,7 +100,7 @@ impl Curve {
     }
 
     /// Value and derivatives from precomputed basis values.
-    pub fn derivs_with(&self, b: &BasisDerivs, nd: usize) -> CurveDerivs {
+    pub(crate) fn derivs_with(&self, b: &BasisDerivs, nd: usize) -> CurveDerivs {
         let first = b.first();
         let p = b.degree;
         let mut a = [[0.0f64; 3]; 3]; // a[k] = k-th derivative of (w x, w y, w)
@@ -149,7 +149,7 @@ impl Curve {
     }
 
     /// The same curve with its degree raised by one.
-    pub fn elevated(&self) -> Result<Curve> {
+    pub(crate) fn elevated(&self) -> Result<Curve> {
         let (kv, e) = elevation(&self.knots)?;
         let (cp, w) = apply_homogeneous(&e, &self.control_points, self.weights.as_deref());
         Ok(Curve { knots: kv, control_points: cp, weights: w })

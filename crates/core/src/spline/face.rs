@@ -16,7 +16,7 @@ use crate::spline::volume::Point3;
 pub type Face = TensorSpline<2, 3>;
 
 /// Value and first derivatives `(f, f_s, f_t)` of a face.
-pub type FaceDerivs = (Point3, Point3, Point3);
+pub(crate) type FaceDerivs = (Point3, Point3, Point3);
 
 impl Face {
     /// Validate lengths, finiteness and weights (open knot vectors only: a face is one
@@ -43,7 +43,7 @@ impl Face {
     /// The same surface with direction `dir` reversed on its domain `[a, b]`:
     /// `g(.., u_dir, ..) = f(.., a + b - u_dir, ..)` (knots `a + b - u` in reverse order,
     /// control points reversed in that direction).
-    pub fn reversed_in(&self, dir: usize) -> Result<Self> {
+    pub(crate) fn reversed_in(&self, dir: usize) -> Result<Self> {
         let kv = &self.knots[dir];
         let (a, b) = kv.domain();
         let knots: Vec<f64> = kv

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result, MAX_CONTROL_POINTS, MAX_DEGREE};
 
 /// Tolerance under which two knots count as equal (relative to the domain length).
-pub const KNOT_TOL: f64 = 1e-12;
+pub(crate) const KNOT_TOL: f64 = 1e-12;
 
 /// A non-decreasing knot vector `t_0 <= ... <= t_{n+p}` of a degree-`p` spline space
 /// with `n` basis functions; the parameter domain is `[t_p, t_n]`.
@@ -26,7 +26,7 @@ impl KnotVector {
     }
 
     /// Validate and wrap a knot vector, marking it periodic or not.
-    pub fn with_periodic(degree: usize, knots: Vec<f64>, periodic: bool) -> Result<Self> {
+    pub(crate) fn with_periodic(degree: usize, knots: Vec<f64>, periodic: bool) -> Result<Self> {
         let bad = |reason: String| Error::Knots { context: String::new(), reason };
         if degree == 0 || degree > MAX_DEGREE {
             return Err(Error::Degree {
@@ -78,7 +78,7 @@ impl KnotVector {
 
     /// Open knot vector with the given strictly increasing breakpoints; every interior
     /// break gets multiplicity `interior_mult` (1 gives `C^{p-1}`).
-    pub fn open_from_breaks(degree: usize, breaks: &[f64], interior_mult: usize) -> Self {
+    pub(crate) fn open_from_breaks(degree: usize, breaks: &[f64], interior_mult: usize) -> Self {
         assert!(breaks.len() >= 2);
         let mut knots = vec![breaks[0]; degree + 1];
         for &b in &breaks[1..breaks.len() - 1] {
@@ -101,7 +101,7 @@ impl KnotVector {
     /// `t_p <= ... <= t_{p + d - 1}` in `[a, a + period)` with `t_p = a`, `d` of them (the
     /// dimension of the periodic space); the stored vector continues them periodically,
     /// `t_{k + d} = t_k + period`, `p` knots past both ends (`d + 2p + 1` knots in all).
-    pub fn periodic_from_period(degree: usize, period_knots: &[f64], period: f64) -> Result<Self> {
+    pub(crate) fn periodic_from_period(degree: usize, period_knots: &[f64], period: f64) -> Result<Self> {
         let d = period_knots.len();
         if d == 0 || period.is_nan() || period <= 0.0 {
             return Err(Error::Knots {
@@ -149,13 +149,13 @@ impl KnotVector {
     }
 
     /// The knots of one period of a periodic vector, `t_p, ..., t_{p + d - 1}`.
-    pub fn period_knots(&self) -> &[f64] {
+    pub(crate) fn period_knots(&self) -> &[f64] {
         &self.knots[self.degree..self.degree + self.dim()]
     }
 
     /// The bi-infinite periodic continuation `t_k` for any integer `k` of a periodic
     /// vector (`t_{k + d} = t_k + L`), equal to the stored knot for `0 <= k < len`.
-    pub fn extended(&self, k: isize) -> f64 {
+    pub(crate) fn extended(&self, k: isize) -> f64 {
         if !self.periodic || (k >= 0 && (k as usize) < self.knots.len()) {
             return self.knots[k.clamp(0, self.knots.len() as isize - 1) as usize];
         }
@@ -192,7 +192,7 @@ impl KnotVector {
     }
 
     /// Whether both ends are clamped (`p + 1` equal knots).
-    pub fn is_open(&self) -> bool {
+    pub(crate) fn is_open(&self) -> bool {
         let p = self.degree;
         let k = &self.knots;
         let n = k.len();
@@ -201,7 +201,7 @@ impl KnotVector {
 
     /// Knot span index `s` with `t_s <= u < t_{s+1}`, `p <= s < n`; the right end of the
     /// domain belongs to the last non-empty span. Values outside are clamped.
-    pub fn find_span(&self, u: f64) -> usize {
+    pub(crate) fn find_span(&self, u: f64) -> usize {
         let p = self.degree;
         let n = self.num_basis();
         let k = &self.knots;
@@ -238,8 +238,9 @@ impl KnotVector {
         self.knots.iter().filter(|&&t| (t - u).abs() <= tol).count()
     }
 
+    #[cfg(test)]
     /// Continuity `C^{p - m}` of the basis at the knot `u` of multiplicity `m`.
-    pub fn continuity_at(&self, u: f64) -> isize {
+    pub(crate) fn continuity_at(&self, u: f64) -> isize {
         self.degree as isize - self.multiplicity(u) as isize
     }
 
@@ -308,7 +309,7 @@ impl KnotVector {
     }
 
     /// The knots to insert to bisect the given elements (by span index).
-    pub fn midpoints_of(&self, spans: &[usize]) -> Vec<f64> {
+    pub(crate) fn midpoints_of(&self, spans: &[usize]) -> Vec<f64> {
         spans.iter().map(|&s| 0.5 * (self.knots[s] + self.knots[s + 1])).collect()
     }
 
@@ -339,7 +340,7 @@ impl KnotVector {
 
     /// Union of two open vectors of the same degree and domain: every break with the
     /// larger of its two multiplicities (knots closer than [`KNOT_TOL`] merge).
-    pub fn union(&self, other: &Self) -> Result<Self> {
+    pub(crate) fn union(&self, other: &Self) -> Result<Self> {
         if self.degree != other.degree || self.domain() != other.domain() || self.periodic != other.periodic {
             return Err(Error::Invalid(format!(
                 "knot union needs equal degree and domain, got p={} on {:?} and p={} on {:?}",
@@ -440,7 +441,7 @@ impl KnotVector {
 
     /// The vector of degree `p + 1` spanning the degree-elevated space: every break's
     /// multiplicity raised by one (continuity is kept).
-    pub fn elevated(&self) -> Self {
+    pub(crate) fn elevated(&self) -> Self {
         let mut knots = Vec::with_capacity(self.knots.len() + self.num_elements() + 1);
         let bm = self.breaks_with_multiplicity();
         let p = self.degree;

@@ -5,7 +5,7 @@
 //! **One basis.** The slices are first brought to one tensor basis, exactly: every slice
 //! is degree-elevated to the largest degree per direction (continuity kept), then
 //! refined by knot insertion to the union of all knot vectors (every break with its
-//! largest multiplicity), [`common_basis`]. Periodic directions (ring maps) stay periodic.
+//! largest multiplicity), `common_basis`. Periodic directions (ring maps) stay periodic.
 //!
 //! **In `z`.** The parameter of slice `i` is `ζ_i = (z_i - z_0) / (z_{m-1} - z_0)`, so
 //! that `z(ζ)` is affine and `det J = (z_{m-1} - z_0) det J_xy` where the slices share
@@ -61,7 +61,7 @@ fn slices_err(slice: Option<usize>, reason: String) -> Error {
 
 /// Check the heights: one per slice, at least two, finite, strictly increasing with gaps
 /// above `1e-9` of the total height.
-pub fn check_heights(z: &[f64], slices: usize) -> Result<()> {
+pub(crate) fn check_heights(z: &[f64], slices: usize) -> Result<()> {
     if z.len() != slices {
         return Err(slices_err(None, format!("{} heights for {slices} slices (one z per slice)", z.len())));
     }
@@ -86,7 +86,7 @@ pub fn check_heights(z: &[f64], slices: usize) -> Result<()> {
 /// The slices on one tensor basis (see the module doc); the maps are unchanged (to
 /// rounding). Errors name the first slice that does not fit slice 0: a different
 /// periodicity (a ring and a four-sided map) or parameter domain.
-pub fn common_basis(slices: &[Surface]) -> Result<Vec<Surface>> {
+pub(crate) fn common_basis(slices: &[Surface]) -> Result<Vec<Surface>> {
     let Some(first) = slices.first() else {
         return Err(slices_err(None, "no slices".into()));
     };
@@ -143,7 +143,7 @@ pub fn common_basis(slices: &[Surface]) -> Result<Vec<Surface>> {
 }
 
 /// `ζ_i = (z_i - z_0) / (z_{m-1} - z_0)`, exactly 0 and 1 at the ends.
-pub fn zeta_of(z: &[f64]) -> Vec<f64> {
+pub(crate) fn zeta_of(z: &[f64]) -> Vec<f64> {
     let (a, b) = (z[0], z[z.len() - 1]);
     let mut t: Vec<f64> = z.iter().map(|&x| (x - a) / (b - a)).collect();
     t[0] = 0.0;
@@ -152,7 +152,7 @@ pub fn zeta_of(z: &[f64]) -> Vec<f64> {
 }
 
 /// The knot vector in `ζ` of an interpolation through parameters `zeta`.
-pub fn zeta_knots(zeta: &[f64], interpolation: Interpolation) -> KnotVector {
+pub(crate) fn zeta_knots(zeta: &[f64], interpolation: Interpolation) -> KnotVector {
     let m = zeta.len();
     let (degree, inner) = match (interpolation, m) {
         (Interpolation::Linear, _) | (_, 2) => (1, &zeta[1..m - 1]),
@@ -166,7 +166,7 @@ pub fn zeta_knots(zeta: &[f64], interpolation: Interpolation) -> KnotVector {
 }
 
 /// Interpolate slices that share one basis ([`common_basis`]) at heights `z`.
-pub fn interpolate(slices: &[Surface], z: &[f64], interpolation: Interpolation) -> Result<Volume> {
+pub(crate) fn interpolate(slices: &[Surface], z: &[f64], interpolation: Interpolation) -> Result<Volume> {
     check_heights(z, slices.len())?;
     if let Some(i) = slices.iter().position(|s| s.knots != slices[0].knots) {
         return Err(slices_err(
@@ -218,15 +218,16 @@ pub fn interpolate(slices: &[Surface], z: &[f64], interpolation: Interpolation) 
     Volume::new([k[0].clone(), k[1].clone(), kz], cps, rational.then_some(weights))
 }
 
+#[cfg(test)]
 /// [`common_basis`] then [`interpolate`].
-pub fn loft_slices(slices: &[Surface], z: &[f64], interpolation: Interpolation) -> Result<Volume> {
+pub(crate) fn loft_slices(slices: &[Surface], z: &[f64], interpolation: Interpolation) -> Result<Volume> {
     check_heights(z, slices.len())?;
     interpolate(&common_basis(slices)?, z, interpolation)
 }
 
 /// The planar map at parameter `ζ` of a lofted volume: the section's control net with
 /// `z` dropped (the initial guess of a slice inserted there).
-pub fn planar_section(vol: &Volume, zeta: f64) -> Surface {
+pub(crate) fn planar_section(vol: &Volume, zeta: f64) -> Surface {
     let (pts, weights) = vol.section(2, zeta);
     Surface {
         knots: [vol.knots[0].clone(), vol.knots[1].clone()],

@@ -41,7 +41,7 @@ use crate::spline::knots::KnotVector;
 /// The weights `w_0..=w_p` with `B(x_1, ..., x_p) = sum_j w_j c_{s-p+j}` for the
 /// polynomial piece of a degree-`p` spline on the non-empty interval `[t_s, t_{s+1}]`,
 /// `t` given by `knot(k)` for integer `k` (see the module documentation).
-pub fn blossom_weights(knot: impl Fn(isize) -> f64, p: usize, s: isize, x: &[f64]) -> Vec<f64> {
+pub(crate) fn blossom_weights(knot: impl Fn(isize) -> f64, p: usize, s: isize, x: &[f64]) -> Vec<f64> {
     let mut d: Vec<Vec<f64>> = (0..=p).map(|j| (0..=p).map(|k| if k == j { 1.0 } else { 0.0 }).collect()).collect();
     for r in 1..=p {
         for jj in (r..=p).rev() {
@@ -100,7 +100,7 @@ fn expand(rows: Vec<Vec<(usize, f64)>>, n_fine: usize, n_coarse: usize) -> Csr {
 /// vectors of one degree and period with `fine ⊇ coarse` (one period of knots); the
 /// columns of the `p` repeated coarse functions are zero, so `P c` is right for wrapped
 /// control points. Exact: `sum_k (P c)_k N'_k = sum_k c_k N_k`.
-pub fn periodic_prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
+pub(crate) fn periodic_prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
     if !coarse.is_periodic() || !fine.is_periodic() || !fine.contains(coarse) {
         return Err(Error::Invalid(format!(
             "periodic refinement needs two periodic vectors of one degree and period with the fine one containing the coarse one (p={} on {:?}, periodic {}; p={} on {:?}, periodic {})",
@@ -141,7 +141,7 @@ pub fn periodic_prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<C
 /// more time, [`KnotVector::elevated`]) and `E` (`n' x n`, stored functions) by
 /// interpolation at the `d'` Greville abscissae of the elevated periodic space, reduced
 /// to `[a, a + L)`.
-pub fn periodic_elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
+pub(crate) fn periodic_elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if !kv.is_periodic() {
         return Err(Error::Invalid("periodic_elevation needs a periodic knot vector".into()));
     }
@@ -173,7 +173,7 @@ pub fn periodic_elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
 /// curve as an ordinary clamped spline whose first and last control points coincide (the
 /// seam's continuity is no longer built into the basis). Coefficients by blossoming, as
 /// in [`periodic_prolongation`].
-pub fn periodic_to_open(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
+pub(crate) fn periodic_to_open(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if !kv.is_periodic() {
         return Err(Error::Invalid("periodic_to_open needs a periodic knot vector".into()));
     }
@@ -206,7 +206,7 @@ pub type Element = (usize, f64, f64);
 /// Bézier extraction operators of a periodic vector, per element `(span, a, b)` of the
 /// domain: `ops[e][j * (p + 1) + k]` is the `k`-th Bernstein coefficient on `[a, b]` of
 /// the stored B-spline `N_{span - p + j}`, the blossom at `(a^{p-k}, b^k)`.
-pub fn periodic_extraction(kv: &KnotVector) -> (Vec<Element>, Vec<Vec<f64>>) {
+pub(crate) fn periodic_extraction(kv: &KnotVector) -> (Vec<Element>, Vec<Vec<f64>>) {
     let p = kv.degree();
     let elements = kv.elements();
     let ops = elements

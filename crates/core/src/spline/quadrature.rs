@@ -2,7 +2,7 @@
 
 /// An `n`-point Gauss–Legendre rule on `[-1, 1]`: exact for polynomials of degree `2n - 1`.
 #[derive(Debug, Clone)]
-pub struct GaussLegendre {
+pub(crate) struct GaussLegendre {
     /// Abscissae in `(-1, 1)`, increasing.
     pub points: Vec<f64>,
     /// Positive weights summing to 2.

@@ -78,7 +78,7 @@ pub fn prolongation(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
 /// obtained by interpolation at the Greville abscissae of the elevated space, which is
 /// exact because the spaces are nested. Periodic vectors go to
 /// [`crate::spline::periodic::periodic_elevation`].
-pub fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
+pub(crate) fn elevation(kv: &KnotVector) -> Result<(KnotVector, Csr)> {
     if kv.is_periodic() {
         return crate::spline::periodic::periodic_elevation(kv);
     }

@@ -5,8 +5,7 @@ use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
-use crate::spline::refine::elevation;
-use crate::spline::tensor::{apply_homogeneous, TensorSpline};
+use crate::spline::tensor::TensorSpline;
 
 /// The four sides of the parameter square, in the order south, east, north, west.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -98,7 +97,7 @@ impl Surface {
 
     /// The diameter of the control points' bounding box, which contains the map (convex
     /// hull property of the B-spline and NURBS basis): the length scale of a map.
-    pub fn control_diameter(&self) -> f64 {
+    pub(crate) fn control_diameter(&self) -> f64 {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in &self.control_points {
             for d in 0..2 {
@@ -129,7 +128,7 @@ impl Surface {
     }
 
     /// Value and derivatives from precomputed univariate basis values.
-    pub fn derivs_with(&self, bu: &BasisDerivs, bv: &BasisDerivs, nd: usize) -> SurfaceDerivs {
+    pub(crate) fn derivs_with(&self, bu: &BasisDerivs, bv: &BasisDerivs, nd: usize) -> SurfaceDerivs {
         // h[a][b] = d^a/du^a d^b/dv^b of (w x, w y, w), the orders up to nd first
         const ORDERS: [[usize; 2]; 6] = [[0, 0], [1, 0], [0, 1], [2, 0], [1, 1], [0, 2]];
         let mut sums = [([0.0; 2], 0.0); 6];
@@ -215,7 +214,7 @@ impl Surface {
     }
 
     /// Linear indices of the control points on a side, in the side's orientation.
-    pub fn side_indices(shape: [usize; 2], side: Side) -> Vec<usize> {
+    pub(crate) fn side_indices(shape: [usize; 2], side: Side) -> Vec<usize> {
         let [nx, ny] = shape;
         match side {
             Side::South => (0..nx).collect(),
@@ -238,12 +237,13 @@ impl Surface {
 }
 
 impl Surface {
+    #[cfg(test)]
     /// The same map with both degrees raised by one.
-    pub fn elevated(&self) -> Result<Surface> {
-        let (kx, ex) = elevation(&self.knots[0])?;
-        let (ky, ey) = elevation(&self.knots[1])?;
+    pub(crate) fn elevated(&self) -> Result<Surface> {
+        let (kx, ex) = crate::spline::refine::elevation(&self.knots[0])?;
+        let (ky, ey) = crate::spline::refine::elevation(&self.knots[1])?;
         let op = ey.kron(&ex);
-        let (cp, w) = apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
+        let (cp, w) = crate::spline::tensor::apply_homogeneous(&op, &self.control_points, self.weights.as_deref());
         Ok(Surface { knots: [kx, ky], control_points: cp, weights: w })
     }
 }
@@ -252,7 +252,7 @@ impl Surface {
 /// (`periodic_to_open`): the same map on its domain (weights kept, control points in
 /// homogeneous form), for formats without periodic bases. Maps without a periodic
 /// direction come back unchanged.
-pub fn open_equivalent(map: &crate::spline::surface::Surface) -> Result<crate::spline::surface::Surface> {
+pub(crate) fn open_equivalent(map: &crate::spline::surface::Surface) -> Result<crate::spline::surface::Surface> {
     let mut out = map.clone();
     for dir in 0..2 {
         if !out.knots[dir].is_periodic() {

@@ -17,6 +17,7 @@
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
+use crate::spline::bezier::BezierExtraction;
 use crate::spline::knots::KnotVector;
 use crate::spline::refine::{elevation, prolongation};
 
@@ -200,14 +201,61 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
         (0..P).rev().fold(0, |lin, d| lin * shape[d] + i[d])
     }
 
+    #[cfg(test)]
     /// The multi-index of a linear index.
-    pub fn unindex(&self, mut lin: usize) -> [usize; P] {
+    pub(crate) fn unindex(&self, mut lin: usize) -> [usize; P] {
         let shape = self.shape();
         std::array::from_fn(|d| {
             let i = lin % shape[d];
             lin /= shape[d];
             i
         })
+    }
+
+    /// Bézier extraction: per direction, the univariate operators of `spline::bezier`
+    /// (`N_i = Σ_k C_ik B_k^p` on each element).
+    pub(crate) fn extraction(&self) -> Result<[BezierExtraction; P]> {
+        let ex = self.knots.iter().map(BezierExtraction::new).collect::<Result<Vec<_>>>()?;
+        ex.try_into().map_err(|_| Error::Invalid("one extraction per direction".into()))
+    }
+
+    /// The homogeneous Bézier net `(w x, w)` of element `e` (indices of the element per
+    /// direction), `Π_d (p_d + 1)` points, first index fastest:
+    /// `H_a = Σ_i (w_i c_i, w_i) Π_d C^d_{i_d a_d}` with the extraction operators `C^d`
+    /// of [`TensorSpline::extraction`]. The control points are visited first index
+    /// fastest and each product is formed from the last direction down.
+    pub(crate) fn bezier_net(&self, ex: &[BezierExtraction; P], e: [usize; P]) -> Vec<Homogeneous<D>> {
+        let deg = self.degrees();
+        let n: [usize; P] = std::array::from_fn(|d| deg[d] + 1);
+        let first: [usize; P] = std::array::from_fn(|d| ex[d].elements[e[d]].0 - deg[d]);
+        let ops: [&[f64]; P] = std::array::from_fn(|d| ex[d].ops[e[d]].as_slice());
+        let len: usize = n.iter().product();
+        let local: Vec<[usize; P]> = (0..len)
+            .map(|mut lin| {
+                std::array::from_fn(|d| {
+                    let i = lin % n[d];
+                    lin /= n[d];
+                    i
+                })
+            })
+            .collect();
+        let mut net = vec![([0.0; D], 0.0); len];
+        for i in &local {
+            let g = self.index(std::array::from_fn(|d| first[d] + i[d]));
+            let (c, w) = (self.control_points[g], self.weight(g));
+            let h: [f64; D] = std::array::from_fn(|k| w * c[k]);
+            for (out, a) in net.iter_mut().zip(&local) {
+                let f = (0..P).rev().fold(1.0, |f, d| f * ops[d][i[d] * n[d] + a[d]]);
+                if f == 0.0 {
+                    continue;
+                }
+                for k in 0..D {
+                    out.0[k] += f * h[k];
+                }
+                out.1 += f * w;
+            }
+        }
+        net
     }
 
     /// Weight of control point `k` (1 for B-splines).
@@ -287,20 +335,20 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
 
     /// Knot insertion in direction `dir`: the same map on the finer knot vector `fine`
     /// (which must contain this one's).
-    pub fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
+    pub(crate) fn refined_in(&self, dir: usize, fine: &KnotVector) -> Result<Self> {
         let op = prolongation(&self.knots[dir], fine)?;
         Ok(self.mapped(dir, fine.clone(), &op))
     }
 
     /// The same map with the degree in direction `dir` raised by one (continuity kept).
-    pub fn elevated_in(&self, dir: usize) -> Result<Self> {
+    pub(crate) fn elevated_in(&self, dir: usize) -> Result<Self> {
         let (kv, op) = elevation(&self.knots[dir])?;
         Ok(self.mapped(dir, kv, &op))
     }
 
     /// The prolongation `P_{P-1} ⊗ .. ⊗ P_0` from this map's basis to the finer tensor
     /// basis `fine`.
-    pub fn prolongation_to(&self, fine: &[KnotVector; P]) -> Result<Csr> {
+    pub(crate) fn prolongation_to(&self, fine: &[KnotVector; P]) -> Result<Csr> {
         let mut op = prolongation(&self.knots[P - 1], &fine[P - 1])?;
         for d in (0..P - 1).rev() {
             op = op.kron(&prolongation(&self.knots[d], &fine[d])?);
@@ -309,7 +357,7 @@ impl<const P: usize, const D: usize> TensorSpline<P, D> {
     }
 
     /// The same map on the finer tensor basis `fine` (knot insertion in every direction;
-    /// for `D = 2` with the whole [`Self::prolongation_to`] at once).
+    /// for `D = 2` with the whole `Self::prolongation_to` at once).
     pub fn refined(&self, fine: &[KnotVector; P]) -> Result<Self> {
         if D == 2 {
             let op = self.prolongation_to(fine)?;

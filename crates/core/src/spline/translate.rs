@@ -26,7 +26,7 @@ use crate::spline::periodic::add_wrapped;
 /// points smoothly in time, and the time extrapolation of `pipeline::sweep` keeps its
 /// order; a refit to shifted samples would only be `C^{p-1}`.
 #[derive(Debug)]
-pub struct PeriodicTranslate {
+pub(crate) struct PeriodicTranslate {
     kv: KnotVector,
     mass: crate::linalg::linsolve::LinearSolver,
     gauss: crate::spline::quadrature::GaussLegendre,
@@ -62,7 +62,11 @@ impl PeriodicTranslate {
     }
 
     /// `P s_sigma` (see the type) for a polynomial curve `s` on this projector's knots.
-    pub fn translate(&mut self, s: &crate::spline::curve::Curve, sigma: f64) -> Result<crate::spline::curve::Curve> {
+    pub(crate) fn translate(
+        &mut self,
+        s: &crate::spline::curve::Curve,
+        sigma: f64,
+    ) -> Result<crate::spline::curve::Curve> {
         if s.knots != self.kv || s.is_rational() || !sigma.is_finite() {
             return Err(Error::Invalid(format!(
                 "a translate projection needs a polynomial curve on the projector's knots and a finite shift (rational {}, same knots {}, shift {sigma})",

@@ -6,13 +6,13 @@
 //! Control point `(i, j, k)` is stored at `(k n_η + j) n_ξ + i` (`ξ` fastest, then `η`).
 //! Validation, indexing, evaluation, knot insertion and degree elevation are those of the
 //! tensor core [`TensorSpline`] (one direction at a time, on the homogeneous coordinates
-//! `(w x, w y, w z, w)`, periodic directions included); Bézier extraction per element is
-//! the tensor product of the univariate operators of `spline::bezier`.
+//! `(w x, w y, w z, w)`, periodic directions included), Bézier extraction per element
+//! too (`TensorSpline::bezier_net`, the tensor product of the univariate operators of
+//! `spline::bezier`).
 
 use crate::error::Result;
 use crate::linalg::sparse::Csr;
 use crate::spline::basis::BasisDerivs;
-use crate::spline::bezier::BezierExtraction;
 use crate::spline::knots::KnotVector;
 use crate::spline::tensor::{apply_along, projected, TensorSpline};
 
@@ -68,7 +68,7 @@ impl Volume {
 
     /// Value and first derivatives from precomputed univariate basis values (with at
     /// least first derivatives; the caller picks the spans, e.g. on element boundaries).
-    pub fn derivs_with(&self, b: &[BasisDerivs; 3]) -> VolumeDerivs {
+    pub(crate) fn derivs_with(&self, b: &[BasisDerivs; 3]) -> VolumeDerivs {
         let (x, d) = self.first_derivs(b.each_ref());
         VolumeDerivs { x, d }
     }
@@ -83,57 +83,6 @@ impl Volume {
         let op = Csr::from_rows(self.shape()[dir], rows);
         let h = apply_along(&op, dir, self.shape(), &self.homogeneous());
         (projected(&h), self.weights.as_ref().map(|_| h.iter().map(|p| p.1).collect()))
-    }
-
-    /// Bézier extraction: per direction, the univariate operators.
-    pub(crate) fn extraction(&self) -> Result<[BezierExtraction; 3]> {
-        Ok([
-            BezierExtraction::new(&self.knots[0])?,
-            BezierExtraction::new(&self.knots[1])?,
-            BezierExtraction::new(&self.knots[2])?,
-        ])
-    }
-
-    /// The homogeneous Bézier net `(w x, w y, w z, w)` of element `e` (indices of the
-    /// element per direction), `(p + 1)(q + 1)(r + 1)` points, first index fastest:
-    /// `H_abc = Σ_ijk h_ijk C^ξ_ia C^η_jb C^ζ_kc` with the extraction operators `C`.
-    pub(crate) fn bezier_net(&self, ex: &[BezierExtraction; 3], e: [usize; 3]) -> Vec<[f64; 4]> {
-        let [p, q, r] = self.degrees();
-        let [nx, ny, _] = self.shape();
-        let spans = [0, 1, 2].map(|d| ex[d].elements[e[d]].0);
-        let first = [spans[0] - p, spans[1] - q, spans[2] - r];
-        let ops = [0, 1, 2].map(|d| &ex[d].ops[e[d]]);
-        let mut net = vec![[0.0; 4]; (p + 1) * (q + 1) * (r + 1)];
-        for k in 0..=r {
-            for j in 0..=q {
-                for i in 0..=p {
-                    let lin = ((first[2] + k) * ny + first[1] + j) * nx + first[0] + i;
-                    let w = self.weights.as_ref().map_or(1.0, |w| w[lin]);
-                    let c = self.control_points[lin];
-                    let hv = [w * c[0], w * c[1], w * c[2], w];
-                    for cc in 0..=r {
-                        let z = ops[2][k * (r + 1) + cc];
-                        if z == 0.0 {
-                            continue;
-                        }
-                        for b in 0..=q {
-                            let y = z * ops[1][j * (q + 1) + b];
-                            if y == 0.0 {
-                                continue;
-                            }
-                            for a in 0..=p {
-                                let f = y * ops[0][i * (p + 1) + a];
-                                let out = &mut net[(cc * (q + 1) + b) * (p + 1) + a];
-                                for z in 0..4 {
-                                    out[z] += f * hv[z];
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        net
     }
 }
 
@@ -245,7 +194,8 @@ mod tests {
                         for a in 0..=p {
                             let f = bu[a] * bv[b] * bw[c];
                             for z in 0..4 {
-                                h[z] += f * net[(c * (q + 1) + b) * (p + 1) + a][z];
+                                let (x, w) = net[(c * (q + 1) + b) * (p + 1) + a];
+                                h[z] += f * if z < 3 { x[z] } else { w };
                             }
                         }
                     }

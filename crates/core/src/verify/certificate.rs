@@ -179,7 +179,7 @@ pub struct ExcusedPoint {
 }
 
 /// An element where `det J < 0` was proven at a point (`D = 2`: of a map of the plane,
-/// [`FoldInfo`]; `D = 3`: of a volume, [`volume::VolumeFold`]).
+/// `FoldInfo`; `D = 3`: of a volume, `volume::VolumeFold`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(bound(serialize = "[usize; D]: Serialize, [f64; D]: Serialize"))]
 pub struct Fold<const D: usize> {
@@ -196,10 +196,10 @@ pub struct Fold<const D: usize> {
 }
 
 /// A fold of a map of the plane.
-pub type FoldInfo = Fold<2>;
+pub(crate) type FoldInfo = Fold<2>;
 
 /// An element neither proven positive nor shown to fold (`D = 2`: of a map of the plane,
-/// [`UndecidedInfo`]; `D = 3`: of a volume, [`volume::VolumeUndecided`]).
+/// `UndecidedInfo`; `D = 3`: of a volume, `volume::VolumeUndecided`).
 #[derive(Debug, Clone, Serialize)]
 #[serde(bound(serialize = "[usize; D]: Serialize"))]
 pub struct Undecided<const D: usize> {
@@ -219,7 +219,7 @@ pub struct Undecided<const D: usize> {
 }
 
 /// An undecided element of a map of the plane.
-pub type UndecidedInfo = Undecided<2>;
+pub(crate) type UndecidedInfo = Undecided<2>;
 
 /// The bijectivity certificate of a map.
 #[derive(Debug, Clone, Serialize)]
@@ -407,7 +407,7 @@ fn excuse_point(
 /// Angles and `det J` (cross product of the side tangents) at the four corners, in the
 /// order south-west, south-east, north-east, north-west; `forbids_positivity` and
 /// `excused_extent` are filled in by [`certify`].
-pub fn corner_info(map: &Surface) -> Vec<CornerInfo> {
+pub(crate) fn corner_info(map: &Surface) -> Vec<CornerInfo> {
     let sides = Side::ALL.map(|s| map.boundary(s));
     let d = |s: Side, end: bool| {
         let c = &sides[s as usize];
@@ -493,12 +493,13 @@ pub fn certify(map: &Surface, opts: &CertifyOptions) -> Result<Certificate> {
     })
 }
 
+#[cfg(test)]
 /// The global minimum of `det J` by branch and bound on the Bernstein form, in floating
 /// point (no rounding bound: a diagnostic, not a proof): returns `(lower, upper)` with
 /// `lower <= min det J <= upper` up to rounding, `upper - lower <= tol` unless
 /// `max_boxes` is reached; `upper` is a value at a sub-box corner. Polynomial maps only
 /// (for rational maps the numerator is minimised, scaled per element).
-pub fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f64, f64)> {
+pub(crate) fn det_j_min_bounds(map: &Surface, tol: f64, max_boxes: usize) -> Result<(f64, f64)> {
     let dj = Elements::surface(map)?;
     let shape = dj.shape();
     let d = dj.deg;

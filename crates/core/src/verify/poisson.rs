@@ -79,7 +79,7 @@ fn side_interpolant(map: &Surface, side: Side, g: &dyn Fn([f64; 2]) -> f64) -> V
 /// Solve `-Δu = f` in the mapped domain with `u = g` on its boundary; returns the
 /// coefficients of `u_h` on the map's tensor basis (`xi` index fastest). The map must
 /// have `det J != 0` at the quadrature points.
-pub fn solve_poisson(
+pub(crate) fn solve_poisson(
     map: &Surface,
     f: &(dyn Fn([f64; 2]) -> f64 + Sync),
     g: &dyn Fn([f64; 2]) -> f64,
@@ -153,7 +153,7 @@ pub struct PoissonErrors {
 
 /// `L2` and `H1`-seminorm errors of `u_h` (coefficients on the map's basis) against
 /// `exact(x) = (u, grad u)`, with `p + 3` Gauss points per direction and element.
-pub fn poisson_errors(map: &Surface, uh: &[f64], exact: &dyn Fn([f64; 2]) -> (f64, [f64; 2])) -> PoissonErrors {
+pub(crate) fn poisson_errors(map: &Surface, uh: &[f64], exact: &dyn Fn([f64; 2]) -> (f64, [f64; 2])) -> PoissonErrors {
     let [p, q] = map.degrees();
     let nx = map.shape()[0];
     let gx = GaussLegendre::new(p + 3);
@@ -209,7 +209,7 @@ pub struct PoissonReport {
 /// The manufactured solution `u* = sin(π x / a1) sin(π y / a2)` with its gradient, and
 /// `-Δu* = π² (1/a1² + 1/a2²) u*`.
 #[allow(clippy::type_complexity)]
-pub fn manufactured(a: [f64; 2]) -> (impl Fn([f64; 2]) -> (f64, [f64; 2]), impl Fn([f64; 2]) -> f64 + Sync) {
+pub(crate) fn manufactured(a: [f64; 2]) -> (impl Fn([f64; 2]) -> (f64, [f64; 2]), impl Fn([f64; 2]) -> f64 + Sync) {
     use std::f64::consts::PI;
     let (k1, k2) = (PI / a[0], PI / a[1]);
     let exact = move |x: [f64; 2]| {
@@ -223,7 +223,7 @@ pub fn manufactured(a: [f64; 2]) -> (impl Fn([f64; 2]) -> (f64, [f64; 2]), impl 
 
 /// Default length scales: half the extents of the map's bounding box (so that `u*`
 /// makes one full period across the domain in each direction).
-pub fn default_scales(map: &Surface) -> [f64; 2] {
+pub(crate) fn default_scales(map: &Surface) -> [f64; 2] {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for s in Side::ALL {
         for p in map.boundary(s).sample(64) {
@@ -238,7 +238,7 @@ pub fn default_scales(map: &Surface) -> [f64; 2] {
 }
 
 /// Run the benchmark of eq. (44)-(45) on `map` with length scales `a` (default:
-/// [`default_scales`]).
+/// `default_scales`).
 pub fn poisson_benchmark(map: &Surface, a: Option<[f64; 2]>) -> Result<PoissonReport> {
     let t0 = Instant::now();
     let a = a.unwrap_or_else(|| default_scales(map));

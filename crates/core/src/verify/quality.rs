@@ -354,17 +354,14 @@ pub fn quality(map: &Surface) -> Quality {
 ///
 /// where `x_s` is the map's side `s` and `Γ_s` the input side (a spline or analytic
 /// curve, or the polyline through a point cloud). The distance to a curve is found in
-/// two steps: the nearest chord of a sampling of `Γ_s` ([`SAMPLES_PER_SPAN`] chords per
-/// knot span of a spline, [`ANALYTIC_SAMPLES`] of an analytic side), then the curve's
+/// two steps: the nearest chord of a sampling of `Γ_s` (`SAMPLES_PER_SPAN` chords per
+/// knot span of a spline, `ANALYTIC_SAMPLES` of an analytic side), then the curve's
 /// own nearest point by golden-section search on the parameters of that chord and its
 /// two neighbours. Every distance is to a point *on* the curve, so `d_s` never
 /// understates the deviation, and it is at rounding level when the map's side is the
 /// input curve, whatever its parameterization. This is the one measure of the crate:
 /// the solve report's `boundary_deviation` and `winslow check --boundary` both are this
 /// with `n = 400`.
-///
-/// [`SAMPLES_PER_SPAN`]: crate::boundary::validate::SAMPLES_PER_SPAN
-/// [`ANALYTIC_SAMPLES`]: crate::boundary::validate::ANALYTIC_SAMPLES
 pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n: usize) -> [f64; 4] {
     use crate::spline::surface::Side;
     let n = n.max(1);

@@ -66,7 +66,7 @@ impl<'a> Parametric<'a> {
 /// only when it lowers `A` and keeps the coefficients strictly increasing, so `g` stays
 /// strictly monotone (its derivative is a spline with positive coefficients). Returns
 /// `g` and `A / L^2 >= 1` (1 for exact arc length). `None` for point clouds.
-pub fn arc_length_map(side: &SideCurve, elements: usize, samples: usize) -> Result<Option<(ParamMap, f64)>> {
+pub(crate) fn arc_length_map(side: &SideCurve, elements: usize, samples: usize) -> Result<Option<(ParamMap, f64)>> {
     arc_length_iterations(side, elements, samples, 30)
 }
 

@@ -44,7 +44,7 @@ pub fn facing(p1: &[Point], i: usize, p2: &[Point], j: usize, across: Across) ->
 /// open intervals shrunk by `sep` at both ends), the closest pair within `eps` is matched
 /// and the search continues below and above it. Only pairs [`facing`] each other across
 /// the domain count. Returns the pairs `(i, j)` ordered by `i` (and then also by `j`).
-pub fn match_pairs(
+pub(crate) fn match_pairs(
     p1: &[Point],
     c1: &[f64],
     p2: &[Point],
@@ -87,7 +87,7 @@ pub fn match_pairs(
 /// Abscissae of the second side from matched values (eq. 41-42 or monotone cubic):
 /// `known` holds `(index, ξ)` pairs with increasing index and strictly increasing `ξ`,
 /// `c2` the side's own cord-length parameters. The ends are `ξ = 0` and `ξ = 1`.
-pub fn fill_abscissae(c2: &[f64], known: &[(usize, f64)], fill: Fill) -> Result<Vec<f64>> {
+pub(crate) fn fill_abscissae(c2: &[f64], known: &[(usize, f64)], fill: Fill) -> Result<Vec<f64>> {
     let m = c2.len();
     let mut anchors: Vec<(usize, f64)> = vec![(0, 0.0)];
     anchors.extend(known.iter().copied().filter(|&(j, _)| j > 0 && j + 1 < m));
@@ -132,7 +132,7 @@ pub type Constrained = (Vec<f64>, Vec<f64>, Vec<(usize, usize)>);
 /// length of `p1`; `Ξ_2` takes the value of `Ξ_1` at every matched pair (eq. 40, threshold
 /// `eps`, minimum separation `sep`) and is filled in between by `fill`. Returns
 /// `(Ξ_1, Ξ_2, matches)`.
-pub fn constrained_params(
+pub(crate) fn constrained_params(
     p1: &[Point],
     p2: &[Point],
     eps: f64,
@@ -156,7 +156,7 @@ pub fn constrained_params(
 /// pairs with `c1` strictly increasing inside `(0, 1)` and `c2` strictly increasing are
 /// kept (repeated points can give equal parameters). Shared by the four-sided
 /// [`constrained_params`] and the ring matching (`boundary::ring_reparam`).
-pub fn match_clouds(
+pub(crate) fn match_clouds(
     p1: &[Point],
     c1: &[f64],
     p2: &[Point],
@@ -187,7 +187,7 @@ pub fn match_clouds(
 
 /// Most points per side that the quadratic searches ([`match_pairs`], [`min_distance`])
 /// look at; denser clouds are thinned to every k-th point (ends kept).
-pub const MAX_SEARCH_POINTS: usize = 4096;
+pub(crate) const MAX_SEARCH_POINTS: usize = 4096;
 
 /// Indices `0, k, 2k, ..., n-1` with `k` the smallest stride leaving at most
 /// [`MAX_SEARCH_POINTS`] points.
@@ -203,7 +203,7 @@ pub(super) fn thinned(n: usize) -> Vec<usize> {
 /// Smallest distance between points of two opposite sides that are [`facing`] each
 /// other across the domain (brute force on at most [`MAX_SEARCH_POINTS`] points of
 /// each), used to detect narrow gaps; infinite when no pair faces.
-pub fn min_distance(p1: &[Point], p2: &[Point], across: Across) -> f64 {
+pub(crate) fn min_distance(p1: &[Point], p2: &[Point], across: Across) -> f64 {
     let mut best = f64::INFINITY;
     for &i in &thinned(p1.len()) {
         for &j in &thinned(p2.len()) {

@@ -8,7 +8,7 @@
 //!   basis with `c_0 = 0`, `c_n = 1`, minimizing (eq. 39)
 //!   `A(c) = ∫_0^1 ||(f̄ ∘ g)'(ξ)||^2 dξ`; by Cauchy-Schwarz `A >= L^2` (`L` the length of
 //!   the side) with equality exactly for the arc-length parameterization. See
-//!   [`arc_length_map`]. The contour is then re-fitted in the solver's basis as
+//!   `arc_length_map`. The contour is then re-fitted in the solver's basis as
 //!   `f̄ ∘ g` ([`crate::boundary::fit`]).
 //! * **Constrained cord length** (§7.2, eq. 40-42). For two opposite sides `P_1` (cord
 //!   length, `Ξ_1`) and `P_2`, the closest pair `(p^1_i, p^2_j)` within the threshold
@@ -16,7 +16,7 @@
 //!   index ranges below and above the match, after removing the points within a minimum
 //!   cord-length separation `δ` of it. The unmatched abscissae of `P_2` are filled either
 //!   by a Fritsch-Carlson monotone cubic through the matched values or by piecewise cord
-//!   length between consecutive matches (eq. 41-42). See [`constrained_params`].
+//!   length between consecutive matches (eq. 41-42). See `constrained_params`.
 //!
 //! Rings (closed contours, `eta` periodic) use the same matching on the two contours
 //! cut open at the seam: `boundary::ring_reparam`.
@@ -29,8 +29,8 @@ mod arc_length;
 mod matching;
 mod monotone_cubic;
 
-pub use arc_length::*;
-pub use matching::*;
+pub(crate) use arc_length::*;
+pub(crate) use matching::*;
 pub use monotone_cubic::MonotoneCubic;
 
 use serde::Serialize;
@@ -165,7 +165,7 @@ impl ParamMap {
     }
 
     /// `g(ξ)` and `g'(ξ)`.
-    pub fn eval_d(&self, xi: f64) -> (f64, f64) {
+    pub(crate) fn eval_d(&self, xi: f64) -> (f64, f64) {
         match self {
             ParamMap::Monotone(m) => m.eval_d(xi),
             ParamMap::Spline { knots, coefs } => {
@@ -245,7 +245,7 @@ pub fn sample_side(side: &SideCurve, per_element: usize) -> SideSample {
 /// Monotone map `g` with `g(ξ_k) = t_k` from abscissae `ξ_k` of samples at parameters
 /// `t_k` (both non-decreasing, from 0 to 1); samples whose `ξ` or `t` repeats the previous
 /// one are dropped (a stationary stretch of the curve).
-pub fn interpolating_map(xi: &[f64], t: &[f64]) -> Result<ParamMap> {
+pub(crate) fn interpolating_map(xi: &[f64], t: &[f64]) -> Result<ParamMap> {
     let (mut x, mut y) = (Vec::with_capacity(xi.len()), Vec::with_capacity(xi.len()));
     for (&a, &b) in xi.iter().zip(t) {
         if let (Some(&pa), Some(&pb)) = (x.last(), y.last()) {

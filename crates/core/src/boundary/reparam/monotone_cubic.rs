@@ -99,7 +99,7 @@ impl MonotoneCubic {
     }
 
     /// Value and first derivative at `t` (clamped).
-    pub fn eval_d(&self, t: f64) -> (f64, f64) {
+    pub(crate) fn eval_d(&self, t: f64) -> (f64, f64) {
         let n = self.x.len();
         let t = t.clamp(self.x[0], self.x[n - 1]);
         let k = self.interval(t);

@@ -38,7 +38,7 @@ use crate::spline::surface::{Side, Surface};
 /// whose `parDim` is not 1 (G+Smo stores the four boundary curves of a single domain as a
 /// `<MultiPatch parDim="1">`; that is a boundary document, read by
 /// [`crate::io::read`]).
-pub fn is_gismo_multipatch(text: &str) -> bool {
+pub(crate) fn is_gismo_multipatch(text: &str) -> bool {
     let body = text.trim_start_matches('\u{feff}').trim_start();
     body.starts_with('<')
         && body.match_indices("<MultiPatch").any(|(k, _)| {
@@ -50,7 +50,7 @@ pub fn is_gismo_multipatch(text: &str) -> bool {
 }
 
 /// G+Smo's side number (1 west, 2 east, 3 south, 4 north) as a [`Side`].
-pub fn side_of_gismo(k: i64) -> Option<Side> {
+pub(crate) fn side_of_gismo(k: i64) -> Option<Side> {
     match k {
         1 => Some(Side::West),
         2 => Some(Side::East),
@@ -61,7 +61,7 @@ pub fn side_of_gismo(k: i64) -> Option<Side> {
 }
 
 /// The G+Smo number of a [`Side`].
-pub fn gismo_of_side(s: Side) -> u8 {
+pub(crate) fn gismo_of_side(s: Side) -> u8 {
     match s {
         Side::West => 1,
         Side::East => 2,

@@ -43,7 +43,7 @@ fn curve_of(v: Value, ctx: &str) -> Result<Curve> {
     if c.periodic {
         return Err(jerr(ctx, "a periodic curve cannot be a patch side"));
     }
-    c.to_curve().map_err(|e| e.within(ctx))
+    c.into_curve().map_err(|e| e.within(ctx))
 }
 
 /// Parse a multipatch document (see the module documentation); the layout is not
@@ -222,7 +222,7 @@ pub fn parse_json_multipatch(text: &str) -> Result<Layout> {
 }
 
 /// An interface as JSON: `{"patches": [names], "sides": [..], "reversed"}`.
-pub fn interface_json(layout: &Layout, i: &Interface) -> Value {
+pub(crate) fn interface_json(layout: &Layout, i: &Interface) -> Value {
     json!({
         "patches": [layout.patches[i.first.patch].name, layout.patches[i.second.patch].name],
         "sides": [i.first.side.name(), i.second.side.name()],
@@ -233,7 +233,12 @@ pub fn interface_json(layout: &Layout, i: &Interface) -> Value {
 /// The multipatch output document: every patch a `map` with its `report` (the values
 /// of `reports`, one per patch, `null` for none), the interfaces, and `report` at the
 /// top level.
-pub fn multipatch_to_json(layout: &Layout, maps: &[Surface], reports: Vec<Value>, report: Value) -> Result<Value> {
+pub(crate) fn multipatch_to_json(
+    layout: &Layout,
+    maps: &[Surface],
+    reports: Vec<Value>,
+    report: Value,
+) -> Result<Value> {
     if maps.len() != layout.patches.len() || reports.len() != maps.len() {
         return Err(Error::Invalid(format!(
             "{} maps and {} reports for {} patches",
@@ -267,7 +272,7 @@ pub fn multipatch_to_json(layout: &Layout, maps: &[Surface], reports: Vec<Value>
 /// The input document of `layout` with every patch a `boundary` of its four sides
 /// (the interfaces listed): what [`parse_json_multipatch`] reads back as the same
 /// layout.
-pub fn layout_to_json(layout: &Layout) -> Value {
+pub(crate) fn layout_to_json(layout: &Layout) -> Value {
     let patches: Vec<Value> = layout
         .patches
         .iter()

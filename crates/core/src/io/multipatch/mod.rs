@@ -42,7 +42,7 @@ pub struct Patches<'a> {
 }
 
 impl<'a> Patches<'a> {
-    /// The patches of a solved layout with their reports ([`patch_report`]).
+    /// The patches of a solved layout with their reports (`patch_report`).
     pub fn of_solution(sol: &'a MultipatchSolution) -> Result<Self> {
         Ok(Self {
             layout: &sol.layout,
@@ -60,7 +60,7 @@ impl<'a> Patches<'a> {
     }
 
     /// The G+Smo XML multipatch document.
-    pub fn to_gismo_xml(&self) -> Result<String> {
+    pub(crate) fn to_gismo_xml(&self) -> Result<String> {
         let comment = format!("winslow {}: {}", env!("CARGO_PKG_VERSION"), self.message);
         multipatch_to_gismo_xml(self.layout, &self.maps, &comment)
     }
@@ -82,7 +82,7 @@ impl<'a> Patches<'a> {
     /// A VTK multiblock file `path` (`.vtm`) whose blocks are the patches, each an exact
     /// Bézier `.vtu` in the folder next to it named after the file stem; returns the
     /// paths written (the `.vtm` first). Every file goes through the atomic writer.
-    pub fn write_vtm(&self, path: &Path) -> Result<Vec<PathBuf>> {
+    pub(crate) fn write_vtm(&self, path: &Path) -> Result<Vec<PathBuf>> {
         self.check()?;
         let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "layout".into());
         let dir = path.with_file_name(&stem);
@@ -111,7 +111,7 @@ impl<'a> Patches<'a> {
 
 /// The report of one patch: its verdict, certificate and Winslow value (of the final
 /// map) and the report of its fixed-interface solve.
-pub fn patch_report(p: &PatchSolution) -> Value {
+pub(crate) fn patch_report(p: &PatchSolution) -> Value {
     let w = crate::verify::quality::quality(&p.map).functionals.winslow;
     json!({
         "verdict": p.verdict,

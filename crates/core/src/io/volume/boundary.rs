@@ -23,7 +23,7 @@ use crate::spline::knots::KnotVector;
 /// One face of a volume boundary document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct FaceJson {
+pub(crate) struct FaceJson {
     /// Degrees in `s` and `t`.
     pub degree: [usize; 2],
     /// Full open knot vectors in `s` and `t`.
@@ -37,7 +37,7 @@ pub struct FaceJson {
 
 impl FaceJson {
     /// The JSON form of a face.
-    pub fn from_face(f: &Face) -> Self {
+    pub(crate) fn from_face(f: &Face) -> Self {
         FaceJson {
             degree: f.degrees(),
             knots: f.knots.each_ref().map(|k| k.knots().to_vec()),
@@ -47,7 +47,7 @@ impl FaceJson {
     }
 
     /// Validate and map the knot domains to `[0, 1]`; errors name the field.
-    pub fn into_face(self) -> Result<Face> {
+    pub(crate) fn into_face(self) -> Result<Face> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let mut kvs = Vec::with_capacity(2);
         for (d, k) in self.knots.into_iter().enumerate() {

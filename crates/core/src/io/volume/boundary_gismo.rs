@@ -57,7 +57,7 @@ fn face(geom: Node, ctx: &str) -> Result<Option<Face>> {
 /// Parse a G+Smo `<MultiPatch>` of surfaces in space as the six faces of a volume
 /// (module doc); `Ok(None)` when the file is not one (a patch with two coordinates, or
 /// every patch in one plane `z = const`), so that it is read as a multipatch layout.
-pub fn parse_gismo_faces(text: &str) -> Result<Option<VolumeBoundary>> {
+pub(crate) fn parse_gismo_faces(text: &str) -> Result<Option<VolumeBoundary>> {
     if nesting_exceeds(text, MAX_DEPTH) {
         return Err(xml_err("", format!("elements are nested more than {MAX_DEPTH} levels deep")));
     }

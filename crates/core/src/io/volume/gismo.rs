@@ -81,7 +81,7 @@ fn volume(geom: Node, rational: bool, ctx: &str) -> Result<Volume> {
 }
 
 /// Parse a G+Smo XML file holding one `TensorBSpline3` or `TensorNurbs3` geometry.
-pub fn parse_gismo_volume(text: &str) -> Result<Volume> {
+pub(crate) fn parse_gismo_volume(text: &str) -> Result<Volume> {
     if nesting_exceeds(text, MAX_DEPTH) {
         return Err(xml_err("", format!("elements are nested more than {MAX_DEPTH} levels deep")));
     }

@@ -24,7 +24,7 @@ use crate::spline::volume::Volume;
 
 /// The `map` object of a trivariate map document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct VolumeJson {
+pub(crate) struct VolumeJson {
     /// Degrees in `xi`, `eta`, `zeta`.
     pub degree: [usize; 3],
     /// Full knot vectors in `xi`, `eta`, `zeta`.
@@ -41,7 +41,7 @@ pub struct VolumeJson {
 
 impl VolumeJson {
     /// The JSON form of a volume.
-    pub fn from_volume(v: &Volume) -> Self {
+    pub(crate) fn from_volume(v: &Volume) -> Self {
         VolumeJson {
             degree: v.degrees(),
             knots: v.knots.each_ref().map(|k| k.knots().to_vec()),
@@ -52,7 +52,7 @@ impl VolumeJson {
     }
 
     /// Validate and map the knot domains to `[0, 1]`; errors name the field.
-    pub fn into_volume(self) -> Result<Volume> {
+    pub(crate) fn into_volume(self) -> Result<Volume> {
         crate::error::check_control_point_count(self.control_points.len(), "")?;
         let mut kvs = Vec::with_capacity(3);
         for (d, k) in self.knots.into_iter().enumerate() {
@@ -90,7 +90,7 @@ pub(crate) fn parse_volume_json(mut v: Value) -> Result<(String, Volume)> {
 /// A trivariate map document `{"name", "map": {...}}`; the fields of `extra` (an object,
 /// e.g. `{"certificate": ...}`) are added at the top level unless they would replace
 /// `name` or `map`.
-pub fn volume_to_json(name: &str, v: &Volume, extra: Option<Value>) -> Value {
+pub(crate) fn volume_to_json(name: &str, v: &Volume, extra: Option<Value>) -> Value {
     let mut doc = serde_json::Map::new();
     doc.insert("name".into(), Value::String(name.to_string()));
     doc.insert("map".into(), json!(VolumeJson::from_volume(v)));

@@ -18,11 +18,11 @@ use crate::spline::basis::BasisDerivs;
 use crate::spline::volume::Volume;
 
 /// VTK cell type of a Bézier hexahedron.
-pub const VTK_BEZIER_HEXAHEDRON: u8 = 79;
+pub(crate) const VTK_BEZIER_HEXAHEDRON: u8 = 79;
 
 /// Legacy-VTK structured grid of the volume sampled on `(n_ξ+1)(n_η+1)(n_ζ+1)` points
 /// with `det J`.
-pub fn volume_structured_vtk(vol: &Volume, samples: [usize; 3]) -> String {
+pub(crate) fn volume_structured_vtk(vol: &Volume, samples: [usize; 3]) -> String {
     let n = samples.map(|s| s.max(1));
     let total = (n[0] + 1) * (n[1] + 1) * (n[2] + 1);
     let mut out = String::new();
@@ -46,7 +46,7 @@ pub fn volume_structured_vtk(vol: &Volume, samples: [usize; 3]) -> String {
 }
 
 /// VTK's index of point `(i, j, k)` of a higher-order hexahedron of orders `o`.
-pub fn vtk_hex_index(i: usize, j: usize, k: usize, o: [usize; 3]) -> usize {
+pub(crate) fn vtk_hex_index(i: usize, j: usize, k: usize, o: [usize; 3]) -> usize {
     let (ib, jb, kb) = (i == 0 || i == o[0], j == 0 || j == o[1], k == 0 || k == o[2]);
     let nb = ib as usize + jb as usize + kb as usize;
     let corner = |i: usize, j: usize| match (i > 0, j > 0) {
@@ -102,7 +102,7 @@ fn along(m: &[f64], d: [usize; 3], dir: usize, v: &[f64]) -> Vec<f64> {
 }
 
 /// The volume as a VTK XML unstructured grid of Bézier hexahedra (see the module doc).
-pub fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
+pub(crate) fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
     let ex = vol.extraction()?;
     let deg = vol.degrees();
     let npe = (deg[0] + 1) * (deg[1] + 1) * (deg[2] + 1);
@@ -138,9 +138,9 @@ pub fn volume_bezier_vtu(vol: &Volume, comment: &str) -> Result<String> {
                 }
                 let coef = along(&inv[2], deg, 2, &along(&inv[1], deg, 1, &along(&inv[0], deg, 0, &vals)));
                 for &k in &order {
-                    let h = net[k];
-                    let _ = write!(pts, "{:?} {:?} {:?} ", h[0] / h[3], h[1] / h[3], h[2] / h[3]);
-                    let _ = write!(wts, "{:?} ", h[3]);
+                    let (h, w) = net[k];
+                    let _ = write!(pts, "{:?} {:?} {:?} ", h[0] / w, h[1] / w, h[2] / w);
+                    let _ = write!(wts, "{:?} ", w);
                     let _ = write!(dets, "{:?} ", coef[k]);
                 }
                 pts.push('\n');

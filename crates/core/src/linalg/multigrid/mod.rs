@@ -28,7 +28,7 @@ use lines::{grid_width, Lines};
 
 /// The smoother of every level but the coarsest.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Smoother {
+pub(crate) enum Smoother {
     /// Gauss–Seidel in the unknowns' order before the coarse correction, in reverse
     /// order after it (compared with ILU(0) in the tests, BENCHMARKS.md "Multigrid").
     #[cfg_attr(not(test), allow(dead_code))]
@@ -45,7 +45,7 @@ pub enum Smoother {
 
 /// A multigrid V-cycle for `A` (see the module documentation).
 #[derive(Debug)]
-pub struct Multigrid {
+pub(crate) struct Multigrid {
     /// `P_l` maps level `l + 1` to level `l` (level 0 the finest).
     prolongations: Vec<Csr>,
     restrictions: Vec<Csr>,
@@ -62,7 +62,7 @@ pub struct Multigrid {
 }
 
 /// `P^T A P` with `pt = P^T`, rows in parallel, a dense accumulator per thread.
-pub fn galerkin(pt: &Csr, a: &Csr, p: &Csr) -> Csr {
+pub(crate) fn galerkin(pt: &Csr, a: &Csr, p: &Csr) -> Csr {
     let nc = p.ncols;
     let ap = {
         let rows: Vec<Vec<(usize, f64)>> = (0..a.nrows)

@@ -380,7 +380,7 @@ pub fn discretization(map: &Surface, topology: &Topology) -> Result<Arc<Discreti
 }
 
 /// The Coons patch of `map`'s boundary on its basis: the common infeasible start.
-pub fn coons_start(map: &Surface) -> Result<Vec<Point>> {
+pub(crate) fn coons_start(map: &Surface) -> Result<Vec<Point>> {
     let sides = Side::ALL.map(|s| map.boundary(s));
     crate::solve::initial::coons(&map.knots, &sides)
 }

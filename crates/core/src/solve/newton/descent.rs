@@ -154,7 +154,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
 /// along it, `g(t) = ∇J(c + t δ)·δ`, interpolated linearly through `g(0) = g₀ < 0` and
 /// `g(1) = g₁`, vanishes: `t = g₀ / (g₀ - g₁)`, the minimiser of the quadratic through
 /// `J'(0)` and `J'(1)` (the secant step). Proposed when `g₀ < g₁ < 0` (`J` still falls
-/// at the full step, less steeply than at 0) and `t >= 1.1`; at most [`EXTRAPOLATE_MAX`].
+/// at the full step, less steeply than at 0) and `t >= 1.1`; at most `EXTRAPOLATE_MAX`.
 /// Near a minimiser the full Newton step is exact to second order, `g₁ ≈ 0`: `None`.
 pub fn extrapolated_step(g0: f64, g1: f64) -> Option<f64> {
     if !(g0 < g1 && g1 < 0.0) {

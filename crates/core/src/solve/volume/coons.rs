@@ -24,7 +24,7 @@ use crate::spline::volume::Volume;
 
 /// The faces on common knot vectors `knots` (in `ξ`, `η`, `ζ`).
 #[derive(Debug, Clone)]
-pub struct CommonFaces {
+pub(crate) struct CommonFaces {
     /// The volume's knot vectors.
     pub knots: [KnotVector; 3],
     /// The faces on them, in the order of [`CubeSide::ALL`].
@@ -33,7 +33,7 @@ pub struct CommonFaces {
 
 /// Bring the faces of `b` to common knot vectors per direction, each element halved
 /// `refine` times (module doc).
-pub fn common_faces(b: &VolumeBoundary, refine: usize) -> Result<CommonFaces> {
+pub(crate) fn common_faces(b: &VolumeBoundary, refine: usize) -> Result<CommonFaces> {
     let mut faces = b.faces.clone();
     let mut knots = Vec::with_capacity(3);
     for d in 0..3 {
@@ -80,7 +80,7 @@ impl CommonFaces {
     /// The homogeneous boundary net `(w c, w)` on the volume's control net (interior
     /// points zero), every boundary point from the face(s) it lies on; the weights of the
     /// faces meeting at an edge must agree (to `10⁻¹²` relative).
-    pub fn boundary_net(&self) -> Result<Vec<[f64; 4]>> {
+    pub(crate) fn boundary_net(&self) -> Result<Vec<[f64; 4]>> {
         let shape = self.shape();
         let n: usize = shape.iter().product();
         let mut h = vec![[0.0; 4]; n];

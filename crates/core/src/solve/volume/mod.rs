@@ -34,7 +34,7 @@ use crate::verify::certificate::CertifyOptions;
 use coons::{common_faces, coons_fill, volume_of, CommonFaces};
 use winslow::WinslowVolume;
 
-/// Options of [`solve_volume`].
+/// Options of `solve_volume`.
 #[derive(Debug, Clone)]
 pub struct VolumeOptions {
     /// Times every element of the common bases is halved before the solve.
@@ -352,7 +352,7 @@ pub fn boundary_deviation(v: &Volume, b: &VolumeBoundary) -> f64 {
 /// The volume bounded by the faces of `b` (validated first; module doc): certified,
 /// or the last attempt with its certificate (the caller must not treat a volume whose
 /// verdict is not `certified` as valid).
-pub fn solve_volume(b: &VolumeBoundary, opts: &VolumeOptions) -> Result<VolumeSolve> {
+pub(crate) fn solve_volume(b: &VolumeBoundary, opts: &VolumeOptions) -> Result<VolumeSolve> {
     let t0 = Instant::now();
     b.validate()?;
     let diameter = b.diameter();

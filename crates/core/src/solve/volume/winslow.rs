@@ -132,7 +132,7 @@ struct Local {
 /// pattern of `∇²E` is built once, and every evaluation adds the element matrices into
 /// its values.
 #[derive(Debug, Clone)]
-pub struct WinslowVolume {
+pub(crate) struct WinslowVolume {
     shape: [usize; 3],
     /// `tables[d][e]`: the tables of element `e` in direction `d`.
     tables: [Vec<Tables>; 3],
@@ -151,7 +151,7 @@ pub struct WinslowVolume {
 
 /// Energy, gradient (of the free coordinates) and Hessian of [`WinslowVolume`].
 #[derive(Debug, Clone)]
-pub struct Evaluation {
+pub(crate) struct Evaluation {
     /// `E(c)` (`+∞` when `det J <= 0` at a quadrature point).
     pub energy: f64,
     /// `∇E` over the free coordinates, `3 f + component`.

@@ -24,7 +24,7 @@ use crate::spline::surface::{Surface, SurfaceDerivs};
 pub struct HierarchicalMap {
     /// The basis.
     pub basis: HierarchicalBasis,
-    /// Control points in the order of [`HierarchicalBasis::active_functions`].
+    /// Control points in the order of `HierarchicalBasis::active_functions`.
     pub control_points: Vec<Point>,
 }
 
@@ -109,7 +109,7 @@ impl HierarchicalMap {
 
     /// The Bézier patch of every active cell, `(level, cell, patch)`: a one-element tensor
     /// map on the cell's parameter box equal to the THB map there (element extraction).
-    pub fn bezier_patches(&self) -> Result<Vec<(usize, Index2, Surface)>> {
+    pub(crate) fn bezier_patches(&self) -> Result<Vec<(usize, Index2, Surface)>> {
         let mut lc = self.level_coefficients();
         self.basis.active_cells().into_iter().map(|(l, c)| Ok((l, c, self.bezier_patch(&mut lc, l, c)?))).collect()
     }
@@ -186,7 +186,7 @@ impl HierarchicalMap {
 
     /// The knot vectors of the coarsest tensor space containing this THB space: the
     /// level-0 knots and, once each, every edge of an active cell of a finer level.
-    pub fn tensor_knots(&self) -> Result<[KnotVector; 2]> {
+    pub(crate) fn tensor_knots(&self) -> Result<[KnotVector; 2]> {
         let mut edges: [BTreeSet<u64>; 2] = [BTreeSet::new(), BTreeSet::new()];
         for (l, c) in self.basis.active_cells() {
             if l == 0 {
@@ -209,7 +209,7 @@ impl HierarchicalMap {
         Ok([out[0].clone(), out[1].clone()])
     }
 
-    /// The same map as a tensor-product map on [`Self::tensor_knots`] (exact: every
+    /// The same map as a tensor-product map on `Self::tensor_knots` (exact: every
     /// coefficient is the blossom of the piece on an element of its support).
     pub fn to_surface(&self) -> Result<Surface> {
         let kv = self.tensor_knots()?;

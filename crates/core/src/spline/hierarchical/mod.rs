@@ -44,10 +44,10 @@ use crate::error::{Error, Result, MAX_CONTROL_POINTS};
 use crate::spline::knots::KnotVector;
 
 /// A cell or a function of one level: its index per direction (`xi`, `eta`).
-pub type Index2 = [usize; 2];
+pub(crate) type Index2 = [usize; 2];
 
 /// Levels a hierarchy may hold (level `0` included).
-pub const MAX_LEVELS: usize = 24;
+pub(crate) const MAX_LEVELS: usize = 24;
 
 /// One level of the hierarchy: its tensor knot vectors and per direction the elements
 /// and, for each knot position `k`, the element that starts at `t_k`.
@@ -152,27 +152,27 @@ impl HierarchicalBasis {
     }
 
     /// The active functions `(level, index)` in the order of the coefficients.
-    pub fn active_functions(&self) -> &[(usize, Index2)] {
+    pub(crate) fn active_functions(&self) -> &[(usize, Index2)] {
         &self.active
     }
 
     /// The position of the active function `(l, f)` among [`Self::active_functions`].
-    pub fn index_of(&self, l: usize, f: Index2) -> Option<usize> {
+    pub(crate) fn index_of(&self, l: usize, f: Index2) -> Option<usize> {
         self.lookup.get(&(l, f)).copied()
     }
 
     /// The refined cells of level `l` (empty past the finest level).
-    pub fn refined_cells(&self, l: usize) -> impl Iterator<Item = &Index2> {
+    pub(crate) fn refined_cells(&self, l: usize) -> impl Iterator<Item = &Index2> {
         self.refined.get(l).into_iter().flatten()
     }
 
     /// Number of cells per direction at level `l`.
-    pub fn cell_shape(&self, l: usize) -> [usize; 2] {
+    pub(crate) fn cell_shape(&self, l: usize) -> [usize; 2] {
         self.levels[l].elements.each_ref().map(Vec::len)
     }
 
     /// Parameter bounds `[[ξ_0, ξ_1], [η_0, η_1]]` of cell `c` of level `l`.
-    pub fn cell_bounds(&self, l: usize, c: Index2) -> [[f64; 2]; 2] {
+    pub(crate) fn cell_bounds(&self, l: usize, c: Index2) -> [[f64; 2]; 2] {
         std::array::from_fn(|d| {
             let (_, a, b) = self.levels[l].elements[d][c[d]];
             [a, b]
@@ -180,22 +180,22 @@ impl HierarchicalBasis {
     }
 
     /// Knot spans `(s_ξ, s_η)` of cell `c` of level `l`.
-    pub fn cell_spans(&self, l: usize, c: Index2) -> Index2 {
+    pub(crate) fn cell_spans(&self, l: usize, c: Index2) -> Index2 {
         std::array::from_fn(|d| self.levels[l].elements[d][c[d]].0)
     }
 
     /// Whether cell `c` of level `l` lies in `Ω^l`.
-    pub fn in_domain(&self, l: usize, c: Index2) -> bool {
+    pub(crate) fn in_domain(&self, l: usize, c: Index2) -> bool {
         l == 0 || self.refined.get(l - 1).is_some_and(|r| r.contains(&[c[0] / 2, c[1] / 2]))
     }
 
     /// Whether cell `c` of level `l` is refined (lies in `Ω^{l+1}`).
-    pub fn is_refined(&self, l: usize, c: Index2) -> bool {
+    pub(crate) fn is_refined(&self, l: usize, c: Index2) -> bool {
         self.refined.get(l).is_some_and(|r| r.contains(&c))
     }
 
     /// Whether cell `c` of level `l` is active.
-    pub fn is_active_cell(&self, l: usize, c: Index2) -> bool {
+    pub(crate) fn is_active_cell(&self, l: usize, c: Index2) -> bool {
         self.in_domain(l, c) && !self.is_refined(l, c)
     }
 
@@ -247,7 +247,7 @@ impl HierarchicalBasis {
     }
 
     /// Functions of level `l` non-zero on cell `c`, per direction (`p + 1` and `q + 1`).
-    pub fn functions_on(&self, l: usize, c: Index2) -> [Range<usize>; 2] {
+    pub(crate) fn functions_on(&self, l: usize, c: Index2) -> [Range<usize>; 2] {
         std::array::from_fn(|d| self.levels[l].functions(d, c[d]))
     }
 
@@ -258,7 +258,7 @@ impl HierarchicalBasis {
     }
 
     /// Whether `supp β ⊆ Ω^l` for the level-`l` function `f`.
-    pub fn support_in_domain(&self, l: usize, f: Index2) -> bool {
+    pub(crate) fn support_in_domain(&self, l: usize, f: Index2) -> bool {
         l == 0 || self.support_all(l, f, |c| self.in_domain(l, c))
     }
 
@@ -308,7 +308,7 @@ impl HierarchicalBasis {
     /// Refine the active cells `marked` (`(level, cell)`) and, recursively, the coarser
     /// active cells that keep the hierarchy admissible of class `m >= 2` (see the module
     /// doc). A marked cell that is not active is a typed error; so is a level past
-    /// [`MAX_LEVELS`] or a knot vector past the size limit.
+    /// `MAX_LEVELS` or a knot vector past the size limit.
     pub fn refine(&mut self, marked: &[(usize, Index2)], m: usize) -> Result<()> {
         if m < 2 {
             return Err(Error::Invalid(format!("admissibility class must be at least 2, got {m}")));
@@ -378,7 +378,7 @@ impl HierarchicalBasis {
     }
 
     /// Level-`l` refined cells as a sorted list (for writers).
-    pub fn refined_list(&self, l: usize) -> Vec<Index2> {
+    pub(crate) fn refined_list(&self, l: usize) -> Vec<Index2> {
         let mut v: Vec<Index2> = self.refined_cells(l).copied().collect();
         v.sort_by_key(|c| (c[1], c[0]));
         v
@@ -386,7 +386,7 @@ impl HierarchicalBasis {
 
     /// Rebuild a hierarchy from level-0 knots and the refined cells per level (as written
     /// by [`Self::refined_list`]); each refined cell must lie in `Ω^l`.
-    pub fn from_refined(knots: [KnotVector; 2], refined: &[Vec<Index2>]) -> Result<Self> {
+    pub(crate) fn from_refined(knots: [KnotVector; 2], refined: &[Vec<Index2>]) -> Result<Self> {
         let mut out = Self::new(knots)?;
         for (l, cells) in refined.iter().enumerate() {
             if cells.is_empty() {

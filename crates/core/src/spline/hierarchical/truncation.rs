@@ -24,12 +24,11 @@
 use std::collections::HashMap;
 
 use super::{HierarchicalBasis, Index2};
-use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::Point;
 
 /// Insert `u` (strictly inside `(t_0, t_{last})`) into the knot sequence `t` of a degree-`p`
 /// spline with coefficients `c` (`c.len() = t.len() - p - 1`), keeping the function.
-pub fn insert_knot(p: usize, t: &mut Vec<f64>, c: &mut Vec<f64>, u: f64) {
+pub(crate) fn insert_knot(p: usize, t: &mut Vec<f64>, c: &mut Vec<f64>, u: f64) {
     let n = c.len();
     let omega = |j: usize| {
         if t[j + p] <= u {
@@ -57,7 +56,7 @@ pub fn insert_knot(p: usize, t: &mut Vec<f64>, c: &mut Vec<f64>, u: f64) {
 /// given by its local knots `t_{s-p}, ..., t_{s+p+1}` (`2p + 2` values), at the arguments
 /// `x_1, ..., x_p` (de Boor's algorithm with one argument per level). The coefficient of a
 /// B-spline with interior knots `x` in any space containing the piece is this value.
-pub fn blossom<V: Coefficient>(t: &[f64], c: &[V], x: &[f64]) -> V {
+pub(crate) fn blossom<V: Coefficient>(t: &[f64], c: &[V], x: &[f64]) -> V {
     let p = c.len() - 1;
     let mut d: Vec<V> = c.to_vec();
     for r in 1..=p {
@@ -75,7 +74,7 @@ pub fn blossom<V: Coefficient>(t: &[f64], c: &[V], x: &[f64]) -> V {
 
 /// A value the THB coefficients can carry: a point of the plane, or a sparse vector over
 /// the THB functions (the restriction of each function).
-pub trait Coefficient: Clone {
+pub(crate) trait Coefficient: Clone {
     /// The zero value.
     fn zero() -> Self;
     /// `self += a x`.
@@ -99,7 +98,7 @@ impl Coefficient for Point {
 }
 
 /// A sparse vector `(index, value)`, sorted by index.
-pub type Sparse = Vec<(usize, f64)>;
+pub(crate) type Sparse = Vec<(usize, f64)>;
 
 impl Coefficient for Sparse {
     fn zero() -> Self {
@@ -123,7 +122,7 @@ impl Coefficient for Sparse {
 impl HierarchicalBasis {
     /// The two-scale relation in direction `d`: the level-`(l + 1)` functions
     /// `(index, coefficient)` whose combination is the level-`l` function `sigma`.
-    pub fn children_1d(&self, l: usize, d: usize, sigma: usize) -> Vec<(usize, f64)> {
+    pub(crate) fn children_1d(&self, l: usize, d: usize, sigma: usize) -> Vec<(usize, f64)> {
         let kv = &self.levels[l].knots[d];
         let p = kv.degree();
         let mut t: Vec<f64> = kv.knots()[sigma..=sigma + p + 1].to_vec();
@@ -138,7 +137,7 @@ impl HierarchicalBasis {
 
     /// The level-`(l - 1)` functions `(index, P_{τσ})` whose two-scale relation holds the
     /// level-`l` function `tau` (`l >= 1`), in direction `d`.
-    pub fn parents_1d(&self, l: usize, d: usize, tau: usize) -> Vec<(usize, f64)> {
+    pub(crate) fn parents_1d(&self, l: usize, d: usize, tau: usize) -> Vec<(usize, f64)> {
         let e0 = self.levels[l].support(d, tau).start;
         self.levels[l - 1]
             .functions(d, e0 / 2)
@@ -148,7 +147,7 @@ impl HierarchicalBasis {
 }
 
 /// The level coefficients `d^l_τ` of a THB combination (see the module doc), memoised.
-pub struct LevelCoefficients<'a, V: Coefficient> {
+pub(crate) struct LevelCoefficients<'a, V: Coefficient> {
     basis: &'a HierarchicalBasis,
     /// The coefficient of active function `k`.
     leaf: Box<dyn Fn(usize) -> V + 'a>,
@@ -192,7 +191,7 @@ impl<'a, V: Coefficient> LevelCoefficients<'a, V> {
 
     /// The local net of cell `c` of level `l` (in `Ω^l`): `d^l_τ` of the `(p + 1)(q + 1)`
     /// functions non-zero there, `xi` index fastest.
-    pub fn cell_net(&mut self, l: usize, c: Index2) -> Vec<V> {
+    pub(crate) fn cell_net(&mut self, l: usize, c: Index2) -> Vec<V> {
         let [fi, fj] = self.basis.functions_on(l, c);
         let mut out = Vec::with_capacity(fi.len() * fj.len());
         for j in fj {
@@ -204,20 +203,22 @@ impl<'a, V: Coefficient> LevelCoefficients<'a, V> {
     }
 }
 
+#[cfg(test)]
 /// Value and first derivatives `(N, ∂_ξ N, ∂_η N)` of one THB function at a point.
-pub type BasisValue = (usize, [f64; 3]);
+pub(crate) type BasisValue = (usize, [f64; 3]);
 
 impl HierarchicalBasis {
+    #[cfg(test)]
     /// The THB functions non-zero at `(u, v)`: `(index, [value, ∂_ξ, ∂_η])`, from the
     /// restriction of every THB function to the active cell containing the point.
-    pub fn eval_basis(&self, u: f64, v: f64) -> Vec<BasisValue> {
+    pub(crate) fn eval_basis(&self, u: f64, v: f64) -> Vec<BasisValue> {
         let (l, c) = self.cell_at(u, v);
         let mut lc = LevelCoefficients::<Sparse>::new(self, |k| vec![(k, 1.0)]);
         let net = lc.cell_net(l, c);
         let spans = self.cell_spans(l, c);
         let kv = self.knots(l);
-        let mut bu = BasisDerivs::default();
-        let mut bv = BasisDerivs::default();
+        let mut bu = crate::spline::basis::BasisDerivs::default();
+        let mut bv = crate::spline::basis::BasisDerivs::default();
         bu.eval_in_span(&kv[0], spans[0], u, 1);
         bv.eval_in_span(&kv[1], spans[1], v, 1);
         let p1 = self.degrees()[0] + 1;

@@ -34,10 +34,10 @@
 pub const U: f64 = f64::EPSILON / 2.0;
 
 /// Absolute slack added to every error bound: covers underflow (see the module doc).
-pub const TINY: f64 = 1e-290;
+pub(crate) const TINY: f64 = 1e-290;
 
 /// `γ_n = n u / (1 - n u)`, rounded up (relative slack `10^-6`, valid for `n u < 10^-7`).
-pub fn gamma(n: usize) -> f64 {
+pub(crate) fn gamma(n: usize) -> f64 {
     let nu = n as f64 * U;
     debug_assert!(nu < 1e-7);
     nu * (1.0 + 1e-6)
@@ -52,7 +52,7 @@ pub fn amax(v: &[f64]) -> f64 {
 /// `(k_0, .., k_{D-1})` at `Σ_dir k_dir Π_{dir' < dir} (d_dir' + 1)` (direction 0
 /// fastest).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Deg<const D: usize>(pub [usize; D]);
+pub(crate) struct Deg<const D: usize>(pub [usize; D]);
 
 impl<const D: usize> Deg<D> {
     /// Number of coefficients.
@@ -60,7 +60,7 @@ impl<const D: usize> Deg<D> {
         self.0.iter().map(|d| d + 1).product()
     }
     /// Distance between neighbours in direction `dir` in the coefficient array.
-    pub fn stride(self, dir: usize) -> usize {
+    pub(crate) fn stride(self, dir: usize) -> usize {
         self.0[..dir].iter().map(|d| d + 1).product()
     }
     /// Linear index of the multi-index `k`.
@@ -78,7 +78,7 @@ impl<const D: usize> Deg<D> {
     /// Step the multi-index `k` to the next one in the order of the coefficients, over
     /// the directions `from..D` (the others held; after the last one `k` is all zeros
     /// there).
-    pub fn advance(self, k: &mut [usize; D], from: usize) {
+    pub(crate) fn advance(self, k: &mut [usize; D], from: usize) {
         for dir in from..D {
             k[dir] += 1;
             if k[dir] <= self.0[dir] {
@@ -92,7 +92,7 @@ impl<const D: usize> Deg<D> {
         Self(std::array::from_fn(|dir| self.0[dir] + o.0[dir]))
     }
     /// Degree after differencing in direction `dir`.
-    pub fn minus_one(self, dir: usize) -> Self {
+    pub(crate) fn minus_one(self, dir: usize) -> Self {
         let mut d = self.0;
         d[dir] -= 1;
         Self(d)
@@ -115,7 +115,7 @@ fn binom(n: usize, k: usize) -> f64 {
 
 /// Binomial coefficients `binom(n, k)` for `n <= maxn`.
 #[derive(Debug)]
-pub struct Binom {
+pub(crate) struct Binom {
     rows: Vec<Vec<f64>>,
 }
 
@@ -144,7 +144,7 @@ impl Binom {
 /// `binom(n_u, k) binom(n_v, l)` is exact for the degrees used); `D = 3`: three binomials
 /// on each factor, the product, the two products of the divisor's three binomials and
 /// the division.
-pub const fn mul_roundings(d: usize) -> usize {
+pub(crate) const fn mul_roundings(d: usize) -> usize {
     if d == 2 {
         6
     } else {
@@ -154,7 +154,7 @@ pub const fn mul_roundings(d: usize) -> usize {
 
 /// At most how many terms one output coefficient of a product of degrees `da`, `db`
 /// receives (each multi-index of `a` at most once).
-pub fn terms_per_coefficient<const D: usize>(da: Deg<D>) -> usize {
+pub(crate) fn terms_per_coefficient<const D: usize>(da: Deg<D>) -> usize {
     da.len()
 }
 
@@ -164,7 +164,15 @@ pub fn terms_per_coefficient<const D: usize>(da: Deg<D>) -> usize {
 /// one each certificate has always used (so that verdicts and bounds stay bit for bit
 /// what they were): in the plane `((x binom(db_v, l)) b_j) binom(db_u, k)` with
 /// `x = s a_i binom(da_u) binom(da_v)`, in space `x (b_j binom(db_u) binom(db_v) binom(db_w))`.
-pub fn mul_add<const D: usize>(bn: &Binom, a: &[f64], da: Deg<D>, b: &[f64], db: Deg<D>, s: f64, out: &mut [f64]) {
+pub(crate) fn mul_add<const D: usize>(
+    bn: &Binom,
+    a: &[f64],
+    da: Deg<D>,
+    b: &[f64],
+    db: Deg<D>,
+    s: f64,
+    out: &mut [f64],
+) {
     let dn = da.plus(db);
     let wb = db.0[0] + 1;
     let lines = db.len() / wb;
@@ -203,7 +211,7 @@ pub fn mul_add<const D: usize>(bn: &Binom, a: &[f64], da: Deg<D>, b: &[f64], db:
 }
 
 /// Divide the accumulated products by `Π_dir binom(n_dir, k_dir)`.
-pub fn normalize<const D: usize>(bn: &Binom, d: Deg<D>, out: &mut [f64]) {
+pub(crate) fn normalize<const D: usize>(bn: &Binom, d: Deg<D>, out: &mut [f64]) {
     let mut k = [0; D];
     for o in out[..d.len()].iter_mut() {
         *o /= bn.product(d, k);
@@ -213,13 +221,13 @@ pub fn normalize<const D: usize>(bn: &Binom, d: Deg<D>, out: &mut [f64]) {
 
 /// Error bound of one product term `a b` (see the module doc): `a` known to `ea`, `b` to
 /// `eb`, `r` roundings per term.
-pub fn product_error(amax_a: f64, ea: f64, amax_b: f64, eb: f64, r: usize) -> f64 {
+pub(crate) fn product_error(amax_a: f64, ea: f64, amax_b: f64, eb: f64, r: usize) -> f64 {
     (ea * amax_b + (amax_a + ea) * eb + gamma(r) * amax_a * amax_b) * (1.0 + 1e-6)
 }
 
 /// A tensor Bernstein polynomial with the error bound of its coefficients.
 #[derive(Debug, Clone)]
-pub struct Poly<const D: usize> {
+pub(crate) struct Poly<const D: usize> {
     /// Coefficients.
     pub c: Vec<f64>,
     /// Degrees.
@@ -249,7 +257,7 @@ impl<const D: usize> Poly<D> {
 
 /// A sum of products of the same degree, `Σ s a b`, accumulated unnormalised; its error
 /// bound is `Σ product_error` with `mul_roundings + Σ terms` roundings per term.
-pub struct Acc<'a, const D: usize> {
+pub(crate) struct Acc<'a, const D: usize> {
     bn: &'a Binom,
     d: Deg<D>,
     c: Vec<f64>,
@@ -282,7 +290,7 @@ impl<'a, const D: usize> Acc<'a, D> {
 }
 
 /// `Σ_i s_i a_i b_i` for pairs of equal product degree.
-pub fn sum_of_products<const D: usize>(bn: &Binom, pairs: &[(&Poly<D>, &Poly<D>, f64)]) -> Poly<D> {
+pub(crate) fn sum_of_products<const D: usize>(bn: &Binom, pairs: &[(&Poly<D>, &Poly<D>, f64)]) -> Poly<D> {
     let mut acc = Acc::new(bn, pairs[0].0.d.plus(pairs[0].1.d));
     for &(a, b, s) in pairs {
         acc.add(a, b, s);
@@ -343,13 +351,13 @@ fn average_blocks(t: &mut [f64], block: usize, count: usize) {
 
 /// Error bound of the children of a box with coefficients `c` known to `e` (bisected in
 /// every direction).
-pub fn split_error<const D: usize>(c: &[f64], d: Deg<D>, e: f64) -> f64 {
+pub(crate) fn split_error<const D: usize>(c: &[f64], d: Deg<D>, e: f64) -> f64 {
     e + gamma(d.total()) * amax(c) + TINY
 }
 
 /// The `2^D` children of a box bisected in every direction (direction 0 first), indexed
 /// by bits: child `b` is the upper half in direction `dir` when bit `dir` of `b` is set.
-pub fn children<const D: usize>(c: &[f64], d: Deg<D>, tmp: &mut [f64]) -> Vec<Vec<f64>> {
+pub(crate) fn children<const D: usize>(c: &[f64], d: Deg<D>, tmp: &mut [f64]) -> Vec<Vec<f64>> {
     let n = d.len();
     let mut cur: Vec<Vec<f64>> = vec![c.to_vec()];
     for dir in 0..D {
@@ -396,7 +404,7 @@ pub fn eval<const D: usize>(c: &[f64], d: Deg<D>, s: [[f64; 2]; D], tmp: &mut [f
 
 /// Error bound of [`eval`] when the coefficients are known to `e` and the weights
 /// `(1 - s, s)` to a relative `θ_k` each (`k = 0`: exact, as at dyadic points).
-pub fn eval_error<const D: usize>(c: &[f64], d: Deg<D>, e: f64, k: usize) -> f64 {
+pub(crate) fn eval_error<const D: usize>(c: &[f64], d: Deg<D>, e: f64, k: usize) -> f64 {
     // per level: two products (each with its weight's θ_k) and one addition
     e + gamma((k + 3) * d.total()) * amax(c) + TINY
 }

@@ -47,7 +47,7 @@ use crate::spline::knots::KnotVector;
 
 /// The map `c -> d(c)` of a polynomial tensor basis (symbolic data, no control points).
 #[derive(Debug)]
-pub struct DetCoefficients {
+pub(crate) struct DetCoefficients {
     p: usize,
     q: usize,
     nx: usize,
@@ -83,7 +83,7 @@ impl DetCoefficients {
     }
 
     /// Coefficients per element, `(2p) (2q)`.
-    pub fn per_element(&self) -> usize {
+    pub(crate) fn per_element(&self) -> usize {
         4 * self.p * self.q
     }
 
@@ -99,7 +99,7 @@ impl DetCoefficients {
     }
 
     /// Parameter area of element `e` (row-major, `ξ` fastest).
-    pub fn element_area(&self, e: usize) -> f64 {
+    pub(crate) fn element_area(&self, e: usize) -> f64 {
         let n = self.shape()[0];
         let (_, a, b) = self.ex[0].elements[e % n];
         let (_, c, d) = self.ex[1].elements[e / n];
@@ -230,7 +230,7 @@ impl DetCoefficients {
     /// by the boundary control points: e.g. a corner's, `det J` there). Exact up to
     /// rounding: coefficient `k` is free when some `∂²d_k/∂c^x_a ∂c^y_b` with `a` or `b`
     /// free is nonzero.
-    pub fn depends_on_unknowns(&self, dofs: &DofMap) -> Vec<bool> {
+    pub(crate) fn depends_on_unknowns(&self, dofs: &DofMap) -> Vec<bool> {
         let per = self.per_element();
         let mut out = vec![false; self.len()];
         out.par_chunks_mut(per).enumerate().for_each(|(e, o)| {
@@ -263,7 +263,7 @@ impl DetCoefficients {
 
     /// `Σ_k λ_k ∇²d_k` (constant in `c`), a symmetric `2m x 2m` matrix in the unknowns of
     /// `dofs` (only the `x`-`y` blocks are nonzero).
-    pub fn weighted_hessian(&self, lambda: &[f64], dofs: &DofMap) -> Csr {
+    pub(crate) fn weighted_hessian(&self, lambda: &[f64], dofs: &DofMap) -> Csr {
         let per = self.per_element();
         let m = dofs.num_free();
         let ne = self.shape()[0] * self.shape()[1];

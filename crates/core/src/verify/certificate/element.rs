@@ -164,7 +164,7 @@ impl<'a, const D: usize> Elements<'a, D> {
     }
 
     /// Degree of the weight function.
-    pub fn weight_deg(&self) -> Deg<D> {
+    pub(crate) fn weight_deg(&self) -> Deg<D> {
         Deg(self.degrees)
     }
 
@@ -191,7 +191,7 @@ impl<'a, const D: usize> Elements<'a, D> {
     }
 
     /// The nets of element `e` (see the module doc).
-    pub fn nets(&self, e: [usize; D]) -> Nets<D> {
+    pub(crate) fn nets(&self, e: [usize; D]) -> Nets<D> {
         let degrees = self.degrees;
         let dn = Deg(degrees);
         let n = dn.len();
@@ -339,7 +339,7 @@ impl<'a> Elements<'a, 2> {
     /// rounding bound at local corner `(s, t)` (`0` or `1` each) of the element with these
     /// nets: one-sided from this element, from the differences of the Bernstein net (for a
     /// rational map, of `X' W - X W'`, whose bound is taken to first order).
-    pub fn zero_tangent(&self, nets: &Nets<2>, dir: usize, s: usize, t: usize) -> bool {
+    pub(crate) fn zero_tangent(&self, nets: &Nets<2>, dir: usize, s: usize, t: usize) -> bool {
         let [p, q] = self.degrees;
         let d = &nets.dh[dir];
         // index of the difference at the corner, and of the net value there
@@ -366,7 +366,7 @@ impl<'a> Elements<'a, 3> {
 
     /// `det J` (its numerator for rational maps) on element `e`: coefficients, their
     /// bound and scale, and the weight function's net (rational maps).
-    pub fn volume_coefficients(&self, e: [usize; 3]) -> (Vec<f64>, ElementScale, Option<Vec<f64>>) {
+    pub(crate) fn volume_coefficients(&self, e: [usize; 3]) -> (Vec<f64>, ElementScale, Option<Vec<f64>>) {
         let nets = self.nets(e);
         // the differences with the absolute slack
         let d: Vec<Vec<Poly<3>>> = nets

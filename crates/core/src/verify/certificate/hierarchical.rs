@@ -2,7 +2,7 @@
 //! cell the map is one polynomial of degree `(p, q)`, so `det J` is a polynomial of degree
 //! `(2p - 1, 2q - 1)` there and its Bernstein form is exact, as on the elements of a
 //! tensor map. Each active cell is extracted to its Bézier patch
-//! ([`HierarchicalMap::bezier_patches`]) and examined by the same element search as a
+//! (`HierarchicalMap::bezier_patches`) and examined by the same element search as a
 //! tensor map's elements (proof box by box, fold witnesses, subdivision), with the
 //! domain's corners and sides excused only where the cell touches them.
 //!

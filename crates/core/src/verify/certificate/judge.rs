@@ -356,7 +356,7 @@ impl Exact<2> {
 
     /// Exact sign of `det J` on element `e` at the parameter point `(u, v)` (one-sided on
     /// the element's boundary).
-    pub fn sign_at(&self, e: [usize; 2], u: f64, v: f64) -> std::cmp::Ordering {
+    pub(crate) fn sign_at(&self, e: [usize; 2], u: f64, v: f64) -> std::cmp::Ordering {
         let (s, _) = self.local(e, [u, v]);
         self.polys[self.linear(e)].eval(&s).cmp(&Q::zero())
     }

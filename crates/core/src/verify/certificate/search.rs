@@ -490,14 +490,14 @@ impl<const D: usize> Totals<D> {
     }
 
     /// The most negative fold found.
-    pub fn worst_fold(&self) -> Option<&Fold<D>> {
+    pub(crate) fn worst_fold(&self) -> Option<&Fold<D>> {
         self.folds.iter().min_by(|a, b| a.value.total_cmp(&b.value))
     }
 
     /// The finding of these totals: the worst fold (its physical point by `eval`), else
     /// the undecided elements, else certified with `relative = lower bound / mean det J`
     /// (a map of the plane turns the last into `DegenerateCorner` where it excused some).
-    pub fn finding(&self, eval: impl Fn([f64; D]) -> [f64; D], relative: f64) -> super::Finding<D> {
+    pub(crate) fn finding(&self, eval: impl Fn([f64; D]) -> [f64; D], relative: f64) -> super::Finding<D> {
         use super::Finding;
         if let Some(f) = self.worst_fold() {
             Finding::Folded {

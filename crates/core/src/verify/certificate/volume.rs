@@ -36,10 +36,10 @@ use crate::spline::volume::Volume;
 pub type VolumeFinding = Finding<3>;
 
 /// A fold of a volume.
-pub type VolumeFold = Fold<3>;
+pub(crate) type VolumeFold = Fold<3>;
 
 /// An undecided element of a volume.
-pub type VolumeUndecided = Undecided<3>;
+pub(crate) type VolumeUndecided = Undecided<3>;
 
 /// The bijectivity certificate of a volume.
 #[derive(Debug, Clone, Serialize)]
@@ -98,7 +98,7 @@ impl VolumeCertificate {
 
 /// `∫ det J` over the parameter domain by Gauss quadrature (`max degree + 2` points per
 /// direction and element): the volume of the image of a bijective map.
-pub fn volume_integral(vol: &Volume) -> f64 {
+pub(crate) fn volume_integral(vol: &Volume) -> f64 {
     let n = vol.degrees().into_iter().max().unwrap_or(1) + 2;
     let g = GaussLegendre::new(n);
     let pts: [Vec<(BasisDerivs, f64)>; 3] = std::array::from_fn(|d| {
