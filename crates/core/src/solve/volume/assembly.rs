@@ -200,7 +200,8 @@ impl VolumeDiscretization {
         let mut values = if matrix { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
         let batch = 32 * rayon::current_num_threads().max(1);
         for start in (0..ne).step_by(batch) {
-            let locals: Vec<Local> = (start..(start + batch).min(ne)).into_par_iter().map(&element).collect::<Option<_>>()?;
+            let locals: Vec<Local> =
+                (start..(start + batch).min(ne)).into_par_iter().map(&element).collect::<Option<_>>()?;
             for l in locals {
                 scalar += l.scalar;
                 let m = l.idx.len();

@@ -62,11 +62,7 @@ fn dot(a: Point3, b: Point3) -> f64 {
 
 /// `A : H` for symmetric `A` and `H` given by the six entries of [`PAIRS`].
 fn contract(a: &[[f64; 3]; 3], h: &[f64; 6]) -> f64 {
-    PAIRS
-        .iter()
-        .zip(h)
-        .map(|(&(i, j), v)| if i == j { a[i][j] * v } else { 2.0 * a[i][j] * v })
-        .sum()
+    PAIRS.iter().zip(h).map(|(&(i, j), v)| if i == j { a[i][j] * v } else { 2.0 * a[i][j] * v }).sum()
 }
 
 /// The scaled EGG operator of volumes on one [`VolumeDiscretization`].
@@ -114,8 +110,12 @@ impl EggVolume {
         let p = [bx[0].0.degree, by[0].0.degree, bz[0].0.degree];
         let m = idx.len();
         let nq = bx.len() * by.len() * bz.len();
-        let (mut weights, mut vals, mut grads, mut hess) =
-            (Vec::with_capacity(nq), Vec::with_capacity(nq * m), Vec::with_capacity(nq * m), Vec::with_capacity(nq * m));
+        let (mut weights, mut vals, mut grads, mut hess) = (
+            Vec::with_capacity(nq),
+            Vec::with_capacity(nq * m),
+            Vec::with_capacity(nq * m),
+            Vec::with_capacity(nq * m),
+        );
         let mut local: Vec<(f64, Point3, [f64; 6])> = Vec::with_capacity(m);
         for (z, wz) in bz {
             for (y, wy) in by {
@@ -345,8 +345,8 @@ pub(super) fn solve_egg(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spline::volume::Volume;
     use crate::spline::knots::KnotVector;
+    use crate::spline::volume::Volume;
 
     /// A rational curved volume of degrees (3, 2, 2) with an interior wobble.
     fn sample() -> (Volume, Vec<Point3>) {
@@ -427,14 +427,16 @@ mod tests {
         let l = |u: [f64; 3]| -> Point3 {
             let d = [[1.0 + a * u[1], 0.0, 2.0 * c * u[0]], [a * u[0], 1.0, 0.0], [0.0, 2.0 * b * u[2], 1.0]];
             // second derivatives per component, in the order of PAIRS
-            let h = [[0.0, 0.0, 0.0, a, 0.0, 0.0], [0.0, 0.0, 2.0 * b, 0.0, 0.0, 0.0], [2.0 * c, 0.0, 0.0, 0.0, 0.0, 0.0]];
+            let h =
+                [[0.0, 0.0, 0.0, a, 0.0, 0.0], [0.0, 0.0, 2.0 * b, 0.0, 0.0, 0.0], [2.0 * c, 0.0, 0.0, 0.0, 0.0, 0.0]];
             let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
             let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
             let t = am[0][0] + am[1][1] + am[2][2];
             std::array::from_fn(|comp| contract(&am, &h[comp]) / t)
         };
         let rule = crate::spline::quadrature::GaussLegendre::new(4);
-        let nodes: Vec<(f64, f64)> = kv.elements().into_iter().flat_map(|(_, lo, hi)| rule.on(lo, hi).collect::<Vec<_>>()).collect();
+        let nodes: Vec<(f64, f64)> =
+            kv.elements().into_iter().flat_map(|(_, lo, hi)| rule.on(lo, hi).collect::<Vec<_>>()).collect();
         let mut checked = 0;
         for lin in 0..cps.len() {
             let Some(fr) = op.disc.free_index(lin) else { continue };

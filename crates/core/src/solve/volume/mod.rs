@@ -30,10 +30,10 @@ use crate::boundary::volume::{CubeSide, VolumeBoundary};
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
 use crate::linalg::sparse::Csr;
+use crate::spline::knots::KnotVector;
 use crate::spline::volume::{Point3, Volume};
 use crate::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeFinding};
 use crate::verify::certificate::CertifyOptions;
-use crate::spline::knots::KnotVector;
 use assembly::VolumeDiscretization;
 use coons::{common_faces, coons_fill, volume_of, CommonFaces};
 use egg::{solve_egg, EggSolved, EggVolume};
@@ -311,16 +311,14 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
     let degree = template.degrees().into_iter().max().unwrap_or(1);
     let disc = Arc::new(VolumeDiscretization::new(&template, degree + 2));
     let energy = WinslowVolume::on(disc.clone());
-    let method = if opts.method != VolumeMethod::Winslow && is_c1(&cf.knots) { opts.method } else { VolumeMethod::Winslow };
+    let method =
+        if opts.method != VolumeMethod::Winslow && is_c1(&cf.knots) { opts.method } else { VolumeMethod::Winslow };
     let mut egg = None;
     let (current, start, continuation_steps, iterations, relative_gradient, energy_start) = match method {
         VolumeMethod::Egg | VolumeMethod::EggWinslow => {
             // the Coons patch of the faces
-            let disp: Vec<[f64; 3]> = target
-                .iter()
-                .enumerate()
-                .map(|(lin, p)| if is_boundary(lin) { *p } else { [0.0; 3] })
-                .collect();
+            let disp: Vec<[f64; 3]> =
+                target.iter().enumerate().map(|(lin, p)| if is_boundary(lin) { *p } else { [0.0; 3] }).collect();
             let coons = coons_fill(&cf.knots, disp);
             let coons_energy = energy.evaluate(&coons, false).energy;
             let energy_start = coons_energy.is_finite().then_some(coons_energy * scale);
@@ -340,7 +338,8 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
             }
         }
         VolumeMethod::Winslow => {
-            let (cps, start, steps, stats, energy_start) = winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
+            let (cps, start, steps, stats, energy_start) =
+                winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
             (cps, start, steps, stats.iterations, Some(stats.relative_gradient), energy_start.map(|e| e * scale))
         }
     };

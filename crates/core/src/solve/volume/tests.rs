@@ -177,7 +177,11 @@ fn egg_reproduces_an_affine_volume_from_a_wobbled_start() {
         .iter()
         .enumerate()
         .map(|(lin, p)| {
-            let w = if op.discretization().free_index(lin).is_some() { 0.05 * ((lin * 7919 % 11) as f64 / 11.0 - 0.5) } else { 0.0 };
+            let w = if op.discretization().free_index(lin).is_some() {
+                0.05 * ((lin * 7919 % 11) as f64 / 11.0 - 0.5)
+            } else {
+                0.0
+            };
             [p[0] + w, p[1] - w, p[2] + 0.5 * w]
         })
         .collect();
@@ -216,7 +220,8 @@ fn egg_converges_at_order_p_plus_1_to_a_harmonic_shell_sector() {
     for p in [2usize, 3] {
         let mut errors = Vec::new();
         for n in [2usize, 4, 8] {
-            let knots = [KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, 1)];
+            let knots =
+                [KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, 1)];
             let mut cps = interpolate(&knots, exact);
             let vol = Volume::new(knots.clone(), cps.clone(), None).unwrap();
             let op = egg::EggVolume::new(&vol, p + 2);

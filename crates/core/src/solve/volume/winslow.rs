@@ -139,7 +139,6 @@ impl WinslowVolume {
         Self { disc }
     }
 
-
     /// The element's quadrature: weights `w_q` and `∇R_A` at every point (`q m + a`),
     /// tensor products of the univariate tables, `R = w N / W`,
     /// `∇R = (w ∇N W - w N ∇W) / W²`.
@@ -292,8 +291,8 @@ impl WinslowVolume {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spline::volume::Volume;
     use crate::spline::knots::KnotVector;
+    use crate::spline::volume::Volume;
 
     fn sample_j() -> [Point3; 3] {
         [[1.2, 0.1, -0.2], [0.3, 0.9, 0.15], [-0.1, 0.25, 1.4]]
