@@ -116,8 +116,8 @@ pub enum Stage<'a> {
     /// cells of the map it started from, the cells refined, the solve on the refined
     /// basis.
     ThbRound(&'a ThbRound),
-    /// A volume boundary's solve starts (common bases, Coons start, the trivariate
-    /// Winslow minimisation, its certificate; [`solve_volume`]).
+    /// A volume boundary's solve starts (common bases, Coons start, trivariate EGG and/or
+    /// the Winslow minimisation, its certificate; [`solve_volume`]).
     Volume {
         /// The options it runs with, made from the pipeline's.
         options: &'a VolumeOptions,

@@ -1,10 +1,11 @@
 //! Volumes from their six boundary faces (a hexahedral topology, paper §11.1 in 3D):
 //! the faces on common knot vectors, the trivariate Coons patch as the start
-//! (`coons`), the interior control points moved by Newton's method on the 3D Winslow
-//! functional (`winslow`), and the verdict of the volume certificate
-//! ([`certify_volume`]).
+//! (`coons`), the interior control points moved by Newton's method on EGG in Galerkin
+//! form (eq. 8 in 3D, `egg`; the default) and/or on the 3D Winslow functional
+//! (`winslow`), both on one trivariate discretization (`assembly`), and the verdict of
+//! the volume certificate ([`certify_volume`]). [`VolumeMethod`] chooses.
 //!
-//! **Continuation.** Winslow's functional needs a start with `det J > 0` at every
+//! **Continuation** (Winslow only; EGG needs no barrier). Winslow's functional needs a start with `det J > 0` at every
 //! quadrature point. When the Coons patch of the faces is not one (a strongly bulged or
 //! concave face), the boundary is moved there from the trilinear volume of the eight
 //! corners (itself a Coons patch, positive for any convex hexahedron of corners): the
@@ -44,14 +45,15 @@ use winslow::WinslowVolume;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum VolumeMethod {
-    /// EGG in Galerkin form (eq. 8 in 3D, [`egg`]) by Newton from the Coons patch.
+    /// EGG in Galerkin form (eq. 8 in 3D, module `egg`) by Newton from the Coons patch
+    /// (the default, as for planar maps).
+    #[default]
     Egg,
     /// EGG, then the 3D Winslow functional minimised from the EGG map (from the
     /// continuation when the EGG map leaves the barrier).
     EggWinslow,
     /// The 3D Winslow functional minimised from the Coons patch, or from the
     /// continuation when the Coons patch leaves the barrier (module doc).
-    #[default]
     Winslow,
 }
 
@@ -355,6 +357,9 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
     Ok(OnBasis { volume, method, start, continuation_steps, iterations, egg, relative_gradient, energy, energy_start })
 }
 
+/// What [`winslow_from_corners`] returns.
+type FromCorners = (Vec<Point3>, &'static str, usize, Minimised, Option<f64>);
+
 /// The 3D Winslow functional minimised on the unit-frame boundary `target` from the
 /// Coons patch, or by the continuation from the corners' trilinear volume (module doc):
 /// the control points, the start's kind, continuation steps, Newton statistics (the
@@ -365,7 +370,7 @@ fn winslow_from_corners(
     target: &[Point3],
     is_boundary: &dyn Fn(usize) -> bool,
     opts: &VolumeOptions,
-) -> Result<(Vec<Point3>, &'static str, usize, Minimised, Option<f64>)> {
+) -> Result<FromCorners> {
     let shape = cf.shape();
     // the corners' trilinear volume, at the Greville points
     let corner = |i: usize, j: usize, k: usize| {
@@ -429,11 +434,11 @@ fn winslow_from_corners(
         t = tn;
         accepted += 1;
         if t < 1.0 {
-            iterations += minimise(&energy, &mut current, 20, 1e-6)?.iterations;
+            iterations += minimise(energy, &mut current, 20, 1e-6)?.iterations;
             dt *= 2.0;
         }
     }
-    let mut stats = minimise(&energy, &mut current, opts.max_iterations, opts.tolerance)?;
+    let mut stats = minimise(energy, &mut current, opts.max_iterations, opts.tolerance)?;
     stats.iterations += iterations;
     let kind = if accepted == 1 { "coons" } else { "continuation" };
     Ok((current, kind, accepted, stats, coons_energy))

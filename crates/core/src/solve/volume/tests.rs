@@ -13,7 +13,8 @@ fn affine(u: [f64; 3]) -> Point3 {
 fn an_affine_volume_is_reproduced_exactly() {
     let faces = trilinear_faces(affine).map(|f| f.elevated_in(0).unwrap().elevated_in(1).unwrap());
     let b = VolumeBoundary { name: "affine".into(), faces };
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified");
     assert_eq!(s.report.start, "coons");
     assert_eq!(s.volume.degrees(), [2, 2, 2]);
@@ -37,7 +38,8 @@ fn a_bulged_cube_is_certified() {
     // the four side faces keep their top edges straight: only the top's middle point moves
     let b = VolumeBoundary { name: "bulge".into(), faces };
     b.validate().unwrap();
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified", "{:?}", s.report);
     assert!(s.report.relative_gradient.unwrap() < 1e-8, "{:?}", s.report);
     assert!(s.report.boundary_kept);
@@ -57,7 +59,8 @@ fn a_bulged_cube_is_certified() {
 fn a_planted_fold_is_found() {
     let faces = trilinear_faces(affine).map(|f| f.elevated_in(0).unwrap().elevated_in(1).unwrap());
     let b = VolumeBoundary { name: "affine".into(), faces };
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     let mut v = s.volume.clone();
     let shape = v.shape();
     let mid = v.index([shape[0] / 2, shape[1] / 2, shape[2] / 2]);
@@ -84,7 +87,7 @@ fn a_planted_fold_is_found() {
 fn a_nurbs_quarter_cylinder_shell_is_certified() {
     let b = quarter_shell();
     b.validate().unwrap();
-    let s = solve_volume(&b, &VolumeOptions::default()).unwrap();
+    let s = solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified", "{:?}", s.report);
     assert!(s.report.boundary_deviation < 1e-12, "{:?}", s.report);
     // the shell between radii 1 and 2, a quarter turn, height 1: volume 3π/4 (the
