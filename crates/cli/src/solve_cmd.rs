@@ -128,9 +128,12 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
         }
         Stage::Volume { options } => writeln!(
             e,
-            "volume: common bases halved {} time(s), Coons start, 3D Winslow by Newton (at most {} iterations), \
+            "volume: common bases halved {} time(s), Coons start, {} by Newton (at most {} iterations), \
              up to {} further halving(s) while not certified",
-            options.refine, options.max_iterations, options.max_refinements
+            options.refine,
+            options.method.name(),
+            options.max_iterations,
+            options.max_refinements
         ),
         Stage::Layout(LayoutEvent::Bases { patches, classes, basis_functions }) => {
             writeln!(

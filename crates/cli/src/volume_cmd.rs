@@ -1,8 +1,9 @@
 //! `winslow solve VOLUME_BOUNDARY.json -o volume.json`: a volume from its six boundary
 //! faces (`formats-extensions.md`, "Volume boundary"), run by the pipeline
 //! ([`winslow::Input::Volume`], [`winslow::solve::volume`]): common bases,
-//! the trivariate Coons patch as the start, the 3D Winslow functional minimised by
-//! Newton, the verdict of the trivariate certificate. Exit codes as for a map: 0
+//! the trivariate Coons patch as the start, EGG in Galerkin form (eq. 8 in 3D) by
+//! Newton (`--improve winslow`: then the 3D Winslow functional minimised from it), the
+//! verdict of the trivariate certificate. Exit codes as for a map: 0
 //! certified, 3 folded, 5 undecided, 6 certified but the faces not kept.
 
 use super::*;
@@ -51,10 +52,12 @@ pub(super) fn finish(name: &str, out: VolumeSolve, a: &solve_cmd::SolveArgs) -> 
         files::print_json(serde_json::json!({ "report": report, "certificate": cert }))?;
     } else {
         say!(
-            "{}: volume of {}, {} unknowns; start {} ({} continuation step(s)), {} Newton iteration(s), Winslow energy {:.6e}",
+            "{}: volume of {}, {} unknowns; method {}, start {} ({} continuation step(s)), {} Newton iteration(s), \
+             Winslow energy {:.6e}",
             name,
             degrees_and_shape(report.degrees, report.shape),
             report.unknowns,
+            report.method,
             report.start,
             report.continuation_steps,
             report.newton_iterations,

@@ -119,3 +119,44 @@ fn a_bad_gismo_face_set_is_refused_naming_the_face() {
         assert!(err.contains("volume boundary") && err.contains(want), "{name}: {err}");
     }
 }
+
+/// The method of a volume solve in the planar vocabulary: EGG (eq. 8 in 3D) by
+/// default, `--improve winslow` (or `--method winslow`) minimises the 3D Winslow
+/// functional from the EGG map, which lowers its energy; `--improve weak` is refused
+/// before anything is written; a basis that is not `C¹` (the curved pipe is linear
+/// across its wall) is solved by the Winslow functional, and the report says so.
+#[test]
+fn the_volume_method_follows_method_and_improve() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let input = data().join("volumes/twisted-duct.json");
+    let run = |extra: &[&str], out: &str| {
+        let o = bin().arg("solve").arg(&input).arg("-o").arg(dir.join(out)).arg("--json").args(extra).output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        stdout_json(&o)["report"].clone()
+    };
+    let egg = run(&[], "egg.json");
+    assert_eq!((egg["method"].as_str(), egg["start"].as_str()), (Some("egg"), Some("coons")));
+    assert!(egg["egg_iterations"].as_u64().unwrap() >= 1);
+    assert!(egg["egg_relative_residual"].as_f64().unwrap() < 1e-9);
+    assert!(egg["relative_gradient"].is_null());
+    for flag in [["--improve", "winslow"], ["--method", "winslow"]] {
+        let w = run(&flag, "winslow.json");
+        assert_eq!((w["method"].as_str(), w["start"].as_str()), (Some("egg+winslow"), Some("egg")), "{flag:?}");
+        assert!(w["relative_gradient"].as_f64().unwrap() < 1e-8, "{flag:?}");
+        assert!(w["energy"].as_f64().unwrap() < egg["energy"].as_f64().unwrap(), "{flag:?}");
+    }
+    let out = dir.join("weak.json");
+    let o = bin().arg("solve").arg(&input).arg("-o").arg(&out).args(["--improve", "weak"]).output().unwrap();
+    assert!(!o.status.success() && !out.exists());
+    let pipe = bin()
+        .arg("solve")
+        .arg(data().join("volumes/curved-pipe.json"))
+        .arg("-o")
+        .arg(dir.join("pipe.json"))
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert_eq!(pipe.status.code(), Some(0));
+    assert_eq!(stdout_json(&pipe)["report"]["method"], "winslow");
+}

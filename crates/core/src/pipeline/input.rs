@@ -35,8 +35,9 @@ pub enum Input {
     /// A plane graph: every face laid out ([`crate::domain::graph_layout`]), conforming
     /// across shared edges, then solved as one layout.
     Graph(PlaneGraph),
-    /// The six boundary faces of a hexahedral volume: the trivariate Winslow solve from
-    /// the Coons start (`crate::solve::volume::solve_volume`).
+    /// The six boundary faces of a hexahedral volume: the trivariate EGG solve from the
+    /// Coons start, the Winslow functional after it with `improve`
+    /// (`solve_volume`).
     Volume(Box<VolumeBoundary>),
     /// A certified map, improved on its own basis by the pipeline's method (the Winslow
     /// functional by default) with its boundary fixed, and kept only when certified

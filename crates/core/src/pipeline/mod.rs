@@ -116,8 +116,8 @@ pub enum Stage<'a> {
     /// cells of the map it started from, the cells refined, the solve on the refined
     /// basis.
     ThbRound(&'a ThbRound),
-    /// A volume boundary's solve starts (common bases, Coons start, the trivariate
-    /// Winslow minimisation, its certificate; `solve_volume`).
+    /// A volume boundary's solve starts (common bases, Coons start, trivariate EGG and/or
+    /// the Winslow minimisation, its certificate; `solve_volume`).
     Volume {
         /// The options it runs with, made from the pipeline's.
         options: &'a VolumeOptions,
@@ -227,7 +227,7 @@ impl Pipeline {
             Input::Volume(b) => {
                 self.opts.validate()?;
                 self.refuse_method("a volume")?;
-                let options = volume_options(&self.opts);
+                let options = volume_options(&self.opts)?;
                 if !observer(&Stage::Volume { options: &options }) {
                     return Err(Error::Cancelled);
                 }
@@ -391,8 +391,23 @@ pub fn solve(boundary: &Boundary, opts: &SolveOptions) -> Result<Solution> {
 /// The options of a volume solve made from the pipeline's: `refine` extra halvings of
 /// the common bases, at most `repair` further halvings while the map is not certified,
 /// the certificate's options.
-pub(crate) fn volume_options(opts: &SolveOptions) -> VolumeOptions {
-    VolumeOptions { refine: opts.levels.refine, max_refinements: opts.repair.rounds, ..Default::default() }
+/// The volume solve of `opts`: EGG (eq. 8 in 3D), followed by the Winslow functional
+/// with `improve = Some(Winslow)`; the weak form (eq. 14) has no volume analogue here.
+pub(crate) fn volume_options(opts: &SolveOptions) -> Result<VolumeOptions> {
+    use crate::solve::improve::Improve;
+    use crate::solve::volume::VolumeMethod;
+    let method = match opts.improve {
+        None => VolumeMethod::Egg,
+        Some(Improve::Winslow) => VolumeMethod::EggWinslow,
+        Some(Improve::WeakForm) => {
+            return Err(Error::Invalid(
+                "a volume is solved by EGG (eq. 8 in 3D) and improved by the Winslow functional only: \
+                 use --improve winslow or no improvement"
+                    .into(),
+            ))
+        }
+    };
+    Ok(VolumeOptions { method, refine: opts.levels.refine, max_refinements: opts.repair.rounds, ..Default::default() })
 }
 
 /// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input

@@ -14,7 +14,7 @@
 //! | [`options`] | [`SolveOptions`](options::SolveOptions) | |
 //! | [`solver`] | [`EggSolver`](solver::EggSolver): the coarse-to-fine solve of any [`Method`](crate::methods::Method) as a stream of [`Event`](solver::Event)s | §6.3 |
 //! | [`loft`] | [`loft`](loft::loft): a volume from planar slices, certified, with slices inserted (solved from interpolated guesses) where it is not | §11.1, Fig. 23 |
-//! | [`volume`] | `solve_volume`: a volume from its six boundary faces (common bases, trivariate Coons start, 3D Winslow by Newton, boundary continuation), certified | §11.1 |
+//! | [`volume`] | `solve_volume`: a volume from its six boundary faces (common bases, trivariate Coons start, 3D EGG (eq. 8) and/or 3D Winslow by Newton, boundary continuation), certified | §11.1 |
 //! | [`improve`] | [`improve`](improve::improve): a certified map improved on its own basis by a method that needs a bijective start (Winslow, eq. 16), certified again, kept only when certified; the same stage on a layout (one patch: a one-patch layout) serves the free interfaces of [`multipatch`](crate::multipatch) | §4.1, §9, §11.2 |
 //! | [`constrained`] | Gravesen's feasible start [`max_z`](constrained::max_z) (`max z`, `d(c) >= z 1`) and the constrained optimisation [`optimise`](constrained::optimise) of the Liao, Winslow or area-orthogonality functional subject to `d(c) >= ε` (SQP, Clarabel subproblems), from the EGG map or the max-z point: [`run`](constrained::run) | §10.3, eq. (49), Table 3 |
 //! | `kinks` | `keep_kinks`: the `C^0` route, kinks kept exactly (EGG on `Σ¹`, elasticity to the kinked boundary, Winslow on `Σ⁰`) | §9 |

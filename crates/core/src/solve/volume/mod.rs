@@ -1,10 +1,11 @@
 //! Volumes from their six boundary faces (a hexahedral topology, paper §11.1 in 3D):
 //! the faces on common knot vectors, the trivariate Coons patch as the start
-//! (`coons`), the interior control points moved by Newton's method on the 3D Winslow
-//! functional (`winslow`), and the verdict of the volume certificate
-//! ([`certify_volume`]).
+//! (`coons`), the interior control points moved by Newton's method on EGG in Galerkin
+//! form (eq. 8 in 3D, `egg`; the default) and/or on the 3D Winslow functional
+//! (`winslow`), both on one trivariate discretization (`assembly`), and the verdict of
+//! the volume certificate ([`certify_volume`]). [`VolumeMethod`] chooses.
 //!
-//! **Continuation.** Winslow's functional needs a start with `det J > 0` at every
+//! **Continuation** (Winslow only; EGG needs no barrier). Winslow's functional needs a start with `det J > 0` at every
 //! quadrature point. When the Coons patch of the faces is not one (a strongly bulged or
 //! concave face), the boundary is moved there from the trilinear volume of the eight
 //! corners (itself a Coons patch, positive for any convex hexahedron of corners): the
@@ -17,7 +18,9 @@
 //! every element halved ([`VolumeOptions::max_refinements`] times at most); the result
 //! is the last volume with its certificate, whatever its verdict.
 
+pub(crate) mod assembly;
 pub(crate) mod coons;
+pub(crate) mod egg;
 pub(crate) mod winslow;
 
 use std::time::Instant;
@@ -28,15 +31,50 @@ use crate::boundary::volume::{CubeSide, VolumeBoundary};
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
 use crate::linalg::sparse::Csr;
+use crate::spline::knots::KnotVector;
 use crate::spline::volume::{Point3, Volume};
 use crate::verify::certificate::volume::{certify_volume, VolumeCertificate, VolumeFinding};
 use crate::verify::certificate::CertifyOptions;
+use assembly::VolumeDiscretization;
 use coons::{common_faces, coons_fill, volume_of, CommonFaces};
+use egg::{solve_egg, EggSolved, EggVolume};
+use std::sync::Arc;
 use winslow::WinslowVolume;
+
+/// What moves the interior control points of a volume.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VolumeMethod {
+    /// EGG in Galerkin form (eq. 8 in 3D, module `egg`) by Newton from the Coons patch
+    /// (the default, as for planar maps).
+    #[default]
+    Egg,
+    /// EGG, then the 3D Winslow functional minimised from the EGG map (from the
+    /// continuation when the EGG map leaves the barrier).
+    EggWinslow,
+    /// The 3D Winslow functional minimised from the Coons patch, or from the
+    /// continuation when the Coons patch leaves the barrier (module doc).
+    Winslow,
+}
+
+impl VolumeMethod {
+    /// `egg`, `egg+winslow` or `winslow`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VolumeMethod::Egg => "egg",
+            VolumeMethod::EggWinslow => "egg+winslow",
+            VolumeMethod::Winslow => "winslow",
+        }
+    }
+}
 
 /// Options of `solve_volume`.
 #[derive(Debug, Clone)]
 pub struct VolumeOptions {
+    /// The method. EGG needs a `C¹` basis (degree 2 or more, no interior knot of
+    /// multiplicity `p`); on any other the Winslow functional is minimised instead (the
+    /// report's `method` says which ran).
+    pub method: VolumeMethod,
     /// Times every element of the common bases is halved before the solve.
     pub refine: usize,
     /// Further halvings tried when the certificate is not `certified`.
@@ -54,6 +92,7 @@ pub struct VolumeOptions {
 impl Default for VolumeOptions {
     fn default() -> Self {
         Self {
+            method: VolumeMethod::default(),
             refine: 0,
             max_refinements: 2,
             max_iterations: 60,
@@ -68,7 +107,7 @@ impl Default for VolumeOptions {
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct VolumeSolveReport {
-    /// `winslow`.
+    /// The method that ran ([`VolumeMethod::name`]).
     pub method: &'static str,
     /// Degrees of the volume.
     pub degrees: [usize; 3],
@@ -79,18 +118,25 @@ pub struct VolumeSolveReport {
     /// Halvings of the common bases.
     pub refine: usize,
     /// `coons` when the Coons patch of the faces was the start, `continuation` when the
-    /// boundary was moved there from the corners' trilinear volume.
+    /// boundary was moved there from the corners' trilinear volume, `egg` when the
+    /// Winslow functional was minimised from the EGG map.
     pub start: &'static str,
     /// Continuation steps accepted (1 when the Coons patch was the start).
     pub continuation_steps: usize,
-    /// Newton iterations in all (continuation included).
+    /// Newton iterations in all (EGG's and continuation included).
     pub newton_iterations: usize,
+    /// Newton iterations of EGG (`null` when it did not run).
+    pub egg_iterations: Option<usize>,
+    /// `|F|` of the EGG map relative to that of the Coons patch (`null` when EGG did
+    /// not run).
+    pub egg_relative_residual: Option<f64>,
     /// `E` of the Coons patch (`null` when it leaves the barrier).
     pub energy_start: Option<f64>,
-    /// `E` of the result.
+    /// `E` of the result (`null` when it leaves the barrier: possible for EGG).
     pub energy: f64,
-    /// `|∇E|` of the result, relative to that of its start.
-    pub relative_gradient: f64,
+    /// `|∇E|` of the result, relative to that of its start (`null` when the Winslow
+    /// functional was not minimised).
+    pub relative_gradient: Option<f64>,
     /// Largest distance between a face of the result and the input face, at sample
     /// points.
     pub boundary_deviation: f64,
@@ -119,7 +165,6 @@ pub struct VolumeSolve {
 #[derive(Debug, Clone, Copy)]
 struct Minimised {
     iterations: usize,
-    energy: f64,
     relative_gradient: f64,
 }
 
@@ -203,7 +248,7 @@ fn minimise(e: &WinslowVolume, cps: &mut [Point3], max_iterations: usize, tolera
             break;
         }
     }
-    Ok(Minimised { iterations, energy: ev.energy, relative_gradient: norm(&ev.gradient) / g0 })
+    Ok(Minimised { iterations, relative_gradient: norm(&ev.gradient) / g0 })
 }
 
 /// The similarity to unit size: `(centre, scale)` of the bounding box of `pts`.
@@ -228,9 +273,31 @@ fn boundary_points(cf: &CommonFaces) -> Result<(Vec<Point3>, Vec<f64>)> {
     Ok((pts, w))
 }
 
-/// Solve on the common bases `cf` (module doc): the volume (unit frame undone), the
-/// start's kind, continuation steps, Newton statistics and `E` of the Coons patch.
-fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<(Volume, &'static str, usize, Minimised, Option<f64>)> {
+/// What [`solve_on`] did.
+struct OnBasis {
+    volume: Volume,
+    method: VolumeMethod,
+    start: &'static str,
+    continuation_steps: usize,
+    iterations: usize,
+    egg: Option<EggSolved>,
+    relative_gradient: Option<f64>,
+    energy: f64,
+    energy_start: Option<f64>,
+}
+
+/// Whether EGG's second derivatives are defined on `knots`: degree 2 or more and no
+/// interior knot of multiplicity `p` or more in every direction.
+fn is_c1(knots: &[KnotVector; 3]) -> bool {
+    knots.iter().all(|kv| {
+        let b = kv.breaks_with_multiplicity();
+        kv.degree() >= 2 && b.len() >= 2 && b[1..b.len() - 1].iter().all(|&(_, m)| m < kv.degree())
+    })
+}
+
+/// Solve on the common bases `cf` (module doc) with `opts.method`: the volume (unit
+/// frame undone) and what was done.
+fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
     let shape = cf.shape();
     let (target, weights) = boundary_points(cf)?;
     let (centre, scale) = unit_frame(&target);
@@ -244,7 +311,67 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<(Volume, &'static 
     let template = volume_of(cf.knots.clone(), &vec![[0.0, 0.0, 0.0, 1.0]; target.len()], false);
     let template = Volume { weights: rational.then(|| weights.clone()), ..template };
     let degree = template.degrees().into_iter().max().unwrap_or(1);
-    let energy = WinslowVolume::new(&template, degree + 2);
+    let disc = Arc::new(VolumeDiscretization::new(&template, degree + 2));
+    let energy = WinslowVolume::on(disc.clone());
+    let method =
+        if opts.method != VolumeMethod::Winslow && is_c1(&cf.knots) { opts.method } else { VolumeMethod::Winslow };
+    let mut egg = None;
+    let (current, start, continuation_steps, iterations, relative_gradient, energy_start) = match method {
+        VolumeMethod::Egg | VolumeMethod::EggWinslow => {
+            // the Coons patch of the faces
+            let disp: Vec<[f64; 3]> =
+                target.iter().enumerate().map(|(lin, p)| if is_boundary(lin) { *p } else { [0.0; 3] }).collect();
+            let coons = coons_fill(&cf.knots, disp);
+            let coons_energy = energy.evaluate(&coons, false).energy;
+            let energy_start = coons_energy.is_finite().then_some(coons_energy * scale);
+            let mut cps = coons;
+            let op = EggVolume::on(disc.clone());
+            let solved = solve_egg(&op, &mut cps, opts.max_iterations, opts.tolerance)?;
+            egg = Some(solved);
+            let inside = energy.evaluate(&cps, false).energy.is_finite();
+            if method == VolumeMethod::Egg {
+                (cps, "coons", 1, solved.iterations, None, energy_start)
+            } else if inside {
+                let stats = minimise(&energy, &mut cps, opts.max_iterations, opts.tolerance)?;
+                (cps, "egg", 0, solved.iterations + stats.iterations, Some(stats.relative_gradient), energy_start)
+            } else {
+                let (cps, start, steps, stats, _) = winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
+                (cps, start, steps, solved.iterations + stats.iterations, Some(stats.relative_gradient), energy_start)
+            }
+        }
+        VolumeMethod::Winslow => {
+            let (cps, start, steps, stats, energy_start) =
+                winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
+            (cps, start, steps, stats.iterations, Some(stats.relative_gradient), energy_start.map(|e| e * scale))
+        }
+    };
+    let energy = energy.evaluate(&current, false).energy * scale;
+    // exact boundary: the input's control points, not their unit image
+    let (orig, _) = boundary_points(cf)?;
+    let cps: Vec<Point3> = current
+        .iter()
+        .enumerate()
+        .map(|(lin, p)| if is_boundary(lin) { orig[lin] } else { std::array::from_fn(|c| centre[c] + scale * p[c]) })
+        .collect();
+    let volume = Volume::new(cf.knots.clone(), cps, template.weights.clone())?;
+    Ok(OnBasis { volume, method, start, continuation_steps, iterations, egg, relative_gradient, energy, energy_start })
+}
+
+/// What [`winslow_from_corners`] returns.
+type FromCorners = (Vec<Point3>, &'static str, usize, Minimised, Option<f64>);
+
+/// The 3D Winslow functional minimised on the unit-frame boundary `target` from the
+/// Coons patch, or by the continuation from the corners' trilinear volume (module doc):
+/// the control points, the start's kind, continuation steps, Newton statistics (the
+/// continuation's iterations included) and `E` of the Coons patch (unit frame).
+fn winslow_from_corners(
+    energy: &WinslowVolume,
+    cf: &CommonFaces,
+    target: &[Point3],
+    is_boundary: &dyn Fn(usize) -> bool,
+    opts: &VolumeOptions,
+) -> Result<FromCorners> {
+    let shape = cf.shape();
     // the corners' trilinear volume, at the Greville points
     let corner = |i: usize, j: usize, k: usize| {
         let lin = ((k * (shape[2] - 1)) * shape[1] + j * (shape[1] - 1)) * shape[0] + i * (shape[0] - 1);
@@ -297,7 +424,7 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<(Volume, &'static 
         let trial: Vec<Point3> = current.iter().zip(&disp).map(|(p, d)| std::array::from_fn(|c| p[c] + d[c])).collect();
         let ev = energy.evaluate(&trial, false);
         if steps == 1 {
-            coons_energy = ev.energy.is_finite().then_some(ev.energy * scale);
+            coons_energy = ev.energy.is_finite().then_some(ev.energy);
         }
         if !ev.energy.is_finite() {
             dt *= 0.5;
@@ -307,23 +434,14 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<(Volume, &'static 
         t = tn;
         accepted += 1;
         if t < 1.0 {
-            iterations += minimise(&energy, &mut current, 20, 1e-6)?.iterations;
+            iterations += minimise(energy, &mut current, 20, 1e-6)?.iterations;
             dt *= 2.0;
         }
     }
-    let mut stats = minimise(&energy, &mut current, opts.max_iterations, opts.tolerance)?;
+    let mut stats = minimise(energy, &mut current, opts.max_iterations, opts.tolerance)?;
     stats.iterations += iterations;
-    stats.energy *= scale;
-    // exact boundary: the input's control points, not their unit image
-    let (orig, _) = boundary_points(cf)?;
-    let cps: Vec<Point3> = current
-        .iter()
-        .enumerate()
-        .map(|(lin, p)| if is_boundary(lin) { orig[lin] } else { std::array::from_fn(|c| centre[c] + scale * p[c]) })
-        .collect();
-    let volume = Volume::new(cf.knots.clone(), cps, template.weights.clone())?;
     let kind = if accepted == 1 { "coons" } else { "continuation" };
-    Ok((volume, kind, accepted, stats, coons_energy))
+    Ok((current, kind, accepted, stats, coons_energy))
 }
 
 /// Largest distance between the faces of `v` and those of `b` on a 17 x 17 grid per
@@ -359,23 +477,26 @@ pub(crate) fn solve_volume(b: &VolumeBoundary, opts: &VolumeOptions) -> Result<V
     let mut refine = opts.refine;
     loop {
         let cf = common_faces(b, refine)?;
-        let (volume, start, continuation_steps, stats, energy_start) = solve_on(&cf, opts)?;
+        let on = solve_on(&cf, opts)?;
+        let volume = on.volume;
         let certificate = certify_volume(&volume, &opts.certify)?;
         let certified = matches!(certificate.verdict, VolumeFinding::Certified { .. });
         if certified || refine >= opts.refine + opts.max_refinements {
             let deviation = boundary_deviation(&volume, b);
             let report = VolumeSolveReport {
-                method: "winslow",
+                method: on.method.name(),
                 degrees: volume.degrees(),
                 shape: volume.shape(),
                 unknowns: 3 * volume.shape().iter().map(|n| n - 2).product::<usize>(),
                 refine,
-                start,
-                continuation_steps,
-                newton_iterations: stats.iterations,
-                energy_start,
-                energy: stats.energy,
-                relative_gradient: stats.relative_gradient,
+                start: on.start,
+                continuation_steps: on.continuation_steps,
+                newton_iterations: on.iterations,
+                egg_iterations: on.egg.map(|e| e.iterations),
+                egg_relative_residual: on.egg.map(|e| e.relative_residual),
+                energy_start: on.energy_start,
+                energy: on.energy,
+                relative_gradient: on.relative_gradient,
                 boundary_deviation: deviation,
                 boundary_kept: deviation <= 1e-9 * diameter,
                 verdict: certificate.verdict.name(),

@@ -13,7 +13,8 @@ fn affine(u: [f64; 3]) -> Point3 {
 fn an_affine_volume_is_reproduced_exactly() {
     let faces = trilinear_faces(affine).map(|f| f.elevated_in(0).unwrap().elevated_in(1).unwrap());
     let b = VolumeBoundary { name: "affine".into(), faces };
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified");
     assert_eq!(s.report.start, "coons");
     assert_eq!(s.volume.degrees(), [2, 2, 2]);
@@ -37,9 +38,10 @@ fn a_bulged_cube_is_certified() {
     // the four side faces keep their top edges straight: only the top's middle point moves
     let b = VolumeBoundary { name: "bulge".into(), faces };
     b.validate().unwrap();
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified", "{:?}", s.report);
-    assert!(s.report.relative_gradient < 1e-8, "{:?}", s.report);
+    assert!(s.report.relative_gradient.unwrap() < 1e-8, "{:?}", s.report);
     assert!(s.report.boundary_kept);
     // the enclosed volume equals the certificate's mean det J (unit parameter cube)
     assert!(
@@ -57,7 +59,8 @@ fn a_bulged_cube_is_certified() {
 fn a_planted_fold_is_found() {
     let faces = trilinear_faces(affine).map(|f| f.elevated_in(0).unwrap().elevated_in(1).unwrap());
     let b = VolumeBoundary { name: "affine".into(), faces };
-    let s = solve_volume(&b, &VolumeOptions { refine: 1, ..Default::default() }).unwrap();
+    let s =
+        solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, refine: 1, ..Default::default() }).unwrap();
     let mut v = s.volume.clone();
     let shape = v.shape();
     let mid = v.index([shape[0] / 2, shape[1] / 2, shape[2] / 2]);
@@ -84,7 +87,7 @@ fn a_planted_fold_is_found() {
 fn a_nurbs_quarter_cylinder_shell_is_certified() {
     let b = quarter_shell();
     b.validate().unwrap();
-    let s = solve_volume(&b, &VolumeOptions::default()).unwrap();
+    let s = solve_volume(&b, &VolumeOptions { method: VolumeMethod::Winslow, ..Default::default() }).unwrap();
     assert_eq!(s.report.verdict, "certified", "{:?}", s.report);
     assert!(s.report.boundary_deviation < 1e-12, "{:?}", s.report);
     // the shell between radii 1 and 2, a quarter turn, height 1: volume 3π/4 (the
@@ -125,4 +128,124 @@ fn quarter_shell() -> VolumeBoundary {
         Face::new([kv(ps), kv(pt)], cps, weights).unwrap()
     };
     VolumeBoundary { name: "quarter-shell".into(), faces: CubeSide::ALL.map(face) }
+}
+
+/// The control points of the tensor interpolant of `f` at the Greville points of
+/// `knots` (`xi` fastest).
+fn interpolate(knots: &[KnotVector; 3], f: impl Fn([f64; 3]) -> Point3) -> Vec<Point3> {
+    use crate::linalg::linsolve::dense_solve;
+    use crate::spline::basis::dense_values;
+    let g: [Vec<f64>; 3] = std::array::from_fn(|d| knots[d].greville());
+    let n: [usize; 3] = std::array::from_fn(|d| g[d].len());
+    let inv: [Vec<Vec<f64>>; 3] = std::array::from_fn(|d| {
+        let b: Vec<Vec<f64>> = g[d].iter().map(|&u| dense_values(&knots[d], u)).collect();
+        let id: Vec<Vec<f64>> = (0..n[d]).map(|i| (0..n[d]).map(|j| f64::from(u8::from(i == j))).collect()).collect();
+        dense_solve(&b, &id)
+    });
+    let mut v: Vec<Point3> = (0..n[0] * n[1] * n[2])
+        .map(|lin| {
+            let (i, j, k) = (lin % n[0], (lin / n[0]) % n[1], lin / (n[0] * n[1]));
+            f([g[0][i], g[1][j], g[2][k]])
+        })
+        .collect();
+    let stride = [1, n[0], n[0] * n[1]];
+    for d in 0..3 {
+        let mut out = vec![[0.0; 3]; v.len()];
+        for (lin, o) in out.iter_mut().enumerate() {
+            let i = (lin / stride[d]) % n[d];
+            let base = lin - i * stride[d];
+            for (j, c) in inv[d][i].iter().enumerate() {
+                let p = v[base + j * stride[d]];
+                for z in 0..3 {
+                    o[z] += c * p[z];
+                }
+            }
+        }
+        v = out;
+    }
+    v
+}
+
+/// EGG (eq. 8 in 3D) from a wobbled interior start on the faces of an affine volume:
+/// Newton returns the affine map itself (its second derivatives vanish, so it solves
+/// the equation exactly and the discrete solution is unique near it).
+#[test]
+fn egg_reproduces_an_affine_volume_from_a_wobbled_start() {
+    let kv = KnotVector::open_uniform(2, 3);
+    let knots = [kv.clone(), kv.clone(), KnotVector::open_uniform(3, 2)];
+    let exact = interpolate(&knots, affine);
+    let vol = Volume::new(knots, exact.clone(), None).unwrap();
+    let op = egg::EggVolume::new(&vol, 4);
+    let mut cps: Vec<Point3> = exact
+        .iter()
+        .enumerate()
+        .map(|(lin, p)| {
+            let w = if op.discretization().free_index(lin).is_some() {
+                0.05 * ((lin * 7919 % 11) as f64 / 11.0 - 0.5)
+            } else {
+                0.0
+            };
+            [p[0] + w, p[1] - w, p[2] + 0.5 * w]
+        })
+        .collect();
+    let s = egg::solve_egg(&op, &mut cps, 20, 1e-13).unwrap();
+    assert!(s.iterations >= 1, "{s:?}");
+    for (x, y) in cps.iter().zip(&exact) {
+        for c in 0..3 {
+            assert!((x[c] - y[c]).abs() < 1e-12, "{x:?} vs {y:?}");
+        }
+    }
+    // and from the faces through `solve_volume`: the Coons start is the affine map already
+    let faces = trilinear_faces(affine).map(|f| f.elevated_in(0).unwrap().elevated_in(1).unwrap());
+    let b = VolumeBoundary { name: "affine".into(), faces };
+    let s = solve_volume(&b, &VolumeOptions { method: VolumeMethod::Egg, refine: 1, ..Default::default() }).unwrap();
+    assert_eq!((s.report.method, s.report.verdict), ("egg", "certified"));
+    for &u in &[[0.1, 0.2, 0.3], [0.77, 0.13, 0.91]] {
+        let (x, y) = (s.volume.eval(u), affine(u));
+        assert!((0..3).all(|c| (x[c] - y[c]).abs() < 1e-12), "{u:?}: {x:?} vs {y:?}");
+    }
+}
+
+/// Convergence of EGG (eq. 8 in 3D) to the closed-form harmonic volume of a
+/// cylindrical shell sector `r0 <= r <= r1`, `0 <= θ <= θ1`, `0 <= z <= h`: its inverse
+/// `ξ = ln(r/r0)/ln(r1/r0)`, `η = θ/θ1`, `ζ = z/h` is harmonic, so the exact map is
+/// `x = (r0 (r1/r0)^ξ cos θ1η, r0 (r1/r0)^ξ sin θ1η, hζ)`. The boundary control points
+/// are those of the map's interpolant at the Greville points (an `O(h^(p+1))` boundary),
+/// the interior solved by Newton from the interpolant; the largest error at sample
+/// points falls at order `p + 1` under halving of the elements.
+#[test]
+fn egg_converges_at_order_p_plus_1_to_a_harmonic_shell_sector() {
+    let (r0, r1, t1, h) = (1.0f64, 2.0f64, std::f64::consts::FRAC_PI_2, 1.0);
+    let exact = |u: [f64; 3]| -> Point3 {
+        let r = r0 * (r1 / r0).powf(u[0]);
+        [r * (t1 * u[1]).cos(), r * (t1 * u[1]).sin(), h * u[2]]
+    };
+    for p in [2usize, 3] {
+        let mut errors = Vec::new();
+        for n in [2usize, 4, 8] {
+            let knots =
+                [KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, n), KnotVector::open_uniform(p, 1)];
+            let mut cps = interpolate(&knots, exact);
+            let vol = Volume::new(knots.clone(), cps.clone(), None).unwrap();
+            let op = egg::EggVolume::new(&vol, p + 2);
+            let s = egg::solve_egg(&op, &mut cps, 30, 1e-12).unwrap();
+            assert!(s.relative_residual < 1e-10, "{s:?}");
+            let sol = Volume::new(knots, cps, None).unwrap();
+            let mut worst = 0.0f64;
+            for i in 0..=10 {
+                for j in 0..=10 {
+                    for k in 0..=4 {
+                        let u = [i as f64 / 10.0, j as f64 / 10.0, k as f64 / 4.0];
+                        let (x, y) = (sol.eval(u), exact(u));
+                        worst = worst.max((0..3).map(|c| (x[c] - y[c]).powi(2)).sum::<f64>().sqrt());
+                    }
+                }
+            }
+            errors.push(worst);
+        }
+        let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        eprintln!("p = {p}: errors {errors:?}, rates {rates:?}");
+        let last = *rates.last().unwrap();
+        assert!(last > p as f64 + 0.7, "p = {p}: errors {errors:?}, rates {rates:?}");
+    }
 }

@@ -24,13 +24,11 @@
 //! weights fixed), so `∇E` and `∇²E` are quadrature sums of `∇W`, `∇²W` between the
 //! basis gradients `∇R_A`: no other term.
 
-use rayon::prelude::*;
+use std::sync::Arc;
 
+use super::assembly::{Local, VolumeDiscretization};
 use crate::linalg::sparse::Csr;
-use crate::spline::basis::BasisDerivs;
-use crate::spline::knots::KnotVector;
-use crate::spline::quadrature::GaussLegendre;
-use crate::spline::volume::{Point3, Volume};
+use crate::spline::volume::Point3;
 
 /// `W`, `∇W` (9: `d_0, d_1, d_2`) and `∇²W` (9 x 9) at `J` (columns `d`), or `None`
 /// when `det J <= 0`.
@@ -110,43 +108,11 @@ pub fn density(d: &[Point3; 3], hessian: bool) -> Option<(f64, [f64; 9], [[f64; 
     Some((w, g, h))
 }
 
-/// The univariate tables of one element in one direction: the basis functions and
-/// their first derivatives at the element's Gauss points, with the Gauss weights.
-type Tables = Vec<(BasisDerivs, f64)>;
-
-/// What one element adds: `E_e`, `∇E_e` over its `m` basis functions (`3 a + i`) and
-/// `∇²E_e` as `K[(i_b, i_a, a), b]`, column-major `9m x m` (empty without the Hessian).
-struct Local {
-    idx: Vec<usize>,
-    energy: f64,
-    gradient: Vec<f64>,
-    hessian: Vec<f64>,
-}
-
-/// The Winslow energy of volumes on one basis with the weights fixed, the boundary
-/// control points fixed and the interior ones free.
-///
-/// Quadrature is stored as univariate tables per direction and element (the tensor
-/// products `∇R_A` are formed per element when it is evaluated, so memory grows with
-/// the number of knot spans, not with elements x points x functions); the sparsity
-/// pattern of `∇²E` is built once, and every evaluation adds the element matrices into
-/// its values.
+/// The Winslow energy of volumes on one [`VolumeDiscretization`] (its basis, weights,
+/// free unknowns and pattern).
 #[derive(Debug, Clone)]
 pub(crate) struct WinslowVolume {
-    shape: [usize; 3],
-    /// `tables[d][e]`: the tables of element `e` in direction `d`.
-    tables: [Vec<Tables>; 3],
-    /// Weights of the rational basis.
-    weights: Option<Vec<f64>>,
-    /// Free index of each control point (`usize::MAX` for fixed ones).
-    free_of: Vec<usize>,
-    /// Number of free control points.
-    free: usize,
-    /// The pattern of `∇²E` (values zero): row `3 f + i` holds the columns `3 g + j`,
-    /// `g` over `neighbours[f]`, `j = 0, 1, 2`.
-    pattern: Csr,
-    /// Per free control point, the sorted free control points sharing an element with it.
-    neighbours: Vec<Vec<usize>>,
+    disc: Arc<VolumeDiscretization>,
 }
 
 /// Energy, gradient (of the free coordinates) and Hessian of [`WinslowVolume`].
@@ -163,104 +129,21 @@ pub(crate) struct Evaluation {
 impl WinslowVolume {
     /// The energy on the basis of `vol` (its knots and weights), with `g` Gauss points
     /// per direction and element (`max degree + 1` is enough for polynomial maps).
-    pub fn new(vol: &Volume, g: usize) -> Self {
-        let shape = vol.shape();
-        let rule = GaussLegendre::new(g);
-        let tables: [Vec<Tables>; 3] = std::array::from_fn(|d| {
-            let kv: &KnotVector = &vol.knots[d];
-            kv.elements()
-                .into_iter()
-                .map(|(s, a, b)| {
-                    rule.on(a, b)
-                        .map(|(u, w)| {
-                            let mut bd = BasisDerivs::default();
-                            bd.eval_in_span(kv, s, u, 1);
-                            (bd, w)
-                        })
-                        .collect()
-                })
-                .collect()
-        });
-        let mut free_of = vec![usize::MAX; shape.iter().product()];
-        let mut free = 0;
-        for k in 1..shape[2] - 1 {
-            for j in 1..shape[1] - 1 {
-                for i in 1..shape[0] - 1 {
-                    free_of[(k * shape[1] + j) * shape[0] + i] = free;
-                    free += 1;
-                }
-            }
-        }
-        let mut e = Self {
-            shape,
-            tables,
-            weights: vol.weights.clone(),
-            free_of,
-            free,
-            pattern: Csr::default(),
-            neighbours: Vec::new(),
-        };
-        let mut neighbours = vec![Vec::new(); free];
-        for el in 0..e.elements() {
-            let fs: Vec<usize> = e.element_indices(el).into_iter().filter_map(|lin| e.free_index(lin)).collect();
-            for &f in &fs {
-                neighbours[f].extend_from_slice(&fs);
-            }
-        }
-        neighbours.par_iter_mut().for_each(|r| {
-            r.sort_unstable();
-            r.dedup();
-        });
-        let mut row_ptr = Vec::with_capacity(3 * free + 1);
-        let mut col_idx = Vec::new();
-        row_ptr.push(0);
-        for r in &neighbours {
-            for _ in 0..3 {
-                for &g in r {
-                    col_idx.extend([3 * g, 3 * g + 1, 3 * g + 2]);
-                }
-                row_ptr.push(col_idx.len());
-            }
-        }
-        let nnz = col_idx.len();
-        e.pattern = Csr { nrows: 3 * free, ncols: 3 * free, row_ptr, col_idx, values: vec![0.0; nnz] };
-        e.neighbours = neighbours;
-        e
+    #[cfg(test)]
+    pub fn new(vol: &crate::spline::volume::Volume, g: usize) -> Self {
+        Self { disc: Arc::new(VolumeDiscretization::new(vol, g)) }
     }
 
-    /// Number of elements (knot spans per direction multiplied).
-    fn elements(&self) -> usize {
-        self.tables.iter().map(Vec::len).product()
-    }
-
-    /// The element's tables per direction (element `e = (k n₁ + j) n₀ + i`).
-    fn element_tables(&self, e: usize) -> [&Tables; 3] {
-        let (n0, n1) = (self.tables[0].len(), self.tables[1].len());
-        [&self.tables[0][e % n0], &self.tables[1][(e / n0) % n1], &self.tables[2][e / (n0 * n1)]]
-    }
-
-    /// Global indices of the element's basis functions (`a` fastest).
-    fn element_indices(&self, e: usize) -> Vec<usize> {
-        let [bx, by, bz] = self.element_tables(e);
-        let (f, p) =
-            ([bx[0].0.first(), by[0].0.first(), bz[0].0.first()], [bx[0].0.degree, by[0].0.degree, bz[0].0.degree]);
-        let shape = self.shape;
-        let mut idx = Vec::with_capacity((p[0] + 1) * (p[1] + 1) * (p[2] + 1));
-        for c in 0..=p[2] {
-            for b in 0..=p[1] {
-                for a in 0..=p[0] {
-                    idx.push(((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a);
-                }
-            }
-        }
-        idx
+    /// The energy on the discretization `disc`.
+    pub fn on(disc: Arc<VolumeDiscretization>) -> Self {
+        Self { disc }
     }
 
     /// The element's quadrature: weights `w_q` and `∇R_A` at every point (`q m + a`),
     /// tensor products of the univariate tables, `R = w N / W`,
     /// `∇R = (w ∇N W - w N ∇W) / W²`.
     fn element_points(&self, e: usize, idx: &[usize]) -> (Vec<f64>, Vec<Point3>) {
-        let [bx, by, bz] = self.element_tables(e);
+        let [bx, by, bz] = self.disc.element_tables(e);
         let p = [bx[0].0.degree, by[0].0.degree, bz[0].0.degree];
         let m = idx.len();
         let nq = bx.len() * by.len() * bz.len();
@@ -277,7 +160,7 @@ impl WinslowVolume {
                         for b in 0..=p[1] {
                             for a in 0..=p[0] {
                                 let l = *lin.next().expect("one index per basis function");
-                                let w = self.weights.as_ref().map_or(1.0, |w| w[l]);
+                                let w = self.disc.weights.as_ref().map_or(1.0, |w| w[l]);
                                 let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
                                 let g = [
                                     w * x.d[1][a] * y.d[0][b] * z.d[0][c],
@@ -309,7 +192,7 @@ impl WinslowVolume {
     /// w_q Σ_c ∂_c R_a(q) ∂²W/∂(d_c)_(i_a) ∂(d_c')_(i_b)` and `G[(q, c'), b] = ∂_c' R_b(q)`,
     /// `∂²E_e / ∂x_(a, i_a) ∂x_(b, i_b) = (U G)[(i_b, i_a, a), b]`.
     fn element(&self, e: usize, cps: &[Point3], hessian: bool) -> Option<Local> {
-        let idx = self.element_indices(e);
+        let idx = self.disc.element_indices(e);
         let (weights, grads) = self.element_points(e, &idx);
         let (m, nq) = (idx.len(), weights.len());
         let mut energy = 0.0;
@@ -376,91 +259,40 @@ impl WinslowVolume {
                 faer::Par::Seq,
             );
         }
-        Some(Local { idx, energy, gradient: g, hessian: k })
+        Some(Local { idx, scalar: energy, vector: g, matrix: k })
     }
 
     /// Number of free scalar unknowns (3 per interior control point).
     pub fn unknowns(&self) -> usize {
-        3 * self.free
-    }
-
-    /// Free index of control point `lin`, if it is free.
-    pub fn free_index(&self, lin: usize) -> Option<usize> {
-        let f = self.free_of[lin];
-        (f != usize::MAX).then_some(f)
+        self.disc.unknowns()
     }
 
     /// `E`, and `∇E` (and `∇²E` when `hessian`) at the control points `cps`; the
-    /// gradient is empty and the Hessian `None` when `E = +∞`.
-    ///
-    /// Elements are evaluated in parallel in batches and added in element order (the
-    /// same sums as a sequential loop), the Hessian's into the values of the fixed
-    /// pattern.
+    /// gradient is empty and the Hessian `None` when `E = +∞`
+    /// ([`VolumeDiscretization::assemble`]).
     pub fn evaluate(&self, cps: &[Point3], hessian: bool) -> Evaluation {
-        let infinite = Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None };
-        let n = self.unknowns();
-        let ne = self.elements();
-        let mut energy = 0.0;
-        let mut gradient = vec![0.0; n];
-        let mut values = if hessian { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
-        let batch = 32 * rayon::current_num_threads().max(1);
-        for start in (0..ne).step_by(batch) {
-            let locals: Option<Vec<Local>> =
-                (start..(start + batch).min(ne)).into_par_iter().map(|e| self.element(e, cps, hessian)).collect();
-            let Some(locals) = locals else { return infinite };
-            for l in locals {
-                energy += l.energy;
-                let m = l.idx.len();
-                for a in 0..m {
-                    let Some(fa) = self.free_index(l.idx[a]) else { continue };
-                    for ia in 0..3 {
-                        gradient[3 * fa + ia] += l.gradient[3 * a + ia];
-                    }
-                    if !hessian {
-                        continue;
-                    }
-                    let row = &self.neighbours[fa];
-                    for b in 0..m {
-                        let Some(fb) = self.free_index(l.idx[b]) else { continue };
-                        let at = 3 * row.binary_search(&fb).expect("the pattern holds every pair of an element");
-                        for ia in 0..3 {
-                            let p = self.pattern.row_ptr[3 * fa + ia] + at;
-                            for ib in 0..3 {
-                                values[p + ib] += l.hessian[b * 9 * m + (3 * ib + ia) * m + a];
-                            }
-                        }
-                    }
-                }
-            }
+        match self.disc.assemble(hessian, |e| self.element(e, cps, hessian)) {
+            Some((energy, gradient, hessian)) => Evaluation { energy, gradient, hessian },
+            None => Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None },
         }
-        let hessian = hessian.then(|| Csr { values, ..self.pattern.clone() });
-        Evaluation { energy, gradient, hessian }
     }
 
     /// The free coordinates of `cps` (`3 f + component`).
     pub fn gather(&self, cps: &[Point3]) -> Vec<f64> {
-        let mut x = vec![0.0; self.unknowns()];
-        for (lin, p) in cps.iter().enumerate() {
-            if let Some(f) = self.free_index(lin) {
-                x[3 * f..3 * f + 3].copy_from_slice(p);
-            }
-        }
-        x
+        self.disc.gather(cps)
     }
 
     /// `cps` with the free coordinates set to `x`.
     pub fn scatter(&self, cps: &mut [Point3], x: &[f64]) {
-        for (lin, p) in cps.iter_mut().enumerate() {
-            if let Some(f) = self.free_index(lin) {
-                p.copy_from_slice(&x[3 * f..3 * f + 3]);
-            }
-        }
+        self.disc.scatter(cps, x)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spline::knots::KnotVector;
+    use crate::spline::volume::Volume;
 
     fn sample_j() -> [Point3; 3] {
         [[1.2, 0.1, -0.2], [0.3, 0.9, 0.15], [-0.1, 0.25, 1.4]]

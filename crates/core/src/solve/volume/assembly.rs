@@ -1,0 +1,233 @@
+//! The trivariate discretization shared by the volume methods (the 3D Winslow
+//! functional, [`super::winslow`], and EGG in Galerkin form, [`super::egg`]): univariate
+//! quadrature tables per direction and element, the map from control points to free
+//! unknowns (the interior control points; the boundary ones are the Dirichlet data),
+//! the sparsity pattern of the element-coupling matrix, and the addition of element
+//! vectors and matrices into it.
+//!
+//! Unknowns are interleaved, `3 f + component` for the free control point `f`; the
+//! pattern's row `3 f + i` holds the columns `3 g + j` of every free `g` sharing an
+//! element with `f` (`j = 0, 1, 2`), so the Winslow Hessian and the (unsymmetric) EGG
+//! Jacobian share it.
+
+use rayon::prelude::*;
+
+use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
+use crate::spline::knots::KnotVector;
+use crate::spline::quadrature::GaussLegendre;
+use crate::spline::volume::{Point3, Volume};
+
+/// The univariate tables of one element in one direction: the basis functions and
+/// their first and second derivatives at the element's Gauss points, with the Gauss
+/// weights.
+pub(super) type Tables = Vec<(BasisDerivs, f64)>;
+
+/// What one element adds: a scalar, a vector over its `m` basis functions (`3 a + i`)
+/// and a matrix whose entry for row `(a, i_a)` and column `(b, i_b)` is at
+/// `b 9m + (3 i_b + i_a) m + a` (empty when not asked for).
+pub(super) struct Local {
+    pub(super) idx: Vec<usize>,
+    pub(super) scalar: f64,
+    pub(super) vector: Vec<f64>,
+    pub(super) matrix: Vec<f64>,
+}
+
+/// Basis, quadrature, free unknowns and pattern of volumes on one basis with the
+/// weights fixed, the boundary control points fixed and the interior ones free.
+///
+/// Quadrature is stored as univariate tables per direction and element (the tensor
+/// products are formed per element when it is evaluated, so memory grows with the
+/// number of knot spans, not with elements x points x functions); the sparsity pattern
+/// is built once, and every evaluation adds the element matrices into its values.
+#[derive(Debug, Clone)]
+pub struct VolumeDiscretization {
+    shape: [usize; 3],
+    /// `tables[d][e]`: the tables of element `e` in direction `d`.
+    tables: [Vec<Tables>; 3],
+    /// Weights of the rational basis.
+    pub(super) weights: Option<Vec<f64>>,
+    /// Free index of each control point (`usize::MAX` for fixed ones).
+    free_of: Vec<usize>,
+    /// Number of free control points.
+    free: usize,
+    /// The pattern (values zero), see the module doc.
+    pattern: Csr,
+    /// Per free control point, the sorted free control points sharing an element with it.
+    neighbours: Vec<Vec<usize>>,
+}
+
+impl VolumeDiscretization {
+    /// The discretization on the basis of `vol` (its knots and weights), with `g` Gauss
+    /// points per direction and element.
+    pub fn new(vol: &Volume, g: usize) -> Self {
+        let shape = vol.shape();
+        let rule = GaussLegendre::new(g);
+        let tables: [Vec<Tables>; 3] = std::array::from_fn(|d| {
+            let kv: &KnotVector = &vol.knots[d];
+            kv.elements()
+                .into_iter()
+                .map(|(s, a, b)| {
+                    rule.on(a, b)
+                        .map(|(u, w)| {
+                            let mut bd = BasisDerivs::default();
+                            bd.eval_in_span(kv, s, u, 2);
+                            (bd, w)
+                        })
+                        .collect()
+                })
+                .collect()
+        });
+        let mut free_of = vec![usize::MAX; shape.iter().product()];
+        let mut free = 0;
+        for k in 1..shape[2] - 1 {
+            for j in 1..shape[1] - 1 {
+                for i in 1..shape[0] - 1 {
+                    free_of[(k * shape[1] + j) * shape[0] + i] = free;
+                    free += 1;
+                }
+            }
+        }
+        let mut e = Self {
+            shape,
+            tables,
+            weights: vol.weights.clone(),
+            free_of,
+            free,
+            pattern: Csr::default(),
+            neighbours: Vec::new(),
+        };
+        let mut neighbours = vec![Vec::new(); free];
+        for el in 0..e.elements() {
+            let fs: Vec<usize> = e.element_indices(el).into_iter().filter_map(|lin| e.free_index(lin)).collect();
+            for &f in &fs {
+                neighbours[f].extend_from_slice(&fs);
+            }
+        }
+        neighbours.par_iter_mut().for_each(|r| {
+            r.sort_unstable();
+            r.dedup();
+        });
+        let mut row_ptr = Vec::with_capacity(3 * free + 1);
+        let mut col_idx = Vec::new();
+        row_ptr.push(0);
+        for r in &neighbours {
+            for _ in 0..3 {
+                for &g in r {
+                    col_idx.extend([3 * g, 3 * g + 1, 3 * g + 2]);
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        let nnz = col_idx.len();
+        e.pattern = Csr { nrows: 3 * free, ncols: 3 * free, row_ptr, col_idx, values: vec![0.0; nnz] };
+        e.neighbours = neighbours;
+        e
+    }
+
+    /// Number of elements (knot spans per direction multiplied).
+    pub(super) fn elements(&self) -> usize {
+        self.tables.iter().map(Vec::len).product()
+    }
+
+    /// The element's tables per direction (element `e = (k n₁ + j) n₀ + i`).
+    pub(super) fn element_tables(&self, e: usize) -> [&Tables; 3] {
+        let (n0, n1) = (self.tables[0].len(), self.tables[1].len());
+        [&self.tables[0][e % n0], &self.tables[1][(e / n0) % n1], &self.tables[2][e / (n0 * n1)]]
+    }
+
+    /// Global indices of the element's basis functions (`a` fastest).
+    pub(super) fn element_indices(&self, e: usize) -> Vec<usize> {
+        let [bx, by, bz] = self.element_tables(e);
+        let (f, p) =
+            ([bx[0].0.first(), by[0].0.first(), bz[0].0.first()], [bx[0].0.degree, by[0].0.degree, bz[0].0.degree]);
+        let shape = self.shape;
+        let mut idx = Vec::with_capacity((p[0] + 1) * (p[1] + 1) * (p[2] + 1));
+        for c in 0..=p[2] {
+            for b in 0..=p[1] {
+                for a in 0..=p[0] {
+                    idx.push(((f[2] + c) * shape[1] + f[1] + b) * shape[0] + f[0] + a);
+                }
+            }
+        }
+        idx
+    }
+
+    /// Number of free scalar unknowns (3 per interior control point).
+    pub fn unknowns(&self) -> usize {
+        3 * self.free
+    }
+
+    /// Free index of control point `lin`, if it is free.
+    pub fn free_index(&self, lin: usize) -> Option<usize> {
+        let f = self.free_of[lin];
+        (f != usize::MAX).then_some(f)
+    }
+
+    /// The free coordinates of `cps` (`3 f + component`).
+    pub fn gather(&self, cps: &[Point3]) -> Vec<f64> {
+        let mut x = vec![0.0; self.unknowns()];
+        for (lin, p) in cps.iter().enumerate() {
+            if let Some(f) = self.free_index(lin) {
+                x[3 * f..3 * f + 3].copy_from_slice(p);
+            }
+        }
+        x
+    }
+
+    /// `cps` with the free coordinates set to `x`.
+    pub fn scatter(&self, cps: &mut [Point3], x: &[f64]) {
+        for (lin, p) in cps.iter_mut().enumerate() {
+            if let Some(f) = self.free_index(lin) {
+                p.copy_from_slice(&x[3 * f..3 * f + 3]);
+            }
+        }
+    }
+
+    /// The sum of the elements' [`Local`]s made by `element` (`None` when one of them
+    /// is `None`): the scalars added, the vectors into the free unknowns, the matrices
+    /// (when `matrix`) into the values of the pattern. Elements are evaluated in
+    /// parallel in batches and added in element order (the same sums as a sequential
+    /// loop).
+    pub(super) fn assemble<F>(&self, matrix: bool, element: F) -> Option<(f64, Vec<f64>, Option<Csr>)>
+    where
+        F: Fn(usize) -> Option<Local> + Sync,
+    {
+        let n = self.unknowns();
+        let ne = self.elements();
+        let mut scalar = 0.0;
+        let mut vector = vec![0.0; n];
+        let mut values = if matrix { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
+        let batch = 32 * rayon::current_num_threads().max(1);
+        for start in (0..ne).step_by(batch) {
+            let locals: Vec<Local> =
+                (start..(start + batch).min(ne)).into_par_iter().map(&element).collect::<Option<_>>()?;
+            for l in locals {
+                scalar += l.scalar;
+                let m = l.idx.len();
+                for a in 0..m {
+                    let Some(fa) = self.free_index(l.idx[a]) else { continue };
+                    for ia in 0..3 {
+                        vector[3 * fa + ia] += l.vector[3 * a + ia];
+                    }
+                    if !matrix {
+                        continue;
+                    }
+                    let row = &self.neighbours[fa];
+                    for b in 0..m {
+                        let Some(fb) = self.free_index(l.idx[b]) else { continue };
+                        let at = 3 * row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        for ia in 0..3 {
+                            let p = self.pattern.row_ptr[3 * fa + ia] + at;
+                            for ib in 0..3 {
+                                values[p + ib] += l.matrix[b * 9 * m + (3 * ib + ia) * m + a];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let matrix = matrix.then(|| Csr { values, ..self.pattern.clone() });
+        Some((scalar, vector, matrix))
+    }
+}
