@@ -125,7 +125,11 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
 fn outline(doc: Document, a: &ConvertArgs) -> Result<i32> {
     files::OutputPlan::new().input(&a.map).file("-o", &a.output, "domain", files::ext::JSON).check()?;
     let (Document::Layout(layout) | Document::Multipatch(layout)) = doc else {
-        return Err(files::wrong_kind(&doc, &a.map, "--outline takes a multipatch layout (G+Smo <MultiPatch> or JSON)"));
+        return Err(files::wrong_kind(
+            &doc,
+            &a.map,
+            "--outline takes a multipatch layout (G+Smo <MultiPatch> or JSON)",
+        ));
     };
     let domain = winslow::domain::outline(&layout, a.smooth_below)
         .with_context(|| format!("the outline of the layout {}", layout.name))?;
