@@ -240,10 +240,15 @@ impl Mesh {
                     owner.insert((tri[k], tri[(k + 1) % 3]), t);
                 }
             }
-            let found = owner.iter().find_map(|(&(a, b), &t1)| {
-                (a < b && self.boundary[a] && self.boundary[b]).then_some(())?;
-                owner.get(&(b, a)).map(|&t2| (a, b, t1, t2))
-            });
+            // the dividing edge of the smallest node pair: the same mesh on every run (the
+            // hash map's order of iteration is not)
+            let found = owner
+                .iter()
+                .filter_map(|(&(a, b), &t1)| {
+                    (a < b && self.boundary[a] && self.boundary[b]).then_some(())?;
+                    owner.get(&(b, a)).map(|&t2| (a, b, t1, t2))
+                })
+                .min();
             let Some((a, b, t1, t2)) = found else { return };
             let m = self.add_node(lerp(self.nodes[a], self.nodes[b], 0.5), [0.0; 2], false);
             for (t, (x, y)) in [(t1, (a, b)), (t2, (b, a))] {
