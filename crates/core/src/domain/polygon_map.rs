@@ -559,4 +559,20 @@ mod tests {
         let sides = vec![line([0.0, 0.0], [1.0, 0.0]), line([1.0, 0.0], [0.0, 0.0])];
         assert!(PolygonMap::new(&sides, 8, 1).is_err());
     }
+
+    /// The same face gives the same map to the last bit, whatever order the hash maps
+    /// iterate in (every `HashMap` has its own random keys).
+    #[test]
+    fn the_map_is_the_same_on_every_build() {
+        // an L-shaped hexagon: its ear clipping leaves dividing edges to split
+        let p: [Point; 6] = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]];
+        let sides: Vec<Curve> = (0..6).map(|k| line(p[k], p[(k + 1) % 6])).collect();
+        let first = PolygonMap::new(&sides, 6, 1).unwrap();
+        for _ in 0..8 {
+            let again = PolygonMap::new(&sides, 6, 1).unwrap();
+            assert_eq!(again.nodes, first.nodes);
+            assert_eq!(again.images, first.images);
+            assert_eq!(again.triangles, first.triangles);
+        }
+    }
 }
