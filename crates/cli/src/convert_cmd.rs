@@ -65,6 +65,9 @@ pub(super) fn convert(a: ConvertArgs) -> Result<i32> {
     if a.thb {
         anyhow::bail!("--thb keeps a THB map hierarchical, and {} holds no THB map", a.map.display());
     }
+    if a.outline {
+        return outline(doc, &a);
+    }
     let (what, extensions) = match doc {
         Document::Volume { .. } => ("volume", files::ext::VOLUME),
         Document::VolumeBoundary(_) => ("volume boundary", files::ext::VOLUME_BOUNDARY),
@@ -117,6 +120,30 @@ fn convert_patches(layout: &Layout, maps: Vec<Surface>, output: &Path) -> Result
     Ok(codes.into_iter().max().unwrap_or(0))
 }
 
+/// `winslow convert LAYOUT --outline -o DOMAIN.json`: the outer boundary and holes of a
+/// multipatch layout as a `domain` document ([`winslow::domain::outline`]).
+fn outline(doc: Document, a: &ConvertArgs) -> Result<i32> {
+    files::OutputPlan::new().input(&a.map).file("-o", &a.output, "domain", files::ext::JSON).check()?;
+    let (Document::Layout(layout) | Document::Multipatch(layout)) = doc else {
+        return Err(files::wrong_kind(
+            &doc,
+            &a.map,
+            "--outline takes a multipatch layout (G+Smo <MultiPatch> or JSON)",
+        ));
+    };
+    let domain = winslow::domain::outline(&layout, a.smooth_below)
+        .with_context(|| format!("the outline of the layout {}", layout.name))?;
+    files::write(&a.output, &Output::Domain(&domain))?;
+    say!(
+        "{}: outer loop of {} sides, {} holes (sides joining within {} degrees merged)",
+        domain.name,
+        domain.outer.sides.len(),
+        domain.holes.len(),
+        a.smooth_below
+    );
+    Ok(0)
+}
+
 #[derive(Args, Debug)]
 pub(crate) struct ConvertArgs {
     /// Map file (JSON map document, G+Smo XML or IGES; a THB map too), multipatch result, volume or
@@ -130,6 +157,15 @@ pub(crate) struct ConvertArgs {
     /// lines (exact).
     #[arg(long)]
     pub(crate) thb: bool,
+    /// Write the outer boundary and holes of a multipatch layout as a general domain
+    /// (`"domain"` document, .json): the patch sides in no interface chained into loops,
+    /// which `winslow solve` lays out automatically.
+    #[arg(long)]
+    pub(crate) outline: bool,
+    /// With --outline: consecutive sides whose tangents turn by less than this (degrees)
+    /// become one curve (0 keeps every patch side a side of the domain).
+    #[arg(long, default_value_t = 5.0, requires = "outline")]
+    pub(crate) smooth_below: f64,
 }
 
 #[derive(Args, Debug)]

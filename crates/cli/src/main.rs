@@ -139,7 +139,7 @@ enum Command {
     /// or .vtm; a volume as .json, .xml, .vtu or .vtk; the six faces of a volume as .json
     /// or .xml (a G+Smo multipatch). The map is certified again.
     #[command(
-        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml\nExample (a THB map to its exact tensor map):\n  winslow convert tests/data/thb/sector_thb.json -o out/sector_tensor.json\nExample (the six faces of a volume as a G+Smo multipatch):\n  winslow convert tests/data/volumes/twisted-duct.json -o out/twisted-duct-faces.xml"
+        after_help = "Example (a map written by `winslow solve`):\n  winslow convert out/wavy_lid.json -o out/wavy_lid.xml\nExample (a THB map to its exact tensor map):\n  winslow convert tests/data/thb/sector_thb.json -o out/sector_tensor.json\nExample (the six faces of a volume as a G+Smo multipatch):\n  winslow convert tests/data/volumes/twisted-duct.json -o out/twisted-duct-faces.xml\nExample (the outer boundary of a multipatch layout as a domain, to lay out automatically):\n  winslow convert tests/data/gismo/xml/multipatch/TUDflame.xml --outline -o out/tudflame-domain.json"
     )]
     Convert(ConvertArgs),
     /// The hard corpus: seeded families of difficult domains (narrow clearances, spirals,

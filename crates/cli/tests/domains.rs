@@ -165,3 +165,43 @@ fn bad_graphs_are_typed_errors() {
         }
     }
 }
+
+/// `convert LAYOUT --outline`: the plate with a hole's two hand-made patches give a
+/// domain of five corners (the arc's halves merged), which `solve` lays out into five
+/// certified patches covering the same area; a map is refused with exit code 1.
+#[test]
+fn convert_outline_writes_the_domain_of_a_layout() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let (domain, solved) = (dir.join("plate-domain.json"), dir.join("plate.json"));
+    let hand = data().join("gismo/xml/multipatch/plateWithHoleMP.xml");
+    let out = bin().arg("convert").arg(&hand).arg("--outline").arg("-o").arg(&domain).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc = read_json(&domain);
+    assert_eq!(doc["domain"]["outer"]["curves"].as_array().unwrap().len(), 5);
+    assert!(doc["domain"].get("holes").is_none_or(|h| h.as_array().unwrap().is_empty()));
+    // every side kept: six
+    let six = dir.join("plate-six.json");
+    let out = bin().args(["convert", "--outline", "--smooth-below", "0", "-o"]).arg(&six).arg(&hand).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(read_json(&six)["domain"]["outer"]["curves"].as_array().unwrap().len(), 6);
+    let out = bin().arg("solve").arg(&domain).arg("-o").arg(&solved).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    assert_eq!(report["verdicts"], serde_json::json!(vec!["certified"; 5]), "{}", report["message"]);
+    // the quarter plate [-4, 0] x [0, 4] without the unit disc
+    let area = 16.0 - std::f64::consts::PI / 4.0;
+    let got = report["layout"]["area"].as_f64().unwrap();
+    assert!((got - area).abs() < 1e-5 * area, "{got} {area}");
+    // a map has no outline
+    let out = bin()
+        .arg("convert")
+        .arg(data().join("maps/skewed_square.json"))
+        .arg("--outline")
+        .arg("-o")
+        .arg(dir.join("no.json"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!dir.join("no.json").exists());
+}

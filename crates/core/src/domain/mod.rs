@@ -16,6 +16,7 @@
 //! | `graph` | the faces, edges and vertices of a layout under construction: edges split at a point, faces split by a new edge |
 //! | `holes` | cuts from every hole to the outer boundary or another hole |
 //! | `reflex` | cuts from reflex corners into the face |
+//! | `outline` | the outer boundary and holes of a multipatch layout as a domain (the input of a comparison with the hand-made layout) |
 //! | [`template`] | the quadrangulation of every face by its template and the assembly of the multipatch layout |
 //!
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
@@ -26,6 +27,7 @@ pub(crate) mod families;
 pub(crate) mod graph;
 pub(crate) mod harmonic;
 pub(crate) mod holes;
+pub(crate) mod outline;
 pub(crate) mod plane;
 pub(crate) mod polygon_map;
 pub(crate) mod reflex;
@@ -37,6 +39,7 @@ use crate::error::Error;
 use crate::spline::curve::Point;
 
 pub use holes::HoleCut;
+pub use outline::outline;
 pub use plane::{GraphFace, GraphReport, PlaneEdge, PlaneGraph, PlaneLabel};
 pub use reflex::CutReport;
 pub use template::{auto_layout, graph_layout, AutoLayout, LayoutOptions, LayoutReport};

@@ -10,7 +10,11 @@
 use serde::Serialize;
 
 use super::graph::{ccw_angle, end_tangent, Graph};
+use super::harmonic::{polygon_vertex, ArcLength};
+use super::polygon_map::PolygonMap;
+use super::template::{fit_points, POLYGON_MAP_LEVELS};
 use super::validate::{inside, segment_distance};
+use crate::boundary::fit::FitOptions;
 use crate::boundary::validate::sample_side;
 use crate::boundary::SideCurve;
 use crate::error::{Error, Result};
@@ -31,6 +35,11 @@ pub struct CutReport {
     pub ends_on: &'static str,
     /// The four corner angles the cut makes (two at each end), degrees.
     pub new_angles: [f64; 4],
+    /// A curved cut: no straight one stays inside the face, so the cut is the preimage
+    /// of a straight segment of the regular polygon under the face's map onto it
+    /// (written only when true).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub curved: bool,
 }
 
 /// The straight segment from `a` to `b` (degree 1).
@@ -110,17 +119,145 @@ struct Candidate {
     point: Point,
     score: f64,
     angles: [f64; 4],
+    /// A curved cut (from the corner to `point`); `None`: the straight segment.
+    curve: Option<Curve>,
 }
 
 /// Where a cut may end: a corner of the face or a point on its side `k` at the edge
 /// parameter `u`; the point; the directions there (outgoing side, reversed incoming).
 type Target = (Option<usize>, Option<(usize, f64)>, Point, Point, Point);
 
+/// Points of a curved cut's preimage polyline before its fit.
+const CURVED_SAMPLES: usize = 48;
+
+/// Boundary nodes a side of the face's map onto the polygon for curved cuts.
+const CURVED_PER_SIDE: usize = 16;
+
+/// Whether the polyline `cut` (from the boundary of face `f` back to its boundary)
+/// stays inside the face: no chord comes within `tol` of the face's boundary away from
+/// the cut's two ends (the first and last hundredth of the end chords), and its middle
+/// point lies inside.
+fn polyline_inside(g: &Graph, f: usize, cut: &[Point], tol: f64) -> bool {
+    let poly = face_polyline(g, f);
+    let n = poly.len();
+    let m = cut.len() - 1;
+    let e = 1e-2;
+    for k in 0..m {
+        let (mut a, mut b) = (cut[k], cut[k + 1]);
+        if k == 0 {
+            a = [a[0] + e * (b[0] - a[0]), a[1] + e * (b[1] - a[1])];
+        }
+        if k + 1 == m {
+            b = [b[0] + e * (a[0] - b[0]), b[1] + e * (a[1] - b[1])];
+        }
+        if (0..n).any(|i| segment_distance(a, b, poly[i].0, poly[(i + 1) % n].0).0 <= tol) {
+            return false;
+        }
+    }
+    let pts: Vec<Point> = poly.iter().map(|x| x.0).collect();
+    inside(&pts, cut[m / 2])
+}
+
+/// Curved cuts from corner `i` of face `f`, for a corner no straight cut leaves inside
+/// the face: the map of the face onto the regular polygon with as many sides
+/// ([`PolygonMap`], one-to-one on every face because the polygon is convex) carries the
+/// corner to a vertex of the polygon, and the straight segments from it to the other
+/// vertices (not its neighbours) and to the midpoints of the sides not at it, which stay
+/// inside the convex polygon, are carried back: their preimages stay inside the face.
+/// Each is fitted by a spline; the ones whose fit stays inside and whose four new
+/// angles keep the rules of the straight cuts are the candidates, scored alike.
+fn curved_candidates(g: &Graph, f: usize, i: usize, reflex: bool, diameter: f64, fit: &FitOptions) -> Vec<Candidate> {
+    let pi = std::f64::consts::PI;
+    let tol = 1e-9 * diameter;
+    let sides: Vec<Curve> = g.faces[f].sides.iter().map(|&s| g.side_curve(s)).collect();
+    let n = sides.len();
+    let Ok(map) = PolygonMap::new(&sides, CURVED_PER_SIDE, POLYGON_MAP_LEVELS) else { return Vec::new() };
+    let corners = g.corners(f);
+    let o = g.vertices[corners[i]];
+    let (t_out, back) = g.corner_directions(f, i);
+    // the fit scale of the face: ten times its area over its perimeter
+    let poly: Vec<Point> = face_polyline(g, f).into_iter().map(|x| x.0).collect();
+    let perimeter: f64 = (0..poly.len()).map(|k| dist(poly[k], poly[(k + 1) % poly.len()])).sum();
+    let area = (0..poly.len())
+        .map(|k| {
+            let (u, v) = (poly[k], poly[(k + 1) % poly.len()]);
+            u[0] * v[1] - v[0] * u[1]
+        })
+        .sum::<f64>()
+        .abs()
+        / 2.0;
+    let scale = 10.0 * area / perimeter.max(f64::MIN_POSITIVE);
+    let from = polygon_vertex(n, i);
+    let mut targets: Vec<(Point, Target)> = Vec::new();
+    for j in 0..n {
+        if j != i && j != (i + 1) % n && (j + 1) % n != i {
+            let (to, bj) = g.corner_directions(f, j);
+            targets.push((polygon_vertex(n, j), (Some(j), None, g.vertices[corners[j]], to, bj)));
+        }
+        if j != i && (j + 1) % n != i {
+            // the midpoint of side j: the point at half its arc length
+            let (e, fwd) = g.faces[f].sides[j];
+            let u_side = ArcLength::new(&sides[j]).param(0.5);
+            let u = if fwd { u_side } else { 1.0 - u_side };
+            let t = end_tangent_at(&sides[j], u_side);
+            let q = polygon_vertex(n, j);
+            let r = polygon_vertex(n, j + 1);
+            targets.push((
+                [0.5 * (q[0] + r[0]), 0.5 * (q[1] + r[1])],
+                (None, Some((j, u)), g.edges[e].curve.eval(u), t, [-t[0], -t[1]]),
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    for (image, (corner, on_side, p, to, bj)) in targets {
+        let pre: Option<Vec<Point>> = (0..=CURVED_SAMPLES)
+            .map(|k| {
+                let t = k as f64 / CURVED_SAMPLES as f64;
+                map.inverse([from[0] + t * (image[0] - from[0]), from[1] + t * (image[1] - from[1])])
+            })
+            .collect();
+        let Some(mut pts) = pre else { continue };
+        pts[0] = o;
+        pts[CURVED_SAMPLES] = p;
+        let Ok(curve) = fit_points(&pts, diameter, scale, fit) else { continue };
+        if !polyline_inside(g, f, &curve.sample(4 * CURVED_SAMPLES), tol) {
+            continue;
+        }
+        let d0 = end_tangent(&curve, false);
+        let d1 = end_tangent(&curve, true);
+        let d1r = [-d1[0], -d1[1]];
+        let (a1, a2) = (ccw_angle(t_out, d0), ccw_angle(d0, back));
+        let (b1, b2) = (ccw_angle(to, d1r), ccw_angle(d1r, bj));
+        let angles = [a1, a2, b1, b2];
+        let ok = angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
+        if ok {
+            let score = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).fold(pi, f64::min);
+            out.push(Candidate { corner, on_side, point: p, score, angles, curve: Some(curve) });
+        }
+    }
+    out
+}
+
+fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// The unit tangent of `c` at the parameter `u` (in its direction).
+fn end_tangent_at(c: &Curve, u: f64) -> Point {
+    let d = c.derivs(u, 1).d1;
+    let l = d[0].hypot(d[1]);
+    if l > 0.0 && l.is_finite() {
+        [d[0] / l, d[1] / l]
+    } else {
+        end_tangent(c, u > 0.5)
+    }
+}
+
 /// Angles within this of 180° (radians) are flat: such a corner is cut as well.
 const FLAT: f64 = 1e-6;
 
 /// Cut every reflex and flat corner of every face (see the module documentation).
-pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>) -> Result<()> {
+pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, fit: &FitOptions, cuts: &mut Vec<CutReport>) -> Result<()> {
     let tol = 1e-9 * diameter;
     let pi = std::f64::consts::PI;
     for _ in 0..10_000 {
@@ -142,7 +279,7 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>
             Error::Domain {
             at: format!("face {f} (label {label})"),
             reason: format!(
-                "the corner at ({:.6}, {:.6}) ({:.1} degrees) cannot be cut: no straight cut from it stays inside the face",
+                "the corner at ({:.6}, {:.6}) ({:.1} degrees) cannot be cut: no straight cut from it stays inside the face, nor a curved one (the preimages of the segments of the face's map onto the polygon)",
                 o[0],
                 o[1],
                 alpha.to_degrees()
@@ -194,9 +331,12 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>
                     angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
                 if ok {
                     let score = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).fold(pi, f64::min);
-                    cands.push(Candidate { corner, on_side, point: p, score, angles });
+                    cands.push(Candidate { corner, on_side, point: p, score, angles, curve: None });
                 }
             }
+        }
+        if cands.is_empty() {
+            cands = curved_candidates(g, f, i, reflex, diameter, fit);
         }
         // the largest smallest angle; a corner before a new vertex when they tie
         let Some(best) = cands
@@ -216,7 +356,19 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>
             return Err(reflex_error());
         };
         let p = g.vertices[j_vertex];
-        let cut = g.add_edge(line(o, p), o_vertex, j_vertex, false);
+        let curve = match &best.curve {
+            Some(c) => {
+                // the exact ends: the corner and the vertex the split made
+                let mut c = c.clone();
+                let last = c.control_points.len() - 1;
+                c.control_points[0] = o;
+                c.control_points[last] = p;
+                c
+            }
+            None => line(o, p),
+        };
+        let curved = best.curve.is_some();
+        let cut = g.add_edge(curve, o_vertex, j_vertex, false);
         g.split_face(f, ci, cj, cut);
         cuts.push(CutReport {
             from: o,
@@ -224,6 +376,7 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, cuts: &mut Vec<CutReport>
             angle: alpha.to_degrees(),
             ends_on: if best.corner.is_some() { "vertex" } else { "side" },
             new_angles: best.angles.map(f64::to_degrees),
+            curved,
         });
     }
     Err(Error::Domain { at: "layout".into(), reason: "more than 10000 cuts from reflex corners".into() })

@@ -155,7 +155,7 @@ fn dist(a: Point, b: Point) -> f64 {
 /// contour fit of §5 at a tenth of the fit tolerance's accuracy demand relative to
 /// `scale` (the smaller of the diameter and ten times the face's area over its
 /// perimeter, so that a cut through a thin face keeps to it).
-fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
+pub(super) fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
     let (a, b) = (pts[0], pts[pts.len() - 1]);
     let l = dist(a, b);
     let off =
@@ -348,7 +348,7 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
 }
 
 /// Refinements of the triangulation of a face for its [`PolygonMap`].
-const POLYGON_MAP_LEVELS: usize = 2;
+pub(super) const POLYGON_MAP_LEVELS: usize = 2;
 
 /// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
 const SPOKE_SAMPLES: usize = 64;
@@ -468,7 +468,7 @@ fn lay_out_with(
     cut_holes(&mut g, diameter, theta, &mut hole_cuts)?;
     // 2. reflex corners
     let mut cuts = Vec::new();
-    cut_reflex(&mut g, diameter, &mut cuts)?;
+    cut_reflex(&mut g, diameter, &opts.fit, &mut cuts)?;
     // 3. templates: harmonic maps on the faces as they are, then the splits
     let split = edges_to_split(&g);
     let nf = g.faces.len();
