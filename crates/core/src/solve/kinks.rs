@@ -296,12 +296,8 @@ pub fn keep_kinks(
         // once more from the start with the certified maps as the feasible set: every
         // iterate the line search accepts is certified, so the last one is a certified
         // map with `J` no larger than the start's ([`Certified`])
-        let problem = Certified::new(
-            method.problem(moved.clone(), start.clone()),
-            moved.clone(),
-            weights.clone(),
-            opts.certify.clone(),
-        );
+        let problem =
+            Certified::new(method.problem(moved.clone(), start.clone()), moved.clone(), weights.clone(), opts.certify);
         let rerun = FixedBasisSolve::with_problem(problem, moved.dofs.gather(&start), nl).finish()?;
         let rerun_cert = certify(&surface(&rerun.control_points), &opts.certify)?;
         report.certified_rerun = Some(rerun.history.iterations);
