@@ -253,6 +253,18 @@ impl Discretization {
     /// element and direction, and the given DOF map.
     pub fn with_dofs(knots: [KnotVector; 2], nq: usize, dofs: DofMap) -> Self {
         let tables = [DirTable::new(&knots[0], nq), DirTable::new(&knots[1], nq)];
+        Self::with_tables(knots, tables, dofs)
+    }
+
+    /// As [`Discretization::with_dofs`] with `nq` Gauss-Lobatto points per element and
+    /// direction: the integrals (the Winslow functional, eq. 16) then sample the element
+    /// edges, where a map only `C^0` across a knot line has its one-sided limits.
+    pub fn with_dofs_lobatto(knots: [KnotVector; 2], nq: usize, dofs: DofMap) -> Self {
+        let tables = [DirTable::lobatto(&knots[0], nq), DirTable::lobatto(&knots[1], nq)];
+        Self::with_tables(knots, tables, dofs)
+    }
+
+    fn with_tables(knots: [KnotVector; 2], tables: [DirTable; 2], dofs: DofMap) -> Self {
         let (p, q) = (knots[0].degree(), knots[1].degree());
         let vector = LazyPattern::new(&dofs, p, q, 2);
         let scalar = SystemPattern::new(&dofs, p, q, 1);

@@ -8,7 +8,7 @@
 use crate::error::MAX_DEGREE;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::knots::KnotVector;
-use crate::spline::quadrature::GaussLegendre;
+use crate::spline::quadrature::{GaussLegendre, GaussLobatto};
 
 const W: usize = MAX_DEGREE + 1;
 
@@ -44,6 +44,19 @@ impl DirTable {
     /// Tabulate `kv` at `nq` Gauss points per element.
     pub fn new(kv: &KnotVector, nq: usize) -> Self {
         let g = GaussLegendre::new(nq);
+        Self::with_rule(kv, nq, |a, b| g.on(a, b).collect())
+    }
+
+    /// Tabulate `kv` at `nq` Gauss-Lobatto points per element (the element's ends
+    /// included: each element sees its own one-sided limit on a `C^0` knot).
+    pub fn lobatto(kv: &KnotVector, nq: usize) -> Self {
+        let g = GaussLobatto::new(nq);
+        Self::with_rule(kv, g.points.len(), |a, b| g.on(a, b).collect())
+    }
+
+    /// Tabulate `kv` at the points and weights `rule(a, b)` gives on each element `[a, b]`
+    /// (`nq` of them), the basis of the element's span at each (one-sided at its ends).
+    fn with_rule(kv: &KnotVector, nq: usize, rule: impl Fn(f64, f64) -> Vec<(f64, f64)>) -> Self {
         let mut first = Vec::new();
         let mut bounds = Vec::new();
         let mut qp = Vec::new();
@@ -51,7 +64,7 @@ impl DirTable {
         for (span, a, bb) in kv.elements() {
             first.push(span - kv.degree());
             bounds.push((a, bb));
-            for (u, w) in g.on(a, bb) {
+            for (u, w) in rule(a, bb) {
                 b.eval_in_span(kv, span, u, 2);
                 qp.push(QpTab { w, u, n: b.d });
             }

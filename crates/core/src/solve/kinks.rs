@@ -13,17 +13,27 @@
 //!    by the certificate);
 //! 3. minimises the Winslow functional (16) on `Σ⁰` (it allows `C^0`, needs a bijective
 //!    start: [`WinslowMethod`]) from that start, with the kinked boundary fixed;
-//! 4. certifies the result. The map is replaced only by a certified one (the minimised
-//!    map, else the certified start of step 3); otherwise the `Σ¹` map stays, with its
-//!    rounded kinks, and the report says why.
+//! 4. certifies the result. Where the minimiser is not certified, step 3 runs once more
+//!    with the certified maps as its feasible set (module `certified`: every iterate the
+//!    line search accepts is certified), kept where `J` falls and the certified margin
+//!    `min det J / mean det J` stays at least half the start's. The map is replaced only by a certified one (the
+//!    minimised map, else the certified start of step 3); otherwise the `Σ¹` map stays,
+//!    with its rounded kinks, and the report says why.
 //!
 //! Where the full step of 2. is not certified (next to a reflex kink the harmonic map is
 //! singular, `x_ξ → 0`, and a coarse basis cannot follow), the offending elements and a
 //! halo are bisected as in the defect correction (§8.2), the last certified map of the
 //! continuation is prolonged onto the refined basis and the continuation goes on from
 //! there, at most `repair` rounds. Where neither `p + 2` nor `p + 4` Gauss points give a
-//! bijective start, a last try pins the control point next to each kink inside the kink's
-//! wedge (`corner_pins`): the folds left sit at the kink point itself.
+//! bijective start, a third try pins the control point next to each kink inside the kink's
+//! wedge (`corner_pins`): the folds left sit at the kink point itself. With the pins they
+//! sit on the kink's knot line one element row in, one-sided, at every refinement: the
+//! Gauss points never reach a `C^0` knot line. A last try (no pins) takes `p + 4`
+//! Gauss-Lobatto points per element and direction, whose end points put the one-sided
+//! limits of `det J` on every knot line, the kink points included, into the Winslow
+//! barrier; where that gives none either, once more with Gauss-Lobatto points and pins.
+
+mod certified;
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -44,10 +54,12 @@ use crate::discrete::dofs::{DofMap, FIXED};
 use crate::error::Result;
 use crate::methods::egg::EggAssembler;
 use crate::methods::winslow::{winslow_objective, WinslowMethod};
+use crate::methods::Method;
 use crate::spline::curve::Point;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::{Side, Surface};
 use crate::verify::certificate::{certify, Certificate};
+use certified::Certified;
 
 /// Gauss points per direction beyond the degree in the continuation and the final
 /// minimisation: the first try, and the retry where it gives no bijective start.
@@ -82,6 +94,11 @@ pub struct KinkStage {
     pub unknowns: usize,
     /// The knot spans around each kink it moved (`kinks_local`), `None` when all.
     pub local_spans: Option<usize>,
+    /// Newton iterations of the rerun of the final minimisation whose line search accepts
+    /// only certified maps (module `kinks::certified`; absent: not run, the unconstrained
+    /// minimiser was certified).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certified_rerun: Option<usize>,
     /// Whether it met its stopping rule.
     pub converged: bool,
     /// Winslow value (eq. 16) of its start and of its result (`null` where undefined).
@@ -114,6 +131,7 @@ impl KinkStage {
             iterations: 0,
             unknowns: 0,
             local_spans: None,
+            certified_rerun: None,
             converged: false,
             winslow: [None, None],
             kept: false,
@@ -174,11 +192,21 @@ pub(crate) fn keep_kinks(
     // (tests/data/cad_kinks/vnotch.json: 332 degrees inside) the damped minimisers with
     // p + 2 points folded between them at 0.77 of the boundary displacement whatever the
     // refinement, while p + 4 reach the kinked boundary with no refinement
-    // where that gives none either, a last try from the Σ¹ map with p + 4 and the control
+    // where that gives none either, a third try from the Σ¹ map with p + 4 and the control
     // point next to each kink pinned inside the kink's wedge ([`corner_pins`]): the
-    // Winslow barrier does not see `det J` at the kink itself, where the folds sit
-    let tries = [(QUADRATURE_EXTRA[0], false), (QUADRATURE_EXTRA[1], false), (QUADRATURE_EXTRA[1], true)];
-    let mut first = elasticity_start(map, c0, tries[0].0, &[], opts, assembler, diameter, &mut report)?;
+    // Winslow barrier does not see `det J` at the kink itself, where the folds sit;
+    // where the folds then sit on the kink's knot line one element row in (one-sided: cad-
+    // kinks seeds 23 and 24 of the corpus), a last try with Gauss-Lobatto points, which
+    // put the knot lines' one-sided limits into the barrier, first without the pins (with
+    // them seed 24 still folded), then with them (without them seed 5 folded)
+    let tries = [
+        Try { extra: QUADRATURE_EXTRA[0], pinned: false, lobatto: false },
+        Try { extra: QUADRATURE_EXTRA[1], pinned: false, lobatto: false },
+        Try { extra: QUADRATURE_EXTRA[1], pinned: true, lobatto: false },
+        Try { extra: QUADRATURE_EXTRA[1], pinned: false, lobatto: true },
+        Try { extra: QUADRATURE_EXTRA[1], pinned: true, lobatto: true },
+    ];
+    let mut first = elasticity_start(map, c0, tries[0], &[], opts, assembler, diameter, &mut report)?;
     let (mut chosen, mut retried, mut spent) = (tries[0], String::new(), Continuation::default());
     let mut failed = vec![(tries[0], first.cont.steps, report.refinements, report.alpha)];
     for &next in &tries[1..] {
@@ -186,21 +214,21 @@ pub(crate) fn keep_kinks(
             break;
         }
         let mut again = report.clone();
-        let pinned: &[Kink] = if next.1 { &kinked.kinks } else { &[] };
-        let attempt = elasticity_start(map, c0, next.0, pinned, opts, assembler, diameter, &mut again)?;
+        let pinned: &[Kink] = if next.pinned { &kinked.kinks } else { &[] };
+        let attempt = elasticity_start(map, c0, next, pinned, opts, assembler, diameter, &mut again)?;
         spent.steps += attempt.cont.steps;
         spent.iterations += attempt.cont.iterations;
         if !bijective(&attempt.cert) {
             failed.push((next, attempt.cont.steps, again.refinements, again.alpha));
             continue;
         }
-        retried = match next.1 {
-            false => format!(
+        retried = match (next.pinned, next.lobatto) {
+            (false, false) => format!(
                 "; p + {} Gauss points per direction, since p + {} gave no bijective start ({} damped solves, {:.3} \
                  of the boundary displacement reached)",
-                next.0, tries[0].0, first.cont.steps, report.alpha
+                next.extra, tries[0].extra, first.cont.steps, report.alpha
             ),
-            true => format!("; the control point next to each kink pinned, since {}", tried_text(&failed)),
+            _ => format!("; {}, since {}", next.describe(), tried_text(&failed)),
         };
         report = again;
         let earlier = first.cont;
@@ -209,7 +237,6 @@ pub(crate) fn keep_kinks(
         first.cont.iterations = earlier.iterations + spent.iterations;
         chosen = next;
     }
-    let extra = chosen.0;
     let ElasticityStart { level, disc, weights, start, cert: start_cert, cont } = first;
     let [p, q] = map.degrees();
     let method = WinslowMethod;
@@ -247,15 +274,15 @@ pub(crate) fn keep_kinks(
         None => None,
     };
     let moved = match local {
-        Some(dofs) => Arc::new(
-            Discretization::with_dofs(level.knots.clone(), p.max(q) + extra, dofs).with_weights(weights.clone())?,
-        ),
+        Some(dofs) => {
+            Arc::new(chosen.discretization(level.knots.clone(), p.max(q), dofs).with_weights(weights.clone())?)
+        }
         None => disc.clone(),
     };
     report.unknowns = 2 * moved.dofs.num_free();
     report.local_spans = spans;
     let nl = from_bijective_start(opts.nonlinear, &method, diameter, moved.dofs.num_free());
-    let solved = FixedBasisSolve::new(&method, moved, start.clone(), nl).finish()?;
+    let solved = FixedBasisSolve::new(&method, moved.clone(), start.clone(), nl).finish()?;
     report.iterations = solved.history.iterations;
     report.converged = solved.converged();
     report.failure = solved.failure().map(|why| format!("Winslow minimisation: {why}"));
@@ -266,7 +293,29 @@ pub(crate) fn keep_kinks(
     let (cps, cert, which) = if bijective(&cert) {
         (minimised, cert, "the Winslow minimiser")
     } else {
-        (start, start_cert, "the certified elasticity start (the Winslow minimiser is not certified)")
+        // once more from the start with the certified maps as the feasible set: every
+        // iterate the line search accepts is certified, so the last one is a certified
+        // map with `J` no larger than the start's ([`Certified`])
+        let problem =
+            Certified::new(method.problem(moved.clone(), start.clone()), moved.clone(), weights.clone(), opts.certify);
+        let rerun = FixedBasisSolve::with_problem(problem, moved.dofs.gather(&start), nl).finish()?;
+        let rerun_cert = certify(&surface(&rerun.control_points), &opts.certify)?;
+        report.certified_rerun = Some(rerun.history.iterations);
+        let lower = matches!((rerun.objective, rerun.start_objective), (Some(a), Some(b)) if a < b);
+        // a constrained minimiser may hug `det J = 0` where the functional (16) does not
+        // see it (on contour_l_shape: a lower bound of 1e-11 against the start's 1.6e-3):
+        // kept only with at least half the start's relative margin `min det J / mean det J`
+        let margin = |c: &Certificate| c.lower_bound / c.mean_det_j;
+        let margin_kept = margin(&rerun_cert) >= 0.5 * margin(&start_cert);
+        if bijective(&rerun_cert) && lower && margin_kept {
+            report.winslow[1] = rerun.objective.and_then(finite);
+            report.converged = rerun.converged();
+            report.failure =
+                rerun.failure().map(|why| format!("Winslow minimisation within the certified maps: {why}"));
+            (rerun.control_points, rerun_cert, "the Winslow minimiser within the certified maps")
+        } else {
+            (start, start_cert, "the certified elasticity start (the Winslow minimiser is not certified)")
+        }
     };
     report.kept = true;
     report.certificate = cert.message();
@@ -285,14 +334,41 @@ pub(crate) fn keep_kinks(
     Ok(KinkOutcome { map: Some(map), certificate: Some(cert), level: Some(level), report })
 }
 
-/// The tries of [`keep_kinks`] that gave no bijective start, `((p + extra, pinned),
-/// damped solves, refinement rounds, α reached)`, in words.
-fn tried_text(failed: &[((usize, bool), usize, usize, f64)]) -> String {
-    let text = |&((extra, pinned), steps, rounds, alpha): &((usize, bool), usize, usize, f64)| {
-        let every = if pinned { " with the control points next to the kinks pinned" } else { "" };
+/// One try of [`keep_kinks`]: `p + extra` quadrature points per element and direction,
+/// Gauss-Lobatto (the element edges sampled) or Gauss-Legendre, and the control points
+/// next to the kinks pinned ([`corner_pins`]) or not.
+#[derive(Debug, Clone, Copy)]
+struct Try {
+    extra: usize,
+    pinned: bool,
+    lobatto: bool,
+}
+
+impl Try {
+    /// The try in words.
+    fn describe(self) -> String {
+        let rule = if self.lobatto { "Gauss-Lobatto" } else { "Gauss" };
+        let every = if self.pinned { " with the control points next to the kinks pinned" } else { "" };
+        format!("p + {} {rule} points per direction{every}", self.extra)
+    }
+
+    /// The discretization of this try on `knots` of largest degree `p`.
+    fn discretization(self, knots: [KnotVector; 2], p: usize, dofs: DofMap) -> Discretization {
+        match self.lobatto {
+            true => Discretization::with_dofs_lobatto(knots, p + self.extra, dofs),
+            false => Discretization::with_dofs(knots, p + self.extra, dofs),
+        }
+    }
+}
+
+/// The tries of [`keep_kinks`] that gave no bijective start, `(try, damped solves,
+/// refinement rounds, α reached)`, in words.
+fn tried_text(failed: &[(Try, usize, usize, f64)]) -> String {
+    let text = |&(t, steps, rounds, alpha): &(Try, usize, usize, f64)| {
         format!(
-            "p + {extra} Gauss points per direction{every} ({steps} damped solves, {rounds} refinement round(s), \
-             {alpha:.3} of the boundary displacement reached)"
+            "{} ({steps} damped solves, {rounds} refinement round(s), {alpha:.3} of the boundary displacement \
+             reached)",
+            t.describe()
         )
     };
     failed.iter().map(text).collect::<Vec<_>>().join(", ")
@@ -319,7 +395,7 @@ struct ElasticityStart {
 fn elasticity_start(
     map: &Surface,
     c0: &Level,
-    extra: usize,
+    t: Try,
     pinned: &[Kink],
     opts: &SolveOptions,
     assembler: &dyn EggAssembler,
@@ -354,9 +430,7 @@ fn elasticity_start(
                 target[k] = x;
             }
         }
-        let disc = Arc::new(
-            Discretization::with_dofs(level.knots.clone(), p.max(q) + extra, dofs).with_weights(weights.clone())?,
-        );
+        let disc = Arc::new(t.discretization(level.knots.clone(), p.max(q), dofs).with_weights(weights.clone())?);
         if report.refinements == 0 {
             report.boundary_shift =
                 base.iter().zip(&target).fold(0.0f64, |d, (a, b)| d.max((a[0] - b[0]).hypot(a[1] - b[1]))) / diameter;
