@@ -350,24 +350,11 @@ mod tests {
 
     /// A rational curved volume of degrees (3, 2, 2) with an interior wobble.
     fn sample() -> (Volume, Vec<Point3>) {
-        let k = [
+        super::super::tests::curved_rational_volume([
             KnotVector::open_uniform(3, 2),
             KnotVector::open_uniform(2, 2),
             KnotVector::open_from_breaks(2, &[0.0, 0.4, 1.0], 1),
-        ];
-        let shape = k.each_ref().map(KnotVector::num_basis);
-        let n: usize = shape.iter().product();
-        let g: [Vec<f64>; 3] = std::array::from_fn(|d| k[d].greville());
-        let cps: Vec<Point3> = (0..n)
-            .map(|lin| {
-                let (i, j, l) = (lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1]));
-                let (a, b, c) = (g[0][i], g[1][j], g[2][l]);
-                let wob = 0.03 * ((lin * 7919) % 13) as f64 / 13.0;
-                [a + 0.2 * b * c + wob, b + 0.1 * a * a - wob, c + 0.15 * a * b + 0.5 * wob]
-            })
-            .collect();
-        let w: Vec<f64> = (0..n).map(|lin| 1.0 + 0.2 * ((lin * 31) % 5) as f64 / 5.0).collect();
-        (Volume::new(k, cps.clone(), Some(w)).unwrap(), cps)
+        ])
     }
 
     /// The assembled Jacobian against central differences of the residual, on a

@@ -3,6 +3,25 @@ use crate::boundary::volume::tests::trilinear_faces;
 use crate::spline::face::Face;
 use crate::spline::knots::KnotVector;
 
+/// A rational curved volume on the knot vectors `k` (Greville net, sheared, with an
+/// interior wobble and weights in [1, 1.2)): the test map of the EGG and Winslow
+/// derivatives against finite differences.
+pub(super) fn curved_rational_volume(k: [KnotVector; 3]) -> (crate::spline::volume::Volume, Vec<Point3>) {
+    let shape = k.each_ref().map(KnotVector::num_basis);
+    let n: usize = shape.iter().product();
+    let g: [Vec<f64>; 3] = std::array::from_fn(|d| k[d].greville());
+    let cps: Vec<Point3> = (0..n)
+        .map(|lin| {
+            let (i, j, l) = (lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1]));
+            let (a, b, c) = (g[0][i], g[1][j], g[2][l]);
+            let wob = 0.03 * ((lin * 7919) % 13) as f64 / 13.0;
+            [a + 0.2 * b * c + wob, b + 0.1 * a * a - wob, c + 0.15 * a * b + 0.5 * wob]
+        })
+        .collect();
+    let w: Vec<f64> = (0..n).map(|lin| 1.0 + 0.2 * ((lin * 31) % 5) as f64 / 5.0).collect();
+    (crate::spline::volume::Volume::new(k, cps.clone(), Some(w)).unwrap(), cps)
+}
+
 fn affine(u: [f64; 3]) -> Point3 {
     [2.0 + u[0] + 0.3 * u[1] - 0.2 * u[2], -1.0 + 0.1 * u[0] + 1.5 * u[1], 0.4 * u[0] + 0.2 * u[1] + 0.8 * u[2]]
 }

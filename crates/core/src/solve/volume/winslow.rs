@@ -292,7 +292,6 @@ impl WinslowVolume {
 mod tests {
     use super::*;
     use crate::spline::knots::KnotVector;
-    use crate::spline::volume::Volume;
 
     fn sample_j() -> [Point3; 3] {
         [[1.2, 0.1, -0.2], [0.3, 0.9, 0.15], [-0.1, 0.25, 1.4]]
@@ -332,24 +331,12 @@ mod tests {
     /// of the energy and the gradient, on a rational curved volume.
     #[test]
     fn energy_gradient_and_hessian_match_finite_differences() {
-        let k = [
+        let (vol, cps) = super::super::tests::curved_rational_volume([
             KnotVector::open_uniform(2, 2),
             KnotVector::open_uniform(2, 1),
             KnotVector::open_from_breaks(2, &[0.0, 0.4, 1.0], 1),
-        ];
-        let shape = k.each_ref().map(KnotVector::num_basis);
-        let n: usize = shape.iter().product();
-        let g: [Vec<f64>; 3] = std::array::from_fn(|d| k[d].greville());
-        let cps: Vec<Point3> = (0..n)
-            .map(|lin| {
-                let (i, j, l) = (lin % shape[0], (lin / shape[0]) % shape[1], lin / (shape[0] * shape[1]));
-                let (a, b, c) = (g[0][i], g[1][j], g[2][l]);
-                let wob = 0.03 * ((lin * 7919) % 13) as f64 / 13.0;
-                [a + 0.2 * b * c + wob, b + 0.1 * a * a - wob, c + 0.15 * a * b + 0.5 * wob]
-            })
-            .collect();
-        let w: Vec<f64> = (0..n).map(|lin| 1.0 + 0.2 * ((lin * 31) % 5) as f64 / 5.0).collect();
-        let vol = Volume::new(k, cps.clone(), Some(w)).unwrap();
+        ]);
+        let shape = vol.shape();
         let e = WinslowVolume::new(&vol, 4);
         assert_eq!(e.unknowns(), 3 * (shape[0] - 2) * (shape[1] - 2) * (shape[2] - 2));
         let at = e.evaluate(&cps, true);
