@@ -42,9 +42,8 @@ pub struct ThbRepairOptions {
     /// Newton options of each round. Their linear solver as on a tensor basis: by
     /// default ([`LinearMethod::Auto`](crate::linalg::linsolve::LinearMethod::Auto))
     /// GMRES preconditioned by `-diag(K, K)`, `K` the metric Laplacian on the THB
-    /// discretization
-    /// ([`hierarchical_metric_laplace`](crate::methods::hierarchical::hierarchical_metric_laplace)),
-    /// LU for small systems and where GMRES stalls;
+    /// discretization (`methods::hierarchical::hierarchical_metric_laplace`), LU for small
+    /// systems and where GMRES stalls;
     /// [`LinearMethod::Multigrid`](crate::linalg::linsolve::LinearMethod::Multigrid) is
     /// GMRES here (a THB space has no knot-halving transfers yet).
     pub nonlinear: NonlinearOptions,
