@@ -88,7 +88,7 @@ pub(crate) struct Geo {
 impl Geo {
     /// The metric terms `(g11, g12, g22)`: `g11 = x_xi.x_xi`, `g12 = x_xi.x_eta`,
     /// `g22 = x_eta.x_eta`.
-    fn metric(&self) -> (f64, f64, f64) {
+    pub(crate) fn metric(&self) -> (f64, f64, f64) {
         let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
         (dot(self.xu, self.xu), dot(self.xu, self.xv), dot(self.xv, self.xv))
     }

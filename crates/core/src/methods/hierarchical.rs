@@ -38,13 +38,15 @@ pub(crate) struct HierarchicalState {
     /// Residual of every THB function (interleaved, length `2 n`).
     pub res_full: Vec<f64>,
     mass: Option<Csr>,
+    /// The scalar preconditioner `K` in the scalar pattern.
+    prec: Option<Csr>,
 }
 
 impl HierarchicalState {
     /// Storage for `disc` with all control points `cps`.
     pub fn new(disc: Arc<HierarchicalDiscretization>, cps: Vec<Point>) -> Self {
         let n = disc.num_total();
-        Self { res_full: vec![0.0; 2 * n], disc, cps, mass: None }
+        Self { res_full: vec![0.0; 2 * n], disc, cps, mass: None, prec: None }
     }
 
     fn load(&mut self, c: &[f64]) {
@@ -140,6 +142,43 @@ pub(crate) fn hierarchical_egg(
     });
 }
 
+/// The symmetric principal part of the EGG Jacobian on a THB discretization (as the
+/// tensor [`Discretization::metric_laplace`](crate::discrete::assembly::Discretization::metric_laplace)),
+/// `K_ab = ∫ ∇w_a · A ∇w_b / s + shift ∫ w_a w_b` with `A = [[g22, -g12], [-g12, g11]]`
+/// (`s = 1` plain, `s = g11 + g22` scaled; `1e-10 tr A` added to the diagonal of `A`), in
+/// the values of the scalar pattern: `dF/dc = -diag(K, K) + B` with `B` of lower order, so
+/// `-diag(K, K)` preconditions the Newton systems (GMRES).
+pub fn hierarchical_metric_laplace(
+    disc: &HierarchicalDiscretization,
+    cps: &[Point],
+    op: Operator,
+    shift: f64,
+    values: &mut [f64],
+) {
+    disc.assemble(1, &mut [], values, |cell, _, ke| {
+        let n = cell.len();
+        for (k, &wq) in cell.weights.iter().enumerate() {
+            let (g11, g12, g22) = geometry(cell, k, cps).metric();
+            let tr = g11 + g22;
+            let scale = match op {
+                Operator::Scaled if tr > 0.0 => 1.0 / tr,
+                Operator::Plain | Operator::Scaled => 1.0,
+            };
+            let eps = 1e-10 * tr;
+            let w = wq * scale;
+            let (a11, a12, a22) = (w * (g22 + eps), -w * g12, w * (g11 + eps));
+            let b = cell.at(k);
+            for (a, ba) in b.iter().enumerate() {
+                let (ga, gb, ma) = (a11 * ba[1] + a12 * ba[2], a12 * ba[1] + a22 * ba[2], wq * shift * ba[0]);
+                let row = &mut ke[a * n..(a + 1) * n];
+                for (r, bb) in row.iter_mut().zip(b) {
+                    *r += ga * bb[1] + gb * bb[2] + ma * bb[0];
+                }
+            }
+        }
+    });
+}
+
 /// EGG (eq. 8) on a THB discretization, plain or scaled operator.
 #[derive(Debug)]
 pub(crate) struct HierarchicalEggProblem {
@@ -186,6 +225,13 @@ impl DiscreteProblem for HierarchicalEggProblem {
 
     fn mass(&mut self) -> &Csr {
         self.state.mass()
+    }
+
+    fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
+        let s = &mut self.state;
+        let k = s.prec.get_or_insert_with(|| s.disc.scalar.clone());
+        hierarchical_metric_laplace(&s.disc, &s.cps, self.op, shift, &mut k.values);
+        s.prec.as_ref()
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {

@@ -1,6 +1,7 @@
 //! Local defect correction with THB-splines (paper §8.2 on a truncated hierarchical
 //! basis, §4): while the certificate of the THB map finds folded or undecided active
-//! cells, only those cells and a ring of active cells around them are refined
+//! cells, only those cells and (in the first round) a ring of active cells around them
+//! are refined
 //! ([`HierarchicalMap::refined`], admissible of class `m`), the map is prolonged onto the
 //! refined basis (exactly: the THB spaces are nested) and EGG (eq. 8) is solved again on
 //! the THB discretization (`HierarchicalEggProblem`). Where a tensor repair bisects
@@ -15,7 +16,6 @@ use super::newton::{NonlinearOptions, NonlinearSolver, Status};
 use crate::discrete::assembly::Operator;
 use crate::discrete::hierarchical::HierarchicalDiscretization;
 use crate::error::{Error, Result};
-use crate::linalg::linsolve::LinearMethod;
 use crate::methods::hierarchical::HierarchicalEggProblem;
 use crate::methods::DiscreteProblem;
 use crate::spline::hierarchical::map::HierarchicalMap;
@@ -28,14 +28,24 @@ use crate::verify::certificate::{CertifyOptions, Finding};
 pub(crate) struct ThbRepairOptions {
     /// Rounds at most.
     pub rounds: usize,
-    /// Active cells within this many cell widths (of the offending cell's level) of an
-    /// offending cell are refined too.
+    /// In the first round, active cells within this many cell widths (of the offending
+    /// cell's level) of an offending cell are refined too.
     pub ring: usize,
+    /// The same in every later round (default 0: the offending cells and what
+    /// admissibility needs; BENCHMARKS.md "Local defect correction": with 1, puzzle4 ends
+    /// with 949 functions, with 0 with 805, jigsaw01 2,076 against 1,624).
+    pub later_ring: usize,
     /// Admissibility class `m >= 2` of the refined hierarchy.
     pub admissibility: usize,
     /// Operator of eq. (8).
     pub operator: Operator,
-    /// Newton options of each round (the linear solver is sparse LU).
+    /// Newton options of each round. Their linear solver as on a tensor basis: by
+    /// default ([`LinearMethod::Auto`](crate::linalg::linsolve::LinearMethod::Auto))
+    /// GMRES preconditioned by `-diag(K, K)`, `K` the metric Laplacian on the THB
+    /// discretization (`methods::hierarchical::hierarchical_metric_laplace`), LU for small
+    /// systems and where GMRES stalls;
+    /// [`LinearMethod::Multigrid`](crate::linalg::linsolve::LinearMethod::Multigrid) is
+    /// GMRES here (a THB space has no knot-halving transfers yet).
     pub nonlinear: NonlinearOptions,
     /// Certificate options.
     pub certify: CertifyOptions,
@@ -46,6 +56,7 @@ impl Default for ThbRepairOptions {
         Self {
             rounds: 6,
             ring: 1,
+            later_ring: 0,
             admissibility: 2,
             operator: Operator::Scaled,
             nonlinear: NonlinearOptions::default(),
@@ -77,6 +88,18 @@ pub struct ThbRound {
     pub converged: bool,
     /// Seconds of the round (refinement, solve, certificate).
     pub seconds: f64,
+    /// Of `seconds`: the refinement of the basis and the prolongation of the map.
+    pub refine_seconds: f64,
+    /// Of `seconds`: the THB discretization (element extraction of the active cells).
+    pub discretization_seconds: f64,
+    /// Of `seconds`: the Newton solve on the discretization.
+    pub newton_seconds: f64,
+    /// Of `newton_seconds`: the residual and Jacobian assemblies.
+    pub assembly_seconds: f64,
+    /// Of `newton_seconds`: the linear solves (factorizations or preconditioners included).
+    pub linear_seconds: f64,
+    /// Of `seconds`: the certificate of the solved map.
+    pub certify_seconds: f64,
 }
 
 /// The result of `repair_thb`: the last map, its certificate and the rounds.
@@ -120,34 +143,63 @@ pub fn marked_cells(map: &HierarchicalMap, offending: &[CellIndex], ring: usize)
         .collect()
 }
 
+/// A solve of EGG on a THB discretization ([`solve_egg`]).
+#[derive(Debug, Clone)]
+pub struct EggSolve {
+    /// The solved map.
+    pub map: HierarchicalMap,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Whether Newton converged.
+    pub converged: bool,
+    /// Free unknowns `2 m`.
+    pub unknowns: usize,
+    /// Seconds of the discretization (element extraction).
+    pub discretization_seconds: f64,
+    /// Seconds of Newton's residual and Jacobian assemblies.
+    pub assembly_seconds: f64,
+    /// Seconds of Newton's linear solves (preconditioner or factorization included).
+    pub linear_seconds: f64,
+}
+
 /// Solve EGG (eq. 8) on the THB discretization of `map` from its control points (the
-/// fixed ones are the Dirichlet data); returns the solved map, the Newton iterations,
-/// whether Newton converged and the number of unknowns.
-pub(crate) fn solve_egg(
-    map: &HierarchicalMap,
-    operator: Operator,
-    nonlinear: NonlinearOptions,
-) -> Result<(HierarchicalMap, usize, bool, usize)> {
+/// fixed ones are the Dirichlet data), Newton's linear systems by `nonlinear.linear` (see
+/// [`ThbRepairOptions::nonlinear`]).
+pub(crate) fn solve_egg(map: &HierarchicalMap, operator: Operator, nonlinear: NonlinearOptions) -> Result<EggSolve> {
+    let t0 = Instant::now();
     let disc = Arc::new(HierarchicalDiscretization::new(map.basis.clone()));
+    let discretization_seconds = t0.elapsed().as_secs_f64();
     if disc.num_free() == 0 {
-        return Ok((map.clone(), 0, true, 0));
+        let map = map.clone();
+        let (assembly_seconds, linear_seconds) = (0.0, 0.0);
+        return Ok(EggSolve {
+            map,
+            iterations: 0,
+            converged: true,
+            unknowns: 0,
+            discretization_seconds,
+            assembly_seconds,
+            linear_seconds,
+        });
     }
     let c0 = disc.gather(&map.control_points);
     let unknowns = c0.len();
     let prob = HierarchicalEggProblem::new(disc, map.control_points.clone(), operator);
-    let opts = NonlinearOptions { linear: LinearMethod::Lu, ..nonlinear };
-    let mut solver = NonlinearSolver::new(prob, c0, opts);
+    let mut solver = NonlinearSolver::new(prob, c0, nonlinear);
     let mut iterations = 0;
     for it in solver.by_ref() {
         iterations = it?.iteration;
     }
+    let (assembly_seconds, linear_seconds) =
+        (solver.timings.assembly.as_secs_f64(), solver.timings.linear.as_secs_f64());
     let converged = solver.status() == &Status::Converged;
     let (prob, c) = solver.into_parts();
     let cps = prob.control_points(&c);
     if cps.iter().flatten().any(|x| !x.is_finite()) {
         return Err(Error::Invalid("the THB solve produced non-finite control points".into()));
     }
-    Ok((HierarchicalMap::new(map.basis.clone(), cps)?, iterations, converged, unknowns))
+    let map = HierarchicalMap::new(map.basis.clone(), cps)?;
+    Ok(EggSolve { map, iterations, converged, unknowns, discretization_seconds, assembly_seconds, linear_seconds })
 }
 
 #[cfg(test)]
@@ -171,26 +223,38 @@ pub(crate) fn repair_thb_observed(
     while !accepted(&cert) && rounds.len() < opts.rounds {
         let t0 = Instant::now();
         let offending = cert.offending_cells();
-        let marked = marked_cells(&map, &offending, opts.ring);
+        let ring = if rounds.is_empty() { opts.ring } else { opts.later_ring };
+        let marked = marked_cells(&map, &offending, ring);
         if marked.is_empty() {
             break;
         }
         let refined = map.refined(&marked, opts.admissibility)?;
-        let (solved, iterations, converged, unknowns) = solve_egg(&refined, opts.operator, opts.nonlinear)?;
-        map = solved;
+        let refine_seconds = t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        let egg = solve_egg(&refined, opts.operator, opts.nonlinear)?;
+        let newton_seconds = t1.elapsed().as_secs_f64() - egg.discretization_seconds;
+        map = egg.map;
         let verdict = cert.verdict.name();
+        let t2 = Instant::now();
         cert = certify_hierarchical(&map, &opts.certify)?;
+        let certify_seconds = t2.elapsed().as_secs_f64();
         let round = ThbRound {
             round: rounds.len() + 1,
             verdict,
             offending_cells: offending.len(),
             marked_cells: marked.len(),
             functions: map.basis.len(),
-            unknowns,
+            unknowns: egg.unknowns,
             levels: map.basis.num_levels(),
-            iterations,
-            converged,
+            iterations: egg.iterations,
+            converged: egg.converged,
             seconds: t0.elapsed().as_secs_f64(),
+            refine_seconds,
+            discretization_seconds: egg.discretization_seconds,
+            newton_seconds,
+            assembly_seconds: egg.assembly_seconds,
+            linear_seconds: egg.linear_seconds,
+            certify_seconds,
         };
         if !observer(&round) {
             return Err(Error::Cancelled);

@@ -166,3 +166,58 @@ fn newton_recovers_the_affine_map_on_a_thb_basis() {
         assert!(err < 1e-9, "{err}");
     }
 }
+
+/// On a one-level basis the THB metric Laplacian `K` (the preconditioner of the Newton
+/// systems) is the tensor one, both operators, with and without the mass shift.
+#[test]
+fn one_level_metric_laplace_is_the_tensor_one() {
+    let (disc, cps) = curved(3, 2, 7, 0.05);
+    let hd = HierarchicalDiscretization::new(thb_of(&disc, &cps).basis);
+    for op in [Operator::Plain, Operator::Scaled] {
+        for shift in [0.0, 0.7] {
+            let mut st = vec![0.0; disc.stencil_len(1)];
+            disc.metric_laplace(&cps, op, shift, &mut st);
+            let tensor = disc.scalar.matrix(&st).to_dense().concat();
+            let mut k = hd.scalar.clone();
+            hierarchical_metric_laplace(&hd, &cps, op, shift, &mut k.values);
+            let thb = k.to_dense().concat();
+            assert!(rel(&thb, &tensor) < 1e-13, "{op:?} {shift}: {}", rel(&thb, &tensor));
+        }
+    }
+}
+
+/// At an affine map (constant metric, zero second derivatives) the EGG Jacobian is
+/// `-diag(K, K)` by integration by parts (the test functions vanish on the boundary and
+/// are `C^1` across the cells of every level): on a three-level THB basis the
+/// preconditioner the problem gives equals the negated Jacobian up to the `1e-10 tr A`
+/// that keeps `K` definite, for both operators.
+#[test]
+fn at_an_affine_map_the_egg_jacobian_is_minus_the_metric_laplacian() {
+    let (disc, _, exact) = affine(3, 4, 1, 0.0);
+    let map = thb_of(&disc, &exact).refined(&[(0, [1, 2]), (0, [2, 2])], 2).unwrap();
+    let map = map.refined(&[(1, [3, 4])], 2).unwrap();
+    assert_eq!(map.basis.num_levels(), 3);
+    let hd = Arc::new(HierarchicalDiscretization::new(map.basis.clone()));
+    let m = hd.num_free();
+    for op in [Operator::Plain, Operator::Scaled] {
+        let mut prob = HierarchicalEggProblem::new(hd.clone(), map.control_points.clone(), op);
+        let c = prob.unknowns();
+        let mut f = vec![0.0; 2 * m];
+        let mut jac = Csr::default();
+        prob.jacobian(&c, &mut f, &mut jac);
+        let j = jac.to_dense();
+        let k = prob.preconditioner(0.0).unwrap().to_dense();
+        let scale = k.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
+        let mut err = 0.0f64;
+        for r in 0..2 * m {
+            for s in 0..2 * m {
+                let want = if r / m == s / m { -k[r % m][s % m] } else { 0.0 };
+                err = err.max((j[r][s] - want).abs());
+            }
+        }
+        assert!(err < 1e-8 * scale, "{op:?}: {err} vs {scale}");
+        // and K is symmetric positive definite: its Cholesky factorization succeeds
+        let mut lin = crate::linalg::linsolve::LinearSolver::new(LinearMethod::Cholesky);
+        lin.factor(prob.preconditioner(0.0).unwrap()).unwrap();
+    }
+}

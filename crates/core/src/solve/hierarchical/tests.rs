@@ -3,6 +3,7 @@
 //! The repair of folds that the coarse EGG map itself has (puzzle4) is in
 //! `crates/core/tests/thb_repair.rs`.
 use super::*;
+use crate::linalg::linsolve::LinearMethod;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Surface;
 
@@ -47,8 +48,9 @@ fn the_ring_holds_the_neighbouring_active_cells() {
 #[test]
 fn a_planted_fold_is_refined_around_and_solved_away() {
     let coarse = annulus(3, 8);
-    let (egg, _, converged, _) = solve_egg(&coarse, Operator::Scaled, NonlinearOptions::default()).unwrap();
-    assert!(converged);
+    let egg = solve_egg(&coarse, Operator::Scaled, NonlinearOptions::default()).unwrap();
+    assert!(egg.converged);
+    let egg = egg.map;
     let opts = ThbRepairOptions::default();
     assert!(accepted(&certify_hierarchical(&egg, &opts.certify).unwrap()));
     let mut planted = egg.clone();
@@ -74,4 +76,29 @@ fn a_planted_fold_is_refined_around_and_solved_away() {
             assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-2, "({u}, {v}): {a:?} vs {b:?}");
         }
     }
+}
+
+/// Newton's linear systems by GMRES preconditioned with the THB metric Laplacian and by
+/// sparse LU reach the same EGG map on a three-level THB basis, from a perturbed start.
+#[test]
+fn gmres_and_lu_reach_the_same_egg_map() {
+    let map = annulus(3, 8).refined(&[(0, [3, 3]), (0, [4, 3])], 2).unwrap();
+    let mut map = map.refined(&[(1, [7, 7])], 2).unwrap();
+    assert_eq!(map.basis.num_levels(), 3);
+    let disc = HierarchicalDiscretization::new(map.basis.clone());
+    let mut rng = crate::testutil::Lcg::new(3);
+    for &k in disc.free() {
+        for d in 0..2 {
+            map.control_points[k][d] += 0.02 * (rng.uniform() - 0.5);
+        }
+    }
+    let solve = |linear| {
+        let opts = NonlinearOptions { linear, ..NonlinearOptions::default() };
+        let out = solve_egg(&map, Operator::Scaled, opts).unwrap();
+        assert!(out.converged && out.iterations > 0, "{linear:?}");
+        out.map.control_points
+    };
+    let (gmres, lu) = (solve(LinearMethod::Gmres), solve(LinearMethod::Lu));
+    let err = gmres.iter().zip(&lu).fold(0.0f64, |m, (a, b)| m.max((a[0] - b[0]).hypot(a[1] - b[1])));
+    assert!(err < 1e-7, "{err}");
 }

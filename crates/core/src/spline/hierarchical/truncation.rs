@@ -152,6 +152,9 @@ pub(crate) struct LevelCoefficients<'a, V: Coefficient> {
     /// The coefficient of active function `k`.
     leaf: Box<dyn Fn(usize) -> V + 'a>,
     memo: HashMap<(usize, Index2), V>,
+    /// [`HierarchicalBasis::parents_1d`] by `(level, direction, function)`: every
+    /// function of a row of cells asks for the same ones.
+    parents: HashMap<(usize, usize, usize), Vec<(usize, f64)>>,
 }
 
 impl<V: Coefficient> std::fmt::Debug for LevelCoefficients<'_, V> {
@@ -163,7 +166,13 @@ impl<V: Coefficient> std::fmt::Debug for LevelCoefficients<'_, V> {
 impl<'a, V: Coefficient> LevelCoefficients<'a, V> {
     /// The combination with coefficient `leaf(k)` on the `k`-th active function.
     pub fn new(basis: &'a HierarchicalBasis, leaf: impl Fn(usize) -> V + 'a) -> Self {
-        Self { basis, leaf: Box::new(leaf), memo: HashMap::new() }
+        Self { basis, leaf: Box::new(leaf), memo: HashMap::new(), parents: HashMap::new() }
+    }
+
+    /// [`HierarchicalBasis::parents_1d`], memoised.
+    fn parents(&mut self, l: usize, d: usize, tau: usize) -> Vec<(usize, f64)> {
+        let b = self.basis;
+        self.parents.entry((l, d, tau)).or_insert_with(|| b.parents_1d(l, d, tau)).clone()
     }
 
     /// `d^l_τ` for the level-`l` function `tau` whose support meets `Ω^l`.
@@ -175,7 +184,7 @@ impl<'a, V: Coefficient> LevelCoefficients<'a, V> {
         let v = if b.support_in_domain(l, tau) {
             b.index_of(l, tau).map_or_else(V::zero, |k| (self.leaf)(k))
         } else {
-            let (px, py) = (b.parents_1d(l, 0, tau[0]), b.parents_1d(l, 1, tau[1]));
+            let (px, py) = (self.parents(l, 0, tau[0]), self.parents(l, 1, tau[1]));
             let mut v = V::zero();
             for &(sy, wy) in &py {
                 for &(sx, wx) in &px {
