@@ -31,6 +31,9 @@ use crate::linalg::sparse::Csr;
 use crate::spline::curve::{Curve, Point};
 use std::collections::HashMap;
 
+/// Refinements of the triangulation of a face for its [`PolygonMap`].
+pub(super) const POLYGON_MAP_LEVELS: usize = 2;
+
 /// The piecewise-linear map of a face onto the regular polygon (see the module
 /// documentation).
 #[derive(Debug, Clone)]

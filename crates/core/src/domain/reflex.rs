@@ -11,15 +11,15 @@ use serde::Serialize;
 
 use super::graph::{ccw_angle, end_tangent, Graph};
 use super::harmonic::{polygon_vertex, ArcLength};
-use super::polygon_map::PolygonMap;
-use super::template::{fit_points, POLYGON_MAP_LEVELS};
+use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
 use super::validate::{inside, segment_distance};
-use crate::boundary::fit::FitOptions;
+use crate::boundary::fit::{fit_side, FitOptions};
 use crate::boundary::validate::sample_side;
 use crate::boundary::SideCurve;
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
+use crate::spline::surface::Side;
 
 /// A cut from a reflex corner.
 #[derive(Debug, Clone, Serialize)]
@@ -236,6 +236,24 @@ fn curved_candidates(g: &Graph, f: usize, i: usize, reflex: bool, diameter: f64,
         }
     }
     out
+}
+
+/// A spline curve through `pts` from its first to its last point (both kept exactly):
+/// the straight segment when the points are on it (to `1e-9` of the diameter), else the
+/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand relative to
+/// `scale` (the smaller of the diameter and ten times the face's area over its
+/// perimeter, so that a cut through a thin face keeps to it).
+pub(super) fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
+    let (a, b) = (pts[0], pts[pts.len() - 1]);
+    let l = dist(a, b);
+    let off =
+        |p: &Point| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / l.max(f64::MIN_POSITIVE);
+    if pts.iter().all(|p| off(p) <= 1e-9 * diameter) {
+        return Ok(line(a, b));
+    }
+    let opts = FitOptions { max_elements: 16, max_levels: 6, ..*fit };
+    let tol = (10.0 * fit.tol).min(1e-2) * scale.min(diameter);
+    Ok(fit_side(Side::South, &SideCurve::Points(pts.to_vec()), (a, b), &opts, tol)?.finest().clone())
 }
 
 fn dist(a: Point, b: Point) -> f64 {

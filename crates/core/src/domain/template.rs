@@ -38,8 +38,8 @@ use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
 use super::holes::{cut_holes, HoleCut};
 use super::plane::{build_graph, GraphReport, PlaneGraph};
-use super::polygon_map::PolygonMap;
-use super::reflex::{cut_reflex, line, segment_inside, CutReport};
+use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
+use super::reflex::{cut_reflex, fit_points, line, segment_inside, CutReport};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
 use crate::boundary::fit::{fit_side, FitOptions};
@@ -148,24 +148,6 @@ pub struct AutoLayout {
 
 fn dist(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-/// A spline curve through `pts` from its first to its last point (both kept exactly):
-/// the straight segment when the points are on it (to `1e-9` of the diameter), else the
-/// contour fit of §5 at a tenth of the fit tolerance's accuracy demand relative to
-/// `scale` (the smaller of the diameter and ten times the face's area over its
-/// perimeter, so that a cut through a thin face keeps to it).
-pub(super) fn fit_points(pts: &[Point], diameter: f64, scale: f64, fit: &FitOptions) -> Result<Curve> {
-    let (a, b) = (pts[0], pts[pts.len() - 1]);
-    let l = dist(a, b);
-    let off =
-        |p: &Point| ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / l.max(f64::MIN_POSITIVE);
-    if pts.iter().all(|p| off(p) <= 1e-9 * diameter) {
-        return Ok(line(a, b));
-    }
-    let opts = FitOptions { max_elements: 16, max_levels: 6, ..*fit };
-    let tol = (10.0 * fit.tol).min(1e-2) * scale.min(diameter);
-    Ok(fit_side(Side::South, &SideCurve::Points(pts.to_vec()), (a, b), &opts, tol)?.finest().clone())
 }
 
 /// The sides of loop `id` of `domain` as spline curves on `[0, 1]`.
@@ -346,9 +328,6 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
     let (diameter, area) = (report.diameter, report.area);
     lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0)
 }
-
-/// Refinements of the triangulation of a face for its [`PolygonMap`].
-pub(super) const POLYGON_MAP_LEVELS: usize = 2;
 
 /// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
 const SPOKE_SAMPLES: usize = 64;
