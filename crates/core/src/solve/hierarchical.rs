@@ -143,7 +143,7 @@ pub fn marked_cells(map: &HierarchicalMap, offending: &[CellIndex], ring: usize)
         .collect()
 }
 
-/// A solve of EGG on a THB discretization ([`solve_egg`]).
+/// A solve of EGG on a THB discretization (`solve_egg`).
 #[derive(Debug, Clone)]
 pub struct EggSolve {
     /// The solved map.
