@@ -187,6 +187,41 @@ impl DenseCholesky {
     }
 }
 
+/// `out[a][b] = sum_k w[k][a] t[k][b]` for `nloc x nloc` element blocks (`w`, `t` with
+/// `nqp` rows of `nloc`): the quadrature sum of an element matrix as one matrix
+/// product, each output row accumulated in registers for the common sizes.
+pub(crate) fn element_product(out: &mut [f64], w: &[f64], t: &[f64], nloc: usize) {
+    fn fixed<const N: usize>(out: &mut [f64], w: &[f64], t: &[f64]) {
+        for (a, row) in out.chunks_exact_mut(N).enumerate() {
+            let mut acc = [0.0f64; N];
+            for (wk, tk) in w.chunks_exact(N).zip(t.chunks_exact(N)) {
+                let wa = wk[a];
+                let tk: &[f64; N] = tk.try_into().expect("chunk of N");
+                for (r, v) in acc.iter_mut().zip(tk) {
+                    *r += wa * v;
+                }
+            }
+            row.copy_from_slice(&acc);
+        }
+    }
+    match nloc {
+        9 => fixed::<9>(out, w, t),
+        16 => fixed::<16>(out, w, t),
+        25 => fixed::<25>(out, w, t),
+        36 => fixed::<36>(out, w, t),
+        _ => {
+            out.fill(0.0);
+            for (wk, tk) in w.chunks_exact(nloc).zip(t.chunks_exact(nloc)) {
+                for (row, &wa) in out.chunks_exact_mut(nloc).zip(wk) {
+                    for (r, v) in row.iter_mut().zip(tk) {
+                        *r += wa * v;
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
