@@ -122,8 +122,9 @@ fn a_bad_gismo_face_set_is_refused_naming_the_face() {
 
 /// The method of a volume solve in the planar vocabulary: EGG (eq. 8 in 3D) by
 /// default, `--improve winslow` (or `--method winslow`) minimises the 3D Winslow
-/// functional from the EGG map, which lowers its energy; `--improve weak` is refused
-/// before anything is written; a basis that is not `C¹` (the curved pipe is linear
+/// functional from the EGG map, which lowers its energy; `--improve weak` and
+/// `--operator plain` (the 3D operator is the scaled one) are refused before anything is
+/// written; a basis that is not `C¹` (the curved pipe is linear
 /// across its wall) is solved by the Winslow functional, and the report says so.
 #[test]
 fn the_volume_method_follows_method_and_improve() {
@@ -146,9 +147,12 @@ fn the_volume_method_follows_method_and_improve() {
         assert!(w["relative_gradient"].as_f64().unwrap() < 1e-8, "{flag:?}");
         assert!(w["energy"].as_f64().unwrap() < egg["energy"].as_f64().unwrap(), "{flag:?}");
     }
-    let out = dir.join("weak.json");
-    let o = bin().arg("solve").arg(&input).arg("-o").arg(&out).args(["--improve", "weak"]).output().unwrap();
-    assert!(!o.status.success() && !out.exists());
+    for (flags, what) in [(["--improve", "weak"], "winslow"), (["--operator", "plain"], "--operator plain")] {
+        let out = dir.join("refused.json");
+        let o = bin().arg("solve").arg(&input).arg("-o").arg(&out).args(flags).output().unwrap();
+        assert!(!o.status.success() && !out.exists(), "{flags:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(what), "{flags:?}: {}", String::from_utf8_lossy(&o.stderr));
+    }
     let pipe = bin()
         .arg("solve")
         .arg(data().join("volumes/curved-pipe.json"))

@@ -407,6 +407,13 @@ pub(crate) fn volume_options(opts: &SolveOptions) -> Result<VolumeOptions> {
             ))
         }
     };
+    if opts.operator != crate::discrete::assembly::Operator::Scaled {
+        return Err(Error::Invalid(
+            "a volume's EGG operator is the scaled one (sum A_ij d_i d_j x / tr A, A = cof(J)^T cof(J)): \
+             --operator plain is for planar maps"
+                .into(),
+        ));
+    }
     Ok(VolumeOptions { method, refine: opts.levels.refine, max_refinements: opts.repair.rounds, ..Default::default() })
 }
 
