@@ -357,7 +357,8 @@ pub fn quality(map: &Surface) -> Quality {
 /// two steps: the nearest chord of a sampling of `Γ_s` (`SAMPLES_PER_SPAN` chords per
 /// knot span of a spline, `ANALYTIC_SAMPLES` of an analytic side), then the curve's
 /// own nearest point by golden-section search on the parameters of that chord and its
-/// two neighbours. Every distance is to a point *on* the curve, so `d_s` never
+/// two neighbours, finished on a spline side by Newton's method on the foot-point
+/// condition `C'(t)·(C(t) - x) = 0`. Every distance is to a point *on* the curve, so `d_s` never
 /// understates the deviation, and it is at rounding level when the map's side is the
 /// input curve, whatever its parameterization. This is the one measure of the crate:
 /// the solve report's `boundary_deviation` and `winslow check --boundary` both are this
