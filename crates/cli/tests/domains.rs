@@ -205,3 +205,40 @@ fn convert_outline_writes_the_domain_of_a_layout() {
     assert_eq!(out.status.code(), Some(1));
     assert!(!dir.join("no.json").exists());
 }
+
+/// A flat corner with no straight cut inside its face (the corpus's `wiggly-17`, face 5:
+/// a 180° corner on a wiggly edge) is cut along the face's map onto its regular polygon
+/// (`curved` in the cut's report), and every patch of the layout is certified.
+#[test]
+fn a_flat_corner_without_a_straight_cut_gets_a_curved_one() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let corpus = dir.join("corpus");
+    let gen = bin()
+        .args(["corpus", "--general", "--families", "wiggly", "--seed", "17", "--per-family", "1", "-q", "-o"])
+        .arg(&corpus)
+        .output()
+        .unwrap();
+    assert!(gen.status.success(), "{}", String::from_utf8_lossy(&gen.stderr));
+    let out = bin()
+        .arg("solve")
+        .arg(corpus.join("wiggly-17.json"))
+        .arg("-o")
+        .arg(dir.join("wiggly-17-map.json"))
+        .args(["--json", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    let verdicts = report["verdicts"].as_array().unwrap();
+    assert!(!verdicts.is_empty() && verdicts.iter().all(|v| v == "certified"), "{}", report["message"]);
+    let cuts = report["auto_layout"]["cuts"].as_array().unwrap();
+    let curved: Vec<_> = cuts.iter().filter(|c| c["curved"] == true).collect();
+    assert!(!curved.is_empty(), "no curved cut in {cuts:?}");
+    // the corner it starts from is flat, and the cut splits its 180°
+    for c in curved {
+        assert!((c["angle"].as_f64().unwrap() - 180.0).abs() < 1.0, "{c}");
+        let new: Vec<f64> = c["new_angles"].as_array().unwrap().iter().map(|a| a.as_f64().unwrap()).collect();
+        assert!((new[0] + new[1] - 180.0).abs() < 1e-6 && new.iter().all(|&a| a > 0.0), "{c}");
+    }
+}
