@@ -10,12 +10,13 @@
    with and without `--warm-start`.
    `--dask` instead: the family's throughput per worker on a local `dask.distributed`
    cluster of `--workers` single-threaded worker processes (`winslow.solve` mapped over
-   the shapes' documents), against one thread of `solve_many` (issue 34: within 20 %).
+   the shapes' documents, then `solve_many` over chunks of `--chunk` shapes per task),
+   against one thread of `solve_many` (issue 34: within 20 %).
 2. The Python call overhead of `winslow.solve` on a 100-function map
    (cooks_membrane: 10 x 10 functions): the wall time of the call against the wall
    time of the pipeline inside it (`Solution.pipeline_seconds`), summed over 200 calls.
 
-Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2] [--warm | --dask]
+Usage: python scripts/bench_python.py --winslow PATH/TO/winslow [--shapes 1000] [--workers 2] [--warm | --dask [--chunk 50]]
 """
 
 import argparse
@@ -69,6 +70,7 @@ def main():
     ap.add_argument("--overhead-only", action="store_true")
     ap.add_argument("--warm", action="store_true", help="cold against warm-started family solves only")
     ap.add_argument("--dask", action="store_true", help="throughput per worker on a local Dask cluster only")
+    ap.add_argument("--chunk", type=int, default=50, help="shapes per Dask task in the chunked run of --dask")
     a = ap.parse_args()
     if a.dask:
         dask_rows(a)
@@ -86,9 +88,17 @@ def solve_text(text):
     return winslow.solve(winslow.parse(text)).verdict
 
 
+def solve_chunk_text(texts):
+    """Solve a chunk of shapes (their documents' texts) by one thread of solve_many (on
+    a Dask worker): their verdicts."""
+    res = winslow.solve_many([winslow.parse(t) for t in texts], workers=1)
+    return [r.verdict if isinstance(r, winslow.Solution) else "error" for r in res]
+
+
 def dask_rows(a):
     """Shapes per second per worker: one thread of solve_many, then a local Dask cluster
-    of `workers` single-threaded processes mapping `winslow.solve` over the documents."""
+    of `workers` single-threaded processes mapping `winslow.solve` over the documents,
+    one task per shape, then `solve_many` over chunks of `--chunk` shapes per task."""
     from dask.distributed import Client, LocalCluster
 
     shapes = family(a.shapes)
@@ -104,10 +114,16 @@ def dask_rows(a):
         t0 = time.perf_counter()
         verdicts = client.gather(client.map(solve_text, texts, pure=False))
         dt = time.perf_counter() - t0
-    per_worker = len(shapes) / dt / a.workers
-    ok = sum(v in ("certified", "degenerate-corner") for v in verdicts)
-    print(f"Dask, {a.workers} worker processes: {len(shapes) / dt:.2f} shapes/s, {per_worker:.2f} per worker "
-          f"({per_worker / alone:.2f} of one solve_many thread; {ok} bijective)")
+        parts = [texts[i : i + a.chunk] for i in range(0, len(texts), a.chunk)]
+        t0 = time.perf_counter()
+        chunked = [v for part in client.gather(client.map(solve_chunk_text, parts, pure=False)) for v in part]
+        dt_chunked = time.perf_counter() - t0
+    for what, dt, verdicts in (("one task per shape", dt, verdicts),
+                               (f"chunks of {a.chunk} shapes per task", dt_chunked, chunked)):
+        per_worker = len(shapes) / dt / a.workers
+        ok = sum(v in ("certified", "degenerate-corner") for v in verdicts)
+        print(f"Dask, {a.workers} worker processes, {what}: {len(shapes) / dt:.2f} shapes/s, {per_worker:.2f} "
+              f"per worker ({per_worker / alone:.2f} of one solve_many thread; {ok} bijective)")
     print(f"load average: {os.getloadavg()}")
 
 

@@ -137,12 +137,20 @@ pub fn solve_layout(
     let Solved::Layout { solution, laid_out } = outcome(raised, result)? else {
         return Err(invalid("the solve of a layout gave no multipatch result"));
     };
-    let sol = *solution;
-    let mut report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
-    if let Some(m) = laid_out {
-        report["auto_layout"] = serde_json::to_value(&*m).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+    PyLayoutSolution::of(*solution, laid_out.as_deref())
+}
+
+impl PyLayoutSolution {
+    /// The solution of a layout with its report, and the automatic layout's report (under
+    /// `auto_layout`, as `winslow solve DOMAIN` writes it) when the pipeline made the
+    /// layout.
+    pub fn of(sol: MultipatchSolution, laid_out: Option<&winslow::domain::LayoutReport>) -> PyResult<Self> {
+        let mut report = serde_json::to_value(&sol.report).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+        if let Some(m) = laid_out {
+            report["auto_layout"] = serde_json::to_value(m).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
+        }
+        Ok(Self { sol, report })
     }
-    Ok(PyLayoutSolution { sol, report })
 }
 
 /// Lay a general domain or plane graph out into four-sided patches (`winslow layout`):

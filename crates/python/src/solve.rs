@@ -11,7 +11,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use winslow::domain::LayoutReport;
 use winslow::io::ReadOptions;
+use winslow::multipatch::MultipatchSolution;
 use winslow::pipeline::Observer;
 use winslow::solve::report::Solution;
 use winslow::solve::warm::WarmStart;
@@ -21,6 +23,7 @@ use crate::convert::{json_to_py, to_py};
 use crate::errors::{self, IntoPy};
 use crate::geometry::{document_of, PyMap};
 use crate::options::{self, Options};
+use crate::runs::PyLayoutSolution;
 
 /// A solved map with its report.
 #[pyclass(name = "Solution", module = "winslow", frozen)]
@@ -35,7 +38,8 @@ pub struct PySolution {
 }
 
 /// How one shape was solved: cold by the pipeline (with the reason a warm start asked
-/// for did not apply), or from the previous map ([`Pipeline::warm_start`]).
+/// for did not apply), from the previous map ([`Pipeline::warm_start`]), or as a layout
+/// (a multipatch layout, domain or plane graph: one map per patch).
 #[derive(Debug)]
 pub enum Outcome {
     /// The pipeline's solution (its report's `warm_start` says why a start given was not
@@ -43,6 +47,8 @@ pub enum Outcome {
     Cold(Box<Solution>),
     /// Solved from the previous map; the shape's name.
     Warm(Box<WarmStart>, String),
+    /// A layout's maps, with the automatic layout's report when the pipeline made it.
+    Layout(Box<MultipatchSolution>, Option<Box<LayoutReport>>),
 }
 
 impl Outcome {
@@ -54,13 +60,15 @@ impl Outcome {
                     .then_some(&s.map)
             }
             Outcome::Warm(w, _) => Some(&w.map),
+            Outcome::Layout(..) => None,
         }
     }
 }
 
 /// Solve `input`: from `start` (the previous map of its family) when given and the warm
 /// start applies and is certified ([`warm_start`]), else by the pipeline, every stage
-/// to `observer`.
+/// to `observer`. A layout, domain or plane graph is solved cold (`start` does not
+/// apply to one map per patch).
 pub fn solve_input(
     input: Input,
     start: Option<&Surface>,
@@ -68,12 +76,14 @@ pub fn solve_input(
     observer: &mut Observer<'_>,
 ) -> winslow::Result<Outcome> {
     let name = input.name().to_string();
+    let multipatch = input.is_multipatch();
     let mut pipeline = Pipeline::new(input, opts.clone());
-    if let Some(prev) = start {
+    if let Some(prev) = start.filter(|_| !multipatch) {
         pipeline = pipeline.warm_start(prev.clone());
     }
     match pipeline.run(observer)? {
         winslow::Solved::Warm(w) => Ok(Outcome::Warm(w, name)),
+        winslow::Solved::Layout { solution, laid_out } => Ok(Outcome::Layout(solution, laid_out)),
         solved => Ok(Outcome::Cold(Box::new(solved.into_map()?))),
     }
 }
@@ -85,6 +95,7 @@ impl PySolution {
     pub fn of_outcome(outcome: Outcome, seconds: f64) -> PyResult<Self> {
         match outcome {
             Outcome::Cold(sol) => Self::of((*sol, seconds)),
+            Outcome::Layout(..) => Err(errors::invalid("a layout's solution is a LayoutSolution, not a Solution")),
             Outcome::Warm(w, name) => {
                 let report = serde_json::to_value(&*w).map_err(|e| Error::Invalid(e.to_string())).py_err()?;
                 let verdict = w.verdict.name().to_string();
@@ -196,17 +207,20 @@ pub fn document_arg(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Document
     }
 }
 
-/// The pipeline's input of a document for one map ([`Document::into_input`]: a boundary
-/// checked as the CLI does, a map's boundary, a ring); layouts, domains, graphs and volume
-/// boundaries are refused (`winslow.solve` solves those one at a time).
+/// The pipeline's input of a document for `solve_many` ([`Document::into_input`]: a
+/// boundary checked as the CLI does, a map's boundary, a ring, a multipatch layout, a
+/// domain or a plane graph); volume boundaries are refused (`winslow.solve` solves those
+/// one at a time).
 pub fn input_of_document(doc: Document, reorient: bool) -> winslow::Result<Input> {
     let kind = doc.kind();
     match doc.into_input(&ReadOptions { reorient })? {
         input @ (Input::Boundary(_) | Input::Ring(_)) => Ok(input),
+        input if input.is_multipatch() => Ok(input),
         _ => Err(Error::DocumentKind {
             path: None,
             found: kind.into(),
-            needed: "solve_many takes boundaries, maps and rings (winslow.solve solves the others one at a time)"
+            needed: "solve_many takes boundaries, maps, rings, layouts, domains and plane graphs \
+                     (winslow.solve solves the others one at a time)"
                 .into(),
         }),
     }
@@ -332,8 +346,9 @@ fn start_map(obj: &Bound<'_, PyAny>) -> PyResult<Surface> {
 
 /// Solve many shapes on `workers` threads (default: all cores), the GIL released:
 /// `inputs` any iterable of shapes (a list, or a generator of a family); a list in the
-/// order of `inputs`, each a `Solution` or the `WinslowError` of that shape
-/// (not raised). `on_result(index, result)` is called (with the GIL) as each finishes.
+/// order of `inputs`, each a `Solution` (a `LayoutSolution` for a multipatch layout, a
+/// domain or a plane graph, solved cold) or the `WinslowError` of that shape (not
+/// raised). `on_result(index, result)` is called (with the GIL) as each finishes.
 /// Ctrl-C stops the shapes not yet started and raises `KeyboardInterrupt`.
 ///
 /// `same_basis=True` (a family of shapes whose sides share their bases): every shape is
@@ -385,7 +400,7 @@ pub fn solve_many<'py>(
     let stop = AtomicBool::new(false);
     let jobs: Vec<(usize, Input)> =
         prepared.iter().enumerate().filter_map(|(i, p)| p.as_ref().ok().map(|x| (i, x.clone()))).collect();
-    let mut results: Vec<Option<PyResult<PySolution>>> = prepared.into_iter().map(|p| p.err().map(Err)).collect();
+    let mut results: Vec<Option<PyResult<Solved1>>> = prepared.into_iter().map(|p| p.err().map(Err)).collect();
     let mut interrupted = None;
     // one chain per worker (warm start), else one job per shape
     let chains = if warm_start { pool.current_num_threads().max(1) } else { jobs.len().max(1) };
@@ -424,11 +439,11 @@ pub fn solve_many<'py>(
             loop {
                 match rx.recv_timeout(Duration::from_millis(50)) {
                     Ok((i, r)) => {
-                        let r = r.map_err(|e| errors::to_py(&e)).and_then(|(o, t)| PySolution::of_outcome(o, t));
+                        let r = r.map_err(|e| errors::to_py(&e)).and_then(|(o, t)| Solved1::of(o, t));
                         if let Some(cb) = &on_result {
                             Python::attach(|py| -> PyResult<()> {
                                 let arg = match &r {
-                                    Ok(s) => Bound::new(py, s.clone())?.into_any(),
+                                    Ok(s) => s.clone().into_py(py)?,
                                     Err(e) => e.value(py).clone().into_any(),
                                 };
                                 cb.call1(py, (i, arg))?;
@@ -463,7 +478,7 @@ pub fn solve_many<'py>(
         .take(n)
         .map(|r| -> PyResult<Bound<'py, PyAny>> {
             match r {
-                Some(Ok(s)) => Ok(Bound::new(py, s)?.into_any()),
+                Some(Ok(s)) => s.into_py(py),
                 Some(Err(e)) => Ok(e.value(py).clone().into_any()),
                 None => Ok(errors::to_py(&Error::Cancelled).value(py).clone().into_any()),
             }
@@ -472,16 +487,47 @@ pub fn solve_many<'py>(
     PyList::new(py, items)
 }
 
+/// One result of `solve_many`: a map's [`PySolution`], or a layout's
+/// [`PyLayoutSolution`].
+#[derive(Debug, Clone)]
+enum Solved1 {
+    Map(PySolution),
+    Layout(PyLayoutSolution),
+}
+
+impl Solved1 {
+    fn of(outcome: Outcome, seconds: f64) -> PyResult<Self> {
+        match outcome {
+            Outcome::Layout(sol, laid_out) => Ok(Self::Layout(PyLayoutSolution::of(*sol, laid_out.as_deref())?)),
+            o => PySolution::of_outcome(o, seconds).map(Self::Map),
+        }
+    }
+
+    fn into_py(self, py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+        Ok(match self {
+            Self::Map(s) => Bound::new(py, s)?.into_any(),
+            Self::Layout(s) => Bound::new(py, s)?.into_any(),
+        })
+    }
+}
+
 /// Replace every solution whose knot vectors differ from the first solution's by an
-/// error naming the difference.
-fn one_basis(results: &mut [Option<PyResult<PySolution>>]) {
+/// error naming the difference, and every layout's (one map per patch has no one basis).
+fn one_basis(results: &mut [Option<PyResult<Solved1>>]) {
+    for (i, r) in results.iter_mut().enumerate() {
+        if let Some(Ok(Solved1::Layout(_))) = r {
+            let message =
+                format!("same_basis: shape {i} is a layout (one map per patch), not one map on a shared basis");
+            *r = Some(Err(errors::invalid(message)));
+        }
+    }
     let first = results.iter().find_map(|r| match r {
-        Some(Ok(s)) => Some((s.name.clone(), s.map.map.knots.clone())),
+        Some(Ok(Solved1::Map(s))) => Some((s.name.clone(), s.map.map.knots.clone())),
         _ => None,
     });
     let Some((name, knots)) = first else { return };
     for r in results.iter_mut() {
-        if let Some(Ok(s)) = r {
+        if let Some(Ok(Solved1::Map(s))) = r {
             if s.map.map.knots != knots {
                 let [a, b] = s.map.map.shape();
                 let message = format!(

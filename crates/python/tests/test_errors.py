@@ -79,3 +79,7 @@ def test_solve_many_keeps_failures_in_place(data, tmp_path):
     assert isinstance(out[0], winslow.Solution) and out[0].certified
     assert isinstance(out[1], winslow.WinslowError) and out[1].kind == "corner_gap"
     assert isinstance(out[2], winslow.WinslowError) and out[2].kind == "io"
+    # a volume's faces are for winslow.solve, one at a time: that shape's error names its kind
+    vol = winslow.solve_many([data / "volumes" / "twisted-duct.json", data / "quarter_annulus.json"])
+    assert isinstance(vol[0], winslow.WinslowError) and vol[0].kind == "document_kind"
+    assert isinstance(vol[1], winslow.Solution) and vol[1].certified

@@ -102,6 +102,34 @@ def test_layout_solution_round_trip(data, tmp_path):
         np.testing.assert_array_equal(a.control_points, b.control_points)
 
 
+def test_solve_many_takes_layouts_domains_and_boundaries(data):
+    """Layouts and domains among the shapes of solve_many: each result is what
+    winslow.solve gives for it, in the order of the inputs; with same_basis=True a layout
+    is a WinslowError of its own and the boundaries are still solved."""
+    domain = data / "domains" / "l_bracket.json"
+    layout, _ = winslow.layout(domain)
+    inputs = [domain, data / "quarter_annulus.json", layout]
+    seen = []
+    many = winslow.solve_many(inputs, workers=2, on_result=lambda i, r: seen.append((i, type(r).__name__)))
+    assert [type(r).__name__ for r in many] == ["LayoutSolution", "Solution", "LayoutSolution"]
+    assert sorted(seen) == [(0, "LayoutSolution"), (1, "Solution"), (2, "LayoutSolution")]
+    for got, one in zip(many, [winslow.solve(i) for i in inputs]):
+        assert got.verdict == one.verdict
+        maps = got.maps if isinstance(got, winslow.LayoutSolution) else [got.map]
+        ones = one.maps if isinstance(one, winslow.LayoutSolution) else [one.map]
+        assert len(maps) == len(ones)
+        for a, b in zip(maps, ones):
+            np.testing.assert_array_equal(a.control_points, b.control_points)
+    assert many[0].certified and many[0].report["auto_layout"]["patches"] == len(many[0].maps)
+    same = winslow.solve_many([domain, data / "quarter_annulus.json"], same_basis=True)
+    assert isinstance(same[0], winslow.WinslowError) and same[0].kind == "invalid"
+    assert isinstance(same[1], winslow.Solution) and same[1].certified
+    # a warm-started family passes a layout by cold, and goes on after it
+    warm = winslow.solve_many([data / "quarter_annulus.json", domain, data / "quarter_annulus.json"],
+                              workers=1, warm_start=True)
+    assert [type(r).__name__ for r in warm] == ["Solution", "LayoutSolution", "Solution"]
+
+
 def test_improve_lowers_the_winslow_value(data):
     s = winslow.solve(data / "gismo" / "duck.json")
     imp = winslow.improve(s, method="winslow", boundary=data / "gismo" / "duck.json")

@@ -353,14 +353,19 @@ pub fn quality(map: &Surface) -> Quality {
 /// `d_s = max_k dist(x_s(t_k), Γ_s)`, `t_k = k / n`, `k = 0..=n`,
 ///
 /// where `x_s` is the map's side `s` and `Γ_s` the input side (a spline or analytic
-/// curve, or the polyline through a point cloud). The distance to a curve is found in
-/// two steps: the nearest chord of a sampling of `Γ_s` (`SAMPLES_PER_SPAN` chords per
-/// knot span of a spline, `ANALYTIC_SAMPLES` of an analytic side), then the curve's
-/// own nearest point by golden-section search on the parameters of that chord and its
-/// two neighbours, finished on a spline side by Newton's method on the foot-point
-/// condition `C'(t)·(C(t) - x) = 0`. Every distance is to a point *on* the curve, so `d_s` never
-/// understates the deviation, and it is at rounding level when the map's side is the
-/// input curve, whatever its parameterization. This is the one measure of the crate:
+/// curve, or the polyline through a point cloud). A point within rounding (`64 ε` of the
+/// side's coordinates) of `Γ_s` at the same parameter takes that distance (the map's side
+/// is the input curve there, as on the input's own basis). Otherwise the distance to a
+/// curve is found in two steps: the nearest chord of a sampling of `Γ_s`
+/// (`SAMPLES_PER_SPAN` chords per knot span of a spline, `ANALYTIC_SAMPLES` of an
+/// analytic side; runs of chords farther than a chord near the previous point are
+/// skipped by their bounding boxes), then the curve's own nearest point: Newton's method
+/// on the foot-point condition `C'(t)·(C(t) - x) = 0` of a spline side from the foot
+/// point on that chord, and golden-section search on the parameters of the chord and its
+/// two neighbours where Newton's method leaves them or on an analytic side. Every
+/// distance is to a point *on* the curve, so `d_s` never understates the deviation, and
+/// it is at rounding level when the map's side is the input curve, whatever its
+/// parameterization. This is the one measure of the crate:
 /// the solve report's `boundary_deviation` and `winslow check --boundary` both are this
 /// with `n = 400`.
 pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n: usize) -> [f64; 4] {
@@ -372,25 +377,51 @@ pub fn boundary_deviation(map: &Surface, boundary: &crate::boundary::Boundary, n
         // the nearest chord of every point first (cheap), then the curve's nearest points,
         // the points of the farthest chords first: a point whose distance is found not to
         // exceed the largest one so far stops early, which leaves the maximum exact
+        // a point within rounding of the input side's point of the same parameter (the
+        // map's side is the input curve, as on the input's own basis) takes that distance:
+        // a point of the curve, so it does not understate, and it exceeds the distance by
+        // rounding at most
+        let rounding = 64.0 * f64::EPSILON * side.scale;
+        let mut exact: f64 = 0.0;
+        // consecutive points of the map's side lie near each other, so each point's search
+        // starts from the previous point's nearest chord
+        let mut previous = None;
         let mut near: Vec<([f64; 2], (f64, usize))> = (0..=n)
-            .map(|k| {
-                let p = curve.eval(k as f64 / n as f64);
-                (p, side.nearest_chord(p))
+            .filter_map(|k| {
+                let t = k as f64 / n as f64;
+                let p = curve.eval(t);
+                if let Some(q) = side.at_parameter(t) {
+                    let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+                    if d <= rounding {
+                        exact = exact.max(d);
+                        return None;
+                    }
+                }
+                let chord = side.nearest_chord(p, previous);
+                previous = Some(chord.1);
+                Some((p, chord))
             })
             .collect();
         near.sort_by(|a, b| b.1 .0.total_cmp(&a.1 .0));
-        near.iter().fold(0.0, |max: f64, &(p, chord)| max.max(side.distance_beyond(p, chord, max)))
+        near.iter().fold(exact, |max: f64, &(p, chord)| max.max(side.distance_beyond(p, chord, max)))
     })
 }
+
+/// Chords per bounding box of [`SideSamples::nearest_chord`]'s pruning.
+const CHORDS_PER_BOX: usize = 8;
 
 /// An input side sampled at known parameters, for [`boundary_deviation`].
 struct SideSamples<'a> {
     side: &'a crate::boundary::SideCurve,
     /// `(t, x(t))`, increasing `t` (for a point cloud `t` is the index).
     points: Vec<(f64, [f64; 2])>,
+    /// The bounding box `[min, max]` of each run of [`CHORDS_PER_BOX`] consecutive chords.
+    boxes: Vec<[[f64; 2]; 2]>,
     /// The side's `C^0` knots (a spline's knots of multiplicity at least its degree), where
     /// the distance need not be unimodal.
     kinks: Vec<f64>,
+    /// The largest coordinate magnitude or extent of the samples: the scale of rounding.
+    scale: f64,
 }
 
 impl<'a> SideSamples<'a> {
@@ -428,7 +459,34 @@ impl<'a> SideSamples<'a> {
                 .collect(),
             _ => Vec::new(),
         };
-        Self { side, points, kinks }
+        let boxes = points
+            .windows(2)
+            .collect::<Vec<_>>()
+            .chunks(CHORDS_PER_BOX)
+            .map(|run| {
+                run.iter()
+                    .flat_map(|w| [w[0].1, w[1].1])
+                    .fold([[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]], |[lo, hi], q| {
+                        [[lo[0].min(q[0]), lo[1].min(q[1])], [hi[0].max(q[0]), hi[1].max(q[1])]]
+                    })
+            })
+            .collect();
+        let scale = points.iter().flat_map(|q| [q.1[0].abs(), q.1[1].abs()]).fold(0.0, f64::max);
+        Self { side, points, boxes, kinks, scale }
+    }
+
+    /// The side's point at the parameter `t` of `[0, 1]` mapped onto its own parameter
+    /// domain (`None` for a point cloud).
+    fn at_parameter(&self, t: f64) -> Option<[f64; 2]> {
+        use crate::boundary::SideCurve;
+        match self.side {
+            SideCurve::Spline(c) => {
+                let (a, b) = c.knots.domain();
+                Some(c.eval(if t >= 1.0 { b } else { a + t * (b - a) }))
+            }
+            SideCurve::Analytic(f) => Some(f.eval(t)),
+            SideCurve::Points(_) => None,
+        }
     }
 
     fn eval(&self, t: f64) -> [f64; 2] {
@@ -441,25 +499,48 @@ impl<'a> SideSamples<'a> {
     }
 
     /// The distance from `p` to the nearest chord of the sampling and that chord's index
-    /// (the first of equally near ones).
-    fn nearest_chord(&self, p: [f64; 2]) -> (f64, usize) {
+    /// (the first of equally near ones). `guess`, a chord near `p` (the previous point's),
+    /// gives an upper bound `U` of the distance first: a run of chords whose bounding box
+    /// is farther than `U` holds no nearest chord and is skipped, which leaves the result
+    /// exactly that of a scan of every chord.
+    fn nearest_chord(&self, p: [f64; 2], guess: Option<usize>) -> (f64, usize) {
         let pts = &self.points;
         if pts.len() < 2 {
             return (pts.first().map_or(f64::INFINITY, |q| (p[0] - q.1[0]).hypot(p[1] - q.1[1])), 0);
         }
+        let squared = |e: [f64; 2]| e[0] * e[0] + e[1] * e[1];
+        // `U²` with the same relative slack as the chords' own test below, which covers
+        // the rounding of squares against `hypot` (a square that is not a normal number
+        // prunes nothing)
+        let bound = guess.filter(|&i| i + 1 < pts.len()).map_or(f64::INFINITY, |i| {
+            let e = point_segment_offset(p, pts[i].1, pts[i + 1].1);
+            e[0].hypot(e[1])
+        });
+        let u2 = bound * bound;
+        let prune = u2.is_normal();
         // the nearest chord, the first of equally near ones; a chord whose squared
         // distance exceeds `best²` by more than rounding is farther and needs no `hypot`
         // (near ties and squares that are not normal numbers take the distance itself)
         let (mut best, mut at) = (f64::INFINITY, 0);
-        for (i, w) in pts.windows(2).enumerate() {
-            let e = point_segment_offset(p, w[0].1, w[1].1);
-            let b2 = best * best;
-            if b2.is_normal() && e[0] * e[0] + e[1] * e[1] > b2 * (1.0 + 1e-10) {
-                continue;
+        for (b, [lo, hi]) in self.boxes.iter().enumerate() {
+            if prune {
+                let gap = [(lo[0] - p[0]).max(p[0] - hi[0]).max(0.0), (lo[1] - p[1]).max(p[1] - hi[1]).max(0.0)];
+                if squared(gap) > u2 * (1.0 + 1e-10) {
+                    continue;
+                }
             }
-            let d = e[0].hypot(e[1]);
-            if d < best {
-                (best, at) = (d, i);
+            let first = b * CHORDS_PER_BOX;
+            let last = (first + CHORDS_PER_BOX).min(pts.len() - 1);
+            for i in first..last {
+                let e = point_segment_offset(p, pts[i].1, pts[i + 1].1);
+                let b2 = best * best;
+                if b2.is_normal() && squared(e) > b2 * (1.0 + 1e-10) {
+                    continue;
+                }
+                let d = e[0].hypot(e[1]);
+                if d < best {
+                    (best, at) = (d, i);
+                }
             }
         }
         (best, at)
@@ -524,15 +605,41 @@ impl<'a> SideSamples<'a> {
             }
             found.min(fa).min(fb)
         };
+        // Newton's method first, from the foot point on the nearest chord (`t₀`, the
+        // chord's parameters interpolated): on a smooth piece it converges in a few steps
+        // to the foot point the golden section brackets; the golden section is the
+        // fallback where it does not
+        // the distance to the curve at a bracket's end: a sample's point where the end is
+        // a sample (the same value `dist` would give), else the curve evaluated there
+        let near = &pts[at.saturating_sub(1)..(at + 3).min(pts.len())];
+        let end = |t: f64| match near.iter().find(|q| q.0 == t) {
+            Some(&(_, q)) => (p[0] - q[0]).hypot(p[1] - q[1]),
+            None => dist(t),
+        };
+        let first = |lo: f64, hi: f64| {
+            let t0 = {
+                let ((ta, a), (tb, b)) = (pts[at], pts[(at + 1).min(pts.len() - 1)]);
+                let e = point_segment_offset(p, a, b);
+                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                let l2 = dx * dx + dy * dy;
+                let s = if l2 > 0.0 { ((p[0] - e[0] - a[0]) * dx + (p[1] - e[1] - a[1]) * dy) / l2 } else { 0.0 };
+                (ta + s.clamp(0.0, 1.0) * (tb - ta)).clamp(lo, hi)
+            };
+            match self.newton_foot(p, t0, lo, hi) {
+                // the bracket's ends too, as the golden section has them
+                Some(d) => d.min(end(lo)).min(end(hi)),
+                None => golden(lo, hi),
+            }
+        };
         let (lo, hi) = (pts[at.saturating_sub(1)].0, pts[(at + 2).min(pts.len() - 1)].0);
         let mut kinks = self.kinks.iter().copied().filter(|&u| u > lo && u < hi).peekable();
         if kinks.peek().is_none() {
-            return golden(lo, hi);
+            return first(lo, hi);
         }
         let mut ends = vec![lo];
         ends.extend(kinks);
         ends.push(hi);
-        ends.windows(2).map(|w| golden(w[0], w[1])).fold(f64::INFINITY, f64::min)
+        ends.windows(2).map(|w| first(w[0], w[1])).fold(f64::INFINITY, f64::min)
     }
 
     /// The distance from `p` to the spline side's foot point by Newton's method on
@@ -675,6 +782,44 @@ mod tests {
     /// `| |p| - 2 |` to rounding (Newton's foot point), and from points beyond the arc's
     /// ends the distance to the end point (the golden section at the bracket's end).
     #[test]
+    fn nearest_chord_from_any_guess_is_the_scan_of_every_chord() {
+        use crate::boundary::SideCurve;
+        use crate::spline::curve::Curve;
+        use crate::testutil::Lcg;
+        let mut rng = Lcg::new(11);
+        // a wiggly spline side (many boxes of chords) and a dense point cloud with ties
+        let cps: Vec<[f64; 2]> =
+            (0..40).map(|i| [i as f64 / 39.0, 0.2 * (i as f64 * 0.9).sin() + 0.05 * rng.uniform()]).collect();
+        let spline = SideCurve::Spline(Curve::new(KnotVector::open_uniform(3, 37), cps, None).unwrap());
+        let cloud = SideCurve::Points(
+            (0..600).map(|i| [((i / 2) as f64 / 299.0), 0.1 * ((i / 2) as f64 * 0.05).cos()]).collect(),
+        );
+        for side in [&spline, &cloud] {
+            let s = SideSamples::of(side);
+            let chords = s.points.len() - 1;
+            let scan = |p: [f64; 2]| {
+                let mut best = (f64::INFINITY, 0);
+                for i in 0..chords {
+                    let e = point_segment_offset(p, s.points[i].1, s.points[i + 1].1);
+                    if e[0].hypot(e[1]) < best.0 {
+                        best = (e[0].hypot(e[1]), i);
+                    }
+                }
+                best
+            };
+            for _ in 0..300 {
+                let p = [1.4 * rng.uniform() - 0.2, 0.8 * rng.uniform() - 0.4];
+                let want = scan(p);
+                for guess in
+                    [None, Some(0), Some(chords - 1), Some(want.1), Some((rng.uniform() * chords as f64) as usize)]
+                {
+                    assert_eq!(s.nearest_chord(p, guess), want, "{p:?} from {guess:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn side_distance_is_the_closed_form_distance_to_a_circle() {
         use crate::boundary::SideCurve;
         use crate::spline::curve::Curve;
@@ -685,7 +830,7 @@ mod tests {
                 .unwrap(),
         );
         let side = SideSamples::of(&arc);
-        let distance = |p: [f64; 2]| side.distance_beyond(p, side.nearest_chord(p), f64::NEG_INFINITY);
+        let distance = |p: [f64; 2]| side.distance_beyond(p, side.nearest_chord(p, None), f64::NEG_INFINITY);
         let mut rng = Lcg::new(5);
         for k in 0..400 {
             let a = std::f64::consts::FRAC_PI_2 * (0.01 + 0.98 * rng.uniform());

@@ -152,11 +152,11 @@ def solve_many(
     inputs: Iterable[Input],
     *,
     workers: Optional[int] = None,
-    on_result: Optional[Callable[[int, Union[Solution, WinslowError]], None]] = None,
+    on_result: Optional[Callable[[int, Union[Solution, LayoutSolution, WinslowError]], None]] = None,
     same_basis: bool = False,
     warm_start: bool = False,
     **options: Any,
-) -> list[Union[Solution, WinslowError]]: ...
+) -> list[Union[Solution, LayoutSolution, WinslowError]]: ...
 def layout(domain: Union[Document, Path], **options: Any) -> tuple[Document, dict[str, Any]]:
     """``winslow layout``: the multipatch layout of a domain or plane graph, and its report."""
 def improve(
