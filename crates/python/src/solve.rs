@@ -491,22 +491,24 @@ pub fn solve_many<'py>(
 /// [`PyLayoutSolution`].
 #[derive(Debug, Clone)]
 enum Solved1 {
-    Map(PySolution),
-    Layout(PyLayoutSolution),
+    Map(Box<PySolution>),
+    Layout(Box<PyLayoutSolution>),
 }
 
 impl Solved1 {
     fn of(outcome: Outcome, seconds: f64) -> PyResult<Self> {
         match outcome {
-            Outcome::Layout(sol, laid_out) => Ok(Self::Layout(PyLayoutSolution::of(*sol, laid_out.as_deref())?)),
-            o => PySolution::of_outcome(o, seconds).map(Self::Map),
+            Outcome::Layout(sol, laid_out) => {
+                Ok(Self::Layout(Box::new(PyLayoutSolution::of(*sol, laid_out.as_deref())?)))
+            }
+            o => PySolution::of_outcome(o, seconds).map(|s| Self::Map(Box::new(s))),
         }
     }
 
     fn into_py(self, py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
         Ok(match self {
-            Self::Map(s) => Bound::new(py, s)?.into_any(),
-            Self::Layout(s) => Bound::new(py, s)?.into_any(),
+            Self::Map(s) => Bound::new(py, *s)?.into_any(),
+            Self::Layout(s) => Bound::new(py, *s)?.into_any(),
         })
     }
 }
