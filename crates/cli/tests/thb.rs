@@ -113,17 +113,75 @@ fn solve_with_thb_refinement_writes_a_certified_thb_map() {
     let tensor_functions = stdout_json(&out)["basis_functions"].as_u64().unwrap();
     assert!(functions < tensor_functions, "THB {functions} vs tensor {tensor_functions}");
     // outputs that need a tensor map are refused up front, nothing written
-    let png = dir.join("x.png");
+    let vtk = dir.join("x.vtk");
     let out = run(&[
         "solve".as_ref(),
         src.as_os_str(),
         "-o".as_ref(),
         dir.join("again.json").as_os_str(),
-        "--png".as_ref(),
-        png.as_os_str(),
+        "--vtk".as_ref(),
+        vtk.as_os_str(),
         "--refinement".as_ref(),
         "thb".as_ref(),
     ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(!png.exists() && !dir.join("again.json").exists());
+    assert!(!vtk.exists() && !dir.join("again.json").exists());
+}
+
+/// `winslow solve --refinement thb --improve winslow --png P --mesh M`: the THB map is
+/// improved on its own basis (the report's `improvement`, certified), drawn with its
+/// active cells and meshed through its tensor form; `winslow mesh` and `winslow render`
+/// take the THB map file too. `--improve weak` with a THB repair is an error, nothing
+/// written.
+#[test]
+fn a_thb_map_is_improved_drawn_and_meshed() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let src = data().join("gismo/puzzle4.json");
+    let (thb, png, msh) = (dir.join("thb.json"), dir.join("thb.png"), dir.join("thb.su2"));
+    let out = bin()
+        .arg("solve")
+        .arg(&src)
+        .arg("-o")
+        .arg(&thb)
+        .args(["--refinement", "thb", "--improve", "winslow", "--json", "--png"])
+        .arg(&png)
+        .arg("--mesh")
+        .arg(&msh)
+        .args(["--structured", "9x9"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    let imp = &report["improvement"];
+    assert_eq!(imp["method"], "winslow", "{report}");
+    assert!(imp["unknowns"].as_u64().unwrap() > 0);
+    if imp["accepted"].as_bool().unwrap() {
+        assert_eq!(imp["certificate"], "certified");
+        assert!(imp["winslow_after"].as_f64().unwrap() <= imp["winslow_before"].as_f64().unwrap());
+    }
+    assert_eq!(report["verdict"], "certified");
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    assert!(std::fs::metadata(&msh).unwrap().len() > 0);
+    let out = run(&["check".as_ref(), thb.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0));
+    let (msh2, png2) = (dir.join("again.msh"), dir.join("again.png"));
+    let out = bin().arg("mesh").arg(&thb).arg("-o").arg(&msh2).args(["--structured", "9x9"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::metadata(&msh2).unwrap().len() > 0);
+    let out = bin().arg("render").arg(&thb).arg("--png").arg(&png2).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read(&png2).unwrap().starts_with(b"\x89PNG"));
+    // the weak form has no THB discretization
+    let weak = dir.join("weak.json");
+    let out = bin()
+        .arg("solve")
+        .arg(&src)
+        .arg("-o")
+        .arg(&weak)
+        .args(["--refinement", "thb", "--improve", "weak"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!weak.exists());
 }
