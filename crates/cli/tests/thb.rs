@@ -73,10 +73,22 @@ fn a_folded_thb_map_exits_3() {
     let report = stdout_json(&out);
     assert_eq!(report["certificate"]["verdict"]["kind"], "folded");
     assert!(!report["certificate"]["folds"].as_array().unwrap().is_empty());
-    // a THB map is not a tensor map: other commands name the kind
-    let out = run(&["render".as_ref(), path.as_os_str(), "--png".as_ref(), scratch.path().join("x.png").as_os_str()]);
+    // drawn (the fold in magenta), but not meshed: the inverted cells are refused
+    let png = scratch.path().join("x.png");
+    let out = run(&["render".as_ref(), path.as_os_str(), "--png".as_ref(), png.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(png.exists());
+    let msh = scratch.path().join("x.su2");
+    let out = run(&[
+        "mesh".as_ref(),
+        path.as_os_str(),
+        "-o".as_ref(),
+        msh.as_os_str(),
+        "--structured".as_ref(),
+        "33x33".as_ref(),
+    ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("THB map"));
+    assert!(!msh.exists());
 }
 
 /// `winslow solve --refinement thb`: puzzle4 folds without repair; the THB rounds refine
@@ -128,17 +140,17 @@ fn solve_with_thb_refinement_writes_a_certified_thb_map() {
     assert!(!vtk.exists() && !dir.join("again.json").exists());
 }
 
-/// `winslow solve --refinement thb --improve winslow --png P --mesh M`: the THB map is
-/// improved on its own basis (the report's `improvement`, certified), drawn with its
-/// active cells and meshed through its tensor form; `winslow mesh` and `winslow render`
-/// take the THB map file too. `--improve weak` with a THB repair is an error, nothing
-/// written.
+/// `winslow solve --refinement thb --improve winslow --png P`: the THB map is improved on
+/// its own basis (the report's `improvement`, certified) and drawn with its active cells;
+/// `winslow render` takes the THB map file too, `winslow mesh` (and `solve --mesh`) a
+/// certified THB map through its tensor form. `--improve weak` with a THB repair is an
+/// error, nothing written.
 #[test]
 fn a_thb_map_is_improved_drawn_and_meshed() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     let src = data().join("gismo/puzzle4.json");
-    let (thb, png, msh) = (dir.join("thb.json"), dir.join("thb.png"), dir.join("thb.su2"));
+    let (thb, png) = (dir.join("thb.json"), dir.join("thb.png"));
     let out = bin()
         .arg("solve")
         .arg(&src)
@@ -146,9 +158,6 @@ fn a_thb_map_is_improved_drawn_and_meshed() {
         .arg(&thb)
         .args(["--refinement", "thb", "--improve", "winslow", "--json", "--png"])
         .arg(&png)
-        .arg("--mesh")
-        .arg(&msh)
-        .args(["--structured", "9x9"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
@@ -162,13 +171,13 @@ fn a_thb_map_is_improved_drawn_and_meshed() {
     }
     assert_eq!(report["verdict"], "certified");
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
-    assert!(std::fs::metadata(&msh).unwrap().len() > 0);
     let out = run(&["check".as_ref(), thb.as_os_str(), "--json".as_ref()]);
     assert_eq!(out.status.code(), Some(0));
-    let (msh2, png2) = (dir.join("again.msh"), dir.join("again.png"));
-    let out = bin().arg("mesh").arg(&thb).arg("-o").arg(&msh2).args(["--structured", "9x9"]).output().unwrap();
+    let (msh, png2) = (dir.join("sector.su2"), dir.join("again.png"));
+    let sector = data().join("thb/sector_thb.json");
+    let out = bin().arg("mesh").arg(&sector).arg("-o").arg(&msh).args(["--structured", "9x9"]).output().unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(std::fs::metadata(&msh2).unwrap().len() > 0);
+    assert!(std::fs::metadata(&msh).unwrap().len() > 0);
     let out = bin().arg("render").arg(&thb).arg("--png").arg(&png2).output().unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(std::fs::read(&png2).unwrap().starts_with(b"\x89PNG"));

@@ -11,7 +11,7 @@
 //! truncation recursion to `Q`). The values and derivatives of the THB functions at a
 //! Gauss point of `Q` are then `Σ_a C^Q_{ak} (τ_a, ∂_ξ τ_a, ∂_η τ_a, ∂_ξξ τ_a, ∂_ξη τ_a,
 //! ∂_ηη τ_a)`, the univariate factors read from the tables of level `l`
-//! ([`DirTable`]); on a one-level basis `C^Q` is the identity and the values are those of
+//! ([`DirTable`](crate::discrete::tables::DirTable)); on a one-level basis `C^Q` is the identity and the values are those of
 //! the tensor assembly, bit for bit.
 //!
 //! **Fixed functions.** A THB function is fixed (Dirichlet) when its trace on the
@@ -28,11 +28,13 @@ use std::collections::BTreeSet;
 use rayon::prelude::*;
 
 use crate::discrete::dofs::FIXED;
-use crate::discrete::tables::DirTable;
+use crate::discrete::tables::QpTab;
 use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::Point;
 use crate::spline::hierarchical::truncation::{LevelCoefficients, Sparse};
 use crate::spline::hierarchical::{HierarchicalBasis, Index2};
+use crate::spline::quadrature::GaussLegendre;
 
 /// [`HierarchicalDiscretization`]'s offset of a pair of functions not both free.
 const NOT_FREE: u32 = u32::MAX;
@@ -93,9 +95,21 @@ pub(crate) struct HierarchicalDiscretization {
     pub vector: Csr,
 }
 
-/// Per level, the univariate tables of the Gauss points of every element.
-fn level_tables(basis: &HierarchicalBasis, nq: usize) -> Vec<[DirTable; 2]> {
-    (0..basis.num_levels()).map(|l| basis.knots(l).each_ref().map(|kv| DirTable::new(kv, nq))).collect()
+/// The univariate tables of one cell `c` of level `l`: per direction its Gauss points with
+/// the level's B-splines there, as [`DirTable`](crate::discrete::tables::DirTable) tabulates the cell's element (the same
+/// computation, so the same numbers), without tabulating the whole level (a deep level
+/// has `2^l` times the elements of level 0, of which few are active).
+fn cell_tables(basis: &HierarchicalBasis, l: usize, c: Index2, g: &GaussLegendre) -> [Vec<QpTab>; 2] {
+    let (spans, bounds, kv) = (basis.cell_spans(l, c), basis.cell_bounds(l, c), basis.knots(l));
+    std::array::from_fn(|d| {
+        let mut b = BasisDerivs::default();
+        g.on(bounds[d][0], bounds[d][1])
+            .map(|(u, w)| {
+                b.eval_in_span(&kv[d], spans[d], u, 2);
+                QpTab { w, u, n: b.d }
+            })
+            .collect()
+    })
 }
 
 /// Gauss points per direction of a THB discretization: `max(p, q) + 1`.
@@ -110,7 +124,7 @@ impl HierarchicalDiscretization {
     /// fixed functions those with a non-zero trace on the boundary.
     pub fn new(basis: HierarchicalBasis) -> Self {
         let nq = gauss_points(&basis);
-        let tables = level_tables(&basis, nq);
+        let g = GaussLegendre::new(nq);
         let active = basis.active_cells();
         let mut lc = LevelCoefficients::<Sparse>::new(&basis, |k| vec![(k, 1.0)]);
         let nets: Vec<Vec<Sparse>> = active.iter().map(|&(l, c)| lc.cell_net(l, c)).collect();
@@ -119,7 +133,7 @@ impl HierarchicalDiscretization {
         let cells: Vec<CellQuadrature> = active
             .par_iter()
             .zip(nets.par_iter())
-            .map(|(&(l, c), net)| cell_quadrature(&tables[l], c, net, degrees, nq))
+            .map(|(&(l, c), net)| cell_quadrature(&cell_tables(&basis, l, c, &g), net, degrees, nq))
             .collect();
         Self::assembled(&basis, nq, active, nets, cells)
     }
@@ -166,7 +180,7 @@ impl HierarchicalDiscretization {
             })
             .unzip();
         drop(lc);
-        let tables = level_tables(&basis, nq);
+        let g = GaussLegendre::new(nq);
         let degrees = basis.degrees();
         let cells: Vec<CellQuadrature> = active
             .par_iter()
@@ -179,7 +193,7 @@ impl HierarchicalDiscretization {
                     let funcs = cell.funcs.iter().map(|&f| renumber[f].expect("renumbered above")).collect();
                     CellQuadrature { funcs, weights: cell.weights.clone(), values: cell.values.clone() }
                 }
-                None => cell_quadrature(&tables[l], c, net, degrees, nq),
+                None => cell_quadrature(&cell_tables(&basis, l, c, &g), net, degrees, nq),
             })
             .collect();
         Self::assembled(&basis, nq, active, nets, cells)
@@ -375,13 +389,7 @@ impl HierarchicalDiscretization {
 
 /// Values and derivatives of the THB functions of one active cell at its Gauss points,
 /// from the cell's extraction rows `net` (see the module documentation).
-fn cell_quadrature(
-    tables: &[DirTable; 2],
-    cell: Index2,
-    net: &[Sparse],
-    [p, q]: [usize; 2],
-    nq: usize,
-) -> CellQuadrature {
+fn cell_quadrature(tables: &[Vec<QpTab>; 2], net: &[Sparse], [p, q]: [usize; 2], nq: usize) -> CellQuadrature {
     let funcs: Vec<usize> = net.iter().flatten().map(|e| e.0).collect::<BTreeSet<_>>().into_iter().collect();
     let n = funcs.len();
     // extraction rows in local function indices
@@ -394,8 +402,7 @@ fn cell_quadrature(
     for kv in 0..nq {
         for ku in 0..nq {
             let k = kv * nq + ku;
-            let tu = tables[0].at(cell[0], ku);
-            let tv = tables[1].at(cell[1], kv);
+            let (tu, tv) = (&tables[0][ku], &tables[1][kv]);
             weights.push(tu.w * tv.w);
             let out = &mut values[k * n..(k + 1) * n];
             for jb in 0..=q {

@@ -58,8 +58,8 @@ pub struct ThbReport {
     /// Seconds of the THB stage (the conversion, the rounds, the certificates).
     pub thb_seconds: f64,
     /// With `--improve winslow`: the Winslow functional minimized on the repaired THB
-    /// map's basis ([`improve_thb`]); `None` when no improvement was asked for or the
-    /// repaired map is not certified.
+    /// map's basis (`solve::hierarchical::improve`); `None` when no improvement was asked
+    /// for or the repaired map is not certified.
     pub improvement: Option<ThbImprovement>,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
