@@ -16,7 +16,8 @@ fn patch_maps(layout: &Layout) -> Option<Vec<Surface>> {
     layout.patches.iter().map(|p| p.map.clone()).collect()
 }
 
-const RENDER_NEEDS: &str = "render draws a map, a ring map or a multipatch result (run `winslow solve` first)";
+const RENDER_NEEDS: &str =
+    "render draws a map, a THB map, a ring map or a multipatch result (run `winslow solve` first)";
 
 /// `winslow render MAP --png OUT`.
 pub(super) fn render(a: RenderArgs) -> Result<i32> {
@@ -32,6 +33,7 @@ pub(super) fn render(a: RenderArgs) -> Result<i32> {
             let sel = a.backend.select(false)?;
             picture(&sel, map, &opts)?
         }
+        Document::Thb { map, .. } => winslow::io::picture::render_thb(map, &opts).context("drawing the THB map")?,
         Document::Layout(l) | Document::Multipatch(l) => match patch_maps(l) {
             Some(maps) => render_layout(&maps, &opts),
             None => return Err(files::wrong_kind(&doc, &a.map, RENDER_NEEDS)),

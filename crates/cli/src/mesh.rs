@@ -8,6 +8,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use winslow::io::Document;
 use winslow::multipatch::Layout;
+use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::spline::volume::Volume;
 use winslow::Surface;
 use winslow_mesh::formats::{write, Format};
@@ -351,11 +352,27 @@ pub fn make_and_write_volume(volume: &Volume, spec: &MeshSpec, output: &Path, qu
     Ok(())
 }
 
+/// The mesh of a THB map: made from its exact tensor map on the knot lines of its active
+/// cells ([`HierarchicalMap::to_surface`], knot insertion), which the report line says.
+pub fn make_and_write_thb(map: &HierarchicalMap, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
+    let tensor = map.to_surface().context("converting the THB map to its tensor map")?;
+    if !quiet {
+        say!(
+            "THB map of {} functions on {} levels: meshed through its exact tensor map of {} x {} control points (knot insertion)",
+            map.basis.len(),
+            map.basis.num_levels(),
+            tensor.shape()[0],
+            tensor.shape()[1]
+        );
+    }
+    make_and_write(&tensor, spec, output, quiet)
+}
+
 /// `winslow mesh`: a map, or a multipatch result (a JSON result or a G+Smo multipatch
 /// whose patches are maps).
 pub fn run(a: MeshArgs) -> Result<i32> {
     let needed =
-        "mesh needs a map, a multipatch result or a volume (run `winslow solve` or `winslow loft` first, or `solve --mesh`)";
+        "mesh needs a map, a THB map, a multipatch result or a volume (run `winslow solve` or `winslow loft` first, or `solve --mesh`)";
     crate::files::OutputPlan::new().input(&a.map).mesh_maybe("-o", Some(&a.output))?.check()?;
     match crate::files::read(&a.map)? {
         Document::Map { map, .. } => make_and_write(&map, &a.spec, &a.output, false)?,
@@ -364,6 +381,7 @@ pub fn run(a: MeshArgs) -> Result<i32> {
             make_and_write_multipatch(&layout, &a.spec, &a.output, false)?
         }
         Document::Volume { volume, .. } => make_and_write_volume(&volume, &a.spec, &a.output, false)?,
+        Document::Thb { map, .. } => make_and_write_thb(&map, &a.spec, &a.output, false)?,
         other => return Err(crate::files::wrong_kind(&other, &a.map, needed)),
     }
     Ok(0)

@@ -230,7 +230,7 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
             return super::multipatch_cmd::finish(*solution, &a, made);
         }
         Solved::Volume(v) => return super::volume_cmd::finish(&name, *v, &a),
-        Solved::Thb(t) => return super::thb_cmd::finish(&t, &a.output, a.gismo.as_deref(), a.json),
+        Solved::Thb(t) => return super::thb_cmd::finish(&t, &a),
         solved => solved.into_map()?,
     };
     let report = serde_json::to_value(&sol.report)?;
@@ -332,14 +332,15 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
 }
 
 /// With `--refinement thb` the map may come out as a THB map: a single patch, `-o` JSON or
-/// G+Smo XML, no outputs that need a tensor map.
+/// G+Smo XML, no outputs that need a tensor map (`--png` draws the active cells, `--mesh`
+/// meshes the exact tensor form).
 fn thb_outputs(a: &SolveArgs, multipatch: bool) -> Result<()> {
     let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     if multipatch || !matches!(ext.as_str(), "json" | "xml") {
         bail!("--refinement thb solves a single patch and writes a JSON or G+Smo XML map (-o .json or .xml)");
     }
-    let tensor_only = [("--png", a.png.is_some()), ("--vtk", a.vtk.is_some()), ("--iges", a.iges.is_some())];
-    let more = [("--vtu", a.vtu.is_some()), ("--mesh", a.mesh.is_some()), ("--poisson", a.poisson)];
+    let tensor_only = [("--vtk", a.vtk.is_some()), ("--iges", a.iges.is_some())];
+    let more = [("--vtu", a.vtu.is_some()), ("--poisson", a.poisson)];
     if let Some((flag, _)) = tensor_only.iter().chain(&more).find(|(_, on)| *on) {
         bail!("{flag} needs a tensor map: not with --refinement thb (convert the THB map first: winslow convert)");
     }

@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use winslow::io::picture::{render_thb, PictureOptions};
 use winslow::io::Output;
 use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::verify::certificate::hierarchical::certify_hierarchical;
@@ -15,6 +16,7 @@ use winslow::verify::certificate::{certify, CertifyOptions, Finding};
 use winslow::ThbSolution;
 
 use crate::files;
+use crate::solve_cmd::SolveArgs;
 
 /// 0 certified or degenerate corner, 3 folded, 5 undecided.
 fn exit_code(v: &Finding) -> i32 {
@@ -68,7 +70,8 @@ pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &
 /// `winslow solve --refinement thb` when the pipeline repaired the map by THB defect
 /// correction: the THB map written (`-o`, and `--gismo` as `THBSpline2`) with its report
 /// (the certificate, the rounds and the tensor solve's report), which `--json` prints.
-pub(crate) fn finish(out: &ThbSolution, output: &Path, gismo: Option<&Path>, json: bool) -> Result<i32> {
+pub(crate) fn finish(out: &ThbSolution, a: &SolveArgs) -> Result<i32> {
+    let (output, gismo, json) = (a.output.as_path(), a.gismo.as_deref(), a.json);
     let report = serde_json::to_value(&out.report)?;
     let c = &out.report.certificate;
     let label = format!("verdict {:?}: {}", out.report.verdict, out.report.message);
@@ -91,6 +94,17 @@ pub(crate) fn finish(out: &ThbSolution, output: &Path, gismo: Option<&Path>, jso
             out.report.unknowns
         );
         say!("certificate: {}", c.message());
+        if let Some(imp) = &out.report.improvement {
+            say!("improvement: {}", imp.message);
+        }
+    }
+    if let Some(p) = &a.png {
+        let image = render_thb(&out.map, &PictureOptions::default()).context("drawing the THB map")?;
+        files::write(p, &Output::Picture(&image))?;
+    }
+    if let Some(p) = &a.mesh {
+        // a folded map gives inverted cells, which the writers refuse
+        crate::mesh::make_and_write_thb(&out.map, &a.mesh_spec, p, json)?;
     }
     Ok(exit_code(&c.verdict))
 }

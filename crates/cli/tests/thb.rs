@@ -73,10 +73,22 @@ fn a_folded_thb_map_exits_3() {
     let report = stdout_json(&out);
     assert_eq!(report["certificate"]["verdict"]["kind"], "folded");
     assert!(!report["certificate"]["folds"].as_array().unwrap().is_empty());
-    // a THB map is not a tensor map: other commands name the kind
-    let out = run(&["render".as_ref(), path.as_os_str(), "--png".as_ref(), scratch.path().join("x.png").as_os_str()]);
+    // drawn (the fold in magenta), but not meshed: the inverted cells are refused
+    let png = scratch.path().join("x.png");
+    let out = run(&["render".as_ref(), path.as_os_str(), "--png".as_ref(), png.as_os_str()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(png.exists());
+    let msh = scratch.path().join("x.su2");
+    let out = run(&[
+        "mesh".as_ref(),
+        path.as_os_str(),
+        "-o".as_ref(),
+        msh.as_os_str(),
+        "--structured".as_ref(),
+        "33x33".as_ref(),
+    ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("THB map"));
+    assert!(!msh.exists());
 }
 
 /// `winslow solve --refinement thb`: puzzle4 folds without repair; the THB rounds refine
@@ -113,17 +125,72 @@ fn solve_with_thb_refinement_writes_a_certified_thb_map() {
     let tensor_functions = stdout_json(&out)["basis_functions"].as_u64().unwrap();
     assert!(functions < tensor_functions, "THB {functions} vs tensor {tensor_functions}");
     // outputs that need a tensor map are refused up front, nothing written
-    let png = dir.join("x.png");
+    let vtk = dir.join("x.vtk");
     let out = run(&[
         "solve".as_ref(),
         src.as_os_str(),
         "-o".as_ref(),
         dir.join("again.json").as_os_str(),
-        "--png".as_ref(),
-        png.as_os_str(),
+        "--vtk".as_ref(),
+        vtk.as_os_str(),
         "--refinement".as_ref(),
         "thb".as_ref(),
     ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(!png.exists() && !dir.join("again.json").exists());
+    assert!(!vtk.exists() && !dir.join("again.json").exists());
+}
+
+/// `winslow solve --refinement thb --improve winslow --png P`: the THB map is improved on
+/// its own basis (the report's `improvement`, certified) and drawn with its active cells;
+/// `winslow render` takes the THB map file too, `winslow mesh` (and `solve --mesh`) a
+/// certified THB map through its tensor form. `--improve weak` with a THB repair is an
+/// error, nothing written.
+#[test]
+fn a_thb_map_is_improved_drawn_and_meshed() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
+    let src = data().join("gismo/puzzle4.json");
+    let (thb, png) = (dir.join("thb.json"), dir.join("thb.png"));
+    let out = bin()
+        .arg("solve")
+        .arg(&src)
+        .arg("-o")
+        .arg(&thb)
+        .args(["--refinement", "thb", "--improve", "winslow", "--json", "--png"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = stdout_json(&out);
+    let imp = &report["improvement"];
+    assert_eq!(imp["method"], "winslow", "{report}");
+    assert!(imp["unknowns"].as_u64().unwrap() > 0);
+    if imp["accepted"].as_bool().unwrap() {
+        assert_eq!(imp["certificate"], "certified");
+        assert!(imp["winslow_after"].as_f64().unwrap() <= imp["winslow_before"].as_f64().unwrap());
+    }
+    assert_eq!(report["verdict"], "certified");
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let out = run(&["check".as_ref(), thb.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0));
+    let (msh, png2) = (dir.join("sector.su2"), dir.join("again.png"));
+    let sector = data().join("thb/sector_thb.json");
+    let out = bin().arg("mesh").arg(&sector).arg("-o").arg(&msh).args(["--structured", "9x9"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::metadata(&msh).unwrap().len() > 0);
+    let out = bin().arg("render").arg(&thb).arg("--png").arg(&png2).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read(&png2).unwrap().starts_with(b"\x89PNG"));
+    // the weak form has no THB discretization
+    let weak = dir.join("weak.json");
+    let out = bin()
+        .arg("solve")
+        .arg(&src)
+        .arg("-o")
+        .arg(&weak)
+        .args(["--refinement", "thb", "--improve", "weak"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!weak.exists());
 }

@@ -11,7 +11,7 @@
 //! truncation recursion to `Q`). The values and derivatives of the THB functions at a
 //! Gauss point of `Q` are then `Σ_a C^Q_{ak} (τ_a, ∂_ξ τ_a, ∂_η τ_a, ∂_ξξ τ_a, ∂_ξη τ_a,
 //! ∂_ηη τ_a)`, the univariate factors read from the tables of level `l`
-//! ([`DirTable`]); on a one-level basis `C^Q` is the identity and the values are those of
+//! ([`DirTable`](crate::discrete::tables::DirTable)); on a one-level basis `C^Q` is the identity and the values are those of
 //! the tensor assembly, bit for bit.
 //!
 //! **Fixed functions.** A THB function is fixed (Dirichlet) when its trace on the
@@ -28,11 +28,16 @@ use std::collections::BTreeSet;
 use rayon::prelude::*;
 
 use crate::discrete::dofs::FIXED;
-use crate::discrete::tables::DirTable;
+use crate::discrete::tables::QpTab;
 use crate::linalg::sparse::Csr;
+use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::Point;
 use crate::spline::hierarchical::truncation::{LevelCoefficients, Sparse};
 use crate::spline::hierarchical::{HierarchicalBasis, Index2};
+use crate::spline::quadrature::GaussLegendre;
+
+/// [`HierarchicalDiscretization`]'s offset of a pair of functions not both free.
+const NOT_FREE: u32 = u32::MAX;
 
 /// One active cell: its THB functions and their values at the Gauss points.
 #[derive(Debug, Clone)]
@@ -68,6 +73,17 @@ pub(crate) struct HierarchicalDiscretization {
     pub nq: usize,
     /// The active cells (in [`HierarchicalBasis::active_cells`] order).
     pub cells: Vec<CellQuadrature>,
+    /// `(level, cell)` of every entry of `cells`.
+    keys: Vec<(usize, Index2)>,
+    /// The extraction rows of every cell (see the module documentation), kept for
+    /// [`Self::refined`].
+    nets: Vec<Vec<Sparse>>,
+    /// The active functions `(level, index)` of the basis.
+    functions: Vec<(usize, Index2)>,
+    /// Per cell, for every pair `(a, b)` of its functions (`a * n + b`) both free, the
+    /// position of column `b` in the scalar pattern's row of `a`, relative to the row's
+    /// start ([`NOT_FREE`] otherwise): the scatter of [`Self::assemble`] without searches.
+    offsets: Vec<Vec<u32>>,
     /// Free index of every THB function, or [`FIXED`].
     free_of: Vec<usize>,
     /// THB functions of the free unknowns, increasing.
@@ -79,21 +95,122 @@ pub(crate) struct HierarchicalDiscretization {
     pub vector: Csr,
 }
 
+/// The univariate tables of one cell `c` of level `l`: per direction its Gauss points with
+/// the level's B-splines there, as [`DirTable`](crate::discrete::tables::DirTable) tabulates the cell's element (the same
+/// computation, so the same numbers), without tabulating the whole level (a deep level
+/// has `2^l` times the elements of level 0, of which few are active).
+fn cell_tables(basis: &HierarchicalBasis, l: usize, c: Index2, g: &GaussLegendre) -> [Vec<QpTab>; 2] {
+    let (spans, bounds, kv) = (basis.cell_spans(l, c), basis.cell_bounds(l, c), basis.knots(l));
+    std::array::from_fn(|d| {
+        let mut b = BasisDerivs::default();
+        g.on(bounds[d][0], bounds[d][1])
+            .map(|(u, w)| {
+                b.eval_in_span(&kv[d], spans[d], u, 2);
+                QpTab { w, u, n: b.d }
+            })
+            .collect()
+    })
+}
+
+/// Gauss points per direction of a THB discretization: `max(p, q) + 1`.
+fn gauss_points(basis: &HierarchicalBasis) -> usize {
+    let [p, q] = basis.degrees();
+    p.max(q) + 1
+}
+
 impl HierarchicalDiscretization {
     /// The discretization of `basis` with `max(p, q) + 1` Gauss points per direction (as
     /// the tensor [`Discretization::new`](crate::discrete::assembly::Discretization::new)),
     /// fixed functions those with a non-zero trace on the boundary.
     pub fn new(basis: HierarchicalBasis) -> Self {
-        let [p, q] = basis.degrees();
-        let nq = p.max(q) + 1;
-        let tables: Vec<[DirTable; 2]> =
-            (0..basis.num_levels()).map(|l| basis.knots(l).each_ref().map(|kv| DirTable::new(kv, nq))).collect();
+        let nq = gauss_points(&basis);
+        let g = GaussLegendre::new(nq);
         let active = basis.active_cells();
         let mut lc = LevelCoefficients::<Sparse>::new(&basis, |k| vec![(k, 1.0)]);
         let nets: Vec<Vec<Sparse>> = active.iter().map(|&(l, c)| lc.cell_net(l, c)).collect();
         drop(lc);
+        let degrees = basis.degrees();
+        let cells: Vec<CellQuadrature> = active
+            .par_iter()
+            .zip(nets.par_iter())
+            .map(|(&(l, c), net)| cell_quadrature(&cell_tables(&basis, l, c, &g), net, degrees, nq))
+            .collect();
+        Self::assembled(&basis, nq, active, nets, cells)
+    }
+
+    /// The discretization of `basis`, a refinement of `before` (the basis of `self`):
+    /// equal to [`Self::new`]`(basis)`, but the element extraction and the quadrature
+    /// values are computed again only on the active cells that are new or whose
+    /// extraction the refinement may change
+    /// ([`HierarchicalBasis::extraction_changed`]); the other cells keep theirs, the
+    /// THB functions renumbered. When `basis` is no refinement of `before`, everything
+    /// is computed again.
+    pub fn refined(&self, before: &HierarchicalBasis, basis: HierarchicalBasis) -> Self {
+        let nq = gauss_points(&basis);
+        let Some(newly) = basis.newly_refined(before) else { return Self::new(basis) };
+        if nq != self.nq || before.active_functions() != self.functions.as_slice() {
+            return Self::new(basis);
+        }
+        let renumber: Vec<Option<usize>> = self.functions.iter().map(|&(l, f)| basis.index_of(l, f)).collect();
+        let old: std::collections::HashMap<(usize, Index2), usize> =
+            self.keys.iter().enumerate().map(|(k, &key)| (key, k)).collect();
+        let active = basis.active_cells();
+        // a kept cell: its old position and its net in the new numbering
+        let kept: Vec<Option<(usize, Vec<Sparse>)>> = active
+            .par_iter()
+            .map(|&(l, c)| {
+                let &k = old.get(&(l, c))?;
+                if basis.extraction_changed(&newly, l, c) {
+                    return None;
+                }
+                let net = self.nets[k]
+                    .iter()
+                    .map(|row| row.iter().map(|&(f, v)| renumber[f].map(|g| (g, v))).collect::<Option<Sparse>>())
+                    .collect::<Option<Vec<Sparse>>>()?;
+                Some((k, net))
+            })
+            .collect();
+        let mut lc = LevelCoefficients::<Sparse>::new(&basis, |k| vec![(k, 1.0)]);
+        let (from, nets): (Vec<Option<usize>>, Vec<Vec<Sparse>>) = active
+            .iter()
+            .zip(kept)
+            .map(|(&(l, c), kept)| match kept {
+                Some((k, net)) => (Some(k), net),
+                None => (None, lc.cell_net(l, c)),
+            })
+            .unzip();
+        drop(lc);
+        let g = GaussLegendre::new(nq);
+        let degrees = basis.degrees();
+        let cells: Vec<CellQuadrature> = active
+            .par_iter()
+            .zip(nets.par_iter())
+            .zip(&from)
+            .map(|((&(l, c), net), from)| match from {
+                // the same rows, renumbered (monotone: the order of the functions is kept)
+                Some(k) => {
+                    let cell = &self.cells[*k];
+                    let funcs = cell.funcs.iter().map(|&f| renumber[f].expect("renumbered above")).collect();
+                    CellQuadrature { funcs, weights: cell.weights.clone(), values: cell.values.clone() }
+                }
+                None => cell_quadrature(&cell_tables(&basis, l, c, &g), net, degrees, nq),
+            })
+            .collect();
+        Self::assembled(&basis, nq, active, nets, cells)
+    }
+
+    /// The fixed functions, the DOF map and the patterns from the cells of `basis` and
+    /// their extraction rows.
+    fn assembled(
+        basis: &HierarchicalBasis,
+        nq: usize,
+        keys: Vec<(usize, Index2)>,
+        nets: Vec<Vec<Sparse>>,
+        cells: Vec<CellQuadrature>,
+    ) -> Self {
+        let [p, q] = basis.degrees();
         let mut on_boundary = vec![false; basis.len()];
-        for (&(l, c), net) in active.iter().zip(&nets) {
+        for (&(l, c), net) in keys.iter().zip(&nets) {
             let shape = basis.cell_shape(l);
             for (a, row) in net.iter().enumerate() {
                 let (ia, ja) = (a % (p + 1), a / (p + 1));
@@ -110,11 +227,6 @@ impl HierarchicalDiscretization {
                 }
             }
         }
-        let cells: Vec<CellQuadrature> = active
-            .par_iter()
-            .zip(nets.par_iter())
-            .map(|(&(l, c), net)| cell_quadrature(&tables[l], c, net, [p, q], nq))
-            .collect();
         let mut free_of = vec![FIXED; basis.len()];
         let mut free = Vec::new();
         for (k, &b) in on_boundary.iter().enumerate() {
@@ -124,20 +236,40 @@ impl HierarchicalDiscretization {
             }
         }
         let m = free.len();
-        let mut rows: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); m];
+        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); m];
         for cell in &cells {
             let fs: Vec<usize> = cell.funcs.iter().map(|&k| free_of[k]).filter(|&f| f != FIXED).collect();
             for &a in &fs {
-                rows[a].extend(fs.iter().copied());
+                rows[a].extend_from_slice(&fs);
             }
         }
+        rows.par_iter_mut().for_each(|r| {
+            r.sort_unstable();
+            r.dedup();
+        });
         let scalar = Csr::from_rows(m, rows.iter().map(|r| r.iter().map(|&c| (c, 0.0)).collect()).collect());
         let vrows: Vec<Vec<(usize, f64)>> = (0..2)
             .flat_map(|_| rows.iter())
             .map(|r| r.iter().map(|&c| (c, 0.0)).chain(r.iter().map(|&c| (m + c, 0.0))).collect())
             .collect();
         let vector = Csr::from_rows(2 * m, vrows);
-        Self { nq, cells, free_of, free, scalar, vector }
+        let offsets = cells
+            .par_iter()
+            .map(|cell| {
+                let fr: Vec<usize> = cell.funcs.iter().map(|&k| free_of[k]).collect();
+                let mut out = vec![NOT_FREE; fr.len() * fr.len()];
+                for (a, &fa) in fr.iter().enumerate().filter(|e| *e.1 != FIXED) {
+                    let cols = &scalar.col_idx[scalar.row_ptr[fa]..scalar.row_ptr[fa + 1]];
+                    for (b, &fb) in fr.iter().enumerate().filter(|e| *e.1 != FIXED) {
+                        let off = cols.binary_search(&fb).expect("the pattern holds every coupling of a cell");
+                        out[a * fr.len() + b] = u32::try_from(off).expect("a row of a cell pattern is short");
+                    }
+                }
+                out
+            })
+            .collect();
+        let functions = basis.active_functions().to_vec();
+        Self { nq, cells, keys, nets, functions, offsets, free_of, free, scalar, vector }
     }
 
     /// Number of THB functions.
@@ -194,7 +326,7 @@ impl HierarchicalDiscretization {
         let srow = &self.scalar;
         let m = self.num_free();
         const CHUNK: usize = 256;
-        for chunk in self.cells.chunks(CHUNK) {
+        for (chunk, offsets) in self.cells.chunks(CHUNK).zip(self.offsets.chunks(CHUNK)) {
             let local: Vec<(Vec<f64>, Vec<f64>)> = chunk
                 .par_iter()
                 .map(|cell| {
@@ -205,7 +337,7 @@ impl HierarchicalDiscretization {
                     (re, ke)
                 })
                 .collect();
-            for (cell, (re, ke)) in chunk.iter().zip(local) {
+            for ((cell, (re, ke)), off) in chunk.iter().zip(local).zip(offsets) {
                 let n = cell.len();
                 if want_res {
                     for (a, &k) in cell.funcs.iter().enumerate() {
@@ -217,18 +349,17 @@ impl HierarchicalDiscretization {
                 if !want_mat {
                     continue;
                 }
-                let fr: Vec<usize> = cell.funcs.iter().map(|&k| self.free_of[k]).collect();
-                for (a, &fa) in fr.iter().enumerate() {
+                for (a, &k) in cell.funcs.iter().enumerate() {
+                    let fa = self.free_of[k];
                     if fa == FIXED {
                         continue;
                     }
                     let (r0, r1) = (srow.row_ptr[fa], srow.row_ptr[fa + 1]);
-                    let cols = &srow.col_idx[r0..r1];
-                    for (b, &fb) in fr.iter().enumerate() {
-                        if fb == FIXED {
+                    for (b, &o) in off[a * n..(a + 1) * n].iter().enumerate() {
+                        if o == NOT_FREE {
                             continue;
                         }
-                        let off = cols.binary_search(&fb).expect("the pattern holds every coupling of a cell");
+                        let off = o as usize;
                         for z in 0..ncomp {
                             let row = z * m + fa;
                             for d in 0..ncomp {
@@ -258,13 +389,7 @@ impl HierarchicalDiscretization {
 
 /// Values and derivatives of the THB functions of one active cell at its Gauss points,
 /// from the cell's extraction rows `net` (see the module documentation).
-fn cell_quadrature(
-    tables: &[DirTable; 2],
-    cell: Index2,
-    net: &[Sparse],
-    [p, q]: [usize; 2],
-    nq: usize,
-) -> CellQuadrature {
+fn cell_quadrature(tables: &[Vec<QpTab>; 2], net: &[Sparse], [p, q]: [usize; 2], nq: usize) -> CellQuadrature {
     let funcs: Vec<usize> = net.iter().flatten().map(|e| e.0).collect::<BTreeSet<_>>().into_iter().collect();
     let n = funcs.len();
     // extraction rows in local function indices
@@ -277,8 +402,7 @@ fn cell_quadrature(
     for kv in 0..nq {
         for ku in 0..nq {
             let k = kv * nq + ku;
-            let tu = tables[0].at(cell[0], ku);
-            let tv = tables[1].at(cell[1], kv);
+            let (tu, tv) = (&tables[0][ku], &tables[1][kv]);
             weights.push(tu.w * tv.w);
             let out = &mut values[k * n..(k + 1) * n];
             for jb in 0..=q {
@@ -306,6 +430,69 @@ mod tests {
     fn basis(p: usize, n: usize) -> HierarchicalBasis {
         let kv = KnotVector::open_uniform(p, n);
         HierarchicalBasis::new([kv.clone(), kv]).unwrap()
+    }
+
+    /// Refined round by round (cells of several levels, admissibility pulling coarser
+    /// cells along, degrees 2 and 3, classes 2 and 3), the discretization updated by
+    /// [`HierarchicalDiscretization::refined`] equals the one made from scratch bit for bit
+    /// (cells, their functions, weights and values, free functions, patterns), while it
+    /// kept the extraction of some cells from the round before.
+    #[test]
+    fn the_refined_discretization_equals_a_new_one() {
+        for (p, m) in [(3, 2), (2, 2), (3, 3)] {
+            let mut b = basis(p, 7);
+            let mut disc = HierarchicalDiscretization::new(b.clone());
+            let mut seed = 12345u64;
+            let mut kept_total = 0;
+            for round in 0..6 {
+                let active = b.active_cells();
+                // a few cells, the finest more often (where a repair refines)
+                let finest = active.iter().map(|c| c.0).max().unwrap();
+                let mut marked = Vec::new();
+                for _ in 0..3 {
+                    seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    let pick = (seed >> 33) as usize;
+                    let pool: Vec<_> = active.iter().filter(|c| round % 3 == 0 || c.0 == finest).collect();
+                    let c = *pool[pick % pool.len()];
+                    if !marked.contains(&c) {
+                        marked.push(c);
+                    }
+                }
+                let before = b.clone();
+                b.refine(&marked, m).unwrap();
+                let newly = b.newly_refined(&before).unwrap();
+                let old: BTreeSet<_> = before.active_cells().into_iter().collect();
+                let kept = b
+                    .active_cells()
+                    .into_iter()
+                    .filter(|&(l, c)| old.contains(&(l, c)) && !b.extraction_changed(&newly, l, c))
+                    .count();
+                kept_total += kept;
+                let updated = disc.refined(&before, b.clone());
+                let fresh = HierarchicalDiscretization::new(b.clone());
+                assert_eq!(updated.cells.len(), fresh.cells.len());
+                for (k, (u, f)) in updated.cells.iter().zip(&fresh.cells).enumerate() {
+                    assert_eq!(u.funcs, f.funcs, "p {p} round {round} cell {k}");
+                    assert_eq!(u.weights, f.weights, "p {p} round {round} cell {k}");
+                    assert_eq!(u.values, f.values, "p {p} round {round} cell {k}");
+                }
+                assert_eq!(updated.keys, fresh.keys);
+                assert_eq!(updated.nets, fresh.nets);
+                assert_eq!((&updated.free_of, &updated.free), (&fresh.free_of, &fresh.free));
+                for (a, c) in [(&updated.scalar, &fresh.scalar), (&updated.vector, &fresh.vector)] {
+                    assert_eq!((&a.row_ptr, &a.col_idx, a.nrows), (&c.row_ptr, &c.col_idx, c.nrows));
+                }
+                disc = updated;
+            }
+            assert!(kept_total > 0, "p {p}: no cell kept its extraction");
+        }
+        // not a refinement: made from scratch
+        let b = basis(3, 7);
+        let mut r = b.clone();
+        r.refine(&[(0, [3, 3])], 2).unwrap();
+        let d = HierarchicalDiscretization::new(r.clone()).refined(&r, b.clone());
+        assert_eq!(d.cells.len(), b.active_cells().len());
+        assert_eq!(d.free, HierarchicalDiscretization::new(b).free);
     }
 
     /// On every cell the extracted THB functions sum to one with zero derivatives

@@ -1,10 +1,13 @@
 //! A picture of a map without any GPU or window: the image of a fine parameter grid
 //! filled with a `det J` heat map (Gouraud-shaded triangles), the iso-lines of `xi` and
 //! `eta`, and the boundary. Non-positive `det J` is painted magenta, a colour that no
-//! positive value uses. Output is an RGBA buffer; the CLI encodes it as PNG.
+//! positive value uses. Output is an RGBA buffer; the CLI encodes it as PNG. A THB map
+//! ([`render_thb`]) is drawn with the borders of its active cells instead of iso-lines.
 
+use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::curve::Point;
+use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::spline::surface::Surface;
 use crate::verify::quality::grid_abscissae;
 
@@ -135,6 +138,42 @@ pub fn render(map: &Surface, opts: &PictureOptions) -> Image {
     render_sampled(n, &pts, &det, opts)
 }
 
+/// Render a THB map: the `det J` heat map of [`render`] (sampled on its exact tensor
+/// form, [`HierarchicalMap::to_surface`]) with the borders of the active cells drawn
+/// where [`render`] draws iso-lines (`opts.grid_lines` is not used).
+pub fn render_thb(map: &HierarchicalMap, opts: &PictureOptions) -> Result<Image> {
+    let tensor = map.to_surface()?;
+    let n = render_resolution(opts);
+    let (pts, det) = sample(&tensor, n);
+    let borders = active_cell_borders(map, &tensor);
+    let opts = PictureOptions { grid_lines: 0, ..opts.clone() };
+    Ok(render_patches_with(n, &[(&pts, &det)], &opts, &borders))
+}
+
+/// The images of the edges of every active cell of `map` (through `tensor`, the same
+/// map), as polylines of 9 points each; an edge shared by two cells of one level once.
+pub(crate) fn active_cell_borders(map: &HierarchicalMap, tensor: &Surface) -> Vec<Vec<Point>> {
+    let mut edges = std::collections::BTreeSet::new();
+    for (l, c) in map.basis.active_cells() {
+        let [[a, b], [cc, d]] = map.basis.cell_bounds(l, c);
+        for e in [[a, cc, b, cc], [a, d, b, d], [a, cc, a, d], [b, cc, b, d]] {
+            edges.insert(e.map(f64::to_bits));
+        }
+    }
+    edges
+        .into_iter()
+        .map(|e| {
+            let [u0, v0, u1, v1] = e.map(f64::from_bits);
+            (0..=8)
+                .map(|k| {
+                    let t = k as f64 / 8.0;
+                    tensor.eval(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Points and `det J` of `map` on the `(n+1)^2` grid of [`render`].
 fn sample(map: &Surface, n: usize) -> (Vec<Point>, Vec<f64>) {
     let mut pts = Vec::with_capacity((n + 1) * (n + 1));
@@ -213,6 +252,11 @@ pub fn render_sampled(n: usize, pts: &[Point], det: &[f64], opts: &PictureOption
 
 /// [`render_sampled`] of several patches in one picture (one colour scale).
 pub(crate) fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], opts: &PictureOptions) -> Image {
+    render_patches_with(n, patches, opts, &[])
+}
+
+/// [`render_patches_sampled`], the polylines `lines` drawn as iso-lines are.
+fn render_patches_with(n: usize, patches: &[(&[Point], &[f64])], opts: &PictureOptions, lines: &[Vec<Point>]) -> Image {
     for (pts, det) in patches {
         assert_eq!(pts.len(), (n + 1) * (n + 1), "render_sampled: {} points for n = {n}", pts.len());
         assert_eq!(det.len(), pts.len(), "render_sampled: det and points differ in length");
@@ -285,6 +329,12 @@ pub(crate) fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], o
             }
         }
     }
+    for line in lines {
+        for q in line.windows(2) {
+            let (a, b) = (cv.to_px(q[0]), cv.to_px(q[1]));
+            cv.line(a, b, [30, 30, 30], 0.7);
+        }
+    }
     for &(a, b) in &opts.segments {
         let (pa, pb) = (cv.to_px(a), cv.to_px(b));
         cv.line(pa, pb, [220, 30, 30], 1.0);
@@ -302,4 +352,44 @@ pub(crate) fn render_patches_sampled(n: usize, patches: &[(&[Point], &[f64])], o
         }
     }
     Image { width: w, height: h, rgba: cv.rgba }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spline::knots::KnotVector;
+
+    /// The identity of the unit square on a quadratic 4 x 4 basis, one cell refined: its
+    /// THB picture is the tensor picture without iso-lines (one colour: `det J = 1`) plus
+    /// the borders of the active cells. A border between two level-1 cells (no knot line
+    /// of level 0) and a level-0 knot line are drawn; the centre of a level-1 cell is not.
+    #[test]
+    fn a_thb_picture_draws_the_active_cell_borders() {
+        let kv = KnotVector::open_uniform(2, 4);
+        let g = kv.greville();
+        let cps = g.iter().flat_map(|&v| g.iter().map(move |&u| [u, v])).collect();
+        let s = Surface::new([kv.clone(), kv], cps, None).unwrap();
+        let map = HierarchicalMap::from_surface(&s).unwrap().refined(&[(0, [1, 1])], 2).unwrap();
+        let opts = PictureOptions { size: 400, resolution: 40, ..Default::default() };
+        let thb = render_thb(&map, &opts).unwrap();
+        let plain = render(&s, &PictureOptions { grid_lines: 0, ..opts.clone() });
+        assert_eq!((thb.width, thb.height), (plain.width, plain.height));
+        let (w, h) = (thb.width, thb.height);
+        // the canvas of an image of the unit square: scale and padding as `render` sets them
+        let sc = opts.size as f64 * 0.92;
+        let pad = (w as f64 - sc) / 2.0;
+        let px = |x: f64, y: f64| ((x * sc + pad) as usize, (h as f64 - (y * sc + pad)) as usize);
+        let block_differs = |(x, y): (usize, usize)| {
+            (y - 1..=y + 1).any(|yy| {
+                (x - 1..=x + 1).any(|xx| {
+                    let k = 4 * (yy * w + xx);
+                    thb.rgba[k..k + 3] != plain.rgba[k..k + 3]
+                })
+            })
+        };
+        assert!(block_differs(px(0.375, 0.3)), "the border between two level-1 cells");
+        assert!(block_differs(px(0.75, 0.6)), "a level-0 knot line");
+        assert!(!block_differs(px(0.3125, 0.3125)), "the centre of a level-1 cell");
+        assert!(!block_differs(px(0.625, 0.875)), "the centre of a level-0 cell");
+    }
 }

@@ -17,10 +17,8 @@
 
 use std::sync::Arc;
 
-#[cfg(test)]
 use super::density::{lowered, raised, shift_diagonal};
 use super::galerkin::block_mass;
-#[cfg(test)]
 use super::winslow::{projected_density_hessian, projection_lowered, projection_raised, winslow_density};
 use super::DiscreteProblem;
 use crate::discrete::assembly::{egg_point, element_product, EggRows, Geo, Operator};
@@ -102,7 +100,6 @@ fn geometry(cell: &CellQuadrature, k: usize, cps: &[Point]) -> Geo {
 }
 
 /// `e = (x_ξ, x_η, y_ξ, y_η)` at point `k` of `cell`.
-#[cfg(test)]
 fn gradient(cell: &CellQuadrature, k: usize, cps: &[Point]) -> [f64; 4] {
     let mut e = [0.0; 4];
     for (b, &f) in cell.at(k).iter().zip(&cell.funcs) {
@@ -241,7 +238,6 @@ impl DiscreteProblem for HierarchicalEggProblem {
 
 /// `J = ∫ W` (eq. 16) on a THB discretization, `+∞` when `det J <= 0` at a quadrature
 /// point; summed cell by cell in order.
-#[cfg(test)]
 pub(crate) fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, cps: &[Point]) -> f64 {
     use rayon::prelude::*;
     let cells: Vec<f64> = disc
@@ -268,7 +264,6 @@ pub(crate) fn hierarchical_winslow_objective(disc: &HierarchicalDiscretization, 
 /// `projected` towards its positive semidefinite projection (as
 /// [`winslow_gradient_with`](super::winslow::winslow_gradient_with)):
 /// `∂F^z_a/∂c^d_b = -∫ Σ_ij ∂_i w_a (∂²W/∂e_{2z+i}∂e_{2d+j}) ∂_j w_b`.
-#[cfg(test)]
 pub(crate) fn hierarchical_winslow_gradient(
     disc: &HierarchicalDiscretization,
     cps: &[Point],
@@ -320,7 +315,6 @@ pub(crate) fn hierarchical_winslow_gradient(
 /// start; the Hessian modified as [`WinslowProblem`](super::winslow::WinslowProblem)'s
 /// (partial, then full projection of each point's density Hessian, then diagonal shifts)
 /// where Newton finds it not definite.
-#[cfg(test)]
 #[derive(Debug)]
 pub(crate) struct HierarchicalWinslowProblem {
     /// Discretization, control points and storage.
@@ -331,7 +325,6 @@ pub(crate) struct HierarchicalWinslowProblem {
     raised: bool,
 }
 
-#[cfg(test)]
 impl HierarchicalWinslowProblem {
     /// Set up with all control points `cps` (free ones are the start).
     pub fn new(disc: Arc<HierarchicalDiscretization>, cps: Vec<Point>) -> Self {
@@ -347,7 +340,6 @@ impl HierarchicalWinslowProblem {
     }
 }
 
-#[cfg(test)]
 impl DiscreteProblem for HierarchicalWinslowProblem {
     fn size(&self) -> usize {
         2 * self.state.disc.num_free()

@@ -12,8 +12,10 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::{Observer, Stage};
-use crate::error::Result;
-use crate::solve::hierarchical::{repair_thb_observed, ThbRepairOptions, ThbRound};
+use crate::error::{Error, Result};
+use crate::solve::hierarchical::improve::{improve_thb, ThbImprovement};
+use crate::solve::hierarchical::{accepted, repair_thb_observed, ThbRepairOptions, ThbRound};
+use crate::solve::improve::Improve;
 use crate::solve::options::{Refinement, SolveOptions};
 use crate::solve::report::{Report, Solution, Verdict};
 use crate::spline::hierarchical::map::HierarchicalMap;
@@ -55,6 +57,10 @@ pub struct ThbReport {
     pub thb_rounds: Vec<ThbRound>,
     /// Seconds of the THB stage (the conversion, the rounds, the certificates).
     pub thb_seconds: f64,
+    /// With `--improve winslow`: the Winslow functional minimized on the repaired THB
+    /// map's basis (`solve::hierarchical::improve`); `None` when no improvement was asked
+    /// for or the repaired map is not certified.
+    pub improvement: Option<ThbImprovement>,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
 }
@@ -91,24 +97,42 @@ fn thb_options(opts: &SolveOptions) -> ThbRepairOptions {
 /// at most `opts.repair.rounds` rounds, each refining the offending cells and `opts.repair.halo`
 /// cells around them, EGG with the options' operator and Newton options, the
 /// certificate with theirs; every round to `observer`.
+///
+/// With `--improve winslow` the certified THB map is then improved on its own basis
+/// ([`improve_thb`]); `--improve weak` is refused ([`Error::Invalid`]): the weak form
+/// (eq. 14) has no THB discretization here.
 pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<ThbSolution> {
     let t0 = Instant::now();
+    if opts.improve == Some(Improve::WeakForm) {
+        return Err(Error::Invalid(
+            "a THB map (--refinement thb) is improved by the Winslow functional only (eq. 16): \
+             use --improve winslow or no improvement"
+                .into(),
+        ));
+    }
     let start = HierarchicalMap::from_surface(&sol.map)?;
     let out = repair_thb_observed(start, &thb_options(opts), &mut |round| observer(&Stage::ThbRound(round)))?;
-    let c = out.certificate;
+    let (map, c, improvement) = match opts.improve {
+        Some(Improve::Winslow) if accepted(&out.certificate) => {
+            let imp = improve_thb(&out.map, &out.certificate, opts.nonlinear, &opts.certify)?;
+            (imp.map, imp.certificate, Some(imp.report))
+        }
+        _ => (out.map, out.certificate, None),
+    };
     let report = ThbReport {
         refinement: Refinement::Thb,
         verdict: Verdict::of_finding(&c.verdict),
         message: c.message(),
-        functions: out.map.basis.len(),
-        levels: out.map.basis.num_levels(),
+        functions: map.basis.len(),
+        levels: map.basis.num_levels(),
         unknowns: out.rounds.last().map_or(0, |r| r.unknowns),
         certificate: c,
         thb_rounds: out.rounds,
         thb_seconds: t0.elapsed().as_secs_f64(),
+        improvement,
         solve: sol.report,
     };
-    Ok(ThbSolution { name: sol.name, map: out.map, report })
+    Ok(ThbSolution { name: sol.name, map, report })
 }
 
 #[cfg(test)]
@@ -117,7 +141,7 @@ mod tests {
     use super::*;
     use crate::error::Error;
     use crate::io::{read_boundary, ReadOptions};
-    use crate::solve::hierarchical::{accepted, repair_thb};
+    use crate::solve::hierarchical::repair_thb;
     use crate::testutil::data;
 
     /// puzzle4 with `--refinement thb` (the geometry of the CLI's THB test): the

@@ -19,7 +19,7 @@ use crate::error::{Error, Result};
 use crate::methods::hierarchical::HierarchicalEggProblem;
 use crate::methods::DiscreteProblem;
 use crate::spline::hierarchical::map::HierarchicalMap;
-use crate::spline::hierarchical::Index2;
+use crate::spline::hierarchical::{HierarchicalBasis, Index2};
 use crate::verify::certificate::hierarchical::{certify_hierarchical, CellIndex, HierarchicalCertificate};
 use crate::verify::certificate::{CertifyOptions, Finding};
 
@@ -165,10 +165,22 @@ pub struct EggSolve {
 /// Solve EGG (eq. 8) on the THB discretization of `map` from its control points (the
 /// fixed ones are the Dirichlet data), Newton's linear systems by `nonlinear.linear` (see
 /// [`ThbRepairOptions::nonlinear`]).
+#[cfg(test)]
 pub(crate) fn solve_egg(map: &HierarchicalMap, operator: Operator, nonlinear: NonlinearOptions) -> Result<EggSolve> {
     let t0 = Instant::now();
     let disc = Arc::new(HierarchicalDiscretization::new(map.basis.clone()));
-    let discretization_seconds = t0.elapsed().as_secs_f64();
+    solve_egg_on(map, disc, t0.elapsed().as_secs_f64(), operator, nonlinear)
+}
+
+/// [`solve_egg`] on `disc`, the discretization of `map.basis` (made in
+/// `discretization_seconds`).
+fn solve_egg_on(
+    map: &HierarchicalMap,
+    disc: Arc<HierarchicalDiscretization>,
+    discretization_seconds: f64,
+    operator: Operator,
+    nonlinear: NonlinearOptions,
+) -> Result<EggSolve> {
     if disc.num_free() == 0 {
         let map = map.clone();
         let (assembly_seconds, linear_seconds) = (0.0, 0.0);
@@ -220,6 +232,8 @@ pub(crate) fn repair_thb_observed(
     let mut map = map;
     let mut cert = certify_hierarchical(&map, &opts.certify)?;
     let mut rounds = Vec::new();
+    // the last round's basis and discretization: the next one extracts only what changed
+    let mut last: Option<(HierarchicalBasis, Arc<HierarchicalDiscretization>)> = None;
     while !accepted(&cert) && rounds.len() < opts.rounds {
         let t0 = Instant::now();
         let offending = cert.offending_cells();
@@ -231,7 +245,12 @@ pub(crate) fn repair_thb_observed(
         let refined = map.refined(&marked, opts.admissibility)?;
         let refine_seconds = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let egg = solve_egg(&refined, opts.operator, opts.nonlinear)?;
+        let disc = Arc::new(match &last {
+            Some((before, disc)) => disc.refined(before, refined.basis.clone()),
+            None => HierarchicalDiscretization::new(refined.basis.clone()),
+        });
+        let egg = solve_egg_on(&refined, disc.clone(), t1.elapsed().as_secs_f64(), opts.operator, opts.nonlinear)?;
+        last = Some((refined.basis.clone(), disc));
         let newton_seconds = t1.elapsed().as_secs_f64() - egg.discretization_seconds;
         map = egg.map;
         let verdict = cert.verdict.name();
@@ -264,5 +283,6 @@ pub(crate) fn repair_thb_observed(
     Ok(ThbRepair { map, certificate: cert, rounds })
 }
 
+pub mod improve;
 #[cfg(test)]
 mod tests;

@@ -102,3 +102,56 @@ fn gmres_and_lu_reach_the_same_egg_map() {
     let err = gmres.iter().zip(&lu).fold(0.0f64, |m, (a, b)| m.max((a[0] - b[0]).hypot(a[1] - b[1])));
     assert!(err < 1e-7, "{err}");
 }
+
+/// The Winslow improvement on a THB basis (`improve::improve_thb`): from the EGG map of
+/// the annulus on a three-level THB basis (certified) Newton converges, the minimizer is
+/// certified and kept, `J` falls, the fixed (boundary) control points stay, and the
+/// minimizer is stationary: central differences of `J` along free unknowns vanish
+/// against those at the start. A folded start is refused ([`Error::InfeasibleStart`]).
+#[test]
+fn the_winslow_improvement_on_a_thb_basis_minimizes_and_is_certified() {
+    use super::improve::improve_thb;
+    use crate::methods::hierarchical::hierarchical_winslow_objective;
+    let map = annulus(3, 8).refined(&[(0, [3, 3]), (0, [4, 3])], 2).unwrap();
+    let map = map.refined(&[(1, [7, 7])], 2).unwrap();
+    let opts = ThbRepairOptions::default();
+    let egg = solve_egg(&map, Operator::Scaled, NonlinearOptions::default()).unwrap().map;
+    let cert = certify_hierarchical(&egg, &opts.certify).unwrap();
+    assert!(accepted(&cert), "{}", cert.message());
+    let out = improve_thb(&egg, &cert, NonlinearOptions::default(), &opts.certify).unwrap();
+    let r = &out.report;
+    assert!(r.accepted && r.converged && r.iterations > 0, "{r:?}");
+    assert!(accepted(&out.certificate));
+    let (before, after) = (r.winslow_before.unwrap(), r.winslow_after.unwrap());
+    assert!(after < before, "{before} -> {after}");
+    assert!(r.max_displacement > 0.0 && r.max_displacement < 0.05, "{r:?}");
+    let disc = HierarchicalDiscretization::new(egg.basis.clone());
+    for k in 0..egg.basis.len() {
+        if !disc.free().contains(&k) {
+            assert_eq!(out.map.control_points[k], egg.control_points[k], "fixed function {k}");
+        }
+    }
+    let j = |cps: &[[f64; 2]]| hierarchical_winslow_objective(&disc, cps);
+    let slope = |cps: &[[f64; 2]], k: usize, d: usize| {
+        let h = 1e-6;
+        let (mut a, mut b) = (cps.to_vec(), cps.to_vec());
+        a[k][d] += h;
+        b[k][d] -= h;
+        (j(&a) - j(&b)) / (2.0 * h)
+    };
+    let (mut at_start, mut at_min) = (0.0f64, 0.0f64);
+    for &k in disc.free().iter().step_by(7) {
+        for d in 0..2 {
+            at_start = at_start.max(slope(&egg.control_points, k, d).abs());
+            at_min = at_min.max(slope(&out.map.control_points, k, d).abs());
+        }
+    }
+    assert!(at_min < 2e-3 * at_start, "{at_min} vs {at_start}");
+    // a folded start
+    let mut folded = egg.clone();
+    folded.control_points[disc.free()[disc.num_free() / 2]][0] += 0.8;
+    let fc = certify_hierarchical(&folded, &opts.certify).unwrap();
+    assert!(!accepted(&fc));
+    let err = improve_thb(&folded, &fc, NonlinearOptions::default(), &opts.certify).unwrap_err();
+    assert!(matches!(err, Error::InfeasibleStart { .. }), "{err}");
+}

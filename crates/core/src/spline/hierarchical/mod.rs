@@ -293,6 +293,43 @@ impl HierarchicalBasis {
         self.active = active;
     }
 
+    /// The cells refined in `self` and not in `before`, per level, when `self` is a
+    /// refinement of `before` (the same level-0 knots, every refined cell of `before`
+    /// refined here); `None` otherwise.
+    pub(crate) fn newly_refined(&self, before: &Self) -> Option<Vec<Vec<Index2>>> {
+        let refines = self.levels[0].knots == before.levels[0].knots
+            && before.refined.len() <= self.refined.len()
+            && before.refined.iter().zip(&self.refined).all(|(b, s)| b.is_subset(s));
+        refines.then(|| {
+            self.refined
+                .iter()
+                .enumerate()
+                .map(|(l, s)| s.iter().filter(|c| !before.is_refined(l, **c)).copied().collect())
+                .collect()
+        })
+    }
+
+    /// Whether the restriction of the THB functions to the active cell `c` of level `l`
+    /// (its element extraction) may differ from that in the hierarchy `self` was refined
+    /// from, given the cells refined since ([`Self::newly_refined`]); `c` active in both.
+    ///
+    /// On `Q = (l, c)` the extraction is the level coefficients `d^l_τ` of the functions
+    /// `τ` non-zero on `Q` (`truncation`). The recursion for `d^l_τ` reads the state
+    /// (active, masked by `Ω^{k+1}`, outside `Ω^k`) of level-`k` functions non-zero on
+    /// `Q`'s ancestor of level `k` (a parent's support contains its child's), for
+    /// `k <= l`; that state depends on `Ω^k` and `Ω^{k+1}` on the function's support,
+    /// which lies in the support extension `S(Q, k)`. The level-`l` functions on `Q` are
+    /// never masked (`Q` is not refined), and `S(Q, k + 1) ⊆ S(Q, k)`. So the extraction
+    /// is unchanged unless a cell of some level `k < l` was refined inside `S(Q, k)`.
+    pub(crate) fn extraction_changed(&self, newly: &[Vec<Index2>], l: usize, c: Index2) -> bool {
+        (0..l.min(newly.len())).any(|k| {
+            !newly[k].is_empty() && {
+                let [ri, rj] = self.support_extension(l, c, k);
+                newly[k].iter().any(|q| ri.contains(&q[0]) && rj.contains(&q[1]))
+            }
+        })
+    }
+
     /// Cells of level `k` of the support extension `S(Q, k)` of cell `c` of level `l >= k`:
     /// the union of the supports of the level-`k` functions non-zero on `Q`'s ancestor.
     fn support_extension(&self, l: usize, c: Index2, k: usize) -> [Range<usize>; 2] {
