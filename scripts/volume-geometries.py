@@ -15,6 +15,13 @@ Each is a trivariate net P(i, j, k) (with weights W(i, j, k)) on knot vectors pe
 direction; the faces are its six boundary layers, so shared edges agree exactly.
 
   python3 scripts/volume-geometries.py tests/data/volumes
+
+Not bundled, for the size benchmark (BENCHMARKS.md, issue 33), written when named:
+
+  twisted-duct-fine the twisted duct on 3 x 3 x 8 elements: --refine 3 gives
+                    24 x 24 x 64 elements, 112,320 unknowns
+
+  python3 scripts/volume-geometries.py out twisted-duct-fine
 """
 import json
 import math
@@ -70,6 +77,13 @@ def twisted_duct():
         a, b, t = 2 * u - 1, 2 * v - 1, 0.5 * math.pi * w
         return (a * math.cos(t) - b * math.sin(t), a * math.sin(t) + b * math.cos(t), 4 * w)
     return faces_of(*sampled([2, 2, 3], [2, 2, 6], f))
+
+
+def twisted_duct_fine():
+    def f(u, v, w):
+        a, b, t = 2 * u - 1, 2 * v - 1, 0.5 * math.pi * w
+        return (a * math.cos(t) - b * math.sin(t), a * math.sin(t) + b * math.cos(t), 4 * w)
+    return faces_of(*sampled([2, 2, 3], [3, 3, 8], f))
 
 
 def curved_pipe():
@@ -138,11 +152,21 @@ GEOMETRIES = {
     "blade-passage": blade_passage,
 }
 
+BENCHMARK_GEOMETRIES = {
+    "twisted-duct-fine": twisted_duct_fine,
+}
+
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "tests/data/volumes"
     os.makedirs(out, exist_ok=True)
-    for name, make in GEOMETRIES.items():
+    named = sys.argv[2:]
+    every = {**GEOMETRIES, **BENCHMARK_GEOMETRIES}
+    unknown = [n for n in named if n not in every]
+    if unknown:
+        sys.exit(f"unknown geometry {unknown[0]!r}: one of {', '.join(every)}")
+    chosen = {n: every[n] for n in named} if named else GEOMETRIES
+    for name, make in chosen.items():
         doc = {"name": name, "volume_boundary": make()}
         with open(os.path.join(out, name + ".json"), "w") as fh:
             json.dump(doc, fh)

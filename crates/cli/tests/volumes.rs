@@ -121,7 +121,7 @@ fn a_bad_gismo_face_set_is_refused_naming_the_face() {
 }
 
 /// The method of a volume solve in the planar vocabulary: EGG (eq. 8 in 3D) by
-/// default, `--improve winslow` (or `--method winslow`) minimises the 3D Winslow
+/// default (its Newton step by GMRES, by LU with `--linear lu`), `--improve winslow` (or `--method winslow`) minimises the 3D Winslow
 /// functional from the EGG map, which lowers its energy; `--improve weak` and
 /// `--operator plain` (the 3D operator is the scaled one) are refused before anything is
 /// written; a basis that is not `C¹` (the curved pipe is linear
@@ -141,6 +141,13 @@ fn the_volume_method_follows_method_and_improve() {
     assert!(egg["egg_iterations"].as_u64().unwrap() >= 1);
     assert!(egg["egg_relative_residual"].as_f64().unwrap() < 1e-9);
     assert!(egg["relative_gradient"].is_null());
+    // the Newton step by GMRES (84 unknowns: above `auto`'s LU limit), or by LU
+    assert_eq!(egg["egg_linear"].as_str(), Some("gmres"));
+    assert!(egg["egg_krylov_iterations"].as_u64().unwrap() >= 1);
+    let lu = run(&["--linear", "lu"], "lu.json");
+    assert_eq!((lu["egg_linear"].as_str(), lu["egg_krylov_iterations"].as_u64()), (Some("lu"), Some(0)));
+    assert_eq!(lu["egg_iterations"], egg["egg_iterations"]);
+    assert!(lu["egg_relative_residual"].as_f64().unwrap() < 1e-9);
     for flag in [["--improve", "winslow"], ["--method", "winslow"]] {
         let w = run(&flag, "winslow.json");
         assert_eq!((w["method"].as_str(), w["start"].as_str()), (Some("egg+winslow"), Some("egg")), "{flag:?}");

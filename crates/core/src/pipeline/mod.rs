@@ -414,7 +414,13 @@ pub(crate) fn volume_options(opts: &SolveOptions) -> Result<VolumeOptions> {
                 .into(),
         ));
     }
-    Ok(VolumeOptions { method, refine: opts.levels.refine, max_refinements: opts.repair.rounds, ..Default::default() })
+    Ok(VolumeOptions {
+        method,
+        refine: opts.levels.refine,
+        max_refinements: opts.repair.rounds,
+        linear: opts.nonlinear.linear,
+        ..Default::default()
+    })
 }
 
 /// With [`BasisChoice::Auto`], after [`auto_fallback`] asked to solve `first` (input

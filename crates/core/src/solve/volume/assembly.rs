@@ -23,15 +23,22 @@ use crate::spline::volume::{Point3, Volume};
 /// weights.
 pub(super) type Tables = Vec<(BasisDerivs, f64)>;
 
-/// What one element adds: a scalar, a vector over its `m` basis functions (`3 a + i`)
-/// and a matrix whose entry for row `(a, i_a)` and column `(b, i_b)` is at
-/// `b 9m + (3 i_b + i_a) m + a` (empty when not asked for).
+/// What one element adds: a scalar, a vector over its `m` basis functions (`3 a + i`),
+/// a matrix whose entry for row `(a, i_a)` and column `(b, i_b)` is at
+/// `b 9m + (3 i_b + i_a) m + a`, and a scalar matrix (one entry per pair of basis
+/// functions, `(a, b)` at `b m + a`) (the matrices empty when not asked for).
 pub(super) struct Local {
     pub(super) idx: Vec<usize>,
     pub(super) scalar: f64,
     pub(super) vector: Vec<f64>,
     pub(super) matrix: Vec<f64>,
+    pub(super) scalar_matrix: Vec<f64>,
 }
+
+/// What [`VolumeDiscretization::assemble`] returns: the scalars added, the vector over
+/// the free unknowns, the matrix on the pattern and the scalar matrix on the scalar
+/// pattern (each matrix `None` when not asked for).
+pub(super) type Assembled = (f64, Vec<f64>, Option<Csr>, Option<Csr>);
 
 /// Basis, quadrature, free unknowns and pattern of volumes on one basis with the
 /// weights fixed, the boundary control points fixed and the interior ones free.
@@ -53,6 +60,9 @@ pub struct VolumeDiscretization {
     free: usize,
     /// The pattern (values zero), see the module doc.
     pattern: Csr,
+    /// The scalar pattern: row `f` holds the free control points sharing an element
+    /// with `f` (values zero).
+    scalar_pattern: Csr,
     /// Per free control point, the sorted free control points sharing an element with it.
     neighbours: Vec<Vec<usize>>,
 }
@@ -95,6 +105,7 @@ impl VolumeDiscretization {
             free_of,
             free,
             pattern: Csr::default(),
+            scalar_pattern: Csr::default(),
             neighbours: Vec::new(),
         };
         let mut neighbours = vec![Vec::new(); free];
@@ -121,6 +132,14 @@ impl VolumeDiscretization {
         }
         let nnz = col_idx.len();
         e.pattern = Csr { nrows: 3 * free, ncols: 3 * free, row_ptr, col_idx, values: vec![0.0; nnz] };
+        let mut row_ptr = Vec::with_capacity(free + 1);
+        row_ptr.push(0);
+        for r in &neighbours {
+            row_ptr.push(row_ptr[row_ptr.len() - 1] + r.len());
+        }
+        let col_idx: Vec<usize> = neighbours.concat();
+        let nnz = col_idx.len();
+        e.scalar_pattern = Csr { nrows: free, ncols: free, row_ptr, col_idx, values: vec![0.0; nnz] };
         e.neighbours = neighbours;
         e
     }
@@ -186,10 +205,11 @@ impl VolumeDiscretization {
 
     /// The sum of the elements' [`Local`]s made by `element` (`None` when one of them
     /// is `None`): the scalars added, the vectors into the free unknowns, the matrices
-    /// (when `matrix`) into the values of the pattern. Elements are evaluated in
+    /// (when `matrix`) into the values of the pattern, the scalar matrices (when
+    /// `scalar_matrix`) into those of the scalar pattern. Elements are evaluated in
     /// parallel in batches and added in element order (the same sums as a sequential
     /// loop).
-    pub(super) fn assemble<F>(&self, matrix: bool, element: F) -> Option<(f64, Vec<f64>, Option<Csr>)>
+    pub(super) fn assemble<F>(&self, matrix: bool, scalar_matrix: bool, element: F) -> Option<Assembled>
     where
         F: Fn(usize) -> Option<Local> + Sync,
     {
@@ -198,6 +218,7 @@ impl VolumeDiscretization {
         let mut scalar = 0.0;
         let mut vector = vec![0.0; n];
         let mut values = if matrix { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
+        let mut scalar_values = if scalar_matrix { vec![0.0; self.scalar_pattern.nnz()] } else { Vec::new() };
         let batch = 32 * rayon::current_num_threads().max(1);
         for start in (0..ne).step_by(batch) {
             let locals: Vec<Local> =
@@ -210,13 +231,20 @@ impl VolumeDiscretization {
                     for ia in 0..3 {
                         vector[3 * fa + ia] += l.vector[3 * a + ia];
                     }
-                    if !matrix {
+                    if !matrix && !scalar_matrix {
                         continue;
                     }
                     let row = &self.neighbours[fa];
                     for b in 0..m {
                         let Some(fb) = self.free_index(l.idx[b]) else { continue };
-                        let at = 3 * row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        let at = row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        if scalar_matrix {
+                            scalar_values[self.scalar_pattern.row_ptr[fa] + at] += l.scalar_matrix[b * m + a];
+                        }
+                        if !matrix {
+                            continue;
+                        }
+                        let at = 3 * at;
                         for ia in 0..3 {
                             let p = self.pattern.row_ptr[3 * fa + ia] + at;
                             for ib in 0..3 {
@@ -228,6 +256,7 @@ impl VolumeDiscretization {
             }
         }
         let matrix = matrix.then(|| Csr { values, ..self.pattern.clone() });
-        Some((scalar, vector, matrix))
+        let scalar_matrix = scalar_matrix.then(|| Csr { values: scalar_values, ..self.scalar_pattern.clone() });
+        Some((scalar, vector, matrix, scalar_matrix))
     }
 }

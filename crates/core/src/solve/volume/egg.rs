@@ -44,8 +44,6 @@
 use std::sync::Arc;
 
 use super::assembly::{Local, VolumeDiscretization};
-use crate::error::{Error, Result};
-use crate::linalg::linsolve::{LinearMethod, LinearSolver};
 use crate::linalg::sparse::Csr;
 use crate::spline::volume::Point3;
 
@@ -65,6 +63,32 @@ fn contract(a: &[[f64; 3]; 3], h: &[f64; 6]) -> f64 {
     PAIRS.iter().zip(h).map(|(&(i, j), v)| if i == j { a[i][j] * v } else { 2.0 * a[i][j] * v }).sum()
 }
 
+/// The table of one point (see `EggVolume::element_points`) of the B-splines `N` made
+/// that of the rational basis `R = w N / Σ w N` with the weights `w`.
+fn rational(table: &mut [f64], w: impl Iterator<Item = f64>) {
+    let m = table.len() / 10;
+    for (a, wa) in w.enumerate() {
+        for k in 0..10 {
+            table[k * m + a] *= wa;
+        }
+    }
+    let sum = |k: usize| table[k * m..(k + 1) * m].iter().sum::<f64>();
+    let (ws, wg, wh): (f64, [f64; 3], [f64; 6]) =
+        (sum(0), std::array::from_fn(|i| sum(1 + i)), std::array::from_fn(|k| sum(4 + k)));
+    for a in 0..m {
+        let r = table[a] / ws;
+        let gr: Point3 = std::array::from_fn(|i| (table[(1 + i) * m + a] - r * wg[i]) / ws);
+        for k in 0..6 {
+            let (i, j) = PAIRS[k];
+            table[(4 + k) * m + a] = (table[(4 + k) * m + a] - gr[i] * wg[j] - gr[j] * wg[i] - r * wh[k]) / ws;
+        }
+        table[a] = r;
+        for i in 0..3 {
+            table[(1 + i) * m + a] = gr[i];
+        }
+    }
+}
+
 /// The scaled EGG operator of volumes on one [`VolumeDiscretization`].
 #[derive(Debug, Clone)]
 pub struct EggVolume {
@@ -79,6 +103,11 @@ pub struct EggEvaluation {
     pub residual: Vec<f64>,
     /// `∂F/∂c` over the free coordinates.
     pub jacobian: Option<Csr>,
+    /// The stiffness of the cofactor metric over the free control points (one scalar
+    /// unknown each), `K_AB = ∫ ∇R_A · (A / tr A) ∇R_B dξ`: SPD where `det J ≠ 0`, and
+    /// `-diag(K, K, K)` is the Jacobian's principal part (integrate `R_A (A : ∇²R_B) / T`
+    /// by parts), the preconditioner of its GMRES solve.
+    pub laplace: Option<Csr>,
 }
 
 impl EggVolume {
@@ -100,91 +129,95 @@ impl EggVolume {
         &self.disc
     }
 
-    /// The element's quadrature: weights `w_q`, and at every point (`q m + a`) `R_a`,
-    /// `∇R_a` and `∇²R_a` (the six entries of [`PAIRS`]); rational:
-    /// `R = n / W`, `∇R = (∇n - R ∇W) / W`, `∂_ij R = (∂_ij n - ∂_i R ∂_j W - ∂_j R ∂_i W - R ∂_ij W) / W`
-    /// with `n = w N` and `W = Σ n`.
-    #[allow(clippy::type_complexity)]
-    fn element_points(&self, e: usize, idx: &[usize]) -> (Vec<f64>, Vec<f64>, Vec<Point3>, Vec<[f64; 6]>) {
+    /// The element's quadrature: weights `w_q`, and at every point `q` the table
+    /// `B[(10 q + k) m + a]` of `R_a` (`k = 0`), `∇R_a` (`k = 1..4`) and `∇²R_a` (`k =
+    /// 4..10`, the six entries of [`PAIRS`]); tensor products of the univariate tables,
+    /// and for a rational basis `R = n / W`, `∇R = (∇n - R ∇W) / W`,
+    /// `∂_ij R = (∂_ij n - ∂_i R ∂_j W - ∂_j R ∂_i W - R ∂_ij W) / W` with `n = w N` and
+    /// `W = Σ n`.
+    fn element_points(&self, e: usize, idx: &[usize]) -> (Vec<f64>, Vec<f64>) {
         let [bx, by, bz] = self.disc.element_tables(e);
         let p = [bx[0].0.degree, by[0].0.degree, bz[0].0.degree];
         let m = idx.len();
         let nq = bx.len() * by.len() * bz.len();
-        let (mut weights, mut vals, mut grads, mut hess) = (
-            Vec::with_capacity(nq),
-            Vec::with_capacity(nq * m),
-            Vec::with_capacity(nq * m),
-            Vec::with_capacity(nq * m),
-        );
-        let mut local: Vec<(f64, Point3, [f64; 6])> = Vec::with_capacity(m);
+        let mut weights = Vec::with_capacity(nq);
+        let mut basis = vec![0.0; nq * 10 * m];
         for (z, wz) in bz {
             for (y, wy) in by {
                 for (x, wx) in bx {
-                    local.clear();
-                    let (mut ws, mut wg, mut wh) = (0.0, [0.0; 3], [0.0; 6]);
-                    let mut lin = idx.iter();
+                    let q = weights.len();
+                    let table = &mut basis[q * 10 * m..(q + 1) * 10 * m];
+                    let mut lin = 0;
                     for c in 0..=p[2] {
                         for b in 0..=p[1] {
+                            let (y0, y1, y2, z0, z1, z2) =
+                                (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
+                            let yz = [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1];
                             for a in 0..=p[0] {
-                                let l = *lin.next().expect("one index per basis function");
-                                let w = self.disc.weights.as_ref().map_or(1.0, |w| w[l]);
-                                let f = |i: usize, j: usize, k: usize| w * x.d[i][a] * y.d[j][b] * z.d[k][c];
-                                let n = f(0, 0, 0);
-                                let g = [f(1, 0, 0), f(0, 1, 0), f(0, 0, 1)];
-                                let h = [f(2, 0, 0), f(0, 2, 0), f(0, 0, 2), f(1, 1, 0), f(1, 0, 1), f(0, 1, 1)];
-                                ws += n;
-                                for q in 0..3 {
-                                    wg[q] += g[q];
+                                let (x0, x1, x2) = (x.d[0][a], x.d[1][a], x.d[2][a]);
+                                let f = [
+                                    x0 * yz[0],
+                                    x1 * yz[0],
+                                    x0 * yz[1],
+                                    x0 * yz[2],
+                                    x2 * yz[0],
+                                    x0 * yz[3],
+                                    x0 * yz[4],
+                                    x1 * yz[1],
+                                    x1 * yz[2],
+                                    x0 * yz[5],
+                                ];
+                                for (k, v) in f.into_iter().enumerate() {
+                                    table[k * m + lin] = v;
                                 }
-                                for q in 0..6 {
-                                    wh[q] += h[q];
-                                }
-                                local.push((n, g, h));
+                                lin += 1;
                             }
                         }
                     }
-                    for (n, g, h) in &local {
-                        let r = n / ws;
-                        let gr: Point3 = std::array::from_fn(|i| (g[i] - r * wg[i]) / ws);
-                        let hr: [f64; 6] = std::array::from_fn(|k| {
-                            let (i, j) = PAIRS[k];
-                            (h[k] - gr[i] * wg[j] - gr[j] * wg[i] - r * wh[k]) / ws
-                        });
-                        vals.push(r);
-                        grads.push(gr);
-                        hess.push(hr);
+                    if let Some(w) = self.disc.weights.as_ref() {
+                        rational(table, idx.iter().map(|&l| w[l]));
                     }
                     weights.push(wx * wy * wz);
                 }
             }
         }
-        (weights, vals, grads, hess)
+        (weights, basis)
     }
 
-    /// Element `e`'s residual and Jacobian (see [`Local`]; the scalar is unused);
-    /// `None` when `tr A = 0` at one of its points.
-    fn element(&self, e: usize, cps: &[Point3], jacobian: bool) -> Option<Local> {
+    /// Element `e`'s residual, Jacobian (when `jacobian`) and cofactor-metric stiffness
+    /// `K_ab = Σ_q w_q ∇R_a · (A/T) ∇R_b` (when `laplace`; see [`Local`], the scalar is
+    /// unused); `None` when `tr A = 0` at one of its points.
+    fn element(&self, e: usize, cps: &[Point3], jacobian: bool, laplace: bool) -> Option<Local> {
         let idx = self.disc.element_indices(e);
-        let (weights, vals, grads, hess) = self.element_points(e, &idx);
+        let (weights, basis) = self.element_points(e, &idx);
         let (m, nq) = (idx.len(), weights.len());
+        // x, ∇x and ∇²x at every point: X[(10 q + k), c] = Σ_a B[(10 q + k), a] c_(a, c)
+        let mut cl = vec![0.0; 3 * m];
+        for (a, &lin) in idx.iter().enumerate() {
+            for c in 0..3 {
+                cl[c * m + a] = cps[lin][c];
+            }
+        }
+        let mut xq = vec![0.0; 30 * nq];
+        faer::linalg::matmul::matmul(
+            faer::MatMut::from_column_major_slice_mut(&mut xq, 10 * nq, 3),
+            faer::Accum::Replace,
+            faer::MatRef::from_row_major_slice(&basis, 10 * nq, m),
+            faer::MatRef::from_column_major_slice(&cl, m, 3),
+            1.0,
+            faer::Par::Seq,
+        );
         let mut res = vec![0.0; 3 * m];
         let mut qm = if jacobian { vec![0.0; nq * 9 * m] } else { Vec::new() };
+        // K = U V: U[a, (q, i)] = w_q ((A/T) ∇R_a)_i, V[(q, i), b] = ∂_i R_b
+        let (mut um, mut vm) =
+            if laplace { (vec![0.0; 3 * nq * m], vec![0.0; 3 * nq * m]) } else { (Vec::new(), Vec::new()) };
         for (q, &wq) in weights.iter().enumerate() {
-            let (rq, gq, hq) = (&vals[q * m..(q + 1) * m], &grads[q * m..(q + 1) * m], &hess[q * m..(q + 1) * m]);
+            let table = &basis[q * 10 * m..(q + 1) * 10 * m];
+            let (rq, gq, hq) = (&table[..m], &table[m..4 * m], &table[4 * m..]);
             // J's columns and the components' Hessians
-            let mut d = [[0.0; 3]; 3];
-            let mut xh = [[0.0; 6]; 3];
-            for a in 0..m {
-                let c = cps[idx[a]];
-                for comp in 0..3 {
-                    for col in 0..3 {
-                        d[col][comp] += c[comp] * gq[a][col];
-                    }
-                    for k in 0..6 {
-                        xh[comp][k] += c[comp] * hq[a][k];
-                    }
-                }
-            }
+            let d: [Point3; 3] = std::array::from_fn(|col| std::array::from_fn(|c| xq[c * 10 * nq + 10 * q + 1 + col]));
+            let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| xq[c * 10 * nq + 10 * q + 4 + k]));
             let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
             let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
             let t = am[0][0] + am[1][1] + am[2][2];
@@ -192,9 +225,18 @@ impl EggVolume {
                 return None;
             }
             let l: [f64; 3] = std::array::from_fn(|c| contract(&am, &xh[c]) / t);
-            for a in 0..m {
+            for (r, &v) in res.chunks_exact_mut(3).zip(rq) {
                 for c in 0..3 {
-                    res[3 * a + c] += wq * rq[a] * l[c];
+                    r[c] += wq * v * l[c];
+                }
+            }
+            if laplace {
+                for a in 0..m {
+                    let g = [gq[a], gq[m + a], gq[2 * m + a]];
+                    for i in 0..3 {
+                        um[(3 * q + i) * m + a] = wq * (am[i][0] * g[0] + am[i][1] * g[1] + am[i][2] * g[2]) / t;
+                        vm[(3 * q + i) * m + a] = g[i];
+                    }
                 }
             }
             if !jacobian {
@@ -224,9 +266,18 @@ impl EggVolume {
                 }
             }
             let row = &mut qm[q * 9 * m..(q + 1) * 9 * m];
+            // the coefficients of A : ∇²R_b / T in the order of PAIRS
+            let ah: [f64; 6] = std::array::from_fn(|k| {
+                let (i, j) = PAIRS[k];
+                if i == j {
+                    am[i][j] / t
+                } else {
+                    2.0 * am[i][j] / t
+                }
+            });
             for b in 0..m {
-                let v = contract(&am, &hq[b]) / t;
-                let g = gq[b];
+                let v = (0..6).map(|k| ah[k] * hq[k * m + b]).sum::<f64>();
+                let g = [gq[b], gq[m + b], gq[2 * m + b]];
                 for ib in 0..3 {
                     for ia in 0..3 {
                         let mut x = g[0] * s[ia][0][ib] + g[1] * s[ia][1][ib] + g[2] * s[ia][2][ib];
@@ -243,7 +294,7 @@ impl EggVolume {
             let mut pm = vec![0.0; m * nq];
             for (q, &wq) in weights.iter().enumerate() {
                 for a in 0..m {
-                    pm[q * m + a] = wq * vals[q * m + a];
+                    pm[q * m + a] = wq * basis[q * 10 * m + a];
                 }
             }
             k = vec![0.0; 9 * m * m];
@@ -256,7 +307,19 @@ impl EggVolume {
                 faer::Par::Seq,
             );
         }
-        Some(Local { idx, scalar: 0.0, vector: res, matrix: k })
+        let mut kl = Vec::new();
+        if laplace {
+            kl = vec![0.0; m * m];
+            faer::linalg::matmul::matmul(
+                faer::MatMut::from_column_major_slice_mut(&mut kl, m, m),
+                faer::Accum::Replace,
+                faer::MatRef::from_column_major_slice(&um, m, 3 * nq),
+                faer::MatRef::from_column_major_slice(&vm, m, 3 * nq).transpose(),
+                1.0,
+                faer::Par::Seq,
+            );
+        }
+        Some(Local { idx, scalar: 0.0, vector: res, matrix: k, scalar_matrix: kl })
     }
 
     /// Number of free scalar unknowns (3 per interior control point).
@@ -267,80 +330,22 @@ impl EggVolume {
     /// `F` (and `∂F/∂c` when `jacobian`) at the control points `cps`
     /// ([`VolumeDiscretization::assemble`]).
     pub fn evaluate(&self, cps: &[Point3], jacobian: bool) -> EggEvaluation {
-        match self.disc.assemble(jacobian, |e| self.element(e, cps, jacobian)) {
-            Some((_, residual, jacobian)) => EggEvaluation { residual, jacobian },
-            None => EggEvaluation { residual: Vec::new(), jacobian: None },
+        self.evaluate_with(cps, jacobian, false)
+    }
+
+    /// [`EggVolume::evaluate`], with the cofactor-metric stiffness `K` of the scalar
+    /// unknowns when `laplace` ([`EggEvaluation::laplace`]).
+    pub fn evaluate_with(&self, cps: &[Point3], jacobian: bool, laplace: bool) -> EggEvaluation {
+        match self.disc.assemble(jacobian, laplace, |e| self.element(e, cps, jacobian, laplace)) {
+            Some((_, residual, jacobian, laplace)) => EggEvaluation { residual, jacobian, laplace },
+            None => EggEvaluation { residual: Vec::new(), jacobian: None, laplace: None },
         }
     }
 }
 
-/// Statistics of one EGG solve.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct EggSolved {
-    pub(super) iterations: usize,
-    /// `|F|` of the result relative to that of the start.
-    pub(super) relative_residual: f64,
-}
+mod newton;
 
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-/// Newton's method on `F(c) = 0` over the free control points of `cps` (the rest are
-/// the Dirichlet data), sparse LU on the Jacobian, the step halved while `|F|` does not
-/// decrease (Armijo on `|F|`); stops when `|F| <= tolerance max(|F(start)|, 1)` (the
-/// operator is of unit size in the unit frame the volume solve works in) or after
-/// `max_iterations`.
-pub(super) fn solve_egg(
-    op: &EggVolume,
-    cps: &mut [Point3],
-    max_iterations: usize,
-    tolerance: f64,
-) -> Result<EggSolved> {
-    let mut ev = op.evaluate(cps, true);
-    if ev.residual.is_empty() && op.unknowns() > 0 {
-        return Err(Error::InfeasibleStart {
-            method: "3D EGG".into(),
-            reason: "the cofactor metric vanishes (J of rank 1 or less) at a quadrature point of the start".into(),
-        });
-    }
-    let f0 = norm(&ev.residual);
-    let stop = tolerance * f0.max(1.0);
-    let mut x = op.disc.gather(cps);
-    let mut solver = LinearSolver::new(LinearMethod::Lu);
-    let mut iterations = 0;
-    let mut fnorm = f0;
-    while iterations < max_iterations && op.unknowns() > 0 && fnorm > stop {
-        let jac = ev.jacobian.as_ref().expect("evaluated with the Jacobian");
-        solver.factor(jac)?;
-        let rhs: Vec<f64> = ev.residual.iter().map(|f| -f).collect();
-        let d = solver.solve(&rhs)?;
-        if !d.iter().all(|v| v.is_finite()) {
-            return Err(Error::NoConvergence("3D EGG: the Newton step is not finite".into()));
-        }
-        iterations += 1;
-        let mut alpha = 1.0;
-        let mut accepted = None;
-        for _ in 0..30 {
-            let trial: Vec<f64> = x.iter().zip(&d).map(|(a, b)| a + alpha * b).collect();
-            let mut c = cps.to_vec();
-            op.disc.scatter(&mut c, &trial);
-            let t = op.evaluate(&c, false);
-            let tn = if t.residual.is_empty() { f64::INFINITY } else { norm(&t.residual) };
-            if tn <= (1.0 - 1e-4 * alpha) * fnorm {
-                accepted = Some((trial, c));
-                break;
-            }
-            alpha *= 0.5;
-        }
-        let Some((trial, c)) = accepted else { break };
-        x = trial;
-        cps.copy_from_slice(&c);
-        ev = op.evaluate(cps, true);
-        fnorm = norm(&ev.residual);
-    }
-    Ok(EggSolved { iterations, relative_residual: fnorm / f0.max(f64::MIN_POSITIVE) })
-}
+pub(super) use newton::{solve_egg, EggSolved};
 
 #[cfg(test)]
 mod tests {

@@ -87,6 +87,11 @@ pub struct VolumeOptions {
     pub max_continuation: usize,
     /// Options of the volume certificate.
     pub certify: CertifyOptions,
+    /// The linear solver of EGG's Newton steps (module `egg::newton`): sparse LU
+    /// ([`LinearMethod::Lu`]), or GMRES preconditioned by the cofactor metric's stiffness
+    /// (the others; [`LinearMethod::Auto`], the default, factorizes up to 64 unknowns
+    /// and falls back to LU when GMRES fails).
+    pub linear: LinearMethod,
 }
 
 impl Default for VolumeOptions {
@@ -99,6 +104,7 @@ impl Default for VolumeOptions {
             tolerance: 1e-10,
             max_continuation: 64,
             certify: CertifyOptions::default(),
+            linear: LinearMethod::Auto,
         }
     }
 }
@@ -130,6 +136,11 @@ pub struct VolumeSolveReport {
     /// `|F|` of the EGG map relative to that of the Coons patch (`null` when EGG did
     /// not run).
     pub egg_relative_residual: Option<f64>,
+    /// The linear solver of EGG's last Newton step, `lu` or `gmres` (`null` when EGG
+    /// did not run).
+    pub egg_linear: Option<&'static str>,
+    /// GMRES iterations of all EGG Newton steps (`null` when EGG did not run).
+    pub egg_krylov_iterations: Option<usize>,
     /// `E` of the Coons patch (`null` when it leaves the barrier).
     pub energy_start: Option<f64>,
     /// `E` of the result (`null` when it leaves the barrier: possible for EGG).
@@ -326,7 +337,7 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
             let energy_start = coons_energy.is_finite().then_some(coons_energy * scale);
             let mut cps = coons;
             let op = EggVolume::on(disc.clone());
-            let solved = solve_egg(&op, &mut cps, opts.max_iterations, opts.tolerance)?;
+            let solved = solve_egg(&op, &mut cps, opts.max_iterations, opts.tolerance, opts.linear)?;
             egg = Some(solved);
             let inside = energy.evaluate(&cps, false).energy.is_finite();
             if method == VolumeMethod::Egg {
@@ -494,6 +505,8 @@ pub(crate) fn solve_volume(b: &VolumeBoundary, opts: &VolumeOptions) -> Result<V
                 newton_iterations: on.iterations,
                 egg_iterations: on.egg.map(|e| e.iterations),
                 egg_relative_residual: on.egg.map(|e| e.relative_residual),
+                egg_linear: on.egg.map(|e| if e.linear == LinearMethod::Lu { "lu" } else { "gmres" }),
+                egg_krylov_iterations: on.egg.map(|e| e.krylov_iterations),
                 energy_start: on.energy_start,
                 energy: on.energy,
                 relative_gradient: on.relative_gradient,

@@ -259,7 +259,7 @@ impl WinslowVolume {
                 faer::Par::Seq,
             );
         }
-        Some(Local { idx, scalar: energy, vector: g, matrix: k })
+        Some(Local { idx, scalar: energy, vector: g, matrix: k, scalar_matrix: Vec::new() })
     }
 
     /// Number of free scalar unknowns (3 per interior control point).
@@ -271,8 +271,8 @@ impl WinslowVolume {
     /// gradient is empty and the Hessian `None` when `E = +∞`
     /// ([`VolumeDiscretization::assemble`]).
     pub fn evaluate(&self, cps: &[Point3], hessian: bool) -> Evaluation {
-        match self.disc.assemble(hessian, |e| self.element(e, cps, hessian)) {
-            Some((energy, gradient, hessian)) => Evaluation { energy, gradient, hessian },
+        match self.disc.assemble(hessian, false, |e| self.element(e, cps, hessian)) {
+            Some((energy, gradient, hessian, _)) => Evaluation { energy, gradient, hessian },
             None => Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None },
         }
     }
