@@ -219,10 +219,13 @@ fn admissible(angles: [f64; 4], reflex: bool) -> bool {
 
 /// A cut's score: how far its new angles that are not flat stay from 0 and 180 degrees,
 /// `min(a, π - a)` over them (a flat one is allowed only where a reflex corner is cut
-/// along a side's extension, and is cut next).
+/// along a side's extension, and is cut next), rounded to `1e-9` radians so that cuts
+/// equal up to rounding tie (an L's two side extensions, at 90 degrees and at 90 degrees
+/// plus an ulp).
 fn score(angles: [f64; 4]) -> f64 {
     let pi = std::f64::consts::PI;
-    angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).map(|a| a.min(pi - a)).fold(pi, f64::min)
+    let s = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).map(|a| a.min(pi - a)).fold(pi, f64::min);
+    (s * 1e9).round() * 1e-9
 }
 
 /// Whether the polyline `cut` (from the boundary of face `f` back to its boundary)
