@@ -206,11 +206,13 @@ fn convert_outline_writes_the_domain_of_a_layout() {
     assert!(!dir.join("no.json").exists());
 }
 
-/// A flat corner with no straight cut inside its face (the corpus's `wiggly-17`, face 5:
-/// a 180° corner on a wiggly edge) is cut along the face's map onto its regular polygon
-/// (`curved` in the cut's report), and every patch of the layout is certified.
+/// A flat corner with no straight cut along its bisector inside its face (the corpus's
+/// `wiggly-17`, face 5: a 180° corner on a wiggly edge) is cut straight to a point
+/// searched along the sides (`spread` in the cut's report; before, a curved cut split its
+/// 180° into 1° and 179°): its new angles stay at least 30° from 0° and 180°, and every
+/// patch of the layout is certified.
 #[test]
-fn a_flat_corner_without_a_straight_cut_gets_a_curved_one() {
+fn a_flat_corner_without_a_straight_bisector_cut_is_cut_far_from_0_and_180_degrees() {
     let scratch = tempfile::tempdir().unwrap();
     let dir = scratch.path();
     let corpus = dir.join("corpus");
@@ -233,12 +235,16 @@ fn a_flat_corner_without_a_straight_cut_gets_a_curved_one() {
     let verdicts = report["verdicts"].as_array().unwrap();
     assert!(!verdicts.is_empty() && verdicts.iter().all(|v| v == "certified"), "{}", report["message"]);
     let cuts = report["auto_layout"]["cuts"].as_array().unwrap();
-    let curved: Vec<_> = cuts.iter().filter(|c| c["curved"] == true).collect();
-    assert!(!curved.is_empty(), "no curved cut in {cuts:?}");
-    // the corner it starts from is flat, and the cut splits its 180°
-    for c in curved {
-        assert!((c["angle"].as_f64().unwrap() - 180.0).abs() < 1.0, "{c}");
+    let spread: Vec<_> = cuts.iter().filter(|c| c["spread"] == true).collect();
+    assert!(!spread.is_empty(), "no searched cut end in {cuts:?}");
+    // one starts from a flat corner and splits its 180° far from 0° and 180°
+    let flat = spread.iter().filter(|c| (c["angle"].as_f64().unwrap() - 180.0).abs() < 1.0);
+    let mut n = 0;
+    for c in flat {
         let new: Vec<f64> = c["new_angles"].as_array().unwrap().iter().map(|a| a.as_f64().unwrap()).collect();
-        assert!((new[0] + new[1] - 180.0).abs() < 1e-6 && new.iter().all(|&a| a > 0.0), "{c}");
+        assert!((new[0] + new[1] - 180.0).abs() < 1e-6 && new.iter().all(|&a| a > 30.0 && a < 150.0), "{c}");
+        n += 1;
     }
+    assert!(n > 0, "no cut from a flat corner in {cuts:?}");
+    assert!(report["auto_layout"]["corner_angles"][0].as_f64().unwrap() > 29.0);
 }

@@ -2,8 +2,11 @@
 //! removed by splitting faces): every corner of a face whose interior angle exceeds 180°
 //! is cut by a straight edge into the face, along the angle's bisector to the first side
 //! it meets, or from the corner to an end of that side; of these candidates that stay
-//! inside the face and leave all four new corner angles below 180°, the one whose
-//! smallest new angle is largest is taken. A cut never ends inside an edge that another face shares (that face
+//! inside the face and leave all four new corner angles below 180°, the one whose new
+//! angles stay farthest from 0° and 180° is taken (the largest `min(a, 180° - a)` over
+//! them, a flat part of a reflex corner left out: it is cut next). Where that is below 30° (the cut meets a
+//! side at a grazing angle), straight cuts to points spread along the sides that do not
+//! meet the corner are candidates too, scored alike. A cut never ends inside an edge that another face shares (that face
 //! would get a 180° corner there). The worst reflex corner is cut first, until none is
 //! left.
 
@@ -40,6 +43,10 @@ pub struct CutReport {
     /// (written only when true).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub curved: bool,
+    /// The end was chosen among points spread along the sides, because the cuts along
+    /// the bisector and the side extensions end at a sliver (written only when true).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub spread: bool,
 }
 
 /// The straight segment from `a` to `b` (degree 1).
@@ -60,7 +67,11 @@ fn face_polyline(g: &Graph, f: usize) -> Vec<(Point, usize)> {
 /// Whether the straight segment `a b` stays inside face `f` (it touches the face's
 /// boundary only at its ends).
 pub(super) fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) -> bool {
-    let poly = face_polyline(g, f);
+    segment_inside_polyline(&face_polyline(g, f), a, b, tol)
+}
+
+/// [`segment_inside`] on the face's sampled boundary `poly` ([`face_polyline`]).
+fn segment_inside_polyline(poly: &[(Point, usize)], a: Point, b: Point, tol: f64) -> bool {
     let n = poly.len();
     // the segment without its ends, which lie on the boundary
     let e = 1e-6;
@@ -121,6 +132,8 @@ struct Candidate {
     angles: [f64; 4],
     /// A curved cut (from the corner to `point`); `None`: the straight segment.
     curve: Option<Curve>,
+    /// Its end was found among points spread along the sides ([`spread_candidates`]).
+    spread: bool,
 }
 
 /// Where a cut may end: a corner of the face or a point on its side `k` at the edge
@@ -132,6 +145,88 @@ const CURVED_SAMPLES: usize = 48;
 
 /// Boundary nodes a side of the face's map onto the polygon for curved cuts.
 const CURVED_PER_SIDE: usize = 16;
+
+/// Below this smallest new angle (radians, 30 degrees) of the best straight cut along
+/// the bisector or the side extensions, straight cuts to points spread along the sides
+/// ([`spread_candidates`]) are tried as well.
+pub(super) const GOOD_CUT_ANGLE: f64 = std::f64::consts::PI / 6.0;
+
+/// Points per side (at equal fractions of its arc length, ends excluded) that
+/// [`spread_candidates`] tries as a cut's end.
+const SPREAD_SAMPLES: usize = 32;
+
+/// Straight cuts from corner `i` of face `f` to points spread along every side that does
+/// not meet the corner (`SPREAD_SAMPLES - 1` interior points at equal fractions of its
+/// arc length), for a corner whose cuts along the bisector and the side extensions end
+/// at a sliver (a side met at a grazing angle): those that stay inside the face and keep
+/// the rules of [`cut_reflex`], scored alike (how far the four new angles stay from 0
+/// and 180 degrees). A
+/// cut to a side at the corner would leave a face of two corners, so those sides are
+/// skipped.
+fn spread_candidates(g: &Graph, f: usize, i: usize, reflex: bool, tol: f64) -> Vec<Candidate> {
+    let n = g.faces[f].sides.len();
+    let poly = face_polyline(g, f);
+    let o = g.vertices[g.corners(f)[i]];
+    let (t_out, back) = g.corner_directions(f, i);
+    let mut out = Vec::new();
+    for k in 0..n {
+        if k == i || (k + 1) % n == i {
+            continue;
+        }
+        let (e, fwd) = g.faces[f].sides[k];
+        let c = &g.edges[e].curve;
+        let arc = ArcLength::new(c);
+        for j in 1..SPREAD_SAMPLES {
+            let u = arc.param(j as f64 / SPREAD_SAMPLES as f64);
+            let p = c.eval(u);
+            if !segment_inside_polyline(&poly, o, p, tol) {
+                continue;
+            }
+            let mut t = end_tangent_at(c, u);
+            if !fwd {
+                t = [-t[0], -t[1]];
+            }
+            let d = [p[0] - o[0], p[1] - o[1]];
+            let angles = [
+                ccw_angle(t_out, d),
+                ccw_angle(d, back),
+                ccw_angle(t, [-d[0], -d[1]]),
+                ccw_angle([-d[0], -d[1]], [-t[0], -t[1]]),
+            ];
+            if admissible(angles, reflex) {
+                out.push(Candidate {
+                    corner: None,
+                    on_side: Some((k, u)),
+                    point: p,
+                    score: score(angles),
+                    angles,
+                    curve: None,
+                    spread: true,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The rules every cut keeps: no new reflex angle and no sliver; a flat part only where
+/// the corner was reflex (it is cut next). `angles`: the two at the corner, then the two
+/// at the cut's end.
+fn admissible(angles: [f64; 4], reflex: bool) -> bool {
+    let pi = std::f64::consts::PI;
+    angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (angles[0] < pi - FLAT && angles[1] < pi - FLAT))
+}
+
+/// A cut's score: how far its new angles that are not flat stay from 0 and 180 degrees,
+/// `min(a, π - a)` over them (a flat one is allowed only where a reflex corner is cut
+/// along a side's extension, and is cut next), rounded to `1e-9` radians so that cuts
+/// equal up to rounding tie (an L's two side extensions, at 90 degrees and at 90 degrees
+/// plus an ulp).
+fn score(angles: [f64; 4]) -> f64 {
+    let pi = std::f64::consts::PI;
+    let s = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).map(|a| a.min(pi - a)).fold(pi, f64::min);
+    (s * 1e9).round() * 1e-9
+}
 
 /// Whether the polyline `cut` (from the boundary of face `f` back to its boundary)
 /// stays inside the face: no chord comes within `tol` of the face's boundary away from
@@ -167,7 +262,6 @@ fn polyline_inside(g: &Graph, f: usize, cut: &[Point], tol: f64) -> bool {
 /// Each is fitted by a spline; the ones whose fit stays inside and whose four new
 /// angles keep the rules of the straight cuts are the candidates, scored alike.
 fn curved_candidates(g: &Graph, f: usize, i: usize, reflex: bool, diameter: f64, fit: &FitOptions) -> Vec<Candidate> {
-    let pi = std::f64::consts::PI;
     let tol = 1e-9 * diameter;
     let sides: Vec<Curve> = g.faces[f].sides.iter().map(|&s| g.side_curve(s)).collect();
     let n = sides.len();
@@ -229,10 +323,16 @@ fn curved_candidates(g: &Graph, f: usize, i: usize, reflex: bool, diameter: f64,
         let (a1, a2) = (ccw_angle(t_out, d0), ccw_angle(d0, back));
         let (b1, b2) = (ccw_angle(to, d1r), ccw_angle(d1r, bj));
         let angles = [a1, a2, b1, b2];
-        let ok = angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
-        if ok {
-            let score = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).fold(pi, f64::min);
-            out.push(Candidate { corner, on_side, point: p, score, angles, curve: Some(curve) });
+        if admissible(angles, reflex) {
+            out.push(Candidate {
+                corner,
+                on_side,
+                point: p,
+                score: score(angles),
+                angles,
+                curve: Some(curve),
+                spread: false,
+            });
         }
     }
     out
@@ -275,7 +375,17 @@ fn end_tangent_at(c: &Curve, u: f64) -> Point {
 const FLAT: f64 = 1e-6;
 
 /// Cut every reflex and flat corner of every face (see the module documentation).
-pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, fit: &FitOptions, cuts: &mut Vec<CutReport>) -> Result<()> {
+///
+/// `search`: below this smallest new angle (radians) of the best cut along the bisector
+/// or the side extensions, cuts to points spread along the sides are tried as well
+/// ([`GOOD_CUT_ANGLE`] by default; 0: never, π: always).
+pub(crate) fn cut_reflex(
+    g: &mut Graph,
+    diameter: f64,
+    fit: &FitOptions,
+    search: f64,
+    cuts: &mut Vec<CutReport>,
+) -> Result<()> {
     let tol = 1e-9 * diameter;
     let pi = std::f64::consts::PI;
     for _ in 0..10_000 {
@@ -343,15 +453,26 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, fit: &FitOptions, cuts: &
                 let b1 = ccw_angle(to, [-d[0], -d[1]]);
                 let b2 = ccw_angle([-d[0], -d[1]], bj);
                 let angles = [a1, a2, b1, b2];
-                // no new reflex angle and no sliver; a flat part only where the corner
-                // was reflex (it is cut next)
-                let ok =
-                    angles.iter().all(|&a| a > 1e-3 && a < pi + FLAT) && (reflex || (a1 < pi - FLAT && a2 < pi - FLAT));
-                if ok {
-                    let score = angles.iter().copied().filter(|a| (a - pi).abs() > FLAT).fold(pi, f64::min);
-                    cands.push(Candidate { corner, on_side, point: p, score, angles, curve: None });
+                if admissible(angles, reflex) {
+                    cands.push(Candidate {
+                        corner,
+                        on_side,
+                        point: p,
+                        score: score(angles),
+                        angles,
+                        curve: None,
+                        spread: false,
+                    });
                 }
             }
+        }
+        // a sliver at the best cut's end (or none inside): cuts to points along the sides
+        if cands.iter().map(|c| c.score).fold(f64::NEG_INFINITY, f64::max) < search {
+            let spread: Vec<Candidate> = spread_candidates(g, f, i, reflex, tol)
+                .into_iter()
+                .filter(|c| !cands.iter().any(|x| x.point == c.point))
+                .collect();
+            cands.extend(spread);
         }
         if cands.is_empty() {
             cands = curved_candidates(g, f, i, reflex, diameter, fit);
@@ -385,7 +506,7 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, fit: &FitOptions, cuts: &
             }
             None => line(o, p),
         };
-        let curved = best.curve.is_some();
+        let (curved, spread) = (best.curve.is_some(), best.spread);
         let cut = g.add_edge(curve, o_vertex, j_vertex, false);
         g.split_face(f, ci, cj, cut);
         cuts.push(CutReport {
@@ -395,6 +516,7 @@ pub(crate) fn cut_reflex(g: &mut Graph, diameter: f64, fit: &FitOptions, cuts: &
             ends_on: if best.corner.is_some() { "vertex" } else { "side" },
             new_angles: best.angles.map(f64::to_degrees),
             curved,
+            spread,
         });
     }
     Err(Error::Domain { at: "layout".into(), reason: "more than 10000 cuts from reflex corners".into() })

@@ -7,7 +7,10 @@
 //!    `build_graph`, each labelled. Holes are cut away by `holes`.
 //! 2. **Reflex corners** are cut by straight edges into the face (`reflex`);
 //!    a cut ending inside an edge shared with another face gives that face a flat
-//!    corner, cut in turn.
+//!    corner, cut in turn. A cut's end is where its new angles stay farthest from 0° and
+//!    180°; where the cuts along the bisector and the side extensions leave a sliver, the
+//!    end is searched along the sides. A domain without holes whose layout is not valid
+//!    so is laid out again without that search, then with it at every corner.
 //! 3. **Templates**: a face with four corners stays one patch. Every other face with `N`
 //!    corners is cut into `N` quads around one interior vertex (valence `N`), the
 //!    midpoint template: the harmonic map of the regular `N`-gon onto the face
@@ -39,7 +42,7 @@ use super::harmonic::{ArcLength, HarmonicMap};
 use super::holes::{cut_holes, HoleCut};
 use super::plane::{build_graph, GraphReport, PlaneGraph};
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
-use super::reflex::{cut_reflex, fit_points, line, segment_inside, CutReport};
+use super::reflex::{cut_reflex, fit_points, line, segment_inside, CutReport, GOOD_CUT_ANGLE};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
 use crate::boundary::fit::{fit_side, FitOptions};
@@ -125,6 +128,10 @@ pub struct LayoutReport {
     pub hole_cut_tries: Vec<HoleCutTry>,
     /// Cuts from reflex corners.
     pub cuts: Vec<CutReport>,
+    /// Below this smallest new angle (degrees) of a cut along a corner's bisector or
+    /// side extensions, the cut's end was searched along the sides (`cuts[].spread`):
+    /// 30 by default; 0 (never) or 180 (always) where the default gives no valid layout.
+    pub cut_search: f64,
     /// The template of every face.
     pub faces: Vec<FaceReport>,
     /// Interior vertices of valence other than 4.
@@ -316,7 +323,7 @@ pub fn auto_layout(domain: &Domain, opts: &LayoutOptions) -> Result<AutoLayout> 
     }
     g.faces.push(face);
     let area = checked.area;
-    lay_out_graph(g, &d.name, diameter, area, (Some(checked), None), opts, t0)
+    lay_out_graph(g, &d.name, diameter, area, (Some(checked), None), opts, t0, &CUT_SEARCHES)
 }
 
 /// Lay out the plane graph `pg`: its faces (with their holes and labels) as
@@ -326,20 +333,26 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
     opts.fit.validate()?;
     let (g, report) = build_graph(pg, &opts.fit)?;
     let (diameter, area) = (report.diameter, report.area);
-    lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0)
+    lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0, &CUT_SEARCHES)
 }
 
 /// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
 const SPOKE_SAMPLES: usize = 64;
 
+/// The searches of the cuts' ends tried in turn on a domain without holes until the
+/// layout is valid (radians, [`cut_reflex`]): below 30 degrees, never, always.
+const CUT_SEARCHES: [f64; 3] = [GOOD_CUT_ANGLE, 0.0, std::f64::consts::PI];
+
 /// The directions (degrees) of the cuts from holes that are tried; `NaN`: every hole
 /// toward its nearest neighbour ([`cut_holes`]).
 const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
 
-/// Steps 2 to 4 on a graph of faces (with holes). With holes, the layout is made for
-/// every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid one
-/// ([`validate_layout`]: no patch crossing itself or another) whose smallest patch
-/// corner angle is largest is kept; every try is in the report.
+/// Steps 2 to 4 on a graph of faces (with holes). Without holes, the layout is made with
+/// every search of the cuts' ends in `searches` in turn until it is valid
+/// ([`validate_layout`]: no patch crossing itself or another). With holes, it is made
+/// with the first search for every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid
+/// one whose smallest patch corner angle is largest is kept; every try is in the report.
+#[allow(clippy::too_many_arguments)]
 fn lay_out_graph(
     g: Graph,
     name: &str,
@@ -348,19 +361,29 @@ fn lay_out_graph(
     checked: (Option<DomainReport>, Option<GraphReport>),
     opts: &LayoutOptions,
     t0: Instant,
+    searches: &[f64],
 ) -> Result<AutoLayout> {
     if g.faces.iter().all(|f| f.holes.is_empty()) {
-        let auto = lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, f64::NAN, false)?;
-        if validate_layout(&auto.layout).is_ok() {
-            return Ok(auto);
+        // per search of the cuts' ends: the harmonic maps' cuts, and where they leave a
+        // face or cross, their preimages under the maps of the faces onto the polygons;
+        // the first valid layout is kept, else the first one made (which the solve
+        // refuses, naming the patch), else the first error
+        let mut first: Option<Result<AutoLayout>> = None;
+        for &search in searches {
+            for inverse in [false, true] {
+                let auto =
+                    lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, f64::NAN, inverse, search);
+                if auto.as_ref().is_ok_and(|a| validate_layout(&a.layout).is_ok()) {
+                    return auto;
+                }
+                if first.as_ref().is_none_or(|f| f.is_err() && auto.is_ok()) {
+                    first = Some(auto);
+                }
+            }
         }
-        // the harmonic maps' cuts leave a face or cross: their preimages under the maps
-        // of the faces onto the polygons instead
-        return Ok(match lay_out_with(g, name, diameter, area, checked, opts, t0, f64::NAN, true) {
-            Ok(inv) if validate_layout(&inv.layout).is_ok() => inv,
-            _ => auto,
-        });
+        return first.unwrap_or_else(|| Err(Error::Invalid("layout: no search of the cuts was tried".into())));
     }
+    let first_search = searches.first().copied().unwrap_or(GOOD_CUT_ANGLE);
     let mut best: Option<(AutoLayout, bool)> = None;
     let mut first_err = None;
     let mut tries = Vec::new();
@@ -369,7 +392,8 @@ fn lay_out_graph(
             break;
         }
         for theta in HOLE_CUT_DIRECTIONS {
-            match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta, inverse) {
+            match lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, theta, inverse, first_search)
+            {
                 Ok(auto) => {
                     let valid = validate_layout(&auto.layout);
                     let min_angle = auto.report.corner_angles[0];
@@ -430,7 +454,9 @@ pub struct HoleCutTry {
     pub error: Option<String>,
 }
 
-/// Steps 2 to 4 with the cuts from holes in direction `theta` (degrees).
+/// Steps 2 to 4 with the cuts from holes in direction `theta` (degrees), the cuts'
+/// ends searched along the sides below the smallest new angle `search` (radians,
+/// [`cut_reflex`]).
 #[allow(clippy::too_many_arguments)]
 fn lay_out_with(
     mut g: Graph,
@@ -442,12 +468,13 @@ fn lay_out_with(
     t0: Instant,
     theta: f64,
     inverse: bool,
+    search: f64,
 ) -> Result<AutoLayout> {
     let mut hole_cuts = Vec::new();
     cut_holes(&mut g, diameter, theta, &mut hole_cuts)?;
     // 2. reflex corners
     let mut cuts = Vec::new();
-    cut_reflex(&mut g, diameter, &opts.fit, &mut cuts)?;
+    cut_reflex(&mut g, diameter, &opts.fit, search, &mut cuts)?;
     // 3. templates: harmonic maps on the faces as they are, then the splits
     let split = edges_to_split(&g);
     let nf = g.faces.len();
@@ -612,6 +639,7 @@ fn lay_out_with(
         hole_cut_direction: (!theta.is_nan()).then_some(theta),
         hole_cut_tries: Vec::new(),
         cuts,
+        cut_search: search.to_degrees(),
         faces,
         irregular_vertices,
         patches: layout.patches.len(),

@@ -495,3 +495,80 @@ fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
         }
     }
 }
+
+/// `min(a, 180 - a)` over a cut's new angles that are not flat (degrees): how far they
+/// stay from 0 and 180 degrees.
+fn cut_margin(c: &CutReport) -> f64 {
+    c.new_angles.iter().filter(|a| (*a - 180.0).abs() > 1e-4).map(|a| a.min(180.0 - a)).fold(180.0, f64::min)
+}
+
+/// A reflex corner of `180 + 2 atan(0.0875)` ≈ 190 degrees whose bisector (straight up)
+/// meets the steep top side at `atan(4 / 9)` ≈ 23.96 degrees, and whose side extensions
+/// leave 10 degrees at the corner: its cut ends at a point searched along the sides
+/// (`spread`), every new angle at least 40 degrees from 0 and 180; the two four-sided
+/// faces are one patch each and their areas add up to the domain's.
+#[test]
+fn a_cut_whose_bisector_grazes_a_side_ends_where_its_angles_are_best() {
+    let pts = [[0.0, 0.0], [2.0, 0.175], [4.0, 0.0], [4.0, 10.0], [0.0, 1.0]];
+    let d = polygon(&pts);
+    let auto = auto_layout(&d, &LayoutOptions::default()).unwrap();
+    let r = &auto.report;
+    assert_eq!(r.cuts.len(), 1, "{:#?}", r.cuts);
+    let c = &r.cuts[0];
+    assert_eq!(c.from, [2.0, 0.175]);
+    assert!(c.spread && c.ends_on == "side", "{c:?}");
+    let bisector = (4.0f64 / 9.0).atan().to_degrees();
+    assert!((bisector - 23.96).abs() < 0.01);
+    assert!(cut_margin(c) >= 40.0, "{c:?}");
+    // the end is on the top side, from (4, 10) to (0, 1)
+    let on_top = (c.to[0] - 4.0) * (1.0 - 10.0) - (c.to[1] - 10.0) * (0.0 - 4.0);
+    assert!(on_top.abs() < 1e-9, "{c:?}");
+    assert_eq!(auto.layout.patches.len(), 2);
+    validate_layout(&auto.layout).unwrap();
+    // shoelace area of the pentagon: (-0.7 + 40 + 4) / 2
+    assert!((total_area(&auto.layout) - 21.65).abs() < 1e-9, "{}", total_area(&auto.layout));
+    certified(&auto, "kink");
+}
+
+/// The smallest and largest patch corner angle over seeds 1 to 4 of the N-gon, L, T, U,
+/// E and plus families (the layout alone): every angle between 35 and 155 degrees; the
+/// plus shapes, whose cuts met their far sides at 32.5 degrees before the cuts' ends
+/// were searched, between 44 and 100.
+#[test]
+fn patch_corner_angles_of_the_corpus_stay_away_from_0_and_180() {
+    use super::corpus::DomainFamily;
+    let families =
+        [DomainFamily::Ngon, DomainFamily::L, DomainFamily::T, DomainFamily::U, DomainFamily::E, DomainFamily::Plus];
+    for fam in families {
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for seed in 1..=4 {
+            let d = fam.generate(seed);
+            let auto = auto_layout(&d, &LayoutOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+            validate_layout(&auto.layout).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+            lo = lo.min(auto.report.corner_angles[0]);
+            hi = hi.max(auto.report.corner_angles[1]);
+        }
+        assert!(lo > 35.0 && hi < 155.0, "{}: {lo}..{hi}", fam.name());
+        if fam == DomainFamily::Plus {
+            assert!(lo > 44.0 && hi < 100.0, "plus: {lo}..{hi}");
+        }
+    }
+}
+
+/// `wiggly-17`'s flat corner (on a wiggly edge, no straight cut along its bisector
+/// inside its face): by default cut straight to a point searched along the sides, the
+/// smallest patch corner angle 29.5 degrees (1.0 when it took the curved cut to a side
+/// midpoint, the preimage of a segment of the face's map onto the polygon), and every
+/// patch certified.
+#[test]
+fn a_flat_corner_is_cut_far_from_0_and_180_degrees() {
+    let g = crate::domain::families::wiggly(17);
+    let auto = graph_layout(&g, &LayoutOptions::default()).unwrap();
+    validate_layout(&auto.layout).unwrap();
+    let r = &auto.report;
+    assert!(r.corner_angles[0] > 29.0, "{:?}", r.corner_angles);
+    let flat: Vec<&CutReport> = r.cuts.iter().filter(|c| (c.angle - 180.0).abs() < 1.0).collect();
+    assert!(!flat.is_empty() && flat.iter().all(|c| !c.curved), "{:#?}", r.cuts);
+    assert!(flat.iter().any(|c| c.spread && cut_margin(c) > 45.0), "{:#?}", r.cuts);
+    certified(&auto, &g.name);
+}
