@@ -65,62 +65,75 @@ pub(crate) struct Multigrid {
     sweeps: usize,
 }
 
-/// `P^T A P`, rows in parallel, a dense accumulator per thread; the rows of `P` and
-/// `P^T` generated from the 1D factors.
+/// `P^T A P`, one coarse row at a time (in parallel): `t = (P^T)_i A`, a sparse row of
+/// the fine level, then `t P`; the rows of `P` and `P^T` generated from the 1D factors.
+/// No intermediate matrix (`A P` would be a fine-by-coarse matrix of about half the
+/// entries of `A`) is formed.
 pub(crate) fn galerkin(a: &Csr, p: &TensorProlongation) -> Csr {
-    let nc = p.ncols();
-    let ap = {
-        let rows: Vec<Vec<(usize, f64)>> = (0..a.nrows)
-            .into_par_iter()
-            .map_init(
-                || (vec![0.0; nc], vec![false; nc], Vec::new()),
-                |(acc, seen, touched), i| {
-                    for (k, aik) in a.row(i) {
-                        for (j, pkj) in p.row(k) {
-                            if !seen[j] {
-                                seen[j] = true;
-                                touched.push(j);
-                            }
-                            acc[j] += aik * pkj;
-                        }
-                    }
-                    gather_row(acc, seen, touched)
-                },
-            )
-            .collect();
-        Csr::from_rows(nc, rows)
-    };
+    let (nf, nc) = (a.nrows, p.ncols());
     let rows: Vec<Vec<(usize, f64)>> = (0..nc)
         .into_par_iter()
         .map_init(
-            || (vec![0.0; nc], vec![false; nc], Vec::new()),
-            |(acc, seen, touched), i| {
+            || (Accumulator::new(nf), Accumulator::new(nc)),
+            |(fine, coarse), i| {
                 for (k, pik) in p.row_of_transpose(i) {
-                    for (j, v) in ap.row(k) {
-                        if !seen[j] {
-                            seen[j] = true;
-                            touched.push(j);
-                        }
-                        acc[j] += pik * v;
+                    for (m, akm) in a.row(k) {
+                        fine.add(m, pik * akm);
                     }
                 }
-                gather_row(acc, seen, touched)
+                for (m, t) in fine.drain() {
+                    for (j, pmj) in p.row(m) {
+                        coarse.add(j, t * pmj);
+                    }
+                }
+                coarse.sorted_row()
             },
         )
         .collect();
     Csr::from_rows(nc, rows)
 }
 
-/// The accumulated row (sorted by column), the accumulator cleared.
-fn gather_row(acc: &mut [f64], seen: &mut [bool], touched: &mut Vec<usize>) -> Vec<(usize, f64)> {
-    touched.sort_unstable();
-    let row = touched.iter().map(|&j| (j, acc[j])).collect();
-    for &j in touched.iter() {
-        acc[j] = 0.0;
-        seen[j] = false;
+/// A dense accumulator of a sparse row: the values, which entries are set, and those
+/// entries in the order first touched.
+struct Accumulator {
+    acc: Vec<f64>,
+    seen: Vec<bool>,
+    touched: Vec<usize>,
+}
+
+impl Accumulator {
+    fn new(n: usize) -> Self {
+        Self { acc: vec![0.0; n], seen: vec![false; n], touched: Vec::new() }
     }
-    touched.clear();
-    row
+
+    fn add(&mut self, j: usize, v: f64) {
+        if !self.seen[j] {
+            self.seen[j] = true;
+            self.touched.push(j);
+        }
+        self.acc[j] += v;
+    }
+
+    /// The entries in the order first touched, the accumulator cleared.
+    fn drain(&mut self) -> Vec<(usize, f64)> {
+        let row = self.touched.iter().map(|&j| (j, self.acc[j])).collect();
+        self.clear();
+        row
+    }
+
+    /// The entries sorted by column, the accumulator cleared.
+    fn sorted_row(&mut self) -> Vec<(usize, f64)> {
+        self.touched.sort_unstable();
+        self.drain()
+    }
+
+    fn clear(&mut self) {
+        for &j in &self.touched {
+            self.acc[j] = 0.0;
+            self.seen[j] = false;
+        }
+        self.touched.clear();
+    }
 }
 
 fn diagonal_positions(a: &Csr) -> Result<Vec<usize>> {

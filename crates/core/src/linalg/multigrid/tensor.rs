@@ -154,4 +154,19 @@ mod tests {
             assert!(t.row_of_transpose(k).eq(pt.row(k)), "row {k} of P^T");
         }
     }
+
+    /// The Galerkin operator from the generated rows, without the intermediate `A P`,
+    /// equals `P^T A P` of the stored matrices to rounding, with the same pattern.
+    #[test]
+    fn galerkin_equals_the_stored_triple_product() {
+        let t = TensorProlongation::new(random(23, 11, 4), random(17, 9, 5));
+        let a = random(t.nrows(), t.nrows(), 6);
+        let p = t.matrix();
+        let want = p.transpose().matmul(&a).matmul(&p);
+        let got = super::super::galerkin(&a, &t);
+        assert_eq!((got.row_ptr.clone(), got.col_idx.clone()), (want.row_ptr.clone(), want.col_idx.clone()));
+        let scale = want.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let err = got.values.iter().zip(&want.values).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(err <= 1e-13 * scale, "{err} against {scale}");
+    }
 }
