@@ -8,21 +8,26 @@ mod common;
 use common::{bin, data};
 
 /// The estimated peak within 2x of the measured one at three sizes of wavy_lid (4 400 to
-/// 70 000 unknowns; each size its own process, so that one's peak is not the next's).
+/// 70 000 unknowns; each size its own process, so that one's peak is not the next's),
+/// with the default linear solver and with the multigrid preconditioner (`--linear
+/// multigrid`, its own model in `winslow::solve::memory`).
 #[test]
 fn the_estimate_is_within_2x_of_the_measured_peak() {
-    for refine in [2, 3, 4] {
-        let out = bin()
-            .args(["bench", "--json", "--refinements", &refine.to_string()])
-            .arg(data().join("wavy_lid.json"))
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "refine {refine}: {}", String::from_utf8_lossy(&out.stderr));
-        let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        let (peak, estimate) = (row["peak_mib"].as_f64().unwrap(), row["estimated_mib"].as_f64().unwrap());
-        let ratio = peak / estimate;
-        assert!((0.5..=2.0).contains(&ratio), "refine {refine}: peak {peak:.1} MiB, estimate {estimate:.1} MiB");
-        assert_eq!(row["verdict"], "certified", "refine {refine}");
+    for linear in ["auto", "multigrid"] {
+        for refine in [2, 3, 4] {
+            let out = bin()
+                .args(["bench", "--json", "--linear", linear, "--refinements", &refine.to_string()])
+                .arg(data().join("wavy_lid.json"))
+                .output()
+                .unwrap();
+            let at = format!("--linear {linear}, refine {refine}");
+            assert!(out.status.success(), "{at}: {}", String::from_utf8_lossy(&out.stderr));
+            let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            let (peak, estimate) = (row["peak_mib"].as_f64().unwrap(), row["estimated_mib"].as_f64().unwrap());
+            let ratio = peak / estimate;
+            assert!((0.5..=2.0).contains(&ratio), "{at}: peak {peak:.1} MiB, estimate {estimate:.1} MiB");
+            assert_eq!(row["verdict"], "certified", "{at}");
+        }
     }
 }
 

@@ -3,7 +3,9 @@
 //! element boundary (the inverse of the knot halving of paper §6.3), and the
 //! prolongations of the free scalar unknowns between consecutive spaces by exact knot
 //! insertion ([`crate::spline::refine::prolongation`]), one 1D operator per direction,
-//! `P = P_eta ⊗ P_xi` restricted to the interior functions.
+//! `P = P_eta ⊗ P_xi` restricted to the interior functions, held as its two 1D factors
+//! ([`crate::linalg::multigrid::TensorProlongation`]: the restriction of the Kronecker product to the interior
+//! functions is the product of the 1D operators restricted to the interior ones).
 //!
 //! A coarse interior function vanishes on the boundary of the parameter square, so its
 //! fine coefficients on the boundary functions are zero: `P` maps free coarse unknowns
@@ -12,6 +14,8 @@
 use super::assembly::Discretization;
 use super::dofs::DofMap;
 use crate::error::Result;
+#[cfg(test)]
+use crate::linalg::multigrid::TensorProlongation;
 use crate::linalg::sparse::Csr;
 use crate::spline::knots::KnotVector;
 use crate::spline::refine::prolongation;
@@ -52,9 +56,34 @@ fn coarsened_basis(knots: &[KnotVector; 2]) -> Option<[KnotVector; 2]> {
     Some([x.unwrap_or_else(|| knots[0].clone()), y.unwrap_or_else(|| knots[1].clone())])
 }
 
+/// The 1D prolongation from `coarse` to `fine` with the first and last rows and columns
+/// (the boundary functions) left out, and its zeros.
+fn interior_1d(coarse: &KnotVector, fine: &KnotVector) -> Result<Csr> {
+    let p = prolongation(coarse, fine)?;
+    let (nf, nc) = (p.nrows, p.ncols);
+    let rows = (1..nf.saturating_sub(1))
+        .map(|i| p.row(i).filter(|&(j, v)| j > 0 && j + 1 < nc && v != 0.0).map(|(j, v)| (j - 1, v)).collect())
+        .collect();
+    Ok(Csr::from_rows(nc.saturating_sub(2), rows))
+}
+
 /// The prolongation of the interior (free) functions of the coarse tensor basis to
-/// those of the fine one: `P_eta ⊗ P_xi` with the rows and columns of boundary
-/// functions left out.
+/// those of the fine one, `P_eta ⊗ P_xi` with the rows and columns of boundary functions
+/// left out, as the product of the two 1D operators restricted to their interior
+/// functions (the free functions of [`DofMap::interior`], `xi` fastest).
+#[cfg(test)]
+pub(crate) fn interior_tensor_prolongation(
+    coarse: &[KnotVector; 2],
+    fine: &[KnotVector; 2],
+) -> Result<TensorProlongation> {
+    Ok(TensorProlongation::new(interior_1d(&coarse[0], &fine[0])?, interior_1d(&coarse[1], &fine[1])?))
+}
+
+/// The prolongation of the interior (free) functions of the coarse tensor basis to
+/// those of the fine one as a stored matrix: `P_eta ⊗ P_xi` with the rows and columns
+/// of boundary functions left out (the reference [`interior_tensor_prolongation`] is
+/// tested against).
+#[cfg(test)]
 pub(crate) fn interior_prolongation(coarse: &[KnotVector; 2], fine: &[KnotVector; 2]) -> Result<Csr> {
     let px = prolongation(&coarse[0], &fine[0])?;
     let py = prolongation(&coarse[1], &fine[1])?;
@@ -81,7 +110,14 @@ pub(crate) fn interior_prolongation(coarse: &[KnotVector; 2], fine: &[KnotVector
 /// to the first's, ..., down to a space of at most [`COARSEST_FREE`] free functions (or
 /// one that cannot be coarsened). Empty when `disc` is not a patch with every boundary
 /// function fixed (periodic or interface sides), or is small already.
-pub(crate) fn free_prolongations(disc: &Discretization) -> Result<Vec<Csr>> {
+#[cfg(test)]
+pub(crate) fn free_prolongations(disc: &Discretization) -> Result<Vec<TensorProlongation>> {
+    Ok(free_prolongation_factors(disc)?.into_iter().map(TensorProlongation::from).collect())
+}
+
+/// [`free_prolongations`] as the 1D factors `[P_xi, P_eta]` of each `P = P_eta ⊗ P_xi`
+/// (restricted to the interior functions).
+pub(crate) fn free_prolongation_factors(disc: &Discretization) -> Result<Vec<[Csr; 2]>> {
     let shape = disc.shape();
     if disc.dofs != DofMap::interior(shape) {
         return Ok(Vec::new());
@@ -91,8 +127,8 @@ pub(crate) fn free_prolongations(disc: &Discretization) -> Result<Vec<Csr>> {
     let mut free = disc.dofs.num_free();
     while free > COARSEST_FREE {
         let Some(coarse) = coarsened_basis(&fine) else { break };
-        let p = interior_prolongation(&coarse, &fine)?;
-        free = p.ncols;
+        let p = [interior_1d(&coarse[0], &fine[0])?, interior_1d(&coarse[1], &fine[1])?];
+        free = p[0].ncols * p[1].ncols;
         out.push(p);
         fine = coarse;
     }
@@ -168,11 +204,44 @@ mod tests {
         let disc = Discretization::new([KnotVector::open_uniform(3, 64), KnotVector::open_uniform(3, 8)]);
         let ps = free_prolongations(&disc).unwrap();
         assert!(!ps.is_empty());
-        assert_eq!(ps[0].nrows, disc.dofs.num_free());
+        assert_eq!(ps[0].nrows(), disc.dofs.num_free());
         for w in ps.windows(2) {
-            assert_eq!(w[0].ncols, w[1].nrows);
+            assert_eq!(w[0].ncols(), w[1].nrows());
         }
-        assert!(ps.last().unwrap().ncols <= COARSEST_FREE);
+        assert!(ps.last().unwrap().ncols() <= COARSEST_FREE);
+    }
+
+    /// The two 1D passes of the tensor prolongation equal the stored interior matrix
+    /// `P` (and `P^T`) times a vector to rounding, on degrees (3, 2) with double knots,
+    /// and its generated rows are the stored matrix's, entry for entry.
+    #[test]
+    fn tensor_passes_equal_the_stored_prolongation() {
+        let fine = [
+            KnotVector::open_uniform(3, 12).with_inserted(&[0.3, 0.31]),
+            KnotVector::open_uniform(2, 9).with_inserted(&[0.5, 0.5]),
+        ];
+        let coarse = coarsened_basis(&fine).unwrap();
+        let stored = interior_prolongation(&coarse, &fine).unwrap();
+        let t = interior_tensor_prolongation(&coarse, &fine).unwrap();
+        assert_eq!((t.nrows(), t.ncols()), (stored.nrows, stored.ncols));
+        let stored_t = stored.transpose();
+        for k in 0..stored.nrows {
+            assert!(t.row(k).eq(stored.row(k)), "row {k} of P");
+        }
+        for k in 0..stored.ncols {
+            assert!(t.row_of_transpose(k).eq(stored_t.row(k)), "row {k} of P^T");
+        }
+        let mut rng = crate::testutil::Lcg::new(9);
+        let c: Vec<f64> = (0..t.ncols()).map(|_| rng.uniform() - 0.5).collect();
+        let r: Vec<f64> = (0..t.nrows()).map(|_| rng.uniform() - 0.5).collect();
+        let (mut pc, mut ptr) = (vec![0.0; t.nrows()], vec![0.0; t.ncols()]);
+        t.prolong(&c, &mut pc);
+        t.restrict(&r, &mut ptr);
+        for (got, want) in [(pc, stored.apply(&c)), (ptr, stored_t.apply(&r))] {
+            let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let err = got.iter().zip(&want).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(err <= 1e-14 * scale, "{err} against {scale}");
+        }
     }
 
     /// The metric Laplacian `K` ([`Discretization::metric_laplace`]) of a stretched,

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
-use crate::linalg::multigrid::{Multigrid, Smoother};
+use crate::linalg::multigrid::{Multigrid, Smoother, TensorProlongation};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
 
@@ -184,7 +184,7 @@ pub struct LinearSolver {
     /// Fill-reducing order of the `m` scalar unknowns (see [`LinearSolver::set_ordering`]).
     order: Option<Vec<usize>>,
     /// The prolongations of the multigrid hierarchy (see [`LinearSolver::set_transfers`]).
-    transfers: Vec<Csr>,
+    transfers: Vec<TensorProlongation>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
     /// The most GMRES iterations one solve took (diagnostics).
@@ -243,11 +243,11 @@ impl LinearSolver {
         self.order = Some(order.to_vec());
     }
 
-    /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l]` maps the free
-    /// scalar unknowns of space `l + 1` to those of space `l`, space 0 the one of the
-    /// problem's `m` scalar unknowns (see `discrete::transfers`).
-    pub(crate) fn set_transfers(&mut self, transfers: Vec<Csr>) {
-        self.transfers = transfers;
+    /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l] = [P_0, P_1]` maps
+    /// the free scalar unknowns of space `l + 1` to those of space `l` by `P_1 ⊗ P_0`,
+    /// space 0 the one of the problem's `m` scalar unknowns (see `discrete::transfers`).
+    pub(crate) fn set_transfers(&mut self, transfers: Vec<[Csr; 2]>) {
+        self.transfers = transfers.into_iter().map(TensorProlongation::from).collect();
     }
 
     /// The fill-reducing order for a matrix of `n` unknowns, if one is known.
@@ -449,6 +449,39 @@ impl LinearSolver {
         self.factor_krylov(n, None, k)
     }
 
+    /// As [`LinearSolver::factor_operator`] with `k` handed over: the multigrid V-cycle
+    /// of [`LinearMethod::Multigrid`] keeps it as its finest operator (no copy), the other
+    /// preconditioners are set up from it as from a borrowed one.
+    ///
+    /// Errors: as [`LinearSolver::factor_operator`].
+    pub(crate) fn factor_operator_owned(&mut self, n: usize, k: Option<Csr>) -> Result<()> {
+        self.resolve(n);
+        let fits = |k: &Csr| self.transfers.first().is_some_and(|p| p.nrows() == k.nrows && n.is_multiple_of(k.nrows));
+        match k {
+            Some(k) if self.method == LinearMethod::Multigrid && fits(&k) => {
+                let mut mg = match self.precond.take() {
+                    Some(Preconditioner::NegMultigrid(mg)) => mg,
+                    _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
+                };
+                mg.factor_owned(k)?;
+                self.precond = Some(Preconditioner::NegMultigrid(mg));
+                self.fresh = true;
+                self.last_krylov = 0;
+                Ok(())
+            }
+            k => self.factor_operator(n, k.as_ref()),
+        }
+    }
+
+    /// Free the operators of a multigrid preconditioner that is about to be set up again
+    /// ([`LinearSolver::wants_preconditioner`]), before its new operator is built; the
+    /// other preconditioners are kept (their analysis is reused).
+    pub(crate) fn release_multigrid(&mut self) {
+        if matches!(self.precond, Some(Preconditioner::NegMultigrid(..))) {
+            self.precond = None;
+        }
+    }
+
     /// [`LinearMethod::Pcg`] for a system held as an operator: the block-Jacobi
     /// preconditioner from the diagonal blocks `blocks` of the system (each SPD, of the
     /// size of the ordering given with [`LinearSolver::set_ordering`]), factorized in
@@ -472,7 +505,7 @@ impl LinearSolver {
         let block = k.filter(|k| k.nrows > 0 && n.is_multiple_of(k.nrows));
         let previous = self.precond.take();
         let multigrid = self.method == LinearMethod::Multigrid
-            && block.is_some_and(|k| self.transfers.first().is_some_and(|p| p.nrows == k.nrows));
+            && block.is_some_and(|k| self.transfers.first().is_some_and(|p| p.nrows() == k.nrows));
         let no_matrix = || Error::LinearSolver("ILU(0) needs the matrix: no preconditioner for an operator".into());
         self.precond = match (block, previous) {
             // the multigrid hierarchy set up (again) for the new approximation
@@ -481,7 +514,7 @@ impl LinearSolver {
                     Some(Preconditioner::NegMultigrid(mg)) => mg,
                     _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
                 };
-                mg.factor(k)?;
+                mg.factor_owned(k.clone())?;
                 Some(Preconditioner::NegMultigrid(mg))
             }
             // a new approximation: refactor in place (same pattern), in single

@@ -175,8 +175,8 @@ impl DiscreteProblem for EggProblem {
     }
 
     /// The knot-halving hierarchy below the basis (`discrete::transfers`).
-    fn transfers(&self) -> Vec<Csr> {
-        crate::discrete::transfers::free_prolongations(&self.state.disc).unwrap_or_default()
+    fn transfers(&self) -> Vec<[Csr; 2]> {
+        crate::discrete::transfers::free_prolongation_factors(&self.state.disc).unwrap_or_default()
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
@@ -187,6 +187,13 @@ impl DiscreteProblem for EggProblem {
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         let op = self.op;
         Some(self.state.preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))
+    }
+
+    /// `K` as [`DiscreteProblem::preconditioner`], handed over (the state keeps neither
+    /// it nor its stencil storage).
+    fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
+        let op = self.op;
+        Some(self.state.take_preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))
     }
 }
 

@@ -37,7 +37,7 @@ impl GalerkinState {
             stencil: Vec::new(),
             mass: None,
             pstencil: Vec::new(),
-            prec: disc.scalar.csr.clone(),
+            prec: Csr::default(),
             disc,
         }
     }
@@ -105,8 +105,19 @@ impl GalerkinState {
             self.pstencil = vec![0.0; self.disc.stencil_len(1)];
         }
         fill(&self.disc, &self.cps, &mut self.pstencil);
+        if self.prec.values.len() != self.disc.scalar.src.len() {
+            self.prec = self.disc.scalar.csr.clone();
+        }
         self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
         &self.prec
+    }
+
+    /// [`GalerkinState::preconditioner`] handed over: `K` in a new matrix, its stencil
+    /// storage freed after the gather, neither kept.
+    pub fn take_preconditioner(&mut self, fill: impl FnOnce(&Discretization, &[Point], &mut [f64])) -> Csr {
+        self.preconditioner(fill);
+        self.pstencil = Vec::new();
+        std::mem::take(&mut self.prec)
     }
 }
 

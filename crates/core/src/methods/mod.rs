@@ -142,6 +142,11 @@ pub trait DiscreteProblem {
     fn preconditioner(&mut self, _shift: f64) -> Option<&Csr> {
         None
     }
+    /// [`DiscreteProblem::preconditioner`] handed over: the problem keeps no copy of `K`
+    /// (a multigrid V-cycle then holds the only one). The default clones it.
+    fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
+        self.preconditioner(shift).cloned()
+    }
     /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
     /// factorizations (see `crate::linalg::linsolve::LinearSolver::set_ordering`).
     fn ordering(&self) -> Option<&[usize]> {
@@ -149,9 +154,10 @@ pub trait DiscreteProblem {
     }
     /// The prolongations of the nested spaces below the problem's scalar space, finest
     /// first, for a multigrid preconditioner of [`DiscreteProblem::preconditioner`]'s
-    /// `K` (see `crate::linalg::linsolve::LinearSolver::set_transfers`); empty (the
-    /// default) when the problem has none.
-    fn transfers(&self) -> Vec<Csr> {
+    /// `K` (see `crate::linalg::linsolve::LinearSolver::set_transfers`), each as the 1D
+    /// factors `[P_0, P_1]` of `P = P_1 ⊗ P_0` (unknowns numbered direction 0 fastest);
+    /// empty (the default) when the problem has none.
+    fn transfers(&self) -> Vec<[Csr; 2]> {
         Vec::new()
     }
     /// All control points of the map with unknowns `c` (fixed ones as given).
@@ -198,10 +204,13 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     fn preconditioner(&mut self, shift: f64) -> Option<&Csr> {
         (**self).preconditioner(shift)
     }
+    fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
+        (**self).take_preconditioner(shift)
+    }
     fn ordering(&self) -> Option<&[usize]> {
         (**self).ordering()
     }
-    fn transfers(&self) -> Vec<Csr> {
+    fn transfers(&self) -> Vec<[Csr; 2]> {
         (**self).transfers()
     }
     fn control_points(&self, c: &[f64]) -> Vec<Point> {

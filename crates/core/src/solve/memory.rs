@@ -53,20 +53,19 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 /// stencil storage (`discrete::stencil::StencilOperator`, 8 B per nonzero) and the
 /// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
 /// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
-/// gather map, the metric Laplacian `K` in stencil storage and in CSR, and the V-cycle's
-/// copy of `K`, its line factors and coarse levels. With [`MULTIGRID_BYTES_PER_UNKNOWN`]
-/// fitted by least squares to the peaks (`VmHWM`, dev profile, one geometry per process)
-/// of wavy_lid (279 k unknowns), male_rotor (541 k) and puzzle4 (461 k) at `--refine 5`
-/// with the ILU(0)-smoothed V-cycle: measured over estimated 0.92-1.08 (BENCHMARKS.md,
-/// "Toward 10^6 unknowns"); with the line smoother, which keeps no ILU(0) copy of `K`
-/// and needs fewer GMRES vectors, 0.73-0.88 at the same sizes (an upper bound now).
-pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 18;
+/// gather map and the metric Laplacian `K` in CSR, held once (by the V-cycle), with its
+/// line factors and coarse levels; the transfers are 1D factors. With
+/// [`MULTIGRID_BYTES_PER_UNKNOWN`] chosen on the peaks (`VmHWM`, dev profile, one
+/// geometry per process) of wavy_lid, male_rotor and puzzle4 at `--refine 4` and `5`
+/// (70 k to 541 k unknowns) with `K` held once: measured over estimated 0.86-1.14
+/// (BENCHMARKS.md, "Peak memory per unknown: `K` held once").
+pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 14;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see
 /// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
 /// iteration, up to 100), the vectors of a Newton step, and the single-precision
 /// Cholesky factors of the elasticity prolongation's two diagonal blocks.
-pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 1700;
+pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 800;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB

@@ -399,14 +399,14 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         self.lin.krylov_tol = if shift.is_some() { KRYLOV_TOL } else { self.forcing() };
         // the pseudo-time shift changes with every step: no frozen preconditioner then
         let n = self.c.len();
-        let k = if shift.is_some() || self.lin.wants_preconditioner(n) {
-            self.problem.preconditioner(shift.map_or(0.0, |dt| 1.0 / dt))
-        } else {
-            None
-        };
+        let refresh = shift.is_some() || self.lin.wants_preconditioner(n);
         if self.operator {
-            self.lin.factor_operator(n, k)?;
+            // the V-cycle keeps the problem's `K` (no copy on either side), the old one
+            // freed before the new one is built
+            let k = refresh.then(|| self.lin.release_multigrid()).and_then(|()| self.problem.take_preconditioner(0.0));
+            self.lin.factor_operator_owned(n, k)?;
         } else {
+            let k = if refresh { self.problem.preconditioner(shift.map_or(0.0, |dt| 1.0 / dt)) } else { None };
             self.lin.factor_stored(k)?;
         }
         self.timings.factor += t.elapsed();

@@ -1,6 +1,8 @@
 //! Geometric multigrid for a symmetric positive definite scalar operator `A` on a
 //! hierarchy of nested spaces given by its prolongations (for the spline hierarchy:
-//! exact knot insertion, [`crate::discrete::transfers`]). Coarse operators are the
+//! exact knot insertion, [`crate::discrete::transfers`], held as the two 1D factors of
+//! `P = P_eta ⊗ P_xi` and applied in two 1D passes, [`TensorProlongation`]; no 2D
+//! transfer matrix is stored). Coarse operators are the
 //! Galerkin products `A_{l+1} = P_l^T A_l P_l` (the variational coarse operator: the
 //! bilinear form restricted to the coarse subspace, what rediscretization on the coarse
 //! basis with the fine geometry would give); the coarsest is factorized densely.
@@ -23,8 +25,10 @@ use crate::linalg::krylov::Ilu0;
 use crate::linalg::sparse::Csr;
 
 mod lines;
+mod tensor;
 
 use lines::{grid_width, Lines};
+pub(crate) use tensor::TensorProlongation;
 
 /// The smoother of every level but the coarsest.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,10 +50,10 @@ pub(crate) enum Smoother {
 /// A multigrid V-cycle for `A` (see the module documentation).
 #[derive(Debug)]
 pub(crate) struct Multigrid {
-    /// `P_l` maps level `l + 1` to level `l` (level 0 the finest).
-    prolongations: Vec<Csr>,
-    restrictions: Vec<Csr>,
-    /// `A_l`, finest first; the last is the coarsest.
+    /// `P_l` maps level `l + 1` to level `l` (level 0 the finest); `P_l^T` restricts.
+    prolongations: Vec<TensorProlongation>,
+    /// `A_l`, finest first; the last is the coarsest (`A_0` is the operator handed to
+    /// [`Multigrid::factor_owned`]: the cycle holds the only copy).
     operators: Vec<Csr>,
     /// Position of the diagonal entry of each row of each operator.
     diagonals: Vec<Vec<usize>>,
@@ -61,61 +65,75 @@ pub(crate) struct Multigrid {
     sweeps: usize,
 }
 
-/// `P^T A P` with `pt = P^T`, rows in parallel, a dense accumulator per thread.
-pub(crate) fn galerkin(pt: &Csr, a: &Csr, p: &Csr) -> Csr {
-    let nc = p.ncols;
-    let ap = {
-        let rows: Vec<Vec<(usize, f64)>> = (0..a.nrows)
-            .into_par_iter()
-            .map_init(
-                || (vec![0.0; nc], vec![false; nc], Vec::new()),
-                |(acc, seen, touched), i| {
-                    for (k, aik) in a.row(i) {
-                        for (j, pkj) in p.row(k) {
-                            if !seen[j] {
-                                seen[j] = true;
-                                touched.push(j);
-                            }
-                            acc[j] += aik * pkj;
-                        }
-                    }
-                    gather_row(acc, seen, touched)
-                },
-            )
-            .collect();
-        Csr::from_rows(nc, rows)
-    };
-    let rows: Vec<Vec<(usize, f64)>> = (0..pt.nrows)
+/// `P^T A P`, one coarse row at a time (in parallel): `t = (P^T)_i A`, a sparse row of
+/// the fine level, then `t P`; the rows of `P` and `P^T` generated from the 1D factors.
+/// No intermediate matrix (`A P` would be a fine-by-coarse matrix of about half the
+/// entries of `A`) is formed.
+pub(crate) fn galerkin(a: &Csr, p: &TensorProlongation) -> Csr {
+    let (nf, nc) = (a.nrows, p.ncols());
+    let rows: Vec<Vec<(usize, f64)>> = (0..nc)
         .into_par_iter()
         .map_init(
-            || (vec![0.0; nc], vec![false; nc], Vec::new()),
-            |(acc, seen, touched), i| {
-                for (k, pik) in pt.row(i) {
-                    for (j, v) in ap.row(k) {
-                        if !seen[j] {
-                            seen[j] = true;
-                            touched.push(j);
-                        }
-                        acc[j] += pik * v;
+            || (Accumulator::new(nf), Accumulator::new(nc)),
+            |(fine, coarse), i| {
+                for (k, pik) in p.row_of_transpose(i) {
+                    for (m, akm) in a.row(k) {
+                        fine.add(m, pik * akm);
                     }
                 }
-                gather_row(acc, seen, touched)
+                for (m, t) in fine.drain() {
+                    for (j, pmj) in p.row(m) {
+                        coarse.add(j, t * pmj);
+                    }
+                }
+                coarse.sorted_row()
             },
         )
         .collect();
     Csr::from_rows(nc, rows)
 }
 
-/// The accumulated row (sorted by column), the accumulator cleared.
-fn gather_row(acc: &mut [f64], seen: &mut [bool], touched: &mut Vec<usize>) -> Vec<(usize, f64)> {
-    touched.sort_unstable();
-    let row = touched.iter().map(|&j| (j, acc[j])).collect();
-    for &j in touched.iter() {
-        acc[j] = 0.0;
-        seen[j] = false;
+/// A dense accumulator of a sparse row: the values, which entries are set, and those
+/// entries in the order first touched.
+struct Accumulator {
+    acc: Vec<f64>,
+    seen: Vec<bool>,
+    touched: Vec<usize>,
+}
+
+impl Accumulator {
+    fn new(n: usize) -> Self {
+        Self { acc: vec![0.0; n], seen: vec![false; n], touched: Vec::new() }
     }
-    touched.clear();
-    row
+
+    fn add(&mut self, j: usize, v: f64) {
+        if !self.seen[j] {
+            self.seen[j] = true;
+            self.touched.push(j);
+        }
+        self.acc[j] += v;
+    }
+
+    /// The entries in the order first touched, the accumulator cleared.
+    fn drain(&mut self) -> Vec<(usize, f64)> {
+        let row = self.touched.iter().map(|&j| (j, self.acc[j])).collect();
+        self.clear();
+        row
+    }
+
+    /// The entries sorted by column, the accumulator cleared.
+    fn sorted_row(&mut self) -> Vec<(usize, f64)> {
+        self.touched.sort_unstable();
+        self.drain()
+    }
+
+    fn clear(&mut self) {
+        for &j in &self.touched {
+            self.acc[j] = 0.0;
+            self.seen[j] = false;
+        }
+        self.touched.clear();
+    }
 }
 
 fn diagonal_positions(a: &Csr) -> Result<Vec<usize>> {
@@ -128,11 +146,9 @@ impl Multigrid {
     /// A cycle on the hierarchy `prolongations` (`P_l`: level `l + 1` to level `l`, finest
     /// first), with `sweeps` smoothing sweeps before and after each coarse correction;
     /// [`Multigrid::factor`] gives it its operator.
-    pub fn new(prolongations: Vec<Csr>, smoother: Smoother, sweeps: usize) -> Self {
-        let restrictions = prolongations.iter().map(Csr::transpose).collect();
+    pub fn new(prolongations: Vec<TensorProlongation>, smoother: Smoother, sweeps: usize) -> Self {
         Self {
             prolongations,
-            restrictions,
             operators: Vec::new(),
             diagonals: Vec::new(),
             ilu: Vec::new(),
@@ -145,7 +161,7 @@ impl Multigrid {
 
     /// Number of unknowns of the finest level.
     pub fn size(&self) -> usize {
-        self.prolongations.first().map_or(self.coarse.size(), |p| p.nrows)
+        self.prolongations.first().map_or(self.coarse.size(), TensorProlongation::nrows)
     }
 
     /// Number of levels (the finest included).
@@ -153,25 +169,36 @@ impl Multigrid {
         self.prolongations.len() + 1
     }
 
-    /// Set up the cycle for the SPD `a` (of the finest level's size): the Galerkin coarse
-    /// operators, the smoothers and the coarsest factorization. Reuses the storage of a
-    /// previous set-up.
+    /// Set up the cycle for the SPD `a` (of the finest level's size): a copy of `a`, then
+    /// [`Multigrid::factor_owned`].
+    ///
+    /// Errors: as [`Multigrid::factor_owned`].
+    #[cfg(test)]
+    pub fn factor(&mut self, a: &Csr) -> Result<()> {
+        self.factor_owned(a.clone())
+    }
+
+    /// Set up the cycle for the SPD `a` (of the finest level's size), which it keeps as
+    /// its finest operator: the Galerkin coarse operators, the smoothers and the coarsest
+    /// factorization. The operators of a previous set-up are dropped first.
     ///
     /// Errors: [`Error::LinearSolver`] when `a`'s size does not match the hierarchy, a
     /// row has no diagonal entry, or the coarsest operator is not positive definite.
-    pub fn factor(&mut self, a: &Csr) -> Result<()> {
-        let n0 = self.prolongations.first().map_or(a.nrows, |p| p.nrows);
+    pub fn factor_owned(&mut self, a: Csr) -> Result<()> {
+        let n0 = self.prolongations.first().map_or(a.nrows, TensorProlongation::nrows);
         if a.nrows != n0 || a.ncols != n0 {
             return Err(Error::LinearSolver(format!(
                 "multigrid: a {} x {} operator on a hierarchy of {n0} fine unknowns",
                 a.nrows, a.ncols
             )));
         }
-        let mut operators = std::mem::take(&mut self.operators);
-        operators.resize_with(self.levels(), Csr::default);
-        operators[0].update(a);
-        for l in 0..self.prolongations.len() {
-            operators[l + 1] = galerkin(&self.restrictions[l], &operators[l], &self.prolongations[l]);
+        // the previous operators and smoothers go before the new ones are built
+        self.release();
+        let mut operators = Vec::with_capacity(self.levels());
+        operators.push(a);
+        for (l, p) in self.prolongations.iter().enumerate() {
+            let coarse = galerkin(&operators[l], p);
+            operators.push(coarse);
         }
         let smoothed = &operators[..operators.len() - 1];
         self.diagonals = match self.smoother {
@@ -197,6 +224,14 @@ impl Multigrid {
         Ok(())
     }
 
+    /// Drop the operators and smoothers of the last set-up (the hierarchy stays).
+    fn release(&mut self) {
+        self.operators = Vec::new();
+        self.lines = Vec::new();
+        self.ilu = Vec::new();
+        self.diagonals = Vec::new();
+    }
+
     /// `x = B b`, one V-cycle from `x = 0` (`B ≈ A^{-1}`).
     pub fn apply(&self, b: &[f64], x: &mut [f64]) {
         x.fill(0.0);
@@ -218,10 +253,12 @@ impl Multigrid {
         for (ri, bi) in r.iter_mut().zip(b) {
             *ri = bi - *ri;
         }
-        let rc = self.restrictions[l].apply(&r);
+        let p = &self.prolongations[l];
+        let mut rc = vec![0.0; p.ncols()];
+        p.restrict(&r, &mut rc);
         let mut xc = vec![0.0; rc.len()];
         self.cycle(l + 1, &rc, &mut xc);
-        self.prolongations[l].mul_vec(&xc, &mut r);
+        p.prolong(&xc, &mut r);
         for (xi, ci) in x.iter_mut().zip(&r) {
             *xi += ci;
         }

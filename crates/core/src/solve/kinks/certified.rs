@@ -96,7 +96,11 @@ impl<P: DiscreteProblem> DiscreteProblem for Certified<P> {
     fn ordering(&self) -> Option<&[usize]> {
         self.inner.ordering()
     }
-    fn transfers(&self) -> Vec<Csr> {
+    fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
+        self.inner.take_preconditioner(shift)
+    }
+
+    fn transfers(&self) -> Vec<[Csr; 2]> {
         self.inner.transfers()
     }
     fn control_points(&self, c: &[f64]) -> Vec<Point> {

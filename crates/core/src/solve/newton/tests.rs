@@ -269,7 +269,7 @@ impl DiscreteProblem for MatrixOnly {
     fn ordering(&self) -> Option<&[usize]> {
         self.0.ordering()
     }
-    fn transfers(&self) -> Vec<Csr> {
+    fn transfers(&self) -> Vec<[Csr; 2]> {
         self.0.transfers()
     }
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
