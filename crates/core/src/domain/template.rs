@@ -336,6 +336,16 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
     lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0, &CUT_SEARCHES)
 }
 
+/// [`graph_layout`] with the given searches of the cuts' ends in turn (tests reach the
+/// curved cuts with `[0.0]`: no search).
+#[cfg(test)]
+pub(super) fn graph_layout_searching(pg: &PlaneGraph, opts: &LayoutOptions, searches: &[f64]) -> Result<AutoLayout> {
+    let t0 = Instant::now();
+    let (g, report) = build_graph(pg, &opts.fit)?;
+    let (diameter, area) = (report.diameter, report.area);
+    lay_out_graph(g, &pg.name, diameter, area, (None, Some(report)), opts, t0, searches)
+}
+
 /// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
 const SPOKE_SAMPLES: usize = 64;
 
