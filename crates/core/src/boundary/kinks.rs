@@ -214,6 +214,67 @@ impl CornerTurnings {
     }
 }
 
+/// A corner of a point cloud that the cloud resolves as a rounding ([`rounding_of`]):
+/// not a kink, the `C^1` fit follows it (the report's `roundings`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Rounding {
+    /// The side.
+    pub side: Side,
+    /// The cord-length abscissa of the vertex turning most, in `[0, 1]`.
+    pub parameter: f64,
+    /// That vertex (in the coordinates the hierarchy was built in).
+    pub point: Point,
+    /// Turning of the chords at the detection's window `w`, degrees.
+    pub turning_degrees: f64,
+    /// The radius of the circular fillet with the same turning at the same scale.
+    pub radius: f64,
+    /// Its sagitta `R (1 / cos(θ / 2) - 1)`: how far inside the sharp corner the cloud
+    /// passes.
+    pub sagitta: f64,
+    /// Points of the cloud within the half-turn window `v` of the vertex per direction.
+    pub points: usize,
+}
+
+/// Whether the corner of a point cloud at vertex `j` (turning `θ` at the window `w`) is a
+/// rounding the cloud resolves, and its size: with `h` the mean point spacing, the
+/// smallest window `v = m h` at which the chords turn by at least `θ / 2`. A polygon's
+/// vertex turns by all of `θ` between its neighbours (`m = 1`): a kink. A circular fillet
+/// of radius `R` turns by `v / R` at the window `v` (both chords on the arc), so half of
+/// `θ` at `v = R θ / 2`: `R ≈ 2 v / θ`, and the cloud passes `s = R (1 / cos(θ / 2) - 1)`
+/// inside the sharp corner. Where `s` exceeds the fit tolerance `tol` the rounding is
+/// geometry the `C^1` fit must follow within `tol`, not a `C^0` point: `Some((R, s, m))`.
+/// `None` for a kink: `m = 1`, `s <= tol`, or `θ` within a degree of a cusp.
+pub(crate) fn rounding_of(points: &[Point], j: usize, w: f64, tol: f64) -> Option<(f64, f64, usize)> {
+    let n = points.len();
+    if n < 3 || j == 0 || j + 1 >= n {
+        return None;
+    }
+    let mut s = vec![0.0; n];
+    for q in 1..n {
+        s[q] = s[q - 1] + (points[q][0] - points[q - 1][0]).hypot(points[q][1] - points[q - 1][1]);
+    }
+    let h = s[n - 1] / (n - 1) as f64;
+    let theta = chord_turning(points, &s, j, w).to_radians();
+    if !(theta > 0.0 && h > 0.0) || theta >= std::f64::consts::PI - 1f64.to_radians() {
+        return None;
+    }
+    // the window at which half the turning is reached; 0.999: a point spacing of the
+    // window itself counts
+    let mut m = 1;
+    while chord_turning(points, &s, j, 0.999 * m as f64 * h).to_radians() < 0.5 * theta {
+        m += 1;
+        if m as f64 * h >= w {
+            break;
+        }
+    }
+    if m == 1 {
+        return None;
+    }
+    let radius = 2.0 * m as f64 * h / theta;
+    let sagitta = radius * (1.0 / (0.5 * theta).cos() - 1.0);
+    (sagitta > tol).then_some((radius, sagitta, m))
+}
+
 /// The kinks of `boundary` that `mode` keeps (south, east, north, west, each by
 /// parameter), or that the report names when `mode` is [`KinkMode::None`] and `report`
 /// is set (then with the thresholds of [`KinkMode::Auto`]). `input_basis`: every `C^0`
@@ -234,6 +295,9 @@ pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Candidates {
     sides: [SideCandidates; 4],
+    /// With [`Candidates::with_roundings`]: the fit tolerance above which a point cloud's
+    /// rounded corner is not a kink ([`rounding_of`]).
+    rounding_tol: Option<f64>,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -262,7 +326,46 @@ impl Candidates {
             },
             SideCurve::Analytic(_) => SideCandidates::None,
         };
-        Self { sides: Side::ALL.map(side) }
+        Self { sides: Side::ALL.map(side), rounding_tol: None }
+    }
+
+    /// The same candidates, a point cloud's corner that the cloud resolves as a rounding
+    /// whose sagitta exceeds `tol` (the absolute fit tolerance) no kink in any mode
+    /// ([`rounding_of`]; [`Candidates::roundings`] lists them).
+    pub fn with_roundings(mut self, tol: f64) -> Self {
+        self.rounding_tol = Some(tol);
+        self
+    }
+
+    /// Whether the corner at vertex `j` of `points` is a rounding (never without
+    /// [`Candidates::with_roundings`]).
+    fn rounding(&self, points: &[Point], turnings: &CornerTurnings, j: usize) -> Option<(f64, f64, usize)> {
+        self.rounding_tol.and_then(|tol| rounding_of(points, j, turnings.w, tol))
+    }
+
+    /// The corners of the point clouds turning at least the threshold of `mode` that are
+    /// roundings, not kinks ([`Candidates::with_roundings`]); none without it.
+    pub fn roundings(&self, mode: KinkMode) -> Vec<Rounding> {
+        let mut out = Vec::new();
+        let Some(cloud_min) = mode.cloud_threshold() else { return out };
+        for (s, side) in Side::ALL.into_iter().zip(&self.sides) {
+            if let SideCandidates::Cloud { params, points, turnings } = side {
+                for (j, turn) in turnings.corners(cloud_min) {
+                    if let Some((radius, sagitta, m)) = self.rounding(points, turnings, j) {
+                        out.push(Rounding {
+                            side: s,
+                            parameter: params[j],
+                            point: points[j],
+                            turning_degrees: turn,
+                            radius,
+                            sagitta,
+                            points: m,
+                        });
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// The kinks `mode` keeps, as [`detect`] with the same arguments finds them (a mode
@@ -290,6 +393,9 @@ impl Candidates {
                 }
                 SideCandidates::Cloud { params, points, turnings } => {
                     for (j, turn) in turnings.corners(cloud_min) {
+                        if self.rounding(points, turnings, j).is_some() {
+                            continue;
+                        }
                         out.push(Kink {
                             side: s,
                             parameter: params[j],

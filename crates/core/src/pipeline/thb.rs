@@ -66,10 +66,11 @@ impl ThbSolution {
     }
 }
 
-/// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`], repair
-/// rounds allowed, and the map folded or undecided.
+/// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`] (or
+/// [`Refinement::Auto`] on a boundary with rounded point-cloud corners, the report's
+/// `roundings`), repair rounds allowed, and the map folded or undecided.
 pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
-    opts.repair.refinement == Refinement::Thb
+    opts.repair.refinement.resolved(!sol.report.boundary.roundings.is_empty()) == Refinement::Thb
         && opts.repair.rounds > 0
         && matches!(sol.report.outcome.verdict, Verdict::Folded | Verdict::Undecided)
 }

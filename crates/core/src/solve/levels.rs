@@ -4,10 +4,49 @@
 //! 4), always ending with the finest.
 
 use crate::boundary::hierarchy::Level;
+use crate::boundary::kinks::Rounding;
 use crate::error::{Error, Result};
 use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Side;
+
+/// At most this many halvings of an end span by [`graded_at_roundings`].
+pub(crate) const MAX_GRADING: usize = 8;
+
+/// `level` graded towards the sides with rounded point-cloud corners
+/// ([`Rounding`]): at such a side the knot vector across it (`xi` at west and east,
+/// `eta` at south and north) has its end span halved until it is at most `R / (2 d)`
+/// wide (`R` the smallest rounding radius on the side, `d` the boundary's diameter, both
+/// in the hierarchy's coordinates), at most [`MAX_GRADING`] times; the sides refined
+/// exactly (the boundary is unchanged). A rounded reflex corner (a jigsaw tab's
+/// shoulder) bends the map within about `R` of the side, and a bulb behind a neck is
+/// squeezed into a thin layer along it: one span across was measured to fold at the
+/// side, five halvings of it certify (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
+pub(crate) fn graded_at_roundings(level: &Level, roundings: &[Rounding], diameter: f64) -> Result<Level> {
+    let mut knots = level.knots.clone();
+    for side in Side::ALL {
+        let Some(radius) = roundings.iter().filter(|r| r.side == side).map(|r| r.radius).min_by(f64::total_cmp) else {
+            continue;
+        };
+        let target = radius / (2.0 * diameter);
+        let d = 1 - side.direction();
+        let at_start = matches!(side, Side::South | Side::West);
+        for _ in 0..MAX_GRADING {
+            let elems = knots[d].elements();
+            let Some(&(_, a, b)) = (if at_start { elems.first() } else { elems.last() }) else { break };
+            if !(b - a > target) {
+                break;
+            }
+            knots[d] = knots[d].with_inserted(&[0.5 * (a + b)]);
+        }
+    }
+    if knots == level.knots {
+        return Ok(level.clone());
+    }
+    let sides = Side::ALL.map(|s| level.sides[s as usize].refined(&knots[s.direction()]));
+    let sides: [Curve; 4] = sides.into_iter().collect::<Result<Vec<_>>>()?.try_into().expect("four sides");
+    Ok(Level { knots, sides })
+}
 
 /// Choose the levels to solve: from the coarsest, each next one at least `growth` times
 /// larger, always ending with the finest. A level of nearly the finest's size (less than
