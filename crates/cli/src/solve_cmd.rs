@@ -212,6 +212,11 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if opts.repair.refinement == Refinement::Thb {
         thb_outputs(&a, input.is_multipatch())?;
     }
+    // `auto` would write a THB map where the boundary has rounded corners: outputs that
+    // need a tensor map (or a map file other than JSON or XML) keep the tensor repair
+    if opts.repair.refinement == Refinement::Auto && thb_outputs(&a, false).is_err() {
+        opts.repair.refinement = Refinement::Tensor;
+    }
     match &input {
         Input::Volume(_) => super::volume_cmd::plan(&a, path)?,
         input => output_plan(&a, &[path], input.is_multipatch())?,

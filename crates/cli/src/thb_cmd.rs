@@ -92,5 +92,11 @@ pub(crate) fn finish(out: &ThbSolution, output: &Path, gismo: Option<&Path>, jso
         );
         say!("certificate: {}", c.message());
     }
-    Ok(exit_code(&c.verdict))
+    // as for a tensor map: 6 for a bijective map whose boundary is not the input's or
+    // whose kinks the C0 route could not keep (the THB rounds start from its map)
+    let r = &out.report.solve;
+    Ok(match exit_code(&c.verdict) {
+        0 if !r.boundary.kept || !r.kinks_kept() => 6,
+        code => code,
+    })
 }

@@ -78,8 +78,8 @@ pub struct Hierarchy {
     /// points taken from the input's sides (`Kink::point_on`).
     pub detected: Vec<Kink>,
     /// The point clouds' corners (at the thresholds of [`KinkMode::Auto`]) that the cloud
-    /// resolves as roundings wider than the fit tolerance: no kinks in any mode, the
-    /// `C^1` fit follows them (`kinks::rounding_of`); in the normalised coordinates.
+    /// resolves as roundings: no kinks in any mode, the `C^1` fit follows them or rounds
+    /// them within its tolerance (`kinks::rounding_of`); in the normalised coordinates.
     pub roundings: Vec<Rounding>,
 }
 
@@ -152,7 +152,7 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
     let mut fallback = None;
     // measured once: the kinks kept by `opts.kinks` and those the report names
     let floor = opts.kinks.cloud_threshold().map_or(CLOUD_AUTO, |t| t.min(CLOUD_AUTO));
-    let found = Candidates::find(boundary, floor).with_roundings(tol_abs);
+    let found = Candidates::find(boundary, floor).with_roundings();
     if opts.basis != BasisChoice::Fitted {
         let mut kept = found.kinks(opts.kinks, true);
         match input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS, &kept)? {

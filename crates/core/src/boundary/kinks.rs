@@ -235,16 +235,27 @@ pub struct Rounding {
     pub points: usize,
 }
 
+/// The share of a corner's turning that the chords to the neighbours of a polygon's vertex
+/// turn by at least ([`rounding_of`]): a vertex sampled on both legs turns by all of it
+/// (up to noise); the sharpest jigsaw roundings, resolved by two points, by 48 to 59 %
+/// (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
+pub(crate) const VERTEX_SHARE: f64 = 0.9;
+
 /// Whether the corner of a point cloud at vertex `j` (turning `θ` at the window `w`) is a
 /// rounding the cloud resolves, and its size: with `h` the mean point spacing, the
 /// smallest window `v = m h` at which the chords turn by at least `θ / 2`. A polygon's
-/// vertex turns by all of `θ` between its neighbours (`m = 1`): a kink. A circular fillet
-/// of radius `R` turns by `v / R` at the window `v` (both chords on the arc), so half of
-/// `θ` at `v = R θ / 2`: `R ≈ 2 v / θ`, and the cloud passes `s = R (1 / cos(θ / 2) - 1)`
-/// inside the sharp corner. Where `s` exceeds the fit tolerance `tol` the rounding is
-/// geometry the `C^1` fit must follow within `tol`, not a `C^0` point: `Some((R, s, m))`.
-/// `None` for a kink: `m = 1`, `s <= tol`, or `θ` within a degree of a cusp.
-pub(crate) fn rounding_of(points: &[Point], j: usize, w: f64, tol: f64) -> Option<(f64, f64, usize)> {
+/// vertex turns by all of `θ` between its neighbours: a kink where the chords to the
+/// neighbours turn by at least [`VERTEX_SHARE`] of `θ`, or where `θ` is within a degree of
+/// a cusp (`None`). Otherwise the cloud resolves the corner as a curve over two or more
+/// chords, and the `C^1` fit either follows it or rounds it within its tolerance: a
+/// rounding, no kink (BENCHMARKS.md "Puzzle necks and hair-thin gaps": keeping such
+/// corners as kinks made the jigsaw pieces time out, and a 36-degree one whose sagitta
+/// is below the tolerance sent jigsaw-4 through a `C^0` route that failed).
+/// `Some((R, s, m))`: a circular fillet of radius `R` turns by `v / R` at the window `v`
+/// (both chords on the arc), so half of `θ` at `v = R θ / 2`: `R ≈ 2 v / θ`, and the
+/// cloud passes `s = R (1 / cos(θ / 2) - 1)` inside the sharp corner (the sagitta, to
+/// compare with the fit tolerance: above it the fit follows the rounding).
+pub(crate) fn rounding_of(points: &[Point], j: usize, w: f64) -> Option<(f64, f64, usize)> {
     let n = points.len();
     if n < 3 || j == 0 || j + 1 >= n {
         return None;
@@ -258,21 +269,22 @@ pub(crate) fn rounding_of(points: &[Point], j: usize, w: f64, tol: f64) -> Optio
     if !(theta > 0.0 && h > 0.0) || theta >= std::f64::consts::PI - 1f64.to_radians() {
         return None;
     }
-    // the window at which half the turning is reached; 0.999: a point spacing of the
-    // window itself counts
+    // the turning between the neighbours' chords, then the window at which half of it is
+    // reached; 0.999: a point spacing of the window itself counts
+    let at = |m: usize| chord_turning(points, &s, j, 0.999 * m as f64 * h).to_radians();
+    if at(1) >= VERTEX_SHARE * theta {
+        return None;
+    }
     let mut m = 1;
-    while chord_turning(points, &s, j, 0.999 * m as f64 * h).to_radians() < 0.5 * theta {
+    while at(m) < 0.5 * theta {
         m += 1;
         if m as f64 * h >= w {
             break;
         }
     }
-    if m == 1 {
-        return None;
-    }
     let radius = 2.0 * m as f64 * h / theta;
     let sagitta = radius * (1.0 / (0.5 * theta).cos() - 1.0);
-    (sagitta > tol).then_some((radius, sagitta, m))
+    Some((radius, sagitta, m))
 }
 
 /// The kinks of `boundary` that `mode` keeps (south, east, north, west, each by
@@ -295,9 +307,9 @@ pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Candidates {
     sides: [SideCandidates; 4],
-    /// With [`Candidates::with_roundings`]: the fit tolerance above which a point cloud's
-    /// rounded corner is not a kink ([`rounding_of`]).
-    rounding_tol: Option<f64>,
+    /// With [`Candidates::with_roundings`]: a point cloud's rounded corner is not a kink
+    /// ([`rounding_of`]).
+    roundings: bool,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -326,21 +338,24 @@ impl Candidates {
             },
             SideCurve::Analytic(_) => SideCandidates::None,
         };
-        Self { sides: Side::ALL.map(side), rounding_tol: None }
+        Self { sides: Side::ALL.map(side), roundings: false }
     }
 
     /// The same candidates, a point cloud's corner that the cloud resolves as a rounding
-    /// whose sagitta exceeds `tol` (the absolute fit tolerance) no kink in any mode
-    /// ([`rounding_of`]; [`Candidates::roundings`] lists them).
-    pub fn with_roundings(mut self, tol: f64) -> Self {
-        self.rounding_tol = Some(tol);
+    /// no kink in any mode ([`rounding_of`]; [`Candidates::roundings`] lists them).
+    pub fn with_roundings(mut self) -> Self {
+        self.roundings = true;
         self
     }
 
     /// Whether the corner at vertex `j` of `points` is a rounding (never without
     /// [`Candidates::with_roundings`]).
     fn rounding(&self, points: &[Point], turnings: &CornerTurnings, j: usize) -> Option<(f64, f64, usize)> {
-        self.rounding_tol.and_then(|tol| rounding_of(points, j, turnings.w, tol))
+        if self.roundings {
+            rounding_of(points, j, turnings.w)
+        } else {
+            None
+        }
     }
 
     /// The corners of the point clouds turning at least the threshold of `mode` that are
@@ -607,6 +622,38 @@ mod tests {
             } else {
                 assert!(c.is_empty(), "radius {r}: {c:?}");
             }
+        }
+    }
+
+    /// The rounding rule ([`rounding_of`]) on the closed-form fillet of radius `R` (a
+    /// right-angled corner, sampled every `h = 5e-4`): the fillet turns by `v / R` at the
+    /// window `v`, so the half-turn window is `R π / 4` up to one spacing, and the
+    /// estimated radius is `R` within `2 h / θ` (`θ = π / 2`); its sagitta is `R (√2 - 1)`.
+    /// A polygon's vertex (all of the turning between its neighbours) is a kink, and so is
+    /// a fillet narrower than the spacing.
+    #[test]
+    fn a_fillet_the_cloud_resolves_is_a_rounding() {
+        let h = 5e-4;
+        let theta = std::f64::consts::FRAC_PI_2;
+        for r in [1e-3, 2e-3, 5e-3] {
+            let pts = filleted_corner(r, h);
+            let total: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum();
+            let w = CORNER_WINDOW * total;
+            let c = cloud_corners(&pts, CLOUD_CORNER_DEGREES);
+            assert_eq!(c.len(), 1, "radius {r}: {c:?}");
+            let (radius, s, m) = rounding_of(&pts, c[0].0, w).expect("a rounding");
+            assert!((radius - r).abs() <= 2.0 * h / theta * 1.01, "radius {r}: estimated {radius}");
+            assert!((s - radius * (2f64.sqrt() - 1.0)).abs() <= 0.05 * s, "radius {r}: sagitta {s}");
+            let half = r * theta / 2.0;
+            assert!((m as f64 * h - half).abs() <= h, "radius {r}: half-turn window {m} points against {half}");
+        }
+        // a sharp vertex, and a fillet a fifth of the spacing: all of the turning (or
+        // nearly) between the neighbours
+        for r in [0.0, 1e-4] {
+            let sharp = filleted_corner(r, h);
+            let c = cloud_corners(&sharp, CLOUD_CORNER_DEGREES);
+            assert_eq!(c.len(), 1);
+            assert_eq!(rounding_of(&sharp, c[0].0, 0.02), None, "radius {r}");
         }
     }
 

@@ -60,9 +60,13 @@ pub struct ThbReport {
 }
 
 impl ThbSolution {
-    /// Whether the map is certified (or degenerate only at corners the boundary forces).
+    /// Whether the map is certified (or degenerate only at corners the boundary forces),
+    /// its boundary the input's and the kinks of the `C^0` route kept (as
+    /// [`Report::success`] of the tensor solve it started from).
     pub fn success(&self) -> bool {
         matches!(self.report.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+            && self.report.solve.boundary.kept
+            && self.report.solve.kinks_kept()
     }
 }
 

@@ -220,6 +220,52 @@ pub(crate) const MAX_BASIS: usize = 1 << 22;
 mod tests {
     use super::*;
 
+    /// [`graded_at_roundings`] on the unit square (8 elements per direction, degree 3)
+    /// with a rounding of radius `R = 0.01` on the west side, the diameter `√2`: the
+    /// `xi` end span at `xi = 0` halved until at most `R / (2 d)` wide (0.125 → 0.00390625,
+    /// five halvings), nothing else refined, and the sides the same curves.
+    #[test]
+    fn grading_halves_the_span_across_a_rounded_side() {
+        let kv = KnotVector::open_uniform(3, 8);
+        let line = |a: [f64; 2], b: [f64; 2]| {
+            let cps = kv.greville().into_iter().map(|t| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            Curve::new(kv.clone(), cps.collect(), None).unwrap()
+        };
+        let sides = [
+            line([0.0, 0.0], [1.0, 0.0]),
+            line([1.0, 0.0], [1.0, 1.0]),
+            line([0.0, 1.0], [1.0, 1.0]),
+            line([0.0, 0.0], [0.0, 1.0]),
+        ];
+        let level = Level { knots: [kv.clone(), kv.clone()], sides };
+        let rounding = Rounding {
+            side: Side::West,
+            parameter: 0.5,
+            point: [0.0, 0.5],
+            turning_degrees: 90.0,
+            radius: 0.01,
+            sagitta: 0.004,
+            points: 5,
+        };
+        let d = 2f64.sqrt();
+        let graded = graded_at_roundings(&level, &[rounding], d).unwrap();
+        let xi = graded.knots[0].elements();
+        assert_eq!(xi.len(), 8 + 5);
+        assert_eq!((xi[0].1, xi[0].2), (0.0, 0.00390625));
+        assert!(xi[0].2 <= 0.01 / (2.0 * d) && 2.0 * xi[0].2 > 0.01 / (2.0 * d));
+        assert_eq!(xi.last().map(|e| e.2 - e.1), Some(0.125));
+        assert_eq!(graded.knots[1], kv);
+        for (a, b) in level.sides.iter().zip(&graded.sides) {
+            for k in 0..=50 {
+                let t = k as f64 / 50.0;
+                let (p, q) = (a.eval(t), b.eval(t));
+                assert!((p[0] - q[0]).abs() < 1e-14 && (p[1] - q[1]).abs() < 1e-14);
+            }
+        }
+        // no rounding: the level as it is
+        assert_eq!(graded_at_roundings(&level, &[], d).unwrap().knots, level.knots);
+    }
+
     #[test]
     fn level_selection_quadruples() {
         // 310 replaces 300: both would be solved at nearly one size
