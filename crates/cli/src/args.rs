@@ -176,7 +176,7 @@ pub(crate) struct SolverArgs {
     /// whole basis; `thb` refines only the offending cells and a ring around them on a
     /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml);
     /// `auto` is `thb` where a point-cloud side has corners the cloud resolves as
-    /// roundings wider than the fit tolerance (the report's `roundings`), `tensor` elsewhere.
+    /// roundings (the report's `roundings`; docs/kinks.md), `tensor` elsewhere.
     #[arg(long, value_enum, default_value = "auto")]
     pub(crate) refinement: Refinement,
     /// In repair rounds, solve only for the control points within this many spans of

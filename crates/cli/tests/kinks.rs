@@ -118,9 +118,10 @@ fn step_out_keeps_its_reflex_kinks() {
 
 /// A corpus jigsaw piece (seed 1: tabs with necks rounded at 1/8 to 1/30 of the tab
 /// radius, dense point clouds) by the default route: the rounded corners are reported as
-/// `roundings` (each one's sagitta `R (1 / cos(θ / 2) - 1)` of its radius and turning,
-/// above the fit tolerance), none is a kink (none kept, none rounded by the fit), the
-/// default `--refinement auto` repairs by THB and the THB map is certified: exit 0.
+/// `roundings` (each one's sagitta `R (1 / cos(θ / 2) - 1)` of its radius and turning;
+/// on this piece all above the fit tolerance), none is a kink (none kept, none rounded by
+/// the fit), the default `--refinement auto` repairs by THB and the THB map is
+/// certified: exit 0.
 #[test]
 fn a_jigsaw_piece_certifies_with_its_roundings_reported() {
     let scratch = tempfile::tempdir().unwrap();

@@ -34,7 +34,7 @@ pub(crate) fn graded_at_roundings(level: &Level, roundings: &[Rounding], diamete
         for _ in 0..MAX_GRADING {
             let elems = knots[d].elements();
             let Some(&(_, a, b)) = (if at_start { elems.first() } else { elems.last() }) else { break };
-            if !(b - a > target) {
+            if b - a <= target {
                 break;
             }
             knots[d] = knots[d].with_inserted(&[0.5 * (a + b)]);

@@ -313,9 +313,9 @@ pub struct BoundaryReport {
     /// its tolerance) is not a success ([`Report::success`]); the `boundary_kept` key.
     #[serde(rename = "boundary_kept")]
     pub kept: bool,
-    /// Point-cloud corners the cloud resolves as roundings wider than the fit tolerance:
-    /// no kinks, the `C^1` fit follows them (`boundary::kinks::rounding_of`), in the
-    /// input's coordinates; the key is absent when there are none.
+    /// Point-cloud corners the cloud resolves as roundings over two or more chords: no
+    /// kinks, the `C^1` fit follows them (`boundary::kinks::rounding_of`), in the input's
+    /// coordinates; the key is absent when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub roundings: Vec<Rounding>,
 }
