@@ -209,6 +209,9 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let input = files::input_of(files::read(path)?, path, a.solver.fit.reorient)?;
     let mut opts = if input.is_multipatch() { super::multipatch_cmd::options(&a)? } else { a.solver.options()? };
     opts.report.poisson = a.poisson;
+    if !input.is_multipatch() {
+        opts.repair.refinement = a.solver.refinement;
+    }
     if opts.repair.refinement == Refinement::Thb {
         thb_outputs(&a, input.is_multipatch())?;
     }

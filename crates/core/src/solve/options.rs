@@ -106,7 +106,7 @@ pub struct RepairOptions {
 
 impl Default for RepairOptions {
     fn default() -> Self {
-        Self { rounds: 6, halo: 1, freeze: None, refinement: Refinement::Auto }
+        Self { rounds: 6, halo: 1, freeze: None, refinement: Refinement::Tensor }
     }
 }
 
@@ -136,13 +136,15 @@ pub enum Refinement {
     /// roundings (`boundary::kinks::rounding_of`: no kinks, so the `C^1` fit follows them
     /// and the basis is graded towards those sides, `solve::levels::graded_at_roundings`),
     /// [`Refinement::Tensor`] elsewhere (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
-    #[default]
+    /// The default of `winslow solve`; a THB map comes out where it applies, so the
+    /// library's default stays [`Refinement::Tensor`].
     #[cfg_attr(
         feature = "clap",
         value(help = "thb where a point-cloud side has rounded corners (the jigsaw pieces), tensor elsewhere")
     )]
     Auto,
     /// Bisect the offending knot spans (and a halo) across the whole tensor basis.
+    #[default]
     #[cfg_attr(feature = "clap", value(help = "Bisect the offending knot spans across the tensor basis"))]
     Tensor,
     /// Refine the offending cells (and a ring) of a THB basis only.
