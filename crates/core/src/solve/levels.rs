@@ -222,8 +222,8 @@ mod tests {
 
     /// [`graded_at_roundings`] on the unit square (8 elements per direction, degree 3)
     /// with a rounding of radius `R = 0.01` on the west side, the diameter `√2`: the
-    /// `xi` end span at `xi = 0` halved until at most `R / (2 d)` wide (0.125 → 0.00390625,
-    /// five halvings), nothing else refined, and the sides the same curves.
+    /// `xi` end span at `xi = 0` halved until at most `R / (2 d)` wide (0.125 → 0.001953125,
+    /// six halvings), nothing else refined, and the sides the same curves.
     #[test]
     fn grading_halves_the_span_across_a_rounded_side() {
         let kv = KnotVector::open_uniform(3, 8);
@@ -250,8 +250,8 @@ mod tests {
         let d = 2f64.sqrt();
         let graded = graded_at_roundings(&level, &[rounding], d).unwrap();
         let xi = graded.knots[0].elements();
-        assert_eq!(xi.len(), 8 + 5);
-        assert_eq!((xi[0].1, xi[0].2), (0.0, 0.00390625));
+        assert_eq!(xi.len(), 8 + 6);
+        assert_eq!((xi[0].1, xi[0].2), (0.0, 0.001953125));
         assert!(xi[0].2 <= 0.01 / (2.0 * d) && 2.0 * xi[0].2 > 0.01 / (2.0 * d));
         assert_eq!(xi.last().map(|e| e.2 - e.1), Some(0.125));
         assert_eq!(graded.knots[1], kv);
