@@ -174,8 +174,10 @@ pub(crate) struct SolverArgs {
     pub(crate) no_repair: bool,
     /// How a repair round refines: `tensor` bisects the offending knot spans across the
     /// whole basis; `thb` refines only the offending cells and a ring around them on a
-    /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml).
-    #[arg(long, value_enum, default_value = "tensor")]
+    /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml);
+    /// `auto` is `thb` where a point-cloud side has corners the cloud resolves as
+    /// roundings (the report's `roundings`; docs/kinks.md) in `solve`, `tensor` elsewhere.
+    #[arg(long, value_enum, default_value = "auto")]
     pub(crate) refinement: Refinement,
     /// In repair rounds, solve only for the control points within this many spans of
     /// the offending elements (the rest stay frozen at the prolonged map).
@@ -235,7 +237,8 @@ impl SolverArgs {
         o.nonlinear.linear = self.linear;
         o.repair.rounds = if self.no_repair { 0 } else { self.repair };
         o.repair.freeze = self.repair_freeze;
-        o.repair.refinement = self.refinement;
+        // `auto` is `solve`'s (it may write a THB map); the other commands need tensor maps
+        o.repair.refinement = self.refinement.resolved(false);
         o.operator = self.operator;
         o.levels.max_levels = self.levels;
         o.levels.min_elements = self.min_elements;

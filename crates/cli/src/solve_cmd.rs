@@ -209,8 +209,16 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     let input = files::input_of(files::read(path)?, path, a.solver.fit.reorient)?;
     let mut opts = if input.is_multipatch() { super::multipatch_cmd::options(&a)? } else { a.solver.options()? };
     opts.report.poisson = a.poisson;
+    if !input.is_multipatch() {
+        opts.repair.refinement = a.solver.refinement;
+    }
     if opts.repair.refinement == Refinement::Thb {
         thb_outputs(&a, input.is_multipatch())?;
+    }
+    // `auto` would write a THB map where the boundary has rounded corners: outputs that
+    // need a tensor map (or a map file other than JSON or XML) keep the tensor repair
+    if opts.repair.refinement == Refinement::Auto && thb_outputs(&a, false).is_err() {
+        opts.repair.refinement = Refinement::Tensor;
     }
     match &input {
         Input::Volume(_) => super::volume_cmd::plan(&a, path)?,

@@ -106,5 +106,11 @@ pub(crate) fn finish(out: &ThbSolution, a: &SolveArgs) -> Result<i32> {
         // a folded map gives inverted cells, which the writers refuse
         crate::mesh::make_and_write_thb(&out.map, &a.mesh_spec, p, json)?;
     }
-    Ok(exit_code(&c.verdict))
+    // as for a tensor map: 6 for a bijective map whose boundary is not the input's or
+    // whose kinks the C0 route could not keep (the THB rounds start from its map)
+    let r = &out.report.solve;
+    Ok(match exit_code(&c.verdict) {
+        0 if !r.boundary.kept || !r.kinks_kept() => 6,
+        code => code,
+    })
 }

@@ -115,3 +115,40 @@ fn step_out_keeps_its_reflex_kinks() {
     let check = bin().arg("check").arg(&map).arg("--json").output().unwrap();
     assert_eq!(check.status.code(), Some(0), "{}", String::from_utf8_lossy(&check.stdout));
 }
+
+/// A corpus jigsaw piece (seed 1: tabs with necks rounded at 1/8 to 1/30 of the tab
+/// radius, dense point clouds) by the default route: the rounded corners are reported as
+/// `roundings` (each one's sagitta `R (1 / cos(θ / 2) - 1)` of its radius and turning;
+/// on this piece all above the fit tolerance), none is a kink (none kept, none rounded by
+/// the fit), the default `--refinement auto` repairs by THB and the THB map is
+/// certified: exit 0.
+#[test]
+fn a_jigsaw_piece_certifies_with_its_roundings_reported() {
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path().join("jigsaw");
+    let o = bin()
+        .args(["corpus", "--families", "jigsaw", "--per-family", "1", "--seed", "1", "-q", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let map = scratch.path().join("jigsaw-1.map.json");
+    let out =
+        bin().arg("solve").arg(dir.join("jigsaw-1.json")).arg("-o").arg(&map).args(["--json", "-q"]).output().unwrap();
+    let r = stdout_json(&out);
+    assert_eq!(out.status.code(), Some(0), "{}", r["message"]);
+    assert_eq!((r["refinement"].as_str(), r["verdict"].as_str()), (Some("thb"), Some("certified")));
+    let solve = &r["solve"];
+    assert_eq!(solve["kinks"].as_array().map(Vec::len), Some(0), "{}", solve["kinks"]);
+    let tol = solve["fit_tolerance"].as_f64().unwrap();
+    let roundings = solve["roundings"].as_array().unwrap();
+    assert!(roundings.len() >= 4, "{roundings:?}");
+    for x in roundings {
+        let (radius, sagitta) = (x["radius"].as_f64().unwrap(), x["sagitta"].as_f64().unwrap());
+        let theta = x["turning_degrees"].as_f64().unwrap().to_radians();
+        assert!(theta >= 30f64.to_radians() && x["points"].as_u64().unwrap() >= 1, "{x}");
+        assert!((sagitta - radius * (1.0 / (0.5 * theta).cos() - 1.0)).abs() <= 1e-12 * sagitta, "{x}");
+        assert!(sagitta > tol, "{x} against the tolerance {tol}");
+    }
+    assert_eq!(read_json(&map)["report"]["verdict"], "certified");
+}

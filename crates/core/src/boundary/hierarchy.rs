@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::cord_length::cord_length_params;
 use super::fit::{fit_side_kinked, FitOptions, SideFit};
 use super::input_basis::{input_levels_with, DIRECT_SOLVE_MAX_FUNCTIONS};
-use super::kinks::{Candidates, Kink, KinkKind, KinkedLevel};
+use super::kinks::{Candidates, Kink, KinkKind, KinkedLevel, Rounding};
 pub use super::level::Level;
 use super::normalise::Similarity;
 use super::reparam::{sample_side, ReparamReport, SideParam};
@@ -77,6 +77,10 @@ pub struct Hierarchy {
     /// a ring's cut-open boundary); the report names those not kept as rounded, their
     /// points taken from the input's sides (`Kink::point_on`).
     pub detected: Vec<Kink>,
+    /// The point clouds' corners (at the thresholds of [`KinkMode::Auto`]) that the cloud
+    /// resolves as roundings: no kinks in any mode, the `C^1` fit follows them or rounds
+    /// them within its tolerance (`kinks::rounding_of`); in the normalised coordinates.
+    pub roundings: Vec<Rounding>,
 }
 
 impl Hierarchy {
@@ -148,7 +152,7 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
     let mut fallback = None;
     // measured once: the kinks kept by `opts.kinks` and those the report names
     let floor = opts.kinks.cloud_threshold().map_or(CLOUD_AUTO, |t| t.min(CLOUD_AUTO));
-    let found = Candidates::find(boundary, floor);
+    let found = Candidates::find(boundary, floor).with_roundings();
     if opts.basis != BasisChoice::Fitted {
         let mut kept = found.kinks(opts.kinks, true);
         match input_levels_with(boundary, DIRECT_SOLVE_MAX_FUNCTIONS, &kept)? {
@@ -169,6 +173,7 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
                     similarity: Similarity::IDENTITY,
                     kinked: None,
                     detected: found.kinks(KinkMode::Auto, true),
+                    roundings: found.roundings(KinkMode::Auto),
                 };
                 return with_kinks(h, kept, Vec::new());
             }
@@ -223,6 +228,7 @@ fn normalised_hierarchy(boundary: &Boundary, opts: &FitOptions) -> Result<Hierar
     h.reparam = plan.report;
     h.basis = BasisReport { requested: opts.basis, used: BasisChoice::Fitted, fallback, kinks: None };
     h.detected = found.kinks(KinkMode::Auto, false);
+    h.roundings = found.roundings(KinkMode::Auto);
     with_kinks(h, kept, notes)
 }
 
@@ -325,6 +331,7 @@ pub fn hierarchy_from_fits(fits: [SideFit; 4], tol_abs: f64, diameter: f64) -> R
         similarity: Similarity::IDENTITY,
         kinked: None,
         detected: Vec::new(),
+        roundings: Vec::new(),
     })
 }
 

@@ -214,6 +214,79 @@ impl CornerTurnings {
     }
 }
 
+/// A corner of a point cloud that the cloud resolves as a rounding ([`rounding_of`]):
+/// not a kink, the `C^1` fit follows it (the report's `roundings`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Rounding {
+    /// The side.
+    pub side: Side,
+    /// The cord-length abscissa of the vertex turning most, in `[0, 1]`.
+    pub parameter: f64,
+    /// That vertex (in the coordinates the hierarchy was built in).
+    pub point: Point,
+    /// Turning of the chords at the detection's window `w`, degrees.
+    pub turning_degrees: f64,
+    /// The radius of the circular fillet with the same turning at the same scale.
+    pub radius: f64,
+    /// Its sagitta `R (1 / cos(θ / 2) - 1)`: how far inside the sharp corner the cloud
+    /// passes.
+    pub sagitta: f64,
+    /// Points of the cloud within the half-turn window `v` of the vertex per direction.
+    pub points: usize,
+}
+
+/// The share of a corner's turning that the chords to the neighbours of a polygon's vertex
+/// turn by at least ([`rounding_of`]): a vertex sampled on both legs turns by all of it
+/// (up to noise); the sharpest jigsaw roundings, resolved by two points, by 48 to 59 %
+/// (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
+pub(crate) const VERTEX_SHARE: f64 = 0.9;
+
+/// Whether the corner of a point cloud at vertex `j` (turning `θ` at the window `w`) is a
+/// rounding the cloud resolves, and its size: with `h` the mean point spacing, the
+/// smallest window `v = m h` at which the chords turn by at least `θ / 2`. A polygon's
+/// vertex turns by all of `θ` between its neighbours: a kink where the chords to the
+/// neighbours turn by at least [`VERTEX_SHARE`] of `θ`, or where `θ` is within a degree of
+/// a cusp (`None`). Otherwise the cloud resolves the corner as a curve over two or more
+/// chords, and the `C^1` fit either follows it or rounds it within its tolerance: a
+/// rounding, no kink (BENCHMARKS.md "Puzzle necks and hair-thin gaps": keeping such
+/// corners as kinks made the jigsaw pieces time out, and a 36-degree one whose sagitta
+/// is below the tolerance sent jigsaw-4 through a `C^0` route that failed).
+/// `Some((R, s, m))`: a circular fillet of radius `R` turns by `v / R` at the window `v`
+/// (both chords on the arc), so half of `θ` at `v = R θ / 2`: `R ≈ 2 v / θ`, and the
+/// cloud passes `s = R (1 / cos(θ / 2) - 1)` inside the sharp corner (the sagitta, to
+/// compare with the fit tolerance: above it the fit follows the rounding).
+pub(crate) fn rounding_of(points: &[Point], j: usize, w: f64) -> Option<(f64, f64, usize)> {
+    let n = points.len();
+    if n < 3 || j == 0 || j + 1 >= n {
+        return None;
+    }
+    let mut s = vec![0.0; n];
+    for q in 1..n {
+        s[q] = s[q - 1] + (points[q][0] - points[q - 1][0]).hypot(points[q][1] - points[q - 1][1]);
+    }
+    let h = s[n - 1] / (n - 1) as f64;
+    let theta = chord_turning(points, &s, j, w).to_radians();
+    if !(theta > 0.0 && h > 0.0) || theta >= std::f64::consts::PI - 1f64.to_radians() {
+        return None;
+    }
+    // the turning between the neighbours' chords, then the window at which half of it is
+    // reached; 0.999: a point spacing of the window itself counts
+    let at = |m: usize| chord_turning(points, &s, j, 0.999 * m as f64 * h).to_radians();
+    if at(1) >= VERTEX_SHARE * theta {
+        return None;
+    }
+    let mut m = 1;
+    while at(m) < 0.5 * theta {
+        m += 1;
+        if m as f64 * h >= w {
+            break;
+        }
+    }
+    let radius = 2.0 * m as f64 * h / theta;
+    let sagitta = radius * (1.0 / (0.5 * theta).cos() - 1.0);
+    Some((radius, sagitta, m))
+}
+
 /// The kinks of `boundary` that `mode` keeps (south, east, north, west, each by
 /// parameter), or that the report names when `mode` is [`KinkMode::None`] and `report`
 /// is set (then with the thresholds of [`KinkMode::Auto`]). `input_basis`: every `C^0`
@@ -234,6 +307,9 @@ pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Candidates {
     sides: [SideCandidates; 4],
+    /// With [`Candidates::with_roundings`]: a point cloud's rounded corner is not a kink
+    /// ([`rounding_of`]).
+    roundings: bool,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -262,7 +338,49 @@ impl Candidates {
             },
             SideCurve::Analytic(_) => SideCandidates::None,
         };
-        Self { sides: Side::ALL.map(side) }
+        Self { sides: Side::ALL.map(side), roundings: false }
+    }
+
+    /// The same candidates, a point cloud's corner that the cloud resolves as a rounding
+    /// no kink in any mode ([`rounding_of`]; [`Candidates::roundings`] lists them).
+    pub fn with_roundings(mut self) -> Self {
+        self.roundings = true;
+        self
+    }
+
+    /// Whether the corner at vertex `j` of `points` is a rounding (never without
+    /// [`Candidates::with_roundings`]).
+    fn rounding(&self, points: &[Point], turnings: &CornerTurnings, j: usize) -> Option<(f64, f64, usize)> {
+        if self.roundings {
+            rounding_of(points, j, turnings.w)
+        } else {
+            None
+        }
+    }
+
+    /// The corners of the point clouds turning at least the threshold of `mode` that are
+    /// roundings, not kinks ([`Candidates::with_roundings`]); none without it.
+    pub fn roundings(&self, mode: KinkMode) -> Vec<Rounding> {
+        let mut out = Vec::new();
+        let Some(cloud_min) = mode.cloud_threshold() else { return out };
+        for (s, side) in Side::ALL.into_iter().zip(&self.sides) {
+            if let SideCandidates::Cloud { params, points, turnings } = side {
+                for (j, turn) in turnings.corners(cloud_min) {
+                    if let Some((radius, sagitta, m)) = self.rounding(points, turnings, j) {
+                        out.push(Rounding {
+                            side: s,
+                            parameter: params[j],
+                            point: points[j],
+                            turning_degrees: turn,
+                            radius,
+                            sagitta,
+                            points: m,
+                        });
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// The kinks `mode` keeps, as [`detect`] with the same arguments finds them (a mode
@@ -290,6 +408,9 @@ impl Candidates {
                 }
                 SideCandidates::Cloud { params, points, turnings } => {
                     for (j, turn) in turnings.corners(cloud_min) {
+                        if self.rounding(points, turnings, j).is_some() {
+                            continue;
+                        }
                         out.push(Kink {
                             side: s,
                             parameter: params[j],
@@ -501,6 +622,40 @@ mod tests {
             } else {
                 assert!(c.is_empty(), "radius {r}: {c:?}");
             }
+        }
+    }
+
+    /// The rounding rule ([`rounding_of`]) on the closed-form fillet of radius `R` (a
+    /// right-angled corner, sampled every `h = 5e-4`): the fillet turns by `v / R` at the
+    /// window `v`, so the half-turn window is `R π / 4` up to one spacing, and the
+    /// estimated radius is `R` within `2 h / θ` (`θ = π / 2`); its sagitta is `R (√2 - 1)`.
+    /// A polygon's vertex (all of the turning between its neighbours) is a kink, and so is
+    /// a fillet narrower than the spacing.
+    #[test]
+    fn a_fillet_the_cloud_resolves_is_a_rounding() {
+        let h = 5e-4;
+        let theta = std::f64::consts::FRAC_PI_2;
+        for r in [1e-3, 2e-3, 5e-3] {
+            let pts = filleted_corner(r, h);
+            let total: f64 = pts.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum();
+            let w = CORNER_WINDOW * total;
+            let c = cloud_corners(&pts, CLOUD_CORNER_DEGREES);
+            assert_eq!(c.len(), 1, "radius {r}: {c:?}");
+            let (radius, s, m) = rounding_of(&pts, c[0].0, w).expect("a rounding");
+            assert!((radius - r).abs() <= 2.0 * h / theta * 1.01, "radius {r}: estimated {radius}");
+            // the turning measured at the window w is 80 to 90 degrees
+            let sag = |deg: f64| radius * (1.0 / (0.5 * deg.to_radians()).cos() - 1.0);
+            assert!(s >= sag(80.0) && s <= sag(90.0) * (1.0 + 1e-12), "radius {r}: sagitta {s}");
+            let half = r * theta / 2.0;
+            assert!((m as f64 * h - half).abs() <= h, "radius {r}: half-turn window {m} points against {half}");
+        }
+        // a sharp vertex, and a fillet a fifth of the spacing: all of the turning (or
+        // nearly) between the neighbours
+        for r in [0.0, 1e-4] {
+            let sharp = filleted_corner(r, h);
+            let c = cloud_corners(&sharp, CLOUD_CORNER_DEGREES);
+            assert_eq!(c.len(), 1);
+            assert_eq!(rounding_of(&sharp, c[0].0, 0.02), None, "radius {r}");
         }
     }
 

@@ -438,6 +438,7 @@ pub(crate) fn ring_hierarchy_with(
         similarity: fit.similarity,
         // on the cut-open boundary, in the input's coordinates (the report measures there)
         detected: crate::boundary::kinks::detect(&cut, crate::boundary::KinkMode::Auto, false),
+        roundings: Vec::new(),
     };
     Ok((h, cut))
 }

@@ -253,6 +253,7 @@ fn solve_patch(
         kinked: None,
         similarity: Similarity::IDENTITY,
         detected: crate::boundary::kinks::detect(&boundary, crate::boundary::KinkMode::Auto, true),
+        roundings: Vec::new(),
     };
     let mut o = opts.clone();
     o.levels.refine = 0;

@@ -66,16 +66,21 @@ pub struct ThbReport {
 }
 
 impl ThbSolution {
-    /// Whether the map is certified (or degenerate only at corners the boundary forces).
+    /// Whether the map is certified (or degenerate only at corners the boundary forces),
+    /// its boundary the input's and the kinks of the `C^0` route kept (as
+    /// [`Report::success`] of the tensor solve it started from).
     pub fn success(&self) -> bool {
         matches!(self.report.verdict, Verdict::Certified | Verdict::DegenerateCorner)
+            && self.report.solve.boundary.kept
+            && self.report.solve.kinks_kept()
     }
 }
 
-/// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`], repair
-/// rounds allowed, and the map folded or undecided.
+/// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`] (or
+/// [`Refinement::Auto`] on a boundary with rounded point-cloud corners, the report's
+/// `roundings`), repair rounds allowed, and the map folded or undecided.
 pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
-    opts.repair.refinement == Refinement::Thb
+    opts.repair.refinement.resolved(!sol.report.boundary.roundings.is_empty()) == Refinement::Thb
         && opts.repair.rounds > 0
         && matches!(sol.report.outcome.verdict, Verdict::Folded | Verdict::Undecided)
 }

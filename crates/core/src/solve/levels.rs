@@ -4,10 +4,49 @@
 //! 4), always ending with the finest.
 
 use crate::boundary::hierarchy::Level;
+use crate::boundary::kinks::Rounding;
 use crate::error::{Error, Result};
 use crate::spline::curve::Curve;
 use crate::spline::knots::KnotVector;
 use crate::spline::surface::Side;
+
+/// At most this many halvings of an end span by [`graded_at_roundings`].
+pub(crate) const MAX_GRADING: usize = 8;
+
+/// `level` graded towards the sides with rounded point-cloud corners
+/// ([`Rounding`]): at such a side the knot vector across it (`xi` at west and east,
+/// `eta` at south and north) has its end span halved until it is at most `R / (2 d)`
+/// wide (`R` the smallest rounding radius on the side, `d` the boundary's diameter, both
+/// in the hierarchy's coordinates), at most [`MAX_GRADING`] times; the sides refined
+/// exactly (the boundary is unchanged). A rounded reflex corner (a jigsaw tab's
+/// shoulder) bends the map within about `R` of the side, and a bulb behind a neck is
+/// squeezed into a thin layer along it: one span across was measured to fold at the
+/// side, five halvings of it certify (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
+pub(crate) fn graded_at_roundings(level: &Level, roundings: &[Rounding], diameter: f64) -> Result<Level> {
+    let mut knots = level.knots.clone();
+    for side in Side::ALL {
+        let Some(radius) = roundings.iter().filter(|r| r.side == side).map(|r| r.radius).min_by(f64::total_cmp) else {
+            continue;
+        };
+        let target = radius / (2.0 * diameter);
+        let d = 1 - side.direction();
+        let at_start = matches!(side, Side::South | Side::West);
+        for _ in 0..MAX_GRADING {
+            let elems = knots[d].elements();
+            let Some(&(_, a, b)) = (if at_start { elems.first() } else { elems.last() }) else { break };
+            if b - a <= target {
+                break;
+            }
+            knots[d] = knots[d].with_inserted(&[0.5 * (a + b)]);
+        }
+    }
+    if knots == level.knots {
+        return Ok(level.clone());
+    }
+    let sides = Side::ALL.map(|s| level.sides[s as usize].refined(&knots[s.direction()]));
+    let sides: [Curve; 4] = sides.into_iter().collect::<Result<Vec<_>>>()?.try_into().expect("four sides");
+    Ok(Level { knots, sides })
+}
 
 /// Choose the levels to solve: from the coarsest, each next one at least `growth` times
 /// larger, always ending with the finest. A level of nearly the finest's size (less than
@@ -180,6 +219,52 @@ pub(crate) const MAX_BASIS: usize = 1 << 22;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`graded_at_roundings`] on the unit square (8 elements per direction, degree 3)
+    /// with a rounding of radius `R = 0.01` on the west side, the diameter `√2`: the
+    /// `xi` end span at `xi = 0` halved until at most `R / (2 d)` wide (0.125 → 0.001953125,
+    /// six halvings), nothing else refined, and the sides the same curves.
+    #[test]
+    fn grading_halves_the_span_across_a_rounded_side() {
+        let kv = KnotVector::open_uniform(3, 8);
+        let line = |a: [f64; 2], b: [f64; 2]| {
+            let cps = kv.greville().into_iter().map(|t| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            Curve::new(kv.clone(), cps.collect(), None).unwrap()
+        };
+        let sides = [
+            line([0.0, 0.0], [1.0, 0.0]),
+            line([1.0, 0.0], [1.0, 1.0]),
+            line([0.0, 1.0], [1.0, 1.0]),
+            line([0.0, 0.0], [0.0, 1.0]),
+        ];
+        let level = Level { knots: [kv.clone(), kv.clone()], sides };
+        let rounding = Rounding {
+            side: Side::West,
+            parameter: 0.5,
+            point: [0.0, 0.5],
+            turning_degrees: 90.0,
+            radius: 0.01,
+            sagitta: 0.004,
+            points: 5,
+        };
+        let d = 2f64.sqrt();
+        let graded = graded_at_roundings(&level, &[rounding], d).unwrap();
+        let xi = graded.knots[0].elements();
+        assert_eq!(xi.len(), 8 + 6);
+        assert_eq!((xi[0].1, xi[0].2), (0.0, 0.001953125));
+        assert!(xi[0].2 <= 0.01 / (2.0 * d) && 2.0 * xi[0].2 > 0.01 / (2.0 * d));
+        assert_eq!(xi.last().map(|e| e.2 - e.1), Some(0.125));
+        assert_eq!(graded.knots[1], kv);
+        for (a, b) in level.sides.iter().zip(&graded.sides) {
+            for k in 0..=50 {
+                let t = k as f64 / 50.0;
+                let (p, q) = (a.eval(t), b.eval(t));
+                assert!((p[0] - q[0]).abs() < 1e-14 && (p[1] - q[1]).abs() < 1e-14);
+            }
+        }
+        // no rounding: the level as it is
+        assert_eq!(graded_at_roundings(&level, &[], d).unwrap().knots, level.knots);
+    }
 
     #[test]
     fn level_selection_quadruples() {

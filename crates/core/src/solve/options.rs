@@ -132,6 +132,17 @@ impl Default for ReportOptions {
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Refinement {
+    /// [`Refinement::Thb`] where a point-cloud side has corners the cloud resolves as
+    /// roundings (`boundary::kinks::rounding_of`: no kinks, so the `C^1` fit follows them
+    /// and the basis is graded towards those sides, `solve::levels::graded_at_roundings`),
+    /// [`Refinement::Tensor`] elsewhere (BENCHMARKS.md "Puzzle necks and hair-thin gaps").
+    /// The default of `winslow solve`; a THB map comes out where it applies, so the
+    /// library's default stays [`Refinement::Tensor`].
+    #[cfg_attr(
+        feature = "clap",
+        value(help = "thb where a point-cloud side has rounded corners (the jigsaw pieces), tensor elsewhere")
+    )]
+    Auto,
     /// Bisect the offending knot spans (and a halo) across the whole tensor basis.
     #[default]
     #[cfg_attr(feature = "clap", value(help = "Bisect the offending knot spans across the tensor basis"))]
@@ -139,6 +150,18 @@ pub enum Refinement {
     /// Refine the offending cells (and a ring) of a THB basis only.
     #[cfg_attr(feature = "clap", value(help = "Refine only the offending cells and a ring around them (THB-splines)"))]
     Thb,
+}
+
+impl Refinement {
+    /// The refinement this one stands for on a boundary with (`roundings`) or without
+    /// rounded point-cloud corners: [`Refinement::Auto`] resolved, the others as they are.
+    pub fn resolved(self, roundings: bool) -> Self {
+        match self {
+            Refinement::Auto if roundings => Refinement::Thb,
+            Refinement::Auto => Refinement::Tensor,
+            r => r,
+        }
+    }
 }
 
 /// Which control points the `C^0` route's final Winslow minimisation moves (paper §9,

@@ -13,6 +13,7 @@ use super::options::SolveOptions;
 use super::repair::RepairRound;
 use crate::boundary::corners::{corner_report, CornerReport, KinkReport};
 use crate::boundary::hierarchy::{BasisReport, Hierarchy};
+use crate::boundary::kinks::Rounding;
 use crate::discrete::assembly::Operator;
 use crate::spline::curve::Curve;
 use crate::spline::surface::{Side, Surface};
@@ -312,6 +313,11 @@ pub struct BoundaryReport {
     /// its tolerance) is not a success ([`Report::success`]); the `boundary_kept` key.
     #[serde(rename = "boundary_kept")]
     pub kept: bool,
+    /// Point-cloud corners the cloud resolves as roundings over two or more chords: no
+    /// kinks, the `C^1` fit follows them (`boundary::kinks::rounding_of`), in the input's
+    /// coordinates; the key is absent when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub roundings: Vec<Rounding>,
 }
 
 impl Report {
@@ -525,6 +531,16 @@ impl Solution {
                 c0_route: ctx.c0_route,
                 deviation: ctx.boundary_deviation,
                 kept: boundary_kept,
+                roundings: h
+                    .roundings
+                    .iter()
+                    .map(|r| Rounding {
+                        point: h.similarity.to_physical(r.point),
+                        radius: h.similarity.length(r.radius),
+                        sagitta: h.similarity.length(r.sagitta),
+                        ..r.clone()
+                    })
+                    .collect(),
             },
         };
         Self { name: name.to_string(), map, report }

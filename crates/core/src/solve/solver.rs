@@ -14,7 +14,7 @@ use super::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
 use super::improve::{improve, Improvement};
 use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
-use super::levels::{prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
+use super::levels::{graded_at_roundings, prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
 use super::memory::MemoryEstimate;
 use super::newton::{Iterate, NonlinearOptions};
 use super::options::{Refinement, SolveOptions};
@@ -142,7 +142,14 @@ impl EggSolver {
             (BasisChoice::Input, BasisChoice::Input) => (1, f64::INFINITY),
             _ => (opts.levels.min_elements, opts.levels.aspect),
         };
-        let levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.levels.refine, aspect)?;
+        let mut levels = prepare_levels(hierarchy.levels.clone(), min_elements, opts.levels.refine, aspect)?;
+        // rounded point-cloud corners: the finest level graded towards their sides, and
+        // `Refinement::Auto` is THB
+        let mut opts = opts;
+        opts.repair.refinement = opts.repair.refinement.resolved(!hierarchy.roundings.is_empty());
+        if let Some(last) = levels.last_mut().filter(|_| !hierarchy.roundings.is_empty()) {
+            *last = graded_at_roundings(last, &hierarchy.roundings, hierarchy.diameter)?;
+        }
         // kinks kept (§9): the levels hold them at multiplicity p (Σ⁰); solve on Σ¹, the
         // finest prepared Σ⁰ is where the C0 route ends
         let (levels, c0) = match hierarchy.kinked {
