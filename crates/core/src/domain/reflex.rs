@@ -378,7 +378,8 @@ const FLAT: f64 = 1e-6;
 ///
 /// `search`: below this smallest new angle (radians) of the best cut along the bisector
 /// or the side extensions, cuts to points spread along the sides are tried as well
-/// ([`GOOD_CUT_ANGLE`] by default; 0: never, π: always).
+/// ([`GOOD_CUT_ANGLE`] by default; 0: only where no such cut stays inside the face,
+/// `-inf`: never, π: always).
 pub(crate) fn cut_reflex(
     g: &mut Graph,
     diameter: f64,

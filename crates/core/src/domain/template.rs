@@ -337,7 +337,7 @@ pub fn graph_layout(pg: &PlaneGraph, opts: &LayoutOptions) -> Result<AutoLayout>
 }
 
 /// [`graph_layout`] with the given searches of the cuts' ends in turn (tests reach the
-/// curved cuts with `[0.0]`: no search).
+/// curved cuts with `[f64::NEG_INFINITY]`: never a search).
 #[cfg(test)]
 pub(super) fn graph_layout_searching(pg: &PlaneGraph, opts: &LayoutOptions, searches: &[f64]) -> Result<AutoLayout> {
     let t0 = Instant::now();
@@ -350,7 +350,8 @@ pub(super) fn graph_layout_searching(pg: &PlaneGraph, opts: &LayoutOptions, sear
 const SPOKE_SAMPLES: usize = 64;
 
 /// The searches of the cuts' ends tried in turn on a domain without holes until the
-/// layout is valid (radians, [`cut_reflex`]): below 30 degrees, never, always.
+/// layout is valid (radians, [`cut_reflex`]): below 30 degrees, only where no straight
+/// cut along the bisector or a side extension stays inside, always.
 const CUT_SEARCHES: [f64; 3] = [GOOD_CUT_ANGLE, 0.0, std::f64::consts::PI];
 
 /// The directions (degrees) of the cuts from holes that are tried; `NaN`: every hole
