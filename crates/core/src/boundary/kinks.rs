@@ -214,7 +214,7 @@ impl CornerTurnings {
     }
 }
 
-/// A corner of a point cloud that the cloud resolves as a rounding ([`rounding_of`]):
+/// A corner of a point cloud that the cloud resolves as a rounding (`rounding_of`):
 /// not a kink, the `C^1` fit follows it (the report's `roundings`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Rounding {
