@@ -187,26 +187,33 @@ fn spread_candidates(g: &Graph, f: usize, i: usize, reflex: bool, tol: f64) -> V
                 t = [-t[0], -t[1]];
             }
             let d = [p[0] - o[0], p[1] - o[1]];
-            let angles = [
-                ccw_angle(t_out, d),
-                ccw_angle(d, back),
-                ccw_angle(t, [-d[0], -d[1]]),
-                ccw_angle([-d[0], -d[1]], [-t[0], -t[1]]),
-            ];
-            if admissible(angles, reflex) {
-                out.push(Candidate {
-                    corner: None,
-                    on_side: Some((k, u)),
-                    point: p,
-                    score: score(angles),
-                    angles,
-                    curve: None,
-                    spread: true,
-                });
-            }
+            let angles = cut_angles([t_out, back], d, [t, [-t[0], -t[1]]], [-d[0], -d[1]]);
+            out.extend(Candidate::admitted(angles, reflex, (None, Some((k, u)), p), None, true));
         }
     }
     out
+}
+
+/// The four new angles of a cut (the two at the corner, then the two at its end): it
+/// leaves the corner (outgoing side `t_out`, reversed incoming side `back`) along
+/// `start`, and arrives at its end, whose sides go `to` and (reversed) `bj`, so that
+/// `home` points from the end back along the cut.
+fn cut_angles([t_out, back]: [Point; 2], start: Point, [to, bj]: [Point; 2], home: Point) -> [f64; 4] {
+    [ccw_angle(t_out, start), ccw_angle(start, back), ccw_angle(to, home), ccw_angle(home, bj)]
+}
+
+impl Candidate {
+    /// The cut of `angles` ([`cut_angles`]) to `point` (a corner of the face or a point
+    /// on a side), when it keeps the rules of [`admissible`], scored by [`score`].
+    fn admitted(
+        angles: [f64; 4],
+        reflex: bool,
+        (corner, on_side, point): (Option<usize>, Option<(usize, f64)>, Point),
+        curve: Option<Curve>,
+        spread: bool,
+    ) -> Option<Self> {
+        admissible(angles, reflex).then(|| Self { corner, on_side, point, score: score(angles), angles, curve, spread })
+    }
 }
 
 /// The rules every cut keeps: no new reflex angle and no sliver; a flat part only where
@@ -319,20 +326,9 @@ fn curved_candidates(g: &Graph, f: usize, i: usize, reflex: bool, diameter: f64,
         }
         let d0 = end_tangent(&curve, false);
         let d1 = end_tangent(&curve, true);
-        let d1r = [-d1[0], -d1[1]];
-        let (a1, a2) = (ccw_angle(t_out, d0), ccw_angle(d0, back));
-        let (b1, b2) = (ccw_angle(to, d1r), ccw_angle(d1r, bj));
-        let angles = [a1, a2, b1, b2];
-        if admissible(angles, reflex) {
-            out.push(Candidate {
-                corner,
-                on_side,
-                point: p,
-                score: score(angles),
-                angles,
-                curve: Some(curve),
-                spread: false,
-            });
+        let angles = cut_angles([t_out, back], d0, [to, bj], [-d1[0], -d1[1]]);
+        if let Some(c) = Candidate::admitted(angles, reflex, (corner, on_side, p), Some(curve), false) {
+            out.push(c);
         }
     }
     out
@@ -449,22 +445,8 @@ pub(crate) fn cut_reflex(
                     continue;
                 }
                 let d = [p[0] - o[0], p[1] - o[1]];
-                let a1 = ccw_angle(t_out, d);
-                let a2 = ccw_angle(d, back);
-                let b1 = ccw_angle(to, [-d[0], -d[1]]);
-                let b2 = ccw_angle([-d[0], -d[1]], bj);
-                let angles = [a1, a2, b1, b2];
-                if admissible(angles, reflex) {
-                    cands.push(Candidate {
-                        corner,
-                        on_side,
-                        point: p,
-                        score: score(angles),
-                        angles,
-                        curve: None,
-                        spread: false,
-                    });
-                }
+                let angles = cut_angles([t_out, back], d, [to, bj], [-d[0], -d[1]]);
+                cands.extend(Candidate::admitted(angles, reflex, (corner, on_side, p), None, false));
             }
         }
         // a sliver at the best cut's end (or none inside): cuts to points along the sides
