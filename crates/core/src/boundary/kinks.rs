@@ -299,6 +299,23 @@ pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> 
     }
 }
 
+/// [`detect`] with a point cloud's rounded corners taken out as roundings
+/// ([`Candidates::with_roundings`]): the kinks and the roundings, as the hierarchy of a
+/// four-sided boundary reports them (a ring's report uses it too).
+pub(crate) fn detect_with_roundings(
+    boundary: &Boundary,
+    mode: KinkMode,
+    input_basis: bool,
+) -> (Vec<Kink>, Vec<Rounding>) {
+    match mode.cloud_threshold() {
+        Some(floor) => {
+            let found = Candidates::find(boundary, floor).with_roundings();
+            (found.kinks(mode, input_basis), found.roundings(mode))
+        }
+        None => (Vec::new(), Vec::new()),
+    }
+}
+
 /// The candidate kinks of a boundary's sides, measured once ([`Candidates::find`]): the
 /// interior knots of spline sides that [`spline_kinks`] lists, and the turnings of point
 /// clouds' vertices; [`Candidates::kinks`] gives the kinks of any mode from them, as

@@ -427,6 +427,9 @@ pub(crate) fn ring_hierarchy_with(
         side_fit(Side::West, Some(0)),
     ];
     let cut = cut_open(ring, seam.map(|p| fit.similarity.to_physical(p)));
+    // on the cut-open boundary, in the input's coordinates (the report measures there)
+    let (detected, roundings) =
+        crate::boundary::kinks::detect_with_roundings(&cut, crate::boundary::KinkMode::Auto, false);
     let h = Hierarchy {
         levels,
         fits,
@@ -436,9 +439,8 @@ pub(crate) fn ring_hierarchy_with(
         basis: BasisReport::fitted(),
         kinked: None,
         similarity: fit.similarity,
-        // on the cut-open boundary, in the input's coordinates (the report measures there)
-        detected: crate::boundary::kinks::detect(&cut, crate::boundary::KinkMode::Auto, false),
-        roundings: Vec::new(),
+        detected,
+        roundings,
     };
     Ok((h, cut))
 }
@@ -453,6 +455,54 @@ mod tests {
         ClosedContour::Analytic(Analytic::new(move |t| {
             [c[0] + r * (TAU * t + phase).cos(), c[1] + r * (TAU * t + phase).sin()]
         }))
+    }
+
+    /// A square of side 4 (its corners rounded at radius `r`), as a counter-clockwise
+    /// point cloud with spacing about `h`, starting in the middle of its bottom side.
+    fn rounded_square(r: f64, h: f64) -> Vec<Point> {
+        let q = std::f64::consts::FRAC_PI_2;
+        let a = 2.0 - r;
+        let mut pts = Vec::new();
+        // a straight part from `from` up to `to` (excluded)
+        let segment = |pts: &mut Vec<Point>, from: Point, to: Point| {
+            let n = ((to[0] - from[0]).hypot(to[1] - from[1]) / h).ceil().max(1.0) as usize;
+            pts.extend((0..n).map(|i| {
+                let t = i as f64 / n as f64;
+                [from[0] + t * (to[0] - from[0]), from[1] + t * (to[1] - from[1])]
+            }));
+        };
+        let mut at = [0.0, -2.0];
+        for (k, c) in [[a, -a], [a, a], [-a, a], [-a, -a]].into_iter().enumerate() {
+            let start = -q + k as f64 * q;
+            let on = |phi: f64| [c[0] + r * phi.cos(), c[1] + r * phi.sin()];
+            segment(&mut pts, at, on(start));
+            // (no arc on a sharp corner: the next straight part starts there)
+            let m = if r > 0.0 { (q * r / h).ceil() as usize } else { 0 };
+            pts.extend((0..m).map(|i| on(start + q * i as f64 / m as f64)));
+            at = on(start + q);
+        }
+        segment(&mut pts, at, [0.0, -2.0]);
+        pts
+    }
+
+    /// A ring whose outer contour is a cloud with rounded corners (four points to each
+    /// quarter circle, as the jigsaw necks): its report lists them as roundings, not as
+    /// kinks (a kink not kept would make the solve's exit code say "kinks not kept"); the
+    /// same corners sharp are kinks.
+    #[test]
+    fn rounded_corners_of_a_cloud_contour_are_roundings_not_kinks() {
+        let opts = FitOptions::default();
+        let ring = |outer| Ring { name: "rounded".into(), inner: circle(1.0, [0.0; 2], 0.3), outer };
+        let rounded = ring(ClosedContour::Points(rounded_square(0.05, 0.02)));
+        let (h, cut) = ring_hierarchy_with(&rounded, &opts, EtaRefinement::default()).unwrap();
+        assert!(h.detected.is_empty(), "{:?}", h.detected);
+        assert_eq!(h.roundings.len(), 4, "{:?}", h.roundings);
+        assert!(h.roundings.iter().all(|r| r.radius > 0.02 && r.radius < 0.2), "{:?}", h.roundings);
+        // without the rounding rule the same corners were kinks
+        assert_eq!(crate::boundary::kinks::detect(&cut, crate::boundary::KinkMode::Auto, false).len(), 4);
+        let sharp = ring(ClosedContour::Points(rounded_square(0.0, 0.02)));
+        let (h, _) = ring_hierarchy_with(&sharp, &opts, EtaRefinement::default()).unwrap();
+        assert_eq!((h.detected.len(), h.roundings.len()), (4, 0), "{:?}", h.roundings);
     }
 
     #[test]
