@@ -174,7 +174,8 @@ pub(crate) struct SolverArgs {
     pub(crate) no_repair: bool,
     /// How a repair round refines: `tensor` bisects the offending knot spans across the
     /// whole basis; `thb` refines only the offending cells and a ring around them on a
-    /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml);
+    /// THB basis, and a map it repaired is written as a THB map (-o .json or .xml; .vtu
+    /// as a Bézier cell per active cell; .igs and .vtk as its exact tensor form);
     /// `auto` is `thb` where a point-cloud side has corners the cloud resolves as
     /// roundings (the report's `roundings`; docs/kinks.md) in `solve`, `tensor` elsewhere.
     #[arg(long, value_enum, default_value = "auto")]

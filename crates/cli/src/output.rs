@@ -301,7 +301,7 @@ pub fn check_text(r: &CheckReport) -> String {
     s
 }
 
-fn poisson_line(s: &mut String, p: &PoissonReport) {
+pub(crate) fn poisson_line(s: &mut String, p: &PoissonReport) {
     let _ = writeln!(
         s,
         "  Poisson benchmark (a = {:.4}, {:.4}; {} unknowns): Q(x) = {:.6e}, L2 error {:.3e}, H1 error {:.3e}, {:.3} s",

@@ -212,13 +212,8 @@ pub(super) fn solve(a: SolveArgs) -> Result<i32> {
     if !input.is_multipatch() {
         opts.repair.refinement = a.solver.refinement;
     }
-    if opts.repair.refinement == Refinement::Thb {
-        thb_outputs(&a, input.is_multipatch())?;
-    }
-    // `auto` would write a THB map where the boundary has rounded corners: outputs that
-    // need a tensor map (or a map file other than JSON or XML) keep the tensor repair
-    if opts.repair.refinement == Refinement::Auto && thb_outputs(&a, false).is_err() {
-        opts.repair.refinement = Refinement::Tensor;
+    if a.solver.refinement == Refinement::Thb && input.is_multipatch() {
+        bail!("--refinement thb solves a single patch: a layout is repaired by tensor refinement");
     }
     match &input {
         Input::Volume(_) => super::volume_cmd::plan(&a, path)?,
@@ -337,22 +332,6 @@ pub(super) fn solve_from_start(a: &SolveArgs, start: &Path) -> Result<i32> {
         say_raw!("{s}");
     }
     Ok(output::exit_code(r.verdict))
-}
-
-/// With `--refinement thb` the map may come out as a THB map: a single patch, `-o` JSON or
-/// G+Smo XML, no outputs that need a tensor map (`--png` draws the active cells, `--mesh`
-/// meshes the exact tensor form).
-fn thb_outputs(a: &SolveArgs, multipatch: bool) -> Result<()> {
-    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    if multipatch || !matches!(ext.as_str(), "json" | "xml") {
-        bail!("--refinement thb solves a single patch and writes a JSON or G+Smo XML map (-o .json or .xml)");
-    }
-    let tensor_only = [("--vtk", a.vtk.is_some()), ("--iges", a.iges.is_some())];
-    let more = [("--vtu", a.vtu.is_some()), ("--poisson", a.poisson)];
-    if let Some((flag, _)) = tensor_only.iter().chain(&more).find(|(_, on)| *on) {
-        bail!("{flag} needs a tensor map: not with --refinement thb (convert the THB map first: winslow convert)");
-    }
-    Ok(())
 }
 
 /// Check every output of `solve` before the work ([`files::OutputPlan`]): a single map's

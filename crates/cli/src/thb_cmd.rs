@@ -67,19 +67,23 @@ pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &
     Ok(exit_code(&certificate.verdict))
 }
 
-/// `winslow solve --refinement thb` when the pipeline repaired the map by THB defect
-/// correction: the THB map written (`-o`, and `--gismo` as `THBSpline2`) with its report
-/// (the certificate, the rounds and the tensor solve's report), which `--json` prints.
+/// `winslow solve --refinement thb|auto` when the pipeline repaired the map by THB
+/// defect correction: the THB map written with its report (the certificate, the rounds
+/// and the tensor solve's report), which `--json` prints: `-o` and `--gismo`
+/// (`THBSpline2`) as a THB map, `--vtu` with a Bézier cell per active cell, `--iges`
+/// and `--vtk` as its exact tensor form (`winslow::io` picks by extension).
 pub(crate) fn finish(out: &ThbSolution, a: &SolveArgs) -> Result<i32> {
-    let (output, gismo, json) = (a.output.as_path(), a.gismo.as_deref(), a.json);
+    let json = a.json;
     let report = serde_json::to_value(&out.report)?;
     let c = &out.report.certificate;
     let label = format!("verdict {:?}: {}", out.report.verdict, out.report.message);
     let extra = Some(serde_json::json!({ "report": &report }));
     let thb = Output::Thb { name: &out.name, map: &out.map, label: &label, extra };
-    files::write(output, &thb)?;
-    if let Some(p) = gismo {
-        files::write_as(p, "xml", &thb)?;
+    files::write(&a.output, &thb)?;
+    for (path, ext) in [(&a.gismo, "xml"), (&a.iges, "igs"), (&a.vtu, "vtu"), (&a.vtk, "vtk")] {
+        if let Some(p) = path {
+            files::write_as(p, ext, &thb)?;
+        }
     }
     if json {
         files::print_json(report)?;
@@ -96,6 +100,11 @@ pub(crate) fn finish(out: &ThbSolution, a: &SolveArgs) -> Result<i32> {
         say!("certificate: {}", c.message());
         if let Some(imp) = &out.report.improvement {
             say!("improvement: {}", imp.message);
+        }
+        if let Some(p) = &out.report.poisson {
+            let mut s = String::new();
+            crate::output::poisson_line(&mut s, p);
+            say_raw!("{s}");
         }
     }
     if let Some(p) = &a.png {

@@ -93,7 +93,7 @@ fn a_folded_thb_map_exits_3() {
 
 /// `winslow solve --refinement thb`: puzzle4 folds without repair; the THB rounds refine
 /// only around the folds and the THB map written is certified by `winslow check`, with
-/// fewer functions than the tensor repair's map. THB output is JSON or G+Smo XML only.
+/// fewer functions than the tensor repair's map; the other outputs take the THB map.
 #[test]
 fn solve_with_thb_refinement_writes_a_certified_thb_map() {
     let scratch = tempfile::tempdir().unwrap();
@@ -124,20 +124,43 @@ fn solve_with_thb_refinement_writes_a_certified_thb_map() {
     assert_eq!(out.status.code(), Some(0));
     let tensor_functions = stdout_json(&out)["basis_functions"].as_u64().unwrap();
     assert!(functions < tensor_functions, "THB {functions} vs tensor {tensor_functions}");
-    // outputs that need a tensor map are refused up front, nothing written
-    let vtk = dir.join("x.vtk");
-    let out = run(&[
-        "solve".as_ref(),
-        src.as_os_str(),
-        "-o".as_ref(),
-        dir.join("again.json").as_os_str(),
-        "--vtk".as_ref(),
-        vtk.as_os_str(),
-        "--refinement".as_ref(),
-        "thb".as_ref(),
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(!vtk.exists() && !dir.join("again.json").exists());
+    // every output takes the THB map: VTU with one Bézier cell per active cell, IGES and
+    // VTK as its exact tensor form (read back and certified: the same mean det J), the
+    // Poisson benchmark on that tensor form
+    let (vtu, igs, vtk) = (dir.join("x.vtu"), dir.join("x.igs"), dir.join("x.vtk"));
+    let out = bin()
+        .arg("solve")
+        .arg(&src)
+        .arg("-o")
+        .arg(dir.join("again.json"))
+        .arg("--vtu")
+        .arg(&vtu)
+        .arg("--iges")
+        .arg(&igs)
+        .arg("--vtk")
+        .arg(&vtk)
+        .args(["--refinement", "thb", "--poisson", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let again = stdout_json(&out);
+    assert!(again["poisson"]["q"].as_f64().unwrap().is_finite(), "{again}");
+    let cells = checked["certificate"]["cells"].as_u64().unwrap();
+    let text = std::fs::read_to_string(&vtu).unwrap();
+    assert!(text.contains(&format!("NumberOfCells=\"{cells}\"")), "{cells} active cells");
+    assert!(std::fs::read_to_string(&vtk).unwrap().starts_with("# vtk DataFile"));
+    let out = run(&["check".as_ref(), igs.as_os_str(), "--json".as_ref()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let (a, b) = (
+        stdout_json(&out)["certificate"]["mean_det_j"].as_f64().unwrap(),
+        checked["certificate"]["mean_det_j"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 1e-10 * b.abs(), "mean det J of the IGES tensor form {a} vs the THB map's {b}");
+    // a layout is repaired by tensor refinement: THB refused up front, nothing written
+    let layout = data().join("gismo/xml/multipatch/plateWithHoleMP.xml");
+    let out = bin().arg("solve").arg(&layout).arg("-o").arg(dir.join("mp.json")).args(["--refinement", "thb"]).output();
+    assert_eq!(out.unwrap().status.code(), Some(1));
+    assert!(!dir.join("mp.json").exists());
 }
 
 /// `winslow solve --refinement thb --improve winslow --png P`: the THB map is improved on

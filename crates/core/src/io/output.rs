@@ -5,7 +5,7 @@
 //! | output | extensions |
 //! |---|---|
 //! | map | `.json` (map document with the extra fields), `.xml` (G+Smo), `.igs`/`.iges` (IGES 5.3 entity 128), `.vtu` (exact Bézier cells), `.vtk` (sampled structured grid) |
-//! | THB map | `.json` (the `thb` map kind with the extra fields), `.xml` (G+Smo `THBSpline2`) |
+//! | THB map | `.json` (the `thb` map kind with the extra fields), `.xml` (G+Smo `THBSpline2`), `.vtu` (one exact Bézier cell per active cell), `.igs`/`.iges` and `.vtk` (the exact tensor form, by knot insertion) |
 //! | volume | `.json`, `.xml` (G+Smo `TensorBSpline3`), `.vtu` (Bézier hexahedra), `.vtk` (sampled grid) |
 //! | multipatch | `.json` (multipatch document), `.xml` (G+Smo `<MultiPatch>`), `.vtm` (VTK multiblock, one `.vtu` per patch in a folder beside it) |
 //! | layout, boundary, ring | `.json` |
@@ -30,7 +30,7 @@ use super::picture::Image;
 use super::ring::ring_to_json;
 use super::volume::json::volume_to_json;
 use super::volume::vtk::{volume_bezier_vtu, volume_structured_vtk};
-use super::vtk::{bezier_vtu, structured_grid_vtk};
+use super::vtk::{bezier_vtu, structured_grid_vtk, thb_bezier_vtu};
 use crate::boundary::ring::Ring;
 use crate::boundary::Boundary;
 use crate::domain::{Domain, PlaneGraph};
@@ -122,7 +122,8 @@ impl Output<'_> {
             Output::Volume { .. } => ".json, .xml, .vtu or .vtk",
             Output::Multipatch(_) => ".json, .xml or .vtm",
             Output::Layout(_) | Output::Boundary(_) | Output::Ring(_) | Output::Domain(_) | Output::Graph(_) => ".json",
-            Output::VolumeBoundary(_) | Output::Thb { .. } => ".json or .xml",
+            Output::Thb { .. } => ".json, .xml, .vtu (a Bézier cell per active cell), .igs, .iges or .vtk",
+            Output::VolumeBoundary(_) => ".json or .xml",
             Output::Picture(_) => ".png",
         }
     }
@@ -161,6 +162,13 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Map { map, .. }, "vtk") => text(structured_grid_vtk(map, MAP_VTK_SAMPLES)),
         (Output::Thb { name, map, extra, .. }, "json" | "") => write_json(path, &thb_to_json(name, map, extra.clone())),
         (Output::Thb { map, label, .. }, "xml") => text(thb_to_gismo_xml(map, label)),
+        (Output::Thb { map, label, .. }, "vtu") => text(thb_bezier_vtu(map, label)?),
+        // formats without hierarchical splines: the exact tensor form (knot insertion)
+        (Output::Thb { name, map, label, .. }, "igs" | "iges" | "vtk") => {
+            let tensor = map.to_surface()?;
+            let label = format!("{label} (the THB map's exact tensor form)");
+            write_as(path, &ext, &Output::Map { name, map: &tensor, label: &label, extra: None })
+        }
         (Output::Volume { name, volume, extra, .. }, "json" | "") => {
             write_json(path, &volume_to_json(name, volume, extra.clone()))
         }

@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
 use crate::spline::bezier::bernstein;
+use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::spline::surface::Surface;
 use crate::verify::quality::sample_det_j;
 
@@ -150,8 +151,23 @@ fn bezier_elements(map: &Surface) -> Result<Vec<BezierElement>> {
 /// The map as a VTK XML unstructured grid of Bézier quadrilaterals (see the module
 /// documentation). `comment` (e.g. the certificate's verdict) goes into an XML comment.
 pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
-    let elements = bezier_elements(map)?;
-    let [p, q] = map.degrees();
+    Ok(elements_vtu(&bezier_elements(map)?, map.degrees(), map.weights.is_some(), comment))
+}
+
+/// A THB map as Bézier quadrilaterals: one cell per active cell, its net the cell's
+/// Bézier patch ([`HierarchicalMap::bezier_patches`]; the THB map restricted to an
+/// active cell is one polynomial piece of degree `(p, q)`, so the cells are the map
+/// exactly), cells in the order of [`crate::spline::hierarchical::HierarchicalBasis::active_cells`].
+pub(crate) fn thb_bezier_vtu(map: &HierarchicalMap, comment: &str) -> Result<String> {
+    let mut elements = Vec::new();
+    for (_, _, patch) in map.bezier_patches()? {
+        elements.extend(bezier_elements(&patch)?);
+    }
+    Ok(elements_vtu(&elements, map.basis.degrees(), false, comment))
+}
+
+/// The VTU document of Bézier `elements` of degree `[p, q]`.
+fn elements_vtu(elements: &[BezierElement], [p, q]: [usize; 2], rational: bool, comment: &str) -> String {
     let npe = (p + 1) * (q + 1);
     let (ne, np) = (elements.len(), elements.len() * npe);
     // VTK order of each element's points
@@ -167,12 +183,11 @@ pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     }
     let _ = writeln!(out, "<VTKFile type=\"UnstructuredGrid\" version=\"2.2\" byte_order=\"LittleEndian\">");
     let _ = writeln!(out, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{ne}\">");
-    let rational = map.weights.is_some();
     let attrs = if rational { " RationalWeights=\"RationalWeights\"" } else { "" };
     let _ = writeln!(out, "<PointData Scalars=\"det_J\"{attrs}>");
     let array = |out: &mut String, name: &str, f: &dyn Fn(&BezierElement, usize) -> f64| {
         let _ = writeln!(out, "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">");
-        for e in &elements {
+        for e in elements {
             for &k in &order {
                 let _ = write!(out, "{:?} ", f(e, k));
             }
@@ -194,7 +209,7 @@ pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     }
     let _ = writeln!(out, "\n</DataArray>\n</CellData>\n<Points>");
     let _ = writeln!(out, "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">");
-    for e in &elements {
+    for e in elements {
         for &k in &order {
             let _ = write!(out, "{:?} {:?} 0 ", e.points[k][0], e.points[k][1]);
         }
@@ -202,7 +217,7 @@ pub(crate) fn bezier_vtu(map: &Surface, comment: &str) -> Result<String> {
     }
     let _ = writeln!(out, "</DataArray>\n</Points>");
     cells_and_end(&mut out, ne, npe, VTK_BEZIER_QUADRILATERAL);
-    Ok(out)
+    out
 }
 
 /// The `<Cells>` of `ne` cells of type `cell_type` with `npe` consecutive points each,
@@ -304,6 +319,48 @@ pub(crate) mod tests {
                             assert!((dj - d).abs() < 1e-12 * d.abs().max(1.0), "cell {cell}: {dj} vs {d}");
                         }
                     }
+                }
+            }
+        }
+    }
+
+    /// A THB map (three levels) as Bézier cells: one cell per active cell, in the order
+    /// of `active_cells`, whose Bézier net is the THB map on that cell (points to
+    /// rounding at interior and corner points) and whose det_J coefficients reproduce
+    /// the THB map's det J at the uniform nodes.
+    #[test]
+    fn thb_cells_reproduce_the_thb_map() {
+        let thb = HierarchicalMap::from_surface(&curved(false)).unwrap().refined(&[(0, [0, 0])], 2).unwrap();
+        let (l, c) = thb.basis.cell_at(0.1, 0.1);
+        let thb = thb.refined(&[(l, c)], 2).unwrap();
+        assert_eq!(thb.basis.num_levels(), 3);
+        let a = arrays(&thb_bezier_vtu(&thb, "").unwrap());
+        let [p, q] = thb.basis.degrees();
+        let npe = (p + 1) * (q + 1);
+        let cells = thb.basis.active_cells();
+        assert_eq!(a["types"], vec![77.0; cells.len()]);
+        assert_eq!(a["connectivity"].len(), cells.len() * npe);
+        let (mut bs, mut bt) = (vec![0.0; p + 1], vec![0.0; q + 1]);
+        for (cell, &(l, c)) in cells.iter().enumerate() {
+            let [[u0, u1], [v0, v1]] = thb.basis.cell_bounds(l, c);
+            for (s, t) in [(0.3, 0.7), (0.0, 1.0), (0.5, 0.0), (1.0, 1.0)] {
+                bernstein(p, s, &mut bs);
+                bernstein(q, t, &mut bt);
+                let (mut x, mut y, mut dj) = (0.0, 0.0, 0.0);
+                for l in 0..=q {
+                    for k in 0..=p {
+                        let at = cell * npe + vtk_quad_index(k, l, p, q);
+                        x += bs[k] * bt[l] * a["Points"][3 * at];
+                        y += bs[k] * bt[l] * a["Points"][3 * at + 1];
+                        dj += bs[k] * bt[l] * a["det_J"][at];
+                    }
+                }
+                let (u, v) = (u0 + s * (u1 - u0), v0 + t * (v1 - v0));
+                let e = thb.eval(u, v);
+                assert!((x - e[0]).abs() < 1e-13 && (y - e[1]).abs() < 1e-13, "cell {cell} at {s}, {t}");
+                if (s * p as f64).fract() == 0.0 && (t * q as f64).fract() == 0.0 {
+                    let d = thb.derivs(u, v).det_j();
+                    assert!((dj - d).abs() < 1e-12 * d.abs().max(1.0), "cell {cell}: {dj} vs {d}");
                 }
             }
         }

@@ -20,6 +20,7 @@ use crate::solve::options::{Refinement, SolveOptions};
 use crate::solve::report::{Report, Solution, Verdict};
 use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::verify::certificate::hierarchical::HierarchicalCertificate;
+use crate::verify::poisson::{poisson_benchmark, PoissonReport};
 
 /// A THB map solved by the pipeline: the tensor solve's map repaired by THB defect
 /// correction.
@@ -61,6 +62,10 @@ pub struct ThbReport {
     /// map's basis (`solve::hierarchical::improve`); `None` when no improvement was asked
     /// for or the repaired map is not certified.
     pub improvement: Option<ThbImprovement>,
+    /// With `--poisson` (the options' `report.poisson`): the manufactured-solution Poisson
+    /// benchmark ([`crate::verify::poisson`]) on the THB map's exact tensor form.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub poisson: Option<PoissonReport>,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
 }
@@ -135,6 +140,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         thb_rounds: out.rounds,
         thb_seconds: t0.elapsed().as_secs_f64(),
         improvement,
+        poisson: if opts.report.poisson { poisson_benchmark(&map.to_surface()?, None).ok() } else { None },
         solve: sol.report,
     };
     Ok(ThbSolution { name: sol.name, map, report })
