@@ -155,8 +155,8 @@ pub(crate) struct ConvertArgs {
     #[arg(short, long)]
     pub(crate) output: PathBuf,
     /// A THB map stays a THB map (`.json` with the map kind "thb", `.xml` as G+Smo
-    /// THBSpline2); without it a THB map becomes the tensor map on its active cells' knot
-    /// lines (exact).
+    /// THBSpline2, `.vtu` as one Bézier cell per active cell); without it a THB map
+    /// becomes the tensor map on its active cells' knot lines (exact).
     #[arg(long)]
     pub(crate) thb: bool,
     /// Write the outer boundary and holes of a multipatch layout as a general domain

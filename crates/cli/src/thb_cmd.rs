@@ -40,10 +40,10 @@ pub(crate) fn check(name: &str, map: &HierarchicalMap, opts: &CertifyOptions, js
 }
 
 /// `winslow convert THB -o OUT [--thb]`: the tensor map (certified again, the verdict in
-/// the file) by the output's extension, or the THB map itself (`.json`, `.xml`).
+/// the file) by the output's extension, or the THB map itself (`.json`, `.xml`, `.vtu`).
 pub(crate) fn convert(name: &str, map: &HierarchicalMap, input: &Path, output: &Path, thb: bool) -> Result<i32> {
     if thb {
-        files::OutputPlan::new().input(input).file("-o", output, "THB map", &["json", "xml"]).check()?;
+        files::OutputPlan::new().input(input).file("-o", output, "THB map", &["json", "xml", "vtu"]).check()?;
         let c = certify_hierarchical(map, &CertifyOptions::default()).context("certifying the THB map")?;
         let extra = Some(serde_json::json!({ "report": { "certificate": &c } }));
         let label = format!("certificate: {}", c.message());

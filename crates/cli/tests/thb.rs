@@ -51,9 +51,16 @@ fn check_and_convert_a_thb_map() {
     let (orig, again) = (read_json(&src), read_json(&back));
     assert_eq!(orig["map"]["control_points"], again["map"]["control_points"]);
     assert_eq!(orig["map"]["refined"], again["map"]["refined"]);
-    // --thb refuses other outputs, and the input is never replaced
-    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&dir.join("x.vtu")), "--thb".as_ref()]);
+    // --thb writes VTU cells per active cell (one cell per active cell of the
+    // certificate), refuses formats without hierarchical splines, and never replaces the input
+    let vtu = dir.join("x.vtu");
+    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&vtu), "--thb".as_ref()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let cells = report["certificate"]["cells"].as_u64().unwrap();
+    assert!(std::fs::read_to_string(&vtu).unwrap().contains(&format!("NumberOfCells=\"{cells}\"")));
+    let out = run(&["convert".as_ref(), &os(&src), "-o".as_ref(), &os(&dir.join("x.igs")), "--thb".as_ref()]);
     assert_eq!(out.status.code(), Some(1));
+    assert!(!dir.join("x.igs").exists());
     let out = run(&["convert".as_ref(), &os(&back), "-o".as_ref(), &os(&back), "--thb".as_ref()]);
     assert_eq!(out.status.code(), Some(1));
 }
