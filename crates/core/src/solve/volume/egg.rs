@@ -147,31 +147,25 @@ impl EggVolume {
                 for (x, wx) in bx {
                     let q = weights.len();
                     let table = &mut basis[q * 10 * m..(q + 1) * 10 * m];
+                    // rows of `a` are contiguous: the run of `a` at fixed (b, c) is one
+                    // slice per derivative, the product of the x-table with one number
+                    let na = p[0] + 1;
                     let mut lin = 0;
                     for c in 0..=p[2] {
                         for b in 0..=p[1] {
                             let (y0, y1, y2, z0, z1, z2) =
                                 (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
                             let yz = [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1];
-                            for a in 0..=p[0] {
-                                let (x0, x1, x2) = (x.d[0][a], x.d[1][a], x.d[2][a]);
-                                let f = [
-                                    x0 * yz[0],
-                                    x1 * yz[0],
-                                    x0 * yz[1],
-                                    x0 * yz[2],
-                                    x2 * yz[0],
-                                    x0 * yz[3],
-                                    x0 * yz[4],
-                                    x1 * yz[1],
-                                    x1 * yz[2],
-                                    x0 * yz[5],
-                                ];
-                                for (k, v) in f.into_iter().enumerate() {
-                                    table[k * m + lin] = v;
+                            // (x derivative, yz factor) of each of the ten rows
+                            const ROWS: [(usize, usize); 10] =
+                                [(0, 0), (1, 0), (0, 1), (0, 2), (2, 0), (0, 3), (0, 4), (1, 1), (1, 2), (0, 5)];
+                            for (k, &(dx, f)) in ROWS.iter().enumerate() {
+                                let (xs, v) = (&x.d[dx][..na], yz[f]);
+                                for (t, &xa) in table[k * m + lin..k * m + lin + na].iter_mut().zip(xs) {
+                                    *t = xa * v;
                                 }
-                                lin += 1;
                             }
+                            lin += na;
                         }
                     }
                     if let Some(w) = self.disc.weights.as_ref() {
@@ -207,14 +201,18 @@ impl EggVolume {
             1.0,
             faer::Par::Seq,
         );
-        let mut res = vec![0.0; 3 * m];
+        // the residual by component (`c m + a`), interleaved at the end
+        let mut rc = vec![0.0; 3 * m];
+        // Q[q, (3 i_b + i_a) m + b] = ∂L_(i_a)/∂c_(b, i_b) at q (rows of b contiguous)
         let mut qm = if jacobian { vec![0.0; nq * 9 * m] } else { Vec::new() };
         // K = U V: U[a, (q, i)] = w_q ((A/T) ∇R_a)_i, V[(q, i), b] = ∂_i R_b
         let (mut um, mut vm) =
             if laplace { (vec![0.0; 3 * nq * m], vec![0.0; 3 * nq * m]) } else { (Vec::new(), Vec::new()) };
+        let mut v = vec![0.0; if jacobian { m } else { 0 }];
         for (q, &wq) in weights.iter().enumerate() {
             let table = &basis[q * 10 * m..(q + 1) * 10 * m];
             let (rq, gq, hq) = (&table[..m], &table[m..4 * m], &table[4 * m..]);
+            let (g0, g1, g2) = (&gq[..m], &gq[m..2 * m], &gq[2 * m..]);
             // J's columns and the components' Hessians
             let d: [Point3; 3] = std::array::from_fn(|col| std::array::from_fn(|c| xq[c * 10 * nq + 10 * q + 1 + col]));
             let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| xq[c * 10 * nq + 10 * q + 4 + k]));
@@ -225,18 +223,19 @@ impl EggVolume {
                 return None;
             }
             let l: [f64; 3] = std::array::from_fn(|c| contract(&am, &xh[c]) / t);
-            for (r, &v) in res.chunks_exact_mut(3).zip(rq) {
-                for c in 0..3 {
-                    r[c] += wq * v * l[c];
+            for (c, &lc) in l.iter().enumerate() {
+                for (r, &ra) in rc[c * m..(c + 1) * m].iter_mut().zip(rq) {
+                    *r += wq * ra * lc;
                 }
             }
             if laplace {
-                for a in 0..m {
-                    let g = [gq[a], gq[m + a], gq[2 * m + a]];
-                    for i in 0..3 {
-                        um[(3 * q + i) * m + a] = wq * (am[i][0] * g[0] + am[i][1] * g[1] + am[i][2] * g[2]) / t;
-                        vm[(3 * q + i) * m + a] = g[i];
+                for i in 0..3 {
+                    let (a0, a1, a2) = (am[i][0], am[i][1], am[i][2]);
+                    let row = &mut um[(3 * q + i) * m..(3 * q + i + 1) * m];
+                    for (((u, &x0), &x1), &x2) in row.iter_mut().zip(g0).zip(g1).zip(g2) {
+                        *u = wq * (a0 * x0 + a1 * x1 + a2 * x2) / t;
                     }
+                    vm[(3 * q + i) * m..(3 * q + i + 1) * m].copy_from_slice(&gq[i * m..(i + 1) * m]);
                 }
             }
             if !jacobian {
@@ -265,8 +264,7 @@ impl EggVolume {
                     }
                 }
             }
-            let row = &mut qm[q * 9 * m..(q + 1) * 9 * m];
-            // the coefficients of A : ∇²R_b / T in the order of PAIRS
+            // v_b = A : ∇²R_b / T, the coefficients in the order of PAIRS
             let ah: [f64; 6] = std::array::from_fn(|k| {
                 let (i, j) = PAIRS[k];
                 if i == j {
@@ -275,18 +273,32 @@ impl EggVolume {
                     2.0 * am[i][j] / t
                 }
             });
-            for b in 0..m {
-                let v = (0..6).map(|k| ah[k] * hq[k * m + b]).sum::<f64>();
-                let g = [gq[b], gq[m + b], gq[2 * m + b]];
-                for ib in 0..3 {
-                    for ia in 0..3 {
-                        let mut x = g[0] * s[ia][0][ib] + g[1] * s[ia][1][ib] + g[2] * s[ia][2][ib];
-                        if ia == ib {
-                            x += v;
+            let h: [&[f64]; 6] = std::array::from_fn(|k| &hq[k * m..(k + 1) * m]);
+            for (b, vb) in v.iter_mut().enumerate() {
+                *vb = ah[0] * h[0][b] + ah[1] * h[1][b] + ah[2] * h[2][b] + ah[3] * h[3][b] + ah[4] * h[4][b]
+                    + ah[5] * h[5][b];
+            }
+            let row = &mut qm[q * 9 * m..(q + 1) * 9 * m];
+            for ib in 0..3 {
+                for ia in 0..3 {
+                    let (s0, s1, s2) = (s[ia][0][ib], s[ia][1][ib], s[ia][2][ib]);
+                    let out = &mut row[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
+                    if ia == ib {
+                        for ((((o, &x0), &x1), &x2), &vb) in out.iter_mut().zip(g0).zip(g1).zip(g2).zip(&v) {
+                            *o = x0 * s0 + x1 * s1 + x2 * s2 + vb;
                         }
-                        row[b * 9 + 3 * ib + ia] = x;
+                    } else {
+                        for (((o, &x0), &x1), &x2) in out.iter_mut().zip(g0).zip(g1).zip(g2) {
+                            *o = x0 * s0 + x1 * s1 + x2 * s2;
+                        }
                     }
                 }
+            }
+        }
+        let mut res = vec![0.0; 3 * m];
+        for (a, r) in res.chunks_exact_mut(3).enumerate() {
+            for (c, x) in r.iter_mut().enumerate() {
+                *x = rc[c * m + a];
             }
         }
         let mut k = Vec::new();
@@ -297,15 +309,24 @@ impl EggVolume {
                     pm[q * m + a] = wq * basis[q * 10 * m + a];
                 }
             }
-            k = vec![0.0; 9 * m * m];
+            // P Q, column-major: entry (a, (3 i_b + i_a) m + b) at ((3 i_b + i_a) m + b) m + a
+            let mut pq = vec![0.0; 9 * m * m];
             faer::linalg::matmul::matmul(
-                faer::MatMut::from_column_major_slice_mut(&mut k, m, 9 * m),
+                faer::MatMut::from_column_major_slice_mut(&mut pq, m, 9 * m),
                 faer::Accum::Replace,
                 faer::MatRef::from_column_major_slice(&pm, m, nq),
                 faer::MatRef::from_row_major_slice(&qm, nq, 9 * m),
                 1.0,
                 faer::Par::Seq,
             );
+            // to the layout of `Local`: (a, i_a; b, i_b) at b 9m + (3 i_b + i_a) m + a
+            k = vec![0.0; 9 * m * m];
+            for blk in 0..9 {
+                for b in 0..m {
+                    k[b * 9 * m + blk * m..b * 9 * m + (blk + 1) * m]
+                        .copy_from_slice(&pq[(blk * m + b) * m..(blk * m + b + 1) * m]);
+                }
+            }
         }
         let mut kl = Vec::new();
         if laplace {

@@ -149,34 +149,38 @@ impl WinslowVolume {
         let nq = bx.len() * by.len() * bz.len();
         let mut weights = Vec::with_capacity(nq);
         let mut grads = Vec::with_capacity(nq * m);
-        let mut vals = Vec::with_capacity(m);
+        // per point: n = w N and ∇n of every function (`a` fastest)
+        let (mut n, mut gn) = (vec![0.0; m], [vec![0.0; m], vec![0.0; m], vec![0.0; m]]);
+        let w: Vec<f64> = self.disc.weights.as_ref().map_or_else(|| vec![1.0; m], |w| idx.iter().map(|&l| w[l]).collect());
+        let na = p[0] + 1;
         for (z, wz) in bz {
             for (y, wy) in by {
                 for (x, wx) in bx {
-                    vals.clear();
-                    let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
-                    let mut lin = idx.iter();
+                    let mut lin = 0;
                     for c in 0..=p[2] {
                         for b in 0..=p[1] {
-                            for a in 0..=p[0] {
-                                let l = *lin.next().expect("one index per basis function");
-                                let w = self.disc.weights.as_ref().map_or(1.0, |w| w[l]);
-                                let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
-                                let g = [
-                                    w * x.d[1][a] * y.d[0][b] * z.d[0][c],
-                                    w * x.d[0][a] * y.d[1][b] * z.d[0][c],
-                                    w * x.d[0][a] * y.d[0][b] * z.d[1][c],
-                                ];
-                                wsum += n;
-                                for q in 0..3 {
-                                    wgrad[q] += g[q];
-                                }
-                                vals.push((n, g));
+                            let (y0, y1, z0, z1) = (y.d[0][b], y.d[1][b], z.d[0][c], z.d[1][c]);
+                            for a in 0..na {
+                                let wa = w[lin + a];
+                                n[lin + a] = wa * x.d[0][a] * y0 * z0;
+                                gn[0][lin + a] = wa * x.d[1][a] * y0 * z0;
+                                gn[1][lin + a] = wa * x.d[0][a] * y1 * z0;
+                                gn[2][lin + a] = wa * x.d[0][a] * y0 * z1;
                             }
+                            lin += na;
                         }
                     }
-                    grads.extend(vals.iter().map(|(n, g)| -> Point3 {
-                        std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum))
+                    // the sums in the order of the functions
+                    let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
+                    for a in 0..m {
+                        wsum += n[a];
+                        for q in 0..3 {
+                            wgrad[q] += gn[q][a];
+                        }
+                    }
+                    let w2 = wsum * wsum;
+                    grads.extend((0..m).map(|a| -> Point3 {
+                        std::array::from_fn(|q| (gn[q][a] * wsum - n[a] * wgrad[q]) / w2)
                     }));
                     weights.push(wx * wy * wz);
                 }
@@ -275,6 +279,11 @@ impl WinslowVolume {
             Some((energy, gradient, hessian, _)) => Evaluation { energy, gradient, hessian },
             None => Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None },
         }
+    }
+
+    /// Hand back a Hessian no longer needed ([`VolumeDiscretization::recycle`]).
+    pub fn recycle(&self, hessian: Csr) {
+        self.disc.recycle(hessian)
     }
 
     /// The free coordinates of `cps` (`3 f + component`).
