@@ -270,9 +270,16 @@ impl VolumeDiscretization {
                         continue;
                     }
                     let row = &self.neighbours[fa];
+                    // the element's free functions come in runs of consecutive free
+                    // indices (`a` fastest), which are consecutive in the row
+                    let mut last: Option<(usize, usize)> = None;
                     for b in 0..m {
                         let Some(fb) = self.free_index(l.idx[b]) else { continue };
-                        let at = row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        let at = match last {
+                            Some((g, at)) if g + 1 == fb && row.get(at + 1) == Some(&fb) => at + 1,
+                            _ => row.binary_search(&fb).expect("the pattern holds every pair of an element"),
+                        };
+                        last = Some((fb, at));
                         if scalar_matrix {
                             scalar_values[self.scalar_pattern.row_ptr[fa] + at] += l.scalar_matrix[b * m + a];
                         }

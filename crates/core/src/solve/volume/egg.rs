@@ -141,35 +141,36 @@ impl EggVolume {
         let m = idx.len();
         let nq = bx.len() * by.len() * bz.len();
         let mut weights = Vec::with_capacity(nq);
-        let mut basis = vec![0.0; nq * 10 * m];
+        // written in order (no zero fill first)
+        let mut basis = Vec::with_capacity(nq * 10 * m);
+        let (na, nb) = (p[0] + 1, p[1] + 1);
+        // (x derivative, yz factor) of each of the ten rows
+        const ROWS: [(usize, usize); 10] =
+            [(0, 0), (1, 0), (0, 1), (0, 2), (2, 0), (0, 3), (0, 4), (1, 1), (1, 2), (0, 5)];
+        // over the functions (`lin = (c nb + b) na + a`): the x-table repeated per (b, c),
+        // per x-point and derivative, and the six yz products per (y, z)-point, so that
+        // every row of the table is one product of two vectors of length m
+        let xs: Vec<[Vec<f64>; 3]> = bx
+            .iter()
+            .map(|(x, _)| std::array::from_fn(|dx| (0..m).map(|lin| x.d[dx][lin % na]).collect()))
+            .collect();
+        let mut yz = [vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]];
         for (z, wz) in bz {
             for (y, wy) in by {
-                for (x, wx) in bx {
+                for lin in 0..m {
+                    let (b, c) = ((lin / na) % nb, lin / (na * nb));
+                    let (y0, y1, y2, z0, z1, z2) = (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
+                    for (f, v) in [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1].into_iter().enumerate() {
+                        yz[f][lin] = v;
+                    }
+                }
+                for ((_, wx), xq) in bx.iter().zip(&xs) {
                     let q = weights.len();
-                    let table = &mut basis[q * 10 * m..(q + 1) * 10 * m];
-                    // rows of `a` are contiguous: the run of `a` at fixed (b, c) is one
-                    // slice per derivative, the product of the x-table with one number
-                    let na = p[0] + 1;
-                    let mut lin = 0;
-                    for c in 0..=p[2] {
-                        for b in 0..=p[1] {
-                            let (y0, y1, y2, z0, z1, z2) =
-                                (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
-                            let yz = [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1];
-                            // (x derivative, yz factor) of each of the ten rows
-                            const ROWS: [(usize, usize); 10] =
-                                [(0, 0), (1, 0), (0, 1), (0, 2), (2, 0), (0, 3), (0, 4), (1, 1), (1, 2), (0, 5)];
-                            for (k, &(dx, f)) in ROWS.iter().enumerate() {
-                                let (xs, v) = (&x.d[dx][..na], yz[f]);
-                                for (t, &xa) in table[k * m + lin..k * m + lin + na].iter_mut().zip(xs) {
-                                    *t = xa * v;
-                                }
-                            }
-                            lin += na;
-                        }
+                    for &(dx, f) in &ROWS {
+                        basis.extend(xq[dx].iter().zip(&yz[f]).map(|(&xa, &v)| xa * v));
                     }
                     if let Some(w) = self.disc.weights.as_ref() {
-                        rational(table, idx.iter().map(|&l| w[l]));
+                        rational(&mut basis[q * 10 * m..(q + 1) * 10 * m], idx.iter().map(|&l| w[l]));
                     }
                     weights.push(wx * wy * wz);
                 }
@@ -204,7 +205,8 @@ impl EggVolume {
         // the residual by component (`c m + a`), interleaved at the end
         let mut rc = vec![0.0; 3 * m];
         // Q[q, (3 i_b + i_a) m + b] = ∂L_(i_a)/∂c_(b, i_b) at q (rows of b contiguous)
-        let mut qm = if jacobian { vec![0.0; nq * 9 * m] } else { Vec::new() };
+        // (written in order, no zero fill first)
+        let mut qm = Vec::with_capacity(if jacobian { nq * 9 * m } else { 0 });
         // K = U V: U[a, (q, i)] = w_q ((A/T) ∇R_a)_i, V[(q, i), b] = ∂_i R_b
         let (mut um, mut vm) =
             if laplace { (vec![0.0; 3 * nq * m], vec![0.0; 3 * nq * m]) } else { (Vec::new(), Vec::new()) };
@@ -278,19 +280,14 @@ impl EggVolume {
                 *vb = ah[0] * h[0][b] + ah[1] * h[1][b] + ah[2] * h[2][b] + ah[3] * h[3][b] + ah[4] * h[4][b]
                     + ah[5] * h[5][b];
             }
-            let row = &mut qm[q * 9 * m..(q + 1) * 9 * m];
             for ib in 0..3 {
                 for ia in 0..3 {
                     let (s0, s1, s2) = (s[ia][0][ib], s[ia][1][ib], s[ia][2][ib]);
-                    let out = &mut row[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
+                    let cols = g0.iter().zip(g1).zip(g2);
                     if ia == ib {
-                        for ((((o, &x0), &x1), &x2), &vb) in out.iter_mut().zip(g0).zip(g1).zip(g2).zip(&v) {
-                            *o = x0 * s0 + x1 * s1 + x2 * s2 + vb;
-                        }
+                        qm.extend(cols.zip(&v).map(|(((&x0, &x1), &x2), &vb)| x0 * s0 + x1 * s1 + x2 * s2 + vb));
                     } else {
-                        for (((o, &x0), &x1), &x2) in out.iter_mut().zip(g0).zip(g1).zip(g2) {
-                            *o = x0 * s0 + x1 * s1 + x2 * s2;
-                        }
+                        qm.extend(cols.map(|((&x0, &x1), &x2)| x0 * s0 + x1 * s1 + x2 * s2));
                     }
                 }
             }
@@ -320,11 +317,10 @@ impl EggVolume {
                 faer::Par::Seq,
             );
             // to the layout of `Local`: (a, i_a; b, i_b) at b 9m + (3 i_b + i_a) m + a
-            k = vec![0.0; 9 * m * m];
-            for blk in 0..9 {
-                for b in 0..m {
-                    k[b * 9 * m + blk * m..b * 9 * m + (blk + 1) * m]
-                        .copy_from_slice(&pq[(blk * m + b) * m..(blk * m + b + 1) * m]);
+            k = Vec::with_capacity(9 * m * m);
+            for b in 0..m {
+                for blk in 0..9 {
+                    k.extend_from_slice(&pq[(blk * m + b) * m..(blk * m + b + 1) * m]);
                 }
             }
         }

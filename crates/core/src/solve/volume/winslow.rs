@@ -201,7 +201,8 @@ impl WinslowVolume {
         let (m, nq) = (idx.len(), weights.len());
         let mut energy = 0.0;
         let mut g = vec![0.0; 3 * m];
-        let mut u = if hessian { vec![0.0; 27 * m * nq] } else { Vec::new() };
+        // (written in order, no zero fill first)
+        let mut u = Vec::with_capacity(if hessian { 27 * m * nq } else { 0 });
         // the gradients by component, for the columns of U
         let soa: [Vec<f64>; 3] =
             if hessian { std::array::from_fn(|c| grads.iter().map(|g| g[c]).collect()) } else { Default::default() };
@@ -230,16 +231,13 @@ impl WinslowVolume {
             if hessian {
                 let (gx, gy, gz) =
                     (&soa[0][q * m..(q + 1) * m], &soa[1][q * m..(q + 1) * m], &soa[2][q * m..(q + 1) * m]);
+                // U's columns (3 q + c_b), rows (3 i_b + i_a) m + a, in order
                 for cb in 0..3 {
-                    let column = &mut u[(3 * q + cb) * 9 * m..(3 * q + cb + 1) * 9 * m];
                     for ib in 0..3 {
                         let kb = 3 * cb + ib;
                         for ia in 0..3 {
                             let (h0, h1, h2) = (wq * hw[ia][kb], wq * hw[3 + ia][kb], wq * hw[6 + ia][kb]);
-                            let out = &mut column[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
-                            for (a, o) in out.iter_mut().enumerate() {
-                                *o = h0 * gx[a] + h1 * gy[a] + h2 * gz[a];
-                            }
+                            u.extend(gx.iter().zip(gy).zip(gz).map(|((&x, &y), &z)| h0 * x + h1 * y + h2 * z));
                         }
                     }
                 }
