@@ -150,10 +150,8 @@ impl EggVolume {
         // over the functions (`lin = (c nb + b) na + a`): the x-table repeated per (b, c),
         // per x-point and derivative, and the six yz products per (y, z)-point, so that
         // every row of the table is one product of two vectors of length m
-        let xs: Vec<[Vec<f64>; 3]> = bx
-            .iter()
-            .map(|(x, _)| std::array::from_fn(|dx| (0..m).map(|lin| x.d[dx][lin % na]).collect()))
-            .collect();
+        let xs: Vec<[Vec<f64>; 3]> =
+            bx.iter().map(|(x, _)| std::array::from_fn(|dx| (0..m).map(|lin| x.d[dx][lin % na]).collect())).collect();
         let mut yz = [vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]];
         for (z, wz) in bz {
             for (y, wy) in by {
@@ -277,7 +275,11 @@ impl EggVolume {
             });
             let h: [&[f64]; 6] = std::array::from_fn(|k| &hq[k * m..(k + 1) * m]);
             for (b, vb) in v.iter_mut().enumerate() {
-                *vb = ah[0] * h[0][b] + ah[1] * h[1][b] + ah[2] * h[2][b] + ah[3] * h[3][b] + ah[4] * h[4][b]
+                *vb = ah[0] * h[0][b]
+                    + ah[1] * h[1][b]
+                    + ah[2] * h[2][b]
+                    + ah[3] * h[3][b]
+                    + ah[4] * h[4][b]
                     + ah[5] * h[5][b];
             }
             for ib in 0..3 {
@@ -405,6 +407,28 @@ mod tests {
                 assert!((jac.get(l, k) - fd).abs() < 1e-7 * (1.0 + fd.abs()), "jac {l} {k}: {} vs {fd}", jac.get(l, k));
             }
         }
+    }
+
+    /// A Jacobian handed back and overwritten by the next assembly equals one assembled
+    /// into a new matrix (its old values are cleared, its pattern is the pattern), and
+    /// a matrix of another size is not taken.
+    #[test]
+    fn a_recycled_jacobian_is_assembled_afresh() {
+        let (vol, cps) = sample();
+        let op = EggVolume::new(&vol, 4);
+        let mut moved = cps.clone();
+        for (k, p) in moved.iter_mut().enumerate() {
+            p[k % 3] += 0.01 * ((k % 7) as f64 - 3.0);
+        }
+        let first = op.evaluate(&cps, true).jacobian.unwrap();
+        let fresh = op.evaluate(&moved, true).jacobian.unwrap();
+        op.disc.recycle(first);
+        let reused = op.evaluate(&moved, true).jacobian.unwrap();
+        assert!(fresh.values.iter().any(|v| *v != 0.0));
+        assert_eq!((&reused.row_ptr, &reused.col_idx), (&fresh.row_ptr, &fresh.col_idx));
+        assert_eq!(reused.values, fresh.values, "the same sums in the same order");
+        op.disc.recycle(Csr { nrows: 3, ncols: 3, row_ptr: vec![0, 0, 0, 0], col_idx: vec![], values: vec![] });
+        assert_eq!(op.evaluate(&moved, true).jacobian.unwrap().values, fresh.values);
     }
 
     /// The residual against the operator evaluated directly: for the quadratic volume

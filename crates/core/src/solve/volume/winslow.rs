@@ -151,7 +151,8 @@ impl WinslowVolume {
         let mut grads = Vec::with_capacity(nq * m);
         // per point: n = w N and ∇n of every function (`a` fastest)
         let (mut n, mut gn) = (vec![0.0; m], [vec![0.0; m], vec![0.0; m], vec![0.0; m]]);
-        let w: Vec<f64> = self.disc.weights.as_ref().map_or_else(|| vec![1.0; m], |w| idx.iter().map(|&l| w[l]).collect());
+        let w: Vec<f64> =
+            self.disc.weights.as_ref().map_or_else(|| vec![1.0; m], |w| idx.iter().map(|&l| w[l]).collect());
         let na = p[0] + 1;
         for (z, wz) in bz {
             for (y, wy) in by {
@@ -179,9 +180,9 @@ impl WinslowVolume {
                         }
                     }
                     let w2 = wsum * wsum;
-                    grads.extend((0..m).map(|a| -> Point3 {
-                        std::array::from_fn(|q| (gn[q][a] * wsum - n[a] * wgrad[q]) / w2)
-                    }));
+                    grads.extend(
+                        (0..m).map(|a| -> Point3 { std::array::from_fn(|q| (gn[q][a] * wsum - n[a] * wgrad[q]) / w2) }),
+                    );
                     weights.push(wx * wy * wz);
                 }
             }
