@@ -10,6 +10,8 @@
 //! element with `f` (`j = 0, 1, 2`), so the Winslow Hessian and the (unsymmetric) EGG
 //! Jacobian share it.
 
+use std::sync::Mutex;
+
 use rayon::prelude::*;
 
 use crate::linalg::sparse::Csr;
@@ -46,8 +48,11 @@ pub(super) type Assembled = (f64, Vec<f64>, Option<Csr>, Option<Csr>);
 /// Quadrature is stored as univariate tables per direction and element (the tensor
 /// products are formed per element when it is evaluated, so memory grows with the
 /// number of knot spans, not with elements x points x functions); the sparsity pattern
-/// is built once, and every evaluation adds the element matrices into its values.
-#[derive(Debug, Clone)]
+/// is held once, as the column indices of a matrix on it that its user hands back
+/// ([`VolumeDiscretization::recycle`]) and the next assembly overwrites, so no
+/// evaluation copies the pattern (the column indices are made again from the
+/// neighbours only when no matrix was handed back).
+#[derive(Debug)]
 pub struct VolumeDiscretization {
     shape: [usize; 3],
     /// `tables[d][e]`: the tables of element `e` in direction `d`.
@@ -58,8 +63,11 @@ pub struct VolumeDiscretization {
     free_of: Vec<usize>,
     /// Number of free control points.
     free: usize,
-    /// The pattern (values zero), see the module doc.
-    pattern: Csr,
+    /// Row pointers of the pattern (see the module doc).
+    row_ptr: Vec<usize>,
+    /// A matrix on the pattern handed back by its user, to be overwritten by the next
+    /// assembly.
+    spare: Mutex<Option<Csr>>,
     /// The scalar pattern: row `f` holds the free control points sharing an element
     /// with `f` (values zero).
     scalar_pattern: Csr,
@@ -104,7 +112,8 @@ impl VolumeDiscretization {
             weights: vol.weights.clone(),
             free_of,
             free,
-            pattern: Csr::default(),
+            row_ptr: Vec::new(),
+            spare: Mutex::new(None),
             scalar_pattern: Csr::default(),
             neighbours: Vec::new(),
         };
@@ -120,18 +129,13 @@ impl VolumeDiscretization {
             r.dedup();
         });
         let mut row_ptr = Vec::with_capacity(3 * free + 1);
-        let mut col_idx = Vec::new();
         row_ptr.push(0);
         for r in &neighbours {
             for _ in 0..3 {
-                for &g in r {
-                    col_idx.extend([3 * g, 3 * g + 1, 3 * g + 2]);
-                }
-                row_ptr.push(col_idx.len());
+                row_ptr.push(row_ptr[row_ptr.len() - 1] + 3 * r.len());
             }
         }
-        let nnz = col_idx.len();
-        e.pattern = Csr { nrows: 3 * free, ncols: 3 * free, row_ptr, col_idx, values: vec![0.0; nnz] };
+        e.row_ptr = row_ptr;
         let mut row_ptr = Vec::with_capacity(free + 1);
         row_ptr.push(0);
         for r in &neighbours {
@@ -142,6 +146,36 @@ impl VolumeDiscretization {
         e.scalar_pattern = Csr { nrows: free, ncols: free, row_ptr, col_idx, values: vec![0.0; nnz] };
         e.neighbours = neighbours;
         e
+    }
+
+    /// A matrix on the pattern with every value zero: the one handed back, or a new one.
+    fn pattern_matrix(&self) -> Csr {
+        let spare = self.spare.lock().map(|mut s| s.take()).unwrap_or(None);
+        if let Some(mut m) = spare {
+            m.values.fill(0.0);
+            return m;
+        }
+        let nnz = self.row_ptr[self.row_ptr.len() - 1];
+        let mut col_idx = Vec::with_capacity(nnz);
+        for r in &self.neighbours {
+            for _ in 0..3 {
+                for &g in r {
+                    col_idx.extend([3 * g, 3 * g + 1, 3 * g + 2]);
+                }
+            }
+        }
+        let n = 3 * self.free;
+        Csr { nrows: n, ncols: n, row_ptr: self.row_ptr.clone(), col_idx, values: vec![0.0; nnz] }
+    }
+
+    /// Hand back a matrix of [`VolumeDiscretization::assemble`] that is no longer
+    /// needed: the next assembly of a matrix writes into it instead of making a new one.
+    pub(super) fn recycle(&self, m: Csr) {
+        if m.nrows == 3 * self.free && m.row_ptr == self.row_ptr {
+            if let Ok(mut s) = self.spare.lock() {
+                *s = Some(m);
+            }
+        }
     }
 
     /// Number of elements (knot spans per direction multiplied).
@@ -217,7 +251,8 @@ impl VolumeDiscretization {
         let ne = self.elements();
         let mut scalar = 0.0;
         let mut vector = vec![0.0; n];
-        let mut values = if matrix { vec![0.0; self.pattern.nnz()] } else { Vec::new() };
+        let mut out = matrix.then(|| self.pattern_matrix());
+        let mut values = out.as_mut().map_or(Vec::new(), |m| std::mem::take(&mut m.values));
         let mut scalar_values = if scalar_matrix { vec![0.0; self.scalar_pattern.nnz()] } else { Vec::new() };
         let batch = 32 * rayon::current_num_threads().max(1);
         for start in (0..ne).step_by(batch) {
@@ -235,9 +270,16 @@ impl VolumeDiscretization {
                         continue;
                     }
                     let row = &self.neighbours[fa];
+                    // the element's free functions come in runs of consecutive free
+                    // indices (`a` fastest), which are consecutive in the row
+                    let mut last: Option<(usize, usize)> = None;
                     for b in 0..m {
                         let Some(fb) = self.free_index(l.idx[b]) else { continue };
-                        let at = row.binary_search(&fb).expect("the pattern holds every pair of an element");
+                        let at = match last {
+                            Some((g, at)) if g + 1 == fb && row.get(at + 1) == Some(&fb) => at + 1,
+                            _ => row.binary_search(&fb).expect("the pattern holds every pair of an element"),
+                        };
+                        last = Some((fb, at));
                         if scalar_matrix {
                             scalar_values[self.scalar_pattern.row_ptr[fa] + at] += l.scalar_matrix[b * m + a];
                         }
@@ -246,7 +288,7 @@ impl VolumeDiscretization {
                         }
                         let at = 3 * at;
                         for ia in 0..3 {
-                            let p = self.pattern.row_ptr[3 * fa + ia] + at;
+                            let p = self.row_ptr[3 * fa + ia] + at;
                             for ib in 0..3 {
                                 values[p + ib] += l.matrix[b * 9 * m + (3 * ib + ia) * m + a];
                             }
@@ -255,7 +297,7 @@ impl VolumeDiscretization {
                 }
             }
         }
-        let matrix = matrix.then(|| Csr { values, ..self.pattern.clone() });
+        let matrix = out.map(|m| Csr { values, ..m });
         let scalar_matrix = scalar_matrix.then(|| Csr { values: scalar_values, ..self.scalar_pattern.clone() });
         Some((scalar, vector, matrix, scalar_matrix))
     }

@@ -141,41 +141,34 @@ impl EggVolume {
         let m = idx.len();
         let nq = bx.len() * by.len() * bz.len();
         let mut weights = Vec::with_capacity(nq);
-        let mut basis = vec![0.0; nq * 10 * m];
+        // written in order (no zero fill first)
+        let mut basis = Vec::with_capacity(nq * 10 * m);
+        let (na, nb) = (p[0] + 1, p[1] + 1);
+        // (x derivative, yz factor) of each of the ten rows
+        const ROWS: [(usize, usize); 10] =
+            [(0, 0), (1, 0), (0, 1), (0, 2), (2, 0), (0, 3), (0, 4), (1, 1), (1, 2), (0, 5)];
+        // over the functions (`lin = (c nb + b) na + a`): the x-table repeated per (b, c),
+        // per x-point and derivative, and the six yz products per (y, z)-point, so that
+        // every row of the table is one product of two vectors of length m
+        let xs: Vec<[Vec<f64>; 3]> =
+            bx.iter().map(|(x, _)| std::array::from_fn(|dx| (0..m).map(|lin| x.d[dx][lin % na]).collect())).collect();
+        let mut yz = [vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]];
         for (z, wz) in bz {
             for (y, wy) in by {
-                for (x, wx) in bx {
+                for lin in 0..m {
+                    let (b, c) = ((lin / na) % nb, lin / (na * nb));
+                    let (y0, y1, y2, z0, z1, z2) = (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
+                    for (f, v) in [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1].into_iter().enumerate() {
+                        yz[f][lin] = v;
+                    }
+                }
+                for ((_, wx), xq) in bx.iter().zip(&xs) {
                     let q = weights.len();
-                    let table = &mut basis[q * 10 * m..(q + 1) * 10 * m];
-                    let mut lin = 0;
-                    for c in 0..=p[2] {
-                        for b in 0..=p[1] {
-                            let (y0, y1, y2, z0, z1, z2) =
-                                (y.d[0][b], y.d[1][b], y.d[2][b], z.d[0][c], z.d[1][c], z.d[2][c]);
-                            let yz = [y0 * z0, y1 * z0, y0 * z1, y2 * z0, y0 * z2, y1 * z1];
-                            for a in 0..=p[0] {
-                                let (x0, x1, x2) = (x.d[0][a], x.d[1][a], x.d[2][a]);
-                                let f = [
-                                    x0 * yz[0],
-                                    x1 * yz[0],
-                                    x0 * yz[1],
-                                    x0 * yz[2],
-                                    x2 * yz[0],
-                                    x0 * yz[3],
-                                    x0 * yz[4],
-                                    x1 * yz[1],
-                                    x1 * yz[2],
-                                    x0 * yz[5],
-                                ];
-                                for (k, v) in f.into_iter().enumerate() {
-                                    table[k * m + lin] = v;
-                                }
-                                lin += 1;
-                            }
-                        }
+                    for &(dx, f) in &ROWS {
+                        basis.extend(xq[dx].iter().zip(&yz[f]).map(|(&xa, &v)| xa * v));
                     }
                     if let Some(w) = self.disc.weights.as_ref() {
-                        rational(table, idx.iter().map(|&l| w[l]));
+                        rational(&mut basis[q * 10 * m..(q + 1) * 10 * m], idx.iter().map(|&l| w[l]));
                     }
                     weights.push(wx * wy * wz);
                 }
@@ -207,14 +200,19 @@ impl EggVolume {
             1.0,
             faer::Par::Seq,
         );
-        let mut res = vec![0.0; 3 * m];
-        let mut qm = if jacobian { vec![0.0; nq * 9 * m] } else { Vec::new() };
+        // the residual by component (`c m + a`), interleaved at the end
+        let mut rc = vec![0.0; 3 * m];
+        // Q[q, (3 i_b + i_a) m + b] = ∂L_(i_a)/∂c_(b, i_b) at q (rows of b contiguous)
+        // (written in order, no zero fill first)
+        let mut qm = Vec::with_capacity(if jacobian { nq * 9 * m } else { 0 });
         // K = U V: U[a, (q, i)] = w_q ((A/T) ∇R_a)_i, V[(q, i), b] = ∂_i R_b
         let (mut um, mut vm) =
             if laplace { (vec![0.0; 3 * nq * m], vec![0.0; 3 * nq * m]) } else { (Vec::new(), Vec::new()) };
+        let mut v = vec![0.0; if jacobian { m } else { 0 }];
         for (q, &wq) in weights.iter().enumerate() {
             let table = &basis[q * 10 * m..(q + 1) * 10 * m];
             let (rq, gq, hq) = (&table[..m], &table[m..4 * m], &table[4 * m..]);
+            let (g0, g1, g2) = (&gq[..m], &gq[m..2 * m], &gq[2 * m..]);
             // J's columns and the components' Hessians
             let d: [Point3; 3] = std::array::from_fn(|col| std::array::from_fn(|c| xq[c * 10 * nq + 10 * q + 1 + col]));
             let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| xq[c * 10 * nq + 10 * q + 4 + k]));
@@ -225,18 +223,19 @@ impl EggVolume {
                 return None;
             }
             let l: [f64; 3] = std::array::from_fn(|c| contract(&am, &xh[c]) / t);
-            for (r, &v) in res.chunks_exact_mut(3).zip(rq) {
-                for c in 0..3 {
-                    r[c] += wq * v * l[c];
+            for (c, &lc) in l.iter().enumerate() {
+                for (r, &ra) in rc[c * m..(c + 1) * m].iter_mut().zip(rq) {
+                    *r += wq * ra * lc;
                 }
             }
             if laplace {
-                for a in 0..m {
-                    let g = [gq[a], gq[m + a], gq[2 * m + a]];
-                    for i in 0..3 {
-                        um[(3 * q + i) * m + a] = wq * (am[i][0] * g[0] + am[i][1] * g[1] + am[i][2] * g[2]) / t;
-                        vm[(3 * q + i) * m + a] = g[i];
+                for i in 0..3 {
+                    let (a0, a1, a2) = (am[i][0], am[i][1], am[i][2]);
+                    let row = &mut um[(3 * q + i) * m..(3 * q + i + 1) * m];
+                    for (((u, &x0), &x1), &x2) in row.iter_mut().zip(g0).zip(g1).zip(g2) {
+                        *u = wq * (a0 * x0 + a1 * x1 + a2 * x2) / t;
                     }
+                    vm[(3 * q + i) * m..(3 * q + i + 1) * m].copy_from_slice(&gq[i * m..(i + 1) * m]);
                 }
             }
             if !jacobian {
@@ -265,8 +264,7 @@ impl EggVolume {
                     }
                 }
             }
-            let row = &mut qm[q * 9 * m..(q + 1) * 9 * m];
-            // the coefficients of A : ∇²R_b / T in the order of PAIRS
+            // v_b = A : ∇²R_b / T, the coefficients in the order of PAIRS
             let ah: [f64; 6] = std::array::from_fn(|k| {
                 let (i, j) = PAIRS[k];
                 if i == j {
@@ -275,18 +273,31 @@ impl EggVolume {
                     2.0 * am[i][j] / t
                 }
             });
-            for b in 0..m {
-                let v = (0..6).map(|k| ah[k] * hq[k * m + b]).sum::<f64>();
-                let g = [gq[b], gq[m + b], gq[2 * m + b]];
-                for ib in 0..3 {
-                    for ia in 0..3 {
-                        let mut x = g[0] * s[ia][0][ib] + g[1] * s[ia][1][ib] + g[2] * s[ia][2][ib];
-                        if ia == ib {
-                            x += v;
-                        }
-                        row[b * 9 + 3 * ib + ia] = x;
+            let h: [&[f64]; 6] = std::array::from_fn(|k| &hq[k * m..(k + 1) * m]);
+            for (b, vb) in v.iter_mut().enumerate() {
+                *vb = ah[0] * h[0][b]
+                    + ah[1] * h[1][b]
+                    + ah[2] * h[2][b]
+                    + ah[3] * h[3][b]
+                    + ah[4] * h[4][b]
+                    + ah[5] * h[5][b];
+            }
+            for ib in 0..3 {
+                for ia in 0..3 {
+                    let (s0, s1, s2) = (s[ia][0][ib], s[ia][1][ib], s[ia][2][ib]);
+                    let cols = g0.iter().zip(g1).zip(g2);
+                    if ia == ib {
+                        qm.extend(cols.zip(&v).map(|(((&x0, &x1), &x2), &vb)| x0 * s0 + x1 * s1 + x2 * s2 + vb));
+                    } else {
+                        qm.extend(cols.map(|((&x0, &x1), &x2)| x0 * s0 + x1 * s1 + x2 * s2));
                     }
                 }
+            }
+        }
+        let mut res = vec![0.0; 3 * m];
+        for (a, r) in res.chunks_exact_mut(3).enumerate() {
+            for (c, x) in r.iter_mut().enumerate() {
+                *x = rc[c * m + a];
             }
         }
         let mut k = Vec::new();
@@ -297,15 +308,23 @@ impl EggVolume {
                     pm[q * m + a] = wq * basis[q * 10 * m + a];
                 }
             }
-            k = vec![0.0; 9 * m * m];
+            // P Q, column-major: entry (a, (3 i_b + i_a) m + b) at ((3 i_b + i_a) m + b) m + a
+            let mut pq = vec![0.0; 9 * m * m];
             faer::linalg::matmul::matmul(
-                faer::MatMut::from_column_major_slice_mut(&mut k, m, 9 * m),
+                faer::MatMut::from_column_major_slice_mut(&mut pq, m, 9 * m),
                 faer::Accum::Replace,
                 faer::MatRef::from_column_major_slice(&pm, m, nq),
                 faer::MatRef::from_row_major_slice(&qm, nq, 9 * m),
                 1.0,
                 faer::Par::Seq,
             );
+            // to the layout of `Local`: (a, i_a; b, i_b) at b 9m + (3 i_b + i_a) m + a
+            k = Vec::with_capacity(9 * m * m);
+            for b in 0..m {
+                for blk in 0..9 {
+                    k.extend_from_slice(&pq[(blk * m + b) * m..(blk * m + b + 1) * m]);
+                }
+            }
         }
         let mut kl = Vec::new();
         if laplace {
@@ -388,6 +407,28 @@ mod tests {
                 assert!((jac.get(l, k) - fd).abs() < 1e-7 * (1.0 + fd.abs()), "jac {l} {k}: {} vs {fd}", jac.get(l, k));
             }
         }
+    }
+
+    /// A Jacobian handed back and overwritten by the next assembly equals one assembled
+    /// into a new matrix (its old values are cleared, its pattern is the pattern), and
+    /// a matrix of another size is not taken.
+    #[test]
+    fn a_recycled_jacobian_is_assembled_afresh() {
+        let (vol, cps) = sample();
+        let op = EggVolume::new(&vol, 4);
+        let mut moved = cps.clone();
+        for (k, p) in moved.iter_mut().enumerate() {
+            p[k % 3] += 0.01 * ((k % 7) as f64 - 3.0);
+        }
+        let first = op.evaluate(&cps, true).jacobian.unwrap();
+        let fresh = op.evaluate(&moved, true).jacobian.unwrap();
+        op.disc.recycle(first);
+        let reused = op.evaluate(&moved, true).jacobian.unwrap();
+        assert!(fresh.values.iter().any(|v| *v != 0.0));
+        assert_eq!((&reused.row_ptr, &reused.col_idx), (&fresh.row_ptr, &fresh.col_idx));
+        assert_eq!(reused.values, fresh.values, "the same sums in the same order");
+        op.disc.recycle(Csr { nrows: 3, ncols: 3, row_ptr: vec![0, 0, 0, 0], col_idx: vec![], values: vec![] });
+        assert_eq!(op.evaluate(&moved, true).jacobian.unwrap().values, fresh.values);
     }
 
     /// The residual against the operator evaluated directly: for the quadratic volume

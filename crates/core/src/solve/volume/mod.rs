@@ -183,17 +183,18 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// `a + s diag(|a|)`.
-fn shifted(a: &Csr, s: f64) -> Csr {
+/// `a + s diag(|a|)` (`a` itself, not a copy, when `s = 0`).
+fn shifted(a: &Csr, s: f64) -> std::borrow::Cow<'_, Csr> {
+    if s <= 0.0 {
+        return std::borrow::Cow::Borrowed(a);
+    }
     let mut b = a.clone();
-    if s > 0.0 {
-        for i in 0..b.nrows {
-            if let Some(p) = b.position(i, i) {
-                b.values[p] += s * b.values[p].abs().max(1e-300);
-            }
+    for i in 0..b.nrows {
+        if let Some(p) = b.position(i, i) {
+            b.values[p] += s * b.values[p].abs().max(1e-300);
         }
     }
-    b
+    std::borrow::Cow::Owned(b)
 }
 
 /// Newton's method with a backtracking (Armijo) line search on `E` over the free
@@ -253,6 +254,9 @@ fn minimise(e: &WinslowVolume, cps: &mut [Point3], max_iterations: usize, tolera
         let decrease = ev.energy - energy;
         x = trial;
         cps.copy_from_slice(&c);
+        if let Some(h) = ev.hessian.take() {
+            e.recycle(h);
+        }
         ev = e.evaluate(cps, true);
         shift = if shift < 1e-5 { 0.0 } else { shift * 0.1 };
         if decrease <= 1e-15 * energy.abs() {
@@ -339,10 +343,9 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
             let op = EggVolume::on(disc.clone());
             let solved = solve_egg(&op, &mut cps, opts.max_iterations, opts.tolerance, opts.linear)?;
             egg = Some(solved);
-            let inside = energy.evaluate(&cps, false).energy.is_finite();
             if method == VolumeMethod::Egg {
                 (cps, "coons", 1, solved.iterations, None, energy_start)
-            } else if inside {
+            } else if energy.evaluate(&cps, false).energy.is_finite() {
                 let stats = minimise(&energy, &mut cps, opts.max_iterations, opts.tolerance)?;
                 (cps, "egg", 0, solved.iterations + stats.iterations, Some(stats.relative_gradient), energy_start)
             } else {

@@ -149,35 +149,40 @@ impl WinslowVolume {
         let nq = bx.len() * by.len() * bz.len();
         let mut weights = Vec::with_capacity(nq);
         let mut grads = Vec::with_capacity(nq * m);
-        let mut vals = Vec::with_capacity(m);
+        // per point: n = w N and ∇n of every function (`a` fastest)
+        let (mut n, mut gn) = (vec![0.0; m], [vec![0.0; m], vec![0.0; m], vec![0.0; m]]);
+        let w: Vec<f64> =
+            self.disc.weights.as_ref().map_or_else(|| vec![1.0; m], |w| idx.iter().map(|&l| w[l]).collect());
+        let na = p[0] + 1;
         for (z, wz) in bz {
             for (y, wy) in by {
                 for (x, wx) in bx {
-                    vals.clear();
-                    let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
-                    let mut lin = idx.iter();
+                    let mut lin = 0;
                     for c in 0..=p[2] {
                         for b in 0..=p[1] {
-                            for a in 0..=p[0] {
-                                let l = *lin.next().expect("one index per basis function");
-                                let w = self.disc.weights.as_ref().map_or(1.0, |w| w[l]);
-                                let n = w * x.d[0][a] * y.d[0][b] * z.d[0][c];
-                                let g = [
-                                    w * x.d[1][a] * y.d[0][b] * z.d[0][c],
-                                    w * x.d[0][a] * y.d[1][b] * z.d[0][c],
-                                    w * x.d[0][a] * y.d[0][b] * z.d[1][c],
-                                ];
-                                wsum += n;
-                                for q in 0..3 {
-                                    wgrad[q] += g[q];
-                                }
-                                vals.push((n, g));
+                            let (y0, y1, z0, z1) = (y.d[0][b], y.d[1][b], z.d[0][c], z.d[1][c]);
+                            for a in 0..na {
+                                let wa = w[lin + a];
+                                n[lin + a] = wa * x.d[0][a] * y0 * z0;
+                                gn[0][lin + a] = wa * x.d[1][a] * y0 * z0;
+                                gn[1][lin + a] = wa * x.d[0][a] * y1 * z0;
+                                gn[2][lin + a] = wa * x.d[0][a] * y0 * z1;
                             }
+                            lin += na;
                         }
                     }
-                    grads.extend(vals.iter().map(|(n, g)| -> Point3 {
-                        std::array::from_fn(|q| (g[q] * wsum - n * wgrad[q]) / (wsum * wsum))
-                    }));
+                    // the sums in the order of the functions
+                    let (mut wsum, mut wgrad) = (0.0, [0.0; 3]);
+                    for a in 0..m {
+                        wsum += n[a];
+                        for q in 0..3 {
+                            wgrad[q] += gn[q][a];
+                        }
+                    }
+                    let w2 = wsum * wsum;
+                    grads.extend(
+                        (0..m).map(|a| -> Point3 { std::array::from_fn(|q| (gn[q][a] * wsum - n[a] * wgrad[q]) / w2) }),
+                    );
                     weights.push(wx * wy * wz);
                 }
             }
@@ -197,7 +202,8 @@ impl WinslowVolume {
         let (m, nq) = (idx.len(), weights.len());
         let mut energy = 0.0;
         let mut g = vec![0.0; 3 * m];
-        let mut u = if hessian { vec![0.0; 27 * m * nq] } else { Vec::new() };
+        // (written in order, no zero fill first)
+        let mut u = Vec::with_capacity(if hessian { 27 * m * nq } else { 0 });
         // the gradients by component, for the columns of U
         let soa: [Vec<f64>; 3] =
             if hessian { std::array::from_fn(|c| grads.iter().map(|g| g[c]).collect()) } else { Default::default() };
@@ -226,16 +232,13 @@ impl WinslowVolume {
             if hessian {
                 let (gx, gy, gz) =
                     (&soa[0][q * m..(q + 1) * m], &soa[1][q * m..(q + 1) * m], &soa[2][q * m..(q + 1) * m]);
+                // U's columns (3 q + c_b), rows (3 i_b + i_a) m + a, in order
                 for cb in 0..3 {
-                    let column = &mut u[(3 * q + cb) * 9 * m..(3 * q + cb + 1) * 9 * m];
                     for ib in 0..3 {
                         let kb = 3 * cb + ib;
                         for ia in 0..3 {
                             let (h0, h1, h2) = (wq * hw[ia][kb], wq * hw[3 + ia][kb], wq * hw[6 + ia][kb]);
-                            let out = &mut column[(3 * ib + ia) * m..(3 * ib + ia + 1) * m];
-                            for (a, o) in out.iter_mut().enumerate() {
-                                *o = h0 * gx[a] + h1 * gy[a] + h2 * gz[a];
-                            }
+                            u.extend(gx.iter().zip(gy).zip(gz).map(|((&x, &y), &z)| h0 * x + h1 * y + h2 * z));
                         }
                     }
                 }
@@ -275,6 +278,11 @@ impl WinslowVolume {
             Some((energy, gradient, hessian, _)) => Evaluation { energy, gradient, hessian },
             None => Evaluation { energy: f64::INFINITY, gradient: Vec::new(), hessian: None },
         }
+    }
+
+    /// Hand back a Hessian no longer needed ([`VolumeDiscretization::recycle`]).
+    pub fn recycle(&self, hessian: Csr) {
+        self.disc.recycle(hessian)
     }
 
     /// The free coordinates of `cps` (`3 f + component`).

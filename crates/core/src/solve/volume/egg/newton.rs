@@ -209,6 +209,9 @@ pub(in crate::solve::volume) fn solve_egg(
         let Some((trial, c, t, tn)) = accepted else { break };
         x = trial;
         cps.copy_from_slice(&c);
+        if let Some(j) = ev.jacobian.take() {
+            op.disc.recycle(j);
+        }
         (ev, fnorm) = (t, tn);
     }
     Ok(EggSolved {
