@@ -15,7 +15,7 @@ use super::assembly::Discretization;
 use super::dofs::FIXED;
 use crate::linalg::krylov::MatVec;
 
-/// Rows of the stencil product per parallel task.
+/// Functions of the stencil product per parallel task (their rows of every component).
 const ROWS_PER_TASK: usize = 1024;
 
 /// `sum_t terms[t]` added in the order of [`crate::linalg::sparse::Csr::mul_vec`]: four
@@ -58,32 +58,48 @@ impl Discretization {
         let (wx, wy) = (2 * p + 1, 2 * q + 1);
         let free = self.dofs.free();
         let dofs = &self.dofs;
-        // the products of row `z m + f` in the gathered matrix's column order
-        // (component, then the neighbours by `dj`, then `di`), summed as the matrix does
-        let row = |z: usize, f: usize, terms: &mut Vec<f64>| -> f64 {
+        // the free neighbours of free function `f` in the gathered matrix's column order
+        // (by `dj`, then `di`): `(slot, free index)`, the same for every component pair
+        let columns = |f: usize, cols: &mut Vec<(usize, usize)>| {
             let k = free[f];
             let (i, j) = (k % nx, k / nx);
-            let base = k * row_len + z * ncomp * sw;
-            terms.clear();
-            for d in 0..ncomp {
-                for dj in j.saturating_sub(q)..(j + q + 1).min(ny) {
-                    for di in i.saturating_sub(p)..(i + p + 1).min(nx) {
-                        let fc = dofs.free_index(dj * nx + di);
-                        if fc != FIXED {
-                            let s = (dj + q - j) * wx + (di + p - i);
-                            terms.push(stencil[base + d * sw + s] * x[d * m + fc]);
-                        }
+            cols.clear();
+            for dj in j.saturating_sub(q)..(j + q + 1).min(ny) {
+                for di in i.saturating_sub(p)..(i + p + 1).min(nx) {
+                    let fc = dofs.free_index(dj * nx + di);
+                    if fc != FIXED {
+                        cols.push(((dj + q - j) * wx + (di + p - i), fc));
                     }
                 }
+            }
+        };
+        // the products of row `z m + f` in the gathered matrix's column order
+        // (component, then the neighbours), summed as the matrix does
+        let row = |z: usize, f: usize, cols: &[(usize, usize)], terms: &mut Vec<f64>| -> f64 {
+            let base = free[f] * row_len + z * ncomp * sw;
+            terms.clear();
+            for d in 0..ncomp {
+                let (st, xd) = (&stencil[base + d * sw..][..sw], &x[d * m..][..m]);
+                terms.extend(cols.iter().map(|&(s, fc)| st[s] * xd[fc]));
             }
             sum_as_csr(terms)
         };
         debug_assert!(wy * wx == sw && y.len() == ncomp * m && x.len() == ncomp * m);
-        y.par_chunks_mut(ROWS_PER_TASK).enumerate().for_each(|(c, ys)| {
-            let mut terms = Vec::with_capacity(ncomp * sw);
-            for (o, yi) in ys.iter_mut().enumerate() {
-                let r = c * ROWS_PER_TASK + o;
-                *yi = row(r / m, r % m, &mut terms);
+        // each task: the rows of functions `c R .. (c + 1) R` of every component
+        let mut tasks: Vec<Vec<&mut [f64]>> = (0..m.div_ceil(ROWS_PER_TASK)).map(|_| Vec::new()).collect();
+        for part in y.chunks_mut(m.max(1)) {
+            for (task, ys) in tasks.iter_mut().zip(part.chunks_mut(ROWS_PER_TASK)) {
+                task.push(ys);
+            }
+        }
+        tasks.into_par_iter().enumerate().for_each(|(c, mut parts)| {
+            let (mut cols, mut terms) = (Vec::with_capacity(sw), Vec::with_capacity(ncomp * sw));
+            for o in 0..parts.first().map_or(0, |ys| ys.len()) {
+                let f = c * ROWS_PER_TASK + o;
+                columns(f, &mut cols);
+                for (z, ys) in parts.iter_mut().enumerate() {
+                    ys[o] = row(z, f, &cols, &mut terms);
+                }
             }
         });
         true

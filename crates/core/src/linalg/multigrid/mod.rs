@@ -12,10 +12,13 @@
 //! correction `x += P_l x_{l+1}`, ν post-smoothing sweeps. The smoother
 //! ([`Smoother`]) is alternating line Gauss–Seidel (the lines of both directions of the
 //! tensor grid, each line's banded block solved exactly: robust where the metric makes
-//! one direction stiff, `g11 >> g22` in a narrow gap), symmetric Gauss–Seidel or ILU(0)
+//! one direction stiff, `g11 >> g22` in a narrow gap; the lines of one direction
+//! either one after the other or by colours, each colour's lines in parallel), symmetric Gauss–Seidel or ILU(0)
 //! on the level's pattern, each forward before and backward after the coarse correction;
 //! BENCHMARKS.md "Multigrid" has the measured choice (ILU(0) diverges as a smoother on
-//! the metrics of puzzle4's necks).
+//! the metrics of puzzle4's necks). Under the line smoothers the operators of the
+//! smoothed levels are held as stencils of `f32` values without column indices
+//! ([`grid`]), a quarter of the CSR storage and of the memory traffic of a sweep.
 
 use rayon::prelude::*;
 
@@ -24,9 +27,11 @@ use crate::linalg::dense::DenseCholesky;
 use crate::linalg::krylov::Ilu0;
 use crate::linalg::sparse::Csr;
 
+mod grid;
 mod lines;
 mod tensor;
 
+use grid::{GridOperator, Rows};
 use lines::{grid_width, Lines};
 pub(crate) use tensor::TensorProlongation;
 
@@ -44,7 +49,13 @@ pub(crate) enum Smoother {
     /// Alternating line Gauss–Seidel: block Gauss–Seidel over the lines of direction 0,
     /// then over those of direction 1 (the reverse after the coarse correction), each
     /// line's block `A_LL` factorized once ([`lines`]).
+    #[cfg_attr(not(test), allow(dead_code))]
     Lines,
+    /// [`Smoother::Lines`] with the lines of each direction in colours (line `l` of colour
+    /// `l mod (w + 1)`, `w` the farthest coupling across the lines: 4 colours at degree
+    /// 3): the lines of one colour do not couple, their corrections are computed in
+    /// parallel ([`lines::Lines::sweep_coloured`]).
+    ColouredLines,
 }
 
 /// A multigrid V-cycle for `A` (see the module documentation).
@@ -53,8 +64,13 @@ pub(crate) struct Multigrid {
     /// `P_l` maps level `l + 1` to level `l` (level 0 the finest); `P_l^T` restricts.
     prolongations: Vec<TensorProlongation>,
     /// `A_l`, finest first; the last is the coarsest (`A_0` is the operator handed to
-    /// [`Multigrid::factor_owned`]: the cycle holds the only copy).
+    /// [`Multigrid::factor_owned`]: the cycle holds the only copy). Empty for a level held
+    /// in `grids`.
     operators: Vec<Csr>,
+    /// Under the line smoothers, `A_l` of each smoothed level in stencil form where it
+    /// fits ([`GridOperator`], `f32` values without column indices), read by the
+    /// smoother and the residual instead of the CSR matrix, which is dropped.
+    grids: Vec<Option<GridOperator>>,
     /// Position of the diagonal entry of each row of each operator.
     diagonals: Vec<Vec<usize>>,
     ilu: Vec<Ilu0>,
@@ -150,6 +166,7 @@ impl Multigrid {
         Self {
             prolongations,
             operators: Vec::new(),
+            grids: Vec::new(),
             diagonals: Vec::new(),
             ilu: Vec::new(),
             lines: Vec::new(),
@@ -207,10 +224,10 @@ impl Multigrid {
         };
         self.ilu = match self.smoother {
             Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel | Smoother::Lines => Vec::new(),
+            Smoother::SymmetricGaussSeidel | Smoother::Lines | Smoother::ColouredLines => Vec::new(),
         };
         self.lines = match self.smoother {
-            Smoother::Lines => smoothed
+            Smoother::Lines | Smoother::ColouredLines => smoothed
                 .iter()
                 .map(|a| {
                     let nx = grid_width(a);
@@ -220,6 +237,17 @@ impl Multigrid {
             Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
         };
         self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
+        self.grids = match self.smoother {
+            Smoother::Lines | Smoother::ColouredLines => {
+                operators[..operators.len() - 1].iter().map(|a| GridOperator::from_csr(a, grid_width(a))).collect()
+            }
+            Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
+        };
+        for (a, g) in operators.iter_mut().zip(&self.grids) {
+            if g.is_some() {
+                *a = Csr::default();
+            }
+        }
         self.operators = operators;
         Ok(())
     }
@@ -227,6 +255,7 @@ impl Multigrid {
     /// Drop the operators and smoothers of the last set-up (the hierarchy stays).
     fn release(&mut self) {
         self.operators = Vec::new();
+        self.grids = Vec::new();
         self.lines = Vec::new();
         self.ilu = Vec::new();
         self.diagonals = Vec::new();
@@ -244,12 +273,14 @@ impl Multigrid {
             self.coarse.solve_columns(x);
             return;
         }
-        let a = &self.operators[l];
         let mut r = vec![0.0; b.len()];
         for _ in 0..self.sweeps {
             self.smooth(l, b, x, &mut r, false);
         }
-        a.mul_vec(x, &mut r);
+        match self.grid(l) {
+            Some(g) => g.mul_vec(x, &mut r),
+            None => self.operators[l].mul_vec(x, &mut r),
+        }
         for (ri, bi) in r.iter_mut().zip(b) {
             *ri = bi - *ri;
         }
@@ -265,6 +296,11 @@ impl Multigrid {
         for _ in 0..self.sweeps {
             self.smooth(l, b, x, &mut r, true);
         }
+    }
+
+    /// The stencil form of level `l`'s operator, if it is held so.
+    fn grid(&self, l: usize) -> Option<&GridOperator> {
+        self.grids.get(l).and_then(Option::as_ref)
     }
 
     /// One smoothing sweep on level `l` (`r` scratch of the level's size).
@@ -286,15 +322,20 @@ impl Multigrid {
                     (0..a.nrows).for_each(&mut relax);
                 }
             }
-            Smoother::Lines => {
+            Smoother::Lines | Smoother::ColouredLines => {
                 let mut scratch = Vec::new();
                 let [l0, l1] = &self.lines[l];
+                let a: &dyn Rows = match self.grid(l) {
+                    Some(g) => g,
+                    None => a,
+                };
+                let sweep = if self.smoother == Smoother::Lines { Lines::sweep } else { Lines::sweep_coloured };
                 if backward {
-                    l1.sweep(a, b, x, true, &mut scratch);
-                    l0.sweep(a, b, x, true, &mut scratch);
+                    sweep(l1, a, b, x, true, &mut scratch);
+                    sweep(l0, a, b, x, true, &mut scratch);
                 } else {
-                    l0.sweep(a, b, x, false, &mut scratch);
-                    l1.sweep(a, b, x, false, &mut scratch);
+                    sweep(l0, a, b, x, false, &mut scratch);
+                    sweep(l1, a, b, x, false, &mut scratch);
                 }
             }
             Smoother::Ilu0 => {
