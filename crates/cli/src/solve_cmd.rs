@@ -174,6 +174,15 @@ fn print_stage(e: &mut impl Write, stage: &Stage<'_>) -> std::io::Result<()> {
             if r.converged { "" } else { " (NOT converged)" },
             r.seconds
         ),
+        Stage::ThbFallback { thb } => writeln!(
+            e,
+            "THB refinement left the map {} after {} round(s) ({} offending cell(s), {} functions): solving again with \
+             the tensor repair",
+            format!("{:?}", thb.verdict).to_lowercase(),
+            thb.rounds,
+            thb.offending_cells,
+            thb.functions
+        ),
         Stage::Solver(Event::LevelFinished(r)) => writeln!(
             e,
             "  level done: {} iterations, {}, initial det J min {:.3e}, {:.3} s",

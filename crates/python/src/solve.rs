@@ -246,6 +246,7 @@ pub fn event(stage: &Stage<'_>) -> Value {
         Stage::WarmStart { used, reason } => json!({ "stage": "warm_start", "used": used, "reason": reason }),
         Stage::Improve { method } => json!({ "stage": "improve", "method": method.name() }),
         Stage::ThbRound(r) => json!({ "stage": "thb_round", "round": r }),
+        Stage::ThbFallback { thb } => json!({ "stage": "thb_fallback", "thb": thb }),
         _ => json!({ "stage": "other" }),
     }
 }

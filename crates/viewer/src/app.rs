@@ -11,6 +11,7 @@ use egui::epaint::Mesh;
 use egui::{Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Sense, Shape, Stroke, Ui, Vec2};
 use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
+use winslow::solve::options::Refinement;
 use winslow::Point;
 
 use crate::colour::{colour_at, fold_colour, is_positive, ColourScale, ScaleKind};
@@ -421,8 +422,14 @@ impl ViewerApp {
                 painter.add(heat_mesh(mv, &scale, |k| to(mv.positions[k])));
             }
             if d.grid {
+                // a THB map's active cells where a tensor map has iso-lines (as its PNG)
                 let stroke = Stroke::new(0.8, Color32::from_black_alpha(150));
-                for line in mv.iso.xi.iter().chain(&mv.iso.eta) {
+                let lines = match &mv.thb {
+                    Some(t) => &t.borders[..],
+                    None => &[],
+                };
+                let iso = mv.iso.xi.iter().chain(&mv.iso.eta).filter(|_| mv.thb.is_none());
+                for line in lines.iter().chain(iso) {
                     painter.add(Shape::line(line.iter().map(|&p| to(p)).collect(), stroke));
                 }
             }
@@ -532,7 +539,14 @@ impl ViewerApp {
                         to([(k % (n + 1)) as f64 / n as f64, (k / (n + 1)) as f64 / n as f64])
                     }));
                 }
-                if d.knots {
+                if let Some(t) = mv.thb.as_ref().filter(|_| d.knots || d.grid) {
+                    // the active cells of a THB map (in place of knot lines and iso-lines)
+                    let stroke = Stroke::new(0.8, Color32::from_black_alpha(150));
+                    for (_, [[a, b], [c, e]]) in &t.cells {
+                        let r = Rect::from_two_pos(to([*a, *c]), to([*b, *e]));
+                        painter.rect_stroke(r, 0.0, stroke, egui::StrokeKind::Middle);
+                    }
+                } else if d.knots && mv.thb.is_none() {
                     let stroke = Stroke::new(0.6, Color32::from_black_alpha(70));
                     for &u in &mv.breaks[0] {
                         painter.line_segment([to([u, 0.0]), to([u, 1.0])], stroke);
@@ -541,7 +555,7 @@ impl ViewerApp {
                         painter.line_segment([to([0.0, v]), to([1.0, v])], stroke);
                     }
                 }
-                if d.grid {
+                if d.grid && mv.thb.is_none() {
                     let stroke = Stroke::new(0.8, Color32::from_black_alpha(150));
                     let m = mv.iso.density;
                     for k in 1..m {

@@ -5,7 +5,9 @@
 //! lines and control net, the folded elements and the verdict of the solver, and solve
 //! a boundary in a background thread while watching the residuals. A general domain or
 //! plane graph opens as its automatic multipatch layout (patch borders, irregular
-//! vertices), solved like any layout. A volume (trivariate map) opens as three
+//! vertices), solved like any layout. A THB map (a file, or a solve with THB refinement)
+//! shows its `det J` sampled on its active cells, the cells themselves and the THB
+//! certificate's verdict. A volume (trivariate map) opens as three
 //! orthogonal slices with their `det J` heat maps, one slider per parameter direction.
 //!
 //! The numbers all come from the core crate `winslow`; this crate only arranges and
@@ -26,6 +28,7 @@ pub mod scene;
 mod sections;
 pub mod solve_job;
 pub mod state;
+pub mod thb_view;
 pub mod view;
 pub mod volume_view;
 

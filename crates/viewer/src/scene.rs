@@ -11,6 +11,7 @@ use winslow::boundary::validate::sample_side;
 use winslow::domain::{auto_layout, graph_layout, LayoutOptions};
 use winslow::io::{checked_boundary, read_with_report, Document, ReadOptions};
 use winslow::multipatch::MultipatchSolution;
+use winslow::pipeline::ThbSolution;
 use winslow::solve::report::Solution;
 use winslow::verify::quality::DetJSample;
 use winslow::{Boundary, Point, Side, SideCurve, Surface};
@@ -19,6 +20,7 @@ use crate::certificate::{Certificate, Quality};
 use crate::folds::{folded_elements, FoldedElement};
 use crate::layout_view::LayoutView;
 use crate::sampler::DetJSampler;
+use crate::thb_view::{default_thb_resolution, ThbView};
 use crate::view::{bounds_of, Bounds};
 
 /// Heat-map resolution bounds (cells per direction).
@@ -171,6 +173,9 @@ pub struct MapView {
     /// Kinks of the boundary (paper §9) and whether the map keeps them exactly, from the
     /// solver's report or the one stored in the map file.
     pub kinks: Vec<(Point, bool)>,
+    /// The THB map this view shows (`map` is then its exact tensor form): its active
+    /// cells, their borders and the THB certificate ([`crate::thb_view`]).
+    pub thb: Option<ThbView>,
 }
 
 /// The matched pairs stored in a map file's `"report"` (`reparam.matches[].points`).
@@ -196,6 +201,20 @@ impl MapView {
     ) -> Self {
         let n = resolution.clamp(RESOLUTION_RANGE.0, RESOLUTION_RANGE.1);
         let sample = sampler.sample(&map, n);
+        Self::sampled(map, sampler.name().to_string(), sample, density, certificate, Certificate::exact)
+    }
+
+    /// Prepare `map` with its `det J` sample (made by `sampler`); `exact` gives the exact
+    /// certificate of the map from its quality numbers.
+    pub(crate) fn sampled(
+        map: Surface,
+        sampler: String,
+        sample: DetJSample,
+        density: usize,
+        certificate: Option<Certificate>,
+        exact: impl FnOnce(&Surface, &Quality) -> Certificate,
+    ) -> Self {
+        let n = sample.n;
         let (du, dv) = (map.knots[0].domain(), map.knots[1].domain());
         let mut positions = Vec::with_capacity((n + 1) * (n + 1));
         for j in 0..=n {
@@ -211,11 +230,11 @@ impl MapView {
         let breaks = [inner(map.knots[0].breaks()), inner(map.knots[1].breaks())];
         let quality = Quality::of(&map, &sample);
         let folds = folded_elements(&map, &sample, quality.forced_corners());
-        let exact_certificate = Certificate::exact(&map, &quality);
+        let exact_certificate = exact(&map, &quality);
         let certificate = certificate.unwrap_or_else(|| exact_certificate.clone());
         Self {
             map,
-            sampler: sampler.name().to_string(),
+            sampler,
             sample,
             positions,
             bounds,
@@ -229,6 +248,7 @@ impl MapView {
             report: None,
             matches: Vec::new(),
             kinks: Vec::new(),
+            thb: None,
         }
     }
 
@@ -237,9 +257,13 @@ impl MapView {
         self.sample.n
     }
 
-    /// `det J` and `x` at a parameter point (core evaluation).
+    /// `det J` and `x` at a parameter point (core evaluation; of a THB map, on its
+    /// active cell).
     pub fn probe(&self, q: [f64; 2]) -> (Point, f64) {
-        let d = self.map.derivs(q[0], q[1], 1);
+        let d = match &self.thb {
+            Some(t) => t.map.derivs(q[0], q[1]),
+            None => self.map.derivs(q[0], q[1], 1),
+        };
         (d.x, d.det_j())
     }
 
@@ -267,7 +291,7 @@ pub struct Scene {
     pub name: String,
     /// File it came from.
     pub path: Option<PathBuf>,
-    /// What the file was ("boundary", "map", "multipatch", "ring", "ring map", "domain",
+    /// What the file was ("boundary", "map", "THB map", "multipatch", "ring", "ring map", "domain",
     /// "graph", "layout").
     pub kind: &'static str,
     /// The ring (O-grid, `eta` periodic) a solve fits: of a ring document, or the two
@@ -321,7 +345,7 @@ impl Scene {
     ) -> anyhow::Result<Self> {
         use anyhow::Context;
         // a map file may carry the solver's report
-        let report = report.filter(|_| matches!(doc, Document::Map { .. }));
+        let report = report.filter(|_| matches!(doc, Document::Map { .. } | Document::Thb { .. }));
         let stored = report.as_ref().and_then(Certificate::from_stored);
         let mut scene = Self::from_document(doc, sampler, settings, stored)
             .with_context(|| format!("opening {}", path.display()))?;
@@ -415,10 +439,20 @@ impl Scene {
                     .wrong_kind(None, "a planar document here (the viewer opens a volume file as three slices; the faces of a volume are solved by `winslow solve`)")
                     .into())
             }
-            doc @ Document::Thb { .. } => {
-                return Err(doc
-                    .wrong_kind(None, "a tensor map here (the viewer draws tensor maps: `winslow convert` turns a THB map into its exact tensor map)")
-                    .into())
+            Document::Thb { name, map } => {
+                let res = settings.resolution.unwrap_or_else(|| default_thb_resolution(&map));
+                let mv = MapView::thb(map, res, settings.density, certificate)?;
+                let sides = Document::Map { name: name.clone(), map: mv.map.clone() }.into_boundary()?;
+                Self {
+                    name,
+                    path: None,
+                    kind: "THB map",
+                    boundary: BoundaryView::new(sides),
+                    map: Some(mv),
+                    patches: Vec::new(),
+                    ring: None,
+                    layout: None,
+                }
             }
         })
     }
@@ -522,6 +556,18 @@ impl Scene {
         self.map = Some(mv);
     }
 
+    /// Put a THB solve's map into the scene (keeps the input boundary): its verdict from
+    /// the THB certificate, the report of the tensor solve it started from.
+    pub fn set_thb_solution(&mut self, solution: ThbSolution, settings: SceneSettings) -> anyhow::Result<()> {
+        let res = settings.resolution.unwrap_or_else(|| default_thb_resolution(&solution.map));
+        let cert = Certificate::from_thb_report(&solution.report);
+        let mut mv = MapView::thb(solution.map, res, settings.density, Some(cert))?;
+        mv.kinks = solution.report.solve.boundary.kinks.iter().map(|k| (k.point, k.kept)).collect();
+        mv.report = Some(solution.report.solve);
+        self.map = Some(mv);
+        Ok(())
+    }
+
     /// Put a map without a solver report into the scene (a method of a comparison): its
     /// verdict is the core's exact certificate; the input boundary stays.
     pub fn set_map(&mut self, map: Surface, sampler: &dyn DetJSampler, settings: SceneSettings) {
@@ -537,7 +583,19 @@ impl Scene {
             use crate::certificate::CertificateSource;
             let cert = matches!(mv.certificate.source, CertificateSource::Solver | CertificateSource::File)
                 .then_some(mv.certificate);
-            let mut new = MapView::new(mv.map, sampler, res, settings.density, cert);
+            let mut new = match mv.thb {
+                Some(t) => {
+                    let res = settings.resolution.unwrap_or_else(|| default_thb_resolution(&t.map));
+                    // drawn before, so it draws again; were it to fail, the tensor form's sample
+                    match MapView::thb(t.map.clone(), res, settings.density, cert.clone()) {
+                        Ok(v) => v,
+                        Err(_) => {
+                            MapView { thb: Some(t), ..MapView::new(mv.map, sampler, res, settings.density, cert) }
+                        }
+                    }
+                }
+                None => MapView::new(mv.map, sampler, res, settings.density, cert),
+            };
             new.report = report;
             new.matches = matches;
             new.kinks = kinks;

@@ -33,12 +33,20 @@ pub(crate) fn file_section(ui: &mut Ui, scene: &Scene) {
             let [p, q] = mv.map.degrees();
             let [nx, ny] = mv.map.shape();
             ui.label("map");
-            ui.label(format!(
-                "p = ({p}, {q}), {nx}x{ny} control points,\n{}x{} elements{}",
-                mv.map.knots[0].num_elements(),
-                mv.map.knots[1].num_elements(),
-                if mv.map.weights.is_some() { ", rational" } else { "" }
-            ));
+            match &mv.thb {
+                Some(t) => ui.label(format!(
+                    "THB, p = ({p}, {q}), {} functions,\n{} active cells of {} levels\n(tensor form {nx}x{ny})",
+                    t.map.basis.len(),
+                    t.cells.len(),
+                    t.levels()
+                )),
+                None => ui.label(format!(
+                    "p = ({p}, {q}), {nx}x{ny} control points,\n{}x{} elements{}",
+                    mv.map.knots[0].num_elements(),
+                    mv.map.knots[1].num_elements(),
+                    if mv.map.weights.is_some() { ", rational" } else { "" }
+                )),
+            };
             ui.end_row();
         }
     });

@@ -16,7 +16,8 @@ use winslow::methods::egg::CpuAssembler;
 use winslow::multipatch::layout::Layout;
 use winslow::multipatch::solve::{LayoutEvent, MultipatchSolution};
 use winslow::pipeline::compare::{compare, CompareEvent, CompareOptions, Comparison, MethodChoice};
-use winslow::pipeline::Solved;
+use winslow::pipeline::{Solved, ThbSolution};
+use winslow::solve::hierarchical::ThbRound;
 use winslow::solve::options::SolveOptions;
 use winslow::solve::report::InitialGuess;
 use winslow::solve::report::Solution;
@@ -44,10 +45,16 @@ pub enum Msg {
         /// Number of methods.
         count: usize,
     },
+    /// A round of the THB defect correction finished (its offending and marked cells,
+    /// functions, Newton iterations).
+    ThbRound(ThbRound),
     /// An event of a layout's solve (its bases, a round of patch solves, the free stage).
     Layout(LayoutEvent),
     /// The solve finished.
     Finished(Box<Solution>),
+    /// The solve finished with a THB map (`--refinement thb`, or `auto` on rounded
+    /// point-cloud corners: the THB defect correction of paper §8.2 ran).
+    FinishedThb(Box<ThbSolution>),
     /// The solve of a layout finished: every patch's map, certificate and the report.
     SolvedLayout(Box<MultipatchSolution>),
     /// The comparison finished.
@@ -75,6 +82,7 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
             }
             Stage::Solver(e) => send(Msg::Event((*e).clone())),
             Stage::Layout(e) => send(Msg::Layout((*e).clone())),
+            Stage::ThbRound(r) => send(Msg::ThbRound((*r).clone())),
             _ => {}
         }
         !cancelled()
@@ -82,12 +90,7 @@ pub fn run(input: Input, opts: &SolveOptions, cancel: &AtomicBool, send: &mut dy
     match out {
         Ok(Solved::Map(sol)) => send(Msg::Finished(sol)),
         Ok(Solved::Layout { solution, .. }) => send(Msg::SolvedLayout(solution)),
-        Ok(Solved::Thb(t)) => send(Msg::Failed(format!(
-            "{}: the THB map (verdict {}) is not drawn by the viewer, which draws tensor maps: write it with \
-             `winslow solve --refinement thb` and `winslow convert` turns it into its exact tensor map",
-            t.name,
-            t.report.verdict.name()
-        ))),
+        Ok(Solved::Thb(t)) => send(Msg::FinishedThb(t)),
         Ok(other) => send(Msg::Failed(format!(
             "the pipeline returned a result the viewer does not draw (verdict {})",
             other.verdict().name()
@@ -162,6 +165,8 @@ pub struct Progress {
     pub method: Option<(String, usize, usize)>,
     /// In a layout's solve: the last stage, in words.
     pub layout: Option<String>,
+    /// In a THB defect correction: the last round, in words.
+    pub thb: Option<String>,
 }
 
 impl Progress {
@@ -188,7 +193,18 @@ impl Progress {
                 self.level = None;
             }
             Msg::Layout(e) => self.layout = Some(layout_text(e)),
-            Msg::Finished(_) | Msg::SolvedLayout(_) | Msg::Compared(_) | Msg::Failed(_) | Msg::Cancelled => {}
+            Msg::ThbRound(r) => {
+                self.thb = Some(format!(
+                    "THB round {}: {} offending cells, {} marked; {} functions on {} levels, {} iterations",
+                    r.round, r.offending_cells, r.marked_cells, r.functions, r.levels, r.iterations
+                ))
+            }
+            Msg::Finished(_)
+            | Msg::FinishedThb(_)
+            | Msg::SolvedLayout(_)
+            | Msg::Compared(_)
+            | Msg::Failed(_)
+            | Msg::Cancelled => {}
         }
     }
 
@@ -206,7 +222,7 @@ impl Progress {
     }
 
     fn level_text(&self) -> String {
-        if let Some(l) = &self.layout {
+        if let Some(l) = self.layout.as_ref().or(self.thb.as_ref()) {
             return l.clone();
         }
         let Some((level, levels)) = self.level else {
@@ -280,6 +296,8 @@ pub struct SolveJob {
     comparison: Option<Comparison>,
     /// A finished layout solve, until taken ([`SolveJob::take_layout`]).
     layout: Option<MultipatchSolution>,
+    /// A finished THB solve, until taken ([`SolveJob::take_thb`]).
+    thb: Option<ThbSolution>,
 }
 
 impl SolveJob {
@@ -337,7 +355,17 @@ impl SolveJob {
             .ok();
         let state =
             if handle.is_some() { JobState::Running } else { JobState::Failed("could not start a thread".into()) };
-        Self { name, state, progress: Progress::default(), rx, cancel, handle, comparison: None, layout: None }
+        Self {
+            name,
+            state,
+            progress: Progress::default(),
+            rx,
+            cancel,
+            handle,
+            comparison: None,
+            layout: None,
+            thb: None,
+        }
     }
 
     /// The comparison, once, after a comparison job finished.
@@ -348,6 +376,11 @@ impl SolveJob {
     /// The layout's solution, once, after a layout job finished.
     pub fn take_layout(&mut self) -> Option<MultipatchSolution> {
         self.layout.take()
+    }
+
+    /// The THB map, once, after a solve that ended with one ([`Msg::FinishedThb`]).
+    pub fn take_thb(&mut self) -> Option<ThbSolution> {
+        self.thb.take()
     }
 
     /// Ask the thread to stop at the next event.
@@ -378,6 +411,10 @@ impl SolveJob {
             Msg::SolvedLayout(s) => {
                 self.state = JobState::Finished;
                 self.layout = Some(*s);
+            }
+            Msg::FinishedThb(s) => {
+                self.state = JobState::Finished;
+                self.thb = Some(*s);
             }
             Msg::Failed(e) => self.state = JobState::Failed(e),
             Msg::Cancelled => self.state = JobState::Cancelled,

@@ -9,7 +9,7 @@ use egui::Vec2;
 use winslow::boundary::{BasisChoice, KinkMode};
 use winslow::discrete::assembly::Operator;
 use winslow::pipeline::compare::{CompareOptions, Comparison, MethodChoice};
-use winslow::solve::options::SolveOptions;
+use winslow::solve::options::{Refinement, SolveOptions};
 use winslow::Point;
 
 use crate::colour::{ColourScale, ScaleKind};
@@ -67,6 +67,10 @@ pub struct SolveSettings {
     pub basis: BasisChoice,
     /// Kinks inside the sides kept exactly (paper §9): auto or none.
     pub kinks: KinkMode,
+    /// How a folded map is repaired (paper §8.2): tensor (bisected knot spans), thb
+    /// (refined THB cells around the folds: the solve ends with a THB map) or auto (THB
+    /// on rounded point-cloud corners), as `winslow solve --refinement`.
+    pub refinement: Refinement,
 }
 
 impl Default for SolveSettings {
@@ -79,6 +83,7 @@ impl Default for SolveSettings {
             fit_tol: d.fit.tol,
             basis: d.fit.basis,
             kinks: d.fit.kinks,
+            refinement: Refinement::Auto,
         }
     }
 }
@@ -93,6 +98,7 @@ impl SolveSettings {
         o.fit.tol = self.fit_tol;
         o.fit.basis = self.basis;
         o.fit.kinks = self.kinks;
+        o.repair.refinement = self.refinement;
         o
     }
 }
@@ -383,6 +389,10 @@ impl ViewerState {
             self.set_layout_solution(l);
             return true;
         }
+        if let Some(t) = job.take_thb() {
+            self.set_thb_solution(t);
+            return true;
+        }
         let Some(job) = self.job.as_mut() else { return false };
         let changed = solution.is_some() || before != (job.state.clone(), job.progress.history.len());
         match (&job.state, solution) {
@@ -411,6 +421,19 @@ impl ViewerState {
         }
     }
 
+    /// Put a THB solve's map into the scene.
+    fn set_thb_solution(&mut self, sol: winslow::ThbSolution) {
+        let name = sol.name.clone();
+        let message = sol.report.message.clone();
+        let Some(scene) = self.scene.as_mut() else { return };
+        self.status = Some(match scene.set_thb_solution(sol, self.settings) {
+            Ok(()) => format!("solved {name} (THB): {message}"),
+            Err(e) => format!("solved {name} (THB), but its map cannot be drawn: {e:#}"),
+        });
+        self.refit = true;
+        self.selected_fold = None;
+    }
+
     /// Block until a running solve ends and take its result (for `--screenshot`).
     pub fn wait_for_solve(&mut self) {
         if let Some(job) = self.job.as_mut() {
@@ -420,6 +443,9 @@ impl ViewerState {
             }
             if let Some(l) = self.job.as_mut().and_then(|j| j.take_layout()) {
                 self.set_layout_solution(l);
+            }
+            if let Some(t) = self.job.as_mut().and_then(|j| j.take_thb()) {
+                self.set_thb_solution(t);
             }
             if let Some(sol) = solution {
                 self.status = Some(format!("solved {}: {}", sol.name, sol.report.outcome.message));

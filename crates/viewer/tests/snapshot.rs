@@ -292,3 +292,55 @@ fn solved_domain_layout_snapshot() {
     h.run();
     h.snapshot("solved_domain_layout");
 }
+
+#[test]
+fn thb_map_snapshot() {
+    // puzzle4 solved in the viewer with THB refinement (paper §8.2 on THB cells): the det J
+    // heat map sampled on the active cells, the cells' borders in both views, the THB
+    // certificate's verdict in the side panel
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("gismo/puzzle4.json")).unwrap();
+    app.state.solve.refinement = winslow::solve::options::Refinement::Thb;
+    assert!(app.state.start_solve(|| {}));
+    app.state.wait_for_solve();
+    let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    let thb = mv.thb.as_ref().expect("a THB map");
+    assert!(thb.levels() > 1);
+    assert_eq!(thb.cells.len(), thb.map.basis.active_cells().len());
+    assert_eq!(mv.certificate.verdict, winslow::solve::report::Verdict::Certified, "{}", mv.certificate.message);
+    assert_eq!(mv.exact_certificate.verdict, winslow::solve::report::Verdict::Certified);
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("thb_map");
+}
+
+#[test]
+fn a_thb_file_opens_with_its_cells_and_det_j() {
+    // the bundled THB sector: the viewer's det J (its heat map's samples and the probe)
+    // is the library's evaluation of the THB map
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("thb/sector_thb.json")).unwrap();
+    let scene = app.state.scene.as_ref().unwrap();
+    assert_eq!(scene.kind, "THB map");
+    let Document::Thb { map, .. } = winslow::read(&data("thb/sector_thb.json")).unwrap() else { panic!("a THB map") };
+    let mv = scene.map.as_ref().unwrap();
+    let thb = mv.thb.as_ref().expect("drawn as a THB map");
+    assert_eq!(thb.cells.len(), map.basis.active_cells().len());
+    assert!(thb.levels() >= 2);
+    let n = mv.sample.n;
+    for (i, j) in [(0, 0), (1, n - 1), (n / 3, n / 2), (n - 2, 3), (n, n)] {
+        let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+        let exact = map.derivs(u, v).det_j();
+        let scale = exact.abs().max(1e-300);
+        assert!((mv.sample.values[j * (n + 1) + i] - exact).abs() <= 1e-12 * scale, "({u}, {v})");
+        assert!((mv.probe([u, v]).1 - exact).abs() <= 1e-12 * scale);
+    }
+    // the verdict is the THB certificate's
+    let c = winslow::verify::certificate::hierarchical::certify_hierarchical(&map, &Default::default()).unwrap();
+    assert_eq!(mv.exact_certificate.verdict, winslow::solve::report::Verdict::of_finding(&c.verdict));
+    // the settings change draws it again, still as a THB map
+    app.state.set_settings(winslow_viewer::scene::SceneSettings { resolution: Some(40), density: 8 });
+    let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    assert!(mv.thb.is_some());
+    assert_eq!(mv.sample.n, 40);
+}

@@ -151,8 +151,9 @@ pub fn render_thb(map: &HierarchicalMap, opts: &PictureOptions) -> Result<Image>
 }
 
 /// The images of the edges of every active cell of `map` (through `tensor`, the same
-/// map), as polylines of 9 points each; an edge shared by two cells of one level once.
-pub(crate) fn active_cell_borders(map: &HierarchicalMap, tensor: &Surface) -> Vec<Vec<Point>> {
+/// map), as polylines of 9 points each; an edge shared by two cells of one level once
+/// (the PNG's and the viewer's picture of the active cells).
+pub fn active_cell_borders(map: &HierarchicalMap, tensor: &Surface) -> Vec<Vec<Point>> {
     let mut edges = std::collections::BTreeSet::new();
     for (l, c) in map.basis.active_cells() {
         let [[a, b], [cc, d]] = map.basis.cell_bounds(l, c);

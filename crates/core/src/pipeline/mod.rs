@@ -92,6 +92,12 @@ pub enum Stage<'a> {
         /// Why.
         reason: &'a str,
     },
+    /// THB refinement left the map folded or undecided after its rounds: the input is
+    /// solved again with the tensor repair; the stages of that solve follow.
+    ThbFallback {
+        /// What the THB rounds ended with.
+        thb: &'a crate::solve::report::ThbFallback,
+    },
     /// A general domain or a plane graph was laid out automatically: the layout solved
     /// next and what the layout did.
     LaidOut(&'a AutoLayout),
@@ -207,10 +213,12 @@ impl Pipeline {
                     None => None,
                 };
                 let opts = self.opts.clone();
+                let tensor = self.with_tensor_repair();
                 let (mut sol, _) = self.run_keeping_hierarchy(observer)?;
                 sol.report.solve.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
                 if thb::repairs(&sol, &opts) {
-                    return thb::repair(sol, &opts, observer).map(|t| Solved::Thb(Box::new(t)));
+                    let t = thb::repair(sol, &opts, observer)?;
+                    return thb::or_tensor_repair(t, tensor, observer);
                 }
                 Ok(Solved::Map(Box::new(sol)))
             }
@@ -303,6 +311,21 @@ impl Pipeline {
         let assembler = self.assembler.clone();
         solve_multipatch(layout, &self.opts, assembler, &mut |e| observer(&Stage::Layout(e)))
             .map(|s| Solved::Layout { solution: Box::new(s), laid_out })
+    }
+
+    /// The same pipeline with the tensor repair ([`Refinement::Tensor`]): the fallback of
+    /// a THB defect correction that does not end certified ([`thb::or_tensor_repair`]).
+    fn with_tensor_repair(&self) -> Self {
+        let mut opts = self.opts.clone();
+        opts.repair.refinement = crate::solve::options::Refinement::Tensor;
+        Self {
+            input: self.input.clone(),
+            opts,
+            assembler: self.assembler.clone(),
+            method: self.method.clone(),
+            eta_refinement: self.eta_refinement,
+            warm: None,
+        }
     }
 
     /// [`Pipeline::run`] of a boundary or a ring, with the hierarchy the solution was

@@ -17,7 +17,7 @@ use crate::solve::hierarchical::improve::{improve_thb, ThbImprovement};
 use crate::solve::hierarchical::{accepted, repair_thb_observed, ThbRepairOptions, ThbRound};
 use crate::solve::improve::Improve;
 use crate::solve::options::{Refinement, SolveOptions};
-use crate::solve::report::{Report, Solution, Verdict};
+use crate::solve::report::{Report, Solution, ThbFallback, Verdict};
 use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::verify::certificate::hierarchical::HierarchicalCertificate;
 use crate::verify::poisson::{poisson_benchmark, PoissonReport};
@@ -66,6 +66,13 @@ pub struct ThbReport {
     /// benchmark ([`crate::verify::poisson`]) on the THB map's exact tensor form.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub poisson: Option<PoissonReport>,
+    /// When the rounds (a ring of `--halo` cells in the first, the offending cells only
+    /// in the later ones) left the map folded or undecided, so that they ran again from
+    /// the tensor map with a ring of 2 cells in every round: what the first
+    /// rounds ended with (`thb_rounds` are then the second rounds'; the map is theirs when
+    /// certified, the first rounds' otherwise). Absent when the first rounds sufficed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_attempt: Option<ThbFallback>,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
 }
@@ -81,6 +88,14 @@ impl ThbSolution {
     }
 }
 
+/// The ring (in cell widths of the offending cell's level) of every round of the second
+/// THB attempt, when the first one (ring `--halo` then 0) does not certify: on the hard
+/// corpus's puzzle-3 the first attempt's offending cells grow every round (64 to 456 in
+/// six rounds, BENCHMARKS.md "THB on the puzzle family"), a ring of 1 in every round
+/// leaves 14 after six rounds, a ring of 2 certifies in six with 20,702 functions (the
+/// tensor repair: 62,238).
+pub(crate) const RETRY_RING: usize = 2;
+
 /// Whether the pipeline repairs `sol` by THB refinement: [`Refinement::Thb`] (or
 /// [`Refinement::Auto`] on a boundary with rounded point-cloud corners, the report's
 /// `roundings`), repair rounds allowed, and the map folded or undecided.
@@ -88,6 +103,38 @@ pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
     opts.repair.refinement.resolved(!sol.report.boundary.roundings.is_empty()) == Refinement::Thb
         && opts.repair.rounds > 0
         && matches!(sol.report.outcome.verdict, Verdict::Folded | Verdict::Undecided)
+}
+
+/// The THB map `t` when its certificate accepts it; otherwise the tensor repair's map
+/// (`tensor`, the same input with [`Refinement::Tensor`], solved from the start: the
+/// tensor solve's repair state is gone), its report's `thb_fallback` saying what the THB
+/// rounds ended with, when that map is accepted ([`Report::success`]'s verdicts); the THB
+/// map again when neither is.
+pub(crate) fn or_tensor_repair(
+    t: ThbSolution,
+    tensor: super::Pipeline,
+    observer: &mut Observer<'_>,
+) -> Result<super::Solved> {
+    use super::Solved;
+    if matches!(t.report.verdict, Verdict::Certified | Verdict::DegenerateCorner) {
+        return Ok(Solved::Thb(Box::new(t)));
+    }
+    let note = ThbFallback {
+        verdict: t.report.verdict,
+        rounds: t.report.thb_rounds.len(),
+        functions: t.report.functions,
+        offending_cells: t.report.certificate.offending_cells().len(),
+        seconds: t.report.thb_seconds,
+    };
+    if !observer(&Stage::ThbFallback { thb: &note }) {
+        return Err(Error::Cancelled);
+    }
+    let (mut sol, _) = tensor.run_keeping_hierarchy(observer)?;
+    if !matches!(sol.report.outcome.verdict, Verdict::Certified | Verdict::DegenerateCorner) {
+        return Ok(Solved::Thb(Box::new(t)));
+    }
+    sol.report.solve.thb_fallback = Some(note);
+    Ok(Solved::Map(Box::new(sol)))
 }
 
 /// The options of the THB defect correction from those of the solve: its repair rounds
@@ -121,7 +168,25 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         ));
     }
     let start = HierarchicalMap::from_surface(&sol.map)?;
-    let out = repair_thb_observed(start, &thb_options(opts), &mut |round| observer(&Stage::ThbRound(round)))?;
+    let narrow = thb_options(opts);
+    let mut out = repair_thb_observed(start.clone(), &narrow, &mut |round| observer(&Stage::ThbRound(round)))?;
+    let mut first_attempt = None;
+    if !accepted(&out.certificate) && !out.rounds.is_empty() {
+        let seconds = t0.elapsed().as_secs_f64();
+        // the rounds again from the tensor map, a ring of `RETRY_RING` cells in every round
+        let wide = ThbRepairOptions { ring: RETRY_RING, later_ring: RETRY_RING, ..narrow };
+        let again = repair_thb_observed(start, &wide, &mut |round| observer(&Stage::ThbRound(round)))?;
+        first_attempt = Some(ThbFallback {
+            verdict: Verdict::of_finding(&out.certificate.verdict),
+            rounds: out.rounds.len(),
+            functions: out.map.basis.len(),
+            offending_cells: out.certificate.offending_cells().len(),
+            seconds,
+        });
+        if accepted(&again.certificate) {
+            out = again;
+        }
+    }
     let (map, c, improvement) = match opts.improve {
         Some(Improve::Winslow) if accepted(&out.certificate) => {
             let imp = improve_thb(&out.map, &out.certificate, opts.nonlinear, &opts.certify)?;
@@ -141,6 +206,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         thb_seconds: t0.elapsed().as_secs_f64(),
         improvement,
         poisson: if opts.report.poisson { poisson_benchmark(&map.to_surface()?, None).ok() } else { None },
+        first_attempt,
         solve: sol.report,
     };
     Ok(ThbSolution { name: sol.name, map, report })
@@ -220,5 +286,45 @@ mod tests {
         // stopped at the first round
         let out = Pipeline::new(b, opts).run(&mut |stage| !matches!(stage, Stage::ThbRound(_)));
         assert!(matches!(out, Err(Error::Cancelled)), "{:?}", out.map(|s| s.kind()));
+    }
+
+    /// A THB defect correction that ends folded (puzzle4's tensor map, no round) falls
+    /// back to the tensor repair, which certifies puzzle4 in its six rounds: the
+    /// tensor map comes back with the THB rounds' outcome in `thb_fallback`, after a
+    /// [`Stage::ThbFallback`]; a certified THB map is returned as it is.
+    #[test]
+    fn a_folded_thb_repair_falls_back_to_the_tensor_repair() {
+        let b = read_boundary(&data("gismo/puzzle4.json"), &ReadOptions::default()).unwrap();
+        let mut opts = SolveOptions::default();
+        opts.repair.refinement = Refinement::Thb;
+        let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
+        opts.repair.rounds = 0;
+        let t = repair(unrepaired, &opts, &mut |_| true).unwrap();
+        assert_eq!(t.report.verdict, Verdict::Folded, "{}", t.report.message);
+        assert!(t.report.thb_rounds.is_empty() && t.report.first_attempt.is_none());
+        let tensor_opts = SolveOptions::default();
+        assert_eq!(tensor_opts.repair.refinement, Refinement::Tensor);
+        let mut fell_back = 0;
+        let out = or_tensor_repair(t.clone(), Pipeline::new(b.clone(), tensor_opts), &mut |stage| {
+            if let Stage::ThbFallback { thb } = stage {
+                assert_eq!((thb.rounds, thb.verdict), (0, Verdict::Folded));
+                fell_back += 1;
+            }
+            true
+        })
+        .unwrap();
+        assert_eq!(fell_back, 1);
+        let Solved::Map(sol) = out else { panic!("the tensor map, got a {}", out.kind()) };
+        assert_eq!(sol.report.outcome.verdict, Verdict::Certified, "{}", sol.report.outcome.message);
+        assert!(sol.report.solve.repairs > 0);
+        let note = sol.report.solve.thb_fallback.as_ref().expect("the THB rounds' outcome");
+        assert_eq!((note.rounds, note.functions), (0, t.report.functions));
+        assert!(note.offending_cells > 0);
+        let v = serde_json::to_value(&sol.report).unwrap();
+        assert_eq!(v["thb_fallback"]["verdict"], "folded");
+        // the same tensor solve as without THB: the fallback is the tensor route's map
+        let Solved::Map(direct) = Pipeline::new(b, SolveOptions::default()).solve().unwrap() else { panic!() };
+        assert_eq!(direct.map.control_points, sol.map.control_points);
+        assert!(serde_json::to_value(&direct.report).unwrap().get("thb_fallback").is_none());
     }
 }

@@ -234,6 +234,28 @@ pub struct SolveStage {
     /// apply: `{"used": false, "reason": ...}`; absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warm_start: Option<WarmNote>,
+    /// When THB refinement was asked for and its rounds left the map folded or
+    /// undecided, so the tensor repair ran instead (`crate::pipeline`): what the THB
+    /// rounds ended with; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thb_fallback: Option<ThbFallback>,
+}
+
+/// What a THB defect correction that did not end certified (or degenerate at forced
+/// corners only) ended with: the `thb_fallback` field of a report (the tensor repair then
+/// took over) and the `first_attempt` of a THB report (`crate::pipeline::ThbReport`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThbFallback {
+    /// Verdict of the THB map after its rounds.
+    pub verdict: Verdict,
+    /// THB rounds run.
+    pub rounds: usize,
+    /// THB functions of that map.
+    pub functions: usize,
+    /// Folded and undecided active cells left.
+    pub offending_cells: usize,
+    /// Seconds of the THB stage.
+    pub seconds: f64,
 }
 
 /// The outcome of a solve: the certificate and the verdict drawn from it.
@@ -505,6 +527,7 @@ impl Solution {
                 improvement: ctx.improvement,
                 seconds: ctx.elapsed.as_secs_f64(),
                 warm_start: None,
+                thb_fallback: None,
             },
             outcome: Outcome { certificate, verdict, message },
             det_j: DetJReport {

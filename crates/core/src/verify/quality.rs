@@ -7,7 +7,9 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::error::Result;
 use crate::spline::basis::BasisDerivs;
+use crate::spline::hierarchical::map::HierarchicalMap;
 use crate::spline::quadrature::GaussLegendre;
 use crate::spline::surface::Surface;
 
@@ -114,6 +116,38 @@ pub fn sample_det_j(map: &Surface, n: usize) -> DetJSample {
         rows.collect::<Vec<_>>().into_par_iter().for_each_init(|| vec![[[0.0f64; 3]; 2]; nx], fill_row);
     }
     DetJSample::from_values(n, values)
+}
+
+/// Sample `det J` of a THB map on the grid of [`sample_det_j`] (`t_i = i / n` across the
+/// level-0 domain), active cell by active cell: every grid point is evaluated on the
+/// Bézier patch of an active cell holding it (`HierarchicalMap::bezier_patches`: the
+/// polynomial the THB certificate bounds, paper eq. 43 per cell); a point on a border
+/// of cells by the first of them in `active_cells` order. Cells run in parallel.
+pub fn sample_det_j_hierarchical(map: &HierarchicalMap, n: usize) -> Result<DetJSample> {
+    let n = n.max(1);
+    let k0 = map.basis.knots(0);
+    let (du, dv) = (k0[0].domain(), k0[1].domain());
+    let us: Vec<f64> = grid_abscissae(n).map(|t| du.0 + (du.1 - du.0) * t).collect();
+    let vs: Vec<f64> = grid_abscissae(n).map(|t| dv.0 + (dv.1 - dv.0) * t).collect();
+    // the grid indices in a closed interval [a, b]
+    let within = |ts: &[f64], (a, b): (f64, f64)| ts.partition_point(|&t| t < a)..ts.partition_point(|&t| t <= b);
+    let patches = map.bezier_patches()?;
+    let per_cell: Vec<Vec<(usize, f64)>> = patches
+        .par_iter()
+        .map(|(_, _, patch)| {
+            let (ri, rj) = (within(&us, patch.knots[0].domain()), within(&vs, patch.knots[1].domain()));
+            rj.flat_map(|j| ri.clone().map(move |i| (j, i)))
+                .map(|(j, i)| (j * (n + 1) + i, patch.derivs(us[i], vs[j], 1).det_j()))
+                .collect()
+        })
+        .collect();
+    let mut values = vec![f64::NAN; (n + 1) * (n + 1)];
+    for (k, d) in per_cell.into_iter().flatten() {
+        if values[k].is_nan() {
+            values[k] = d;
+        }
+    }
+    Ok(DetJSample::from_values(n, values))
 }
 
 /// Integrals of the map by Gauss quadrature on every element.

@@ -103,6 +103,17 @@ impl ViewerApp {
                 ui.selectable_value(&mut s.kinks, KinkMode::Auto, "auto");
                 ui.selectable_value(&mut s.kinks, KinkMode::None, "none");
             });
+            ui.horizontal(|ui| {
+                ui.label("refinement").on_hover_text(
+                    "how a folded map is repaired (paper §8.2): tensor bisects whole knot spans; thb refines \
+                     THB cells around the folds only and ends with a THB map (active cells drawn); auto: thb \
+                     on rounded point-cloud corners, tensor elsewhere",
+                );
+                for (r, name) in [(Refinement::Auto, "auto"), (Refinement::Tensor, "tensor"), (Refinement::Thb, "thb")]
+                {
+                    ui.selectable_value(&mut s.refinement, r, name);
+                }
+            });
             ui.add(egui::Slider::new(&mut s.min_elements, 1..=64).text("min elements"));
             ui.add(egui::Slider::new(&mut s.refine, 0..=4).text("extra refinements"));
             ui.add(egui::Slider::new(&mut s.fit_tol, 1e-7..=1e-2).logarithmic(true).text("fit tolerance"));

@@ -172,7 +172,7 @@ impl HierarchicalBasis {
     }
 
     /// Parameter bounds `[[ξ_0, ξ_1], [η_0, η_1]]` of cell `c` of level `l`.
-    pub(crate) fn cell_bounds(&self, l: usize, c: Index2) -> [[f64; 2]; 2] {
+    pub fn cell_bounds(&self, l: usize, c: Index2) -> [[f64; 2]; 2] {
         std::array::from_fn(|d| {
             let (_, a, b) = self.levels[l].elements[d][c[d]];
             [a, b]

@@ -162,3 +162,45 @@ fn side_distance_is_the_closed_form_distance_to_a_circle() {
         assert!((distance(p) - exact).abs() <= 4e-15 * r, "{p:?}: {} vs {exact}", distance(p));
     }
 }
+
+/// The THB sample, cell by cell on the Bézier patches, is the map's own `det J` at every
+/// grid point and the sample of its exact tensor form, on a genuine three-level THB map
+/// (coefficients only the hierarchical space has).
+#[test]
+fn thb_sample_is_the_maps_det_j() {
+    use crate::spline::hierarchical::map::HierarchicalMap;
+    // a near-identity map with small wiggles on every active function
+    let mut seed = 7u64;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let tensor0 = HierarchicalMap::from_surface(&identity(4)).unwrap();
+    let map0 = tensor0.refined(&[(0, [1, 1]), (0, [2, 1]), (0, [1, 2])], 2).unwrap();
+    let map0 = map0.refined(&[(1, [3, 3]), (1, [2, 3])], 2).unwrap();
+    assert_eq!(map0.basis.num_levels(), 3);
+    let cps = map0.control_points.iter().map(|p| [p[0] + 0.02 * rnd(), p[1] + 0.02 * rnd()]).collect();
+    let map = HierarchicalMap::new(map0.basis.clone(), cps).unwrap();
+    let n = 37;
+    let s = sample_det_j_hierarchical(&map, n).unwrap();
+    let tensor = sample_det_j(&map.to_surface().unwrap(), n);
+    for j in 0..=n {
+        for i in 0..=n {
+            let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+            let d = map.derivs(u, v);
+            let exact = d.xu[0] * d.xv[1] - d.xv[0] * d.xu[1];
+            let got = s.values[j * (n + 1) + i];
+            assert!((got - exact).abs() < 1e-11, "({u}, {v}): {got} vs {exact}");
+            assert!((got - tensor.values[j * (n + 1) + i]).abs() < 1e-11);
+        }
+    }
+    assert!((s.min - tensor.min).abs() < 1e-11 && (s.max - tensor.max).abs() < 1e-11);
+}
+
+/// The identity of the unit square as a quadratic map with `e` elements per direction.
+fn identity(e: usize) -> Surface {
+    let k = KnotVector::open_uniform(2, e);
+    let g = k.greville();
+    let cps = g.iter().flat_map(|&v| g.iter().map(move |&u| [u, v])).collect();
+    Surface::new([k.clone(), k], cps, None).unwrap()
+}
