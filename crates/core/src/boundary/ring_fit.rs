@@ -19,7 +19,7 @@
 //! **Rounded corners of a cloud** (roundings by the rule of `boundary::kinks`, no kinks):
 //! near them the chords are sampled too and elements are bisected below `p + 1` samples,
 //! so that the fit follows a fillet resolved by a few points to its tolerance
-//! ([`roundings`]).
+//! (`ring_fit/roundings.rs`).
 //!
 //! **Normalisation.** Like a four-sided boundary
 //! (`boundary::normalise::Similarity`), a ring far from the origin or of extreme
