@@ -299,6 +299,18 @@ pub(crate) fn detect(boundary: &Boundary, mode: KinkMode, input_basis: bool) -> 
     }
 }
 
+/// The rounded corners of a closed point cloud (a ring's contour, opened at its first
+/// point as the ring's report does): the corners turning at least
+/// [`CLOUD_CORNER_DEGREES`] that [`rounding_of`] finds resolved, as
+/// `(vertex index, radius R, points m)`.
+pub(crate) fn closed_cloud_roundings(points: &[Point]) -> Vec<(usize, f64, usize)> {
+    let mut open = points.to_vec();
+    open.extend(points.first().copied());
+    let turnings = CornerTurnings::of(&open, CLOUD_CORNER_DEGREES);
+    let corners = turnings.corners(CLOUD_CORNER_DEGREES);
+    corners.into_iter().filter_map(|(j, _)| rounding_of(&open, j, turnings.w).map(|(r, _, m)| (j, r, m))).collect()
+}
+
 /// [`detect`] with a point cloud's rounded corners taken out as roundings
 /// ([`Candidates::with_roundings`]): the kinks and the roundings, as the hierarchy of a
 /// four-sided boundary reports them (a ring's report uses it too).

@@ -16,10 +16,17 @@
 //! four-sided point fits (`REGULARIZATION`, `λ Σ_e h_e^3 ∫_e |f''|^2`). The loop ends
 //! when no element is marked or the next level would pass the element cap.
 //!
+//! **Rounded corners of a cloud** (roundings by the rule of `boundary::kinks`, no kinks):
+//! near them the chords are sampled too and elements are bisected below `p + 1` samples,
+//! so that the fit follows a fillet resolved by a few points to its tolerance
+//! (`ring_fit/roundings.rs`).
+//!
 //! **Normalisation.** Like a four-sided boundary
 //! (`boundary::normalise::Similarity`), a ring far from the origin or of extreme
 //! size is fitted and solved in the coordinates `(x - c) / s` of its outer contour's
 //! bounding box and mapped back; [`RingFit`] lives in those coordinates.
+mod roundings;
+
 use super::fit::{FitOptions, SideFit, REGULARIZATION};
 use super::hierarchy::{BasisReport, Hierarchy, Level};
 use super::normalise::Similarity;
@@ -35,6 +42,7 @@ use crate::spline::curve::{Curve, Point};
 use crate::spline::knots::KnotVector;
 use crate::spline::quadrature::GaussLegendre;
 use crate::spline::surface::Side;
+use roundings::{along_roundings, rounded_elements};
 
 /// Arc-length fraction of the first crossing of the ray `o + t dir`, `t > 0`, with the
 /// closed polygon whose vertices have fractions `s` (`None` when it misses).
@@ -335,6 +343,11 @@ pub fn fit_ring_with(
     if let Some(m) = matched {
         outer = m;
     }
+    // rounded corners of a cloud: the chords there sampled too, refined below p + 1
+    // samples per element
+    let (inner, near_i) = along_roundings(&inner_c, inner);
+    let (outer, near_o) = along_roundings(&outer_c, outer);
+    let near = [near_i, near_o];
     let tol_abs = tol * diameter;
     let mut levels = Vec::new();
     let mut kv = KnotVector::periodic_uniform(degree, 4.max(degree + 1).next_power_of_two());
@@ -354,13 +367,18 @@ pub fn fit_ring_with(
         // samples of both contours
         let halves = kv.halved();
         let (ni, no) = (samples_per_element(&halves, &inner), samples_per_element(&halves, &outer));
+        let rounded = [rounded_elements(&kv, &inner, &near[0]), rounded_elements(&kv, &outer, &near[1])];
         let uniform = refinement == EtaRefinement::Uniform;
         let marked: Vec<usize> = (0..per_i.len())
             .filter(|&e| uniform || per_i[e].max(per_o[e]) > tol_abs)
             .filter(|&e| {
-                // a contour that misses the tolerance here needs samples in both halves
-                let enough = |per: &[f64], n: &[usize]| per[e] <= tol_abs || (2 * e..2 * e + 2).all(|h| n[h] > degree);
-                enough(&per_i, &ni) && enough(&per_o, &no)
+                // a contour that misses the tolerance here needs samples in both halves,
+                // or one sample in each near a rounded corner
+                let enough = |per: &[f64], n: &[usize], rounded: &[bool]| {
+                    let least = if rounded[e] { 0 } else { degree };
+                    per[e] <= tol_abs || (2 * e..2 * e + 2).all(|h| n[h] > least)
+                };
+                enough(&per_i, &ni, &rounded[0]) && enough(&per_o, &no, &rounded[1])
             })
             .collect();
         if marked.is_empty()
@@ -459,7 +477,7 @@ mod tests {
 
     /// A square of side 4 (its corners rounded at radius `r`), as a counter-clockwise
     /// point cloud with spacing about `h`, starting in the middle of its bottom side.
-    fn rounded_square(r: f64, h: f64) -> Vec<Point> {
+    pub(super) fn rounded_square(r: f64, h: f64) -> Vec<Point> {
         let q = std::f64::consts::FRAC_PI_2;
         let a = 2.0 - r;
         let mut pts = Vec::new();
