@@ -583,7 +583,7 @@ fn a_flat_corner_is_cut_far_from_0_and_180_degrees() {
 #[test]
 fn without_the_search_a_flat_corner_is_cut_straight() {
     let g = crate::domain::families::wiggly(17);
-    let auto = super::template::graph_layout_searching(&g, &LayoutOptions::default(), &[f64::NEG_INFINITY]).unwrap();
+    let auto = super::layout::graph_layout_searching(&g, &LayoutOptions::default(), &[f64::NEG_INFINITY]).unwrap();
     validate_layout(&auto.layout).unwrap();
     let r = &auto.report;
     assert!(r.cuts.iter().all(|c| !c.curved && !c.spread), "{:#?}", r.cuts);
