@@ -17,7 +17,8 @@
 //! | `holes` | cuts from every hole to the outer boundary or another hole |
 //! | `reflex` | cuts from reflex corners into the face |
 //! | `outline` | the outer boundary and holes of a multipatch layout as a domain (the input of a comparison with the hand-made layout) |
-//! | [`template`] | the quadrangulation of every face by its template and the assembly of the multipatch layout |
+//! | [`template`] | the quadrangulation of every face by its template (the midpoint template, a face split in two), placed by the harmonic map or the map onto the polygon |
+//! | [`layout`] | the automatic layout as a whole: the sides into a graph of faces, the cuts, the tries (searches of the cuts' ends, directions of the hole cuts, the maps onto the polygons), its report and the multipatch layout |
 //!
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
 
@@ -27,6 +28,7 @@ pub(crate) mod families;
 pub(crate) mod graph;
 pub(crate) mod harmonic;
 pub(crate) mod holes;
+pub mod layout;
 pub(crate) mod outline;
 pub(crate) mod plane;
 pub(crate) mod polygon_map;
@@ -39,10 +41,10 @@ use crate::error::Error;
 use crate::spline::curve::Point;
 
 pub use holes::HoleCut;
+pub use layout::{auto_layout, graph_layout, AutoLayout, LayoutOptions, LayoutReport};
 pub use outline::outline;
 pub use plane::{GraphFace, GraphReport, PlaneEdge, PlaneGraph, PlaneLabel};
 pub use reflex::CutReport;
-pub use template::{auto_layout, graph_layout, AutoLayout, LayoutOptions, LayoutReport};
 pub use validate::{validate_domain, DomainReport};
 
 /// A closed loop: a chain of sides, each starting where the previous one ends (the last

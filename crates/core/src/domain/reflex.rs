@@ -8,7 +8,10 @@
 //! side at a grazing angle), straight cuts to points spread along the sides that do not
 //! meet the corner are candidates too, scored alike. A cut never ends inside an edge that another face shares (that face
 //! would get a 180° corner there). The worst reflex corner is cut first, until none is
-//! left.
+//! left. A ray from a reflex corner may meet one of the corner's own (curved) sides:
+//! that cut would leave a face of two corners, so the part of the side between its end
+//! and the corner gets a flat corner at its arc-length midpoint, cut in turn; a flat
+//! corner's cut never ends on its own sides.
 
 use serde::Serialize;
 
@@ -47,6 +50,19 @@ pub struct CutReport {
     /// the bisector and the side extensions end at a sliver (written only when true).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub spread: bool,
+    /// The cut ends on a side at the reflex corner (its extension or bisector meets it
+    /// again), which would leave a face of two corners: the part of that side between
+    /// the cut's end and the corner got a corner at its arc-length midpoint (flat, so it
+    /// is cut in turn); written only when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub corner_added: Option<Point>,
+}
+
+/// Whether side `k` of a face of `n` corners meets its corner `i` (a cut from the corner
+/// to that side would leave a face of two corners). Faces of one or two corners have no
+/// such rule.
+fn at_corner(n: usize, i: usize, k: usize) -> bool {
+    n > 2 && (k == i || (k + 1) % n == i)
 }
 
 /// The straight segment from `a` to `b` (degree 1).
@@ -70,8 +86,31 @@ pub(super) fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) 
     segment_inside_polyline(&face_polyline(g, f), a, b, tol)
 }
 
-/// [`segment_inside`] on the face's sampled boundary `poly` ([`face_polyline`]).
+/// `poly` with the points `ends` on it made vertices: each that is not already one goes
+/// into the chord nearest to it. A cut's end on a curved side lies on the curve, not on
+/// its chords: where the side bulges out of the face, the chord passes inside the curve
+/// (by its sagitta, `h² / 8R` for a chord of length `h` on a circle of radius `R`), so
+/// the cut would cross it next to its end and count as leaving the face.
+fn with_ends(poly: &[(Point, usize)], ends: [Point; 2]) -> Vec<(Point, usize)> {
+    let mut out = poly.to_vec();
+    for q in ends {
+        let n = out.len();
+        if n < 2 || out.iter().any(|x| x.0 == q) {
+            continue;
+        }
+        let nearest = (0..n)
+            .map(|i| (segment_distance(out[i].0, out[(i + 1) % n].0, q, q).0, i))
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .map_or(0, |x| x.1);
+        out.insert(nearest + 1, (q, out[nearest].1));
+    }
+    out
+}
+
+/// [`segment_inside`] on the face's sampled boundary `poly` ([`face_polyline`]), its
+/// ends made vertices of it ([`with_ends`]).
 fn segment_inside_polyline(poly: &[(Point, usize)], a: Point, b: Point, tol: f64) -> bool {
+    let poly = with_ends(poly, [a, b]);
     let n = poly.len();
     // the segment without its ends, which lie on the boundary
     let e = 1e-6;
@@ -421,6 +460,11 @@ pub(crate) fn cut_reflex(
             let (c, s) = (theta.cos(), theta.sin());
             let dir = [c * t_out[0] - s * t_out[1], s * t_out[0] + c * t_out[1]];
             let Some((k, u, _)) = ray_hit(g, f, o, dir, 1e3 * tol) else { continue };
+            // a cut to a side at the corner leaves a face of two corners: taken only from a
+            // reflex corner, whose side part is then given a corner (see below)
+            if !reflex && at_corner(n, i, k) {
+                continue;
+            }
             let (e, fwd) = g.faces[f].sides[k];
             // the hit point on the side, and the two corners of that side
             let mut targets: Vec<Target> = Vec::new();
@@ -467,9 +511,23 @@ pub(crate) fn cut_reflex(
         else {
             return Err(reflex_error());
         };
+        let mut corner_added = None;
         let j_vertex = match (best.corner, best.on_side) {
             (Some(j), _) => corners[j],
-            (None, Some((k, u))) => g.split_edge(g.faces[f].sides[k].0, u)?.0,
+            (None, Some((k, u))) => {
+                let e = g.faces[f].sides[k].0;
+                let (v, e2) = g.split_edge(e, u)?;
+                if at_corner(n, i, k) {
+                    // the part of the side between the cut's end and the corner would
+                    // be a face of two corners: it gets a third, flat one at its
+                    // arc-length midpoint, which is cut in turn
+                    let part = if g.edges[e].a == o_vertex { e } else { e2 };
+                    let m = ArcLength::new(&g.edges[part].curve).param(0.5);
+                    let (mid, _) = g.split_edge(part, m)?;
+                    corner_added = Some(g.vertices[mid]);
+                }
+                v
+            }
             (None, None) => return Err(reflex_error()),
         };
         let now = g.corners(f);
@@ -500,6 +558,7 @@ pub(crate) fn cut_reflex(
             new_angles: best.angles.map(f64::to_degrees),
             curved,
             spread,
+            corner_added,
         });
     }
     Err(Error::Domain { at: "layout".into(), reason: "more than 10000 cuts from reflex corners".into() })

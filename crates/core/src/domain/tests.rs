@@ -573,24 +573,63 @@ fn a_flat_corner_is_cut_far_from_0_and_180_degrees() {
     certified(&auto, &g.name);
 }
 
-/// The curved cut, reached on `wiggly-17` when the cuts' ends are never searched along
-/// the sides (a search below `-inf`; `0` still searches where no straight cut along the
-/// bisector stays inside): its flat corner has no straight cut inside its face, so it is cut along the
-/// preimage of a segment of the face's map onto the regular polygon; the 180° corner is
-/// split into two positive angles, the layout is valid and every patch certified.
+/// `wiggly-17` when the cuts' ends are never searched along the sides (a search below
+/// `-inf`): its flat corner used to have no straight cut inside its face (the test ran on
+/// the chords of a side that bulges out of the face, which pass inside the curve) and took
+/// a curved one; with the cut's ends made vertices of the sampled boundary, every cut is
+/// straight along a bisector or a side extension, the 180° corner is split into two
+/// positive angles, the layout is valid and every patch certified. (The curved cut is
+/// reached on TUDflame's outline: `a_cut_meeting_its_own_side_gives_that_side_a_corner`.)
 #[test]
-fn without_the_search_a_flat_corner_gets_a_curved_cut() {
+fn without_the_search_a_flat_corner_is_cut_straight() {
     let g = crate::domain::families::wiggly(17);
-    let auto = super::template::graph_layout_searching(&g, &LayoutOptions::default(), &[f64::NEG_INFINITY]).unwrap();
+    let auto = super::layout::graph_layout_searching(&g, &LayoutOptions::default(), &[f64::NEG_INFINITY]).unwrap();
     validate_layout(&auto.layout).unwrap();
     let r = &auto.report;
-    let curved: Vec<&CutReport> = r.cuts.iter().filter(|c| c.curved).collect();
-    assert!(!curved.is_empty(), "{:#?}", r.cuts);
-    for c in &curved {
-        assert!((c.angle - 180.0).abs() < 1.0, "{c:?}");
+    assert!(r.cuts.iter().all(|c| !c.curved && !c.spread), "{:#?}", r.cuts);
+    let flat: Vec<&CutReport> = r.cuts.iter().filter(|c| (c.angle - 180.0).abs() < 1.0).collect();
+    assert!(!flat.is_empty(), "{:#?}", r.cuts);
+    for c in &flat {
         let [a1, a2, ..] = c.new_angles;
         assert!(a1 > 0.0 && a2 > 0.0 && (a1 + a2 - c.angle).abs() < 1e-6, "{c:?}");
     }
-    assert!(r.cuts.iter().all(|c| !c.spread), "{:#?}", r.cuts);
     certified(&auto, &g.name);
+}
+
+/// TUDflame given only its outer boundary (`winslow convert --outline`: tangent joints
+/// merged, five corners): the 253-degree corner's bisector and the extension of its
+/// outgoing side meet its own incoming side again (the flame's left arm), which would
+/// leave a face of two corners. The cut is taken and that side's part gets a flat
+/// corner at its arc-length midpoint, cut in turn; before, the corner was cut to the
+/// lower side of the top arm at 11.5 degrees and one patch of the arm folded. Every
+/// patch is certified now.
+#[test]
+fn a_cut_meeting_its_own_side_gives_that_side_a_corner() {
+    let layout = match crate::io::read(&crate::testutil::data("gismo/xml/multipatch/TUDflame.xml")).unwrap() {
+        crate::io::Document::Layout(l) => l,
+        other => panic!("TUDflame is a {}", other.kind()),
+    };
+    let d = outline(&layout, 5.0).unwrap();
+    assert_eq!(d.outer.sides.len(), 5);
+    let auto = auto_layout(&d, &LayoutOptions::default()).unwrap();
+    validate_layout(&auto.layout).unwrap();
+    let r = &auto.report;
+    let added: Vec<&CutReport> = r.cuts.iter().filter(|c| c.corner_added.is_some()).collect();
+    assert_eq!(added.len(), 1, "{:#?}", r.cuts);
+    let c = added[0];
+    assert!(c.angle > 250.0, "{c:?}");
+    // the new corner is flat, so it is cut in turn, from where it was put: no straight
+    // cut from it stays inside the arm, so the cut is curved (the preimage of a segment
+    // of the face's map onto the polygon), splitting the 180 degrees into two positive
+    // angles
+    let corner = c.corner_added.unwrap();
+    let from: Vec<&CutReport> = r.cuts.iter().filter(|x| x.from == corner).collect();
+    assert_eq!(from.len(), 1, "{:#?}", r.cuts);
+    let [a1, a2, ..] = from[0].new_angles;
+    assert!((from[0].angle - 180.0).abs() < 1e-6 && from[0].curved, "{:?}", from[0]);
+    assert!(a1 > 0.0 && a2 > 0.0 && (a1 + a2 - 180.0).abs() < 1e-6, "{:?}", from[0]);
+    // no new angle of the reflex corner's cut near 0 (its flat part is cut next)
+    assert!(c.new_angles.iter().all(|&a| a > 70.0), "{c:?}");
+    assert!(r.corner_angles[0] > 15.0, "{:?}", r.corner_angles);
+    certified(&auto, &d.name);
 }
