@@ -331,7 +331,7 @@ fn lay_out_with(
     let mut cuts = Vec::new();
     cut_reflex(&mut g, diameter, &opts.fit, search, &mut cuts)?;
     // 3. templates
-    let faces = apply_templates(&mut g, opts, diameter, inverse)?;
+    let faces = apply_templates(&mut g, &opts.fit, opts.rings, diameter, inverse)?;
     // 4. the layout
     let layout = layout_of(&g, name)?;
     let valence = g.valences();

@@ -21,7 +21,6 @@ use serde::Serialize;
 use super::cycles::{polyline, signed_area};
 use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
-use super::layout::LayoutOptions;
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
 use super::reflex::{fit_points, line, segment_inside};
 use crate::boundary::fit::FitOptions;
@@ -179,9 +178,12 @@ const SPOKE_SAMPLES: usize = 64;
 /// interior vertex and cuts placed by the harmonic map of the regular polygon onto the
 /// face, or with `inverse` by the inverse of the face's map onto the polygon
 /// ([`PolygonMap`]). Returns the report of every face.
+/// `fit` fits the cuts, `rings` are the rings of each face's discrete harmonic map (the
+/// layout options' `fit` and `rings`).
 pub(super) fn apply_templates(
     g: &mut Graph,
-    opts: &LayoutOptions,
+    fit: &FitOptions,
+    rings: usize,
     diameter: f64,
     inverse: bool,
 ) -> Result<Vec<FaceReport>> {
@@ -212,10 +214,10 @@ pub(super) fn apply_templates(
         };
         let curves: Vec<Curve> =
             if template == Template::One { Vec::new() } else { sides.iter().map(|&s| g.side_curve(s)).collect() };
-        let h = (template != Template::One).then(|| HarmonicMap::new(&curves, opts.rings));
+        let h = (template != Template::One).then(|| HarmonicMap::new(&curves, rings));
         // a face the map cannot be built on keeps the harmonic map's cuts
         let pm = (inverse && template != Template::One)
-            .then(|| PolygonMap::new(&curves, opts.rings, POLYGON_MAP_LEVELS).ok())
+            .then(|| PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok())
             .flatten();
         plans.push((template, k, h, pm));
     }
@@ -259,14 +261,14 @@ pub(super) fn apply_templates(
                 });
                 let c = if let Some(pts) = through {
                     report.inverse = true;
-                    spoke_curve(pts, p0, p2, diameter, scales[f], &opts.fit)?
+                    spoke_curve(pts, p0, p2, diameter, scales[f], fit)?
                 } else if h.min_area_ratio <= 0.0 && segment_inside(g, f, p0, p2, 1e-9 * diameter) {
                     report.straight = true;
                     line(p0, p2)
                 } else {
                     let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
                     pts.extend(h.spoke(r + 2).into_iter().skip(1));
-                    spoke_curve(pts, p0, p2, diameter, scales[f], &opts.fit)?
+                    spoke_curve(pts, p0, p2, diameter, scales[f], fit)?
                 };
                 let cut = g.add_edge(c, m0, m2, false);
                 g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
@@ -294,18 +296,11 @@ pub(super) fn apply_templates(
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
                     let c = if let Some((_, spokes)) = &inv {
-                        spoke_curve(
-                            spokes[s].clone(),
-                            g.vertices[centre],
-                            g.vertices[m],
-                            diameter,
-                            scales[f],
-                            &opts.fit,
-                        )?
+                        spoke_curve(spokes[s].clone(), g.vertices[centre], g.vertices[m], diameter, scales[f], fit)?
                     } else if star.is_some() {
                         line(g.vertices[centre], g.vertices[m])
                     } else {
-                        spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], &opts.fit)?
+                        spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], fit)?
                     };
                     spokes.push(g.add_edge(c, centre, m, false));
                     parts.push((a, b));
