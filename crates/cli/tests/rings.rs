@@ -61,33 +61,6 @@ fn solve_ring_matches_a_narrow_gap() {
     assert!(sj[0] > 10.0 * sj[1], "min scaled J matched {} vs arc length {}", sj[0], sj[1]);
 }
 
-/// A square of side 4 centred at the origin, its corners rounded at radius `r`, as a
-/// counter-clockwise closed point cloud with spacing about `h` (starting in the middle
-/// of its bottom side; `ceil(pi r / 2h)` points on each quarter circle).
-fn rounded_square(r: f64, h: f64) -> Vec<[f64; 2]> {
-    let q = std::f64::consts::FRAC_PI_2;
-    let a = 2.0 - r;
-    let mut pts = Vec::new();
-    let segment = |pts: &mut Vec<[f64; 2]>, from: [f64; 2], to: [f64; 2]| {
-        let n = ((to[0] - from[0]).hypot(to[1] - from[1]) / h).ceil().max(1.0) as usize;
-        pts.extend((0..n).map(|i| {
-            let t = i as f64 / n as f64;
-            [from[0] + t * (to[0] - from[0]), from[1] + t * (to[1] - from[1])]
-        }));
-    };
-    let mut at = [0.0, -2.0];
-    for (k, c) in [[a, -a], [a, a], [-a, a], [-a, -a]].into_iter().enumerate() {
-        let start = -q + k as f64 * q;
-        let on = |phi: f64| [c[0] + r * phi.cos(), c[1] + r * phi.sin()];
-        segment(&mut pts, at, on(start));
-        let m = (q * r / h).ceil() as usize;
-        pts.extend((0..m).map(|i| on(start + q * i as f64 / m as f64)));
-        at = on(start + q);
-    }
-    segment(&mut pts, at, [0.0, -2.0]);
-    pts
-}
-
 /// A ring whose outer contour is a point cloud of a square with tight fillets (radius
 /// 0.05 and 0.02 at spacing 0.02: four and two points per quarter circle) around a
 /// circle: the fillets are roundings, not kinks, the ring fit follows them to its
@@ -97,7 +70,7 @@ fn rounded_square(r: f64, h: f64) -> Vec<[f64; 2]> {
 fn a_ring_with_tight_fillets_certifies_within_the_fit_tolerance() {
     let scratch = tempfile::tempdir().unwrap();
     for (r, per_fillet) in [(0.05, 4), (0.02, 2)] {
-        let outer = rounded_square(r, 0.02);
+        let outer = winslow::testutil::rounded_square(r, 0.02);
         let inner: Vec<[f64; 2]> = (0..256)
             .map(|k| {
                 let t = std::f64::consts::TAU * k as f64 / 256.0 + 0.3;

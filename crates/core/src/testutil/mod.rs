@@ -58,5 +58,35 @@ impl Lcg {
     }
 }
 
+/// A square of side 4 centred at the origin, its corners rounded at radius `r` (sharp for
+/// `r = 0`), as a counter-clockwise closed point cloud with spacing about `h`, starting in
+/// the middle of its bottom side (`ceil(pi r / 2h)` points on each quarter circle): the
+/// contour of the ring tests of rounded corners (`boundary::ring_fit`, the CLI's rings).
+pub fn rounded_square(r: f64, h: f64) -> Vec<[f64; 2]> {
+    let q = std::f64::consts::FRAC_PI_2;
+    let a = 2.0 - r;
+    let mut pts = Vec::new();
+    // a straight part from `from` up to `to` (excluded)
+    let segment = |pts: &mut Vec<[f64; 2]>, from: [f64; 2], to: [f64; 2]| {
+        let n = ((to[0] - from[0]).hypot(to[1] - from[1]) / h).ceil().max(1.0) as usize;
+        pts.extend((0..n).map(|i| {
+            let t = i as f64 / n as f64;
+            [from[0] + t * (to[0] - from[0]), from[1] + t * (to[1] - from[1])]
+        }));
+    };
+    let mut at = [0.0, -2.0];
+    for (k, c) in [[a, -a], [a, a], [-a, a], [-a, -a]].into_iter().enumerate() {
+        let start = -q + k as f64 * q;
+        let on = |phi: f64| [c[0] + r * phi.cos(), c[1] + r * phi.sin()];
+        segment(&mut pts, at, on(start));
+        // (no arc on a sharp corner: the next straight part starts there)
+        let m = if r > 0.0 { (q * r / h).ceil() as usize } else { 0 };
+        pts.extend((0..m).map(|i| on(start + q * i as f64 / m as f64)));
+        at = on(start + q);
+    }
+    segment(&mut pts, at, [0.0, -2.0]);
+    pts
+}
+
 pub mod exercise;
 pub mod mutate;
