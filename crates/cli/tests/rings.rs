@@ -80,7 +80,7 @@ fn a_ring_with_tight_fillets_certifies_within_the_fit_tolerance() {
         let ring =
             serde_json::json!({"name": "fillets", "ring": {"inner": {"points": inner}, "outer": {"points": outer}}});
         let input = scratch.path().join(format!("fillets-{per_fillet}.json"));
-        std::fs::write(&input, ring.to_string()).unwrap();
+        winslow::io::write_bytes(&input, ring.to_string().as_bytes()).unwrap();
         let map = scratch.path().join(format!("fillets-{per_fillet}.map.json"));
         let out = bin().arg("solve").arg(&input).arg("-o").arg(&map).arg("--json").output().unwrap();
         let r = common::stdout_json(&out);
