@@ -108,6 +108,17 @@ fn verdict_from_name(s: &str) -> Option<Verdict> {
         .find(|&v| v.name() == s)
 }
 
+/// The det J lines of an exact certificate's details (tensor or THB): the proven lower
+/// bound where the `verdict` is good, the smallest value found otherwise, then the mean.
+pub(crate) fn det_j_details(verdict: Verdict, lower_bound: f64, min_found: f64, mean: f64) -> Vec<(String, String)> {
+    let first = if verdict_is_good(verdict) {
+        ("proven det J lower bound".to_string(), format!("{lower_bound:.4e}"))
+    } else {
+        ("smallest det J found".to_string(), format!("{min_found:.4e}"))
+    };
+    vec![first, ("mean det J".to_string(), format!("{mean:.4e}"))]
+}
+
 impl Certificate {
     /// The verdict of a solver report.
     pub fn from_report(r: &Report) -> Self {
@@ -180,14 +191,8 @@ impl Certificate {
         use winslow::verify::certificate::{certify, CertifyOptions};
         let Ok(c) = certify(map, &CertifyOptions::default()) else { return Self::from_sample(q) };
         let verdict = Verdict::of_certificate(&c);
-        let mut details = Vec::new();
-        if verdict_is_good(verdict) {
-            details.push(("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)));
-        } else {
-            details.push(("smallest det J found".to_string(), format!("{:.4e}", c.min_value_found)));
-        }
+        let mut details = det_j_details(verdict, c.lower_bound, c.min_value_found, c.mean_det_j);
         details.extend([
-            ("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)),
             ("det J degree".to_string(), format!("{}x{}", c.det_degree[0], c.det_degree[1])),
             ("elements / boxes / depth".to_string(), format!("{} / {} / {}", c.elements, c.boxes, c.max_depth)),
         ]);

@@ -18,7 +18,7 @@ use winslow::verify::certificate::CertifyOptions;
 use winslow::verify::quality::sample_det_j_hierarchical;
 use winslow::Point;
 
-use crate::certificate::{verdict_is_good, Certificate, CertificateSource};
+use crate::certificate::{det_j_details, Certificate, CertificateSource};
 use crate::scene::{MapView, RESOLUTION_RANGE};
 
 /// What a map view holds beyond the tensor form when the map is a THB map.
@@ -51,14 +51,8 @@ impl Certificate {
     /// The verdict of the THB certificate of a map.
     pub fn of_thb(c: &HierarchicalCertificate) -> Self {
         let verdict = Verdict::of_finding(&c.verdict);
-        let mut details = Vec::new();
-        if verdict_is_good(verdict) {
-            details.push(("proven det J lower bound".to_string(), format!("{:.4e}", c.lower_bound)));
-        } else {
-            details.push(("smallest det J found".to_string(), format!("{:.4e}", c.min_value_found)));
-        }
+        let mut details = det_j_details(verdict, c.lower_bound, c.min_value_found, c.mean_det_j);
         details.extend([
-            ("mean det J".to_string(), format!("{:.4e}", c.mean_det_j)),
             ("THB functions".to_string(), c.functions.to_string()),
             ("active cells / levels".to_string(), format!("{} / {}", c.cells, c.levels)),
             ("folded / undecided cells".to_string(), format!("{} / {}", c.folds.len(), c.undecided.len())),

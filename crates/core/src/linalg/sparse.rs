@@ -116,26 +116,31 @@ impl Csr {
         y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, ys)| self.mul_rows(c * CHUNK, x, ys));
     }
 
-    /// `y_k = (A x)_{first + k}`: the row's entries as slices, four partial sums (the
-    /// additions of one row do not wait on each other).
+    /// `y_k = (A x)_{first + k}` ([`Csr::row_dot`] per row).
     fn mul_rows(&self, first: usize, x: &[f64], y: &mut [f64]) {
         for (k, yi) in y.iter_mut().enumerate() {
-            let r = self.row_ptr[first + k]..self.row_ptr[first + k + 1];
-            let (cols, vals) = (&self.col_idx[r.clone()], &self.values[r]);
-            let mut acc = [0.0f64; 4];
-            let (c4, v4) = (cols.chunks_exact(4), vals.chunks_exact(4));
-            let (cr, vr) = (c4.remainder(), v4.remainder());
-            for (c, v) in c4.zip(v4) {
-                for l in 0..4 {
-                    acc[l] += v[l] * x[c[l]];
-                }
-            }
-            let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-            for (c, v) in cr.iter().zip(vr) {
-                sum += v * x[*c];
-            }
-            *yi = sum;
+            *yi = self.row_dot(first + k, x);
         }
+    }
+
+    /// `(A x)_i`: the row's entries as slices, four partial sums (the additions of one row
+    /// do not wait on each other), the remainder added last.
+    pub(crate) fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        let (cols, vals) = (&self.col_idx[r.clone()], &self.values[r]);
+        let mut acc = [0.0f64; 4];
+        let (c4, v4) = (cols.chunks_exact(4), vals.chunks_exact(4));
+        let (cr, vr) = (c4.remainder(), v4.remainder());
+        for (c, v) in c4.zip(v4) {
+            for l in 0..4 {
+                acc[l] += v[l] * x[c[l]];
+            }
+        }
+        let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        for (c, v) in cr.iter().zip(vr) {
+            sum += v * x[*c];
+        }
+        sum
     }
 
     /// `A x` as a new vector.

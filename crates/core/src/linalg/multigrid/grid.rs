@@ -20,23 +20,9 @@ pub(crate) trait Rows: Sync {
 }
 
 impl Rows for Csr {
-    /// The row's products in four partial sums (independent additions).
+    /// The row's products in four partial sums ([`Csr::row_dot`]).
     fn residual_at(&self, b: &[f64], x: &[f64], i: usize) -> f64 {
-        let r = self.row_ptr[i]..self.row_ptr[i + 1];
-        let (cols, vals) = (&self.col_idx[r.clone()], &self.values[r]);
-        let mut acc = [0.0f64; 4];
-        let (c4, v4) = (cols.chunks_exact(4), vals.chunks_exact(4));
-        let (cr, vr) = (c4.remainder(), v4.remainder());
-        for (c, v) in c4.zip(v4) {
-            for l in 0..4 {
-                acc[l] += v[l] * x[c[l]];
-            }
-        }
-        let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-        for (c, v) in cr.iter().zip(vr) {
-            sum += v * x[*c];
-        }
-        b[i] - sum
+        b[i] - self.row_dot(i, x)
     }
 }
 
