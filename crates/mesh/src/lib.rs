@@ -33,6 +33,7 @@ pub mod formats;
 pub mod high_order;
 pub mod multipatch;
 pub mod quality;
+pub mod rectangle;
 pub mod seam;
 pub mod structured;
 pub mod topology;

@@ -39,11 +39,14 @@
 //! with the start side's (same coordinate along the seam, bit for bit), so the seam is
 //! one line of nodes shared by the triangles on both sides, with no boundary edge on
 //! it; the walls are the groups `inner` and `outer` ([`crate::seam::wall_names`]).
-//! A ring's rectangle is its mean length around by its mean width (area over length
-//! around; the seam's own width may be the narrowest place), the extent around rounded
-//! to a power of two (spade's splits of the seam's segments stay on them bit for bit),
-//! and spade's refinement stops at the guard's vertex count (a ring whose width varies a
-//! hundredfold makes slivers, refined without end).
+//! A ring's rectangle is its mean width across and, around, the arc length of the local
+//! aspect ([`crate::rectangle`]): where the ring narrows, the rectangle stretches, so a
+//! well-shaped triangle there is one about as wide as the ring is, not a sliver of the
+//! mean width's shape (a ring whose width varies a hundredfold, the rotor in its casing,
+//! made angles of 0 and 180 degrees and ran into the vertex guard before). The extent
+//! around is a power of two (spade's splits of the seam's segments stay on them bit for
+//! bit). A size whose expected vertex count (over the area, or over a ring's rectangle
+//! with its local widths) is above the guard is refused before any refinement.
 //!
 //! The minimum angle holds in the stretched parameter rectangle (spade's guarantee);
 //! the physical angles are reported by [`crate::quality`].
@@ -59,6 +62,7 @@ use winslow::{Side, Surface};
 use crate::equidistribution::{segment_deviation, SideCurve};
 use crate::error::{MeshError, Result};
 use crate::high_order::JacobianProbe;
+use crate::rectangle::Rectangle;
 use crate::{BoundaryEdge, ElementKind, Mesh};
 
 /// Options of an unstructured mesh.
@@ -214,21 +218,43 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         let x: Vec<DVec2> = boundary.iter().map(|q| at(map, *q)).collect();
         0.5 * (0..x.len()).map(|k| x[k].perp_dot(x[(k + 1) % x.len()])).sum::<f64>()
     };
-    let mut scale = parameter_scale(map);
-    if let Some(d) = sd {
+    let rect = match sd {
         // across a ring: its mean width (area over the length around), not the width at
-        // the seam, which may be the narrowest or the widest place
-        let across = area.abs() / scale[d];
-        if across.is_finite() && across > 0.0 {
-            scale[1 - d] = across;
+        // the seam, which may be the narrowest or the widest place; around: the local
+        // aspect's arc length (crate::rectangle)
+        Some(d) => {
+            let scale = parameter_scale(map);
+            let across = area.abs() / scale[d];
+            if across.is_finite() && across > 0.0 {
+                Rectangle::ring(map, d, scale[d], across)
+            } else {
+                let mut scale = scale;
+                scale[d] = 2f64.powi(scale[d].log2().round() as i32);
+                Rectangle::linear(scale)
+            }
         }
-        // a power of two around: spade splits a segment at `w0 a + w1 b` with
-        // `w0 = 1 - w1`, which is exactly `L` for `a = b = L = 2^k`, so the end side's
-        // points stay on it bit for bit and their copies land on it
-        scale[d] = 2f64.powi(scale[d].log2().round() as i32);
+        None => Rectangle::linear(parameter_scale(map)),
+    };
+    let extent = rect.extent();
+    let expected = match rect.expected_vertices(opts.size) {
+        Some(e) if e.is_finite() => e.min(1e15) as usize + nb,
+        _ => (area.abs() / (0.433 * opts.size * opts.size) / 2.0) as usize + nb,
+    };
+    // `expected` counts equilateral triangles of edge `size`; the size criterion halves
+    // edges longer than `size`, so the meshes have more: 2.4 times on the quarter
+    // annulus, 2.8 on the rotor's ring (sizes 0.01 to 0.2). Twice it is below what
+    // refinement makes (curvature and det J only add): a size the guard would stop
+    // anyway is refused before any work
+    if expected.saturating_mul(2) > opts.max_vertices {
+        return Err(MeshError::Triangulation(format!(
+            "at least {} vertices expected for triangles of size {} ({}), more than the limit of {}; use a larger size",
+            expected.saturating_mul(2),
+            opts.size,
+            if rect.is_warped() { "over the ring, each as wide as the ring is there" } else { "over the area" },
+            opts.max_vertices
+        )));
     }
-    let expected = (area.abs() / (0.433 * opts.size * opts.size) / 2.0) as usize + nb;
-    let verts: Vec<Point2<f64>> = boundary.iter().map(|q| Point2::new(q.x * scale.x, q.y * scale.y)).collect();
+    let verts: Vec<Point2<f64>> = boundary.iter().map(|q| rect.point(*q)).collect();
     let mut cdt = Cdt::bulk_load_cdt(verts, edges).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
     let mut phys: Vec<DVec2> = Vec::new();
     let mut det: Vec<f64> = Vec::new();
@@ -248,7 +274,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         // the first round also bounds the area by the equilateral triangle of edge `size`
         // in the stretched rectangle: most vertices come from spade's own refinement
         let mut params = RefinementParameters::new().with_angle_limit(limit).with_max_additional_vertices(budget);
-        if round == 0 {
+        if round == 0 && !rect.is_warped() {
             params = params.with_max_allowed_area(0.433 * opts.size * opts.size);
         }
         let r = if settled {
@@ -266,15 +292,16 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             )));
         }
         // map the new vertices (in parallel: one spline evaluation each)
-        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| snap(v.position(), scale)).collect();
+        let pos: Vec<Point2<f64>> = cdt.vertices().map(|v| snap(v.position(), extent)).collect();
+        let prm: Vec<DVec2> = pos.par_iter().map(|p| rect.param(*p)).collect();
         // vertices from `first_new` on are new since the last scan: a triangle or segment of
         // older vertices only existed then and passed (inserting a point only makes
         // triangles that have it as a vertex; a split edge's triangles are gone)
         let first_new = phys.len();
-        let fresh: Vec<(DVec2, f64)> = pos[phys.len()..]
+        let fresh: Vec<(DVec2, f64)> = prm[phys.len()..]
             .par_iter()
-            .map(|p| {
-                let d = map.derivs(p.x / scale.x, p.y / scale.y, 1);
+            .map(|q| {
+                let d = map.derivs(q.x, q.y, 1);
                 (DVec2::from(d.x), d.det_j())
             })
             .collect();
@@ -283,7 +310,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
             det.push(d);
         }
         stats.map += lap();
-        let param = |i: usize| DVec2::new(pos[i].x / scale.x, pos[i].y / scale.y);
+        let param = |i: usize| prm[i];
         let faces: Vec<[usize; 3]> = cdt
             .inner_faces()
             .map(|f| f.vertices().map(|h| h.fix().index()))
@@ -312,7 +339,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
                 // a triangle on both sides of a seam would fold when they are identified
                 let spans = sd.is_some_and(|d| {
                     let q = v.map(|i| pos[i]);
-                    let end = if d == 0 { scale.x } else { scale.y };
+                    let end = extent[d];
                     let c = |p: Point2<f64>| if d == 0 { p.x } else { p.y };
                     q.iter().any(|&p| c(p) == 0.0) && q.iter().any(|&p| c(p) == end)
                 });
@@ -359,8 +386,8 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         split.sort_unstable_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)).then(y.2.cmp(&x.2)));
         split.dedup_by_key(|x| (x.0, x.1));
         stats.criteria += lap();
-        if split.is_empty() && sd.is_none_or(|d| seam_mirrors(&cdt, d, scale).is_empty()) {
-            let mesh = build(&cdt, phys, scale, sd.map(|d| (d, crate::seam::wall_names(map, d))))?;
+        if split.is_empty() && sd.is_none_or(|d| seam_mirrors(&cdt, d, extent).is_empty()) {
+            let mesh = build(&cdt, phys, &rect, sd.map(|d| (d, crate::seam::wall_names(map, d))))?;
             stats.build = lap();
             return Ok((mesh, stats));
         }
@@ -392,7 +419,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         }
         // the points refinement put on one side of a seam, copied to the other
         if let Some(d) = sd {
-            for m in seam_mirrors(&cdt, d, scale) {
+            for m in seam_mirrors(&cdt, d, extent) {
                 inserted.push(cdt.insert(m).map_err(|e| MeshError::Triangulation(format!("{e:?}")))?);
             }
         }
@@ -439,13 +466,13 @@ fn star_meets_limits(cdt: &Cdt, v: spade::handles::FixedVertexHandle, limit: Ang
 /// coordinate `0` and `L_d` of the stretched rectangle) hold the same points: each
 /// vertex of one side without a partner at the same coordinate along the side (bit for
 /// bit) on the other, copied there. Sorted (deterministic).
-fn seam_mirrors(cdt: &Cdt, d: usize, scale: DVec2) -> Vec<Point2<f64>> {
-    let end = scale[d];
+fn seam_mirrors(cdt: &Cdt, d: usize, extent: DVec2) -> Vec<Point2<f64>> {
+    let end = extent[d];
     let split = |p: Point2<f64>| if d == 0 { (p.x, p.y) } else { (p.y, p.x) };
     let make = |fixed: f64, along: f64| if d == 0 { Point2::new(fixed, along) } else { Point2::new(along, fixed) };
     let (mut lo, mut hi) = (BTreeSet::new(), BTreeSet::new());
     for v in cdt.vertices() {
-        let (fixed, along) = split(snap(v.position(), scale));
+        let (fixed, along) = split(snap(v.position(), extent));
         if fixed == 0.0 {
             lo.insert(along.to_bits());
         } else if fixed == end {
@@ -461,7 +488,7 @@ fn seam_mirrors(cdt: &Cdt, d: usize, scale: DVec2) -> Vec<Point2<f64>> {
 /// rectangle `[0, L_xi] x [0, L_eta]` put on it: spade splits a segment at
 /// `w0 a + w1 b`, which can miss `L` by an ulp; the vertex is on the segment all the same
 /// (spade inserts it into the edge).
-fn snap(p: Point2<f64>, scale: DVec2) -> Point2<f64> {
+fn snap(p: Point2<f64>, extent: DVec2) -> Point2<f64> {
     let s = |x: f64, l: f64| {
         if (x - l).abs() <= 1e-12 * l {
             l
@@ -471,7 +498,7 @@ fn snap(p: Point2<f64>, scale: DVec2) -> Point2<f64> {
             x
         }
     };
-    Point2::new(s(p.x, scale.x), s(p.y, scale.y))
+    Point2::new(s(p.x, extent.x), s(p.y, extent.y))
 }
 
 /// The side of a boundary edge from its parameters.
@@ -491,15 +518,10 @@ fn side_of(a: DVec2, b: DVec2) -> Option<Side> {
 
 /// The mesh of the triangulation; with a seam `(d, wall names)`, the vertices of the
 /// seam's end side are identified with the start side's and its edges are no boundary.
-fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2, seam: Option<(usize, [&str; 2])>) -> Result<Mesh> {
+fn build(cdt: &Cdt, points: Vec<DVec2>, rect: &Rectangle, seam: Option<(usize, [&str; 2])>) -> Result<Mesh> {
+    let extent = rect.extent();
     // x / L is exactly 0 or 1 on the sides (their points are exactly 0 or L)
-    let mut params: Vec<DVec2> = cdt
-        .vertices()
-        .map(|v| {
-            let p = snap(v.position(), scale);
-            DVec2::new(p.x / scale.x, p.y / scale.y)
-        })
-        .collect();
+    let mut params: Vec<DVec2> = cdt.vertices().map(|v| rect.param(snap(v.position(), extent))).collect();
     let mut points = points;
     // the index of each vertex in the mesh (a seam's end side: its start-side partner's)
     let mut index: Vec<usize> = (0..params.len()).collect();
@@ -537,8 +559,7 @@ fn build(cdt: &Cdt, points: Vec<DVec2>, scale: DVec2, seam: Option<(usize, [&str
     for e in cdt.undirected_edges().filter(|e| e.is_constraint_edge()) {
         let [va, vb] = e.vertices();
         let [a, b] = [va, vb].map(|h| h.fix().index());
-        let param = |p: Point2<f64>| DVec2::new(p.x / scale.x, p.y / scale.y);
-        let (pa, pb) = (param(snap(va.position(), scale)), param(snap(vb.position(), scale)));
+        let (pa, pb) = (rect.param(snap(va.position(), extent)), rect.param(snap(vb.position(), extent)));
         let Some(side) = side_of(pa, pb) else {
             return Err(MeshError::Triangulation(format!("constraint edge {a}-{b} is not on a side")));
         };

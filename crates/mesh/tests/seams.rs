@@ -233,3 +233,52 @@ fn curved_elements_of_a_triangulated_ring_keep_the_seam() {
     assert_eq!(distinct.len(), cubic.points.len());
     validate(&cubic, Format::Gmsh).unwrap();
 }
+
+/// A periodic ring in polar form: the outer wall the circle of radius 2, the inner wall
+/// at radius `r(t) = 1 + 0.97 (1 + cos t) / 2`, across along the rays: 0.03 wide at angle
+/// 0 and 1 wide at angle pi, a width varying 33-fold around (the rotor in its casing
+/// varies 250-fold).
+fn narrowing_ring() -> Surface {
+    let ku = winslow::KnotVector::open_uniform(1, 1);
+    let kv = winslow::KnotVector::periodic_uniform(3, 64);
+    let mut cps = Vec::new();
+    for j in 0..kv.num_basis() {
+        let t = 2.0 * std::f64::consts::PI * ((j % 64) as f64) / 64.0;
+        for r in [1.0 + 0.485 * (1.0 + t.cos()), 2.0] {
+            cps.push([r * t.cos(), r * t.sin()]);
+        }
+    }
+    Surface::new([ku, kv], cps, None).unwrap()
+}
+
+#[test]
+fn a_ring_narrowing_thirtyfold_is_triangulated_without_slivers() {
+    let map = narrowing_ring();
+    for size in [0.2, 0.05] {
+        let mesh = unstructured(&map, &UnstructuredOptions { size, ..Default::default() }).unwrap();
+        assert_annulus(&mesh, [Side::West, Side::East]);
+        assert_on_map(&mesh, &map);
+        // physical angles: the rectangle stretched by the local aspect around keeps the
+        // triangles in the narrow part about as wide as the ring is there (a rectangle of
+        // the mean width made 0.9 to 177.8 degrees and aspect ratios of 43 at size 0.2;
+        // now 21.7 to 120.3 and 2.4)
+        let q = winslow_mesh::quality::quality(&mesh).unwrap();
+        assert!(q.angle[0] > 15.0 && q.angle[1] < 140.0, "size {size}: angles {:?}", q.angle);
+    }
+}
+
+#[test]
+fn a_size_beyond_the_vertex_guard_is_refused_before_refinement() {
+    // size 0.05 makes about 6 000 vertices (above); 0.01 about 25 times as many
+    let map = narrowing_ring();
+    let opts = UnstructuredOptions { size: 0.01, max_vertices: 20_000, ..Default::default() };
+    match unstructured(&map, &opts) {
+        Err(MeshError::Triangulation(why)) => {
+            assert!(why.contains("vertices expected") && why.contains("limit of 20000"), "{why}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // a size the guard admits is not refused up front
+    let opts = UnstructuredOptions { size: 0.05, max_vertices: 20_000, ..Default::default() };
+    assert!(unstructured(&map, &opts).unwrap().points.len() < 20_000);
+}
