@@ -32,8 +32,10 @@ pub(crate) struct CommonFaces {
 }
 
 /// Bring the faces of `b` to common knot vectors per direction, each element halved
-/// `refine` times (module doc).
-pub(crate) fn common_faces(b: &VolumeBoundary, refine: usize) -> Result<CommonFaces> {
+/// `refine` times and then the knots `extra[d]` inserted in direction `d` (local
+/// defect correction; each strictly inside a span of the vector it is inserted into)
+/// (module doc).
+pub(crate) fn common_faces(b: &VolumeBoundary, refine: usize, extra: &[Vec<f64>; 3]) -> Result<CommonFaces> {
     let mut faces = b.faces.clone();
     let mut knots = Vec::with_capacity(3);
     for d in 0..3 {
@@ -54,6 +56,11 @@ pub(crate) fn common_faces(b: &VolumeBoundary, refine: usize) -> Result<CommonFa
         }
         for _ in 0..refine {
             kv = kv.halved();
+        }
+        // a knot already there (a later halving's midpoint) is not inserted twice
+        let new: Vec<f64> = extra[d].iter().copied().filter(|u| !kv.knots().contains(u)).collect();
+        if !new.is_empty() {
+            kv = kv.with_inserted(&new);
         }
         for &(k, q) in &users {
             if faces[k].knots[q] != kv {
@@ -209,7 +216,7 @@ mod tests {
         let b = VolumeBoundary { name: "t".into(), faces };
         b.validate().unwrap();
         for refine in [0, 2] {
-            let c = common_faces(&b, refine).unwrap();
+            let c = common_faces(&b, refine, &Default::default()).unwrap();
             assert_eq!(c.knots[0].degree(), 3);
             let v = c.coons().unwrap();
             for &u in &[[0.1, 0.2, 0.3], [0.5, 0.5, 0.5], [0.9, 0.33, 0.71], [0.0, 1.0, 0.4]] {
