@@ -30,10 +30,12 @@
 mod assembler;
 pub mod bench;
 mod device;
+mod multigrid;
 mod sample;
 
 pub use assembler::{GpuAssembler, Stats, Timings};
 pub use device::{Gpu, GpuOptions};
+pub use multigrid::{GpuCycle, GpuCycles, Operation, Vector};
 pub use sample::MapSample;
 
 use std::sync::Arc;
@@ -44,6 +46,9 @@ use winslow::methods::egg::{CpuAssembler, EggAssembler};
 pub const ASSEMBLY_WGSL: &str = include_str!("../../../shaders/assembly.wgsl");
 /// WGSL source of the `det J` sampling kernel (f64; see [`shader_source`]).
 pub const DET_J_WGSL: &str = include_str!("../../../shaders/det_j.wgsl");
+
+/// WGSL source of the multigrid cycle's level kernels (f64 only; see [`GpuCycles`]).
+pub const MULTIGRID_WGSL: &str = include_str!("../../../shaders/multigrid.wgsl");
 
 /// The first line of every shader, selecting f64.
 pub const F64_ALIAS: &str = "alias real = f64;";
