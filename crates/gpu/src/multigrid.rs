@@ -81,6 +81,11 @@ const NONE: u32 = u32::MAX;
 /// short, so it runs in row blocks of about this much work.
 const COARSE_WORK: usize = 4096;
 
+/// Loop iterations one line's invocation may take on a software adapter: lavapipe cut
+/// an invocation of about 65 000 short, while lines of about 33 000 (513 unknowns on the
+/// stencil of degree 3) gave the CPU's bits. Longer lines keep the cycle on the CPU there.
+const SOFTWARE_LINE_WORK: u64 = 40_000;
+
 /// Bytes per parameter record in the uniform buffer (the dynamic-offset alignment).
 const RECORD: u64 = 256;
 
@@ -521,6 +526,20 @@ impl GpuCycles {
         ] {
             if bytes > max {
                 return Err(GpuError::TooLarge(format!("multigrid {what}: {bytes} bytes, the adapter binds {max}")));
+            }
+        }
+        if gpu.is_software() {
+            for at in &layout.levels {
+                let (Some(OpAt::Stencil { bx, by, .. }), Some(lines)) = (at.op, at.lines) else { continue };
+                for d in lines {
+                    let per = (2 * by as u64 + 1) * (2 * bx as u64 + 2) + 2 * (d.bw as u64 + 1) + 1;
+                    if d.len as u64 * per > SOFTWARE_LINE_WORK {
+                        return Err(GpuError::TooLarge(format!(
+                            "multigrid lines of {} unknowns: more work than a software adapter runs in one invocation",
+                            d.len
+                        )));
+                    }
+                }
             }
         }
         gpu.scoped(|| {
