@@ -339,6 +339,18 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(err <= 1e-9 * scale, "GPU and CPU multigrid maps differ by {err:e}");
+    // `bench` runs the same path and its JSON rows name the back end with the cycles
+    let out = bin()
+        .arg("bench")
+        .arg(data().join("quarter_annulus.json"))
+        .args(["--refinements", "2", "--backend", "gpu", "--linear", "multigrid", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let backend = row["backend"].as_str().unwrap();
+    assert!(backend.starts_with("gpu") && backend.contains("multigrid V-cycles on the GPU: "), "{backend}");
+    assert!(!backend.contains("V-cycles on the GPU: 0"), "{backend}");
 }
 
 #[test]
