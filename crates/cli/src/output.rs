@@ -504,6 +504,9 @@ pub struct BenchRow {
     pub reparam: &'static str,
     /// Matched pairs.
     pub matches: usize,
+    /// The back end (`report.backend`: the adapter, and under `--linear multigrid` the
+    /// V-cycles its kernels ran so far in this process).
+    pub backend: String,
 }
 
 impl BenchRow {
@@ -537,6 +540,7 @@ impl BenchRow {
             scaled_jacobian_min: r.measures.quality.scaled_jacobian.min,
             reparam: r.fit.reparam.used.name(),
             matches: r.fit.reparam.matches.len(),
+            backend: r.setup.backend.clone(),
         }
     }
 }

@@ -283,6 +283,76 @@ fn solve_on_the_gpu_writes_the_cpu_map() {
     }
 }
 
+/// `--backend gpu --linear multigrid`: the multigrid preconditioner's V-cycles run on the
+/// GPU (the report's back end counts them) and the solve takes the CPU's Newton and GMRES
+/// iterations on every level and writes its map to 1e-9.
+#[test]
+fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
+    if !gpu_available_or_required() {
+        return;
+    }
+    let scratch = tempfile::tempdir().unwrap();
+    let mut runs = Vec::new();
+    for backend in ["cpu", "gpu"] {
+        let map = scratch.path().join(format!("{backend}.json"));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join("quarter_annulus.json"))
+            .arg("-o")
+            .arg(&map)
+            .args(["--backend", backend, "--linear", "multigrid", "--min-elements", "40", "-q"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{backend}: {}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+        runs.push(doc);
+    }
+    let backend = runs[1]["report"]["backend"].as_str().unwrap();
+    let cycles: usize = backend
+        .split("multigrid V-cycles on the GPU: ")
+        .nth(1)
+        .and_then(|s| s.split(|c: char| !c.is_ascii_digit()).next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no GPU cycles in {backend}"));
+    assert!(cycles > 0 && !backend.contains("on the CPU after"), "{backend}");
+    let levels = |d: &serde_json::Value| -> Vec<(u64, u64)> {
+        d["report"]["levels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| (l["newton_iterations"].as_u64().unwrap(), l["krylov_iterations"].as_u64().unwrap()))
+            .collect()
+    };
+    assert_eq!(levels(&runs[0]), levels(&runs[1]));
+    assert!(levels(&runs[1]).iter().any(|&(_, k)| k > 0), "no GMRES iterations: {:?}", levels(&runs[1]));
+    let pts = |d: &serde_json::Value| -> Vec<f64> {
+        d["map"]["control_points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|p| p.as_array().unwrap().clone())
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (pts(&runs[0]), pts(&runs[1]));
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(err <= 1e-9 * scale, "GPU and CPU multigrid maps differ by {err:e}");
+    // `bench` runs the same path and its JSON rows name the back end with the cycles
+    let out = bin()
+        .arg("bench")
+        .arg(data().join("quarter_annulus.json"))
+        .args(["--refinements", "2", "--backend", "gpu", "--linear", "multigrid", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let backend = row["backend"].as_str().unwrap();
+    assert!(backend.starts_with("gpu") && backend.contains("multigrid V-cycles on the GPU: "), "{backend}");
+    assert!(!backend.contains("V-cycles on the GPU: 0"), "{backend}");
+}
+
 #[test]
 fn bench_on_the_gpu_prints_throughput_and_the_time_split() {
     if !gpu_available_or_required() {

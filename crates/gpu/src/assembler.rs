@@ -13,12 +13,14 @@ use std::time::Instant;
 
 use winslow::discrete::assembly::{Discretization, Operator};
 use winslow::discrete::tables::DirTable;
+use winslow::linalg::multigrid_kernels::CycleBackend;
 use winslow::methods::egg::{CpuAssembler, EggAssembler};
 use winslow::spline::curve::Point;
 use winslow::spline::surface::Surface;
 use winslow::verify::quality::DetJSample;
 
 use crate::device::Gpu;
+use crate::multigrid::GpuCycles;
 use crate::{GpuError, Precision};
 
 /// Where the time of one kind of call went, summed over calls.
@@ -48,7 +50,7 @@ impl Timings {
         self.upload + self.dispatch + self.readback + self.cpu
     }
 
-    fn add(&mut self, o: &Timings) {
+    pub(crate) fn add(&mut self, o: &Timings) {
         self.calls += o.calls;
         self.quadrature_points += o.quadrature_points;
         self.upload += o.upload;
@@ -73,6 +75,11 @@ pub struct Stats {
     pub elasticity: Timings,
     /// `det J` samples.
     pub det_j: Timings,
+    /// Multigrid V-cycles run on the GPU (`calls`) under `--linear multigrid`
+    /// ([`crate::GpuCycles`]).
+    pub multigrid: Timings,
+    /// Multigrid set-ups or cycles that ran on the CPU instead (GPU errors).
+    pub multigrid_fallbacks: u64,
     /// Calls that failed on the GPU and were done by the CPU instead.
     pub fallbacks: u64,
     /// The last GPU error.
@@ -166,6 +173,8 @@ pub struct GpuAssembler {
     chunk_bytes: u64,
     /// Jacobian by the per-entry kernel instead of element matrices.
     per_entry: bool,
+    /// The multigrid cycle's kernels (`None` without `SHADER_F64`).
+    cycles: Option<Arc<GpuCycles>>,
 }
 
 fn key_of(disc: &Discretization) -> (Vec<f64>, usize, Vec<f64>, usize, usize, usize) {
@@ -211,12 +220,13 @@ impl GpuAssembler {
     pub fn new(gpu: Arc<Gpu>) -> Self {
         let chunk_bytes = gpu.chunk_bytes();
         Self {
-            gpu,
             cache: Mutex::new(Vec::new()),
             stats: Mutex::new(Stats::default()),
             busy: Mutex::new(()),
             chunk_bytes,
             per_entry: false,
+            cycles: GpuCycles::new(gpu.clone()).map(Arc::new),
+            gpu,
         }
     }
 
@@ -249,7 +259,13 @@ impl GpuAssembler {
 
     /// Timings so far.
     pub fn stats(&self) -> Stats {
-        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+        let mut s = self.stats.lock().map(|s| s.clone()).unwrap_or_default();
+        if let Some(c) = &self.cycles {
+            let (t, fallbacks, last) = c.stats();
+            (s.multigrid, s.multigrid_fallbacks) = (t, fallbacks);
+            s.last_error = s.last_error.or(last);
+        }
+        s
     }
 
     /// Zero the timings.
@@ -257,6 +273,14 @@ impl GpuAssembler {
         if let Ok(mut s) = self.stats.lock() {
             *s = Stats::default();
         }
+        if let Some(c) = &self.cycles {
+            c.reset_stats();
+        }
+    }
+
+    /// The multigrid cycle's kernels on this GPU (`None` without `SHADER_F64`).
+    pub fn cycles(&self) -> Option<&Arc<GpuCycles>> {
+        self.cycles.as_ref()
     }
 
     fn record(&self, f: impl FnOnce(&mut Stats)) {
@@ -661,6 +685,18 @@ impl EggAssembler for GpuAssembler {
         if s.fallbacks > 0 {
             name.push_str(&format!(" ({} calls fell back to the CPU)", s.fallbacks));
         }
+        if s.multigrid.calls > 0 || s.multigrid_fallbacks > 0 {
+            name.push_str(&format!("; multigrid V-cycles on the GPU: {}", s.multigrid.calls));
+        }
+        if s.multigrid_fallbacks > 0 {
+            name.push_str(&format!(" ({} on the CPU after GPU errors)", s.multigrid_fallbacks));
+        }
         name
+    }
+
+    /// The GPU runs the level work of `--linear multigrid`'s V-cycle ([`GpuCycles`]),
+    /// where the adapter has `SHADER_F64`.
+    fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
+        self.cycles.clone().map(|c| c as Arc<dyn CycleBackend>)
     }
 }

@@ -47,6 +47,8 @@ pub struct Gpu {
     pub(crate) limits: wgpu::Limits,
     pub(crate) assembly: AssemblyKernels,
     pub(crate) det_j: DetJKernel,
+    /// The multigrid cycle's kernels (f64 only: `None` in f32).
+    pub(crate) multigrid: Option<crate::multigrid::MultigridKernels>,
 }
 
 fn is_software(info: &wgpu::AdapterInfo) -> bool {
@@ -95,10 +97,11 @@ impl Gpu {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let assembly = assembly_kernels(&device, precision);
         let det_j = det_j_kernel(&device, precision);
+        let multigrid = (precision == Precision::F64).then(|| crate::multigrid::multigrid_kernels(&device));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Wgpu(e.to_string()));
         }
-        Ok(Self { device, queue, info: adapter.get_info(), precision, limits, assembly, det_j })
+        Ok(Self { device, queue, info: adapter.get_info(), precision, limits, assembly, det_j, multigrid })
     }
 
     /// The adapter's name, driver and wgpu back end.

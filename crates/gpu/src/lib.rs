@@ -13,6 +13,13 @@
 //! ([`winslow::discrete::tables::DirTable`], [`winslow::spline::basis::BasisDerivs`]) and are uploaded
 //! once per basis; the GPU only runs the tensor-product sums.
 //!
+//! [`GpuCycles`] implements [`winslow::linalg::multigrid_kernels::CycleBackend`]: under
+//! `--linear multigrid` the multigrid V-cycle's level work (stencil residual, coloured
+//! line Gauss–Seidel, the two 1D transfer passes, the coarsest solve;
+//! `shaders/multigrid.wgsl`) runs on the GPU with the level data uploaded once per
+//! set-up, giving the CPU cycle's bits on lavapipe. [`GpuAssembler`] hands it to the
+//! solver where the adapter has `SHADER_F64`.
+//!
 //! Precision: f64 where the adapter offers `SHADER_F64` (lavapipe does); otherwise (or
 //! on request) the matrices run in f32 and the residual on the CPU in f64, so Newton
 //! still converges to the f64 tolerance. [`Gpu::describe`] says which ran.
@@ -30,10 +37,12 @@
 mod assembler;
 pub mod bench;
 mod device;
+mod multigrid;
 mod sample;
 
 pub use assembler::{GpuAssembler, Stats, Timings};
 pub use device::{Gpu, GpuOptions};
+pub use multigrid::{GpuCycle, GpuCycles, Operation, Vector};
 pub use sample::MapSample;
 
 use std::sync::Arc;
@@ -44,6 +53,9 @@ use winslow::methods::egg::{CpuAssembler, EggAssembler};
 pub const ASSEMBLY_WGSL: &str = include_str!("../../../shaders/assembly.wgsl");
 /// WGSL source of the `det J` sampling kernel (f64; see [`shader_source`]).
 pub const DET_J_WGSL: &str = include_str!("../../../shaders/det_j.wgsl");
+
+/// WGSL source of the multigrid cycle's level kernels (f64 only; see [`GpuCycles`]).
+pub const MULTIGRID_WGSL: &str = include_str!("../../../shaders/multigrid.wgsl");
 
 /// The first line of every shader, selecting f64.
 pub const F64_ALIAS: &str = "alias real = f64;";

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
-use winslow_gpu::{shader_source, Precision, ASSEMBLY_WGSL, DET_J_WGSL, F64_ALIAS};
+use winslow_gpu::{shader_source, Precision, ASSEMBLY_WGSL, DET_J_WGSL, F64_ALIAS, MULTIGRID_WGSL};
 
 fn validate(name: &str, src: &str, caps: Capabilities) -> naga::Module {
     let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
@@ -56,6 +56,15 @@ fn embedded_sources_are_the_files() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders");
     assert_eq!(std::fs::read_to_string(dir.join("assembly.wgsl")).unwrap(), ASSEMBLY_WGSL);
     assert_eq!(std::fs::read_to_string(dir.join("det_j.wgsl")).unwrap(), DET_J_WGSL);
+    assert_eq!(std::fs::read_to_string(dir.join("multigrid.wgsl")).unwrap(), MULTIGRID_WGSL);
+    let multigrid: Vec<String> = validate("multigrid", MULTIGRID_WGSL, Capabilities::FLOAT64)
+        .entry_points
+        .iter()
+        .map(|e| e.name.clone())
+        .collect();
+    for e in ["residual", "line_smooth", "transfer_rows", "transfer_cols", "coarse_solve"] {
+        assert!(multigrid.iter().any(|n| n == e), "multigrid.wgsl lacks entry point {e}: {multigrid:?}");
+    }
     let entries: Vec<String> = validate("assembly", ASSEMBLY_WGSL, Capabilities::FLOAT64)
         .entry_points
         .iter()

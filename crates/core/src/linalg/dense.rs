@@ -165,6 +165,11 @@ impl DenseCholesky {
         self.n
     }
 
+    /// `L`, row-major `n x n` (the upper triangle zero).
+    pub fn factor_values(&self) -> &[f64] {
+        &self.l
+    }
+
     /// Overwrite each length-`n` column of `x` with `(sign A)^{-1}` times it: forward
     /// substitution with `L`, back substitution with `Lᵀ`.
     pub fn solve_columns(&self, x: &mut [f64]) {

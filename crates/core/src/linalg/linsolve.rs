@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
+use crate::linalg::multigrid::kernels::CycleBackend;
 use crate::linalg::multigrid::{Multigrid, Smoother, TensorProlongation};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
@@ -189,6 +190,8 @@ pub struct LinearSolver {
     order: Option<Vec<usize>>,
     /// The prolongations of the multigrid hierarchy (see [`LinearSolver::set_transfers`]).
     transfers: Vec<TensorProlongation>,
+    /// Where the multigrid cycle's level work runs (see [`LinearSolver::set_cycle_backend`]).
+    cycle_backend: Option<std::sync::Arc<dyn CycleBackend>>,
     /// Total GMRES iterations spent (diagnostics).
     pub krylov_iterations: usize,
     /// The most GMRES iterations one solve took (diagnostics).
@@ -225,6 +228,7 @@ impl LinearSolver {
             matrix: None,
             order: None,
             transfers: Vec::new(),
+            cycle_backend: None,
             krylov_iterations: 0,
             krylov_max: 0,
             solves: 0,
@@ -252,6 +256,19 @@ impl LinearSolver {
     /// space 0 the one of the problem's `m` scalar unknowns (see `discrete::transfers`).
     pub(crate) fn set_transfers(&mut self, transfers: Vec<[Csr; 2]>) {
         self.transfers = transfers.into_iter().map(TensorProlongation::from).collect();
+    }
+
+    /// Run the level work of [`LinearMethod::Multigrid`]'s cycle on `backend` (the GPU
+    /// crate's kernels) instead of the CPU, where it takes the cycle.
+    pub(crate) fn set_cycle_backend(&mut self, backend: Option<std::sync::Arc<dyn CycleBackend>>) {
+        self.cycle_backend = backend;
+    }
+
+    /// A multigrid cycle on the hierarchy and back end of this solver.
+    fn new_multigrid(&self) -> Box<Multigrid> {
+        let mut mg = Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS);
+        mg.set_backend(self.cycle_backend.clone());
+        Box::new(mg)
     }
 
     /// The fill-reducing order for a matrix of `n` unknowns, if one is known.
@@ -465,7 +482,7 @@ impl LinearSolver {
             Some(k) if self.method == LinearMethod::Multigrid && fits(&k) => {
                 let mut mg = match self.precond.take() {
                     Some(Preconditioner::NegMultigrid(mg)) => mg,
-                    _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
+                    _ => self.new_multigrid(),
                 };
                 mg.factor_owned(k)?;
                 self.precond = Some(Preconditioner::NegMultigrid(mg));
@@ -516,7 +533,7 @@ impl LinearSolver {
             (Some(k), previous) if multigrid => {
                 let mut mg = match previous {
                     Some(Preconditioner::NegMultigrid(mg)) => mg,
-                    _ => Box::new(Multigrid::new(self.transfers.clone(), MG_SMOOTHER, MG_SWEEPS)),
+                    _ => self.new_multigrid(),
                 };
                 mg.factor_owned(k.clone())?;
                 Some(Preconditioner::NegMultigrid(mg))

@@ -26,3 +26,4 @@ pub mod sparse;
 pub mod split_cholesky;
 
 pub use krylov::MatVec;
+pub use multigrid::kernels as multigrid_kernels;

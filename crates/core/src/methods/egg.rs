@@ -10,6 +10,7 @@ use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
 
 use crate::discrete::assembly::{Discretization, Operator};
+use crate::linalg::multigrid_kernels::CycleBackend;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 use crate::spline::surface::Surface;
@@ -38,6 +39,11 @@ pub trait EggAssembler: Send + Sync {
     }
     /// Human-readable name of the back end (`"cpu"`, `"gpu: <adapter>"`).
     fn name(&self) -> String;
+    /// The kernels that run a multigrid V-cycle's level work on this back end
+    /// ([`crate::linalg::multigrid_kernels`]); `None` (the default): the CPU.
+    fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
+        None
+    }
 }
 
 /// The multi-threaded CPU assembler.
@@ -177,6 +183,10 @@ impl DiscreteProblem for EggProblem {
     /// The knot-halving hierarchy below the basis (`discrete::transfers`).
     fn transfers(&self) -> Vec<[Csr; 2]> {
         crate::discrete::transfers::free_prolongation_factors(&self.state.disc).unwrap_or_default()
+    }
+
+    fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
+        self.assembler.cycle_backend()
     }
 
     fn control_points(&self, c: &[f64]) -> Vec<Point> {

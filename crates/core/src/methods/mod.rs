@@ -160,6 +160,12 @@ pub trait DiscreteProblem {
     fn transfers(&self) -> Vec<[Csr; 2]> {
         Vec::new()
     }
+    /// Where the level work of a multigrid V-cycle over [`DiscreteProblem::transfers`]
+    /// runs: the quadrature back end's kernels (the GPU crate's), or `None` (the
+    /// default) for the CPU.
+    fn cycle_backend(&self) -> Option<std::sync::Arc<dyn crate::linalg::multigrid_kernels::CycleBackend>> {
+        None
+    }
     /// All control points of the map with unknowns `c` (fixed ones as given).
     fn control_points(&self, c: &[f64]) -> Vec<Point>;
 }
@@ -212,6 +218,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn transfers(&self) -> Vec<[Csr; 2]> {
         (**self).transfers()
+    }
+    fn cycle_backend(&self) -> Option<std::sync::Arc<dyn crate::linalg::multigrid_kernels::CycleBackend>> {
+        (**self).cycle_backend()
     }
     fn control_points(&self, c: &[f64]) -> Vec<Point> {
         (**self).control_points(c)

@@ -252,6 +252,7 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         }
         if linear == LinearMethod::Multigrid {
             lin.set_transfers(problem.transfers());
+            lin.set_cycle_backend(problem.cycle_backend());
         }
         Self {
             problem,

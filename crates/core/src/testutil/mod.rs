@@ -90,3 +90,40 @@ pub fn rounded_square(r: f64, h: f64) -> Vec<[f64; 2]> {
 
 pub mod exercise;
 pub mod mutate;
+
+/// The multigrid V-cycle of `--linear multigrid` for the metric Laplacian `K` of a
+/// stretched, sheared quarter annulus (radii 1 and `1 + t`, `r = 1 + t v^2`; degree 3,
+/// `ne x ne` elements, the knot-halving hierarchy of its interior functions), for the
+/// back ends' tests. With `far`, `K + ε (e_0 e_last^T + e_last e_0^T)` (`ε` a thousandth
+/// of the diagonal's mean): a coupling outside every stencil, so the levels are held
+/// as CSR matrices, not stencils.
+///
+/// Errors: the set-up's ([`crate::Error::LinearSolver`]).
+pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::linalg::multigrid_kernels::Cycle> {
+    use crate::discrete::assembly::{Discretization, Operator};
+    use crate::spline::knots::KnotVector;
+    let kv = KnotVector::open_uniform(3, ne);
+    let disc = Discretization::new([kv.clone(), kv.clone()]);
+    let g = kv.greville();
+    let mut cps = Vec::new();
+    for &v in &g {
+        for &u in &g {
+            let r = 1.0 + t * v * v;
+            let a = std::f64::consts::FRAC_PI_2 * (u + 0.2 * u * (1.0 - u) * v);
+            cps.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    let mut st = vec![0.0; disc.stencil_len(1)];
+    disc.metric_laplace(&cps, Operator::Scaled, 0.0, &mut st);
+    let mut k = disc.scalar.matrix(&st);
+    if far {
+        let n = k.nrows;
+        let eps = 1e-3 * (0..n).map(|i| k.get(i, i)).sum::<f64>() / n as f64;
+        let mut triplets: Vec<(usize, usize, f64)> =
+            (0..n).flat_map(|i| k.row(i).map(move |(j, v)| (i, j, v))).collect();
+        triplets.extend([(0, n - 1, eps), (n - 1, 0, eps)]);
+        k = crate::linalg::sparse::Csr::from_triplets(n, n, &triplets);
+    }
+    let p = crate::discrete::transfers::free_prolongation_factors(&disc)?;
+    crate::linalg::multigrid_kernels::Cycle::new(p, k)
+}

@@ -29,12 +29,12 @@ impl Rows for Csr {
 /// A grid operator (see the module documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct GridOperator {
-    nx: usize,
-    ny: usize,
+    pub(super) nx: usize,
+    pub(super) ny: usize,
     /// Half widths `[b_x, b_y]` of the stencil.
-    half: [usize; 2],
+    pub(super) half: [usize; 2],
     /// Row `i`'s value of the coupling `(dx, dy)` at `(i w_y + dy + b_y) w_x + dx + b_x`.
-    values: Vec<f32>,
+    pub(super) values: Vec<f32>,
 }
 
 /// Rows per parallel task of [`GridOperator::mul_vec`].

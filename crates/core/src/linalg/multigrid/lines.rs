@@ -24,18 +24,18 @@ use crate::linalg::sparse::Csr;
 #[derive(Debug, Clone)]
 pub struct Lines {
     /// First unknown of each line.
-    starts: Vec<usize>,
+    pub(super) starts: Vec<usize>,
     /// Distance between consecutive unknowns of a line.
-    stride: usize,
+    pub(super) stride: usize,
     /// Unknowns per line.
-    len: usize,
+    pub(super) len: usize,
     /// Bandwidth of each line's block.
-    bw: usize,
+    pub(super) bw: usize,
     /// Banded Cholesky factors, line after line: `l[(L len + t)(bw + 1) + d] = L[t][t - d]`.
-    factors: Vec<f64>,
+    pub(super) factors: Vec<f64>,
     /// Colours of [`Lines::sweep_coloured`]: one more than the farthest coupling between
     /// two lines (at most the number of lines).
-    colours: usize,
+    pub(super) colours: usize,
 }
 
 impl Lines {

@@ -20,6 +20,8 @@
 //! smoothed levels are held as stencils of `f32` values without column indices
 //! ([`grid`]), a quarter of the CSR storage and of the memory traffic of a sweep.
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
@@ -28,10 +30,12 @@ use crate::linalg::krylov::Ilu0;
 use crate::linalg::sparse::Csr;
 
 mod grid;
+pub mod kernels;
 mod lines;
 mod tensor;
 
 use grid::{GridOperator, Rows};
+use kernels::{CycleBackend, DeviceCycle};
 use lines::{grid_width, Lines};
 pub(crate) use tensor::TensorProlongation;
 
@@ -79,6 +83,10 @@ pub(crate) struct Multigrid {
     coarse: DenseCholesky,
     smoother: Smoother,
     sweeps: usize,
+    /// Where the level work runs after each set-up ([`kernels`]; `None`: the CPU) ...
+    backend: Option<Arc<dyn CycleBackend>>,
+    /// ... and the cycle uploaded there.
+    device: Option<Box<dyn DeviceCycle>>,
 }
 
 /// `P^T A P`, one coarse row at a time (in parallel): `t = (P^T)_i A`, a sparse row of
@@ -173,6 +181,8 @@ impl Multigrid {
             coarse: DenseCholesky::default(),
             smoother,
             sweeps: sweeps.max(1),
+            backend: None,
+            device: None,
         }
     }
 
@@ -249,6 +259,7 @@ impl Multigrid {
             }
         }
         self.operators = operators;
+        self.upload();
         Ok(())
     }
 
@@ -259,10 +270,20 @@ impl Multigrid {
         self.lines = Vec::new();
         self.ilu = Vec::new();
         self.diagonals = Vec::new();
+        self.device = None;
     }
 
-    /// `x = B b`, one V-cycle from `x = 0` (`B ≈ A^{-1}`).
+    /// `x = B b`, one V-cycle from `x = 0` (`B ≈ A^{-1}`): on the back end the cycle
+    /// was uploaded to, the CPU where there is none or it fails.
     pub fn apply(&self, b: &[f64], x: &mut [f64]) {
+        if self.device.as_ref().is_some_and(|d| d.apply(b, x).is_ok()) {
+            return;
+        }
+        self.apply_cpu(b, x);
+    }
+
+    /// [`Multigrid::apply`] on the CPU.
+    fn apply_cpu(&self, b: &[f64], x: &mut [f64]) {
         x.fill(0.0);
         self.cycle(0, b, x);
     }

@@ -17,9 +17,9 @@ use crate::linalg::sparse::Csr;
 #[derive(Debug, Clone, Default)]
 pub(crate) struct TensorProlongation {
     /// `[P_0, P_1]`, each `n^f_d x n^c_d`.
-    factors: [Csr; 2],
+    pub(super) factors: [Csr; 2],
     /// `[P_0^T, P_1^T]`.
-    transposes: [Csr; 2],
+    pub(super) transposes: [Csr; 2],
 }
 
 /// Rows per parallel task of a pass.

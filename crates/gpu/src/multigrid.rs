@@ -1,0 +1,494 @@
+//! The multigrid V-cycle's level work on the GPU ([`GpuCycles`], the core's
+//! [`CycleBackend`]): the kernels of `shaders/multigrid.wgsl` (stencil residual, coloured
+//! line Gauss–Seidel, the two 1D transfer passes, the coarsest dense solve).
+//!
+//! At each set-up of the cycle ([`CycleBackend::upload`]) the levels' stencils (`f32`,
+//! as the CPU holds them), the CSR levels, line factors, 1D transfer factors and the
+//! coarsest Cholesky factor (`f64`) go up once, and the whole V-cycle is recorded once
+//! as a list of dispatches ([`v_cycle`] over a recorder of the operations), each with its
+//! parameter record in one uniform buffer (dynamic offsets). Per application only the
+//! right-hand side goes up and `x_0` comes back: every level's `b`, `x`, `r` and the
+//! transfer scratch stay on the device (`f64`), the dispatches run in one submission.
+//! Needs `SHADER_F64`: without it the cycle stays on the CPU.
+//!
+//! Precision per buffer: `stencil` `f32` (the CPU's `GridOperator` values, widened
+//! before each product); `reals` (line factors, transfer factors, CSR level values,
+//! coarsest factor) and `vecs` (level vectors) `f64`; every sum in `f64`, in the CPU's
+//! order.
+
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use winslow::linalg::multigrid_kernels::{v_cycle, CycleBackend, DeviceCycle, Hierarchy, LevelKernels};
+
+use crate::assembler::Timings;
+use crate::device::Gpu;
+use crate::{GpuError, Precision};
+
+mod program;
+
+use program::{pack, Kernel, Layout, OpAt, Params, Recorder, Step, NONE};
+
+/// Cycles run on the GPU with their times, set-ups or cycles that fell back to the CPU,
+/// and the last GPU error.
+type CycleStats = (Timings, u64, Option<String>);
+
+/// Loop iterations one line's invocation may take on a software adapter: lavapipe cut
+/// an invocation of about 65 000 short, while lines of about 33 000 (513 unknowns on the
+/// stencil of degree 3) gave the CPU's bits. Longer lines keep the cycle on the CPU there.
+const SOFTWARE_LINE_WORK: u64 = 40_000;
+
+/// Bytes per parameter record in the uniform buffer (the dynamic-offset alignment).
+const RECORD: u64 = 256;
+
+/// The compiled kernels of `shaders/multigrid.wgsl`.
+#[derive(Debug)]
+pub(crate) struct MultigridKernels {
+    layout: wgpu::BindGroupLayout,
+    residual: wgpu::ComputePipeline,
+    line_smooth: wgpu::ComputePipeline,
+    transfer_rows: wgpu::ComputePipeline,
+    transfer_cols: wgpu::ComputePipeline,
+    coarse_solve: wgpu::ComputePipeline,
+}
+
+/// Compile the kernels (f64 only; see the module documentation).
+pub(crate) fn multigrid_kernels(device: &wgpu::Device) -> MultigridKernels {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("multigrid.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(crate::shader_source(crate::MULTIGRID_WGSL, Precision::F64).into()),
+    });
+    let buffer = |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: dynamic, min_binding_size: None },
+        count: None,
+    };
+    let ro = wgpu::BufferBindingType::Storage { read_only: true };
+    let entries = [
+        buffer(0, wgpu::BufferBindingType::Uniform, true),
+        buffer(1, ro, false),
+        buffer(2, ro, false),
+        buffer(3, ro, false),
+        buffer(4, wgpu::BufferBindingType::Storage { read_only: false }, false),
+    ];
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("multigrid.wgsl"),
+        entries: &entries,
+    });
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("multigrid.wgsl"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = |entry: &str| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    MultigridKernels {
+        residual: pipeline("residual"),
+        line_smooth: pipeline("line_smooth"),
+        transfer_rows: pipeline("transfer_rows"),
+        transfer_cols: pipeline("transfer_cols"),
+        coarse_solve: pipeline("coarse_solve"),
+        layout,
+    }
+}
+
+/// One operation of the cycle, run on its own ([`GpuCycle::run`], for tests).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Operation {
+    /// [`LevelKernels::smooth`]`(level, dir, backward)`.
+    Smooth(usize, usize, bool),
+    /// [`LevelKernels::residual`].
+    Residual(usize),
+    /// [`LevelKernels::restrict`].
+    Restrict(usize),
+    /// [`LevelKernels::prolong_add`].
+    ProlongAdd(usize),
+    /// [`LevelKernels::coarse_solve`].
+    CoarseSolve,
+}
+
+/// A level's vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Vector {
+    /// `b_l`.
+    B,
+    /// `x_l`.
+    X,
+    /// `r_l` (smoothed levels only).
+    R,
+}
+
+/// The GPU's cycle back end, shared by the assembler that hands it to the solver; counts
+/// the cycles run and the time they took.
+#[derive(Debug)]
+pub struct GpuCycles {
+    gpu: Arc<Gpu>,
+    stats: Arc<Mutex<CycleStats>>,
+}
+
+impl GpuCycles {
+    /// The back end on `gpu`; `None` without `SHADER_F64` (the cycle needs `f64`).
+    pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
+        gpu.multigrid.as_ref()?;
+        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))) })
+    }
+
+    /// Cycles run (`calls`) and their upload, dispatch and readback seconds; set-ups
+    /// that did not go to the GPU and the last reason.
+    pub fn stats(&self) -> (Timings, u64, Option<String>) {
+        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+    }
+
+    /// Zero the statistics.
+    pub fn reset_stats(&self) {
+        if let Ok(mut s) = self.stats.lock() {
+            *s = Default::default();
+        }
+    }
+
+    /// Upload `h` (see the module documentation).
+    ///
+    /// Errors: [`GpuError`] when the hierarchy does not fit the adapter's limits or wgpu
+    /// fails.
+    pub fn try_upload(&self, h: &Hierarchy<'_>) -> Result<GpuCycle, GpuError> {
+        let gpu = &self.gpu;
+        let kernels = gpu
+            .multigrid
+            .as_ref()
+            .ok_or_else(|| GpuError::NoAdapter(" with SHADER_F64 for the multigrid cycle".into()))?;
+        let (layout, packed) = pack(h)?;
+        let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+        for (what, bytes) in [
+            ("level vectors", 8 * layout.vec_len as u64),
+            ("factors", 8 * packed.reals.len() as u64),
+            ("indices", 4 * packed.idx.len() as u64),
+            ("stencils", 4 * packed.stencil.len() as u64),
+        ] {
+            if bytes > max {
+                return Err(GpuError::TooLarge(format!("multigrid {what}: {bytes} bytes, the adapter binds {max}")));
+            }
+        }
+        if gpu.is_software() {
+            for at in &layout.levels {
+                let (Some(OpAt::Stencil { bx, by, .. }), Some(lines)) = (at.op, at.lines) else { continue };
+                for d in lines {
+                    let per = (2 * by as u64 + 1) * (2 * bx as u64 + 2) + 2 * (d.bw as u64 + 1) + 1;
+                    if d.len as u64 * per > SOFTWARE_LINE_WORK {
+                        return Err(GpuError::TooLarge(format!(
+                            "multigrid lines of {} unknowns: more work than a software adapter runs in one invocation",
+                            d.len
+                        )));
+                    }
+                }
+            }
+        }
+        gpu.scoped(|| {
+            let mut rec = Recorder { layout: &layout, steps: Vec::new() };
+            let levels = layout.levels.len();
+            v_cycle(&mut rec, levels, layout.sweeps, 0);
+            let program = rec.steps;
+            let reals = gpu.storage_init("multigrid reals", bytemuck::cast_slice(&packed.reals));
+            let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx));
+            let stencil = gpu.storage_init("multigrid stencils", bytemuck::cast_slice(&packed.stencil));
+            let vecs = gpu.storage_init("multigrid vectors", &vec![0u8; 8 * layout.vec_len]);
+            let n0 = layout.levels[0].size as u64;
+            let staging = gpu.staging(8 * n0);
+            let (params, bind) = self.bind(kernels, &program, &reals, &idx, &stencil, &vecs);
+            gpu.submit_wait(None)?;
+            Ok(GpuCycle {
+                gpu: gpu.clone(),
+                stats: self.stats.clone(),
+                layout,
+                program,
+                buffers: Mutex::new(Buffers { reals, idx, stencil, vecs, staging, _params: params, bind }),
+            })
+        })
+    }
+
+    /// The uniform buffer of `steps`' parameter records and the bind group over it.
+    fn bind(
+        &self,
+        kernels: &MultigridKernels,
+        steps: &[Step],
+        reals: &wgpu::Buffer,
+        idx: &wgpu::Buffer,
+        stencil: &wgpu::Buffer,
+        vecs: &wgpu::Buffer,
+    ) -> (wgpu::Buffer, wgpu::BindGroup) {
+        let mut bytes = vec![0u8; (RECORD as usize) * steps.len().max(1)];
+        for (k, s) in steps.iter().enumerate() {
+            let p = bytemuck::bytes_of(&s.params);
+            bytes[k * RECORD as usize..][..p.len()].copy_from_slice(p);
+        }
+        let params = self.gpu.uniform("multigrid params", &bytes);
+        let bind = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("multigrid"),
+            layout: &kernels.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry { binding: 1, resource: reals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: idx.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: stencil.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: vecs.as_entire_binding() },
+            ],
+        });
+        (params, bind)
+    }
+
+    fn record(&self, f: impl FnOnce(&mut CycleStats)) {
+        if let Ok(mut s) = self.stats.lock() {
+            f(&mut s);
+        }
+    }
+}
+
+impl CycleBackend for GpuCycles {
+    fn upload(&self, h: &Hierarchy<'_>) -> winslow::Result<Box<dyn DeviceCycle>> {
+        match self.try_upload(h) {
+            Ok(c) => Ok(Box::new(c)),
+            Err(e) => {
+                eprintln!("warning: GPU multigrid set-up: {e}; the cycle runs on the CPU");
+                self.record(|s| {
+                    s.1 += 1;
+                    s.2 = Some(e.to_string());
+                });
+                Err(winslow::Error::LinearSolver(format!("GPU multigrid set-up: {e}")))
+            }
+        }
+    }
+}
+
+/// The device buffers of an uploaded cycle.
+#[derive(Debug)]
+struct Buffers {
+    reals: wgpu::Buffer,
+    idx: wgpu::Buffer,
+    stencil: wgpu::Buffer,
+    vecs: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    /// The parameter records `bind` reads.
+    _params: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+/// A V-cycle uploaded to the GPU (see the module documentation).
+#[derive(Debug)]
+pub struct GpuCycle {
+    gpu: Arc<Gpu>,
+    stats: Arc<Mutex<CycleStats>>,
+    layout: Layout,
+    program: Vec<Step>,
+    /// Held while a call uses the buffers.
+    buffers: Mutex<Buffers>,
+}
+
+impl GpuCycle {
+    /// Dispatches of one V-cycle.
+    pub fn dispatches(&self) -> usize {
+        self.program.len()
+    }
+
+    fn kernels(&self) -> Result<&MultigridKernels, GpuError> {
+        self.gpu.multigrid.as_ref().ok_or_else(|| GpuError::Wgpu("multigrid kernels missing".into()))
+    }
+
+    fn lock(&self) -> Result<std::sync::MutexGuard<'_, Buffers>, GpuError> {
+        self.buffers.lock().map_err(|e| GpuError::Wgpu(e.to_string()))
+    }
+
+    /// Offset and length of vector `v` of level `l`.
+    fn place(&self, v: Vector, l: usize) -> Result<(u64, usize), GpuError> {
+        let at = self.layout.levels.get(l).ok_or_else(|| GpuError::Wgpu(format!("no level {l}")))?;
+        let off = match v {
+            Vector::B => at.b,
+            Vector::X => at.x,
+            Vector::R => at.r,
+        };
+        if off == NONE {
+            return Err(GpuError::Wgpu(format!("level {l} has no {v:?}")));
+        }
+        Ok((off as u64 * 8, at.size as usize))
+    }
+
+    /// Write vector `v` of level `l`.
+    ///
+    /// Errors: a level or vector that does not exist, a length that does not match.
+    pub fn write(&self, v: Vector, l: usize, values: &[f64]) -> Result<(), GpuError> {
+        let (off, n) = self.place(v, l)?;
+        if values.len() != n {
+            return Err(GpuError::Wgpu(format!("{} values for a level of {n}", values.len())));
+        }
+        let b = self.lock()?;
+        self.gpu.queue.write_buffer(&b.vecs, off, bytemuck::cast_slice(values));
+        self.gpu.submit_wait(None)
+    }
+
+    /// Read vector `v` of level `l`.
+    ///
+    /// Errors: as [`GpuCycle::write`], and wgpu's.
+    pub fn read(&self, v: Vector, l: usize) -> Result<Vec<f64>, GpuError> {
+        let (off, n) = self.place(v, l)?;
+        let b = self.lock()?;
+        let staging = self.gpu.staging(8 * n as u64);
+        let mut out = vec![0.0; n];
+        self.read_back(&b.vecs, off, &staging, &mut out, None)?;
+        Ok(out)
+    }
+
+    /// Run one operation on the vectors as they are on the device.
+    ///
+    /// Errors: wgpu's.
+    pub fn run(&self, op: Operation) -> Result<(), GpuError> {
+        let mut rec = Recorder { layout: &self.layout, steps: Vec::new() };
+        match op {
+            Operation::Smooth(l, dir, backward) => rec.smooth(l, dir, backward),
+            Operation::Residual(l) => rec.residual(l),
+            Operation::Restrict(l) => rec.restrict(l),
+            Operation::ProlongAdd(l) => rec.prolong_add(l),
+            Operation::CoarseSolve => rec.coarse_solve(),
+        }
+        let steps = rec.steps;
+        let b = self.lock()?;
+        let cycles = GpuCycles { gpu: self.gpu.clone(), stats: self.stats.clone() };
+        self.gpu.scoped(|| {
+            let (_params, bind) = cycles.bind(self.kernels()?, &steps, &b.reals, &b.idx, &b.stencil, &b.vecs);
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            self.encode(&mut enc, &steps, &bind)?;
+            self.gpu.submit_wait(Some(enc.finish()))
+        })
+    }
+
+    /// Record `steps`, each dispatch in its own compute pass (so that it sees the writes
+    /// of the ones before it).
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, steps: &[Step], bind: &wgpu::BindGroup) -> Result<(), GpuError> {
+        let k = self.kernels()?;
+        let max = self.gpu.limits.max_compute_workgroups_per_dimension.max(1) as u64;
+        for (n, s) in steps.iter().enumerate() {
+            let count = s.params.count as u64;
+            if count == 0 {
+                continue;
+            }
+            let (pipeline, per_group) = match s.kernel {
+                Kernel::Residual => (&k.residual, 64),
+                Kernel::LineSmooth => (&k.line_smooth, 64),
+                Kernel::TransferRows => (&k.transfer_rows, 64),
+                Kernel::TransferCols => (&k.transfer_cols, 64),
+                Kernel::CoarseSolve => (&k.coarse_solve, 1),
+            };
+            let groups = count.div_ceil(per_group);
+            let x = groups.min(max);
+            let y = groups.div_ceil(x);
+            if y > max {
+                return Err(GpuError::TooLarge(format!("{count} invocations in one dispatch")));
+            }
+            // a pass per dispatch: the writes of one are visible to the next
+            let mut pass = enc
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("multigrid"), timestamp_writes: None });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[(n as u64 * RECORD) as u32]);
+            pass.dispatch_workgroups(x as u32, y as u32, 1);
+        }
+        Ok(())
+    }
+
+    /// Copy `out.len()` reals at byte `off` of `src` into `out` through `staging`, after
+    /// `enc`'s commands when given.
+    fn read_back(
+        &self,
+        src: &wgpu::Buffer,
+        off: u64,
+        staging: &wgpu::Buffer,
+        out: &mut [f64],
+        enc: Option<wgpu::CommandEncoder>,
+    ) -> Result<(), GpuError> {
+        let bytes = 8 * out.len() as u64;
+        if bytes == 0 {
+            return Ok(());
+        }
+        let mut enc = enc.unwrap_or_else(|| self.gpu.device.create_command_encoder(&Default::default()));
+        enc.copy_buffer_to_buffer(src, off, staging, 0, bytes);
+        self.gpu.submit_wait(Some(enc.finish()))?;
+        let slice = staging.slice(0..bytes);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            // the receiver lives until after the poll below
+            let _ = tx.send(r);
+        });
+        self.gpu
+            .device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
+            .map_err(|e| GpuError::Wgpu(e.to_string()))?;
+        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        {
+            let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+            let data = &view[..bytes as usize];
+            match bytemuck::try_cast_slice::<u8, f64>(data) {
+                Ok(v) => out.copy_from_slice(v),
+                Err(_) => out.copy_from_slice(&bytemuck::pod_collect_to_vec::<u8, f64>(data)),
+            }
+        }
+        staging.unmap();
+        Ok(())
+    }
+
+    /// `x = B b`: one V-cycle on the device from `x_0 = 0`.
+    ///
+    /// Errors: a length that does not match the finest level, and wgpu's.
+    pub fn try_apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), GpuError> {
+        let at = self.layout.levels[0];
+        let n = at.size as usize;
+        if b.len() != n || x.len() != n {
+            return Err(GpuError::Wgpu(format!("{} / {} values for a cycle of {n}", b.len(), x.len())));
+        }
+        let buf = self.lock()?;
+        let mut t = Timings { calls: 1, ..Default::default() };
+        let t0 = Instant::now();
+        self.gpu.scoped(|| {
+            self.gpu.queue.write_buffer(&buf.vecs, at.b as u64 * 8, bytemuck::cast_slice(b));
+            t.bytes_up += 8 * n as u64;
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            enc.clear_buffer(&buf.vecs, at.x as u64 * 8, Some(8 * n as u64));
+            self.encode(&mut enc, &self.program, &buf.bind)?;
+            self.gpu.submit_wait(Some(enc.finish()))?;
+            t.dispatch += t0.elapsed().as_secs_f64();
+            let t1 = Instant::now();
+            self.read_back(&buf.vecs, at.x as u64 * 8, &buf.staging, x, None)?;
+            t.readback += t1.elapsed().as_secs_f64();
+            t.bytes_down += 8 * n as u64;
+            Ok(())
+        })?;
+        if let Ok(mut s) = self.stats.lock() {
+            s.0.add(&t);
+        }
+        Ok(())
+    }
+}
+
+impl DeviceCycle for GpuCycle {
+    fn apply(&self, b: &[f64], x: &mut [f64]) -> winslow::Result<()> {
+        self.try_apply(b, x).map_err(|e| {
+            eprintln!("warning: GPU multigrid cycle: {e}; this cycle runs on the CPU");
+            if let Ok(mut s) = self.stats.lock() {
+                s.1 += 1;
+                s.2 = Some(e.to_string());
+            }
+            winslow::Error::LinearSolver(format!("GPU multigrid cycle: {e}"))
+        })
+    }
+}

@@ -1,0 +1,361 @@
+//! The recorded V-cycle of [`super::GpuCycles`]: the layout of an uploaded hierarchy in
+//! the kernels' buffers ([`pack`]), the parameter record of each dispatch ([`Params`],
+//! `Params` in `shaders/multigrid.wgsl`) and the recorder that turns the core's cycle
+//! operations ([`LevelKernels`], strung together by `v_cycle`) into dispatches.
+
+use winslow::linalg::multigrid_kernels::{Hierarchy, LevelKernels, LevelOperator, LineBlocks};
+use winslow::linalg::sparse::Csr;
+
+use crate::GpuError;
+
+/// The parameter record of `multigrid.wgsl` (all `u32`; `Params` there).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct Params {
+    pub(super) count: u32,
+    pub(super) op_kind: u32,
+    pub(super) nx: u32,
+    pub(super) ny: u32,
+    pub(super) bx: u32,
+    pub(super) by: u32,
+    pub(super) st_off: u32,
+    pub(super) csr_ptr: u32,
+    pub(super) csr_col: u32,
+    pub(super) csr_val: u32,
+    pub(super) b_off: u32,
+    pub(super) x_off: u32,
+    pub(super) r_off: u32,
+    pub(super) l_starts: u32,
+    pub(super) l_stride: u32,
+    pub(super) l_len: u32,
+    pub(super) l_bw: u32,
+    pub(super) l_fac: u32,
+    pub(super) l_first: u32,
+    pub(super) l_step: u32,
+    pub(super) a_ptr: u32,
+    pub(super) a_col: u32,
+    pub(super) a_val: u32,
+    pub(super) m0: u32,
+    pub(super) n0: u32,
+    pub(super) in_off: u32,
+    pub(super) out_off: u32,
+    pub(super) t_off: u32,
+    pub(super) accumulate: u32,
+    pub(super) zero_off: u32,
+    pub(super) cn: u32,
+    pub(super) c_fac: u32,
+    pub(super) c_lo: u32,
+    pub(super) c_hi: u32,
+    pub(super) c_phase: u32,
+    pub(super) c_pad: u32,
+}
+
+/// `NONE` of the shader: no vector to zero.
+pub(super) const NONE: u32 = u32::MAX;
+/// Multiply-adds per dispatch of the coarsest solve (one invocation): lavapipe cut a
+/// single invocation of the whole solve at 289 unknowns (about 65 000 loop iterations)
+/// short, so it runs in row blocks of about this much work.
+const COARSE_WORK: usize = 4096;
+
+/// Which kernel a recorded step runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kernel {
+    Residual,
+    LineSmooth,
+    TransferRows,
+    TransferCols,
+    CoarseSolve,
+}
+
+/// One dispatch of the recorded cycle.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Step {
+    pub(super) kernel: Kernel,
+    pub(super) params: Params,
+}
+
+/// Where a level's operator lives.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum OpAt {
+    Stencil { nx: u32, ny: u32, bx: u32, by: u32, st_off: u32 },
+    Csr { ptr: u32, col: u32, val: u32 },
+}
+
+/// Where a direction's lines live.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LinesAt {
+    pub(super) starts: u32,
+    pub(super) stride: u32,
+    pub(super) len: u32,
+    pub(super) bw: u32,
+    pub(super) fac: u32,
+    pub(super) colours: u32,
+    pub(super) count: u32,
+}
+
+/// A 1D factor in `idx` / `reals`: row pointers, columns, values, rows, columns.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FactorAt {
+    pub(super) ptr: u32,
+    pub(super) col: u32,
+    pub(super) val: u32,
+    pub(super) rows: u32,
+    pub(super) cols: u32,
+}
+
+/// Offsets of everything a level's operations read and write.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LevelAt {
+    pub(super) size: u32,
+    pub(super) b: u32,
+    pub(super) x: u32,
+    pub(super) r: u32,
+    pub(super) op: Option<OpAt>,
+    pub(super) lines: Option<[LinesAt; 2]>,
+}
+
+/// The layout of an uploaded hierarchy.
+#[derive(Debug, Clone)]
+pub(super) struct Layout {
+    pub(super) levels: Vec<LevelAt>,
+    /// Per transfer: `[P_0, P_1]` and `[P_0^T, P_1^T]`.
+    pub(super) transfers: Vec<([FactorAt; 2], [FactorAt; 2])>,
+    pub(super) coarse_fac: u32,
+    pub(super) t_off: u32,
+    pub(super) vec_len: usize,
+    pub(super) sweeps: usize,
+}
+
+fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
+    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("multigrid {what} = {v} exceeds 32 bits")))
+}
+
+/// The host copies of the uploaded buffers, being built.
+#[derive(Default)]
+pub(super) struct Packed {
+    pub(super) reals: Vec<f64>,
+    pub(super) idx: Vec<u32>,
+    pub(super) stencil: Vec<f32>,
+}
+
+impl Packed {
+    fn csr(&mut self, a: &Csr) -> Result<FactorAt, GpuError> {
+        let ptr = to_u32(self.idx.len(), "index")?;
+        for &p in &a.row_ptr {
+            self.idx.push(to_u32(p, "row pointer")?);
+        }
+        let col = to_u32(self.idx.len(), "index")?;
+        for &c in &a.col_idx {
+            self.idx.push(to_u32(c, "column")?);
+        }
+        let val = to_u32(self.reals.len(), "real")?;
+        self.reals.extend_from_slice(&a.values);
+        Ok(FactorAt { ptr, col, val, rows: to_u32(a.nrows, "rows")?, cols: to_u32(a.ncols, "columns")? })
+    }
+
+    fn lines(&mut self, l: &LineBlocks<'_>) -> Result<LinesAt, GpuError> {
+        let starts = to_u32(self.idx.len(), "index")?;
+        for &s in l.starts {
+            self.idx.push(to_u32(s, "line start")?);
+        }
+        let fac = to_u32(self.reals.len(), "real")?;
+        self.reals.extend_from_slice(l.factors);
+        Ok(LinesAt {
+            starts,
+            stride: to_u32(l.stride, "stride")?,
+            len: to_u32(l.len, "line length")?,
+            bw: to_u32(l.bandwidth, "bandwidth")?,
+            fac,
+            colours: to_u32(l.colours.max(1), "colours")?,
+            count: to_u32(l.starts.len(), "lines")?,
+        })
+    }
+}
+
+/// Pack `h` into the three read-only buffers and lay out the vectors.
+pub(super) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
+    let mut p = Packed::default();
+    let mut levels = Vec::new();
+    let mut off = 0usize;
+    for (l, (op, lines)) in h.levels.iter().enumerate() {
+        let n = op.size();
+        let op = match *op {
+            LevelOperator::Stencil { nx, ny, half, values } => {
+                let st_off = to_u32(p.stencil.len(), "stencil offset")?;
+                p.stencil.extend_from_slice(values);
+                OpAt::Stencil {
+                    nx: to_u32(nx, "grid width")?,
+                    ny: to_u32(ny, "grid height")?,
+                    bx: to_u32(half[0], "half width")?,
+                    by: to_u32(half[1], "half width")?,
+                    st_off,
+                }
+            }
+            LevelOperator::Csr(a) => {
+                let f = p.csr(a)?;
+                OpAt::Csr { ptr: f.ptr, col: f.col, val: f.val }
+            }
+        };
+        let lines = [p.lines(&lines[0])?, p.lines(&lines[1])?];
+        let at = |k: usize| to_u32(off + k * n, "vector offset");
+        levels.push(LevelAt {
+            size: to_u32(n, "level size")?,
+            b: at(0)?,
+            x: at(1)?,
+            r: at(2)?,
+            op: Some(op),
+            lines: Some(lines),
+        });
+        off += 3 * n;
+        debug_assert_eq!(n, h.size(l));
+    }
+    let (cn, cfac) = h.coarse;
+    levels.push(LevelAt {
+        size: to_u32(cn, "coarsest size")?,
+        b: to_u32(off, "vector offset")?,
+        x: to_u32(off + cn, "vector offset")?,
+        r: NONE,
+        op: None,
+        lines: None,
+    });
+    off += 2 * cn;
+    let coarse_fac = to_u32(p.reals.len(), "real")?;
+    p.reals.extend_from_slice(cfac);
+    let mut transfers = Vec::new();
+    let mut t_len = 0usize;
+    for t in &h.transfers {
+        let pro = [p.csr(t.prolongation[0])?, p.csr(t.prolongation[1])?];
+        let res = [p.csr(t.restriction[0])?, p.csr(t.restriction[1])?];
+        // t of a pass: n_1 m_0 values
+        t_len = t_len.max(pro[1].cols as usize * pro[0].rows as usize).max(res[1].cols as usize * res[0].rows as usize);
+        transfers.push((pro, res));
+    }
+    let t_off = to_u32(off, "vector offset")?;
+    let vec_len = off + t_len;
+    to_u32(vec_len, "vector length")?;
+    Ok((Layout { levels, transfers, coarse_fac, t_off, vec_len, sweeps: h.sweeps }, p))
+}
+
+/// Records the dispatches of [`LevelKernels`] operations.
+pub(super) struct Recorder<'a> {
+    pub(super) layout: &'a Layout,
+    pub(super) steps: Vec<Step>,
+}
+
+impl Recorder<'_> {
+    fn level(&self, l: usize) -> Params {
+        let at = &self.layout.levels[l];
+        let mut p = Params { b_off: at.b, x_off: at.x, r_off: at.r, zero_off: NONE, ..Default::default() };
+        match at.op {
+            Some(OpAt::Stencil { nx, ny, bx, by, st_off }) => {
+                (p.op_kind, p.nx, p.ny, p.bx, p.by, p.st_off) = (0, nx, ny, bx, by, st_off);
+            }
+            Some(OpAt::Csr { ptr, col, val }) => {
+                (p.op_kind, p.csr_ptr, p.csr_col, p.csr_val) = (1, ptr, col, val);
+            }
+            None => {}
+        }
+        p
+    }
+
+    /// `out = (a_1 ⊗ a_0) in` (added when `accumulate`), `zero` zeroed.
+    fn kron(&mut self, a: [FactorAt; 2], input: u32, out: u32, accumulate: bool, zero: u32) {
+        let t_off = self.layout.t_off;
+        let base = Params { m0: a[0].rows, n0: a[0].cols, in_off: input, out_off: out, t_off, ..Default::default() };
+        let rows = Params {
+            count: a[1].cols * a[0].rows,
+            a_ptr: a[0].ptr,
+            a_col: a[0].col,
+            a_val: a[0].val,
+            zero_off: NONE,
+            ..base
+        };
+        self.steps.push(Step { kernel: Kernel::TransferRows, params: rows });
+        let cols = Params {
+            count: a[1].rows * a[0].rows,
+            a_ptr: a[1].ptr,
+            a_col: a[1].col,
+            a_val: a[1].val,
+            accumulate: accumulate as u32,
+            zero_off: zero,
+            ..base
+        };
+        self.steps.push(Step { kernel: Kernel::TransferCols, params: cols });
+    }
+}
+
+impl LevelKernels for Recorder<'_> {
+    fn smooth(&mut self, l: usize, dir: usize, backward: bool) {
+        let Some(lines) = self.layout.levels[l].lines.map(|ls| ls[dir]) else { return };
+        if lines.len == 0 {
+            return;
+        }
+        let c = lines.colours;
+        let colours: Vec<u32> = if backward { (0..c).rev().collect() } else { (0..c).collect() };
+        for k in colours {
+            let count = (lines.count - k).div_ceil(c);
+            let params = Params {
+                count,
+                l_starts: lines.starts,
+                l_stride: lines.stride,
+                l_len: lines.len,
+                l_bw: lines.bw,
+                l_fac: lines.fac,
+                l_first: k,
+                l_step: c,
+                ..self.level(l)
+            };
+            self.steps.push(Step { kernel: Kernel::LineSmooth, params });
+        }
+    }
+
+    fn residual(&mut self, l: usize) {
+        let params = Params { count: self.layout.levels[l].size, ..self.level(l) };
+        self.steps.push(Step { kernel: Kernel::Residual, params });
+    }
+
+    fn restrict(&mut self, l: usize) {
+        let (fine, coarse) = (self.layout.levels[l], self.layout.levels[l + 1]);
+        let a = self.layout.transfers[l].1;
+        self.kron(a, fine.r, coarse.b, false, coarse.x);
+    }
+
+    fn prolong_add(&mut self, l: usize) {
+        let (fine, coarse) = (self.layout.levels[l], self.layout.levels[l + 1]);
+        let a = self.layout.transfers[l].0;
+        self.kron(a, coarse.x, fine.x, true, NONE);
+    }
+
+    fn coarse_solve(&mut self) {
+        let c = self.layout.levels.len() - 1;
+        let at = self.layout.levels[c];
+        let base = Params {
+            count: 1,
+            cn: at.size,
+            c_fac: self.layout.coarse_fac,
+            b_off: at.b,
+            x_off: at.x,
+            ..Default::default()
+        };
+        let n = at.size;
+        // forward: row i costs i multiply-adds; backward: n - 1 - i
+        for phase in [0u32, 1] {
+            let mut lo = 0u32;
+            while lo < n {
+                let (mut hi, mut work) = (lo, 0usize);
+                while hi < n && (hi == lo || work < COARSE_WORK) {
+                    work += if phase == 0 { hi as usize } else { (n - 1 - hi) as usize } + 1;
+                    hi += 1;
+                }
+                let params = Params { c_lo: lo, c_hi: hi, c_phase: phase, ..base };
+                self.steps.push(Step { kernel: Kernel::CoarseSolve, params });
+                lo = hi;
+            }
+        }
+        // the backward blocks run from the last rows to the first
+        let first_back = self.steps.iter().rposition(|s| s.kernel == Kernel::CoarseSolve && s.params.c_phase == 0);
+        if let Some(k) = first_back {
+            self.steps[k + 1..].reverse();
+        }
+    }
+}
