@@ -111,7 +111,7 @@ pub(crate) const AUTO_MAX_KRYLOV: usize = 500;
 /// "Multigrid", the test
 /// `discrete::transfers::tests::multigrid_reduction_is_independent_of_h`). One direction's
 /// lines on each side of the coarse correction ([`Smoother::SplitColouredLines`]: 13/7
-/// passes over each level's stencil per cycle against 5) took 0.79-0.93 times the CPU of
+/// passes over each level's stencil per cycle against 5) took 0.78-0.93 times the CPU of
 /// both directions on each side at refine 4 of wavy_lid, male_rotor and puzzle4, with
 /// 0-33 % more GMRES iterations (BENCHMARKS.md "Half the sweeps"); its cycle is not
 /// symmetric, which flexible GMRES, the only Krylov method it preconditions, allows.

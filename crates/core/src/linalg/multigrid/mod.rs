@@ -60,6 +60,7 @@ pub(crate) enum Smoother {
     /// `l mod (w + 1)`, `w` the farthest coupling across the lines: 4 colours at degree
     /// 3): the lines of one colour do not couple, their corrections are computed in
     /// parallel ([`lines::Lines::sweep_coloured`]).
+    #[cfg_attr(not(test), allow(dead_code))]
     ColouredLines,
     /// [`Smoother::ColouredLines`] with one direction on each side of the coarse
     /// correction: the lines of direction 0 (forward) before it, those of direction 1
