@@ -58,7 +58,8 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 /// [`MULTIGRID_BYTES_PER_UNKNOWN`] fitted to the peaks (`VmHWM`, dev profile, one
 /// geometry per process) of wavy_lid (degrees 3 x 2), male_rotor (3) and puzzle4 (2) at
 /// `--refine 4` and `5` (70 k to 541 k unknowns) under the split line smoother: measured
-/// over estimated 0.91-1.07 (800 and 14 before overestimated puzzle4's degree-2 peaks
+/// over estimated 0.91-1.07, quarter_annulus at 918 k 0.90, wavy_lid at 4 k to 70 k
+/// 0.99-1.02 (800 and 14 before overestimated puzzle4's degree-2 peaks
 /// by up to 1.3x; BENCHMARKS.md, "Half the sweeps").
 pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 19;
 
