@@ -9,8 +9,9 @@ use common::{bin, data};
 
 /// The estimated peak within 2x of the measured one at three sizes of wavy_lid (4 400 to
 /// 70 000 unknowns; each size its own process, so that one's peak is not the next's),
-/// with the default linear solver and with the multigrid preconditioner (`--linear
-/// multigrid`, its own model in `winslow::solve::memory`).
+/// with the default linear solver, and within 1.5x with the multigrid preconditioner
+/// (`--linear multigrid`, its own model in `winslow::solve::memory`, fitted to its peaks:
+/// 0.99-1.02 on these three).
 #[test]
 fn the_estimate_is_within_2x_of_the_measured_peak() {
     for linear in ["auto", "multigrid"] {
@@ -25,7 +26,8 @@ fn the_estimate_is_within_2x_of_the_measured_peak() {
             let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
             let (peak, estimate) = (row["peak_mib"].as_f64().unwrap(), row["estimated_mib"].as_f64().unwrap());
             let ratio = peak / estimate;
-            assert!((0.5..=2.0).contains(&ratio), "{at}: peak {peak:.1} MiB, estimate {estimate:.1} MiB");
+            let within = if linear == "multigrid" { 1.5 } else { 2.0 };
+            assert!((1.0 / within..=within).contains(&ratio), "{at}: peak {peak:.1} MiB, estimate {estimate:.1} MiB");
             assert_eq!(row["verdict"], "certified", "{at}");
         }
     }

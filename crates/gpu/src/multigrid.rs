@@ -194,7 +194,7 @@ impl GpuCycles {
         gpu.scoped(|| {
             let mut rec = Recorder { layout: &layout, steps: Vec::new() };
             let levels = layout.levels.len();
-            v_cycle(&mut rec, levels, layout.sweeps, 0);
+            v_cycle(&mut rec, levels, layout.smoothing, 0);
             let program = rec.steps;
             let reals = gpu.storage_init("multigrid reals", bytemuck::cast_slice(&packed.reals));
             let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx));

@@ -298,14 +298,15 @@ mod tests {
     #[test]
     fn multigrid_reduction_is_independent_of_h() {
         let sizes = [32, 64, 128];
-        let lines = [Smoother::ColouredLines, Smoother::Lines];
+        let lines = [Smoother::ColouredLines, Smoother::Lines, Smoother::SplitColouredLines];
         assert!(lines.contains(&crate::linalg::linsolve::MG_SMOOTHER));
         for t in [3.0, 0.03] {
-            for smoother in [Smoother::ColouredLines, Smoother::Lines, Smoother::SymmetricGaussSeidel, Smoother::Ilu0] {
+            for smoother in lines.into_iter().chain([Smoother::SymmetricGaussSeidel, Smoother::Ilu0]) {
                 let rho: Vec<f64> = sizes.iter().map(|&ne| reduction(ne, t, smoother, 8)).collect();
                 eprintln!("t = {t}, {smoother:?}: reduction per cycle {rho:?} on {sizes:?} elements");
                 let bound = match smoother {
                     Smoother::Lines | Smoother::ColouredLines => 0.6,
+                    Smoother::SplitColouredLines => 0.8,
                     Smoother::SymmetricGaussSeidel if t > 1.0 => 0.99,
                     _ => continue,
                 };

@@ -110,8 +110,13 @@ pub(crate) const AUTO_MAX_KRYLOV: usize = 500;
 /// its CPU time within 1-3 % on 2 threads (where the two components of `-diag(B, B)`
 /// already fill both), and uses more threads where there are more (BENCHMARKS.md
 /// "Multigrid", the test
-/// `discrete::transfers::tests::multigrid_reduction_is_independent_of_h`).
-pub(crate) const MG_SMOOTHER: Smoother = Smoother::ColouredLines;
+/// `discrete::transfers::tests::multigrid_reduction_is_independent_of_h`). One direction's
+/// lines on each side of the coarse correction ([`Smoother::SplitColouredLines`]: 13/7
+/// passes over each level's stencil per cycle against 5) took 0.78-0.93 times the CPU of
+/// both directions on each side at refine 4 of wavy_lid, male_rotor and puzzle4, with
+/// 0-33 % more GMRES iterations (BENCHMARKS.md "Half the sweeps"); its cycle is not
+/// symmetric, which flexible GMRES, the only Krylov method it preconditions, allows.
+pub(crate) const MG_SMOOTHER: Smoother = Smoother::SplitColouredLines;
 
 /// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
 pub(crate) const MG_SWEEPS: usize = 1;

@@ -55,17 +55,21 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 /// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
 /// gather map and the metric Laplacian `K` in CSR, held once (by the V-cycle), with its
 /// line factors and coarse levels; the transfers are 1D factors. With
-/// [`MULTIGRID_BYTES_PER_UNKNOWN`] chosen on the peaks (`VmHWM`, dev profile, one
-/// geometry per process) of wavy_lid, male_rotor and puzzle4 at `--refine 4` and `5`
-/// (70 k to 541 k unknowns) with `K` held once: measured over estimated 0.86-1.14
-/// (BENCHMARKS.md, "Peak memory per unknown: `K` held once").
-pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 14;
+/// [`MULTIGRID_BYTES_PER_UNKNOWN`] fitted to the peaks (`VmHWM`, dev profile, one
+/// geometry per process) of wavy_lid (degrees 3 x 2), male_rotor (3) and puzzle4 (2) at
+/// `--refine 4` and `5` (70 k to 541 k unknowns) under the split line smoother: measured
+/// over estimated 0.91-1.07, quarter_annulus at 918 k 0.90, wavy_lid at 4 k to 70 k
+/// 0.99-1.02 (800 and 14 before overestimated puzzle4's degree-2 peaks
+/// by up to 1.3x; BENCHMARKS.md, "Half the sweeps").
+pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 19;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see
 /// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
-/// iteration, up to 100), the vectors of a Newton step, and the single-precision
-/// Cholesky factors of the elasticity prolongation's two diagonal blocks.
-pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 800;
+/// iteration, 16 B per unknown and iteration: 200-370 B at the 12-23 iterations these
+/// solves take at most), the vectors of a Newton step, and the single-precision
+/// Cholesky factors of the elasticity prolongation's two diagonal blocks; the fit puts
+/// the part that grows with the stencil in the per-nonzero weight.
+pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 300;
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB

@@ -3,7 +3,7 @@
 //! `Params` in `shaders/multigrid.wgsl`) and the recorder that turns the core's cycle
 //! operations ([`LevelKernels`], strung together by `v_cycle`) into dispatches.
 
-use winslow::linalg::multigrid_kernels::{Hierarchy, LevelKernels, LevelOperator, LineBlocks};
+use winslow::linalg::multigrid_kernels::{Hierarchy, LevelKernels, LevelOperator, LineBlocks, Smoothing};
 use winslow::linalg::sparse::Csr;
 
 use crate::GpuError;
@@ -123,7 +123,7 @@ pub(super) struct Layout {
     pub(super) coarse_fac: u32,
     pub(super) t_off: u32,
     pub(super) vec_len: usize,
-    pub(super) sweeps: usize,
+    pub(super) smoothing: Smoothing,
 }
 
 fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
@@ -233,7 +233,7 @@ pub(super) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
     let t_off = to_u32(off, "vector offset")?;
     let vec_len = off + t_len;
     to_u32(vec_len, "vector length")?;
-    Ok((Layout { levels, transfers, coarse_fac, t_off, vec_len, sweeps: h.sweeps }, p))
+    Ok((Layout { levels, transfers, coarse_fac, t_off, vec_len, smoothing: h.smoothing }, p))
 }
 
 /// Records the dispatches of [`LevelKernels`] operations.

@@ -97,6 +97,47 @@ impl GridOperator {
         sum
     }
 
+    /// Half width of the stencil across the lines of direction `dir` (direction 0: the
+    /// lines are the grid's rows, `b_y`; direction 1: its columns, `b_x`).
+    pub fn across(&self, dir: usize) -> usize {
+        self.half[1 - dir.min(1)]
+    }
+
+    /// `Σ_j a_ij x_j` over the couplings `j` of row `i` that lie on the lines at offset
+    /// `d` from `i`'s line (direction `dir`, see [`GridOperator::across`]) with bit
+    /// `d + b` of `mask` set: the part of `(A x)_i` from those lines. Each stencil row is
+    /// summed in [`GridOperator::row_product`]'s order without the terms left out, so
+    /// where the left-out `x_j` are zero the result has `(A x)_i`'s bits.
+    pub fn masked_product(&self, x: &[f64], i: usize, dir: usize, mask: u64) -> f64 {
+        if mask == 0 {
+            return 0.0;
+        }
+        let [bx, by] = self.half;
+        let (wx, wy) = (2 * bx + 1, 2 * by + 1);
+        let (ix, iy) = (i % self.nx, i / self.nx);
+        let (x0, x1) = (ix.saturating_sub(bx), (ix + bx + 1).min(self.nx));
+        let vals = &self.values[i * wx * wy..][..wx * wy];
+        let mut sum = 0.0;
+        for jy in iy.saturating_sub(by)..(iy + by + 1).min(self.ny) {
+            if dir == 0 && mask & (1 << (jy + by - iy)) == 0 {
+                continue;
+            }
+            let row = &vals[(jy + by - iy) * wx + (x0 + bx - ix)..][..x1 - x0];
+            let xs = &x[jy * self.nx + x0..jy * self.nx + x1];
+            sum += if dir == 0 {
+                row.iter().zip(xs).map(|(v, xv)| f64::from(*v) * xv).sum::<f64>()
+            } else {
+                row.iter()
+                    .zip(xs)
+                    .enumerate()
+                    .filter(|(t, _)| mask & (1 << (x0 + t + bx - ix)) != 0)
+                    .map(|(_, (v, xv))| f64::from(*v) * xv)
+                    .sum::<f64>()
+            };
+        }
+        sum
+    }
+
     /// `y = A x` (rows in parallel).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(ROWS).enumerate().for_each(|(c, ys)| {

@@ -18,7 +18,12 @@
 //! BENCHMARKS.md "Multigrid" has the measured choice (ILU(0) diverges as a smoother on
 //! the metrics of puzzle4's necks). Under the line smoothers the operators of the
 //! smoothed levels are held as stencils of `f32` values without column indices
-//! ([`grid`]), a quarter of the CSR storage and of the memory traffic of a sweep.
+//! ([`grid`]), a quarter of the CSR storage and of the memory traffic of a sweep. On
+//! those levels the first sweep starts from `x = 0` and reads only the couplings to the
+//! lines visited before each line; where it is the only sweep before the coarse
+//! correction ([`Smoother::SplitColouredLines`]) the residual `b - A x` after it is the
+//! couplings to the lines visited after each line ([`lines::Lines::sweep_from_zero`]):
+//! one read of the stencil for both.
 
 use std::sync::Arc;
 
@@ -59,7 +64,14 @@ pub(crate) enum Smoother {
     /// `l mod (w + 1)`, `w` the farthest coupling across the lines: 4 colours at degree
     /// 3): the lines of one colour do not couple, their corrections are computed in
     /// parallel ([`lines::Lines::sweep_coloured`]).
+    #[cfg_attr(not(test), allow(dead_code))]
     ColouredLines,
+    /// [`Smoother::ColouredLines`] with one direction on each side of the coarse
+    /// correction: the lines of direction 0 (forward) before it, those of direction 1
+    /// (backward) after it, half the sweeps of the alternating order. The cycle is then
+    /// not symmetric (its pre-smoother is not the adjoint of its post-smoother): a
+    /// preconditioner for flexible GMRES, not for CG.
+    SplitColouredLines,
 }
 
 /// A multigrid V-cycle for `A` (see the module documentation).
@@ -234,10 +246,13 @@ impl Multigrid {
         };
         self.ilu = match self.smoother {
             Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel | Smoother::Lines | Smoother::ColouredLines => Vec::new(),
+            Smoother::SymmetricGaussSeidel
+            | Smoother::Lines
+            | Smoother::ColouredLines
+            | Smoother::SplitColouredLines => Vec::new(),
         };
         self.lines = match self.smoother {
-            Smoother::Lines | Smoother::ColouredLines => smoothed
+            Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => smoothed
                 .iter()
                 .map(|a| {
                     let nx = grid_width(a);
@@ -248,7 +263,7 @@ impl Multigrid {
         };
         self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
         self.grids = match self.smoother {
-            Smoother::Lines | Smoother::ColouredLines => {
+            Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => {
                 operators[..operators.len() - 1].iter().map(|a| GridOperator::from_csr(a, grid_width(a))).collect()
             }
             Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
@@ -295,15 +310,35 @@ impl Multigrid {
             return;
         }
         let mut r = vec![0.0; b.len()];
-        for _ in 0..self.sweeps {
+        // the first pre-smoothing sweep starts from x = 0: on a stencil level its lines
+        // read only the lines visited before them, and where it is the only sweep before
+        // the coarse correction the residual comes with it ([`Lines::sweep_from_zero`])
+        let split = self.smoother == Smoother::SplitColouredLines;
+        let mut fused = false;
+        let mut pre = self.sweeps;
+        if let Some(g) = self.grid(l).filter(|g| self.lines.len() > l && g.across(0) < 32 && g.across(1) < 32) {
+            let coloured = self.smoother != Smoother::Lines;
+            let [l0, l1] = &self.lines[l];
+            let mut scratch = Vec::new();
+            fused = split && self.sweeps == 1;
+            l0.sweep_from_zero(g, b, x, coloured, false, fused.then_some(&mut r[..]), &mut scratch);
+            if !split {
+                let sweep = if coloured { Lines::sweep_coloured } else { Lines::sweep };
+                sweep(l1, g, b, x, false, &mut scratch);
+            }
+            pre -= 1;
+        }
+        for _ in 0..pre {
             self.smooth(l, b, x, &mut r, false);
         }
-        match self.grid(l) {
-            Some(g) => g.mul_vec(x, &mut r),
-            None => self.operators[l].mul_vec(x, &mut r),
-        }
-        for (ri, bi) in r.iter_mut().zip(b) {
-            *ri = bi - *ri;
+        if !fused {
+            match self.grid(l) {
+                Some(g) => g.mul_vec(x, &mut r),
+                None => self.operators[l].mul_vec(x, &mut r),
+            }
+            for (ri, bi) in r.iter_mut().zip(b) {
+                *ri = bi - *ri;
+            }
         }
         let p = &self.prolongations[l];
         let mut rc = vec![0.0; p.ncols()];
@@ -343,7 +378,7 @@ impl Multigrid {
                     (0..a.nrows).for_each(&mut relax);
                 }
             }
-            Smoother::Lines | Smoother::ColouredLines => {
+            Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => {
                 let mut scratch = Vec::new();
                 let [l0, l1] = &self.lines[l];
                 let a: &dyn Rows = match self.grid(l) {
@@ -351,7 +386,11 @@ impl Multigrid {
                     None => a,
                 };
                 let sweep = if self.smoother == Smoother::Lines { Lines::sweep } else { Lines::sweep_coloured };
-                if backward {
+                if self.smoother == Smoother::SplitColouredLines {
+                    // direction 0 before the coarse correction, direction 1 after it
+                    let (lines, backward) = if backward { (l1, true) } else { (l0, false) };
+                    sweep(lines, a, b, x, backward, &mut scratch);
+                } else if backward {
                     sweep(l1, a, b, x, true, &mut scratch);
                     sweep(l0, a, b, x, true, &mut scratch);
                 } else {
