@@ -209,8 +209,7 @@ const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
 /// with the first search for every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid
 /// one whose smallest patch corner angle is largest is kept; every try is in the report.
 /// Either way the layout through the maps of the faces onto the polygons is made when the
-/// first has no valid layout, or only one with a patch corner below `MIN_TEMPLATE_ANGLE`
-/// or a searched interior vertex ([`sharp`]).
+/// first has no valid layout or only one with a patch corner below `MIN_TEMPLATE_ANGLE`.
 #[allow(clippy::too_many_arguments)]
 fn lay_out_graph(
     g: Graph,
@@ -225,7 +224,7 @@ fn lay_out_graph(
     if g.faces.iter().all(|f| f.holes.is_empty()) {
         // per search of the cuts' ends: the harmonic maps' cuts, and where they leave a
         // face or cross (or the valid layout has a patch corner below
-        // `MIN_TEMPLATE_ANGLE` or a searched interior vertex), their preimages under the maps of
+        // `MIN_TEMPLATE_ANGLE`), their preimages under the maps of
         // the faces onto the polygons; the first valid layout is kept (of two, the one
         // whose smallest patch corner angle is larger), else the first one made (which
         // the solve refuses, naming the patch), else the first error
@@ -311,12 +310,11 @@ fn lay_out_graph(
     }
 }
 
-/// Whether a layout has a patch corner below `MIN_TEMPLATE_ANGLE` (15 degrees), or a face
-/// whose interior vertex was searched (the harmonic map's placement was poor there):
-/// then the layout through the maps of the faces onto the polygons is made too, and the
-/// one with the larger smallest corner kept.
+/// Whether a layout has a patch corner below `MIN_TEMPLATE_ANGLE` (15 degrees): then the
+/// layout through the maps of the faces onto the polygons is made too, and the one with
+/// the larger smallest corner kept.
 fn sharp(r: &LayoutReport) -> bool {
-    r.corner_angles[0] < MIN_TEMPLATE_ANGLE || r.faces.iter().any(|f| f.angle_search.as_ref().is_some_and(|s| s.kept))
+    r.corner_angles[0] < MIN_TEMPLATE_ANGLE
 }
 
 /// One try of a direction of the cuts from holes.
