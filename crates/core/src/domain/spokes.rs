@@ -94,7 +94,8 @@ fn estimate(pm: &PolygonMap, q: Point, at_mids: &[(Point, Point)]) -> Option<f64
     let mut e = Vec::with_capacity(k);
     for s in 0..k {
         let mid = pm.side_midpoint(s);
-        let (near, m, m_near) = (pm.inverse(lerp(q, mid, CHORD))?, pm.inverse(mid)?, pm.inverse(lerp(q, mid, 1.0 - CHORD))?);
+        let (near, m, m_near) =
+            (pm.inverse(lerp(q, mid, CHORD))?, pm.inverse(mid)?, pm.inverse(lerp(q, mid, 1.0 - CHORD))?);
         d.push(unit([near[0] - x[0], near[1] - x[1]]));
         e.push(unit([m_near[0] - m[0], m_near[1] - m[1]]));
     }
@@ -136,7 +137,7 @@ pub(super) fn search_centre(pm: &PolygonMap, at_mids: &[(Point, Point)]) -> Opti
     let mut step = reach / 12.0;
     for _ in 0..4 {
         loop {
-            let Some((q, v)) = best else { return None };
+            let (q, v) = best?;
             for dir in [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]] {
                 consider([q[0] + step * dir[0], q[1] + step * dir[1]], &mut best);
             }

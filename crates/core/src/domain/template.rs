@@ -19,9 +19,9 @@
 use serde::Serialize;
 
 use super::cycles::{polyline, signed_area};
+use super::graph::end_tangent;
 use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
-use super::graph::end_tangent;
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
 use super::reflex::{fit_points, line, segment_inside};
 use super::spokes::{curve_angles, score, search_centre, MIN_TEMPLATE_ANGLE};
@@ -56,7 +56,7 @@ pub struct FaceReport {
     /// by the harmonic map of the polygon onto the faces is not valid.
     pub inverse: bool,
     /// The smallest of the patch corner angles the template made (degrees; the midpoint
-    /// template: at the interior vertex and at the side midpoints, [`super::spokes`]).
+    /// template: at the interior vertex and at the side midpoints, `domain::spokes`).
     pub min_angle: Option<f64>,
     /// The search of the interior vertex, where the first placement had a new patch
     /// corner within `MIN_TEMPLATE_ANGLE` (15) degrees of 0 or 180.
@@ -64,7 +64,7 @@ pub struct FaceReport {
 }
 
 /// The search of a midpoint template's interior vertex in the parameter domain of the
-/// face's map onto the polygon ([`super::spokes`]).
+/// face's map onto the polygon (`domain::spokes`).
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct AngleSearch {
@@ -347,7 +347,8 @@ pub(super) fn apply_templates(
                 let mut angles = curve_angles(&cuts, &at_mids);
                 let first = score(&angles);
                 if first < MIN_TEMPLATE_ANGLE {
-                    let built = if pm.is_none() { PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok() } else { None };
+                    let built =
+                        if pm.is_none() { PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok() } else { None };
                     let mut search = AngleSearch { first, polygon_point: None, searched: None, kept: false };
                     if let Some(pm) = pm.as_ref().or(built.as_ref()) {
                         let found = search_centre(pm, &at_mids).and_then(|(q, _)| {
@@ -377,7 +378,8 @@ pub(super) fn apply_templates(
                 }
                 report.min_angle = Some(angles.iter().fold(f64::INFINITY, |m, a| m.min(a.to_degrees())));
                 let centre = g.add_vertex(centre_point);
-                let spokes: Vec<usize> = cuts.into_iter().zip(&mids).map(|(c, &m)| g.add_edge(c, centre, m, false)).collect();
+                let spokes: Vec<usize> =
+                    cuts.into_iter().zip(&mids).map(|(c, &m)| g.add_edge(c, centre, m, false)).collect();
                 for s in 0..k {
                     let prev = (s + k - 1) % k;
                     let sides = vec![parts[s].0, (spokes[s], false), (spokes[prev], true), parts[prev].1];

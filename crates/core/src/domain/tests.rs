@@ -490,7 +490,8 @@ fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
         validate_layout(&auto.layout).unwrap_or_else(|e| panic!("{}: {e}", d.name));
         // through the map onto the polygon: the first way that the layout is valid, or
         // the interior vertex searched in the polygon where a corner was sharp
-        let through_polygon = |f: &super::template::FaceReport| f.inverse || f.angle_search.as_ref().is_some_and(|s| s.kept);
+        let through_polygon =
+            |f: &super::template::FaceReport| f.inverse || f.angle_search.as_ref().is_some_and(|s| s.kept);
         assert!(auto.report.faces.iter().any(through_polygon), "{}", d.name);
         conforming_bit_for_bit(&auto.layout);
         assert_area_is_the_domains(d, &auto.layout);
