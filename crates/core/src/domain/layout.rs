@@ -32,6 +32,7 @@ use super::graph::{Face, FaceSide, Graph};
 use super::holes::{cut_holes, HoleCut};
 use super::plane::{build_graph, GraphReport, PlaneGraph};
 use super::reflex::{cut_reflex, CutReport, GOOD_CUT_ANGLE};
+use super::spokes::MIN_TEMPLATE_ANGLE;
 use super::template::{apply_templates, FaceReport, IrregularVertex};
 use super::validate::{validate_domain, DomainReport};
 use super::{domain_error, Domain, LoopId};
@@ -207,6 +208,8 @@ const HOLE_CUT_DIRECTIONS: [f64; 5] = [f64::NAN, 0.0, 90.0, 45.0, 135.0];
 /// ([`validate_layout`]: no patch crossing itself or another). With holes, it is made
 /// with the first search for every cut direction of [`HOLE_CUT_DIRECTIONS`] and the valid
 /// one whose smallest patch corner angle is largest is kept; every try is in the report.
+/// Either way the layout through the maps of the faces onto the polygons is made when the
+/// first has no valid layout or only one with a patch corner below `MIN_TEMPLATE_ANGLE`.
 #[allow(clippy::too_many_arguments)]
 fn lay_out_graph(
     g: Graph,
@@ -220,20 +223,35 @@ fn lay_out_graph(
 ) -> Result<AutoLayout> {
     if g.faces.iter().all(|f| f.holes.is_empty()) {
         // per search of the cuts' ends: the harmonic maps' cuts, and where they leave a
-        // face or cross, their preimages under the maps of the faces onto the polygons;
-        // the first valid layout is kept, else the first one made (which the solve
-        // refuses, naming the patch), else the first error
+        // face or cross (or the valid layout has a patch corner below
+        // `MIN_TEMPLATE_ANGLE`), their preimages under the maps of
+        // the faces onto the polygons; the first valid layout is kept (of two, the one
+        // whose smallest patch corner angle is larger), else the first one made (which
+        // the solve refuses, naming the patch), else the first error
         let mut first: Option<Result<AutoLayout>> = None;
         for &search in searches {
+            let mut valid: Option<AutoLayout> = None;
             for inverse in [false, true] {
                 let auto =
                     lay_out_with(g.clone(), name, diameter, area, checked.clone(), opts, t0, f64::NAN, inverse, search);
-                if auto.as_ref().is_ok_and(|a| validate_layout(&a.layout).is_ok()) {
-                    return auto;
+                match auto {
+                    Ok(a) if validate_layout(&a.layout).is_ok() => {
+                        if valid.as_ref().is_none_or(|v| a.report.corner_angles[0] > v.report.corner_angles[0]) {
+                            valid = Some(a);
+                        }
+                        if valid.as_ref().is_some_and(|v| !sharp(&v.report)) {
+                            break;
+                        }
+                    }
+                    auto => {
+                        if first.as_ref().is_none_or(|f| f.is_err() && auto.is_ok()) {
+                            first = Some(auto);
+                        }
+                    }
                 }
-                if first.as_ref().is_none_or(|f| f.is_err() && auto.is_ok()) {
-                    first = Some(auto);
-                }
+            }
+            if let Some(v) = valid {
+                return Ok(v);
             }
         }
         return first.unwrap_or_else(|| Err(Error::Invalid("layout: no search of the cuts was tried".into())));
@@ -243,7 +261,7 @@ fn lay_out_graph(
     let mut first_err = None;
     let mut tries = Vec::new();
     for inverse in [false, true] {
-        if best.as_ref().is_some_and(|b| b.1) {
+        if best.as_ref().is_some_and(|b| b.1 && !sharp(&b.0.report)) {
             break;
         }
         for theta in HOLE_CUT_DIRECTIONS {
@@ -290,6 +308,13 @@ fn lay_out_graph(
         (None, Some(e)) => Err(e),
         (None, None) => Err(Error::Invalid("layout: no direction of cuts from holes was tried".into())),
     }
+}
+
+/// Whether a layout has a patch corner below `MIN_TEMPLATE_ANGLE` (15 degrees): then the
+/// layout through the maps of the faces onto the polygons is made too, and the one with
+/// the larger smallest corner kept.
+fn sharp(r: &LayoutReport) -> bool {
+    r.corner_angles[0] < MIN_TEMPLATE_ANGLE
 }
 
 /// One try of a direction of the cuts from holes.

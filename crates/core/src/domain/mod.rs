@@ -16,6 +16,7 @@
 //! | `graph` | the faces, edges and vertices of a layout under construction: edges split at a point, faces split by a new edge |
 //! | `holes` | cuts from every hole to the outer boundary or another hole |
 //! | `reflex` | cuts from reflex corners into the face |
+//! | `spokes` | the spokes of the midpoint template, the patch corner angles they make, and the interior vertex searched where one is near 0° or 180° |
 //! | `outline` | the outer boundary and holes of a multipatch layout as a domain (the input of a comparison with the hand-made layout) |
 //! | [`template`] | the quadrangulation of every face by its template (the midpoint template, a face split in two), placed by the harmonic map or the map onto the polygon |
 //! | [`layout`] | the automatic layout as a whole: the sides into a graph of faces, the cuts, the tries (searches of the cuts' ends, directions of the hole cuts, the maps onto the polygons), its report and the multipatch layout |
@@ -33,6 +34,7 @@ pub(crate) mod outline;
 pub(crate) mod plane;
 pub(crate) mod polygon_map;
 pub(crate) mod reflex;
+pub(crate) mod spokes;
 pub mod template;
 pub(crate) mod validate;
 

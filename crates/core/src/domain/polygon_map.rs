@@ -459,9 +459,19 @@ impl PolygonMap {
     /// The preimages of `samples + 1` evenly spaced points on the segment from the
     /// centre of the polygon to the midpoint of its side `s`.
     pub(crate) fn spoke(&self, s: usize, samples: usize) -> Option<Vec<Point>> {
-        let (a, b) = (polygon_vertex(self.n, s), polygon_vertex(self.n, s + 1));
-        let mid = lerp(a, b, 0.5);
-        (0..=samples).map(|i| self.inverse(lerp([0.0, 0.0], mid, i as f64 / samples as f64))).collect()
+        self.segment([0.0, 0.0], self.side_midpoint(s), samples)
+    }
+
+    /// The midpoint of the polygon's side `s` (the image of the arc-length midpoint of
+    /// the face's side `s`).
+    pub(crate) fn side_midpoint(&self, s: usize) -> Point {
+        lerp(polygon_vertex(self.n, s), polygon_vertex(self.n, s + 1), 0.5)
+    }
+
+    /// The preimages of `samples + 1` evenly spaced points on the segment of the polygon
+    /// from `a` to `b`.
+    pub(crate) fn segment(&self, a: Point, b: Point, samples: usize) -> Option<Vec<Point>> {
+        (0..=samples).map(|i| self.inverse(lerp(a, b, i as f64 / samples as f64))).collect()
     }
 }
 

@@ -19,10 +19,12 @@
 use serde::Serialize;
 
 use super::cycles::{polyline, signed_area};
+use super::graph::end_tangent;
 use super::graph::{Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
 use super::reflex::{fit_points, line, segment_inside};
+use super::spokes::{curve_angles, score, search_centre, MIN_TEMPLATE_ANGLE};
 use crate::boundary::fit::FitOptions;
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
@@ -53,6 +55,32 @@ pub struct FaceReport {
     /// onto the polygon (`PolygonMap`, one-to-one on every face), taken when the layout
     /// by the harmonic map of the polygon onto the faces is not valid.
     pub inverse: bool,
+    /// The smallest of the patch corner angles the template made (degrees; the midpoint
+    /// template: at the interior vertex and at the side midpoints, `domain::spokes`).
+    pub min_angle: Option<f64>,
+    /// The search of the interior vertex, where the first placement had a new patch
+    /// corner within `MIN_TEMPLATE_ANGLE` (15) degrees of 0 or 180.
+    pub angle_search: Option<AngleSearch>,
+}
+
+/// The search of a midpoint template's interior vertex in the parameter domain of the
+/// face's map onto the polygon (`domain::spokes`).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct AngleSearch {
+    /// The first placement's score: its smallest `min(α, 180° − α)` over the new patch
+    /// corners `α`, degrees.
+    pub first: f64,
+    /// The point of the regular polygon (inscribed in the unit circle) whose preimage is
+    /// the searched interior vertex (`None`: no map onto the polygon, or no point with a
+    /// preimage).
+    pub polygon_point: Option<Point>,
+    /// The searched placement's score (its spokes fitted), degrees.
+    pub searched: Option<f64>,
+    /// The searched placement scores higher and was taken: the spokes are the preimages
+    /// of the segments from `polygon_point` to the polygon's side midpoints, not those
+    /// `straight` and `inverse` describe.
+    pub kept: bool,
 }
 
 /// An interior vertex whose valence is not 4.
@@ -191,7 +219,7 @@ pub(super) fn apply_templates(
     let split = edges_to_split(g);
     let nf = g.faces.len();
     #[allow(clippy::type_complexity)]
-    let mut plans: Vec<(Template, usize, Option<HarmonicMap>, Option<PolygonMap>)> = Vec::with_capacity(nf);
+    let mut plans: Vec<(Template, usize, Option<HarmonicMap>, Option<PolygonMap>, Vec<Curve>)> = Vec::with_capacity(nf);
     // per face: ten times its area over its perimeter (the fit scale of its cuts)
     let scales: Vec<f64> = (0..nf)
         .map(|f| {
@@ -219,7 +247,7 @@ pub(super) fn apply_templates(
         let pm = (inverse && template != Template::One)
             .then(|| PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok())
             .flatten();
-        plans.push((template, k, h, pm));
+        plans.push((template, k, h, pm, curves));
     }
     let mut mids: Vec<Option<usize>> = Vec::new();
     for e in 0..split.len() {
@@ -232,7 +260,7 @@ pub(super) fn apply_templates(
     }
     mids.resize(g.vertices.len(), None);
     let mut faces = Vec::with_capacity(nf);
-    for (f, (template, k, h, pm)) in plans.into_iter().enumerate() {
+    for (f, (template, k, h, pm, curves)) in plans.into_iter().enumerate() {
         let label = g.faces[f].label.clone();
         let hv = halves(g, f, &mids, k);
         let mut report = FaceReport {
@@ -244,6 +272,8 @@ pub(super) fn apply_templates(
             harmonic_min_area_ratio: h.as_ref().map(|h| h.min_area_ratio),
             straight: false,
             inverse: false,
+            min_angle: None,
+            angle_search: None,
         };
         match (template, h) {
             (Template::One, _) | (_, None) => {}
@@ -288,23 +318,68 @@ pub(super) fn apply_templates(
                     .flatten();
                 report.straight = star.is_some();
                 report.inverse = inv.is_some();
-                let centre = g.add_vertex(inv.as_ref().map(|i| i.0).or(star).unwrap_or_else(|| h.centre()));
-                let mut spokes = Vec::with_capacity(k);
+                let mut centre_point = inv.as_ref().map(|i| i.0).or(star).unwrap_or_else(|| h.centre());
+                let mut mids = Vec::with_capacity(k);
                 let mut parts = Vec::with_capacity(k);
                 for (s, side) in hv.iter().enumerate() {
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    let c = if let Some((_, spokes)) = &inv {
-                        spoke_curve(spokes[s].clone(), g.vertices[centre], g.vertices[m], diameter, scales[f], fit)?
-                    } else if star.is_some() {
-                        line(g.vertices[centre], g.vertices[m])
-                    } else {
-                        spoke_curve(h.spoke(s), g.vertices[centre], g.vertices[m], diameter, scales[f], fit)?
-                    };
-                    spokes.push(g.add_edge(c, centre, m, false));
+                    mids.push(m);
                     parts.push((a, b));
                 }
+                let mut cuts = Vec::with_capacity(k);
+                for (s, &m) in mids.iter().enumerate() {
+                    let to = g.vertices[m];
+                    cuts.push(if let Some((_, spokes)) = &inv {
+                        spoke_curve(spokes[s].clone(), centre_point, to, diameter, scales[f], fit)?
+                    } else if star.is_some() {
+                        line(centre_point, to)
+                    } else {
+                        spoke_curve(h.spoke(s), centre_point, to, diameter, scales[f], fit)?
+                    });
+                }
+                // the new patch corners; near 0 or 180 degrees, the interior vertex searched
+                let at_mids: Vec<(Point, Point)> = parts
+                    .iter()
+                    .map(|&(a, b)| (end_tangent(&g.side_curve(a), true), end_tangent(&g.side_curve(b), false)))
+                    .collect();
+                let mut angles = curve_angles(&cuts, &at_mids);
+                let first = score(&angles);
+                if first < MIN_TEMPLATE_ANGLE {
+                    let built =
+                        if pm.is_none() { PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok() } else { None };
+                    let mut search = AngleSearch { first, polygon_point: None, searched: None, kept: false };
+                    if let Some(pm) = pm.as_ref().or(built.as_ref()) {
+                        let found = search_centre(pm, &at_mids).and_then(|(q, _)| {
+                            let spokes: Option<Vec<Vec<Point>>> =
+                                (0..k).map(|s| pm.segment(q, pm.side_midpoint(s), SPOKE_SAMPLES)).collect();
+                            Some((q, pm.inverse(q)?, spokes?))
+                        });
+                        if let Some((q, x, spokes)) = found {
+                            search.polygon_point = Some(q);
+                            let fitted: Option<Vec<Curve>> = spokes
+                                .into_iter()
+                                .zip(&mids)
+                                .map(|(pts, &m)| spoke_curve(pts, x, g.vertices[m], diameter, scales[f], fit).ok())
+                                .collect();
+                            if let Some(fitted) = fitted {
+                                let a = curve_angles(&fitted, &at_mids);
+                                let v = score(&a);
+                                search.searched = Some(v);
+                                if v > first {
+                                    search.kept = true;
+                                    (centre_point, cuts, angles) = (x, fitted, a);
+                                }
+                            }
+                        }
+                    }
+                    report.angle_search = Some(search);
+                }
+                report.min_angle = Some(angles.iter().fold(f64::INFINITY, |m, a| m.min(a.to_degrees())));
+                let centre = g.add_vertex(centre_point);
+                let spokes: Vec<usize> =
+                    cuts.into_iter().zip(&mids).map(|(c, &m)| g.add_edge(c, centre, m, false)).collect();
                 for s in 0..k {
                     let prev = (s + k - 1) % k;
                     let sides = vec![parts[s].0, (spokes[s], false), (spokes[prev], true), parts[prev].1];

@@ -474,9 +474,10 @@ fn folded_harmonic_maps_give_straight_cuts_from_a_star_centre() {
 
 /// The plates whose holes are within 1-5 % of the contour and of each other (seeds 1, 3,
 /// 7 and 9 of the corpus) and the U shape of seed 3: the harmonic maps of the polygons
-/// onto their thin faces put cuts outside the faces in every direction of the hole cuts;
-/// the preimages under the maps of the faces onto the polygons (one-to-one on every
-/// face) stay inside: the layout is valid, conforming, its patches' areas add up to the
+/// onto their thin faces put cuts outside the faces in every direction of the hole cuts
+/// (or cuts with corners below 15 degrees, where the interior vertex is searched in the
+/// polygon); the preimages under the maps of the faces onto the polygons (one-to-one on
+/// every face) stay inside: the layout is valid, conforming, its patches' areas add up to the
 /// domain's, and plate 1 and the U shape are certified.
 #[test]
 fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
@@ -487,7 +488,11 @@ fn thin_faces_take_their_cuts_from_the_map_onto_the_polygon() {
     for d in &domains {
         let auto = auto_layout(d, &LayoutOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", d.name));
         validate_layout(&auto.layout).unwrap_or_else(|e| panic!("{}: {e}", d.name));
-        assert!(auto.report.faces.iter().any(|f| f.inverse), "{}", d.name);
+        // through the map onto the polygon: the first way that the layout is valid, or
+        // the interior vertex searched in the polygon where a corner was sharp
+        let through_polygon =
+            |f: &super::template::FaceReport| f.inverse || f.angle_search.as_ref().is_some_and(|s| s.kept);
+        assert!(auto.report.faces.iter().any(through_polygon), "{}", d.name);
         conforming_bit_for_bit(&auto.layout);
         assert_area_is_the_domains(d, &auto.layout);
         if d.name == "plate-1" || d.name.starts_with("u-") {
@@ -632,4 +637,57 @@ fn a_cut_meeting_its_own_side_gives_that_side_a_corner() {
     assert!(c.new_angles.iter().all(|&a| a > 70.0), "{c:?}");
     assert!(r.corner_angles[0] > 15.0, "{:?}", r.corner_angles);
     certified(&auto, &d.name);
+}
+
+/// A flat triangle `(0, 0), (1, 0), (1/2, 3/20)` (corners of 16.70, 16.70 and 146.60
+/// degrees): the harmonic map of the equilateral triangle onto it is affine, so the
+/// first placement of its midpoint template has the centroid `(1/2, 1/20)` as interior
+/// vertex and straight spokes; the two spokes to the slanted sides' midpoints
+/// `(1/2 ± 1/4, 3/40)` meet there at `180° − 2 atan(1/10)`, `min(α, 180° − α) =
+/// 2 atan(1/10) = 11.42°`, below the threshold of 15. The interior vertex is searched:
+/// the map onto the polygon is the affine map's inverse too, so the searched vertex is
+/// the affine image of the polygon point the report names, the spokes stay straight, and
+/// every new patch corner is 15 degrees or more from 0 and 180.
+#[test]
+fn a_template_corner_below_the_threshold_is_searched_away() {
+    let tri = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.15]];
+    let auto = auto_layout(&polygon(&tri), &LayoutOptions::default()).unwrap();
+    let r = &auto.report;
+    assert_eq!(r.faces.len(), 1);
+    let face = &r.faces[0];
+    assert_eq!(face.template, "midpoint");
+    let search = face.angle_search.as_ref().expect("the first placement scores below 15 degrees");
+    let first = 2.0 * 0.1f64.atan().to_degrees();
+    assert!((search.first - first).abs() < 1e-8, "{} {first}", search.first);
+    assert!(search.kept);
+    let searched = search.searched.unwrap();
+    assert!(searched >= 15.0, "{searched}");
+    assert!(face.min_angle.unwrap() >= searched - 1e-9);
+    // the searched vertex is the affine image of the polygon point (barycentric
+    // coordinates in the equilateral triangle carried to the face's corners)
+    let q = search.polygon_point.unwrap();
+    let v: Vec<Point> = (0..3).map(|s| polygon_vertex(3, s)).collect();
+    let det = (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]);
+    let l1 = ((q[0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (q[1] - v[0][1])) / det;
+    let l2 = ((v[1][0] - v[0][0]) * (q[1] - v[0][1]) - (q[0] - v[0][0]) * (v[1][1] - v[0][1])) / det;
+    let want = [
+        (1.0 - l1 - l2) * tri[0][0] + l1 * tri[1][0] + l2 * tri[2][0],
+        (1.0 - l1 - l2) * tri[0][1] + l1 * tri[1][1] + l2 * tri[2][1],
+    ];
+    let c = face.centre.unwrap();
+    assert!((c[0] - want[0]).abs() < 1e-9 && (c[1] - want[1]).abs() < 1e-9, "{c:?} {want:?}");
+    // straight spokes, and every patch corner 15 degrees or more (the triangle's own
+    // corners are 16.70 degrees)
+    for p in &auto.layout.patches {
+        for s in &p.sides {
+            let (a, b) = s.endpoints();
+            for x in &s.control_points {
+                let off = ((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])).abs();
+                assert!(off < 1e-9, "{:?}", s.control_points);
+            }
+        }
+    }
+    assert!(r.corner_angles[0] >= 15.0 && r.corner_angles[1] <= 165.0, "{:?}", r.corner_angles);
+    validate_layout(&auto.layout).unwrap();
+    certified(&auto, "flat triangle");
 }
