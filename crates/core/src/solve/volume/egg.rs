@@ -44,6 +44,7 @@
 use std::sync::Arc;
 
 use super::assembly::{Local, VolumeDiscretization};
+use super::tensor_points;
 use crate::linalg::sparse::Csr;
 use crate::spline::volume::Point3;
 
@@ -341,6 +342,123 @@ impl EggVolume {
         Some(Local { idx, scalar: 0.0, vector: res, matrix: k, scalar_matrix: kl })
     }
 
+    /// Element `e`'s residual (`dir` `None`) or its part of the Jacobian's product
+    /// `F'(c) v` with the displacement `dir` of the control points (zero at the fixed
+    /// ones), without the Jacobian: at each point, with `δd_a = ∂_a δx` and
+    /// `δX_c = ∇²δx_c` of `δx = Σ_B R_B dir_B`,
+    ///
+    /// `δL_c = (δA : X_c + A : δX_c - L_c δT) / T`, `δA_ij = δc_i · c_j + c_i · δc_j`,
+    /// `δc_i = δd_(i+1) × d_(i+2) + d_(i+1) × δd_(i+2)`, `δT = tr δA`
+    ///
+    /// (the directional derivative of `L_c`, which the Jacobian's columns of
+    /// [`EggVolume::element`] hold per basis function), and `δF_(a,c) = Σ_q w_q R_a δL_c`.
+    /// On a polynomial basis the values at the points and the integrals are sum
+    /// factorised ([`super::tensor_points`]), on a rational one they go through the
+    /// basis tables of [`EggVolume::element_points`]. `None` when `tr A = 0` at one of
+    /// its points.
+    fn element_linear(&self, e: usize, cps: &[Point3], dir: Option<&[Point3]>) -> Option<Local> {
+        let idx = self.disc.element_indices(e);
+        let m = idx.len();
+        let k = if dir.is_some() { 6 } else { 3 };
+        // x (columns 0..3) and δx (columns 3..6)
+        let mut cl = vec![0.0; k * m];
+        for (a, &lin) in idx.iter().enumerate() {
+            for c in 0..3 {
+                cl[c * m + a] = cps[lin][c];
+                if let Some(dir) = dir {
+                    cl[(3 + c) * m + a] = dir[lin][c];
+                }
+            }
+        }
+        let tables = self.disc.element_tables(e);
+        // their values, gradients and Hessians at every point, X[c 10 n_q + s_q q + s_k k]
+        let ((weights, xq, basis), (sq, sk)) = if self.disc.weights.is_some() {
+            let (weights, basis) = self.element_points(e, &idx);
+            let nq = weights.len();
+            let mut xq = vec![0.0; k * 10 * nq];
+            faer::linalg::matmul::matmul(
+                faer::MatMut::from_column_major_slice_mut(&mut xq, 10 * nq, k),
+                faer::Accum::Replace,
+                faer::MatRef::from_row_major_slice(&basis, 10 * nq, m),
+                faer::MatRef::from_column_major_slice(&cl, m, k),
+                1.0,
+                faer::Par::Seq,
+            );
+            ((weights, xq, Some(basis)), (10, 1))
+        } else {
+            let weights = tensor_points::weights(tables);
+            let nq = weights.len();
+            ((weights, tensor_points::values(tables, &cl), None), (1, nq))
+        };
+        let nq = weights.len();
+        // w_q δL_c(q) (or w_q L_c(q)) per component, `c n_q + q`
+        let mut f = vec![0.0; 3 * nq];
+        for (q, &wq) in weights.iter().enumerate() {
+            let at = |col: usize, k: usize| xq[col * 10 * nq + sq * q + sk * k];
+            let d: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(c, 1 + j)));
+            let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(c, 4 + k)));
+            let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
+            let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
+            let t = am[0][0] + am[1][1] + am[2][2];
+            if t.is_nan() || t <= 0.0 {
+                return None;
+            }
+            if dir.is_none() {
+                for c in 0..3 {
+                    f[c * nq + q] = wq * (contract(&am, &xh[c]) / t);
+                }
+                continue;
+            }
+            let dd: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(3 + c, 1 + j)));
+            let dxh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(3 + c, 4 + k)));
+            let dcof: [Point3; 3] = std::array::from_fn(|i| {
+                let (u, v) = (cross(dd[(i + 1) % 3], d[(i + 2) % 3]), cross(d[(i + 1) % 3], dd[(i + 2) % 3]));
+                [u[0] + v[0], u[1] + v[1], u[2] + v[2]]
+            });
+            let da: [[f64; 3]; 3] =
+                std::array::from_fn(|i| std::array::from_fn(|j| dot(dcof[i], cof[j]) + dot(cof[i], dcof[j])));
+            let dt = da[0][0] + da[1][1] + da[2][2];
+            for c in 0..3 {
+                let l = contract(&am, &xh[c]) / t;
+                f[c * nq + q] = wq * ((contract(&da, &xh[c]) + contract(&am, &dxh[c]) - l * dt) / t);
+            }
+        }
+        // Σ_q R_a(q) f_c(q), `c m + a`
+        let rc = match basis {
+            Some(basis) => {
+                let mut rc = vec![0.0; 3 * m];
+                for q in 0..nq {
+                    let rq = &basis[q * 10 * m..q * 10 * m + m];
+                    for c in 0..3 {
+                        let fq = f[c * nq + q];
+                        for (r, &ra) in rc[c * m..(c + 1) * m].iter_mut().zip(rq) {
+                            *r += ra * fq;
+                        }
+                    }
+                }
+                rc
+            }
+            None => tensor_points::integrals(tables, &f),
+        };
+        let mut res = vec![0.0; 3 * m];
+        for (a, r) in res.chunks_exact_mut(3).enumerate() {
+            for (c, x) in r.iter_mut().enumerate() {
+                *x = rc[c * m + a];
+            }
+        }
+        Some(Local { idx, scalar: 0.0, vector: res, matrix: Vec::new(), scalar_matrix: Vec::new() })
+    }
+
+    /// `F'(c) v` over the free coordinates (`3 f + component`, as the residual) without
+    /// assembling the Jacobian ([`EggVolume::element_linear`], elements added in
+    /// order): the assembled Jacobian's product to rounding, at the cost of about one
+    /// residual. `None` when `tr A = 0` at a quadrature point.
+    fn jacobian_times(&self, cps: &[Point3], v: &[f64]) -> Option<Vec<f64>> {
+        let mut dir = vec![[0.0; 3]; cps.len()];
+        self.disc.scatter(&mut dir, v);
+        self.disc.assemble(false, false, |e| self.element_linear(e, cps, Some(&dir))).map(|(_, y, _, _)| y)
+    }
+
     /// Number of free scalar unknowns (3 per interior control point).
     pub fn unknowns(&self) -> usize {
         self.disc.unknowns()
@@ -355,7 +473,15 @@ impl EggVolume {
     /// [`EggVolume::evaluate`], with the cofactor-metric stiffness `K` of the scalar
     /// unknowns when `laplace` ([`EggEvaluation::laplace`]).
     pub fn evaluate_with(&self, cps: &[Point3], jacobian: bool, laplace: bool) -> EggEvaluation {
-        match self.disc.assemble(jacobian, laplace, |e| self.element(e, cps, jacobian, laplace)) {
+        let residual_only = !jacobian && !laplace;
+        let element = |e| {
+            if residual_only {
+                self.element_linear(e, cps, None)
+            } else {
+                self.element(e, cps, jacobian, laplace)
+            }
+        };
+        match self.disc.assemble(jacobian, laplace, element) {
             Some((_, residual, jacobian, laplace)) => EggEvaluation { residual, jacobian, laplace },
             None => EggEvaluation { residual: Vec::new(), jacobian: None, laplace: None },
         }
@@ -407,6 +533,91 @@ mod tests {
                 assert!((jac.get(l, k) - fd).abs() < 1e-7 * (1.0 + fd.abs()), "jac {l} {k}: {} vs {fd}", jac.get(l, k));
             }
         }
+    }
+
+    /// The Jacobian's product without the Jacobian ([`EggVolume::jacobian_times`]) equals
+    /// the assembled Jacobian times the vector to rounding, on a rational curved volume
+    /// and vectors of pseudo-random coefficients.
+    #[test]
+    fn the_matrix_free_product_is_the_assembled_one() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        for (vol, cps) in [sample(), polynomial()] {
+            let op = EggVolume::new(&vol, 5);
+            let jac = op.evaluate(&cps, true).jacobian.unwrap();
+            let n = op.unknowns();
+            for _ in 0..4 {
+                let v = random(&mut state, n);
+                let mut want = vec![0.0; n];
+                jac.mul_vec(&v, &mut want);
+                let got = op.jacobian_times(&cps, &v).unwrap();
+                // the size of the sums: |J| |v| row by row
+                let scale = (0..n)
+                    .map(|r| {
+                        (jac.row_ptr[r]..jac.row_ptr[r + 1]).map(|p| (jac.values[p] * v[jac.col_idx[p]]).abs()).sum()
+                    })
+                    .fold(0.0f64, f64::max);
+                let err = got.iter().zip(&want).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
+                assert!(scale > 1e-3 && err < 1e-13 * scale, "max difference {err} at scale {scale}");
+            }
+        }
+    }
+
+    /// `n` pseudo-random numbers in `[-0.5, 0.5)` (xorshift).
+    fn random(state: &mut u64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|_| {
+                *state ^= *state << 13;
+                *state ^= *state >> 7;
+                *state ^= *state << 17;
+                (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect()
+    }
+
+    /// [`sample`] without its weights: a polynomial curved volume.
+    fn polynomial() -> (Volume, Vec<Point3>) {
+        let (vol, cps) = sample();
+        (Volume::new(vol.knots.clone(), cps.clone(), None).unwrap(), cps)
+    }
+
+    /// The sum-factorised values, gradients and Hessians at the Gauss points
+    /// ([`tensor_points::values`]) and integrals against the basis
+    /// ([`tensor_points::integrals`]) equal those through the tensor basis table, on
+    /// every element of a polynomial volume, for pseudo-random coefficients; and so
+    /// the residual through them equals the one of [`EggVolume::element`].
+    #[test]
+    fn sum_factorisation_is_the_basis_table_product() {
+        let (vol, cps) = polynomial();
+        let op = EggVolume::new(&vol, 5);
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        for e in 0..op.disc.elements() {
+            let idx = op.disc.element_indices(e);
+            let (weights, basis) = op.element_points(e, &idx);
+            let tables = op.disc.element_tables(e);
+            assert_eq!(tensor_points::weights(tables), weights);
+            let (m, nq) = (idx.len(), weights.len());
+            let u = random(&mut state, 2 * m);
+            let got = tensor_points::values(tables, &u);
+            for col in 0..2 {
+                for (row, q) in (0..10).flat_map(|row| (0..nq).map(move |q| (row, q))) {
+                    let want: f64 = (0..m).map(|a| basis[(10 * q + row) * m + a] * u[col * m + a]).sum();
+                    let g = got[(10 * col + row) * nq + q];
+                    assert!((g - want).abs() < 1e-12 * (1.0 + want.abs()), "{e} {col} {row}: {g} vs {want}");
+                }
+            }
+            let f = random(&mut state, 3 * nq);
+            let got = tensor_points::integrals(tables, &f);
+            for c in 0..3 {
+                for a in 0..m {
+                    let want: f64 = (0..nq).map(|q| basis[q * 10 * m + a] * f[c * nq + q]).sum();
+                    assert!((got[c * m + a] - want).abs() < 1e-13, "{e} {c} {a}: {} vs {want}", got[c * m + a]);
+                }
+            }
+        }
+        let fast = op.evaluate(&cps, false).residual;
+        let table = op.evaluate_with(&cps, false, true).residual;
+        let err = fast.iter().zip(&table).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
+        assert!(fast.iter().any(|f| f.abs() > 1e-3) && err < 1e-13, "{err}");
     }
 
     /// A Jacobian handed back and overwritten by the next assembly equals one assembled
