@@ -44,6 +44,7 @@
 use std::sync::Arc;
 
 use super::assembly::{Local, VolumeDiscretization};
+use super::tensor_points;
 use crate::linalg::sparse::Csr;
 use crate::spline::volume::Point3;
 
@@ -341,6 +342,123 @@ impl EggVolume {
         Some(Local { idx, scalar: 0.0, vector: res, matrix: k, scalar_matrix: kl })
     }
 
+    /// Element `e`'s residual (`dir` `None`) or its part of the Jacobian's product
+    /// `F'(c) v` with the displacement `dir` of the control points (zero at the fixed
+    /// ones), without the Jacobian: at each point, with `δd_a = ∂_a δx` and
+    /// `δX_c = ∇²δx_c` of `δx = Σ_B R_B dir_B`,
+    ///
+    /// `δL_c = (δA : X_c + A : δX_c - L_c δT) / T`, `δA_ij = δc_i · c_j + c_i · δc_j`,
+    /// `δc_i = δd_(i+1) × d_(i+2) + d_(i+1) × δd_(i+2)`, `δT = tr δA`
+    ///
+    /// (the directional derivative of `L_c`, which the Jacobian's columns of
+    /// [`EggVolume::element`] hold per basis function), and `δF_(a,c) = Σ_q w_q R_a δL_c`.
+    /// On a polynomial basis the values at the points and the integrals are sum
+    /// factorised ([`super::tensor_points`]), on a rational one they go through the
+    /// basis tables of [`EggVolume::element_points`]. `None` when `tr A = 0` at one of
+    /// its points.
+    fn element_linear(&self, e: usize, cps: &[Point3], dir: Option<&[Point3]>) -> Option<Local> {
+        let idx = self.disc.element_indices(e);
+        let m = idx.len();
+        let k = if dir.is_some() { 6 } else { 3 };
+        // x (columns 0..3) and δx (columns 3..6)
+        let mut cl = vec![0.0; k * m];
+        for (a, &lin) in idx.iter().enumerate() {
+            for c in 0..3 {
+                cl[c * m + a] = cps[lin][c];
+                if let Some(dir) = dir {
+                    cl[(3 + c) * m + a] = dir[lin][c];
+                }
+            }
+        }
+        let tables = self.disc.element_tables(e);
+        // their values, gradients and Hessians at every point, X[c 10 n_q + s_q q + s_k k]
+        let ((weights, xq, basis), (sq, sk)) = if self.disc.weights.is_some() {
+            let (weights, basis) = self.element_points(e, &idx);
+            let nq = weights.len();
+            let mut xq = vec![0.0; k * 10 * nq];
+            faer::linalg::matmul::matmul(
+                faer::MatMut::from_column_major_slice_mut(&mut xq, 10 * nq, k),
+                faer::Accum::Replace,
+                faer::MatRef::from_row_major_slice(&basis, 10 * nq, m),
+                faer::MatRef::from_column_major_slice(&cl, m, k),
+                1.0,
+                faer::Par::Seq,
+            );
+            ((weights, xq, Some(basis)), (10, 1))
+        } else {
+            let weights = tensor_points::weights(tables);
+            let nq = weights.len();
+            ((weights, tensor_points::values(tables, &cl), None), (1, nq))
+        };
+        let nq = weights.len();
+        // w_q δL_c(q) (or w_q L_c(q)) per component, `c n_q + q`
+        let mut f = vec![0.0; 3 * nq];
+        for (q, &wq) in weights.iter().enumerate() {
+            let at = |col: usize, k: usize| xq[col * 10 * nq + sq * q + sk * k];
+            let d: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(c, 1 + j)));
+            let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(c, 4 + k)));
+            let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
+            let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
+            let t = am[0][0] + am[1][1] + am[2][2];
+            if t.is_nan() || t <= 0.0 {
+                return None;
+            }
+            if dir.is_none() {
+                for c in 0..3 {
+                    f[c * nq + q] = wq * (contract(&am, &xh[c]) / t);
+                }
+                continue;
+            }
+            let dd: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(3 + c, 1 + j)));
+            let dxh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(3 + c, 4 + k)));
+            let dcof: [Point3; 3] = std::array::from_fn(|i| {
+                let (u, v) = (cross(dd[(i + 1) % 3], d[(i + 2) % 3]), cross(d[(i + 1) % 3], dd[(i + 2) % 3]));
+                [u[0] + v[0], u[1] + v[1], u[2] + v[2]]
+            });
+            let da: [[f64; 3]; 3] =
+                std::array::from_fn(|i| std::array::from_fn(|j| dot(dcof[i], cof[j]) + dot(cof[i], dcof[j])));
+            let dt = da[0][0] + da[1][1] + da[2][2];
+            for c in 0..3 {
+                let l = contract(&am, &xh[c]) / t;
+                f[c * nq + q] = wq * ((contract(&da, &xh[c]) + contract(&am, &dxh[c]) - l * dt) / t);
+            }
+        }
+        // Σ_q R_a(q) f_c(q), `c m + a`
+        let rc = match basis {
+            Some(basis) => {
+                let mut rc = vec![0.0; 3 * m];
+                for q in 0..nq {
+                    let rq = &basis[q * 10 * m..q * 10 * m + m];
+                    for c in 0..3 {
+                        let fq = f[c * nq + q];
+                        for (r, &ra) in rc[c * m..(c + 1) * m].iter_mut().zip(rq) {
+                            *r += ra * fq;
+                        }
+                    }
+                }
+                rc
+            }
+            None => tensor_points::integrals(tables, &f),
+        };
+        let mut res = vec![0.0; 3 * m];
+        for (a, r) in res.chunks_exact_mut(3).enumerate() {
+            for (c, x) in r.iter_mut().enumerate() {
+                *x = rc[c * m + a];
+            }
+        }
+        Some(Local { idx, scalar: 0.0, vector: res, matrix: Vec::new(), scalar_matrix: Vec::new() })
+    }
+
+    /// `F'(c) v` over the free coordinates (`3 f + component`, as the residual) without
+    /// assembling the Jacobian ([`EggVolume::element_linear`], elements added in
+    /// order): the assembled Jacobian's product to rounding, at the cost of about one
+    /// residual. `None` when `tr A = 0` at a quadrature point.
+    fn jacobian_times(&self, cps: &[Point3], v: &[f64]) -> Option<Vec<f64>> {
+        let mut dir = vec![[0.0; 3]; cps.len()];
+        self.disc.scatter(&mut dir, v);
+        self.disc.assemble(false, false, |e| self.element_linear(e, cps, Some(&dir))).map(|(_, y, _, _)| y)
+    }
+
     /// Number of free scalar unknowns (3 per interior control point).
     pub fn unknowns(&self) -> usize {
         self.disc.unknowns()
@@ -355,7 +473,15 @@ impl EggVolume {
     /// [`EggVolume::evaluate`], with the cofactor-metric stiffness `K` of the scalar
     /// unknowns when `laplace` ([`EggEvaluation::laplace`]).
     pub fn evaluate_with(&self, cps: &[Point3], jacobian: bool, laplace: bool) -> EggEvaluation {
-        match self.disc.assemble(jacobian, laplace, |e| self.element(e, cps, jacobian, laplace)) {
+        let residual_only = !jacobian && !laplace;
+        let element = |e| {
+            if residual_only {
+                self.element_linear(e, cps, None)
+            } else {
+                self.element(e, cps, jacobian, laplace)
+            }
+        };
+        match self.disc.assemble(jacobian, laplace, element) {
             Some((_, residual, jacobian, laplace)) => EggEvaluation { residual, jacobian, laplace },
             None => EggEvaluation { residual: Vec::new(), jacobian: None, laplace: None },
         }
@@ -367,133 +493,4 @@ mod newton;
 pub(super) use newton::{solve_egg, EggSolved};
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::spline::knots::KnotVector;
-    use crate::spline::volume::Volume;
-
-    /// A rational curved volume of degrees (3, 2, 2) with an interior wobble.
-    fn sample() -> (Volume, Vec<Point3>) {
-        super::super::tests::curved_rational_volume([
-            KnotVector::open_uniform(3, 2),
-            KnotVector::open_uniform(2, 2),
-            KnotVector::open_from_breaks(2, &[0.0, 0.4, 1.0], 1),
-        ])
-    }
-
-    /// The assembled Jacobian against central differences of the residual, on a
-    /// rational curved volume.
-    #[test]
-    fn jacobian_matches_finite_differences() {
-        let (vol, cps) = sample();
-        let op = EggVolume::new(&vol, 5);
-        let at = op.evaluate(&cps, true);
-        assert_eq!(at.residual.len(), op.unknowns());
-        assert!(at.residual.iter().any(|f| f.abs() > 1e-3), "a wobbled volume is not a solution");
-        let x0 = op.disc.gather(&cps);
-        let jac = at.jacobian.unwrap();
-        let eps = 1e-6;
-        for k in 0..x0.len() {
-            let shifted = |s: f64| {
-                let mut x = x0.clone();
-                x[k] += s;
-                let mut c = cps.clone();
-                op.disc.scatter(&mut c, &x);
-                op.evaluate(&c, false).residual
-            };
-            let (p, m) = (shifted(eps), shifted(-eps));
-            for l in 0..x0.len() {
-                let fd = (p[l] - m[l]) / (2.0 * eps);
-                assert!((jac.get(l, k) - fd).abs() < 1e-7 * (1.0 + fd.abs()), "jac {l} {k}: {} vs {fd}", jac.get(l, k));
-            }
-        }
-    }
-
-    /// A Jacobian handed back and overwritten by the next assembly equals one assembled
-    /// into a new matrix (its old values are cleared, its pattern is the pattern), and
-    /// a matrix of another size is not taken.
-    #[test]
-    fn a_recycled_jacobian_is_assembled_afresh() {
-        let (vol, cps) = sample();
-        let op = EggVolume::new(&vol, 4);
-        let mut moved = cps.clone();
-        for (k, p) in moved.iter_mut().enumerate() {
-            p[k % 3] += 0.01 * ((k % 7) as f64 - 3.0);
-        }
-        let first = op.evaluate(&cps, true).jacobian.unwrap();
-        let fresh = op.evaluate(&moved, true).jacobian.unwrap();
-        op.disc.recycle(first);
-        let reused = op.evaluate(&moved, true).jacobian.unwrap();
-        assert!(fresh.values.iter().any(|v| *v != 0.0));
-        assert_eq!((&reused.row_ptr, &reused.col_idx), (&fresh.row_ptr, &fresh.col_idx));
-        assert_eq!(reused.values, fresh.values, "the same sums in the same order");
-        op.disc.recycle(Csr { nrows: 3, ncols: 3, row_ptr: vec![0, 0, 0, 0], col_idx: vec![], values: vec![] });
-        assert_eq!(op.evaluate(&moved, true).jacobian.unwrap().values, fresh.values);
-    }
-
-    /// The residual against the operator evaluated directly: for the quadratic volume
-    /// `x = ξ + a ξη`, `y = η + b ζ²`, `z = ζ + c ξ²` (control points from its blossoms,
-    /// so the B-spline basis holds it exactly), `F_(A,c) = ∫ R_A L_c` with `L_c` from the
-    /// closed-form derivatives, summed over the same Gauss points.
-    #[test]
-    fn residual_matches_the_operator_in_closed_form() {
-        let kv = KnotVector::open_uniform(2, 2);
-        let k = [kv.clone(), kv.clone(), kv.clone()];
-        let (a, b, c) = (0.3, -0.2, 0.25);
-        let t = kv.knots();
-        let g = kv.greville();
-        let sq: Vec<f64> = (0..kv.num_basis()).map(|i| t[i + 1] * t[i + 2]).collect();
-        let n = kv.num_basis();
-        let cps: Vec<Point3> = (0..n * n * n)
-            .map(|lin| {
-                let (i, j, l) = (lin % n, (lin / n) % n, lin / (n * n));
-                [g[i] + a * g[i] * g[j], g[j] + b * sq[l], g[l] + c * sq[i]]
-            })
-            .collect();
-        let vol = Volume::new(k, cps.clone(), None).unwrap();
-        for u in [[0.2, 0.7, 0.4], [0.9, 0.1, 0.55]] {
-            let (x, want) = (vol.eval(u), [u[0] + a * u[0] * u[1], u[1] + b * u[2] * u[2], u[2] + c * u[0] * u[0]]);
-            assert!((0..3).all(|i| (x[i] - want[i]).abs() < 1e-14), "{x:?} vs {want:?}");
-        }
-        let op = EggVolume::new(&vol, 4);
-        let f = op.evaluate(&cps, false).residual;
-        let l = |u: [f64; 3]| -> Point3 {
-            let d = [[1.0 + a * u[1], 0.0, 2.0 * c * u[0]], [a * u[0], 1.0, 0.0], [0.0, 2.0 * b * u[2], 1.0]];
-            // second derivatives per component, in the order of PAIRS
-            let h =
-                [[0.0, 0.0, 0.0, a, 0.0, 0.0], [0.0, 0.0, 2.0 * b, 0.0, 0.0, 0.0], [2.0 * c, 0.0, 0.0, 0.0, 0.0, 0.0]];
-            let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
-            let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
-            let t = am[0][0] + am[1][1] + am[2][2];
-            std::array::from_fn(|comp| contract(&am, &h[comp]) / t)
-        };
-        let rule = crate::spline::quadrature::GaussLegendre::new(4);
-        let nodes: Vec<(f64, f64)> =
-            kv.elements().into_iter().flat_map(|(_, lo, hi)| rule.on(lo, hi).collect::<Vec<_>>()).collect();
-        let mut checked = 0;
-        for lin in 0..cps.len() {
-            let Some(fr) = op.disc.free_index(lin) else { continue };
-            let ijk = [lin % n, (lin / n) % n, lin / (n * n)];
-            let mut want = [0.0; 3];
-            for &(x, wx) in &nodes {
-                for &(y, wy) in &nodes {
-                    for &(z, wz) in &nodes {
-                        let u = [x, y, z];
-                        let r: f64 = (0..3).map(|d| crate::spline::basis::dense_values(&kv, u[d])[ijk[d]]).product();
-                        let lv = l(u);
-                        for comp in 0..3 {
-                            want[comp] += wx * wy * wz * r * lv[comp];
-                        }
-                    }
-                }
-            }
-            for comp in 0..3 {
-                let got = f[3 * fr + comp];
-                assert!((got - want[comp]).abs() < 1e-13, "{lin} {comp}: {got} vs {}", want[comp]);
-            }
-            assert!(want.iter().any(|w| w.abs() > 1e-3), "a curved volume is not a solution");
-            checked += 1;
-        }
-        assert_eq!(checked, 8);
-    }
-}
+mod tests;

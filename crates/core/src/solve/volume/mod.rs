@@ -24,6 +24,7 @@
 pub(crate) mod assembly;
 pub(crate) mod coons;
 pub(crate) mod egg;
+pub(crate) mod tensor_points;
 pub(crate) mod winslow;
 
 use std::time::Instant;

@@ -14,18 +14,22 @@
 //! `crate::solve::newton`), which keeps Newton's quadratic convergence while the first
 //! steps take few Krylov iterations.
 //!
-//! The unknowns of the volume are interleaved (`3 f + component`), those of `P`'s
-//! blocks are not: GMRES runs on the system in component blocks (`component m + f`),
-//! [`ComponentBlocks`].
+//! GMRES does not need the Jacobian as a matrix: each product `F'(c) v` is the
+//! directional derivative of the residual, evaluated element by element at about the
+//! cost of one residual ([`JacobianProduct`]), against an assembly of `9 m²` entries per
+//! element of `m` functions (a dense `m x n_q` by `n_q x 9 m` product per element, and
+//! the addition into the pattern). The Jacobian is assembled only for LU (`--linear lu`,
+//! small systems, or after GMRES failed). The unknowns of the volume are interleaved
+//! (`3 f + component`), those of `P`'s blocks are not: GMRES runs on the system in
+//! component blocks (`component m + f`).
 
 use crate::error::{Error, Result};
 use crate::linalg::krylov::MatVec;
 use crate::linalg::linsolve::{LinearMethod, LinearSolver, AUTO_LU_LIMIT, KRYLOV_TOL};
-use crate::linalg::sparse::Csr;
 use crate::solve::newton::ETA_MAX;
 use crate::spline::volume::Point3;
 
-use super::EggVolume;
+use super::{EggEvaluation, EggVolume};
 
 /// Statistics of one EGG solve.
 #[derive(Debug, Clone, Copy)]
@@ -44,9 +48,14 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// The interleaved matrix `a` (unknown `3 f + c`) as the operator on the component
-/// blocks (unknown `c m + f`, `m` free control points): `y = Π a Πᵀ x`.
-struct ComponentBlocks<'a>(&'a Csr);
+/// The Jacobian `F'(c)` at the control points `cps` as the operator on the component
+/// blocks (unknown `c m + f`, `m` free control points; the volume's unknowns are
+/// interleaved, `3 f + c`): `y = Π F'(c) Πᵀ x`, each product without the Jacobian
+/// ([`EggVolume::jacobian_times`]).
+struct JacobianProduct<'a> {
+    op: &'a EggVolume,
+    cps: &'a [Point3],
+}
 
 /// `x` in component blocks (`c m + f`) to interleaved (`3 f + c`).
 fn interleaved(x: &[f64]) -> Vec<f64> {
@@ -60,11 +69,14 @@ fn blocked(x: &[f64]) -> Vec<f64> {
     (0..x.len()).map(|k| x[3 * (k % m) + k / m]).collect()
 }
 
-impl MatVec for ComponentBlocks<'_> {
+impl MatVec for JacobianProduct<'_> {
     fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        let mut yi = vec![0.0; x.len()];
-        self.0.mul_vec(&interleaved(x), &mut yi);
-        y.copy_from_slice(&blocked(&yi));
+        match self.op.jacobian_times(self.cps, &interleaved(x)) {
+            Some(yi) => y.copy_from_slice(&blocked(&yi)),
+            // `tr A = 0` at a point (not at a point whose residual was evaluated):
+            // GMRES fails on the non-finite product
+            None => y.fill(f64::NAN),
+        }
     }
 }
 
@@ -101,15 +113,18 @@ impl Step {
         self.gmres.as_ref().is_some_and(|g| g.wants_preconditioner(n))
     }
 
-    /// `d` of `jac d = rhs`, GMRES to the relative residual `eta` with the
-    /// preconditioner `-diag(K, K, K)` of `laplace` (`None`: the frozen one).
-    fn solve(&mut self, jac: &Csr, laplace: Option<&Csr>, rhs: &[f64], eta: f64) -> Result<Vec<f64>> {
+    /// `d` of `F'(c) d = rhs` at the control points `cps` (`ev` evaluated there): GMRES
+    /// to the relative residual `eta` with the Jacobian's products
+    /// ([`JacobianProduct`], no Jacobian assembled) and the preconditioner
+    /// `-diag(K, K, K)` of `ev.laplace` (`None`: the frozen one); LU of `ev.jacobian`
+    /// (assembled here when `ev` has none, after a GMRES failure).
+    fn solve(&mut self, op: &EggVolume, cps: &[Point3], ev: &EggEvaluation, rhs: &[f64], eta: f64) -> Result<Vec<f64>> {
         if let Some(g) = self.gmres.as_mut() {
             g.krylov_tol = eta;
             let before = g.krylov_iterations;
             let r = g
-                .factor_operator(rhs.len(), laplace)
-                .and_then(|()| g.solve_operator(&ComponentBlocks(jac), &blocked(rhs)));
+                .factor_operator(rhs.len(), ev.laplace.as_ref())
+                .and_then(|()| g.solve_operator(&JacobianProduct { op, cps }, &blocked(rhs)));
             self.krylov_iterations += g.krylov_iterations - before;
             match r {
                 Ok(d) => return Ok(interleaved(&d)),
@@ -117,6 +132,16 @@ impl Step {
                 Err(_) => self.gmres = None,
             }
         }
+        let assembled;
+        let jac = match ev.jacobian.as_ref() {
+            Some(j) => j,
+            None => {
+                assembled = op.evaluate(cps, true).jacobian.ok_or_else(|| {
+                    Error::LinearSolver("3D EGG: the cofactor metric vanishes at a quadrature point".into())
+                })?;
+                &assembled
+            }
+        };
         self.lu.factor(jac)?;
         self.lu.solve(rhs)
     }
@@ -165,7 +190,8 @@ pub(in crate::solve::volume) fn solve_egg(
 ) -> Result<EggSolved> {
     let n = op.unknowns();
     let mut step = Step::new(n, linear);
-    let mut ev = op.evaluate_with(cps, true, step.wants_laplace(n));
+    // GMRES multiplies with the Jacobian without assembling it (`Step::solve`)
+    let mut ev = op.evaluate_with(cps, step.gmres.is_none(), step.wants_laplace(n));
     if ev.residual.is_empty() && n > 0 {
         return Err(Error::InfeasibleStart {
             method: "3D EGG".into(),
@@ -179,14 +205,14 @@ pub(in crate::solve::volume) fn solve_egg(
     let mut fnorm = f0;
     let mut previous = None;
     while iterations < max_iterations && n > 0 && fnorm > stop {
-        if ev.jacobian.is_none() {
+        let (direct, laplace) = (step.gmres.is_none(), step.wants_laplace(n));
+        if direct && ev.jacobian.is_none() || laplace && ev.laplace.is_none() {
             // the line search's residual at this point was enough to decide to go on
-            ev = op.evaluate_with(cps, true, step.wants_laplace(n));
+            ev = op.evaluate_with(cps, direct, laplace);
         }
-        let jac = ev.jacobian.as_ref().expect("evaluated with the Jacobian");
         let rhs: Vec<f64> = ev.residual.iter().map(|f| -f).collect();
         let eta = forcing(previous, fnorm, stop);
-        let d = step.solve(jac, ev.laplace.as_ref(), &rhs, eta)?;
+        let d = step.solve(op, cps, &ev, &rhs, eta)?;
         if !d.iter().all(|v| v.is_finite()) {
             return Err(Error::NoConvergence("3D EGG: the Newton step is not finite".into()));
         }
@@ -284,12 +310,14 @@ mod tests {
         let n = op.unknowns();
         let ev = op.evaluate_with(&cps, true, true);
         let rhs: Vec<f64> = ev.residual.iter().map(|f| -f).collect();
-        let jac = ev.jacobian.as_ref().unwrap();
+        assert!(ev.jacobian.is_some());
         let mut lu = Step::new(n, LinearMethod::Lu);
         let mut gmres = Step::new(n, LinearMethod::Gmres);
         assert_eq!((lu.method(), gmres.method()), (LinearMethod::Lu, LinearMethod::Gmres));
-        let a = lu.solve(jac, None, &rhs, 1e-12).unwrap();
-        let b = gmres.solve(jac, ev.laplace.as_ref(), &rhs, 1e-12).unwrap();
+        let a = lu.solve(&op, &cps, &ev, &rhs, 1e-12).unwrap();
+        // GMRES with the Jacobian's products, no assembled Jacobian
+        let ev = EggEvaluation { jacobian: None, ..ev };
+        let b = gmres.solve(&op, &cps, &ev, &rhs, 1e-12).unwrap();
         assert_eq!(gmres.method(), LinearMethod::Gmres, "GMRES converged, no fallback");
         assert!(gmres.krylov_iterations >= 2, "{}", gmres.krylov_iterations);
         let (size, err) = (norm(&a), norm(&a.iter().zip(&b).map(|(x, y)| x - y).collect::<Vec<_>>()));
