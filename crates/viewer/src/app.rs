@@ -17,7 +17,9 @@ use winslow::Point;
 use crate::colour::{colour_at, fold_colour, is_positive, ColourScale, ScaleKind};
 use crate::export::write_png;
 use crate::mesh_overlay::{mesh_section, paint_overlay};
-use crate::paint::{control_net, crosshair, element_outline, heat_mesh, irregular_colour, side_colours};
+use crate::paint::{
+    control_net, crosshair, element_outline, heat_mesh, irregular_colour, side_colours, thb_control_net,
+};
 use crate::sampler::DetJSampler;
 use crate::scene::RESOLUTION_RANGE;
 use crate::sections::{
@@ -437,7 +439,11 @@ impl ViewerApp {
                 paint_overlay(&painter, o, side_colours(), |k| to(o.mesh.points[k].to_array()));
             }
             if d.net {
-                control_net(&painter, &mv.map, &to);
+                // a THB map's own net (its active functions), not its tensor form's
+                match &mv.thb {
+                    Some(t) => thb_control_net(&painter, &t.map, &to),
+                    None => control_net(&painter, &mv.map, &to),
+                }
             }
             for side in &mv.sides {
                 painter.add(Shape::line(side.iter().map(|&p| to(p)).collect(), Stroke::new(1.6, Color32::BLACK)));

@@ -3,6 +3,7 @@
 
 use egui::epaint::{Mesh, Vertex, WHITE_UV};
 use egui::{Color32, Pos2, Shape, Stroke, Vec2};
+use winslow::spline::hierarchical::map::HierarchicalMap;
 use winslow::Point;
 
 use crate::colour::{fold_colour, is_positive, ColourScale};
@@ -73,6 +74,19 @@ pub(crate) fn control_net(painter: &egui::Painter, map: &winslow::Surface, to: &
     }
     for i in 0..nx {
         painter.add(Shape::line((0..ny).map(|j| to(map.cp(i, j))).collect(), stroke));
+    }
+    for p in &map.control_points {
+        painter.circle_filled(to(*p), 2.0, Color32::from_rgb(60, 60, 60));
+    }
+}
+
+/// The control net of a THB map ([`HierarchicalMap::control_net`]: on every level the
+/// segments between neighbouring active functions' control points), in the colours of the
+/// tensor net; the points of the active functions.
+pub(crate) fn thb_control_net(painter: &egui::Painter, map: &HierarchicalMap, to: &impl Fn(Point) -> Pos2) {
+    let stroke = Stroke::new(0.8, Color32::from_rgb(90, 90, 90));
+    for [a, b] in map.control_net() {
+        painter.line_segment([to(map.control_points[a]), to(map.control_points[b])], stroke);
     }
     for p in &map.control_points {
         painter.circle_filled(to(*p), 2.0, Color32::from_rgb(60, 60, 60));

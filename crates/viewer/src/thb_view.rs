@@ -3,9 +3,10 @@
 //! ([`sample_det_j_hierarchical`]: each grid point on the Bézier patch of its active
 //! cell, the polynomial the certificate bounds), the active cells in the parameter
 //! square and their borders in the physical domain (the PNG's geometry,
-//! [`active_cell_borders`]), and the verdict of the THB certificate
-//! ([`certify_hierarchical`], active cell by active cell). Everything else a map view
-//! shows (iso-lines, the control net, inversion under the pointer, the mesh overlay) is
+//! [`active_cell_borders`]), the control net of the active functions
+//! ([`HierarchicalMap::control_net`], drawn by the app), and the verdict of the THB
+//! certificate ([`certify_hierarchical`], active cell by active cell). Everything else a
+//! map view shows (iso-lines, inversion under the pointer, the mesh overlay) is
 //! read off the THB map's exact tensor form ([`HierarchicalMap::to_surface`]: knot
 //! insertion on the lines of all active cells, the same polynomial on every cell).
 

@@ -315,6 +315,23 @@ fn thb_map_snapshot() {
 }
 
 #[test]
+fn thb_control_net_snapshot() {
+    // the bundled THB sector with the control net on: the net of its active functions
+    // (segments between neighbours of one level), not the net of its tensor form
+    let mut app = ViewerApp::new(Arc::new(CpuSampler));
+    app.state.open(&data("thb/sector_thb.json")).unwrap();
+    app.state.display.net = true;
+    let mv = app.state.scene.as_ref().unwrap().map.as_ref().unwrap();
+    let thb = mv.thb.as_ref().expect("a THB map");
+    // fewer points than the tensor form draws: the THB map's own control points
+    assert!(thb.map.control_points.len() < mv.map.control_points.len());
+    assert!(!thb.map.control_net().is_empty());
+    let mut h = harness(app);
+    h.run();
+    h.snapshot("thb_control_net");
+}
+
+#[test]
 fn a_thb_file_opens_with_its_cells_and_det_j() {
     // the bundled THB sector: the viewer's det J (its heat map's samples and the probe)
     // is the library's evaluation of the THB map

@@ -4,7 +4,10 @@
 //! rounds are allowed, the map becomes a THB map on the same basis (exact: a one-level
 //! hierarchy) and [`repair_thb_observed`] refines only the offending cells and a ring
 //! around them, round by round ([`Stage::ThbRound`](super::Stage::ThbRound)), until the
-//! certificate accepts the map or the rounds run out. The result is
+//! certificate accepts the map or the rounds run out. When the offending cells grow in
+//! two successive rounds (the folds pushed deeper instead of removed) or the rounds end
+//! unaccepted, the rounds start again from the tensor map with a ring of
+//! `RETRY_RING` cells in every round. The result is
 //! [`Solved::Thb`](super::Solved::Thb): the THB map and its [`ThbReport`].
 
 use std::time::Instant;
@@ -66,13 +69,19 @@ pub struct ThbReport {
     /// benchmark ([`crate::verify::poisson`]) on the THB map's exact tensor form.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub poisson: Option<PoissonReport>,
-    /// When the rounds (a ring of `--halo` cells in the first, the offending cells only
-    /// in the later ones) left the map folded or undecided, so that they ran again from
-    /// the tensor map with a ring of 2 cells in every round: what the first
-    /// rounds ended with (`thb_rounds` are then the second rounds'; the map is theirs when
-    /// certified, the first rounds' otherwise). Absent when the first rounds sufficed.
+    /// When the first rounds (a ring of `--halo` cells in the first, the offending cells
+    /// only in the later ones) left the map folded or undecided, or were stopped because
+    /// the offending cells grew in two successive rounds (`solve::hierarchical::growing`),
+    /// so that the rounds ran again from the tensor map with a ring of 2 cells in every
+    /// round: what the first rounds ended with. When the second rounds certify, the map and
+    /// `thb_rounds` are theirs (and `first_rounds` the first ones); otherwise the first
+    /// rounds'. Absent when the first rounds sufficed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_attempt: Option<ThbFallback>,
+    /// The first rounds when the second ones certified (see `first_attempt`); empty (and
+    /// absent from the JSON) otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub first_rounds: Vec<ThbRound>,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
 }
@@ -168,13 +177,14 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         ));
     }
     let start = HierarchicalMap::from_surface(&sol.map)?;
-    let narrow = thb_options(opts);
+    // the first rounds stop as soon as the offending cells keep growing
+    let narrow = ThbRepairOptions { stop_when_growing: true, ..thb_options(opts) };
     let mut out = repair_thb_observed(start.clone(), &narrow, &mut |round| observer(&Stage::ThbRound(round)))?;
-    let mut first_attempt = None;
+    let (mut first_attempt, mut first_rounds) = (None, Vec::new());
     if !accepted(&out.certificate) && !out.rounds.is_empty() {
         let seconds = t0.elapsed().as_secs_f64();
         // the rounds again from the tensor map, a ring of `RETRY_RING` cells in every round
-        let wide = ThbRepairOptions { ring: RETRY_RING, later_ring: RETRY_RING, ..narrow };
+        let wide = ThbRepairOptions { ring: RETRY_RING, later_ring: RETRY_RING, stop_when_growing: false, ..narrow };
         let again = repair_thb_observed(start, &wide, &mut |round| observer(&Stage::ThbRound(round)))?;
         first_attempt = Some(ThbFallback {
             verdict: Verdict::of_finding(&out.certificate.verdict),
@@ -184,7 +194,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
             seconds,
         });
         if accepted(&again.certificate) {
-            out = again;
+            first_rounds = std::mem::replace(&mut out, again).rounds;
         }
     }
     let (map, c, improvement) = match opts.improve {
@@ -207,6 +217,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         improvement,
         poisson: if opts.report.poisson { poisson_benchmark(&map.to_surface()?, None).ok() } else { None },
         first_attempt,
+        first_rounds,
         solve: sol.report,
     };
     Ok(ThbSolution { name: sol.name, map, report })

@@ -35,6 +35,10 @@ pub(crate) struct ThbRepairOptions {
     /// admissibility needs; BENCHMARKS.md "Local defect correction": with 1, puzzle4 ends
     /// with 949 functions, with 0 with 805, jigsaw01 2,076 against 1,624).
     pub later_ring: usize,
+    /// Stop the rounds as soon as the offending cells have grown in [`GROWTHS`]
+    /// successive rounds ([`growing`]; the map is then not accepted): the caller starts again with
+    /// a wider ring instead of paying every round of one that does not remove the folds.
+    pub stop_when_growing: bool,
     /// Admissibility class `m >= 2` of the refined hierarchy.
     pub admissibility: usize,
     /// Operator of eq. (8).
@@ -57,6 +61,7 @@ impl Default for ThbRepairOptions {
             rounds: 6,
             ring: 1,
             later_ring: 0,
+            stop_when_growing: false,
             admissibility: 2,
             operator: Operator::Scaled,
             nonlinear: NonlinearOptions::default(),
@@ -82,6 +87,9 @@ pub struct ThbRound {
     pub unknowns: usize,
     /// Levels after refinement.
     pub levels: usize,
+    /// The ring of the round: active cells within this many cell widths of an offending
+    /// cell were marked too.
+    pub ring: usize,
     /// Newton iterations of the round's solve.
     pub iterations: usize,
     /// Whether the round's solve converged.
@@ -111,6 +119,20 @@ pub(crate) struct ThbRepair {
     pub certificate: HierarchicalCertificate,
     /// The rounds run.
     pub rounds: Vec<ThbRound>,
+}
+
+/// Successive rounds in which the offending cells must grow before the THB rounds are
+/// abandoned for a wider ring ([`ThbRepairOptions::stop_when_growing`]).
+pub(crate) const GROWTHS: usize = 2;
+
+/// Whether the offending cells grew in each of the last `k` rounds: `offending` holds the
+/// offending cells before every round so far and now, and its last `k + 1` entries rise
+/// strictly. On the hard corpus's puzzles they grow from the start (puzzle-3: 64, 101,
+/// 138, ...; BENCHMARKS.md "THB on the puzzle family"): a ring of 1 then 0 pushes the
+/// folds one level deeper along the necks round after round, where a ring of 2 removes
+/// them.
+pub(crate) fn growing(offending: &[usize], k: usize) -> bool {
+    offending.len() > k && offending[offending.len() - k - 1..].windows(2).all(|w| w[0] < w[1])
 }
 
 /// Whether a verdict needs no repair (certified, or a degenerate corner that the boundary
@@ -234,9 +256,15 @@ pub(crate) fn repair_thb_observed(
     let mut rounds = Vec::new();
     // the last round's basis and discretization: the next one extracts only what changed
     let mut last: Option<(HierarchicalBasis, Arc<HierarchicalDiscretization>)> = None;
+    // the offending cells before every round so far
+    let mut history = Vec::new();
     while !accepted(&cert) && rounds.len() < opts.rounds {
         let t0 = Instant::now();
         let offending = cert.offending_cells();
+        history.push(offending.len());
+        if opts.stop_when_growing && growing(&history, GROWTHS) {
+            return Ok(ThbRepair { map, certificate: cert, rounds });
+        }
         let ring = if rounds.is_empty() { opts.ring } else { opts.later_ring };
         let marked = marked_cells(&map, &offending, ring);
         if marked.is_empty() {
@@ -265,6 +293,7 @@ pub(crate) fn repair_thb_observed(
             functions: map.basis.len(),
             unknowns: egg.unknowns,
             levels: map.basis.num_levels(),
+            ring,
             iterations: egg.iterations,
             converged: egg.converged,
             seconds: t0.elapsed().as_secs_f64(),

@@ -155,3 +155,21 @@ fn the_winslow_improvement_on_a_thb_basis_minimizes_and_is_certified() {
     let err = improve_thb(&folded, &fc, NonlinearOptions::default(), &opts.certify).unwrap_err();
     assert!(matches!(err, Error::InfeasibleStart { .. }), "{err}");
 }
+
+/// The growth criterion on the offending cells before each round (counts measured with
+/// ring 1 then 0, BENCHMARKS.md "THB: deciding the ring without a failed attempt"): the
+/// puzzles whose folds the narrow ring pushes deeper grow in two successive rounds and
+/// stop there (puzzle-3 after two rounds, puzzle-4 likewise); puzzle4's (20, 24, 20)
+/// and a first round alone never do; a fall starts the count again.
+#[test]
+fn the_rounds_stop_when_the_offending_cells_grow_twice_in_a_row() {
+    let stops_after = |seq: &[usize]| (1..=seq.len()).find(|&n| growing(&seq[..n], GROWTHS)).map(|n| n - 1);
+    assert_eq!(GROWTHS, 2);
+    assert_eq!(stops_after(&[64, 101, 138, 183, 272, 456]), Some(2), "puzzle-3");
+    assert_eq!(stops_after(&[54, 85, 146, 117, 125, 274]), Some(2), "puzzle-4");
+    assert_eq!(stops_after(&[20, 24, 20]), None, "bundled puzzle4");
+    assert_eq!(stops_after(&[13, 8, 15]), None, "puzzle-2");
+    assert_eq!(stops_after(&[20, 24, 24, 30]), None, "equal counts are no growth");
+    assert_eq!(stops_after(&[9, 5, 7, 6, 8, 11]), Some(5), "a fall starts the count again");
+    assert!(!growing(&[3], 2) && !growing(&[3, 4], 2) && growing(&[3, 4, 5], 2) && !growing(&[3, 4, 5], 3));
+}

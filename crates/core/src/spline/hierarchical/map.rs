@@ -71,6 +71,25 @@ impl HierarchicalMap {
         Self::new(basis, map.control_points.clone())
     }
 
+    /// The control net of the map: for every level `l`, the segments between the control
+    /// points of the active functions `(l, [i, j])` and `(l, [i + 1, j])`, or `(l, [i, j])`
+    /// and `(l, [i, j + 1])`, when both are active (the level's tensor control net
+    /// restricted to its active functions; on a one-level map the tensor net), as pairs of
+    /// indices into `control_points`, by level, then `eta`, then `xi` (the `xi` segment of
+    /// a function before its `eta` segment).
+    pub fn control_net(&self) -> Vec<[usize; 2]> {
+        let b = &self.basis;
+        let mut out = Vec::new();
+        for (k, &(l, [i, j])) in b.active_functions().iter().enumerate() {
+            for next in [[i + 1, j], [i, j + 1]] {
+                if let Some(n) = b.index_of(l, next) {
+                    out.push([k, n]);
+                }
+            }
+        }
+        out
+    }
+
     /// The level coefficients of the map (see `truncation`).
     pub(crate) fn level_coefficients(&self) -> LevelCoefficients<'_, Point> {
         LevelCoefficients::new(&self.basis, |k| self.control_points[k])

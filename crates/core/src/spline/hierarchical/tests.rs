@@ -282,3 +282,53 @@ fn from_refined_rebuilds_the_hierarchy() {
     let bad = vec![vec![], vec![[7, 7]]];
     assert!(HierarchicalBasis::from_refined(b.knots(0).clone(), &bad).is_err());
 }
+
+/// The control net of a THB map: on one level the tensor net (`nx (ny - 1) + ny (nx - 1)`
+/// segments). After refinement, the identity `x(ξ, η) = (ξ, η)` keeps its control points
+/// at the Greville abscissae of each active function's own level (the THB basis preserves
+/// the coefficients of every function of the coarsest space it lies in: the identity lies
+/// in `S^0`), so every segment joins two functions of one level that are neighbours in its
+/// index grid and is the axis-parallel step between their Greville abscissae; every pair of
+/// such neighbours is a segment.
+#[test]
+fn the_control_net_joins_neighbouring_active_functions_of_one_level() {
+    let knots = [kv(3, &[0.0, 0.25, 0.5, 0.75, 1.0]), kv(2, &[0.0, 0.3, 0.6, 1.0])];
+    let (gx, gy) = (knots[0].greville(), knots[1].greville());
+    let cps = gy.iter().flat_map(|&y| gx.iter().map(move |&x| [x, y])).collect();
+    let s = Surface::new(knots, cps, None).unwrap();
+    let map = HierarchicalMap::from_surface(&s).unwrap();
+    let [nx, ny] = [gx.len(), gy.len()];
+    assert_eq!(map.control_net().len(), nx * (ny - 1) + ny * (nx - 1));
+    // three of the four columns of coarse cells, then a 4 x 4 block of level-1 cells
+    let coarse: Vec<(usize, Index2)> = (1..4).flat_map(|i| (0..3).map(move |j| (0, [i, j]))).collect();
+    let map = map.refined(&coarse, 2).unwrap();
+    let fine: Vec<(usize, Index2)> = (3..7).flat_map(|i| (1..5).map(move |j| (1, [i, j]))).collect();
+    let map = map.refined(&fine, 2).unwrap();
+    assert_eq!(map.basis.num_levels(), 3);
+    let b = &map.basis;
+    let greville = |l: usize, f: Index2| [b.knots(l)[0].greville()[f[0]], b.knots(l)[1].greville()[f[1]]];
+    for (k, &(l, f)) in b.active_functions().iter().enumerate() {
+        let (x, g) = (map.control_points[k], greville(l, f));
+        assert!((x[0] - g[0]).abs() < 1e-13 && (x[1] - g[1]).abs() < 1e-13, "({l}, {f:?}): {x:?} vs {g:?}");
+    }
+    let net = map.control_net();
+    let mut expected = 0;
+    for &(l, [i, j]) in b.active_functions() {
+        expected += usize::from(b.index_of(l, [i + 1, j]).is_some()) + usize::from(b.index_of(l, [i, j + 1]).is_some());
+    }
+    assert_eq!(net.len(), expected);
+    let mut levels = BTreeSet::new();
+    for &[a, c] in &net {
+        let ((la, fa), (lc, fc)) = (b.active_functions()[a], b.active_functions()[c]);
+        assert_eq!(la, lc, "one level");
+        assert!(fc == [fa[0] + 1, fa[1]] || fc == [fa[0], fa[1] + 1], "{fa:?} {fc:?}");
+        let (pa, pc) = (map.control_points[a], map.control_points[c]);
+        let (ga, gc) = (greville(la, fa), greville(lc, fc));
+        for d in 0..2 {
+            assert!(((pc[d] - pa[d]) - (gc[d] - ga[d])).abs() < 1e-13);
+        }
+        assert!((gc[0] > ga[0] && gc[1] == ga[1]) || (gc[0] == ga[0] && gc[1] > ga[1]), "{ga:?} {gc:?}");
+        levels.insert(la);
+    }
+    assert!(levels.len() >= 2, "segments on the coarse and a finer level: {levels:?}");
+}
