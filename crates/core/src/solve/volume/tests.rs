@@ -270,3 +270,32 @@ fn egg_converges_at_order_p_plus_1_to_a_harmonic_shell_sector() {
         assert!(last > p as f64 + 0.7, "p = {p}: errors {errors:?}, rates {rates:?}");
     }
 }
+
+/// Defect correction bisects the spans of the offending elements and one span around
+/// them, per direction, and nothing else.
+#[test]
+fn the_offending_spans_and_their_halo_are_bisected() {
+    let knots = [KnotVector::open_uniform(2, 8), KnotVector::open_uniform(2, 4), KnotVector::open_uniform(2, 1)];
+    // elements (2, 0, 0) and (3, 3, 0): spans 1..=4 in xi, 0, 1, 2, 3 in eta, 0 in zeta
+    let mids = offending_midpoints(&knots, &[[2, 0, 0], [3, 3, 0]], 1);
+    assert_eq!(mids[0], vec![0.1875, 0.3125, 0.4375, 0.5625]);
+    assert_eq!(mids[1], vec![0.125, 0.375, 0.625, 0.875]);
+    assert_eq!(mids[2], vec![0.5]);
+    // no halo: the elements' own spans
+    let mids = offending_midpoints(&knots, &[[7, 1, 0]], 0);
+    assert_eq!(mids, [vec![0.9375], vec![0.375], vec![0.5]]);
+    // the refined common faces hold exactly those knots more, the faces refined exactly
+    let corner = |u: [f64; 3]| [u[0] + 0.2 * u[1] * u[2], 2.0 * u[1] - 0.1 * u[0], u[2] + 0.3 * u[0] * u[1]];
+    let b = VolumeBoundary { name: "t".into(), faces: trilinear_faces(corner) };
+    let plain = coons::common_faces(&b, 0, &Default::default()).unwrap();
+    let extra = [vec![0.25], vec![0.5, 0.75], vec![]];
+    let refined = coons::common_faces(&b, 0, &extra).unwrap();
+    for d in 0..3 {
+        assert_eq!(refined.knots[d], plain.knots[d].with_inserted(&extra[d]));
+    }
+    let (v0, v1) = (plain.coons().unwrap(), refined.coons().unwrap());
+    for u in [[0.1, 0.2, 0.3], [0.6, 0.8, 0.9]] {
+        let (x, y) = (v0.eval(u), v1.eval(u));
+        assert!((0..3).all(|c| (x[c] - y[c]).abs() < 1e-13), "{u:?}");
+    }
+}
