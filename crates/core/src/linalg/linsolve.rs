@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
 use crate::linalg::multigrid::kernels::CycleBackend;
-use crate::linalg::multigrid::{Multigrid, Smoother, TensorProlongation};
+use crate::linalg::multigrid::{Multigrid, TensorProlongation};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
 
@@ -99,27 +99,7 @@ pub(crate) const MAX_KRYLOV: usize = 2000;
 /// aspect ratio ~100: 2000 iterations per Newton step), and LU is cheaper.
 pub(crate) const AUTO_MAX_KRYLOV: usize = 500;
 
-/// Smoother of [`LinearMethod::Multigrid`]: alternating line Gauss–Seidel, the lines of
-/// each direction by colours (the lines of one colour in parallel). On the metric
-/// Laplacians of the Newton solves themselves (puzzle4 at 3 600, 57 600 and 230 400
-/// scalar unknowns) the V(1,1)-cycle with ILU(0) reduced the residual by 0.078, 0.78 and
-/// 2.9 per cycle (divergent: ILU(0) of these non-M-matrices is not a convergent
-/// smoother), with symmetric Gauss–Seidel by 0.91 at every size, with the lines by 0.18,
-/// 0.42, 0.53; the lines solve the stiff direction of a narrow gap exactly. The coloured
-/// order gives the lexicographic one's GMRES iterations per Newton step within 0.4 and
-/// its CPU time within 1-3 % on 2 threads (where the two components of `-diag(B, B)`
-/// already fill both), and uses more threads where there are more (BENCHMARKS.md
-/// "Multigrid", the test
-/// `discrete::transfers::tests::multigrid_reduction_is_independent_of_h`). One direction's
-/// lines on each side of the coarse correction ([`Smoother::SplitColouredLines`]: 13/7
-/// passes over each level's stencil per cycle against 5) took 0.78-0.93 times the CPU of
-/// both directions on each side at refine 4 of wavy_lid, male_rotor and puzzle4, with
-/// 0-33 % more GMRES iterations (BENCHMARKS.md "Half the sweeps"); its cycle is not
-/// symmetric, which flexible GMRES, the only Krylov method it preconditions, allows.
-pub(crate) const MG_SMOOTHER: Smoother = Smoother::SplitColouredLines;
-
-/// Smoothing sweeps before and after each coarse correction of [`LinearMethod::Multigrid`].
-pub(crate) const MG_SWEEPS: usize = 1;
+pub(crate) use super::multigrid::{MG_SMOOTHER, MG_SWEEPS};
 
 /// GMRES iterations above which a frozen SPD preconditioner is rebuilt.
 pub(crate) const REFRESH_KRYLOV: usize = 30;
