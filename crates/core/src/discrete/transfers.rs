@@ -244,34 +244,10 @@ mod tests {
         }
     }
 
-    /// The metric Laplacian `K` ([`Discretization::metric_laplace`]) of a stretched,
-    /// sheared map on `p = 3` with `ne x ne` elements: a quarter annulus with radii 1 and
-    /// `1 + t`, stretched radially towards the inner side (`r = 1 + t v^2`, degenerate at
-    /// `v = 0` like a map into a reflex corner) and sheared (`g12 != 0`). `t = 3`: cells of
-    /// aspect ratio up to ~10 away from the inner side; `t = 0.03`: a narrow gap, cells of
-    /// aspect ratio 50 and more (`g11 / g22` above 2500).
-    fn stretched_laplacian(ne: usize, t: f64) -> (Discretization, Csr) {
-        let kv = KnotVector::open_uniform(3, ne);
-        let disc = Discretization::new([kv.clone(), kv.clone()]);
-        let g = kv.greville();
-        let mut cps = Vec::new();
-        for &v in &g {
-            for &u in &g {
-                let r = 1.0 + t * v * v;
-                let a = std::f64::consts::FRAC_PI_2 * (u + 0.2 * u * (1.0 - u) * v);
-                cps.push([r * a.cos(), r * a.sin()]);
-            }
-        }
-        let mut st = vec![0.0; disc.stencil_len(1)];
-        disc.metric_laplace(&cps, super::super::assembly::Operator::Scaled, 0.0, &mut st);
-        let k = disc.scalar.matrix(&st);
-        (disc, k)
-    }
-
     /// The mean residual reduction per V-cycle of the stationary iteration
     /// `x += B (b - K x)` over `cycles` cycles from `x = 0`, `b` random.
     fn reduction(ne: usize, t: f64, smoother: Smoother, cycles: usize) -> f64 {
-        let (disc, k) = stretched_laplacian(ne, t);
+        let (disc, k) = crate::testutil::stretched_laplacian(ne, t);
         let mut mg = Multigrid::new(free_prolongations(&disc).unwrap(), smoother, 1);
         mg.factor(&k).unwrap();
         let mut rng = crate::testutil::Lcg::new(3);
@@ -317,7 +293,7 @@ mod tests {
             }
         }
         for ne in sizes {
-            let (disc, _) = stretched_laplacian(ne, 3.0);
+            let (disc, _) = crate::testutil::stretched_laplacian(ne, 3.0);
             assert!(!free_prolongations(&disc).unwrap().is_empty(), "{ne}: no coarse level");
         }
     }

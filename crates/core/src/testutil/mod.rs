@@ -91,15 +91,16 @@ pub fn rounded_square(r: f64, h: f64) -> Vec<[f64; 2]> {
 pub mod exercise;
 pub mod mutate;
 
-/// The multigrid V-cycle of `--linear multigrid` for the metric Laplacian `K` of a
-/// stretched, sheared quarter annulus (radii 1 and `1 + t`, `r = 1 + t v^2`; degree 3,
-/// `ne x ne` elements, the knot-halving hierarchy of its interior functions), for the
-/// back ends' tests. With `far`, `K + ε (e_0 e_last^T + e_last e_0^T)` (`ε` a thousandth
-/// of the diagonal's mean): a coupling outside every stencil, so the levels are held
-/// as CSR matrices, not stencils.
-///
-/// Errors: the set-up's ([`crate::Error::LinearSolver`]).
-pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::linalg::multigrid_kernels::Cycle> {
+/// The metric Laplacian `K` (`Discretization::metric_laplace`, scaled operator) of a
+/// stretched, sheared map on `p = 3` with `ne x ne` elements: a quarter annulus with
+/// radii 1 and `1 + t`, stretched radially towards the inner side (`r = 1 + t v^2`,
+/// degenerate at `v = 0` like a map into a reflex corner) and sheared (`g12 != 0`).
+/// `t = 3`: cells of aspect ratio up to ~10 away from the inner side; `t = 0.03`: a
+/// narrow gap, cells of aspect ratio 50 and more (`g11 / g22` above 2500).
+pub(crate) fn stretched_laplacian(
+    ne: usize,
+    t: f64,
+) -> (crate::discrete::assembly::Discretization, crate::linalg::sparse::Csr) {
     use crate::discrete::assembly::{Discretization, Operator};
     use crate::spline::knots::KnotVector;
     let kv = KnotVector::open_uniform(3, ne);
@@ -115,7 +116,38 @@ pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::lin
     }
     let mut st = vec![0.0; disc.stencil_len(1)];
     disc.metric_laplace(&cps, Operator::Scaled, 0.0, &mut st);
-    let mut k = disc.scalar.matrix(&st);
+    let k = disc.scalar.matrix(&st);
+    (disc, k)
+}
+
+/// A symmetric positive definite banded matrix of size `n` and bandwidth 3 (the
+/// bandwidth of a cubic spline line), diagonally dominant, its entries drawn from `rng`.
+#[cfg(test)]
+pub(crate) fn banded_spd(n: usize, rng: &mut Lcg) -> crate::linalg::sparse::Csr {
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push((i, i, 8.0 + rng.uniform()));
+        for d in 1..=3 {
+            if i + d < n {
+                let v = rng.uniform() - 0.5;
+                t.push((i, i + d, v));
+                t.push((i + d, i, v));
+            }
+        }
+    }
+    crate::linalg::sparse::Csr::from_triplets(n, n, &t)
+}
+
+/// The multigrid V-cycle of `--linear multigrid` for the metric Laplacian `K` of a
+/// stretched, sheared quarter annulus (radii 1 and `1 + t`, `r = 1 + t v^2`; degree 3,
+/// `ne x ne` elements, the knot-halving hierarchy of its interior functions), for the
+/// back ends' tests. With `far`, `K + ε (e_0 e_last^T + e_last e_0^T)` (`ε` a thousandth
+/// of the diagonal's mean): a coupling outside every stencil, so the levels are held
+/// as CSR matrices, not stencils.
+///
+/// Errors: the set-up's ([`crate::Error::LinearSolver`]).
+pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::linalg::multigrid_kernels::Cycle> {
+    let (disc, mut k) = stretched_laplacian(ne, t);
     if far {
         let n = k.nrows;
         let eps = 1e-3 * (0..n).map(|i| k.get(i, i)).sum::<f64>() / n as f64;

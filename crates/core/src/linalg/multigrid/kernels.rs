@@ -397,28 +397,14 @@ fn line_view(l: &Lines) -> LineBlocks<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testutil::Lcg;
+    use crate::testutil::{banded_spd, Lcg};
 
     /// A symmetric, diagonally dominant tensor operator `T_y ⊗ T_x + S` (bandwidth 3 per
     /// direction) on an `n x n` grid, and the knot-insertion-like hierarchy of averaging
     /// prolongations down to a few unknowns.
     fn case(n: usize) -> (Vec<[Csr; 2]>, Csr) {
         let mut rng = Lcg::new(11);
-        let banded = |n: usize, rng: &mut Lcg| {
-            let mut t = Vec::new();
-            for i in 0..n {
-                t.push((i, i, 8.0 + rng.uniform()));
-                for d in 1..=3 {
-                    if i + d < n {
-                        let v = rng.uniform() - 0.5;
-                        t.push((i, i + d, v));
-                        t.push((i + d, i, v));
-                    }
-                }
-            }
-            Csr::from_triplets(n, n, &t)
-        };
-        let a = banded(n, &mut rng).kron(&banded(n, &mut rng));
+        let a = banded_spd(n, &mut rng).kron(&banded_spd(n, &mut rng));
         // P: fine m = 2 c - 1 from coarse c, (1/2, 1, 1/2) weights
         let mut ps = Vec::new();
         let mut m = n;

@@ -318,19 +318,7 @@ mod tests {
     /// A symmetric positive definite banded matrix of size `n` and bandwidth 3 (the
     /// bandwidth of a cubic spline line), diagonally dominant, pseudo-random.
     fn banded(n: usize, seed: u64) -> Csr {
-        let mut rng = crate::testutil::Lcg::new(seed);
-        let mut t = Vec::new();
-        for i in 0..n {
-            t.push((i, i, 8.0 + rng.uniform()));
-            for d in 1..=3 {
-                if i + d < n {
-                    let v = rng.uniform() - 0.5;
-                    t.push((i, i + d, v));
-                    t.push((i + d, i, v));
-                }
-            }
-        }
-        Csr::from_triplets(n, n, &t)
+        crate::testutil::banded_spd(n, &mut crate::testutil::Lcg::new(seed))
     }
 
     fn residual(a: &Csr, b: &[f64], x: &[f64]) -> f64 {
