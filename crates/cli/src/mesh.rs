@@ -70,7 +70,7 @@ pub struct MeshSpec {
 pub struct MeshArgs {
     /// Map file (JSON map document or G+Smo XML), or a multipatch result (JSON with
     /// "patches", or a G+Smo multipatch whose patches are maps): one conforming mesh,
-    /// --structured only, a cell group per patch; or a trivariate map (`winslow loft`):
+    /// structured or triangulated, a cell group per face (or patch); or a trivariate map (`winslow loft`):
     /// hexahedra, --structured NXxNYxNZ, .vtu or .msh.
     pub map: PathBuf,
     /// Output: .msh (Gmsh 4.1), .su2, .xyz (PLOT3D), .vtu, or a directory (OpenFOAM
@@ -196,6 +196,18 @@ fn parse_points(s: &str) -> Result<[usize; 2]> {
     Ok([n(a)?, n(b)?])
 }
 
+/// The options of `--unstructured`.
+fn unstructured_options(spec: &MeshSpec) -> Result<UnstructuredOptions> {
+    Ok(UnstructuredOptions {
+        size: spec.size.context("--unstructured needs --size H")?,
+        min_angle: spec.min_angle,
+        chord_tol: spec.chord_tol,
+        det_j_ratio: (spec.det_j_ratio > 0.0).then_some(spec.det_j_ratio),
+        order: spec.order as usize,
+        ..Default::default()
+    })
+}
+
 /// Build the mesh `spec` asks for, write it, print the quality table; returns 0.
 pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
     let format = Format::from_path(output)?;
@@ -213,16 +225,7 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
         if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {
             bail!("--cluster and --equidistribute apply to --structured meshes only");
         }
-        let size = spec.size.context("--unstructured needs --size H")?;
-        let opts = UnstructuredOptions {
-            size,
-            min_angle: spec.min_angle,
-            chord_tol: spec.chord_tol,
-            det_j_ratio: (spec.det_j_ratio > 0.0).then_some(spec.det_j_ratio),
-            order: spec.order as usize,
-            ..Default::default()
-        };
-        let (mesh, st) = unstructured_with_stats(map, &opts)?;
+        let (mesh, st) = unstructured_with_stats(map, &unstructured_options(spec)?)?;
         stats = Some(st);
         mesh
     } else {
@@ -263,31 +266,53 @@ pub fn make_and_write(map: &Surface, spec: &MeshSpec, output: &Path, quiet: bool
     Ok(())
 }
 
-/// Mesh a multipatch result (every patch a map): one conforming structured mesh, a
-/// cell group per patch and a boundary group per outer side; prints the resolution of
-/// each direction class and the quality table.
+/// Mesh a multipatch result (every patch a map): one conforming mesh, structured
+/// (`--structured NXxNY`, points made equal across interfaces) or triangulated
+/// (`--unstructured --size H`, interface points shared by both patches), a cell group
+/// per face (or patch) and a boundary group per outer side; prints the resolution and
+/// the quality table.
 pub fn make_and_write_multipatch(layout: &Layout, spec: &MeshSpec, output: &Path, quiet: bool) -> Result<()> {
     let format = Format::from_path(output)?;
-    let Some(s) = &spec.structured else {
-        bail!(
-            "a multipatch result is meshed with --structured NXxNY (points per patch, made equal across interfaces); --unstructured meshes of several patches are not supported"
-        );
-    };
     if !spec.cluster.is_empty() || !spec.equidistribute.is_empty() {
         bail!(
-            "--cluster and --equidistribute apply to a single map; a multipatch result is meshed with uniform points"
+            "--cluster and --equidistribute apply to a single map; a multipatch result is meshed with uniform points or --unstructured"
         );
     }
     if spec.order != 1 {
         bail!("--order {}: a multipatch result is meshed with linear cells only", spec.order);
     }
     let t = Instant::now();
-    let mp = winslow_mesh::multipatch(layout, parse_points(s)?)?;
-    let mesh = &mp.mesh;
+    let mut lines = Vec::new();
+    let (mesh, gap) = if let Some(s) = &spec.structured {
+        let mp = winslow_mesh::multipatch(layout, parse_points(s)?)?;
+        let classes: Vec<String> = mp.class_points.iter().enumerate().map(|(c, n)| format!("{c}: {n}")).collect();
+        lines.push(format!("points per direction class (equal across interfaces): {}", classes.join(", ")));
+        for (p, n) in mp.patch_points.iter().enumerate() {
+            lines.push(format!("{}: {}x{} points", layout.label(p), n[0], n[1]));
+        }
+        (mp.mesh, mp.interface_gap)
+    } else if spec.unstructured {
+        let mt = winslow_mesh::multipatch_unstructured(layout, &unstructured_options(spec)?)?;
+        lines.push(format!(
+            "interface points agreed after {} round{} of triangulating the patches",
+            mt.rounds,
+            if mt.rounds == 1 { "" } else { "s" }
+        ));
+        let (lo, hi) = (mt.patch_cells.iter().min().copied(), mt.patch_cells.iter().max().copied());
+        lines.push(format!("triangles per patch {} to {}", lo.unwrap_or(0), hi.unwrap_or(0)));
+        let st = mt.stats;
+        lines.push(format!(
+            "meshing (summed over patches): boundary {:.3} s, spade refinement {:.3} s, mapping {:.3} s, criteria {:.3} s, insertion {:.3} s, mesh {:.3} s",
+            st.boundary, st.refine, st.map, st.criteria, st.insert, st.build
+        ));
+        (mt.mesh, mt.interface_gap)
+    } else {
+        bail!("say which mesh: --structured NXxNY or --unstructured --size H");
+    };
     let built = t.elapsed().as_secs_f64();
-    let q = quality(mesh)?;
+    let q = quality(&mesh)?;
     let t = Instant::now();
-    let files = write(mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
+    let files = write(&mesh, output, format).with_context(|| format!("writing {}", output.display()))?;
     let written = t.elapsed().as_secs_f64();
     if !quiet {
         say!(
@@ -298,14 +323,14 @@ pub fn make_and_write_multipatch(layout: &Layout, spec: &MeshSpec, output: &Path
             mesh.points.len(),
             format.name()
         );
-        let classes: Vec<String> = mp.class_points.iter().enumerate().map(|(c, n)| format!("{c}: {n}")).collect();
-        say!("  points per direction class (equal across interfaces): {}", classes.join(", "));
-        for (p, n) in mp.patch_points.iter().enumerate() {
-            say!("  {}: {}x{} points", layout.label(p), n[0], n[1]);
+        for l in lines {
+            say!("  {l}");
         }
         let groups: Vec<&str> = mesh.boundary_groups().into_iter().map(|g| g.0).collect();
         say!("  boundary groups: {}", groups.join(", "));
-        say!("  largest interface gap {:.3e}", mp.interface_gap);
+        let cells: Vec<&str> = mesh.cell_groups().into_iter().map(|g| g.0).collect();
+        say!("  cell groups: {}", cells.join(", "));
+        say!("  largest interface gap {gap:.3e}");
         say_raw!("{}", q.table());
         say!("  built in {built:.3} s, checked and written in {written:.3} s");
     }

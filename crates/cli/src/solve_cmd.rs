@@ -422,7 +422,7 @@ pub(crate) struct SolveArgs {
     pub(crate) backend: BackendArgs,
     /// Also write a mesh of the solved map (same options as `winslow mesh`): .msh,
     /// .su2, .xyz, .vtu or a directory (OpenFOAM); of a layout, one conforming mesh of
-    /// all patches (--structured only).
+    /// all patches (structured or triangulated), a cell group per face.
     #[arg(long, value_name = "OUT")]
     pub(crate) mesh: Option<PathBuf>,
     #[command(flatten)]

@@ -142,6 +142,13 @@ fn a_plane_graph_is_laid_out_solved_and_meshed_by_face() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let groups: std::collections::BTreeSet<String> = surface_groups(&msh).into_iter().collect();
     assert_eq!(groups, faces);
+    // and one conforming triangulation, the same groups
+    let tri = dir.join("t.msh");
+    let out =
+        bin().args(["mesh", "--unstructured", "--size", "0.1", "-q", "-o"]).arg(&tri).arg(&solved).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let groups: std::collections::BTreeSet<String> = surface_groups(&tri).into_iter().collect();
+    assert_eq!(groups, faces);
 }
 
 #[test]

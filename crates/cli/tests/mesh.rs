@@ -356,10 +356,26 @@ fn a_multipatch_result_is_one_conforming_mesh() {
     assert!(su2.contains("NMARK= 6\n"));
     assert!(std::fs::read_to_string(dir.join("plate.vtu")).unwrap().contains("Name=\"patch\""));
     assert!(dir.join("case/constant/polyMesh/cellZones").exists());
-    // refused, nothing written: PLOT3D (one block), unstructured, curved, clustered
+    // triangulated: one conforming mesh with the same groups
+    let (ok, _, err) = run(&[
+        "mesh",
+        result.to_str().unwrap(),
+        "-o",
+        dir.join("u.msh").to_str().unwrap(),
+        "--unstructured",
+        "--size",
+        "0.5",
+    ]);
+    assert!(ok, "{err}");
+    let (nodes, cells, clockwise) = msh_cells(dir.join("u.msh").to_str().unwrap());
+    assert_eq!(clockwise, 0);
+    // a triangulated disk: 2 nodes - boundary nodes - 2 triangles
+    assert!(cells > nodes && cells < 2 * nodes, "{nodes} nodes, {cells} triangles");
+    assert_eq!(msh_physical_names(&dir.join("u.msh")), msh_physical_names(&dir.join("json.msh")));
+    // refused, nothing written: PLOT3D (one block), curved, clustered
     let refused: [(&str, &[&str]); 4] = [
         ("plate.xyz", &["--structured", "9x7"]),
-        ("u.msh", &["--unstructured", "--size", "0.5"]),
+        ("u2.msh", &["--unstructured", "--size", "0.5", "--order", "2"]),
         ("o2.msh", &["--structured", "9x7", "--order", "2"]),
         ("c.msh", &["--structured", "9x7", "--cluster", "eta:arctan:3"]),
     ];

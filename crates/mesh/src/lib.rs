@@ -13,7 +13,7 @@
 //! | [`quality`] | cell areas, angles, aspect ratio, skewness, growth, non-orthogonality; the refusal of inverted cells |
 //! | [`seam`] | periodic seams: a ring's periodic direction, or two coinciding sides of a ring cut into a four-sided map, merged into one line of nodes; walls named `inner`/`outer` |
 //! | [`topology`] | edges shared by cells (faces of the finite-volume view) |
-//! | [`multipatch`](mod@multipatch) | one conforming structured mesh of a multipatch result: nodes merged through the interfaces, a cell group per patch, a boundary group per outer side |
+//! | [`multipatch`](mod@multipatch) | one conforming mesh of a multipatch result, structured or triangulated: nodes merged through the interfaces, a cell group per face, a boundary group per outer side |
 //! | [`validate`] | the rules a solver's reader enforces (positive volumes, one orientation, no duplicate nodes, non-orthogonality below 90° for OpenFOAM), checked before every write |
 //! | [`volume`] | structured hexahedral meshes of a trivariate map (a loft), corner Jacobians checked, the six sides named; `.vtu` and `.msh` |
 //! | [`formats`] | writers: Gmsh MSH 4.1, VTK `.vtu`, SU2, PLOT3D, OpenFOAM `polyMesh` |
@@ -45,7 +45,7 @@ pub use distribution::{Distribution, End};
 pub use equidistribution::Equidistribution;
 pub use error::{MeshError, Result};
 pub use glam::DVec2;
-pub use multipatch::{multipatch, MultipatchMesh};
+pub use multipatch::{multipatch, multipatch_unstructured, MultipatchMesh, MultipatchTriangulation};
 pub use quality::{CellQuality, Quality};
 use rayon::prelude::*;
 pub use structured::{structured, StructuredOptions};

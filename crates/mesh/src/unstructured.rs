@@ -99,7 +99,7 @@ fn at(map: &Surface, q: DVec2) -> DVec2 {
 }
 
 /// Parameters on a side at equal physical arc length, `n` segments (ends excluded).
-fn side_points(map: &Surface, side: Side, size: f64) -> Vec<DVec2> {
+pub(crate) fn side_points(map: &Surface, side: Side, size: f64) -> Vec<DVec2> {
     let param = |t: f64| match side {
         Side::South => DVec2::new(t, 0.0),
         Side::East => DVec2::new(1.0, t),
@@ -171,6 +171,23 @@ pub struct MeshingStats {
     pub build: f64,
 }
 
+/// Rounds and times added (several meshes' stats summed).
+impl std::ops::AddAssign for MeshingStats {
+    fn add_assign(&mut self, o: Self) {
+        let Self { rounds, spade_refinements, boundary, refine, map, criteria, insert, build } = o;
+        self.rounds += rounds;
+        self.spade_refinements += spade_refinements;
+        [self.boundary, self.refine, self.map, self.criteria, self.insert, self.build] = [
+            self.boundary + boundary,
+            self.refine + refine,
+            self.map + map,
+            self.criteria + criteria,
+            self.insert + insert,
+            self.build + build,
+        ];
+    }
+}
+
 /// A triangulation of `map`'s image (linear triangles, counter-clockwise).
 pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
     unstructured_with_stats(map, opts).map(|(m, _)| m)
@@ -178,6 +195,37 @@ pub fn unstructured(map: &Surface, opts: &UnstructuredOptions) -> Result<Mesh> {
 
 /// [`unstructured`] and where its time went.
 pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Result<(Mesh, MeshingStats)> {
+    triangulate(map, opts, None)
+}
+
+/// The boundary points of a side given in advance: parameters along the side's own
+/// direction (`xi` on south and north, `eta` on west and east), strictly between its
+/// corners; the side list of the rectangle's boundary walk (its first corner, then these
+/// counter-clockwise).
+fn prescribed_side(side: Side, along: &[f64]) -> Vec<DVec2> {
+    let mut t: Vec<f64> = along.to_vec();
+    if matches!(side, Side::North | Side::West) {
+        t.reverse();
+    }
+    let (corner, at): (DVec2, fn(f64) -> DVec2) = match side {
+        Side::South => (DVec2::new(0.0, 0.0), |t| DVec2::new(t, 0.0)),
+        Side::East => (DVec2::new(1.0, 0.0), |t| DVec2::new(1.0, t)),
+        Side::North => (DVec2::new(1.0, 1.0), |t| DVec2::new(t, 1.0)),
+        Side::West => (DVec2::new(0.0, 1.0), |t| DVec2::new(0.0, t)),
+    };
+    std::iter::once(corner).chain(t.into_iter().map(at)).collect()
+}
+
+/// The triangulation of [`unstructured_with_stats`], with the boundary points of every
+/// side given (`sides[s]`: see [`prescribed_side`]; a patch of a multipatch layout, whose
+/// interface points its neighbour must share) or made at equal arc length (`None`).
+/// Refinement may still split boundary segments (spade's encroachment, the size and chord
+/// criteria); the caller reads the sides' final points from the mesh's boundary edges.
+pub(crate) fn triangulate(
+    map: &Surface,
+    opts: &UnstructuredOptions,
+    sides: Option<&[Vec<f64>; 4]>,
+) -> Result<(Mesh, MeshingStats)> {
     let mut stats = MeshingStats::default();
     let mut clock = Instant::now();
     let mut lap = || {
@@ -186,7 +234,7 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         t
     };
     // a ring's seam (periodic, or two coinciding sides): its two sides get one point set
-    let seam = crate::seam::seams(map)?;
+    let seam = if sides.is_some() { crate::seam::Seams::default() } else { crate::seam::seams(map)? };
     let sd = seam.dir();
     if !(opts.size.is_finite() && opts.size > 0.0) {
         return Err(MeshError::param("size", format!("must be positive, got {}", opts.size)));
@@ -195,7 +243,10 @@ pub fn unstructured_with_stats(map: &Surface, opts: &UnstructuredOptions) -> Res
         return Err(MeshError::param("min angle", format!("must be in [0, 34] degrees, got {}", opts.min_angle)));
     }
     let chord_tol = opts.chord_tol.unwrap_or(opts.size / 20.0);
-    let mut lists = Side::ALL.map(|side| side_points(map, side, opts.size));
+    let mut lists = match sides {
+        Some(given) => Side::ALL.map(|side| prescribed_side(side, &given[side as usize])),
+        None => Side::ALL.map(|side| side_points(map, side, opts.size)),
+    };
     if let Some(d) = sd {
         // the end side: its first corner, then the start side's interior points in
         // reverse (both run counter-clockwise around the square)

@@ -1,4 +1,7 @@
-//! One conforming structured mesh of a multipatch result (paper §11.2-11.3): every
+//! One conforming mesh of a multipatch result (paper §11.2-11.3), structured
+//! (quadrilaterals, below) or triangulated ([`multipatch_unstructured`]).
+//!
+//! The structured mesh: every
 //! patch's map sampled on its own grid, the nodes of neighbouring patches merged
 //! through the layout's interfaces (patch side to patch side, with `reversed`), never by
 //! a search for coinciding coordinates.
@@ -20,6 +23,10 @@
 //! patch-local), and the nodes of an interface are evaluated on both sides and must
 //! agree to `1e-9` of the layout's diameter (the patches share their interface
 //! control points), else the interface is named in the error.
+
+mod triangles;
+
+pub use triangles::{multipatch_unstructured, MultipatchTriangulation, MAX_ROUNDS};
 
 use glam::DVec2;
 use rayon::prelude::*;
@@ -92,20 +99,13 @@ pub fn cell_groups(layout: &Layout) -> (Vec<String>, Vec<usize>) {
     (names, of)
 }
 
-/// The conforming linear mesh of `layout` (every patch a map) with about `points`
-/// `[nx, ny]` per patch (see the module documentation for how the counts are made to
-/// agree across interfaces). Not checked for inverted cells: the writers validate.
-pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh> {
-    if points[0] < 2 || points[1] < 2 {
-        return Err(MeshError::param(
-            "points",
-            format!("need at least 2 per direction, got {}x{}", points[0], points[1]),
-        ));
-    }
+/// The map of every patch; an error names a patch given by its boundary only (not
+/// solved) or with a periodic direction.
+pub(crate) fn patch_maps(layout: &Layout) -> Result<Vec<&Surface>> {
     if layout.patches.is_empty() {
         return Err(MeshError::param("layout", "no patches"));
     }
-    let maps: Vec<&Surface> = layout
+    layout
         .patches
         .iter()
         .enumerate()
@@ -121,7 +121,20 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
             }
             Ok(map)
         })
-        .collect::<Result<_>>()?;
+        .collect()
+}
+
+/// The conforming linear mesh of `layout` (every patch a map) with about `points`
+/// `[nx, ny]` per patch (see the module documentation for how the counts are made to
+/// agree across interfaces). Not checked for inverted cells: the writers validate.
+pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh> {
+    if points[0] < 2 || points[1] < 2 {
+        return Err(MeshError::param(
+            "points",
+            format!("need at least 2 per direction, got {}x{}", points[0], points[1]),
+        ));
+    }
+    let maps = patch_maps(layout)?;
     let classes = direction_classes(layout);
     let mut class_points = vec![0usize; classes.len()];
     for m in &classes.member {
@@ -131,53 +144,88 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
     }
     let patch_points: Vec<[usize; 2]> =
         classes.member.iter().map(|m| [class_points[m[0].0], class_points[m[1].0]]).collect();
-    let mut offset = Vec::with_capacity(maps.len() + 1);
-    offset.push(0usize);
-    for n in &patch_points {
-        offset.push(offset.last().copied().unwrap_or(0) + n[0] * n[1]);
-    }
-    let local = |p: usize, [i, j]: [usize; 2]| offset[p] + j * patch_points[p][0] + i;
-    // every patch-local node: its patch, parameters and position
-    let total = offset[maps.len()];
-    let samples: Vec<(usize, DVec2, DVec2)> = (0..maps.len())
+    // every patch's grid: its nodes `xi` fastest, its quadrilaterals, its sides' nodes
+    let grids: Vec<PatchMesh> = (0..maps.len())
         .into_par_iter()
-        .flat_map_iter(|p| {
+        .map(|p| {
             let [nx, ny] = patch_points[p];
             let map = maps[p];
-            (0..ny).flat_map(move |j| {
-                (0..nx).map(move |i| {
-                    let q = DVec2::new(i as f64 / (nx - 1) as f64, j as f64 / (ny - 1) as f64);
-                    (p, q, DVec2::from(map.eval(q.x, q.y)))
-                })
-            })
+            let params: Vec<DVec2> = (0..ny)
+                .flat_map(|j| (0..nx).map(move |i| DVec2::new(i as f64 / (nx - 1) as f64, j as f64 / (ny - 1) as f64)))
+                .collect();
+            let points = params.iter().map(|q| DVec2::from(map.eval(q.x, q.y))).collect();
+            let id = |[i, j]: [usize; 2]| j * nx + i;
+            let mut cells = Vec::with_capacity(4 * (nx - 1) * (ny - 1));
+            for j in 0..ny - 1 {
+                for i in 0..nx - 1 {
+                    cells.extend([id([i, j]), id([i + 1, j]), id([i + 1, j + 1]), id([i, j + 1])]);
+                }
+            }
+            let sides = Side::ALL.map(|s| side_nodes(s, [nx, ny]).into_iter().map(id).collect());
+            PatchMesh { points, params, cells, sides }
         })
         .collect();
-    debug_assert_eq!(samples.len(), total);
-    // merge through the interfaces
+    let (mesh, interface_gap) = merge(layout, grids, ElementKind::Quad)?;
+    Ok(MultipatchMesh { mesh, class_points, patch_points, interface_gap })
+}
+
+/// One patch's mesh before the merge: its nodes, its cells (local node indices, corners
+/// counter-clockwise) and the nodes of each side in the side's parameter direction
+/// (south and north with increasing `xi`, west and east with `eta`), corners included.
+#[derive(Debug, Clone)]
+pub(crate) struct PatchMesh {
+    /// Physical node coordinates.
+    pub points: Vec<DVec2>,
+    /// Patch-local parameters of the nodes.
+    pub params: Vec<DVec2>,
+    /// Cell connectivity, local indices.
+    pub cells: Vec<usize>,
+    /// The nodes of each side (indexed by `Side as usize`), along the side.
+    pub sides: [Vec<usize>; 4],
+}
+
+/// The conforming mesh of the patches' meshes: the nodes of every interface's two sides
+/// identified pairwise (same count, the second side's order reversed when the interface
+/// is), never by a search for coinciding coordinates; a node keeps its first patch's
+/// position and parameters. The cells are grouped by face ([`cell_groups`]) and the
+/// outer sides' edges by `PATCH.SIDE`, counter-clockwise around their patch. Also
+/// returns the largest distance between the two evaluations of an interface node; more
+/// than `1e-9` of the layout's diameter is an error naming the interface.
+pub(crate) fn merge(layout: &Layout, patches: Vec<PatchMesh>, kind: ElementKind) -> Result<(Mesh, f64)> {
+    let mut offset = Vec::with_capacity(patches.len() + 1);
+    offset.push(0usize);
+    for m in &patches {
+        offset.push(offset.last().copied().unwrap_or(0) + m.points.len());
+    }
+    let total = offset[patches.len()];
+    let at = |x: usize| {
+        let p = offset.partition_point(|&o| o <= x) - 1;
+        (p, x - offset[p])
+    };
     let mut parent: Vec<usize> = (0..total).collect();
     let diameter = layout.diameter();
     let mut gap = 0.0f64;
     for (k, itf) in layout.interfaces.iter().enumerate() {
         let (a, b) = (itf.first, itf.second);
-        if a.patch >= maps.len() || b.patch >= maps.len() {
+        if a.patch >= patches.len() || b.patch >= patches.len() {
             return Err(MeshError::param(format!("interface {k}"), "names a patch that does not exist"));
         }
-        let na = side_nodes(a.side, patch_points[a.patch]);
-        let mut nb = side_nodes(b.side, patch_points[b.patch]);
+        let na = &patches[a.patch].sides[a.side as usize];
+        let mut nb = patches[b.patch].sides[b.side as usize].clone();
         let name = |ps: PatchSide| format!("{}.{}", patch_name(layout, ps.patch), ps.side.name());
         if na.len() != nb.len() {
             return Err(MeshError::param(
                 format!("interface {} - {}", name(a), name(b)),
-                format!("{} and {} points on its two sides (the direction classes disagree)", na.len(), nb.len()),
+                format!("{} and {} points on its two sides (the patches' meshes disagree)", na.len(), nb.len()),
             ));
         }
         if itf.reversed {
             nb.reverse();
         }
         let mut worst = 0.0f64;
-        for (u, v) in na.iter().zip(&nb) {
-            let (x, y) = (local(a.patch, *u), local(b.patch, *v));
-            worst = worst.max(samples[x].2.distance(samples[y].2));
+        for (&u, &v) in na.iter().zip(&nb) {
+            let (x, y) = (offset[a.patch] + u, offset[b.patch] + v);
+            worst = worst.max(patches[a.patch].points[u].distance(patches[b.patch].points[v]));
             let (rx, ry) = (find(&mut parent, x), find(&mut parent, y));
             if rx != ry {
                 // the smaller index represents: the node keeps its first patch's sample
@@ -201,29 +249,27 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
         let r = find(&mut parent, x);
         if global[r] == usize::MAX {
             global[r] = pts.len();
-            pts.push(samples[r].2);
-            params.push(samples[r].1);
+            let (p, i) = at(r);
+            pts.push(patches[p].points[i]);
+            params.push(patches[p].params[i]);
         }
         global[x] = global[r];
     }
-    let id = |p: usize, ij: [usize; 2]| global[local(p, ij)];
+    let id = |p: usize, i: usize| global[offset[p] + i];
     let (group_names, group_of) = cell_groups(layout);
+    let corners = kind.corners();
     let mut cells = Vec::new();
     let mut cell_group = Vec::new();
-    for (p, &[nx, ny]) in patch_points.iter().enumerate() {
-        for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                cells.extend([id(p, [i, j]), id(p, [i + 1, j]), id(p, [i + 1, j + 1]), id(p, [i, j + 1])]);
-                cell_group.push(group_of[p]);
-            }
-        }
+    for (p, m) in patches.iter().enumerate() {
+        cells.extend(m.cells.iter().map(|&i| id(p, i)));
+        cell_group.extend(std::iter::repeat_n(group_of[p], m.cells.len() / corners));
     }
     // the outer sides, each counter-clockwise around its patch
     let mut boundary = Vec::new();
     let mut edge_group = Vec::new();
     let mut boundary_names = Vec::new();
     for ps in layout.outer_sides() {
-        let nodes = side_nodes(ps.side, patch_points[ps.patch]);
+        let nodes = &patches[ps.patch].sides[ps.side as usize];
         let mut edges: Vec<BoundaryEdge> = nodes
             .windows(2)
             .map(|w| BoundaryEdge { side: ps.side, nodes: vec![id(ps.patch, w[0]), id(ps.patch, w[1])] })
@@ -242,7 +288,7 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
     let mesh = Mesh {
         points: pts,
         params,
-        kind: ElementKind::Quad,
+        kind,
         order: 1,
         cells,
         boundary,
@@ -251,5 +297,5 @@ pub fn multipatch(layout: &Layout, points: [usize; 2]) -> Result<MultipatchMesh>
         names: side_names(),
         groups: Some(groups),
     };
-    Ok(MultipatchMesh { mesh, class_points, patch_points, interface_gap: gap })
+    Ok((mesh, gap))
 }
