@@ -186,12 +186,8 @@ fn patches_valid(sides: &[NewSide], p: &Placement) -> bool {
     let k = sides.len();
     (0..k).all(|s| {
         let prev = (s + k - 1) % k;
-        let quad = [
-            sides[s].halves.0.clone(),
-            reversed(&p.cuts[s]),
-            reversed(&p.cuts[prev]),
-            reversed(&sides[prev].halves.1),
-        ];
+        let quad =
+            [sides[s].halves.0.clone(), reversed(&p.cuts[s]), reversed(&p.cuts[prev]), reversed(&sides[prev].halves.1)];
         let b = Boundary { name: String::new(), sides: quad.map(SideCurve::Spline) };
         inspect(&b).is_ok_and(|r| r.orientation == Orientation::CounterClockwise)
     })
@@ -321,9 +317,10 @@ pub(super) fn best(
             };
             let total = own.min(fa.1.score()).min(fb.1.score());
             let irregular = usize::from(fa.0 != 4) + usize::from(fb.0 != 4);
-            let better = best.as_ref().map_or(total > midpoint.score() || (total == midpoint.score() && irregular < 1), |b| {
-                total > b.score || (total == b.score && irregular < b.irregular)
-            });
+            let better =
+                best.as_ref().map_or(total > midpoint.score() || (total == midpoint.score() && irregular < 1), |b| {
+                    total > b.score || (total == b.score && irregular < b.irregular)
+                });
             if !better || !patches_valid(&a, &fa.1) || !patches_valid(&b, &fb.1) {
                 continue;
             }
@@ -398,7 +395,9 @@ pub(super) fn apply(
             b.push((fwd, p));
         }
         (End::Mid(j), None) => {
-            return Err(Error::Invalid(format!("layout: the cut across face {f} to side {j} has no split of its halves")))
+            return Err(Error::Invalid(format!(
+                "layout: the cut across face {f} to side {j} has no split of its halves"
+            )))
         }
     }
     let [(ka, pa), (kb, pb)] = plan.faces;

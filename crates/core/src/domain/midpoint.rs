@@ -211,8 +211,7 @@ pub(super) fn place(
         }
         search = Some(s);
     }
-    let placement =
-        Placement { centre, cuts, angles, straight: star.is_some(), inverse: inv.is_some(), search };
+    let placement = Placement { centre, cuts, angles, straight: star.is_some(), inverse: inv.is_some(), search };
     Ok((placement, built))
 }
 

@@ -281,7 +281,8 @@ pub(super) fn apply_templates(
                     }
                     if !report.inverse {
                         let built = PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok();
-                        let fitted = built.as_ref().and_then(through).and_then(|pts| cf.curve(pts, p0, p2, scales[f]).ok());
+                        let fitted =
+                            built.as_ref().and_then(through).and_then(|pts| cf.curve(pts, p0, p2, scales[f]).ok());
                         others.extend(
                             fitted
                                 .filter(|x| polyline_inside(g, f, &x.sample(4 * SPOKE_SAMPLES), tol))

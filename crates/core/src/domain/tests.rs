@@ -756,7 +756,11 @@ fn a_thin_face_is_cut_across_into_quads() {
         conforming_bit_for_bit(&auto.layout);
         let exact =
             (0..n).map(|k| 0.5 * (pts[k][0] * pts[(k + 1) % n][1] - pts[(k + 1) % n][0] * pts[k][1])).sum::<f64>();
-        assert!((total_area(&auto.layout) - exact).abs() < 1e-12 * exact, "{n}: {} vs {exact}", total_area(&auto.layout));
+        assert!(
+            (total_area(&auto.layout) - exact).abs() < 1e-12 * exact,
+            "{n}: {} vs {exact}",
+            total_area(&auto.layout)
+        );
         // moved by a similarity (rotation by 30 degrees, scale 2, shift): the same layout moved
         let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
         let sim = |p: Point| [2.0 * (c * p[0] - s * p[1]) - 1.0, 2.0 * (s * p[0] + c * p[1]) + 3.0];
