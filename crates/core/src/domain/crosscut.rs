@@ -111,9 +111,15 @@ fn reversed(c: &Curve) -> Curve {
     c.reversed().normalized()
 }
 
-/// `c` split at its arc-length midpoint: the parameter, the halves and their tangents
-/// at the midpoint (arriving, leaving).
-fn halve(c: &Curve) -> Result<(f64, (Curve, Curve), (Point, Point))> {
+/// A curve split at its arc-length midpoint: the parameter, the halves and their
+/// tangents at the midpoint (arriving, leaving).
+type Halved = (f64, (Curve, Curve), (Point, Point));
+
+/// The halves of a side and the vertex between them.
+type SidePart = ((FaceSide, FaceSide), usize);
+
+/// `c` split at its arc-length midpoint ([`Halved`]).
+fn halve(c: &Curve) -> Result<Halved> {
     let u = ArcLength::new(c).param(0.5);
     let (a, b) = split_curve(c, u)?;
     let at = (end_tangent(&a, true), end_tangent(&b, false));
@@ -229,7 +235,7 @@ pub(super) fn best(
         mid: whole.mids[s],
         at: whole.at_mids[s],
     };
-    let ends: Vec<(usize, End)> = if n % 2 == 0 {
+    let ends: Vec<(usize, End)> = if n.is_multiple_of(2) {
         (0..n / 2).map(|i| (i, End::Corner(i + n / 2))).collect()
     } else {
         (0..n)
@@ -368,8 +374,7 @@ pub(super) fn apply(
     let e2 = g.add_edge(c2, p, to, false);
     let back = ((e2, false), (e1, false));
     let fwd = ((e1, true), (e2, true));
-    let (mut a, mut b): (Vec<((FaceSide, FaceSide), usize)>, Vec<((FaceSide, FaceSide), usize)>) =
-        (Vec::new(), Vec::new());
+    let (mut a, mut b): (Vec<SidePart>, Vec<SidePart>) = (Vec::new(), Vec::new());
     match (plan.end, plan.quarters) {
         (End::Corner(j), _) => {
             a.extend((i..j).map(|s| (parts[s], mids[s])));
@@ -380,7 +385,7 @@ pub(super) fn apply(
         (End::Mid(j), Some([ua, ub])) => {
             // the halves of side j (boundary edges: no other face has them) split at
             // their own midpoints
-            let mut split = |s: FaceSide, u: f64| -> Result<((FaceSide, FaceSide), usize)> {
+            let mut split = |s: FaceSide, u: f64| -> Result<SidePart> {
                 let (v, e2) = g.split_edge(s.0, u)?;
                 Ok((if s.1 { ((s.0, true), (e2, true)) } else { ((e2, false), (s.0, false)) }, v))
             };

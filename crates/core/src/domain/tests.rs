@@ -741,7 +741,7 @@ fn a_thin_face_is_cut_across_into_quads() {
         // the cut: from a corner to the opposite corner or side midpoint, the images of
         // the polygon's points
         let i = pts.iter().position(|&p| p == cut.from).expect("the cut starts at a corner");
-        let want = if n % 2 == 0 {
+        let want = if n.is_multiple_of(2) {
             pts[(i + n / 2) % n]
         } else {
             let j = (i + (n - 1) / 2) % n;
