@@ -8,7 +8,7 @@
 
 use super::graph::{FaceSide, Graph};
 use crate::error::{Error, Result};
-use crate::spline::curve::Point;
+use crate::spline::curve::{Curve, Point};
 
 /// The direction in which half-edge `h` leaves its start vertex: the angle of the chord
 /// to the point a thousandth of the way along.
@@ -78,15 +78,28 @@ pub fn trace(g: &Graph, halves: &[FaceSide]) -> Result<Vec<Vec<FaceSide>>> {
 pub fn polyline(g: &Graph, cycle: &[FaceSide]) -> Vec<Point> {
     let mut pts = Vec::new();
     for &(e, fwd) in cycle {
-        let c = &g.edges[e].curve;
-        let m = 16 * c.knots.num_elements().max(1);
-        let mut p = c.sample(m);
-        if !fwd {
-            p.reverse();
-        }
-        pts.extend_from_slice(&p[..m]);
+        add_samples(&mut pts, &g.edges[e].curve, fwd);
     }
     pts
+}
+
+/// [`polyline`] of a closed chain of curves, each in its own direction.
+pub(crate) fn curves_polyline(curves: &[Curve]) -> Vec<Point> {
+    let mut pts = Vec::new();
+    for c in curves {
+        add_samples(&mut pts, c, true);
+    }
+    pts
+}
+
+/// The samples of `c` (16 per knot span, forwards or backwards) but its last, added to `pts`.
+fn add_samples(pts: &mut Vec<Point>, c: &Curve, fwd: bool) {
+    let m = 16 * c.knots.num_elements().max(1);
+    let mut p = c.sample(m);
+    if !fwd {
+        p.reverse();
+    }
+    pts.extend_from_slice(&p[..m]);
 }
 
 /// Signed area of a closed polyline (shoelace; positive counter-clockwise).

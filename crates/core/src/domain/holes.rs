@@ -17,7 +17,7 @@ use serde::Serialize;
 use super::cycles::{polyline, signed_area, trace};
 use super::graph::{FaceSide, Graph};
 use super::reflex::{line, ray_hit_edges};
-use super::validate::segment_distance;
+use super::validate::{nearest_chord, segment_distance};
 use crate::error::{Error, Result};
 use crate::spline::curve::Point;
 
@@ -38,16 +38,30 @@ fn dist(a: Point, b: Point) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-/// Whether the straight segment `a b` meets none of `edges` except at its ends.
+/// Whether the straight segment `a b` meets none of `edges` except at its ends: on the
+/// edges' polylines (16 chords per knot span) with `a` and `b` made vertices of them
+/// first ([`nearest_chord`]: a cut's end on a curved edge lies on the curve, and where
+/// the edge bulges away from the cut, the chord there passes between them).
 fn segment_clear(g: &Graph, edges: &[usize], a: Point, b: Point, tol: f64) -> bool {
+    let mut lines: Vec<Vec<Point>> = edges
+        .iter()
+        .map(|&k| {
+            let c = &g.edges[k].curve;
+            c.sample(16 * c.knots.num_elements().max(1))
+        })
+        .collect();
+    for q in [a, b] {
+        if lines.iter().any(|l| l.contains(&q)) {
+            continue;
+        }
+        if let Some((l, i)) = nearest_chord(&lines, false, q) {
+            lines[l].insert(i + 1, q);
+        }
+    }
     let e = 1e-6;
     let a1 = [a[0] + e * (b[0] - a[0]), a[1] + e * (b[1] - a[1])];
     let b1 = [b[0] + e * (a[0] - b[0]), b[1] + e * (a[1] - b[1])];
-    edges.iter().all(|&k| {
-        let c = &g.edges[k].curve;
-        let p = c.sample(16 * c.knots.num_elements().max(1));
-        p.windows(2).all(|w| segment_distance(a1, b1, w[0], w[1]).0 > tol)
-    })
+    lines.iter().all(|p| p.windows(2).all(|w| segment_distance(a1, b1, w[0], w[1]).0 > tol))
 }
 
 /// The vertex of hole `k` of face `f` from which the cut in direction `dir` (`-1`: left,
@@ -248,4 +262,50 @@ pub(crate) fn cut_holes(g: &mut Graph, diameter: f64, theta: f64, cuts: &mut Vec
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spline::curve::Curve;
+    use crate::spline::knots::KnotVector;
+
+    /// The unit circle as four quarter arcs (rational quadratics), the edges of `g`.
+    fn circle(g: &mut Graph) -> Vec<usize> {
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let corners = [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]];
+        let v: Vec<usize> = corners.iter().map(|&p| g.add_vertex(p)).collect();
+        (0..4)
+            .map(|k| {
+                let (a, b) = (corners[k], corners[(k + 1) % 4]);
+                let mid = [a[0] + b[0], a[1] + b[1]];
+                let arc = Curve::new(KnotVector::open_uniform(2, 1), vec![a, mid, b], Some(vec![1.0, w, 1.0])).unwrap();
+                g.add_edge(arc, v[k], v[(k + 1) % 4], true)
+            })
+            .collect()
+    }
+
+    /// A segment from inside the unit circle to a point of it that is not one of its
+    /// samples meets no edge: its end lies on the arc, and the chord there passes inside
+    /// the circle by up to `1 - cos(45° / 16)` = 0.0012, which the segment crossed before
+    /// its ends were made vertices of the polylines. A segment through a second edge (a
+    /// segment of the `x` axis) is not clear, with or without that.
+    #[test]
+    fn a_segment_to_a_point_of_a_curved_edge_is_clear() {
+        let mut g = Graph::default();
+        let edges = circle(&mut g);
+        let q = g.edges[edges[0]].curve.eval(0.3);
+        assert!((q[0].hypot(q[1]) - 1.0).abs() < 1e-15);
+        // the polyline of 16 chords misses q: the chord nearest to it is inside the circle
+        let p = g.edges[edges[0]].curve.sample(16);
+        assert!(!p.contains(&q));
+        let a = [0.3, 0.1];
+        assert!(segment_clear(&g, &edges, a, q, 1e-9));
+        // the same from a point below the x axis, across a segment of it: not clear
+        let (u, v) = (g.add_vertex([-0.5, 0.0]), g.add_vertex([0.95, 0.0]));
+        let mut more = edges.clone();
+        more.push(g.add_edge(line([-0.5, 0.0], [0.95, 0.0]), u, v, false));
+        assert!(!segment_clear(&g, &more, [0.3, -0.1], q, 1e-9));
+        assert!(segment_clear(&g, &more, [0.3, 0.1], q, 1e-9));
+    }
 }

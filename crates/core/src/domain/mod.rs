@@ -17,19 +17,23 @@
 //! | `holes` | cuts from every hole to the outer boundary or another hole |
 //! | `reflex` | cuts from reflex corners into the face |
 //! | `spokes` | the spokes of the midpoint template, the patch corner angles they make, and the interior vertex searched where one is near 0° or 180° |
+//! | `midpoint` | the midpoint template (`N` quads around one interior vertex): its placement by the harmonic map, the map onto the polygon, a star centre or the searched vertex, and its quads |
+//! | `crosscut` | the cut across a thin face whose midpoint template keeps a corner near 0° or 180°: corner to opposite corner (or side midpoint), two faces with fewer corners |
 //! | `outline` | the outer boundary and holes of a multipatch layout as a domain (the input of a comparison with the hand-made layout) |
-//! | [`template`] | the quadrangulation of every face by its template (the midpoint template, a face split in two), placed by the harmonic map or the map onto the polygon |
+//! | [`template`] | the quadrangulation of every face by its template (the midpoint template, a face split in two, a face cut across), placed by the harmonic map or the map onto the polygon |
 //! | [`layout`] | the automatic layout as a whole: the sides into a graph of faces, the cuts, the tries (searches of the cuts' ends, directions of the hole cuts, the maps onto the polygons), its report and the multipatch layout |
 //!
 //! Files are read by [`crate::io::read`] ([`crate::io::Document::Domain`]).
 
 pub mod corpus;
+pub(crate) mod crosscut;
 pub(crate) mod cycles;
 pub(crate) mod families;
 pub(crate) mod graph;
 pub(crate) mod harmonic;
 pub(crate) mod holes;
 pub mod layout;
+pub(crate) mod midpoint;
 pub(crate) mod outline;
 pub(crate) mod plane;
 pub(crate) mod polygon_map;

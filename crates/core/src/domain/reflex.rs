@@ -18,7 +18,7 @@ use serde::Serialize;
 use super::graph::{ccw_angle, end_tangent, Graph};
 use super::harmonic::{polygon_vertex, ArcLength};
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
-use super::validate::{inside, segment_distance};
+use super::validate::{inside, nearest_chord, segment_distance};
 use crate::boundary::fit::{fit_side, FitOptions};
 use crate::boundary::validate::sample_side;
 use crate::boundary::SideCurve;
@@ -87,21 +87,15 @@ pub(super) fn segment_inside(g: &Graph, f: usize, a: Point, b: Point, tol: f64) 
 }
 
 /// `poly` with the points `ends` on it made vertices: each that is not already one goes
-/// into the chord nearest to it. A cut's end on a curved side lies on the curve, not on
-/// its chords: where the side bulges out of the face, the chord passes inside the curve
-/// (by its sagitta, `h² / 8R` for a chord of length `h` on a circle of radius `R`), so
-/// the cut would cross it next to its end and count as leaving the face.
+/// into the chord nearest to it ([`nearest_chord`], which says why).
 fn with_ends(poly: &[(Point, usize)], ends: [Point; 2]) -> Vec<(Point, usize)> {
     let mut out = poly.to_vec();
     for q in ends {
-        let n = out.len();
-        if n < 2 || out.iter().any(|x| x.0 == q) {
+        if out.len() < 2 || out.iter().any(|x| x.0 == q) {
             continue;
         }
-        let nearest = (0..n)
-            .map(|i| (segment_distance(out[i].0, out[(i + 1) % n].0, q, q).0, i))
-            .min_by(|x, y| x.0.total_cmp(&y.0))
-            .map_or(0, |x| x.1);
+        let pts = vec![out.iter().map(|x| x.0).collect()];
+        let nearest = nearest_chord(&pts, true, q).map_or(0, |x| x.1);
         out.insert(nearest + 1, (q, out[nearest].1));
     }
     out
@@ -237,7 +231,7 @@ fn spread_candidates(g: &Graph, f: usize, i: usize, reflex: bool, tol: f64) -> V
 /// leaves the corner (outgoing side `t_out`, reversed incoming side `back`) along
 /// `start`, and arrives at its end, whose sides go `to` and (reversed) `bj`, so that
 /// `home` points from the end back along the cut.
-fn cut_angles([t_out, back]: [Point; 2], start: Point, [to, bj]: [Point; 2], home: Point) -> [f64; 4] {
+pub(super) fn cut_angles([t_out, back]: [Point; 2], start: Point, [to, bj]: [Point; 2], home: Point) -> [f64; 4] {
     [ccw_angle(t_out, start), ccw_angle(start, back), ccw_angle(to, home), ccw_angle(home, bj)]
 }
 
@@ -278,7 +272,7 @@ fn score(angles: [f64; 4]) -> f64 {
 /// stays inside the face: no chord comes within `tol` of the face's boundary away from
 /// the cut's two ends (the first and last hundredth of the end chords), and its middle
 /// point lies inside.
-fn polyline_inside(g: &Graph, f: usize, cut: &[Point], tol: f64) -> bool {
+pub(super) fn polyline_inside(g: &Graph, f: usize, cut: &[Point], tol: f64) -> bool {
     let poly = face_polyline(g, f);
     let n = poly.len();
     let m = cut.len() - 1;

@@ -59,12 +59,18 @@ pub(super) fn midpoint_angles(d: &[Point], e: &[Point], at_mids: &[(Point, Point
     let k = d.len();
     let mut out = Vec::with_capacity(3 * k);
     for s in 0..k {
-        let (t_in, t_out) = at_mids[s];
         out.push(ccw_angle(d[s], d[(s + 1) % k]));
-        out.push(ccw_angle(e[s], neg(t_in)));
-        out.push(ccw_angle(t_out, e[s]));
+        out.extend(side_angles(e[s], at_mids[s]));
     }
     out
+}
+
+/// The two new patch corner angles (radians) where a cut leaves a side's midpoint into
+/// the face along `e`, the side arriving along `t⁻` and leaving along `t⁺`: `∠(e → −t⁻)`
+/// in the patch before the midpoint and `∠(t⁺ → e)` in the one after (they sum to `π`
+/// where the side is smooth).
+pub(super) fn side_angles(e: Point, (t_in, t_out): (Point, Point)) -> [f64; 2] {
+    [ccw_angle(e, neg(t_in)), ccw_angle(t_out, e)]
 }
 
 /// [`midpoint_angles`] of spoke curves (each from the interior vertex to its side's

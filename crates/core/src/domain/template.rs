@@ -1,33 +1,46 @@
 //! The templates of the automatic layout (issue 31, step 3 of [`super::layout`]): a face
 //! with four corners stays one patch. Every other face with `N` corners is cut into `N`
-//! quads around one interior vertex (valence `N`), the midpoint template: the harmonic
-//! map of the regular `N`-gon onto the face (`HarmonicMap`, Hinz & Buffa) places the
-//! interior vertex (the image of the polygon's centre) and the cuts (the images of the
-//! segments from the centre to the midpoints of the sides, fitted by splines); the sides
-//! are split at their arc-length midpoints, the images of the polygon's side midpoints. A
-//! four-sided face beside a split edge is split too, by the image of the segment between
-//! the midpoints of that edge and the opposite one (so the splits run through chains of
-//! four-sided faces and the layout stays conforming), or into four when both pairs are
-//! split. Where the layout so made is not valid, the interior vertex and the cuts are
-//! placed by the inverse of the map of the face onto the polygon (`PolygonMap`,
-//! one-to-one on every face); where a harmonic map folds and no such map is taken, the
-//! cuts are straight from a point the face is star-shaped about.
+//! quads around one interior vertex (valence `N`), the midpoint template
+//! ([`super::midpoint`]): the harmonic map of the regular `N`-gon onto the face
+//! (`HarmonicMap`, Hinz & Buffa) places the interior vertex (the image of the polygon's
+//! centre) and the cuts (the images of the segments from the centre to the midpoints of
+//! the sides, fitted by splines); the sides are split at their arc-length midpoints, the
+//! images of the polygon's side midpoints. A four-sided face beside a split edge is split
+//! too, by the image of the segment between the midpoints of that edge and the opposite
+//! one (so the splits run through chains of four-sided faces and the layout stays
+//! conforming), or into four when both pairs are split. Where the layout so made is not
+//! valid, the interior vertex and the cuts are placed by the inverse of the map of the
+//! face onto the polygon (`PolygonMap`, one-to-one on every face); where a harmonic map
+//! folds and no such map is taken, the cuts are straight from a point the face is
+//! star-shaped about.
+//!
+//! Every template's new patch corners are scored (`spokes::score`, the smallest
+//! `min(α, 180° − α)`): below `MIN_TEMPLATE_ANGLE` (15°) the midpoint template's interior
+//! vertex is searched (`super::spokes`), a face split in two tries its other placements
+//! (the straight segment where it stays inside, the preimage through the map onto the
+//! polygon), and a face of five corners or more whose midpoint template still scores
+//! below 15° tries the cuts across it ([`super::crosscut`]: two faces with fewer corners),
+//! the best placement kept.
 //!
 //! The report of every face ([`FaceReport`]) and the interior vertices whose valence is
 //! not 4 ([`IrregularVertex`]) are defined here.
 
 use serde::Serialize;
 
-use super::cycles::{polyline, signed_area};
-use super::graph::end_tangent;
-use super::graph::{Face, FaceSide, Graph};
+use super::crosscut;
+use super::cycles::polyline;
+use super::graph::{end_tangent, Face, FaceSide, Graph};
 use super::harmonic::{ArcLength, HarmonicMap};
+use super::midpoint::{self, fit_scale, tangents_at_mid, CutFit, SplitFace, SPOKE_SAMPLES};
 use super::polygon_map::{PolygonMap, POLYGON_MAP_LEVELS};
-use super::reflex::{fit_points, line, segment_inside};
-use super::spokes::{curve_angles, score, search_centre, MIN_TEMPLATE_ANGLE};
+use super::reflex::{line, polyline_inside, segment_inside};
+use super::spokes::{score, side_angles, MIN_TEMPLATE_ANGLE};
 use crate::boundary::fit::FitOptions;
 use crate::error::{Error, Result};
 use crate::spline::curve::{Curve, Point};
+
+pub use super::crosscut::{CrossCut, CrossFace};
+pub use super::midpoint::AngleSearch;
 
 /// The template of one face.
 #[derive(Debug, Clone, Serialize)]
@@ -37,7 +50,9 @@ pub struct FaceReport {
     pub label: String,
     /// Its corners.
     pub corners: usize,
-    /// `"one patch"`, `"split in two"` or `"midpoint"` (`N` quads around a vertex).
+    /// `"one patch"`, `"split in two"`, `"midpoint"` (`N` quads around a vertex) or
+    /// `"cut across"` (two faces with fewer corners, each by the midpoint template:
+    /// `cut_across`).
     pub template: &'static str,
     /// Patches it became.
     pub patches: usize,
@@ -49,38 +64,29 @@ pub struct FaceReport {
     /// The harmonic map folds (`harmonic_min_area_ratio <= 0`), so its spokes may leave
     /// the face: the cuts are straight instead, from a point the face is star-shaped
     /// about (see `star_centre`) to the side midpoints, or the straight segment between the
-    /// two midpoints of a face split in two when it lies inside.
+    /// two midpoints of a face split in two when it lies inside. (A face cut across: its
+    /// midpoint template's, which the cut replaced.)
     pub straight: bool,
     /// The cuts are the preimages of the polygon's segments under the map of the face
     /// onto the polygon (`PolygonMap`, one-to-one on every face), taken when the layout
-    /// by the harmonic map of the polygon onto the faces is not valid.
+    /// by the harmonic map of the polygon onto the faces is not valid. (A face cut
+    /// across: its midpoint template's.)
     pub inverse: bool,
     /// The smallest of the patch corner angles the template made (degrees; the midpoint
-    /// template: at the interior vertex and at the side midpoints, `domain::spokes`).
+    /// template: at the interior vertex and at the side midpoints, `domain::spokes`; a
+    /// face split in two: the four where its cut meets the split sides; a face cut
+    /// across: its cut's four and its two faces' templates').
     pub min_angle: Option<f64>,
     /// The search of the interior vertex, where the first placement had a new patch
-    /// corner within `MIN_TEMPLATE_ANGLE` (15) degrees of 0 or 180.
+    /// corner within `MIN_TEMPLATE_ANGLE` (15) degrees of 0 or 180 (a face cut across:
+    /// its midpoint template's). A face split in two whose first cut scores below 15
+    /// degrees: `first` its score, `searched` the best of its other placements (the
+    /// straight segment where it stays inside, the preimage through the map onto the
+    /// polygon), `kept` when that is higher; no `polygon_point`.
     pub angle_search: Option<AngleSearch>,
-}
-
-/// The search of a midpoint template's interior vertex in the parameter domain of the
-/// face's map onto the polygon (`domain::spokes`).
-#[derive(Debug, Clone, Serialize)]
-#[non_exhaustive]
-pub struct AngleSearch {
-    /// The first placement's score: its smallest `min(α, 180° − α)` over the new patch
-    /// corners `α`, degrees.
-    pub first: f64,
-    /// The point of the regular polygon (inscribed in the unit circle) whose preimage is
-    /// the searched interior vertex (`None`: no map onto the polygon, or no point with a
-    /// preimage).
-    pub polygon_point: Option<Point>,
-    /// The searched placement's score (its spokes fitted), degrees.
-    pub searched: Option<f64>,
-    /// The searched placement scores higher and was taken: the spokes are the preimages
-    /// of the segments from `polygon_point` to the polygon's side midpoints, not those
-    /// `straight` and `inverse` describe.
-    pub kept: bool,
+    /// The cut across the face (`template: "cut across"`), written only then.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_across: Option<CrossCut>,
 }
 
 /// An interior vertex whose valence is not 4.
@@ -92,10 +98,6 @@ pub struct IrregularVertex {
     pub valence: usize,
 }
 
-fn dist(a: Point, b: Point) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
 /// How a face is quadrangulated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Template {
@@ -103,7 +105,8 @@ enum Template {
     One,
     /// Four corners, sides `r` and `r + 2` split: two patches.
     Two(usize),
-    /// `N` quads around the image of the polygon's centre.
+    /// `N` quads around the image of the polygon's centre (or, where that scores below
+    /// 15 degrees, a cut across).
     Midpoint,
 }
 
@@ -158,48 +161,16 @@ fn halves(g: &Graph, f: usize, mids: &[Option<usize>], n: usize) -> Halves {
     out
 }
 
-/// A point about which the closed counter-clockwise polyline `p` is strictly
-/// star-shaped (every `(p_i - c) × (p_{i+1} - c) > 0`, so every ray from `c` meets the
-/// boundary once and the straight segments from `c` to boundary points cut the face
-/// into simple sectors): `first` if it is one, else the area centroid, else the mean
-/// of the vertices; `None` when none is.
-pub(super) fn star_centre(p: &[Point], first: Point) -> Option<Point> {
-    let n = p.len();
-    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
-    for i in 0..n {
-        let (u, v) = (p[i], p[(i + 1) % n]);
-        let w = u[0] * v[1] - v[0] * u[1];
-        a += w;
-        cx += (u[0] + v[0]) * w;
-        cy += (u[1] + v[1]) * w;
-    }
-    let centroid = [cx / (3.0 * a), cy / (3.0 * a)];
-    let mean = p.iter().fold([0.0, 0.0], |m, q| [m[0] + q[0] / n as f64, m[1] + q[1] / n as f64]);
-    [first, centroid, mean].into_iter().find(|c| {
-        (0..n).all(|i| {
-            let (u, v) = (p[i], p[(i + 1) % n]);
-            (u[0] - c[0]) * (v[1] - c[1]) - (u[1] - c[1]) * (v[0] - c[0]) > 0.0
-        })
-    })
+/// The four new patch corner angles (radians) of a face split in two by `c`, from the
+/// midpoint between the halves `(a0, b0)` of one side to the midpoint between the halves
+/// `(a2, b2)` of the opposite one (`spokes::side_angles` at each end).
+fn split_angles(g: &Graph, c: &Curve, (a0, b0): (FaceSide, FaceSide), (a2, b2): (FaceSide, FaceSide)) -> Vec<f64> {
+    let e0 = end_tangent(c, false);
+    let e2 = end_tangent(c, true);
+    let mut out = side_angles(e0, tangents_at_mid(g, a0, b0)).to_vec();
+    out.extend(side_angles([-e2[0], -e2[1]], tangents_at_mid(g, a2, b2)));
+    out
 }
-
-/// A spoke of the harmonic map as a curve from `from` to `to` (its exact ends).
-fn spoke_curve(
-    mut pts: Vec<Point>,
-    from: Point,
-    to: Point,
-    diameter: f64,
-    scale: f64,
-    fit: &FitOptions,
-) -> Result<Curve> {
-    let last = pts.len() - 1;
-    pts[0] = from;
-    pts[last] = to;
-    fit_points(&pts, diameter, scale, fit)
-}
-
-/// Points on a spoke taken from a [`PolygonMap`] before the spline fit.
-const SPOKE_SAMPLES: usize = 64;
 
 /// Step 3 of the layout (see [`super::layout`]): every face of `g` quadrangulated by its
 /// template, the edges to split split at their arc-length midpoints; the template's
@@ -215,19 +186,14 @@ pub(super) fn apply_templates(
     diameter: f64,
     inverse: bool,
 ) -> Result<Vec<FaceReport>> {
+    let cf = CutFit { fit, rings, diameter };
     // 3. templates: harmonic maps on the faces as they are, then the splits
     let split = edges_to_split(g);
     let nf = g.faces.len();
     #[allow(clippy::type_complexity)]
     let mut plans: Vec<(Template, usize, Option<HarmonicMap>, Option<PolygonMap>, Vec<Curve>)> = Vec::with_capacity(nf);
     // per face: ten times its area over its perimeter (the fit scale of its cuts)
-    let scales: Vec<f64> = (0..nf)
-        .map(|f| {
-            let p = polyline(g, &g.faces[f].sides);
-            let perimeter: f64 = (0..p.len()).map(|i| dist(p[i], p[(i + 1) % p.len()])).sum();
-            10.0 * signed_area(&p).abs() / perimeter.max(f64::MIN_POSITIVE)
-        })
-        .collect();
+    let scales: Vec<f64> = (0..nf).map(|f| fit_scale(&polyline(g, &g.faces[f].sides))).collect();
     for f in 0..nf {
         let sides = &g.faces[f].sides;
         let k = sides.len();
@@ -274,6 +240,7 @@ pub(super) fn apply_templates(
             inverse: false,
             min_angle: None,
             angle_search: None,
+            cut_across: None,
         };
         match (template, h) {
             (Template::One, _) | (_, None) => {}
@@ -284,22 +251,58 @@ pub(super) fn apply_templates(
                     return Err(Error::Invalid(format!("layout: face {f} is not split in two as planned")));
                 };
                 let (p0, p2) = (g.vertices[m0], g.vertices[m2]);
-                let through = pm.as_ref().and_then(|pm| {
+                let through = |pm: &PolygonMap| {
                     let mut pts: Vec<Point> = pm.spoke(r, SPOKE_SAMPLES)?.into_iter().rev().collect();
                     pts.extend(pm.spoke(r + 2, SPOKE_SAMPLES)?.into_iter().skip(1));
                     Some(pts)
-                });
-                let c = if let Some(pts) = through {
+                };
+                let tol = 1e-9 * diameter;
+                let c = if let Some(pts) = pm.as_ref().and_then(through) {
                     report.inverse = true;
-                    spoke_curve(pts, p0, p2, diameter, scales[f], fit)?
-                } else if h.min_area_ratio <= 0.0 && segment_inside(g, f, p0, p2, 1e-9 * diameter) {
+                    cf.curve(pts, p0, p2, scales[f])?
+                } else if h.min_area_ratio <= 0.0 && segment_inside(g, f, p0, p2, tol) {
                     report.straight = true;
                     line(p0, p2)
                 } else {
                     let mut pts: Vec<Point> = h.spoke(r).into_iter().rev().collect();
                     pts.extend(h.spoke(r + 2).into_iter().skip(1));
-                    spoke_curve(pts, p0, p2, diameter, scales[f], fit)?
+                    cf.curve(pts, p0, p2, scales[f])?
                 };
+                let mut angles = split_angles(g, &c, (a0, b0), (a2, b2));
+                let first = score(&angles);
+                let mut c = c;
+                if first < MIN_TEMPLATE_ANGLE {
+                    // the other placements: the straight segment where it stays inside,
+                    // the preimage through the map onto the polygon
+                    let mut search = AngleSearch::new(first);
+                    let mut others = Vec::new();
+                    if !report.straight && segment_inside(g, f, p0, p2, tol) {
+                        others.push((line(p0, p2), true, false));
+                    }
+                    if !report.inverse {
+                        let built = PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok();
+                        let fitted =
+                            built.as_ref().and_then(through).and_then(|pts| cf.curve(pts, p0, p2, scales[f]).ok());
+                        others.extend(
+                            fitted
+                                .filter(|x| polyline_inside(g, f, &x.sample(4 * SPOKE_SAMPLES), tol))
+                                .map(|x| (x, false, true)),
+                        );
+                    }
+                    for (x, straight, inv) in others {
+                        let a = split_angles(g, &x, (a0, b0), (a2, b2));
+                        let v = score(&a);
+                        if search.searched.is_none_or(|s| v > s) {
+                            search.searched = Some(v);
+                            if v > score(&angles) {
+                                search.kept = true;
+                                (c, angles, report.straight, report.inverse) = (x, a, straight, inv);
+                            }
+                        }
+                    }
+                    report.angle_search = Some(search);
+                }
+                report.min_angle = Some(angles.iter().fold(f64::INFINITY, |m, a| m.min(a.to_degrees())));
                 let cut = g.add_edge(c, m0, m2, false);
                 g.faces[f].sides = vec![b0, s1, a2, (cut, false)];
                 g.faces.push(Face::new(vec![b2, s3, a0, (cut, true)], label.clone()));
@@ -307,91 +310,47 @@ pub(super) fn apply_templates(
                 report.patches = 2;
             }
             (Template::Midpoint, Some(h)) => {
-                // a folded harmonic map: straight spokes from a point the face is
-                // star-shaped about, where there is one
-                let inv = pm.as_ref().and_then(|pm| {
-                    let spokes: Option<Vec<Vec<Point>>> = (0..k).map(|s| pm.spoke(s, SPOKE_SAMPLES)).collect();
-                    Some((pm.centre()?, spokes?))
-                });
-                let star = (inv.is_none() && h.min_area_ratio <= 0.0)
-                    .then(|| star_centre(&polyline(g, &g.faces[f].sides), h.centre()))
-                    .flatten();
-                report.straight = star.is_some();
-                report.inverse = inv.is_some();
-                let mut centre_point = inv.as_ref().map(|i| i.0).or(star).unwrap_or_else(|| h.centre());
-                let mut mids = Vec::with_capacity(k);
                 let mut parts = Vec::with_capacity(k);
+                let mut mid_vertices = Vec::with_capacity(k);
                 for (s, side) in hv.iter().enumerate() {
                     let &Ok((a, b, m)) = side else {
                         return Err(Error::Invalid(format!("layout: side {s} of face {f} is not split as planned")));
                     };
-                    mids.push(m);
+                    mid_vertices.push(m);
                     parts.push((a, b));
                 }
-                let mut cuts = Vec::with_capacity(k);
-                for (s, &m) in mids.iter().enumerate() {
-                    let to = g.vertices[m];
-                    cuts.push(if let Some((_, spokes)) = &inv {
-                        spoke_curve(spokes[s].clone(), centre_point, to, diameter, scales[f], fit)?
-                    } else if star.is_some() {
-                        line(centre_point, to)
-                    } else {
-                        spoke_curve(h.spoke(s), centre_point, to, diameter, scales[f], fit)?
-                    });
+                let whole = SplitFace {
+                    mids: mid_vertices.iter().map(|&m| g.vertices[m]).collect(),
+                    at_mids: parts.iter().map(|&(a, b)| tangents_at_mid(g, a, b)).collect(),
+                    polyline: polyline(g, &g.faces[f].sides),
+                    scale: scales[f],
+                    curves,
+                };
+                let (placement, built) = midpoint::place(&whole, &h, pm.as_ref(), cf)?;
+                report.straight = placement.straight;
+                report.inverse = placement.inverse;
+                report.angle_search = placement.search.clone();
+                // still near 0 or 180 degrees: the cuts across the face
+                let across = if placement.score() < MIN_TEMPLATE_ANGLE {
+                    let map = pm.as_ref().or(built.as_ref());
+                    crosscut::best(g, f, &whole, &parts, map, &placement, inverse, cf)?
+                } else {
+                    None
+                };
+                if let Some(plan) = across {
+                    let min_angle = plan.min_angle();
+                    let (r, patches) = crosscut::apply(g, f, &parts, &mid_vertices, plan, placement.score(), &label)?;
+                    report.min_angle = Some(min_angle);
+                    report.template = "cut across";
+                    report.patches = patches;
+                    report.cut_across = Some(r);
+                } else {
+                    report.min_angle = Some(placement.min_angle());
+                    let centre = midpoint::apply(g, Some(f), &parts, &mid_vertices, placement, &label);
+                    report.template = "midpoint";
+                    report.patches = k;
+                    report.centre = Some(g.vertices[centre]);
                 }
-                // the new patch corners; near 0 or 180 degrees, the interior vertex searched
-                let at_mids: Vec<(Point, Point)> = parts
-                    .iter()
-                    .map(|&(a, b)| (end_tangent(&g.side_curve(a), true), end_tangent(&g.side_curve(b), false)))
-                    .collect();
-                let mut angles = curve_angles(&cuts, &at_mids);
-                let first = score(&angles);
-                if first < MIN_TEMPLATE_ANGLE {
-                    let built =
-                        if pm.is_none() { PolygonMap::new(&curves, rings, POLYGON_MAP_LEVELS).ok() } else { None };
-                    let mut search = AngleSearch { first, polygon_point: None, searched: None, kept: false };
-                    if let Some(pm) = pm.as_ref().or(built.as_ref()) {
-                        let found = search_centre(pm, &at_mids).and_then(|(q, _)| {
-                            let spokes: Option<Vec<Vec<Point>>> =
-                                (0..k).map(|s| pm.segment(q, pm.side_midpoint(s), SPOKE_SAMPLES)).collect();
-                            Some((q, pm.inverse(q)?, spokes?))
-                        });
-                        if let Some((q, x, spokes)) = found {
-                            search.polygon_point = Some(q);
-                            let fitted: Option<Vec<Curve>> = spokes
-                                .into_iter()
-                                .zip(&mids)
-                                .map(|(pts, &m)| spoke_curve(pts, x, g.vertices[m], diameter, scales[f], fit).ok())
-                                .collect();
-                            if let Some(fitted) = fitted {
-                                let a = curve_angles(&fitted, &at_mids);
-                                let v = score(&a);
-                                search.searched = Some(v);
-                                if v > first {
-                                    search.kept = true;
-                                    (centre_point, cuts, angles) = (x, fitted, a);
-                                }
-                            }
-                        }
-                    }
-                    report.angle_search = Some(search);
-                }
-                report.min_angle = Some(angles.iter().fold(f64::INFINITY, |m, a| m.min(a.to_degrees())));
-                let centre = g.add_vertex(centre_point);
-                let spokes: Vec<usize> =
-                    cuts.into_iter().zip(&mids).map(|(c, &m)| g.add_edge(c, centre, m, false)).collect();
-                for s in 0..k {
-                    let prev = (s + k - 1) % k;
-                    let sides = vec![parts[s].0, (spokes[s], false), (spokes[prev], true), parts[prev].1];
-                    if s == 0 {
-                        g.faces[f].sides = sides;
-                    } else {
-                        g.faces.push(Face::new(sides, label.clone()));
-                    }
-                }
-                report.template = "midpoint";
-                report.patches = k;
-                report.centre = Some(g.vertices[centre]);
             }
         }
         faces.push(report);

@@ -451,7 +451,7 @@ fn folded_harmonic_maps_give_straight_cuts_from_a_star_centre() {
     // its notch): the centroid sees every side; a thin
     // C shape is star-shaped about no point tried
     let dart = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [1.0, 1.6], [0.0, 2.0]];
-    let c = super::template::star_centre(&dart, [1.0, 1.9]).unwrap();
+    let c = super::midpoint::star_centre(&dart, [1.0, 1.9]).unwrap();
     // the centroid of the dart: (1, 0.9037...) = (1, 61 / 67.5)
     assert!((c[0] - 1.0).abs() < 1e-14 && (c[1] - 2.44 / 2.7).abs() < 1e-14, "{c:?}");
     for i in 0..dart.len() {
@@ -459,7 +459,7 @@ fn folded_harmonic_maps_give_straight_cuts_from_a_star_centre() {
         assert!((u[0] - c[0]) * (v[1] - c[1]) - (u[1] - c[1]) * (v[0] - c[0]) > 0.0);
     }
     let cee = [[0.0, 0.0], [3.0, 0.0], [3.0, 0.2], [0.2, 0.2], [0.2, 2.8], [3.0, 2.8], [3.0, 3.0], [0.0, 3.0]];
-    assert!(super::template::star_centre(&cee, [1.5, 1.5]).is_none());
+    assert!(super::midpoint::star_centre(&cee, [1.5, 1.5]).is_none());
     // wiggly-9: a face whose harmonic map folds gets straight spokes, and the whole
     // graph is certified (with the harmonic spokes a patch crossed itself)
     let g = crate::domain::families::wiggly(9);
@@ -690,4 +690,89 @@ fn a_template_corner_below_the_threshold_is_searched_away() {
     assert!(r.corner_angles[0] >= 15.0 && r.corner_angles[1] <= 165.0, "{:?}", r.corner_angles);
     validate_layout(&auto.layout).unwrap();
     certified(&auto, "flat triangle");
+}
+
+/// Every patch corner of a layout as a point (the ends of its sides).
+fn patch_corners(l: &Layout) -> Vec<Point> {
+    l.patches.iter().flat_map(|p| p.sides.iter().map(|c| c.endpoints().0)).collect()
+}
+
+/// A thin straight-sided face, the affine image `x -> A x + b` of the regular polygon
+/// with `n` corners (`A` stretches 7:1 along a direction at 20 degrees).
+fn thin(n: usize, a: [[f64; 2]; 2], b: Point) -> (Vec<Point>, impl Fn(Point) -> Point) {
+    let f = move |p: Point| [a[0][0] * p[0] + a[0][1] * p[1] + b[0], a[1][0] * p[0] + a[1][1] * p[1] + b[1]];
+    ((0..n).map(|s| f(polygon_vertex(n, s))).collect(), f)
+}
+
+/// `A` of [`thin`]: `R(20°) diag(7, 1) R(-20°)`, sheared a little.
+fn stretch() -> [[f64; 2]; 2] {
+    let (c, s) = (20f64.to_radians().cos(), 20f64.to_radians().sin());
+    let (l1, l2) = (7.0, 1.0);
+    [[l1 * c * c + l2 * s * s, (l1 - l2) * c * s + 0.3], [(l1 - l2) * c * s, l1 * s * s + l2 * c * c]]
+}
+
+/// The cut across a thin hexagon and a thin pentagon, affine images of the regular
+/// ones: their midpoint templates keep a corner below 15 degrees, so each is cut across,
+/// by the straight segment (the face is convex) from a corner to the opposite corner
+/// (the hexagon: two quads) or to the midpoint of the opposite side (the pentagon: two
+/// quads, that side's halves split at their own midpoints). The cut is the affine image
+/// of the polygon's segment, its midpoint the image of the segment's midpoint; no
+/// interior vertex is irregular; the patches' areas add up to the face's exactly; the
+/// interfaces conform bit for bit; every new corner is at least 15 degrees; and the
+/// layout of the face moved by a similarity is the moved layout (every patch corner).
+#[test]
+fn a_thin_face_is_cut_across_into_quads() {
+    for n in [6, 5] {
+        let (pts, f) = thin(n, stretch(), [4.0, 2.0]);
+        let auto = auto_layout(&polygon(&pts), &LayoutOptions::default()).unwrap();
+        let r = &auto.report;
+        assert_eq!(r.faces.len(), 1);
+        let face = &r.faces[0];
+        assert_eq!(face.template, "cut across", "{n}: {face:#?}");
+        let search = face.angle_search.as_ref().expect("the midpoint template was searched");
+        let cut = face.cut_across.as_ref().unwrap();
+        assert!(cut.midpoint_score < 15.0 && search.searched.is_none_or(|s| s < 15.0), "{n}: {cut:#?}");
+        assert!(cut.score > cut.midpoint_score && cut.score >= 15.0, "{n}: {cut:#?}");
+        assert!(cut.straight, "{n}");
+        assert_eq!([cut.faces[0].corners, cut.faces[1].corners], [4, 4]);
+        assert!(r.irregular_vertices.is_empty(), "{n}: {:?}", r.irregular_vertices);
+        assert_eq!(auto.layout.patches.len(), 8);
+        assert!(face.min_angle.unwrap() >= 15.0, "{n}: {face:#?}");
+        // the cut: from a corner to the opposite corner or side midpoint, the images of
+        // the polygon's points
+        let i = pts.iter().position(|&p| p == cut.from).expect("the cut starts at a corner");
+        let want = if n.is_multiple_of(2) {
+            pts[(i + n / 2) % n]
+        } else {
+            let j = (i + (n - 1) / 2) % n;
+            let (u, v) = (polygon_vertex(n, j), polygon_vertex(n, j + 1));
+            f([0.5 * (u[0] + v[0]), 0.5 * (u[1] + v[1])])
+        };
+        assert!((cut.to[0] - want[0]).abs() < 1e-12 && (cut.to[1] - want[1]).abs() < 1e-12, "{n}: {cut:?}");
+        let corners = patch_corners(&auto.layout);
+        let p = [0.5 * (cut.from[0] + cut.to[0]), 0.5 * (cut.from[1] + cut.to[1])];
+        assert!(corners.iter().any(|q| (q[0] - p[0]).abs() < 1e-12 && (q[1] - p[1]).abs() < 1e-12), "{n}");
+        validate_layout(&auto.layout).unwrap();
+        conforming_bit_for_bit(&auto.layout);
+        let exact =
+            (0..n).map(|k| 0.5 * (pts[k][0] * pts[(k + 1) % n][1] - pts[(k + 1) % n][0] * pts[k][1])).sum::<f64>();
+        assert!(
+            (total_area(&auto.layout) - exact).abs() < 1e-12 * exact,
+            "{n}: {} vs {exact}",
+            total_area(&auto.layout)
+        );
+        // moved by a similarity (rotation by 30 degrees, scale 2, shift): the same layout moved
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let sim = |p: Point| [2.0 * (c * p[0] - s * p[1]) - 1.0, 2.0 * (s * p[0] + c * p[1]) + 3.0];
+        let moved: Vec<Point> = pts.iter().map(|&p| sim(p)).collect();
+        let again = auto_layout(&polygon(&moved), &LayoutOptions::default()).unwrap();
+        assert_eq!(again.report.faces[0].template, "cut across");
+        let there = patch_corners(&again.layout);
+        assert_eq!(there.len(), corners.len());
+        for (a, b) in corners.iter().zip(&there) {
+            let m = sim(*a);
+            assert!((m[0] - b[0]).abs() < 1e-9 && (m[1] - b[1]).abs() < 1e-9, "{n}: {m:?} vs {b:?}");
+        }
+        certified(&auto, &format!("thin {n}-gon"));
+    }
 }

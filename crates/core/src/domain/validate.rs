@@ -87,6 +87,28 @@ pub(crate) fn segment_distance(a: Point, b: Point, c: Point, d: Point) -> (f64, 
     })
 }
 
+/// The chord nearest to `q` among the polylines `lines` (a closed polyline's chords
+/// include the one from its last point back to its first): the polyline's index and the
+/// index of the chord's first point; `None` when no polyline has a chord. A cut's end on
+/// a curved side is made a vertex of the side's sampled polyline by inserting it there:
+/// it lies on the curve, not on the chords, and where the side bulges away from the cut
+/// the chord passes between the cut and its end (by the sagitta `h² / 8R` of a chord of
+/// length `h` on a circle of radius `R`), so the cut would seem to cross it.
+pub(crate) fn nearest_chord(lines: &[Vec<Point>], closed: bool, q: Point) -> Option<(usize, usize)> {
+    let mut best: Option<(f64, usize, usize)> = None;
+    for (l, p) in lines.iter().enumerate() {
+        let n = p.len();
+        let chords = if closed && n > 1 { n } else { n.saturating_sub(1) };
+        for i in 0..chords {
+            let d = segment_distance(p[i], p[(i + 1) % n], q, q).0;
+            if best.is_none_or(|b| d < b.0) {
+                best = Some((d, l, i));
+            }
+        }
+    }
+    best.map(|b| (b.1, b.2))
+}
+
 /// A segment of some loop: (loop index, segment index).
 type Seg = (usize, usize);
 
