@@ -162,6 +162,7 @@ pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::lin
 
 /// The unsymmetric tridiagonal matrix `tridiag(-1, 2.5, -1.2)` of size `n` (a 1D
 /// convection-diffusion operator): the system of the linear solvers' and GMRES's tests.
+#[cfg(test)]
 pub(crate) fn poisson_1d(n: usize) -> crate::linalg::sparse::Csr {
     let mut t = Vec::new();
     for i in 0..n {
