@@ -159,3 +159,20 @@ pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::lin
     let p = crate::discrete::transfers::free_prolongation_factors(&disc)?;
     crate::linalg::multigrid_kernels::Cycle::new(p, k)
 }
+
+/// The unsymmetric tridiagonal matrix `tridiag(-1, 2.5, -1.2)` of size `n` (a 1D
+/// convection-diffusion operator): the system of the linear solvers' and GMRES's tests.
+#[cfg(test)]
+pub(crate) fn poisson_1d(n: usize) -> crate::linalg::sparse::Csr {
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push((i, i, 2.5));
+        if i > 0 {
+            t.push((i, i - 1, -1.0));
+        }
+        if i + 1 < n {
+            t.push((i, i + 1, -1.2));
+        }
+    }
+    crate::linalg::sparse::Csr::from_triplets(n, n, &t)
+}

@@ -1,18 +1,5 @@
 use super::*;
-
-fn poisson_1d(n: usize) -> Csr {
-    let mut t = Vec::new();
-    for i in 0..n {
-        t.push((i, i, 2.5));
-        if i > 0 {
-            t.push((i, i - 1, -1.0));
-        }
-        if i + 1 < n {
-            t.push((i, i + 1, -1.2));
-        }
-    }
-    Csr::from_triplets(n, n, &t)
-}
+use crate::testutil::poisson_1d;
 
 /// `A = -(T + s I)` with the symmetric `T = tridiag(-1, 2, -1)` (eigenvalues in
 /// `(0, 4)`): negative definite for `s = 0.1`, indefinite for `s = -1`.

@@ -109,6 +109,21 @@ pub struct EggEvaluation {
     /// `-diag(K, K, K)` is the Jacobian's principal part (integrate `R_A (A : ∇²R_B) / T`
     /// by parts), the preconditioner of its GMRES solve.
     pub laplace: Option<Csr>,
+    /// The Winslow energy `∫ |cof J|²_F / det J dξ = ∫ tr A / det J dξ` at the same
+    /// points (`super::winslow`'s functional, to rounding; `+∞` where `det J <= 0`),
+    /// for the report: `tr A` is at hand and `det J = d₀ · c₀`.
+    pub energy: f64,
+}
+
+/// The Winslow density `tr A / det J` at a point of the columns `d` of `J` and its
+/// cofactor columns `cof` (`det J = d₀ · c₀`), `+∞` where `det J <= 0`.
+fn winslow_density(d: &[Point3; 3], cof: &[Point3; 3], t: f64) -> f64 {
+    let det = dot(d[0], cof[0]);
+    if det > 0.0 {
+        t / det
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl EggVolume {
@@ -179,8 +194,9 @@ impl EggVolume {
     }
 
     /// Element `e`'s residual, Jacobian (when `jacobian`) and cofactor-metric stiffness
-    /// `K_ab = Σ_q w_q ∇R_a · (A/T) ∇R_b` (when `laplace`; see [`Local`], the scalar is
-    /// unused); `None` when `tr A = 0` at one of its points.
+    /// `K_ab = Σ_q w_q ∇R_a · (A/T) ∇R_b` (when `laplace`), through the basis tables of
+    /// [`EggVolume::element_points`] (see [`Local`]; the scalar is the element's Winslow
+    /// energy, [`EggEvaluation::energy`]); `None` when `tr A = 0` at one of its points.
     fn element(&self, e: usize, cps: &[Point3], jacobian: bool, laplace: bool) -> Option<Local> {
         let idx = self.disc.element_indices(e);
         let (weights, basis) = self.element_points(e, &idx);
@@ -210,6 +226,7 @@ impl EggVolume {
         let (mut um, mut vm) =
             if laplace { (vec![0.0; 3 * nq * m], vec![0.0; 3 * nq * m]) } else { (Vec::new(), Vec::new()) };
         let mut v = vec![0.0; if jacobian { m } else { 0 }];
+        let mut energy = 0.0;
         for (q, &wq) in weights.iter().enumerate() {
             let table = &basis[q * 10 * m..(q + 1) * 10 * m];
             let (rq, gq, hq) = (&table[..m], &table[m..4 * m], &table[4 * m..]);
@@ -223,6 +240,7 @@ impl EggVolume {
             if t.is_nan() || t <= 0.0 {
                 return None;
             }
+            energy += wq * winslow_density(&d, &cof, t);
             let l: [f64; 3] = std::array::from_fn(|c| contract(&am, &xh[c]) / t);
             for (c, &lc) in l.iter().enumerate() {
                 for (r, &ra) in rc[c * m..(c + 1) * m].iter_mut().zip(rq) {
@@ -339,7 +357,7 @@ impl EggVolume {
                 faer::Par::Seq,
             );
         }
-        Some(Local { idx, scalar: 0.0, vector: res, matrix: k, scalar_matrix: kl })
+        Some(Local { idx, scalar: energy, vector: res, matrix: k, scalar_matrix: kl })
     }
 
     /// Element `e`'s residual (`dir` `None`) or its part of the Jacobian's product
@@ -356,7 +374,12 @@ impl EggVolume {
     /// factorised ([`super::tensor_points`]), on a rational one they go through the
     /// basis tables of [`EggVolume::element_points`]. `None` when `tr A = 0` at one of
     /// its points.
-    fn element_linear(&self, e: usize, cps: &[Point3], dir: Option<&[Point3]>) -> Option<Local> {
+    ///
+    /// With the residual (`dir` `None`) come the element's Winslow energy (the scalar,
+    /// [`EggEvaluation::energy`]) and, when `laplace` (polynomial basis only), the
+    /// cofactor-metric stiffness `K` of [`EggVolume::element`], sum factorised
+    /// ([`tensor_points::stiffness`] with `C = w_q A / T`).
+    fn element_linear(&self, e: usize, cps: &[Point3], dir: Option<&[Point3]>, laplace: bool) -> Option<Local> {
         let idx = self.disc.element_indices(e);
         let m = idx.len();
         let k = if dir.is_some() { 6 } else { 3 };
@@ -393,6 +416,10 @@ impl EggVolume {
         let nq = weights.len();
         // w_q δL_c(q) (or w_q L_c(q)) per component, `c n_q + q`
         let mut f = vec![0.0; 3 * nq];
+        // w_q A_ij / T, `(3 i + j) n_q + q`
+        let laplace = laplace && dir.is_none() && basis.is_none();
+        let mut coef = vec![0.0; if laplace { 9 * nq } else { 0 }];
+        let mut energy = 0.0;
         for (q, &wq) in weights.iter().enumerate() {
             let at = |col: usize, k: usize| xq[col * 10 * nq + sq * q + sk * k];
             let d: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(c, 1 + j)));
@@ -406,6 +433,12 @@ impl EggVolume {
             if dir.is_none() {
                 for c in 0..3 {
                     f[c * nq + q] = wq * (contract(&am, &xh[c]) / t);
+                }
+                energy += wq * winslow_density(&d, &cof, t);
+                if laplace {
+                    for (ij, a) in am.iter().flatten().enumerate() {
+                        coef[ij * nq + q] = wq * a / t;
+                    }
                 }
                 continue;
             }
@@ -446,7 +479,8 @@ impl EggVolume {
                 *x = rc[c * m + a];
             }
         }
-        Some(Local { idx, scalar: 0.0, vector: res, matrix: Vec::new(), scalar_matrix: Vec::new() })
+        let scalar_matrix = if laplace { tensor_points::stiffness(tables, &coef) } else { Vec::new() };
+        Some(Local { idx, scalar: energy, vector: res, matrix: Vec::new(), scalar_matrix })
     }
 
     /// `F'(c) v` over the free coordinates (`3 f + component`, as the residual) without
@@ -456,7 +490,7 @@ impl EggVolume {
     fn jacobian_times(&self, cps: &[Point3], v: &[f64]) -> Option<Vec<f64>> {
         let mut dir = vec![[0.0; 3]; cps.len()];
         self.disc.scatter(&mut dir, v);
-        self.disc.assemble(false, false, |e| self.element_linear(e, cps, Some(&dir))).map(|(_, y, _, _)| y)
+        self.disc.assemble(false, false, |e| self.element_linear(e, cps, Some(&dir), false)).map(|(_, y, _, _)| y)
     }
 
     /// Number of free scalar unknowns (3 per interior control point).
@@ -472,18 +506,22 @@ impl EggVolume {
 
     /// [`EggVolume::evaluate`], with the cofactor-metric stiffness `K` of the scalar
     /// unknowns when `laplace` ([`EggEvaluation::laplace`]).
+    ///
+    /// Without the Jacobian the residual (and `K` on a polynomial basis) come from
+    /// [`EggVolume::element_linear`] (sum factorised), the Jacobian (and `K` on a
+    /// rational basis) from the basis tables of [`EggVolume::element`].
     pub fn evaluate_with(&self, cps: &[Point3], jacobian: bool, laplace: bool) -> EggEvaluation {
-        let residual_only = !jacobian && !laplace;
+        let tables = jacobian || laplace && self.disc.weights.is_some();
         let element = |e| {
-            if residual_only {
-                self.element_linear(e, cps, None)
-            } else {
+            if tables {
                 self.element(e, cps, jacobian, laplace)
+            } else {
+                self.element_linear(e, cps, None, laplace)
             }
         };
         match self.disc.assemble(jacobian, laplace, element) {
-            Some((_, residual, jacobian, laplace)) => EggEvaluation { residual, jacobian, laplace },
-            None => EggEvaluation { residual: Vec::new(), jacobian: None, laplace: None },
+            Some((energy, residual, jacobian, laplace)) => EggEvaluation { residual, jacobian, laplace, energy },
+            None => EggEvaluation { residual: Vec::new(), jacobian: None, laplace: None, energy: f64::INFINITY },
         }
     }
 }

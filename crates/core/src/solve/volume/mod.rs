@@ -200,6 +200,8 @@ pub struct VolumeSolve {
 struct Minimised {
     iterations: usize,
     relative_gradient: f64,
+    /// `E` of the result.
+    energy: f64,
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -286,7 +288,7 @@ fn minimise(e: &WinslowVolume, cps: &mut [Point3], max_iterations: usize, tolera
             break;
         }
     }
-    Ok(Minimised { iterations, relative_gradient: norm(&ev.gradient) / g0 })
+    Ok(Minimised { iterations, relative_gradient: norm(&ev.gradient) / g0, energy: ev.energy })
 }
 
 /// The similarity to unit size: `(centre, scale)` of the bounding box of `pts`.
@@ -354,35 +356,38 @@ fn solve_on(cf: &CommonFaces, opts: &VolumeOptions) -> Result<OnBasis> {
     let method =
         if opts.method != VolumeMethod::Winslow && is_c1(&cf.knots) { opts.method } else { VolumeMethod::Winslow };
     let mut egg = None;
-    let (current, start, continuation_steps, iterations, relative_gradient, energy_start) = match method {
+    // the Winslow energies of the start and the result (report fields) come with the
+    // last evaluations of the methods, none is evaluated for them alone
+    let (current, start, continuation_steps, iterations, relative_gradient, energy_start, energy) = match method {
         VolumeMethod::Egg | VolumeMethod::EggWinslow => {
             // the Coons patch of the faces
             let disp: Vec<[f64; 3]> =
                 target.iter().enumerate().map(|(lin, p)| if is_boundary(lin) { *p } else { [0.0; 3] }).collect();
-            let coons = coons_fill(&cf.knots, disp);
-            let coons_energy = energy.evaluate(&coons, false).energy;
-            let energy_start = coons_energy.is_finite().then_some(coons_energy * scale);
-            let mut cps = coons;
+            let mut cps = coons_fill(&cf.knots, disp);
             let op = EggVolume::on(disc.clone());
             let solved = solve_egg(&op, &mut cps, opts.max_iterations, opts.tolerance, opts.linear)?;
+            let energy_start = solved.energy_start.is_finite().then_some(solved.energy_start * scale);
             egg = Some(solved);
             if method == VolumeMethod::Egg {
-                (cps, "coons", 1, solved.iterations, None, energy_start)
-            } else if energy.evaluate(&cps, false).energy.is_finite() {
+                (cps, "coons", 1, solved.iterations, None, energy_start, solved.energy)
+            } else if solved.energy.is_finite() {
                 let stats = minimise(&energy, &mut cps, opts.max_iterations, opts.tolerance)?;
-                (cps, "egg", 0, solved.iterations + stats.iterations, Some(stats.relative_gradient), energy_start)
+                let it = solved.iterations + stats.iterations;
+                (cps, "egg", 0, it, Some(stats.relative_gradient), energy_start, stats.energy)
             } else {
                 let (cps, start, steps, stats, _) = winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
-                (cps, start, steps, solved.iterations + stats.iterations, Some(stats.relative_gradient), energy_start)
+                let it = solved.iterations + stats.iterations;
+                (cps, start, steps, it, Some(stats.relative_gradient), energy_start, stats.energy)
             }
         }
         VolumeMethod::Winslow => {
             let (cps, start, steps, stats, energy_start) =
                 winslow_from_corners(&energy, cf, &target, &is_boundary, opts)?;
-            (cps, start, steps, stats.iterations, Some(stats.relative_gradient), energy_start.map(|e| e * scale))
+            let it = stats.iterations;
+            (cps, start, steps, it, Some(stats.relative_gradient), energy_start.map(|e| e * scale), stats.energy)
         }
     };
-    let energy = energy.evaluate(&current, false).energy * scale;
+    let energy = energy * scale;
     // exact boundary: the input's control points, not their unit image
     let (orig, _) = boundary_points(cf)?;
     let cps: Vec<Point3> = current

@@ -44,56 +44,67 @@ pub(super) fn weights(t: [&Tables; 3]) -> Vec<f64> {
 /// the tables `t` of each of the `k = u.len() / m` coefficient vectors `u` (column `c` at
 /// `u[c m..]`, functions `a` fastest, as `VolumeDiscretization::element_indices`), in
 /// the layout `out[(10 c + row) n_q + q]`.
+///
+/// The columns go through each pass together (the `x` points of all columns
+/// contiguous, `(col, x)`), so that the `y` and `z` passes are updates of vectors of
+/// `k g₀` and `g₁ k g₀` numbers, not of `g₀` and `g₁ g₀`; the result is then
+/// transposed to the layout above. The same products and sums in the same order as
+/// column by column.
 pub(super) fn values(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
     let n: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
     let g: [usize; 3] = std::array::from_fn(|d| t[d].len());
     let m = n[0] * n[1] * n[2];
     let nq = g[0] * g[1] * g[2];
     let cols = u.len() / m;
-    let mut out = vec![0.0; cols * 10 * nq];
-    // U¹[dx][(c n₁ + b) g₀ + x], U²[pair][(c g₁ + y) g₀ + x]
-    let mut u1 = vec![0.0; 3 * n[2] * n[1] * g[0]];
-    let mut u2 = vec![0.0; 6 * n[2] * g[1] * g[0]];
-    for (col, uc) in u.chunks_exact(m).enumerate() {
-        let s1 = n[2] * n[1] * g[0];
-        for dx in 0..3 {
-            for cb in 0..n[2] * n[1] {
-                let coef = &uc[cb * n[0]..(cb + 1) * n[0]];
-                for (x, (tx, _)) in t[0].iter().enumerate() {
-                    let row = &tx.d[dx][..n[0]];
-                    u1[dx * s1 + cb * g[0] + x] = coef.iter().zip(row).map(|(a, b)| a * b).sum();
+    // a run of the points x of all columns, (col, x)
+    let run = cols * g[0];
+    // U¹[dx][(c n₁ + b) run + col g₀ + x]
+    let s1 = n[2] * n[1] * run;
+    let mut u1 = vec![0.0; 3 * s1];
+    for (dx, u1d) in u1.chunks_exact_mut(s1).enumerate() {
+        for (cb, dst) in u1d.chunks_exact_mut(run).enumerate() {
+            for (col, dc) in dst.chunks_exact_mut(g[0]).enumerate() {
+                let coef = &u[col * m + cb * n[0]..][..n[0]];
+                for (o, (tx, _)) in dc.iter_mut().zip(t[0]) {
+                    *o = coef.iter().zip(&tx.d[dx][..n[0]]).map(|(a, b)| a * b).sum();
                 }
             }
         }
-        let s2 = n[2] * g[1] * g[0];
-        for (pair, &[dx, dy]) in PAIRS_XY.iter().enumerate() {
+    }
+    // U²[pair][(c g₁ + y) run + col g₀ + x]
+    let s2 = n[2] * g[1] * run;
+    let mut u2 = vec![0.0; 6 * s2];
+    for (&[dx, dy], u2p) in PAIRS_XY.iter().zip(u2.chunks_exact_mut(s2)) {
+        for (cy, dst) in u2p.chunks_exact_mut(run).enumerate() {
+            let (c, ty) = (cy / g[1], &t[1][cy % g[1]].0);
+            for b in 0..n[1] {
+                let f = ty.d[dy][b];
+                let src = &u1[dx * s1 + (c * n[1] + b) * run..][..run];
+                for (o, s) in dst.iter_mut().zip(src) {
+                    *o += f * s;
+                }
+            }
+        }
+    }
+    // each row's values, a plane of (y, col, x) at a time: V[row][z][(y run + col g₀ + x)]
+    let plane = g[1] * run;
+    let mut v = vec![0.0; 10 * g[2] * plane];
+    for ((row, r), vr) in ROWS.iter().enumerate().zip(v.chunks_exact_mut(g[2] * plane)) {
+        let src = &u2[ROW_PAIR[row] * s2..(ROW_PAIR[row] + 1) * s2];
+        for ((tz, _), dz) in t[2].iter().zip(vr.chunks_exact_mut(plane)) {
             for c in 0..n[2] {
-                for (y, (ty, _)) in t[1].iter().enumerate() {
-                    let dst = &mut u2[pair * s2 + (c * g[1] + y) * g[0]..][..g[0]];
-                    dst.fill(0.0);
-                    for b in 0..n[1] {
-                        let f = ty.d[dy][b];
-                        let src = &u1[dx * s1 + (c * n[1] + b) * g[0]..][..g[0]];
-                        for (o, s) in dst.iter_mut().zip(src) {
-                            *o += f * s;
-                        }
-                    }
+                let f = tz.d[r[2]][c];
+                for (o, s) in dz.iter_mut().zip(&src[c * plane..(c + 1) * plane]) {
+                    *o += f * s;
                 }
             }
         }
-        // each row's values over the points, a plane of (x, y) at a time (vectorised)
-        let plane = g[1] * g[0];
-        for (row, r) in ROWS.iter().enumerate() {
-            let src = &u2[ROW_PAIR[row] * s2..(ROW_PAIR[row] + 1) * s2];
-            let dst = &mut out[(col * 10 + row) * nq..(col * 10 + row + 1) * nq];
-            for (z, (tz, _)) in t[2].iter().enumerate() {
-                let dz = &mut dst[z * plane..(z + 1) * plane];
-                for c in 0..n[2] {
-                    let f = tz.d[r[2]][c];
-                    for (o, s) in dz.iter_mut().zip(&src[c * plane..(c + 1) * plane]) {
-                        *o += f * s;
-                    }
-                }
+    }
+    let mut out = vec![0.0; cols * 10 * nq];
+    for (col, oc) in out.chunks_exact_mut(10 * nq).enumerate() {
+        for (or, vr) in oc.chunks_exact_mut(nq).zip(v.chunks_exact(g[2] * plane)) {
+            for (ozy, vzy) in or.chunks_exact_mut(g[0]).zip(vr.chunks_exact(run)) {
+                ozy.copy_from_slice(&vzy[col * g[0]..(col + 1) * g[0]]);
             }
         }
     }
@@ -144,4 +155,78 @@ pub(super) fn integrals(t: [&Tables; 3], f: &[f64]) -> Vec<f64> {
         }
     }
     r
+}
+
+/// The stiffness `K[b m + a] = Σ_q Σ_ij ∂_i R_a(q) C_ij(q) ∂_j R_b(q)` of the
+/// coefficients `C_ij` at the points (`c[(3 i + j) n_q + q]`, the Gauss weights
+/// included), sum factorised: `∂_i R_a = X^(δ_i0)_(a₀) Y^(δ_i1)_(a₁) Z^(δ_i2)_(a₂)`, so
+/// for each `(i, j)`
+///
+/// `T¹_(a₀ b₀)(y, z) = Σ_x X^(δ_i0)_(a₀) X^(δ_j0)_(b₀) C_ij`,
+/// `T²_(a₁ b₁ a₀ b₀)(z) = Σ_y Y^(δ_i1)_(a₁) Y^(δ_j1)_(b₁) T¹`,
+///
+/// the `T²` of the pairs with the same `z` derivatives `(δ_i2, δ_j2)` added (four
+/// groups), and `K = Σ_z Z^(δ_i2)_(a₂) Z^(δ_j2)_(b₂) T²` per group: `O(p^{d+1})` per
+/// entry and point instead of `O(p^d)` per entry times `n_q` for the dense product
+/// `Σ_q`. Only for the polynomial basis, as [`values`].
+pub(super) fn stiffness(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
+    let n: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
+    let g: [usize; 3] = std::array::from_fn(|d| t[d].len());
+    let (m, nq) = (n[0] * n[1] * n[2], g[0] * g[1] * g[2]);
+    // blocks (a₀, b₀), then [a₁][b₁][a₀ b₀]
+    let b0 = n[0] * n[0];
+    let b1 = n[1] * n[1] * b0;
+    // T²[group][z][a₁][b₁][a₀ b₀], group 2 δ_i2 + δ_j2
+    let mut t2 = vec![0.0; 4 * g[2] * b1];
+    let mut t1 = vec![0.0; g[2] * g[1] * b0];
+    for i in 0..3 {
+        for j in 0..3 {
+            let cij = &c[(3 * i + j) * nq..(3 * i + j + 1) * nq];
+            let da = [usize::from(i == 0), usize::from(i == 1), usize::from(i == 2)];
+            let db = [usize::from(j == 0), usize::from(j == 1), usize::from(j == 2)];
+            for (dst, cz) in t1.chunks_exact_mut(b0).zip(cij.chunks_exact(g[0])) {
+                for a0 in 0..n[0] {
+                    for bb in 0..n[0] {
+                        dst[a0 * n[0] + bb] =
+                            t[0].iter().zip(cz).map(|((tx, _), &cq)| tx.d[da[0]][a0] * tx.d[db[0]][bb] * cq).sum();
+                    }
+                }
+            }
+            let group = &mut t2[(2 * da[2] + db[2]) * g[2] * b1..][..g[2] * b1];
+            for (z, gz) in group.chunks_exact_mut(b1).enumerate() {
+                for (ab, dst) in gz.chunks_exact_mut(b0).enumerate() {
+                    let (a1, bb) = (ab / n[1], ab % n[1]);
+                    for (y, (ty, _)) in t[1].iter().enumerate() {
+                        let f = ty.d[da[1]][a1] * ty.d[db[1]][bb];
+                        for (o, s) in dst.iter_mut().zip(&t1[(z * g[1] + y) * b0..][..b0]) {
+                            *o += f * s;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Kᵇ[a₂][b₂][a₁][b₁][a₀ b₀]
+    let mut kb = vec![0.0; n[2] * n[2] * b1];
+    for (group, t2g) in t2.chunks_exact(g[2] * b1).enumerate() {
+        let (dza, dzb) = (group / 2, group % 2);
+        for (ab, dst) in kb.chunks_exact_mut(b1).enumerate() {
+            let (a2, bb) = (ab / n[2], ab % n[2]);
+            for ((tz, _), src) in t[2].iter().zip(t2g.chunks_exact(b1)) {
+                let f = tz.d[dza][a2] * tz.d[dzb][bb];
+                for (o, s) in dst.iter_mut().zip(src) {
+                    *o += f * s;
+                }
+            }
+        }
+    }
+    // to K[b m + a], a = (a₂ n₁ + a₁) n₀ + a₀
+    let mut k = vec![0.0; m * m];
+    for (i, v) in kb.into_iter().enumerate() {
+        let (a0b0, a1b1, a2b2) = (i % b0, (i / b0) % (n[1] * n[1]), i / b1);
+        let (a0, bb0, a1, bb1, a2, bb2) =
+            (a0b0 / n[0], a0b0 % n[0], a1b1 / n[1], a1b1 % n[1], a2b2 / n[2], a2b2 % n[2]);
+        k[((bb2 * n[1] + bb1) * n[0] + bb0) * m + (a2 * n[1] + a1) * n[0] + a0] = v;
+    }
+    k
 }

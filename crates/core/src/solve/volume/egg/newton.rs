@@ -42,6 +42,10 @@ pub(in crate::solve::volume) struct EggSolved {
     pub(in crate::solve::volume) linear: LinearMethod,
     /// GMRES iterations of all Newton steps.
     pub(in crate::solve::volume) krylov_iterations: usize,
+    /// The Winslow energy of the start and of the result ([`EggEvaluation::energy`],
+    /// from the evaluations of the residual: `+∞` where `det J <= 0`).
+    pub(in crate::solve::volume) energy_start: f64,
+    pub(in crate::solve::volume) energy: f64,
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -77,6 +81,12 @@ impl MatVec for JacobianProduct<'_> {
             // GMRES fails on the non-finite product
             None => y.fill(f64::NAN),
         }
+    }
+
+    /// A product is evaluated at every quadrature point of every element (about the
+    /// cost of one residual): GMRES forms its residuals from the products it made.
+    fn costly(&self) -> bool {
+        true
     }
 }
 
@@ -199,6 +209,7 @@ pub(in crate::solve::volume) fn solve_egg(
         });
     }
     let f0 = norm(&ev.residual);
+    let energy_start = ev.energy;
     let stop = tolerance * f0.max(1.0);
     let mut x = op.disc.gather(cps);
     let mut iterations = 0;
@@ -245,6 +256,8 @@ pub(in crate::solve::volume) fn solve_egg(
         relative_residual: fnorm / f0.max(f64::MIN_POSITIVE),
         linear: step.method(),
         krylov_iterations: step.krylov_iterations,
+        energy_start,
+        energy: ev.energy,
     })
 }
 

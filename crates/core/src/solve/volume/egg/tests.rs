@@ -126,6 +126,71 @@ fn sum_factorisation_is_the_basis_table_product() {
     assert!(fast.iter().any(|f| f.abs() > 1e-3) && err < 1e-13, "{err}");
 }
 
+/// The sum-factorised stiffness ([`tensor_points::stiffness`]) equals
+/// `Σ_q Σ_ij ∂_i R_a C_ij ∂_j R_b` through the tensor basis table, on every element of a
+/// polynomial volume, for pseudo-random coefficients `C` (not symmetric: every pair
+/// `(i, j)` is its own term); and the cofactor-metric stiffness `K` assembled through
+/// it equals the one of the basis tables ([`EggVolume::element`]).
+#[test]
+fn sum_factorised_stiffness_is_the_basis_table_sum() {
+    let (vol, cps) = polynomial();
+    let op = EggVolume::new(&vol, 5);
+    let mut state = 0x1234_5678_9abc_def1_u64;
+    for e in 0..op.disc.elements() {
+        let idx = op.disc.element_indices(e);
+        let (weights, basis) = op.element_points(e, &idx);
+        let (m, nq) = (idx.len(), weights.len());
+        let c = random(&mut state, 9 * nq);
+        let got = tensor_points::stiffness(op.disc.element_tables(e), &c);
+        let grad = |q: usize, i: usize, a: usize| basis[(10 * q + 1 + i) * m + a];
+        let mut scale = 0.0f64;
+        for a in 0..m {
+            for b in 0..m {
+                let mut want = 0.0;
+                for q in 0..nq {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            want += grad(q, i, a) * c[(3 * i + j) * nq + q] * grad(q, j, b);
+                        }
+                    }
+                }
+                scale = scale.max(want.abs());
+                let g = got[b * m + a];
+                assert!((g - want).abs() < 1e-11 * (1.0 + want.abs()), "{e} ({a}, {b}): {g} vs {want}");
+            }
+        }
+        assert!(scale > 1e-2, "{scale}");
+    }
+    let fast = op.evaluate_with(&cps, false, true);
+    let table = op.evaluate_with(&cps, true, true);
+    let (k, kt) = (fast.laplace.unwrap(), table.laplace.unwrap());
+    assert_eq!((&k.row_ptr, &k.col_idx), (&kt.row_ptr, &kt.col_idx));
+    let size = kt.values.iter().fold(0.0f64, |e, v| e.max(v.abs()));
+    let err = k.values.iter().zip(&kt.values).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
+    assert!(size > 1e-2 && err < 1e-13 * size, "{err} at {size}");
+}
+
+/// The Winslow energy that comes with the residual ([`EggEvaluation::energy`]) is that
+/// of [`super::super::winslow::WinslowVolume`] on the same quadrature to rounding, on
+/// the sum-factorised and the basis-table path, polynomial and rational; and `+∞` on a
+/// volume folded by a reflected interior control point.
+#[test]
+fn the_residuals_winslow_energy_is_the_functionals() {
+    for (vol, cps) in [sample(), polynomial()] {
+        let op = EggVolume::new(&vol, 5);
+        let want = super::super::winslow::WinslowVolume::new(&vol, 5).evaluate(&cps, false).energy;
+        for (jacobian, laplace) in [(false, false), (false, true), (true, false)] {
+            let got = op.evaluate_with(&cps, jacobian, laplace).energy;
+            assert!(want.is_finite() && (got - want).abs() < 1e-13 * want, "{got} vs {want}");
+        }
+        let mut folded = cps.clone();
+        let lin = (0..cps.len()).find(|&l| op.disc.free_index(l).is_some()).unwrap();
+        folded[lin] = std::array::from_fn(|c| 3.0 * cps[lin][c] - 2.0 * cps[lin + 1][c]);
+        assert_eq!(super::super::winslow::WinslowVolume::new(&vol, 5).evaluate(&folded, false).energy, f64::INFINITY);
+        assert_eq!(op.evaluate(&folded, false).energy, f64::INFINITY);
+    }
+}
+
 /// A Jacobian handed back and overwritten by the next assembly equals one assembled
 /// into a new matrix (its old values are cleared, its pattern is the pattern), and
 /// a matrix of another size is not taken.
