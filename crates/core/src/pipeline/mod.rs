@@ -365,7 +365,7 @@ impl Pipeline {
             Input::Boundary(_) | Input::Ring(_) => {}
         }
         let (_, _, solver) = self.plan(&self.opts)?;
-        Ok(MemoryEstimate::for_levels_with(solver.plan(), self.opts.nonlinear.linear))
+        Ok(solver.estimate())
     }
 
     /// The fit of the input and the solver of its levels (nothing large allocated yet).
@@ -390,7 +390,7 @@ impl Pipeline {
     /// its estimated peak exceeds `opts.max_memory`.
     fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
         let (boundary, hierarchy, mut solver) = self.plan(opts)?;
-        let estimate = MemoryEstimate::for_levels_with(solver.plan(), opts.nonlinear.linear);
+        let estimate = solver.estimate();
         opts.max_memory.check(&estimate, opts.levels.refine, &format!("solving '{}'", self.input.name()))?;
         let fitted =
             Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };

@@ -31,7 +31,6 @@
 //! allocates ([`reserve`]), so an address-space limit (`ulimit -v`) that the limit did not
 //! see is a typed error too, not the allocator's abort.
 
-use crate::boundary::hierarchy::Level;
 pub use crate::error::human;
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::LinearMethod;
@@ -70,6 +69,48 @@ pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 19;
 /// Cholesky factors of the elasticity prolongation's two diagonal blocks; the fit puts
 /// the part that grows with the stencil in the per-nonzero weight.
 pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 300;
+
+/// Unknowns of a level from which `--linear auto` ([`LinearMethod::Auto`]) solves its
+/// Newton systems as `--linear multigrid` does ([`auto_linear`]); below it, GMRES
+/// preconditioned by the single-precision Cholesky factor of `K` (LU up to 64 unknowns).
+/// Chosen on the CPU seconds of both at refine 4, 5 and 6 (BENCHMARKS.md, "Auto switching").
+pub(crate) const AUTO_MULTIGRID_UNKNOWNS: usize = 800_000;
+
+/// The linear solver of a level with knot vectors `knots` when `requested` is asked
+/// for: `requested` itself unless it is [`LinearMethod::Auto`]; for `Auto`,
+/// [`LinearMethod::Multigrid`] on a non-periodic tensor basis of at least
+/// [`AUTO_MULTIGRID_UNKNOWNS`] unknowns, or of fewer whose estimated peak with the direct
+/// preconditioner ([`MemoryEstimate::for_knots_with`]) exceeds `limit` (bytes; `None`:
+/// no limit) while the multigrid one does not; `Auto` otherwise.
+pub(crate) fn auto_linear(knots: &[KnotVector; 2], requested: LinearMethod, limit: Option<u64>) -> LinearMethod {
+    if requested != LinearMethod::Auto || knots.iter().any(KnotVector::is_periodic) {
+        return requested;
+    }
+    let direct = MemoryEstimate::with_weights(knots, BYTES_PER_UNKNOWN, BYTES_PER_NONZERO);
+    if direct.unknowns >= AUTO_MULTIGRID_UNKNOWNS {
+        return LinearMethod::Multigrid;
+    }
+    let multigrid = MemoryEstimate::with_weights(knots, MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO);
+    match limit {
+        Some(limit) if direct.bytes > limit && multigrid.bytes <= limit => LinearMethod::Multigrid,
+        _ => LinearMethod::Auto,
+    }
+}
+
+/// With the environment variable `WINSLOW_MEMORY_TRACE` set, one line on standard error
+/// per call: `stage`, the resident memory now (`VmRSS`) and the peak so far (`VmHWM`), in
+/// MiB (Linux; nothing elsewhere). The stages of a solve (each level's set-up, elasticity
+/// prolongation, Newton assembly, preconditioner set-up, Krylov solve, certificate,
+/// report) then show where its peak is reached (BENCHMARKS.md, "Where the peak is").
+pub fn trace(stage: impl FnOnce() -> String) {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    if !*ON.get_or_init(|| std::env::var_os("WINSLOW_MEMORY_TRACE").is_some()) {
+        return;
+    }
+    let Ok(status) = std::fs::read_to_string("/proc/self/status") else { return };
+    let mib = |key: &str| field_kib(&status, key).map_or(0.0, |kb| kb as f64 / 1024.0);
+    eprintln!("memory: {:<48} rss {:>9.1} MiB  peak {:>9.1} MiB", stage(), mib("VmRSS:"), mib("VmHWM:"));
+}
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
@@ -120,13 +161,19 @@ impl MemoryEstimate {
     /// [`MULTIGRID_BYTES_PER_UNKNOWN`] for [`LinearMethod::Multigrid`],
     /// [`BYTES_PER_NONZERO`] and [`BYTES_PER_UNKNOWN`] otherwise.
     pub(crate) fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
+        match linear {
+            LinearMethod::Multigrid => {
+                Self::with_weights(knots, MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO)
+            }
+            _ => Self::with_weights(knots, BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
+        }
+    }
+
+    /// `BASE + per_unknown · unknowns + per_nonzero · nonzeros` on the basis `knots`.
+    fn with_weights(knots: &[KnotVector; 2], per_unknown: u64, per_nonzero: u64) -> Self {
         let functions = knots[0].dim() * knots[1].dim();
         let nonzeros = 4 * interacting_pairs(&knots[0]) * interacting_pairs(&knots[1]);
         let unknowns = 2 * functions;
-        let (per_unknown, per_nonzero) = match linear {
-            LinearMethod::Multigrid => (MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO),
-            _ => (BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
-        };
         let bytes = BASE
             .saturating_add(per_unknown.saturating_mul(unknowns as u64))
             .saturating_add(per_nonzero.saturating_mul(nonzeros as u64));
@@ -150,17 +197,6 @@ impl MemoryEstimate {
         let factor = if free { FREE_INTERFACE_FACTOR } else { 1 };
         sum.bytes = BASE.saturating_add(sum.bytes.saturating_mul(factor));
         sum
-    }
-
-    /// [`MemoryEstimate::for_levels`] for Newton systems solved by `linear`
-    /// ([`MemoryEstimate::for_knots_with`]).
-    pub(crate) fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
-        levels.iter().map(|l| Self::for_knots_with(&l.knots, linear)).max_by_key(|e| e.bytes).unwrap_or(Self {
-            functions: 0,
-            unknowns: 0,
-            nonzeros: 0,
-            bytes: BASE,
-        })
     }
 }
 
