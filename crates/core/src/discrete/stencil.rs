@@ -68,7 +68,6 @@ impl Stencil32 {
         words.shrink_to_fit();
         Self { words, len }
     }
-
 }
 
 impl StencilValues for Stencil32 {

@@ -49,26 +49,25 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 
 /// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
 /// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
-/// stencil storage (`discrete::stencil::StencilOperator`, 8 B per nonzero) and the
-/// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
-/// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
-/// gather map and the metric Laplacian `K` in CSR, held once (by the V-cycle), with its
-/// line factors and coarse levels; the transfers are 1D factors. With
+/// stencil storage, rounded to single precision after each assembly
+/// (`discrete::stencil::Stencil32`), and neither the vector nor the scalar pattern is
+/// built (`K` and the elasticity blocks come from their stencil storage, the transfers
+/// are 1D factors). The peak is the assembly of a Newton step after the first (the
+/// `f64` stencil storage the assembler writes, 8 B per nonzero, beside the frozen
+/// V-cycle: `f32` stencils and line factors of every level) or the set-up of the
+/// V-cycle (the `f32` Jacobian, `K` in CSR and its stencil storage). With
 /// [`MULTIGRID_BYTES_PER_UNKNOWN`] fitted to the peaks (`VmHWM`, dev profile, one
-/// geometry per process) of wavy_lid (degrees 3 x 2), male_rotor (3) and puzzle4 (2) at
-/// `--refine 4` and `5` (70 k to 541 k unknowns) under the split line smoother: measured
-/// over estimated 0.91-1.07, quarter_annulus at 918 k 0.90, wavy_lid at 4 k to 70 k
-/// 0.99-1.02 (800 and 14 before overestimated puzzle4's degree-2 peaks
-/// by up to 1.3x; BENCHMARKS.md, "Half the sweeps").
-pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 19;
+/// geometry per process; `WINSLOW_MEMORY_TRACE` shows the stage) of quarter_annulus at
+/// 918 k and male_rotor at 2.13 M unknowns (degrees 3 x 2 and 3: 70 and 98 nonzeros per
+/// unknown): measured over estimated 0.98 and 1.05 there, 0.99-1.26 on quarter_annulus,
+/// wavy_lid, puzzle4 (degree 2: 50 nonzeros per unknown) and male_rotor at `--refine 4`
+/// and `5` (BENCHMARKS.md, "Under 1 KiB per unknown").
+pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 11;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see
-/// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
-/// iteration, 16 B per unknown and iteration: 200-370 B at the 12-23 iterations these
-/// solves take at most), the vectors of a Newton step, and the single-precision
-/// Cholesky factors of the elasticity prolongation's two diagonal blocks; the fit puts
-/// the part that grows with the stencil in the per-nonzero weight.
-pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 300;
+/// [`MULTIGRID_BYTES_PER_NONZERO`]): the vectors of a Newton step and of the flexible
+/// GMRES basis (two per iteration), and the freed vectors the allocator keeps.
+pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 150;
 
 /// Unknowns of a level from which `--linear auto` ([`LinearMethod::Auto`]) solves its
 /// Newton systems as `--linear multigrid` does ([`auto_linear`]); below it, GMRES
@@ -415,6 +414,28 @@ mod tests {
         let Error::Memory { needed, available, ref advice, .. } = e else { panic!("{e}") };
         assert_eq!((needed, available), (b.bytes, b.bytes - 1));
         assert!(advice.contains("--refine 1"), "{advice}");
+    }
+
+    /// `--linear auto` on a level: unchanged below [`AUTO_MULTIGRID_UNKNOWNS`] unless the
+    /// factorization's estimate exceeds the limit while multigrid's fits; multigrid from
+    /// that size on; an explicit solver and a periodic basis are never changed.
+    #[test]
+    fn auto_switches_to_multigrid_by_size_and_by_memory() {
+        let k = |e| [KnotVector::open_uniform(3, e), KnotVector::open_uniform(3, e)];
+        let (small, large) = (k(200), k(640));
+        let (a, m) = (LinearMethod::Auto, LinearMethod::Multigrid);
+        assert!(2 * 203 * 203 < AUTO_MULTIGRID_UNKNOWNS && 2 * 643 * 643 >= AUTO_MULTIGRID_UNKNOWNS);
+        assert_eq!(auto_linear(&small, a, None), a);
+        assert_eq!(auto_linear(&large, a, None), m);
+        assert_eq!(auto_linear(&large, LinearMethod::Gmres, None), LinearMethod::Gmres);
+        let direct = MemoryEstimate::for_knots_with(&small, a).bytes;
+        let multigrid = MemoryEstimate::for_knots_with(&small, m).bytes;
+        assert!(multigrid < direct / 3, "{multigrid} against {direct}");
+        assert_eq!(auto_linear(&small, a, Some(direct)), a);
+        assert_eq!(auto_linear(&small, a, Some(direct - 1)), m);
+        assert_eq!(auto_linear(&small, a, Some(multigrid - 1)), a);
+        let ring = [KnotVector::open_uniform(3, 640), KnotVector::periodic_uniform(3, 640)];
+        assert_eq!(auto_linear(&ring, a, Some(1)), a);
     }
 
     #[test]

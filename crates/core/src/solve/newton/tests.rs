@@ -321,7 +321,12 @@ fn stencil_operator_newton_equals_matrix_newton() {
     assert_eq!(ia.len(), ib.len());
     assert_eq!(ia[0], ib[0]);
     let steps = ia.len() - 1;
-    assert!(a.krylov_iterations().abs_diff(b.krylov_iterations()) <= steps, "{} against {}", a.krylov_iterations(), b.krylov_iterations());
+    assert!(
+        a.krylov_iterations().abs_diff(b.krylov_iterations()) <= steps,
+        "{} against {}",
+        a.krylov_iterations(),
+        b.krylov_iterations()
+    );
     let gap = a.solution().iter().zip(b.solution()).fold(0.0f64, |g, (x, y)| g.max((x - y).abs()));
     assert!(gap <= 1e-9, "the solutions differ by {gap:e}");
     assert!(!d_op.vector.is_built() && d_mat.vector.is_built());
