@@ -72,7 +72,10 @@ pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 150;
 /// Unknowns of a level from which `--linear auto` ([`LinearMethod::Auto`]) solves its
 /// Newton systems as `--linear multigrid` does ([`auto_linear`]); below it, GMRES
 /// preconditioned by the single-precision Cholesky factor of `K` (LU up to 64 unknowns).
-/// Chosen on the CPU seconds of both at refine 4, 5 and 6 (BENCHMARKS.md, "Auto switching").
+/// Chosen on the CPU seconds and peaks of both at refine 4, 5 and 6 of four geometries
+/// (BENCHMARKS.md, "Under 1 KiB per unknown, and `--linear auto` choosing multigrid": no
+/// size wins on time on all four; from about 10^6 unknowns multigrid is within 0.94-1.26x
+/// of the CPU time at 4-5x less memory).
 pub(crate) const AUTO_MULTIGRID_UNKNOWNS: usize = 800_000;
 
 /// The linear solver of a level with knot vectors `knots` when `requested` is asked
@@ -100,7 +103,7 @@ pub(crate) fn auto_linear(knots: &[KnotVector; 2], requested: LinearMethod, limi
 /// per call: `stage`, the resident memory now (`VmRSS`) and the peak so far (`VmHWM`), in
 /// MiB (Linux; nothing elsewhere). The stages of a solve (each level's set-up, elasticity
 /// prolongation, Newton assembly, preconditioner set-up, Krylov solve, certificate,
-/// report) then show where its peak is reached (BENCHMARKS.md, "Where the peak is").
+/// report) then show where its peak is reached (BENCHMARKS.md, "Under 1 KiB per unknown").
 pub fn trace(stage: impl FnOnce() -> String) {
     static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     if !*ON.get_or_init(|| std::env::var_os("WINSLOW_MEMORY_TRACE").is_some()) {
