@@ -584,7 +584,18 @@ mod tests {
         opts.levels.refine = 2;
         let estimate = Pipeline::new(puzzle4(), opts.clone()).estimate().unwrap();
         assert!(estimate.bytes > crate::solve::memory::BASE && estimate.unknowns > 0);
-        let limit = estimate.bytes - 1;
+        // below the factorization's estimate but above multigrid's, `--linear auto` solves
+        // the finest level by multigrid instead of refusing (`solve::memory::auto_linear`)
+        let mut multigrid = opts.clone();
+        multigrid.nonlinear.linear = crate::linalg::linsolve::LinearMethod::Multigrid;
+        let multigrid = Pipeline::new(puzzle4(), multigrid).estimate().unwrap();
+        assert!(multigrid.bytes < estimate.bytes - 1, "{multigrid:?} against {estimate:?}");
+        let between =
+            SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(estimate.bytes - 1), ..opts.clone() };
+        let solved = Pipeline::new(puzzle4(), between).solve().unwrap().into_map().unwrap();
+        assert_eq!(solved.report.outcome.verdict, Verdict::Certified);
+        // below both: refused, with the factorization's estimate as the need
+        let limit = multigrid.bytes - 1;
         let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(limit), ..opts };
         let mut stages = 0;
         let out = Pipeline::new(puzzle4(), opts.clone()).run(&mut |_| {
