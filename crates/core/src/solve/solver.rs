@@ -266,15 +266,9 @@ impl EggSolver {
         let interior = self.opts.topology == Topology::dirichlet() && !self.free_boxes.iter().any(|(i, _)| *i == k);
         let linear = self.linear_for(&level.knots, interior);
         // the level's estimated peak reserved and released: a limit the pipeline's check
-        // did not see (an address-space limit) is a typed error here, not an abort later;
-        // under multigrid, whose resident peak is a smaller share of the address space it
-        // maps (the allocator's per-thread arenas, the threads' stacks), with half again
-        // (wavy_lid at 1.1 M unknowns, 0.97 GiB estimated, aborted under `ulimit -v` 1 GiB
-        // when only the estimate was reserved)
-        let bytes = MemoryEstimate::for_knots_with(&level.knots, linear).bytes;
-        let headroom = if linear == LinearMethod::Multigrid { bytes / 2 } else { 0 };
+        // did not see (an address-space limit) is a typed error here, not an abort later
         crate::solve::memory::reserve(
-            bytes.saturating_add(headroom),
+            MemoryEstimate::for_knots_with(&level.knots, linear).bytes,
             &format!("level {k} ({} x {} functions)", level.knots[0].dim(), level.knots[1].dim()),
         )?;
         trace(|| format!("level {k}: start ({linear:?})"));
