@@ -162,7 +162,7 @@ pub(crate) struct SolverArgs {
     /// shared geometries, see BENCHMARKS.md).
     #[arg(long, value_enum, default_value = "scaled")]
     pub(crate) operator: Operator,
-    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), auto (LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations), or multigrid (GMRES preconditioned by a multigrid V-cycle for the metric Laplacian instead of its factorization).
+    /// Linear solver: sparse LU, GMRES (preconditioned by the metric Laplacian), auto (LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations; on a patch from 800 000 unknowns on, or where the factorization would exceed --max-memory, multigrid), or multigrid (GMRES preconditioned by a multigrid V-cycle for the metric Laplacian instead of its factorization).
     #[arg(long, value_enum, default_value = "auto")]
     pub(crate) linear: LinearMethod,
     /// Rounds of defect correction: while the certificate says folded or undecided,

@@ -10,10 +10,11 @@ use common::{bin, data};
 /// The estimated peak within 2x of the measured one at three sizes of wavy_lid (4 400 to
 /// 70 000 unknowns; each size its own process, so that one's peak is not the next's),
 /// with the default linear solver, and within 1.5x with the multigrid preconditioner
-/// (`--linear multigrid`, its own model in `winslow::solve::memory`, fitted to its peaks:
-/// 0.99-1.02 on these three).
+/// (`--linear multigrid`, its own model in `winslow::solve::memory`, fitted to the peaks
+/// at 0.9 M and 2.1 M unknowns: measured over estimated 1.13, 1.33, 1.26 on these
+/// three).
 #[test]
-fn the_estimate_is_within_2x_of_the_measured_peak() {
+fn the_estimate_is_within_2x_by_factorization_and_1_5x_by_multigrid() {
     for linear in ["auto", "multigrid"] {
         for refine in [2, 3, 4] {
             let out = bin()

@@ -49,8 +49,10 @@ pub struct Discretization {
     /// Pattern of the 2-component systems (EGG Jacobian, elasticity, block mass), built
     /// on first use.
     pub vector: LazyPattern,
-    /// Pattern of scalar systems (mass, Laplacian).
-    pub scalar: SystemPattern,
+    /// Pattern of scalar systems (mass, Laplacian), built on first use (a solve by
+    /// `--linear multigrid` on a patch takes `K` and the elasticity blocks straight from
+    /// their stencil storage and never builds it).
+    pub scalar: LazyPattern,
     /// Fill-reducing (nested-dissection) order of the free scalar unknowns for sparse
     /// Cholesky factorizations, `ordering[new] = old`; see [`crate::linalg::ordering`].
     pub ordering: Vec<usize>,
@@ -233,7 +235,7 @@ impl Discretization {
     fn with_tables(knots: [KnotVector; 2], tables: [DirTable; 2], dofs: DofMap) -> Self {
         let (p, q) = (knots[0].degree(), knots[1].degree());
         let vector = LazyPattern::new(&dofs, p, q, 2);
-        let scalar = SystemPattern::new(&dofs, p, q, 1);
+        let scalar = LazyPattern::new(&dofs, p, q, 1);
         let nx = dofs.shape()[0];
         let nodes: Vec<[usize; 2]> = dofs.free().iter().map(|&k| [k % nx, k / nx]).collect();
         let ordering = crate::linalg::ordering::nested_dissection(&nodes, [p, q]);

@@ -18,6 +18,68 @@ use crate::linalg::krylov::MatVec;
 /// Functions of the stencil product per parallel task (their rows of every component).
 const ROWS_PER_TASK: usize = 1024;
 
+/// Stencil storage as [`Discretization::stencil_product`] reads it: entry `i` as `f64`.
+pub(crate) trait StencilValues: Sync {
+    /// Entry `i`.
+    fn at(&self, i: usize) -> f64;
+    /// Number of entries.
+    fn entries(&self) -> usize;
+}
+
+impl StencilValues for [f64] {
+    #[inline]
+    fn at(&self, i: usize) -> f64 {
+        self[i]
+    }
+    fn entries(&self) -> usize {
+        self.len()
+    }
+}
+
+/// Stencil storage rounded to single precision, two entries per 64-bit word (entry `i`
+/// in the low half of word `i / 2` when `i` is even, the high half when odd): half the
+/// storage and memory traffic of the `f64` storage the assemblers write. Made in place
+/// from that storage ([`Stencil32::pack`]: no second array), so a Jacobian of eq. (12)
+/// held for the Krylov iterations of a Newton step costs 392 B per unknown at degree 3
+/// instead of 784; the product then multiplies with `A` rounded entrywise to `f32`
+/// (relative change at most `2^-24` per entry) inside the `f64` Newton iteration, whose
+/// residual `F` stays exact (BENCHMARKS.md, "Under 1 KiB per unknown").
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Stencil32 {
+    words: Vec<u64>,
+    len: usize,
+}
+
+impl Stencil32 {
+    /// `stencil` rounded to `f32`, in its own allocation (the words written over the
+    /// entries already read, the unused half released).
+    pub fn pack(stencil: Vec<f64>) -> Self {
+        let len = stencil.len();
+        // same size and alignment: collected in place
+        let mut words: Vec<u64> = stencil.into_iter().map(f64::to_bits).collect();
+        let half = len.div_ceil(2);
+        let single = |w: u64| u64::from((f64::from_bits(w) as f32).to_bits());
+        for j in 0..half {
+            // entries 2j and 2j + 1 are read before word j (j <= 2j) is written
+            let hi = if 2 * j + 1 < len { single(words[2 * j + 1]) } else { 0 };
+            words[j] = single(words[2 * j]) | (hi << 32);
+        }
+        words.truncate(half);
+        words.shrink_to_fit();
+        Self { words, len }
+    }
+}
+
+impl StencilValues for Stencil32 {
+    #[inline]
+    fn at(&self, i: usize) -> f64 {
+        f64::from(f32::from_bits((self.words[i >> 1] >> ((i & 1) * 32)) as u32))
+    }
+    fn entries(&self) -> usize {
+        self.len
+    }
+}
+
 /// `sum_t terms[t]` added in the order of [`crate::linalg::sparse::Csr::mul_vec`]: four
 /// partial sums over the first `4 floor(n / 4)` terms (term `t` into sum `t mod 4`),
 /// combined as `(s_0 + s_1) + (s_2 + s_3)`, then the remaining terms one by one; the
@@ -46,7 +108,13 @@ impl Discretization {
     /// [`crate::linalg::sparse::Csr::mul_vec`] adds them). Periodic replicas are not
     /// summed: for a basis with replicas use the gathered matrix (this returns `false`
     /// and leaves `y` alone).
-    pub(crate) fn stencil_product(&self, ncomp: usize, stencil: &[f64], x: &[f64], y: &mut [f64]) -> bool {
+    pub(crate) fn stencil_product<S: StencilValues + ?Sized>(
+        &self,
+        ncomp: usize,
+        stencil: &S,
+        x: &[f64],
+        y: &mut [f64],
+    ) -> bool {
         if !self.dofs.replicas().is_empty() {
             return false;
         }
@@ -79,8 +147,8 @@ impl Discretization {
             let base = free[f] * row_len + z * ncomp * sw;
             terms.clear();
             for d in 0..ncomp {
-                let (st, xd) = (&stencil[base + d * sw..][..sw], &x[d * m..][..m]);
-                terms.extend(cols.iter().map(|&(s, fc)| st[s] * xd[fc]));
+                let (st, xd) = (base + d * sw, &x[d * m..][..m]);
+                terms.extend(cols.iter().map(|&(s, fc)| stencil.at(st + s) * xd[fc]));
             }
             sum_as_csr(terms)
         };
@@ -107,47 +175,58 @@ impl Discretization {
 }
 
 impl Discretization {
-    /// The diagonal block `A_zz` (free-free, in the scalar pattern [`Discretization::scalar`])
+    /// The diagonal block `A_zz` (free-free, with the pattern of [`Discretization::scalar`])
     /// of the `ncomp`-component system whose stencil storage is `stencil`: the block the
-    /// gathered matrix has in rows and columns `z m .. (z + 1) m`, entry for entry. Only
-    /// for a basis without periodic replicas (`None` otherwise).
-    pub(crate) fn stencil_diagonal_block(
+    /// gathered matrix has in rows and columns `z m .. (z + 1) m`, entry for entry, built
+    /// from the stencil storage alone (the free neighbours of each free function in slot
+    /// order, the scalar pattern's columns; the pattern with its gather map is not
+    /// needed). Only for a basis without periodic replicas (`None` otherwise).
+    pub(crate) fn stencil_diagonal_block<S: StencilValues + ?Sized>(
         &self,
         ncomp: usize,
-        stencil: &[f64],
+        stencil: &S,
         z: usize,
     ) -> Option<crate::linalg::sparse::Csr> {
-        if !self.dofs.replicas().is_empty() || z >= ncomp || stencil.len() != self.stencil_len(ncomp) {
+        if !self.dofs.replicas().is_empty() || z >= ncomp || stencil.entries() != self.stencil_len(ncomp) {
             return None;
         }
-        let sw = self.stencil_width();
-        let mut block = self.scalar.csr.clone();
-        // the scalar pattern reads function `k`'s slot `s` at `k sw + s`; the block
-        // (z, z) of the system stores it at `k ncomp² sw + (z ncomp + z) sw + s`
-        for (v, &src) in block.values.iter_mut().zip(&self.scalar.src) {
-            let (k, s) = (src / sw, src % sw);
-            *v = stencil[k * ncomp * ncomp * sw + (z * ncomp + z) * sw + s];
+        let (p, q) = self.degrees();
+        let (sw, shape, m) = (self.stencil_width(), self.shape(), self.dofs.num_free());
+        let mut row_ptr = Vec::with_capacity(m + 1);
+        row_ptr.push(0);
+        let (mut col_idx, mut values) = (Vec::with_capacity(m * sw), Vec::with_capacity(m * sw));
+        // function `k`'s block (z, z) lies at `k ncomp² sw + (z ncomp + z) sw`
+        for &k in self.dofs.free() {
+            let row = k * ncomp * ncomp * sw + (z * ncomp + z) * sw;
+            for (s, kk) in super::pattern::stencil_neighbours(shape, p, q, k) {
+                let fc = self.dofs.free_index(kk);
+                if fc != FIXED {
+                    col_idx.push(fc);
+                    values.push(stencil.at(row + s));
+                }
+            }
+            row_ptr.push(col_idx.len());
         }
-        Some(block)
+        Some(crate::linalg::sparse::Csr { nrows: m, ncols: m, row_ptr, col_idx, values })
     }
 }
 
-/// The free-free system of `ncomp` components held as stencil storage, as an operator
-/// for the Krylov methods ([`MatVec`]): the EGG Jacobian of eq. (12) without its CSR
-/// copies. Only for a basis without periodic replicas
-/// ([`StencilOperator::new`] says `None` otherwise).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct StencilOperator<'a> {
+/// The free-free system of `ncomp` components held as stencil storage (`f64`, or
+/// [`Stencil32`]), as an operator for the Krylov methods ([`MatVec`]): the EGG Jacobian
+/// of eq. (12) or the elasticity system without their CSR copies. Only for a basis
+/// without periodic replicas ([`StencilOperator::new`] says `None` otherwise).
+#[derive(Debug)]
+pub(crate) struct StencilOperator<'a, S: StencilValues + ?Sized = [f64]> {
     disc: &'a Discretization,
     ncomp: usize,
-    stencil: &'a [f64],
+    stencil: &'a S,
 }
 
-impl<'a> StencilOperator<'a> {
+impl<'a, S: StencilValues + ?Sized> StencilOperator<'a, S> {
     /// The system of `ncomp` components whose stencil storage is `stencil` on `disc`;
     /// `None` when `disc` has periodic replicas or `stencil` has the wrong length.
-    pub fn new(disc: &'a Discretization, ncomp: usize, stencil: &'a [f64]) -> Option<Self> {
-        (disc.dofs.replicas().is_empty() && stencil.len() == disc.stencil_len(ncomp)).then_some(Self {
+    pub fn new(disc: &'a Discretization, ncomp: usize, stencil: &'a S) -> Option<Self> {
+        (disc.dofs.replicas().is_empty() && stencil.entries() == disc.stencil_len(ncomp)).then_some(Self {
             disc,
             ncomp,
             stencil,
@@ -155,7 +234,7 @@ impl<'a> StencilOperator<'a> {
     }
 }
 
-impl MatVec for StencilOperator<'_> {
+impl<S: StencilValues + ?Sized> MatVec for StencilOperator<'_, S> {
     fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         let done = self.disc.stencil_product(self.ncomp, self.stencil, x, y);
         debug_assert!(done, "checked in StencilOperator::new");
@@ -189,7 +268,7 @@ mod tests {
         }
         let disc = Discretization::new([kx, ky]);
         let m = disc.dofs.num_free();
-        for (ncomp, pattern) in [(2, &*disc.vector), (1, &disc.scalar)] {
+        for (ncomp, pattern) in [(2, &*disc.vector), (1, &*disc.scalar)] {
             let mut st = vec![0.0; disc.stencil_len(ncomp)];
             if ncomp == 2 {
                 let mut res = vec![0.0; 2 * disc.dofs.num_total()];
@@ -201,15 +280,61 @@ mod tests {
             let x: Vec<f64> = (0..ncomp * m).map(|_| rng.uniform() - 0.5).collect();
             let (mut y, mut z) = (vec![0.0; ncomp * m], vec![0.0; ncomp * m]);
             a.mul_vec(&x, &mut y);
-            assert!(disc.stencil_product(ncomp, &st, &x, &mut z));
+            assert!(disc.stencil_product(ncomp, &st[..], &x, &mut z));
             let scale = y.iter().fold(0.0f64, |s, v| s.max(v.abs()));
             assert!(scale > 0.0, "{ncomp} components: a zero product");
             // the same terms added in the same order: the same bits
             let differ = y.iter().zip(&z).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
             assert_eq!(differ, 0, "{ncomp} components: {differ} of {} entries differ", y.len());
-            let op = StencilOperator::new(&disc, ncomp, &st).expect("no replicas");
+            let op = StencilOperator::new(&disc, ncomp, &st[..]).expect("no replicas");
             MatVec::mul_vec(&op, &x, &mut z);
             assert_eq!(y, z);
         }
+    }
+
+    /// The single-precision storage: every entry is the `f64` entry rounded to `f32`
+    /// (an odd length included), and the EGG Jacobian's product from it differs from the
+    /// `f64` product by at most the rounding bound `2^-24 Σ_j |a_ij x_j|` per row.
+    #[test]
+    fn packed_product_is_the_product_rounded_to_single_precision() {
+        let odd: Vec<f64> = (0..7).map(|i| 1.0 / (3.0 + i as f64) - 0.1).collect();
+        let packed = Stencil32::pack(odd.clone());
+        assert_eq!(packed.entries(), 7);
+        for (i, v) in odd.iter().enumerate() {
+            assert_eq!(packed.at(i), f64::from(*v as f32), "entry {i}");
+        }
+        let kx = KnotVector::open_uniform(3, 6);
+        let ky = KnotVector::open_uniform(2, 5).with_inserted(&[0.5]);
+        let (gx, gy) = (kx.greville(), ky.greville());
+        let mut rng = Lcg::new(9);
+        let cps: Vec<[f64; 2]> = gy
+            .iter()
+            .flat_map(|&v| gx.iter().map(move |&u| (u, v)))
+            .map(|(u, v)| {
+                let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
+                [r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]
+            })
+            .collect();
+        let disc = Discretization::new([kx, ky]);
+        let m = disc.dofs.num_free();
+        let mut st = vec![0.0; disc.stencil_len(2)];
+        let mut res = vec![0.0; 2 * disc.dofs.num_total()];
+        disc.egg(&cps, Operator::Scaled, &mut res, &mut st);
+        let x: Vec<f64> = (0..2 * m).map(|_| rng.uniform() - 0.5).collect();
+        let (mut y, mut z, mut bound) = (vec![0.0; 2 * m], vec![0.0; 2 * m], vec![0.0; 2 * m]);
+        assert!(disc.stencil_product(2, &st[..], &x, &mut y));
+        let abs: Vec<f64> = st.iter().map(|v| v.abs()).collect();
+        let xabs: Vec<f64> = x.iter().map(|v| v.abs()).collect();
+        assert!(disc.stencil_product(2, &abs[..], &xabs, &mut bound));
+        let packed = Stencil32::pack(st);
+        assert!(disc.stencil_product(2, &packed, &x, &mut z));
+        let mut changed = 0;
+        for i in 0..2 * m {
+            // |fl32(a) - a| <= 2^-24 |a|, plus the rounding of the f64 sums
+            let tol = 6.0e-8 * bound[i] + 1e-15 * bound[i];
+            assert!((y[i] - z[i]).abs() <= tol, "row {i}: {} against {} (bound {tol:e})", z[i], y[i]);
+            changed += usize::from(y[i] != z[i]);
+        }
+        assert!(changed > 0, "the product did not see the rounding");
     }
 }

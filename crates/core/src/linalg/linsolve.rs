@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
 use crate::linalg::multigrid::kernels::CycleBackend;
-use crate::linalg::multigrid::{Multigrid, TensorProlongation};
+use crate::linalg::multigrid::{Multigrid, Smoother, TensorProlongation};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
 
@@ -40,10 +40,16 @@ pub enum LinearMethod {
     #[cfg_attr(feature = "clap", value(help = "GMRES, preconditioned by the metric Laplacian"))]
     Gmres,
     /// LU up to `AUTO_LU_LIMIT` unknowns, GMRES above; GMRES falls back to LU when it
-    /// does not converge within `AUTO_MAX_KRYLOV` iterations.
+    /// does not converge within `AUTO_MAX_KRYLOV` iterations. The solve pipeline resolves
+    /// it per level for EGG on a patch: [`LinearMethod::Multigrid`] from
+    /// `solve::memory::AUTO_MULTIGRID_UNKNOWNS` unknowns on, and on a level whose
+    /// estimated peak with the factorization exceeds the memory limit
+    /// (`solve::memory::auto_linear`).
     #[cfg_attr(
         feature = "clap",
-        value(help = "LU up to 64 unknowns, GMRES above, LU again when GMRES needs 500 iterations")
+        value(
+            help = "LU up to 64 unknowns, GMRES above (LU again when GMRES needs 500 iterations); multigrid from 800 000 unknowns on, or where the factorization would not fit in --max-memory"
+        )
     )]
     Auto,
     /// Restarted flexible GMRES as [`LinearMethod::Gmres`], preconditioned by
@@ -116,6 +122,9 @@ enum Preconditioner {
     BlockJacobi(Vec<Cholesky<f32>>),
     /// `P = -diag(B, ..., B)`, `B` a multigrid V-cycle for `K`.
     NegMultigrid(Box<Multigrid>),
+    /// `P = diag(B_1, ..., B_c)`, `B_z` a symmetric multigrid V-cycle for the diagonal
+    /// block `A_zz` (block Jacobi with V-cycles, for CG).
+    BlockMultigrid(Vec<Multigrid>),
 }
 
 impl Preconditioner {
@@ -147,6 +156,12 @@ impl Preconditioner {
                 b.par_chunks(m).zip(x.par_chunks_mut(m)).for_each(|(bs, xs)| {
                     mg.apply(bs, xs);
                     xs.iter_mut().for_each(|v| *v = -*v);
+                });
+            }
+            Self::BlockMultigrid(cycles) => {
+                let m = x.len() / cycles.len().max(1);
+                cycles.par_iter().zip(b.par_chunks(m).zip(x.par_chunks_mut(m))).for_each(|(mg, (bs, xs))| {
+                    mg.apply(bs, xs);
                 });
             }
         }
@@ -502,6 +517,30 @@ impl LinearSolver {
         }
         let factors = blocks.par_iter().map(|b| self.cholesky::<f32>(b, None)).collect::<Result<Vec<_>>>()?;
         self.precond = Some(Preconditioner::BlockJacobi(factors));
+        Ok(())
+    }
+
+    /// [`LinearMethod::Pcg`] for a system held as an operator, preconditioned by
+    /// symmetric multigrid V-cycles of its diagonal blocks (`diag(B_1, ..., B_c)`, block
+    /// Jacobi with each block's cycle on the hierarchy of [`LinearSolver::set_transfers`],
+    /// alternating coloured line Gauss–Seidel before and its adjoint after the coarse
+    /// correction: a symmetric cycle, as CG needs): this adds the cycle of the next
+    /// block, which it keeps as its finest operator (the blocks handed over one at a time,
+    /// so that one block's matrix exists at a time). [`LinearSolver::solve_operator`]
+    /// then runs CG with the operator.
+    ///
+    /// Errors: [`Error::LinearSolver`] for the other methods, without a hierarchy of the
+    /// block's size, or as `Multigrid::factor_owned`.
+    pub(crate) fn factor_block_multigrid(&mut self, block: Csr) -> Result<()> {
+        if self.method != LinearMethod::Pcg || self.transfers.first().is_none_or(|p| p.nrows() != block.nrows) {
+            return Err(Error::LinearSolver("no multigrid hierarchy for this block".into()));
+        }
+        let mut mg = Multigrid::new(self.transfers.clone(), Smoother::ColouredLines, MG_SWEEPS);
+        mg.factor_owned(block)?;
+        match &mut self.precond {
+            Some(Preconditioner::BlockMultigrid(cycles)) => cycles.push(mg),
+            _ => self.precond = Some(Preconditioner::BlockMultigrid(vec![mg])),
+        }
         Ok(())
     }
 

@@ -10,6 +10,7 @@ use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
 
 use crate::discrete::assembly::{Discretization, Operator};
+use crate::discrete::stencil::Stencil32;
 use crate::linalg::multigrid_kernels::CycleBackend;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
@@ -103,6 +104,11 @@ impl Method for EggMethod {
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send> {
         Box::new(EggProblem::new(disc, control_points, self.operator, self.assembler.clone()))
     }
+
+    /// [`EggProblem`] offers the knot-halving hierarchy and the stencil operator.
+    fn multigrid(&self) -> bool {
+        true
+    }
 }
 
 /// EGG on one level: the `GalerkinState` (discretization, control points, storage
@@ -153,22 +159,32 @@ impl DiscreteProblem for EggProblem {
         s.gather_jacobian(jac);
     }
 
-    /// The Jacobian left in the stencil storage (`discrete::stencil`): on a
-    /// basis without periodic replicas.
+    /// The Jacobian kept as its stencil storage rounded to single precision
+    /// (`discrete::stencil::Stencil32`, packed in place after the assembly; the last
+    /// step's is freed before this one is assembled): on a basis without periodic
+    /// replicas.
     fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
         let s = &mut self.state;
         if !s.disc.dofs.replicas().is_empty() {
             return false;
         }
+        s.packed = None;
         s.load_for_jacobian(c);
         self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
         s.restrict_residual(f);
+        s.packed = Some(Stencil32::pack(std::mem::take(&mut s.stencil)));
         true
     }
 
+    /// `y = J x` with the single-precision Jacobian of the last
+    /// [`DiscreteProblem::jacobian_operator`] (the `f64` stencil storage when there is
+    /// none).
     fn jacobian_product(&self, x: &[f64], y: &mut [f64]) {
         let s = &self.state;
-        s.disc.stencil_product(2, &s.stencil, x, y);
+        match &s.packed {
+            Some(j) => s.disc.stencil_product(2, j, x, y),
+            None => s.disc.stencil_product(2, &s.stencil[..], x, y),
+        };
     }
 
     fn mass(&mut self) -> &Csr {

@@ -8,6 +8,7 @@
 use std::sync::Arc;
 
 use crate::discrete::assembly::Discretization;
+use crate::discrete::stencil::Stencil32;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
@@ -20,8 +21,12 @@ pub(crate) struct GalerkinState {
     pub cps: Vec<Point>,
     /// The residual of every basis function (interleaved, length `2 n`).
     pub res_full: Vec<f64>,
-    /// Stencil storage of the vector system; empty until the first Jacobian.
+    /// Stencil storage of the vector system; empty until the first Jacobian (and after
+    /// it was packed into [`GalerkinState::packed`]).
     pub stencil: Vec<f64>,
+    /// The vector system's stencil storage rounded to single precision, for products
+    /// only (`discrete::stencil::Stencil32`; the Jacobian operator of EGG).
+    pub packed: Option<Stencil32>,
     mass: Option<Csr>,
     pstencil: Vec<f64>,
     prec: Csr,
@@ -35,6 +40,7 @@ impl GalerkinState {
             cps,
             res_full: vec![0.0; 2 * n],
             stencil: Vec::new(),
+            packed: None,
             mass: None,
             pstencil: Vec::new(),
             prec: Csr::default(),
@@ -113,11 +119,25 @@ impl GalerkinState {
     }
 
     /// [`GalerkinState::preconditioner`] handed over: `K` in a new matrix, its stencil
-    /// storage freed after the gather, neither kept.
+    /// storage freed after the gather, neither kept. On a basis without periodic replicas
+    /// the matrix is built from the stencil storage alone
+    /// ([`Discretization::stencil_diagonal_block`]: the same entries, without the scalar
+    /// pattern and its gather map).
     pub fn take_preconditioner(&mut self, fill: impl FnOnce(&Discretization, &[Point], &mut [f64])) -> Csr {
-        self.preconditioner(fill);
-        self.pstencil = Vec::new();
-        std::mem::take(&mut self.prec)
+        let mut st = std::mem::take(&mut self.pstencil);
+        if st.is_empty() {
+            st = vec![0.0; self.disc.stencil_len(1)];
+        }
+        fill(&self.disc, &self.cps, &mut st);
+        match self.disc.stencil_diagonal_block(1, &st[..], 0) {
+            Some(k) => k,
+            None => {
+                self.pstencil = st;
+                self.preconditioner(|_, _, _| {});
+                self.pstencil = Vec::new();
+                std::mem::take(&mut self.prec)
+            }
+        }
     }
 }
 

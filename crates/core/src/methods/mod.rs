@@ -250,6 +250,14 @@ pub trait Method: Send + Sync + std::fmt::Debug {
     }
     /// The discrete problem on `disc` starting from `control_points`.
     fn problem(&self, disc: Arc<Discretization>, control_points: Vec<Point>) -> Box<dyn DiscreteProblem + Send>;
+    /// Whether its problems are root-finding ones that offer the multigrid hierarchy
+    /// ([`DiscreteProblem::transfers`]) and the Jacobian as an operator on a patch whose
+    /// boundary functions are all fixed, so that `--linear auto` may solve them by
+    /// `--linear multigrid` (`crate::solve::memory::auto_linear`); `false` (the default)
+    /// keeps the solver asked for.
+    fn multigrid(&self) -> bool {
+        false
+    }
 }
 
 /// Largest difference between the Jacobian at `c` and central differences of the

@@ -365,7 +365,7 @@ impl Pipeline {
             Input::Boundary(_) | Input::Ring(_) => {}
         }
         let (_, _, solver) = self.plan(&self.opts)?;
-        Ok(MemoryEstimate::for_levels_with(solver.plan(), self.opts.nonlinear.linear))
+        Ok(solver.estimate())
     }
 
     /// The fit of the input and the solver of its levels (nothing large allocated yet).
@@ -390,7 +390,7 @@ impl Pipeline {
     /// its estimated peak exceeds `opts.max_memory`.
     fn attempt(&self, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<(Solution, Arc<Hierarchy>)> {
         let (boundary, hierarchy, mut solver) = self.plan(opts)?;
-        let estimate = MemoryEstimate::for_levels_with(solver.plan(), opts.nonlinear.linear);
+        let estimate = solver.estimate();
         opts.max_memory.check(&estimate, opts.levels.refine, &format!("solving '{}'", self.input.name()))?;
         let fitted =
             Stage::Fitted { input: &self.input, boundary: &boundary, hierarchy: &hierarchy, method: solver.method() };
@@ -584,7 +584,18 @@ mod tests {
         opts.levels.refine = 2;
         let estimate = Pipeline::new(puzzle4(), opts.clone()).estimate().unwrap();
         assert!(estimate.bytes > crate::solve::memory::BASE && estimate.unknowns > 0);
-        let limit = estimate.bytes - 1;
+        // below the factorization's estimate but above multigrid's, `--linear auto` solves
+        // the finest level by multigrid instead of refusing (`solve::memory::auto_linear`)
+        let mut multigrid = opts.clone();
+        multigrid.nonlinear.linear = crate::linalg::linsolve::LinearMethod::Multigrid;
+        let multigrid = Pipeline::new(puzzle4(), multigrid).estimate().unwrap();
+        assert!(multigrid.bytes < estimate.bytes - 1, "{multigrid:?} against {estimate:?}");
+        let between =
+            SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(estimate.bytes - 1), ..opts.clone() };
+        let solved = Pipeline::new(puzzle4(), between).solve().unwrap().into_map().unwrap();
+        assert_eq!(solved.report.outcome.verdict, Verdict::Certified);
+        // below both: refused, with the factorization's estimate as the need
+        let limit = multigrid.bytes - 1;
         let opts = SolveOptions { max_memory: crate::solve::memory::MemoryLimit::Bytes(limit), ..opts };
         let mut stages = 0;
         let out = Pipeline::new(puzzle4(), opts.clone()).run(&mut |_| {

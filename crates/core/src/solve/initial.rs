@@ -8,7 +8,7 @@ use std::sync::Arc;
 use super::fixed_basis::FixedBasisSolve;
 use super::newton::NonlinearOptions;
 use crate::discrete::assembly::Discretization;
-use crate::discrete::stencil::StencilOperator;
+use crate::discrete::stencil::{Stencil32, StencilOperator};
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::{LinearMethod, LinearSolver};
 use crate::methods::egg::{CpuAssembler, EggAssembler};
@@ -102,15 +102,18 @@ pub const LAME: (f64, f64) = (0.3 / (1.3 * 0.4), 1.0 / 2.6);
 /// every control point (the fixed ones carry `target - base`). It is linear in the
 /// boundary displacement, so `base + alpha u` moves the boundary by `alpha`.
 pub(crate) fn elasticity_displacement(disc: &Discretization, base: &[Point], target: &[Point]) -> Result<Vec<Point>> {
-    elasticity_displacement_with(&CpuAssembler, disc, base, target)
+    elasticity_displacement_with(&CpuAssembler, disc, base, target, LinearMethod::Auto)
 }
 
-/// [`elasticity_displacement`] with the elasticity operator assembled by `assembler`.
+/// [`elasticity_displacement`] with the elasticity operator assembled by `assembler`; under
+/// `linear` = [`LinearMethod::Multigrid`] (the level's Newton solver) above
+/// [`ITERATIVE_ELASTICITY`] unknowns the system is solved by [`multigrid_elasticity`].
 pub(crate) fn elasticity_displacement_with(
     assembler: &dyn EggAssembler,
     disc: &Discretization,
     base: &[Point],
     target: &[Point],
+    linear: LinearMethod,
 ) -> Result<Vec<Point>> {
     let mut diff = vec![[0.0; 2]; base.len()];
     let mut moved = false;
@@ -123,9 +126,21 @@ pub(crate) fn elasticity_displacement_with(
     if disc.dofs.num_free() == 0 || !moved {
         return Ok(diff);
     }
-    let mut st = vec![0.0; disc.stencil_len(2)];
-    assembler.elasticity(disc, base, LAME.0, LAME.1, &mut st);
+    let assemble = || {
+        let mut st = vec![0.0; disc.stencil_len(2)];
+        assembler.elasticity(disc, base, LAME.0, LAME.1, &mut st);
+        st
+    };
+    let mut st = assemble();
     let rhs: Vec<f64> = disc.apply_to_fixed(&st, &diff).into_iter().map(|v| -v).collect();
+    if linear == LinearMethod::Multigrid && rhs.len() > ITERATIVE_ELASTICITY {
+        if let Some(u) = multigrid_elasticity(disc, st, &rhs) {
+            disc.dofs.scatter(&u, &mut diff);
+            return Ok(diff);
+        }
+        // CG did not converge (or there is no hierarchy): the system again, solved as below
+        st = assemble();
+    }
     let u = match stencil_elasticity(disc, &st, &rhs) {
         Some(u) => u,
         None => matrix_elasticity(disc, &st, &rhs)?,
@@ -150,6 +165,32 @@ fn stencil_elasticity(disc: &Discretization, st: &[f64], rhs: &[f64]) -> Option<
     lin.set_ordering(&disc.ordering);
     lin.krylov_tol = ELASTICITY_TOL;
     lin.factor_blocks(&blocks).ok()?;
+    lin.solve_operator(&op, rhs).ok()
+}
+
+/// The elasticity system of stencil storage `st` solved by CG under `--linear multigrid`
+/// (all above [`ITERATIVE_ELASTICITY`] unknowns): the stencil storage rounded to single
+/// precision in place ([`Stencil32`]: half its memory) is the operator, and the
+/// preconditioner is block Jacobi with a symmetric multigrid V-cycle for each diagonal
+/// block (`LinearSolver::factor_block_multigrid`, the blocks gathered one at a time)
+/// instead of their Cholesky factors, whose fill grows as `m log m`. The result solves
+/// the single-precision system to [`ELASTICITY_TOL`]: an initial guess, whose boundary
+/// (the fixed control points) is exact. `None` on a basis without a multigrid hierarchy or
+/// when CG does not converge.
+fn multigrid_elasticity(disc: &Discretization, st: Vec<f64>, rhs: &[f64]) -> Option<Vec<f64>> {
+    let transfers = crate::discrete::transfers::free_prolongation_factors(disc).ok()?;
+    if transfers.is_empty() || !disc.dofs.replicas().is_empty() {
+        return None;
+    }
+    let packed = Stencil32::pack(st);
+    let mut lin = LinearSolver::new(LinearMethod::Pcg);
+    lin.set_transfers(transfers);
+    lin.krylov_tol = ELASTICITY_TOL;
+    for z in 0..2 {
+        lin.factor_block_multigrid(disc.stencil_diagonal_block(2, &packed, z)?).ok()?;
+    }
+    crate::solve::memory::trace(|| format!("elasticity ({} unknowns): multigrid set up", rhs.len()));
+    let op = StencilOperator::new(disc, 2, &packed)?;
     lin.solve_operator(&op, rhs).ok()
 }
 
@@ -266,7 +307,7 @@ pub(crate) fn continuation_with(
     let (mut done, mut step) = (0.0f64, 1.0f64);
     // displacement from `base` to the full target; linear in the boundary motion, so
     // a fraction `f` of the remaining motion is `f * u`
-    let mut u = elasticity_displacement_with(assembler, disc, &base, target)?;
+    let mut u = elasticity_displacement_with(assembler, disc, &base, target, nl.linear)?;
     if !positive(&base) {
         // the prolonged map itself is not positive on this level's (denser) sample:
         // damping the boundary motion cannot make the guess positive, Newton starts
@@ -298,7 +339,7 @@ pub(crate) fn continuation_with(
             base = sol;
             done = a;
             step = (2.0 * step).min(1.0 - done).max(MIN_CONTINUATION_STEP);
-            u = elasticity_displacement_with(assembler, disc, &base, target)?;
+            u = elasticity_displacement_with(assembler, disc, &base, target, nl.linear)?;
         } else if exhausted {
             // out of steps: the full boundary from the last positive map (the damped
             // guess would carry a wrong boundary into the level's solve)

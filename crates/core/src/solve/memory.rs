@@ -31,7 +31,6 @@
 //! allocates ([`reserve`]), so an address-space limit (`ulimit -v`) that the limit did not
 //! see is a typed error too, not the allocator's abort.
 
-use crate::boundary::hierarchy::Level;
 pub use crate::error::human;
 use crate::error::{Error, Result};
 use crate::linalg::linsolve::LinearMethod;
@@ -50,26 +49,70 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 
 /// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
 /// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
-/// stencil storage (`discrete::stencil::StencilOperator`, 8 B per nonzero) and the
-/// elasticity prolongation too, so the vector Jacobian is never gathered into a matrix;
-/// per nonzero `z` (`z / 4` of the scalar pattern) remain the scalar pattern with its
-/// gather map and the metric Laplacian `K` in CSR, held once (by the V-cycle), with its
-/// line factors and coarse levels; the transfers are 1D factors. With
+/// stencil storage, rounded to single precision after each assembly
+/// (`discrete::stencil::Stencil32`), and neither the vector nor the scalar pattern is
+/// built (`K` and the elasticity blocks come from their stencil storage, the transfers
+/// are 1D factors). The peak is the assembly of a Newton step after the first (the
+/// `f64` stencil storage the assembler writes, 8 B per nonzero, beside the frozen
+/// V-cycle: `f32` stencils and line factors of every level) or the set-up of the
+/// V-cycle (the `f32` Jacobian, `K` in CSR and its stencil storage). With
 /// [`MULTIGRID_BYTES_PER_UNKNOWN`] fitted to the peaks (`VmHWM`, dev profile, one
-/// geometry per process) of wavy_lid (degrees 3 x 2), male_rotor (3) and puzzle4 (2) at
-/// `--refine 4` and `5` (70 k to 541 k unknowns) under the split line smoother: measured
-/// over estimated 0.91-1.07, quarter_annulus at 918 k 0.90, wavy_lid at 4 k to 70 k
-/// 0.99-1.02 (800 and 14 before overestimated puzzle4's degree-2 peaks
-/// by up to 1.3x; BENCHMARKS.md, "Half the sweeps").
-pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 19;
+/// geometry per process; `WINSLOW_MEMORY_TRACE` shows the stage) of quarter_annulus at
+/// 918 k and male_rotor at 2.13 M unknowns (degrees 3 x 2 and 3: 70 and 98 nonzeros per
+/// unknown): measured over estimated 0.98 and 1.05 there, 0.99-1.26 on quarter_annulus,
+/// wavy_lid, puzzle4 (degree 2: 50 nonzeros per unknown) and male_rotor at `--refine 4`
+/// and `5` (BENCHMARKS.md, "Under 1 KiB per unknown").
+pub(crate) const MULTIGRID_BYTES_PER_NONZERO: u64 = 11;
 
 /// Peak bytes per unknown of the finest level with `--linear multigrid` (see
-/// [`MULTIGRID_BYTES_PER_NONZERO`]): the flexible GMRES basis (two vectors per
-/// iteration, 16 B per unknown and iteration: 200-370 B at the 12-23 iterations these
-/// solves take at most), the vectors of a Newton step, and the single-precision
-/// Cholesky factors of the elasticity prolongation's two diagonal blocks; the fit puts
-/// the part that grows with the stencil in the per-nonzero weight.
-pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 300;
+/// [`MULTIGRID_BYTES_PER_NONZERO`]): the vectors of a Newton step and of the flexible
+/// GMRES basis (two per iteration), and the freed vectors the allocator keeps.
+pub(crate) const MULTIGRID_BYTES_PER_UNKNOWN: u64 = 150;
+
+/// Unknowns of a level from which `--linear auto` ([`LinearMethod::Auto`]) solves its
+/// Newton systems as `--linear multigrid` does ([`auto_linear`]); below it, GMRES
+/// preconditioned by the single-precision Cholesky factor of `K` (LU up to 64 unknowns).
+/// Chosen on the CPU seconds and peaks of both at refine 4, 5 and 6 of four geometries
+/// (BENCHMARKS.md, "Under 1 KiB per unknown, and `--linear auto` choosing multigrid": no
+/// size wins on time on all four; from about 10^6 unknowns multigrid is within 0.94-1.26x
+/// of the CPU time at 4-5x less memory).
+pub(crate) const AUTO_MULTIGRID_UNKNOWNS: usize = 800_000;
+
+/// The linear solver of a level with knot vectors `knots` when `requested` is asked
+/// for: `requested` itself unless it is [`LinearMethod::Auto`]; for `Auto`,
+/// [`LinearMethod::Multigrid`] on a non-periodic tensor basis of at least
+/// [`AUTO_MULTIGRID_UNKNOWNS`] unknowns, or of fewer whose estimated peak with the direct
+/// preconditioner ([`MemoryEstimate::for_knots_with`]) exceeds `limit` (bytes; `None`:
+/// no limit) while the multigrid one does not; `Auto` otherwise.
+pub(crate) fn auto_linear(knots: &[KnotVector; 2], requested: LinearMethod, limit: Option<u64>) -> LinearMethod {
+    if requested != LinearMethod::Auto || knots.iter().any(KnotVector::is_periodic) {
+        return requested;
+    }
+    let direct = MemoryEstimate::with_weights(knots, BYTES_PER_UNKNOWN, BYTES_PER_NONZERO);
+    if direct.unknowns >= AUTO_MULTIGRID_UNKNOWNS {
+        return LinearMethod::Multigrid;
+    }
+    let multigrid = MemoryEstimate::with_weights(knots, MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO);
+    match limit {
+        Some(limit) if direct.bytes > limit && multigrid.bytes <= limit => LinearMethod::Multigrid,
+        _ => LinearMethod::Auto,
+    }
+}
+
+/// With the environment variable `WINSLOW_MEMORY_TRACE` set, one line on standard error
+/// per call: `stage`, the resident memory now (`VmRSS`) and the peak so far (`VmHWM`), in
+/// MiB (Linux; nothing elsewhere). The stages of a solve (each level's set-up, elasticity
+/// prolongation, Newton assembly, preconditioner set-up, Krylov solve, certificate,
+/// report) then show where its peak is reached (BENCHMARKS.md, "Under 1 KiB per unknown").
+pub fn trace(stage: impl FnOnce() -> String) {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    if !*ON.get_or_init(|| std::env::var_os("WINSLOW_MEMORY_TRACE").is_some()) {
+        return;
+    }
+    let Ok(status) = std::fs::read_to_string("/proc/self/status") else { return };
+    let mib = |key: &str| field_kib(&status, key).map_or(0.0, |kb| kb as f64 / 1024.0);
+    eprintln!("memory: {:<48} rss {:>9.1} MiB  peak {:>9.1} MiB", stage(), mib("VmRSS:"), mib("VmHWM:"));
+}
 
 /// How much more than the fixed stage's sum a layout's free-interface stage takes. Measured
 /// (VmHWM, dev profile, TUDflame's 5 patches, `--refine 2, 3, 4`): fixed 41, 121, 389 MiB
@@ -120,13 +163,19 @@ impl MemoryEstimate {
     /// [`MULTIGRID_BYTES_PER_UNKNOWN`] for [`LinearMethod::Multigrid`],
     /// [`BYTES_PER_NONZERO`] and [`BYTES_PER_UNKNOWN`] otherwise.
     pub(crate) fn for_knots_with(knots: &[KnotVector; 2], linear: LinearMethod) -> Self {
+        match linear {
+            LinearMethod::Multigrid => {
+                Self::with_weights(knots, MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO)
+            }
+            _ => Self::with_weights(knots, BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
+        }
+    }
+
+    /// `BASE + per_unknown · unknowns + per_nonzero · nonzeros` on the basis `knots`.
+    fn with_weights(knots: &[KnotVector; 2], per_unknown: u64, per_nonzero: u64) -> Self {
         let functions = knots[0].dim() * knots[1].dim();
         let nonzeros = 4 * interacting_pairs(&knots[0]) * interacting_pairs(&knots[1]);
         let unknowns = 2 * functions;
-        let (per_unknown, per_nonzero) = match linear {
-            LinearMethod::Multigrid => (MULTIGRID_BYTES_PER_UNKNOWN, MULTIGRID_BYTES_PER_NONZERO),
-            _ => (BYTES_PER_UNKNOWN, BYTES_PER_NONZERO),
-        };
         let bytes = BASE
             .saturating_add(per_unknown.saturating_mul(unknowns as u64))
             .saturating_add(per_nonzero.saturating_mul(nonzeros as u64));
@@ -150,17 +199,6 @@ impl MemoryEstimate {
         let factor = if free { FREE_INTERFACE_FACTOR } else { 1 };
         sum.bytes = BASE.saturating_add(sum.bytes.saturating_mul(factor));
         sum
-    }
-
-    /// [`MemoryEstimate::for_levels`] for Newton systems solved by `linear`
-    /// ([`MemoryEstimate::for_knots_with`]).
-    pub(crate) fn for_levels_with(levels: &[Level], linear: LinearMethod) -> Self {
-        levels.iter().map(|l| Self::for_knots_with(&l.knots, linear)).max_by_key(|e| e.bytes).unwrap_or(Self {
-            functions: 0,
-            unknowns: 0,
-            nonzeros: 0,
-            bytes: BASE,
-        })
     }
 }
 
@@ -379,6 +417,29 @@ mod tests {
         let Error::Memory { needed, available, ref advice, .. } = e else { panic!("{e}") };
         assert_eq!((needed, available), (b.bytes, b.bytes - 1));
         assert!(advice.contains("--refine 1"), "{advice}");
+    }
+
+    /// `--linear auto` on a level: unchanged below [`AUTO_MULTIGRID_UNKNOWNS`] unless the
+    /// factorization's estimate exceeds the limit while multigrid's fits; multigrid from
+    /// that size on; an explicit solver and a periodic basis are never changed.
+    #[test]
+    fn auto_switches_to_multigrid_by_size_and_by_memory() {
+        let k = |e| [KnotVector::open_uniform(3, e), KnotVector::open_uniform(3, e)];
+        let (small, large) = (k(200), k(640));
+        let (a, m) = (LinearMethod::Auto, LinearMethod::Multigrid);
+        let unknowns = |k: &[KnotVector; 2]| MemoryEstimate::for_knots(k).unknowns;
+        assert!(unknowns(&small) < AUTO_MULTIGRID_UNKNOWNS && unknowns(&large) >= AUTO_MULTIGRID_UNKNOWNS);
+        assert_eq!(auto_linear(&small, a, None), a);
+        assert_eq!(auto_linear(&large, a, None), m);
+        assert_eq!(auto_linear(&large, LinearMethod::Gmres, None), LinearMethod::Gmres);
+        let direct = MemoryEstimate::for_knots_with(&small, a).bytes;
+        let multigrid = MemoryEstimate::for_knots_with(&small, m).bytes;
+        assert!(multigrid < direct / 3, "{multigrid} against {direct}");
+        assert_eq!(auto_linear(&small, a, Some(direct)), a);
+        assert_eq!(auto_linear(&small, a, Some(direct - 1)), m);
+        assert_eq!(auto_linear(&small, a, Some(multigrid - 1)), a);
+        let ring = [KnotVector::open_uniform(3, 640), KnotVector::periodic_uniform(3, 640)];
+        assert_eq!(auto_linear(&ring, a, Some(1)), a);
     }
 
     #[test]

@@ -386,6 +386,8 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         }
         self.f = f;
         self.timings.assembly += t.elapsed();
+        let n = self.c.len();
+        crate::solve::memory::trace(|| format!("newton ({n} unknowns): Jacobian assembled"));
         if let Some(dt) = shift {
             // F_i = int w_i L(x) and L is elliptic (like the Laplacian), so dF/dc is
             // negative definite near a solution; the dissipative pseudo-transient
@@ -399,7 +401,6 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         let t = Instant::now();
         self.lin.krylov_tol = if shift.is_some() { KRYLOV_TOL } else { self.forcing() };
         // the pseudo-time shift changes with every step: no frozen preconditioner then
-        let n = self.c.len();
         let refresh = shift.is_some() || self.lin.wants_preconditioner(n);
         if self.operator {
             // the V-cycle keeps the problem's `K` (no copy on either side), the old one
@@ -411,9 +412,11 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
             self.lin.factor_stored(k)?;
         }
         self.timings.factor += t.elapsed();
+        crate::solve::memory::trace(|| format!("newton ({n} unknowns): preconditioner set up"));
         let rhs: Vec<f64> = self.f.iter().map(|v| -v).collect();
         let dx = self.newton_solve(&rhs);
         self.timings.linear += t.elapsed();
+        crate::solve::memory::trace(|| format!("newton ({n} unknowns): linear solve"));
         dx
     }
 

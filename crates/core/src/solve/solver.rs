@@ -15,7 +15,7 @@ use super::improve::{improve, Improvement};
 use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
 use super::levels::{graded_at_roundings, prepare_levels, select_levels, DIRECT_REFINED_MAX_FUNCTIONS};
-use super::memory::MemoryEstimate;
+use super::memory::{auto_linear, trace, MemoryEstimate};
 use super::newton::{Iterate, NonlinearOptions};
 use super::options::{Refinement, SolveOptions};
 use super::repair::{frozen_discretization, plan_repair, RepairRound};
@@ -26,7 +26,9 @@ use crate::boundary::normalise::Similarity;
 use crate::boundary::BasisChoice;
 use crate::boundary::Boundary;
 use crate::discrete::assembly::Discretization;
+use crate::discrete::topology::Topology;
 use crate::error::{Error, Result};
+use crate::linalg::linsolve::LinearMethod;
 use crate::methods::egg::{EggAssembler, EggMethod};
 use crate::methods::{Method, Start};
 use crate::spline::surface::{Side, Surface};
@@ -103,6 +105,10 @@ pub struct EggSolver {
     boundary: Boundary,
     /// The hierarchy the plan was made from: its similarity, kinks and basis report.
     hierarchy: Arc<Hierarchy>,
+    /// The memory limit (`opts.max_memory` resolved when the solver was made), bytes:
+    /// `--linear auto` solves a level whose direct preconditioner would not fit with
+    /// multigrid ([`auto_linear`]).
+    memory_limit: Option<u64>,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -164,6 +170,7 @@ impl EggSolver {
         };
         let chosen = select_levels(&sizes, opts.levels.growth, opts.levels.max_levels, direct_max);
         let plan = chosen.into_iter().map(|k| levels[k].clone()).collect();
+        let memory_limit = opts.max_memory.resolve().map(|(bytes, _)| bytes);
         Ok(Self {
             plan,
             opts,
@@ -184,6 +191,7 @@ impl EggSolver {
             c0,
             boundary: boundary.clone(),
             hierarchy,
+            memory_limit,
         })
     }
 
@@ -197,12 +205,40 @@ impl EggSolver {
         &*self.method
     }
 
-    /// Nonlinear options of a level with `m` free functions: the residual made
-    /// dimensionless (`F_i = ∫ w_i L` with `∫ w_i ~ 1/m`, so `||F|| sqrt(m)` divided by
-    /// [`Method::residual_size`] is the relative residual) and the step tolerance in
-    /// length units.
-    fn level_options(&self, m: usize) -> NonlinearOptions {
-        scaled_options(self.opts.nonlinear, &*self.method, self.diameter, m)
+    /// Nonlinear options of a level with `m` free functions whose Newton systems are
+    /// solved by `linear`: the residual made dimensionless (`F_i = ∫ w_i L` with `∫ w_i ~
+    /// 1/m`, so `||F|| sqrt(m)` divided by [`Method::residual_size`] is the relative
+    /// residual) and the step tolerance in length units.
+    fn level_options(&self, m: usize, linear: LinearMethod) -> NonlinearOptions {
+        let mut nl = scaled_options(self.opts.nonlinear, &*self.method, self.diameter, m);
+        nl.linear = linear;
+        nl
+    }
+
+    /// The linear solver of a level with basis `knots` and DOF map `interior` (every
+    /// boundary function fixed, the multigrid hierarchy's condition): `--linear auto`
+    /// resolved by [`auto_linear`] for EGG (multigrid on large levels and on those whose
+    /// direct preconditioner would not fit in the memory limit), the option as given
+    /// otherwise.
+    fn linear_for(&self, knots: &[crate::spline::knots::KnotVector; 2], interior: bool) -> LinearMethod {
+        let requested = self.opts.nonlinear.linear;
+        if !interior || !self.method.multigrid() {
+            return requested;
+        }
+        auto_linear(knots, requested, self.memory_limit)
+    }
+
+    /// The estimated peak of the solve ([`MemoryEstimate`]): the largest of its levels',
+    /// each with the linear solver it will use ([`EggSolver::linear_for`]).
+    pub(crate) fn estimate(&self) -> MemoryEstimate {
+        let plain = self.opts.topology == Topology::dirichlet();
+        let level = |l: &Level| MemoryEstimate::for_knots_with(&l.knots, self.linear_for(&l.knots, plain));
+        self.plan.iter().map(level).max_by_key(|e| e.bytes).unwrap_or(MemoryEstimate {
+            functions: 0,
+            unknowns: 0,
+            nonzeros: 0,
+            bytes: super::memory::BASE,
+        })
     }
 
     /// A method that needs a bijective start gets one the certificate proves (or one
@@ -227,12 +263,15 @@ impl EggSolver {
     fn start_level(&mut self, k: usize) -> Result<Event> {
         let t0 = Instant::now();
         let level = &self.plan[k];
+        let interior = self.opts.topology == Topology::dirichlet() && !self.free_boxes.iter().any(|(i, _)| *i == k);
+        let linear = self.linear_for(&level.knots, interior);
         // the level's estimated peak reserved and released: a limit the pipeline's check
         // did not see (an address-space limit) is a typed error here, not an abort later
         crate::solve::memory::reserve(
-            MemoryEstimate::for_knots(&level.knots).bytes,
+            MemoryEstimate::for_knots_with(&level.knots, linear).bytes,
             &format!("level {k} ({} x {} functions)", level.knots[0].dim(), level.knots[1].dim()),
         )?;
+        trace(|| format!("level {k}: start ({linear:?})"));
         let topology = &self.opts.topology;
         let weights = level.weights()?;
         let disc = Arc::new(
@@ -249,7 +288,7 @@ impl EggSolver {
                 let fine = prev.refined(&level.knots)?.control_points;
                 let mut target = fine.clone();
                 set_boundary(disc.shape(), &level.sides, &mut target)?;
-                let nl = self.level_options(disc.dofs.num_free());
+                let nl = self.level_options(disc.dofs.num_free(), linear);
                 let (method, assembler) = (&*self.method, &*self.assembler);
                 let positive = |c: &[crate::spline::curve::Point]| det_j_min(assembler, &disc, c) > 0.0;
                 let out =
@@ -262,7 +301,8 @@ impl EggSolver {
         let initial_det_j_min = det_j_min(&*self.assembler, &disc, &cps);
         self.check_start(level, &weights, &cps)?;
         let m = disc.dofs.num_free();
-        let solver = FixedBasisSolve::new(&*self.method, disc, cps, self.level_options(m));
+        trace(|| format!("level {k}: initial guess"));
+        let solver = FixedBasisSolve::new(&*self.method, disc, cps, self.level_options(m, linear));
         let report = LevelReport {
             level: k,
             shape,
@@ -308,6 +348,7 @@ impl EggSolver {
         let knots = self.plan[a.level].knots.clone();
         self.previous = Some(Surface { knots, control_points: solved.control_points, weights: a.weights });
         self.reports.push(a.report.clone());
+        trace(|| format!("level {}: solved", a.level));
         Ok(Event::LevelFinished(a.report))
     }
 
@@ -423,7 +464,9 @@ impl EggSolver {
             improvement,
             elapsed,
         };
-        Ok(Solution::new(&boundary.name, map, self.reports, ctx))
+        let solution = Solution::new(&boundary.name, map, self.reports, ctx);
+        trace(|| "report".into());
+        Ok(solution)
     }
 
     /// The hierarchy the solver was made from.
@@ -440,6 +483,7 @@ impl EggSolver {
             // in the input's coordinates: the certificate of the map as it is written,
             // reused by `finish` when no later stage changes the map
             self.certificate = Some(certify(&self.sim.physical_surface(map)?, &self.opts.certify)?);
+            trace(|| "certificate".into());
         }
         let cert = self.certificate.as_ref().expect("set above");
         // THB refinement repairs the unrepaired map afterwards (`solve::hierarchical`)

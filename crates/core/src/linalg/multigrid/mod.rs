@@ -63,8 +63,9 @@ pub(crate) enum Smoother {
     /// [`Smoother::Lines`] with the lines of each direction in colours (line `l` of colour
     /// `l mod (w + 1)`, `w` the farthest coupling across the lines: 4 colours at degree
     /// 3): the lines of one colour do not couple, their corrections are computed in
-    /// parallel ([`lines::Lines::sweep_coloured`]).
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// parallel ([`lines::Lines::sweep_coloured`]). Its cycle is symmetric (the
+    /// post-smoother is the pre-smoother's adjoint): the CG preconditioner of the
+    /// elasticity prolongation under `--linear multigrid`.
     ColouredLines,
     /// [`Smoother::ColouredLines`] with one direction on each side of the coarse
     /// correction: the lines of direction 0 (forward) before it, those of direction 1
@@ -255,46 +256,34 @@ impl Multigrid {
         }
         // the previous operators and smoothers go before the new ones are built
         self.release();
+        // level by level: the coarse operator, then the level's smoother and stencil
+        // form, after which its CSR matrix goes (only one fine matrix exists at a time)
+        let lines_smoother =
+            matches!(self.smoother, Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines);
         let mut operators = Vec::with_capacity(self.levels());
-        operators.push(a);
-        for (l, p) in self.prolongations.iter().enumerate() {
-            let coarse = galerkin(&operators[l], p);
-            operators.push(coarse);
-        }
-        let smoothed = &operators[..operators.len() - 1];
-        self.diagonals = match self.smoother {
-            Smoother::SymmetricGaussSeidel => smoothed.iter().map(diagonal_positions).collect::<Result<_>>()?,
-            _ => Vec::new(),
-        };
-        self.ilu = match self.smoother {
-            Smoother::Ilu0 => smoothed.iter().map(Ilu0::new).collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel
-            | Smoother::Lines
-            | Smoother::ColouredLines
-            | Smoother::SplitColouredLines => Vec::new(),
-        };
-        self.lines = match self.smoother {
-            Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => smoothed
-                .iter()
-                .map(|a| {
-                    let nx = grid_width(a);
-                    Ok([Lines::new(a, nx, 0)?, Lines::new(a, nx, 1)?])
-                })
-                .collect::<Result<_>>()?,
-            Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
-        };
-        self.coarse.factor(operators.last().expect("at least one level"), 1.0)?;
-        self.grids = match self.smoother {
-            Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => {
-                operators[..operators.len() - 1].iter().map(|a| GridOperator::from_csr(a, grid_width(a))).collect()
+        let (mut diagonals, mut ilu, mut lines, mut grids) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut current = a;
+        for p in &self.prolongations {
+            let coarse = galerkin(&current, p);
+            match self.smoother {
+                Smoother::SymmetricGaussSeidel => diagonals.push(diagonal_positions(&current)?),
+                Smoother::Ilu0 => ilu.push(Ilu0::new(&current)?),
+                Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => {
+                    let nx = grid_width(&current);
+                    lines.push([Lines::new(&current, nx, 0)?, Lines::new(&current, nx, 1)?]);
+                    let grid = GridOperator::from_csr(&current, nx);
+                    if grid.is_some() {
+                        current = Csr::default();
+                    }
+                    grids.push(grid);
+                }
             }
-            Smoother::SymmetricGaussSeidel | Smoother::Ilu0 => Vec::new(),
-        };
-        for (a, g) in operators.iter_mut().zip(&self.grids) {
-            if g.is_some() {
-                *a = Csr::default();
-            }
+            operators.push(std::mem::replace(&mut current, coarse));
         }
+        self.coarse.factor(&current, 1.0)?;
+        operators.push(current);
+        debug_assert!(!lines_smoother || grids.len() + 1 == operators.len());
+        (self.diagonals, self.ilu, self.lines, self.grids) = (diagonals, ilu, lines, grids);
         self.operators = operators;
         self.upload();
         Ok(())

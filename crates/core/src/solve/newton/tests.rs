@@ -278,10 +278,13 @@ impl DiscreteProblem for MatrixOnly {
 }
 
 /// With the multigrid preconditioner the Newton solve of EGG (eq. 12) multiplies with the
-/// stencil storage instead of the gathered matrix: on a curved, perturbed map (degrees
-/// 3 and 2, a double knot, two levels below the basis) every iterate, GMRES count and the
-/// solution are those of the solve over the matrix, bit for bit (the stencil product adds
-/// the same terms in the same order), and the vector pattern is never built.
+/// Jacobian's stencil storage rounded to single precision (`discrete::stencil::Stencil32`)
+/// instead of the gathered matrix: on a curved, perturbed map (degrees 3 and 2, a double
+/// knot, two levels below the basis) it takes as many Newton steps, its GMRES
+/// iterations differ by at most one per step, and the solution is the matrix solve's to
+/// the Newton tolerance (`1e-7` on a map of diameter 6; the residual `F` is exact in
+/// both, only the Newton directions carry the rounding); neither the vector nor the
+/// scalar pattern is built (`K` comes from its stencil storage).
 #[test]
 fn stencil_operator_newton_equals_matrix_newton() {
     use crate::discrete::assembly::{Discretization, Operator};
@@ -313,11 +316,21 @@ fn stencil_operator_newton_equals_matrix_newton() {
     let mut b = NonlinearSolver::new(mat, c0, opts);
     let ia: Vec<Iterate> = a.by_ref().collect::<Result<_>>().unwrap();
     let ib: Vec<Iterate> = b.by_ref().collect::<Result<_>>().unwrap();
-    assert_eq!(*a.status(), Status::Converged);
+    assert_eq!((a.status(), b.status()), (&Status::Converged, &Status::Converged));
     assert!(ia.len() >= 3 && a.krylov_iterations() > 0, "{} iterates", ia.len());
-    assert_eq!(ia, ib);
-    assert_eq!((a.krylov_iterations(), a.krylov_max()), (b.krylov_iterations(), b.krylov_max()));
-    let same = a.solution().iter().zip(b.solution()).all(|(x, y)| x.to_bits() == y.to_bits());
-    assert!(same, "the solutions differ");
+    assert_eq!(ia.len(), ib.len());
+    assert_eq!(ia[0], ib[0]);
+    let steps = ia.len() - 1;
+    assert!(
+        a.krylov_iterations().abs_diff(b.krylov_iterations()) <= steps,
+        "{} against {}",
+        a.krylov_iterations(),
+        b.krylov_iterations()
+    );
+    let gap = a.solution().iter().zip(b.solution()).fold(0.0f64, |g, (x, y)| g.max((x - y).abs()));
+    // both stop at the scaled residual 1e-9 after different last steps (measured 8.9e-9
+    // on a map of diameter 6)
+    assert!(gap <= 1e-7, "the solutions differ by {gap:e}");
     assert!(!d_op.vector.is_built() && d_mat.vector.is_built());
+    assert!(!d_op.scalar.is_built());
 }
