@@ -239,6 +239,37 @@ pub struct SolveStage {
     /// rounds ended with; absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thb_fallback: Option<ThbFallback>,
+    /// When THB refinement was asked for and this map needed no repair: the contour
+    /// fit's THB start that was tried and not kept (not certified, or not fewer
+    /// functions; `crate::pipeline`, docs/thb.md); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thb_contour: Option<ThbStart>,
+}
+
+/// The start of the THB rounds (`crate::pipeline::ThbReport::start`), or the contour start
+/// tried on a map that needed no repair (`SolveStage::thb_contour`).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct ThbStart {
+    /// `"contour"`: the THB basis of the contour fit, the boundary the fitted sides, EGG
+    /// solved on it from the tensor map's blossoms; `"tensor"`: the tensor solve's map on
+    /// its own basis (a one-level THB map).
+    pub basis: &'static str,
+    /// Why the contour basis was not used (`None` when it was).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// THB functions of the start.
+    pub functions: usize,
+    /// Levels of its hierarchy.
+    pub levels: usize,
+    /// Newton iterations of the EGG solve on the contour basis (0 for the tensor start).
+    pub iterations: usize,
+    /// Whether that solve converged (true for the tensor start).
+    pub converged: bool,
+    /// The verdict of the start map's certificate (the contour start after its solve).
+    pub verdict: Verdict,
+    /// Seconds of the contour basis, the blossoms and the solve (0 for the tensor start).
+    pub seconds: f64,
 }
 
 /// What a THB defect correction that did not end certified (or degenerate at forced
@@ -528,6 +559,7 @@ impl Solution {
                 seconds: ctx.elapsed.as_secs_f64(),
                 warm_start: None,
                 thb_fallback: None,
+                thb_contour: None,
             },
             outcome: Outcome { certificate, verdict, message },
             det_j: DetJReport {
