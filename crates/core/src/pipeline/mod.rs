@@ -220,12 +220,6 @@ impl Pipeline {
                     let t = thb::repair(sol, Some(&hierarchy), &opts, observer)?;
                     return thb::or_tensor_repair(t, tensor, observer);
                 }
-                if thb::coarsens(&sol, &opts) {
-                    match thb::coarser(&sol, &hierarchy, &opts, observer)? {
-                        Ok(t) => return Ok(Solved::Thb(Box::new(t))),
-                        Err(note) => sol.report.solve.thb_contour = Some(note),
-                    }
-                }
                 Ok(Solved::Map(Box::new(sol)))
             }
             Input::Layout(_) => self.run_layout(None, observer),

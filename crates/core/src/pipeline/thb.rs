@@ -9,8 +9,7 @@
 //! certificate accepts the map or the rounds run out. When the offending cells grow in
 //! two successive rounds (the folds pushed deeper instead of removed) or the rounds end
 //! unaccepted, the rounds start again from the same start with a ring of
-//! `RETRY_RING` cells in every round. A certified tensor map is replaced by the contour
-//! basis's map when that is certified with fewer functions ([`coarser`]). The result is
+//! `RETRY_RING` cells in every round. The result is
 //! [`Solved::Thb`](super::Solved::Thb): the THB map and its [`ThbReport`].
 
 use std::time::Instant;
@@ -125,47 +124,6 @@ pub(crate) fn repairs(sol: &Solution, opts: &SolveOptions) -> bool {
         && matches!(sol.report.outcome.verdict, Verdict::Folded | Verdict::Undecided)
 }
 
-/// Whether the pipeline tries the contour fit's THB basis on the tensor solve `sol`
-/// although it needs no repair: THB refinement (as in [`repairs`]), repair rounds allowed,
-/// the map accepted (certified or a degenerate corner), and no `--improve weak` (which
-/// has no THB discretization).
-pub(crate) fn coarsens(sol: &Solution, opts: &SolveOptions) -> bool {
-    opts.repair.refinement.resolved(!sol.report.boundary.roundings.is_empty()) == Refinement::Thb
-        && opts.repair.rounds > 0
-        && opts.improve != Some(Improve::WeakForm)
-        && matches!(sol.report.outcome.verdict, Verdict::Certified | Verdict::DegenerateCorner)
-}
-
-/// The THB map of the contour fit's basis for the accepted tensor solve `sol` on the
-/// hierarchy `h` ([`start`], no repair round) when the contour basis applies, its map is
-/// accepted as well and it has fewer functions than `sol`'s; otherwise `Err` with what
-/// the start was (the tensor map stays, its report's `thb_contour` says so).
-pub(crate) fn coarser(
-    sol: &Solution,
-    h: &Hierarchy,
-    opts: &SolveOptions,
-    observer: &mut Observer<'_>,
-) -> Result<std::result::Result<ThbSolution, ThbStart>> {
-    let mut once = opts.clone();
-    once.repair.rounds = 0;
-    let t = repair(sol.clone(), Some(h), &once, observer)?;
-    let fewer = t.map.basis.len() < sol.map.control_points.len();
-    if t.report.start.basis == "contour" && accepted(&t.report.certificate) && fewer {
-        return Ok(Ok(t));
-    }
-    let mut note = t.report.start;
-    if note.reason.is_none() {
-        note.reason = Some(format!(
-            "the contour basis's map ({} functions) is {:?} with {} functions against the tensor map's {}",
-            note.functions,
-            t.report.verdict,
-            t.map.basis.len(),
-            sol.map.control_points.len()
-        ));
-    }
-    Ok(Err(note))
-}
-
 /// The THB map `t` when its certificate accepts it; otherwise the tensor repair's map
 /// (`tensor`, the same input with [`Refinement::Tensor`], solved from the start: the
 /// tensor solve's repair state is gone), its report's `thb_fallback` saying what the THB
@@ -216,7 +174,8 @@ fn thb_options(opts: &SolveOptions) -> ThbRepairOptions {
 /// coarsest level, each side refined along itself only) with EGG solved on it
 /// ([`solve_egg`]); the tensor map `sol.map` (one level) when there is no hierarchy, the
 /// fit keeps kinks exactly (knots of multiplicity `p`), the contour basis does not
-/// apply or is not smaller than the tensor basis (the reason in the report).
+/// apply or is not smaller than the tensor basis, or the solve on it fails (the reason in
+/// the report).
 fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(HierarchicalMap, ThbStart)> {
     let t0 = Instant::now();
     let tensor = |reason: String| -> Result<(HierarchicalMap, ThbStart)> {
@@ -254,7 +213,10 @@ fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(
         }
         Err(why) => return tensor(why),
     };
-    let egg = solve_egg(&thb, opts.operator, opts.nonlinear)?;
+    let egg = match solve_egg(&thb, opts.operator, opts.nonlinear) {
+        Ok(egg) => egg,
+        Err(e) => return tensor(format!("the EGG solve on the contour basis failed: {e}")),
+    };
     let cert = certify_hierarchical(&egg.map, &opts.certify)?;
     let report = ThbStart {
         basis: "contour",

@@ -239,15 +239,9 @@ pub struct SolveStage {
     /// rounds ended with; absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub thb_fallback: Option<ThbFallback>,
-    /// When THB refinement was asked for and this map needed no repair: the contour
-    /// fit's THB start that was tried and not kept (not certified, or not fewer
-    /// functions; `crate::pipeline`, docs/thb.md); absent otherwise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub thb_contour: Option<ThbStart>,
 }
 
-/// The start of the THB rounds (`crate::pipeline::ThbReport::start`), or the contour start
-/// tried on a map that needed no repair (`SolveStage::thb_contour`).
+/// The start of the THB rounds (`crate::pipeline::ThbReport::start`).
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct ThbStart {
@@ -559,7 +553,6 @@ impl Solution {
                 seconds: ctx.elapsed.as_secs_f64(),
                 warm_start: None,
                 thb_fallback: None,
-                thb_contour: None,
             },
             outcome: Outcome { certificate, verdict, message },
             det_j: DetJReport {

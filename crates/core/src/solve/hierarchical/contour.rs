@@ -188,16 +188,21 @@ mod tests {
     use crate::spline::curve::Curve;
     use crate::testutil::Lcg;
 
-    /// A map on `[0, 1]²` whose four sides are splines on their own dyadic knots (south
-    /// detailed near 0.3, north uniform, east detailed near 0.8, west coarse), with
+    /// A map on `[0, 1]²` whose four sides are splines on their own dyadic knots (level 0
+    /// 32 uniform elements; south with spans of 1/256 on [0.25, 0.375], north halved,
+    /// east with spans of 1/128 on [0.75, 0.875], west level 0), with
     /// perturbed control points, and whose basis is the tensor product of the unions of
     /// opposite sides' knots (as the tensor hierarchy builds it).
     fn detailed_map() -> (Surface, [KnotVector; 4], [KnotVector; 2]) {
         let p = 3;
-        let level0 = KnotVector::open_uniform(p, 4);
-        let south = level0.with_inserted(&[0.3125, 0.328125, 0.34375, 0.375, 0.28125]);
+        let level0 = KnotVector::open_uniform(p, 32);
+        // the dyadic knots k / 2^m, k in `ks`, that level 0 lacks
+        let detail = |m: i32, ks: std::ops::RangeInclusive<i32>| -> Vec<f64> {
+            ks.map(|k| k as f64 / 2f64.powi(m)).filter(|&u| level0.multiplicity(u) == 0).collect()
+        };
+        let south = level0.with_inserted(&detail(8, 64..=96));
         let north = level0.halved();
-        let east = level0.with_inserted(&[0.8125, 0.78125, 0.796875, 0.875]);
+        let east = level0.with_inserted(&detail(7, 96..=112));
         let west = level0.clone();
         let knots = [south.union(&north).unwrap(), east.union(&west).unwrap()];
         let mut rng = Lcg::new(11);
