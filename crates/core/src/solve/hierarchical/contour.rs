@@ -175,7 +175,7 @@ pub(crate) fn contour_start(
     let extent = map.control_points.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs())).max(f64::MIN_POSITIVE);
     for s in Side::ALL {
         let diff = boundary_difference(&tensor, map, s)?;
-        if !(diff <= BOUNDARY_TOL * extent) {
+        if diff.is_nan() || diff > BOUNDARY_TOL * extent {
             return Ok(Err(format!("the THB basis does not reproduce the {s} side ({diff:.3e} apart)")));
         }
     }
