@@ -97,6 +97,18 @@ pub(crate) fn finish(out: &ThbSolution, a: &SolveArgs) -> Result<i32> {
             out.map.basis.num_levels(),
             out.report.unknowns
         );
+        let st = &out.report.start;
+        match &st.reason {
+            None => say!(
+                "THB start: the contour fit's THB basis ({} functions on {} levels, each side refined along \
+                 itself only), EGG in {} Newton iteration(s): {:?}",
+                st.functions,
+                st.levels,
+                st.iterations,
+                st.verdict
+            ),
+            Some(why) => say!("THB start: the tensor map ({} functions): {why}", st.functions),
+        }
         say!("certificate: {}", c.message());
         if let Some(imp) = &out.report.improvement {
             say!("improvement: {}", imp.message);

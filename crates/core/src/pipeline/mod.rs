@@ -214,10 +214,10 @@ impl Pipeline {
                 };
                 let opts = self.opts.clone();
                 let tensor = self.with_tensor_repair();
-                let (mut sol, _) = self.run_keeping_hierarchy(observer)?;
+                let (mut sol, hierarchy) = self.run_keeping_hierarchy(observer)?;
                 sol.report.solve.warm_start = why.map(|reason| WarmNote { used: false, reason: Some(reason) });
                 if thb::repairs(&sol, &opts) {
-                    let t = thb::repair(sol, &opts, observer)?;
+                    let t = thb::repair(sol, Some(&hierarchy), &opts, observer)?;
                     return thb::or_tensor_repair(t, tensor, observer);
                 }
                 Ok(Solved::Map(Box::new(sol)))

@@ -1,12 +1,14 @@
 //! The THB defect correction as a stage of the pipeline (paper §8.2 on a truncated
 //! hierarchical basis, §4; issue 35). With [`Refinement::Thb`] the coarse-to-fine solve
 //! runs without tensor repair rounds; when its map is folded or undecided and repair
-//! rounds are allowed, the map becomes a THB map on the same basis (exact: a one-level
-//! hierarchy) and [`repair_thb_observed`] refines only the offending cells and a ring
+//! rounds are allowed, the rounds start from the contour fit's THB basis (each side
+//! refined along itself only, `solve::hierarchical::contour`, EGG solved on it) or, where
+//! that does not apply, from the tensor map as a one-level THB map, and
+//! [`repair_thb_observed`] refines only the offending cells and a ring
 //! around them, round by round ([`Stage::ThbRound`](super::Stage::ThbRound)), until the
 //! certificate accepts the map or the rounds run out. When the offending cells grow in
 //! two successive rounds (the folds pushed deeper instead of removed) or the rounds end
-//! unaccepted, the rounds start again from the tensor map with a ring of
+//! unaccepted, the rounds start again from the same start with a ring of
 //! `RETRY_RING` cells in every round. The result is
 //! [`Solved::Thb`](super::Solved::Thb): the THB map and its [`ThbReport`].
 
@@ -15,14 +17,18 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::{Observer, Stage};
+use crate::boundary::hierarchy::Hierarchy;
+use crate::boundary::BasisChoice;
 use crate::error::{Error, Result};
+use crate::solve::hierarchical::contour::contour_start;
 use crate::solve::hierarchical::improve::{improve_thb, ThbImprovement};
-use crate::solve::hierarchical::{accepted, repair_thb_observed, ThbRepairOptions, ThbRound};
+use crate::solve::hierarchical::{accepted, repair_thb_observed, solve_egg, ThbRepairOptions, ThbRound};
 use crate::solve::improve::Improve;
+use crate::solve::levels::prepare_levels;
 use crate::solve::options::{Refinement, SolveOptions};
-use crate::solve::report::{Report, Solution, ThbFallback, Verdict};
+use crate::solve::report::{Report, Solution, ThbFallback, ThbStart, Verdict};
 use crate::spline::hierarchical::map::HierarchicalMap;
-use crate::verify::certificate::hierarchical::HierarchicalCertificate;
+use crate::verify::certificate::hierarchical::{certify_hierarchical, HierarchicalCertificate};
 use crate::verify::poisson::{poisson_benchmark, PoissonReport};
 
 /// A THB map solved by the pipeline: the tensor solve's map repaired by THB defect
@@ -82,6 +88,10 @@ pub struct ThbReport {
     /// absent from the JSON) otherwise.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub first_rounds: Vec<ThbRound>,
+    /// Where the THB rounds started: the THB basis of the contour fit (each side refined
+    /// only along itself, `solve::hierarchical::contour`) with EGG solved on it, or the
+    /// tensor solve's map, and why.
+    pub start: ThbStart,
     /// The report of the tensor solve the THB stage started from.
     pub solve: Report,
 }
@@ -159,6 +169,68 @@ fn thb_options(opts: &SolveOptions) -> ThbRepairOptions {
     }
 }
 
+/// The map the THB rounds start from: with the hierarchy `h` the tensor solve's map was
+/// solved on, the THB basis of its contour fit ([`contour_start`]: level 0 the solver's
+/// coarsest level, each side refined along itself only) with EGG solved on it
+/// ([`solve_egg`]); the tensor map `sol.map` (one level) when there is no hierarchy, the
+/// fit keeps kinks exactly (knots of multiplicity `p`), the contour basis does not
+/// apply or is not smaller than the tensor basis, or the solve on it fails (the reason in
+/// the report).
+fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(HierarchicalMap, ThbStart)> {
+    let t0 = Instant::now();
+    let tensor = |reason: String| -> Result<(HierarchicalMap, ThbStart)> {
+        let map = HierarchicalMap::from_surface(&sol.map)?;
+        let report = ThbStart {
+            basis: "tensor",
+            reason: Some(reason),
+            functions: map.basis.len(),
+            levels: 1,
+            iterations: 0,
+            converged: true,
+            verdict: sol.report.outcome.verdict,
+            seconds: 0.0,
+        };
+        Ok((map, report))
+    };
+    let Some(h) = h else { return tensor("no contour fit (the tensor map was given)".into()) };
+    if h.kinked.is_some() {
+        return tensor("kinks kept exactly (C0 route): their knots are not dyadic".into());
+    }
+    // the solver's coarsest level (`EggSolver::with_method`: balanced, its minimum elements)
+    let (min_elements, aspect) = match (h.basis.requested, h.basis.used) {
+        (BasisChoice::Input, BasisChoice::Input) => (1, f64::INFINITY),
+        _ => (opts.levels.min_elements, opts.levels.aspect),
+    };
+    let Some(coarse) = prepare_levels(vec![h.levels[0].clone()], min_elements, 0, aspect)?.into_iter().next() else {
+        return tensor("no coarse level".into());
+    };
+    let sides = h.fits.each_ref().map(|f| f.finest().knots.clone());
+    let thb = match contour_start(&sol.map, coarse.knots, &sides, ThbRepairOptions::default().admissibility)? {
+        Ok(thb) if thb.basis.len() < sol.map.control_points.len() => thb,
+        Ok(thb) => {
+            let n = thb.basis.len();
+            return tensor(format!("the contour basis ({n} functions) is not smaller than the tensor one"));
+        }
+        Err(why) => return tensor(why),
+    };
+    let egg = match solve_egg(&thb, opts.operator, opts.nonlinear) {
+        Ok(egg) => egg,
+        Err(e) => return tensor(format!("the EGG solve on the contour basis failed: {e}")),
+    };
+    let cert = certify_hierarchical(&egg.map, &opts.certify)?;
+    let report = ThbStart {
+        basis: "contour",
+        reason: None,
+        functions: egg.map.basis.len(),
+        levels: egg.map.basis.num_levels(),
+        iterations: egg.iterations,
+        converged: egg.converged,
+        verdict: Verdict::of_finding(&cert.verdict),
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    Ok((egg.map, report))
+}
+
 /// The THB defect correction of the tensor solve `sol` (see the module documentation):
 /// at most `opts.repair.rounds` rounds, each refining the offending cells and `opts.repair.halo`
 /// cells around them, EGG with the options' operator and Newton options, the
@@ -167,7 +239,12 @@ fn thb_options(opts: &SolveOptions) -> ThbRepairOptions {
 /// With `--improve winslow` the certified THB map is then improved on its own basis
 /// ([`improve_thb`]); `--improve weak` is refused ([`Error::Invalid`]): the weak form
 /// (eq. 14) has no THB discretization here.
-pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer<'_>) -> Result<ThbSolution> {
+pub(crate) fn repair(
+    sol: Solution,
+    hierarchy: Option<&Hierarchy>,
+    opts: &SolveOptions,
+    observer: &mut Observer<'_>,
+) -> Result<ThbSolution> {
     let t0 = Instant::now();
     if opts.improve == Some(Improve::WeakForm) {
         return Err(Error::Invalid(
@@ -176,7 +253,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
                 .into(),
         ));
     }
-    let start = HierarchicalMap::from_surface(&sol.map)?;
+    let (start, start_report) = start(&sol, hierarchy, opts)?;
     // the first rounds stop as soon as the offending cells keep growing
     let narrow = ThbRepairOptions { stop_when_growing: true, ..thb_options(opts) };
     let mut out = repair_thb_observed(start.clone(), &narrow, &mut |round| observer(&Stage::ThbRound(round)))?;
@@ -218,6 +295,7 @@ pub(crate) fn repair(sol: Solution, opts: &SolveOptions, observer: &mut Observer
         poisson: if opts.report.poisson { poisson_benchmark(&map.to_surface()?, None).ok() } else { None },
         first_attempt,
         first_rounds,
+        start: start_report,
         solve: sol.report,
     };
     Ok(ThbSolution { name: sol.name, map, report })
@@ -234,7 +312,8 @@ mod tests {
 
     /// puzzle4 with `--refinement thb` (the geometry of the CLI's THB test): the
     /// pipeline's THB result is, bit for bit, what the front end made before the stage
-    /// moved into the pipeline (the tensor solve without repair, then `repair_thb` with
+    /// moved into the pipeline (the tensor solve without repair, its THB start (`start`:
+    /// the contour basis), then `repair_thb` with
     /// the options' rounds, halo, operator, Newton and certificate options); the observer
     /// sees every round, in order, after the tensor solve's stages, and stops the run at
     /// the first round with [`Error::Cancelled`].
@@ -244,9 +323,11 @@ mod tests {
         let mut opts = SolveOptions::default();
         opts.repair.refinement = Refinement::Thb;
         // the former path: the pipeline's map (no tensor repair, no fallback), then the repair
-        let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
+        let (unrepaired, h) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
         assert!(repairs(&unrepaired, &opts), "{:?}", unrepaired.report.outcome.verdict);
-        let before = repair_thb(HierarchicalMap::from_surface(&unrepaired.map).unwrap(), &thb_options(&opts)).unwrap();
+        let (begin, how) = start(&unrepaired, Some(&h), &opts).unwrap();
+        assert_eq!(how.functions, begin.basis.len());
+        let before = repair_thb(begin, &thb_options(&opts)).unwrap();
         assert!(accepted(&before.certificate), "{}", before.certificate.message());
 
         let mut seen = Vec::new();
@@ -310,7 +391,7 @@ mod tests {
         opts.repair.refinement = Refinement::Thb;
         let (unrepaired, _) = Pipeline::new(b.clone(), opts.clone()).run_keeping_hierarchy(&mut |_| true).unwrap();
         opts.repair.rounds = 0;
-        let t = repair(unrepaired, &opts, &mut |_| true).unwrap();
+        let t = repair(unrepaired, None, &opts, &mut |_| true).unwrap();
         assert_eq!(t.report.verdict, Verdict::Folded, "{}", t.report.message);
         assert!(t.report.thb_rounds.is_empty() && t.report.first_attempt.is_none());
         let tensor_opts = SolveOptions::default();

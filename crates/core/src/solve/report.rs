@@ -241,6 +241,31 @@ pub struct SolveStage {
     pub thb_fallback: Option<ThbFallback>,
 }
 
+/// The start of the THB rounds (`crate::pipeline::ThbReport::start`).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct ThbStart {
+    /// `"contour"`: the THB basis of the contour fit, the boundary the fitted sides, EGG
+    /// solved on it from the tensor map's blossoms; `"tensor"`: the tensor solve's map on
+    /// its own basis (a one-level THB map).
+    pub basis: &'static str,
+    /// Why the contour basis was not used (`None` when it was).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// THB functions of the start.
+    pub functions: usize,
+    /// Levels of its hierarchy.
+    pub levels: usize,
+    /// Newton iterations of the EGG solve on the contour basis (0 for the tensor start).
+    pub iterations: usize,
+    /// Whether that solve converged (true for the tensor start).
+    pub converged: bool,
+    /// The verdict of the start map's certificate (the contour start after its solve).
+    pub verdict: Verdict,
+    /// Seconds of the contour basis, the blossoms and the solve (0 for the tensor start).
+    pub seconds: f64,
+}
+
 /// What a THB defect correction that did not end certified (or degenerate at forced
 /// corners only) ended with: the `thb_fallback` field of a report (the tensor repair then
 /// took over) and the `first_attempt` of a THB report (`crate::pipeline::ThbReport`).

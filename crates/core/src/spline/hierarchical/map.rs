@@ -163,12 +163,42 @@ impl HierarchicalMap {
     pub fn refined(&self, marked: &[(usize, Index2)], m: usize) -> Result<Self> {
         let mut basis = self.basis.clone();
         basis.refine(marked, m)?;
+        self.blossomed(basis, true)
+    }
+
+    /// This map in the THB space of `basis` (a hierarchy of the same degrees on the same
+    /// domain, any level-0 knots) by the blossom quasi-interpolant: the coefficient of an
+    /// active function `(l, f)` is the blossom, at `f`'s interior knots, of this map's
+    /// polynomial piece at a point of an active level-`l` cell `Q` in `supp f` (the
+    /// centre of `Q`; in a direction where `f` is the first or last function, the
+    /// domain's end: there `Q` touches the boundary). When this map lies in the THB
+    /// space it is reproduced (the coefficient of an active function is the level-`l`
+    /// coefficient of the piece on any active level-`l` cell of its support, `truncation`).
+    /// The functions non-zero on a side are the 1D THB functions of the side's row of
+    /// cells, and their coefficients read only this map's boundary curve: the THB map's
+    /// boundary is this map's when the curve is one polynomial on each active cell along
+    /// the side and lies in the side's 1D THB space (checked by the caller, e.g. through
+    /// [`Self::to_surface`]).
+    pub fn quasi_interpolant(&self, basis: HierarchicalBasis) -> Result<Self> {
+        if basis.degrees() != self.basis.degrees()
+            || (0..2).any(|d| basis.knots(0)[d].domain() != self.basis.knots(0)[d].domain())
+        {
+            return Err(Error::Invalid(
+                "a THB quasi-interpolant needs a basis of the same degrees on the same domain".into(),
+            ));
+        }
+        self.blossomed(basis, false)
+    }
+
+    /// The coefficients on `basis` by blossoming (see [`Self::quasi_interpolant`]);
+    /// with `keep`, `basis` refines `self.basis` and the functions active in both keep
+    /// their coefficients (the blossom of the same piece, both times), the new ones are
+    /// blossomed at the centre of their cell.
+    fn blossomed(&self, basis: HierarchicalBasis, keep: bool) -> Result<Self> {
         let mut old = self.level_coefficients();
         let mut cps = Vec::with_capacity(basis.len());
         for &(l, f) in basis.active_functions() {
-            // a function active before and after keeps its coefficient: it is the blossom of
-            // the same piece on an active cell of its level in its support, both times
-            if let Some(k) = self.basis.index_of(l, f) {
+            if let Some(k) = self.basis.index_of(l, f).filter(|_| keep) {
                 cps.push(self.control_points[k]);
                 continue;
             }
@@ -177,8 +207,17 @@ impl HierarchicalMap {
                 .flat_map(|j| ri.clone().map(move |i| [i, j]))
                 .find(|&c| basis.is_active_cell(l, c))
                 .ok_or_else(|| Error::Invalid(format!("active function {f:?} of level {l} has no active cell")))?;
-            let [[a, b], [cc, dd]] = basis.cell_bounds(l, cell);
-            cps.push(self.piece_blossom(&mut old, [0.5 * (a + b), 0.5 * (cc + dd)], basis.knots(l), f));
+            let bounds = basis.cell_bounds(l, cell);
+            let kv = basis.knots(l);
+            let at: [f64; 2] = std::array::from_fn(|d| {
+                let [a, b] = bounds[d];
+                match f[d] {
+                    0 if !keep => a,
+                    i if !keep && i + 1 == kv[d].num_basis() => b,
+                    _ => 0.5 * (a + b),
+                }
+            });
+            cps.push(self.piece_blossom(&mut old, at, kv, f));
         }
         Self::new(basis, cps)
     }
