@@ -323,10 +323,53 @@ fn address_space_limit(s: &str) -> Option<u64> {
     line["Max address space".len()..].split_whitespace().next()?.parse().ok()
 }
 
-/// Reserve `bytes` and release them at once: [`Error::Memory`] when the allocator
-/// refuses (an address-space limit, a heuristic overcommit refusal), instead of the abort
-/// that a failing allocation inside the solve would be. Pages are not touched.
+/// The address space that faer's dense products take on x86-64 (its `private-gemm-x86`
+/// kernels) in each thread that runs one: a thread-local buffer of twice the L3 cache,
+/// allocated (not touched) on the thread's first product and kept. On a machine that
+/// reports a 480 MiB L3 this is 960 MiB per thread, which an address-space limit
+/// (`ulimit -v`) may not hold: the allocation then aborts inside faer. Counted for the
+/// main thread and every thread of the pool; 0 where the L3 size is not known (Linux's
+/// `/sys/devices/system/cpu/cpu0/cache`) or on other architectures.
+pub fn dense_product_workspace() -> u64 {
+    static L3: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    let l3 = *L3.get_or_init(|| if cfg!(target_arch = "x86_64") { l3_cache_bytes().unwrap_or(0) } else { 0 });
+    2 * l3 * (rayon::current_num_threads() as u64 + 1)
+}
+
+/// The size of the L3 cache from Linux's sysfs (`index*/level` 3, `size` like `491520K`).
+fn l3_cache_bytes() -> Option<u64> {
+    let dir = std::path::Path::new("/sys/devices/system/cpu/cpu0/cache");
+    std::fs::read_dir(dir).ok()?.flatten().find_map(|e| {
+        let level = std::fs::read_to_string(e.path().join("level")).ok()?;
+        (level.trim() == "3").then_some(())?;
+        cache_size(&std::fs::read_to_string(e.path().join("size")).ok()?)
+    })
+}
+
+/// `491520K`, `32M` or `1024` as bytes.
+fn cache_size(s: &str) -> Option<u64> {
+    let s = s.trim();
+    let (digits, unit) = match s.char_indices().find(|(_, c)| !c.is_ascii_digit()) {
+        Some((i, _)) => (&s[..i], &s[i..]),
+        None => (s, ""),
+    };
+    let n: u64 = digits.parse().ok()?;
+    let k = match unit {
+        "" => 1,
+        "K" => 1 << 10,
+        "M" => 1 << 20,
+        "G" => 1 << 30,
+        _ => return None,
+    };
+    n.checked_mul(k)
+}
+
+/// Reserve `bytes`, and the address space of the dense products
+/// ([`dense_product_workspace`]), and release them at once: [`Error::Memory`] when the
+/// allocator refuses (an address-space limit, a heuristic overcommit refusal), instead of
+/// the abort that a failing allocation inside the solve would be. Pages are not touched.
 pub fn reserve(bytes: u64, what: &str) -> Result<()> {
+    let bytes = bytes.saturating_add(dense_product_workspace());
     let mut probe: Vec<u8> = Vec::new();
     let n = usize::try_from(bytes).unwrap_or(usize::MAX);
     probe.try_reserve_exact(n).map_err(|_| Error::Memory {
@@ -456,6 +499,10 @@ mod tests {
 
     #[test]
     fn impossible_reservations_are_a_typed_error() {
+        assert_eq!(cache_size("491520K"), Some(480 << 20));
+        assert_eq!(cache_size("32M\n"), Some(32 << 20));
+        assert_eq!(cache_size("4096"), Some(4096));
+        assert_eq!(cache_size("12X"), None);
         let e = reserve(u64::MAX / 2, "a test").unwrap_err();
         assert!(matches!(e, Error::Memory { .. }), "{e}");
         assert!(reserve(1 << 20, "a test").is_ok());
