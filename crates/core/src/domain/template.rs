@@ -1,7 +1,7 @@
 //! The templates of the automatic layout (issue 31, step 3 of [`super::layout`]): a face
 //! with four corners stays one patch. Every other face with `N` corners is cut into `N`
 //! quads around one interior vertex (valence `N`), the midpoint template
-//! ([`super::midpoint`]): the harmonic map of the regular `N`-gon onto the face
+//! (`domain::midpoint`): the harmonic map of the regular `N`-gon onto the face
 //! (`HarmonicMap`, Hinz & Buffa) places the interior vertex (the image of the polygon's
 //! centre) and the cuts (the images of the segments from the centre to the midpoints of
 //! the sides, fitted by splines); the sides are split at their arc-length midpoints, the
@@ -19,7 +19,7 @@
 //! vertex is searched (`super::spokes`), a face split in two tries its other placements
 //! (the straight segment where it stays inside, the preimage through the map onto the
 //! polygon), and a face of five corners or more whose midpoint template still scores
-//! below 15° tries the cuts across it ([`super::crosscut`]: two faces with fewer corners),
+//! below 15° tries the cuts across it (`domain::crosscut`: two faces with fewer corners),
 //! the best placement kept.
 //!
 //! The report of every face ([`FaceReport`]) and the interior vertices whose valence is

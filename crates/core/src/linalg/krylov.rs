@@ -17,7 +17,7 @@ pub trait MatVec {
 
     /// Whether one product costs far more than a few vector updates of the operator's
     /// size (a matrix-free product evaluated element by element at every quadrature
-    /// point): [`gmres`] then forms each cycle's residual from the products it made in
+    /// point): `gmres` then forms each cycle's residual from the products it made in
     /// the cycle instead of one more product (see there). `false` unless overridden.
     fn costly(&self) -> bool {
         false

@@ -96,7 +96,7 @@ fn flip(t: &[f64], reversed: bool) -> Vec<f64> {
 }
 
 /// The conforming linear triangulation of `layout` (every patch a map) with the
-/// options of a single map's ([`crate::unstructured`]; `order` must be 1: curved cells
+/// options of a single map's ([`crate::unstructured()`]; `order` must be 1: curved cells
 /// need one map per mesh). Not checked for inverted cells: the writers validate.
 pub fn multipatch_unstructured(layout: &Layout, opts: &UnstructuredOptions) -> Result<MultipatchTriangulation> {
     if opts.order != 1 {
