@@ -78,11 +78,33 @@ fn side_values(mesh: &Mesh) -> [Vec<f64>; 4] {
     })
 }
 
-/// The union of two sorted point sets, a value of `a` kept where both have one.
+/// The union of two sorted point sets (one pass), a value of `a` kept where both have
+/// one (within [`SAME`]).
 fn union(a: &[f64], b: &[f64]) -> Vec<f64> {
-    let mut out: Vec<f64> = a.to_vec();
-    out.extend(b.iter().copied().filter(|t| !a.iter().any(|s| (s - t).abs() <= SAME)));
-    out.sort_by(f64::total_cmp);
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        match (a.get(i), b.get(j)) {
+            (Some(&s), Some(&t)) if (s - t).abs() <= SAME => {
+                out.push(s);
+                i += 1;
+                j += 1;
+            }
+            (Some(&s), Some(&t)) if s < t => {
+                out.push(s);
+                i += 1;
+            }
+            (Some(&s), None) => {
+                out.push(s);
+                i += 1;
+            }
+            (_, Some(&t)) => {
+                out.push(t);
+                j += 1;
+            }
+            (None, None) => break,
+        }
+    }
     out
 }
 
@@ -173,4 +195,20 @@ pub fn multipatch_unstructured(layout: &Layout, opts: &UnstructuredOptions) -> R
         .collect();
     let (mesh, interface_gap) = merge(layout, patches, ElementKind::Triangle)?;
     Ok(MultipatchTriangulation { mesh, rounds, patch_cells, interface_gap, stats })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn union_keeps_one_of_each_point_and_the_first_sets_values() {
+        let a = [0.25, 0.5, 0.75];
+        let b = [0.125, 0.5 + 1e-13, 0.625, 0.75, 0.875];
+        assert_eq!(union(&a, &b), vec![0.125, 0.25, 0.5, 0.625, 0.75, 0.875]);
+        assert_eq!(union(&b, &a)[2], 0.5 + 1e-13);
+        assert_eq!(union(&a, &[]), a.to_vec());
+        assert_eq!(union(&[], &a), a.to_vec());
+        assert_eq!(flip(&[0.25, 0.5], true), vec![0.5, 0.75]);
+    }
 }
