@@ -53,19 +53,7 @@ fn solve_on_the_gpu_writes_the_cpu_map() {
             maps.push(doc["map"].clone());
         }
         assert_eq!(maps[0]["knots"], maps[1]["knots"]);
-        let pts = |m: &serde_json::Value| -> Vec<f64> {
-            m["control_points"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .flat_map(|p| p.as_array().unwrap().clone())
-                .map(|v| v.as_f64().unwrap())
-                .collect()
-        };
-        let (a, b) = (pts(&maps[0]), pts(&maps[1]));
-        assert_eq!(a.len(), b.len());
-        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        let (err, scale) = control_point_gap(&maps[0], &maps[1]);
         assert!(err <= 1e-9 * scale, "{geom}: GPU and CPU maps differ by {err:e}");
     }
 }
@@ -112,19 +100,7 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     };
     assert_eq!(levels(&runs[0]), levels(&runs[1]));
     assert!(levels(&runs[1]).iter().any(|&(_, k)| k > 0), "no GMRES iterations: {:?}", levels(&runs[1]));
-    let pts = |d: &serde_json::Value| -> Vec<f64> {
-        d["map"]["control_points"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|p| p.as_array().unwrap().clone())
-            .map(|v| v.as_f64().unwrap())
-            .collect()
-    };
-    let (a, b) = (pts(&runs[0]), pts(&runs[1]));
-    assert_eq!(a.len(), b.len());
-    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let (err, scale) = control_point_gap(&runs[0]["map"], &runs[1]["map"]);
     assert!(err <= 1e-9 * scale, "GPU and CPU multigrid maps differ by {err:e}");
     // `bench` runs the same path and its JSON rows name the back end with the cycles
     let out = bin()
@@ -154,4 +130,23 @@ fn bench_on_the_gpu_prints_throughput_and_the_time_split() {
     }
     // two sizes, residual and Jacobian rows each
     assert_eq!(text.lines().filter(|l| l.contains(" | F | ") || l.contains(" | J | ")).count(), 4, "{text}");
+}
+
+/// The largest difference between two JSON maps' control point coordinates, and the
+/// largest coordinate of the first (the maps must have as many control points).
+fn control_point_gap(a: &serde_json::Value, b: &serde_json::Value) -> (f64, f64) {
+    let pts = |m: &serde_json::Value| -> Vec<f64> {
+        m["control_points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|p| p.as_array().unwrap().clone())
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (pts(a), pts(b));
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    (err, scale)
 }
