@@ -18,13 +18,20 @@ alias real = f64;
 //   then Y = a_1 t (prolongation P = P_1 (x) P_0 and restriction P^T alike); the second
 //   pass writes y, or adds it to its output (x += P x_c), and may zero a vector of its
 //   size (x_{l+1} = 0 after the restriction);
-// - `coarse_solve`: the dense Cholesky solve of the coarsest level, one invocation.
+// - `coarse_solve`: the dense Cholesky solve of the coarsest level, one invocation;
+// - `system_product`: y = A x for the free-free Galerkin system of `s_comp` components
+//   held as its stencil storage in single precision (the Newton Jacobian of eq. 12 that
+//   GMRES multiplies with; crates/core/src/discrete/stencil.rs,
+//   `Discretization::stencil_product`), one invocation per row, the row's terms added
+//   as `Csr::mul_vec` adds them.
 //
 // Buffers: `vecs` holds every level's b, x, r and the transfer scratch t (read-write);
 // `reals` the line factors, the 1D transfer factors, CSR level values and the coarsest
 // factor; `idx` their row pointers, column indices and the lines' first unknowns;
-// `stencil` the levels' stencil values in single precision (the CPU's storage), each
-// product widened and summed in `real`.
+// `stencil0` .. `stencil3` the levels' stencil values in single precision (the CPU's
+// storage), each product widened and summed in `real`: one array split into chunks of
+// 2^st_shift entries, one binding each, so that no binding exceeds the adapter's
+// storage-binding limit (lavapipe: 128 MiB); `st_at` reads entry g of the whole.
 
 struct Params {
     // invocations of this dispatch
@@ -76,6 +83,17 @@ struct Params {
     c_hi: u32,
     c_phase: u32,
     c_pad: u32,
+    // stencil chunks: entry g lies in chunk g >> st_shift at g & st_mask
+    st_shift: u32,
+    st_mask: u32,
+    // system product: offsets into `idx` of the free functions (their global indices)
+    // and of the free index of every function (NONE: fixed), free functions m, components
+    s_free: u32,
+    s_free_of: u32,
+    s_m: u32,
+    s_comp: u32,
+    s_pad0: u32,
+    s_pad1: u32,
 }
 
 const WG: u32 = 64u;
@@ -84,11 +102,33 @@ const NONE: u32 = 0xffffffffu;
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> reals: array<real>;
 @group(0) @binding(2) var<storage, read> idx: array<u32>;
-@group(0) @binding(3) var<storage, read> stencil: array<f32>;
+@group(0) @binding(3) var<storage, read> stencil0: array<f32>;
 @group(0) @binding(4) var<storage, read_write> vecs: array<real>;
+@group(0) @binding(5) var<storage, read> stencil1: array<f32>;
+@group(0) @binding(6) var<storage, read> stencil2: array<f32>;
+@group(0) @binding(7) var<storage, read> stencil3: array<f32>;
 
 fn linear_id(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * WG;
+}
+
+// Entry g of the stencil values (see the buffers above).
+fn st_at(g: u32) -> f32 {
+    let j = g & P.st_mask;
+    switch g >> P.st_shift {
+        case 0u: {
+            return stencil0[j];
+        }
+        case 1u: {
+            return stencil1[j];
+        }
+        case 2u: {
+            return stencil2[j];
+        }
+        default: {
+            return stencil3[j];
+        }
+    }
 }
 
 // (A x)_i on a stencil level (GridOperator::row_product): per stencil row dy the
@@ -109,7 +149,7 @@ fn stencil_row(i: u32) -> real {
         let xs = P.x_off + jy * P.nx + x0;
         var s = -real(0.0);
         for (var k = 0u; k < x1 - x0; k++) {
-            s += real(stencil[row + k]) * vecs[xs + k];
+            s += real(st_at(row + k)) * vecs[xs + k];
         }
         sum += s;
     }
@@ -264,4 +304,72 @@ fn coarse_solve() {
         }
         vecs[x + i] = s / reals[f + i * n + i];
     }
+}
+
+// Discretization::stencil_product for row z m + f (component z, free function f at
+// global index k = i + nx j): the terms a x over the components d, then the free
+// neighbours (dj, then di) of k, the entry of neighbour slot s at
+// st_off + (k c^2 + z c + d) sw + s (sw = (2p + 1)(2q + 1), p = bx, q = by), each x at
+// x_off + d m + its free index; summed as Csr::mul_vec sums a row: the first
+// 4 floor(n / 4) terms into four partial sums (term t into sum t mod 4), combined as
+// (s_0 + s_1) + (s_2 + s_3), then the remaining terms in order. Written at r_off + row.
+@compute @workgroup_size(64)
+fn system_product(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let row = linear_id(gid, nwg);
+    if row >= P.count {
+        return;
+    }
+    let m = P.s_m;
+    let nc = P.s_comp;
+    let z = row / m;
+    let f = row % m;
+    let k = idx[P.s_free + f];
+    let i = k % P.nx;
+    let j = k / P.nx;
+    let wx = 2u * P.bx + 1u;
+    let sw = wx * (2u * P.by + 1u);
+    let i0 = i - min(i, P.bx);
+    let i1 = min(i + P.bx + 1u, P.nx);
+    let j0 = j - min(j, P.by);
+    let j1 = min(j + P.by + 1u, P.ny);
+    var cols = 0u;
+    for (var dj = j0; dj < j1; dj++) {
+        for (var di = i0; di < i1; di++) {
+            if idx[P.s_free_of + dj * P.nx + di] != NONE {
+                cols++;
+            }
+        }
+    }
+    let n = nc * cols;
+    let full = n - n % 4u;
+    var acc = array<real, 4>(real(0.0), real(0.0), real(0.0), real(0.0));
+    var sum = real(0.0);
+    var t = 0u;
+    let base = P.st_off + (k * nc + z) * nc * sw;
+    for (var d = 0u; d < nc; d++) {
+        let st = base + d * sw;
+        let xo = P.x_off + d * m;
+        for (var dj = j0; dj < j1; dj++) {
+            for (var di = i0; di < i1; di++) {
+                let fc = idx[P.s_free_of + dj * P.nx + di];
+                if fc == NONE {
+                    continue;
+                }
+                let term = real(st_at(st + (dj + P.by - j) * wx + (di + P.bx - i))) * vecs[xo + fc];
+                if t < full {
+                    acc[t % 4u] += term;
+                } else {
+                    if t == full {
+                        sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+                    }
+                    sum += term;
+                }
+                t++;
+            }
+        }
+    }
+    if full == n {
+        sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    }
+    vecs[P.r_off + row] = sum;
 }

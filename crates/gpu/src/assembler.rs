@@ -13,6 +13,7 @@ use std::time::Instant;
 
 use winslow::discrete::assembly::{Discretization, Operator};
 use winslow::discrete::tables::DirTable;
+use winslow::discrete::OperatorBackend;
 use winslow::linalg::multigrid_kernels::CycleBackend;
 use winslow::methods::egg::{CpuAssembler, EggAssembler};
 use winslow::spline::curve::Point;
@@ -21,6 +22,7 @@ use winslow::verify::quality::DetJSample;
 
 use crate::device::Gpu;
 use crate::multigrid::GpuCycles;
+use crate::product::GpuProducts;
 use crate::{GpuError, Precision};
 
 /// Where the time of one kind of call went, summed over calls.
@@ -80,6 +82,12 @@ pub struct Stats {
     pub multigrid: Timings,
     /// Multigrid set-ups or cycles that ran on the CPU instead (GPU errors).
     pub multigrid_fallbacks: u64,
+    /// Products with the Newton Jacobian run on the GPU (`calls`; `upload` and
+    /// `bytes_up` include the Jacobian's upload once per Newton step) under
+    /// `--linear multigrid` ([`crate::GpuProducts`]).
+    pub jacobian_products: Timings,
+    /// Jacobian uploads or products that ran on the CPU instead (GPU errors).
+    pub jacobian_product_fallbacks: u64,
     /// Calls that failed on the GPU and were done by the CPU instead.
     pub fallbacks: u64,
     /// The last GPU error.
@@ -175,6 +183,8 @@ pub struct GpuAssembler {
     per_entry: bool,
     /// The multigrid cycle's kernels (`None` without `SHADER_F64`).
     cycles: Option<Arc<GpuCycles>>,
+    /// The Newton Jacobian's product (`None` without `SHADER_F64`).
+    products: Option<Arc<GpuProducts>>,
 }
 
 fn key_of(disc: &Discretization) -> (Vec<f64>, usize, Vec<f64>, usize, usize, usize) {
@@ -226,6 +236,7 @@ impl GpuAssembler {
             chunk_bytes,
             per_entry: false,
             cycles: GpuCycles::new(gpu.clone()).map(Arc::new),
+            products: GpuProducts::new(gpu.clone()).map(Arc::new),
             gpu,
         }
     }
@@ -265,6 +276,11 @@ impl GpuAssembler {
             (s.multigrid, s.multigrid_fallbacks) = (t, fallbacks);
             s.last_error = s.last_error.or(last);
         }
+        if let Some(p) = &self.products {
+            let (t, fallbacks, last) = p.stats();
+            (s.jacobian_products, s.jacobian_product_fallbacks) = (t, fallbacks);
+            s.last_error = s.last_error.or(last);
+        }
         s
     }
 
@@ -275,6 +291,9 @@ impl GpuAssembler {
         }
         if let Some(c) = &self.cycles {
             c.reset_stats();
+        }
+        if let Some(p) = &self.products {
+            p.reset_stats();
         }
     }
 
@@ -691,6 +710,12 @@ impl EggAssembler for GpuAssembler {
         if s.multigrid_fallbacks > 0 {
             name.push_str(&format!(" ({} on the CPU after GPU errors)", s.multigrid_fallbacks));
         }
+        if s.jacobian_products.calls > 0 || s.jacobian_product_fallbacks > 0 {
+            name.push_str(&format!("; Jacobian products on the GPU: {}", s.jacobian_products.calls));
+        }
+        if s.jacobian_product_fallbacks > 0 {
+            name.push_str(&format!(" ({} on the CPU after GPU errors)", s.jacobian_product_fallbacks));
+        }
         name
     }
 
@@ -698,5 +723,11 @@ impl EggAssembler for GpuAssembler {
     /// where the adapter has `SHADER_F64`.
     fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
         self.cycles.clone().map(|c| c as Arc<dyn CycleBackend>)
+    }
+
+    /// The GPU multiplies with the Newton Jacobian under `--linear multigrid`
+    /// ([`GpuProducts`]), where the adapter has `SHADER_F64`.
+    fn operator_backend(&self) -> Option<Arc<dyn OperatorBackend>> {
+        self.products.clone().map(|p| p as Arc<dyn OperatorBackend>)
     }
 }

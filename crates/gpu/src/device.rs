@@ -97,7 +97,9 @@ impl Gpu {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let assembly = assembly_kernels(&device, precision);
         let det_j = det_j_kernel(&device, precision);
-        let multigrid = (precision == Precision::F64).then(|| crate::multigrid::multigrid_kernels(&device));
+        // the multigrid kernels bind seven storage buffers (`multigrid::STORAGE_BINDINGS`)
+        let bindings = limits.max_storage_buffers_per_shader_stage >= crate::multigrid::STORAGE_BINDINGS;
+        let multigrid = (precision == Precision::F64 && bindings).then(|| crate::multigrid::multigrid_kernels(&device));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Wgpu(e.to_string()));
         }

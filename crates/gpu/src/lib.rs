@@ -17,8 +17,12 @@
 //! `--linear multigrid` the multigrid V-cycle's level work (stencil residual, coloured
 //! line Gauss–Seidel, the two 1D transfer passes, the coarsest solve;
 //! `shaders/multigrid.wgsl`) runs on the GPU with the level data uploaded once per
-//! set-up, giving the CPU cycle's bits on lavapipe. [`GpuAssembler`] hands it to the
-//! solver where the adapter has `SHADER_F64`.
+//! set-up, giving the CPU cycle's bits on lavapipe. [`GpuProducts`] implements
+//! [`winslow::discrete::OperatorBackend`]: GMRES's product with the Newton Jacobian
+//! (its single-precision stencil storage uploaded once per Newton step) runs on the GPU
+//! too, also with the CPU's bits on lavapipe. [`GpuAssembler`] hands both to the solver
+//! where the adapter has `SHADER_F64`; the levels' and the Jacobian's stencil values are
+//! split over up to four bindings, so that neither is limited by one storage binding.
 //!
 //! Precision: f64 where the adapter offers `SHADER_F64` (lavapipe does); otherwise (or
 //! on request) the matrices run in f32 and the residual on the CPU in f64, so Newton
@@ -38,11 +42,13 @@ mod assembler;
 pub mod bench;
 mod device;
 mod multigrid;
+mod product;
 mod sample;
 
 pub use assembler::{GpuAssembler, Stats, Timings};
 pub use device::{Gpu, GpuOptions};
 pub use multigrid::{GpuCycle, GpuCycles, Operation, Vector};
+pub use product::{GpuProduct, GpuProducts};
 pub use sample::MapSample;
 
 use std::sync::Arc;

@@ -9,10 +9,14 @@
 //! parameter record in one uniform buffer (dynamic offsets). Per application only the
 //! right-hand side goes up and `x_0` comes back: every level's `b`, `x`, `r` and the
 //! transfer scratch stay on the device (`f64`), the dispatches run in one submission.
-//! Needs `SHADER_F64`: without it the cycle stays on the CPU.
+//! Needs `SHADER_F64` and seven storage bindings per stage: without them the cycle stays
+//! on the CPU. The same kernels and buffers serve the Newton Jacobian's product
+//! ([`crate::product`]).
 //!
 //! Precision per buffer: `stencil` `f32` (the CPU's `GridOperator` values, widened
-//! before each product); `reals` (line factors, transfer factors, CSR level values,
+//! before each product), split over up to four bindings of at most the adapter's
+//! storage-binding limit each ([`StencilChunks`]: the finest stencil of 10^6 unknowns,
+//! 262 MB, exceeds lavapipe's 128 MiB); `reals` (line factors, transfer factors, CSR level values,
 //! coarsest factor) and `vecs` (level vectors) `f64`; every sum in `f64`, in the CPU's
 //! order.
 
@@ -25,13 +29,16 @@ use crate::assembler::Timings;
 use crate::device::Gpu;
 use crate::{GpuError, Precision};
 
+mod dispatch;
 mod program;
 
-use program::{pack, Kernel, Layout, OpAt, Params, Recorder, Step, NONE};
+pub(crate) use dispatch::{bind, encode, read_back, Bound, StencilChunks, STORAGE_BINDINGS};
+use program::{pack, Layout, OpAt, Recorder, NONE};
+pub(crate) use program::{Kernel, Params, Step};
 
 /// Cycles run on the GPU with their times, set-ups or cycles that fell back to the CPU,
 /// and the last GPU error.
-type CycleStats = (Timings, u64, Option<String>);
+pub(crate) type CycleStats = (Timings, u64, Option<String>);
 
 /// Loop iterations one line's invocation may take on a software adapter: lavapipe cut
 /// an invocation of about 65 000 short, while lines of about 33 000 (513 unknowns on the
@@ -50,6 +57,7 @@ pub(crate) struct MultigridKernels {
     transfer_rows: wgpu::ComputePipeline,
     transfer_cols: wgpu::ComputePipeline,
     coarse_solve: wgpu::ComputePipeline,
+    system_product: wgpu::ComputePipeline,
 }
 
 /// Compile the kernels (f64 only; see the module documentation).
@@ -71,6 +79,9 @@ pub(crate) fn multigrid_kernels(device: &wgpu::Device) -> MultigridKernels {
         buffer(2, ro, false),
         buffer(3, ro, false),
         buffer(4, wgpu::BufferBindingType::Storage { read_only: false }, false),
+        buffer(5, ro, false),
+        buffer(6, ro, false),
+        buffer(7, ro, false),
     ];
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("multigrid.wgsl"),
@@ -97,6 +108,7 @@ pub(crate) fn multigrid_kernels(device: &wgpu::Device) -> MultigridKernels {
         transfer_rows: pipeline("transfer_rows"),
         transfer_cols: pipeline("transfer_cols"),
         coarse_solve: pipeline("coarse_solve"),
+        system_product: pipeline("system_product"),
         layout,
     }
 }
@@ -133,13 +145,23 @@ pub enum Vector {
 pub struct GpuCycles {
     gpu: Arc<Gpu>,
     stats: Arc<Mutex<CycleStats>>,
+    /// Largest binding of stencil values ([`StencilChunks`]).
+    chunk_bytes: u64,
 }
 
 impl GpuCycles {
     /// The back end on `gpu`; `None` without `SHADER_F64` (the cycle needs `f64`).
     pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
         gpu.multigrid.as_ref()?;
-        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))) })
+        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))), chunk_bytes: u64::MAX })
+    }
+
+    /// Bind the levels' stencil values in chunks of at most `bytes` (the adapter's
+    /// storage-binding limit otherwise; rounded down to a power of two entries), at most
+    /// four: for tests of the split at small sizes.
+    pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
+        self.chunk_bytes = bytes;
+        self
     }
 
     /// Cycles run (`calls`) and their upload, dispatch and readback seconds; set-ups
@@ -171,7 +193,6 @@ impl GpuCycles {
             ("level vectors", 8 * layout.vec_len as u64),
             ("factors", 8 * packed.reals.len() as u64),
             ("indices", 4 * packed.idx.len() as u64),
-            ("stencils", 4 * packed.stencil.len() as u64),
         ] {
             if bytes > max {
                 return Err(GpuError::TooLarge(format!("multigrid {what}: {bytes} bytes, the adapter binds {max}")));
@@ -196,59 +217,25 @@ impl GpuCycles {
             let levels = layout.levels.len();
             v_cycle(&mut rec, levels, layout.smoothing, 0);
             let program = rec.steps;
+            let stencil = StencilChunks::upload(gpu, "multigrid stencils", &packed.stencil, self.chunk_bytes)?;
+            let stencil_bindings = stencil.used(packed.stencil.len());
             let reals = gpu.storage_init("multigrid reals", bytemuck::cast_slice(&packed.reals));
             let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx));
-            let stencil = gpu.storage_init("multigrid stencils", bytemuck::cast_slice(&packed.stencil));
             let vecs = gpu.storage_init("multigrid vectors", &vec![0u8; 8 * layout.vec_len]);
             let n0 = layout.levels[0].size as u64;
             let staging = gpu.staging(8 * n0);
-            let (params, bind) = self.bind(kernels, &program, &reals, &idx, &stencil, &vecs);
+            let bound = Bound { reals: &reals, idx: &idx, stencil: &stencil, vecs: &vecs };
+            let (params, bind) = bind(gpu, kernels, &program, &bound);
             gpu.submit_wait(None)?;
             Ok(GpuCycle {
                 gpu: gpu.clone(),
                 stats: self.stats.clone(),
                 layout,
                 program,
+                stencil_bindings,
                 buffers: Mutex::new(Buffers { reals, idx, stencil, vecs, staging, _params: params, bind }),
             })
         })
-    }
-
-    /// The uniform buffer of `steps`' parameter records and the bind group over it.
-    fn bind(
-        &self,
-        kernels: &MultigridKernels,
-        steps: &[Step],
-        reals: &wgpu::Buffer,
-        idx: &wgpu::Buffer,
-        stencil: &wgpu::Buffer,
-        vecs: &wgpu::Buffer,
-    ) -> (wgpu::Buffer, wgpu::BindGroup) {
-        let mut bytes = vec![0u8; (RECORD as usize) * steps.len().max(1)];
-        for (k, s) in steps.iter().enumerate() {
-            let p = bytemuck::bytes_of(&s.params);
-            bytes[k * RECORD as usize..][..p.len()].copy_from_slice(p);
-        }
-        let params = self.gpu.uniform("multigrid params", &bytes);
-        let bind = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("multigrid"),
-            layout: &kernels.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry { binding: 1, resource: reals.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: idx.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: stencil.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: vecs.as_entire_binding() },
-            ],
-        });
-        (params, bind)
     }
 
     fn record(&self, f: impl FnOnce(&mut CycleStats)) {
@@ -279,12 +266,18 @@ impl CycleBackend for GpuCycles {
 struct Buffers {
     reals: wgpu::Buffer,
     idx: wgpu::Buffer,
-    stencil: wgpu::Buffer,
+    stencil: StencilChunks,
     vecs: wgpu::Buffer,
     staging: wgpu::Buffer,
     /// The parameter records `bind` reads.
     _params: wgpu::Buffer,
     bind: wgpu::BindGroup,
+}
+
+impl Buffers {
+    fn bound(&self) -> Bound<'_> {
+        Bound { reals: &self.reals, idx: &self.idx, stencil: &self.stencil, vecs: &self.vecs }
+    }
 }
 
 /// A V-cycle uploaded to the GPU (see the module documentation).
@@ -294,6 +287,8 @@ pub struct GpuCycle {
     stats: Arc<Mutex<CycleStats>>,
     layout: Layout,
     program: Vec<Step>,
+    /// Bindings that hold stencil values.
+    stencil_bindings: usize,
     /// Held while a call uses the buffers.
     buffers: Mutex<Buffers>,
 }
@@ -304,8 +299,9 @@ impl GpuCycle {
         self.program.len()
     }
 
-    fn kernels(&self) -> Result<&MultigridKernels, GpuError> {
-        self.gpu.multigrid.as_ref().ok_or_else(|| GpuError::Wgpu("multigrid kernels missing".into()))
+    /// Bindings the levels' stencil values were split over (1 when they fit one).
+    pub fn stencil_bindings(&self) -> usize {
+        self.stencil_bindings
     }
 
     fn lock(&self) -> Result<std::sync::MutexGuard<'_, Buffers>, GpuError> {
@@ -347,7 +343,7 @@ impl GpuCycle {
         let b = self.lock()?;
         let staging = self.gpu.staging(8 * n as u64);
         let mut out = vec![0.0; n];
-        self.read_back(&b.vecs, off, &staging, &mut out, None)?;
+        read_back(&self.gpu, &b.vecs, off, &staging, &mut out, None)?;
         Ok(out)
     }
 
@@ -365,86 +361,13 @@ impl GpuCycle {
         }
         let steps = rec.steps;
         let b = self.lock()?;
-        let cycles = GpuCycles { gpu: self.gpu.clone(), stats: self.stats.clone() };
+        let kernels = self.gpu.multigrid.as_ref().ok_or_else(|| GpuError::Wgpu("multigrid kernels missing".into()))?;
         self.gpu.scoped(|| {
-            let (_params, bind) = cycles.bind(self.kernels()?, &steps, &b.reals, &b.idx, &b.stencil, &b.vecs);
+            let (_params, bind) = bind(&self.gpu, kernels, &steps, &b.bound());
             let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-            self.encode(&mut enc, &steps, &bind)?;
+            encode(&self.gpu, &mut enc, &steps, &bind)?;
             self.gpu.submit_wait(Some(enc.finish()))
         })
-    }
-
-    /// Record `steps`, each dispatch in its own compute pass (so that it sees the writes
-    /// of the ones before it).
-    fn encode(&self, enc: &mut wgpu::CommandEncoder, steps: &[Step], bind: &wgpu::BindGroup) -> Result<(), GpuError> {
-        let k = self.kernels()?;
-        let max = self.gpu.limits.max_compute_workgroups_per_dimension.max(1) as u64;
-        for (n, s) in steps.iter().enumerate() {
-            let count = s.params.count as u64;
-            if count == 0 {
-                continue;
-            }
-            let (pipeline, per_group) = match s.kernel {
-                Kernel::Residual => (&k.residual, 64),
-                Kernel::LineSmooth => (&k.line_smooth, 64),
-                Kernel::TransferRows => (&k.transfer_rows, 64),
-                Kernel::TransferCols => (&k.transfer_cols, 64),
-                Kernel::CoarseSolve => (&k.coarse_solve, 1),
-            };
-            let groups = count.div_ceil(per_group);
-            let x = groups.min(max);
-            let y = groups.div_ceil(x);
-            if y > max {
-                return Err(GpuError::TooLarge(format!("{count} invocations in one dispatch")));
-            }
-            // a pass per dispatch: the writes of one are visible to the next
-            let mut pass = enc
-                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("multigrid"), timestamp_writes: None });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, bind, &[(n as u64 * RECORD) as u32]);
-            pass.dispatch_workgroups(x as u32, y as u32, 1);
-        }
-        Ok(())
-    }
-
-    /// Copy `out.len()` reals at byte `off` of `src` into `out` through `staging`, after
-    /// `enc`'s commands when given.
-    fn read_back(
-        &self,
-        src: &wgpu::Buffer,
-        off: u64,
-        staging: &wgpu::Buffer,
-        out: &mut [f64],
-        enc: Option<wgpu::CommandEncoder>,
-    ) -> Result<(), GpuError> {
-        let bytes = 8 * out.len() as u64;
-        if bytes == 0 {
-            return Ok(());
-        }
-        let mut enc = enc.unwrap_or_else(|| self.gpu.device.create_command_encoder(&Default::default()));
-        enc.copy_buffer_to_buffer(src, off, staging, 0, bytes);
-        self.gpu.submit_wait(Some(enc.finish()))?;
-        let slice = staging.slice(0..bytes);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            // the receiver lives until after the poll below
-            let _ = tx.send(r);
-        });
-        self.gpu
-            .device
-            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
-            .map_err(|e| GpuError::Wgpu(e.to_string()))?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-        {
-            let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-            let data = &view[..bytes as usize];
-            match bytemuck::try_cast_slice::<u8, f64>(data) {
-                Ok(v) => out.copy_from_slice(v),
-                Err(_) => out.copy_from_slice(&bytemuck::pod_collect_to_vec::<u8, f64>(data)),
-            }
-        }
-        staging.unmap();
-        Ok(())
     }
 
     /// `x = B b`: one V-cycle on the device from `x_0 = 0`.
@@ -464,11 +387,11 @@ impl GpuCycle {
             t.bytes_up += 8 * n as u64;
             let mut enc = self.gpu.device.create_command_encoder(&Default::default());
             enc.clear_buffer(&buf.vecs, at.x as u64 * 8, Some(8 * n as u64));
-            self.encode(&mut enc, &self.program, &buf.bind)?;
+            encode(&self.gpu, &mut enc, &self.program, &buf.bind)?;
             self.gpu.submit_wait(Some(enc.finish()))?;
             t.dispatch += t0.elapsed().as_secs_f64();
             let t1 = Instant::now();
-            self.read_back(&buf.vecs, at.x as u64 * 8, &buf.staging, x, None)?;
+            read_back(&self.gpu, &buf.vecs, at.x as u64 * 8, &buf.staging, x, None)?;
             t.readback += t1.elapsed().as_secs_f64();
             t.bytes_down += 8 * n as u64;
             Ok(())

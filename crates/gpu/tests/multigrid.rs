@@ -14,9 +14,13 @@
 
 use std::sync::{Arc, OnceLock};
 
+use winslow::discrete::assembly::{Discretization, Operator};
+use winslow::discrete::{PackedSystem, Stencil32};
 use winslow::linalg::multigrid_kernels::{CpuLevels, Cycle};
+use winslow::linalg::MatVec;
+use winslow::spline::knots::KnotVector;
 use winslow::testutil::{multigrid_cycle, Lcg};
-use winslow_gpu::{gpu_required, Gpu, GpuCycles, GpuOptions, Operation, Precision, Vector};
+use winslow_gpu::{gpu_required, Gpu, GpuCycles, GpuOptions, GpuProducts, Operation, Precision, Vector};
 
 fn gpu() -> Option<Arc<Gpu>> {
     static GPU: OnceLock<Option<Arc<Gpu>>> = OnceLock::new();
@@ -63,9 +67,9 @@ fn randomize(cpu: &mut CpuLevels<'_>, dev: &winslow_gpu::GpuCycle, rng: &mut Lcg
 
 /// Every operation of every level on random vectors: the GPU's result equals the CPU's
 /// (module documentation); returns whether all were bit-identical.
-fn kernels_agree(cycle: &Cycle, g: &Arc<Gpu>) -> bool {
+fn kernels_agree(cycle: &Cycle, backend: &GpuCycles) -> bool {
     let h = cycle.hierarchy();
-    let dev = GpuCycles::new(g.clone()).expect("f64 kernels").try_upload(&h).expect("upload");
+    let dev = backend.try_upload(&h).expect("upload");
     let mut cpu = cycle.cpu_levels();
     let mut rng = Lcg::new(17);
     let smoothed = h.levels.len();
@@ -126,7 +130,7 @@ fn each_kernel_equals_the_cpu() {
     let Some(g) = gpu() else { return };
     for (ne, far, t) in [(32, false, 0.03), (24, false, 3.0), (40, false, 3.0), (24, true, 3.0)] {
         let cycle = multigrid_cycle(ne, t, far).unwrap();
-        let bits = kernels_agree(&cycle, &g);
+        let bits = kernels_agree(&cycle, &GpuCycles::new(g.clone()).expect("f64 kernels"));
         eprintln!("{ne} elements, far coupling {far}: bit-identical {bits}");
         if g.is_software() {
             assert!(bits, "{ne} elements: lavapipe should give the CPU's bits");
@@ -165,6 +169,85 @@ fn one_v_cycle_equals_the_cpu_cycle() {
             cycle.apply(&b, &mut want);
             let (rel, _) = compare(&got, &want);
             assert!(rel <= 1e-7, "far {far}: relative difference to the solver's cycle {rel:e}");
+        }
+    }
+}
+
+/// The levels' stencil values split over all four bindings (chunks of 2^14 entries: 64 KiB
+/// instead of the adapter's limit) give the CPU's results, kernel by kernel and for a
+/// whole V-cycle: the split that lets the finest stencil of 10^6 unknowns (262 MB) up
+/// on lavapipe (128 MiB per binding), tested at a size CI runs.
+#[test]
+fn stencil_split_over_bindings_equals_the_cpu() {
+    let Some(g) = gpu() else { return };
+    let cycle = multigrid_cycle(32, 0.03, false).unwrap();
+    let h = cycle.hierarchy();
+    let backend = GpuCycles::new(g.clone()).unwrap().with_chunk_bytes(1 << 16);
+    let dev = backend.try_upload(&h).unwrap();
+    assert_eq!(dev.stencil_bindings(), 4, "the case should need four chunks of 2^14 entries");
+    let bits = kernels_agree(&cycle, &backend);
+    let mut rng = Lcg::new(9);
+    let b = random(h.size(0), &mut rng);
+    let mut got = vec![0.0; b.len()];
+    dev.try_apply(&b, &mut got).unwrap();
+    let mut cpu = cycle.cpu_levels();
+    cpu.b[0].copy_from_slice(&b);
+    cpu.cycle();
+    let (rel, same) = compare(&got, &cpu.x[0]);
+    assert!(rel <= 1e-12, "relative difference {rel:e}");
+    if g.is_software() {
+        assert!(bits && same, "lavapipe should give the CPU's bits with the split stencil");
+    }
+    // more than four chunks do not fit the bindings: a typed error, no upload
+    let tiny = GpuCycles::new(g.clone()).unwrap().with_chunk_bytes(1 << 15);
+    assert!(matches!(tiny.try_upload(&h), Err(winslow_gpu::GpuError::TooLarge(_))));
+}
+
+/// The EGG Jacobian (eq. 12, plain and scaled operator) of a curved map with unequal
+/// degrees and a double knot, its stencil storage rounded to `f32`: the GPU's product
+/// equals the CPU's (`PackedSystem`'s `MatVec`, which the core tests against the
+/// assembled matrix) on random vectors, twice in a row on one upload, with the values in
+/// one binding and split over two; the CPU's bits on lavapipe.
+#[test]
+fn jacobian_product_equals_the_cpu_product() {
+    let Some(g) = gpu() else { return };
+    let kx = KnotVector::open_uniform(3, 12).with_inserted(&[0.4]);
+    let ky = KnotVector::open_uniform(2, 9).with_inserted(&[0.5]);
+    let (gx, gy) = (kx.greville(), ky.greville());
+    let mut rng = Lcg::new(21);
+    let mut cps = Vec::new();
+    for &v in &gy {
+        for &u in &gx {
+            let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
+            cps.push([r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]);
+        }
+    }
+    let disc = Discretization::new([kx, ky]);
+    let n = 2 * disc.dofs.num_free();
+    assert!(disc.dofs.num_free() < disc.dofs.num_total(), "the case should have fixed functions");
+    for op in [Operator::Plain, Operator::Scaled] {
+        let mut st = vec![0.0; disc.stencil_len(2)];
+        let mut res = vec![0.0; 2 * disc.dofs.num_total()];
+        disc.egg(&cps, op, &mut res, &mut st);
+        let packed = Stencil32::pack(st);
+        let sys = PackedSystem::new(&disc, 2, &packed).expect("no periodic replicas");
+        // 16 x 12 functions, 4 x 35 entries each: 26 880 entries, two chunks of 2^14
+        for (chunk, bindings) in [(u64::MAX, 1), (1 << 16, 2)] {
+            let backend = GpuProducts::new(g.clone()).unwrap().with_chunk_bytes(chunk);
+            let dev = backend.try_upload(&sys).unwrap();
+            assert_eq!(dev.stencil_bindings(), bindings, "{} entries in chunks of {chunk} bytes", packed.len());
+            for _ in 0..2 {
+                let x = random(n, &mut rng);
+                let (mut want, mut got) = (vec![0.0; n], vec![1.0; n]);
+                sys.mul_vec(&x, &mut want);
+                dev.try_apply(&x, &mut got).unwrap();
+                let (rel, same) = compare(&got, &want);
+                assert!(rel <= 1e-12, "{op:?}, chunks of {chunk} bytes: relative difference {rel:e}");
+                if g.is_software() {
+                    assert!(same, "{op:?}, chunks of {chunk} bytes: lavapipe should give the CPU's bits");
+                }
+            }
+            assert_eq!(backend.stats().0.calls, 2);
         }
     }
 }

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 
 use super::assembly::Discretization;
 use super::dofs::FIXED;
+use crate::error::Result;
 use crate::linalg::krylov::MatVec;
 
 /// Functions of the stencil product per parallel task (their rows of every component).
@@ -45,7 +46,7 @@ impl StencilValues for [f64] {
 /// (relative change at most `2^-24` per entry) inside the `f64` Newton iteration, whose
 /// residual `F` stays exact (BENCHMARKS.md, "Under 1 KiB per unknown").
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Stencil32 {
+pub struct Stencil32 {
     words: Vec<u64>,
     len: usize,
 }
@@ -67,6 +68,23 @@ impl Stencil32 {
         words.truncate(half);
         words.shrink_to_fit();
         Self { words, len }
+    }
+
+    /// The storage: entry `i` is `f32::from_bits` of the low 32 bits of word `i / 2`
+    /// when `i` is even, of the high 32 bits when odd (in memory on a little-endian
+    /// machine: the `f32` entries in order).
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether there are no entries.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
     }
 }
 
@@ -239,6 +257,79 @@ impl<S: StencilValues + ?Sized> MatVec for StencilOperator<'_, S> {
         let done = self.disc.stencil_product(self.ncomp, self.stencil, x, y);
         debug_assert!(done, "checked in StencilOperator::new");
     }
+}
+
+/// The free-free system of `ncomp` components on `disc` held as its stencil storage in
+/// single precision ([`Stencil32`]; the Newton Jacobian of eq. 12 that GMRES multiplies
+/// with under the multigrid preconditioner): what an [`OperatorBackend`] uploads, and
+/// the CPU's product with it ([`MatVec`]: [`Discretization::stencil_product`], row
+/// `z m + f` summed as `Csr::mul_vec` sums it), which the back end reproduces. Only for
+/// a basis without periodic replicas.
+#[derive(Debug, Clone, Copy)]
+pub struct PackedSystem<'a> {
+    disc: &'a Discretization,
+    ncomp: usize,
+    values: &'a Stencil32,
+}
+
+impl<'a> PackedSystem<'a> {
+    /// The system of `ncomp` components with stencil storage `values` on `disc`; `None`
+    /// when `disc` has periodic replicas or `values` has the wrong length
+    /// ([`Discretization::stencil_len`]).
+    pub fn new(disc: &'a Discretization, ncomp: usize, values: &'a Stencil32) -> Option<Self> {
+        StencilOperator::new(disc, ncomp, values).map(|_| Self { disc, ncomp, values })
+    }
+
+    /// The basis: its shape, degrees (the stencil half widths) and free functions.
+    pub fn discretization(&self) -> &'a Discretization {
+        self.disc
+    }
+
+    /// Components `c`: entry `(k c^2 + z c + d) sw + s` couples component `z` of
+    /// function `k` with component `d` of its neighbour in slot `s`
+    /// (`sw = (2p + 1)(2q + 1)`, slot `dj (2p + 1) + di`).
+    pub fn components(&self) -> usize {
+        self.ncomp
+    }
+
+    /// The values.
+    pub fn values(&self) -> &'a Stencil32 {
+        self.values
+    }
+
+    /// Rows (and columns): `c m`.
+    pub fn size(&self) -> usize {
+        self.ncomp * self.disc.dofs.num_free()
+    }
+}
+
+impl MatVec for PackedSystem<'_> {
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        let done = self.disc.stencil_product(self.ncomp, self.values, x, y);
+        debug_assert!(done, "checked in PackedSystem::new");
+    }
+}
+
+/// A back end that multiplies with a [`PackedSystem`] where its data lives (the GPU
+/// crate's kernel): it uploads the system once (per Newton step) and applies it per
+/// product; without one (the default) the CPU multiplies ([`MatVec`] of
+/// [`PackedSystem`]).
+pub trait OperatorBackend: Send + Sync + std::fmt::Debug {
+    /// The system on the back end, or why it cannot go there (the caller then keeps the
+    /// CPU product).
+    ///
+    /// Errors: the back end's, as [`crate::Error::LinearSolver`].
+    fn upload(&self, system: &PackedSystem<'_>) -> Result<Box<dyn DeviceOperator>>;
+}
+
+/// A [`PackedSystem`] uploaded to a back end.
+pub trait DeviceOperator: Send + Sync + std::fmt::Debug {
+    /// `y = A x`, the product of [`PackedSystem`]'s [`MatVec`] (to rounding; its bits
+    /// where the back end does the same operations in the same order).
+    ///
+    /// Errors: the back end's, as [`crate::Error::LinearSolver`] (the caller then
+    /// multiplies on the CPU).
+    fn apply(&self, x: &[f64], y: &mut [f64]) -> Result<()>;
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
 
 use crate::discrete::assembly::{Discretization, Operator};
-use crate::discrete::stencil::Stencil32;
+use crate::discrete::stencil::{OperatorBackend, PackedSystem, Stencil32};
 use crate::linalg::multigrid_kernels::CycleBackend;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
@@ -43,6 +43,12 @@ pub trait EggAssembler: Send + Sync {
     /// The kernels that run a multigrid V-cycle's level work on this back end
     /// ([`crate::linalg::multigrid_kernels`]); `None` (the default): the CPU.
     fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
+        None
+    }
+    /// The kernel that multiplies with the Newton Jacobian's single-precision stencil
+    /// storage on this back end ([`OperatorBackend`]: GMRES's product under the
+    /// multigrid preconditioner); `None` (the default): the CPU.
+    fn operator_backend(&self) -> Option<Arc<dyn OperatorBackend>> {
         None
     }
 }
@@ -168,19 +174,30 @@ impl DiscreteProblem for EggProblem {
         if !s.disc.dofs.replicas().is_empty() {
             return false;
         }
-        s.packed = None;
+        (s.packed, s.device) = (None, None);
         s.load_for_jacobian(c);
         self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
         s.restrict_residual(f);
-        s.packed = Some(Stencil32::pack(std::mem::take(&mut s.stencil)));
+        let packed = s.packed.insert(Stencil32::pack(std::mem::take(&mut s.stencil)));
+        // uploaded once per Newton step where the back end multiplies (the CPU product
+        // otherwise, and where the upload fails: the back end says why)
+        s.device = self
+            .assembler
+            .operator_backend()
+            .zip(PackedSystem::new(&s.disc, 2, packed))
+            .and_then(|(b, sys)| b.upload(&sys).ok());
         true
     }
 
     /// `y = J x` with the single-precision Jacobian of the last
-    /// [`DiscreteProblem::jacobian_operator`] (the `f64` stencil storage when there is
-    /// none).
+    /// [`DiscreteProblem::jacobian_operator`]: on the operator back end where it was
+    /// uploaded (the CPU's product where that fails), else on the CPU (the `f64` stencil
+    /// storage when there is no packed one).
     fn jacobian_product(&self, x: &[f64], y: &mut [f64]) {
         let s = &self.state;
+        if s.device.as_ref().is_some_and(|d| d.apply(x, y).is_ok()) {
+            return;
+        }
         match &s.packed {
             Some(j) => s.disc.stencil_product(2, j, x, y),
             None => s.disc.stencil_product(2, &s.stencil[..], x, y),

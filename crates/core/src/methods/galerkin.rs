@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use crate::discrete::assembly::Discretization;
-use crate::discrete::stencil::Stencil32;
+use crate::discrete::stencil::{DeviceOperator, Stencil32};
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
@@ -27,6 +27,9 @@ pub(crate) struct GalerkinState {
     /// The vector system's stencil storage rounded to single precision, for products
     /// only (`discrete::stencil::Stencil32`; the Jacobian operator of EGG).
     pub packed: Option<Stencil32>,
+    /// [`GalerkinState::packed`] uploaded to the assembler's operator back end
+    /// (`discrete::stencil::OperatorBackend`), where there is one.
+    pub device: Option<Box<dyn DeviceOperator>>,
     mass: Option<Csr>,
     pstencil: Vec<f64>,
     prec: Csr,
@@ -41,6 +44,7 @@ impl GalerkinState {
             res_full: vec![0.0; 2 * n],
             stencil: Vec::new(),
             packed: None,
+            device: None,
             mass: None,
             pstencil: Vec::new(),
             prec: Csr::default(),

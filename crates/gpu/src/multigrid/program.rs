@@ -11,47 +11,55 @@ use crate::GpuError;
 /// The parameter record of `multigrid.wgsl` (all `u32`; `Params` there).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct Params {
-    pub(super) count: u32,
-    pub(super) op_kind: u32,
-    pub(super) nx: u32,
-    pub(super) ny: u32,
-    pub(super) bx: u32,
-    pub(super) by: u32,
-    pub(super) st_off: u32,
-    pub(super) csr_ptr: u32,
-    pub(super) csr_col: u32,
-    pub(super) csr_val: u32,
-    pub(super) b_off: u32,
-    pub(super) x_off: u32,
-    pub(super) r_off: u32,
-    pub(super) l_starts: u32,
-    pub(super) l_stride: u32,
-    pub(super) l_len: u32,
-    pub(super) l_bw: u32,
-    pub(super) l_fac: u32,
-    pub(super) l_first: u32,
-    pub(super) l_step: u32,
-    pub(super) a_ptr: u32,
-    pub(super) a_col: u32,
-    pub(super) a_val: u32,
-    pub(super) m0: u32,
-    pub(super) n0: u32,
-    pub(super) in_off: u32,
-    pub(super) out_off: u32,
-    pub(super) t_off: u32,
-    pub(super) accumulate: u32,
-    pub(super) zero_off: u32,
-    pub(super) cn: u32,
-    pub(super) c_fac: u32,
-    pub(super) c_lo: u32,
-    pub(super) c_hi: u32,
-    pub(super) c_phase: u32,
-    pub(super) c_pad: u32,
+pub(crate) struct Params {
+    pub(crate) count: u32,
+    pub(crate) op_kind: u32,
+    pub(crate) nx: u32,
+    pub(crate) ny: u32,
+    pub(crate) bx: u32,
+    pub(crate) by: u32,
+    pub(crate) st_off: u32,
+    pub(crate) csr_ptr: u32,
+    pub(crate) csr_col: u32,
+    pub(crate) csr_val: u32,
+    pub(crate) b_off: u32,
+    pub(crate) x_off: u32,
+    pub(crate) r_off: u32,
+    pub(crate) l_starts: u32,
+    pub(crate) l_stride: u32,
+    pub(crate) l_len: u32,
+    pub(crate) l_bw: u32,
+    pub(crate) l_fac: u32,
+    pub(crate) l_first: u32,
+    pub(crate) l_step: u32,
+    pub(crate) a_ptr: u32,
+    pub(crate) a_col: u32,
+    pub(crate) a_val: u32,
+    pub(crate) m0: u32,
+    pub(crate) n0: u32,
+    pub(crate) in_off: u32,
+    pub(crate) out_off: u32,
+    pub(crate) t_off: u32,
+    pub(crate) accumulate: u32,
+    pub(crate) zero_off: u32,
+    pub(crate) cn: u32,
+    pub(crate) c_fac: u32,
+    pub(crate) c_lo: u32,
+    pub(crate) c_hi: u32,
+    pub(crate) c_phase: u32,
+    pub(crate) c_pad: u32,
+    pub(crate) st_shift: u32,
+    pub(crate) st_mask: u32,
+    pub(crate) s_free: u32,
+    pub(crate) s_free_of: u32,
+    pub(crate) s_m: u32,
+    pub(crate) s_comp: u32,
+    pub(crate) s_pad0: u32,
+    pub(crate) s_pad1: u32,
 }
 
 /// `NONE` of the shader: no vector to zero.
-pub(super) const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 /// Multiply-adds per dispatch of the coarsest solve (one invocation): lavapipe cut a
 /// single invocation of the whole solve at 289 unknowns (about 65 000 loop iterations)
 /// short, so it runs in row blocks of about this much work.
@@ -59,71 +67,73 @@ const COARSE_WORK: usize = 4096;
 
 /// Which kernel a recorded step runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Kernel {
+pub(crate) enum Kernel {
     Residual,
     LineSmooth,
     TransferRows,
     TransferCols,
     CoarseSolve,
+    /// `system_product` (the Galerkin system's product, `crate::product`).
+    SystemProduct,
 }
 
 /// One dispatch of the recorded cycle.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Step {
-    pub(super) kernel: Kernel,
-    pub(super) params: Params,
+pub(crate) struct Step {
+    pub(crate) kernel: Kernel,
+    pub(crate) params: Params,
 }
 
 /// Where a level's operator lives.
 #[derive(Debug, Clone, Copy)]
-pub(super) enum OpAt {
+pub(crate) enum OpAt {
     Stencil { nx: u32, ny: u32, bx: u32, by: u32, st_off: u32 },
     Csr { ptr: u32, col: u32, val: u32 },
 }
 
 /// Where a direction's lines live.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct LinesAt {
-    pub(super) starts: u32,
-    pub(super) stride: u32,
-    pub(super) len: u32,
-    pub(super) bw: u32,
-    pub(super) fac: u32,
-    pub(super) colours: u32,
-    pub(super) count: u32,
+pub(crate) struct LinesAt {
+    pub(crate) starts: u32,
+    pub(crate) stride: u32,
+    pub(crate) len: u32,
+    pub(crate) bw: u32,
+    pub(crate) fac: u32,
+    pub(crate) colours: u32,
+    pub(crate) count: u32,
 }
 
 /// A 1D factor in `idx` / `reals`: row pointers, columns, values, rows, columns.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FactorAt {
-    pub(super) ptr: u32,
-    pub(super) col: u32,
-    pub(super) val: u32,
-    pub(super) rows: u32,
-    pub(super) cols: u32,
+pub(crate) struct FactorAt {
+    pub(crate) ptr: u32,
+    pub(crate) col: u32,
+    pub(crate) val: u32,
+    pub(crate) rows: u32,
+    pub(crate) cols: u32,
 }
 
 /// Offsets of everything a level's operations read and write.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct LevelAt {
-    pub(super) size: u32,
-    pub(super) b: u32,
-    pub(super) x: u32,
-    pub(super) r: u32,
-    pub(super) op: Option<OpAt>,
-    pub(super) lines: Option<[LinesAt; 2]>,
+pub(crate) struct LevelAt {
+    pub(crate) size: u32,
+    pub(crate) b: u32,
+    pub(crate) x: u32,
+    pub(crate) r: u32,
+    pub(crate) op: Option<OpAt>,
+    pub(crate) lines: Option<[LinesAt; 2]>,
 }
 
 /// The layout of an uploaded hierarchy.
 #[derive(Debug, Clone)]
-pub(super) struct Layout {
-    pub(super) levels: Vec<LevelAt>,
+pub(crate) struct Layout {
+    pub(crate) levels: Vec<LevelAt>,
     /// Per transfer: `[P_0, P_1]` and `[P_0^T, P_1^T]`.
-    pub(super) transfers: Vec<([FactorAt; 2], [FactorAt; 2])>,
-    pub(super) coarse_fac: u32,
-    pub(super) t_off: u32,
-    pub(super) vec_len: usize,
-    pub(super) smoothing: Smoothing,
+    pub(crate) transfers: Vec<([FactorAt; 2], [FactorAt; 2])>,
+    pub(crate) coarse_fac: u32,
+    pub(crate) t_off: u32,
+    pub(crate) vec_len: usize,
+    pub(crate) smoothing: Smoothing,
 }
 
 fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
@@ -132,10 +142,10 @@ fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
 
 /// The host copies of the uploaded buffers, being built.
 #[derive(Default)]
-pub(super) struct Packed {
-    pub(super) reals: Vec<f64>,
-    pub(super) idx: Vec<u32>,
-    pub(super) stencil: Vec<f32>,
+pub(crate) struct Packed {
+    pub(crate) reals: Vec<f64>,
+    pub(crate) idx: Vec<u32>,
+    pub(crate) stencil: Vec<f32>,
 }
 
 impl Packed {
@@ -173,7 +183,7 @@ impl Packed {
 }
 
 /// Pack `h` into the three read-only buffers and lay out the vectors.
-pub(super) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
+pub(crate) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
     let mut p = Packed::default();
     let mut levels = Vec::new();
     let mut off = 0usize;
@@ -237,9 +247,9 @@ pub(super) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
 }
 
 /// Records the dispatches of [`LevelKernels`] operations.
-pub(super) struct Recorder<'a> {
-    pub(super) layout: &'a Layout,
-    pub(super) steps: Vec<Step>,
+pub(crate) struct Recorder<'a> {
+    pub(crate) layout: &'a Layout,
+    pub(crate) steps: Vec<Step>,
 }
 
 impl Recorder<'_> {

@@ -1,0 +1,195 @@
+//! What the multigrid cycle ([`super::GpuCycle`]) and the system product
+//! ([`crate::product`]) share on the device: the stencil values split over several
+//! bindings ([`StencilChunks`]), the bind group over the kernels' buffers ([`bind`]), the
+//! recording of dispatches ([`encode`]) and the readback of `f64` vectors ([`read_back`]).
+
+use super::program::{Kernel, Params, Step};
+use super::{MultigridKernels, RECORD};
+use crate::device::Gpu;
+use crate::GpuError;
+
+/// Bindings of the stencil values (`stencil0` .. `stencil3` of `shaders/multigrid.wgsl`).
+pub(crate) const STENCIL_BINDINGS: usize = 4;
+
+/// Storage buffers the kernels bind (`reals`, `idx`, `vecs` and the stencil chunks): the
+/// kernels are compiled only where the adapter allows this many per shader stage.
+pub(crate) const STORAGE_BINDINGS: u32 = 3 + STENCIL_BINDINGS as u32;
+
+/// Single-precision stencil values in up to [`STENCIL_BINDINGS`] buffers of `2^shift`
+/// entries each (the last one shorter; unused bindings get a 16-byte placeholder), so
+/// that no binding exceeds the adapter's storage-binding limit: entry `g` lies in
+/// buffer `g >> shift` at `g & (2^shift - 1)` (`st_at` of the shader).
+#[derive(Debug)]
+pub(crate) struct StencilChunks {
+    buffers: Vec<wgpu::Buffer>,
+    shift: u32,
+}
+
+impl StencilChunks {
+    /// Upload `values` in chunks of at most `max_bytes` (and the adapter's binding and
+    /// buffer limits), rounded down to a power of two entries.
+    ///
+    /// Errors: [`GpuError::TooLarge`] when more than [`STENCIL_BINDINGS`] chunks are
+    /// needed.
+    pub(crate) fn upload(gpu: &Gpu, what: &str, values: &[f32], max_bytes: u64) -> Result<Self, GpuError> {
+        let limit = max_bytes.min(gpu.limits.max_storage_buffer_binding_size).min(gpu.limits.max_buffer_size);
+        let entries = (limit / 4).max(1);
+        let shift = (63 - entries.leading_zeros()).min(31);
+        let chunk = 1usize << shift;
+        let parts = values.len().div_ceil(chunk).max(1);
+        if parts > STENCIL_BINDINGS {
+            return Err(GpuError::TooLarge(format!(
+                "{what}: {} bytes of stencil values, {STENCIL_BINDINGS} bindings of {} bytes",
+                4 * values.len(),
+                4 * chunk
+            )));
+        }
+        let mut buffers: Vec<wgpu::Buffer> =
+            values.chunks(chunk).map(|c| gpu.storage_init(what, bytemuck::cast_slice(c))).collect();
+        while buffers.len() < STENCIL_BINDINGS {
+            buffers.push(gpu.storage_init(what, &[0u8; 16]));
+        }
+        Ok(Self { buffers, shift })
+    }
+
+    /// Buffers holding values (the placeholders not counted).
+    pub(crate) fn used(&self, len: usize) -> usize {
+        len.div_ceil(1usize << self.shift).max(1)
+    }
+
+    /// `p` with the chunk size of these buffers.
+    fn params(&self, mut p: Params) -> Params {
+        p.st_shift = self.shift;
+        p.st_mask = ((1u64 << self.shift) - 1) as u32;
+        p
+    }
+}
+
+/// The buffers of one bind group of the kernels.
+pub(crate) struct Bound<'a> {
+    pub(crate) reals: &'a wgpu::Buffer,
+    pub(crate) idx: &'a wgpu::Buffer,
+    pub(crate) stencil: &'a StencilChunks,
+    pub(crate) vecs: &'a wgpu::Buffer,
+}
+
+/// The uniform buffer of `steps`' parameter records (each with the chunk size of
+/// `b.stencil`) and the bind group over it and `b`.
+pub(crate) fn bind(
+    gpu: &Gpu,
+    kernels: &MultigridKernels,
+    steps: &[Step],
+    b: &Bound<'_>,
+) -> (wgpu::Buffer, wgpu::BindGroup) {
+    let mut bytes = vec![0u8; (RECORD as usize) * steps.len().max(1)];
+    for (k, s) in steps.iter().enumerate() {
+        let params = b.stencil.params(s.params);
+        let p = bytemuck::bytes_of(&params);
+        bytes[k * RECORD as usize..][..p.len()].copy_from_slice(p);
+    }
+    let params = gpu.uniform("multigrid params", &bytes);
+    fn whole(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+        wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+    }
+    let st = &b.stencil.buffers;
+    let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("multigrid"),
+        layout: &kernels.layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                }),
+            },
+            whole(1, b.reals),
+            whole(2, b.idx),
+            whole(3, &st[0]),
+            whole(4, b.vecs),
+            whole(5, &st[1]),
+            whole(6, &st[2]),
+            whole(7, &st[3]),
+        ],
+    });
+    (params, bind)
+}
+
+/// Record `steps` (each with its record of `bind`), each dispatch in its own compute
+/// pass (so that it sees the writes of the ones before it).
+pub(crate) fn encode(
+    gpu: &Gpu,
+    enc: &mut wgpu::CommandEncoder,
+    steps: &[Step],
+    bind: &wgpu::BindGroup,
+) -> Result<(), GpuError> {
+    let k = gpu.multigrid.as_ref().ok_or_else(|| GpuError::Wgpu("multigrid kernels missing".into()))?;
+    let max = gpu.limits.max_compute_workgroups_per_dimension.max(1) as u64;
+    for (n, s) in steps.iter().enumerate() {
+        let count = s.params.count as u64;
+        if count == 0 {
+            continue;
+        }
+        let (pipeline, per_group) = match s.kernel {
+            Kernel::Residual => (&k.residual, 64),
+            Kernel::LineSmooth => (&k.line_smooth, 64),
+            Kernel::TransferRows => (&k.transfer_rows, 64),
+            Kernel::TransferCols => (&k.transfer_cols, 64),
+            Kernel::CoarseSolve => (&k.coarse_solve, 1),
+            Kernel::SystemProduct => (&k.system_product, 64),
+        };
+        let groups = count.div_ceil(per_group);
+        let x = groups.min(max);
+        let y = groups.div_ceil(x);
+        if y > max {
+            return Err(GpuError::TooLarge(format!("{count} invocations in one dispatch")));
+        }
+        // a pass per dispatch: the writes of one are visible to the next
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("multigrid"), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind, &[(n as u64 * RECORD) as u32]);
+        pass.dispatch_workgroups(x as u32, y as u32, 1);
+    }
+    Ok(())
+}
+
+/// Copy `out.len()` reals (`f64`) at byte `off` of `src` into `out` through `staging`,
+/// after `enc`'s commands when given.
+pub(crate) fn read_back(
+    gpu: &Gpu,
+    src: &wgpu::Buffer,
+    off: u64,
+    staging: &wgpu::Buffer,
+    out: &mut [f64],
+    enc: Option<wgpu::CommandEncoder>,
+) -> Result<(), GpuError> {
+    let bytes = 8 * out.len() as u64;
+    if bytes == 0 {
+        return Ok(());
+    }
+    let mut enc = enc.unwrap_or_else(|| gpu.device.create_command_encoder(&Default::default()));
+    enc.copy_buffer_to_buffer(src, off, staging, 0, bytes);
+    gpu.submit_wait(Some(enc.finish()))?;
+    let slice = staging.slice(0..bytes);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        // the receiver lives until after the poll below
+        let _ = tx.send(r);
+    });
+    gpu.device
+        .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
+        .map_err(|e| GpuError::Wgpu(e.to_string()))?;
+    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    {
+        let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+        let data = &view[..bytes as usize];
+        match bytemuck::try_cast_slice::<u8, f64>(data) {
+            Ok(v) => out.copy_from_slice(v),
+            Err(_) => out.copy_from_slice(&bytemuck::pod_collect_to_vec::<u8, f64>(data)),
+        }
+    }
+    staging.unmap();
+    Ok(())
+}

@@ -1,0 +1,258 @@
+//! The Newton Jacobian's product on the GPU ([`GpuProducts`], the core's
+//! [`OperatorBackend`]): under `--linear multigrid` GMRES multiplies with the Jacobian of
+//! eq. (12) held as its single-precision stencil storage
+//! ([`winslow::discrete::PackedSystem`]); here that storage goes up once per Newton step
+//! (split over up to four bindings, [`StencilChunks`]) with the free functions' indices,
+//! and each product `y = J x` is one dispatch of `system_product`
+//! (`shaders/multigrid.wgsl`, one invocation per row, the CPU's terms added in the
+//! CPU's order: on lavapipe the CPU product's bits). Per product `x` goes up and `y`
+//! comes back (`8 c m` bytes each way); GMRES's basis and the rest of its iteration stay
+//! on the CPU.
+
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use winslow::discrete::dofs::FIXED;
+use winslow::discrete::{DeviceOperator, OperatorBackend, PackedSystem};
+
+use crate::assembler::Timings;
+use crate::device::Gpu;
+use crate::multigrid::{bind, encode, read_back, Bound, CycleStats, Kernel, Params, StencilChunks, Step};
+use crate::GpuError;
+
+/// The GPU's product back end, shared by the assembler that hands it to the solver;
+/// counts the products and their times.
+#[derive(Debug)]
+pub struct GpuProducts {
+    gpu: Arc<Gpu>,
+    stats: Arc<Mutex<CycleStats>>,
+    chunk_bytes: u64,
+}
+
+fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
+    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("system product: {what} = {v} exceeds 32 bits")))
+}
+
+/// The values of `s` as `f32` (in place on a little-endian machine).
+fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
+    let v = s.values();
+    if cfg!(target_endian = "little") {
+        std::borrow::Cow::Borrowed(&bytemuck::cast_slice::<u64, f32>(v.words())[..v.len()])
+    } else {
+        let at = |i: usize| f32::from_bits((v.words()[i >> 1] >> ((i & 1) * 32)) as u32);
+        std::borrow::Cow::Owned((0..v.len()).map(at).collect())
+    }
+}
+
+impl GpuProducts {
+    /// The back end on `gpu`; `None` without the `f64` kernels (`SHADER_F64`).
+    pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
+        gpu.multigrid.as_ref()?;
+        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))), chunk_bytes: u64::MAX })
+    }
+
+    /// Bind the stencil values in chunks of at most `bytes` (as
+    /// [`crate::GpuCycles::with_chunk_bytes`]).
+    pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
+        self.chunk_bytes = bytes;
+        self
+    }
+
+    /// Products run (`calls`) with their upload, dispatch and readback seconds; uploads or
+    /// products that fell back to the CPU and the last reason.
+    pub fn stats(&self) -> (Timings, u64, Option<String>) {
+        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+    }
+
+    /// Zero the statistics.
+    pub fn reset_stats(&self) {
+        if let Ok(mut s) = self.stats.lock() {
+            *s = Default::default();
+        }
+    }
+
+    /// Upload `sys`: the free functions' global indices, every function's free index,
+    /// the values.
+    ///
+    /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
+    /// fails.
+    pub fn try_upload(&self, sys: &PackedSystem<'_>) -> Result<GpuProduct, GpuError> {
+        let gpu = &self.gpu;
+        let kernels = gpu
+            .multigrid
+            .as_ref()
+            .ok_or_else(|| GpuError::NoAdapter(" with SHADER_F64 for the system product".into()))?;
+        let t0 = Instant::now();
+        let disc = sys.discretization();
+        let dofs = &disc.dofs;
+        let (m, n) = (dofs.num_free(), sys.size());
+        let [nx, ny] = disc.shape();
+        let (p, q) = disc.degrees();
+        let mut idx = Vec::with_capacity(m + dofs.num_total());
+        for &k in dofs.free() {
+            idx.push(to_u32(k, "function")?);
+        }
+        for k in 0..dofs.num_total() {
+            idx.push(match dofs.free_index(k) {
+                FIXED => u32::MAX,
+                f => to_u32(f, "free index")?,
+            });
+        }
+        to_u32(sys.values().len(), "stencil entries")?;
+        let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+        for (what, bytes) in [("vectors", 16 * n as u64), ("indices", 4 * idx.len() as u64)] {
+            if bytes > max {
+                return Err(GpuError::TooLarge(format!(
+                    "system product {what}: {bytes} bytes, the adapter binds {max}"
+                )));
+            }
+        }
+        let params = Params {
+            count: to_u32(n, "rows")?,
+            nx: to_u32(nx, "shape")?,
+            ny: to_u32(ny, "shape")?,
+            bx: to_u32(p, "degree")?,
+            by: to_u32(q, "degree")?,
+            x_off: 0,
+            r_off: to_u32(n, "rows")?,
+            s_free: 0,
+            s_free_of: to_u32(m, "free functions")?,
+            s_m: to_u32(m, "free functions")?,
+            s_comp: to_u32(sys.components(), "components")?,
+            ..Default::default()
+        };
+        let step = [Step { kernel: Kernel::SystemProduct, params }];
+        let values = values(sys);
+        let device = gpu.scoped(|| {
+            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.chunk_bytes)?;
+            let stencil_bindings = stencil.used(values.len());
+            let idx = gpu.storage_init("system indices", bytemuck::cast_slice(&idx));
+            let reals = gpu.storage_init("system reals", &[0u8; 16]);
+            let vecs = gpu.storage_empty("system vectors", 2 * n as u64);
+            let staging = gpu.staging(8 * n as u64);
+            let bound = Bound { reals: &reals, idx: &idx, stencil: &stencil, vecs: &vecs };
+            let (params, bind) = bind(gpu, kernels, &step, &bound);
+            gpu.submit_wait(None)?;
+            Ok(GpuProduct {
+                gpu: gpu.clone(),
+                stats: self.stats.clone(),
+                n,
+                step,
+                stencil_bindings,
+                buffers: Mutex::new(Buffers {
+                    _stencil: stencil,
+                    _idx: idx,
+                    _reals: reals,
+                    vecs,
+                    staging,
+                    _params: params,
+                    bind,
+                }),
+            })
+        })?;
+        let bytes = 4 * values.len() as u64 + 4 * (m + dofs.num_total()) as u64;
+        self.record(|s| {
+            s.0.upload += t0.elapsed().as_secs_f64();
+            s.0.bytes_up += bytes;
+        });
+        Ok(device)
+    }
+
+    fn record(&self, f: impl FnOnce(&mut CycleStats)) {
+        if let Ok(mut s) = self.stats.lock() {
+            f(&mut s);
+        }
+    }
+}
+
+impl OperatorBackend for GpuProducts {
+    fn upload(&self, system: &PackedSystem<'_>) -> winslow::Result<Box<dyn DeviceOperator>> {
+        match self.try_upload(system) {
+            Ok(p) => Ok(Box::new(p)),
+            Err(e) => {
+                eprintln!("warning: GPU Jacobian product set-up: {e}; the products run on the CPU");
+                self.record(|s| {
+                    s.1 += 1;
+                    s.2 = Some(e.to_string());
+                });
+                Err(winslow::Error::LinearSolver(format!("GPU Jacobian product set-up: {e}")))
+            }
+        }
+    }
+}
+
+/// The device buffers of an uploaded system.
+#[derive(Debug)]
+struct Buffers {
+    /// The values, indices and placeholder the bind group reads.
+    _stencil: StencilChunks,
+    _idx: wgpu::Buffer,
+    _reals: wgpu::Buffer,
+    /// `x` (the first `n` values) and `y`.
+    vecs: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    _params: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+/// A system uploaded to the GPU (see the module documentation).
+#[derive(Debug)]
+pub struct GpuProduct {
+    gpu: Arc<Gpu>,
+    stats: Arc<Mutex<CycleStats>>,
+    n: usize,
+    step: [Step; 1],
+    stencil_bindings: usize,
+    /// Held while a product uses the buffers.
+    buffers: Mutex<Buffers>,
+}
+
+impl GpuProduct {
+    /// Bindings the values were split over (1 when they fit one).
+    pub fn stencil_bindings(&self) -> usize {
+        self.stencil_bindings
+    }
+
+    /// `y = A x` on the device.
+    ///
+    /// Errors: lengths that do not match the system, and wgpu's.
+    pub fn try_apply(&self, x: &[f64], y: &mut [f64]) -> Result<(), GpuError> {
+        let n = self.n;
+        if x.len() != n || y.len() != n {
+            return Err(GpuError::Wgpu(format!("{} / {} values for a system of {n}", x.len(), y.len())));
+        }
+        let buf = self.buffers.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
+        let mut t = Timings { calls: 1, ..Default::default() };
+        let t0 = Instant::now();
+        self.gpu.scoped(|| {
+            self.gpu.queue.write_buffer(&buf.vecs, 0, bytemuck::cast_slice(x));
+            t.bytes_up += 8 * n as u64;
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            encode(&self.gpu, &mut enc, &self.step, &buf.bind)?;
+            self.gpu.submit_wait(Some(enc.finish()))?;
+            t.dispatch += t0.elapsed().as_secs_f64();
+            let t1 = Instant::now();
+            read_back(&self.gpu, &buf.vecs, 8 * n as u64, &buf.staging, y, None)?;
+            t.readback += t1.elapsed().as_secs_f64();
+            t.bytes_down += 8 * n as u64;
+            Ok(())
+        })?;
+        if let Ok(mut s) = self.stats.lock() {
+            s.0.add(&t);
+        }
+        Ok(())
+    }
+}
+
+impl DeviceOperator for GpuProduct {
+    fn apply(&self, x: &[f64], y: &mut [f64]) -> winslow::Result<()> {
+        self.try_apply(x, y).map_err(|e| {
+            eprintln!("warning: GPU Jacobian product: {e}; this product runs on the CPU");
+            if let Ok(mut s) = self.stats.lock() {
+                s.1 += 1;
+                s.2 = Some(e.to_string());
+            }
+            winslow::Error::LinearSolver(format!("GPU Jacobian product: {e}"))
+        })
+    }
+}
