@@ -101,19 +101,8 @@ pub(crate) fn stretched_laplacian(
     ne: usize,
     t: f64,
 ) -> (crate::discrete::assembly::Discretization, crate::linalg::sparse::Csr) {
-    use crate::discrete::assembly::{Discretization, Operator};
-    use crate::spline::knots::KnotVector;
-    let kv = KnotVector::open_uniform(3, ne);
-    let disc = Discretization::new([kv.clone(), kv.clone()]);
-    let g = kv.greville();
-    let mut cps = Vec::new();
-    for &v in &g {
-        for &u in &g {
-            let r = 1.0 + t * v * v;
-            let a = std::f64::consts::FRAC_PI_2 * (u + 0.2 * u * (1.0 - u) * v);
-            cps.push([r * a.cos(), r * a.sin()]);
-        }
-    }
+    use crate::discrete::assembly::Operator;
+    let (disc, cps) = stretched_map(ne, t);
     let mut st = vec![0.0; disc.stencil_len(1)];
     disc.metric_laplace(&cps, Operator::Scaled, 0.0, &mut st);
     let k = disc.scalar.matrix(&st);
@@ -158,6 +147,26 @@ pub fn multigrid_cycle(ne: usize, t: f64, far: bool) -> crate::Result<crate::lin
     }
     let p = crate::discrete::transfers::free_prolongation_factors(&disc)?;
     crate::linalg::multigrid_kernels::Cycle::new(p, k)
+}
+
+/// The basis and control points of [`multigrid_cycle`]'s map (the stretched, sheared
+/// quarter annulus of degree 3 on `ne x ne` elements, radii 1 and `1 + t`): the map whose
+/// EGG Jacobian the GPU product's benchmark multiplies with.
+pub fn stretched_map(ne: usize, t: f64) -> (crate::discrete::assembly::Discretization, Vec<[f64; 2]>) {
+    use crate::discrete::assembly::Discretization;
+    use crate::spline::knots::KnotVector;
+    let kv = KnotVector::open_uniform(3, ne);
+    let disc = Discretization::new([kv.clone(), kv.clone()]);
+    let g = kv.greville();
+    let mut cps = Vec::new();
+    for &v in &g {
+        for &u in &g {
+            let r = 1.0 + t * v * v;
+            let a = std::f64::consts::FRAC_PI_2 * (u + 0.2 * u * (1.0 - u) * v);
+            cps.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    (disc, cps)
 }
 
 /// The unsymmetric tridiagonal matrix `tridiag(-1, 2.5, -1.2)` of size `n` (a 1D
