@@ -9,11 +9,12 @@ alias real = f64;
 // without fused multiply-adds the results are the CPU's bits):
 //
 // - `residual`: r = b - A x on a level, one invocation per row;
-// - `line_smooth`: one colour of a coloured line Gauss-Seidel sweep, one invocation per
-//   line of the colour: the line's residual (b - A x)_L, the banded Cholesky solve with
-//   the factor computed on the CPU at set-up, x_L += the correction. Lines of one colour
-//   are farther apart than the operator couples, so no invocation reads what another
-//   writes;
+// - `line_residual`, `line_smooth`: one colour of a coloured line Gauss-Seidel sweep in
+//   two dispatches: the residual (b - A x)_L at every unknown of the colour's lines (one
+//   invocation per unknown), then per line of the colour (one invocation each) the banded
+//   Cholesky solve with the factor computed on the CPU at set-up and x_L += the
+//   correction. Lines of one colour are farther apart than the operator couples, so no
+//   invocation reads what another writes;
 // - `transfer_rows`, `transfer_cols`: y = (a_1 (x) a_0) x in two 1D passes, t = X a_0^T
 //   then Y = a_1 t (prolongation P = P_1 (x) P_0 and restriction P^T alike); the second
 //   pass writes y, or adds it to its output (x += P x_c), and may zero a vector of its
@@ -192,8 +193,25 @@ fn residual(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     vecs[P.r_off + i] = vecs[P.b_off + i] - row_product(i);
 }
 
-// Lines::correction and Lines::add for line l_first + q l_step: the line's residual into
-// r at the line's unknowns, L y = r, L^T d = y in place, x_L += d.
+// Lines::correction, first half: the residual (b - A x)_L into r at the unknowns of the
+// lines of one colour, one invocation per unknown (q = line's place in the colour times
+// l_len plus the unknown's place on the line): a dispatch of its own before
+// `line_smooth`, so that no invocation loops over a whole long line's stencil rows
+// (lavapipe cut invocations of about 65 000 loop iterations short). The lines of a
+// colour do not couple, so every residual is the one the line's own sweep would take.
+@compute @workgroup_size(64)
+fn line_residual(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let q = linear_id(gid, nwg);
+    if q >= P.count {
+        return;
+    }
+    let li = P.l_first + (q / P.l_len) * P.l_step;
+    let i = idx[P.l_starts + li] + (q % P.l_len) * P.l_stride;
+    vecs[P.r_off + i] = vecs[P.b_off + i] - row_product(i);
+}
+
+// Lines::correction, second half, and Lines::add for line l_first + q l_step: with the
+// line's residual in r (`line_residual`), L y = r, L^T d = y in place, x_L += d.
 @compute @workgroup_size(64)
 fn line_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let q = linear_id(gid, nwg);
@@ -206,10 +224,6 @@ fn line_smooth(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let w = P.l_bw + 1u;
     let f = P.l_fac + li * len * w;
     let st = P.l_stride;
-    for (var t = 0u; t < len; t++) {
-        let i = s0 + t * st;
-        vecs[P.r_off + i] = vecs[P.b_off + i] - row_product(i);
-    }
     let r = P.r_off + s0;
     for (var t = 0u; t < len; t++) {
         var s = vecs[r + t * st];

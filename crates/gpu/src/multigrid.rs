@@ -33,7 +33,7 @@ mod dispatch;
 mod program;
 
 pub(crate) use dispatch::{bind, encode, read_back, Bound, StencilChunks, STORAGE_BINDINGS};
-use program::{pack, Layout, OpAt, Recorder, NONE};
+use program::{pack, Layout, Recorder, NONE};
 pub(crate) use program::{Kernel, Params, Step};
 
 /// Cycles run on the GPU with their times, set-ups or cycles that fell back to the CPU,
@@ -42,7 +42,10 @@ pub(crate) type CycleStats = (Timings, u64, Option<String>);
 
 /// Loop iterations one line's invocation may take on a software adapter: lavapipe cut
 /// an invocation of about 65 000 short, while lines of about 33 000 (513 unknowns on the
-/// stencil of degree 3) gave the CPU's bits. Longer lines keep the cycle on the CPU there.
+/// stencil of degree 3, when the line's residual was in the same invocation) gave the
+/// CPU's bits. The residual now has a dispatch of its own (`line_residual`), so a line's
+/// invocation costs `2 (b + 1) + 1` iterations per unknown (bandwidth `b`): lines of up
+/// to about 4 400 unknowns at degree 3. Longer lines keep the cycle on the CPU there.
 const SOFTWARE_LINE_WORK: u64 = 40_000;
 
 /// Bytes per parameter record in the uniform buffer (the dynamic-offset alignment).
@@ -53,6 +56,7 @@ const RECORD: u64 = 256;
 pub(crate) struct MultigridKernels {
     layout: wgpu::BindGroupLayout,
     residual: wgpu::ComputePipeline,
+    line_residual: wgpu::ComputePipeline,
     line_smooth: wgpu::ComputePipeline,
     transfer_rows: wgpu::ComputePipeline,
     transfer_cols: wgpu::ComputePipeline,
@@ -104,6 +108,7 @@ pub(crate) fn multigrid_kernels(device: &wgpu::Device) -> MultigridKernels {
     };
     MultigridKernels {
         residual: pipeline("residual"),
+        line_residual: pipeline("line_residual"),
         line_smooth: pipeline("line_smooth"),
         transfer_rows: pipeline("transfer_rows"),
         transfer_cols: pipeline("transfer_cols"),
@@ -200,9 +205,9 @@ impl GpuCycles {
         }
         if gpu.is_software() {
             for at in &layout.levels {
-                let (Some(OpAt::Stencil { bx, by, .. }), Some(lines)) = (at.op, at.lines) else { continue };
+                let Some(lines) = at.lines else { continue };
                 for d in lines {
-                    let per = (2 * by as u64 + 1) * (2 * bx as u64 + 2) + 2 * (d.bw as u64 + 1) + 1;
+                    let per = 2 * (d.bw as u64 + 1) + 1;
                     if d.len as u64 * per > SOFTWARE_LINE_WORK {
                         return Err(GpuError::TooLarge(format!(
                             "multigrid lines of {} unknowns: more work than a software adapter runs in one invocation",

@@ -251,3 +251,28 @@ fn jacobian_product_equals_the_cpu_product() {
         }
     }
 }
+
+/// Lines of 643 unknowns (640 elements of degree 3: 413 449 unknowns on the finest
+/// level), longer than a software adapter ran in one invocation while each line's
+/// residual shared it (lavapipe stopped at about 615): with the residual in a dispatch of
+/// its own the cycle uploads there too and equals the CPU's cycle (its bits on
+/// lavapipe).
+#[test]
+fn long_lines_run_on_the_gpu() {
+    let Some(g) = gpu() else { return };
+    let cycle = multigrid_cycle(640, 3.0, false).unwrap();
+    let h = cycle.hierarchy();
+    let dev = GpuCycles::new(g.clone()).unwrap().try_upload(&h).expect("lines of 643 unknowns upload");
+    let mut rng = Lcg::new(13);
+    let b = random(h.size(0), &mut rng);
+    let mut got = vec![0.0; b.len()];
+    dev.try_apply(&b, &mut got).unwrap();
+    let mut cpu = cycle.cpu_levels();
+    cpu.b[0].copy_from_slice(&b);
+    cpu.cycle();
+    let (rel, same) = compare(&got, &cpu.x[0]);
+    assert!(rel <= 1e-12, "relative difference {rel:e}");
+    if g.is_software() {
+        assert!(same, "lavapipe should give the CPU's bits");
+    }
+}

@@ -133,6 +133,7 @@ pub(crate) fn encode(
         }
         let (pipeline, per_group) = match s.kernel {
             Kernel::Residual => (&k.residual, 64),
+            Kernel::LineResidual => (&k.line_residual, 64),
             Kernel::LineSmooth => (&k.line_smooth, 64),
             Kernel::TransferRows => (&k.transfer_rows, 64),
             Kernel::TransferCols => (&k.transfer_cols, 64),

@@ -69,6 +69,7 @@ const COARSE_WORK: usize = 4096;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Kernel {
     Residual,
+    LineResidual,
     LineSmooth,
     TransferRows,
     TransferCols,
@@ -305,7 +306,7 @@ impl LevelKernels for Recorder<'_> {
         for k in colours {
             let count = (lines.count - k).div_ceil(c);
             let params = Params {
-                count,
+                count: count * lines.len,
                 l_starts: lines.starts,
                 l_stride: lines.stride,
                 l_len: lines.len,
@@ -315,7 +316,8 @@ impl LevelKernels for Recorder<'_> {
                 l_step: c,
                 ..self.level(l)
             };
-            self.steps.push(Step { kernel: Kernel::LineSmooth, params });
+            self.steps.push(Step { kernel: Kernel::LineResidual, params });
+            self.steps.push(Step { kernel: Kernel::LineSmooth, params: Params { count, ..params } });
         }
     }
 
