@@ -58,9 +58,10 @@ fn solve_on_the_gpu_writes_the_cpu_map() {
     }
 }
 
-/// `--backend gpu --linear multigrid`: the multigrid preconditioner's V-cycles run on the
-/// GPU (the report's back end counts them) and the solve takes the CPU's Newton and GMRES
-/// iterations on every level and writes its map to 1e-9.
+/// `--backend gpu --linear multigrid`: the multigrid preconditioner's V-cycles and
+/// GMRES's products with the Newton Jacobian run on the GPU (the report's back end counts
+/// them: at least one product per GMRES iteration) and the solve takes the CPU's Newton
+/// and GMRES iterations on every level and writes its map to 1e-9.
 #[test]
 fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     if !gpu_available_or_required() {
@@ -83,12 +84,15 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
         runs.push(doc);
     }
     let backend = runs[1]["report"]["backend"].as_str().unwrap();
-    let cycles: usize = backend
-        .split("multigrid V-cycles on the GPU: ")
-        .nth(1)
-        .and_then(|s| s.split(|c: char| !c.is_ascii_digit()).next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no GPU cycles in {backend}"));
+    let count = |what: &str| -> usize {
+        backend
+            .split(what)
+            .nth(1)
+            .and_then(|s| s.split(|c: char| !c.is_ascii_digit()).next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("no {what} in {backend}"))
+    };
+    let (cycles, products) = (count("multigrid V-cycles on the GPU: "), count("Jacobian products on the GPU: "));
     assert!(cycles > 0 && !backend.contains("on the CPU after"), "{backend}");
     let levels = |d: &serde_json::Value| -> Vec<(u64, u64)> {
         d["report"]["levels"]
@@ -100,6 +104,8 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     };
     assert_eq!(levels(&runs[0]), levels(&runs[1]));
     assert!(levels(&runs[1]).iter().any(|&(_, k)| k > 0), "no GMRES iterations: {:?}", levels(&runs[1]));
+    let krylov: u64 = levels(&runs[1]).iter().map(|&(_, k)| k).sum();
+    assert!(products as u64 >= krylov, "{products} GPU products for {krylov} GMRES iterations: {backend}");
     let (err, scale) = control_point_gap(&runs[0]["map"], &runs[1]["map"]);
     assert!(err <= 1e-9 * scale, "GPU and CPU multigrid maps differ by {err:e}");
     // `bench` runs the same path and its JSON rows name the back end with the cycles
@@ -114,6 +120,10 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     let backend = row["backend"].as_str().unwrap();
     assert!(backend.starts_with("gpu") && backend.contains("multigrid V-cycles on the GPU: "), "{backend}");
     assert!(!backend.contains("V-cycles on the GPU: 0"), "{backend}");
+    assert!(
+        backend.contains("Jacobian products on the GPU: ") && !backend.contains("products on the GPU: 0"),
+        "{backend}"
+    );
 }
 
 #[test]
