@@ -12,8 +12,12 @@
 //!
 //! Each cycle and product is applied `CYCLES` times after one warm-up; the GPU time is
 //! wall time of `GpuCycle::try_apply` / `GpuProduct::try_apply` (upload of the input, the
-//! dispatches, readback of the output). A size that does not fit the adapter prints the
-//! reason in its row (`too large`) and the others still run.
+//! dispatches, readback of the output). "max rel diff" compares with the solver's CPU
+//! cycle (which takes each level's residual from its first sweep, summed in another
+//! order: equal to rounding), "CPU levels" with the level operations on the CPU in the
+//! GPU's order (`CpuLevels::cycle`: 0 where the adapter fuses no multiply-adds, as
+//! lavapipe). A size that does not fit the adapter prints the reason in its row
+//! (`too large`) and the others still run.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -62,12 +66,18 @@ fn cycle_row(backend: &GpuCycles, ne: usize) -> Result<String, Box<dyn std::erro
         Ok::<(), GpuError>(())
     })?;
     let gpu_s = seconds(|| dev.try_apply(&b, &mut xg))?;
+    // the level operations on the CPU in the GPU's order (`CpuLevels`): the same bits
+    // where the adapter fuses no multiply-adds
+    let mut levels = cycle.cpu_levels();
+    levels.b[0].copy_from_slice(&b);
+    levels.cycle();
     Ok(format!(
-        "| {ne} | {n} | {} | {} | {} | {cpu:.3e} | {gpu_s:.3e} | {upload:.3e} | {:.1e} |",
+        "| {ne} | {n} | {} | {} | {} | {cpu:.3e} | {gpu_s:.3e} | {upload:.3e} | {:.1e} | {:.1e} |",
         h.num_levels(),
         dev.dispatches(),
         dev.stencil_bindings(),
-        rel_diff(&xc, &xg)
+        rel_diff(&xc, &xg),
+        rel_diff(&levels.x[0], &xg)
     ))
 }
 
@@ -114,9 +124,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("V-cycle (metric Laplacian, degree 3)");
     println!();
     println!(
-        "| elements | unknowns | levels | dispatches | stencil bindings | CPU s/cycle | GPU s/cycle | GPU upload s | max rel diff |"
+        "| elements | unknowns | levels | dispatches | stencil bindings | CPU s/cycle | GPU s/cycle | GPU upload s | max rel diff | max rel diff, CPU levels |"
     );
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for &ne in &sizes {
         println!("{}", cycle_row(&cycles, ne)?);
     }
