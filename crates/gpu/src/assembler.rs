@@ -23,7 +23,7 @@ use winslow::verify::quality::DetJSample;
 use crate::device::Gpu;
 use crate::multigrid::GpuCycles;
 use crate::product::GpuProducts;
-use crate::{GpuError, Precision};
+use crate::{to_u32, GpuError, Precision};
 
 /// Where the time of one kind of call went, summed over calls.
 #[derive(Debug, Clone, Copy, Default)]
@@ -219,10 +219,6 @@ fn element_ranges(t: &DirTable, nfun: usize) -> Vec<u32> {
         }
     }
     r.into_iter().flat_map(|(lo, hi)| if lo == u32::MAX { [1, 0] } else { [lo, hi] }).collect()
-}
-
-fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
-    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("{what} = {v} exceeds 32 bits")))
 }
 
 impl GpuAssembler {

@@ -103,6 +103,11 @@ pub fn shader_source(f64_source: &str, precision: Precision) -> String {
     }
 }
 
+/// `v` as the kernels' `u32` index, or [`GpuError::TooLarge`] naming `what`.
+pub(crate) fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
+    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("{what} = {v} exceeds 32 bits")))
+}
+
 /// Which quadrature back end a command uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]

@@ -21,7 +21,6 @@
 //! order.
 
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
 
 use winslow::linalg::multigrid_kernels::{v_cycle, CycleBackend, DeviceCycle, Hierarchy, LevelKernels};
 
@@ -32,13 +31,9 @@ use crate::{GpuError, Precision};
 mod dispatch;
 mod program;
 
-pub(crate) use dispatch::{bind, encode, read_back, Bound, StencilChunks, STORAGE_BINDINGS};
+pub(crate) use dispatch::{bind, read_back, Bound, Shared, StencilChunks, STORAGE_BINDINGS};
 use program::{pack, Layout, Recorder, NONE};
 pub(crate) use program::{Kernel, Params, Step};
-
-/// Cycles run on the GPU with their times, set-ups or cycles that fell back to the CPU,
-/// and the last GPU error.
-pub(crate) type CycleStats = (Timings, u64, Option<String>);
 
 /// Loop iterations one line's invocation may take on a software adapter: lavapipe cut
 /// an invocation of about 65 000 short, while lines of about 33 000 (513 unknowns on the
@@ -148,38 +143,32 @@ pub enum Vector {
 /// the cycles run and the time they took.
 #[derive(Debug)]
 pub struct GpuCycles {
-    gpu: Arc<Gpu>,
-    stats: Arc<Mutex<CycleStats>>,
-    /// Largest binding of stencil values ([`StencilChunks`]).
-    chunk_bytes: u64,
+    k: Shared,
 }
 
 impl GpuCycles {
     /// The back end on `gpu`; `None` without `SHADER_F64` (the cycle needs `f64`).
     pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
-        gpu.multigrid.as_ref()?;
-        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))), chunk_bytes: u64::MAX })
+        Shared::new(gpu).map(|k| Self { k })
     }
 
     /// Bind the levels' stencil values in chunks of at most `bytes` (the adapter's
     /// storage-binding limit otherwise; rounded down to a power of two entries), at most
     /// four: for tests of the split at small sizes.
     pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
-        self.chunk_bytes = bytes;
+        self.k.chunk_bytes = bytes;
         self
     }
 
     /// Cycles run (`calls`) and their upload, dispatch and readback seconds; set-ups
     /// that did not go to the GPU and the last reason.
     pub fn stats(&self) -> (Timings, u64, Option<String>) {
-        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+        self.k.stats()
     }
 
     /// Zero the statistics.
     pub fn reset_stats(&self) {
-        if let Ok(mut s) = self.stats.lock() {
-            *s = Default::default();
-        }
+        self.k.reset();
     }
 
     /// Upload `h` (see the module documentation).
@@ -187,11 +176,8 @@ impl GpuCycles {
     /// Errors: [`GpuError`] when the hierarchy does not fit the adapter's limits or wgpu
     /// fails.
     pub fn try_upload(&self, h: &Hierarchy<'_>) -> Result<GpuCycle, GpuError> {
-        let gpu = &self.gpu;
-        let kernels = gpu
-            .multigrid
-            .as_ref()
-            .ok_or_else(|| GpuError::NoAdapter(" with SHADER_F64 for the multigrid cycle".into()))?;
+        let gpu = &self.k.gpu;
+        let kernels = self.k.kernels()?;
         let (layout, packed) = pack(h)?;
         let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         for (what, bytes) in [
@@ -222,7 +208,7 @@ impl GpuCycles {
             let levels = layout.levels.len();
             v_cycle(&mut rec, levels, layout.smoothing, 0);
             let program = rec.steps;
-            let stencil = StencilChunks::upload(gpu, "multigrid stencils", &packed.stencil, self.chunk_bytes)?;
+            let stencil = StencilChunks::upload(gpu, "multigrid stencils", &packed.stencil, self.k.chunk_bytes)?;
             let stencil_bindings = stencil.used(packed.stencil.len());
             let reals = gpu.storage_init("multigrid reals", bytemuck::cast_slice(&packed.reals));
             let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx));
@@ -233,8 +219,7 @@ impl GpuCycles {
             let (params, bind) = bind(gpu, kernels, &program, &bound);
             gpu.submit_wait(None)?;
             Ok(GpuCycle {
-                gpu: gpu.clone(),
-                stats: self.stats.clone(),
+                k: self.k.clone(),
                 layout,
                 program,
                 stencil_bindings,
@@ -242,26 +227,13 @@ impl GpuCycles {
             })
         })
     }
-
-    fn record(&self, f: impl FnOnce(&mut CycleStats)) {
-        if let Ok(mut s) = self.stats.lock() {
-            f(&mut s);
-        }
-    }
 }
 
 impl CycleBackend for GpuCycles {
     fn upload(&self, h: &Hierarchy<'_>) -> winslow::Result<Box<dyn DeviceCycle>> {
         match self.try_upload(h) {
             Ok(c) => Ok(Box::new(c)),
-            Err(e) => {
-                eprintln!("warning: GPU multigrid set-up: {e}; the cycle runs on the CPU");
-                self.record(|s| {
-                    s.1 += 1;
-                    s.2 = Some(e.to_string());
-                });
-                Err(winslow::Error::LinearSolver(format!("GPU multigrid set-up: {e}")))
-            }
+            Err(e) => Err(self.k.fallback("multigrid set-up", e)),
         }
     }
 }
@@ -288,8 +260,7 @@ impl Buffers {
 /// A V-cycle uploaded to the GPU (see the module documentation).
 #[derive(Debug)]
 pub struct GpuCycle {
-    gpu: Arc<Gpu>,
-    stats: Arc<Mutex<CycleStats>>,
+    k: Shared,
     layout: Layout,
     program: Vec<Step>,
     /// Bindings that hold stencil values.
@@ -336,8 +307,8 @@ impl GpuCycle {
             return Err(GpuError::Wgpu(format!("{} values for a level of {n}", values.len())));
         }
         let b = self.lock()?;
-        self.gpu.queue.write_buffer(&b.vecs, off, bytemuck::cast_slice(values));
-        self.gpu.submit_wait(None)
+        self.k.gpu.queue.write_buffer(&b.vecs, off, bytemuck::cast_slice(values));
+        self.k.gpu.submit_wait(None)
     }
 
     /// Read vector `v` of level `l`.
@@ -346,9 +317,9 @@ impl GpuCycle {
     pub fn read(&self, v: Vector, l: usize) -> Result<Vec<f64>, GpuError> {
         let (off, n) = self.place(v, l)?;
         let b = self.lock()?;
-        let staging = self.gpu.staging(8 * n as u64);
+        let staging = self.k.gpu.staging(8 * n as u64);
         let mut out = vec![0.0; n];
-        read_back(&self.gpu, &b.vecs, off, &staging, &mut out, None)?;
+        read_back(&self.k.gpu, &b.vecs, off, &staging, &mut out, None)?;
         Ok(out)
     }
 
@@ -366,12 +337,12 @@ impl GpuCycle {
         }
         let steps = rec.steps;
         let b = self.lock()?;
-        let kernels = self.gpu.multigrid.as_ref().ok_or_else(|| GpuError::Wgpu("multigrid kernels missing".into()))?;
-        self.gpu.scoped(|| {
-            let (_params, bind) = bind(&self.gpu, kernels, &steps, &b.bound());
-            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-            encode(&self.gpu, &mut enc, &steps, &bind)?;
-            self.gpu.submit_wait(Some(enc.finish()))
+        let kernels = self.k.kernels()?;
+        self.k.gpu.scoped(|| {
+            let (_params, bind) = bind(&self.k.gpu, kernels, &steps, &b.bound());
+            let mut enc = self.k.gpu.device.create_command_encoder(&Default::default());
+            dispatch::encode(&self.k.gpu, &mut enc, &steps, &bind)?;
+            self.k.gpu.submit_wait(Some(enc.finish()))
         })
     }
 
@@ -385,38 +356,13 @@ impl GpuCycle {
             return Err(GpuError::Wgpu(format!("{} / {} values for a cycle of {n}", b.len(), x.len())));
         }
         let buf = self.lock()?;
-        let mut t = Timings { calls: 1, ..Default::default() };
-        let t0 = Instant::now();
-        self.gpu.scoped(|| {
-            self.gpu.queue.write_buffer(&buf.vecs, at.b as u64 * 8, bytemuck::cast_slice(b));
-            t.bytes_up += 8 * n as u64;
-            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-            enc.clear_buffer(&buf.vecs, at.x as u64 * 8, Some(8 * n as u64));
-            encode(&self.gpu, &mut enc, &self.program, &buf.bind)?;
-            self.gpu.submit_wait(Some(enc.finish()))?;
-            t.dispatch += t0.elapsed().as_secs_f64();
-            let t1 = Instant::now();
-            read_back(&self.gpu, &buf.vecs, at.x as u64 * 8, &buf.staging, x, None)?;
-            t.readback += t1.elapsed().as_secs_f64();
-            t.bytes_down += 8 * n as u64;
-            Ok(())
-        })?;
-        if let Ok(mut s) = self.stats.lock() {
-            s.0.add(&t);
-        }
-        Ok(())
+        let (b_at, x_at) = (at.b as u64 * 8, at.x as u64 * 8);
+        self.k.call(&buf.vecs, &buf.staging, &buf.bind, &self.program, b, x, (b_at, Some(x_at), x_at))
     }
 }
 
 impl DeviceCycle for GpuCycle {
     fn apply(&self, b: &[f64], x: &mut [f64]) -> winslow::Result<()> {
-        self.try_apply(b, x).map_err(|e| {
-            eprintln!("warning: GPU multigrid cycle: {e}; this cycle runs on the CPU");
-            if let Ok(mut s) = self.stats.lock() {
-                s.1 += 1;
-                s.2 = Some(e.to_string());
-            }
-            winslow::Error::LinearSolver(format!("GPU multigrid cycle: {e}"))
-        })
+        self.try_apply(b, x).map_err(|e| self.k.fallback("multigrid cycle", e))
     }
 }

@@ -17,20 +17,14 @@ use winslow::discrete::{DeviceOperator, OperatorBackend, PackedSystem};
 
 use crate::assembler::Timings;
 use crate::device::Gpu;
-use crate::multigrid::{bind, encode, read_back, Bound, CycleStats, Kernel, Params, StencilChunks, Step};
-use crate::GpuError;
+use crate::multigrid::{bind, Bound, Kernel, Params, Shared, StencilChunks, Step};
+use crate::{to_u32, GpuError};
 
 /// The GPU's product back end, shared by the assembler that hands it to the solver;
 /// counts the products and their times.
 #[derive(Debug)]
 pub struct GpuProducts {
-    gpu: Arc<Gpu>,
-    stats: Arc<Mutex<CycleStats>>,
-    chunk_bytes: u64,
-}
-
-fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
-    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("system product: {what} = {v} exceeds 32 bits")))
+    k: Shared,
 }
 
 /// The values of `s` as `f32` (in place on a little-endian machine).
@@ -47,28 +41,25 @@ fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
 impl GpuProducts {
     /// The back end on `gpu`; `None` without the `f64` kernels (`SHADER_F64`).
     pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
-        gpu.multigrid.as_ref()?;
-        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))), chunk_bytes: u64::MAX })
+        Shared::new(gpu).map(|k| Self { k })
     }
 
     /// Bind the stencil values in chunks of at most `bytes` (as
     /// [`crate::GpuCycles::with_chunk_bytes`]).
     pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
-        self.chunk_bytes = bytes;
+        self.k.chunk_bytes = bytes;
         self
     }
 
     /// Products run (`calls`) with their upload, dispatch and readback seconds; uploads or
     /// products that fell back to the CPU and the last reason.
     pub fn stats(&self) -> (Timings, u64, Option<String>) {
-        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+        self.k.stats()
     }
 
     /// Zero the statistics.
     pub fn reset_stats(&self) {
-        if let Ok(mut s) = self.stats.lock() {
-            *s = Default::default();
-        }
+        self.k.reset();
     }
 
     /// Upload `sys`: the free functions' global indices, every function's free index,
@@ -77,11 +68,8 @@ impl GpuProducts {
     /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
     /// fails.
     pub fn try_upload(&self, sys: &PackedSystem<'_>) -> Result<GpuProduct, GpuError> {
-        let gpu = &self.gpu;
-        let kernels = gpu
-            .multigrid
-            .as_ref()
-            .ok_or_else(|| GpuError::NoAdapter(" with SHADER_F64 for the system product".into()))?;
+        let gpu = &self.k.gpu;
+        let kernels = self.k.kernels()?;
         let t0 = Instant::now();
         let disc = sys.discretization();
         let dofs = &disc.dofs;
@@ -90,15 +78,15 @@ impl GpuProducts {
         let (p, q) = disc.degrees();
         let mut idx = Vec::with_capacity(m + dofs.num_total());
         for &k in dofs.free() {
-            idx.push(to_u32(k, "function")?);
+            idx.push(to_u32(k, "system product function")?);
         }
         for k in 0..dofs.num_total() {
             idx.push(match dofs.free_index(k) {
                 FIXED => u32::MAX,
-                f => to_u32(f, "free index")?,
+                f => to_u32(f, "system product free index")?,
             });
         }
-        to_u32(sys.values().len(), "stencil entries")?;
+        to_u32(sys.values().len(), "system product stencil entries")?;
         let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         for (what, bytes) in [("vectors", 16 * n as u64), ("indices", 4 * idx.len() as u64)] {
             if bytes > max {
@@ -124,7 +112,7 @@ impl GpuProducts {
         let step = [Step { kernel: Kernel::SystemProduct, params }];
         let values = values(sys);
         let device = gpu.scoped(|| {
-            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.chunk_bytes)?;
+            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.k.chunk_bytes)?;
             let stencil_bindings = stencil.used(values.len());
             let idx = gpu.storage_init("system indices", bytemuck::cast_slice(&idx));
             let reals = gpu.storage_init("system reals", &[0u8; 16]);
@@ -134,8 +122,7 @@ impl GpuProducts {
             let (params, bind) = bind(gpu, kernels, &step, &bound);
             gpu.submit_wait(None)?;
             Ok(GpuProduct {
-                gpu: gpu.clone(),
-                stats: self.stats.clone(),
+                k: self.k.clone(),
                 n,
                 step,
                 stencil_bindings,
@@ -151,17 +138,11 @@ impl GpuProducts {
             })
         })?;
         let bytes = 4 * values.len() as u64 + 4 * (m + dofs.num_total()) as u64;
-        self.record(|s| {
+        self.k.record(|s| {
             s.0.upload += t0.elapsed().as_secs_f64();
             s.0.bytes_up += bytes;
         });
         Ok(device)
-    }
-
-    fn record(&self, f: impl FnOnce(&mut CycleStats)) {
-        if let Ok(mut s) = self.stats.lock() {
-            f(&mut s);
-        }
     }
 }
 
@@ -169,14 +150,7 @@ impl OperatorBackend for GpuProducts {
     fn upload(&self, system: &PackedSystem<'_>) -> winslow::Result<Box<dyn DeviceOperator>> {
         match self.try_upload(system) {
             Ok(p) => Ok(Box::new(p)),
-            Err(e) => {
-                eprintln!("warning: GPU Jacobian product set-up: {e}; the products run on the CPU");
-                self.record(|s| {
-                    s.1 += 1;
-                    s.2 = Some(e.to_string());
-                });
-                Err(winslow::Error::LinearSolver(format!("GPU Jacobian product set-up: {e}")))
-            }
+            Err(e) => Err(self.k.fallback("Jacobian product set-up", e)),
         }
     }
 }
@@ -198,8 +172,7 @@ struct Buffers {
 /// A system uploaded to the GPU (see the module documentation).
 #[derive(Debug)]
 pub struct GpuProduct {
-    gpu: Arc<Gpu>,
-    stats: Arc<Mutex<CycleStats>>,
+    k: Shared,
     n: usize,
     step: [Step; 1],
     stencil_bindings: usize,
@@ -222,37 +195,12 @@ impl GpuProduct {
             return Err(GpuError::Wgpu(format!("{} / {} values for a system of {n}", x.len(), y.len())));
         }
         let buf = self.buffers.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
-        let mut t = Timings { calls: 1, ..Default::default() };
-        let t0 = Instant::now();
-        self.gpu.scoped(|| {
-            self.gpu.queue.write_buffer(&buf.vecs, 0, bytemuck::cast_slice(x));
-            t.bytes_up += 8 * n as u64;
-            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-            encode(&self.gpu, &mut enc, &self.step, &buf.bind)?;
-            self.gpu.submit_wait(Some(enc.finish()))?;
-            t.dispatch += t0.elapsed().as_secs_f64();
-            let t1 = Instant::now();
-            read_back(&self.gpu, &buf.vecs, 8 * n as u64, &buf.staging, y, None)?;
-            t.readback += t1.elapsed().as_secs_f64();
-            t.bytes_down += 8 * n as u64;
-            Ok(())
-        })?;
-        if let Ok(mut s) = self.stats.lock() {
-            s.0.add(&t);
-        }
-        Ok(())
+        self.k.call(&buf.vecs, &buf.staging, &buf.bind, &self.step, x, y, (0, None, 8 * n as u64))
     }
 }
 
 impl DeviceOperator for GpuProduct {
     fn apply(&self, x: &[f64], y: &mut [f64]) -> winslow::Result<()> {
-        self.try_apply(x, y).map_err(|e| {
-            eprintln!("warning: GPU Jacobian product: {e}; this product runs on the CPU");
-            if let Ok(mut s) = self.stats.lock() {
-                s.1 += 1;
-                s.2 = Some(e.to_string());
-            }
-            winslow::Error::LinearSolver(format!("GPU Jacobian product: {e}"))
-        })
+        self.try_apply(x, y).map_err(|e| self.k.fallback("Jacobian product", e))
     }
 }

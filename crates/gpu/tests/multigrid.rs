@@ -65,6 +65,19 @@ fn randomize(cpu: &mut CpuLevels<'_>, dev: &winslow_gpu::GpuCycle, rng: &mut Lcg
     }
 }
 
+/// One V-cycle of `b` on the device (from a result buffer of ones: it must be
+/// overwritten) against the CPU's level operations in the cycle's order (`v_cycle`): the
+/// GPU's result, the relative difference and whether the bits are equal.
+fn gpu_against_cpu_levels(cycle: &Cycle, dev: &winslow_gpu::GpuCycle, b: &[f64]) -> (Vec<f64>, f64, bool) {
+    let mut got = vec![1.0; b.len()];
+    dev.try_apply(b, &mut got).unwrap();
+    let mut cpu = cycle.cpu_levels();
+    cpu.b[0].copy_from_slice(b);
+    cpu.cycle();
+    let (rel, same) = compare(&got, &cpu.x[0]);
+    (got, rel, same)
+}
+
 /// Every operation of every level on random vectors: the GPU's result equals the CPU's
 /// (module documentation); returns whether all were bit-identical.
 fn kernels_agree(cycle: &Cycle, backend: &GpuCycles) -> bool {
@@ -152,13 +165,7 @@ fn one_v_cycle_equals_the_cpu_cycle() {
         let mut rng = Lcg::new(5);
         for _ in 0..2 {
             let b = random(h.size(0), &mut rng);
-            let mut got = vec![1.0; b.len()];
-            dev.try_apply(&b, &mut got).unwrap();
-            // the CPU's level operations in the cycle's order (`v_cycle`)
-            let mut cpu = cycle.cpu_levels();
-            cpu.b[0].copy_from_slice(&b);
-            cpu.cycle();
-            let (rel, same) = compare(&got, &cpu.x[0]);
+            let (got, rel, same) = gpu_against_cpu_levels(&cycle, &dev, &b);
             assert!(rel <= 1e-12, "far {far}: relative difference {rel:e}");
             if g.is_software() {
                 assert!(same, "far {far}: lavapipe should give the CPU's bits");
@@ -188,12 +195,7 @@ fn stencil_split_over_bindings_equals_the_cpu() {
     let bits = kernels_agree(&cycle, &backend);
     let mut rng = Lcg::new(9);
     let b = random(h.size(0), &mut rng);
-    let mut got = vec![0.0; b.len()];
-    dev.try_apply(&b, &mut got).unwrap();
-    let mut cpu = cycle.cpu_levels();
-    cpu.b[0].copy_from_slice(&b);
-    cpu.cycle();
-    let (rel, same) = compare(&got, &cpu.x[0]);
+    let (_, rel, same) = gpu_against_cpu_levels(&cycle, &dev, &b);
     assert!(rel <= 1e-12, "relative difference {rel:e}");
     if g.is_software() {
         assert!(bits && same, "lavapipe should give the CPU's bits with the split stencil");
@@ -265,12 +267,7 @@ fn long_lines_run_on_the_gpu() {
     let dev = GpuCycles::new(g.clone()).unwrap().try_upload(&h).expect("lines of 643 unknowns upload");
     let mut rng = Lcg::new(13);
     let b = random(h.size(0), &mut rng);
-    let mut got = vec![0.0; b.len()];
-    dev.try_apply(&b, &mut got).unwrap();
-    let mut cpu = cycle.cpu_levels();
-    cpu.b[0].copy_from_slice(&b);
-    cpu.cycle();
-    let (rel, same) = compare(&got, &cpu.x[0]);
+    let (_, rel, same) = gpu_against_cpu_levels(&cycle, &dev, &b);
     assert!(rel <= 1e-12, "relative difference {rel:e}");
     if g.is_software() {
         assert!(same, "lavapipe should give the CPU's bits");

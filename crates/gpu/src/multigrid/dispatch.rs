@@ -3,10 +3,105 @@
 //! bindings ([`StencilChunks`]), the bind group over the kernels' buffers ([`bind`]), the
 //! recording of dispatches ([`encode`]) and the readback of `f64` vectors ([`read_back`]).
 
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
 use super::program::{Kernel, Params, Step};
 use super::{MultigridKernels, RECORD};
+use crate::assembler::Timings;
 use crate::device::Gpu;
 use crate::GpuError;
+
+/// Calls run on the GPU with their times, set-ups or calls that fell back to the CPU,
+/// and the last GPU error.
+pub(crate) type CycleStats = (Timings, u64, Option<String>);
+
+/// What a back end of these kernels ([`super::GpuCycles`], [`crate::GpuProducts`]) and
+/// the objects it uploads share: the device, the statistics, the largest binding of
+/// stencil values.
+#[derive(Debug, Clone)]
+pub(crate) struct Shared {
+    pub(crate) gpu: Arc<Gpu>,
+    stats: Arc<Mutex<CycleStats>>,
+    pub(crate) chunk_bytes: u64,
+}
+
+impl Shared {
+    /// On `gpu`; `None` without the kernels (`SHADER_F64`, seven storage bindings).
+    pub(crate) fn new(gpu: Arc<Gpu>) -> Option<Self> {
+        gpu.multigrid.as_ref()?;
+        Some(Self { gpu, stats: Arc::new(Mutex::new((Timings::default(), 0, None))), chunk_bytes: u64::MAX })
+    }
+
+    /// The kernels.
+    pub(crate) fn kernels(&self) -> Result<&MultigridKernels, GpuError> {
+        self.gpu
+            .multigrid
+            .as_ref()
+            .ok_or_else(|| GpuError::NoAdapter(" with SHADER_F64 for the multigrid kernels".into()))
+    }
+
+    pub(crate) fn stats(&self) -> CycleStats {
+        self.stats.lock().map(|s| s.clone()).unwrap_or_default()
+    }
+
+    pub(crate) fn reset(&self) {
+        self.record(|s| *s = Default::default());
+    }
+
+    pub(crate) fn record(&self, f: impl FnOnce(&mut CycleStats)) {
+        if let Ok(mut s) = self.stats.lock() {
+            f(&mut s);
+        }
+    }
+
+    /// `e` of `what` counted as a fallback to the CPU, said on stderr, as the core's error.
+    pub(crate) fn fallback(&self, what: &str, e: GpuError) -> winslow::Error {
+        eprintln!("warning: GPU {what}: {e}; it runs on the CPU");
+        self.record(|s| {
+            s.1 += 1;
+            s.2 = Some(e.to_string());
+        });
+        winslow::Error::LinearSolver(format!("GPU {what}: {e}"))
+    }
+
+    /// One call: `input` written at byte `at.0` of `vecs`, the `n` reals at byte `at.1`
+    /// zeroed, `steps` run, `output` read from byte `at.2` through `staging`; counted with
+    /// its times.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn call(
+        &self,
+        vecs: &wgpu::Buffer,
+        staging: &wgpu::Buffer,
+        bind: &wgpu::BindGroup,
+        steps: &[Step],
+        input: &[f64],
+        output: &mut [f64],
+        at: (u64, Option<u64>, u64),
+    ) -> Result<(), GpuError> {
+        let gpu = &self.gpu;
+        let mut t = Timings { calls: 1, ..Default::default() };
+        let t0 = Instant::now();
+        gpu.scoped(|| {
+            gpu.queue.write_buffer(vecs, at.0, bytemuck::cast_slice(input));
+            t.bytes_up += 8 * input.len() as u64;
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            if let Some(zero) = at.1 {
+                enc.clear_buffer(vecs, zero, Some(8 * output.len() as u64));
+            }
+            encode(gpu, &mut enc, steps, bind)?;
+            gpu.submit_wait(Some(enc.finish()))?;
+            t.dispatch += t0.elapsed().as_secs_f64();
+            let t1 = Instant::now();
+            read_back(gpu, vecs, at.2, staging, output, None)?;
+            t.readback += t1.elapsed().as_secs_f64();
+            t.bytes_down += 8 * output.len() as u64;
+            Ok(())
+        })?;
+        self.record(|s| s.0.add(&t));
+        Ok(())
+    }
+}
 
 /// Bindings of the stencil values (`stencil0` .. `stencil3` of `shaders/multigrid.wgsl`).
 pub(crate) const STENCIL_BINDINGS: usize = 4;

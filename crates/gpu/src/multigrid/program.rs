@@ -138,7 +138,7 @@ pub(crate) struct Layout {
 }
 
 fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
-    u32::try_from(v).map_err(|_| GpuError::TooLarge(format!("multigrid {what} = {v} exceeds 32 bits")))
+    crate::to_u32(v, &format!("multigrid {what}"))
 }
 
 /// The host copies of the uploaded buffers, being built.
