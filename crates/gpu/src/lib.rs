@@ -47,8 +47,8 @@ mod sample;
 
 pub use assembler::{GpuAssembler, Stats, Timings};
 pub use device::{Gpu, GpuOptions};
-pub use multigrid::{GpuCycle, GpuCycles, Operation, Vector};
-pub use product::{GpuProduct, GpuProducts};
+pub use multigrid::{CycleKernels, GpuBackend, GpuCycle, GpuCycles, Operation, Vector};
+pub use product::{GpuProduct, GpuProducts, ProductKernels};
 pub use sample::MapSample;
 
 use std::sync::Arc;

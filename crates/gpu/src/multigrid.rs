@@ -20,6 +20,7 @@
 //! coarsest factor) and `vecs` (level vectors) `f64`; every sum in `f64`, in the CPU's
 //! order.
 
+use std::marker::PhantomData;
 use std::sync::{Arc, Mutex};
 
 use winslow::linalg::multigrid_kernels::{v_cycle, CycleBackend, DeviceCycle, Hierarchy, LevelKernels};
@@ -140,19 +141,30 @@ pub enum Vector {
 }
 
 /// The GPU's cycle back end, shared by the assembler that hands it to the solver; counts
-/// the cycles run and the time they took.
+/// the cycles run and the time they took ([`GpuBackend::stats`]).
+pub type GpuCycles = GpuBackend<CycleKernels>;
+
+/// Marks a [`GpuBackend`] that uploads multigrid cycles ([`GpuCycles`]).
 #[derive(Debug)]
-pub struct GpuCycles {
+pub enum CycleKernels {}
+
+/// A back end of the kernels of `shaders/multigrid.wgsl`, shared by the assembler that
+/// hands it to the solver: the V-cycle ([`GpuCycles`]) or the Jacobian product
+/// ([`crate::GpuProducts`]), counting the calls run on the GPU, their times and the ones
+/// that fell back to the CPU.
+#[derive(Debug)]
+pub struct GpuBackend<K> {
     k: Shared,
+    kind: PhantomData<fn() -> K>,
 }
 
-impl GpuCycles {
-    /// The back end on `gpu`; `None` without `SHADER_F64` (the cycle needs `f64`).
+impl<K> GpuBackend<K> {
+    /// The back end on `gpu`; `None` without `SHADER_F64` (the kernels need `f64`).
     pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
-        Shared::new(gpu).map(|k| Self { k })
+        Shared::new(gpu).map(|k| Self { k, kind: PhantomData })
     }
 
-    /// Bind the levels' stencil values in chunks of at most `bytes` (the adapter's
+    /// Bind the stencil values in chunks of at most `bytes` (the adapter's
     /// storage-binding limit otherwise; rounded down to a power of two entries), at most
     /// four: for tests of the split at small sizes.
     pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
@@ -160,8 +172,8 @@ impl GpuCycles {
         self
     }
 
-    /// Cycles run (`calls`) and their upload, dispatch and readback seconds; set-ups
-    /// that did not go to the GPU and the last reason.
+    /// Calls run on the GPU (`calls`) and their upload, dispatch and readback seconds;
+    /// set-ups or calls that ran on the CPU instead and the last reason.
     pub fn stats(&self) -> (Timings, u64, Option<String>) {
         self.k.stats()
     }
@@ -171,6 +183,12 @@ impl GpuCycles {
         self.k.reset();
     }
 
+    pub(crate) fn shared(&self) -> &Shared {
+        &self.k
+    }
+}
+
+impl GpuCycles {
     /// Upload `h` (see the module documentation).
     ///
     /// Errors: [`GpuError`] when the hierarchy does not fit the adapter's limits or wgpu

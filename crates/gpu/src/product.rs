@@ -9,23 +9,23 @@
 //! comes back (`8 c m` bytes each way); GMRES's basis and the rest of its iteration stay
 //! on the CPU.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 use std::time::Instant;
 
 use winslow::discrete::dofs::FIXED;
 use winslow::discrete::{DeviceOperator, OperatorBackend, PackedSystem};
 
-use crate::assembler::Timings;
-use crate::device::Gpu;
-use crate::multigrid::{bind, Bound, Kernel, Params, Shared, StencilChunks, Step};
+use crate::multigrid::{bind, Bound, GpuBackend, Kernel, Params, Shared, StencilChunks, Step};
 use crate::{to_u32, GpuError};
 
 /// The GPU's product back end, shared by the assembler that hands it to the solver;
-/// counts the products and their times.
+/// counts the products and their times ([`GpuBackend::stats`]; the Jacobian's uploads
+/// count in `upload` and `bytes_up`).
+pub type GpuProducts = GpuBackend<ProductKernels>;
+
+/// Marks a [`GpuBackend`] that uploads Galerkin systems ([`GpuProducts`]).
 #[derive(Debug)]
-pub struct GpuProducts {
-    k: Shared,
-}
+pub enum ProductKernels {}
 
 /// The values of `s` as `f32` (in place on a little-endian machine).
 fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
@@ -39,37 +39,14 @@ fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
 }
 
 impl GpuProducts {
-    /// The back end on `gpu`; `None` without the `f64` kernels (`SHADER_F64`).
-    pub fn new(gpu: Arc<Gpu>) -> Option<Self> {
-        Shared::new(gpu).map(|k| Self { k })
-    }
-
-    /// Bind the stencil values in chunks of at most `bytes` (as
-    /// [`crate::GpuCycles::with_chunk_bytes`]).
-    pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
-        self.k.chunk_bytes = bytes;
-        self
-    }
-
-    /// Products run (`calls`) with their upload, dispatch and readback seconds; uploads or
-    /// products that fell back to the CPU and the last reason.
-    pub fn stats(&self) -> (Timings, u64, Option<String>) {
-        self.k.stats()
-    }
-
-    /// Zero the statistics.
-    pub fn reset_stats(&self) {
-        self.k.reset();
-    }
-
     /// Upload `sys`: the free functions' global indices, every function's free index,
     /// the values.
     ///
     /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
     /// fails.
     pub fn try_upload(&self, sys: &PackedSystem<'_>) -> Result<GpuProduct, GpuError> {
-        let gpu = &self.k.gpu;
-        let kernels = self.k.kernels()?;
+        let gpu = &self.shared().gpu;
+        let kernels = self.shared().kernels()?;
         let t0 = Instant::now();
         let disc = sys.discretization();
         let dofs = &disc.dofs;
@@ -112,7 +89,7 @@ impl GpuProducts {
         let step = [Step { kernel: Kernel::SystemProduct, params }];
         let values = values(sys);
         let device = gpu.scoped(|| {
-            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.k.chunk_bytes)?;
+            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.shared().chunk_bytes)?;
             let stencil_bindings = stencil.used(values.len());
             let idx = gpu.storage_init("system indices", bytemuck::cast_slice(&idx));
             let reals = gpu.storage_init("system reals", &[0u8; 16]);
@@ -122,7 +99,7 @@ impl GpuProducts {
             let (params, bind) = bind(gpu, kernels, &step, &bound);
             gpu.submit_wait(None)?;
             Ok(GpuProduct {
-                k: self.k.clone(),
+                k: self.shared().clone(),
                 n,
                 step,
                 stencil_bindings,
@@ -138,7 +115,7 @@ impl GpuProducts {
             })
         })?;
         let bytes = 4 * values.len() as u64 + 4 * (m + dofs.num_total()) as u64;
-        self.k.record(|s| {
+        self.shared().record(|s| {
             s.0.upload += t0.elapsed().as_secs_f64();
             s.0.bytes_up += bytes;
         });
@@ -150,7 +127,7 @@ impl OperatorBackend for GpuProducts {
     fn upload(&self, system: &PackedSystem<'_>) -> winslow::Result<Box<dyn DeviceOperator>> {
         match self.try_upload(system) {
             Ok(p) => Ok(Box::new(p)),
-            Err(e) => Err(self.k.fallback("Jacobian product set-up", e)),
+            Err(e) => Err(self.shared().fallback("Jacobian product set-up", e)),
         }
     }
 }
