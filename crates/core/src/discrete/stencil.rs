@@ -262,7 +262,7 @@ impl<S: StencilValues + ?Sized> MatVec for StencilOperator<'_, S> {
 /// The free-free system of `ncomp` components on `disc` held as its stencil storage in
 /// single precision ([`Stencil32`]; the Newton Jacobian of eq. 12 that GMRES multiplies
 /// with under the multigrid preconditioner): what an [`OperatorBackend`] uploads, and
-/// the CPU's product with it ([`MatVec`]: [`Discretization::stencil_product`], row
+/// the CPU's product with it ([`MatVec`]: `Discretization::stencil_product`, row
 /// `z m + f` summed as `Csr::mul_vec` sums it), which the back end reproduces. Only for
 /// a basis without periodic replicas.
 #[derive(Debug, Clone, Copy)]
