@@ -45,6 +45,13 @@ pub trait EggAssembler: Send + Sync {
     fn cycle_backend(&self) -> Option<Arc<dyn CycleBackend>> {
         None
     }
+    /// Whether [`EggAssembler::egg`] is [`Discretization::egg`] on the CPU: the Jacobian
+    /// operator of `--linear multigrid` is then assembled by row bands straight into
+    /// single precision (`Discretization::egg_single`, the same bits); `false` (the
+    /// default): assembled by [`EggAssembler::egg`] in `f64`, then rounded.
+    fn assembles_on_cpu(&self) -> bool {
+        false
+    }
 }
 
 /// The multi-threaded CPU assembler.
@@ -57,6 +64,9 @@ impl EggAssembler for CpuAssembler {
     }
     fn name(&self) -> String {
         "cpu".into()
+    }
+    fn assembles_on_cpu(&self) -> bool {
+        true
     }
 }
 
@@ -169,6 +179,12 @@ impl DiscreteProblem for EggProblem {
             return false;
         }
         s.packed = None;
+        if self.assembler.assembles_on_cpu() {
+            s.load(c);
+            s.packed = Some(s.disc.egg_single(&s.cps, self.op, &mut s.res_full));
+            s.restrict_residual(f);
+            return true;
+        }
         s.load_for_jacobian(c);
         self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
         s.restrict_residual(f);
@@ -220,6 +236,13 @@ impl DiscreteProblem for EggProblem {
     fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
         let op = self.op;
         Some(self.state.take_preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))
+    }
+
+    /// `K` as [`DiscreteProblem::take_preconditioner`], as a grid stencil of the free
+    /// functions (no matrix) where they are a rectangle of the basis grid.
+    fn take_preconditioner_grid(&mut self, shift: f64) -> Option<crate::linalg::multigrid::GridStencil> {
+        let op = self.op;
+        self.state.take_preconditioner_grid(|disc, cps, st| disc.metric_laplace(cps, op, shift, st))
     }
 }
 
