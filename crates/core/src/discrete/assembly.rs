@@ -410,7 +410,7 @@ impl Discretization {
                     body(s, item);
                 }
             } else {
-                rows.into_par_iter().zip(r_chunks).zip(m_chunks).for_each_init(|| Scratch::new(p, q, ncomp), &body);
+                rows.into_par_iter().zip(r_chunks).zip(m_chunks).for_each_init(|| Scratch::new(p, q, ncomp), body);
             }
         }
     }

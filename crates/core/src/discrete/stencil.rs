@@ -264,7 +264,7 @@ impl Discretization {
             let (fx, fy) = (f % gx, f / gx);
             for (s, v) in row.iter_mut().enumerate() {
                 let (dx, dy) = ((fx + s % (2 * p + 1)).checked_sub(p), (fy + s / (2 * p + 1)).checked_sub(q));
-                if !dx.is_some_and(|x| x < gx) || !dy.is_some_and(|y| y < gy) {
+                if dx.is_none_or(|x| x >= gx) || dy.is_none_or(|y| y >= gy) {
                     *v = 0.0;
                 }
             }
@@ -415,8 +415,9 @@ mod tests {
     #[test]
     fn grid_stencil_is_the_matrix_and_sets_up_the_same_cycle() {
         use crate::linalg::multigrid::{Multigrid, TensorProlongation, MG_SMOOTHER, MG_SWEEPS};
-        let kx = KnotVector::open_uniform(3, 24);
-        let ky = KnotVector::open_uniform(3, 20).with_inserted(&[0.35]);
+        // 51 x 44 functions: two coarser spaces (the coarsest at most 400 functions)
+        let kx = KnotVector::open_uniform(3, 48);
+        let ky = KnotVector::open_uniform(3, 40).with_inserted(&[0.35]);
         let mut rng = Lcg::new(8);
         let cps = curved_map(&kx, &ky, &mut rng);
         let disc = Discretization::new([kx, ky]);
