@@ -45,7 +45,7 @@ impl SparseRows for Csr {
 }
 
 /// A scalar operator on an `nx x ny` grid of unknowns in double precision, stored as
-/// [`GridOperator`] stores it (`(2 b_x + 1)(2 b_y + 1)` values per row, coupling `(dx,
+/// the V-cycle's `f32` grid operator stores it (`(2 b_x + 1)(2 b_y + 1)` values per row, coupling `(dx,
 /// dy)` at `(dy + b_y) w_x + dx + b_x`, the couplings outside the grid zero): the
 /// metric Laplacian `K` straight from its stencil storage (its free rows, the couplings
 /// to fixed functions left out), handed to the V-cycle with no CSR matrix
