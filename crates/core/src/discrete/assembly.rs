@@ -325,6 +325,22 @@ impl Discretization {
     where
         K: Fn(usize, usize, &mut Scratch) + Sync,
     {
+        self.assemble_band(ncomp, 0..self.tables[1].num_elements(), res, stencil, &kernel);
+    }
+
+    /// [`Discretization::assemble`] over the element rows `band`, into `res` and `stencil`
+    /// from the band's first function row on; each entry summed in the whole assembly's
+    /// order (by colour): a row whose elements are all in the band gets the same bits.
+    pub(crate) fn assemble_band<K>(
+        &self,
+        ncomp: usize,
+        band: std::ops::Range<usize>,
+        res: &mut [f64],
+        stencil: &mut [f64],
+        kernel: &K,
+    ) where
+        K: Fn(usize, usize, &mut Scratch) + Sync,
+    {
         let (p, q) = self.degrees();
         let nx = self.shape()[0];
         let sw = self.stencil_width();
@@ -335,14 +351,17 @@ impl Discretization {
         res.fill(0.0);
         stencil.fill(0.0);
         // one thread for small bases, where waking the pool costs more than it saves
-        let serial = self.num_elements() * tx.nq * ty.nq < SERIAL_ASSEMBLY_POINTS;
+        let serial = band.len() * tx.num_elements() * tx.nq * ty.nq < SERIAL_ASSEMBLY_POINTS;
         let mut scratch = None;
+        let row0 = ty.first.get(band.start).copied().unwrap_or(0);
         for color in 0..=q {
-            let rows: Vec<usize> = (color..ty.num_elements()).step_by(q + 1).collect();
-            let r_ranges: Vec<(usize, usize)> =
-                rows.iter().map(|&ey| (ty.first[ey] * nx * ncomp, (ty.first[ey] + q + 1) * nx * ncomp)).collect();
-            let m_ranges: Vec<(usize, usize)> =
-                rows.iter().map(|&ey| (ty.first[ey] * nx * row_len, (ty.first[ey] + q + 1) * nx * row_len)).collect();
+            let rows: Vec<usize> = band.clone().filter(|ey| ey % (q + 1) == color).collect();
+            let ranges = |w: usize| -> Vec<(usize, usize)> {
+                rows.iter()
+                    .map(|&ey| ((ty.first[ey] - row0) * nx * w, (ty.first[ey] - row0 + q + 1) * nx * w))
+                    .collect()
+            };
+            let (r_ranges, m_ranges) = (ranges(ncomp), ranges(row_len));
             let r_chunks: Vec<Option<&mut [f64]>> = if want_res {
                 split_ranges(res, &r_ranges).into_iter().map(Some).collect()
             } else {
@@ -546,10 +565,21 @@ impl Discretization {
     /// `res` has length `2 n` (full, component-interleaved); `stencil` has length
     /// [`Discretization::stencil_len`]`(2)` or is empty.
     pub fn egg(&self, cps: &[[f64; 2]], op: Operator, res: &mut [f64], stencil: &mut [f64]) {
+        let want_mat = !stencil.is_empty();
+        self.assemble(2, res, stencil, self.egg_kernel(cps, op, want_mat));
+    }
+
+    /// The element kernel of [`Discretization::egg`] (with the element matrices when
+    /// `want_mat`).
+    pub(crate) fn egg_kernel<'a>(
+        &'a self,
+        cps: &'a [[f64; 2]],
+        op: Operator,
+        want_mat: bool,
+    ) -> impl Fn(usize, usize, &mut Scratch) + Sync + 'a {
         let nq = [self.tables[0].nq, self.tables[1].nq];
         let nqp = nq[0] * nq[1];
-        let want_mat = !stencil.is_empty();
-        self.assemble(2, res, stencil, |ex, ey, s| {
+        move |ex, ey, s| {
             let nloc = s.nloc;
             s.re.fill(0.0);
             if want_mat {
@@ -573,7 +603,7 @@ impl Discretization {
                     element_product(ke, &s.wa, tz, nloc);
                 }
             }
-        });
+        }
     }
 
     /// Scalar mass matrix `int w_a w_b` (eq. 30) into `stencil` (length `stencil_len(1)`).

@@ -11,10 +11,11 @@
 
 use rayon::prelude::*;
 
-use super::assembly::Discretization;
+use super::assembly::{Discretization, Operator};
 use super::dofs::FIXED;
 use crate::error::Result;
 use crate::linalg::krylov::MatVec;
+use crate::linalg::multigrid::GridStencil;
 
 /// Functions of the stencil product per parallel task (their rows of every component).
 const ROWS_PER_TASK: usize = 1024;
@@ -85,6 +86,22 @@ impl Stencil32 {
     /// Whether there are no entries.
     pub fn is_empty(&self) -> bool {
         self.len == 0
+    }
+}
+
+impl Stencil32 {
+    /// An empty storage that [`Stencil32::extend`] fills up to `len` entries.
+    fn with_capacity(len: usize) -> Self {
+        Self { words: Vec::with_capacity(len.div_ceil(2)), len: 0 }
+    }
+
+    /// `entries` rounded to `f32` appended (in parallel; `entries` and the storage so far
+    /// of even length): the words [`Stencil32::pack`] makes of them.
+    fn extend(&mut self, entries: &[f64]) {
+        debug_assert!(self.len.is_multiple_of(2) && entries.len().is_multiple_of(2));
+        let single = |v: f64| u64::from((v as f32).to_bits());
+        self.words.par_extend(entries.par_chunks(2).with_min_len(4096).map(|w| single(w[0]) | (single(w[1]) << 32)));
+        self.len += entries.len();
     }
 }
 
@@ -192,7 +209,87 @@ impl Discretization {
     }
 }
 
+/// Element rows per band of [`Discretization::egg_single`] (times `q + 1`): the band's
+/// `q` element rows below it are assembled again (`q / (16 (q + 1))` of the work, 5 %
+/// at degree 3) for the band's `f64` storage of about `16 (q + 1) + 2 q` function rows.
+const BAND_ROWS: usize = 16;
+
 impl Discretization {
+    /// The EGG residual (eq. 8, into the full `res`) and the Jacobian (eq. 12) in stencil
+    /// storage rounded to single precision, assembled by bands of element rows: each
+    /// band's function rows in `f64`, those whose elements are all in the band then
+    /// rounded into the [`Stencil32`] (the band carries the `q` element rows below it, so
+    /// every entry gets its contributions in the whole assembly's order). The same bits
+    /// as [`Discretization::egg`] followed by [`Stencil32::pack`], with the `f64`
+    /// storage of one band at a time instead of the whole Jacobian's (784 B per unknown
+    /// at degree 3, the peak of a Newton step at 10^6 unknowns).
+    pub(crate) fn egg_single(&self, cps: &[[f64; 2]], op: Operator, res: &mut [f64]) -> Stencil32 {
+        let (_, q) = self.degrees();
+        let [nx, ny] = self.shape();
+        let row_len = 4 * self.stencil_width();
+        let first = &self.tables[1].first;
+        let ney = self.tables[1].num_elements();
+        let kernel = self.egg_kernel(cps, op, true);
+        let mut out = Stencil32::with_capacity(self.stencil_len(2));
+        let (mut band_res, mut band_st) = (Vec::new(), Vec::new());
+        for e0 in (0..ney).step_by(BAND_ROWS * (q + 1)) {
+            let e1 = (e0 + BAND_ROWS * (q + 1)).min(ney);
+            // the function rows this band completes, and the element rows they have
+            let (out0, out1) = (if e0 == 0 { 0 } else { first[e0] }, if e1 == ney { ny } else { first[e1] });
+            let eb = first[..e0].partition_point(|&f| f + q < out0);
+            let row0 = first[eb];
+            let rows = first[e1 - 1] + q + 1 - row0;
+            band_res.resize(rows * nx * 2, 0.0);
+            band_st.resize(rows * nx * row_len, 0.0);
+            self.assemble_band(2, eb..e1, &mut band_res, &mut band_st, &kernel);
+            res[out0 * nx * 2..out1 * nx * 2]
+                .copy_from_slice(&band_res[(out0 - row0) * nx * 2..(out1 - row0) * nx * 2]);
+            out.extend(&band_st[(out0 - row0) * nx * row_len..(out1 - row0) * nx * row_len]);
+        }
+        debug_assert_eq!(out.len, self.stencil_len(2));
+        out
+    }
+}
+
+impl Discretization {
+    /// The scalar system whose stencil storage is `stencil` (length
+    /// [`Discretization::stencil_len`]`(1)`) as a grid stencil of its free functions
+    /// ([`GridStencil`]: the free rows, the couplings to fixed functions zero), made in
+    /// place in that storage: the entries of
+    /// [`Discretization::stencil_diagonal_block`]'s matrix without the matrix. Only when
+    /// the free functions are a rectangle of the basis grid (a patch whose boundary
+    /// functions are fixed) without periodic replicas; `Err` gives the storage back
+    /// otherwise.
+    pub(crate) fn free_grid_stencil(&self, mut stencil: Vec<f64>) -> std::result::Result<GridStencil, Vec<f64>> {
+        let (p, q) = self.degrees();
+        let ([nx, _], sw, free) = (self.shape(), self.stencil_width(), self.dofs.free());
+        let (Some(&k0), Some(&k1)) = (free.first(), free.last()) else { return Err(stencil) };
+        let (i0, j0, i1, j1) = (k0 % nx, k0 / nx, k1 % nx + 1, k1 / nx + 1);
+        let rectangle = i1 > i0
+            && (i1 - i0) * (j1 - j0) == free.len()
+            && free.iter().all(|&k| (i0..i1).contains(&(k % nx)) && (j0..j1).contains(&(k / nx)));
+        if !rectangle || !self.dofs.replicas().is_empty() || stencil.len() != self.stencil_len(1) {
+            return Err(stencil);
+        }
+        // the rows of the free functions moved down in order (row `f` from row `k >= f`)
+        for (f, &k) in free.iter().enumerate() {
+            stencil.copy_within(k * sw..(k + 1) * sw, f * sw);
+        }
+        stencil.truncate(free.len() * sw);
+        stencil.shrink_to_fit();
+        let (gx, gy) = (i1 - i0, j1 - j0);
+        stencil.par_chunks_mut(sw).enumerate().with_min_len(ROWS_PER_TASK).for_each(|(f, row)| {
+            let (fx, fy) = (f % gx, f / gx);
+            for (s, v) in row.iter_mut().enumerate() {
+                let (dx, dy) = ((fx + s % (2 * p + 1)).checked_sub(p), (fy + s / (2 * p + 1)).checked_sub(q));
+                if dx.is_none_or(|x| x >= gx) || dy.is_none_or(|y| y >= gy) {
+                    *v = 0.0;
+                }
+            }
+        });
+        Ok(GridStencil { nx: gx, ny: gy, half: [p, q], values: stencil })
+    }
+
     /// The diagonal block `A_zz` (free-free, with the pattern of [`Discretization::scalar`])
     /// of the `ncomp`-component system whose stencil storage is `stencil`: the block the
     /// gathered matrix has in rows and columns `z m .. (z + 1) m`, entry for entry, built
@@ -210,21 +307,45 @@ impl Discretization {
         }
         let (p, q) = self.degrees();
         let (sw, shape, m) = (self.stencil_width(), self.shape(), self.dofs.num_free());
+        let free = self.dofs.free();
+        // function `k`'s block (z, z) lies at `k ncomp² sw + (z ncomp + z) sw`; its row
+        // holds the free neighbours in slot order
+        let free_neighbours = |k: usize| {
+            super::pattern::stencil_neighbours(shape, p, q, k)
+                .map(move |(s, kk)| (s, self.dofs.free_index(kk)))
+                .filter(|&(_, fc)| fc != FIXED)
+        };
+        // the row lengths, then each task's rows written into its part of the arrays
         let mut row_ptr = Vec::with_capacity(m + 1);
         row_ptr.push(0);
-        let (mut col_idx, mut values) = (Vec::with_capacity(m * sw), Vec::with_capacity(m * sw));
-        // function `k`'s block (z, z) lies at `k ncomp² sw + (z ncomp + z) sw`
-        for &k in self.dofs.free() {
-            let row = k * ncomp * ncomp * sw + (z * ncomp + z) * sw;
-            for (s, kk) in super::pattern::stencil_neighbours(shape, p, q, k) {
-                let fc = self.dofs.free_index(kk);
-                if fc != FIXED {
-                    col_idx.push(fc);
-                    values.push(stencil.at(row + s));
+        let lengths: Vec<usize> =
+            free.par_iter().with_min_len(ROWS_PER_TASK).map(|&k| free_neighbours(k).count()).collect();
+        for len in lengths {
+            row_ptr.push(row_ptr.last().copied().unwrap_or(0) + len);
+        }
+        let nnz = row_ptr[m];
+        let (mut col_idx, mut values) = (vec![0; nnz], vec![0.0; nnz]);
+        let mut parts = Vec::with_capacity(m.div_ceil(ROWS_PER_TASK));
+        let (mut cols, mut vals) = (&mut col_idx[..], &mut values[..]);
+        for first in (0..m).step_by(ROWS_PER_TASK) {
+            let last = (first + ROWS_PER_TASK).min(m);
+            let len = row_ptr[last] - row_ptr[first];
+            let (c, rest_c) = std::mem::take(&mut cols).split_at_mut(len);
+            let (v, rest_v) = std::mem::take(&mut vals).split_at_mut(len);
+            (cols, vals) = (rest_c, rest_v);
+            parts.push((first..last, c, v));
+        }
+        parts.into_par_iter().for_each(|(rows, c, v)| {
+            let mut at = 0;
+            for &k in &free[rows] {
+                let row = k * ncomp * ncomp * sw + (z * ncomp + z) * sw;
+                for (s, fc) in free_neighbours(k) {
+                    c[at] = fc;
+                    v[at] = stencil.at(row + s);
+                    at += 1;
                 }
             }
-            row_ptr.push(col_idx.len());
-        }
+        });
         Some(crate::linalg::sparse::Csr { nrows: m, ncols: m, row_ptr, col_idx, values })
     }
 }
@@ -340,6 +461,82 @@ mod tests {
 
     use super::*;
 
+    /// Control points of a curved map (a sheared annulus sector) at the Greville points of
+    /// `kx`, `ky`, perturbed pseudo-randomly.
+    fn curved_map(kx: &KnotVector, ky: &KnotVector, rng: &mut Lcg) -> Vec<[f64; 2]> {
+        let (gx, gy) = (kx.greville(), ky.greville());
+        gy.iter()
+            .flat_map(|&v| gx.iter().map(move |&u| (u, v)))
+            .map(|(u, v)| {
+                let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
+                [r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]
+            })
+            .collect()
+    }
+
+    /// The Jacobian by row bands in single precision ([`Discretization::egg_single`]) is
+    /// the whole assembly packed ([`Discretization::egg`], then [`Stencil32::pack`]) word
+    /// for word, with the same residual bits, on a curved map of degrees (3, 2) with a
+    /// double knot in each direction and element rows for three bands, the last shorter.
+    #[test]
+    fn banded_single_precision_jacobian_is_the_whole_assembly_packed() {
+        let kx = KnotVector::open_uniform(3, 5).with_inserted(&[0.4]);
+        let ky = KnotVector::open_uniform(2, 120).with_inserted(&[0.5]);
+        let cps = curved_map(&kx, &ky, &mut Lcg::new(3));
+        let disc = Discretization::new([kx, ky]);
+        assert!(disc.tables[1].num_elements() > 2 * BAND_ROWS * 3);
+        for op in [Operator::Plain, Operator::Scaled] {
+            let (mut st, mut res) = (vec![0.0; disc.stencil_len(2)], vec![0.0; 2 * disc.dofs.num_total()]);
+            disc.egg(&cps, op, &mut res, &mut st);
+            let want = Stencil32::pack(st);
+            let mut banded = vec![f64::NAN; res.len()];
+            let got = disc.egg_single(&cps, op, &mut banded);
+            assert_eq!((got.len, got.words.len()), (want.len, want.words.len()));
+            let differ = got.words.iter().zip(&want.words).filter(|(a, b)| a != b).count();
+            assert_eq!(differ, 0, "{op:?}: {differ} of {} words differ", want.words.len());
+            assert!(res.iter().zip(&banded).all(|(a, b)| a.to_bits() == b.to_bits()), "{op:?}: residuals differ");
+        }
+    }
+
+    /// `K` as a grid stencil of the free functions ([`Discretization::free_grid_stencil`])
+    /// has the entries of its matrix ([`Discretization::stencil_diagonal_block`]), and the
+    /// V-cycle set up from it without a matrix of the finest level
+    /// (`Multigrid::factor_stencil`) is the one set up from the matrix: its output has the
+    /// same bits.
+    #[test]
+    fn grid_stencil_is_the_matrix_and_sets_up_the_same_cycle() {
+        use crate::linalg::multigrid::{Multigrid, TensorProlongation, MG_SMOOTHER, MG_SWEEPS};
+        // 51 x 44 functions: two coarser spaces (the coarsest at most 400 functions)
+        let kx = KnotVector::open_uniform(3, 48);
+        let ky = KnotVector::open_uniform(3, 40).with_inserted(&[0.35]);
+        let mut rng = Lcg::new(8);
+        let cps = curved_map(&kx, &ky, &mut rng);
+        let disc = Discretization::new([kx, ky]);
+        let mut st = vec![0.0; disc.stencil_len(1)];
+        disc.metric_laplace(&cps, Operator::Scaled, 0.0, &mut st);
+        let k = disc.stencil_diagonal_block(1, &st[..], 0).expect("no replicas");
+        let g = disc.free_grid_stencil(st).expect("the free functions are a rectangle");
+        assert_eq!(g.to_csr(), k);
+        let transfers: Vec<TensorProlongation> = crate::discrete::transfers::free_prolongation_factors(&disc)
+            .expect("nested spaces")
+            .into_iter()
+            .map(TensorProlongation::from)
+            .collect();
+        assert!(transfers.len() >= 2);
+        let (mut from_matrix, mut from_grid) = (
+            Multigrid::new(transfers.clone(), MG_SMOOTHER, MG_SWEEPS),
+            Multigrid::new(transfers, MG_SMOOTHER, MG_SWEEPS),
+        );
+        from_matrix.factor_owned(k).expect("SPD");
+        from_grid.factor_stencil(g).expect("SPD");
+        let b: Vec<f64> = (0..disc.dofs.num_free()).map(|_| rng.uniform() - 0.5).collect();
+        let (mut x, mut y) = (vec![0.0; b.len()], vec![0.0; b.len()]);
+        from_matrix.apply(&b, &mut x);
+        from_grid.apply(&b, &mut y);
+        assert!(x.iter().any(|v| *v != 0.0));
+        assert!(x.iter().zip(&y).all(|(u, v)| u.to_bits() == v.to_bits()), "the cycles differ");
+    }
+
     /// The stencil product equals the gathered EGG Jacobian (eq. 12) and metric
     /// Laplacian times a random vector bit for bit, on a curved map with unequal
     /// degrees and a double knot.
@@ -396,16 +593,8 @@ mod tests {
         }
         let kx = KnotVector::open_uniform(3, 6);
         let ky = KnotVector::open_uniform(2, 5).with_inserted(&[0.5]);
-        let (gx, gy) = (kx.greville(), ky.greville());
         let mut rng = Lcg::new(9);
-        let cps: Vec<[f64; 2]> = gy
-            .iter()
-            .flat_map(|&v| gx.iter().map(move |&u| (u, v)))
-            .map(|(u, v)| {
-                let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
-                [r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]
-            })
-            .collect();
+        let cps = curved_map(&kx, &ky, &mut rng);
         let disc = Discretization::new([kx, ky]);
         let m = disc.dofs.num_free();
         let mut st = vec![0.0; disc.stencil_len(2)];

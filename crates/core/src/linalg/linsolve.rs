@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::linalg::dense::{DenseCholesky, DenseLu, DENSE_LIMIT};
 use crate::linalg::krylov::{cg, gmres, Ilu0, MatVec};
 use crate::linalg::multigrid::kernels::CycleBackend;
-use crate::linalg::multigrid::{Multigrid, Smoother, TensorProlongation};
+use crate::linalg::multigrid::{GridStencil, Multigrid, Smoother, TensorProlongation};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
 
@@ -480,18 +480,41 @@ impl LinearSolver {
         let fits = |k: &Csr| self.transfers.first().is_some_and(|p| p.nrows() == k.nrows && n.is_multiple_of(k.nrows));
         match k {
             Some(k) if self.method == LinearMethod::Multigrid && fits(&k) => {
-                let mut mg = match self.precond.take() {
-                    Some(Preconditioner::NegMultigrid(mg)) => mg,
-                    _ => self.new_multigrid(),
-                };
-                mg.factor_owned(k)?;
-                self.precond = Some(Preconditioner::NegMultigrid(mg));
-                self.fresh = true;
-                self.last_krylov = 0;
-                Ok(())
+                self.set_up_multigrid(|mg| mg.factor_owned(k))
             }
             k => self.factor_operator(n, k.as_ref()),
         }
+    }
+
+    /// The multigrid preconditioner (the last one's cycle reused) set up by `factor`.
+    fn set_up_multigrid(&mut self, factor: impl FnOnce(&mut Multigrid) -> Result<()>) -> Result<()> {
+        let mut mg = match self.precond.take() {
+            Some(Preconditioner::NegMultigrid(mg)) => mg,
+            _ => self.new_multigrid(),
+        };
+        factor(&mut mg)?;
+        self.precond = Some(Preconditioner::NegMultigrid(mg));
+        self.fresh = true;
+        self.last_krylov = 0;
+        Ok(())
+    }
+
+    /// As [`LinearSolver::factor_operator_owned`] with `K` as a grid stencil
+    /// (`Multigrid::factor_stencil`: no CSR matrix of `K`); a method other than
+    /// [`LinearMethod::Multigrid`], or a hierarchy of another size, gets its CSR matrix.
+    ///
+    /// Errors: as [`LinearSolver::factor_operator`].
+    pub(crate) fn factor_operator_grid(&mut self, n: usize, k: GridStencil) -> Result<()> {
+        self.resolve(n);
+        let m = k.nx * k.ny;
+        if self.method != LinearMethod::Multigrid
+            || m == 0
+            || !n.is_multiple_of(m)
+            || self.transfers.first().is_none_or(|p| p.nrows() != m)
+        {
+            return self.factor_operator_owned(n, Some(k.to_csr()));
+        }
+        self.set_up_multigrid(|mg| mg.factor_stencil(k))
     }
 
     /// Free the operators of a multigrid preconditioner that is about to be set up again

@@ -27,3 +27,4 @@ pub mod split_cholesky;
 
 pub use krylov::MatVec;
 pub use multigrid::kernels as multigrid_kernels;
+pub use multigrid::GridStencil;

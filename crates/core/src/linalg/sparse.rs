@@ -32,9 +32,11 @@ impl Csr {
     /// Build from per-row lists of `(col, value)`; duplicates are summed.
     pub(crate) fn from_rows(ncols: usize, rows: Vec<Vec<(usize, f64)>>) -> Self {
         let nrows = rows.len();
+        // at most this many entries: no growth by doubling (up to twice the matrix)
+        let entries = rows.iter().map(Vec::len).sum();
         let mut row_ptr = Vec::with_capacity(nrows + 1);
-        let mut col_idx = Vec::new();
-        let mut values = Vec::new();
+        let mut col_idx = Vec::with_capacity(entries);
+        let mut values = Vec::with_capacity(entries);
         row_ptr.push(0);
         for mut r in rows {
             r.sort_by_key(|e| e.0);

@@ -51,6 +51,13 @@ pub trait EggAssembler: Send + Sync {
     fn operator_backend(&self) -> Option<Arc<dyn OperatorBackend>> {
         None
     }
+    /// Whether [`EggAssembler::egg`] is [`Discretization::egg`] on the CPU: the Jacobian
+    /// operator of `--linear multigrid` is then assembled by row bands straight into
+    /// single precision (`Discretization::egg_single`, the same bits); `false` (the
+    /// default): assembled by [`EggAssembler::egg`] in `f64`, then rounded.
+    fn assembles_on_cpu(&self) -> bool {
+        false
+    }
 }
 
 /// The multi-threaded CPU assembler.
@@ -63,6 +70,9 @@ impl EggAssembler for CpuAssembler {
     }
     fn name(&self) -> String {
         "cpu".into()
+    }
+    fn assembles_on_cpu(&self) -> bool {
+        true
     }
 }
 
@@ -175,10 +185,18 @@ impl DiscreteProblem for EggProblem {
             return false;
         }
         (s.packed, s.device) = (None, None);
-        s.load_for_jacobian(c);
-        self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
-        s.restrict_residual(f);
-        let packed = s.packed.insert(Stencil32::pack(std::mem::take(&mut s.stencil)));
+        let packed = if self.assembler.assembles_on_cpu() {
+            // by row bands straight into single precision (the same bits as below)
+            s.load(c);
+            let single = s.disc.egg_single(&s.cps, self.op, &mut s.res_full);
+            s.restrict_residual(f);
+            s.packed.insert(single)
+        } else {
+            s.load_for_jacobian(c);
+            self.assembler.egg(&s.disc, &s.cps, self.op, &mut s.res_full, &mut s.stencil);
+            s.restrict_residual(f);
+            s.packed.insert(Stencil32::pack(std::mem::take(&mut s.stencil)))
+        };
         // uploaded once per Newton step where the back end multiplies (the CPU product
         // otherwise, and where the upload fails: the back end says why)
         s.device = self
@@ -237,6 +255,13 @@ impl DiscreteProblem for EggProblem {
     fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
         let op = self.op;
         Some(self.state.take_preconditioner(|disc, cps, st| disc.metric_laplace(cps, op, shift, st)))
+    }
+
+    /// `K` as [`DiscreteProblem::take_preconditioner`], as a grid stencil of the free
+    /// functions (no matrix) where they are a rectangle of the basis grid.
+    fn take_preconditioner_grid(&mut self, shift: f64) -> Option<crate::linalg::multigrid::GridStencil> {
+        let op = self.op;
+        self.state.take_preconditioner_grid(|disc, cps, st| disc.metric_laplace(cps, op, shift, st))
     }
 }
 

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use crate::discrete::assembly::Discretization;
 use crate::discrete::stencil::{DeviceOperator, Stencil32};
+use crate::linalg::multigrid::GridStencil;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
 
@@ -120,6 +121,28 @@ impl GalerkinState {
         }
         self.disc.scalar.gather_into(&self.pstencil, &mut self.prec.values);
         &self.prec
+    }
+
+    /// [`GalerkinState::preconditioner`] handed over as a grid stencil of the free
+    /// functions, made in place in its stencil storage
+    /// ([`Discretization::free_grid_stencil`]: no matrix); `None` (the storage kept) where
+    /// the free functions are not a rectangle of the basis grid.
+    pub fn take_preconditioner_grid(
+        &mut self,
+        fill: impl FnOnce(&Discretization, &[Point], &mut [f64]),
+    ) -> Option<GridStencil> {
+        let mut st = std::mem::take(&mut self.pstencil);
+        if st.len() != self.disc.stencil_len(1) {
+            st = vec![0.0; self.disc.stencil_len(1)];
+        }
+        fill(&self.disc, &self.cps, &mut st);
+        match self.disc.free_grid_stencil(st) {
+            Ok(k) => Some(k),
+            Err(st) => {
+                self.pstencil = st;
+                None
+            }
+        }
     }
 
     /// [`GalerkinState::preconditioner`] handed over: `K` in a new matrix, its stencil

@@ -147,6 +147,12 @@ pub trait DiscreteProblem {
     fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
         self.preconditioner(shift).cloned()
     }
+    /// [`DiscreteProblem::take_preconditioner`] as a grid stencil of the free functions
+    /// (`linalg::multigrid::GridStencil`, no matrix: the V-cycle's set-up reads it),
+    /// where the problem has one; `None` (the default) otherwise.
+    fn take_preconditioner_grid(&mut self, _shift: f64) -> Option<crate::linalg::multigrid::GridStencil> {
+        None
+    }
     /// A fill-reducing order of the `m` scalar unknowns for sparse Cholesky
     /// factorizations (see `crate::linalg::linsolve::LinearSolver::set_ordering`).
     fn ordering(&self) -> Option<&[usize]> {
@@ -212,6 +218,9 @@ impl<P: DiscreteProblem + ?Sized> DiscreteProblem for Box<P> {
     }
     fn take_preconditioner(&mut self, shift: f64) -> Option<Csr> {
         (**self).take_preconditioner(shift)
+    }
+    fn take_preconditioner_grid(&mut self, shift: f64) -> Option<crate::linalg::multigrid::GridStencil> {
+        (**self).take_preconditioner_grid(shift)
     }
     fn ordering(&self) -> Option<&[usize]> {
         (**self).ordering()

@@ -49,13 +49,14 @@ pub const BYTES_PER_UNKNOWN: u64 = 200;
 
 /// Peak bytes per nonzero of the finest level's vector Jacobian with `--linear
 /// multigrid` ([`LinearMethod::Multigrid`]): the Newton systems are solved over the
-/// stencil storage, rounded to single precision after each assembly
-/// (`discrete::stencil::Stencil32`), and neither the vector nor the scalar pattern is
-/// built (`K` and the elasticity blocks come from their stencil storage, the transfers
-/// are 1D factors). The peak is the assembly of a Newton step after the first (the
-/// `f64` stencil storage the assembler writes, 8 B per nonzero, beside the frozen
-/// V-cycle: `f32` stencils and line factors of every level) or the set-up of the
-/// V-cycle (the `f32` Jacobian, `K` in CSR and its stencil storage). With
+/// stencil storage in single precision (`discrete::stencil::Stencil32`, assembled by
+/// row bands on the CPU: `Discretization::egg_single`), and neither the vector nor the
+/// scalar pattern is built (`K` goes to the V-cycle as a grid stencil, the elasticity
+/// blocks come from their stencil storage, the transfers are 1D factors). The V-cycle
+/// is set up before the Jacobian is assembled; the peak is now the assembly of a later
+/// Newton step beside the frozen V-cycle, or its flexible GMRES basis, and these
+/// constants over-estimate it by 1.1-1.5x at about 10^6 unknowns (BENCHMARKS.md, "10^6
+/// unknowns on 2 cores"; not refitted). With
 /// [`MULTIGRID_BYTES_PER_UNKNOWN`] fitted to the peaks (`VmHWM`, dev profile, one
 /// geometry per process; `WINSLOW_MEMORY_TRACE` shows the stage) of quarter_annulus at
 /// 918 k and male_rotor at 2.13 M unknowns (degrees 3 x 2 and 3: 70 and 98 nonzeros per

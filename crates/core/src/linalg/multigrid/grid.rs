@@ -26,6 +26,73 @@ impl Rows for Csr {
     }
 }
 
+/// The rows of a sparse scalar operator, as the cycle's set-up reads them (the Galerkin
+/// product, the line factors): a CSR matrix, or the finest level's [`GridStencil`].
+pub(crate) trait SparseRows: Sync {
+    /// Number of rows (and columns).
+    fn n_rows(&self) -> usize;
+    /// The entries `(column, value)` of row `i`, by ascending column.
+    fn entries(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_;
+}
+
+impl SparseRows for Csr {
+    fn n_rows(&self) -> usize {
+        self.nrows
+    }
+    fn entries(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.row(i)
+    }
+}
+
+/// A scalar operator on an `nx x ny` grid of unknowns in double precision, stored as
+/// the V-cycle's `f32` grid operator stores it (`(2 b_x + 1)(2 b_y + 1)` values per row, coupling `(dx,
+/// dy)` at `(dy + b_y) w_x + dx + b_x`, the couplings outside the grid zero): the
+/// metric Laplacian `K` straight from its stencil storage (its free rows, the couplings
+/// to fixed functions left out), handed to the V-cycle with no CSR matrix
+/// (`Multigrid::factor_stencil`). Its entries are those of the CSR matrix with the
+/// pattern of the grid's tensor stencil.
+#[derive(Debug, Clone)]
+pub struct GridStencil {
+    /// Unknowns per grid row ...
+    pub nx: usize,
+    /// ... and grid rows.
+    pub ny: usize,
+    /// Half widths `[b_x, b_y]`.
+    pub half: [usize; 2],
+    /// The values, row after row.
+    pub values: Vec<f64>,
+}
+
+impl GridStencil {
+    /// The couplings of row `i` inside the grid: `(column, slot)` by ascending column.
+    fn slots(&self, i: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let [bx, by] = self.half;
+        let (ix, iy) = (i % self.nx, i / self.nx);
+        let (x0, x1) = (ix.saturating_sub(bx), (ix + bx + 1).min(self.nx));
+        (iy.saturating_sub(by)..(iy + by + 1).min(self.ny)).flat_map(move |jy| {
+            (x0..x1).map(move |jx| (jy * self.nx + jx, (jy + by - iy) * (2 * bx + 1) + jx + bx - ix))
+        })
+    }
+
+    /// The CSR matrix of the same entries.
+    pub fn to_csr(&self) -> Csr {
+        let n = self.nx * self.ny;
+        let w = (2 * self.half[0] + 1) * (2 * self.half[1] + 1);
+        let rows = (0..n).map(|i| self.slots(i).map(|(c, s)| (c, self.values[i * w + s])).collect()).collect();
+        Csr::from_rows(n, rows)
+    }
+}
+
+impl SparseRows for GridStencil {
+    fn n_rows(&self) -> usize {
+        self.nx * self.ny
+    }
+    fn entries(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let w = (2 * self.half[0] + 1) * (2 * self.half[1] + 1);
+        self.slots(i).map(move |(c, s)| (c, self.values[i * w + s]))
+    }
+}
+
 /// A grid operator (see the module documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct GridOperator {
@@ -51,26 +118,37 @@ impl GridOperator {
             return None;
         }
         let ny = n / nx;
-        let mut half = [0, 0];
-        for i in 0..n {
-            for (c, _) in a.row(i) {
-                half[0] = half[0].max((i % nx).abs_diff(c % nx));
-                half[1] = half[1].max((i / nx).abs_diff(c / nx));
-            }
-        }
+        // the half widths (maxima: the same whatever the split of the rows)
+        let (hx, hy) = (0..n)
+            .into_par_iter()
+            .with_min_len(ROWS)
+            .map(|i| {
+                a.row(i).fold((0, 0), |(hx, hy), (c, _)| {
+                    (hx.max((i % nx).abs_diff(c % nx)), hy.max((i / nx).abs_diff(c / nx)))
+                })
+            })
+            .reduce(|| (0, 0), |x, y| (x.0.max(y.0), x.1.max(y.1)));
+        let half = [hx, hy];
         let (wx, wy) = (2 * half[0] + 1, 2 * half[1] + 1);
         if wx * wy * n > 4 * a.nnz() {
             return None;
         }
         let mut values = vec![0.0f32; n * wx * wy];
-        for i in 0..n {
+        values.par_chunks_mut(wx * wy).enumerate().with_min_len(ROWS).for_each(|(i, row)| {
             let (ix, iy) = (i % nx, i / nx);
             for (c, v) in a.row(i) {
                 let (dx, dy) = (c % nx + half[0] - ix, c / nx + half[1] - iy);
-                values[(i * wy + dy) * wx + dx] = v as f32;
+                row[dy * wx + dx] = v as f32;
             }
-        }
+        });
         Some(Self { nx, ny, half, values })
+    }
+
+    /// `a` rounded to single precision: the operator [`GridOperator::from_csr`] makes of
+    /// the CSR matrix of the same entries.
+    pub fn from_stencil(a: &GridStencil) -> Self {
+        let values = a.values.par_iter().with_min_len(ROWS).map(|&v| v as f32).collect();
+        Self { nx: a.nx, ny: a.ny, half: a.half, values }
     }
 
     /// Number of rows (and columns).

@@ -15,12 +15,15 @@
 
 use rayon::prelude::*;
 
-use super::grid::{GridOperator, Rows};
+use super::grid::{GridOperator, Rows, SparseRows};
 use crate::error::{Error, Result};
 use crate::linalg::sparse::Csr;
 
 /// Rows per parallel task of the residual of [`Lines::sweep_from_zero`].
 const RESIDUAL_ROWS: usize = 2048;
+
+/// Rows per parallel task of the scans of [`Lines::new`].
+const SETUP_ROWS: usize = 4096;
 
 /// The lines of one direction of an `nx x ny` grid: line `j` of direction 0 holds the
 /// unknowns `j nx + t`, `t < nx`; line `i` of direction 1 holds `i + t nx`, `t < ny`.
@@ -48,63 +51,68 @@ impl Lines {
     /// factorized.
     ///
     /// Errors: [`Error::LinearSolver`] when a block is not positive definite.
-    pub fn new(a: &Csr, nx: usize, dir: usize) -> Result<Self> {
-        let n = a.nrows;
+    pub fn new<A: SparseRows>(a: &A, nx: usize, dir: usize) -> Result<Self> {
+        let n = a.n_rows();
         let ny = n / nx.max(1);
         let (starts, stride, len): (Vec<usize>, usize, usize) = match dir {
             0 => ((0..ny).map(|j| j * nx).collect(), 1, nx),
             _ => ((0..nx).collect(), nx, ny),
         };
-        // bandwidth: the farthest coupling along a line; and across the lines
+        // bandwidth: the farthest coupling along a line; and across the lines (maxima:
+        // the same whatever the split of the rows between threads)
         let line_of = |i: usize| if dir == 0 { i / nx.max(1) } else { i % nx.max(1) };
-        let (mut bw, mut across) = (0, 0);
-        for (i, row) in (0..n).map(|i| (i, a.row(i))) {
-            for (c, _) in row {
-                if let Some(d) = along(i, c, stride, nx, dir) {
-                    bw = bw.max(d.unsigned_abs());
-                }
-                across = across.max(line_of(i).abs_diff(line_of(c)));
-            }
-        }
+        let (bw, across) = (0..n)
+            .into_par_iter()
+            .with_min_len(SETUP_ROWS)
+            .map(|i| {
+                a.entries(i).fold((0, 0), |(bw, across), (c, _)| {
+                    let d = along(i, c, stride, nx, dir).map_or(0, isize::unsigned_abs);
+                    (bw.max(d), across.max(line_of(i).abs_diff(line_of(c))))
+                })
+            })
+            .reduce(|| (0, 0), |x, y| (x.0.max(y.0), x.1.max(y.1)));
         let colours = (across + 1).min(starts.len()).max(1);
         let w = bw + 1;
         let mut factors = vec![0.0; starts.len() * len * w];
-        for (li, &s0) in starts.iter().enumerate() {
-            let f = &mut factors[li * len * w..(li + 1) * len * w];
-            for t in 0..len {
-                let i = s0 + t * stride;
-                for (c, v) in a.row(i) {
-                    if let Some(d) = along(i, c, stride, nx, dir) {
-                        if d <= 0 && (-d) as usize <= t {
-                            f[t * w + (-d) as usize] = v;
+        // each line's block factorized on its own (in parallel: the lines are independent)
+        factors.par_chunks_mut((len * w).max(1)).zip(starts.par_iter()).enumerate().try_for_each(
+            |(li, (f, &s0))| {
+                for t in 0..len {
+                    let i = s0 + t * stride;
+                    for (c, v) in a.entries(i) {
+                        if let Some(d) = along(i, c, stride, nx, dir) {
+                            if d <= 0 && (-d) as usize <= t {
+                                f[t * w + (-d) as usize] = v;
+                            }
                         }
                     }
                 }
-            }
-            // banded Cholesky in place: row t holds L[t][t - d], d = 0..=bw
-            for t in 0..len {
-                for d in (1..=bw.min(t)).rev() {
-                    let j = t - d;
-                    let mut s = f[t * w + d];
-                    for e in 1..=bw.min(j) {
-                        // L[t][j - e] L[j][j - e], j - e >= t - bw
-                        let k = d + e;
-                        if k <= bw {
-                            s -= f[t * w + k] * f[j * w + e];
+                // banded Cholesky in place: row t holds L[t][t - d], d = 0..=bw
+                for t in 0..len {
+                    for d in (1..=bw.min(t)).rev() {
+                        let j = t - d;
+                        let mut s = f[t * w + d];
+                        for e in 1..=bw.min(j) {
+                            // L[t][j - e] L[j][j - e], j - e >= t - bw
+                            let k = d + e;
+                            if k <= bw {
+                                s -= f[t * w + k] * f[j * w + e];
+                            }
                         }
+                        f[t * w + d] = s / f[j * w];
                     }
-                    f[t * w + d] = s / f[j * w];
+                    let mut s = f[t * w];
+                    for d in 1..=bw.min(t) {
+                        s -= f[t * w + d] * f[t * w + d];
+                    }
+                    if s.is_nan() || s <= 0.0 {
+                        return Err(Error::LinearSolver(format!("line smoother: block {li} not definite at {t}")));
+                    }
+                    f[t * w] = s.sqrt();
                 }
-                let mut s = f[t * w];
-                for d in 1..=bw.min(t) {
-                    s -= f[t * w + d] * f[t * w + d];
-                }
-                if s.is_nan() || s <= 0.0 {
-                    return Err(Error::LinearSolver(format!("line smoother: block {li} not definite at {t}")));
-                }
-                f[t * w] = s.sqrt();
-            }
-        }
+                Ok(())
+            },
+        )?;
         Ok(Self { starts, stride, len, bw, factors, colours, dir })
     }
 

@@ -39,7 +39,8 @@ pub mod kernels;
 mod lines;
 mod tensor;
 
-use grid::{GridOperator, Rows};
+pub use grid::GridStencil;
+use grid::{GridOperator, Rows, SparseRows};
 use kernels::{CycleBackend, DeviceCycle};
 use lines::{grid_width, Lines};
 pub(crate) use tensor::TensorProlongation;
@@ -128,15 +129,15 @@ pub(crate) struct Multigrid {
 /// the fine level, then `t P`; the rows of `P` and `P^T` generated from the 1D factors.
 /// No intermediate matrix (`A P` would be a fine-by-coarse matrix of about half the
 /// entries of `A`) is formed.
-pub(crate) fn galerkin(a: &Csr, p: &TensorProlongation) -> Csr {
-    let (nf, nc) = (a.nrows, p.ncols());
+pub(crate) fn galerkin<A: SparseRows>(a: &A, p: &TensorProlongation) -> Csr {
+    let (nf, nc) = (a.n_rows(), p.ncols());
     let rows: Vec<Vec<(usize, f64)>> = (0..nc)
         .into_par_iter()
         .map_init(
             || (Accumulator::new(nf), Accumulator::new(nc)),
             |(fine, coarse), i| {
                 for (k, pik) in p.row_of_transpose(i) {
-                    for (m, akm) in a.row(k) {
+                    for (m, akm) in a.entries(k) {
                         fine.add(m, pik * akm);
                     }
                 }
@@ -256,22 +257,76 @@ impl Multigrid {
         }
         // the previous operators and smoothers go before the new ones are built
         self.release();
+        self.setup(a, Vec::with_capacity(self.levels()), Vec::new(), Vec::new())
+    }
+
+    /// [`Multigrid::factor_owned`] for the operator held as a grid stencil (`K` from
+    /// its stencil storage): the finest level's lines, stencil form and Galerkin product
+    /// read it directly, and it goes after them, so no CSR matrix of the finest level is
+    /// built. The cycle is the one [`Multigrid::factor_owned`] sets up for its CSR matrix
+    /// (the same coarse operators, factors and `f32` stencil); where that one would keep
+    /// the finest level in CSR (a grid too small for a stencil to pay, another smoother)
+    /// the matrix is made and handed to it.
+    ///
+    /// Errors: as [`Multigrid::factor_owned`].
+    pub fn factor_stencil(&mut self, a: GridStencil) -> Result<()> {
+        let [bx, by] = a.half;
+        let n = a.n_rows();
+        // couplings inside the grid per direction: the CSR matrix's nonzeros are their product
+        let inside = |len: usize, b: usize| (0..len).map(|i| (i + b + 1).min(len) - i.saturating_sub(b)).sum::<usize>();
+        let as_csr = a.nx <= bx + 1
+            || a.ny <= by
+            || (2 * bx + 1) * (2 * by + 1) * n > 4 * inside(a.nx, bx) * inside(a.ny, by)
+            || !matches!(self.smoother, Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines)
+            || self.prolongations.first().is_none_or(|p| p.nrows() != n);
+        if as_csr {
+            return self.factor_owned(a.to_csr());
+        }
+        self.release();
+        let p = &self.prolongations[0];
+        let (coarse, ((l0, l1), grid)) = rayon::join(
+            || galerkin(&a, p),
+            || {
+                rayon::join(
+                    || rayon::join(|| Lines::new(&a, a.nx, 0), || Lines::new(&a, a.nx, 1)),
+                    || GridOperator::from_stencil(&a),
+                )
+            },
+        );
+        drop(a);
+        let mut operators = Vec::with_capacity(self.levels());
+        operators.push(Csr::default());
+        self.setup(coarse, operators, vec![[l0?, l1?]], vec![Some(grid)])
+    }
+
+    /// The levels from `operators.len()` on, `a` the operator of that level (the finer
+    /// levels' operators, lines and stencil forms given).
+    fn setup(
+        &mut self,
+        a: Csr,
+        mut operators: Vec<Csr>,
+        mut lines: Vec<[Lines; 2]>,
+        mut grids: Vec<Option<GridOperator>>,
+    ) -> Result<()> {
         // level by level: the coarse operator, then the level's smoother and stencil
         // form, after which its CSR matrix goes (only one fine matrix exists at a time)
         let lines_smoother =
             matches!(self.smoother, Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines);
-        let mut operators = Vec::with_capacity(self.levels());
-        let (mut diagonals, mut ilu, mut lines, mut grids) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut diagonals, mut ilu) = (Vec::new(), Vec::new());
         let mut current = a;
-        for p in &self.prolongations {
+        for p in &self.prolongations[operators.len()..] {
             let coarse = galerkin(&current, p);
             match self.smoother {
                 Smoother::SymmetricGaussSeidel => diagonals.push(diagonal_positions(&current)?),
                 Smoother::Ilu0 => ilu.push(Ilu0::new(&current)?),
                 Smoother::Lines | Smoother::ColouredLines | Smoother::SplitColouredLines => {
                     let nx = grid_width(&current);
-                    lines.push([Lines::new(&current, nx, 0)?, Lines::new(&current, nx, 1)?]);
-                    let grid = GridOperator::from_csr(&current, nx);
+                    // the two directions' lines and the stencil form side by side
+                    let ((l0, l1), grid) = rayon::join(
+                        || rayon::join(|| Lines::new(&current, nx, 0), || Lines::new(&current, nx, 1)),
+                        || GridOperator::from_csr(&current, nx),
+                    );
+                    lines.push([l0?, l1?]);
                     if grid.is_some() {
                         current = Csr::default();
                     }
