@@ -13,11 +13,15 @@
 /// Subgrids with at most this many unknowns are not dissected further.
 const LEAF: usize = 64;
 
-/// Nested-dissection order of the grid points `nodes` (`[i, j]` per unknown) for a
-/// matrix that couples points up to `reach = [p, q]` apart in each direction. Returns
-/// `order` with `order[new] = old`, a permutation of `0..nodes.len()`.
-pub(crate) fn nested_dissection(nodes: &[[usize; 2]], reach: [usize; 2]) -> Vec<usize> {
-    let mut work: Vec<([usize; 2], usize)> = nodes.iter().enumerate().map(|(k, &ij)| (ij, k)).collect();
+/// Nested-dissection order of the grid points `nodes` (`[i, j]` per unknown, or `[i, j,
+/// k]` on a trivariate grid) for a matrix that couples points up to `reach = [p, q]`
+/// (`[p, q, r]`) apart in each direction. Returns `order` with `order[new] = old`, a
+/// permutation of `0..nodes.len()`. Each subgrid is cut across its longest extent in
+/// units of the reach (the first direction of the longest), by a separator `reach`
+/// layers wide, the halves ordered first; subgrids of at most [`LEAF`] points in the
+/// natural order (the last index slowest).
+pub(crate) fn nested_dissection<const D: usize>(nodes: &[[usize; D]], reach: [usize; D]) -> Vec<usize> {
+    let mut work: Vec<([usize; D], usize)> = nodes.iter().enumerate().map(|(k, &ij)| (ij, k)).collect();
     let mut order = Vec::with_capacity(nodes.len());
     dissect(&mut work, reach, &mut order);
     order
@@ -40,24 +44,34 @@ pub fn inverse(order: &[usize]) -> Vec<usize> {
     inv
 }
 
-fn dissect(nodes: &mut [([usize; 2], usize)], reach: [usize; 2], out: &mut Vec<usize>) {
-    let natural = |nodes: &mut [([usize; 2], usize)], out: &mut Vec<usize>| {
-        nodes.sort_unstable_by_key(|&(ij, _)| (ij[1], ij[0]));
+/// The indices of `ij` from the last to the first (the natural order's sort key).
+fn reversed<const D: usize>(ij: &[usize; D]) -> [usize; D] {
+    std::array::from_fn(|k| ij[D - 1 - k])
+}
+
+fn dissect<const D: usize>(nodes: &mut [([usize; D], usize)], reach: [usize; D], out: &mut Vec<usize>) {
+    let natural = |nodes: &mut [([usize; D], usize)], out: &mut Vec<usize>| {
+        nodes.sort_unstable_by_key(|(ij, _)| reversed(ij));
         out.extend(nodes.iter().map(|n| n.1));
     };
     if nodes.len() <= LEAF {
         return natural(nodes, out);
     }
-    let mut lo = [usize::MAX; 2];
-    let mut hi = [0; 2];
+    let mut lo = [usize::MAX; D];
+    let mut hi = [0; D];
     for (ij, _) in nodes.iter() {
-        for d in 0..2 {
+        for d in 0..D {
             lo[d] = lo[d].min(ij[d]);
             hi[d] = hi[d].max(ij[d]);
         }
     }
-    // cut across the longer extent (in units of the separator width)
-    let d = if (hi[0] - lo[0]) * reach[1].max(1) >= (hi[1] - lo[1]) * reach[0].max(1) { 0 } else { 1 };
+    // cut across the longest extent (in units of the separator width)
+    let mut d = 0;
+    for k in 1..D {
+        if (hi[k] - lo[k]) * reach[d].max(1) > (hi[d] - lo[d]) * reach[k].max(1) {
+            d = k;
+        }
+    }
     let w = reach[d].max(1);
     let extent = hi[d] - lo[d] + 1;
     if extent < 2 * w + 1 {
@@ -66,7 +80,7 @@ fn dissect(nodes: &mut [([usize; 2], usize)], reach: [usize; 2], out: &mut Vec<u
     }
     let cut = lo[d] + (extent - w) / 2;
     // left | separator | right, each contiguous after sorting on the cut coordinate
-    nodes.sort_unstable_by_key(|&(ij, _)| (ij[d], ij[1 - d]));
+    nodes.sort_unstable_by_key(|(ij, _)| (ij[d], reversed(ij)));
     let left = nodes.partition_point(|n| n.0[d] < cut);
     let right = nodes.partition_point(|n| n.0[d] < cut + w);
     let (a, rest) = nodes.split_at_mut(left);
@@ -119,6 +133,29 @@ mod tests {
         let max_left = (0..nodes.len()).filter(|&k| nodes[k][0] < c0).map(|k| pos[k]).max().unwrap();
         let min_right = (0..nodes.len()).filter(|&k| nodes[k][0] > c1).map(|k| pos[k]).min().unwrap();
         assert!(max_left < min_right);
+    }
+
+    /// On a trivariate grid: a permutation, whose top separator is `r` planes across the
+    /// longest extent in units of the reach (here `z`), the points on one side of it
+    /// all ordered before those on the other.
+    #[test]
+    fn trivariate_halves_are_uncoupled() {
+        let (nx, ny, nz, reach) = (12, 10, 40, [2, 2, 3]);
+        let nodes: Vec<[usize; 3]> =
+            (0..nz).flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| [i, j, k]))).collect();
+        let order = nested_dissection(&nodes, reach);
+        let mut seen = vec![false; nodes.len()];
+        order.iter().for_each(|&k| seen[k] = true);
+        assert!(order.len() == nodes.len() && seen.iter().all(|&s| s));
+        let last = &order[order.len() - reach[2] * nx * ny..];
+        let zs: std::collections::BTreeSet<usize> = last.iter().map(|&k| nodes[k][2]).collect();
+        assert_eq!(zs.len(), reach[2]);
+        let (z0, z1) = (*zs.first().unwrap(), *zs.last().unwrap());
+        assert_eq!(z1 - z0 + 1, reach[2]);
+        let pos = inverse(&order);
+        let max_below = (0..nodes.len()).filter(|&k| nodes[k][2] < z0).map(|k| pos[k]).max().unwrap();
+        let min_above = (0..nodes.len()).filter(|&k| nodes[k][2] > z1).map(|k| pos[k]).min().unwrap();
+        assert!(max_below < min_above);
     }
 
     #[test]
