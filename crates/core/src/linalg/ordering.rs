@@ -117,45 +117,43 @@ mod tests {
     /// is within `reach` of a point of the right half. Checked through the defining
     /// property of nested dissection for the elimination: a point eliminated before a
     /// separator couples only to points of its own half or to later separators.
+    /// The top separator of `order` (its last `len` points) is `w` consecutive layers
+    /// across direction `d`, and the points on one side of it are all ordered before
+    /// those on the other: a point eliminated before the separator couples only to its
+    /// own half or to later separators.
+    fn assert_top_separator<const D: usize>(nodes: &[[usize; D]], order: &[usize], d: usize, w: usize, len: usize) {
+        let mut seen = vec![false; nodes.len()];
+        order.iter().for_each(|&k| seen[k] = true);
+        assert!(order.len() == nodes.len() && seen.iter().all(|&s| s), "a permutation");
+        let layers: std::collections::BTreeSet<usize> =
+            order[order.len() - len..].iter().map(|&k| nodes[k][d]).collect();
+        assert_eq!(layers.len(), w);
+        let (c0, c1) = (*layers.first().unwrap(), *layers.last().unwrap());
+        assert_eq!(c1 - c0 + 1, w);
+        let pos = inverse(order);
+        let max_left = (0..nodes.len()).filter(|&k| nodes[k][d] < c0).map(|k| pos[k]).max().unwrap();
+        let min_right = (0..nodes.len()).filter(|&k| nodes[k][d] > c1).map(|k| pos[k]).min().unwrap();
+        assert!(max_left < min_right);
+    }
+
+    /// The last block of the order is the top separator: `p` columns.
     #[test]
     fn halves_are_uncoupled() {
         let (nx, ny, reach) = (90, 40, [3, 3]);
         let nodes = grid(nx, ny);
         let order = nested_dissection(&nodes, reach);
-        // the last block of the order is the top separator: p columns or q rows
-        let last = &order[order.len() - reach[0] * ny..];
-        let cols: std::collections::BTreeSet<usize> = last.iter().map(|&k| nodes[k][0]).collect();
-        assert_eq!(cols.len(), reach[0]);
-        let (c0, c1) = (*cols.first().unwrap(), *cols.last().unwrap());
-        assert_eq!(c1 - c0 + 1, reach[0]);
-        // left of the separator is ordered entirely before right of it
-        let pos = inverse(&order);
-        let max_left = (0..nodes.len()).filter(|&k| nodes[k][0] < c0).map(|k| pos[k]).max().unwrap();
-        let min_right = (0..nodes.len()).filter(|&k| nodes[k][0] > c1).map(|k| pos[k]).min().unwrap();
-        assert!(max_left < min_right);
+        assert_top_separator(&nodes, &order, 0, reach[0], reach[0] * ny);
     }
 
-    /// On a trivariate grid: a permutation, whose top separator is `r` planes across the
-    /// longest extent in units of the reach (here `z`), the points on one side of it
-    /// all ordered before those on the other.
+    /// On a trivariate grid the top separator is `r` planes across the longest extent
+    /// in units of the reach (here `z`).
     #[test]
     fn trivariate_halves_are_uncoupled() {
         let (nx, ny, nz, reach) = (12, 10, 40, [2, 2, 3]);
         let nodes: Vec<[usize; 3]> =
             (0..nz).flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| [i, j, k]))).collect();
         let order = nested_dissection(&nodes, reach);
-        let mut seen = vec![false; nodes.len()];
-        order.iter().for_each(|&k| seen[k] = true);
-        assert!(order.len() == nodes.len() && seen.iter().all(|&s| s));
-        let last = &order[order.len() - reach[2] * nx * ny..];
-        let zs: std::collections::BTreeSet<usize> = last.iter().map(|&k| nodes[k][2]).collect();
-        assert_eq!(zs.len(), reach[2]);
-        let (z0, z1) = (*zs.first().unwrap(), *zs.last().unwrap());
-        assert_eq!(z1 - z0 + 1, reach[2]);
-        let pos = inverse(&order);
-        let max_below = (0..nodes.len()).filter(|&k| nodes[k][2] < z0).map(|k| pos[k]).max().unwrap();
-        let min_above = (0..nodes.len()).filter(|&k| nodes[k][2] > z1).map(|k| pos[k]).min().unwrap();
-        assert!(max_below < min_above);
+        assert_top_separator(&nodes, &order, 2, reach[2], reach[2] * nx * ny);
     }
 
     #[test]

@@ -214,7 +214,8 @@ impl VolumeDiscretization {
     /// points (the EGG preconditioner `K`).
     pub(super) fn ordering(&self) -> Vec<usize> {
         let s = self.shape.map(|k| k.saturating_sub(2).max(1));
-        let p: [usize; 3] = std::array::from_fn(|d| self.tables[d].first().and_then(|t| t.first()).map_or(1, |t| t.0.degree));
+        let p: [usize; 3] =
+            std::array::from_fn(|d| self.tables[d].first().and_then(|t| t.first()).map_or(1, |t| t.0.degree));
         let nodes: Vec<[usize; 3]> = (0..self.free).map(|f| [f % s[0], (f / s[0]) % s[1], f / (s[0] * s[1])]).collect();
         crate::linalg::ordering::nested_dissection(&nodes, p)
     }

@@ -60,6 +60,25 @@ fn in_order<T>(g: [usize; 3], o: [usize; 3], mut f: impl FnMut([usize; 3]) -> T)
     out
 }
 
+/// An element's tables in the [`contraction_order`] `o`, with the numbers of functions
+/// `nat` per direction, and `n` and of points `g` in that order.
+struct Ordered<'a> {
+    o: [usize; 3],
+    nat: [usize; 3],
+    t: [&'a Tables; 3],
+    n: [usize; 3],
+    g: [usize; 3],
+}
+
+impl<'a> Ordered<'a> {
+    fn of(t: [&'a Tables; 3]) -> Self {
+        let o = contraction_order(t);
+        let nat: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
+        let t = [t[o[0]], t[o[1]], t[o[2]]];
+        Self { o, nat, t, n: std::array::from_fn(|d| nat[o[d]]), g: std::array::from_fn(|d| t[d].len()) }
+    }
+}
+
 /// [`in_order`]'s multi-indices as indices `(i_z g_y + i_y) g_x + i_x` of the natural
 /// order.
 fn natural_index(g: [usize; 3], o: [usize; 3]) -> Vec<usize> {
@@ -94,16 +113,8 @@ pub(super) fn weights(t: [&Tables; 3]) -> Vec<f64> {
 /// of vectors of `k g_(o₀)` and `g_(o₁) k g_(o₀)` numbers; the result is then moved to
 /// the layout above.
 pub(super) fn values(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
-    values_in_order(t, u)
-}
-
-fn values_in_order(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
-    let o = contraction_order(t);
-    let nat: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
     // the tables, sizes, coefficients and derivative orders in the contraction order
-    let t = [t[o[0]], t[o[1]], t[o[2]]];
-    let n: [usize; 3] = std::array::from_fn(|d| nat[o[d]]);
-    let g: [usize; 3] = std::array::from_fn(|d| t[d].len());
+    let Ordered { o, nat, t, n, g } = Ordered::of(t);
     let m = n[0] * n[1] * n[2];
     let nq = g[0] * g[1] * g[2];
     let cols = u.len() / m;
@@ -124,66 +135,70 @@ fn values_in_order(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
         std::array::from_fn(|row| PAIRS_XY.iter().position(|p| p[..] == rows[row][..2]).unwrap_or(0));
     // a run of the first direction's points of all columns, (col, x)
     let run = cols * g[0];
-    // U¹[dx][(c n₁ + b) run + col g₀ + x]
+    // U¹[dx][(c n₁ + b) run + col g₀ + x] (every buffer written in order or from its
+    // first term, without a zero fill first)
     let s1 = n[2] * n[1] * run;
-    let mut u1 = vec![0.0; 3 * s1];
-    for (dx, u1d) in u1.chunks_exact_mut(s1).enumerate() {
-        for (cb, dst) in u1d.chunks_exact_mut(run).enumerate() {
-            for (col, dc) in dst.chunks_exact_mut(g[0]).enumerate() {
+    let mut u1 = Vec::with_capacity(3 * s1);
+    for dx in 0..3 {
+        for cb in 0..n[2] * n[1] {
+            for col in 0..cols {
                 let coef = &u[col * m + cb * n[0]..][..n[0]];
-                for (o, (tx, _)) in dc.iter_mut().zip(t[0]) {
-                    *o = coef.iter().zip(&tx.d[dx][..n[0]]).map(|(a, b)| a * b).sum();
-                }
+                u1.extend(
+                    t[0].iter().map(|(tx, _)| coef.iter().zip(&tx.d[dx][..n[0]]).map(|(a, b)| a * b).sum::<f64>()),
+                );
             }
         }
     }
     // U²[pair][(c g₁ + y) run + col g₀ + x]
     let s2 = n[2] * g[1] * run;
-    let mut u2 = vec![0.0; 6 * s2];
-    for (&[dx, dy], u2p) in PAIRS_XY.iter().zip(u2.chunks_exact_mut(s2)) {
-        for (cy, dst) in u2p.chunks_exact_mut(run).enumerate() {
+    let mut u2 = Vec::with_capacity(6 * s2);
+    for &[dx, dy] in &PAIRS_XY {
+        for cy in 0..n[2] * g[1] {
             let (c, ty) = (cy / g[1], &t[1][cy % g[1]].0);
-            for b in 0..n[1] {
+            let src = |b: usize| &u1[dx * s1 + (c * n[1] + b) * run..][..run];
+            let start = u2.len();
+            u2.extend(src(0).iter().map(|s| ty.d[dy][0] * s));
+            let dst = &mut u2[start..];
+            for b in 1..n[1] {
                 let f = ty.d[dy][b];
-                let src = &u1[dx * s1 + (c * n[1] + b) * run..][..run];
-                for (o, s) in dst.iter_mut().zip(src) {
+                for (o, s) in dst.iter_mut().zip(src(b)) {
                     *o += f * s;
                 }
             }
         }
     }
     // each row's values, a plane of (y, col, x) at a time, the sum over the last
-    // direction's functions but its last term in `acc`, and the last term added on the
-    // way to the layout `out[(10 col + row) n_q + (z g₁ + y) g₀ + x]` (no copy)
+    // direction's functions but its last term: V[row][z][(y run + col g₀ + x)] ...
     let plane = g[1] * run;
-    let mut out = vec![0.0; cols * 10 * nq];
-    let mut acc = vec![0.0; plane];
+    let mut v = Vec::with_capacity(10 * g[2] * plane);
     for (row, r) in rows.iter().enumerate() {
         let src = &u2[row_pair[row] * s2..(row_pair[row] + 1) * s2];
-        let (head, last) = src.split_at((n[2] - 1) * plane);
-        for (z, (tz, _)) in t[2].iter().enumerate() {
+        for (tz, _) in t[2] {
             let f = &tz.d[r[2]][..n[2]];
-            let mut terms = head.chunks_exact(plane).zip(f);
-            match terms.next() {
-                Some((term, &fc)) => {
-                    for (o, s) in acc.iter_mut().zip(term) {
-                        *o = fc * s;
-                    }
-                }
-                None => acc.fill(0.0),
+            let start = v.len();
+            match n[2] {
+                1 => v.extend(std::iter::repeat_n(0.0, plane)),
+                _ => v.extend(src[..plane].iter().map(|s| f[0] * s)),
             }
-            for (term, &fc) in terms {
+            let acc = &mut v[start..];
+            for (term, &fc) in src.chunks_exact(plane).zip(f).take(n[2] - 1).skip(1) {
                 for (o, s) in acc.iter_mut().zip(term) {
                     *o += fc * s;
                 }
             }
-            let fl = f[n[2] - 1];
-            for (y, (ay, ly)) in acc.chunks_exact(run).zip(last.chunks_exact(run)).enumerate() {
-                for col in 0..cols {
-                    let dst = &mut out[(10 * col + row) * nq + (z * g[1] + y) * g[0]..][..g[0]];
-                    for ((o, a), l) in dst.iter_mut().zip(&ay[col * g[0]..][..g[0]]).zip(&ly[col * g[0]..][..g[0]]) {
-                        *o = a + fl * l;
-                    }
+        }
+    }
+    // ... and the last term added on the way to the layout
+    // `out[(10 col + row) n_q + (z g₁ + y) g₀ + x]`, written in order (no copy)
+    let mut out = Vec::with_capacity(cols * 10 * nq);
+    for col in 0..cols {
+        for (row, r) in rows.iter().enumerate() {
+            let last = &u2[row_pair[row] * s2 + (n[2] - 1) * plane..][..plane];
+            for ((tz, _), vz) in t[2].iter().zip(v[row * g[2] * plane..].chunks_exact(plane)) {
+                let fl = tz.d[r[2]][n[2] - 1];
+                for (ay, ly) in vz.chunks_exact(run).zip(last.chunks_exact(run)) {
+                    let (ay, ly) = (&ay[col * g[0]..][..g[0]], &ly[col * g[0]..][..g[0]]);
+                    out.extend(ay.iter().zip(ly).map(|(a, l)| a + fl * l));
                 }
             }
         }
@@ -198,15 +213,7 @@ fn values_in_order(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
 /// The transpose of [`values`]' passes in the reverse order: the direction with the
 /// fewest functions is contracted first, which is the cheapest order here.
 pub(super) fn integrals(t: [&Tables; 3], f: &[f64]) -> Vec<f64> {
-    integrals_in_order(t, f)
-}
-
-fn integrals_in_order(t: [&Tables; 3], f: &[f64]) -> Vec<f64> {
-    let o = contraction_order(t);
-    let nat: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
-    let t = [t[o[0]], t[o[1]], t[o[2]]];
-    let n: [usize; 3] = std::array::from_fn(|d| nat[o[d]]);
-    let g: [usize; 3] = std::array::from_fn(|d| t[d].len());
+    let Ordered { o, nat, t, n, g } = Ordered::of(t);
     let (m, nq) = (n[0] * n[1] * n[2], g[0] * g[1] * g[2]);
     let cols = f.len() / nq;
     let mut r = vec![0.0; cols * m];
@@ -278,10 +285,6 @@ fn integrals_in_order(t: [&Tables; 3], f: &[f64]) -> Vec<f64> {
 /// `n_x²` per point, the second `n_x² n_y²` per `(y, z)` point); `c` is moved to that
 /// order of the points first.
 pub(super) fn stiffness(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
-    stiffness_in_order(t, c)
-}
-
-fn stiffness_in_order(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
     let nat: [usize; 3] = std::array::from_fn(|d| t[d][0].0.degree + 1);
     let gn: [usize; 3] = std::array::from_fn(|d| t[d].len());
     let mut so = [0, 1, 2];

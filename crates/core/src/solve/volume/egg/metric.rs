@@ -32,21 +32,29 @@ fn contract(a: [f64; 6], h: [f64; 6]) -> f64 {
     a[0] * h[0] + a[1] * h[1] + a[2] * h[2] + 2.0 * a[3] * h[3] + 2.0 * a[4] * h[4] + 2.0 * a[5] * h[5]
 }
 
+/// `a + b`.
+#[inline(always)]
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
 /// The columns `d_j = ∂_j x` of `J` and the components' Hessians `∇²x_c` (entries in
 /// the order of `egg::PAIRS`) at point `q` of the coefficient columns `first..first +
-/// 3` of the rows `x`.
+/// 3` of the rows `x` (array literals, not `std::array::from_fn`, whose closures the
+/// compiler left as calls in the loop over the points).
 #[inline(always)]
 fn jacobian_at(x: &[&[f64]; 60], first: usize, q: usize) -> ([[f64; 3]; 3], [[f64; 6]; 3]) {
-    let d = std::array::from_fn(|j| std::array::from_fn(|c| x[10 * (first + c) + 1 + j][q]));
-    let h = std::array::from_fn(|c| std::array::from_fn(|k| x[10 * (first + c) + 4 + k][q]));
-    (d, h)
+    let v = |c: usize, k: usize| x[10 * (first + c) + k][q];
+    let d = [[v(0, 1), v(1, 1), v(2, 1)], [v(0, 2), v(1, 2), v(2, 2)], [v(0, 3), v(1, 3), v(2, 3)]];
+    let h = |c: usize| [v(c, 4), v(c, 5), v(c, 6), v(c, 7), v(c, 8), v(c, 9)];
+    (d, [h(0), h(1), h(2)])
 }
 
 /// The cofactor columns `c_i = d_(i+1) × d_(i+2)` and the six entries of `A_ij = c_i ·
 /// c_j`.
 #[inline(always)]
 fn cofactor_metric(d: &[[f64; 3]; 3]) -> ([[f64; 3]; 3], [f64; 6]) {
-    let c: [[f64; 3]; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
+    let c = [cross(d[1], d[2]), cross(d[2], d[0]), cross(d[0], d[1])];
     let a = [dot(c[0], c[0]), dot(c[1], c[1]), dot(c[2], c[2]), dot(c[0], c[1]), dot(c[0], c[2]), dot(c[1], c[2])];
     (c, a)
 }
@@ -71,21 +79,7 @@ pub(in crate::solve::volume) fn residual(
     density: &mut [f64],
     coef: &mut [f64],
 ) -> bool {
-    if coef.is_empty() {
-        residual_points::<false>(w, x, f, density, coef)
-    } else {
-        residual_points::<true>(w, x, f, density, coef)
-    }
-}
-
-#[inline(always)]
-fn residual_points<const METRIC: bool>(
-    w: &[f64],
-    x: &[f64],
-    f: &mut [f64],
-    density: &mut [f64],
-    coef: &mut [f64],
-) -> bool {
+    let metric = !coef.is_empty();
     let nq = w.len();
     let x = rows(x, nq, 3);
     let density = &mut density[..nq];
@@ -106,7 +100,7 @@ fn residual_points<const METRIC: bool>(
         f2[q] = wq * (contract(a, h[2]) / t);
         let det = dot(d[0], cof[0]);
         density[q] = wq * if det > 0.0 { t / det } else { f64::INFINITY };
-        if METRIC {
+        if metric {
             // A_ij in the order (3 i + j)
             let full = [a[0], a[3], a[4], a[3], a[1], a[5], a[4], a[5], a[2]];
             for k in 0..9 {
@@ -146,18 +140,19 @@ fn linearised_points(w: &[f64], x: &[f64], f: &mut [f64]) -> bool {
         let (cof, a) = cofactor_metric(&d);
         let t = a[0] + a[1] + a[2];
         ok &= t > 0.0;
-        let dcof: [[f64; 3]; 3] = std::array::from_fn(|i| {
-            let (u, v) = (cross(dd[(i + 1) % 3], d[(i + 2) % 3]), cross(d[(i + 1) % 3], dd[(i + 2) % 3]));
-            [u[0] + v[0], u[1] + v[1], u[2] + v[2]]
-        });
+        let dcof = [
+            add(cross(dd[1], d[2]), cross(d[1], dd[2])),
+            add(cross(dd[2], d[0]), cross(d[2], dd[0])),
+            add(cross(dd[0], d[1]), cross(d[0], dd[1])),
+        ];
         let da = |i: usize, j: usize| dot(dcof[i], cof[j]) + dot(cof[i], dcof[j]);
         let da = [da(0, 0), da(1, 1), da(2, 2), da(0, 1), da(0, 2), da(1, 2)];
         let dt = da[0] + da[1] + da[2];
-        let out: [f64; 3] = std::array::from_fn(|c| {
+        let out = |c: usize| {
             let l = contract(a, h[c]) / t;
             wq * ((contract(da, h[c]) + contract(a, dh[c]) - l * dt) / t)
-        });
-        (f0[q], f1[q], f2[q]) = (out[0], out[1], out[2]);
+        };
+        (f0[q], f1[q], f2[q]) = (out(0), out(1), out(2));
     }
     ok
 }
