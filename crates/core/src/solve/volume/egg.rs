@@ -47,17 +47,10 @@ use super::assembly::{Local, VolumeDiscretization};
 use super::tensor_points;
 use crate::linalg::sparse::Csr;
 use crate::spline::volume::Point3;
+use metric::{cross, dot};
 
 /// Pairs `(i, j)` of the six second derivatives, in the order they are stored.
 const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
-
-fn cross(a: Point3, b: Point3) -> Point3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn dot(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// `A : H` for symmetric `A` and `H` given by the six entries of [`PAIRS`].
 fn contract(a: &[[f64; 3]; 3], h: &[f64; 6]) -> f64 {
