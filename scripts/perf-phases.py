@@ -9,7 +9,8 @@ Jacobian"):
 
 Each sample goes to the first phase whose pattern names a frame of its stack, from the
 leaf up; samples without one are listed by their leaf (e.g. faer's `gemm` kernels,
-whose stacks are not unwound).
+whose stacks are not unwound). The EGG element's samples are then split by the first
+kernel named on their stack (the sum-factorised passes, the per-point work).
 """
 import collections
 import sys
@@ -23,6 +24,16 @@ PHASES = [
     ("addition into the pattern", "VolumeDiscretization::assemble"),
     ("discretization set-up", "VolumeDiscretization::new"),
     ("pattern matrix", "pattern_matrix"),
+]
+
+
+KERNELS = [
+    "tensor_points::values",
+    "tensor_points::stiffness",
+    "tensor_points::integrals",
+    "metric::linearised",
+    "metric::residual",
+    "EggVolume::element_points",
 ]
 
 
@@ -43,17 +54,22 @@ def samples(path):
 
 
 def main():
-    phases, leaves, n = collections.Counter(), collections.Counter(), 0
+    phases, leaves, kernels, n = collections.Counter(), collections.Counter(), collections.Counter(), 0
     for s in samples(sys.argv[1]):
         n += 1
         name = next((k for fr in s for k, pat in PHASES if pat in fr), None)
         if name is None:
             leaves[s[0] if s else "?"] += 1
             name = "other"
+        if name == "EGG element":
+            kernels[next((k for fr in s for k in KERNELS if k in fr), "the rest (gathers, allocation)")] += 1
         phases[name] += 1
     for k, v in phases.most_common():
         print(f"{k:32s} {v:7d} {100 * v / n:5.1f} %")
     print(f"{'samples':32s} {n:7d}")
+    print("\nEGG element, by kernel:")
+    for k, v in kernels.most_common():
+        print(f"{k:32s} {v:7d} {100 * v / n:5.1f} %")
     print("\nother, by leaf:")
     for k, v in leaves.most_common(15):
         print(f"{v:7d} {k[:90]}")

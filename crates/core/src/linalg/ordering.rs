@@ -13,11 +13,15 @@
 /// Subgrids with at most this many unknowns are not dissected further.
 const LEAF: usize = 64;
 
-/// Nested-dissection order of the grid points `nodes` (`[i, j]` per unknown) for a
-/// matrix that couples points up to `reach = [p, q]` apart in each direction. Returns
-/// `order` with `order[new] = old`, a permutation of `0..nodes.len()`.
-pub(crate) fn nested_dissection(nodes: &[[usize; 2]], reach: [usize; 2]) -> Vec<usize> {
-    let mut work: Vec<([usize; 2], usize)> = nodes.iter().enumerate().map(|(k, &ij)| (ij, k)).collect();
+/// Nested-dissection order of the grid points `nodes` (`[i, j]` per unknown, or `[i, j,
+/// k]` on a trivariate grid) for a matrix that couples points up to `reach = [p, q]`
+/// (`[p, q, r]`) apart in each direction. Returns `order` with `order[new] = old`, a
+/// permutation of `0..nodes.len()`. Each subgrid is cut across its longest extent in
+/// units of the reach (the first direction of the longest), by a separator `reach`
+/// layers wide, the halves ordered first; subgrids of at most [`LEAF`] points in the
+/// natural order (the last index slowest).
+pub(crate) fn nested_dissection<const D: usize>(nodes: &[[usize; D]], reach: [usize; D]) -> Vec<usize> {
+    let mut work: Vec<([usize; D], usize)> = nodes.iter().enumerate().map(|(k, &ij)| (ij, k)).collect();
     let mut order = Vec::with_capacity(nodes.len());
     dissect(&mut work, reach, &mut order);
     order
@@ -40,24 +44,34 @@ pub fn inverse(order: &[usize]) -> Vec<usize> {
     inv
 }
 
-fn dissect(nodes: &mut [([usize; 2], usize)], reach: [usize; 2], out: &mut Vec<usize>) {
-    let natural = |nodes: &mut [([usize; 2], usize)], out: &mut Vec<usize>| {
-        nodes.sort_unstable_by_key(|&(ij, _)| (ij[1], ij[0]));
+/// The indices of `ij` from the last to the first (the natural order's sort key).
+fn reversed<const D: usize>(ij: &[usize; D]) -> [usize; D] {
+    std::array::from_fn(|k| ij[D - 1 - k])
+}
+
+fn dissect<const D: usize>(nodes: &mut [([usize; D], usize)], reach: [usize; D], out: &mut Vec<usize>) {
+    let natural = |nodes: &mut [([usize; D], usize)], out: &mut Vec<usize>| {
+        nodes.sort_unstable_by_key(|(ij, _)| reversed(ij));
         out.extend(nodes.iter().map(|n| n.1));
     };
     if nodes.len() <= LEAF {
         return natural(nodes, out);
     }
-    let mut lo = [usize::MAX; 2];
-    let mut hi = [0; 2];
+    let mut lo = [usize::MAX; D];
+    let mut hi = [0; D];
     for (ij, _) in nodes.iter() {
-        for d in 0..2 {
+        for d in 0..D {
             lo[d] = lo[d].min(ij[d]);
             hi[d] = hi[d].max(ij[d]);
         }
     }
-    // cut across the longer extent (in units of the separator width)
-    let d = if (hi[0] - lo[0]) * reach[1].max(1) >= (hi[1] - lo[1]) * reach[0].max(1) { 0 } else { 1 };
+    // cut across the longest extent (in units of the separator width)
+    let mut d = 0;
+    for k in 1..D {
+        if (hi[k] - lo[k]) * reach[d].max(1) > (hi[d] - lo[d]) * reach[k].max(1) {
+            d = k;
+        }
+    }
     let w = reach[d].max(1);
     let extent = hi[d] - lo[d] + 1;
     if extent < 2 * w + 1 {
@@ -66,7 +80,7 @@ fn dissect(nodes: &mut [([usize; 2], usize)], reach: [usize; 2], out: &mut Vec<u
     }
     let cut = lo[d] + (extent - w) / 2;
     // left | separator | right, each contiguous after sorting on the cut coordinate
-    nodes.sort_unstable_by_key(|&(ij, _)| (ij[d], ij[1 - d]));
+    nodes.sort_unstable_by_key(|(ij, _)| (ij[d], reversed(ij)));
     let left = nodes.partition_point(|n| n.0[d] < cut);
     let right = nodes.partition_point(|n| n.0[d] < cut + w);
     let (a, rest) = nodes.split_at_mut(left);
@@ -103,22 +117,43 @@ mod tests {
     /// is within `reach` of a point of the right half. Checked through the defining
     /// property of nested dissection for the elimination: a point eliminated before a
     /// separator couples only to points of its own half or to later separators.
+    /// The top separator of `order` (its last `len` points) is `w` consecutive layers
+    /// across direction `d`, and the points on one side of it are all ordered before
+    /// those on the other: a point eliminated before the separator couples only to its
+    /// own half or to later separators.
+    fn assert_top_separator<const D: usize>(nodes: &[[usize; D]], order: &[usize], d: usize, w: usize, len: usize) {
+        let mut seen = vec![false; nodes.len()];
+        order.iter().for_each(|&k| seen[k] = true);
+        assert!(order.len() == nodes.len() && seen.iter().all(|&s| s), "a permutation");
+        let layers: std::collections::BTreeSet<usize> =
+            order[order.len() - len..].iter().map(|&k| nodes[k][d]).collect();
+        assert_eq!(layers.len(), w);
+        let (c0, c1) = (*layers.first().unwrap(), *layers.last().unwrap());
+        assert_eq!(c1 - c0 + 1, w);
+        let pos = inverse(order);
+        let max_left = (0..nodes.len()).filter(|&k| nodes[k][d] < c0).map(|k| pos[k]).max().unwrap();
+        let min_right = (0..nodes.len()).filter(|&k| nodes[k][d] > c1).map(|k| pos[k]).min().unwrap();
+        assert!(max_left < min_right);
+    }
+
+    /// The last block of the order is the top separator: `p` columns.
     #[test]
     fn halves_are_uncoupled() {
         let (nx, ny, reach) = (90, 40, [3, 3]);
         let nodes = grid(nx, ny);
         let order = nested_dissection(&nodes, reach);
-        // the last block of the order is the top separator: p columns or q rows
-        let last = &order[order.len() - reach[0] * ny..];
-        let cols: std::collections::BTreeSet<usize> = last.iter().map(|&k| nodes[k][0]).collect();
-        assert_eq!(cols.len(), reach[0]);
-        let (c0, c1) = (*cols.first().unwrap(), *cols.last().unwrap());
-        assert_eq!(c1 - c0 + 1, reach[0]);
-        // left of the separator is ordered entirely before right of it
-        let pos = inverse(&order);
-        let max_left = (0..nodes.len()).filter(|&k| nodes[k][0] < c0).map(|k| pos[k]).max().unwrap();
-        let min_right = (0..nodes.len()).filter(|&k| nodes[k][0] > c1).map(|k| pos[k]).min().unwrap();
-        assert!(max_left < min_right);
+        assert_top_separator(&nodes, &order, 0, reach[0], reach[0] * ny);
+    }
+
+    /// On a trivariate grid the top separator is `r` planes across the longest extent
+    /// in units of the reach (here `z`).
+    #[test]
+    fn trivariate_halves_are_uncoupled() {
+        let (nx, ny, nz, reach) = (12, 10, 40, [2, 2, 3]);
+        let nodes: Vec<[usize; 3]> =
+            (0..nz).flat_map(|k| (0..ny).flat_map(move |j| (0..nx).map(move |i| [i, j, k]))).collect();
+        let order = nested_dissection(&nodes, reach);
+        assert_top_separator(&nodes, &order, 2, reach[2], reach[2] * nx * ny);
     }
 
     #[test]

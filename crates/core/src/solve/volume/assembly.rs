@@ -206,6 +206,20 @@ impl VolumeDiscretization {
         idx
     }
 
+    /// A nested-dissection order of the free control points
+    /// ([`crate::linalg::ordering::nested_dissection`] of their grid, `shape - 2` points
+    /// per direction, which couple up to `p_d` apart in direction `d`): separators of
+    /// `p_d` layers of the grid, exact on this structured grid. The fill-reducing order
+    /// of the sparse Cholesky factorization of a scalar matrix on the free control
+    /// points (the EGG preconditioner `K`).
+    pub(super) fn ordering(&self) -> Vec<usize> {
+        let s = self.shape.map(|k| k.saturating_sub(2).max(1));
+        let p: [usize; 3] =
+            std::array::from_fn(|d| self.tables[d].first().and_then(|t| t.first()).map_or(1, |t| t.0.degree));
+        let nodes: Vec<[usize; 3]> = (0..self.free).map(|f| [f % s[0], (f / s[0]) % s[1], f / (s[0] * s[1])]).collect();
+        crate::linalg::ordering::nested_dissection(&nodes, p)
+    }
+
     /// Number of free scalar unknowns (3 per interior control point).
     pub fn unknowns(&self) -> usize {
         3 * self.free
@@ -242,7 +256,7 @@ impl VolumeDiscretization {
     /// (when `matrix`) into the values of the pattern, the scalar matrices (when
     /// `scalar_matrix`) into those of the scalar pattern. Elements are evaluated in
     /// parallel in batches and added in element order (the same sums as a sequential
-    /// loop).
+    /// loop), a batch while the next one is evaluated.
     pub(super) fn assemble<F>(&self, matrix: bool, scalar_matrix: bool, element: F) -> Option<Assembled>
     where
         F: Fn(usize) -> Option<Local> + Sync,
@@ -255,9 +269,8 @@ impl VolumeDiscretization {
         let mut values = out.as_mut().map_or(Vec::new(), |m| std::mem::take(&mut m.values));
         let mut scalar_values = if scalar_matrix { vec![0.0; self.scalar_pattern.nnz()] } else { Vec::new() };
         let batch = 32 * rayon::current_num_threads().max(1);
-        for start in (0..ne).step_by(batch) {
-            let locals: Vec<Local> =
-                (start..(start + batch).min(ne)).into_par_iter().map(&element).collect::<Option<_>>()?;
+        // the elements of a batch added on this thread while the next batch is evaluated
+        let mut add = |locals: Vec<Local>| {
             for l in locals {
                 scalar += l.scalar;
                 let m = l.idx.len();
@@ -296,6 +309,15 @@ impl VolumeDiscretization {
                     }
                 }
             }
+        };
+        let mut pending: Option<Vec<Local>> = None;
+        let mut start = 0;
+        while start < ne || pending.is_some() {
+            let range = start..(start + batch).min(ne);
+            let evaluate = || range.into_par_iter().map(&element).collect::<Option<Vec<Local>>>();
+            let ((), locals) = rayon::join(|| pending.take().map_or((), &mut add), evaluate);
+            pending = if start < ne { Some(locals?) } else { None };
+            start = (start + batch).min(ne);
         }
         let matrix = out.map(|m| Csr { values, ..m });
         let scalar_matrix = scalar_matrix.then(|| Csr { values: scalar_values, ..self.scalar_pattern.clone() });

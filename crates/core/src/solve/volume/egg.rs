@@ -47,17 +47,10 @@ use super::assembly::{Local, VolumeDiscretization};
 use super::tensor_points;
 use crate::linalg::sparse::Csr;
 use crate::spline::volume::Point3;
+use metric::{cross, dot};
 
 /// Pairs `(i, j)` of the six second derivatives, in the order they are stored.
 const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
-
-fn cross(a: Point3, b: Point3) -> Point3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn dot(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// `A : H` for symmetric `A` and `H` given by the six entries of [`PAIRS`].
 fn contract(a: &[[f64; 3]; 3], h: &[f64; 6]) -> f64 {
@@ -394,24 +387,32 @@ impl EggVolume {
             }
         }
         let tables = self.disc.element_tables(e);
-        // their values, gradients and Hessians at every point, X[c 10 n_q + s_q q + s_k k]
-        let ((weights, xq, basis), (sq, sk)) = if self.disc.weights.is_some() {
+        // their values, gradients and Hessians at every point, as rows over the points,
+        // X[(10 c + row) n_q + q]
+        let (weights, xq, basis) = if self.disc.weights.is_some() {
             let (weights, basis) = self.element_points(e, &idx);
             let nq = weights.len();
-            let mut xq = vec![0.0; k * 10 * nq];
+            // X[c 10 n_q + 10 q + row], then moved to the rows
+            let mut xt = vec![0.0; k * 10 * nq];
             faer::linalg::matmul::matmul(
-                faer::MatMut::from_column_major_slice_mut(&mut xq, 10 * nq, k),
+                faer::MatMut::from_column_major_slice_mut(&mut xt, 10 * nq, k),
                 faer::Accum::Replace,
                 faer::MatRef::from_row_major_slice(&basis, 10 * nq, m),
                 faer::MatRef::from_column_major_slice(&cl, m, k),
                 1.0,
                 faer::Par::Seq,
             );
-            ((weights, xq, Some(basis)), (10, 1))
+            let mut xq = vec![0.0; k * 10 * nq];
+            for (xc, tc) in xq.chunks_exact_mut(10 * nq).zip(xt.chunks_exact(10 * nq)) {
+                for (q, point) in tc.chunks_exact(10).enumerate() {
+                    for (row, &v) in point.iter().enumerate() {
+                        xc[row * nq + q] = v;
+                    }
+                }
+            }
+            (weights, xq, Some(basis))
         } else {
-            let weights = tensor_points::weights(tables);
-            let nq = weights.len();
-            ((weights, tensor_points::values(tables, &cl), None), (1, nq))
+            (tensor_points::weights(tables), tensor_points::values(tables, &cl), None)
         };
         let nq = weights.len();
         // w_q δL_c(q) (or w_q L_c(q)) per component, `c n_q + q`
@@ -420,41 +421,17 @@ impl EggVolume {
         let laplace = laplace && dir.is_none() && basis.is_none();
         let mut coef = vec![0.0; if laplace { 9 * nq } else { 0 }];
         let mut energy = 0.0;
-        for (q, &wq) in weights.iter().enumerate() {
-            let at = |col: usize, k: usize| xq[col * 10 * nq + sq * q + sk * k];
-            let d: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(c, 1 + j)));
-            let xh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(c, 4 + k)));
-            let cof: [Point3; 3] = std::array::from_fn(|i| cross(d[(i + 1) % 3], d[(i + 2) % 3]));
-            let am: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dot(cof[i], cof[j])));
-            let t = am[0][0] + am[1][1] + am[2][2];
-            if t.is_nan() || t <= 0.0 {
-                return None;
-            }
-            if dir.is_none() {
-                for c in 0..3 {
-                    f[c * nq + q] = wq * (contract(&am, &xh[c]) / t);
-                }
-                energy += wq * winslow_density(&d, &cof, t);
-                if laplace {
-                    for (ij, a) in am.iter().flatten().enumerate() {
-                        coef[ij * nq + q] = wq * a / t;
-                    }
-                }
-                continue;
-            }
-            let dd: [Point3; 3] = std::array::from_fn(|j| std::array::from_fn(|c| at(3 + c, 1 + j)));
-            let dxh: [[f64; 6]; 3] = std::array::from_fn(|c| std::array::from_fn(|k| at(3 + c, 4 + k)));
-            let dcof: [Point3; 3] = std::array::from_fn(|i| {
-                let (u, v) = (cross(dd[(i + 1) % 3], d[(i + 2) % 3]), cross(d[(i + 1) % 3], dd[(i + 2) % 3]));
-                [u[0] + v[0], u[1] + v[1], u[2] + v[2]]
-            });
-            let da: [[f64; 3]; 3] =
-                std::array::from_fn(|i| std::array::from_fn(|j| dot(dcof[i], cof[j]) + dot(cof[i], dcof[j])));
-            let dt = da[0][0] + da[1][1] + da[2][2];
-            for c in 0..3 {
-                let l = contract(&am, &xh[c]) / t;
-                f[c * nq + q] = wq * ((contract(&da, &xh[c]) + contract(&am, &dxh[c]) - l * dt) / t);
-            }
+        let ok = if dir.is_none() {
+            let mut density = vec![0.0; nq];
+            let ok = metric::residual(&weights, &xq, &mut f, &mut density, &mut coef);
+            // in point order, as a sum over the points
+            energy = density.iter().fold(energy, |e, d| e + d);
+            ok
+        } else {
+            metric::linearised(&weights, &xq, &mut f)
+        };
+        if !ok {
+            return None;
         }
         // Σ_q R_a(q) f_c(q), `c m + a`
         let rc = match basis {
@@ -526,6 +503,7 @@ impl EggVolume {
     }
 }
 
+mod metric;
 mod newton;
 
 pub(super) use newton::{solve_egg, EggSolved};

@@ -104,14 +104,23 @@ impl Step {
     /// [`LinearMethod::Auto`] up to `AUTO_LU_LIMIT` unknowns) factorizes; the others run
     /// GMRES ([`LinearMethod::Multigrid`] has no hierarchy of volumes: GMRES with the
     /// factorized `K`), and `Auto` falls back to LU.
-    fn new(n: usize, linear: LinearMethod) -> Self {
+    ///
+    /// `K` is factorized in the nested-dissection order of the free control points'
+    /// grid (`VolumeDiscretization::ordering`).
+    fn new(op: &EggVolume, linear: LinearMethod) -> Self {
+        let n = op.unknowns();
         let direct = match linear {
             LinearMethod::Lu | LinearMethod::Cholesky | LinearMethod::NegCholesky | LinearMethod::Pcg => true,
             LinearMethod::Auto => n <= AUTO_LU_LIMIT,
             LinearMethod::Gmres | LinearMethod::Multigrid => false,
         };
+        let gmres = (!direct).then(|| {
+            let mut g = LinearSolver::new(LinearMethod::Gmres);
+            g.set_ordering(&op.disc.ordering());
+            g
+        });
         Self {
-            gmres: (!direct).then(|| LinearSolver::new(LinearMethod::Gmres)),
+            gmres,
             lu: LinearSolver::new(LinearMethod::Lu),
             fallback: linear == LinearMethod::Auto,
             krylov_iterations: 0,
@@ -199,7 +208,7 @@ pub(in crate::solve::volume) fn solve_egg(
     linear: LinearMethod,
 ) -> Result<EggSolved> {
     let n = op.unknowns();
-    let mut step = Step::new(n, linear);
+    let mut step = Step::new(op, linear);
     // GMRES multiplies with the Jacobian without assembling it (`Step::solve`)
     let mut ev = op.evaluate_with(cps, step.gmres.is_none(), step.wants_laplace(n));
     if ev.residual.is_empty() && n > 0 {
@@ -320,12 +329,11 @@ mod tests {
     fn the_gmres_step_is_the_lu_step() {
         let (vol, cps) = crate::solve::volume::tests::curved_rational_volume(knots());
         let op = EggVolume::new(&vol, 5);
-        let n = op.unknowns();
         let ev = op.evaluate_with(&cps, true, true);
         let rhs: Vec<f64> = ev.residual.iter().map(|f| -f).collect();
         assert!(ev.jacobian.is_some());
-        let mut lu = Step::new(n, LinearMethod::Lu);
-        let mut gmres = Step::new(n, LinearMethod::Gmres);
+        let mut lu = Step::new(&op, LinearMethod::Lu);
+        let mut gmres = Step::new(&op, LinearMethod::Gmres);
         assert_eq!((lu.method(), gmres.method()), (LinearMethod::Lu, LinearMethod::Gmres));
         let a = lu.solve(&op, &cps, &ev, &rhs, 1e-12).unwrap();
         // GMRES with the Jacobian's products, no assembled Jacobian

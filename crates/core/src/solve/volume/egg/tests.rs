@@ -49,7 +49,7 @@ fn jacobian_matches_finite_differences() {
 #[test]
 fn the_matrix_free_product_is_the_assembled_one() {
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    for (vol, cps) in [sample(), polynomial()] {
+    for (vol, cps) in [sample(), polynomial(), polynomial_223()] {
         let op = EggVolume::new(&vol, 5);
         let jac = op.evaluate(&cps, true).jacobian.unwrap();
         let n = op.unknowns();
@@ -86,44 +86,63 @@ fn polynomial() -> (Volume, Vec<Point3>) {
     (Volume::new(vol.knots.clone(), cps.clone(), None).unwrap(), cps)
 }
 
+/// A polynomial curved volume of degrees (2, 2, 3) (the twisted ducts' degrees): the
+/// sum factorisation contracts `z` first, and numbers the points with `z` fastest.
+fn polynomial_223() -> (Volume, Vec<Point3>) {
+    let (vol, cps) = super::super::tests::curved_rational_volume([
+        KnotVector::open_uniform(2, 2),
+        KnotVector::open_from_breaks(2, &[0.0, 0.4, 1.0], 1),
+        KnotVector::open_uniform(3, 2),
+    ]);
+    (Volume::new(vol.knots.clone(), cps.clone(), None).unwrap(), cps)
+}
+
 /// The sum-factorised values, gradients and Hessians at the Gauss points
 /// ([`tensor_points::values`]) and integrals against the basis
 /// ([`tensor_points::integrals`]) equal those through the tensor basis table, on
-/// every element of a polynomial volume, for pseudo-random coefficients; and so
-/// the residual through them equals the one of [`EggVolume::element`].
+/// every element of a polynomial volume (degrees (3, 2, 2), contracted in the natural
+/// order, and (2, 2, 3), `z` first), for pseudo-random coefficients, the points in the
+/// order of [`tensor_points::points_in_natural_order`]; and so the residual through
+/// them equals the one of [`EggVolume::element`].
 #[test]
 fn sum_factorisation_is_the_basis_table_product() {
-    let (vol, cps) = polynomial();
-    let op = EggVolume::new(&vol, 5);
     let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    for e in 0..op.disc.elements() {
-        let idx = op.disc.element_indices(e);
-        let (weights, basis) = op.element_points(e, &idx);
-        let tables = op.disc.element_tables(e);
-        assert_eq!(tensor_points::weights(tables), weights);
-        let (m, nq) = (idx.len(), weights.len());
-        let u = random(&mut state, 2 * m);
-        let got = tensor_points::values(tables, &u);
-        for col in 0..2 {
-            for (row, q) in (0..10).flat_map(|row| (0..nq).map(move |q| (row, q))) {
-                let want: f64 = (0..m).map(|a| basis[(10 * q + row) * m + a] * u[col * m + a]).sum();
-                let g = got[(10 * col + row) * nq + q];
-                assert!((g - want).abs() < 1e-12 * (1.0 + want.abs()), "{e} {col} {row}: {g} vs {want}");
+    for (vol, cps) in [polynomial(), polynomial_223()] {
+        let op = EggVolume::new(&vol, 5);
+        for e in 0..op.disc.elements() {
+            let idx = op.disc.element_indices(e);
+            let (weights, basis) = op.element_points(e, &idx);
+            let tables = op.disc.element_tables(e);
+            let nat = tensor_points::points_in_natural_order(tables);
+            let mut seen = vec![false; nat.len()];
+            nat.iter().for_each(|&q| seen[q] = true);
+            assert!(seen.iter().all(|&s| s), "a permutation of the points");
+            let w: Vec<f64> = nat.iter().map(|&q| weights[q]).collect();
+            assert_eq!(tensor_points::weights(tables), w);
+            let (m, nq) = (idx.len(), weights.len());
+            let u = random(&mut state, 2 * m);
+            let got = tensor_points::values(tables, &u);
+            for col in 0..2 {
+                for (row, q) in (0..10).flat_map(|row| (0..nq).map(move |q| (row, q))) {
+                    let want: f64 = (0..m).map(|a| basis[(10 * nat[q] + row) * m + a] * u[col * m + a]).sum();
+                    let g = got[(10 * col + row) * nq + q];
+                    assert!((g - want).abs() < 1e-12 * (1.0 + want.abs()), "{e} {col} {row}: {g} vs {want}");
+                }
+            }
+            let f = random(&mut state, 3 * nq);
+            let got = tensor_points::integrals(tables, &f);
+            for c in 0..3 {
+                for a in 0..m {
+                    let want: f64 = (0..nq).map(|q| basis[nat[q] * 10 * m + a] * f[c * nq + q]).sum();
+                    assert!((got[c * m + a] - want).abs() < 1e-13, "{e} {c} {a}: {} vs {want}", got[c * m + a]);
+                }
             }
         }
-        let f = random(&mut state, 3 * nq);
-        let got = tensor_points::integrals(tables, &f);
-        for c in 0..3 {
-            for a in 0..m {
-                let want: f64 = (0..nq).map(|q| basis[q * 10 * m + a] * f[c * nq + q]).sum();
-                assert!((got[c * m + a] - want).abs() < 1e-13, "{e} {c} {a}: {} vs {want}", got[c * m + a]);
-            }
-        }
+        let fast = op.evaluate(&cps, false).residual;
+        let table = op.evaluate_with(&cps, false, true).residual;
+        let err = fast.iter().zip(&table).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
+        assert!(fast.iter().any(|f| f.abs() > 1e-3) && err < 1e-13, "{err}");
     }
-    let fast = op.evaluate(&cps, false).residual;
-    let table = op.evaluate_with(&cps, false, true).residual;
-    let err = fast.iter().zip(&table).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
-    assert!(fast.iter().any(|f| f.abs() > 1e-3) && err < 1e-13, "{err}");
 }
 
 /// The sum-factorised stiffness ([`tensor_points::stiffness`]) equals
@@ -133,41 +152,44 @@ fn sum_factorisation_is_the_basis_table_product() {
 /// it equals the one of the basis tables ([`EggVolume::element`]).
 #[test]
 fn sum_factorised_stiffness_is_the_basis_table_sum() {
-    let (vol, cps) = polynomial();
-    let op = EggVolume::new(&vol, 5);
     let mut state = 0x1234_5678_9abc_def1_u64;
-    for e in 0..op.disc.elements() {
-        let idx = op.disc.element_indices(e);
-        let (weights, basis) = op.element_points(e, &idx);
-        let (m, nq) = (idx.len(), weights.len());
-        let c = random(&mut state, 9 * nq);
-        let got = tensor_points::stiffness(op.disc.element_tables(e), &c);
-        let grad = |q: usize, i: usize, a: usize| basis[(10 * q + 1 + i) * m + a];
-        let mut scale = 0.0f64;
-        for a in 0..m {
-            for b in 0..m {
-                let mut want = 0.0;
-                for q in 0..nq {
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            want += grad(q, i, a) * c[(3 * i + j) * nq + q] * grad(q, j, b);
+    for (vol, cps) in [polynomial(), polynomial_223()] {
+        let op = EggVolume::new(&vol, 5);
+        for e in 0..op.disc.elements() {
+            let idx = op.disc.element_indices(e);
+            let (weights, basis) = op.element_points(e, &idx);
+            let (m, nq) = (idx.len(), weights.len());
+            let c = random(&mut state, 9 * nq);
+            let tables = op.disc.element_tables(e);
+            let got = tensor_points::stiffness(tables, &c);
+            let nat = tensor_points::points_in_natural_order(tables);
+            let grad = |q: usize, i: usize, a: usize| basis[(10 * nat[q] + 1 + i) * m + a];
+            let mut scale = 0.0f64;
+            for a in 0..m {
+                for b in 0..m {
+                    let mut want = 0.0;
+                    for q in 0..nq {
+                        for i in 0..3 {
+                            for j in 0..3 {
+                                want += grad(q, i, a) * c[(3 * i + j) * nq + q] * grad(q, j, b);
+                            }
                         }
                     }
+                    scale = scale.max(want.abs());
+                    let g = got[b * m + a];
+                    assert!((g - want).abs() < 1e-11 * (1.0 + want.abs()), "{e} ({a}, {b}): {g} vs {want}");
                 }
-                scale = scale.max(want.abs());
-                let g = got[b * m + a];
-                assert!((g - want).abs() < 1e-11 * (1.0 + want.abs()), "{e} ({a}, {b}): {g} vs {want}");
             }
+            assert!(scale > 1e-2, "{scale}");
         }
-        assert!(scale > 1e-2, "{scale}");
+        let fast = op.evaluate_with(&cps, false, true);
+        let table = op.evaluate_with(&cps, true, true);
+        let (k, kt) = (fast.laplace.unwrap(), table.laplace.unwrap());
+        assert_eq!((&k.row_ptr, &k.col_idx), (&kt.row_ptr, &kt.col_idx));
+        let size = kt.values.iter().fold(0.0f64, |e, v| e.max(v.abs()));
+        let err = k.values.iter().zip(&kt.values).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
+        assert!(size > 1e-2 && err < 1e-13 * size, "{err} at {size}");
     }
-    let fast = op.evaluate_with(&cps, false, true);
-    let table = op.evaluate_with(&cps, true, true);
-    let (k, kt) = (fast.laplace.unwrap(), table.laplace.unwrap());
-    assert_eq!((&k.row_ptr, &k.col_idx), (&kt.row_ptr, &kt.col_idx));
-    let size = kt.values.iter().fold(0.0f64, |e, v| e.max(v.abs()));
-    let err = k.values.iter().zip(&kt.values).fold(0.0f64, |e, (a, b)| e.max((a - b).abs()));
-    assert!(size > 1e-2 && err < 1e-13 * size, "{err} at {size}");
 }
 
 /// The Winslow energy that comes with the residual ([`EggEvaluation::energy`]) is that
@@ -176,7 +198,7 @@ fn sum_factorised_stiffness_is_the_basis_table_sum() {
 /// volume folded by a reflected interior control point.
 #[test]
 fn the_residuals_winslow_energy_is_the_functionals() {
-    for (vol, cps) in [sample(), polynomial()] {
+    for (vol, cps) in [sample(), polynomial(), polynomial_223()] {
         let op = EggVolume::new(&vol, 5);
         let want = super::super::winslow::WinslowVolume::new(&vol, 5).evaluate(&cps, false).energy;
         for (jacobian, laplace) in [(false, false), (false, true), (true, false)] {
