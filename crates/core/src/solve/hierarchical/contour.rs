@@ -389,16 +389,13 @@ mod tests {
         let eta = KnotVector::open_uniform(p, 6);
         let (nx, ny) = (xi.num_basis(), eta.num_basis());
         let (gx, gy) = (xi.greville(), eta.greville());
-        let cps: Vec<[f64; 2]> = (0..ny)
-            .flat_map(|j| {
-                let gx = gx.clone();
-                let w: Vec<f64> = (0..nx).map(|_| 0.03 * (rng.uniform() - 0.5)).collect();
-                (0..nx).map(move |i| {
-                    let bump = if j == 0 || j + 1 == ny { w[i] } else { 0.0 };
-                    [gx[i] + 0.5 * gy[j] * gx[i], gy[j] + bump]
-                })
-            })
-            .collect();
+        let mut cps: Vec<[f64; 2]> = Vec::with_capacity(nx * ny);
+        for (j, &y) in gy.iter().enumerate() {
+            for &x in &gx {
+                let bump = if j == 0 || j + 1 == ny { 0.03 * (rng.uniform() - 0.5) } else { 0.0 };
+                cps.push([x + 0.5 * y * x, y + bump]);
+            }
+        }
         let map = Surface::new([xi.clone(), eta.clone()], cps, None).unwrap();
         let levels = coarsened_levels(&map.knots, 8).unwrap();
         // 45 elements: two levels below (12 elements at level 0), the finest 48 elements
