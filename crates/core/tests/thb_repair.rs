@@ -35,4 +35,23 @@ fn puzzle4_is_repaired_with_fewer_unknowns_than_tensor_refinement() {
     assert_eq!(Verdict::of_finding(&again.verdict), out.report.verdict);
     let thb_unknowns = 2 * out.map.basis.len();
     assert!(thb_unknowns < tensor_unknowns, "THB {thb_unknowns} vs tensor {tensor_unknowns}");
+    // on its input basis (15 quadratic elements) the rounds start from the contour basis on
+    // the input's coarsened levels (8, then 16 elements), smaller than the tensor map,
+    // and end with at least 3x fewer functions than the tensor repair (BENCHMARKS.md "THB:
+    // the contour start on input bases": 800 against 2,491)
+    let start = &out.report.start;
+    assert_eq!(start.basis, "contour", "{:?}", start.reason);
+    assert!(
+        start.functions < out.report.solve.setup.basis_functions,
+        "{} vs {}",
+        start.functions,
+        out.report.solve.setup.basis_functions
+    );
+    assert_eq!(out.map.basis.knots(0)[0].num_elements(), 8);
+    assert!(
+        3 * out.map.basis.len() <= tensor.map.control_points.len(),
+        "{} vs {}",
+        out.map.basis.len(),
+        tensor.map.control_points.len()
+    );
 }

@@ -545,6 +545,14 @@ impl ViewerApp {
                         to([(k % (n + 1)) as f64 / n as f64, (k / (n + 1)) as f64 / n as f64])
                     }));
                 }
+                if let Some(s) = mv.thb.as_ref().and_then(|t| t.start.as_ref()).filter(|_| d.start) {
+                    // the start of the THB rounds: its active cells, under the map's
+                    let stroke = Stroke::new(2.2, Color32::from_rgba_unmultiplied(30, 90, 220, 170));
+                    for (_, [[a, b], [c, e]]) in &s.cells {
+                        let r = Rect::from_two_pos(to([*a, *c]), to([*b, *e]));
+                        painter.rect_stroke(r, 0.0, stroke, egui::StrokeKind::Middle);
+                    }
+                }
                 if let Some(t) = mv.thb.as_ref().filter(|_| d.knots || d.grid) {
                     // the active cells of a THB map (in place of knot lines and iso-lines)
                     let stroke = Stroke::new(0.8, Color32::from_black_alpha(150));

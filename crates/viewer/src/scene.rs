@@ -20,7 +20,7 @@ use crate::certificate::{Certificate, Quality};
 use crate::folds::{folded_elements, FoldedElement};
 use crate::layout_view::LayoutView;
 use crate::sampler::DetJSampler;
-use crate::thb_view::{default_thb_resolution, ThbView};
+use crate::thb_view::{default_thb_resolution, ThbStartView, ThbView};
 use crate::view::{bounds_of, Bounds};
 
 /// Heat-map resolution bounds (cells per direction).
@@ -352,6 +352,9 @@ impl Scene {
         if let (Some(mv), Some(r)) = (scene.map.as_mut(), &report) {
             mv.matches = stored_matches(r);
             mv.kinks = winslow::boundary::kinks::kinks_in_report(r);
+            if let Some(t) = mv.thb.as_mut() {
+                t.start = ThbStartView::from_report(&t.map, r);
+            }
         }
         scene.path = Some(path.to_path_buf());
         Ok(scene)
@@ -562,6 +565,11 @@ impl Scene {
         let res = settings.resolution.unwrap_or_else(|| default_thb_resolution(&solution.map));
         let cert = Certificate::from_thb_report(&solution.report);
         let mut mv = MapView::thb(solution.map, res, settings.density, Some(cert))?;
+        if let Some(t) = mv.thb.as_mut() {
+            let st = &solution.report.start;
+            let v = ThbStartView::new(&t.map, st.basis, st.functions, st.verdict.name(), &st.refined)?;
+            t.start = Some(v);
+        }
         mv.kinks = solution.report.solve.boundary.kinks.iter().map(|k| (k.point, k.kept)).collect();
         mv.report = Some(solution.report.solve);
         self.map = Some(mv);
@@ -588,7 +596,12 @@ impl Scene {
                     let res = settings.resolution.unwrap_or_else(|| default_thb_resolution(&t.map));
                     // drawn before, so it draws again; were it to fail, the tensor form's sample
                     match MapView::thb(t.map.clone(), res, settings.density, cert.clone()) {
-                        Ok(v) => v,
+                        Ok(mut v) => {
+                            if let Some(n) = v.thb.as_mut() {
+                                n.start = t.start;
+                            }
+                            v
+                        }
                         Err(_) => {
                             MapView { thb: Some(t), ..MapView::new(mv.map, sampler, res, settings.density, cert) }
                         }

@@ -42,13 +42,16 @@ pub struct DisplayOptions {
     pub knots: bool,
     /// The input boundary over the map.
     pub boundary: bool,
+    /// The active cells of the start of a THB solve's rounds (the report's `start`), in
+    /// the parameter view.
+    pub start: bool,
     /// Colour scale kind.
     pub scale: ScaleKind,
 }
 
 impl Default for DisplayOptions {
     fn default() -> Self {
-        Self { heat: true, grid: true, net: false, knots: true, boundary: true, scale: ScaleKind::Log }
+        Self { heat: true, grid: true, net: false, knots: true, boundary: true, start: true, scale: ScaleKind::Log }
     }
 }
 

@@ -31,6 +31,47 @@ pub struct ThbView {
     pub cells: Vec<(usize, [[f64; 2]; 2])>,
     /// The images of the active cells' edges (polylines of 9 points).
     pub borders: Vec<Vec<Point>>,
+    /// Where the THB rounds started (the report's `start`), when the map came from a
+    /// THB solve.
+    pub start: Option<ThbStartView>,
+}
+
+/// The start of a THB solve's rounds as drawn: the contour fit's THB basis or the tensor
+/// map (the report's `start`), its active cells on the levels of the final map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThbStartView {
+    /// `"contour"` or `"tensor"`.
+    pub basis: String,
+    /// THB functions of the start.
+    pub functions: usize,
+    /// Its verdict (before the rounds).
+    pub verdict: String,
+    /// Its active cells: level and parameter box (as [`ThbView::cells`]).
+    pub cells: Vec<(usize, [[f64; 2]; 2])>,
+}
+
+impl ThbStartView {
+    /// The start with the refined cells `refined` (per level) on the levels of `map`.
+    pub fn new(
+        map: &HierarchicalMap,
+        basis: &str,
+        functions: usize,
+        verdict: &str,
+        refined: &[Vec<[usize; 2]>],
+    ) -> anyhow::Result<Self> {
+        let b = map.basis.with_refined(refined)?;
+        let cells = b.active_cells().into_iter().map(|(l, c)| (l, b.cell_bounds(l, c))).collect();
+        Ok(Self { basis: basis.to_string(), functions, verdict: verdict.to_string(), cells })
+    }
+
+    /// The start of a THB report (`start`) as `winslow solve --refinement thb` writes it
+    /// beside the map; `None` without one or when it does not fit the map.
+    pub fn from_report(map: &HierarchicalMap, report: &serde_json::Value) -> Option<Self> {
+        let s = report.get("start")?;
+        let refined: Vec<Vec<[usize; 2]>> = serde_json::from_value(s.get("refined")?.clone()).ok()?;
+        let functions = s.get("functions")?.as_u64()? as usize;
+        Self::new(map, s.get("basis")?.as_str()?, functions, s.get("verdict")?.as_str()?, &refined).ok()
+    }
 }
 
 impl ThbView {
@@ -98,7 +139,7 @@ impl MapView {
         let cells = map.basis.active_cells().into_iter().map(|(l, c)| (l, map.basis.cell_bounds(l, c))).collect();
         let borders = active_cell_borders(&map, &tensor);
         let mut mv = MapView::sampled(tensor, "cpu: THB cells".into(), sample, density, certificate, |_, _| exact);
-        mv.thb = Some(ThbView { map, cells, borders });
+        mv.thb = Some(ThbView { map, cells, borders, start: None });
         Ok(mv)
     }
 }
@@ -151,5 +192,41 @@ mod tests {
             assert!((dj - det).abs() < 1e-12 * det.abs().max(1.0));
             assert!((x[0] - d.x[0]).abs() < 1e-13 && (x[1] - d.x[1]).abs() < 1e-13);
         }
+    }
+
+    /// The start of a THB solve (puzzle4 on its input basis: the contour start on the
+    /// input's coarsened levels) as the viewer draws it, from the solve's report and from
+    /// the report as written beside the map (JSON): the same cells, as many as the
+    /// report's `cells_per_level` say, tiling the unit square, each active cell of the
+    /// repaired map inside one of them (the rounds only refine).
+    #[test]
+    fn the_start_of_a_thb_solve_is_drawn_from_its_report() {
+        use winslow::io::{read_boundary, ReadOptions};
+        use winslow::solve::options::{Refinement, SolveOptions};
+        let b = read_boundary(&winslow::testutil::data("gismo/puzzle4.json"), &ReadOptions::default()).unwrap();
+        let mut opts = SolveOptions::default();
+        opts.repair.refinement = Refinement::Thb;
+        let winslow::Solved::Thb(sol) = winslow::Pipeline::new(b, opts).solve().unwrap() else {
+            panic!("puzzle4 is repaired by THB rounds")
+        };
+        let st = &sol.report.start;
+        assert_eq!(st.basis, "contour");
+        let view = ThbStartView::new(&sol.map, st.basis, st.functions, st.verdict.name(), &st.refined).unwrap();
+        let json = serde_json::to_value(&sol.report).unwrap();
+        assert_eq!(ThbStartView::from_report(&sol.map, &json).as_ref(), Some(&view));
+        assert_eq!(view.cells.len(), st.cells_per_level.iter().sum::<usize>());
+        assert_eq!(view.functions, st.functions_per_level.iter().sum::<usize>());
+        let area: f64 = view.cells.iter().map(|(_, b)| (b[0][1] - b[0][0]) * (b[1][1] - b[1][0])).sum();
+        assert!((area - 1.0).abs() < 1e-12, "{area}");
+        let mv = MapView::thb(sol.map.clone(), 64, 8, None).unwrap();
+        let t = mv.thb.as_ref().unwrap();
+        assert!(t.cells.len() > view.cells.len());
+        let inside = |c: &[[f64; 2]; 2], s: &[[f64; 2]; 2]| (0..2).all(|d| s[d][0] <= c[d][0] && c[d][1] <= s[d][1]);
+        for (l, c) in &t.cells {
+            let n = view.cells.iter().filter(|(ls, s)| ls <= l && inside(c, s)).count();
+            assert_eq!(n, 1, "cell {c:?} of level {l}");
+        }
+        // a report without a start (or not of this map) gives none
+        assert!(ThbStartView::from_report(&sol.map, &serde_json::json!({"verdict": "certified"})).is_none());
     }
 }

@@ -37,7 +37,12 @@ pub(crate) struct ThbJson {
     pub degree: [usize; 2],
     /// Level-0 knot vectors `[xi, eta]` (open).
     pub knots: [Vec<f64>; 2],
-    /// `refined[l]`: the refined cells `[i, j]` of level `l` (each halved into four cells
+    /// The knot vectors `[xi, eta]` of the given finer levels `1, 2, ...` (each splitting
+    /// every element of the level below in two at one new simple knot; the levels past
+    /// them halve the last one); absent when every level halves the one below.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub levels: Vec<[Vec<f64>; 2]>,
+    /// `refined[l]`: the refined cells `[i, j]` of level `l` (each split into four cells
     /// of level `l + 1`).
     pub refined: Vec<Vec<Index2>>,
     /// One control point per active THB function, in the order of the module doc.
@@ -67,9 +72,14 @@ fn map_of(map: ThbJson, ctx: &str) -> Result<HierarchicalMap> {
     if map.weights.is_some() {
         return Err(bad("a THB map is polynomial: weights must be null".into()));
     }
-    let [kx, ky] = map.knots;
-    let knots = [KnotVector::new(map.degree[0], kx)?, KnotVector::new(map.degree[1], ky)?];
-    let basis = HierarchicalBasis::from_refined(knots, &map.refined).map_err(|e| e.within(ctx))?;
+    let level = |[kx, ky]: [Vec<f64>; 2]| -> Result<[KnotVector; 2]> {
+        Ok([KnotVector::new(map.degree[0], kx)?, KnotVector::new(map.degree[1], ky)?])
+    };
+    let mut levels = vec![level(map.knots)?];
+    for kv in map.levels {
+        levels.push(level(kv)?);
+    }
+    let basis = HierarchicalBasis::from_refined_levels(levels, &map.refined).map_err(|e| e.within(ctx))?;
     HierarchicalMap::new(basis, map.control_points).map_err(|e| e.within(ctx))
 }
 
@@ -96,14 +106,12 @@ pub(crate) fn thb_of_json(v: Value) -> Result<(String, HierarchicalMap)> {
 /// The JSON document of a THB map; `extra` (e.g. `{"report": ...}`) is merged at the top.
 pub(crate) fn thb_to_json(name: &str, map: &HierarchicalMap, extra: Option<Value>) -> Value {
     let b = &map.basis;
-    let mut refined: Vec<Vec<Index2>> = (0..b.num_levels()).map(|l| b.refined_list(l)).collect();
-    while refined.last().is_some_and(Vec::is_empty) {
-        refined.pop();
-    }
+    let refined = b.refined_lists();
     let m = ThbJson {
         kind: "thb".into(),
         degree: b.degrees(),
         knots: b.knots(0).each_ref().map(|k| k.knots().to_vec()),
+        levels: b.given_levels().iter().map(|kv| kv.each_ref().map(|k| k.knots().to_vec())).collect(),
         refined,
         control_points: map.control_points.clone(),
         weights: None,
@@ -250,6 +258,33 @@ mod tests {
         assert_eq!(back.control_points, map.control_points);
         let again = serde_json::to_string_pretty(&thb_to_json("t", &back, None)).unwrap();
         assert_eq!(again, text);
+    }
+
+    /// A map on given levels (not halvings) keeps them through JSON: the same hierarchy,
+    /// the same map; without them (the halvings read instead) the map would differ.
+    #[test]
+    fn json_round_trip_keeps_given_levels() {
+        let kv = |p| KnotVector::open_from_breaks(p, &[0.0, 0.3, 0.55, 1.0], 1);
+        let coarse = [kv(2), kv(3)];
+        let fine = [coarse[0].with_inserted(&[0.1, 0.5, 0.9]), coarse[1].with_inserted(&[0.2, 0.4, 0.6])];
+        let basis = HierarchicalBasis::with_levels(vec![coarse, fine]).unwrap();
+        let mut rng = Lcg::new(8);
+        let cps = (0..basis.len()).map(|_| [rng.uniform(), rng.uniform()]).collect();
+        let map = HierarchicalMap::new(basis, cps).unwrap().refined(&[(0, [1, 1]), (0, [0, 2])], 2).unwrap();
+        let v = thb_to_json("t", &map, None);
+        assert_eq!(v["map"]["levels"].as_array().map(Vec::len), Some(1));
+        let text = serde_json::to_string_pretty(&v).unwrap();
+        let (_, back) = parse_thb(&text).unwrap();
+        assert_eq!(back.basis.given_levels(), map.basis.given_levels());
+        assert_eq!(back.basis.active_functions(), map.basis.active_functions());
+        assert_eq!(serde_json::to_string_pretty(&thb_to_json("t", &back, None)).unwrap(), text);
+        let (u, w) = (0.45, 0.35);
+        assert_eq!(back.eval(u, w), map.eval(u, w));
+        // the same document without its levels is another map (the levels halved)
+        let mut halved = v.clone();
+        halved["map"].as_object_mut().unwrap().remove("levels");
+        let (_, other) = thb_of_json(halved).unwrap();
+        assert_ne!(other.eval(u, w), map.eval(u, w));
     }
 
     #[test]

@@ -161,10 +161,13 @@ pub fn write_as(path: &Path, extension: &str, out: &Output) -> Result<()> {
         (Output::Map { map, label, .. }, "vtu") => text(bezier_vtu(map, label)?),
         (Output::Map { map, .. }, "vtk") => text(structured_grid_vtk(map, MAP_VTK_SAMPLES)),
         (Output::Thb { name, map, extra, .. }, "json" | "") => write_json(path, &thb_to_json(name, map, extra.clone())),
-        (Output::Thb { map, label, .. }, "xml") => text(thb_to_gismo_xml(map, label)),
+        (Output::Thb { map, label, .. }, "xml") if map.basis.given_levels().is_empty() => {
+            text(thb_to_gismo_xml(map, label))
+        }
         (Output::Thb { map, label, .. }, "vtu") => text(thb_bezier_vtu(map, label)?),
-        // formats without hierarchical splines: the exact tensor form (knot insertion)
-        (Output::Thb { name, map, label, .. }, "igs" | "iges" | "vtk") => {
+        // formats without hierarchical splines (and G+Smo's THBSplineBasis2, whose levels
+        // halve, for a map on given levels): the exact tensor form (knot insertion)
+        (Output::Thb { name, map, label, .. }, "igs" | "iges" | "vtk" | "xml") => {
             let tensor = map.to_surface()?;
             let label = format!("{label} (the THB map's exact tensor form)");
             write_as(path, &ext, &Output::Map { name, map: &tensor, label: &label, extra: None })

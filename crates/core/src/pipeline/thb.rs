@@ -20,7 +20,7 @@ use super::{Observer, Stage};
 use crate::boundary::hierarchy::Hierarchy;
 use crate::boundary::BasisChoice;
 use crate::error::{Error, Result};
-use crate::solve::hierarchical::contour::contour_start;
+use crate::solve::hierarchical::contour::{coarsened_levels, contour_start};
 use crate::solve::hierarchical::improve::{improve_thb, ThbImprovement};
 use crate::solve::hierarchical::{accepted, repair_thb_observed, solve_egg, ThbRepairOptions, ThbRound};
 use crate::solve::improve::Improve;
@@ -28,6 +28,7 @@ use crate::solve::levels::prepare_levels;
 use crate::solve::options::{Refinement, SolveOptions};
 use crate::solve::report::{Report, Solution, ThbFallback, ThbStart, Verdict};
 use crate::spline::hierarchical::map::HierarchicalMap;
+use crate::spline::hierarchical::HierarchicalBasis;
 use crate::verify::certificate::hierarchical::{certify_hierarchical, HierarchicalCertificate};
 use crate::verify::poisson::{poisson_benchmark, PoissonReport};
 
@@ -189,6 +190,9 @@ fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(
             converged: true,
             verdict: sol.report.outcome.verdict,
             seconds: 0.0,
+            functions_per_level: map.basis.functions_per_level(),
+            cells_per_level: map.basis.cells_per_level(),
+            refined: Vec::new(),
         };
         Ok((map, report))
     };
@@ -196,16 +200,24 @@ fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(
     if h.kinked.is_some() {
         return tensor("kinks kept exactly (C0 route): their knots are not dyadic".into());
     }
-    // the solver's coarsest level (`EggSolver::with_method`: balanced, its minimum elements)
-    let (min_elements, aspect) = match (h.basis.requested, h.basis.used) {
-        (BasisChoice::Input, BasisChoice::Input) => (1, f64::INFINITY),
-        _ => (opts.levels.min_elements, opts.levels.aspect),
-    };
-    let Some(coarse) = prepare_levels(vec![h.levels[0].clone()], min_elements, 0, aspect)?.into_iter().next() else {
-        return tensor("no coarse level".into());
-    };
     let sides = h.fits.each_ref().map(|f| f.finest().knots.clone());
-    let thb = match contour_start(&sol.map, coarse.knots, &sides, ThbRepairOptions::default().admissibility)? {
+    let basis = if matches!(h.basis.used, BasisChoice::Input) {
+        // the input basis: its knot vectors the finest given level, every other break
+        // removed below it, down to the solver's minimum elements
+        match coarsened_levels(&sol.map.knots, opts.levels.min_elements) {
+            Ok(levels) => HierarchicalBasis::with_levels(levels)?,
+            Err(why) => return tensor(format!("the input basis has no coarser levels: {why}")),
+        }
+    } else {
+        // the solver's coarsest level (`EggSolver::with_method`: balanced, its minimum elements)
+        let (min_elements, aspect) = (opts.levels.min_elements, opts.levels.aspect);
+        let Some(coarse) = prepare_levels(vec![h.levels[0].clone()], min_elements, 0, aspect)?.into_iter().next()
+        else {
+            return tensor("no coarse level".into());
+        };
+        HierarchicalBasis::new(coarse.knots)?
+    };
+    let thb = match contour_start(&sol.map, basis, &sides, ThbRepairOptions::default().admissibility)? {
         Ok(thb) if thb.basis.len() < sol.map.control_points.len() => thb,
         Ok(thb) => {
             let n = thb.basis.len();
@@ -227,6 +239,9 @@ fn start(sol: &Solution, h: Option<&Hierarchy>, opts: &SolveOptions) -> Result<(
         converged: egg.converged,
         verdict: Verdict::of_finding(&cert.verdict),
         seconds: t0.elapsed().as_secs_f64(),
+        functions_per_level: egg.map.basis.functions_per_level(),
+        cells_per_level: egg.map.basis.cells_per_level(),
+        refined: egg.map.basis.refined_lists(),
     };
     Ok((egg.map, report))
 }

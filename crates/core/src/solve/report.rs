@@ -264,6 +264,14 @@ pub struct ThbStart {
     pub verdict: Verdict,
     /// Seconds of the contour basis, the blossoms and the solve (0 for the tensor start).
     pub seconds: f64,
+    /// Active THB functions of each level of the start, coarse to fine.
+    pub functions_per_level: Vec<usize>,
+    /// Active cells of each level of the start, coarse to fine.
+    pub cells_per_level: Vec<usize>,
+    /// The refined cells `[i, j]` of each level of the start (as the THB map's `refined`,
+    /// on the same level knots: the rounds refine the start further), so that the start's
+    /// active cells can be drawn from the written map.
+    pub refined: Vec<Vec<[usize; 2]>>,
 }
 
 /// What a THB defect correction that did not end certified (or degenerate at forced

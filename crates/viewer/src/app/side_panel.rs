@@ -48,6 +48,17 @@ impl ViewerApp {
             ui.checkbox(&mut d.knots, "knot lines");
             ui.checkbox(&mut d.boundary, "input boundary");
         });
+        if let Some(st) =
+            self.state.scene.as_ref().and_then(|s| s.map.as_ref()).and_then(|m| m.thb.as_ref()?.start.as_ref())
+        {
+            ui.checkbox(&mut d.start, "THB start's cells (blue)").on_hover_text(format!(
+                "where the THB rounds started: the {} start, {} functions, {} active cells, {}",
+                st.basis,
+                st.functions,
+                st.cells.len(),
+                st.verdict
+            ));
+        }
         ui.horizontal(|ui| {
             ui.label("colour scale");
             ui.selectable_value(&mut d.scale, ScaleKind::Log, ScaleKind::Log.label());

@@ -2,9 +2,12 @@
 //! paper §4: "a (truncated) hierarchical spline basis ... allowing for local refinement").
 //!
 //! **Hierarchy.** Level `0` is an open tensor space `S^0` with knot vectors `(T_ξ^0, T_η^0)`;
-//! level `l + 1` halves every element of level `l` (dyadic refinement,
-//! [`KnotVector::halved`]), so `S^0 ⊂ S^1 ⊂ ...` and a level-`l` cell `(i, j)` has the four
-//! children `(2i + a, 2j + b)`, `a, b ∈ {0, 1}`. The domains `Ω^0 = [0, 1]² ⊇ Ω^1 ⊇ ...` are
+//! level `l + 1` splits every element of level `l` in two in each direction: by default at
+//! its midpoint (dyadic refinement, [`KnotVector::halved`]); the first levels may instead be
+//! given ([`HierarchicalBasis::with_levels`]: an input basis's knot vector as a finer level,
+//! its coarser levels every other break removed), each splitting every element of the level
+//! below at one new simple knot anywhere inside it. Either way `S^0 ⊂ S^1 ⊂ ...` and a
+//! level-`l` cell `(i, j)` has the four children `(2i + a, 2j + b)`, `a, b ∈ {0, 1}`. The domains `Ω^0 = [0, 1]² ⊇ Ω^1 ⊇ ...` are
 //! unions of cells: `Ω^{l+1}` is the union of the level-`l` cells marked *refined*. A
 //! level-`l` cell is *active* when it lies in `Ω^l` and is not refined; the active cells
 //! tile the domain.
@@ -98,6 +101,9 @@ impl Level {
 #[derive(Debug, Clone)]
 pub struct HierarchicalBasis {
     levels: Vec<Level>,
+    /// The given finer levels `1, 2, ...` ([`Self::with_levels`]); the levels past them
+    /// halve the last one.
+    given: Vec<[KnotVector; 2]>,
     /// `refined[l]`: the level-`l` cells that are refined (their children make `Ω^{l+1}`).
     refined: Vec<BTreeSet<Index2>>,
     /// Active functions `(level, index)`, by level, then `eta` index, then `xi` index.
@@ -118,12 +124,66 @@ impl HierarchicalBasis {
         }
         let mut out = Self {
             levels: vec![Level::new(knots)],
+            given: Vec::new(),
             refined: vec![BTreeSet::new()],
             active: vec![],
             lookup: HashMap::new(),
         };
         out.update_active();
         Ok(out)
+    }
+
+    /// The hierarchy on the open knot vectors `levels[0]` with the finer levels
+    /// `levels[1..]` given (the levels past them halve the last one): each level of the
+    /// same degrees and domain as the one below, holding its knots with their
+    /// multiplicities and exactly one new simple knot strictly inside each of its elements,
+    /// per direction (so that a cell still has four children). A typed error names the
+    /// level and direction otherwise.
+    pub fn with_levels(levels: Vec<[KnotVector; 2]>) -> Result<Self> {
+        let mut it = levels.into_iter();
+        let first = it.next().ok_or_else(|| Error::Invalid("a hierarchy needs a level 0".into()))?;
+        let mut out = Self::new(first)?;
+        for (l, knots) in it.enumerate().map(|(k, kv)| (k + 1, kv)) {
+            if l >= MAX_LEVELS {
+                return Err(Error::TooLarge {
+                    context: "hierarchical basis".into(),
+                    what: "levels".into(),
+                    found: l + 1,
+                    limit: MAX_LEVELS,
+                });
+            }
+            for d in 0..2 {
+                if let Err(why) = splits_in_two(&out.levels[l - 1].knots[d], &knots[d]) {
+                    return Err(Error::Knots {
+                        context: format!("hierarchical basis, level {l}, direction {}", ["xi", "eta"][d]),
+                        reason: why,
+                    });
+                }
+            }
+            out.given.push(knots.clone());
+            out.levels.push(Level::new(knots));
+            out.refined.push(BTreeSet::new());
+        }
+        Ok(out)
+    }
+
+    /// The given finer levels (`levels[1..]` of [`Self::with_levels`]; empty when every
+    /// level halves the one below).
+    pub(crate) fn given_levels(&self) -> &[[KnotVector; 2]] {
+        &self.given
+    }
+
+    /// The knot value splitting element `e` of level `l` in direction `d` (the end of its
+    /// first child), creating no level: from level `l + 1` when it exists, the midpoint
+    /// otherwise (a level past the given ones halves).
+    pub(crate) fn split_point(&self, l: usize, d: usize, e: usize) -> f64 {
+        match self.levels.get(l + 1) {
+            Some(next) => next.elements[d][2 * e].2,
+            None => {
+                let (_, a, b) = self.levels[l].elements[d][e];
+                0.5 * (a + b)
+            }
+        }
     }
 
     /// Degrees `(p, q)`.
@@ -298,6 +358,7 @@ impl HierarchicalBasis {
     /// refined here); `None` otherwise.
     pub(crate) fn newly_refined(&self, before: &Self) -> Option<Vec<Vec<Index2>>> {
         let refines = self.levels[0].knots == before.levels[0].knots
+            && self.given == before.given
             && before.refined.len() <= self.refined.len()
             && before.refined.iter().zip(&self.refined).all(|(b, s)| b.is_subset(s));
         refines.then(|| {
@@ -399,7 +460,10 @@ impl HierarchicalBasis {
                 });
             }
             let last = &self.levels[self.levels.len() - 1];
-            let knots = last.knots.each_ref().map(KnotVector::halved);
+            let knots = match self.given.get(self.levels.len() - 1) {
+                Some(given) => given.clone(),
+                None => last.knots.each_ref().map(KnotVector::halved),
+            };
             if let Some(kv) = knots.iter().find(|kv| kv.num_basis() > MAX_CONTROL_POINTS) {
                 return Err(Error::TooLarge {
                     context: "hierarchical basis".into(),
@@ -414,6 +478,44 @@ impl HierarchicalBasis {
         Ok(())
     }
 
+    /// The hierarchy on the same levels (level 0 and the given ones) with the refined cells
+    /// `refined[l]` instead of this one's (e.g. the start of the THB rounds, the report's
+    /// `start.refined`, on the levels of the map they made); each refined cell must lie in
+    /// `Ω^l`.
+    pub fn with_refined(&self, refined: &[Vec<[usize; 2]>]) -> Result<Self> {
+        let mut levels = vec![self.levels[0].knots.clone()];
+        levels.extend(self.given.iter().cloned());
+        Self::from_refined_levels(levels, refined)
+    }
+
+    /// Active functions of each level, coarse to fine.
+    pub fn functions_per_level(&self) -> Vec<usize> {
+        let mut out = vec![0; self.num_levels()];
+        for &(l, _) in &self.active {
+            out[l] += 1;
+        }
+        out
+    }
+
+    /// Active cells of each level, coarse to fine.
+    pub fn cells_per_level(&self) -> Vec<usize> {
+        let mut out = vec![0; self.num_levels()];
+        for (l, _) in self.active_cells() {
+            out[l] += 1;
+        }
+        out
+    }
+
+    /// The refined cells of every level ([`Self::refined_list`]), the trailing empty
+    /// levels left out.
+    pub(crate) fn refined_lists(&self) -> Vec<Vec<Index2>> {
+        let mut refined: Vec<Vec<Index2>> = (0..self.num_levels()).map(|l| self.refined_list(l)).collect();
+        while refined.last().is_some_and(Vec::is_empty) {
+            refined.pop();
+        }
+        refined
+    }
+
     /// Level-`l` refined cells as a sorted list (for writers).
     pub(crate) fn refined_list(&self, l: usize) -> Vec<Index2> {
         let mut v: Vec<Index2> = self.refined_cells(l).copied().collect();
@@ -424,7 +526,13 @@ impl HierarchicalBasis {
     /// Rebuild a hierarchy from level-0 knots and the refined cells per level (as written
     /// by [`Self::refined_list`]); each refined cell must lie in `Ω^l`.
     pub(crate) fn from_refined(knots: [KnotVector; 2], refined: &[Vec<Index2>]) -> Result<Self> {
-        let mut out = Self::new(knots)?;
+        Self::from_refined_levels(vec![knots], refined)
+    }
+
+    /// [`Self::from_refined`] on the hierarchy with the given levels
+    /// ([`Self::with_levels`]: `levels[0]` is level 0).
+    pub(crate) fn from_refined_levels(levels: Vec<[KnotVector; 2]>, refined: &[Vec<Index2>]) -> Result<Self> {
+        let mut out = Self::with_levels(levels)?;
         for (l, cells) in refined.iter().enumerate() {
             if cells.is_empty() {
                 continue;
@@ -444,4 +552,26 @@ impl HierarchicalBasis {
         out.update_active();
         Ok(out)
     }
+}
+
+/// Why `fine` is not `coarse` with one new simple knot strictly inside each element of
+/// `coarse` (the knots of `coarse` kept with their multiplicities, same degree and domain).
+fn splits_in_two(coarse: &KnotVector, fine: &KnotVector) -> std::result::Result<(), String> {
+    if coarse.degree() != fine.degree() || coarse.domain() != fine.domain() {
+        return Err("another degree or domain than the level below".into());
+    }
+    if fine.is_periodic() || !fine.is_open() {
+        return Err("not an open (clamped), non-periodic knot vector".into());
+    }
+    let (cb, fb) = (coarse.breaks_with_multiplicity(), fine.breaks_with_multiplicity());
+    if fb.len() != 2 * cb.len() - 1 {
+        return Err(format!("{} elements, not twice the {} below", fb.len() - 1, cb.len() - 1));
+    }
+    for (k, &(u, m)) in fb.iter().enumerate() {
+        let ok = if k % 2 == 0 { cb[k / 2] == (u, m) } else { m == 1 && cb[k / 2].0 < u && u < cb[k / 2 + 1].0 };
+        if !ok {
+            return Err(format!("the knot {u} (multiplicity {m}) does not split one element of the level below"));
+        }
+    }
+    Ok(())
 }

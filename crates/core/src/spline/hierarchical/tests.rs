@@ -332,3 +332,56 @@ fn the_control_net_joins_neighbouring_active_functions_of_one_level() {
     }
     assert!(levels.len() >= 2, "segments on the coarse and a finer level: {levels:?}");
 }
+
+/// Given levels that split each element off its midpoint (an input basis's knots, every
+/// other break removed below): the two-scale relation is knot insertion of the finer
+/// level's knots, a tensor map on level 0 refined through the given levels and past them
+/// (halving) stays the same map (exact prolongation), the basis is a partition of unity,
+/// and a level that does not split every element in two is refused with its level named.
+#[test]
+fn given_levels_are_nested_and_refinement_through_them_keeps_the_map() {
+    let coarse = [kv(3, &[0.0, 0.3, 0.5, 1.0]), kv(2, &[0.0, 0.4, 0.7, 1.0])];
+    let l1 = [coarse[0].with_inserted(&[0.1, 0.42, 0.9]), coarse[1].with_inserted(&[0.05, 0.6, 0.71])];
+    let l2 = [l1[0].with_inserted(&[0.02, 0.2, 0.31, 0.47, 0.6, 0.95]), l1[1].halved()];
+    let b = HierarchicalBasis::with_levels(vec![coarse.clone(), l1.clone(), l2.clone()]).unwrap();
+    assert_eq!(b.given_levels().len(), 2);
+    // the two-scale relation of level 0 to level 1 is the knot insertion matrix
+    for d in 0..2 {
+        let pm = prolongation(&coarse[d], &l1[d]).unwrap();
+        for s in 0..coarse[d].num_basis() {
+            let ch = b.children_1d(0, d, s);
+            for i in 0..l1[d].num_basis() {
+                let want: f64 = pm.row(i).filter(|e| e.0 == s).map(|e| e.1).sum();
+                let got: f64 = ch.iter().filter(|e| e.0 == i).map(|e| e.1).sum();
+                assert!((want - got).abs() < 1e-14, "d={d} s={s} i={i}: {got} vs {want}");
+            }
+        }
+    }
+    let mut rng = Lcg::new(17);
+    let n = coarse[0].num_basis() * coarse[1].num_basis();
+    let s = Surface::new(coarse.clone(), (0..n).map(|_| [rng.uniform(), rng.uniform()]).collect(), None).unwrap();
+    let mut map = HierarchicalMap::new(b, s.control_points.clone()).unwrap();
+    for step in 0..4 {
+        let (l, c) = map.basis.cell_at(rng.uniform(), rng.uniform());
+        let (l2c, c2) = map.basis.cell_at(0.01, 0.99);
+        map = map.refined(&[(l, c), (l2c, c2)], 2).unwrap();
+        for _ in 0..200 {
+            let (u, v) = (rng.uniform(), rng.uniform());
+            let (a, t) = (map.eval(u, v), s.eval(u, v));
+            assert!((a[0] - t[0]).abs() < 1e-13 && (a[1] - t[1]).abs() < 1e-13, "step {step} at ({u}, {v})");
+            let sum: f64 = map.basis.eval_basis(u, v).iter().map(|x| x.1[0]).sum();
+            assert!((sum - 1.0).abs() < 1e-13, "partition of unity: {sum}");
+        }
+    }
+    assert!(map.basis.num_levels() >= 4, "refined past the given levels");
+    // the level-1 cells' bounds are the given knots, not midpoints
+    assert_eq!(map.basis.knots(1)[0], l1[0]);
+    assert_eq!(map.basis.knots(3)[0], l2[0].halved());
+    // a level with an element left whole, or two knots in one element, is refused
+    let whole = [coarse[0].with_inserted(&[0.1, 0.42]), l1[1].clone()];
+    let err = HierarchicalBasis::with_levels(vec![coarse.clone(), whole]).unwrap_err().to_string();
+    assert!(err.contains("level 1") && err.contains("xi"), "{err}");
+    let two = [l1[0].clone(), coarse[1].with_inserted(&[0.05, 0.1, 0.6, 0.71])];
+    let err = HierarchicalBasis::with_levels(vec![coarse, two]).unwrap_err().to_string();
+    assert!(err.contains("level 1") && err.contains("eta"), "{err}");
+}

@@ -2,8 +2,8 @@
 //! functions to an active cell.
 //!
 //! **Two-scale relation.** A level-`l` B-spline `σ` with local knots `t_σ, ..., t_{σ+p+1}`
-//! is a combination of the level-`(l + 1)` B-splines obtained by inserting the midpoints
-//! of its non-empty spans (Boehm): inserting `u` into a knot sequence `t` maps the
+//! is a combination of the level-`(l + 1)` B-splines obtained by inserting the split points
+//! of its non-empty spans (their midpoints, or the given level's knots; Boehm): inserting `u` into a knot sequence `t` maps the
 //! coefficients `c_j` to `ĉ_j = ω_j c_j + (1 - ω_j) c_{j-1}` with
 //! `ω_j = (u - t_j) / (t_{j+p} - t_j)` clamped to `[0, 1]` (`c_{-1} = c_n = 0`).
 //!
@@ -126,7 +126,10 @@ impl HierarchicalBasis {
         let kv = &self.levels[l].knots[d];
         let p = kv.degree();
         let mut t: Vec<f64> = kv.knots()[sigma..=sigma + p + 1].to_vec();
-        let mids: Vec<f64> = t.windows(2).filter(|w| w[1] > w[0]).map(|w| 0.5 * (w[0] + w[1])).collect();
+        // the split points of the support's elements (consecutive from the first)
+        let e0 = self.levels[l].support(d, sigma).start;
+        let n_spans = t.windows(2).filter(|w| w[1] > w[0]).count();
+        let mids: Vec<f64> = (e0..e0 + n_spans).map(|e| self.split_point(l, d, e)).collect();
         let mut c = vec![1.0];
         for u in mids {
             insert_knot(p, &mut t, &mut c, u);
