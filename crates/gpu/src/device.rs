@@ -221,6 +221,33 @@ impl Gpu {
         Ok(())
     }
 
+    /// Copy `bytes` of `src` from offset `off` into `staging` (after `enc`'s commands when
+    /// given), wait for it, and map `staging`'s first `bytes` for reading: the caller reads
+    /// the returned slice's mapped range, then unmaps `staging`.
+    pub(crate) fn copy_and_map<'a>(
+        &self,
+        enc: Option<wgpu::CommandEncoder>,
+        src: &wgpu::Buffer,
+        off: u64,
+        staging: &'a wgpu::Buffer,
+        bytes: u64,
+    ) -> Result<wgpu::BufferSlice<'a>, GpuError> {
+        let mut enc = enc.unwrap_or_else(|| self.device.create_command_encoder(&Default::default()));
+        enc.copy_buffer_to_buffer(src, off, staging, 0, bytes);
+        self.submit_wait(Some(enc.finish()))?;
+        let slice = staging.slice(0..bytes);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            // the receiver lives until after the poll below
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
+            .map_err(|e| GpuError::Wgpu(e.to_string()))?;
+        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        Ok(slice)
+    }
+
     /// Copy `len` reals from `src` (offset 0) through `staging` into `out` as f64.
     pub(crate) fn read_into(
         &self,
@@ -233,19 +260,7 @@ impl Gpu {
             return Ok(());
         }
         let bytes = self.real_bytes(len as u64);
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(src, 0, staging, 0, bytes.next_multiple_of(4));
-        self.submit_wait(Some(enc.finish()))?;
-        let slice = staging.slice(0..bytes.next_multiple_of(4));
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            // the receiver lives until after the poll below
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
-            .map_err(|e| GpuError::Wgpu(e.to_string()))?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        let slice = self.copy_and_map(None, src, 0, staging, bytes.next_multiple_of(4))?;
         {
             let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             let data = &view[..bytes as usize];

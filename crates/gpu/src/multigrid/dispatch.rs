@@ -265,19 +265,7 @@ pub(crate) fn read_back(
     if bytes == 0 {
         return Ok(());
     }
-    let mut enc = enc.unwrap_or_else(|| gpu.device.create_command_encoder(&Default::default()));
-    enc.copy_buffer_to_buffer(src, off, staging, 0, bytes);
-    gpu.submit_wait(Some(enc.finish()))?;
-    let slice = staging.slice(0..bytes);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        // the receiver lives until after the poll below
-        let _ = tx.send(r);
-    });
-    gpu.device
-        .poll(wgpu::PollType::Wait { submission_index: None, timeout: None })
-        .map_err(|e| GpuError::Wgpu(e.to_string()))?;
-    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let slice = gpu.copy_and_map(enc, src, off, staging, bytes)?;
     {
         let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
         let data = &view[..bytes as usize];
