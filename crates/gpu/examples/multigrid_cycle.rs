@@ -46,6 +46,26 @@ fn seconds<E>(mut f: impl FnMut() -> Result<(), E>) -> Result<f64, E> {
     Ok(t.elapsed().as_secs_f64() / CYCLES as f64)
 }
 
+/// Seconds per call on the CPU and on the GPU (each as [`seconds`]) of one operation on
+/// the same random input of length `n` (from `seed`), with the input and both results.
+#[allow(clippy::type_complexity)]
+fn race(
+    n: usize,
+    seed: u64,
+    mut cpu: impl FnMut(&[f64], &mut [f64]),
+    mut gpu: impl FnMut(&[f64], &mut [f64]) -> Result<(), GpuError>,
+) -> Result<(f64, f64, Vec<f64>, Vec<f64>, Vec<f64>), GpuError> {
+    let mut rng = Lcg::new(seed);
+    let input: Vec<f64> = (0..n).map(|_| rng.uniform() - 0.5).collect();
+    let (mut on_cpu, mut on_gpu) = (vec![0.0; n], vec![0.0; n]);
+    let cpu_s = seconds(|| {
+        cpu(&input, &mut on_cpu);
+        Ok::<(), GpuError>(())
+    })?;
+    let gpu_s = seconds(|| gpu(&input, &mut on_gpu))?;
+    Ok((cpu_s, gpu_s, input, on_cpu, on_gpu))
+}
+
 /// One row of the cycle table.
 fn cycle_row(backend: &GpuCycles, ne: usize) -> Result<String, Box<dyn std::error::Error>> {
     let cycle = multigrid_cycle(ne, 3.0, false)?;
@@ -58,14 +78,7 @@ fn cycle_row(backend: &GpuCycles, ne: usize) -> Result<String, Box<dyn std::erro
         Err(e) => return Err(e.into()),
     };
     let upload = t0.elapsed().as_secs_f64();
-    let mut rng = Lcg::new(1);
-    let b: Vec<f64> = (0..n).map(|_| rng.uniform() - 0.5).collect();
-    let (mut xc, mut xg) = (vec![0.0; n], vec![0.0; n]);
-    let cpu = seconds(|| {
-        cycle.apply(&b, &mut xc);
-        Ok::<(), GpuError>(())
-    })?;
-    let gpu_s = seconds(|| dev.try_apply(&b, &mut xg))?;
+    let (cpu, gpu_s, b, xc, xg) = race(n, 1, |b, x| cycle.apply(b, x), |b, x| dev.try_apply(b, x))?;
     // the level operations on the CPU in the GPU's order (`CpuLevels`): the same bits
     // where the adapter fuses no multiply-adds
     let mut levels = cycle.cpu_levels();
@@ -97,14 +110,7 @@ fn product_row(backend: &GpuProducts, ne: usize) -> Result<String, Box<dyn std::
         Err(e) => return Err(e.into()),
     };
     let upload = t0.elapsed().as_secs_f64();
-    let mut rng = Lcg::new(2);
-    let x: Vec<f64> = (0..n).map(|_| rng.uniform() - 0.5).collect();
-    let (mut yc, mut yg) = (vec![0.0; n], vec![0.0; n]);
-    let cpu = seconds(|| {
-        sys.mul_vec(&x, &mut yc);
-        Ok::<(), GpuError>(())
-    })?;
-    let gpu_s = seconds(|| dev.try_apply(&x, &mut yg))?;
+    let (cpu, gpu_s, _, yc, yg) = race(n, 2, |x, y| sys.mul_vec(x, y), |x, y| dev.try_apply(x, y))?;
     Ok(format!(
         "| {ne} | {n} | {:.0} | {} | {cpu:.3e} | {gpu_s:.3e} | {upload:.3e} | {:.1e} |",
         4.0 * packed.len() as f64 / 1e6,
