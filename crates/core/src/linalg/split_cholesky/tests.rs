@@ -75,7 +75,7 @@ fn finds_the_top_separator() {
 #[test]
 fn solves_like_the_whole_factorization() {
     let (a, order) = grid_matrix(30, 17, 2);
-    let mut split = SplitCholesky::analyze(&a, &order).expect("a split");
+    let mut split = SplitCholesky::<f64>::analyze(&a, &order).expect("a split");
     split.factor(&a).unwrap();
     let n = a.nrows;
     let mut rng = Lcg::new(7);
@@ -109,7 +109,7 @@ fn fails_exactly_when_not_positive_definite() {
     let lmin = eig.iter().fold(f64::INFINITY, |m, &v| m.min(v));
     let lmax = eig.iter().fold(0.0f64, |m, &v| m.max(v));
     assert!(lmin > 0.0);
-    let mut split = SplitCholesky::analyze(&a, &order).expect("a split");
+    let mut split = SplitCholesky::<f64>::analyze(&a, &order).expect("a split");
     for (mu, definite) in
         [(0.999 * lmin, true), (1.001 * lmin, false), (0.5 * (lmin + lmax), false), (1.01 * lmax, false)]
     {
