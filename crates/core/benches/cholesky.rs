@@ -99,7 +99,7 @@ fn bench(c: &mut Criterion) {
                 );
             })
         });
-        let mut split = SplitCholesky::analyze(&a, &order).expect("a top separator");
+        let mut split = SplitCholesky::<f64>::analyze(&a, &order).expect("a top separator");
         g.bench_with_input(BenchmarkId::new("split-factor", &label), &(), |bch, _| {
             bch.iter(|| split.factor(&a).expect("definite"))
         });

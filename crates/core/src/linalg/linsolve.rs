@@ -114,8 +114,9 @@ pub(crate) const REFRESH_KRYLOV: usize = 30;
 #[derive(Debug)]
 enum Preconditioner {
     Ilu(Ilu0),
-    /// `P = -diag(K, ..., K)`, `K = L L^T` in single precision ...
-    NegBlock32(Box<Cholesky<f32>>),
+    /// `P = -diag(K, ..., K)`, `K = L L^T` in single precision (whole, or split at the
+    /// top separator: [`LinearSolver::set_split_preconditioner`]) ...
+    NegBlock32(Box<Direct<f32>>),
     /// ... or in double precision.
     NegBlock(Box<Cholesky<f64>>),
     /// `P = diag(K_11, ..., K_cc)`, the diagonal blocks of the matrix (block Jacobi).
@@ -203,6 +204,9 @@ pub struct LinearSolver {
     fresh: bool,
     /// The single-precision preconditioner failed: factorize in double precision.
     double: bool,
+    /// Factorize the single-precision preconditioner `K` split at its top separator
+    /// (see [`LinearSolver::set_split_preconditioner`]).
+    split_preconditioner: bool,
     fallback: bool,
     /// Relative residual at which GMRES stops.
     pub krylov_tol: f64,
@@ -235,6 +239,7 @@ impl LinearSolver {
             last_krylov: 0,
             fresh: false,
             double: false,
+            split_preconditioner: false,
             fallback,
             krylov_tol: KRYLOV_TOL,
             negated: Csr::default(),
@@ -249,6 +254,16 @@ impl LinearSolver {
     /// Without it, approximate minimum degree.
     pub(crate) fn set_ordering(&mut self, order: &[usize]) {
         self.order = Some(order.to_vec());
+    }
+
+    /// Factorize the single-precision preconditioner `K` of [`LinearMethod::Gmres`] split
+    /// at the top separator of the order given with [`LinearSolver::set_ordering`], the
+    /// two halves at once on two threads ([`crate::linalg::split_cholesky`], from
+    /// `SPLIT_MIN` unknowns), instead of whole on one. For volumes: the factorization of
+    /// their `K` is one sequential stage of the solve (BENCHMARKS.md, issue 33). The
+    /// planar solves keep the whole factor (and the results measured with it).
+    pub(crate) fn set_split_preconditioner(&mut self) {
+        self.split_preconditioner = true;
     }
 
     /// The nested spaces of [`LinearMethod::Multigrid`]: `transfers[l] = [P_0, P_1]` maps
@@ -299,13 +314,18 @@ impl LinearSolver {
         previous: Option<Preconditioner>,
     ) -> Result<Preconditioner> {
         let (slot32, slot64) = match previous {
-            Some(Preconditioner::NegBlock32(c)) => (Some(*c), None),
+            Some(Preconditioner::NegBlock32(c)) => (Some(c), None),
             Some(Preconditioner::NegBlock(c)) => (None, Some(*c)),
             _ => (None, None),
         };
         if !self.double {
-            match self.cholesky::<f32>(k, slot32) {
-                Ok(c) => return Ok(Preconditioner::NegBlock32(Box::new(c))),
+            let mut chol = match slot32 {
+                Some(c) if c.dim() == k.nrows => c,
+                _ if self.split_preconditioner => Box::new(Direct::analyze(k, self.order_for(k.nrows).as_deref())?),
+                _ => Box::new(Direct::Whole(Box::new(Cholesky::analyze(k, self.order_for(k.nrows).as_deref())?))),
+            };
+            match chol.factor(k) {
+                Ok(()) => return Ok(Preconditioner::NegBlock32(chol)),
                 Err(_) => self.double = true,
             }
         }

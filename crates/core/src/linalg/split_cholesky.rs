@@ -20,13 +20,18 @@
 //! A solve runs both halves at once too: forward through `M_h` on `[b_h; 0]` gives `[y_h;
 //! t_h]` with `y_h = L_h⁻¹ b_h` and `W_hᵀ y_h = -R_h t_h`; `x₃ = S⁻¹ (b₃ - W₁ᵀ y₁ - W₂ᵀ
 //! y₂)`; backward through `M_h` on `[y_h; R_hᵀ x₃]` gives `[x_h; x₃]`.
+//!
+//! The factor is held in double or single precision ([`Scalar`]): `f64` for direct
+//! solves, `f32` for a preconditioner (the right-hand sides and solutions are `f64`,
+//! rounded to `T` on the way in and widened on the way out).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
 use faer::linalg::matmul::triangular::{matmul, BlockStructure};
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -35,6 +40,80 @@ use faer::{Accum, Conj, Mat, MatMut, Par, Side};
 use crate::error::{Error, Result};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
+
+/// Floating-point type of a Cholesky factor: `f64` for direct solves, `f32` for the
+/// preconditioners, whose triangular solves are bound by memory bandwidth and take 30 %
+/// less time in single precision (the GMRES iteration counts are unchanged on the
+/// shared geometries; flexible GMRES absorbs the rounding of the preconditioner).
+pub trait Scalar:
+    faer::traits::RealField
+    + faer::traits::ComplexField<Real = Self>
+    + Copy
+    + Send
+    + Sync
+    + std::ops::Add<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::SubAssign
+    + std::ops::AddAssign
+    + std::ops::Neg<Output = Self>
+    + std::iter::Sum
+    + 'static
+{
+    /// `v` rounded to `Self`.
+    fn of(v: f64) -> Self;
+    /// `self` as `f64` (exact).
+    fn wide(self) -> f64;
+    /// `v` as `Self`, `buf` as storage when a conversion is needed.
+    fn cast<'a>(v: &'a [f64], buf: &'a mut Vec<Self>) -> &'a [Self];
+    /// Overwrite `x` with `A^{-1} x` through the factor `llt`.
+    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], buf: &mut Vec<Self>, scratch: &mut MemBuffer);
+}
+
+fn solve_in_place<T: Scalar>(llt: LltRef<'_, usize, T>, x: &mut [T], scratch: &mut MemBuffer) {
+    let n = x.len();
+    llt.solve_in_place_with_conj(
+        Conj::No,
+        MatMut::from_column_major_slice_mut(x, n, 1),
+        Par::Seq,
+        MemStack::new(scratch),
+    );
+}
+
+impl Scalar for f64 {
+    fn of(v: f64) -> Self {
+        v
+    }
+    fn wide(self) -> f64 {
+        self
+    }
+    fn cast<'a>(v: &'a [f64], _: &'a mut Vec<Self>) -> &'a [Self] {
+        v
+    }
+    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], _: &mut Vec<Self>, scratch: &mut MemBuffer) {
+        solve_in_place(llt, x, scratch);
+    }
+}
+
+impl Scalar for f32 {
+    fn of(v: f64) -> Self {
+        v as f32
+    }
+    fn wide(self) -> f64 {
+        f64::from(self)
+    }
+    fn cast<'a>(v: &'a [f64], buf: &'a mut Vec<Self>) -> &'a [Self] {
+        buf.clear();
+        buf.extend(v.iter().map(|&t| t as f32));
+        buf
+    }
+    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], buf: &mut Vec<Self>, scratch: &mut MemBuffer) {
+        Self::cast(x, buf);
+        solve_in_place(llt, buf, scratch);
+        for (xi, &b) in x.iter_mut().zip(buf.iter()) {
+            *xi = f64::from(b);
+        }
+    }
+}
 
 /// Smallest system that is split. Measured on the Winslow Hessians of the shared
 /// geometries (factorization and one solve, whole against split, 2 cores): 1058 unknowns
@@ -49,7 +128,7 @@ const BORDER: usize = usize::MAX;
 /// One half `M_h` of the split: its pattern (lower triangle, local numbering: the half's
 /// unknowns in order, then the separator's), where each entry comes from in `A`, the
 /// symbolic analysis, the factor and `X_h`.
-struct Half {
+struct Half<T: Scalar> {
     /// First unknown of the half in the nested-dissection order, and its length `n_h`.
     first: usize,
     len: usize,
@@ -57,43 +136,44 @@ struct Half {
     row_idx: Vec<usize>,
     /// Position of each entry in `A`'s values ([`BORDER`] for `τ` on the separator's diagonal).
     src: Vec<usize>,
-    entries: Vec<f64>,
+    entries: Vec<T>,
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: Vec<T>,
     factor_scratch: MemBuffer,
     solve_scratch: MemBuffer,
     /// `R_h` (lower triangle of the factor's separator block), then `X_h = τ I - R_h R_hᵀ`
     /// (lower triangle).
-    r: Mat<f64>,
-    x: Mat<f64>,
+    r: Mat<T>,
+    x: Mat<T>,
     /// A right-hand side of `M_h`.
-    rhs: Vec<f64>,
+    rhs: Vec<T>,
 }
 
-/// See the module documentation.
-pub struct SplitCholesky {
+/// See the module documentation; the factor in the precision `T`.
+pub struct SplitCholesky<T: Scalar = f64> {
     /// `order[new] = old`.
     order: Vec<usize>,
-    halves: [Half; 2],
+    halves: [Half<T>; 2],
     /// First unknown of the separator in the order, and its size `s`.
     sep: usize,
     s: usize,
     /// `(i, j, position in A)` of the separator block's lower triangle, local indices.
     a3: Vec<(usize, usize, usize)>,
     /// `S`, then its Cholesky factor `L₃` (lower triangle), and whether it holds one.
-    s3: Mat<f64>,
+    s3: Mat<T>,
     factored: bool,
     dense_scratch: MemBuffer,
     /// Storage of one permuted column.
-    work: Vec<f64>,
+    work: Vec<T>,
 }
 
-impl std::fmt::Debug for SplitCholesky {
+impl<T: Scalar> std::fmt::Debug for SplitCholesky<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SplitCholesky")
             .field("n", &self.order.len())
             .field("halves", &[self.halves[0].len, self.halves[1].len])
             .field("separator", &self.s)
+            .field("bytes", &std::mem::size_of::<T>())
             .finish()
     }
 }
@@ -150,7 +230,7 @@ pub(crate) fn top_split(a: &Csr, order: &[usize]) -> Option<[usize; 3]> {
     (contiguous && n1.min(n2) >= n / 8 && s <= n / 4).then_some([n1, n2, s])
 }
 
-impl SplitCholesky {
+impl<T: Scalar> SplitCholesky<T> {
     /// Symbolic analysis of the SPD pattern of `a` in the nested-dissection order `order`
     /// (`order[new] = old`); `None` when `top_split` finds no split or faer's analysis
     /// of a half is not supernodal. (Worth it from [`SPLIT_MIN`] unknowns on two threads
@@ -163,7 +243,7 @@ impl SplitCholesky {
         let [n1, n2, s] = top_split(a, order)?;
         let sep = n1 + n2;
         let inv = ordering::inverse(order);
-        let half = |first: usize, len: usize| -> Option<Half> {
+        let half = |first: usize, len: usize| -> Option<Half<T>> {
             // local index of a new index in this half or the separator
             let local = |j: usize| match j {
                 j if (first..first + len).contains(&j) => Some(j - first),
@@ -215,23 +295,23 @@ impl SplitCholesky {
             let symbolic =
                 factorize_symbolic_cholesky(pattern, Side::Upper, SymmetricOrdering::Identity, params).ok()?;
             let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { return None };
-            let solve_scratch = MemBuffer::try_new(sn.solve_in_place_scratch::<f64>(1, Par::Seq)).ok()?;
+            let solve_scratch = MemBuffer::try_new(sn.solve_in_place_scratch::<T>(1, Par::Seq)).ok()?;
             let factor_scratch =
-                MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())).ok()?;
+                MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<T>(Par::Seq, Default::default())).ok()?;
             Some(Half {
                 first,
                 len,
-                entries: vec![0.0; src.len()],
+                entries: vec![T::of(0.0); src.len()],
                 col_ptr,
                 row_idx,
                 src,
-                values: vec![0.0; symbolic.len_val()],
+                values: vec![T::of(0.0); symbolic.len_val()],
                 symbolic,
                 factor_scratch,
                 solve_scratch,
                 r: Mat::zeros(s, s),
                 x: Mat::zeros(s, s),
-                rhs: vec![0.0; m],
+                rhs: vec![T::of(0.0); m],
             })
         };
         let (h1, h2) = rayon::join(|| half(0, n1), || half(n1, n2));
@@ -247,7 +327,7 @@ impl SplitCholesky {
             }
         }
         let dense_scratch =
-            MemBuffer::try_new(llt::factor::cholesky_in_place_scratch::<f64>(s, Par::Seq, Default::default())).ok()?;
+            MemBuffer::try_new(llt::factor::cholesky_in_place_scratch::<T>(s, Par::Seq, Default::default())).ok()?;
         Some(Self {
             order: order.to_vec(),
             halves,
@@ -257,7 +337,7 @@ impl SplitCholesky {
             s3: Mat::zeros(s, s),
             factored: false,
             dense_scratch,
-            work: vec![0.0; n],
+            work: vec![T::of(0.0); n],
         })
     }
 
@@ -275,7 +355,7 @@ impl SplitCholesky {
                 rows[j] += v;
             }
         }
-        let tau = rows.iter().fold(0.0f64, |m, &v| m.max(v)).max(f64::MIN_POSITIVE);
+        let tau = T::of(rows.iter().fold(0.0f64, |m, &v| m.max(v)).max(f64::MIN_POSITIVE));
         let [h1, h2] = &mut self.halves;
         let (r1, r2) = rayon::join(|| h1.factor(a, tau), || h2.factor(a, tau));
         r1?;
@@ -289,7 +369,7 @@ impl SplitCholesky {
             }
         }
         for &(i, j, k) in &self.a3 {
-            sm[(i, j)] += a.values[k];
+            sm[(i, j)] += T::of(a.values[k]);
         }
         llt::factor::cholesky_in_place(
             sm.as_mut(),
@@ -313,22 +393,22 @@ impl SplitCholesky {
         let sep = self.sep;
         for col in x.chunks_mut(n) {
             for (w, &old) in self.work.iter_mut().zip(&self.order) {
-                *w = col[old];
+                *w = T::of(col[old]);
             }
             let (body, b3) = self.work.split_at_mut(sep);
             let [h1, h2] = &mut self.halves;
-            let rhs: &[f64] = body;
+            let rhs: &[T] = body;
             let (g1, g2) = rayon::join(|| h1.forward(rhs), || h2.forward(rhs));
             for (i, b) in b3.iter_mut().enumerate() {
                 *b -= g1[i] + g2[i];
             }
             let x3 = MatMut::from_column_major_slice_mut(b3, self.s, 1);
             llt::solve::solve_in_place_with_conj(self.s3.as_ref(), Conj::No, x3, Par::Seq, MemStack::new(&mut []));
-            let x3: &[f64] = b3;
+            let x3: &[T] = b3;
             let (lo, hi) = body.split_at_mut(h2.first);
             rayon::join(|| h1.backward(lo, x3), || h2.backward(hi, x3));
             for (w, &old) in self.work.iter().zip(&self.order) {
-                col[old] = *w;
+                col[old] = w.wide();
             }
         }
     }
@@ -341,16 +421,16 @@ impl SplitCholesky {
 
 /// The supernodal factor of a half (its analysis is supernodal: checked in
 /// [`SplitCholesky::analyze`]).
-fn supernodal<'a>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64]) -> SupernodalLltRef<'a, usize, f64> {
+fn supernodal<'a, T: Scalar>(symbolic: &'a SymbolicCholesky<usize>, values: &'a [T]) -> SupernodalLltRef<'a, usize, T> {
     let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { unreachable!("checked in analyze") };
     SupernodalLltRef::new(sn, values)
 }
 
-impl Half {
+impl<T: Scalar> Half<T> {
     /// Factorize `M_h` with border `tau`, then `R_h` and `X_h = τ I - R_h R_hᵀ`.
-    fn factor(&mut self, a: &Csr, tau: f64) -> Result<()> {
+    fn factor(&mut self, a: &Csr, tau: T) -> Result<()> {
         for (e, &k) in self.entries.iter_mut().zip(&self.src) {
-            *e = if k == BORDER { tau } else { a.values[k] };
+            *e = if k == BORDER { tau } else { T::of(a.values[k]) };
         }
         let m = self.col_ptr.len() - 1;
         let pattern = SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
@@ -394,7 +474,7 @@ impl Half {
             BlockStructure::TriangularLower,
             r.as_ref().transpose(),
             BlockStructure::TriangularUpper,
-            -1.0,
+            T::of(-1.0),
             Par::Seq,
         );
         for i in 0..m - len {
@@ -405,10 +485,10 @@ impl Half {
 
     /// Forward solve through `M_h` on `[b_h; 0]` (`body` holds all halves' right-hand
     /// sides): `y_h = L_h⁻¹ b_h` kept in `rhs`, `W_hᵀ y_h = -R_h t_h` returned.
-    fn forward(&mut self, body: &[f64]) -> Vec<f64> {
+    fn forward(&mut self, body: &[T]) -> Vec<T> {
         let len = self.len;
         self.rhs[..len].copy_from_slice(&body[self.first..self.first + len]);
-        self.rhs[len..].fill(0.0);
+        self.rhs[len..].fill(T::of(0.0));
         let m = self.rhs.len();
         let Self { symbolic, values, solve_scratch, rhs, r, .. } = self;
         supernodal(symbolic, values).l_solve_with_conj(
@@ -418,11 +498,11 @@ impl Half {
             MemStack::new(solve_scratch),
         );
         let t = &rhs[len..];
-        (0..t.len()).map(|i| -(0..=i).map(|j| r[(i, j)] * t[j]).sum::<f64>()).collect()
+        (0..t.len()).map(|i| -(0..=i).map(|j| r[(i, j)] * t[j]).sum::<T>()).collect()
     }
 
     /// Backward solve through `M_h` on `[y_h; R_hᵀ x₃]`: `x_h` into `out`.
-    fn backward(&mut self, out: &mut [f64], x3: &[f64]) {
+    fn backward(&mut self, out: &mut [T], x3: &[T]) {
         let (len, s) = (self.len, x3.len());
         let m = self.rhs.len();
         let Self { symbolic, values, solve_scratch, rhs, r, .. } = self;

@@ -9,60 +9,14 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Par, Side};
+use faer::{Par, Side};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::linalg::ordering;
 use crate::linalg::sparse::Csr;
+pub(super) use crate::linalg::split_cholesky::Scalar;
 use crate::linalg::split_cholesky::{SplitCholesky, SPLIT_MIN};
-
-/// Floating-point type of a Cholesky factor: `f64` for direct solves, `f32` for the
-/// preconditioner, whose triangular solves are bound by memory bandwidth and take 30 %
-/// less time in single precision (the GMRES iteration counts are unchanged on the
-/// shared geometries; flexible GMRES absorbs the rounding of the preconditioner).
-pub(super) trait Scalar:
-    faer::traits::RealField + faer::traits::ComplexField<Real = Self> + Copy + Send + Sync + 'static
-{
-    /// `v` as `Self`, `buf` as storage when a conversion is needed.
-    fn cast<'a>(v: &'a [f64], buf: &'a mut Vec<Self>) -> &'a [Self];
-    /// Overwrite `x` with `A^{-1} x` through the factor `llt`.
-    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], buf: &mut Vec<Self>, scratch: &mut MemBuffer);
-}
-
-fn solve_in_place<T: Scalar>(llt: LltRef<'_, usize, T>, x: &mut [T], scratch: &mut MemBuffer) {
-    let n = x.len();
-    llt.solve_in_place_with_conj(
-        Conj::No,
-        faer::MatMut::from_column_major_slice_mut(x, n, 1),
-        Par::Seq,
-        MemStack::new(scratch),
-    );
-}
-
-impl Scalar for f64 {
-    fn cast<'a>(v: &'a [f64], _: &'a mut Vec<Self>) -> &'a [Self] {
-        v
-    }
-    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], _: &mut Vec<Self>, scratch: &mut MemBuffer) {
-        solve_in_place(llt, x, scratch);
-    }
-}
-
-impl Scalar for f32 {
-    fn cast<'a>(v: &'a [f64], buf: &'a mut Vec<Self>) -> &'a [Self] {
-        buf.clear();
-        buf.extend(v.iter().map(|&t| t as f32));
-        buf
-    }
-    fn solve(llt: LltRef<'_, usize, Self>, x: &mut [f64], buf: &mut Vec<Self>, scratch: &mut MemBuffer) {
-        Self::cast(x, buf);
-        solve_in_place(llt, buf, scratch);
-        for (xi, &b) in x.iter_mut().zip(buf.iter()) {
-            *xi = f64::from(b);
-        }
-    }
-}
 
 /// The parallelism of the numeric Cholesky factorizations: sequential. faer's
 /// rayon-parallel supernodal factorization was 2-3x slower on 2 cores at every size
@@ -161,17 +115,18 @@ impl<T: Scalar> Cholesky<T> {
     }
 }
 
-/// The double-precision Cholesky factor of a direct solve: whole, or, from [`SPLIT_MIN`]
-/// unknowns in a nested-dissection order on two threads or more, split at the order's
-/// top separator with the halves factorized at once ([`SplitCholesky`]: on the Winslow
-/// Hessian of jigsaw01, 9984 unknowns, BENCHMARKS.md).
+/// A Cholesky factor whole, or, from [`SPLIT_MIN`] unknowns in a nested-dissection
+/// order on two threads or more, split at the order's top separator with the halves
+/// factorized at once ([`SplitCholesky`]): in double precision the factor of a direct
+/// solve (on the Winslow Hessian of jigsaw01, 9984 unknowns, BENCHMARKS.md), in single
+/// precision the preconditioner `K` of a volume (`LinearSolver::set_split_preconditioner`).
 #[derive(Debug)]
-pub(super) enum Direct {
-    Whole(Box<Cholesky<f64>>),
-    Split(Box<SplitCholesky>),
+pub(super) enum Direct<T: Scalar = f64> {
+    Whole(Box<Cholesky<T>>),
+    Split(Box<SplitCholesky<T>>),
 }
 
-impl Direct {
+impl<T: Scalar> Direct<T> {
     pub(super) fn analyze(a: &Csr, order: Option<&[usize]>) -> Result<Self> {
         let split = order
             .filter(|_| a.nrows >= SPLIT_MIN && rayon::current_num_threads() >= 2)

@@ -108,10 +108,11 @@ pub(super) fn weights(t: [&Tables; 3]) -> Vec<f64> {
 /// [`points_in_natural_order`].
 ///
 /// The directions are contracted in the [`contraction_order`] `o` (the one with the most
-/// functions first). The columns go through each pass together (the `o₀` points of all
-/// columns contiguous, `(col, i_(o₀))`), so that the second and third passes are updates
-/// of vectors of `k g_(o₀)` and `g_(o₁) k g_(o₀)` numbers; the result is then moved to
-/// the layout above.
+/// functions first). The first pass runs over all columns at once; the second leaves
+/// each column's `(o₁, o₀)` plane of points contiguous, so that the last pass writes each
+/// row of the output one plane at a time, each point's sum over the last direction's
+/// functions taken whole (`((f₀ s₀ + f₁ s₁) + f₂ s₂)`, in one loop over the plane), with
+/// no intermediate buffer or reordering of the result.
 pub(super) fn values(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
     // the tables, sizes, coefficients and derivative orders in the contraction order
     let Ordered { o, nat, t, n, g } = Ordered::of(t);
@@ -133,11 +134,9 @@ pub(super) fn values(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
     let rows: [[usize; 3]; 10] = std::array::from_fn(|row| std::array::from_fn(|d| ROWS[row][o[d]]));
     let row_pair: [usize; 10] =
         std::array::from_fn(|row| PAIRS_XY.iter().position(|p| p[..] == rows[row][..2]).unwrap_or(0));
-    // a run of the first direction's points of all columns, (col, x)
-    let run = cols * g[0];
-    // U¹[dx][(c n₁ + b) run + col g₀ + x] (every buffer written in order or from its
+    // U¹[dx][((c n₁ + b) cols + col) g₀ + x] (every buffer written in order or from its
     // first term, without a zero fill first)
-    let s1 = n[2] * n[1] * run;
+    let s1 = n[2] * n[1] * cols * g[0];
     let mut u1 = Vec::with_capacity(3 * s1);
     for dx in 0..3 {
         for cb in 0..n[2] * n[1] {
@@ -149,56 +148,42 @@ pub(super) fn values(t: [&Tables; 3], u: &[f64]) -> Vec<f64> {
             }
         }
     }
-    // U²[pair][(c g₁ + y) run + col g₀ + x]
-    let s2 = n[2] * g[1] * run;
+    // U²[pair][((c cols + col) g₁ + y) g₀ + x]: a plane of (y, x) per (c, col)
+    let plane = g[1] * g[0];
+    let s2 = n[2] * cols * plane;
     let mut u2 = Vec::with_capacity(6 * s2);
     for &[dx, dy] in &PAIRS_XY {
-        for cy in 0..n[2] * g[1] {
-            let (c, ty) = (cy / g[1], &t[1][cy % g[1]].0);
-            let src = |b: usize| &u1[dx * s1 + (c * n[1] + b) * run..][..run];
-            let start = u2.len();
-            u2.extend(src(0).iter().map(|s| ty.d[dy][0] * s));
-            let dst = &mut u2[start..];
-            for b in 1..n[1] {
-                let f = ty.d[dy][b];
-                for (o, s) in dst.iter_mut().zip(src(b)) {
-                    *o += f * s;
+        for c in 0..n[2] {
+            for col in 0..cols {
+                let src = |b: usize| &u1[dx * s1 + ((c * n[1] + b) * cols + col) * g[0]..][..g[0]];
+                for (ty, _) in t[1] {
+                    let f = &ty.d[dy][..n[1]];
+                    let start = u2.len();
+                    u2.extend(src(0).iter().map(|s| f[0] * s));
+                    let dst = &mut u2[start..];
+                    for (b, &fb) in f.iter().enumerate().skip(1) {
+                        for (o, s) in dst.iter_mut().zip(src(b)) {
+                            *o += fb * s;
+                        }
+                    }
                 }
             }
         }
     }
-    // each row's values, a plane of (y, col, x) at a time, the sum over the last
-    // direction's functions but its last term: V[row][z][(y run + col g₀ + x)] ...
-    let plane = g[1] * run;
-    let mut v = Vec::with_capacity(10 * g[2] * plane);
-    for (row, r) in rows.iter().enumerate() {
-        let src = &u2[row_pair[row] * s2..(row_pair[row] + 1) * s2];
-        for (tz, _) in t[2] {
-            let f = &tz.d[r[2]][..n[2]];
-            let start = v.len();
-            match n[2] {
-                1 => v.extend(std::iter::repeat_n(0.0, plane)),
-                _ => v.extend(src[..plane].iter().map(|s| f[0] * s)),
-            }
-            let acc = &mut v[start..];
-            for (term, &fc) in src.chunks_exact(plane).zip(f).take(n[2] - 1).skip(1) {
-                for (o, s) in acc.iter_mut().zip(term) {
-                    *o += fc * s;
-                }
-            }
-        }
-    }
-    // ... and the last term added on the way to the layout
-    // `out[(10 col + row) n_q + (z g₁ + y) g₀ + x]`, written in order (no copy)
+    // out[(10 col + row) n_q + (z g₁ + y) g₀ + x], a plane at a time
     let mut out = Vec::with_capacity(cols * 10 * nq);
     for col in 0..cols {
         for (row, r) in rows.iter().enumerate() {
-            let last = &u2[row_pair[row] * s2 + (n[2] - 1) * plane..][..plane];
-            for ((tz, _), vz) in t[2].iter().zip(v[row * g[2] * plane..].chunks_exact(plane)) {
-                let fl = tz.d[r[2]][n[2] - 1];
-                for (ay, ly) in vz.chunks_exact(run).zip(last.chunks_exact(run)) {
-                    let (ay, ly) = (&ay[col * g[0]..][..g[0]], &ly[col * g[0]..][..g[0]]);
-                    out.extend(ay.iter().zip(ly).map(|(a, l)| a + fl * l));
+            let src = |c: usize| &u2[row_pair[row] * s2 + (c * cols + col) * plane..][..plane];
+            for (tz, _) in t[2] {
+                let f = &tz.d[r[2]][..n[2]];
+                let start = out.len();
+                out.extend(src(0).iter().map(|s| f[0] * s));
+                let dst = &mut out[start..];
+                for (c, &fc) in f.iter().enumerate().skip(1) {
+                    for (o, s) in dst.iter_mut().zip(src(c)) {
+                        *o += fc * s;
+                    }
                 }
             }
         }
@@ -274,11 +259,18 @@ pub(super) fn integrals(t: [&Tables; 3], f: &[f64]) -> Vec<f64> {
 /// `T¹_(a₀ b₀)(y, z) = Σ_x X^(δ_i0)_(a₀) X^(δ_j0)_(b₀) C_ij`,
 /// `T²_(a₁ b₁ a₀ b₀)(z) = Σ_y Y^(δ_i1)_(a₁) Y^(δ_j1)_(b₁) T¹`,
 ///
-/// the `T²` of the pairs with the same `z` derivatives `(δ_i2, δ_j2)` added (four
-/// groups), and `K = Σ_z Z^(δ_i2)_(a₂) Z^(δ_j2)_(b₂) T²` per group: `O(p^{d+1})` per
-/// entry and point instead of `O(p^d)` per entry times `n_q` for the dense product
+/// the `T²` of the pairs with the same `z` derivatives `(δ_i2, δ_j2)` added (three
+/// groups, see below), and `Σ_z Z^(δ_i2)_(a₂) Z^(δ_j2)_(b₂) T²` per group: `O(p^{d+1})`
+/// per entry and point instead of `O(p^d)` per entry times `n_q` for the dense product
 /// `Σ_q`. Only for the polynomial basis, as [`values`]. The points of `c` in the order of
 /// [`points_in_natural_order`].
+///
+/// `C` is symmetric (`C_ij = C_ji`, the cofactor metric), so the pair `(j, i)` gives the
+/// transpose of the pair `(i, j)`: the passes run over six pairs, for `Q = Σ_i S_ii / 2 +
+/// Σ_(i<j) S_ij` (`S_ij` the pair's term, each off-diagonal pair oriented so that the
+/// `z` derivative is not on `a` alone, [`symmetric_pairs`]), and `K = Q + Qᵀ`, symmetric
+/// bit for bit; 6 of 9 pairs in the first two passes and 3 of 4 groups in the last. (The
+/// entries move at rounding against the sum over all nine pairs.)
 ///
 /// The roles `x, y, z` above go to the directions by increasing number of functions
 /// (ties in their natural order), the cheapest order here (the first pass costs
@@ -320,28 +312,26 @@ pub(super) fn stiffness(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
     // T²[group][z][a₁][b₁][a₀ b₀], group 2 δ_i2 + δ_j2
     let mut t2 = vec![0.0; 4 * g[2] * b1];
     let mut t1 = vec![0.0; g[2] * g[1] * b0];
-    for i in 0..3 {
-        for j in 0..3 {
-            let cij = &c[(3 * i + j) * nq..(3 * i + j + 1) * nq];
-            let da: [usize; 3] = std::array::from_fn(|d| usize::from(so[d] == i));
-            let db: [usize; 3] = std::array::from_fn(|d| usize::from(so[d] == j));
-            for (dst, cz) in t1.chunks_exact_mut(b0).zip(cij.chunks_exact(g[0])) {
-                for a0 in 0..n[0] {
-                    for bb in 0..n[0] {
-                        dst[a0 * n[0] + bb] =
-                            t[0].iter().zip(cz).map(|((tx, _), &cq)| tx.d[da[0]][a0] * tx.d[db[0]][bb] * cq).sum();
-                    }
+    for (i, j, half) in symmetric_pairs(so[2]) {
+        let cij = &c[(3 * i + j) * nq..(3 * i + j + 1) * nq];
+        let da: [usize; 3] = std::array::from_fn(|d| usize::from(so[d] == i));
+        let db: [usize; 3] = std::array::from_fn(|d| usize::from(so[d] == j));
+        for (dst, cz) in t1.chunks_exact_mut(b0).zip(cij.chunks_exact(g[0])) {
+            for a0 in 0..n[0] {
+                for bb in 0..n[0] {
+                    dst[a0 * n[0] + bb] =
+                        t[0].iter().zip(cz).map(|((tx, _), &cq)| tx.d[da[0]][a0] * tx.d[db[0]][bb] * cq).sum();
                 }
             }
-            let group = &mut t2[(2 * da[2] + db[2]) * g[2] * b1..][..g[2] * b1];
-            for (z, gz) in group.chunks_exact_mut(b1).enumerate() {
-                for (ab, dst) in gz.chunks_exact_mut(b0).enumerate() {
-                    let (a1, bb) = (ab / n[1], ab % n[1]);
-                    for (y, (ty, _)) in t[1].iter().enumerate() {
-                        let f = ty.d[da[1]][a1] * ty.d[db[1]][bb];
-                        for (o, s) in dst.iter_mut().zip(&t1[(z * g[1] + y) * b0..][..b0]) {
-                            *o += f * s;
-                        }
+        }
+        let group = &mut t2[(2 * da[2] + db[2]) * g[2] * b1..][..g[2] * b1];
+        for (z, gz) in group.chunks_exact_mut(b1).enumerate() {
+            for (ab, dst) in gz.chunks_exact_mut(b0).enumerate() {
+                let (a1, bb) = (ab / n[1], ab % n[1]);
+                for (y, (ty, _)) in t[1].iter().enumerate() {
+                    let f = half * (ty.d[da[1]][a1] * ty.d[db[1]][bb]);
+                    for (o, s) in dst.iter_mut().zip(&t1[(z * g[1] + y) * b0..][..b0]) {
+                        *o += f * s;
                     }
                 }
             }
@@ -351,6 +341,10 @@ pub(super) fn stiffness(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
     let mut kb = vec![0.0; n[2] * n[2] * b1];
     for (group, t2g) in t2.chunks_exact(g[2] * b1).enumerate() {
         let (dza, dzb) = (group / 2, group % 2);
+        if group == 2 {
+            // empty: no pair has the `z` derivative on `a` alone (`symmetric_pairs`)
+            continue;
+        }
         for (ab, dst) in kb.chunks_exact_mut(b1).enumerate() {
             let (a2, bb) = (ab / n[2], ab % n[2]);
             for ((tz, _), src) in t[2].iter().zip(t2g.chunks_exact(b1)) {
@@ -370,5 +364,23 @@ pub(super) fn stiffness(t: [&Tables; 3], c: &[f64]) -> Vec<f64> {
             (a0b0 / n[0], a0b0 % n[0], a1b1 / n[1], a1b1 % n[1], a2b2 / n[2], a2b2 % n[2]);
         k[f[(bb2 * n[1] + bb1) * n[0] + bb0] * m + f[(a2 * n[1] + a1) * n[0] + a0]] = v;
     }
+    // K = Q + Qᵀ (symmetric bit for bit)
+    for a in 0..m {
+        for b in 0..a {
+            let v = k[a * m + b] + k[b * m + a];
+            k[a * m + b] = v;
+            k[b * m + a] = v;
+        }
+        k[a * m + a] += k[a * m + a];
+    }
     k
+}
+
+/// The pairs `(i, j, s)` of [`stiffness`]'s half `Q = Σ_i C_ii / 2 + Σ_(i<j) C_ij`
+/// (`K = Q + Qᵀ` as `C_ij = C_ji`): `s = 1/2` on the diagonal (exact), and each pair
+/// off it oriented so that the direction `z` (contracted last) is not its first, so that
+/// its `z` derivatives `(δ_iz, δ_jz)` fall in three groups, not four.
+fn symmetric_pairs(z: usize) -> [(usize, usize, f64); 6] {
+    let pair = |i: usize, j: usize| if i == z { (j, i, 1.0) } else { (i, j, 1.0) };
+    [(0, 0, 0.5), pair(0, 1), pair(0, 2), (1, 1, 0.5), pair(1, 2), (2, 2, 0.5)]
 }

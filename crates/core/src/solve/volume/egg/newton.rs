@@ -6,8 +6,11 @@
 //! `∫ R_A (A : ∇²R_B) / tr A` by parts gives `-K_AB` (plus terms of lower order), in each
 //! component, so `P` is the Jacobian's principal part, and `K` is SPD wherever
 //! `det J ≠ 0` (`A = cof(J)ᵀ cof(J)`). `K` is one scalar system (a third of the unknowns,
-//! a ninth of the Jacobian's entries), factorized by sparse Cholesky
-//! ([`LinearSolver::factor_operator`]) and kept over the Newton steps while GMRES
+//! a ninth of the Jacobian's entries), factorized by sparse Cholesky in single precision
+//! ([`LinearSolver::factor_operator`]), in the nested dissection of the free control
+//! points' grid and split at its top separator, the two halves on two threads
+//! ([`LinearSolver::set_split_preconditioner`]; whole on one thread, the factorization
+//! was one sequential stage of a 10^5-unknown solve), and kept over the Newton steps while GMRES
 //! converges in few iterations with it (a frozen preconditioner,
 //! [`LinearSolver::wants_preconditioner`]). GMRES stops at the forcing term of
 //! Eisenstat and Walker (choice 2, as the planar Newton solver,
@@ -106,7 +109,7 @@ impl Step {
     /// factorized `K`), and `Auto` falls back to LU.
     ///
     /// `K` is factorized in the nested-dissection order of the free control points'
-    /// grid (`VolumeDiscretization::ordering`).
+    /// grid (`VolumeDiscretization::ordering`), split at its top separator.
     fn new(op: &EggVolume, linear: LinearMethod) -> Self {
         let n = op.unknowns();
         let direct = match linear {
@@ -117,6 +120,7 @@ impl Step {
         let gmres = (!direct).then(|| {
             let mut g = LinearSolver::new(LinearMethod::Gmres);
             g.set_ordering(&op.disc.ordering());
+            g.set_split_preconditioner();
             g
         });
         Self {

@@ -147,9 +147,10 @@ fn sum_factorisation_is_the_basis_table_product() {
 
 /// The sum-factorised stiffness ([`tensor_points::stiffness`]) equals
 /// `Σ_q Σ_ij ∂_i R_a C_ij ∂_j R_b` through the tensor basis table, on every element of a
-/// polynomial volume, for pseudo-random coefficients `C` (not symmetric: every pair
-/// `(i, j)` is its own term); and the cofactor-metric stiffness `K` assembled through
-/// it equals the one of the basis tables ([`EggVolume::element`]).
+/// polynomial volume, for pseudo-random symmetric coefficients `C` (`C_ij = C_ji`, as the
+/// cofactor metric's: the sum factorisation runs over the six pairs `i <= j`), and is
+/// symmetric bit for bit; and the cofactor-metric stiffness `K` assembled through it
+/// equals the one of the basis tables ([`EggVolume::element`]).
 #[test]
 fn sum_factorised_stiffness_is_the_basis_table_sum() {
     let mut state = 0x1234_5678_9abc_def1_u64;
@@ -159,9 +160,14 @@ fn sum_factorised_stiffness_is_the_basis_table_sum() {
             let idx = op.disc.element_indices(e);
             let (weights, basis) = op.element_points(e, &idx);
             let (m, nq) = (idx.len(), weights.len());
-            let c = random(&mut state, 9 * nq);
+            let mut c = random(&mut state, 9 * nq);
+            for (i, j) in [(1, 0), (2, 0), (2, 1)] {
+                let (lower, upper) = c.split_at_mut((3 * i + j) * nq);
+                upper[..nq].copy_from_slice(&lower[(3 * j + i) * nq..][..nq]);
+            }
             let tables = op.disc.element_tables(e);
             let got = tensor_points::stiffness(tables, &c);
+            assert!((0..m).all(|a| (0..m).all(|b| got[a * m + b] == got[b * m + a])), "symmetric");
             let nat = tensor_points::points_in_natural_order(tables);
             let grad = |q: usize, i: usize, a: usize| basis[(10 * nat[q] + 1 + i) * m + a];
             let mut scale = 0.0f64;
