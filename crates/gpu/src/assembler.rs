@@ -110,6 +110,14 @@ enum StencilTo<'a> {
     Device(&'a jacobian::Packer),
 }
 
+/// The operator's code in `assembly.wgsl`.
+fn op_code(op: Operator) -> u32 {
+    match op {
+        Operator::Plain => 0,
+        Operator::Scaled => 1,
+    }
+}
+
 /// Cached bases (the solver alternates between at most two or three).
 const CACHE: usize = 4;
 
@@ -503,6 +511,15 @@ impl GpuAssembler {
         Ok(())
     }
 
+    /// The basis of `disc` with `cps` uploaded, counted as one call's quadrature.
+    fn basis_with(&self, disc: &Discretization, cps: &[Point], t: &mut Timings) -> Result<Arc<BasisData>, GpuError> {
+        let b = self.basis(disc, t)?;
+        Self::check_lengths(disc, &b, cps)?;
+        t.quadrature_points += b.qp_per_call;
+        self.upload_cps(&b, cps, t)?;
+        Ok(b)
+    }
+
     /// The EGG kernels: the residual's when `res`, the Jacobian's when `mat` (the
     /// per-entry kernel, or element matrices and their gather).
     fn egg_kernels(&self, res: bool, mat: bool) -> Vec<(&wgpu::ComputePipeline, Out)> {
@@ -534,10 +551,7 @@ impl GpuAssembler {
         let want_mat = !stencil.is_empty();
         let mut want_res = !res.is_empty();
         let mut t = Timings { calls: 1, ..Default::default() };
-        let op_code = match op {
-            Operator::Plain => 0,
-            Operator::Scaled => 1,
-        };
+        let op_code = op_code(op);
         if self.gpu.precision() == Precision::F32 && want_res {
             let t0 = Instant::now();
             disc.egg(cps, op, res, &mut []);
@@ -547,10 +561,7 @@ impl GpuAssembler {
         if want_res || want_mat {
             let _busy = self.busy.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
             self.gpu.scoped(|| {
-                let b = self.basis(disc, &mut t)?;
-                Self::check_lengths(disc, &b, cps)?;
-                t.quadrature_points += b.qp_per_call;
-                self.upload_cps(&b, cps, &mut t)?;
+                let b = self.basis_with(disc, cps, &mut t)?;
                 let kernels = self.egg_kernels(want_res, want_mat);
                 self.run_chunks(&b, op_code, true, &kernels, 2, res, StencilTo::Host(stencil), &mut t)
             })?;
@@ -698,7 +709,9 @@ impl EggAssembler for GpuAssembler {
     }
 
     /// The Newton Jacobian assembled into the product's buffers, where the adapter has
-    /// `SHADER_F64` ([`GpuAssembler::try_egg_operator`]).
+    /// `SHADER_F64` ([`GpuAssembler::try_egg_operator`]); `None` on a rational basis
+    /// (assembled on the CPU), with `--gpu-jacobian host`, and after a failure (counted
+    /// as a fallback of the product).
     fn egg_operator(
         &self,
         disc: &Discretization,
@@ -706,6 +719,17 @@ impl EggAssembler for GpuAssembler {
         op: Operator,
         res: &mut [f64],
     ) -> Option<Box<dyn DeviceOperator>> {
-        self.egg_operator_or_none(disc, cps, op, res)
+        let products = self.products.as_ref()?;
+        if disc.is_rational() || !self.device_jacobian() || self.gpu.precision() != Precision::F64 {
+            return None;
+        }
+        match self.try_egg_operator(disc, cps, op, res) {
+            Ok(p) => Some(Box::new(p)),
+            Err(e) => {
+                // the core assembles with `egg` and uploads instead
+                let _ = products.shared().fallback("Jacobian assembly on the device", e);
+                None
+            }
+        }
     }
 }

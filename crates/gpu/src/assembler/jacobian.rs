@@ -11,10 +11,9 @@
 use std::time::Instant;
 
 use winslow::discrete::assembly::{Discretization, Operator};
-use winslow::discrete::DeviceOperator;
 use winslow::spline::curve::Point;
 
-use super::{GpuAssembler, StencilTo};
+use super::{op_code, GpuAssembler, StencilTo};
 use crate::device::Gpu;
 use crate::multigrid::StencilChunks;
 use crate::product::GpuProduct;
@@ -151,22 +150,15 @@ impl GpuAssembler {
         let mut t = Timings { calls: 1, ..Default::default() };
         let len = disc.stencil_len(2);
         to_u32(len, "Jacobian entries")?;
-        let op_code = match op {
-            Operator::Plain => 0,
-            Operator::Scaled => 1,
-        };
         let stencil = {
             let _busy = self.busy.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
             self.gpu.scoped(|| {
-                let b = self.basis(disc, &mut t)?;
-                Self::check_lengths(disc, &b, cps)?;
-                t.quadrature_points += b.qp_per_call;
-                self.upload_cps(&b, cps, &mut t)?;
+                let b = self.basis_with(disc, cps, &mut t)?;
                 let chunk = products.shared().chunk_bytes;
                 let stencil = StencilChunks::on_device(&self.gpu, "Jacobian stencil", len, chunk)?;
                 let packer = Packer::new(&self.gpu, &b.out, &stencil)?;
                 let kernels = self.egg_kernels(true, true);
-                self.run_chunks(&b, op_code, true, &kernels, 2, res, StencilTo::Device(&packer), &mut t)?;
+                self.run_chunks(&b, op_code(op), true, &kernels, 2, res, StencilTo::Device(&packer), &mut t)?;
                 Ok(stencil)
             })?
         };
@@ -184,28 +176,5 @@ impl GpuAssembler {
     /// See [`GpuAssembler::set_device_jacobian`].
     pub fn device_jacobian(&self) -> bool {
         self.device_jacobian.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// `EggAssembler::egg_operator`: the rational bases (assembled on the CPU) and a
-    /// failure return `None`, the latter counted as a fallback of the product.
-    pub(super) fn egg_operator_or_none(
-        &self,
-        disc: &Discretization,
-        cps: &[Point],
-        op: Operator,
-        res: &mut [f64],
-    ) -> Option<Box<dyn DeviceOperator>> {
-        let products = self.products.as_ref()?;
-        if disc.is_rational() || !self.device_jacobian() || self.gpu.precision() != Precision::F64 {
-            return None;
-        }
-        match self.try_egg_operator(disc, cps, op, res) {
-            Ok(p) => Some(Box::new(p)),
-            Err(e) => {
-                // the core assembles with `egg` and uploads instead
-                let _ = products.shared().fallback("Jacobian assembly on the device", e);
-                None
-            }
-        }
     }
 }
