@@ -192,8 +192,9 @@ impl DiscreteProblem for EggProblem {
 
     /// The Jacobian kept as its stencil storage rounded to single precision
     /// (`discrete::stencil::Stencil32`, packed in place after the assembly; the last
-    /// step's is freed before this one is assembled): on a basis without periodic
-    /// replicas.
+    /// step's is freed before this one is assembled), or assembled on the operator back
+    /// end itself ([`EggAssembler::egg_operator`]: no host copy): on a basis without
+    /// periodic replicas.
     fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
         let s = &mut self.state;
         if !s.disc.dofs.replicas().is_empty() {
