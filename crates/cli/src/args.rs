@@ -94,6 +94,15 @@ pub(crate) enum PrecisionArg {
     F32,
 }
 
+/// Where the GPU assembles the Newton Jacobian that GMRES multiplies with.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum GpuJacobianArg {
+    /// Rounded into the product's buffers on the device: it never crosses the bus.
+    Device,
+    /// Read back, packed on the host and uploaded again (the earlier path).
+    Host,
+}
+
 /// Where the quadrature runs.
 #[derive(Args, Debug, Clone)]
 pub(crate) struct BackendArgs {
@@ -105,6 +114,12 @@ pub(crate) struct BackendArgs {
     /// residual in f64 on the CPU; or forced.
     #[arg(long, value_enum, default_value = "auto")]
     pub(crate) precision: PrecisionArg,
+    /// With `--backend gpu --linear multigrid`: the Newton Jacobian assembled on the
+    /// device into the product's buffers (the default), or read back, packed on the host
+    /// and uploaded again (`host`: to measure what the bus carried before; the map is the
+    /// same). `report.backend` counts the bytes either way.
+    #[arg(long, value_enum, default_value = "device")]
+    pub(crate) gpu_jacobian: GpuJacobianArg,
 }
 
 impl BackendArgs {
@@ -116,6 +131,9 @@ impl BackendArgs {
             PrecisionArg::F32 => Some(Precision::F32),
         };
         let sel = winslow_gpu::assembler(self.backend, precision).context("opening the GPU")?;
+        if let Selected::Gpu(g) = &sel {
+            g.set_device_jacobian(self.gpu_jacobian == GpuJacobianArg::Device);
+        }
         if !quiet {
             note!("backend: {}", sel.describe());
         }

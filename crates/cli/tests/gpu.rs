@@ -126,6 +126,65 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     );
 }
 
+/// The bytes over the bus in `report.backend` (`"...; bus: U B up, D B down in all;
+/// per Newton step (N): u B up, d B down; per GMRES iteration (P): u B up, d B down"`),
+/// as `[up, down]` for "in all", each Newton step and each GMRES iteration, with N and P.
+fn bus(backend: &str) -> ([u64; 2], (u64, [u64; 2]), (u64, [u64; 2])) {
+    let num = |s: &str| -> u64 { s.trim().parse().unwrap_or_else(|_| panic!("no number in {s:?}: {backend}")) };
+    let pair = |s: &str| -> [u64; 2] {
+        let (up, down) = s.split_once(" B up, ").unwrap_or_else(|| panic!("{s:?}: {backend}"));
+        [num(up), num(down.split(" B down").next().unwrap())]
+    };
+    let part = |key: &str| backend.split(key).nth(1).unwrap_or_else(|| panic!("no {key:?} in {backend}"));
+    let counted = |key: &str| {
+        let s = part(key);
+        let (count, rest) = s.split_once("): ").unwrap();
+        (num(count), pair(rest))
+    };
+    (pair(part("; bus: ")), counted("; per Newton step ("), counted("; per GMRES iteration ("))
+}
+
+/// `report.backend` counts the bytes over the bus. With the Newton Jacobian assembled
+/// on the device (the default) each Newton step moves less than with `--gpu-jacobian
+/// host` (read back in `f64`, uploaded in `f32`): the difference down is twice the
+/// difference up (8 and 4 bytes per stencil entry), the GMRES iterations move the same
+/// (a vector up for each one down), and the solves are the same.
+#[test]
+fn the_device_jacobian_does_not_cross_the_bus() {
+    if !gpu_available_or_required() {
+        return;
+    }
+    let scratch = tempfile::tempdir().unwrap();
+    let mut runs = Vec::new();
+    for jac in ["device", "host"] {
+        let map = scratch.path().join(format!("{jac}.json"));
+        let out = bin()
+            .arg("solve")
+            .arg(data().join("quarter_annulus.json"))
+            .arg("-o")
+            .arg(&map)
+            .args(["--backend", "gpu", "--linear", "multigrid", "--gpu-jacobian", jac, "--min-elements", "40", "-q"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{jac}: {}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&map).unwrap()).unwrap();
+        let backend = doc["report"]["backend"].as_str().unwrap().to_string();
+        assert!(!backend.contains("on the CPU after"), "{jac}: {backend}");
+        runs.push((bus(&backend), doc));
+    }
+    let ((all_d, (steps_d, step_d), (its_d, it_d)), doc_d) = &runs[0];
+    let ((all_h, (steps_h, step_h), (its_h, it_h)), doc_h) = &runs[1];
+    assert_eq!((steps_d, its_d, it_d), (steps_h, its_h, it_h));
+    assert!(*steps_d > 0 && *its_d > 0);
+    assert_eq!(it_d[0], it_d[1], "per GMRES iteration a vector goes up for each that comes down");
+    let (more_up, more_down) = (step_h[0] - step_d[0], step_h[1] - step_d[1]);
+    assert!(more_up > 0, "{step_h:?} against {step_d:?}");
+    // averages of integer sums over the same steps: each rounded down
+    assert!(more_down.abs_diff(2 * more_up) <= 2, "{more_down} down for {more_up} up");
+    assert!(all_h[1] > all_d[1] && all_h[0] > all_d[0]);
+    assert_eq!(doc_d["map"], doc_h["map"]);
+}
+
 #[test]
 fn bench_on_the_gpu_prints_throughput_and_the_time_split() {
     if !gpu_available_or_required() {

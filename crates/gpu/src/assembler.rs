@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use winslow::discrete::assembly::{Discretization, Operator};
 use winslow::discrete::tables::DirTable;
-use winslow::discrete::OperatorBackend;
+use winslow::discrete::{DeviceOperator, OperatorBackend};
 use winslow::linalg::multigrid_kernels::CycleBackend;
 use winslow::methods::egg::{CpuAssembler, EggAssembler};
 use winslow::spline::curve::Point;
@@ -23,76 +23,11 @@ use winslow::verify::quality::DetJSample;
 use crate::device::Gpu;
 use crate::multigrid::GpuCycles;
 use crate::product::GpuProducts;
+use crate::stats::{Stats, Timings};
 use crate::{to_u32, GpuError, Precision};
 
-/// Where the time of one kind of call went, summed over calls.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Timings {
-    /// Calls.
-    pub calls: u64,
-    /// Quadrature points evaluated (elements times points per element, per call).
-    pub quadrature_points: u64,
-    /// Seconds writing control points (and, on first use of a basis, its tables).
-    pub upload: f64,
-    /// Seconds in kernels (submit to completion).
-    pub dispatch: f64,
-    /// Seconds copying results back and converting them.
-    pub readback: f64,
-    /// Seconds on the CPU (the f64 residual of the f32 path).
-    pub cpu: f64,
-    /// Bytes sent to the GPU.
-    pub bytes_up: u64,
-    /// Bytes read back.
-    pub bytes_down: u64,
-}
-
-impl Timings {
-    /// Total seconds.
-    pub fn total(&self) -> f64 {
-        self.upload + self.dispatch + self.readback + self.cpu
-    }
-
-    pub(crate) fn add(&mut self, o: &Timings) {
-        self.calls += o.calls;
-        self.quadrature_points += o.quadrature_points;
-        self.upload += o.upload;
-        self.dispatch += o.dispatch;
-        self.readback += o.readback;
-        self.cpu += o.cpu;
-        self.bytes_up += o.bytes_up;
-        self.bytes_down += o.bytes_down;
-    }
-}
-
-/// [`Timings`] per kind of call, and the calls that fell back to the CPU.
-#[derive(Debug, Clone, Default)]
-pub struct Stats {
-    /// EGG residual only.
-    pub egg_residual: Timings,
-    /// EGG residual and Jacobian.
-    pub egg_jacobian: Timings,
-    /// Mass matrices.
-    pub mass: Timings,
-    /// Elasticity matrices.
-    pub elasticity: Timings,
-    /// `det J` samples.
-    pub det_j: Timings,
-    /// Multigrid V-cycles run on the GPU (`calls`) under `--linear multigrid`
-    /// ([`crate::GpuCycles`]).
-    pub multigrid: Timings,
-    /// Multigrid set-ups or cycles that ran on the CPU instead (GPU errors).
-    pub multigrid_fallbacks: u64,
-    /// Products with the Newton Jacobian run on the GPU (`calls`; `upload` and
-    /// `bytes_up` include the Jacobian's upload once per Newton step) under
-    /// `--linear multigrid` ([`crate::GpuProducts`]).
-    pub jacobian_products: Timings,
-    /// Jacobian uploads or products that ran on the CPU instead (GPU errors).
-    pub jacobian_product_fallbacks: u64,
-    /// Calls that failed on the GPU and were done by the CPU instead.
-    pub fallbacks: u64,
-    /// The last GPU error.
-    pub last_error: Option<String>,
-}
+mod jacobian;
+pub(crate) use jacobian::PackKernel;
 
 /// The uniform block of `assembly.wgsl` (all `u32`).
 #[repr(C)]
@@ -166,6 +101,23 @@ enum Out {
     Element,
 }
 
+/// Where the stencil storage a kernel writes goes.
+enum StencilTo<'a> {
+    /// Read back into the host's stencil storage (`f64`).
+    Host(&'a mut [f64]),
+    /// Rounded to `f32` into the Jacobian product's bindings on the device
+    /// ([`jacobian::Packer`]): nothing comes back.
+    Device(&'a jacobian::Packer),
+}
+
+/// The operator's code in `assembly.wgsl`.
+fn op_code(op: Operator) -> u32 {
+    match op {
+        Operator::Plain => 0,
+        Operator::Scaled => 1,
+    }
+}
+
 /// Cached bases (the solver alternates between at most two or three).
 const CACHE: usize = 4;
 
@@ -185,6 +137,8 @@ pub struct GpuAssembler {
     cycles: Option<Arc<GpuCycles>>,
     /// The Newton Jacobian's product (`None` without `SHADER_F64`).
     products: Option<Arc<GpuProducts>>,
+    /// The Newton Jacobian assembled into the product's buffers (the default).
+    device_jacobian: std::sync::atomic::AtomicBool,
 }
 
 fn key_of(disc: &Discretization) -> (Vec<f64>, usize, Vec<f64>, usize, usize, usize) {
@@ -233,6 +187,7 @@ impl GpuAssembler {
             per_entry: false,
             cycles: GpuCycles::new(gpu.clone()).map(Arc::new),
             products: GpuProducts::new(gpu.clone()).map(Arc::new),
+            device_jacobian: true.into(),
             gpu,
         }
     }
@@ -241,6 +196,14 @@ impl GpuAssembler {
     /// problems run in more chunks of basis rows.
     pub fn with_chunk_bytes(mut self, bytes: u64) -> Self {
         self.chunk_bytes = bytes.clamp(1024, self.gpu.chunk_bytes());
+        self
+    }
+
+    /// Bind the Newton Jacobian's stencil values for the product in chunks of at most
+    /// `bytes` ([`crate::GpuBackend::with_chunk_bytes`]): for tests of the split at
+    /// small sizes.
+    pub fn with_product_chunk_bytes(mut self, bytes: u64) -> Self {
+        self.products = GpuProducts::new(self.gpu.clone()).map(|p| Arc::new(p.with_chunk_bytes(bytes)));
         self
     }
 
@@ -421,8 +384,8 @@ impl GpuAssembler {
         to_u32(max_rows * nx * 4 * sw, "stencil entries per chunk")?;
         to_u32(max_erows * nex * tx.nq * ty.nq * GEO, "geometry values per chunk")?;
         let upload_bytes = gpu.real_bytes(tab.len() as u64) + 4 * idx.len() as u64;
-        let tab_buf = gpu.storage_real("tables", &tab);
-        let idx_buf = gpu.storage_init("indices", bytemuck::cast_slice(&idx));
+        let tab_buf = gpu.storage_real("tables", &tab)?;
+        let idx_buf = gpu.storage_init("indices", bytemuck::cast_slice(&idx))?;
         let cps = gpu.storage_empty("control points", 2 * (nx * ny) as u64);
         let geo = gpu.storage_empty("geometry", geo_len);
         let out = gpu.storage_empty("stencil", out_len);
@@ -475,9 +438,10 @@ impl GpuAssembler {
     }
 
     /// Run the kernels for every chunk; `geometry` first when `geometry`, then each of
-    /// `kernels` with its output (`true`: the stencil, `ncomp` components; `false`: the
-    /// residual), reading the results into `res` / `stencil`.
-    #[allow(clippy::type_complexity)]
+    /// `kernels` with its output (the stencil of `ncomp` components, the residual, or
+    /// element matrices kept on the GPU), reading the residual into `res` and sending
+    /// the stencil where `stencil` says.
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
     fn run_chunks(
         &self,
         b: &BasisData,
@@ -486,7 +450,7 @@ impl GpuAssembler {
         kernels: &[(&wgpu::ComputePipeline, Out)],
         ncomp: usize,
         res: &mut [f64],
-        stencil: &mut [f64],
+        mut stencil: StencilTo<'_>,
         t: &mut Timings,
     ) -> Result<(), GpuError> {
         let gpu = &self.gpu;
@@ -511,6 +475,11 @@ impl GpuAssembler {
                     Out::Element => (c.ey1 - c.ey0) as u64 * b.params.nex as u64 * 64,
                 };
                 gpu.dispatch(&mut enc, k, &b.bind, n)?;
+                if let (Out::Stencil, StencilTo::Device(packer)) = (out, &stencil) {
+                    // rounded into the product's bindings before the next chunk overwrites it
+                    let (lo, len) = (c.j0 * nx * row_len, (c.j1 - c.j0) * nx * row_len);
+                    packer.record(gpu, &mut enc, lo, len)?;
+                }
             }
             gpu.submit_wait(Some(enc.finish()))?;
             t.dispatch += t0.elapsed().as_secs_f64();
@@ -520,6 +489,7 @@ impl GpuAssembler {
                     continue;
                 }
                 if out == Out::Stencil {
+                    let StencilTo::Host(stencil) = &mut stencil else { continue };
                     let (lo, len) = (c.j0 * nx * row_len, (c.j1 - c.j0) * nx * row_len);
                     gpu.read_into(&b.out, &b.staging, len, &mut stencil[lo..lo + len])?;
                     t.bytes_down += gpu.real_bytes(len as u64);
@@ -541,6 +511,32 @@ impl GpuAssembler {
         Ok(())
     }
 
+    /// The basis of `disc` with `cps` uploaded, counted as one call's quadrature.
+    fn basis_with(&self, disc: &Discretization, cps: &[Point], t: &mut Timings) -> Result<Arc<BasisData>, GpuError> {
+        let b = self.basis(disc, t)?;
+        Self::check_lengths(disc, &b, cps)?;
+        t.quadrature_points += b.qp_per_call;
+        self.upload_cps(&b, cps, t)?;
+        Ok(b)
+    }
+
+    /// The EGG kernels: the residual's when `res`, the Jacobian's when `mat` (the
+    /// per-entry kernel, or element matrices and their gather).
+    fn egg_kernels(&self, res: bool, mat: bool) -> Vec<(&wgpu::ComputePipeline, Out)> {
+        let a = &self.gpu.assembly;
+        let mut kernels = Vec::new();
+        if res {
+            kernels.push((&a.egg_residual, Out::Residual));
+        }
+        if mat && self.per_entry {
+            kernels.push((&a.egg_stencil, Out::Stencil));
+        } else if mat {
+            kernels.push((&a.egg_element, Out::Element));
+            kernels.push((&a.egg_gather, Out::Stencil));
+        }
+        kernels
+    }
+
     /// EGG residual (full, interleaved, length `2 n`, or empty) and, when `stencil` is
     /// non-empty, the Jacobian in stencil storage: [`Discretization::egg`] on the GPU.
     /// In f32 the residual is computed by the CPU in f64.
@@ -555,10 +551,7 @@ impl GpuAssembler {
         let want_mat = !stencil.is_empty();
         let mut want_res = !res.is_empty();
         let mut t = Timings { calls: 1, ..Default::default() };
-        let op_code = match op {
-            Operator::Plain => 0,
-            Operator::Scaled => 1,
-        };
+        let op_code = op_code(op);
         if self.gpu.precision() == Precision::F32 && want_res {
             let t0 = Instant::now();
             disc.egg(cps, op, res, &mut []);
@@ -568,22 +561,9 @@ impl GpuAssembler {
         if want_res || want_mat {
             let _busy = self.busy.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
             self.gpu.scoped(|| {
-                let b = self.basis(disc, &mut t)?;
-                Self::check_lengths(disc, &b, cps)?;
-                t.quadrature_points += b.qp_per_call;
-                self.upload_cps(&b, cps, &mut t)?;
-                let a = &self.gpu.assembly;
-                let mut kernels = Vec::new();
-                if want_res {
-                    kernels.push((&a.egg_residual, Out::Residual));
-                }
-                if want_mat && self.per_entry {
-                    kernels.push((&a.egg_stencil, Out::Stencil));
-                } else if want_mat {
-                    kernels.push((&a.egg_element, Out::Element));
-                    kernels.push((&a.egg_gather, Out::Stencil));
-                }
-                self.run_chunks(&b, op_code, true, &kernels, 2, res, stencil, &mut t)
+                let b = self.basis_with(disc, cps, &mut t)?;
+                let kernels = self.egg_kernels(want_res, want_mat);
+                self.run_chunks(&b, op_code, true, &kernels, 2, res, StencilTo::Host(stencil), &mut t)
             })?;
         }
         self.record(|s| if want_mat { s.egg_jacobian.add(&t) } else { s.egg_residual.add(&t) });
@@ -598,7 +578,7 @@ impl GpuAssembler {
             let b = self.basis(disc, &mut t)?;
             t.quadrature_points += b.qp_per_call;
             let k = [(&self.gpu.assembly.mass_stencil, Out::Stencil)];
-            self.run_chunks(&b, 0, false, &k, 1, &mut [], stencil, &mut t)
+            self.run_chunks(&b, 0, false, &k, 1, &mut [], StencilTo::Host(stencil), &mut t)
         })?;
         self.record(|s| s.mass.add(&t));
         Ok(())
@@ -623,7 +603,7 @@ impl GpuAssembler {
             self.gpu.queue.write_buffer(&b.tab, self.gpu.real_bytes(b.params.lame as u64), &lame);
             self.upload_cps(&b, cps, &mut t)?;
             let k = [(&self.gpu.assembly.elasticity_stencil, Out::Stencil)];
-            self.run_chunks(&b, 0, true, &k, 2, &mut [], stencil, &mut t)
+            self.run_chunks(&b, 0, true, &k, 2, &mut [], StencilTo::Host(stencil), &mut t)
         })?;
         self.record(|s| s.elasticity.add(&t));
         Ok(())
@@ -712,6 +692,7 @@ impl EggAssembler for GpuAssembler {
         if s.jacobian_product_fallbacks > 0 {
             name.push_str(&format!(" ({} on the CPU after GPU errors)", s.jacobian_product_fallbacks));
         }
+        name.push_str(&s.bus());
         name
     }
 
@@ -725,5 +706,30 @@ impl EggAssembler for GpuAssembler {
     /// ([`GpuProducts`]), where the adapter has `SHADER_F64`.
     fn operator_backend(&self) -> Option<Arc<dyn OperatorBackend>> {
         self.products.clone().map(|p| p as Arc<dyn OperatorBackend>)
+    }
+
+    /// The Newton Jacobian assembled into the product's buffers, where the adapter has
+    /// `SHADER_F64` ([`GpuAssembler::try_egg_operator`]); `None` on a rational basis
+    /// (assembled on the CPU), with `--gpu-jacobian host`, and after a failure (counted
+    /// as a fallback of the product).
+    fn egg_operator(
+        &self,
+        disc: &Discretization,
+        cps: &[Point],
+        op: Operator,
+        res: &mut [f64],
+    ) -> Option<Box<dyn DeviceOperator>> {
+        let products = self.products.as_ref()?;
+        if disc.is_rational() || !self.device_jacobian() || self.gpu.precision() != Precision::F64 {
+            return None;
+        }
+        match self.try_egg_operator(disc, cps, op, res) {
+            Ok(p) => Some(Box::new(p)),
+            Err(e) => {
+                // the core assembles with `egg` and uploads instead
+                let _ = products.shared().fallback("Jacobian assembly on the device", e);
+                None
+            }
+        }
     }
 }

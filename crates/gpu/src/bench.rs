@@ -9,7 +9,8 @@ use winslow::discrete::assembly::{Discretization, Operator};
 use winslow::spline::curve::Point;
 use winslow::spline::knots::KnotVector;
 
-use crate::assembler::{GpuAssembler, Timings};
+use crate::assembler::GpuAssembler;
+use crate::stats::Timings;
 
 /// A tensor basis of degree `degree` with about `dofs / 2` functions (so about `dofs`
 /// scalar coefficients), square, and the control points of a smooth curved map (an

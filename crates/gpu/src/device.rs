@@ -49,6 +49,9 @@ pub struct Gpu {
     pub(crate) det_j: DetJKernel,
     /// The multigrid cycle's kernels (f64 only: `None` in f32).
     pub(crate) multigrid: Option<crate::multigrid::MultigridKernels>,
+    /// The kernel rounding the device Jacobian into the product's bindings (with the
+    /// multigrid kernels).
+    pub(crate) pack: Option<crate::assembler::PackKernel>,
 }
 
 fn is_software(info: &wgpu::AdapterInfo) -> bool {
@@ -100,10 +103,11 @@ impl Gpu {
         // the multigrid kernels bind seven storage buffers (`multigrid::STORAGE_BINDINGS`)
         let bindings = limits.max_storage_buffers_per_shader_stage >= crate::multigrid::STORAGE_BINDINGS;
         let multigrid = (precision == Precision::F64 && bindings).then(|| crate::multigrid::multigrid_kernels(&device));
+        let pack = multigrid.is_some().then(|| crate::assembler::PackKernel::new(&device));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Wgpu(e.to_string()));
         }
-        Ok(Self { device, queue, info: adapter.get_info(), precision, limits, assembly, det_j, multigrid })
+        Ok(Self { device, queue, info: adapter.get_info(), precision, limits, assembly, det_j, multigrid, pack })
     }
 
     /// The adapter's name, driver and wgpu back end.
@@ -154,29 +158,77 @@ impl Gpu {
     }
 
     /// A storage buffer holding `values` in the kernels' precision (at least 16 bytes).
-    pub(crate) fn storage_real(&self, label: &str, values: &[f64]) -> wgpu::Buffer {
+    ///
+    /// Errors: as [`Gpu::storage_parts`].
+    pub(crate) fn storage_real(&self, label: &str, values: &[f64]) -> Result<wgpu::Buffer, GpuError> {
         let bytes = self.to_bytes(values);
         self.storage_init(label, &bytes)
     }
 
-    pub(crate) fn storage_init(&self, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-        let mut padded = bytes.to_vec();
-        padded.resize(bytes.len().max(16).next_multiple_of(8), 0);
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    /// A storage buffer holding `bytes` (at least 16, zero-padded to a multiple of 8).
+    ///
+    /// Errors: as [`Gpu::storage_parts`].
+    pub(crate) fn storage_init(&self, label: &str, bytes: &[u8]) -> Result<wgpu::Buffer, GpuError> {
+        self.storage_parts(label, &[bytes], 0, bytes.len())
+    }
+
+    /// A storage buffer holding `len` elements of the concatenation of `parts`, from
+    /// element `skip` on (at least 16 bytes, zero-padded to a multiple of 8), written in
+    /// place into the buffer's mapping at creation (`mapped_at_creation`: wgpu's staging
+    /// memory, copied to the device on unmap): no host copy of the parts is made, and the
+    /// bytes cross the bus once.
+    ///
+    /// Errors: [`GpuError::Wgpu`] when the mapping cannot be had.
+    pub(crate) fn storage_parts<T: bytemuck::Pod>(
+        &self,
+        label: &str,
+        parts: &[&[T]],
+        mut skip: usize,
+        len: usize,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        let size = std::mem::size_of::<T>();
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
-            contents: &padded,
+            size: ((len * size) as u64).max(16).next_multiple_of(8),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: true,
+        });
+        {
+            // the mapping at creation is zeroed: only the parts are written
+            let mut view = buffer.get_mapped_range_mut(..).map_err(|e| GpuError::Wgpu(e.to_string()))?;
+            let (mut at, mut left) = (0usize, len);
+            for part in parts {
+                if left == 0 {
+                    break;
+                }
+                if skip >= part.len() {
+                    skip -= part.len();
+                    continue;
+                }
+                let take = (part.len() - skip).min(left);
+                let bytes: &[u8] = bytemuck::cast_slice(&part[skip..skip + take]);
+                view.slice(at..at + bytes.len()).copy_from_slice(bytes);
+                (at, left, skip) = (at + bytes.len(), left - take, 0);
+            }
+        }
+        buffer.unmap();
+        Ok(buffer)
+    }
+
+    /// A storage buffer of `bytes` (at least 16, rounded up to a multiple of 8) that the
+    /// kernels fill: nothing crosses the bus (wgpu zeroes it on the device).
+    pub(crate) fn storage_zeroed(&self, label: &str, bytes: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(16).next_multiple_of(8),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
         })
     }
 
     /// An uninitialised storage buffer of `len` reals (at least 16 bytes).
     pub(crate) fn storage_empty(&self, label: &str, len: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: (len * self.precision.bytes()).max(16).next_multiple_of(8),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        })
+        self.storage_zeroed(label, len * self.precision.bytes())
     }
 
     pub(crate) fn staging(&self, bytes: u64) -> wgpu::Buffer {

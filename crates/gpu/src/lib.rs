@@ -19,8 +19,10 @@
 //! `shaders/multigrid.wgsl`) runs on the GPU with the level data uploaded once per
 //! set-up, giving the CPU cycle's bits on lavapipe. [`GpuProducts`] implements
 //! [`winslow::discrete::OperatorBackend`]: GMRES's product with the Newton Jacobian
-//! (its single-precision stencil storage uploaded once per Newton step) runs on the GPU
-//! too, also with the CPU's bits on lavapipe. [`GpuAssembler`] hands both to the solver
+//! (its single-precision stencil storage, assembled on the GPU and rounded there into
+//! the product's buffers by `shaders/pack.wgsl`: [`GpuAssembler::try_egg_operator`])
+//! runs on the GPU too, also with the CPU's bits on lavapipe. [`Stats::bus`] counts the
+//! bytes that cross the bus per Newton step and per GMRES iteration. [`GpuAssembler`] hands both to the solver
 //! where the adapter has `SHADER_F64`; the levels' and the Jacobian's stencil values are
 //! split over up to four bindings, so that neither is limited by one storage binding.
 //!
@@ -44,12 +46,14 @@ mod device;
 mod multigrid;
 mod product;
 mod sample;
+mod stats;
 
-pub use assembler::{GpuAssembler, Stats, Timings};
+pub use assembler::GpuAssembler;
 pub use device::{Gpu, GpuOptions};
 pub use multigrid::{CycleKernels, GpuBackend, GpuCycle, GpuCycles, Operation, Vector};
 pub use product::{GpuProduct, GpuProducts, ProductKernels};
 pub use sample::MapSample;
+pub use stats::{BusShare, Stats, Timings};
 
 use std::sync::Arc;
 
@@ -62,6 +66,10 @@ pub const DET_J_WGSL: &str = include_str!("../../../shaders/det_j.wgsl");
 
 /// WGSL source of the multigrid cycle's level kernels (f64 only; see [`GpuCycles`]).
 pub const MULTIGRID_WGSL: &str = include_str!("../../../shaders/multigrid.wgsl");
+
+/// WGSL source of the kernel rounding the device Jacobian into the product's bindings
+/// (f64 only; see [`GpuAssembler::try_egg_operator`]).
+pub const PACK_WGSL: &str = include_str!("../../../shaders/pack.wgsl");
 
 /// The first line of every shader, selecting f64.
 pub const F64_ALIAS: &str = "alias real = f64;";

@@ -4,7 +4,9 @@
 //!
 //! At each set-up of the cycle ([`CycleBackend::upload`]) the levels' stencils (`f32`,
 //! as the CPU holds them), the CSR levels, line factors, 1D transfer factors and the
-//! coarsest Cholesky factor (`f64`) go up once, and the whole V-cycle is recorded once
+//! coarsest Cholesky factor (`f64`) go up once, written from the hierarchy's own storage
+//! straight into the buffers' mappings (no host copy; the level vectors are zeroed on
+//! the device), and the whole V-cycle is recorded once
 //! as a list of dispatches ([`v_cycle`] over a recorder of the operations), each with its
 //! parameter record in one uniform buffer (dynamic offsets). Per application only the
 //! right-hand side goes up and `x_0` comes back: every level's `b`, `x`, `r` and the
@@ -25,8 +27,8 @@ use std::sync::{Arc, Mutex};
 
 use winslow::linalg::multigrid_kernels::{v_cycle, CycleBackend, DeviceCycle, Hierarchy, LevelKernels};
 
-use crate::assembler::Timings;
 use crate::device::Gpu;
+use crate::stats::Timings;
 use crate::{GpuError, Precision};
 
 mod dispatch;
@@ -198,9 +200,10 @@ impl GpuCycles {
         let kernels = self.k.kernels()?;
         let (layout, packed) = pack(h)?;
         let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+        let t0 = std::time::Instant::now();
         for (what, bytes) in [
             ("level vectors", 8 * layout.vec_len as u64),
-            ("factors", 8 * packed.reals.len() as u64),
+            ("factors", 8 * packed.reals_len as u64),
             ("indices", 4 * packed.idx.len() as u64),
         ] {
             if bytes > max {
@@ -221,16 +224,18 @@ impl GpuCycles {
                 }
             }
         }
-        gpu.scoped(|| {
+        let cycle = gpu.scoped(|| {
             let mut rec = Recorder { layout: &layout, steps: Vec::new() };
             let levels = layout.levels.len();
             v_cycle(&mut rec, levels, layout.smoothing, 0);
             let program = rec.steps;
-            let stencil = StencilChunks::upload(gpu, "multigrid stencils", &packed.stencil, self.k.chunk_bytes)?;
-            let stencil_bindings = stencil.used(packed.stencil.len());
-            let reals = gpu.storage_init("multigrid reals", bytemuck::cast_slice(&packed.reals));
-            let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx));
-            let vecs = gpu.storage_init("multigrid vectors", &vec![0u8; 8 * layout.vec_len]);
+            let (st, st_len) = (&packed.stencil, packed.stencil_len);
+            let stencil = StencilChunks::upload(gpu, "multigrid stencils", st, st_len, self.k.chunk_bytes)?;
+            let stencil_bindings = stencil.used(packed.stencil_len);
+            let reals = gpu.storage_parts("multigrid reals", &packed.reals, 0, packed.reals_len)?;
+            let idx = gpu.storage_init("multigrid indices", bytemuck::cast_slice(&packed.idx))?;
+            // the level vectors start at zero on the device: nothing goes up
+            let vecs = gpu.storage_zeroed("multigrid vectors", 8 * layout.vec_len as u64);
             let n0 = layout.levels[0].size as u64;
             let staging = gpu.staging(8 * n0);
             let bound = Bound { reals: &reals, idx: &idx, stencil: &stencil, vecs: &vecs };
@@ -243,7 +248,16 @@ impl GpuCycles {
                 stencil_bindings,
                 buffers: Mutex::new(Buffers { reals, idx, stencil, vecs, staging, _params: params, bind }),
             })
-        })
+        })?;
+        // what went up: the stencils, the factors and the indices (parameter records aside)
+        let bytes = 4 * packed.stencil_len as u64 + 8 * packed.reals_len as u64 + 4 * packed.idx.len() as u64;
+        self.k.record(|s| {
+            s.0.setups += 1;
+            s.0.upload += t0.elapsed().as_secs_f64();
+            s.0.bytes_up += bytes;
+            s.0.setup_bytes += bytes;
+        });
+        Ok(cycle)
     }
 }
 

@@ -12,6 +12,7 @@
 use std::sync::Mutex;
 use std::time::Instant;
 
+use winslow::discrete::assembly::Discretization;
 use winslow::discrete::dofs::FIXED;
 use winslow::discrete::{DeviceOperator, OperatorBackend, PackedSystem};
 
@@ -39,18 +40,43 @@ fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
 }
 
 impl GpuProducts {
-    /// Upload `sys`: the free functions' global indices, every function's free index,
-    /// the values.
+    /// Upload `sys`: the values ([`StencilChunks::upload`], written in place into the
+    /// buffers' mappings), then as [`GpuProducts::on_device`].
     ///
     /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
     /// fails.
     pub fn try_upload(&self, sys: &PackedSystem<'_>) -> Result<GpuProduct, GpuError> {
         let gpu = &self.shared().gpu;
-        let kernels = self.shared().kernels()?;
         let t0 = Instant::now();
+        let values = values(sys);
+        to_u32(values.len(), "system product stencil entries")?;
+        let chunk = self.shared().chunk_bytes;
+        let stencil = gpu.scoped(|| StencilChunks::upload(gpu, "system stencil", &[&values], values.len(), chunk))?;
         let disc = sys.discretization();
+        self.on_device(disc, sys.components(), stencil, values.len(), 4 * values.len() as u64, t0)
+    }
+
+    /// The product with the system of `ncomp` components on `disc` whose `len` stencil
+    /// values are in `stencil` already (uploaded by [`GpuProducts::try_upload`], or
+    /// assembled there: [`crate::GpuAssembler`]'s device Jacobian): the free functions'
+    /// global indices and every function's free index go up. Counted as a set-up with
+    /// `bytes` (the values' upload, if any) and the indices, from `t0`.
+    ///
+    /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
+    /// fails.
+    pub(crate) fn on_device(
+        &self,
+        disc: &Discretization,
+        ncomp: usize,
+        stencil: StencilChunks,
+        len: usize,
+        bytes: u64,
+        t0: Instant,
+    ) -> Result<GpuProduct, GpuError> {
+        let gpu = &self.shared().gpu;
+        let kernels = self.shared().kernels()?;
         let dofs = &disc.dofs;
-        let (m, n) = (dofs.num_free(), sys.size());
+        let (m, n) = (dofs.num_free(), ncomp * dofs.num_free());
         let [nx, ny] = disc.shape();
         let (p, q) = disc.degrees();
         let mut idx = Vec::with_capacity(m + dofs.num_total());
@@ -63,7 +89,6 @@ impl GpuProducts {
                 f => to_u32(f, "system product free index")?,
             });
         }
-        to_u32(sys.values().len(), "system product stencil entries")?;
         let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         for (what, bytes) in [("vectors", 16 * n as u64), ("indices", 4 * idx.len() as u64)] {
             if bytes > max {
@@ -83,16 +108,14 @@ impl GpuProducts {
             s_free: 0,
             s_free_of: to_u32(m, "free functions")?,
             s_m: to_u32(m, "free functions")?,
-            s_comp: to_u32(sys.components(), "components")?,
+            s_comp: to_u32(ncomp, "components")?,
             ..Default::default()
         };
         let step = [Step { kernel: Kernel::SystemProduct, params }];
-        let values = values(sys);
         let device = gpu.scoped(|| {
-            let stencil = StencilChunks::upload(gpu, "system stencil", &values, self.shared().chunk_bytes)?;
-            let stencil_bindings = stencil.used(values.len());
-            let idx = gpu.storage_init("system indices", bytemuck::cast_slice(&idx));
-            let reals = gpu.storage_init("system reals", &[0u8; 16]);
+            let stencil_bindings = stencil.used(len);
+            let idx = gpu.storage_init("system indices", bytemuck::cast_slice(&idx))?;
+            let reals = gpu.storage_zeroed("system reals", 16);
             let vecs = gpu.storage_empty("system vectors", 2 * n as u64);
             let staging = gpu.staging(8 * n as u64);
             let bound = Bound { reals: &reals, idx: &idx, stencil: &stencil, vecs: &vecs };
@@ -101,10 +124,11 @@ impl GpuProducts {
             Ok(GpuProduct {
                 k: self.shared().clone(),
                 n,
+                len,
                 step,
                 stencil_bindings,
                 buffers: Mutex::new(Buffers {
-                    _stencil: stencil,
+                    stencil,
                     _idx: idx,
                     _reals: reals,
                     vecs,
@@ -114,10 +138,12 @@ impl GpuProducts {
                 }),
             })
         })?;
-        let bytes = 4 * values.len() as u64 + 4 * (m + dofs.num_total()) as u64;
+        let bytes = bytes + 4 * (m + dofs.num_total()) as u64;
         self.shared().record(|s| {
+            s.0.setups += 1;
             s.0.upload += t0.elapsed().as_secs_f64();
             s.0.bytes_up += bytes;
+            s.0.setup_bytes += bytes;
         });
         Ok(device)
     }
@@ -136,7 +162,7 @@ impl OperatorBackend for GpuProducts {
 #[derive(Debug)]
 struct Buffers {
     /// The values, indices and placeholder the bind group reads.
-    _stencil: StencilChunks,
+    stencil: StencilChunks,
     _idx: wgpu::Buffer,
     _reals: wgpu::Buffer,
     /// `x` (the first `n` values) and `y`.
@@ -151,6 +177,8 @@ struct Buffers {
 pub struct GpuProduct {
     k: Shared,
     n: usize,
+    /// Stencil entries.
+    len: usize,
     step: [Step; 1],
     stencil_bindings: usize,
     /// Held while a product uses the buffers.
@@ -161,6 +189,32 @@ impl GpuProduct {
     /// Bindings the values were split over (1 when they fit one).
     pub fn stencil_bindings(&self) -> usize {
         self.stencil_bindings
+    }
+
+    /// The stencil values as they are on the device, read back (for tests and
+    /// diagnosis: the solver never reads them).
+    ///
+    /// Errors: wgpu's.
+    pub fn read_stencil(&self) -> Result<Vec<f32>, GpuError> {
+        let gpu = &self.k.gpu;
+        let buf = self.buffers.lock().map_err(|e| GpuError::Wgpu(e.to_string()))?;
+        let chunk = 1usize << buf.stencil.shift();
+        let mut out = Vec::with_capacity(self.len);
+        for (k, b) in buf.stencil.buffers().iter().enumerate().take(self.stencil_bindings) {
+            let n = chunk.min(self.len - k * chunk);
+            if n == 0 {
+                break;
+            }
+            let bytes = 4 * n as u64;
+            let staging = gpu.staging(bytes);
+            let slice = gpu.copy_and_map(None, b, 0, &staging, bytes)?;
+            {
+                let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+                out.extend_from_slice(&bytemuck::pod_collect_to_vec::<u8, f32>(&view[..bytes as usize]));
+            }
+            staging.unmap();
+        }
+        Ok(out)
     }
 
     /// `y = A x` on the device.

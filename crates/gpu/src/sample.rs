@@ -79,9 +79,9 @@ impl Gpu {
         };
         let out = self.scoped(|| {
             let ubuf = self.uniform("det_j params", bytemuck::bytes_of(&params));
-            let tbuf = self.storage_real("det_j tables", &tab);
-            let fbuf = self.storage_init("det_j first", bytemuck::cast_slice(&first));
-            let cbuf = self.storage_real("det_j control points", &cps);
+            let tbuf = self.storage_real("det_j tables", &tab)?;
+            let fbuf = self.storage_init("det_j first", bytemuck::cast_slice(&first))?;
+            let cbuf = self.storage_real("det_j control points", &cps)?;
             let obuf = self.storage_empty("det_j out", 3 * total);
             let staging = self.staging(self.real_bytes(3 * total));
             let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -20,7 +20,7 @@ use winslow::linalg::multigrid_kernels::{CpuLevels, Cycle};
 use winslow::linalg::MatVec;
 use winslow::spline::knots::KnotVector;
 use winslow::testutil::{multigrid_cycle, Lcg};
-use winslow_gpu::{gpu_required, Gpu, GpuCycles, GpuOptions, GpuProducts, Operation, Precision, Vector};
+use winslow_gpu::{gpu_required, Gpu, GpuAssembler, GpuCycles, GpuOptions, GpuProducts, Operation, Precision, Vector};
 
 fn gpu() -> Option<Arc<Gpu>> {
     static GPU: OnceLock<Option<Arc<Gpu>>> = OnceLock::new();
@@ -213,18 +213,7 @@ fn stencil_split_over_bindings_equals_the_cpu() {
 #[test]
 fn jacobian_product_equals_the_cpu_product() {
     let Some(g) = gpu() else { return };
-    let kx = KnotVector::open_uniform(3, 12).with_inserted(&[0.4]);
-    let ky = KnotVector::open_uniform(2, 9).with_inserted(&[0.5]);
-    let (gx, gy) = (kx.greville(), ky.greville());
-    let mut rng = Lcg::new(21);
-    let mut cps = Vec::new();
-    for &v in &gy {
-        for &u in &gx {
-            let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
-            cps.push([r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]);
-        }
-    }
-    let disc = Discretization::new([kx, ky]);
+    let (disc, cps, mut rng) = curved_case();
     let n = 2 * disc.dofs.num_free();
     assert!(disc.dofs.num_free() < disc.dofs.num_total(), "the case should have fixed functions");
     for op in [Operator::Plain, Operator::Scaled] {
@@ -250,6 +239,99 @@ fn jacobian_product_equals_the_cpu_product() {
                 }
             }
             assert_eq!(backend.stats().0.calls, 2);
+        }
+    }
+}
+
+/// A curved map (a perturbed annulus sector) on a bicubic-by-biquadratic basis of 16 x 12
+/// functions with fixed boundary functions, and the random generator after it.
+fn curved_case() -> (Discretization, Vec<[f64; 2]>, Lcg) {
+    let kx = KnotVector::open_uniform(3, 12).with_inserted(&[0.4]);
+    let ky = KnotVector::open_uniform(2, 9).with_inserted(&[0.5]);
+    let (gx, gy) = (kx.greville(), ky.greville());
+    let mut rng = Lcg::new(21);
+    let mut cps = Vec::new();
+    for &v in &gy {
+        for &u in &gx {
+            let (r, t) = (1.0 + 2.0 * v, 1.3 * u + 0.1 * v * v);
+            cps.push([r * t.cos() + 0.02 * (rng.uniform() - 0.5), r * t.sin() + 0.02 * (rng.uniform() - 0.5)]);
+        }
+    }
+    (Discretization::new([kx, ky]), cps, rng)
+}
+
+/// The entries of `s` as `f32`.
+fn entries(s: &Stencil32) -> Vec<f32> {
+    (0..s.len()).map(|i| f32::from_bits((s.words()[i >> 1] >> ((i & 1) * 32)) as u32)).collect()
+}
+
+/// The Newton Jacobian assembled on the device and rounded there into the product's
+/// bindings (`GpuAssembler::try_egg_operator`) is the CPU's packed stencil
+/// (`Stencil32::pack` of `Discretization::egg`): its bits on lavapipe, to `f32`
+/// rounding (2^-24 of the largest entry) elsewhere; in one binding and split over two,
+/// assembled in one chunk of basis rows and in one chunk per row. Its residual and its
+/// product are the CPU's, and the bus carried the control points up and the residual
+/// down for the assembly and the indices up for the product, where the host path (the
+/// path before: `try_egg` into host storage, packed, `try_upload`) also brought the `f64`
+/// stencil down (8 bytes per entry) and sent it up as `f32` (4 bytes per entry).
+#[test]
+fn jacobian_assembled_on_the_device_is_the_cpu_packing() {
+    let Some(g) = gpu() else { return };
+    let (disc, cps, mut rng) = curved_case();
+    let (n, total, len) = (2 * disc.dofs.num_free(), disc.dofs.num_total(), disc.stencil_len(2));
+    for op in [Operator::Plain, Operator::Scaled] {
+        let mut st = vec![0.0; len];
+        let mut res = vec![0.0; 2 * total];
+        disc.egg(&cps, op, &mut res, &mut st);
+        let packed = Stencil32::pack(st);
+        let want = entries(&packed);
+        let sys = PackedSystem::new(&disc, 2, &packed).expect("no periodic replicas");
+        let scale = want.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        // 16 x 12 functions, 4 x 35 entries each: 26 880 entries, two bindings of 2^14;
+        // 1024 bytes per assembly chunk: one basis row each
+        for (rows, product_chunk, bindings) in [(u64::MAX, u64::MAX, 1), (1024, 1 << 16, 2)] {
+            let asm = GpuAssembler::new(g.clone()).with_chunk_bytes(rows).with_product_chunk_bytes(product_chunk);
+            let case = format!("{op:?}, {} assembly chunks, {bindings} bindings", asm.chunks(&disc));
+            asm.reset_stats();
+            let mut got_res = vec![0.0; 2 * total];
+            let dev = asm.try_egg_operator(&disc, &cps, op, &mut got_res).unwrap();
+            assert_eq!(dev.stencil_bindings(), bindings, "{case}");
+            let got = dev.read_stencil().unwrap();
+            assert_eq!(got.len(), want.len(), "{case}");
+            let worst = got.iter().zip(&want).fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+            assert!(worst <= scale * 2f32.powi(-24) * 2.0, "{case}: entries differ by {worst:e} of {scale:e}");
+            let (rel, same_res) = compare(&got_res, &res);
+            assert!(rel <= 1e-12, "{case}: residuals differ by {rel:e}");
+            let x = random(n, &mut rng);
+            let (mut y_cpu, mut y_gpu) = (vec![0.0; n], vec![1.0; n]);
+            sys.mul_vec(&x, &mut y_cpu);
+            dev.try_apply(&x, &mut y_gpu).unwrap();
+            let (rel, same_y) = compare(&y_gpu, &y_cpu);
+            assert!(rel <= 1e-6, "{case}: products differ by {rel:e}");
+            if g.is_software() {
+                let same = got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same && same_res && same_y, "{case}: lavapipe should give the CPU's bits");
+            }
+            // the bus: the residual down, the indices up; nothing of the stencil
+            let s = asm.stats();
+            assert_eq!(s.egg_jacobian.bytes_down, 16 * total as u64, "{case}");
+            let indices = 4 * (n / 2 + total) as u64;
+            assert_eq!((s.jacobian_products.setups, s.jacobian_products.setup_bytes), (1, indices), "{case}");
+            // the path before, on the same assembler: the stencil down in f64 and up in f32
+            asm.reset_stats();
+            let mut host = vec![0.0; len];
+            asm.try_egg(&disc, &cps, op, &mut got_res, &mut host).unwrap();
+            let host = Stencil32::pack(host);
+            let host_worst = entries(&host).iter().zip(&got).fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+            assert!(host_worst <= scale * 2f32.powi(-23), "{case}: the host's packing differs by {host_worst:e}");
+            if g.is_software() {
+                assert_eq!(host_worst, 0.0, "{case}: lavapipe should pack as the host packs");
+            }
+            let products = GpuProducts::new(g.clone()).unwrap();
+            products.try_upload(&PackedSystem::new(&disc, 2, &host).unwrap()).unwrap();
+            let s = asm.stats();
+            assert_eq!(s.egg_jacobian.bytes_down, 16 * total as u64 + 8 * len as u64, "{case}");
+            assert_eq!(products.stats().0.setup_bytes, indices + 4 * len as u64, "{case}");
         }
     }
 }

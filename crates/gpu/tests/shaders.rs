@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
-use winslow_gpu::{shader_source, Precision, ASSEMBLY_WGSL, DET_J_WGSL, F64_ALIAS, MULTIGRID_WGSL};
+use winslow_gpu::{shader_source, Precision, ASSEMBLY_WGSL, DET_J_WGSL, F64_ALIAS, MULTIGRID_WGSL, PACK_WGSL};
 
 fn validate(name: &str, src: &str, caps: Capabilities) -> naga::Module {
     let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
@@ -57,6 +57,9 @@ fn embedded_sources_are_the_files() {
     assert_eq!(std::fs::read_to_string(dir.join("assembly.wgsl")).unwrap(), ASSEMBLY_WGSL);
     assert_eq!(std::fs::read_to_string(dir.join("det_j.wgsl")).unwrap(), DET_J_WGSL);
     assert_eq!(std::fs::read_to_string(dir.join("multigrid.wgsl")).unwrap(), MULTIGRID_WGSL);
+    assert_eq!(std::fs::read_to_string(dir.join("pack.wgsl")).unwrap(), PACK_WGSL);
+    let pack = validate("pack", PACK_WGSL, Capabilities::FLOAT64);
+    assert!(pack.entry_points.iter().any(|e| e.name == "pack"), "pack.wgsl lacks entry point pack");
     let multigrid: Vec<String> = validate("multigrid", MULTIGRID_WGSL, Capabilities::FLOAT64)
         .entry_points
         .iter()

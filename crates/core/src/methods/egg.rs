@@ -10,7 +10,7 @@ use super::galerkin::GalerkinState;
 use super::{DiscreteProblem, Method};
 
 use crate::discrete::assembly::{Discretization, Operator};
-use crate::discrete::stencil::{OperatorBackend, PackedSystem, Stencil32};
+use crate::discrete::stencil::{DeviceOperator, OperatorBackend, PackedSystem, Stencil32};
 use crate::linalg::multigrid_kernels::CycleBackend;
 use crate::linalg::sparse::Csr;
 use crate::spline::curve::Point;
@@ -49,6 +49,21 @@ pub trait EggAssembler: Send + Sync {
     /// storage on this back end ([`OperatorBackend`]: GMRES's product under the
     /// multigrid preconditioner); `None` (the default): the CPU.
     fn operator_backend(&self) -> Option<Arc<dyn OperatorBackend>> {
+        None
+    }
+    /// The residual (as [`EggAssembler::egg`]) and the Jacobian of eq. (23) assembled
+    /// where the operator back end multiplies with it, in its single-precision stencil
+    /// storage (the bits of [`Stencil32::pack`] of [`EggAssembler::egg`]'s), never
+    /// crossing to the host: `Some` where this back end can (the GPU crate assembles
+    /// into the product's buffers); `None` (the default, and when it fails): the caller
+    /// assembles with [`EggAssembler::egg`] and uploads ([`OperatorBackend::upload`]).
+    fn egg_operator(
+        &self,
+        _disc: &Discretization,
+        _cps: &[Point],
+        _op: Operator,
+        _res: &mut [f64],
+    ) -> Option<Box<dyn DeviceOperator>> {
         None
     }
     /// Whether [`EggAssembler::egg`] is [`Discretization::egg`] on the CPU: the Jacobian
@@ -177,14 +192,25 @@ impl DiscreteProblem for EggProblem {
 
     /// The Jacobian kept as its stencil storage rounded to single precision
     /// (`discrete::stencil::Stencil32`, packed in place after the assembly; the last
-    /// step's is freed before this one is assembled): on a basis without periodic
-    /// replicas.
+    /// step's is freed before this one is assembled), or assembled on the operator back
+    /// end itself ([`EggAssembler::egg_operator`]: no host copy): on a basis without
+    /// periodic replicas.
     fn jacobian_operator(&mut self, c: &[f64], f: &mut [f64]) -> bool {
         let s = &mut self.state;
         if !s.disc.dofs.replicas().is_empty() {
             return false;
         }
-        (s.packed, s.device) = (None, None);
+        (s.packed, s.device, s.fallback) = (None, None, Default::default());
+        s.point.clear();
+        if !self.assembler.assembles_on_cpu() {
+            // assembled where it is multiplied: the Jacobian never comes to the host
+            s.load(c);
+            if let Some(device) = self.assembler.egg_operator(&s.disc, &s.cps, self.op, &mut s.res_full) {
+                s.restrict_residual(f);
+                (s.device, s.point) = (Some(device), c.to_vec());
+                return true;
+            }
+        }
         let packed = if self.assembler.assembles_on_cpu() {
             // by row bands straight into single precision (the same bits as below)
             s.load(c);
@@ -218,6 +244,15 @@ impl DiscreteProblem for EggProblem {
         }
         match &s.packed {
             Some(j) => s.disc.stencil_product(2, j, x, y),
+            // assembled on the back end, whose product failed: the CPU assembles it at
+            // the same point once (`egg_single`: the bits of the back end's packing)
+            None if !s.point.is_empty() => {
+                let j = s.fallback.get_or_init(|| {
+                    let mut res = vec![0.0; s.res_full.len()];
+                    s.disc.egg_single(&s.control_points(&s.point), self.op, &mut res)
+                });
+                s.disc.stencil_product(2, j, x, y)
+            }
             None => s.disc.stencil_product(2, &s.stencil[..], x, y),
         };
     }
@@ -298,6 +333,62 @@ mod tests {
             let (max_err, max_val) = crate::methods::jacobian_fd_mismatch(&mut prob, &c, 1e-6);
             assert!(max_err < 1e-7 * max_val, "{op:?}: FD mismatch {max_err} (scale {max_val})");
         }
+    }
+
+    /// A back end whose Jacobian, "assembled where it is multiplied"
+    /// ([`EggAssembler::egg_operator`]), cannot be multiplied with: a lost device.
+    struct LostDevice;
+
+    #[derive(Debug)]
+    struct Lost;
+
+    impl DeviceOperator for Lost {
+        fn apply(&self, _: &[f64], _: &mut [f64]) -> crate::Result<()> {
+            Err(crate::Error::LinearSolver("the device is lost".into()))
+        }
+    }
+
+    impl EggAssembler for LostDevice {
+        fn egg(&self, disc: &Discretization, cps: &[Point], op: Operator, res: &mut [f64], st: &mut [f64]) {
+            disc.egg(cps, op, res, st);
+        }
+        fn name(&self) -> String {
+            "lost".into()
+        }
+        fn egg_operator(
+            &self,
+            d: &Discretization,
+            cps: &[Point],
+            op: Operator,
+            res: &mut [f64],
+        ) -> Option<Box<dyn DeviceOperator>> {
+            d.egg(cps, op, res, &mut []);
+            Some(Box::new(Lost))
+        }
+    }
+
+    /// A Jacobian assembled on its back end keeps no host copy; when its product fails
+    /// there, the CPU assembles it once at the Newton point (not at the control points a
+    /// later residual left) and gives the CPU path's product, bit for bit.
+    #[test]
+    fn a_failed_device_jacobian_is_assembled_again_at_its_point() {
+        let (disc, cps) = setup(3, [5, 4], 3, 0.05);
+        let disc = Arc::new(disc);
+        let mut cpu = EggProblem::new(disc.clone(), cps.clone(), Operator::Scaled, Arc::new(CpuAssembler));
+        let mut dev = EggProblem::new(disc, cps, Operator::Scaled, Arc::new(LostDevice));
+        let c = cpu.unknowns();
+        let n = c.len();
+        let (mut f_cpu, mut f_dev) = (vec![0.0; n], vec![1.0; n]);
+        assert!(cpu.jacobian_operator(&c, &mut f_cpu) && dev.jacobian_operator(&c, &mut f_dev));
+        assert_eq!(f_cpu, f_dev);
+        assert!(dev.state.packed.is_none() && dev.state.stencil.is_empty() && dev.state.fallback.get().is_none());
+        dev.residual(&c.iter().map(|v| v + 0.01).collect::<Vec<_>>(), &mut f_dev);
+        let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+        let (mut y_cpu, mut y_dev) = (vec![0.0; n], vec![1.0; n]);
+        cpu.jacobian_product(&x, &mut y_cpu);
+        dev.jacobian_product(&x, &mut y_dev);
+        assert!(y_cpu.iter().zip(&y_dev).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(dev.state.fallback.get().is_some());
     }
 
     /// Random positive weights in `[0.5, 2]` for a rational basis of `n` functions.

@@ -31,6 +31,12 @@ pub(crate) struct GalerkinState {
     /// [`GalerkinState::packed`] uploaded to the assembler's operator back end
     /// (`discrete::stencil::OperatorBackend`), where there is one.
     pub device: Option<Box<dyn DeviceOperator>>,
+    /// The unknowns at which [`GalerkinState::device`] was assembled on the back end
+    /// itself (`EggAssembler::egg_operator`; empty otherwise): what the CPU needs to
+    /// assemble the Jacobian again should a product there fail.
+    pub point: Vec<f64>,
+    /// That CPU Jacobian, assembled on the first failed product only.
+    pub fallback: std::sync::OnceLock<Stencil32>,
     mass: Option<Csr>,
     pstencil: Vec<f64>,
     prec: Csr,
@@ -46,6 +52,8 @@ impl GalerkinState {
             stencil: Vec::new(),
             packed: None,
             device: None,
+            point: Vec::new(),
+            fallback: std::sync::OnceLock::new(),
             mass: None,
             pstencil: Vec::new(),
             prec: Csr::default(),

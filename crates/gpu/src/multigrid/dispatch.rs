@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use super::program::{Kernel, Params, Step};
 use super::{MultigridKernels, RECORD};
-use crate::assembler::Timings;
 use crate::device::Gpu;
+use crate::stats::Timings;
 use crate::GpuError;
 
 /// Calls run on the GPU with their times, set-ups or calls that fell back to the CPU,
@@ -121,30 +121,77 @@ pub(crate) struct StencilChunks {
 }
 
 impl StencilChunks {
-    /// Upload `values` in chunks of at most `max_bytes` (and the adapter's binding and
-    /// buffer limits), rounded down to a power of two entries.
+    /// The chunk size (`2^shift` entries) for `len` values in chunks of at most
+    /// `max_bytes` (and the adapter's binding and buffer limits), rounded down to a power
+    /// of two entries, and the number of chunks.
     ///
     /// Errors: [`GpuError::TooLarge`] when more than [`STENCIL_BINDINGS`] chunks are
     /// needed.
-    pub(crate) fn upload(gpu: &Gpu, what: &str, values: &[f32], max_bytes: u64) -> Result<Self, GpuError> {
+    fn split(gpu: &Gpu, what: &str, len: usize, max_bytes: u64) -> Result<(u32, usize), GpuError> {
         let limit = max_bytes.min(gpu.limits.max_storage_buffer_binding_size).min(gpu.limits.max_buffer_size);
         let entries = (limit / 4).max(1);
         let shift = (63 - entries.leading_zeros()).min(31);
         let chunk = 1usize << shift;
-        let parts = values.len().div_ceil(chunk).max(1);
+        let parts = len.div_ceil(chunk).max(1);
         if parts > STENCIL_BINDINGS {
             return Err(GpuError::TooLarge(format!(
                 "{what}: {} bytes of stencil values, {STENCIL_BINDINGS} bindings of {} bytes",
-                4 * values.len(),
+                4 * len,
                 4 * chunk
             )));
         }
-        let mut buffers: Vec<wgpu::Buffer> =
-            values.chunks(chunk).map(|c| gpu.storage_init(what, bytemuck::cast_slice(c))).collect();
-        while buffers.len() < STENCIL_BINDINGS {
-            buffers.push(gpu.storage_init(what, &[0u8; 16]));
+        Ok((shift, parts))
+    }
+
+    /// Upload the concatenation of `parts` (`len` values in all) in chunks of at most
+    /// `max_bytes` ([`StencilChunks::split`]), each chunk written in place into its
+    /// buffer's mapping ([`Gpu::storage_parts`]: no host copy of the values).
+    ///
+    /// Errors: [`GpuError::TooLarge`] when more than [`STENCIL_BINDINGS`] chunks are
+    /// needed, and wgpu's.
+    pub(crate) fn upload(
+        gpu: &Gpu,
+        what: &str,
+        parts: &[&[f32]],
+        len: usize,
+        max_bytes: u64,
+    ) -> Result<Self, GpuError> {
+        let (shift, count) = Self::split(gpu, what, len, max_bytes)?;
+        let chunk = 1usize << shift;
+        let mut buffers = Vec::with_capacity(STENCIL_BINDINGS);
+        for k in 0..count {
+            let lo = k * chunk;
+            buffers.push(gpu.storage_parts(what, parts, lo, chunk.min(len - lo.min(len)))?);
         }
-        Ok(Self { buffers, shift })
+        Ok(Self::padded(gpu, what, buffers, shift))
+    }
+
+    /// Chunks for `len` values that a kernel writes on the device (nothing goes up).
+    ///
+    /// Errors: as [`StencilChunks::upload`].
+    pub(crate) fn on_device(gpu: &Gpu, what: &str, len: usize, max_bytes: u64) -> Result<Self, GpuError> {
+        let (shift, count) = Self::split(gpu, what, len, max_bytes)?;
+        let chunk = 1usize << shift;
+        let buffers = (0..count).map(|k| gpu.storage_zeroed(what, 4 * chunk.min(len - k * chunk) as u64)).collect();
+        Ok(Self::padded(gpu, what, buffers, shift))
+    }
+
+    /// `buffers` with 16-byte placeholders for the unused bindings.
+    fn padded(gpu: &Gpu, what: &str, mut buffers: Vec<wgpu::Buffer>, shift: u32) -> Self {
+        while buffers.len() < STENCIL_BINDINGS {
+            buffers.push(gpu.storage_zeroed(what, 16));
+        }
+        Self { buffers, shift }
+    }
+
+    /// The buffers, placeholders included (bindings `stencil0` .. `stencil3`).
+    pub(crate) fn buffers(&self) -> &[wgpu::Buffer] {
+        &self.buffers
+    }
+
+    /// `log2` of the entries per chunk.
+    pub(crate) fn shift(&self) -> u32 {
+        self.shift
     }
 
     /// Buffers holding values (the placeholders not counted).
@@ -152,10 +199,15 @@ impl StencilChunks {
         len.div_ceil(1usize << self.shift).max(1)
     }
 
+    /// `2^shift - 1`: an entry's place in its chunk.
+    pub(crate) fn mask(&self) -> u32 {
+        ((1u64 << self.shift) - 1) as u32
+    }
+
     /// `p` with the chunk size of these buffers.
     fn params(&self, mut p: Params) -> Params {
         p.st_shift = self.shift;
-        p.st_mask = ((1u64 << self.shift) - 1) as u32;
+        p.st_mask = self.mask();
         p
     }
 }

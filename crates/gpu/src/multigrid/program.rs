@@ -141,16 +141,29 @@ fn to_u32(v: usize, what: &str) -> Result<u32, GpuError> {
     crate::to_u32(v, &format!("multigrid {what}"))
 }
 
-/// The host copies of the uploaded buffers, being built.
+/// What goes into the three read-only buffers, being laid out: the indices (built here,
+/// `O(sqrt n)` per level: line starts, 1D factors' pattern), and the reals and stencil
+/// values as the hierarchy's own slices in buffer order (written straight into the
+/// buffers' mappings: no host copy of what is `O(n)`).
 #[derive(Default)]
-pub(crate) struct Packed {
-    pub(crate) reals: Vec<f64>,
+pub(crate) struct Packed<'a> {
+    pub(crate) reals: Vec<&'a [f64]>,
+    pub(crate) reals_len: usize,
     pub(crate) idx: Vec<u32>,
-    pub(crate) stencil: Vec<f32>,
+    pub(crate) stencil: Vec<&'a [f32]>,
+    pub(crate) stencil_len: usize,
 }
 
-impl Packed {
-    fn csr(&mut self, a: &Csr) -> Result<FactorAt, GpuError> {
+impl<'a> Packed<'a> {
+    /// Append `v` to the reals; its offset.
+    fn real(&mut self, v: &'a [f64]) -> Result<u32, GpuError> {
+        let at = to_u32(self.reals_len, "real")?;
+        self.reals.push(v);
+        self.reals_len += v.len();
+        Ok(at)
+    }
+
+    fn csr(&mut self, a: &'a Csr) -> Result<FactorAt, GpuError> {
         let ptr = to_u32(self.idx.len(), "index")?;
         for &p in &a.row_ptr {
             self.idx.push(to_u32(p, "row pointer")?);
@@ -159,18 +172,16 @@ impl Packed {
         for &c in &a.col_idx {
             self.idx.push(to_u32(c, "column")?);
         }
-        let val = to_u32(self.reals.len(), "real")?;
-        self.reals.extend_from_slice(&a.values);
+        let val = self.real(&a.values)?;
         Ok(FactorAt { ptr, col, val, rows: to_u32(a.nrows, "rows")?, cols: to_u32(a.ncols, "columns")? })
     }
 
-    fn lines(&mut self, l: &LineBlocks<'_>) -> Result<LinesAt, GpuError> {
+    fn lines(&mut self, l: &LineBlocks<'a>) -> Result<LinesAt, GpuError> {
         let starts = to_u32(self.idx.len(), "index")?;
         for &s in l.starts {
             self.idx.push(to_u32(s, "line start")?);
         }
-        let fac = to_u32(self.reals.len(), "real")?;
-        self.reals.extend_from_slice(l.factors);
+        let fac = self.real(l.factors)?;
         Ok(LinesAt {
             starts,
             stride: to_u32(l.stride, "stride")?,
@@ -184,7 +195,7 @@ impl Packed {
 }
 
 /// Pack `h` into the three read-only buffers and lay out the vectors.
-pub(crate) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
+pub(crate) fn pack<'a>(h: &Hierarchy<'a>) -> Result<(Layout, Packed<'a>), GpuError> {
     let mut p = Packed::default();
     let mut levels = Vec::new();
     let mut off = 0usize;
@@ -192,8 +203,9 @@ pub(crate) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
         let n = op.size();
         let op = match *op {
             LevelOperator::Stencil { nx, ny, half, values } => {
-                let st_off = to_u32(p.stencil.len(), "stencil offset")?;
-                p.stencil.extend_from_slice(values);
+                let st_off = to_u32(p.stencil_len, "stencil offset")?;
+                p.stencil.push(values);
+                p.stencil_len += values.len();
                 OpAt::Stencil {
                     nx: to_u32(nx, "grid width")?,
                     ny: to_u32(ny, "grid height")?,
@@ -230,8 +242,7 @@ pub(crate) fn pack(h: &Hierarchy<'_>) -> Result<(Layout, Packed), GpuError> {
         lines: None,
     });
     off += 2 * cn;
-    let coarse_fac = to_u32(p.reals.len(), "real")?;
-    p.reals.extend_from_slice(cfac);
+    let coarse_fac = p.real(cfac)?;
     let mut transfers = Vec::new();
     let mut t_len = 0usize;
     for t in &h.transfers {
