@@ -126,10 +126,13 @@ fn multigrid_cycles_on_the_gpu_give_the_cpu_solve() {
     );
 }
 
+/// A count and the bytes `[up, down]` per one of them.
+type Counted = (u64, [u64; 2]);
+
 /// The bytes over the bus in `report.backend` (`"...; bus: U B up, D B down in all;
 /// per Newton step (N): u B up, d B down; per GMRES iteration (P): u B up, d B down"`),
 /// as `[up, down]` for "in all", each Newton step and each GMRES iteration, with N and P.
-fn bus(backend: &str) -> ([u64; 2], (u64, [u64; 2]), (u64, [u64; 2])) {
+fn bus(backend: &str) -> ([u64; 2], Counted, Counted) {
     let num = |s: &str| -> u64 { s.trim().parse().unwrap_or_else(|_| panic!("no number in {s:?}: {backend}")) };
     let pair = |s: &str| -> [u64; 2] {
         let (up, down) = s.split_once(" B up, ").unwrap_or_else(|| panic!("{s:?}: {backend}"));
