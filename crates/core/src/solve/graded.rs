@@ -32,7 +32,7 @@ use crate::spline::surface::Side;
 
 /// A finest-level start whose scaled residual is below this is left alone: quarter_annulus
 /// starts at 5e-4 and male_rotor at 0.05 (2 and 3 Newton steps), wavy_lid at 1.4-3.5 and
-/// puzzle4 at 1.6 from the level 16 times smaller (graded: 20-34 % and 8 % fewer CPU
+/// puzzle4 at 1.6 from the level 16 times smaller (graded: 12-34 % and 8 % fewer CPU
 /// seconds); puzzle4 at 460 k unknowns starts at 0.52 and takes 4 steps, and its graded
 /// level (44 % of the finest size, 4 steps) cost 16 % more than it saved.
 pub(crate) const GRADED_MIN_RESIDUAL: f64 = 1.0;
