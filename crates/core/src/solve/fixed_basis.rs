@@ -123,6 +123,16 @@ impl<P: DiscreteProblem> FixedBasisSolve<P> {
         self.start_objective
     }
 
+    /// The residual `F` of the current iterate.
+    pub(crate) fn residual_vector(&self) -> &[f64] {
+        self.solver.residual_vector()
+    }
+
+    /// `||F||` of the current iterate.
+    pub(crate) fn residual(&self) -> f64 {
+        self.solver.residual()
+    }
+
     /// The next iterate, recorded; `Ok(None)` once converged or failed.
     pub fn step(&mut self) -> Result<Option<Iterate>> {
         let it = self.solver.step()?;

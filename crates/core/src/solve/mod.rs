@@ -8,6 +8,7 @@
 //! | `fixed_basis` | `FixedBasisSolve`: one solve on a fixed basis (scaled options, iterates recorded while they stream, the result taken back, "keep only if certified"), run by every stage below | §4.1, §6, §9, §11 |
 //! | [`initial`] | Coons patch, prolongation plus linear elasticity, boundary continuation | §6.3, §9 |
 //! | `levels` | which levels are solved: balancing, extra refinements, growth factor | §5.4, §6.3 |
+//! | `graded` | the graded level before a multigrid finest level: the coarser level's knots with the finest level's inserted where the finest start's residual sits (a local defect that does not fall with `h`) | §6.3 |
 //! | [`hierarchical`] | `repair_thb`: local defect correction on a THB basis, only the offending cells and a ring refined, EGG solved on the THB discretization (`--refinement thb`) | §4, §8.2 |
 //! | `repair` | local defect correction around folded or undecided elements | §8.2 |
 //! | [`memory`] | the peak memory of a solve estimated from its basis sizes, checked against [`MemoryLimit`](memory::MemoryLimit) (`--max-memory`) before it allocates | |
@@ -23,6 +24,7 @@
 
 pub mod constrained;
 pub(crate) mod fixed_basis;
+pub(crate) mod graded;
 pub mod hierarchical;
 pub mod improve;
 pub mod initial;

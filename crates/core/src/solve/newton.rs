@@ -308,6 +308,11 @@ impl<P: DiscreteProblem> NonlinearSolver<P> {
         self.objective
     }
 
+    /// The residual `F` of the current iterate.
+    pub(crate) fn residual_vector(&self) -> &[f64] {
+        &self.f
+    }
+
     /// Current `||F||`.
     pub fn residual(&self) -> f64 {
         self.norm

@@ -44,6 +44,11 @@ pub struct LevelReport {
     pub unknowns: usize,
     /// Initial guess used.
     pub initial_guess: InitialGuess,
+    /// The level is the graded level put before the finest one (`solve::graded`): the
+    /// coarser level's knots with the finest level's inserted where the finest start's
+    /// residual sits. Written only when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub graded: bool,
     /// Smallest sampled `det J` of the initial guess.
     pub initial_det_j_min: f64,
     /// Damped boundary steps solved before the full boundary (paper §9); 0 when the

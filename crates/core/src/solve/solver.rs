@@ -11,6 +11,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::fixed_basis::{bijective, scaled_options, FixedBasisSolve};
+use super::graded::{graded_level, GRADED_MIN_RESIDUAL};
 use super::improve::{improve, Improvement};
 use super::initial::{continuation_with, coons, det_j_min, set_boundary, Continuation};
 use super::kinks::{keep_kinks, kink_reports, KinkStage};
@@ -109,6 +110,8 @@ pub struct EggSolver {
     /// `--linear auto` solves a level whose direct preconditioner would not fit with
     /// multigrid ([`auto_linear`]).
     memory_limit: Option<u64>,
+    /// A [`graded_level`] was put before the finest level.
+    graded: bool,
 }
 
 impl std::fmt::Debug for EggSolver {
@@ -192,6 +195,7 @@ impl EggSolver {
             boundary: boundary.clone(),
             hierarchy,
             memory_limit,
+            graded: false,
         })
     }
 
@@ -302,13 +306,27 @@ impl EggSolver {
         self.check_start(level, &weights, &cps)?;
         let m = disc.dofs.num_free();
         trace(|| format!("level {k}: initial guess"));
-        let solver = FixedBasisSolve::new(&*self.method, disc, cps, self.level_options(m, linear));
+        let dofs = disc.dofs.clone();
+        let nl = self.level_options(m, linear);
+        let solver = FixedBasisSolve::new(&*self.method, disc, cps, nl);
+        if self.grades(k, linear) && solver.residual() * nl.scale > GRADED_MIN_RESIDUAL {
+            if let Some(g) = graded_level(&self.plan[k - 1], &self.plan[k], &dofs, solver.residual_vector())? {
+                trace(|| {
+                    format!("level {k}: graded level of {} x {} functions first", g.knots[0].dim(), g.knots[1].dim())
+                });
+                drop(solver);
+                self.graded = true;
+                self.plan.insert(k, g);
+                return self.start_level(k);
+            }
+        }
         let report = LevelReport {
             level: k,
             shape,
             elements: [level.knots[0].num_elements(), level.knots[1].num_elements()],
             unknowns: 2 * m,
             initial_guess: guess,
+            graded: self.graded && k + 2 == self.plan.len(),
             initial_det_j_min,
             continuation_steps: cont.steps,
             continuation_iterations: cont.iterations,
@@ -329,6 +347,18 @@ impl EggSolver {
         };
         self.active = Some(Active { level: k, solver, report, started: t0, weights });
         Ok(Event::LevelStarted { level: k, levels: self.plan.len(), shape, unknowns: 2 * m, initial_guess: guess })
+    }
+
+    /// Whether level `k` of the plan, solved by `linear`, is first preceded by a
+    /// [`graded_level`]: the finest level (no defect correction yet) solved by multigrid
+    /// from a solved level below, once per solve.
+    fn grades(&self, k: usize, linear: LinearMethod) -> bool {
+        !self.graded
+            && k > 0
+            && k + 1 == self.plan.len()
+            && self.repairs == 0
+            && linear == LinearMethod::Multigrid
+            && self.previous.is_some()
     }
 
     fn finish_level(&mut self) -> Result<Event> {
@@ -577,6 +607,35 @@ mod tests {
             "area {}",
             r.measures.area
         );
+    }
+
+    /// wavy_lid refined twice under `--linear multigrid`: the start of the finest level
+    /// (prolonged from the level 16 times smaller) has its residual in the rows along the
+    /// wavy lid (scaled 3.5), so a graded level goes before it, nested between the two;
+    /// it takes that defect (its start is above 1), and the finest level starts from its
+    /// solution below 0.2 and converges in at most 3 Newton iterations (5 from the level
+    /// below, BENCHMARKS.md "Finest-level Newton"), certified.
+    #[test]
+    fn the_finest_multigrid_level_starts_from_the_graded_level() {
+        let b = crate::io::read_boundary(&crate::testutil::data("wavy_lid.json"), &Default::default()).unwrap();
+        let mut opts = SolveOptions::default();
+        opts.levels.refine = 2;
+        opts.nonlinear.linear = LinearMethod::Multigrid;
+        let sol = solve(&b, &opts).unwrap();
+        let r = &sol.report;
+        assert_eq!(r.outcome.verdict, Verdict::Certified, "{}", r.outcome.message);
+        let levels = &r.solve.levels;
+        let n = levels.len();
+        assert!(n >= 3 && levels.iter().enumerate().all(|(k, l)| l.graded == (k + 2 == n)), "{levels:?}");
+        let (coarse, graded, finest) = (&levels[n - 3], &levels[n - 2], &levels[n - 1]);
+        assert!(coarse.elements[0] < graded.elements[0] && graded.elements[0] <= finest.elements[0]);
+        assert!(coarse.elements[1] < graded.elements[1] && graded.elements[1] < finest.elements[1]);
+        assert!(graded.scaled_residuals[0] > 1.0, "{:?}", graded.scaled_residuals);
+        assert!(finest.scaled_residuals[0] < 0.2, "{:?}", finest.scaled_residuals);
+        assert!(finest.converged && finest.newton_iterations <= 3, "{finest:?}");
+        // the default solver (a factorization below 800 000 unknowns) grades nothing
+        let plain = solve(&b, &SolveOptions { levels: opts.levels.clone(), ..SolveOptions::default() }).unwrap();
+        assert!(plain.report.solve.levels.iter().all(|l| !l.graded) && plain.report.solve.levels.len() == n - 1);
     }
 
     fn circle(r: f64, c: [f64; 2]) -> crate::boundary::ring::ClosedContour {
