@@ -61,7 +61,8 @@ pub(crate) fn not_nested(basis: &HierarchicalBasis, d: usize, side: &KnotVector)
         let mut found = false;
         for l in 0..MAX_LEVELS - 1 {
             // the split of element `e` of level `l`: the given level's, or the midpoint
-            let mid = if l + 1 < basis.num_levels() { basis.split_point(l, d, e) } else { 0.5 * (a + b) };
+            let mid = if l + 1 < basis.num_levels() { basis.split_point(l, d, e) } else { Some(0.5 * (a + b)) };
+            let Some(mid) = mid else { continue }; // level `l + 1` does not split `d`
             if u == mid {
                 found = true;
                 break;

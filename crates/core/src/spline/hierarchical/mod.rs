@@ -6,8 +6,10 @@
 //! its midpoint (dyadic refinement, [`KnotVector::halved`]); the first levels may instead be
 //! given ([`HierarchicalBasis::with_levels`]: an input basis's knot vector as a finer level,
 //! its coarser levels every other break removed), each splitting every element of the level
-//! below at one new simple knot anywhere inside it. Either way `S^0 ⊂ S^1 ⊂ ...` and a
-//! level-`l` cell `(i, j)` has the four children `(2i + a, 2j + b)`, `a, b ∈ {0, 1}`. The domains `Ω^0 = [0, 1]² ⊇ Ω^1 ⊇ ...` are
+//! below at one new simple knot anywhere inside it, or keeping the knots of one direction
+//! (anisotropic levels). Either way `S^0 ⊂ S^1 ⊂ ...` and a level-`l` cell `(i, j)` has
+//! the children `(2i + a, 2j + b)`, `a, b ∈ {0, 1}` (`i` itself along a direction the
+//! level does not split). The domains `Ω^0 = [0, 1]² ⊇ Ω^1 ⊇ ...` are
 //! unions of cells: `Ω^{l+1}` is the union of the level-`l` cells marked *refined*. A
 //! level-`l` cell is *active* when it lies in `Ω^l` and is not refined; the active cells
 //! tile the domain.
@@ -29,7 +31,8 @@
 //! non-zero THB functions come from at most `m` successive levels (Bracco, Giannelli,
 //! Vázquez 2018, Algorithm "refine_recursive" with the THB neighbourhood
 //! `N(Q, m) = {Q' active of level l - m + 1 : Q' ∩ S(Q, l - m + 2) ≠ ∅}`, `S(Q, k)` the
-//! union of the supports of the level-`k` B-splines non-zero on `Q`).
+//! union of the supports of the level-`k` B-splines non-zero on `Q`; on anisotropic
+//! levels the same, the parents taken per direction).
 //!
 //! Submodules: `truncation` (the two-scale relation and the restriction of the THB
 //! functions to an active cell), [`map`] (THB maps of the plane: control points,
@@ -57,6 +60,9 @@ pub(crate) const MAX_LEVELS: usize = 24;
 #[derive(Debug, Clone)]
 struct Level {
     knots: [KnotVector; 2],
+    /// Per direction, whether this level splits every element of the level below in two
+    /// (`false`: the same knots in that direction, a given level only; level 0: `true`).
+    split: [bool; 2],
     /// `(span, a, b)` per element.
     elements: [Vec<(usize, f64, f64)>; 2],
     /// `first[k]`: the number of distinct knot values `< t_k` (the index of the element
@@ -80,7 +86,7 @@ impl Level {
             // the first knot value is the domain start: element 0 starts there
             out
         });
-        Self { knots, elements, first }
+        Self { knots, split: [true; 2], elements, first }
     }
 
     /// Cells (element indices) of the support of function `f` in direction `d`.
@@ -135,10 +141,12 @@ impl HierarchicalBasis {
 
     /// The hierarchy on the open knot vectors `levels[0]` with the finer levels
     /// `levels[1..]` given (the levels past them halve the last one): each level of the
-    /// same degrees and domain as the one below, holding its knots with their
-    /// multiplicities and exactly one new simple knot strictly inside each of its elements,
-    /// per direction (so that a cell still has four children). A typed error names the
-    /// level and direction otherwise.
+    /// same degrees and domain as the one below, holding, per direction, either its knots
+    /// with their multiplicities and exactly one new simple knot strictly inside each of
+    /// its elements (a split direction: a cell has two children along it), or the same
+    /// knots (an unsplit direction: one child along it, the same span; anisotropic
+    /// refinement), at least one direction split. A typed error names the level and
+    /// direction otherwise.
     pub fn with_levels(levels: Vec<[KnotVector; 2]>) -> Result<Self> {
         let mut it = levels.into_iter();
         let first = it.next().ok_or_else(|| Error::Invalid("a hierarchy needs a level 0".into()))?;
@@ -152,16 +160,26 @@ impl HierarchicalBasis {
                     limit: MAX_LEVELS,
                 });
             }
+            let mut split = [true; 2];
             for d in 0..2 {
-                if let Err(why) = splits_in_two(&out.levels[l - 1].knots[d], &knots[d]) {
-                    return Err(Error::Knots {
-                        context: format!("hierarchical basis, level {l}, direction {}", ["xi", "eta"][d]),
-                        reason: why,
-                    });
+                match splits_in_two(&out.levels[l - 1].knots[d], &knots[d]) {
+                    Ok(s) => split[d] = s,
+                    Err(why) => {
+                        return Err(Error::Knots {
+                            context: format!("hierarchical basis, level {l}, direction {}", ["xi", "eta"][d]),
+                            reason: why,
+                        })
+                    }
                 }
             }
+            if split == [false; 2] {
+                return Err(Error::Knots {
+                    context: format!("hierarchical basis, level {l}"),
+                    reason: "the same knots as the level below in both directions".into(),
+                });
+            }
             out.given.push(knots.clone());
-            out.levels.push(Level::new(knots));
+            out.levels.push(Level { split, ..Level::new(knots) });
             out.refined.push(BTreeSet::new());
         }
         Ok(out)
@@ -174,16 +192,50 @@ impl HierarchicalBasis {
     }
 
     /// The knot value splitting element `e` of level `l` in direction `d` (the end of its
-    /// first child), creating no level: from level `l + 1` when it exists, the midpoint
-    /// otherwise (a level past the given ones halves).
-    pub(crate) fn split_point(&self, l: usize, d: usize, e: usize) -> f64 {
+    /// first child), creating no level: from level `l + 1` when it exists (`None` when
+    /// that level does not split `d`), the midpoint otherwise (a level past the given ones
+    /// halves).
+    pub(crate) fn split_point(&self, l: usize, d: usize, e: usize) -> Option<f64> {
         match self.levels.get(l + 1) {
-            Some(next) => next.elements[d][2 * e].2,
+            Some(next) => next.split[d].then(|| next.elements[d][2 * e].2),
             None => {
                 let (_, a, b) = self.levels[l].elements[d][e];
-                0.5 * (a + b)
+                Some(0.5 * (a + b))
             }
         }
+    }
+
+    /// Whether level `l` splits direction `d` of level `l - 1` (`l >= 1`; a level past the
+    /// existing ones halves).
+    pub(crate) fn splits(&self, l: usize, d: usize) -> bool {
+        self.levels.get(l).is_none_or(|lv| lv.split[d])
+    }
+
+    /// The index along direction `d` of the level-`(l - 1)` parent of the level-`l` cell
+    /// (or element) `i` (`l >= 1`).
+    fn parent_1d(&self, l: usize, d: usize, i: usize) -> usize {
+        if self.splits(l, d) {
+            i / 2
+        } else {
+            i
+        }
+    }
+
+    /// The level-`k` ancestor of cell `c` of level `l >= k`.
+    pub(crate) fn ancestor(&self, l: usize, c: Index2, k: usize) -> Index2 {
+        let mut c = c;
+        for j in (k + 1..=l).rev() {
+            c = std::array::from_fn(|d| self.parent_1d(j, d, c[d]));
+        }
+        c
+    }
+
+    /// The children (of level `l + 1`) of cell `c` of level `l`: two along each direction
+    /// level `l + 1` splits, one along the others.
+    fn children(&self, l: usize, c: Index2) -> impl Iterator<Item = Index2> {
+        let range = |d: usize| if self.splits(l + 1, d) { 2 * c[d]..2 * c[d] + 2 } else { c[d]..c[d] + 1 };
+        let (ri, rj) = (range(0), range(1));
+        rj.flat_map(move |j| ri.clone().map(move |i| [i, j]))
     }
 
     /// Degrees `(p, q)`.
@@ -246,7 +298,7 @@ impl HierarchicalBasis {
 
     /// Whether cell `c` of level `l` lies in `Ω^l`.
     pub(crate) fn in_domain(&self, l: usize, c: Index2) -> bool {
-        l == 0 || self.refined.get(l - 1).is_some_and(|r| r.contains(&[c[0] / 2, c[1] / 2]))
+        l == 0 || self.refined.get(l - 1).is_some_and(|r| r.contains(&self.ancestor(l, c, l - 1)))
     }
 
     /// Whether cell `c` of level `l` is refined (lies in `Ω^{l+1}`).
@@ -296,9 +348,7 @@ impl HierarchicalBasis {
 
     /// Cells of level `l >= 1` in `Ω^l` (the children of the refined cells of level `l - 1`).
     fn domain_cells(&self, l: usize) -> impl Iterator<Item = Index2> + '_ {
-        self.refined[l - 1]
-            .iter()
-            .flat_map(|&[i, j]| [[2 * i, 2 * j], [2 * i + 1, 2 * j], [2 * i, 2 * j + 1], [2 * i + 1, 2 * j + 1]])
+        self.refined[l - 1].iter().flat_map(move |&c| self.children(l - 1, c))
     }
 
     /// Cells of the support of function `f` of level `l`, per direction.
@@ -394,7 +444,7 @@ impl HierarchicalBasis {
     /// Cells of level `k` of the support extension `S(Q, k)` of cell `c` of level `l >= k`:
     /// the union of the supports of the level-`k` functions non-zero on `Q`'s ancestor.
     fn support_extension(&self, l: usize, c: Index2, k: usize) -> [Range<usize>; 2] {
-        let anc = c.map(|x| x >> (l - k));
+        let anc = self.ancestor(l, c, k);
         let fs = self.functions_on(k, anc);
         std::array::from_fn(|d| {
             let lo = self.levels[k].support(d, fs[d].start).start;
@@ -434,7 +484,7 @@ impl HierarchicalBasis {
             let mut nb = BTreeSet::new();
             for j in rj {
                 for i in ri.clone() {
-                    nb.insert([i / 2, j / 2]);
+                    nb.insert([self.parent_1d(k + 1, 0, i), self.parent_1d(k + 1, 1, j)]);
                 }
             }
             for q in nb {
@@ -554,14 +604,18 @@ impl HierarchicalBasis {
     }
 }
 
-/// Why `fine` is not `coarse` with one new simple knot strictly inside each element of
-/// `coarse` (the knots of `coarse` kept with their multiplicities, same degree and domain).
-fn splits_in_two(coarse: &KnotVector, fine: &KnotVector) -> std::result::Result<(), String> {
+/// Whether `fine` is `coarse` with one new simple knot strictly inside each element of
+/// `coarse` (`true`; the knots of `coarse` kept with their multiplicities, same degree and
+/// domain) or `coarse` itself (`false`: the direction is not split); why not otherwise.
+fn splits_in_two(coarse: &KnotVector, fine: &KnotVector) -> std::result::Result<bool, String> {
     if coarse.degree() != fine.degree() || coarse.domain() != fine.domain() {
         return Err("another degree or domain than the level below".into());
     }
     if fine.is_periodic() || !fine.is_open() {
         return Err("not an open (clamped), non-periodic knot vector".into());
+    }
+    if fine == coarse {
+        return Ok(false);
     }
     let (cb, fb) = (coarse.breaks_with_multiplicity(), fine.breaks_with_multiplicity());
     if fb.len() != 2 * cb.len() - 1 {
@@ -573,5 +627,5 @@ fn splits_in_two(coarse: &KnotVector, fine: &KnotVector) -> std::result::Result<
             return Err(format!("the knot {u} (multiplicity {m}) does not split one element of the level below"));
         }
     }
-    Ok(())
+    Ok(true)
 }

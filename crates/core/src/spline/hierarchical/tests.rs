@@ -87,6 +87,24 @@ fn rank(mut a: Vec<Vec<f64>>, tol: f64) -> usize {
     r
 }
 
+/// The values of the THB functions (one row each) at `per_cell` random points inside
+/// every active cell.
+fn cell_collocation(b: &HierarchicalBasis, rng: &mut Lcg, per_cell: usize) -> Vec<Vec<f64>> {
+    let mut rows = Vec::new();
+    for (l, c) in b.active_cells() {
+        let [[a, bb], [cc, dd]] = b.cell_bounds(l, c);
+        for _ in 0..per_cell {
+            let mut row = vec![0.0; b.len()];
+            let (u, v) = (a + (bb - a) * rng.uniform(), cc + (dd - cc) * rng.uniform());
+            for (k, val) in b.eval_basis(u, v) {
+                row[k] = val[0];
+            }
+            rows.push(row);
+        }
+    }
+    rows
+}
+
 #[test]
 fn linear_independence_by_collocation() {
     for (p, q, m) in [(2, 2, 2), (3, 3, 3), (1, 1, 2)] {
@@ -104,17 +122,7 @@ fn linear_independence_by_collocation() {
             .collect();
         // plus points inside the small cells, so that every function is sampled
         let mut rows = rows;
-        for (l, c) in b.active_cells() {
-            let [[a, bb], [cc, dd]] = b.cell_bounds(l, c);
-            for _ in 0..(p + 1) * (q + 1) {
-                let mut row = vec![0.0; n];
-                let (u, v) = (a + (bb - a) * rng.uniform(), cc + (dd - cc) * rng.uniform());
-                for (k, val) in b.eval_basis(u, v) {
-                    row[k] = val[0];
-                }
-                rows.push(row);
-            }
-        }
+        rows.extend(cell_collocation(&b, &mut rng, (p + 1) * (q + 1)));
         assert_eq!(rank(rows, 1e-12), n, "p={p} q={q}: {n} THB functions");
     }
 }
@@ -333,6 +341,33 @@ fn the_control_net_joins_neighbouring_active_functions_of_one_level() {
     assert!(levels.len() >= 2, "segments on the coarse and a finer level: {levels:?}");
 }
 
+/// `map` (equal to the tensor map `s`) refined `steps` times at a random active cell and at
+/// the cell at `at`, class 2: after each step still `s` at 200 random points (the spaces
+/// are nested, the prolongation exact) and a partition of unity there; refined past the
+/// given levels at the end.
+fn refined_keeping(
+    mut map: HierarchicalMap,
+    s: &Surface,
+    rng: &mut Lcg,
+    steps: usize,
+    at: [f64; 2],
+) -> HierarchicalMap {
+    for step in 0..steps {
+        let (l, c) = map.basis.cell_at(rng.uniform(), rng.uniform());
+        let (l2c, c2) = map.basis.cell_at(at[0], at[1]);
+        map = map.refined(&[(l, c), (l2c, c2)], 2).unwrap();
+        for _ in 0..200 {
+            let (u, v) = (rng.uniform(), rng.uniform());
+            let (a, t) = (map.eval(u, v), s.eval(u, v));
+            assert!((a[0] - t[0]).abs() < 1e-13 && (a[1] - t[1]).abs() < 1e-13, "step {step} at ({u}, {v})");
+            let sum: f64 = map.basis.eval_basis(u, v).iter().map(|x| x.1[0]).sum();
+            assert!((sum - 1.0).abs() < 1e-13, "partition of unity: {sum}");
+        }
+    }
+    assert!(map.basis.num_levels() >= 4, "refined past the given levels");
+    map
+}
+
 /// Given levels that split each element off its midpoint (an input basis's knots, every
 /// other break removed below): the two-scale relation is knot insertion of the finer
 /// level's knots, a tensor map on level 0 refined through the given levels and past them
@@ -360,20 +395,8 @@ fn given_levels_are_nested_and_refinement_through_them_keeps_the_map() {
     let mut rng = Lcg::new(17);
     let n = coarse[0].num_basis() * coarse[1].num_basis();
     let s = Surface::new(coarse.clone(), (0..n).map(|_| [rng.uniform(), rng.uniform()]).collect(), None).unwrap();
-    let mut map = HierarchicalMap::new(b, s.control_points.clone()).unwrap();
-    for step in 0..4 {
-        let (l, c) = map.basis.cell_at(rng.uniform(), rng.uniform());
-        let (l2c, c2) = map.basis.cell_at(0.01, 0.99);
-        map = map.refined(&[(l, c), (l2c, c2)], 2).unwrap();
-        for _ in 0..200 {
-            let (u, v) = (rng.uniform(), rng.uniform());
-            let (a, t) = (map.eval(u, v), s.eval(u, v));
-            assert!((a[0] - t[0]).abs() < 1e-13 && (a[1] - t[1]).abs() < 1e-13, "step {step} at ({u}, {v})");
-            let sum: f64 = map.basis.eval_basis(u, v).iter().map(|x| x.1[0]).sum();
-            assert!((sum - 1.0).abs() < 1e-13, "partition of unity: {sum}");
-        }
-    }
-    assert!(map.basis.num_levels() >= 4, "refined past the given levels");
+    let map =
+        refined_keeping(HierarchicalMap::new(b, s.control_points.clone()).unwrap(), &s, &mut rng, 4, [0.01, 0.99]);
     // the level-1 cells' bounds are the given knots, not midpoints
     assert_eq!(map.basis.knots(1)[0], l1[0]);
     assert_eq!(map.basis.knots(3)[0], l2[0].halved());
@@ -384,4 +407,67 @@ fn given_levels_are_nested_and_refinement_through_them_keeps_the_map() {
     let two = [l1[0].clone(), coarse[1].with_inserted(&[0.05, 0.1, 0.6, 0.71])];
     let err = HierarchicalBasis::with_levels(vec![coarse, two]).unwrap_err().to_string();
     assert!(err.contains("level 1") && err.contains("eta"), "{err}");
+}
+
+/// Anisotropic given levels (`eta` not split: the same knots on every level, as on a thin
+/// ring whose few `eta` elements all stay): a refined cell has two children, side by side
+/// along `xi`; refining the south row through the levels keeps the hierarchy admissible
+/// of class 2 (the support extension of a row-0 cell along `eta` reaches row 2 of the
+/// quadratic `eta` functions, so rows 0 to 2 of level 0 are refined, and on every active
+/// cell the THB functions come from at most two successive levels); the functions per
+/// level are those of the supports counted by hand; the basis is a partition of unity and
+/// linearly independent, and a tensor map on level 0 refined through the levels and past
+/// them (halving both directions) stays the same map (nested spaces, exact prolongation).
+/// A level that splits neither direction is refused.
+#[test]
+fn anisotropic_levels_refine_along_one_direction_and_keep_the_map() {
+    let coarse = [kv(3, &[0.0, 0.3, 0.5, 1.0]), kv(2, &[0.0, 0.25, 0.5, 0.75, 1.0])];
+    let l1 = [coarse[0].with_inserted(&[0.1, 0.42, 0.9]), coarse[1].clone()];
+    let l2 = [l1[0].with_inserted(&[0.02, 0.2, 0.31, 0.47, 0.6, 0.95]), coarse[1].clone()];
+    let mut b = HierarchicalBasis::with_levels(vec![coarse.clone(), l1.clone(), l2.clone()]).unwrap();
+    assert!(b.splits(1, 0) && !b.splits(1, 1) && !b.splits(2, 1) && b.splits(3, 1));
+    for s in 0..coarse[1].num_basis() {
+        assert_eq!(b.children_1d(0, 1, s), vec![(s, 1.0)]);
+        assert_eq!(b.parents_1d(2, 1, s), vec![(s, 1.0)]);
+    }
+    // the south row through both given levels
+    b.refine(&[(0, [0, 0]), (0, [1, 0]), (0, [2, 0])], 2).unwrap();
+    assert_eq!(b.cells_per_level(), vec![9, 6, 0]);
+    let row: Vec<(usize, Index2)> = (0..6).map(|i| (1, [i, 0])).collect();
+    b.refine(&row, 2).unwrap();
+    // level 0 keeps row 3 (3 cells); level 1 rows 1 and 2 (6 cells each); level 2 row 0
+    assert_eq!(b.cells_per_level(), vec![3, 12, 12]);
+    for (l, c) in b.active_cells() {
+        assert!(l != 2 || c[1] == 0, "cell ({l}, {c:?}) of level 2 off the south row");
+        let [[a, bb], [cc, dd]] = b.cell_bounds(l, c);
+        let vals = b.eval_basis(0.5 * (a + bb), 0.5 * (cc + dd));
+        let levels: BTreeSet<usize> = vals.iter().map(|v| b.active_functions()[v.0].0).collect();
+        assert!(levels.last().unwrap() - levels.first().unwrap() < 2, "cell ({l}, {c:?}) sees levels {levels:?}");
+    }
+    // level 2: the row `β_0(η)` (support row 0) of the 15 cubic `xi` functions of 12
+    // elements; level 1: `β_1(η)`, `β_2(η)` (supports in rows 0 to 2, not in row 0) times
+    // 9; level 0: `β_3(η)` to `β_5(η)` times 6
+    assert_eq!(b.functions_per_level(), vec![18, 18, 15]);
+    let mut rng = Lcg::new(23);
+    let n = coarse[0].num_basis() * coarse[1].num_basis();
+    let s = Surface::new(coarse.clone(), (0..n).map(|_| [rng.uniform(), rng.uniform()]).collect(), None).unwrap();
+    let mut map = HierarchicalMap::new(
+        HierarchicalBasis::with_levels(vec![coarse.clone(), l1, l2]).unwrap(),
+        s.control_points.clone(),
+    )
+    .unwrap();
+    map = map
+        .refined(
+            &row.iter().map(|&(_, [i, j])| (0, [i / 2, j])).collect::<BTreeSet<_>>().into_iter().collect::<Vec<_>>(),
+            2,
+        )
+        .unwrap();
+    let map = refined_keeping(map, &s, &mut rng, 5, [0.35, 0.01]);
+    // linear independence: collocation inside every active cell
+    let n = map.basis.len();
+    let rows = cell_collocation(&map.basis, &mut rng, 16);
+    assert_eq!(rank(rows, 1e-12), n, "{n} THB functions");
+    // a level with the same knots in both directions is refused
+    let err = HierarchicalBasis::with_levels(vec![coarse.clone(), coarse]).unwrap_err().to_string();
+    assert!(err.contains("level 1") && err.contains("both directions"), "{err}");
 }

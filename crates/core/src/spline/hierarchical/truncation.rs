@@ -123,13 +123,16 @@ impl HierarchicalBasis {
     /// The two-scale relation in direction `d`: the level-`(l + 1)` functions
     /// `(index, coefficient)` whose combination is the level-`l` function `sigma`.
     pub(crate) fn children_1d(&self, l: usize, d: usize, sigma: usize) -> Vec<(usize, f64)> {
+        if !self.splits(l + 1, d) {
+            return vec![(sigma, 1.0)];
+        }
         let kv = &self.levels[l].knots[d];
         let p = kv.degree();
         let mut t: Vec<f64> = kv.knots()[sigma..=sigma + p + 1].to_vec();
         // the split points of the support's elements (consecutive from the first)
         let e0 = self.levels[l].support(d, sigma).start;
         let n_spans = t.windows(2).filter(|w| w[1] > w[0]).count();
-        let mids: Vec<f64> = (e0..e0 + n_spans).map(|e| self.split_point(l, d, e)).collect();
+        let mids: Vec<f64> = (e0..e0 + n_spans).filter_map(|e| self.split_point(l, d, e)).collect();
         let mut c = vec![1.0];
         for u in mids {
             insert_knot(p, &mut t, &mut c, u);
@@ -141,6 +144,9 @@ impl HierarchicalBasis {
     /// The level-`(l - 1)` functions `(index, P_{τσ})` whose two-scale relation holds the
     /// level-`l` function `tau` (`l >= 1`), in direction `d`.
     pub(crate) fn parents_1d(&self, l: usize, d: usize, tau: usize) -> Vec<(usize, f64)> {
+        if !self.splits(l, d) {
+            return vec![(tau, 1.0)];
+        }
         let e0 = self.levels[l].support(d, tau).start;
         self.levels[l - 1]
             .functions(d, e0 / 2)
