@@ -40,8 +40,8 @@ fn values<'a>(s: &PackedSystem<'a>) -> std::borrow::Cow<'a, [f32]> {
 }
 
 impl GpuProducts {
-    /// Upload `sys`: the values ([`StencilChunks::upload`], written in place into the
-    /// buffers' mappings), then as [`GpuProducts::on_device`].
+    /// Upload `sys`: the values (`StencilChunks::upload`, written in place into the
+    /// buffers' mappings), then as `GpuProducts::on_device`.
     ///
     /// Errors: [`GpuError`] when the system does not fit the adapter's limits or wgpu
     /// fails.
